@@ -1,0 +1,67 @@
+//! Cited data embedded in the binary, so that `shoal` runs from any directory.
+//!
+//! Every file under `assets/` keeps the provenance header it came with (`# name/units/source/
+//! citation/license/processing` lines); `assets/PROVENANCE.md` is the index and
+//! `assets/licenses/` holds the licence texts the data require (CSIRO for the SAMBUCA spectra,
+//! Apache-2.0 for the WASI spectra).
+
+/// One embedded data file: its path below `assets/` and its text.
+#[derive(Debug, Clone, Copy)]
+pub struct Asset {
+    /// Path relative to `assets/`, e.g. `"water/water_absorption_wasi6.csv"`.
+    pub path: &'static str,
+    /// The whole file, provenance header included.
+    pub text: &'static str,
+}
+
+macro_rules! embed {
+    ($($path:literal),* $(,)?) => {
+        &[$(Asset { path: $path, text: include_str!(concat!("../assets/", $path)) }),*]
+    };
+}
+
+/// All embedded data files.
+pub const ALL: &[Asset] = embed![
+    "solar/solar_tsis1_hsrs_1nm.csv",
+    "water/water_absorption_wasi6.csv",
+    "water/water_absorption_wopp_v3.csv",
+    "water/water_scattering_pure.csv",
+    "water/sambuca_aw_350_900_lw2002.csv",
+    "srf/srf_s3a_olci.csv",
+    "srf/srf_s3b_olci.csv",
+    "srf/srf_s2a_msi.csv",
+    "srf/srf_s2b_msi.csv",
+    "srf/olci_bands.csv",
+    "phytoplankton/aph_specific_wasi6_classes.csv",
+    "phytoplankton/aph_bricaud1998_coefficients.csv",
+    "phytoplankton/bbph_norm_wasi6.csv",
+    "phytoplankton/sambuca_WL08_aphy.csv",
+    "phytoplankton/sambuca_aphy_star_ALL.csv",
+    "phytoplankton/sambuca_SIOPMatrix.csv",
+    "phytoplankton/sambuca_SIOP_aphy.csv",
+    "benthic/benthic_reflectance.csv",
+    "benthic/sambuca_HI_3.csv",
+    "benthic/sambuca_NCC_3subs.csv",
+    "benthic/sambuca_Moreton_Bay.csv",
+    "benthic/sambuca_WL5_2008.csv",
+    "atmosphere/aerosol_6sv_models.csv",
+    "atmosphere/ozone_absorption_anderson.csv",
+    "atmosphere/atmosphere_gas_absorption_wasi6.csv",
+    "atmosphere/rayleigh_optical_depth_bodhaine1999.csv",
+];
+
+/// The embedded file at `path` (relative to `assets/`), if there is one.
+///
+/// ```
+/// assert!(shoal::assets::find("solar/solar_tsis1_hsrs_1nm.csv").is_some());
+/// assert!(shoal::assets::find("no/such.csv").is_none());
+/// ```
+#[must_use]
+pub fn find(path: &str) -> Option<&'static Asset> {
+    ALL.iter().find(|a| a.path == path)
+}
+
+/// The paths of all embedded files, for error messages and `--list` output.
+pub fn paths() -> impl Iterator<Item = &'static str> {
+    ALL.iter().map(|a| a.path)
+}

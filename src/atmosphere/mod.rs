@@ -1,0 +1,1 @@
+//! Atmosphere (work in progress in this commit).

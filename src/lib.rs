@@ -1,0 +1,30 @@
+//! # Shoal — end-to-end simulation of satellite optical instruments over water
+//!
+//! Shoal simulates the observation chain of an ocean-colour instrument and the retrieval of
+//! water products from what it measures, so that an instrument engineer sees what a design
+//! choice does to chlorophyll-a, suspended matter, CDOM, depth and bottom type.
+//!
+//! ```text
+//! SceneSpec ─scene─► Scene ─water─► WaterReflectance (a, bb, Kd, rrs, Rrs)   [Lee 1998/1999]
+//!                         ─atmosphere─► AtmosphereLut (L_path, T_up, T_down, S, Ed(0+)) [SOS RT]
+//!   L_TOA ─instrument─► Level-0 ─calibration─► Level-1 ─correction─► Rrs ─inversion─► products
+//!                                                            products + truth ─metrics─► errors
+//! ```
+//!
+//! Modules, in chain order (a module imports only those above it; nothing here imports egui):
+//!
+//! | module | what it holds |
+//! |---|---|
+//! | [`units`] | constants, unit conversions, angle helpers |
+//! | [`assets`] | cited spectra embedded in the binary |
+//! | [`spectral`] | wavelength grid, spectra, band sets, `band_from_fine` |
+//! | [`water`] | SIOP sets, IOPs, deep/shallow reflectance (Lee et al. 1998/1999, SAMBUCA) |
+//! | [`atmosphere`] | Rayleigh, aerosols (Mie, WMO models), gases, SOS radiative transfer, LUT |
+//! | [`cli`] | the headless command line (`shoal water`, `shoal atmosphere`, `shoal bench`) |
+
+pub mod assets;
+pub mod atmosphere;
+pub mod cli;
+pub mod spectral;
+pub mod units;
+pub mod water;

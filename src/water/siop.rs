@@ -1,0 +1,173 @@
+//! Specific inherent optical properties (SIOP sets): data that describe what a unit of each
+//! constituent does to absorption and backscattering. A SIOP set is written in RON (see
+//! `presets/siop/`) and resolved onto a wavelength grid before use.
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use super::WaterError;
+use crate::spectral::{Extrapolation, SpectrumSource, WavelengthGrid};
+
+fn default_refractive_index() -> f64 {
+    1.34
+}
+
+/// A SIOP set as written in RON.
+///
+/// Concentrations it scales: chlorophyll-a `chl_mg_m3` (mg m⁻³ = µg L⁻¹), CDOM as its absorption
+/// at the CDOM reference wavelength `cdom_per_m` (m⁻¹; 440 nm in Shoal's presets, 550 nm in
+/// SAMBUCA's defaults), non-algal particles `nap_g_m3` (g m⁻³ = mg L⁻¹).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SiopSpec {
+    /// Short name (`"heron_island"`).
+    pub name: String,
+    /// Where the numbers come from.
+    #[serde(default)]
+    pub description: String,
+    /// Pure-water absorption a_w, m⁻¹.
+    pub water_absorption: SpectrumSource,
+    /// Pure-water backscattering bb_w, m⁻¹.
+    pub water_backscatter: SpectrumSource,
+    /// Chlorophyll-specific phytoplankton absorption a*_ph, m² mg⁻¹.
+    pub phytoplankton_absorption: SpectrumSource,
+    /// Chlorophyll-specific phytoplankton backscattering bb*_ph, m² mg⁻¹.
+    pub phytoplankton_backscatter: SpectrumSource,
+    /// CDOM absorption per unit of `cdom_per_m` (dimensionless shape, 1 at the reference λ).
+    pub cdom_absorption: SpectrumSource,
+    /// Mass-specific NAP absorption a*_NAP, m² g⁻¹.
+    pub nap_absorption: SpectrumSource,
+    /// Mass-specific NAP backscattering bb*_NAP, m² g⁻¹.
+    pub nap_backscatter: SpectrumSource,
+    /// Refractive index of the water (Snell's law at the surface); default 1.34.
+    #[serde(default = "default_refractive_index")]
+    pub water_refractive_index: f64,
+}
+
+impl SiopSpec {
+    /// Read a SIOP set from RON text; `origin` names the file in errors and `base_dir`
+    /// resolves relative CSV paths.
+    pub fn from_ron(text: &str, origin: &str) -> Result<Self, WaterError> {
+        ron::from_str(text).map_err(|e| WaterError::Parse { origin: origin.to_string(), message: e.to_string() })
+    }
+
+    /// Read a SIOP set from a RON file.
+    pub fn from_file(path: &Path) -> Result<Self, WaterError> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| WaterError::Parse { origin: path.display().to_string(), message: e.to_string() })?;
+        Self::from_ron(&text, &path.display().to_string())
+    }
+
+    /// SAMBUCA's default parameterisation (sambuca_core 1.2.3 `forward_model` defaults):
+    /// Wallis Lake 2008 a*_ph, the `lw2002` pure-water absorption, bb_w = 0.00097 (550/λ)^4.32,
+    /// CDOM and NAP exponentials referenced to 550 nm, backscatter power laws referenced to 546 nm.
+    ///
+    /// ```
+    /// let s = shoal::water::SiopSpec::sambuca_default();
+    /// assert_eq!(s.name, "sambuca_default");
+    /// ```
+    #[must_use]
+    pub fn sambuca_default() -> Self {
+        let y = 0.878_138;
+        Self {
+            name: "sambuca_default".into(),
+            description: "SAMBUCA (sambuca_core 1.2.3) default SIOPs: Wallis Lake 2008 a*_ph, lw2002 a_w".into(),
+            water_absorption: SpectrumSource::Asset {
+                file: "water/sambuca_aw_350_900_lw2002.csv".into(),
+                column: "a_water".into(),
+                scale: 1.0,
+                outside: Extrapolation::Error,
+            },
+            water_backscatter: SpectrumSource::PowerLaw { coefficient: 0.00194 / 2.0, reference_nm: 550.0, exponent: 4.32 },
+            phytoplankton_absorption: SpectrumSource::Asset {
+                file: "phytoplankton/sambuca_WL08_aphy.csv".into(),
+                column: "WL08_aphy_star_mean_correct.csv:C2".into(),
+                scale: 1.0,
+                // The measured spectrum stops at 800 nm; phytoplankton absorb nothing there.
+                outside: Extrapolation::Zero,
+            },
+            phytoplankton_backscatter: SpectrumSource::PowerLaw { coefficient: 0.001_577_47, reference_nm: 546.0, exponent: y },
+            cdom_absorption: SpectrumSource::Exponential { coefficient: 1.0, reference_nm: 550.0, slope_per_nm: 0.016_805_2 },
+            nap_absorption: SpectrumSource::Exponential { coefficient: 0.004_33, reference_nm: 550.0, slope_per_nm: 0.009_772_62 },
+            nap_backscatter: SpectrumSource::PowerLaw { coefficient: 0.022_535_3, reference_nm: 546.0, exponent: y },
+            water_refractive_index: 1.337_84,
+        }
+    }
+
+    /// Resolve onto `grid`. Every spectrum must cover the grid (or say what to do outside its
+    /// data) and be finite; a_w must be ≥ 0 and bb_w > 0 (so that u = bb/(a+bb) is defined for
+    /// pure water). Specific spectra may dip slightly below zero: measured a*_ph spectra carry
+    /// noise in the near-infrared (SAMBUCA's Wallis Lake spectrum reaches −4·10⁻⁴ m² mg⁻¹ at
+    /// 749 nm) and SAMBUCA uses them as they are; the model checks a > 0 per evaluation.
+    pub fn resolve(&self, grid: &WavelengthGrid, base_dir: Option<&Path>) -> Result<Siop, WaterError> {
+        let n = self.water_refractive_index;
+        if !(n.is_finite() && (1.0..=1.5).contains(&n)) {
+            return Err(WaterError::OutOfRange {
+                field: "water_refractive_index".into(),
+                value: n,
+                allowed: "1.0 to 1.5".into(),
+            });
+        }
+        let take = |field: &str, src: &SpectrumSource, min: f64| -> Result<Vec<f64>, WaterError> {
+            let v = src
+                .sample(grid, Extrapolation::Error, base_dir)
+                .map_err(|e| WaterError::Siop { set: self.name.clone(), field: field.into(), message: e.to_string() })?;
+            if let Some((i, x)) = v.iter().enumerate().find(|(_, x)| !(x.is_finite() && **x >= min)) {
+                return Err(WaterError::Siop {
+                    set: self.name.clone(),
+                    field: field.into(),
+                    message: format!("value {x} at {} nm; must be finite and ≥ {min}", grid.wavelength_nm(i)),
+                });
+            }
+            Ok(v)
+        };
+        // Specific spectra: finite, and not more negative than measurement noise allows.
+        let noise = -0.01;
+        let siop = Siop {
+            name: self.name.clone(),
+            grid: grid.clone(),
+            a_w: take("water_absorption", &self.water_absorption, 0.0)?,
+            bb_w: take("water_backscatter", &self.water_backscatter, 0.0)?,
+            a_ph_star: take("phytoplankton_absorption", &self.phytoplankton_absorption, noise)?,
+            bb_ph_star: take("phytoplankton_backscatter", &self.phytoplankton_backscatter, noise)?,
+            a_cdom_star: take("cdom_absorption", &self.cdom_absorption, noise)?,
+            a_nap_star: take("nap_absorption", &self.nap_absorption, noise)?,
+            bb_nap_star: take("nap_backscatter", &self.nap_backscatter, noise)?,
+            water_refractive_index: n,
+        };
+        if let Some(i) = siop.bb_w.iter().position(|&b| b <= 0.0) {
+            return Err(WaterError::Siop {
+                set: self.name.clone(),
+                field: "water_backscatter".into(),
+                message: format!("must be > 0 (pure water scatters) but is 0 at {} nm", grid.wavelength_nm(i)),
+            });
+        }
+        Ok(siop)
+    }
+}
+
+/// A SIOP set resolved on a wavelength grid: the spectra the forward model multiplies by the
+/// concentrations. Field names follow the glossary in [`crate::water`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Siop {
+    /// Name of the set.
+    pub name: String,
+    /// The grid every spectrum below is sampled on.
+    pub grid: WavelengthGrid,
+    /// Pure-water absorption, m⁻¹.
+    pub a_w: Vec<f64>,
+    /// Pure-water backscattering, m⁻¹.
+    pub bb_w: Vec<f64>,
+    /// Chl-specific phytoplankton absorption, m² mg⁻¹.
+    pub a_ph_star: Vec<f64>,
+    /// Chl-specific phytoplankton backscattering, m² mg⁻¹.
+    pub bb_ph_star: Vec<f64>,
+    /// CDOM absorption per unit absorption at the reference wavelength (dimensionless).
+    pub a_cdom_star: Vec<f64>,
+    /// Mass-specific NAP absorption, m² g⁻¹.
+    pub a_nap_star: Vec<f64>,
+    /// Mass-specific NAP backscattering, m² g⁻¹.
+    pub bb_nap_star: Vec<f64>,
+    /// Refractive index of water for Snell's law.
+    pub water_refractive_index: f64,
+}
