@@ -401,8 +401,11 @@ mod tests {
 
     #[test]
     fn band_average_of_tsis_matches_the_table_e0() {
-        // E0 band averages in olci_bands.csv were computed from the native SRF and TSIS at 1 nm;
-        // ours goes through the 1 nm grid's hat functions, so agreement is to interpolation error.
+        // E0 band averages in olci_bands.csv were summed from the SRF and TSIS at 1 nm (rectangle
+        // rule); ours integrates SRF × the linear interpolant of TSIS exactly. The two schemes
+        // differ by quadrature error of the 1-nm solar sampling, largest where deep Fraunhofer
+        // lines sit inside a band (Ca II H&K 393/397 nm in Oa01, Hγ 434 nm in Oa03): 0.25 %
+        // below 450 nm, 0.1 % elsewhere.
         let grid = WavelengthGrid::fine();
         let olci = BandSet::from_spec(&BandSetSpec::parse_cli("olci").unwrap()).unwrap();
         let m = BandAverager::new(&grid, &olci).unwrap();
@@ -413,7 +416,8 @@ mod tests {
         let band = m.apply(&e0);
         let expected = Table::from_asset("srf/olci_bands.csv").unwrap().column_f64("E0_tsis_W_m2_nm").unwrap();
         for (i, (got, want)) in band.iter().zip(&expected).enumerate() {
-            assert!((got / want - 1.0).abs() < 2e-3, "band {i}: {got} vs {want}");
+            let tolerance = if olci.bands[i].centre_nm < 450.0 { 2.5e-3 } else { 1e-3 };
+            assert!((got / want - 1.0).abs() < tolerance, "band {i}: {got} vs {want}");
         }
     }
 
