@@ -48,6 +48,7 @@ pub const ALL: &[Asset] = embed![
     "atmosphere/ozone_absorption_anderson.csv",
     "atmosphere/atmosphere_gas_absorption_wasi6.csv",
     "atmosphere/rayleigh_optical_depth_bodhaine1999.csv",
+    "atmosphere/wmo_aerosol_mie.csv",
 ];
 
 /// The embedded file at `path` (relative to `assets/`), if there is one.

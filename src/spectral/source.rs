@@ -93,28 +93,60 @@ impl SpectrumSource {
     ) -> Result<Vec<f64>, SpectralError> {
         let wl = grid.wavelengths_nm();
         match self {
-            Self::Asset { file, column, scale, outside } => {
+            Self::Asset {
+                file,
+                column,
+                scale,
+                outside,
+            } => {
                 let how = pick(*outside, extrapolation);
-                Ok(Spectrum::from_asset(file, column)?.scaled(*scale).resample(grid, how)?)
+                Ok(Spectrum::from_asset(file, column)?
+                    .scaled(*scale)
+                    .resample(grid, how)?)
             }
-            Self::Csv { path, column, scale, outside } => {
+            Self::Csv {
+                path,
+                column,
+                scale,
+                outside,
+            } => {
                 let how = pick(*outside, extrapolation);
                 let full = match base_dir {
                     Some(dir) if path.is_relative() => dir.join(path),
                     _ => path.clone(),
                 };
                 let table = Table::from_file(&full)?;
-                Ok(Spectrum::from_table(&table, column)?.scaled(*scale).resample(grid, how)?)
+                Ok(Spectrum::from_table(&table, column)?
+                    .scaled(*scale)
+                    .resample(grid, how)?)
             }
-            Self::Table { wavelength_nm, values, outside } => Spectrum::new("inline table", wavelength_nm.clone(), values.clone())?
+            Self::Table {
+                wavelength_nm,
+                values,
+                outside,
+            } => Spectrum::new("inline table", wavelength_nm.clone(), values.clone())?
                 .resample(grid, pick(*outside, extrapolation)),
-            Self::PowerLaw { coefficient, reference_nm, exponent } => {
+            Self::PowerLaw {
+                coefficient,
+                reference_nm,
+                exponent,
+            } => {
                 check_finite("PowerLaw", &[*coefficient, *reference_nm, *exponent])?;
-                Ok(wl.iter().map(|l| coefficient * (reference_nm / l).powf(*exponent)).collect())
+                Ok(wl
+                    .iter()
+                    .map(|l| coefficient * (reference_nm / l).powf(*exponent))
+                    .collect())
             }
-            Self::Exponential { coefficient, reference_nm, slope_per_nm } => {
+            Self::Exponential {
+                coefficient,
+                reference_nm,
+                slope_per_nm,
+            } => {
                 check_finite("Exponential", &[*coefficient, *reference_nm, *slope_per_nm])?;
-                Ok(wl.iter().map(|l| coefficient * (-slope_per_nm * (l - reference_nm)).exp()).collect())
+                Ok(wl
+                    .iter()
+                    .map(|l| coefficient * (-slope_per_nm * (l - reference_nm)).exp())
+                    .collect())
             }
             Self::Constant(c) => {
                 check_finite("Constant", &[*c])?;
@@ -125,13 +157,20 @@ impl SpectrumSource {
 }
 
 fn pick(own: Extrapolation, default: Extrapolation) -> Extrapolation {
-    if own == Extrapolation::Error { default } else { own }
+    if own == Extrapolation::Error {
+        default
+    } else {
+        own
+    }
 }
 
 fn check_finite(what: &str, values: &[f64]) -> Result<(), SpectralError> {
     if values.iter().all(|v| v.is_finite()) {
         Ok(())
     } else {
-        Err(SpectralError::BadSpectrum { name: what.into(), message: format!("parameters must be finite, got {values:?}") })
+        Err(SpectralError::BadSpectrum {
+            name: what.into(),
+            message: format!("parameters must be finite, got {values:?}"),
+        })
     }
 }

@@ -56,7 +56,11 @@ impl Table {
             line: 0,
             message: "no header row (expected e.g. `wavelength_nm,value`)".into(),
         })?;
-        Ok(Self { source: source.to_string(), columns, rows })
+        Ok(Self {
+            source: source.to_string(),
+            columns,
+            rows,
+        })
     }
 
     /// Parse an embedded asset (path relative to `assets/`).
@@ -91,17 +95,24 @@ impl Table {
 
     /// Index of column `name`, or an error listing the columns there are.
     pub fn column_index(&self, name: &str) -> Result<usize, SpectralError> {
-        self.columns.iter().position(|c| c == name).ok_or_else(|| SpectralError::UnknownColumn {
-            origin: self.source.clone(),
-            column: name.to_string(),
-            known: self.columns.join(", "),
-        })
+        self.columns
+            .iter()
+            .position(|c| c == name)
+            .ok_or_else(|| SpectralError::UnknownColumn {
+                origin: self.source.clone(),
+                column: name.to_string(),
+                known: self.columns.join(", "),
+            })
     }
 
     /// Column `name` as text cells.
     pub fn column_str(&self, name: &str) -> Result<Vec<&str>, SpectralError> {
         let i = self.column_index(name)?;
-        Ok(self.rows.iter().map(|(_, cells)| cells[i].as_str()).collect())
+        Ok(self
+            .rows
+            .iter()
+            .map(|(_, cells)| cells[i].as_str())
+            .collect())
     }
 
     /// Column `name` as numbers; a cell that is not a finite number is an error naming its line.
@@ -111,13 +122,14 @@ impl Table {
             .iter()
             .map(|(line, cells)| {
                 let cell = &cells[i];
-                cell.parse::<f64>().ok().filter(|v| v.is_finite()).ok_or_else(|| {
-                    SpectralError::Table {
+                cell.parse::<f64>()
+                    .ok()
+                    .filter(|v| v.is_finite())
+                    .ok_or_else(|| SpectralError::Table {
                         origin: self.source.clone(),
                         line: *line,
                         message: format!("column `{name}`: `{cell}` is not a finite number"),
-                    }
-                })
+                    })
             })
             .collect()
     }
@@ -129,7 +141,12 @@ impl Table {
         Self {
             source: self.source.clone(),
             columns: self.columns.clone(),
-            rows: self.rows.iter().filter(|(_, c)| c[key_index] == value).cloned().collect(),
+            rows: self
+                .rows
+                .iter()
+                .filter(|(_, c)| c[key_index] == value)
+                .cloned()
+                .collect(),
         }
     }
 }

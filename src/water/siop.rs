@@ -48,13 +48,18 @@ impl SiopSpec {
     /// Read a SIOP set from RON text; `origin` names the file in errors and `base_dir`
     /// resolves relative CSV paths.
     pub fn from_ron(text: &str, origin: &str) -> Result<Self, WaterError> {
-        ron::from_str(text).map_err(|e| WaterError::Parse { origin: origin.to_string(), message: e.to_string() })
+        ron::from_str(text).map_err(|e| WaterError::Parse {
+            origin: origin.to_string(),
+            message: e.to_string(),
+        })
     }
 
     /// Read a SIOP set from a RON file.
     pub fn from_file(path: &Path) -> Result<Self, WaterError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| WaterError::Parse { origin: path.display().to_string(), message: e.to_string() })?;
+        let text = std::fs::read_to_string(path).map_err(|e| WaterError::Parse {
+            origin: path.display().to_string(),
+            message: e.to_string(),
+        })?;
         Self::from_ron(&text, &path.display().to_string())
     }
 
@@ -71,14 +76,20 @@ impl SiopSpec {
         let y = 0.878_138;
         Self {
             name: "sambuca_default".into(),
-            description: "SAMBUCA (sambuca_core 1.2.3) default SIOPs: Wallis Lake 2008 a*_ph, lw2002 a_w".into(),
+            description:
+                "SAMBUCA (sambuca_core 1.2.3) default SIOPs: Wallis Lake 2008 a*_ph, lw2002 a_w"
+                    .into(),
             water_absorption: SpectrumSource::Asset {
                 file: "water/sambuca_aw_350_900_lw2002.csv".into(),
                 column: "a_water".into(),
                 scale: 1.0,
                 outside: Extrapolation::Error,
             },
-            water_backscatter: SpectrumSource::PowerLaw { coefficient: 0.00194 / 2.0, reference_nm: 550.0, exponent: 4.32 },
+            water_backscatter: SpectrumSource::PowerLaw {
+                coefficient: 0.00194 / 2.0,
+                reference_nm: 550.0,
+                exponent: 4.32,
+            },
             phytoplankton_absorption: SpectrumSource::Asset {
                 file: "phytoplankton/sambuca_WL08_aphy.csv".into(),
                 column: "WL08_aphy_star_mean_correct.csv:C2".into(),
@@ -86,10 +97,26 @@ impl SiopSpec {
                 // The measured spectrum stops at 800 nm; phytoplankton absorb nothing there.
                 outside: Extrapolation::Zero,
             },
-            phytoplankton_backscatter: SpectrumSource::PowerLaw { coefficient: 0.001_577_47, reference_nm: 546.0, exponent: y },
-            cdom_absorption: SpectrumSource::Exponential { coefficient: 1.0, reference_nm: 550.0, slope_per_nm: 0.016_805_2 },
-            nap_absorption: SpectrumSource::Exponential { coefficient: 0.004_33, reference_nm: 550.0, slope_per_nm: 0.009_772_62 },
-            nap_backscatter: SpectrumSource::PowerLaw { coefficient: 0.022_535_3, reference_nm: 546.0, exponent: y },
+            phytoplankton_backscatter: SpectrumSource::PowerLaw {
+                coefficient: 0.001_577_47,
+                reference_nm: 546.0,
+                exponent: y,
+            },
+            cdom_absorption: SpectrumSource::Exponential {
+                coefficient: 1.0,
+                reference_nm: 550.0,
+                slope_per_nm: 0.016_805_2,
+            },
+            nap_absorption: SpectrumSource::Exponential {
+                coefficient: 0.004_33,
+                reference_nm: 550.0,
+                slope_per_nm: 0.009_772_62,
+            },
+            nap_backscatter: SpectrumSource::PowerLaw {
+                coefficient: 0.022_535_3,
+                reference_nm: 546.0,
+                exponent: y,
+            },
             water_refractive_index: 1.337_84,
         }
     }
@@ -99,7 +126,11 @@ impl SiopSpec {
     /// pure water). Specific spectra may dip slightly below zero: measured a*_ph spectra carry
     /// noise in the near-infrared (SAMBUCA's Wallis Lake spectrum reaches −4·10⁻⁴ m² mg⁻¹ at
     /// 749 nm) and SAMBUCA uses them as they are; the model checks a > 0 per evaluation.
-    pub fn resolve(&self, grid: &WavelengthGrid, base_dir: Option<&Path>) -> Result<Siop, WaterError> {
+    pub fn resolve(
+        &self,
+        grid: &WavelengthGrid,
+        base_dir: Option<&Path>,
+    ) -> Result<Siop, WaterError> {
         let n = self.water_refractive_index;
         if !(n.is_finite() && (1.0..=1.5).contains(&n)) {
             return Err(WaterError::OutOfRange {
@@ -111,12 +142,23 @@ impl SiopSpec {
         let take = |field: &str, src: &SpectrumSource, min: f64| -> Result<Vec<f64>, WaterError> {
             let v = src
                 .sample(grid, Extrapolation::Error, base_dir)
-                .map_err(|e| WaterError::Siop { set: self.name.clone(), field: field.into(), message: e.to_string() })?;
-            if let Some((i, x)) = v.iter().enumerate().find(|(_, x)| !(x.is_finite() && **x >= min)) {
+                .map_err(|e| WaterError::Siop {
+                    set: self.name.clone(),
+                    field: field.into(),
+                    message: e.to_string(),
+                })?;
+            if let Some((i, x)) = v
+                .iter()
+                .enumerate()
+                .find(|(_, x)| !(x.is_finite() && **x >= min))
+            {
                 return Err(WaterError::Siop {
                     set: self.name.clone(),
                     field: field.into(),
-                    message: format!("value {x} at {} nm; must be finite and ≥ {min}", grid.wavelength_nm(i)),
+                    message: format!(
+                        "value {x} at {} nm; must be finite and ≥ {min}",
+                        grid.wavelength_nm(i)
+                    ),
                 });
             }
             Ok(v)
@@ -128,8 +170,16 @@ impl SiopSpec {
             grid: grid.clone(),
             a_w: take("water_absorption", &self.water_absorption, 0.0)?,
             bb_w: take("water_backscatter", &self.water_backscatter, 0.0)?,
-            a_ph_star: take("phytoplankton_absorption", &self.phytoplankton_absorption, noise)?,
-            bb_ph_star: take("phytoplankton_backscatter", &self.phytoplankton_backscatter, noise)?,
+            a_ph_star: take(
+                "phytoplankton_absorption",
+                &self.phytoplankton_absorption,
+                noise,
+            )?,
+            bb_ph_star: take(
+                "phytoplankton_backscatter",
+                &self.phytoplankton_backscatter,
+                noise,
+            )?,
             a_cdom_star: take("cdom_absorption", &self.cdom_absorption, noise)?,
             a_nap_star: take("nap_absorption", &self.nap_absorption, noise)?,
             bb_nap_star: take("nap_backscatter", &self.nap_backscatter, noise)?,
@@ -139,7 +189,10 @@ impl SiopSpec {
             return Err(WaterError::Siop {
                 set: self.name.clone(),
                 field: "water_backscatter".into(),
-                message: format!("must be > 0 (pure water scatters) but is 0 at {} nm", grid.wavelength_nm(i)),
+                message: format!(
+                    "must be > 0 (pure water scatters) but is 0 at {} nm",
+                    grid.wavelength_nm(i)
+                ),
             });
         }
         Ok(siop)

@@ -1,0 +1,114 @@
+//! Gas transmittance (ozone, oxygen, water vapour) by the clear-sky model of Gregg & Carder
+//! (1990) as used in WASI (Gege 2012), with the WASI absorption coefficients.
+//!
+//! - T_O3 = exp(−a_oz H_oz M_oz), M_oz = 1.0035/(cos²θ + 0.007)^½ (Paltridge & Platt 1976)
+//! - T_O2 = exp(−1.41 a_ox M′/(1 + 118.3 a_ox M′)^0.45)
+//! - T_H2O = exp(−0.2385 a_wv W M/(1 + 20.07 a_wv W M)^0.45)
+//!
+//! with M the relative air mass (Kasten & Young 1989) and M′ = M·P/1013.25. Absorption is
+//! treated as decoupled from scattering (6S practice, Vermote et al. 1997): the sun–surface and
+//! surface–sensor paths are multiplied by these transmittances, and path radiance by both.
+//!
+//! ## References
+//! - Gregg, W. W. & Carder, K. L. (1990) A simple spectral solar irradiance model for cloudless
+//!   maritime atmospheres. Limnol. Oceanogr. 35, 1657–1675.
+//! - Gege, P. (2012) Analytic model for the direct and diffuse components of downwelling spectral
+//!   irradiance in water. Appl. Opt. 51, 1407–1419.
+//! - Kasten, F. & Young, A. T. (1989) Revised optical air mass tables and approximation formula.
+//!   Appl. Opt. 28, 4735–4738.
+//! - Vermote, E. F. et al. (1997) Second Simulation of the Satellite Signal in the Solar Spectrum,
+//!   6S: an overview. IEEE TGRS 35, 675–686.
+
+use std::sync::OnceLock;
+
+use serde::{Deserialize, Serialize};
+
+use super::AtmosphereError;
+use crate::spectral::{Extrapolation, Spectrum};
+
+const ASSET: &str = "atmosphere/atmosphere_gas_absorption_wasi6.csv";
+
+/// Column amounts of the absorbing gases.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct GasAmounts {
+    /// Total ozone, atm-cm (0.3 atm-cm = 300 DU).
+    pub ozone_atm_cm: f64,
+    /// Precipitable water, cm.
+    pub water_vapour_cm: f64,
+}
+
+impl Default for GasAmounts {
+    fn default() -> Self {
+        Self {
+            ozone_atm_cm: 0.3,
+            water_vapour_cm: 2.0,
+        }
+    }
+}
+
+struct Coefficients {
+    a_oz: Spectrum,
+    a_ox: Spectrum,
+    a_wv: Spectrum,
+}
+
+fn coefficients() -> Result<&'static Coefficients, AtmosphereError> {
+    static C: OnceLock<Result<Coefficients, AtmosphereError>> = OnceLock::new();
+    C.get_or_init(|| {
+        Ok(Coefficients {
+            a_oz: Spectrum::from_asset(ASSET, "a_oz_per_cm")?,
+            a_ox: Spectrum::from_asset(ASSET, "a_ox_per_cm")?,
+            a_wv: Spectrum::from_asset(ASSET, "a_wv_per_cm")?,
+        })
+    })
+    .as_ref()
+    .map_err(Clone::clone)
+}
+
+/// Relative optical air mass for zenith angle θ (Kasten & Young 1989).
+#[must_use]
+pub fn air_mass(cos_zenith: f64) -> f64 {
+    let theta_deg = cos_zenith.clamp(0.0, 1.0).acos().to_degrees();
+    1.0 / (cos_zenith + 0.505_72 * (96.079_95 - theta_deg).powf(-1.6364))
+}
+
+/// One-way gas transmittance at `wavelength_nm` along a path of zenith cosine `mu`.
+pub fn transmittance(
+    wavelength_nm: f64,
+    mu: f64,
+    gases: &GasAmounts,
+    pressure_hpa: f64,
+) -> Result<f64, AtmosphereError> {
+    let c = coefficients()?;
+    let a_oz = c.a_oz.value_at(wavelength_nm, Extrapolation::Error)?;
+    let a_ox = c.a_ox.value_at(wavelength_nm, Extrapolation::Error)?;
+    let a_wv = c.a_wv.value_at(wavelength_nm, Extrapolation::Error)?;
+    let m = air_mass(mu);
+    let m_p = m * pressure_hpa / 1013.25;
+    let m_oz = 1.0035 / (mu * mu + 0.007).sqrt();
+    let t_oz = (-a_oz * gases.ozone_atm_cm * m_oz).exp();
+    let t_ox = (-1.41 * a_ox * m_p / (1.0 + 118.3 * a_ox * m_p).powf(0.45)).exp();
+    let w = gases.water_vapour_cm;
+    let t_wv = (-0.2385 * a_wv * w * m / (1.0 + 20.07 * a_wv * w * m).powf(0.45)).exp();
+    Ok(t_oz * t_ox * t_wv)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn oxygen_a_band_absorbs_and_the_blue_does_not() {
+        let g = GasAmounts::default();
+        let t_760 = transmittance(761.0, 1.0, &g, 1013.25).unwrap();
+        let t_560 = transmittance(560.0, 1.0, &g, 1013.25).unwrap();
+        let t_443 = transmittance(443.0, 1.0, &g, 1013.25).unwrap();
+        assert!(t_760 < 0.6, "O2 A band: {t_760}");
+        assert!(
+            t_560 > 0.95 && t_560 < 0.99,
+            "Chappuis ozone at 560 nm: {t_560}"
+        );
+        assert!(t_443 > 0.99, "{t_443}");
+        assert!((air_mass(1.0) - 1.0).abs() < 1e-3);
+    }
+}

@@ -1,0 +1,576 @@
+//! One wavelength's radiative transfer: path radiance (Fourier coefficients of the multiple
+//! scattering plus exact single scattering), downwelling irradiance at the surface, upward
+//! transmittance and spherical albedo.
+//!
+//! Method (each step cited where it is implemented):
+//! - the aerosol phase function is delta-M truncated to 2N Legendre terms for the multiple
+//!   scattering (Wiscombe 1977), and the single-scattered radiance is computed exactly with the
+//!   full phase function and unscaled optical depths, for the four single-scattering paths over
+//!   a Fresnel surface (sun→view, sun→surface→view, surface→view, surface→surface→view): the TMS
+//!   correction of Nakajima & Tanaka (1988);
+//! - the scalar treatment of Rayleigh scattering errs by −7 % to +2.5 % in the path radiance
+//!   (worst in the blue at small sun zenith, OSOAA reference); a vector (I, Q, U) SOS run of the
+//!   Rayleigh-only column gives the correction ΔIᵐ = Iᵐ_vector − Iᵐ_scalar (m ≤ 2, all orders
+//!   including the first: skylight scattered once and reflected by the surface is polarised),
+//!   added to the mixture's scalar result (the polarisation error is dominated by molecular
+//!   scattering; Gordon, Brown & Evans 1988);
+//! - T_up(μ) is the ratio of the TOA radiance to the emitted radiance for water-leaving radiance
+//!   shaped like an isotropic in-water field transmitted through the surface, L ∝ 1 − R_F(μ),
+//!   over the Fresnel surface; S is the fraction of an isotropic upward source returned down to a
+//!   black surface.
+//!
+//! Radiances here are normalised to a solar flux of 1 normal to the beam: L = I·E₀.
+//!
+//! ## References
+//! - Nakajima, T. & Tanaka, M. (1988) Algorithms for radiative intensity calculations in
+//!   moderately thick atmospheres using a truncation approximation. JQSRT 40, 51–69.
+//! - Gordon, H. R., Brown, J. W., Evans, R. H. (1988) Exact Rayleigh scattering calculations for
+//!   use with the Nimbus-7 Coastal Zone Color Scanner. Appl. Opt. 27, 862–871.
+//! - Wiscombe, W. J. (1977) The delta-M method. J. Atmos. Sci. 34, 1408–1422.
+
+use serde::{Deserialize, Serialize};
+
+use super::fresnel::{fresnel_matrix, fresnel_reflectance};
+use super::kernels::{delta_m, scalar_kernel, vector_rayleigh_kernels};
+use super::phase::PhaseFunction;
+use super::profile::{AltitudeQuadrature, ColumnOptics, Layering};
+use super::sos::{Drive, Kernel, OrderSettings, Streams, solve};
+
+/// Accuracy settings of the radiative transfer: each costs time (see `shoal bench`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct RtAccuracy {
+    /// Gauss streams per hemisphere (2–48).
+    pub streams: usize,
+    /// Largest scattering order; 1 is the single-scattering mode.
+    pub max_orders: usize,
+    /// Largest number of Fourier terms in azimuth (1–96); capped at 2·streams.
+    pub fourier_terms: usize,
+    /// Largest scaled optical depth of one layer.
+    pub max_layer_depth: f64,
+    /// Fewest layers.
+    pub min_layers: usize,
+    /// An order adding less than this fraction of the sum ends the series.
+    pub order_tolerance: f64,
+    /// Add the vector-minus-scalar Rayleigh correction.
+    pub polarization_correction: bool,
+}
+
+impl Default for RtAccuracy {
+    fn default() -> Self {
+        Self {
+            streams: 12,
+            max_orders: 60,
+            fourier_terms: 24,
+            max_layer_depth: 0.02,
+            min_layers: 12,
+            order_tolerance: 1e-4,
+            polarization_correction: true,
+        }
+    }
+}
+
+impl RtAccuracy {
+    /// The named presets of the cost table: `single`, `fast`, `default`, `high`.
+    #[must_use]
+    pub fn preset(name: &str) -> Option<Self> {
+        let d = Self::default();
+        match name {
+            "single" => Some(Self {
+                max_orders: 1,
+                polarization_correction: false,
+                ..d
+            }),
+            "fast" => Some(Self {
+                streams: 6,
+                fourier_terms: 12,
+                max_layer_depth: 0.05,
+                min_layers: 6,
+                order_tolerance: 1e-3,
+                ..d
+            }),
+            "default" => Some(d),
+            "high" => Some(Self {
+                streams: 24,
+                fourier_terms: 48,
+                max_layer_depth: 0.01,
+                min_layers: 26,
+                order_tolerance: 1e-5,
+                ..d
+            }),
+            _ => None,
+        }
+    }
+
+    /// Check ranges; the message names the field and the allowed range.
+    pub fn validate(&self) -> Result<(), super::AtmosphereError> {
+        let bad = |field: &str, value: f64, allowed: &str| {
+            Err(super::AtmosphereError::OutOfRange {
+                field: field.into(),
+                value,
+                allowed: allowed.into(),
+            })
+        };
+        if !(2..=48).contains(&self.streams) {
+            return bad("streams", self.streams as f64, "2 to 48");
+        }
+        if !(1..=500).contains(&self.max_orders) {
+            return bad("max_orders", self.max_orders as f64, "1 to 500");
+        }
+        if !(1..=96).contains(&self.fourier_terms) {
+            return bad("fourier_terms", self.fourier_terms as f64, "1 to 96");
+        }
+        if !(self.max_layer_depth > 0.0 && self.max_layer_depth <= 1.0) {
+            return bad(
+                "max_layer_depth",
+                self.max_layer_depth,
+                "above 0, at most 1",
+            );
+        }
+        if !(1..=500).contains(&self.min_layers) {
+            return bad("min_layers", self.min_layers as f64, "1 to 500");
+        }
+        if !(self.order_tolerance > 0.0 && self.order_tolerance < 0.1) {
+            return bad(
+                "order_tolerance",
+                self.order_tolerance,
+                "above 0, below 0.1",
+            );
+        }
+        Ok(())
+    }
+
+    fn orders(&self) -> OrderSettings {
+        OrderSettings {
+            max_orders: self.max_orders,
+            tolerance: self.order_tolerance,
+        }
+    }
+}
+
+/// The optical column of one wavelength.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WavelengthColumn {
+    /// Wavelength, nm.
+    pub wavelength_nm: f64,
+    /// Rayleigh optical depth.
+    pub tau_rayleigh: f64,
+    /// Depolarisation ratio of air.
+    pub depolarization: f64,
+    /// Aerosol optical depth, single-scattering albedo and phase function, if any.
+    pub aerosol: Option<(f64, f64, PhaseFunction)>,
+    /// Molecular scale height, km.
+    pub rayleigh_scale_height_km: f64,
+    /// Aerosol scale height, km.
+    pub aerosol_scale_height_km: f64,
+    /// Refractive index of the water surface.
+    pub water_index: f64,
+}
+
+impl WavelengthColumn {
+    fn optics(&self) -> ColumnOptics {
+        let (tau_a, ssa) = self
+            .aerosol
+            .as_ref()
+            .map_or((0.0, 1.0), |(t, w, _)| (*t, *w));
+        ColumnOptics {
+            tau_rayleigh: self.tau_rayleigh,
+            tau_aerosol: tau_a,
+            ssa_aerosol: ssa,
+            rayleigh_scale_height_km: self.rayleigh_scale_height_km,
+            aerosol_scale_height_km: self.aerosol_scale_height_km,
+        }
+    }
+
+    fn rayleigh_only(&self) -> Self {
+        Self {
+            aerosol: None,
+            ..self.clone()
+        }
+    }
+
+    /// Layering and truncated aerosol moments for `n` streams: (layering, β′ or None).
+    fn scaled(&self, acc: &RtAccuracy) -> (Layering, Option<Vec<f64>>) {
+        let n_terms = 2 * acc.streams;
+        match &self.aerosol {
+            Some((_, _, phase)) => {
+                let (beta, f) = delta_m(&phase.moments(n_terms), n_terms);
+                (
+                    Layering::new(&self.optics(), f, acc.max_layer_depth, acc.min_layers),
+                    Some(beta),
+                )
+            }
+            None => (
+                Layering::new(&self.optics(), 0.0, acc.max_layer_depth, acc.min_layers),
+                None,
+            ),
+        }
+    }
+
+    /// Total (unscaled) optical depth.
+    #[must_use]
+    pub fn total_tau(&self) -> f64 {
+        self.tau_rayleigh + self.aerosol.as_ref().map_or(0.0, |a| a.0)
+    }
+}
+
+/// Exact single-scattering ingredients for one view cosine: per path p,
+/// (factor F_p, ∫e^{−m_p τ}dτ_R, ∫e^{−m_p τ}dτ_a).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct SsPaths {
+    paths: [(f64, f64, f64); 4],
+}
+
+/// Path radiance and irradiance for one sun position over a set of view cosines.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SunSolution {
+    /// Cosine of the solar zenith angle.
+    pub mu0: f64,
+    /// View cosines.
+    pub user_mu: Vec<f64>,
+    /// Fourier coefficients of the multiple-scattered TOA radiance, [view][m] (polarisation
+    /// correction included), normalised to a unit solar flux.
+    pub ms_fourier: Vec<Vec<f64>>,
+    ss: Vec<SsPaths>,
+    rayleigh_phase: PhaseFunction,
+    aerosol_phase: Option<(f64, PhaseFunction)>,
+    /// Direct downwelling irradiance at 0⁺ per unit solar flux, μ₀ e^{−τ/μ₀} (unscaled τ).
+    pub ed_direct: f64,
+    /// Diffuse downwelling irradiance at 0⁺ per unit solar flux (Fresnel surface, black water).
+    pub ed_diffuse: f64,
+    /// Scattering orders used in the m = 0 term.
+    pub orders: usize,
+}
+
+impl SunSolution {
+    /// Normalised TOA path radiance I (L = I·E₀) for view `i` at relative azimuth Δφ (view − sun,
+    /// radians; 0 puts the sensor on the sun's side).
+    #[must_use]
+    pub fn radiance(&self, i: usize, relative_azimuth_rad: f64) -> f64 {
+        let psi = std::f64::consts::PI - relative_azimuth_rad;
+        let ms: f64 = self.ms_fourier[i]
+            .iter()
+            .enumerate()
+            .map(|(m, c)| {
+                if m == 0 {
+                    *c
+                } else {
+                    2.0 * c * (m as f64 * psi).cos()
+                }
+            })
+            .sum();
+        ms + self.single_scattering(i, relative_azimuth_rad)
+    }
+
+    /// The exact single-scattered part of [`Self::radiance`].
+    #[must_use]
+    pub fn single_scattering(&self, i: usize, relative_azimuth_rad: f64) -> f64 {
+        let (mu0, muv) = (self.mu0, self.user_mu[i]);
+        let (s0, sv) = (
+            (1.0 - mu0 * mu0).max(0.0).sqrt(),
+            (1.0 - muv * muv).max(0.0).sqrt(),
+        );
+        let horizontal = s0 * sv * relative_azimuth_rad.cos();
+        // Θ for paths a, d (in/out in opposite hemispheres) and b, c (same hemisphere).
+        let cos_opposite = -mu0 * muv - horizontal;
+        let cos_same = mu0 * muv - horizontal;
+        let p = &self.ss[i].paths;
+        let mut total = 0.0;
+        for (k, (factor, a_r, a_a)) in p.iter().enumerate() {
+            let c = if k == 0 || k == 3 {
+                cos_opposite
+            } else {
+                cos_same
+            };
+            let mut v = self.rayleigh_phase.value(c) * a_r;
+            if let Some((ssa, phase)) = &self.aerosol_phase {
+                v += ssa * phase.value(c) * a_a;
+            }
+            total += factor * v;
+        }
+        total / (4.0 * std::f64::consts::PI * muv)
+    }
+
+    /// Total Ed(0⁺) per unit solar flux.
+    #[must_use]
+    pub fn ed(&self) -> f64 {
+        self.ed_direct + self.ed_diffuse
+    }
+}
+
+fn fresnel_blocks(mus: &[f64], n: f64) -> Vec<[[f64; 1]; 1]> {
+    mus.iter().map(|&m| [[fresnel_reflectance(m, n)]]).collect()
+}
+
+fn fresnel_blocks3(mus: &[f64], n: f64) -> Vec<[[f64; 3]; 3]> {
+    mus.iter().map(|&m| fresnel_matrix(m, n)).collect()
+}
+
+/// Solve the solar problem for sun cosine `mu0` and view cosines `user_mu`.
+#[must_use]
+pub fn solve_sun(
+    column: &WavelengthColumn,
+    mu0: f64,
+    user_mu: &[f64],
+    acc: &RtAccuracy,
+) -> SunSolution {
+    let streams = Streams::new(acc.streams, user_mu.to_vec());
+    let (layering, beta_a) = column.scaled(acc);
+    let rayleigh_phase = PhaseFunction::Rayleigh {
+        depolarization: column.depolarization,
+    };
+    let beta_r = rayleigh_phase.moments(2);
+    let surf_q = fresnel_blocks(&streams.mu, column.water_index);
+    let surf_u = fresnel_blocks(user_mu, column.water_index);
+    let nadir_only = user_mu.iter().all(|m| *m > 1.0 - 1e-12);
+    let m_max = if nadir_only {
+        0
+    } else if beta_a.is_some() {
+        acc.fourier_terms.min(2 * acc.streams) - 1
+    } else {
+        2.min(acc.fourier_terms - 1)
+    };
+    let mut ms_fourier = vec![Vec::new(); user_mu.len()];
+    let (mut ed_diffuse, mut orders, mut small) = (0.0, 0, 0);
+    for m in 0..=m_max {
+        let kr = scalar_kernel(&streams, &beta_r, m, mu0, column.water_index);
+        let ka = beta_a
+            .as_ref()
+            .map(|b| scalar_kernel(&streams, b, m, mu0, column.water_index));
+        let f = solve(
+            &streams,
+            &layering,
+            &kr,
+            ka.as_ref(),
+            &surf_q,
+            &surf_u,
+            &Drive::Sun { mu0 },
+            acc.orders(),
+        );
+        if m == 0 {
+            ed_diffuse = irradiance(&streams, &f.surface_down);
+            orders = f.orders;
+        }
+        for (coeffs, v) in ms_fourier.iter_mut().zip(&f.toa_user) {
+            coeffs.push(v[0]);
+        }
+        // Stop once two successive terms are negligible against the m = 0 term.
+        let peak0 = ms_fourier.iter().map(|c| c[0].abs()).fold(0.0, f64::max);
+        let peak = f.toa_user.iter().map(|v| v[0].abs()).fold(0.0, f64::max);
+        if m > 2 {
+            small = if peak <= 1e-5 * peak0 { small + 1 } else { 0 };
+            if small >= 2 {
+                break;
+            }
+        }
+    }
+    if acc.polarization_correction && acc.max_orders > 1 {
+        let (dm, de) = polarization_correction(column, mu0, &streams, acc);
+        for (coeffs, d) in ms_fourier.iter_mut().zip(dm) {
+            for (c, dv) in coeffs.iter_mut().zip(d) {
+                *c += dv;
+            }
+        }
+        ed_diffuse += de;
+    }
+    let quad = AltitudeQuadrature::new(&column.optics());
+    let ss = user_mu
+        .iter()
+        .map(|&muv| ss_paths(&quad, mu0, muv, column.water_index))
+        .collect();
+    SunSolution {
+        mu0,
+        user_mu: user_mu.to_vec(),
+        ms_fourier,
+        ss,
+        rayleigh_phase,
+        aerosol_phase: column.aerosol.as_ref().map(|(_, w, p)| (*w, p.clone())),
+        ed_direct: mu0 * (-column.total_tau() / mu0).exp(),
+        ed_diffuse,
+        orders,
+    }
+}
+
+/// Diffuse irradiance 2π Σ wⱼ μⱼ I⁰(μⱼ) from the m = 0 downward radiance.
+fn irradiance<const S: usize>(streams: &Streams, down: &[[f64; S]]) -> f64 {
+    2.0 * std::f64::consts::PI
+        * streams
+            .mu
+            .iter()
+            .zip(&streams.weight)
+            .zip(down)
+            .map(|((m, w), v)| m * w * v[0])
+            .sum::<f64>()
+}
+
+/// The four single-scattering paths over a Fresnel surface for view cosine μ_v: attenuation
+/// exponents m_p and factors F_p (see the module docs), integrated over the profile.
+fn ss_paths(q: &AltitudeQuadrature, mu0: f64, muv: f64, n: f64) -> SsPaths {
+    let t = q.total;
+    let (r0, rv) = (fresnel_reflectance(mu0, n), fresnel_reflectance(muv, n));
+    let specs = [
+        (1.0, 1.0 / mu0 + 1.0 / muv),
+        (rv * (-2.0 * t / muv).exp(), 1.0 / mu0 - 1.0 / muv),
+        (r0 * (-2.0 * t / mu0).exp(), 1.0 / muv - 1.0 / mu0),
+        (
+            r0 * rv * (-2.0 * t * (1.0 / mu0 + 1.0 / muv)).exp(),
+            -(1.0 / mu0 + 1.0 / muv),
+        ),
+    ];
+    let mut paths = [(0.0, 0.0, 0.0); 4];
+    for (p, (factor, m)) in paths.iter_mut().zip(specs) {
+        let (r, a) = q.attenuated(m);
+        *p = (factor, r, a);
+    }
+    SsPaths { paths }
+}
+
+/// ΔIᵐ (m ≤ 2) at the views and ΔEd from vector minus scalar SOS of the Rayleigh-only column.
+fn polarization_correction(
+    column: &WavelengthColumn,
+    mu0: f64,
+    streams: &Streams,
+    acc: &RtAccuracy,
+) -> (Vec<Vec<f64>>, f64) {
+    let ray = column.rayleigh_only();
+    let (layering, _) = ray.scaled(acc);
+    let beta = PhaseFunction::Rayleigh {
+        depolarization: column.depolarization,
+    }
+    .moments(2);
+    let n = column.water_index;
+    let vk = vector_rayleigh_kernels(streams, column.depolarization, mu0, n);
+    let (sq, su) = (
+        fresnel_blocks(&streams.mu, n),
+        fresnel_blocks(&streams.user_mu, n),
+    );
+    let (vq, vu) = (
+        fresnel_blocks3(&streams.mu, n),
+        fresnel_blocks3(&streams.user_mu, n),
+    );
+    let nadir_only = streams.user_mu.iter().all(|m| *m > 1.0 - 1e-12);
+    let mut delta = vec![Vec::new(); streams.user_mu.len()];
+    let mut d_ed = 0.0;
+    for (m, kv) in vk.iter().enumerate() {
+        if nadir_only && m > 0 {
+            break;
+        }
+        let ks: Kernel<1> = scalar_kernel(streams, &beta, m, mu0, n);
+        let fs = solve(
+            streams,
+            &layering,
+            &ks,
+            None,
+            &sq,
+            &su,
+            &Drive::Sun { mu0 },
+            acc.orders(),
+        );
+        let fv = solve(
+            streams,
+            &layering,
+            kv,
+            None,
+            &vq,
+            &vu,
+            &Drive::Sun { mu0 },
+            acc.orders(),
+        );
+        for (i, d) in delta.iter_mut().enumerate() {
+            let vector = fv.toa_user[i][0] + fv.toa_user_first[i][0];
+            let scalar = fs.toa_user[i][0] + fs.toa_user_first[i][0];
+            d.push(vector - scalar);
+        }
+        if m == 0 {
+            d_ed = irradiance(streams, &fv.surface_down) - irradiance(streams, &fs.surface_down);
+        }
+    }
+    (delta, d_ed)
+}
+
+/// Upward transmittance and spherical albedo.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Transmittance {
+    /// View cosines.
+    pub user_mu: Vec<f64>,
+    /// Total (direct + diffuse) upward transmittance per view cosine.
+    pub t_up: Vec<f64>,
+    /// Direct part e^{−τ/μ} (unscaled τ).
+    pub t_up_direct: Vec<f64>,
+    /// Spherical albedo of the atmosphere.
+    pub spherical_albedo: f64,
+}
+
+/// Upward transmittance for `user_mu` and the spherical albedo (m = 0 problems).
+#[must_use]
+pub fn solve_transmittance(
+    column: &WavelengthColumn,
+    user_mu: &[f64],
+    acc: &RtAccuracy,
+) -> Transmittance {
+    let streams = Streams::new(acc.streams, user_mu.to_vec());
+    let (layering, beta_a) = column.scaled(acc);
+    let n = column.water_index;
+    let kr = scalar_kernel(
+        &streams,
+        &PhaseFunction::Rayleigh {
+            depolarization: column.depolarization,
+        }
+        .moments(2),
+        0,
+        0.5,
+        n,
+    );
+    let ka = beta_a
+        .as_ref()
+        .map(|b| scalar_kernel(&streams, b, 0, 0.5, n));
+    let shape = |mu: f64| 1.0 - fresnel_reflectance(mu, n);
+    let tau_scaled = layering.total();
+    // Water-leaving radiance over the Fresnel surface.
+    let drive = Drive::Bottom {
+        quad: streams.mu.iter().map(|&m| [shape(m)]).collect(),
+        user: user_mu.iter().map(|&m| [shape(m)]).collect(),
+    };
+    let f = solve(
+        &streams,
+        &layering,
+        &kr,
+        ka.as_ref(),
+        &fresnel_blocks(&streams.mu, n),
+        &fresnel_blocks(user_mu, n),
+        &drive,
+        acc.orders(),
+    );
+    let t_up = user_mu
+        .iter()
+        .zip(&f.toa_user)
+        .map(|(&mu, v)| (shape(mu) * (-tau_scaled / mu).exp() + v[0]) / shape(mu))
+        .collect();
+    // Isotropic unit source over a black surface: the fraction returned down is S.
+    let black_q = vec![[[0.0]]; streams.n()];
+    let black_u = vec![[[0.0]]; user_mu.len()];
+    let iso = Drive::Bottom {
+        quad: vec![[1.0]; streams.n()],
+        user: vec![[1.0]; user_mu.len()],
+    };
+    let g = solve(
+        &streams,
+        &layering,
+        &kr,
+        ka.as_ref(),
+        &black_q,
+        &black_u,
+        &iso,
+        acc.orders(),
+    );
+    let spherical_albedo = irradiance(&streams, &g.surface_down) / std::f64::consts::PI;
+    Transmittance {
+        user_mu: user_mu.to_vec(),
+        t_up,
+        t_up_direct: user_mu
+            .iter()
+            .map(|&mu| (-column.total_tau() / mu).exp())
+            .collect(),
+        spherical_albedo,
+    }
+}
