@@ -51,6 +51,22 @@ pub const ALL: &[Asset] = embed![
     "atmosphere/wmo_aerosol_mie.csv",
 ];
 
+macro_rules! embed_presets {
+    ($($path:literal),* $(,)?) => {
+        &[$(Asset { path: $path, text: include_str!(concat!("../presets/", $path)) }),*]
+    };
+}
+
+/// Built-in presets (RON files under `presets/`), embedded so that names resolve anywhere.
+pub const PRESETS: &[Asset] =
+    embed_presets!["siop/heron_island.ron", "siop/cyanobacteria_reservoir.ron",];
+
+/// The built-in preset at `path` (relative to `presets/`), if there is one.
+#[must_use]
+pub fn preset(path: &str) -> Option<&'static Asset> {
+    PRESETS.iter().find(|a| a.path == path)
+}
+
 /// The embedded file at `path` (relative to `assets/`), if there is one.
 ///
 /// ```

@@ -20,6 +20,7 @@
 //! | [`spectral`] | wavelength grid, spectra, band sets, `band_from_fine` |
 //! | [`water`] | SIOP sets, IOPs, deep/shallow reflectance (Lee et al. 1998/1999, SAMBUCA) |
 //! | [`atmosphere`] | Rayleigh, aerosols (Mie, WMO models), gases, SOS radiative transfer, LUT |
+//! | [`validation`] | comparisons with reference codes (OSOAA), shared by tests and `shoal bench` |
 //! | [`cli`] | the headless command line (`shoal water`, `shoal atmosphere`, `shoal bench`) |
 
 pub mod assets;
@@ -27,4 +28,5 @@ pub mod atmosphere;
 pub mod cli;
 pub mod spectral;
 pub mod units;
+pub mod validation;
 pub mod water;

@@ -20,9 +20,11 @@ use super::fresnel::fresnel_reflectance;
 ///
 /// ```
 /// use shoal::atmosphere::glint_reflectance;
+/// // Specular geometry at 5 m/s: ρ_g ≈ π·R_F(20°)/(4 cos²20° · π σ²) ≈ 0.21.
 /// let specular = glint_reflectance(0.35, 0.35, std::f64::consts::PI, 5.0, 1.34);
-/// let away = glint_reflectance(0.35, 0.35, 0.0, 5.0, 1.34);
-/// assert!(specular > 0.1 && away < 1e-6);
+/// // Sensor at 40° on the sun's side: facets would have to tilt 30°; almost none do.
+/// let away = glint_reflectance(0.35, 0.70, 0.0, 5.0, 1.34);
+/// assert!((specular - 0.211).abs() < 0.001 && away < 1e-3 * specular);
 /// ```
 #[must_use]
 pub fn glint_reflectance(

@@ -22,6 +22,7 @@ mod fresnel;
 mod gas;
 mod glint;
 mod kernels;
+mod lut;
 mod mie;
 mod phase;
 mod profile;
@@ -30,6 +31,7 @@ mod rayleigh;
 mod rt;
 mod solar;
 mod sos;
+mod spec;
 mod wmo;
 
 pub use aerosol::{
@@ -41,6 +43,7 @@ pub use fresnel::{SEA_REFRACTIVE_INDEX, fresnel_matrix, fresnel_reflectance};
 pub use gas::{GasAmounts, air_mass, transmittance as gas_transmittance};
 pub use glint::glint_reflectance;
 pub use kernels::delta_m;
+pub use lut::{AtmosphereLut, LutAxes};
 pub use mie::{BulkOptics, LogNormal, MieSphere, SizeGrid, integrate_lognormal, mie_sphere};
 pub use phase::{PhaseFunction, rayleigh_beta2};
 pub use profile::{AltitudeQuadrature, ColumnOptics, Layering};
@@ -53,6 +56,7 @@ pub use rt::{
 };
 pub use solar::{e0_on_grid, sun_distance_factor, tsis1};
 pub use sos::Streams;
+pub use spec::{Atmosphere, AtmosphereSpec, AtmosphereTerms, Geometry, Surface};
 pub use wmo::{AerosolType, Component};
 
 use crate::spectral::SpectralError;

@@ -1,4 +1,17 @@
-//! The headless command line.
+//! The headless command line. Every subcommand validates its input at the boundary: bad input
+//! gets one line naming the field and the allowed range, and exit code 2; never a panic.
+//!
+//! | command | what it does |
+//! |---|---|
+//! | `shoal water` | the water model alone: CSV of every intermediate per wavelength (or band) |
+//! | `shoal atmosphere` | the atmosphere alone: CSV of E₀, L_path, T_up, T_down, S, Ed(0⁺) |
+//! | `shoal bench` | performance and accuracy figures (water evaluations/s, LUT build time vs OSOAA) |
+
+mod atmosphere;
+mod bench;
+mod grid;
+mod output;
+mod water;
 
 use std::process::ExitCode;
 
@@ -6,7 +19,7 @@ use clap::{Parser, Subcommand};
 
 /// Shoal: end-to-end simulation of satellite optical instruments over water.
 #[derive(Debug, Parser)]
-#[command(name = "shoal", version, about)]
+#[command(name = "shoal", version, about, long_about = None)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -14,6 +27,13 @@ struct Cli {
 
 #[derive(Debug, Subcommand)]
 enum Command {
+    /// Evaluate the water model (Lee et al. 1998/1999, SAMBUCA) and print CSV.
+    Water(water::WaterArgs),
+    /// Evaluate the atmosphere (successive orders of scattering) and print CSV.
+    Atmosphere(atmosphere::AtmosphereArgs),
+    /// Measure speed and accuracy: water evaluations per second, atmosphere LUT build times
+    /// with their errors against OSOAA.
+    Bench(bench::BenchArgs),
     /// Developer tools that regenerate computed assets.
     #[command(subcommand, hide = true)]
     Dev(DevCommand),
@@ -24,6 +44,47 @@ enum DevCommand {
     /// Print the WMO aerosol component Mie table (assets/atmosphere/wmo_aerosol_mie.csv).
     AerosolTable,
 }
+
+/// What went wrong, and which exit code it earns.
+#[derive(Debug)]
+pub enum CliError {
+    /// The user's input is invalid (exit code 2).
+    Input(String),
+    /// Something failed while running (exit code 1), e.g. writing the output.
+    Run(String),
+}
+
+impl CliError {
+    fn exit_code(&self) -> ExitCode {
+        match self {
+            Self::Input(_) => ExitCode::from(2),
+            Self::Run(_) => ExitCode::from(1),
+        }
+    }
+}
+
+impl std::fmt::Display for CliError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Input(m) | Self::Run(m) => f.write_str(m),
+        }
+    }
+}
+
+macro_rules! input_error {
+    ($($t:ty),*) => {$(
+        impl From<$t> for CliError {
+            fn from(e: $t) -> Self {
+                Self::Input(e.to_string())
+            }
+        }
+    )*};
+}
+input_error!(
+    crate::water::WaterError,
+    crate::atmosphere::AtmosphereError,
+    crate::spectral::SpectralError
+);
 
 /// Entry point of the `shoal` binary.
 #[must_use]
@@ -39,10 +100,19 @@ pub fn main() -> ExitCode {
             };
         }
     };
-    match cli.command {
+    let result = match cli.command {
+        Command::Water(args) => water::run(&args),
+        Command::Atmosphere(args) => atmosphere::run(&args),
+        Command::Bench(args) => bench::run(&args),
         Command::Dev(DevCommand::AerosolTable) => {
-            print!("{}", crate::atmosphere::component_table_csv());
-            ExitCode::SUCCESS
+            output::emit(&crate::atmosphere::component_table_csv(), None)
+        }
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            e.exit_code()
         }
     }
 }

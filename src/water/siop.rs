@@ -121,6 +121,45 @@ impl SiopSpec {
         }
     }
 
+    /// A built-in SIOP set by name: `sambuca_default`, or a file in `presets/siop/`
+    /// (`heron_island`, `cyanobacteria_reservoir`).
+    ///
+    /// ```
+    /// assert!(shoal::water::SiopSpec::preset("heron_island").is_ok());
+    /// assert!(shoal::water::SiopSpec::preset("nile").is_err());
+    /// ```
+    pub fn preset(name: &str) -> Result<Self, WaterError> {
+        if name == "sambuca_default" {
+            return Ok(Self::sambuca_default());
+        }
+        let path = format!("siop/{name}.ron");
+        match crate::assets::preset(&path) {
+            Some(a) => Self::from_ron(a.text, &format!("presets/{path}")),
+            None => Err(WaterError::UnknownName {
+                field: "SIOP set".into(),
+                name: name.into(),
+                known: Self::preset_names().join(", "),
+            }),
+        }
+    }
+
+    /// Names of the built-in SIOP sets.
+    #[must_use]
+    pub fn preset_names() -> Vec<String> {
+        let mut names = vec!["sambuca_default".to_string()];
+        names.extend(
+            crate::assets::PRESETS
+                .iter()
+                .filter_map(|a| {
+                    a.path
+                        .strip_prefix("siop/")
+                        .and_then(|p| p.strip_suffix(".ron"))
+                })
+                .map(str::to_string),
+        );
+        names
+    }
+
     /// Resolve onto `grid`. Every spectrum must cover the grid (or say what to do outside its
     /// data) and be finite; a_w must be ≥ 0 and bb_w > 0 (so that u = bb/(a+bb) is defined for
     /// pure water). Specific spectra may dip slightly below zero: measured a*_ph spectra carry

@@ -1,0 +1,247 @@
+//! The atmosphere look-up table: built once per scene over wavelength, sun zenith, view zenith
+//! and relative azimuth, then interpolated per pixel.
+//!
+//! One SOS solve per (wavelength, sun zenith) node gives the path radiance at every view-zenith
+//! node and, through its Fourier series, every azimuth; one transmittance solve per wavelength
+//! gives T_up at every view-zenith node and the spherical albedo. The table stores normalised
+//! (unit solar flux, gas-free) quantities; E₀ and gas transmittances are applied on evaluation.
+//! Interpolation is multilinear in the angles (degrees); the error it adds is measured by
+//! `shoal bench` against direct solves.
+
+use rayon::prelude::*;
+
+use super::AtmosphereError;
+use super::glint::glint_reflectance;
+use super::rt::{solve_sun, solve_transmittance};
+use super::spec::{Atmosphere, AtmosphereTerms, Geometry, Normalised, Surface};
+
+/// Node positions of the table.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct LutAxes {
+    /// Wavelengths, nm (band centres or a coarse grid).
+    pub wavelengths_nm: Vec<f64>,
+    /// Sun zenith nodes, degrees, increasing.
+    pub sun_zenith_deg: Vec<f64>,
+    /// View zenith nodes, degrees, increasing.
+    pub view_zenith_deg: Vec<f64>,
+    /// Relative azimuth nodes, degrees, increasing within 0–180 (the field is symmetric).
+    pub relative_azimuth_deg: Vec<f64>,
+}
+
+impl LutAxes {
+    /// Axes that cover sun zenith `sza_range` and view zenith up to `max_vza` (degrees), with
+    /// nodes every `sza_step`, `vza_step` and `raz_step` degrees.
+    #[must_use]
+    pub fn covering(
+        wavelengths_nm: Vec<f64>,
+        sza_range: (f64, f64),
+        max_vza: f64,
+        steps: (f64, f64, f64),
+    ) -> Self {
+        let nodes = |lo: f64, hi: f64, step: f64| -> Vec<f64> {
+            if hi - lo < 1e-9 {
+                return vec![lo];
+            }
+            let n = ((hi - lo) / step).ceil().max(1.0) as usize;
+            (0..=n)
+                .map(|i| lo + (hi - lo) * i as f64 / n as f64)
+                .collect()
+        };
+        Self {
+            wavelengths_nm,
+            sun_zenith_deg: nodes(sza_range.0, sza_range.1, steps.0),
+            view_zenith_deg: nodes(0.0, max_vza, steps.1),
+            relative_azimuth_deg: nodes(0.0, 180.0, steps.2),
+        }
+    }
+
+    fn validate(&self) -> Result<(), AtmosphereError> {
+        let check = |name: &str, v: &[f64], lo: f64, hi: f64| {
+            if v.is_empty()
+                || v.windows(2).any(|w| w[1] <= w[0])
+                || v.iter().any(|x| !(lo..=hi).contains(x))
+            {
+                return Err(AtmosphereError::OutOfRange {
+                    field: format!("LUT axis {name}"),
+                    value: v.first().copied().unwrap_or(f64::NAN),
+                    allowed: format!("a non-empty increasing list within {lo}–{hi}"),
+                });
+            }
+            Ok(())
+        };
+        check("wavelengths_nm", &self.wavelengths_nm, 325.0, 1025.0)?;
+        check("sun_zenith_deg", &self.sun_zenith_deg, 0.0, 89.0)?;
+        check("view_zenith_deg", &self.view_zenith_deg, 0.0, 85.0)?;
+        check(
+            "relative_azimuth_deg",
+            &self.relative_azimuth_deg,
+            0.0,
+            180.0,
+        )
+    }
+}
+
+/// The table. Index order: [wavelength][sun][view][azimuth].
+#[derive(Debug, Clone)]
+pub struct AtmosphereLut {
+    axes: LutAxes,
+    atmosphere: Atmosphere,
+    radiance: Vec<f64>,
+    ed: Vec<f64>,
+    t_up: Vec<f64>,
+    spherical_albedo: Vec<f64>,
+    tau_total: Vec<f64>,
+    tau_rayleigh: Vec<f64>,
+}
+
+/// Bracketing nodes and weight for linear interpolation on `nodes` (clamped at the ends).
+fn bracket(nodes: &[f64], x: f64) -> (usize, usize, f64) {
+    if nodes.len() == 1 || x <= nodes[0] {
+        return (0, 0, 0.0);
+    }
+    let last = nodes.len() - 1;
+    if x >= nodes[last] {
+        return (last, last, 0.0);
+    }
+    let j = nodes.partition_point(|&v| v <= x).clamp(1, last);
+    (j - 1, j, (x - nodes[j - 1]) / (nodes[j] - nodes[j - 1]))
+}
+
+impl AtmosphereLut {
+    /// Build the table (parallel over wavelength × sun zenith in the caller's rayon pool).
+    pub fn build(atmosphere: &Atmosphere, axes: LutAxes) -> Result<Self, AtmosphereError> {
+        axes.validate()?;
+        let acc = atmosphere.spec().accuracy;
+        let columns = axes
+            .wavelengths_nm
+            .iter()
+            .map(|&w| atmosphere.column(w))
+            .collect::<Result<Vec<_>, _>>()?;
+        let view_mu: Vec<f64> = axes
+            .view_zenith_deg
+            .iter()
+            .map(|v| v.to_radians().cos())
+            .collect();
+        let (nw, ns, nv, na) = (
+            axes.wavelengths_nm.len(),
+            axes.sun_zenith_deg.len(),
+            axes.view_zenith_deg.len(),
+            axes.relative_azimuth_deg.len(),
+        );
+        let jobs: Vec<(usize, usize)> =
+            (0..nw).flat_map(|w| (0..ns).map(move |s| (w, s))).collect();
+        let sun: Vec<_> = jobs
+            .par_iter()
+            .map(|&(w, s)| {
+                solve_sun(
+                    &columns[w],
+                    axes.sun_zenith_deg[s].to_radians().cos(),
+                    &view_mu,
+                    &acc,
+                )
+            })
+            .collect();
+        let up: Vec<_> = columns
+            .par_iter()
+            .map(|c| solve_transmittance(c, &view_mu, &acc))
+            .collect();
+        let mut radiance = vec![0.0; nw * ns * nv * na];
+        let mut ed = vec![0.0; nw * ns];
+        for (job, sol) in jobs.iter().zip(&sun) {
+            let (w, s) = *job;
+            ed[w * ns + s] = sol.ed();
+            for v in 0..nv {
+                for (a, raz) in axes.relative_azimuth_deg.iter().enumerate() {
+                    radiance[((w * ns + s) * nv + v) * na + a] = sol.radiance(v, raz.to_radians());
+                }
+            }
+        }
+        let t_up = up.iter().flat_map(|t| t.t_up.iter().copied()).collect();
+        let spherical_albedo = up.iter().map(|t| t.spherical_albedo).collect();
+        Ok(Self {
+            tau_total: columns.iter().map(|c| c.total_tau()).collect(),
+            tau_rayleigh: columns.iter().map(|c| c.tau_rayleigh).collect(),
+            axes,
+            atmosphere: atmosphere.clone(),
+            radiance,
+            ed,
+            t_up,
+            spherical_albedo,
+        })
+    }
+
+    /// The axes.
+    #[must_use]
+    pub fn axes(&self) -> &LutAxes {
+        &self.axes
+    }
+
+    /// All terms for wavelength node `w` at geometry `g`, interpolated.
+    pub fn terms(&self, w: usize, g: &Geometry) -> Result<AtmosphereTerms, AtmosphereError> {
+        g.validate()?;
+        let a = &self.axes;
+        let (ns, nv, na) = (
+            a.sun_zenith_deg.len(),
+            a.view_zenith_deg.len(),
+            a.relative_azimuth_deg.len(),
+        );
+        let mut raz = g.relative_azimuth_rad.to_degrees().abs() % 360.0;
+        if raz > 180.0 {
+            raz = 360.0 - raz;
+        }
+        let (s0, s1, ts) = bracket(&a.sun_zenith_deg, g.sun_zenith_rad.to_degrees());
+        let (v0, v1, tv) = bracket(&a.view_zenith_deg, g.view_zenith_rad.to_degrees());
+        let (a0, a1, ta) = bracket(&a.relative_azimuth_deg, raz);
+        let at = |s: usize, v: usize, z: usize| self.radiance[((w * ns + s) * nv + v) * na + z];
+        let lerp = |x: f64, y: f64, t: f64| x + t * (y - x);
+        let plane = |s: usize| {
+            lerp(
+                lerp(at(s, v0, a0), at(s, v0, a1), ta),
+                lerp(at(s, v1, a0), at(s, v1, a1), ta),
+                tv,
+            )
+        };
+        let radiance = lerp(plane(s0), plane(s1), ts);
+        let ed = lerp(self.ed[w * ns + s0], self.ed[w * ns + s1], ts);
+        let t_up = lerp(self.t_up[w * nv + v0], self.t_up[w * nv + v1], tv);
+        let (mu0, muv) = (g.sun_zenith_rad.cos(), g.view_zenith_rad.cos());
+        // Normalised quantities scale smoothly with μ₀ where the direct beam dominates; the
+        // interpolated Ed is rescaled by the exact direct-beam ratio at this sun angle.
+        let tau = self.tau_total[w];
+        let direct_nodes = lerp(
+            a.sun_zenith_deg[s0].to_radians().cos()
+                * (-tau / a.sun_zenith_deg[s0].to_radians().cos()).exp(),
+            a.sun_zenith_deg[s1].to_radians().cos()
+                * (-tau / a.sun_zenith_deg[s1].to_radians().cos()).exp(),
+            ts,
+        );
+        let ed = ed * (mu0 * (-tau / mu0).exp()) / direct_nodes;
+        let t_up_direct = (-tau / muv).exp();
+        let glint = match self.atmosphere.spec().surface {
+            Surface::Flat => 0.0,
+            Surface::Wind { speed_m_s } => {
+                let rho_g = glint_reflectance(
+                    g.sun_zenith_rad,
+                    g.view_zenith_rad,
+                    g.relative_azimuth_rad,
+                    speed_m_s,
+                    self.atmosphere.spec().water_refractive_index,
+                );
+                rho_g / std::f64::consts::PI * mu0 * (-tau / mu0).exp() * t_up_direct
+            }
+        };
+        self.atmosphere.assemble(&Normalised {
+            wavelength_nm: a.wavelengths_nm[w],
+            tau_rayleigh: self.tau_rayleigh[w],
+            tau_aerosol: tau - self.tau_rayleigh[w],
+            mu0,
+            muv,
+            radiance,
+            ed,
+            t_up,
+            t_up_direct,
+            spherical_albedo: self.spherical_albedo[w],
+            glint,
+        })
+    }
+}

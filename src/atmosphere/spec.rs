@@ -1,0 +1,404 @@
+//! The atmosphere as a scene describes it (RON), validated into an [`Atmosphere`] that answers
+//! every term of the TOA signal at a wavelength and geometry.
+//!
+//! TOA radiance over water (Vermote et al. 1997; Gordon & Wang 1994):
+//! L_TOA = L_path + T_up·Lw/(1 − S·ρ_w) (+ glint when the scene asks for it), with
+//! Lw = Rrs·Ed(0⁺), ρ_w ≈ π·Rrs, and gases multiplying the sun–surface–sensor paths.
+
+use serde::{Deserialize, Serialize};
+
+use super::aerosol::mixture_optics;
+use super::fresnel::SEA_REFRACTIVE_INDEX;
+use super::gas::{GasAmounts, transmittance as gas_transmittance};
+use super::glint::glint_reflectance;
+use super::rayleigh::{AIR_DEPOLARIZATION, RayleighColumn, RayleighDepth, STANDARD_PRESSURE_HPA};
+use super::rt::{RtAccuracy, WavelengthColumn, solve_sun, solve_transmittance};
+use super::wmo::AerosolType;
+use super::{AtmosphereError, solar};
+use crate::spectral::{Extrapolation, Spectrum};
+
+/// The sea surface.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
+pub enum Surface {
+    /// A flat Fresnel interface (no glint).
+    #[default]
+    Flat,
+    /// Wind-roughened: the sky is still reflected by the flat Fresnel interface, and Cox–Munk
+    /// sun glint is added as a separate term.
+    Wind {
+        /// Wind speed at 10 m, m s⁻¹ (0–30).
+        speed_m_s: f64,
+    },
+}
+
+impl Surface {
+    /// Parse `flat` or `wind:5`.
+    pub fn parse(text: &str) -> Result<Self, AtmosphereError> {
+        let t = text.trim().to_ascii_lowercase();
+        if t == "flat" {
+            return Ok(Self::Flat);
+        }
+        let bad = || AtmosphereError::OutOfRange {
+            field: "surface".into(),
+            value: f64::NAN,
+            allowed: format!("`flat` or `wind:SPEED` in m/s (got `{text}`)"),
+        };
+        let speed = t
+            .strip_prefix("wind:")
+            .ok_or_else(bad)?
+            .parse::<f64>()
+            .map_err(|_| bad())?;
+        Ok(Self::Wind { speed_m_s: speed })
+    }
+}
+
+/// The atmosphere as written in a scene file or given on the command line.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct AtmosphereSpec {
+    /// Aerosol model.
+    pub aerosol: AerosolType,
+    /// Aerosol optical thickness at 550 nm (0–5).
+    pub aot550: f64,
+    /// Surface pressure, hPa (500–1100).
+    pub pressure_hpa: f64,
+    /// Gas absorption on (O3, O2, H2O) or off.
+    pub gases: bool,
+    /// Gas column amounts when `gases` is on.
+    pub gas_amounts: GasAmounts,
+    /// Surface state.
+    pub surface: Surface,
+    /// Rayleigh optical-depth formula.
+    pub rayleigh: RayleighDepth,
+    /// Latitude of the scene, degrees (gravity in the Rayleigh depth).
+    pub latitude_deg: f64,
+    /// Molecular scale height, km.
+    pub rayleigh_scale_height_km: f64,
+    /// Aerosol scale height, km.
+    pub aerosol_scale_height_km: f64,
+    /// Refractive index of the water surface.
+    pub water_refractive_index: f64,
+    /// Day of year for the Sun–Earth distance (1–366).
+    pub day_of_year: u32,
+    /// Radiative-transfer accuracy settings.
+    pub accuracy: RtAccuracy,
+}
+
+impl Default for AtmosphereSpec {
+    fn default() -> Self {
+        Self {
+            aerosol: AerosolType::Maritime,
+            aot550: 0.1,
+            pressure_hpa: STANDARD_PRESSURE_HPA,
+            gases: false,
+            gas_amounts: GasAmounts::default(),
+            surface: Surface::Flat,
+            rayleigh: RayleighDepth::Bodhaine,
+            latitude_deg: 45.0,
+            rayleigh_scale_height_km: 8.0,
+            aerosol_scale_height_km: 2.0,
+            water_refractive_index: SEA_REFRACTIVE_INDEX,
+            day_of_year: 172,
+            accuracy: RtAccuracy::default(),
+        }
+    }
+}
+
+fn range(field: &str, value: f64, lo: f64, hi: f64, unit: &str) -> Result<(), AtmosphereError> {
+    if value.is_finite() && (lo..=hi).contains(&value) {
+        Ok(())
+    } else {
+        Err(AtmosphereError::OutOfRange {
+            field: field.into(),
+            value,
+            allowed: format!("{lo} to {hi}{unit}"),
+        })
+    }
+}
+
+impl AtmosphereSpec {
+    /// Check every field against its documented range.
+    pub fn validate(&self) -> Result<(), AtmosphereError> {
+        range("aot550", self.aot550, 0.0, 5.0, "")?;
+        range("pressure_hpa", self.pressure_hpa, 500.0, 1100.0, " hPa")?;
+        range(
+            "gas_amounts.ozone_atm_cm",
+            self.gas_amounts.ozone_atm_cm,
+            0.0,
+            1.0,
+            " atm-cm",
+        )?;
+        range(
+            "gas_amounts.water_vapour_cm",
+            self.gas_amounts.water_vapour_cm,
+            0.0,
+            10.0,
+            " cm",
+        )?;
+        if let Surface::Wind { speed_m_s } = self.surface {
+            range("surface wind speed_m_s", speed_m_s, 0.0, 30.0, " m/s")?;
+        }
+        range("latitude_deg", self.latitude_deg, -90.0, 90.0, " degrees")?;
+        range(
+            "rayleigh_scale_height_km",
+            self.rayleigh_scale_height_km,
+            1.0,
+            20.0,
+            " km",
+        )?;
+        range(
+            "aerosol_scale_height_km",
+            self.aerosol_scale_height_km,
+            0.1,
+            20.0,
+            " km",
+        )?;
+        range(
+            "water_refractive_index",
+            self.water_refractive_index,
+            1.0,
+            1.5,
+            "",
+        )?;
+        range("day_of_year", f64::from(self.day_of_year), 1.0, 366.0, "")?;
+        self.accuracy.validate()
+    }
+
+    /// Validate and bind the solar spectrum.
+    pub fn build(&self) -> Result<Atmosphere, AtmosphereError> {
+        self.validate()?;
+        Ok(Atmosphere {
+            spec: self.clone(),
+            e0: solar::tsis1()?,
+        })
+    }
+}
+
+/// Sun and view geometry in radians (degrees only at the edges).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Geometry {
+    /// Solar zenith angle, rad, in [0, 90°).
+    pub sun_zenith_rad: f64,
+    /// View zenith angle, rad, in [0, 90°).
+    pub view_zenith_rad: f64,
+    /// View azimuth minus sun azimuth, rad (0: sensor on the sun's side; π: glint side).
+    pub relative_azimuth_rad: f64,
+}
+
+impl Geometry {
+    /// From degrees.
+    #[must_use]
+    pub fn from_degrees(sun_zenith: f64, view_zenith: f64, relative_azimuth: f64) -> Self {
+        Self {
+            sun_zenith_rad: sun_zenith.to_radians(),
+            view_zenith_rad: view_zenith.to_radians(),
+            relative_azimuth_rad: relative_azimuth.to_radians(),
+        }
+    }
+
+    /// Sun zenith below 89° (the plane-parallel model has no meaning at the horizon), view
+    /// zenith below 85°, finite azimuth.
+    pub fn validate(&self) -> Result<(), AtmosphereError> {
+        range(
+            "sun_zenith (deg)",
+            self.sun_zenith_rad.to_degrees(),
+            0.0,
+            89.0,
+            " degrees",
+        )?;
+        range(
+            "view_zenith (deg)",
+            self.view_zenith_rad.to_degrees(),
+            0.0,
+            85.0,
+            " degrees",
+        )?;
+        range(
+            "relative_azimuth (deg)",
+            self.relative_azimuth_rad.to_degrees(),
+            -360.0,
+            360.0,
+            " degrees",
+        )
+    }
+}
+
+/// Every atmospheric term at one wavelength and geometry.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AtmosphereTerms {
+    /// Wavelength, nm.
+    pub wavelength_nm: f64,
+    /// Extraterrestrial irradiance on the day, W m⁻² nm⁻¹.
+    pub e0_w_m2_nm: f64,
+    /// Rayleigh optical depth.
+    pub tau_rayleigh: f64,
+    /// Aerosol optical depth.
+    pub tau_aerosol: f64,
+    /// Path radiance incl. Fresnel-reflected sky light over black water, W m⁻² sr⁻¹ nm⁻¹.
+    pub l_path_w_m2_sr_nm: f64,
+    /// Path reflectance π L_path/(E₀ μ₀).
+    pub rho_path: f64,
+    /// Total downward transmittance Ed(0⁺)/(E₀ μ₀) (gases included).
+    pub t_down: f64,
+    /// Total upward transmittance for uniform water-leaving radiance (gases included).
+    pub t_up: f64,
+    /// Direct upward transmittance e^{−τ/μ_v}·T_gas.
+    pub t_up_direct: f64,
+    /// Spherical albedo of the atmosphere.
+    pub spherical_albedo: f64,
+    /// Downwelling irradiance just above the surface (black water), W m⁻² nm⁻¹.
+    pub ed_0plus_w_m2_nm: f64,
+    /// Gas transmittance sun→surface→sensor.
+    pub t_gas: f64,
+    /// Sun-glint radiance at TOA (0 for a flat surface), W m⁻² sr⁻¹ nm⁻¹.
+    pub l_glint_w_m2_sr_nm: f64,
+}
+
+/// RT results per unit solar flux and without gases, for one wavelength and geometry.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Normalised {
+    pub wavelength_nm: f64,
+    pub tau_rayleigh: f64,
+    pub tau_aerosol: f64,
+    pub mu0: f64,
+    pub muv: f64,
+    /// Path radiance I (L = I·E₀).
+    pub radiance: f64,
+    /// Ed(0⁺) per unit flux.
+    pub ed: f64,
+    pub t_up: f64,
+    pub t_up_direct: f64,
+    pub spherical_albedo: f64,
+    /// Glint radiance per unit flux.
+    pub glint: f64,
+}
+
+/// A validated atmosphere.
+#[derive(Debug, Clone)]
+pub struct Atmosphere {
+    spec: AtmosphereSpec,
+    e0: Spectrum,
+}
+
+impl Atmosphere {
+    /// The spec it was built from.
+    #[must_use]
+    pub fn spec(&self) -> &AtmosphereSpec {
+        &self.spec
+    }
+
+    /// Extraterrestrial irradiance at `wavelength_nm` on the spec's day, W m⁻² nm⁻¹.
+    pub fn e0(&self, wavelength_nm: f64) -> Result<f64, AtmosphereError> {
+        Ok(self.e0.value_at(wavelength_nm, Extrapolation::Error)?
+            * solar::sun_distance_factor(self.spec.day_of_year))
+    }
+
+    /// The optical column at `wavelength_nm` (350–1000 nm).
+    pub fn column(&self, wavelength_nm: f64) -> Result<WavelengthColumn, AtmosphereError> {
+        range("wavelength_nm", wavelength_nm, 325.0, 1025.0, " nm")?;
+        let s = &self.spec;
+        let site = RayleighColumn {
+            pressure_hpa: s.pressure_hpa,
+            latitude_deg: s.latitude_deg,
+            ..RayleighColumn::default()
+        };
+        let aerosol = if s.aot550 > 0.0 {
+            mixture_optics(s.aerosol, wavelength_nm)?
+                .map(|o| (s.aot550 * o.extinction_ratio, o.ssa, o.phase))
+        } else {
+            None
+        };
+        Ok(WavelengthColumn {
+            wavelength_nm,
+            tau_rayleigh: s.rayleigh.tau(wavelength_nm, &site),
+            depolarization: AIR_DEPOLARIZATION,
+            aerosol,
+            rayleigh_scale_height_km: s.rayleigh_scale_height_km,
+            aerosol_scale_height_km: s.aerosol_scale_height_km,
+            water_index: s.water_refractive_index,
+        })
+    }
+
+    /// One-way gas transmittance along zenith cosine `mu` (1 when gases are off).
+    pub fn gas(&self, wavelength_nm: f64, mu: f64) -> Result<f64, AtmosphereError> {
+        if self.spec.gases {
+            gas_transmittance(
+                wavelength_nm,
+                mu,
+                &self.spec.gas_amounts,
+                self.spec.pressure_hpa,
+            )
+        } else {
+            Ok(1.0)
+        }
+    }
+
+    /// All terms at one wavelength and geometry, by a direct RT solve (what `shoal atmosphere`
+    /// prints; scenes use the LUT).
+    pub fn terms(
+        &self,
+        wavelength_nm: f64,
+        g: &Geometry,
+    ) -> Result<AtmosphereTerms, AtmosphereError> {
+        g.validate()?;
+        let column = self.column(wavelength_nm)?;
+        let (mu0, muv) = (g.sun_zenith_rad.cos(), g.view_zenith_rad.cos());
+        let acc = &self.spec.accuracy;
+        let sun = solve_sun(&column, mu0, &[muv], acc);
+        let up = solve_transmittance(&column, &[muv], acc);
+        let radiance = sun.radiance(0, g.relative_azimuth_rad);
+        let glint = match self.spec.surface {
+            Surface::Flat => 0.0,
+            Surface::Wind { speed_m_s } => {
+                let rho_g = glint_reflectance(
+                    g.sun_zenith_rad,
+                    g.view_zenith_rad,
+                    g.relative_azimuth_rad,
+                    speed_m_s,
+                    column.water_index,
+                );
+                rho_g * mu0 / std::f64::consts::PI * sun.ed_direct / mu0 * up.t_up_direct[0]
+            }
+        };
+        let n = Normalised {
+            wavelength_nm,
+            tau_rayleigh: column.tau_rayleigh,
+            tau_aerosol: column.aerosol.as_ref().map_or(0.0, |a| a.0),
+            mu0,
+            muv,
+            radiance,
+            ed: sun.ed(),
+            t_up: up.t_up[0],
+            t_up_direct: up.t_up_direct[0],
+            spherical_albedo: up.spherical_albedo,
+            glint,
+        };
+        self.assemble(&n)
+    }
+
+    /// Combine normalised RT results with E₀ and gases into physical terms.
+    pub(crate) fn assemble(&self, n: &Normalised) -> Result<AtmosphereTerms, AtmosphereError> {
+        let e0 = self.e0(n.wavelength_nm)?;
+        let (tg0, tgv) = (
+            self.gas(n.wavelength_nm, n.mu0)?,
+            self.gas(n.wavelength_nm, n.muv)?,
+        );
+        let t_gas = tg0 * tgv;
+        let l_path = n.radiance * e0 * t_gas;
+        Ok(AtmosphereTerms {
+            wavelength_nm: n.wavelength_nm,
+            e0_w_m2_nm: e0,
+            tau_rayleigh: n.tau_rayleigh,
+            tau_aerosol: n.tau_aerosol,
+            l_path_w_m2_sr_nm: l_path,
+            rho_path: std::f64::consts::PI * l_path / (e0 * n.mu0),
+            t_down: n.ed / n.mu0 * tg0,
+            t_up: n.t_up * tgv,
+            t_up_direct: n.t_up_direct * tgv,
+            spherical_albedo: n.spherical_albedo,
+            ed_0plus_w_m2_nm: n.ed * e0 * tg0,
+            t_gas,
+            l_glint_w_m2_sr_nm: n.glint * e0 * t_gas,
+        })
+    }
+}

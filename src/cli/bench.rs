@@ -1,0 +1,214 @@
+//! `shoal bench`: what Shoal's physics costs in time and what it buys in accuracy, side by side
+//! with the reference codes' figures measured on this machine class (SAMBUCA Python forward
+//! model: 13–23 thousand evaluations/s at 451 bands on one core; OSOAA: 1–3.5 s per wavelength
+//! and geometry).
+
+use std::time::{Duration, Instant};
+
+use clap::Args;
+
+use super::CliError;
+use crate::atmosphere::{AerosolType, AtmosphereLut, AtmosphereSpec, LutAxes, RtAccuracy};
+use crate::spectral::{BandSet, BandSetSpec, WavelengthGrid};
+use crate::validation::{Comparison, compare_paths, compare_water_runs};
+use crate::water::{
+    Bottom, SiopSpec, SubstrateLibrary, SubstrateMix, WaterColumn, WaterGeometry, WaterModel,
+};
+
+/// Flags of `shoal bench`.
+#[derive(Debug, Args)]
+pub struct BenchArgs {
+    /// Fewer repetitions (a smoke run; figures are noisier).
+    #[arg(long)]
+    pub quick: bool,
+}
+
+fn machine() -> String {
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split(':').nth(1))
+                .map(|s| s.trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown CPU".into());
+    let threads = std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get);
+    format!(
+        "{cpu}, {threads} logical cores, rayon pool {} threads",
+        rayon::current_num_threads()
+    )
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// Median rate (calls per second) of `f` over `reps` repetitions of about `each`.
+fn rate(reps: usize, each: Duration, mut f: impl FnMut(usize)) -> f64 {
+    let samples = (0..reps)
+        .map(|_| {
+            let start = Instant::now();
+            let mut n = 0;
+            while start.elapsed() < each {
+                for _ in 0..100 {
+                    f(n);
+                    n += 1;
+                }
+            }
+            n as f64 / start.elapsed().as_secs_f64()
+        })
+        .collect();
+    median(samples)
+}
+
+fn water_rows(quick: bool) -> Result<(), CliError> {
+    // SAMBUCA's benchmark configuration: 350–800 nm at 1 nm (451 bands), its default SIOPs.
+    let grid = WavelengthGrid::uniform(350.0, 800.0, 1.0)?;
+    let model = WaterModel::new(SiopSpec::sambuca_default().resolve(&grid, None)?);
+    let rb = SubstrateLibrary::embedded()?.mix_on_grid(
+        &SubstrateMix::parse("ncc_sand:0.5,brown_acropora:0.5")?,
+        &grid,
+    )?;
+    let geo = WaterGeometry::from_degrees(30.0, 0.0);
+    let mut out = vec![0.0; grid.len()];
+    let (reps, each) = if quick {
+        (3, Duration::from_millis(100))
+    } else {
+        (7, Duration::from_millis(400))
+    };
+    let mut sink = 0.0;
+    let column = |n: usize, bottom| WaterColumn {
+        chl_mg_m3: 1.0 + (n % 7) as f64 * 0.1,
+        cdom_per_m: 0.05,
+        nap_g_m3: 2.0,
+        bottom,
+    };
+    let shallow = |n: usize| Bottom::Shallow {
+        depth_m: 5.0 + (n % 5) as f64,
+        reflectance: &rb,
+    };
+    let fast_shallow = rate(reps, each, |n| {
+        let _ = model.rrs_above_into(&column(n, shallow(n)), &geo, &mut out);
+        sink += out[100];
+    });
+    let fast_deep = rate(reps, each, |n| {
+        let _ = model.rrs_above_into(&column(n, Bottom::OpticallyDeep), &geo, &mut out);
+        sink += out[100];
+    });
+    let full = rate(reps, each, |n| {
+        if let Ok(r) = model.evaluate(&column(n, shallow(n)), &geo) {
+            sink += r.rrs[100];
+        }
+    });
+    std::hint::black_box(sink);
+    println!("## Water model (Lee 1998/1999), 451 bands, one thread");
+    println!();
+    println!("| evaluation | evaluations/s | × SAMBUCA Python (13–23 k/s) |");
+    println!("|---|---|---|");
+    for (label, r) in [
+        ("shallow, Rrs only (per-pixel path)", fast_shallow),
+        ("optically deep, Rrs only", fast_deep),
+        ("shallow, every intermediate", full),
+    ] {
+        println!(
+            "| {label} | {:.0} | {:.0}–{:.0} |",
+            r,
+            r / 23_000.0,
+            r / 13_000.0
+        );
+    }
+    println!();
+    Ok(())
+}
+
+fn max_abs(c: &[Comparison], keep: impl Fn(&Comparison) -> bool) -> f64 {
+    c.iter()
+        .filter(|x| keep(x))
+        .map(|x| x.error_pct().abs())
+        .fold(0.0, f64::max)
+}
+
+fn atmosphere_rows(quick: bool) -> Result<(), CliError> {
+    let olci = BandSet::from_spec(&BandSetSpec::parse_cli("olci")?)?;
+    let axes = LutAxes::covering(olci.centres_nm(), (55.0, 65.0), 40.0, (5.0, 5.0, 10.0));
+    let nodes = axes.wavelengths_nm.len() * axes.sun_zenith_deg.len();
+    println!(
+        "## Atmosphere LUT, 19 OLCI bands (Lake Hume scene: continental AOT 0.1, sun 55–65°, view 0–40°)"
+    );
+    println!();
+    println!(
+        "LUT nodes: {} wavelengths × {} sun × {} view × {} azimuth; OSOAA would need {nodes} runs × 1–3.5 s = {}–{} s.",
+        axes.wavelengths_nm.len(),
+        axes.sun_zenith_deg.len(),
+        axes.view_zenith_deg.len(),
+        axes.relative_azimuth_deg.len(),
+        nodes,
+        (nodes as f64 * 3.5).round()
+    );
+    println!(
+        "Errors are max |Shoal/OSOAA − 1| over the reference rows (OSOAA's Rayleigh depth, relative azimuth 90°)."
+    );
+    println!();
+    println!(
+        "| accuracy | LUT build (median) | × faster than OSOAA | ρ_path Rayleigh | ρ_path aerosol | t_down | Ed(0+) coupled | T_up Heron | T_up Hume |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|");
+    for preset in ["single", "fast", "default", "high"] {
+        let acc =
+            RtAccuracy::preset(preset).ok_or_else(|| CliError::Run(format!("preset {preset}")))?;
+        let atm = AtmosphereSpec {
+            aerosol: AerosolType::Continental,
+            aot550: 0.1,
+            accuracy: acc,
+            ..Default::default()
+        }
+        .build()?;
+        let reps = if quick { 1 } else { 5 };
+        let times: Vec<f64> = (0..reps)
+            .map(|_| {
+                let start = Instant::now();
+                let lut = AtmosphereLut::build(&atm, axes.clone());
+                std::hint::black_box(&lut);
+                start.elapsed().as_secs_f64()
+            })
+            .collect();
+        let t = median(times);
+        let paths = compare_paths(&acc)?;
+        let water = compare_water_runs(&acc)?;
+        let aerosol = |c: &Comparison| c.aerosol != AerosolType::None;
+        println!(
+            "| {preset} | {:.3} s | {:.0}–{:.0} | {:.2} % | {:.2} % | {:.2} % | {:.2} % | {:.2} % | {:.2} % |",
+            t,
+            nodes as f64 / t,
+            nodes as f64 * 3.5 / t,
+            max_abs(&paths, |c| c.quantity == "rho_path" && !aerosol(c)),
+            max_abs(&paths, |c| c.quantity == "rho_path" && aerosol(c)),
+            max_abs(&paths, |c| c.quantity == "t_down"),
+            max_abs(&water, |c| c.quantity == "ed_0plus"),
+            max_abs(&water, |c| c.quantity == "t_up"
+                && c.case.starts_with("heron")
+                && c.lw_fraction.unwrap_or(0.0) > 0.1),
+            max_abs(&water, |c| c.quantity == "t_up"
+                && c.case.starts_with("hume")
+                && c.lw_fraction.unwrap_or(0.0) > 0.1),
+        );
+    }
+    println!();
+    println!(
+        "T_up columns use rows where the water-leaving radiance is above 10 % of the TOA radiance (OSOAA's T_up_eff is a difference of two large numbers otherwise). Hume's T_up_eff includes the bidirectional shape of that turbid water's radiance at 60° sun, which Shoal's Lambertian water-leaving radiance does not have: see README."
+    );
+    Ok(())
+}
+
+/// Run `shoal bench`.
+pub fn run(args: &BenchArgs) -> Result<(), CliError> {
+    println!("# shoal bench");
+    println!();
+    println!("Machine: {}", machine());
+    println!();
+    water_rows(args.quick)?;
+    atmosphere_rows(args.quick)?;
+    Ok(())
+}

@@ -1,0 +1,73 @@
+//! Writing results: CSV to standard output or, atomically, to a file.
+
+use std::io::Write;
+use std::path::Path;
+
+use super::CliError;
+
+/// Write `text` to `path` (write a temporary file beside it, then rename, so that a failure
+/// never leaves a half-written file) or to standard output.
+pub fn emit(text: &str, path: Option<&Path>) -> Result<(), CliError> {
+    match path {
+        None => {
+            let mut out = std::io::stdout().lock();
+            out.write_all(text.as_bytes())
+                .map_err(|e| CliError::Run(format!("writing to standard output: {e}")))
+        }
+        Some(p) => {
+            let tmp = p.with_extension(format!(
+                "{}.tmp",
+                p.extension().and_then(|e| e.to_str()).unwrap_or("")
+            ));
+            let fail =
+                |e: std::io::Error| CliError::Run(format!("cannot write {}: {e}", p.display()));
+            std::fs::write(&tmp, text).map_err(fail)?;
+            std::fs::rename(&tmp, p).map_err(|e| {
+                let _ = std::fs::remove_file(&tmp);
+                fail(e)
+            })
+        }
+    }
+}
+
+/// A CSV table built row by row; every value must be finite (NaN never reaches the output).
+pub struct Csv {
+    header: Vec<String>,
+    rows: Vec<Vec<String>>,
+}
+
+impl Csv {
+    /// A table with these column names.
+    pub fn new(header: Vec<String>) -> Self {
+        Self {
+            header,
+            rows: Vec::new(),
+        }
+    }
+
+    /// Add a row: a leading label (may be empty to omit) and numbers.
+    pub fn row(&mut self, label: Option<&str>, values: &[f64]) -> Result<(), CliError> {
+        if let Some((i, v)) = values.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+            let offset = usize::from(label.is_some());
+            return Err(CliError::Run(format!(
+                "internal error: column `{}` is {v} (please report this with the command line)",
+                self.header.get(i + offset).map_or("?", String::as_str)
+            )));
+        }
+        let mut cells: Vec<String> = label.map(str::to_string).into_iter().collect();
+        cells.extend(values.iter().map(|v| format!("{v}")));
+        self.rows.push(cells);
+        Ok(())
+    }
+
+    /// The CSV text.
+    pub fn render(&self) -> String {
+        let mut s = self.header.join(",");
+        s.push('\n');
+        for r in &self.rows {
+            s.push_str(&r.join(","));
+            s.push('\n');
+        }
+        s
+    }
+}
