@@ -58,8 +58,7 @@ macro_rules! embed_presets {
 }
 
 /// Built-in presets (RON files under `presets/`), embedded so that names resolve anywhere.
-pub const PRESETS: &[Asset] =
-    embed_presets!["siop/heron_island.ron", "siop/cyanobacteria_reservoir.ron",];
+pub const PRESETS: &[Asset] = embed_presets!["siop/heron_island.ron", "siop/cyanobacteria_reservoir.ron",];
 
 /// The built-in preset at `path` (relative to `presets/`), if there is one.
 #[must_use]

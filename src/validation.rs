@@ -14,8 +14,8 @@
 //! - T_up against OSOAA's T_up_eff = (L_toa − L_path)/Lw of the water runs.
 
 use crate::atmosphere::{
-    AIR_DEPOLARIZATION, AerosolType, AtmosphereError, RayleighDepth, RtAccuracy, WavelengthColumn,
-    mixture_optics, solve_sun, solve_transmittance,
+    AIR_DEPOLARIZATION, AerosolType, AtmosphereError, RayleighDepth, RtAccuracy, WavelengthColumn, mixture_optics,
+    solve_sun, solve_transmittance,
 };
 use crate::spectral::Table;
 
@@ -52,13 +52,8 @@ impl Comparison {
     }
 }
 
-fn column(
-    wavelength_nm: f64,
-    tau_rayleigh: f64,
-    aerosol: AerosolType,
-) -> Result<WavelengthColumn, AtmosphereError> {
-    let aerosol =
-        mixture_optics(aerosol, wavelength_nm)?.map(|o| (0.1 * o.extinction_ratio, o.ssa, o.phase));
+fn column(wavelength_nm: f64, tau_rayleigh: f64, aerosol: AerosolType) -> Result<WavelengthColumn, AtmosphereError> {
+    let aerosol = mixture_optics(aerosol, wavelength_nm)?.map(|o| (0.1 * o.extinction_ratio, o.ssa, o.phase));
     Ok(WavelengthColumn {
         wavelength_nm,
         tau_rayleigh,
@@ -77,24 +72,14 @@ fn parse_aerosol(text: &str) -> Result<AerosolType, AtmosphereError> {
 /// Compare path reflectance and t_down with the black-ocean OSOAA rows (relative azimuth 90°).
 pub fn compare_paths(acc: &RtAccuracy) -> Result<Vec<Comparison>, AtmosphereError> {
     let t = Table::parse(PATH_COMPARE_CSV, "path_compare.csv")?;
-    let (wl, sza, vza) = (
-        t.column_f64("wl_nm")?,
-        t.column_f64("sza")?,
-        t.column_f64("vza")?,
-    );
+    let (wl, sza, vza) = (t.column_f64("wl_nm")?, t.column_f64("sza")?, t.column_f64("vza")?);
     let aer = t.column_str("aer")?;
-    let (tau_r, rho, t_down) = (
-        t.column_f64("tau_ray_osoaa")?,
-        t.column_f64("rho_osoaa_vec_flat")?,
-        t.column_f64("t_down_osoaa_flat")?,
-    );
+    let (tau_r, rho, t_down) =
+        (t.column_f64("tau_ray_osoaa")?, t.column_f64("rho_osoaa_vec_flat")?, t.column_f64("t_down_osoaa_flat")?);
     let mut out = Vec::new();
     for i in 0..t.len() {
         let kind = parse_aerosol(aer[i])?;
-        debug_assert!(
-            (RayleighDepth::OsoaaHansenTravis.tau(wl[i], &Default::default()) - tau_r[i]).abs()
-                < 1e-5
-        );
+        debug_assert!((RayleighDepth::OsoaaHansenTravis.tau(wl[i], &Default::default()) - tau_r[i]).abs() < 1e-5);
         let c = column(wl[i], tau_r[i], kind)?;
         let (mu0, muv) = (sza[i].to_radians().cos(), vza[i].to_radians().cos());
         let s = solve_sun(&c, mu0, &[muv], acc);
@@ -125,23 +110,11 @@ pub fn compare_paths(acc: &RtAccuracy) -> Result<Vec<Comparison>, AtmosphereErro
 /// Compare T_up, coupled Ed(0⁺) and path radiance with the OSOAA water runs (vector, flat).
 pub fn compare_water_runs(acc: &RtAccuracy) -> Result<Vec<Comparison>, AtmosphereError> {
     let t = Table::parse(WATER_REF_CSV, "water_ref.csv")?;
-    let (scenario, rt, wind) = (
-        t.column_str("scenario")?,
-        t.column_str("rt")?,
-        t.column_f64("wind")?,
-    );
-    let (wl, sza, vza, phi) = (
-        t.column_f64("wl_nm")?,
-        t.column_f64("sza")?,
-        t.column_f64("vza")?,
-        t.column_f64("phi")?,
-    );
+    let (scenario, rt, wind) = (t.column_str("scenario")?, t.column_str("rt")?, t.column_f64("wind")?);
+    let (wl, sza, vza, phi) =
+        (t.column_f64("wl_nm")?, t.column_f64("sza")?, t.column_f64("vza")?, t.column_f64("phi")?);
     let aer = t.column_str("aer")?;
-    let (tau_r, e0, rrs) = (
-        t.column_f64("tau_ray")?,
-        t.column_f64("E0")?,
-        t.column_f64("Rrs")?,
-    );
+    let (tau_r, e0, rrs) = (t.column_f64("tau_ray")?, t.column_f64("E0")?, t.column_f64("Rrs")?);
     let (t_up, ed, l_path, lw, l_toa) = (
         t.column_f64("T_up_eff")?,
         t.column_f64("Ed_0p")?,
@@ -160,11 +133,9 @@ pub fn compare_water_runs(acc: &RtAccuracy) -> Result<Vec<Comparison>, Atmospher
         let fraction = Some(lw[i] / l_toa[i]);
         let coupled = s.ed() * e0[i] / (1.0 - up.spherical_albedo * std::f64::consts::PI * rrs[i]);
         let l_path_shoal = s.radiance(0, phi[i].to_radians()) * e0[i];
-        for (quantity, shoal, osoaa) in [
-            ("t_up", up.t_up[0], t_up[i]),
-            ("ed_0plus", coupled, ed[i]),
-            ("l_path", l_path_shoal, l_path[i]),
-        ] {
+        for (quantity, shoal, osoaa) in
+            [("t_up", up.t_up[0], t_up[i]), ("ed_0plus", coupled, ed[i]), ("l_path", l_path_shoal, l_path[i])]
+        {
             out.push(Comparison {
                 case: case.clone(),
                 quantity,

@@ -64,23 +64,12 @@ pub struct ComponentOptics {
 
 /// Compute one component's optics at `wavelength_nm` with the Mie code (slow for dust-like).
 #[must_use]
-pub fn compute_component(
-    component: Component,
-    wavelength_nm: f64,
-    grid: SizeGrid,
-) -> ComponentOptics {
-    let mu: Vec<f64> = table_angles_deg()
-        .iter()
-        .map(|a| a.to_radians().cos())
-        .collect();
+pub fn compute_component(component: Component, wavelength_nm: f64, grid: SizeGrid) -> ComponentOptics {
+    let mu: Vec<f64> = table_angles_deg().iter().map(|a| a.to_radians().cos()).collect();
     let w_um = wavelength_nm * 1e-3;
     let m: Complex = component.refractive_index(w_um);
     let bulk = integrate_lognormal(&component.distribution(), w_um, m, &mu, grid);
-    ComponentOptics {
-        c_ext_um2: bulk.c_ext_um2,
-        c_sca_um2: bulk.c_sca_um2,
-        p11: bulk.p11,
-    }
+    ComponentOptics { c_ext_um2: bulk.c_ext_um2, c_sca_um2: bulk.c_sca_um2, p11: bulk.p11 }
 }
 
 /// Write the whole component table as CSV (what `shoal dev aerosol-table` prints).
@@ -88,22 +77,14 @@ pub fn compute_component(
 pub fn component_table_csv() -> String {
     use rayon::prelude::*;
     let angles = table_angles_deg();
-    let jobs: Vec<(Component, f64)> = Component::ALL
-        .iter()
-        .flat_map(|c| TABLE_WAVELENGTHS_NM.iter().map(move |w| (*c, *w)))
-        .collect();
+    let jobs: Vec<(Component, f64)> =
+        Component::ALL.iter().flat_map(|c| TABLE_WAVELENGTHS_NM.iter().map(move |w| (*c, *w))).collect();
     let rows: Vec<String> = jobs
         .par_iter()
         .map(|(c, w)| {
             let o = compute_component(*c, *w, SizeGrid::Osoaa);
             let p: Vec<String> = o.p11.iter().map(|v| format!("{v:.6e}")).collect();
-            format!(
-                "{},{w},{:.8e},{:.8e},{}",
-                c.key(),
-                o.c_ext_um2,
-                o.c_sca_um2,
-                p.join(",")
-            )
+            format!("{},{w},{:.8e},{:.8e},{}", c.key(), o.c_ext_um2, o.c_sca_um2, p.join(","))
         })
         .collect();
     let mut out = String::new();
@@ -136,10 +117,7 @@ impl ComponentTable {
     /// The embedded table, parsed once.
     pub fn embedded() -> Result<&'static Self, AtmosphereError> {
         static TABLE: OnceLock<Result<ComponentTable, AtmosphereError>> = OnceLock::new();
-        TABLE
-            .get_or_init(|| Self::parse(&Table::from_asset(TABLE_ASSET)?))
-            .as_ref()
-            .map_err(Clone::clone)
+        TABLE.get_or_init(|| Self::parse(&Table::from_asset(TABLE_ASSET)?)).as_ref().map_err(Clone::clone)
     }
 
     fn parse(t: &Table) -> Result<Self, AtmosphereError> {
@@ -148,22 +126,15 @@ impl ComponentTable {
         let wl = t.column_f64("wavelength_nm")?;
         let ext = t.column_f64("c_ext_um2")?;
         let sca = t.column_f64("c_sca_um2")?;
-        let p: Vec<Vec<f64>> = angles_deg
-            .iter()
-            .map(|a| t.column_f64(&format!("p11_{a}")))
-            .collect::<Result<_, _>>()?;
+        let p: Vec<Vec<f64>> =
+            angles_deg.iter().map(|a| t.column_f64(&format!("p11_{a}"))).collect::<Result<_, _>>()?;
         let mut rows = Vec::new();
         for c in Component::ALL {
             let mut optics = Vec::new();
             for w in TABLE_WAVELENGTHS_NM {
                 let i = (0..t.len())
                     .find(|&i| keys[i] == c.key() && (wl[i] - w).abs() < 1e-9)
-                    .ok_or_else(|| {
-                        AtmosphereError::Data(format!(
-                            "{TABLE_ASSET}: no row for {} at {w} nm",
-                            c.key()
-                        ))
-                    })?;
+                    .ok_or_else(|| AtmosphereError::Data(format!("{TABLE_ASSET}: no row for {} at {w} nm", c.key())))?;
                 optics.push(ComponentOptics {
                     c_ext_um2: ext[i],
                     c_sca_um2: sca[i],
@@ -176,15 +147,8 @@ impl ComponentTable {
     }
 
     /// A component's optics at `wavelength_nm` (325–1025 nm), interpolated.
-    pub fn component_at(
-        &self,
-        c: Component,
-        wavelength_nm: f64,
-    ) -> Result<ComponentOptics, AtmosphereError> {
-        let (lo, hi) = (
-            TABLE_WAVELENGTHS_NM[0],
-            TABLE_WAVELENGTHS_NM[TABLE_WAVELENGTHS_NM.len() - 1],
-        );
+    pub fn component_at(&self, c: Component, wavelength_nm: f64) -> Result<ComponentOptics, AtmosphereError> {
+        let (lo, hi) = (TABLE_WAVELENGTHS_NM[0], TABLE_WAVELENGTHS_NM[TABLE_WAVELENGTHS_NM.len() - 1]);
         if !(lo..=hi).contains(&wavelength_nm) {
             return Err(AtmosphereError::OutOfRange {
                 field: "wavelength_nm (aerosol)".into(),
@@ -192,15 +156,8 @@ impl ComponentTable {
                 allowed: format!("{lo} to {hi} nm"),
             });
         }
-        let rows = &self
-            .rows
-            .iter()
-            .find(|(k, _)| *k == c)
-            .ok_or_else(|| AtmosphereError::Data("component".into()))?
-            .1;
-        let j = TABLE_WAVELENGTHS_NM
-            .partition_point(|&w| w <= wavelength_nm)
-            .clamp(1, TABLE_WAVELENGTHS_NM.len() - 1);
+        let rows = &self.rows.iter().find(|(k, _)| *k == c).ok_or_else(|| AtmosphereError::Data("component".into()))?.1;
+        let j = TABLE_WAVELENGTHS_NM.partition_point(|&w| w <= wavelength_nm).clamp(1, TABLE_WAVELENGTHS_NM.len() - 1);
         let (w0, w1) = (TABLE_WAVELENGTHS_NM[j - 1], TABLE_WAVELENGTHS_NM[j]);
         let (a, b) = (&rows[j - 1], &rows[j]);
         let t_log = (wavelength_nm / w0).ln() / (w1 / w0).ln();
@@ -209,12 +166,7 @@ impl ComponentTable {
         Ok(ComponentOptics {
             c_ext_um2: loglog(a.c_ext_um2, b.c_ext_um2),
             c_sca_um2: loglog(a.c_sca_um2, b.c_sca_um2),
-            p11: a
-                .p11
-                .iter()
-                .zip(&b.p11)
-                .map(|(x, y)| x + t * (y - x))
-                .collect(),
+            p11: a.p11.iter().zip(&b.p11).map(|(x, y)| x + t * (y - x)).collect(),
         })
     }
 
@@ -237,19 +189,14 @@ pub struct AerosolOptics {
 }
 
 /// Optics of `kind` at `wavelength_nm`; `None` for the aerosol-free atmosphere.
-pub fn mixture_optics(
-    kind: AerosolType,
-    wavelength_nm: f64,
-) -> Result<Option<AerosolOptics>, AtmosphereError> {
+pub fn mixture_optics(kind: AerosolType, wavelength_nm: f64) -> Result<Option<AerosolOptics>, AtmosphereError> {
     if kind == AerosolType::None {
         return Ok(None);
     }
     let table = ComponentTable::embedded()?;
     let mix = kind.number_fractions();
     let k_ext = |w: f64| -> Result<f64, AtmosphereError> {
-        mix.iter()
-            .map(|(c, n)| Ok(n * table.component_at(*c, w)?.c_ext_um2))
-            .sum()
+        mix.iter().map(|(c, n)| Ok(n * table.component_at(*c, w)?.c_ext_um2)).sum()
     };
     let (mut k_sca, mut p) = (0.0, vec![0.0; table.angles_deg().len()]);
     for (c, n) in &mix {

@@ -55,9 +55,6 @@ mod tests {
         let mu_b = n.atan().cos();
         let (rl, rr) = amplitudes(mu_b, n);
         assert!(rl.abs() < 1e-12 && rr.abs() > 0.1);
-        assert!(
-            (fresnel_reflectance(1e-9, n) - 1.0).abs() < 1e-6,
-            "grazing incidence reflects all"
-        );
+        assert!((fresnel_reflectance(1e-9, n) - 1.0).abs() < 1e-6, "grazing incidence reflects all");
     }
 }

@@ -30,6 +30,7 @@ const ASSET: &str = "atmosphere/atmosphere_gas_absorption_wasi6.csv";
 
 /// Column amounts of the absorbing gases.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct GasAmounts {
     /// Total ozone, atm-cm (0.3 atm-cm = 300 DU).
     pub ozone_atm_cm: f64,
@@ -39,10 +40,7 @@ pub struct GasAmounts {
 
 impl Default for GasAmounts {
     fn default() -> Self {
-        Self {
-            ozone_atm_cm: 0.3,
-            water_vapour_cm: 2.0,
-        }
+        Self { ozone_atm_cm: 0.3, water_vapour_cm: 2.0 }
     }
 }
 
@@ -104,10 +102,7 @@ mod tests {
         let t_560 = transmittance(560.0, 1.0, &g, 1013.25).unwrap();
         let t_443 = transmittance(443.0, 1.0, &g, 1013.25).unwrap();
         assert!(t_760 < 0.6, "O2 A band: {t_760}");
-        assert!(
-            t_560 > 0.95 && t_560 < 0.99,
-            "Chappuis ozone at 560 nm: {t_560}"
-        );
+        assert!(t_560 > 0.95 && t_560 < 0.99, "Chappuis ozone at 560 nm: {t_560}");
         assert!(t_443 > 0.99, "{t_443}");
         assert!((air_mass(1.0) - 1.0).abs() < 1e-3);
     }

@@ -51,6 +51,5 @@ pub fn glint_reflectance(
     let tan2 = (1.0 - cos_beta * cos_beta) / (cos_beta * cos_beta);
     let p = (-tan2 / sigma2).exp() / (std::f64::consts::PI * sigma2);
     let (mu0, muv) = (s[2], v[2]);
-    std::f64::consts::PI * fresnel_reflectance(cos_omega, n) * p
-        / (4.0 * mu0 * muv * cos_beta.powi(4))
+    std::f64::consts::PI * fresnel_reflectance(cos_omega, n) * p / (4.0 * mu0 * muv * cos_beta.powi(4))
 }

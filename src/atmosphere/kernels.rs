@@ -29,42 +29,21 @@ const FOUR_PI: f64 = 4.0 * std::f64::consts::PI;
 /// terms: f = β_{n}/(2n+1), β′ₗ = (βₗ − (2l+1) f)/(1 − f). Returns (β′₀..β′_{n−1}, f).
 #[must_use]
 pub fn delta_m(beta: &[f64], n_terms: usize) -> (Vec<f64>, f64) {
-    let f = beta
-        .get(n_terms)
-        .map_or(0.0, |b| b / (2 * n_terms + 1) as f64)
-        .max(0.0);
-    let scaled = (0..n_terms.min(beta.len()))
-        .map(|l| (beta[l] - (2 * l + 1) as f64 * f) / (1.0 - f))
-        .collect();
+    let f = beta.get(n_terms).map_or(0.0, |b| b / (2 * n_terms + 1) as f64).max(0.0);
+    let scaled = (0..n_terms.min(beta.len())).map(|l| (beta[l] - (2 * l + 1) as f64 * f) / (1.0 - f)).collect();
     (scaled, f)
 }
 
 /// Scalar kernel of Fourier term `m` for Legendre coefficients `beta` (already truncated).
 #[must_use]
-pub fn scalar_kernel(
-    streams: &Streams,
-    beta: &[f64],
-    m: usize,
-    mu0: f64,
-    water_index: f64,
-) -> Kernel<1> {
+pub fn scalar_kernel(streams: &Streams, beta: &[f64], m: usize, mu0: f64, water_index: f64) -> Kernel<1> {
     let l_max = beta.len().saturating_sub(1);
     let nd = streams.n_dirs();
     let nq = 2 * streams.n();
-    let lam = |mu: f64| -> Vec<f64> {
-        if l_max >= m {
-            normalized_legendre(m, l_max, mu)
-        } else {
-            Vec::new()
-        }
-    };
+    let lam = |mu: f64| -> Vec<f64> { if l_max >= m { normalized_legendre(m, l_max, mu) } else { Vec::new() } };
     let dirs: Vec<Vec<f64>> = (0..nd).map(|d| lam(streams.signed_mu(d))).collect();
     let p = |a: &[f64], b: &[f64]| -> f64 {
-        a.iter()
-            .zip(b)
-            .zip(&beta[m.min(beta.len())..])
-            .map(|((x, y), bl)| bl * x * y)
-            .sum()
+        a.iter().zip(b).zip(&beta[m.min(beta.len())..]).map(|((x, y), bl)| bl * x * y).sum()
     };
     let sun = lam(mu0);
     let sun_up = lam(-mu0);
@@ -79,9 +58,7 @@ pub fn scalar_kernel(
     Kernel {
         quad,
         sun: (0..nd).map(|i| [p(&dirs[i], &sun) / FOUR_PI]).collect(),
-        sun_reflected: (0..nd)
-            .map(|i| [r0 * p(&dirs[i], &sun_up) / FOUR_PI])
-            .collect(),
+        sun_reflected: (0..nd).map(|i| [r0 * p(&dirs[i], &sun_up) / FOUR_PI]).collect(),
     }
 }
 
@@ -92,11 +69,7 @@ fn dot(a: Vec3, b: Vec3) -> f64 {
 }
 
 fn cross(a: Vec3, b: Vec3) -> Vec3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 }
 
 /// Propagation vector (z up) for signed cosine μ (positive downward) and azimuth φ, with its
@@ -136,24 +109,12 @@ fn rayleigh_z(mu_out: f64, mu_in: f64, delta: f64, depolarization: f64) -> [[f64
     let f22 = 0.75 * d * (1.0 + cos_t * cos_t);
     let f33 = 1.5 * d * cos_t;
     // F·L(ψ_in): L = [[1,0,0],[0,c,s],[0,-s,c]]
-    let fl = [
-        [f11, f12 * c2i, f12 * s2i],
-        [f12, f22 * c2i, f22 * s2i],
-        [0.0, -f33 * s2i, f33 * c2i],
-    ];
+    let fl = [[f11, f12 * c2i, f12 * s2i], [f12, f22 * c2i, f22 * s2i], [0.0, -f33 * s2i, f33 * c2i]];
     // L(ψ_out)·(F·L)
     [
         fl[0],
-        [
-            c2o * fl[1][0] + s2o * fl[2][0],
-            c2o * fl[1][1] + s2o * fl[2][1],
-            c2o * fl[1][2] + s2o * fl[2][2],
-        ],
-        [
-            -s2o * fl[1][0] + c2o * fl[2][0],
-            -s2o * fl[1][1] + c2o * fl[2][1],
-            -s2o * fl[1][2] + c2o * fl[2][2],
-        ],
+        [c2o * fl[1][0] + s2o * fl[2][0], c2o * fl[1][1] + s2o * fl[2][1], c2o * fl[1][2] + s2o * fl[2][2]],
+        [-s2o * fl[1][0] + c2o * fl[2][0], -s2o * fl[1][1] + c2o * fl[2][1], -s2o * fl[1][2] + c2o * fl[2][2]],
     ]
 }
 
@@ -188,20 +149,11 @@ fn rayleigh_fourier(mu_out: f64, mu_in: f64, depolarization: f64) -> [[[f64; 3];
 
 /// Vector Rayleigh kernels for m = 0, 1, 2.
 #[must_use]
-pub fn vector_rayleigh_kernels(
-    streams: &Streams,
-    depolarization: f64,
-    mu0: f64,
-    water_index: f64,
-) -> Vec<Kernel<3>> {
+pub fn vector_rayleigh_kernels(streams: &Streams, depolarization: f64, mu0: f64, water_index: f64) -> Vec<Kernel<3>> {
     let nd = streams.n_dirs();
     let nq = 2 * streams.n();
     let mut kernels: Vec<Kernel<3>> = (0..3)
-        .map(|_| Kernel {
-            quad: Vec::with_capacity(nd * nq),
-            sun: Vec::new(),
-            sun_reflected: Vec::new(),
-        })
+        .map(|_| Kernel { quad: Vec::with_capacity(nd * nq), sun: Vec::new(), sun_reflected: Vec::new() })
         .collect();
     for i in 0..nd {
         let mu_i = streams.signed_mu(i);
@@ -228,9 +180,7 @@ pub fn vector_rayleigh_kernels(
         for m in 0..3 {
             let col = |k: &[[f64; 3]; 3], c: usize| [k[0][c], k[1][c], k[2][c]];
             let d0 = col(&direct[m], 0);
-            kernels[m]
-                .sun
-                .push([d0[0] * norm, d0[1] * norm, d0[2] * norm]);
+            kernels[m].sun.push([d0[0] * norm, d0[1] * norm, d0[2] * norm]);
             let (a, b) = (col(&reflected[m], 0), col(&reflected[m], 1));
             kernels[m].sun_reflected.push([
                 (a[0] * r[0][0] + b[0] * r[1][0]) * norm,
@@ -253,38 +203,20 @@ mod tests {
         // polarised), which vanishes at normal incidence where r_ℓ² = r_r²: compare there.
         let streams = Streams::new(4, vec![1.0, 0.8]);
         let rho = 0.0279;
-        let beta = super::super::phase::PhaseFunction::Rayleigh {
-            depolarization: rho,
-        }
-        .moments(2);
+        let beta = super::super::phase::PhaseFunction::Rayleigh { depolarization: rho }.moments(2);
         for mu0 in [0.6, 1.0] {
             let vk = vector_rayleigh_kernels(&streams, rho, mu0, 1.34);
             for m in 0..3 {
                 let sk = scalar_kernel(&streams, &beta, m, mu0, 1.34);
                 for (a, b) in vk[m].quad.iter().zip(&sk.quad) {
-                    assert!(
-                        (a[0][0] - b[0][0]).abs() < 1e-12,
-                        "m={m}: {} vs {}",
-                        a[0][0],
-                        b[0][0]
-                    );
+                    assert!((a[0][0] - b[0][0]).abs() < 1e-12, "m={m}: {} vs {}", a[0][0], b[0][0]);
                 }
                 for (a, b) in vk[m].sun.iter().zip(&sk.sun) {
-                    assert!(
-                        (a[0] - b[0]).abs() < 1e-12,
-                        "m={m}: sun {} vs {}",
-                        a[0],
-                        b[0]
-                    );
+                    assert!((a[0] - b[0]).abs() < 1e-12, "m={m}: sun {} vs {}", a[0], b[0]);
                 }
                 if mu0 == 1.0 {
                     for (a, b) in vk[m].sun_reflected.iter().zip(&sk.sun_reflected) {
-                        assert!(
-                            (a[0] - b[0]).abs() < 1e-12,
-                            "m={m}: reflected {} vs {}",
-                            a[0],
-                            b[0]
-                        );
+                        assert!((a[0] - b[0]).abs() < 1e-12, "m={m}: reflected {} vs {}", a[0], b[0]);
                     }
                 }
             }

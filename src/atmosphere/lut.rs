@@ -1,22 +1,28 @@
 //! The atmosphere look-up table: built once per scene over wavelength, sun zenith, view zenith
 //! and relative azimuth, then interpolated per pixel.
 //!
-//! One SOS solve per (wavelength, sun zenith) node gives the path radiance at every view-zenith
-//! node and, through its Fourier series, every azimuth; one transmittance solve per wavelength
-//! gives T_up at every view-zenith node and the spherical albedo. The table stores normalised
-//! (unit solar flux, gas-free) quantities; E₀ and gas transmittances are applied on evaluation.
-//! Interpolation is multilinear in the angles (degrees); the error it adds is measured by
-//! `shoal bench` against direct solves.
+//! One SOS solve per (wavelength, sun zenith) node gives, at every view-zenith node, the Fourier
+//! coefficients of the multiple-scattered path radiance and the single-scattering coefficients;
+//! one transmittance solve per wavelength gives T_up at every view-zenith node and the spherical
+//! albedo. The table stores these normalised (unit solar flux, gas-free) quantities; E₀ and gas
+//! transmittances are applied on evaluation.
+//!
+//! Only smooth quantities are interpolated, bilinearly in the zenith angles: the Fourier
+//! coefficients (azimuth enters through their exact cosine series) and the single-scattering
+//! attenuation integrals; the phase functions are evaluated at the exact scattering angles. So
+//! there is no interpolation in azimuth, where aerosol forward peaks make the radiance steep.
 
 use rayon::prelude::*;
 
 use super::AtmosphereError;
 use super::glint::glint_reflectance;
-use super::rt::{solve_sun, solve_transmittance};
+use super::rt::{Scatterers, SsCoefficients, fourier_sum, solve_sun, solve_transmittance};
 use super::spec::{Atmosphere, AtmosphereTerms, Geometry, Normalised, Surface};
 
-/// Node positions of the table.
+/// Node positions of the table (the azimuth axis sets where `shoal bench` and tests probe; the
+/// table itself is exact in azimuth).
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct LutAxes {
     /// Wavelengths, nm (band centres or a coarse grid).
     pub wavelengths_nm: Vec<f64>,
@@ -32,20 +38,13 @@ impl LutAxes {
     /// Axes that cover sun zenith `sza_range` and view zenith up to `max_vza` (degrees), with
     /// nodes every `sza_step`, `vza_step` and `raz_step` degrees.
     #[must_use]
-    pub fn covering(
-        wavelengths_nm: Vec<f64>,
-        sza_range: (f64, f64),
-        max_vza: f64,
-        steps: (f64, f64, f64),
-    ) -> Self {
+    pub fn covering(wavelengths_nm: Vec<f64>, sza_range: (f64, f64), max_vza: f64, steps: (f64, f64, f64)) -> Self {
         let nodes = |lo: f64, hi: f64, step: f64| -> Vec<f64> {
             if hi - lo < 1e-9 {
                 return vec![lo];
             }
             let n = ((hi - lo) / step).ceil().max(1.0) as usize;
-            (0..=n)
-                .map(|i| lo + (hi - lo) * i as f64 / n as f64)
-                .collect()
+            (0..=n).map(|i| lo + (hi - lo) * i as f64 / n as f64).collect()
         };
         Self {
             wavelengths_nm,
@@ -57,10 +56,7 @@ impl LutAxes {
 
     fn validate(&self) -> Result<(), AtmosphereError> {
         let check = |name: &str, v: &[f64], lo: f64, hi: f64| {
-            if v.is_empty()
-                || v.windows(2).any(|w| w[1] <= w[0])
-                || v.iter().any(|x| !(lo..=hi).contains(x))
-            {
+            if v.is_empty() || v.windows(2).any(|w| w[1] <= w[0]) || v.iter().any(|x| !(lo..=hi).contains(x)) {
                 return Err(AtmosphereError::OutOfRange {
                     field: format!("LUT axis {name}"),
                     value: v.first().copied().unwrap_or(f64::NAN),
@@ -72,21 +68,20 @@ impl LutAxes {
         check("wavelengths_nm", &self.wavelengths_nm, 325.0, 1025.0)?;
         check("sun_zenith_deg", &self.sun_zenith_deg, 0.0, 89.0)?;
         check("view_zenith_deg", &self.view_zenith_deg, 0.0, 85.0)?;
-        check(
-            "relative_azimuth_deg",
-            &self.relative_azimuth_deg,
-            0.0,
-            180.0,
-        )
+        check("relative_azimuth_deg", &self.relative_azimuth_deg, 0.0, 180.0)
     }
 }
 
-/// The table. Index order: [wavelength][sun][view][azimuth].
+/// The table. Index order: [wavelength][sun][view].
 #[derive(Debug, Clone)]
 pub struct AtmosphereLut {
     axes: LutAxes,
     atmosphere: Atmosphere,
-    radiance: Vec<f64>,
+    /// Multiple-scattering Fourier coefficients, zero-padded to `n_fourier` per node.
+    ms: Vec<f64>,
+    n_fourier: usize,
+    ss: Vec<SsCoefficients>,
+    scatterers: Vec<Scatterers>,
     ed: Vec<f64>,
     t_up: Vec<f64>,
     spherical_albedo: Vec<f64>,
@@ -112,50 +107,29 @@ impl AtmosphereLut {
     pub fn build(atmosphere: &Atmosphere, axes: LutAxes) -> Result<Self, AtmosphereError> {
         axes.validate()?;
         let acc = atmosphere.spec().accuracy;
-        let columns = axes
-            .wavelengths_nm
-            .iter()
-            .map(|&w| atmosphere.column(w))
-            .collect::<Result<Vec<_>, _>>()?;
-        let view_mu: Vec<f64> = axes
-            .view_zenith_deg
-            .iter()
-            .map(|v| v.to_radians().cos())
-            .collect();
-        let (nw, ns, nv, na) = (
-            axes.wavelengths_nm.len(),
-            axes.sun_zenith_deg.len(),
-            axes.view_zenith_deg.len(),
-            axes.relative_azimuth_deg.len(),
-        );
-        let jobs: Vec<(usize, usize)> =
-            (0..nw).flat_map(|w| (0..ns).map(move |s| (w, s))).collect();
+        let columns = axes.wavelengths_nm.iter().map(|&w| atmosphere.column(w)).collect::<Result<Vec<_>, _>>()?;
+        let view_mu: Vec<f64> = axes.view_zenith_deg.iter().map(|v| v.to_radians().cos()).collect();
+        let (nw, ns, nv) = (axes.wavelengths_nm.len(), axes.sun_zenith_deg.len(), axes.view_zenith_deg.len());
+        let jobs: Vec<(usize, usize)> = (0..nw).flat_map(|w| (0..ns).map(move |s| (w, s))).collect();
         let sun: Vec<_> = jobs
             .par_iter()
-            .map(|&(w, s)| {
-                solve_sun(
-                    &columns[w],
-                    axes.sun_zenith_deg[s].to_radians().cos(),
-                    &view_mu,
-                    &acc,
-                )
-            })
+            .map(|&(w, s)| solve_sun(&columns[w], axes.sun_zenith_deg[s].to_radians().cos(), &view_mu, &acc))
             .collect();
-        let up: Vec<_> = columns
-            .par_iter()
-            .map(|c| solve_transmittance(c, &view_mu, &acc))
-            .collect();
-        let mut radiance = vec![0.0; nw * ns * nv * na];
+        let up: Vec<_> = columns.par_iter().map(|c| solve_transmittance(c, &view_mu, &acc)).collect();
+        let n_fourier = sun.iter().flat_map(|s| s.ms_fourier.iter().map(Vec::len)).max().unwrap_or(1);
+        let mut ms = vec![0.0; nw * ns * nv * n_fourier];
+        let mut ss = vec![SsCoefficients::default(); nw * ns * nv];
         let mut ed = vec![0.0; nw * ns];
         for (job, sol) in jobs.iter().zip(&sun) {
             let (w, s) = *job;
             ed[w * ns + s] = sol.ed();
             for v in 0..nv {
-                for (a, raz) in axes.relative_azimuth_deg.iter().enumerate() {
-                    radiance[((w * ns + s) * nv + v) * na + a] = sol.radiance(v, raz.to_radians());
-                }
+                let node = (w * ns + s) * nv + v;
+                ms[node * n_fourier..node * n_fourier + sol.ms_fourier[v].len()].copy_from_slice(&sol.ms_fourier[v]);
+                ss[node] = sol.ss[v];
             }
         }
+        let scatterers = (0..nw).map(|w| sun[w * ns].scatterers.clone()).collect();
         let t_up = up.iter().flat_map(|t| t.t_up.iter().copied()).collect();
         let spherical_albedo = up.iter().map(|t| t.spherical_albedo).collect();
         Ok(Self {
@@ -163,7 +137,10 @@ impl AtmosphereLut {
             tau_rayleigh: columns.iter().map(|c| c.tau_rayleigh).collect(),
             axes,
             atmosphere: atmosphere.clone(),
-            radiance,
+            ms,
+            n_fourier,
+            ss,
+            scatterers,
             ed,
             t_up,
             spherical_albedo,
@@ -180,39 +157,37 @@ impl AtmosphereLut {
     pub fn terms(&self, w: usize, g: &Geometry) -> Result<AtmosphereTerms, AtmosphereError> {
         g.validate()?;
         let a = &self.axes;
-        let (ns, nv, na) = (
-            a.sun_zenith_deg.len(),
-            a.view_zenith_deg.len(),
-            a.relative_azimuth_deg.len(),
-        );
-        let mut raz = g.relative_azimuth_rad.to_degrees().abs() % 360.0;
-        if raz > 180.0 {
-            raz = 360.0 - raz;
-        }
+        let (ns, nv, nf) = (a.sun_zenith_deg.len(), a.view_zenith_deg.len(), self.n_fourier);
         let (s0, s1, ts) = bracket(&a.sun_zenith_deg, g.sun_zenith_rad.to_degrees());
         let (v0, v1, tv) = bracket(&a.view_zenith_deg, g.view_zenith_rad.to_degrees());
-        let (a0, a1, ta) = bracket(&a.relative_azimuth_deg, raz);
-        let at = |s: usize, v: usize, z: usize| self.radiance[((w * ns + s) * nv + v) * na + z];
+        let corners = [
+            (s0, v0, (1.0 - ts) * (1.0 - tv)),
+            (s0, v1, (1.0 - ts) * tv),
+            (s1, v0, ts * (1.0 - tv)),
+            (s1, v1, ts * tv),
+        ];
+        let mut fourier = vec![0.0; nf];
+        for &(s, v, weight) in &corners {
+            let node = (w * ns + s) * nv + v;
+            for (f, c) in fourier.iter_mut().zip(&self.ms[node * nf..(node + 1) * nf]) {
+                *f += weight * c;
+            }
+        }
+        let parts: Vec<(f64, &SsCoefficients)> =
+            corners.iter().map(|&(s, v, weight)| (weight, &self.ss[(w * ns + s) * nv + v])).collect();
+        let ss = SsCoefficients::weighted(&parts);
+        let (mu0, muv) = (g.sun_zenith_rad.cos(), g.view_zenith_rad.cos());
+        let radiance = fourier_sum(&fourier, g.relative_azimuth_rad)
+            + self.scatterers[w].single_scattering(&ss, mu0, muv, g.relative_azimuth_rad);
         let lerp = |x: f64, y: f64, t: f64| x + t * (y - x);
-        let plane = |s: usize| {
-            lerp(
-                lerp(at(s, v0, a0), at(s, v0, a1), ta),
-                lerp(at(s, v1, a0), at(s, v1, a1), ta),
-                tv,
-            )
-        };
-        let radiance = lerp(plane(s0), plane(s1), ts);
         let ed = lerp(self.ed[w * ns + s0], self.ed[w * ns + s1], ts);
         let t_up = lerp(self.t_up[w * nv + v0], self.t_up[w * nv + v1], tv);
-        let (mu0, muv) = (g.sun_zenith_rad.cos(), g.view_zenith_rad.cos());
         // Normalised quantities scale smoothly with μ₀ where the direct beam dominates; the
         // interpolated Ed is rescaled by the exact direct-beam ratio at this sun angle.
         let tau = self.tau_total[w];
         let direct_nodes = lerp(
-            a.sun_zenith_deg[s0].to_radians().cos()
-                * (-tau / a.sun_zenith_deg[s0].to_radians().cos()).exp(),
-            a.sun_zenith_deg[s1].to_radians().cos()
-                * (-tau / a.sun_zenith_deg[s1].to_radians().cos()).exp(),
+            a.sun_zenith_deg[s0].to_radians().cos() * (-tau / a.sun_zenith_deg[s0].to_radians().cos()).exp(),
+            a.sun_zenith_deg[s1].to_radians().cos() * (-tau / a.sun_zenith_deg[s1].to_radians().cos()).exp(),
             ts,
         );
         let ed = ed * (mu0 * (-tau / mu0).exp()) / direct_nodes;

@@ -99,25 +99,13 @@ pub fn mie_sphere(x: f64, m: Complex, mu: &[f64]) -> MieSphere {
     }
     let k = 2.0 / (x * x);
     let q_sca = k * q_sca;
-    let g = if q_sca > 0.0 {
-        2.0 * k * g_sum / q_sca
-    } else {
-        0.0
-    };
+    let g = if q_sca > 0.0 { 2.0 * k * g_sum / q_sca } else { 0.0 };
     MieSphere {
         q_ext: k * q_ext,
         q_sca,
         g,
-        s11: s1
-            .iter()
-            .zip(&s2)
-            .map(|(a, b)| a.norm_sqr() + b.norm_sqr())
-            .collect(),
-        s12: s1
-            .iter()
-            .zip(&s2)
-            .map(|(a, b)| b.norm_sqr() - a.norm_sqr())
-            .collect(),
+        s11: s1.iter().zip(&s2).map(|(a, b)| a.norm_sqr() + b.norm_sqr()).collect(),
+        s12: s1.iter().zip(&s2).map(|(a, b)| b.norm_sqr() - a.norm_sqr()).collect(),
     }
 }
 
@@ -186,8 +174,7 @@ impl SizeGrid {
             }
             Self::Log(per_decade) => {
                 let (lo, hi) = (1e-4f64.ln(), alpha_max.ln());
-                let n =
-                    ((hi - lo) / std::f64::consts::LN_10 * per_decade as f64).ceil() as usize + 1;
+                let n = ((hi - lo) / std::f64::consts::LN_10 * per_decade as f64).ceil() as usize + 1;
                 let h = (hi - lo) / (n - 1) as f64;
                 (0..n)
                     .map(|i| {
@@ -206,13 +193,7 @@ impl SizeGrid {
 /// between α = 10⁻⁴ and the distribution's α_max. Cross-sections are means per particle of the
 /// distribution truncated to that range.
 #[must_use]
-pub fn integrate_lognormal(
-    dist: &LogNormal,
-    wavelength_um: f64,
-    m: Complex,
-    mu: &[f64],
-    grid: SizeGrid,
-) -> BulkOptics {
+pub fn integrate_lognormal(dist: &LogNormal, wavelength_um: f64, m: Complex, mu: &[f64], grid: SizeGrid) -> BulkOptics {
     let k = 2.0 * std::f64::consts::PI / wavelength_um;
     let (mut c_ext, mut c_sca, mut g_acc, mut norm) = (0.0, 0.0, 0.0, 0.0);
     let mut s11 = vec![0.0; mu.len()];
@@ -221,9 +202,7 @@ pub fn integrate_lognormal(
         let r = alpha / k;
         // dN = n(r) dr with n(r) = exp(−½(ln(r/r_m)/σ)²)/(r σ √(2π)) and dr = dα/k.
         let z = (r / dist.mode_radius_um).ln() / dist.ln_sigma;
-        let w = (-0.5 * z * z).exp() / (r * dist.ln_sigma * (2.0 * std::f64::consts::PI).sqrt())
-            * d_alpha
-            / k;
+        let w = (-0.5 * z * z).exp() / (r * dist.ln_sigma * (2.0 * std::f64::consts::PI).sqrt()) * d_alpha / k;
         if w < 1e-300 {
             continue;
         }
@@ -240,18 +219,9 @@ pub fn integrate_lognormal(
         }
     }
     let (c_ext, c_sca) = (c_ext / norm, c_sca / norm);
-    let p11: Vec<f64> = s11
-        .iter()
-        .map(|s| 4.0 * std::f64::consts::PI * s / norm / c_sca)
-        .collect();
+    let p11: Vec<f64> = s11.iter().map(|s| 4.0 * std::f64::consts::PI * s / norm / c_sca).collect();
     let dolp = s12.iter().zip(&s11).map(|(a, b)| -a / b).collect();
-    BulkOptics {
-        c_ext_um2: c_ext,
-        c_sca_um2: c_sca,
-        g: g_acc / norm / c_sca,
-        p11,
-        dolp,
-    }
+    BulkOptics { c_ext_um2: c_ext, c_sca_um2: c_sca, g: g_acc / norm / c_sca, p11, dolp }
 }
 
 #[cfg(test)]
@@ -280,18 +250,11 @@ mod tests {
         let m2 = m * m;
         let lorentz = ((m2 - Complex::new(1.0, 0.0)) / (m2 + Complex::new(2.0, 0.0))).norm_sqr();
         let expected = 8.0 / 3.0 * x.powi(4) * lorentz;
-        assert!(
-            (s.q_sca / expected - 1.0).abs() < 1e-3,
-            "{} vs {expected}",
-            s.q_sca
-        );
+        assert!((s.q_sca / expected - 1.0).abs() < 1e-3, "{} vs {expected}", s.q_sca);
         assert!(s.g.abs() < 1e-3);
         let p_fwd = 2.0 * s.s11[0] / (s.q_sca * x * x);
         let p_90 = 2.0 * s.s11[1] / (s.q_sca * x * x);
-        assert!(
-            (p_fwd - 1.5).abs() < 2e-3 && (p_90 - 0.75).abs() < 2e-3,
-            "{p_fwd} {p_90}"
-        );
+        assert!((p_fwd - 1.5).abs() < 2e-3 && (p_90 - 0.75).abs() < 2e-3, "{p_fwd} {p_90}");
     }
 
     #[test]
@@ -302,10 +265,6 @@ mod tests {
         let s = mie_sphere(x, Complex::new(1.53, 0.008), &[]);
         assert!(s.q_ext > s.q_sca && s.q_sca > 0.0);
         let asymptote = 2.0 + 1.9923 * x.powf(-2.0 / 3.0);
-        assert!(
-            (s.q_ext - asymptote).abs() < 2e-3,
-            "{} vs {asymptote}",
-            s.q_ext
-        );
+        assert!((s.q_ext - asymptote).abs() < 2e-3, "{} vs {asymptote}", s.q_ext);
     }
 }

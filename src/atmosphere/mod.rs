@@ -35,8 +35,8 @@ mod spec;
 mod wmo;
 
 pub use aerosol::{
-    AerosolOptics, ComponentOptics, ComponentTable, TABLE_ASSET, TABLE_WAVELENGTHS_NM,
-    component_table_csv, compute_component, mixture_optics, table_angles_deg,
+    AerosolOptics, ComponentOptics, ComponentTable, TABLE_ASSET, TABLE_WAVELENGTHS_NM, component_table_csv,
+    compute_component, mixture_optics, table_angles_deg,
 };
 pub use complex::Complex;
 pub use fresnel::{SEA_REFRACTIVE_INDEX, fresnel_matrix, fresnel_reflectance};
@@ -48,11 +48,10 @@ pub use mie::{BulkOptics, LogNormal, MieSphere, SizeGrid, integrate_lognormal, m
 pub use phase::{PhaseFunction, rayleigh_beta2};
 pub use profile::{AltitudeQuadrature, ColumnOptics, Layering};
 pub use quadrature::{gauss_half, gauss_legendre, legendre_polynomials, normalized_legendre};
-pub use rayleigh::{
-    AIR_DEPOLARIZATION, RayleighColumn, RayleighDepth, STANDARD_PRESSURE_HPA, bodhaine_tau,
-};
+pub use rayleigh::{AIR_DEPOLARIZATION, RayleighColumn, RayleighDepth, STANDARD_PRESSURE_HPA, bodhaine_tau};
 pub use rt::{
-    RtAccuracy, SunSolution, Transmittance, WavelengthColumn, solve_sun, solve_transmittance,
+    RtAccuracy, Scatterers, SsCoefficients, SunSolution, Transmittance, WavelengthColumn, fourier_sum, solve_sun,
+    solve_transmittance,
 };
 pub use solar::{e0_on_grid, sun_distance_factor, tsis1};
 pub use sos::Streams;

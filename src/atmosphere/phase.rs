@@ -40,8 +40,7 @@ impl PhaseFunction {
             && values.iter().all(|v| v.is_finite() && *v > 0.0);
         if !ok {
             return Err(AtmosphereError::Data(
-                "phase function table: angles must rise from 0 to 180 degrees with positive values"
-                    .into(),
+                "phase function table: angles must rise from 0 to 180 degrees with positive values".into(),
             ));
         }
         let mut p = Self::Tabulated {
@@ -65,14 +64,9 @@ impl PhaseFunction {
                 let b2 = rayleigh_beta2(*depolarization);
                 1.0 + b2 * 0.5 * (3.0 * cos_theta * cos_theta - 1.0)
             }
-            Self::Tabulated {
-                angles_rad,
-                ln_values,
-            } => {
+            Self::Tabulated { angles_rad, ln_values } => {
                 let theta = cos_theta.clamp(-1.0, 1.0).acos();
-                let j = angles_rad
-                    .partition_point(|&a| a <= theta)
-                    .clamp(1, angles_rad.len() - 1);
+                let j = angles_rad.partition_point(|&a| a <= theta).clamp(1, angles_rad.len() - 1);
                 let t = (theta - angles_rad[j - 1]) / (angles_rad[j] - angles_rad[j - 1]);
                 (ln_values[j - 1] + t * (ln_values[j] - ln_values[j - 1])).exp()
             }
@@ -107,10 +101,7 @@ impl PhaseFunction {
                         }
                     }
                 }
-                beta.iter()
-                    .enumerate()
-                    .map(|(l, v)| (2 * l + 1) as f64 / 2.0 * v)
-                    .collect()
+                beta.iter().enumerate().map(|(l, v)| (2 * l + 1) as f64 / 2.0 * v).collect()
             }
         }
     }
@@ -137,29 +128,15 @@ mod tests {
     fn tabulated_rayleigh_reproduces_analytic_moments() {
         // On the aerosol table's 2° spacing, ln-linear interpolation of a smooth phase function
         // errs by ~(Δθ)²/8·|d²lnP/dθ²| ≈ 1e-4; the moments inherit that.
-        let r = PhaseFunction::Rayleigh {
-            depolarization: 0.0279,
-        };
+        let r = PhaseFunction::Rayleigh { depolarization: 0.0279 };
         let angles: Vec<f64> = (0..=90).map(|i| 2.0 * f64::from(i)).collect();
-        let values: Vec<f64> = angles
-            .iter()
-            .map(|a: &f64| r.value(a.to_radians().cos()))
-            .collect();
+        let values: Vec<f64> = angles.iter().map(|a: &f64| r.value(a.to_radians().cos())).collect();
         let t = PhaseFunction::from_table(&angles, &values).unwrap();
         let (bt, br) = (t.moments(6), r.moments(6));
         for l in 0..=6 {
-            assert!(
-                (bt[l] - br[l]).abs() < 5e-4,
-                "l={l}: {} vs {}",
-                bt[l],
-                br[l]
-            );
+            assert!((bt[l] - br[l]).abs() < 5e-4, "l={l}: {} vs {}", bt[l], br[l]);
         }
         // OSOAA: β₂ = A/2, A = 2(1−δ)/(2+δ) with δ = 0.0279 → 0.479363.
-        assert!(
-            (br[2] - 0.479_363).abs() < 1e-6,
-            "OSOAA's β₂ for air: {}",
-            br[2]
-        );
+        assert!((br[2] - 0.479_363).abs() < 1e-6, "OSOAA's β₂ for air: {}", br[2]);
     }
 }

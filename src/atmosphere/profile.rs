@@ -33,10 +33,8 @@ pub struct ColumnOptics {
 
 impl ColumnOptics {
     fn densities(&self, z_km: f64) -> (f64, f64) {
-        let e_r = self.tau_rayleigh / self.rayleigh_scale_height_km
-            * (-z_km / self.rayleigh_scale_height_km).exp();
-        let e_a = self.tau_aerosol / self.aerosol_scale_height_km
-            * (-z_km / self.aerosol_scale_height_km).exp();
+        let e_r = self.tau_rayleigh / self.rayleigh_scale_height_km * (-z_km / self.rayleigh_scale_height_km).exp();
+        let e_a = self.tau_aerosol / self.aerosol_scale_height_km * (-z_km / self.aerosol_scale_height_km).exp();
         (e_r, e_a)
     }
 
@@ -84,17 +82,9 @@ impl Layering {
             let ext = e_r + factor * e_a;
             tau.push(target);
             omega.push(if ext > 0.0 { (e_r + scat_a) / ext } else { 1.0 });
-            frac.push(if e_r + scat_a > 0.0 {
-                e_r / (e_r + scat_a)
-            } else {
-                1.0
-            });
+            frac.push(if e_r + scat_a > 0.0 { e_r / (e_r + scat_a) } else { 1.0 });
         }
-        Self {
-            tau,
-            omega,
-            rayleigh_fraction: frac,
-        }
+        Self { tau, omega, rayleigh_fraction: frac }
     }
 
     /// Number of layers K.
@@ -159,12 +149,7 @@ impl AltitudeQuadrature {
                 d_a.push(e_a * w * 0.5 * (b - a));
             }
         }
-        Self {
-            tau,
-            d_tau_rayleigh: d_r,
-            d_tau_aerosol: d_a,
-            total: column.tau_above(0.0, 1.0),
-        }
+        Self { tau, d_tau_rayleigh: d_r, d_tau_aerosol: d_a, total: column.tau_above(0.0, 1.0) }
     }
 
     /// (∫ e^{−m τ} dτ_R, ∫ e^{−m τ} dτ_a) over the column.
@@ -200,10 +185,7 @@ mod tests {
         let c = column();
         let q = AltitudeQuadrature::new(&c);
         let (r, a) = q.attenuated(0.0);
-        assert!(
-            (r - 0.35).abs() < 1e-9 && (a - 0.14).abs() < 1e-9,
-            "{r} {a}"
-        );
+        assert!((r - 0.35).abs() < 1e-9 && (a - 0.14).abs() < 1e-9, "{r} {a}");
         // ∫ e^{−mτ} dτ over the whole column = (1 − e^{−mτ*})/m when both share one profile.
         let mut same = c;
         same.aerosol_scale_height_km = 8.0;

@@ -54,10 +54,7 @@ pub fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
 #[must_use]
 pub fn gauss_half(n: usize) -> (Vec<f64>, Vec<f64>) {
     let (x, w) = gauss_legendre(n);
-    (
-        x.iter().map(|x| 0.5 * (x + 1.0)).collect(),
-        w.iter().map(|w| 0.5 * w).collect(),
-    )
+    (x.iter().map(|x| 0.5 * (x + 1.0)).collect(), w.iter().map(|w| 0.5 * w).collect())
 }
 
 /// Normalised associated Legendre functions Λₗᵐ(μ) for l = m..=l_max (index l − m), with

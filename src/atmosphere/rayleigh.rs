@@ -35,6 +35,7 @@ pub enum RayleighDepth {
 
 /// Site parameters of the Rayleigh column.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct RayleighColumn {
     /// Surface pressure, hPa.
     pub pressure_hpa: f64,
@@ -48,12 +49,7 @@ pub struct RayleighColumn {
 
 impl Default for RayleighColumn {
     fn default() -> Self {
-        Self {
-            pressure_hpa: STANDARD_PRESSURE_HPA,
-            latitude_deg: 45.0,
-            altitude_m: 0.0,
-            co2_ppm: 360.0,
-        }
+        Self { pressure_hpa: STANDARD_PRESSURE_HPA, latitude_deg: 45.0, altitude_m: 0.0, co2_ppm: 360.0 }
     }
 }
 
@@ -72,9 +68,7 @@ impl RayleighDepth {
             Self::Bodhaine => bodhaine_tau(wavelength_nm, column),
             Self::OsoaaHansenTravis => {
                 let l = wavelength_nm * 1e-3;
-                column.pressure_hpa / 1013.0
-                    * 1e-4
-                    * (84.35 / l.powi(4) - 1.225 / l.powi(5) + 1.4 / l.powi(6))
+                column.pressure_hpa / 1013.0 * 1e-4 * (84.35 / l.powi(4) - 1.225 / l.powi(5) + 1.4 / l.powi(6))
             }
         }
     }
@@ -93,8 +87,7 @@ pub fn bodhaine_tau(wavelength_nm: f64, c: &RayleighColumn) -> f64 {
     let f_n2 = 1.034 + 3.17e-4 * l2;
     let f_o2 = 1.096 + 1.385e-3 * l2 + 1.448e-4 * l2 * l2;
     let co2_pct = c.co2_ppm * 1e-4;
-    let f_air = (78.084 * f_n2 + 20.946 * f_o2 + 0.934 + co2_pct * 1.15)
-        / (78.084 + 20.946 + 0.934 + co2_pct);
+    let f_air = (78.084 * f_n2 + 20.946 * f_o2 + 0.934 + co2_pct * 1.15) / (78.084 + 20.946 + 0.934 + co2_pct);
     // Cross-section per molecule, cm² (λ in cm, Ns = 2.546899e19 cm⁻³).
     let l_cm = wavelength_nm * 1e-7;
     let ns = 2.546_899e19;

@@ -38,6 +38,7 @@ use super::sos::{Drive, Kernel, OrderSettings, Streams, solve};
 
 /// Accuracy settings of the radiative transfer: each costs time (see `shoal bench`).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 #[serde(default)]
 pub struct RtAccuracy {
     /// Gauss streams per hemisphere (2–48).
@@ -76,11 +77,7 @@ impl RtAccuracy {
     pub fn preset(name: &str) -> Option<Self> {
         let d = Self::default();
         match name {
-            "single" => Some(Self {
-                max_orders: 1,
-                polarization_correction: false,
-                ..d
-            }),
+            "single" => Some(Self { max_orders: 1, polarization_correction: false, ..d }),
             "fast" => Some(Self {
                 streams: 6,
                 fourier_terms: 12,
@@ -105,11 +102,7 @@ impl RtAccuracy {
     /// Check ranges; the message names the field and the allowed range.
     pub fn validate(&self) -> Result<(), super::AtmosphereError> {
         let bad = |field: &str, value: f64, allowed: &str| {
-            Err(super::AtmosphereError::OutOfRange {
-                field: field.into(),
-                value,
-                allowed: allowed.into(),
-            })
+            Err(super::AtmosphereError::OutOfRange { field: field.into(), value, allowed: allowed.into() })
         };
         if !(2..=48).contains(&self.streams) {
             return bad("streams", self.streams as f64, "2 to 48");
@@ -121,30 +114,19 @@ impl RtAccuracy {
             return bad("fourier_terms", self.fourier_terms as f64, "1 to 96");
         }
         if !(self.max_layer_depth > 0.0 && self.max_layer_depth <= 1.0) {
-            return bad(
-                "max_layer_depth",
-                self.max_layer_depth,
-                "above 0, at most 1",
-            );
+            return bad("max_layer_depth", self.max_layer_depth, "above 0, at most 1");
         }
         if !(1..=500).contains(&self.min_layers) {
             return bad("min_layers", self.min_layers as f64, "1 to 500");
         }
         if !(self.order_tolerance > 0.0 && self.order_tolerance < 0.1) {
-            return bad(
-                "order_tolerance",
-                self.order_tolerance,
-                "above 0, below 0.1",
-            );
+            return bad("order_tolerance", self.order_tolerance, "above 0, below 0.1");
         }
         Ok(())
     }
 
     fn orders(&self) -> OrderSettings {
-        OrderSettings {
-            max_orders: self.max_orders,
-            tolerance: self.order_tolerance,
-        }
+        OrderSettings { max_orders: self.max_orders, tolerance: self.order_tolerance }
     }
 }
 
@@ -169,10 +151,7 @@ pub struct WavelengthColumn {
 
 impl WavelengthColumn {
     fn optics(&self) -> ColumnOptics {
-        let (tau_a, ssa) = self
-            .aerosol
-            .as_ref()
-            .map_or((0.0, 1.0), |(t, w, _)| (*t, *w));
+        let (tau_a, ssa) = self.aerosol.as_ref().map_or((0.0, 1.0), |(t, w, _)| (*t, *w));
         ColumnOptics {
             tau_rayleigh: self.tau_rayleigh,
             tau_aerosol: tau_a,
@@ -183,10 +162,7 @@ impl WavelengthColumn {
     }
 
     fn rayleigh_only(&self) -> Self {
-        Self {
-            aerosol: None,
-            ..self.clone()
-        }
+        Self { aerosol: None, ..self.clone() }
     }
 
     /// Layering and truncated aerosol moments for `n` streams: (layering, β′ or None).
@@ -195,15 +171,9 @@ impl WavelengthColumn {
         match &self.aerosol {
             Some((_, _, phase)) => {
                 let (beta, f) = delta_m(&phase.moments(n_terms), n_terms);
-                (
-                    Layering::new(&self.optics(), f, acc.max_layer_depth, acc.min_layers),
-                    Some(beta),
-                )
+                (Layering::new(&self.optics(), f, acc.max_layer_depth, acc.min_layers), Some(beta))
             }
-            None => (
-                Layering::new(&self.optics(), 0.0, acc.max_layer_depth, acc.min_layers),
-                None,
-            ),
+            None => (Layering::new(&self.optics(), 0.0, acc.max_layer_depth, acc.min_layers), None),
         }
     }
 
@@ -214,11 +184,65 @@ impl WavelengthColumn {
     }
 }
 
-/// Exact single-scattering ingredients for one view cosine: per path p,
-/// (factor F_p, ∫e^{−m_p τ}dτ_R, ∫e^{−m_p τ}dτ_a).
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct SsPaths {
-    paths: [(f64, f64, f64); 4],
+/// Exact single-scattering ingredients for one (sun, view) pair: for each of the four paths
+/// over the Fresnel surface (sun→view; sun→down→surface→view; sun→surface→up→view;
+/// sun→surface→down→surface→view), F_p·∫e^{−m_p τ}dτ_R and F_p·∫e^{−m_p τ}dτ_a. They vary smoothly
+/// with the zenith angles and not at all with azimuth, so a LUT interpolates them and evaluates
+/// the phase functions at the exact scattering angles.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct SsCoefficients(pub [[f64; 2]; 4]);
+
+impl SsCoefficients {
+    /// Σ wᵢ cᵢ, for interpolation.
+    #[must_use]
+    pub fn weighted(parts: &[(f64, &Self)]) -> Self {
+        let mut out = [[0.0; 2]; 4];
+        for (w, c) in parts {
+            for (o, v) in out.iter_mut().zip(&c.0) {
+                o[0] += w * v[0];
+                o[1] += w * v[1];
+            }
+        }
+        Self(out)
+    }
+}
+
+/// The column's two scatterers, for single-scattering evaluations.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Scatterers {
+    /// Molecular phase function.
+    pub rayleigh: PhaseFunction,
+    /// Aerosol single-scattering albedo and phase function, if any.
+    pub aerosol: Option<(f64, PhaseFunction)>,
+}
+
+impl Scatterers {
+    /// Single-scattered TOA radiance (unit solar flux) from coefficients `c` at sun/view cosines
+    /// μ₀, μ_v and relative azimuth Δφ: (1/(4πμ_v)) Σ_p [P_R(Θ_p) c_p,R + ω_a P_a(Θ_p) c_p,a],
+    /// with cos Θ = ∓μ₀μ_v − sinθ₀ sinθ_v cos Δφ (− for paths that change hemisphere).
+    #[must_use]
+    pub fn single_scattering(&self, c: &SsCoefficients, mu0: f64, muv: f64, relative_azimuth_rad: f64) -> f64 {
+        let (s0, sv) = ((1.0 - mu0 * mu0).max(0.0).sqrt(), (1.0 - muv * muv).max(0.0).sqrt());
+        let horizontal = s0 * sv * relative_azimuth_rad.cos();
+        let cos_opposite = -mu0 * muv - horizontal;
+        let cos_same = mu0 * muv - horizontal;
+        let mut total = 0.0;
+        for (k, [c_r, c_a]) in c.0.iter().enumerate() {
+            let cos_t = if k == 0 || k == 3 { cos_opposite } else { cos_same };
+            total += self.rayleigh.value(cos_t) * c_r;
+            if let Some((ssa, phase)) = &self.aerosol {
+                total += ssa * phase.value(cos_t) * c_a;
+            }
+        }
+        total / (4.0 * std::f64::consts::PI * muv)
+    }
+}
+
+/// Σₘ (2 − δₘ₀) cₘ cos mψ with ψ = π − Δφ (azimuth of travel relative to the solar beam).
+#[must_use]
+pub fn fourier_sum(coefficients: &[f64], relative_azimuth_rad: f64) -> f64 {
+    let psi = std::f64::consts::PI - relative_azimuth_rad;
+    coefficients.iter().enumerate().map(|(m, c)| if m == 0 { *c } else { 2.0 * c * (m as f64 * psi).cos() }).sum()
 }
 
 /// Path radiance and irradiance for one sun position over a set of view cosines.
@@ -231,9 +255,10 @@ pub struct SunSolution {
     /// Fourier coefficients of the multiple-scattered TOA radiance, [view][m] (polarisation
     /// correction included), normalised to a unit solar flux.
     pub ms_fourier: Vec<Vec<f64>>,
-    ss: Vec<SsPaths>,
-    rayleigh_phase: PhaseFunction,
-    aerosol_phase: Option<(f64, PhaseFunction)>,
+    /// Single-scattering coefficients per view.
+    pub ss: Vec<SsCoefficients>,
+    /// The scatterers (for single scattering at any angle).
+    pub scatterers: Scatterers,
     /// Direct downwelling irradiance at 0⁺ per unit solar flux, μ₀ e^{−τ/μ₀} (unscaled τ).
     pub ed_direct: f64,
     /// Diffuse downwelling irradiance at 0⁺ per unit solar flux (Fresnel surface, black water).
@@ -247,48 +272,13 @@ impl SunSolution {
     /// radians; 0 puts the sensor on the sun's side).
     #[must_use]
     pub fn radiance(&self, i: usize, relative_azimuth_rad: f64) -> f64 {
-        let psi = std::f64::consts::PI - relative_azimuth_rad;
-        let ms: f64 = self.ms_fourier[i]
-            .iter()
-            .enumerate()
-            .map(|(m, c)| {
-                if m == 0 {
-                    *c
-                } else {
-                    2.0 * c * (m as f64 * psi).cos()
-                }
-            })
-            .sum();
-        ms + self.single_scattering(i, relative_azimuth_rad)
+        fourier_sum(&self.ms_fourier[i], relative_azimuth_rad) + self.single_scattering(i, relative_azimuth_rad)
     }
 
     /// The exact single-scattered part of [`Self::radiance`].
     #[must_use]
     pub fn single_scattering(&self, i: usize, relative_azimuth_rad: f64) -> f64 {
-        let (mu0, muv) = (self.mu0, self.user_mu[i]);
-        let (s0, sv) = (
-            (1.0 - mu0 * mu0).max(0.0).sqrt(),
-            (1.0 - muv * muv).max(0.0).sqrt(),
-        );
-        let horizontal = s0 * sv * relative_azimuth_rad.cos();
-        // Θ for paths a, d (in/out in opposite hemispheres) and b, c (same hemisphere).
-        let cos_opposite = -mu0 * muv - horizontal;
-        let cos_same = mu0 * muv - horizontal;
-        let p = &self.ss[i].paths;
-        let mut total = 0.0;
-        for (k, (factor, a_r, a_a)) in p.iter().enumerate() {
-            let c = if k == 0 || k == 3 {
-                cos_opposite
-            } else {
-                cos_same
-            };
-            let mut v = self.rayleigh_phase.value(c) * a_r;
-            if let Some((ssa, phase)) = &self.aerosol_phase {
-                v += ssa * phase.value(c) * a_a;
-            }
-            total += factor * v;
-        }
-        total / (4.0 * std::f64::consts::PI * muv)
+        self.scatterers.single_scattering(&self.ss[i], self.mu0, self.user_mu[i], relative_azimuth_rad)
     }
 
     /// Total Ed(0⁺) per unit solar flux.
@@ -308,22 +298,18 @@ fn fresnel_blocks3(mus: &[f64], n: f64) -> Vec<[[f64; 3]; 3]> {
 
 /// Solve the solar problem for sun cosine `mu0` and view cosines `user_mu`.
 #[must_use]
-pub fn solve_sun(
-    column: &WavelengthColumn,
-    mu0: f64,
-    user_mu: &[f64],
-    acc: &RtAccuracy,
-) -> SunSolution {
+pub fn solve_sun(column: &WavelengthColumn, mu0: f64, user_mu: &[f64], acc: &RtAccuracy) -> SunSolution {
     let streams = Streams::new(acc.streams, user_mu.to_vec());
     let (layering, beta_a) = column.scaled(acc);
-    let rayleigh_phase = PhaseFunction::Rayleigh {
-        depolarization: column.depolarization,
-    };
+    let rayleigh_phase = PhaseFunction::Rayleigh { depolarization: column.depolarization };
     let beta_r = rayleigh_phase.moments(2);
     let surf_q = fresnel_blocks(&streams.mu, column.water_index);
     let surf_u = fresnel_blocks(user_mu, column.water_index);
     let nadir_only = user_mu.iter().all(|m| *m > 1.0 - 1e-12);
-    let m_max = if nadir_only {
+    // Only m = 0 is needed when the views are all nadir (higher terms vanish there) or in the
+    // single-scattering mode (the path radiance is then the exact single scattering alone, and
+    // the irradiance needs only m = 0).
+    let m_max = if nadir_only || acc.max_orders == 1 {
         0
     } else if beta_a.is_some() {
         acc.fourier_terms.min(2 * acc.streams) - 1
@@ -334,19 +320,8 @@ pub fn solve_sun(
     let (mut ed_diffuse, mut orders, mut small) = (0.0, 0, 0);
     for m in 0..=m_max {
         let kr = scalar_kernel(&streams, &beta_r, m, mu0, column.water_index);
-        let ka = beta_a
-            .as_ref()
-            .map(|b| scalar_kernel(&streams, b, m, mu0, column.water_index));
-        let f = solve(
-            &streams,
-            &layering,
-            &kr,
-            ka.as_ref(),
-            &surf_q,
-            &surf_u,
-            &Drive::Sun { mu0 },
-            acc.orders(),
-        );
+        let ka = beta_a.as_ref().map(|b| scalar_kernel(&streams, b, m, mu0, column.water_index));
+        let f = solve(&streams, &layering, &kr, ka.as_ref(), &surf_q, &surf_u, &Drive::Sun { mu0 }, acc.orders());
         if m == 0 {
             ed_diffuse = irradiance(&streams, &f.surface_down);
             orders = f.orders;
@@ -374,17 +349,16 @@ pub fn solve_sun(
         ed_diffuse += de;
     }
     let quad = AltitudeQuadrature::new(&column.optics());
-    let ss = user_mu
-        .iter()
-        .map(|&muv| ss_paths(&quad, mu0, muv, column.water_index))
-        .collect();
+    let ss = user_mu.iter().map(|&muv| ss_paths(&quad, mu0, muv, column.water_index)).collect();
     SunSolution {
         mu0,
         user_mu: user_mu.to_vec(),
         ms_fourier,
         ss,
-        rayleigh_phase,
-        aerosol_phase: column.aerosol.as_ref().map(|(_, w, p)| (*w, p.clone())),
+        scatterers: Scatterers {
+            rayleigh: rayleigh_phase,
+            aerosol: column.aerosol.as_ref().map(|(_, w, p)| (*w, p.clone())),
+        },
         ed_direct: mu0 * (-column.total_tau() / mu0).exp(),
         ed_diffuse,
         orders,
@@ -394,35 +368,26 @@ pub fn solve_sun(
 /// Diffuse irradiance 2π Σ wⱼ μⱼ I⁰(μⱼ) from the m = 0 downward radiance.
 fn irradiance<const S: usize>(streams: &Streams, down: &[[f64; S]]) -> f64 {
     2.0 * std::f64::consts::PI
-        * streams
-            .mu
-            .iter()
-            .zip(&streams.weight)
-            .zip(down)
-            .map(|((m, w), v)| m * w * v[0])
-            .sum::<f64>()
+        * streams.mu.iter().zip(&streams.weight).zip(down).map(|((m, w), v)| m * w * v[0]).sum::<f64>()
 }
 
 /// The four single-scattering paths over a Fresnel surface for view cosine μ_v: attenuation
 /// exponents m_p and factors F_p (see the module docs), integrated over the profile.
-fn ss_paths(q: &AltitudeQuadrature, mu0: f64, muv: f64, n: f64) -> SsPaths {
+fn ss_paths(q: &AltitudeQuadrature, mu0: f64, muv: f64, n: f64) -> SsCoefficients {
     let t = q.total;
     let (r0, rv) = (fresnel_reflectance(mu0, n), fresnel_reflectance(muv, n));
     let specs = [
         (1.0, 1.0 / mu0 + 1.0 / muv),
         (rv * (-2.0 * t / muv).exp(), 1.0 / mu0 - 1.0 / muv),
         (r0 * (-2.0 * t / mu0).exp(), 1.0 / muv - 1.0 / mu0),
-        (
-            r0 * rv * (-2.0 * t * (1.0 / mu0 + 1.0 / muv)).exp(),
-            -(1.0 / mu0 + 1.0 / muv),
-        ),
+        (r0 * rv * (-2.0 * t * (1.0 / mu0 + 1.0 / muv)).exp(), -(1.0 / mu0 + 1.0 / muv)),
     ];
-    let mut paths = [(0.0, 0.0, 0.0); 4];
+    let mut paths = [[0.0; 2]; 4];
     for (p, (factor, m)) in paths.iter_mut().zip(specs) {
         let (r, a) = q.attenuated(m);
-        *p = (factor, r, a);
+        *p = [factor * r, factor * a];
     }
-    SsPaths { paths }
+    SsCoefficients(paths)
 }
 
 /// ΔIᵐ (m ≤ 2) at the views and ΔEd from vector minus scalar SOS of the Rayleigh-only column.
@@ -434,20 +399,11 @@ fn polarization_correction(
 ) -> (Vec<Vec<f64>>, f64) {
     let ray = column.rayleigh_only();
     let (layering, _) = ray.scaled(acc);
-    let beta = PhaseFunction::Rayleigh {
-        depolarization: column.depolarization,
-    }
-    .moments(2);
+    let beta = PhaseFunction::Rayleigh { depolarization: column.depolarization }.moments(2);
     let n = column.water_index;
     let vk = vector_rayleigh_kernels(streams, column.depolarization, mu0, n);
-    let (sq, su) = (
-        fresnel_blocks(&streams.mu, n),
-        fresnel_blocks(&streams.user_mu, n),
-    );
-    let (vq, vu) = (
-        fresnel_blocks3(&streams.mu, n),
-        fresnel_blocks3(&streams.user_mu, n),
-    );
+    let (sq, su) = (fresnel_blocks(&streams.mu, n), fresnel_blocks(&streams.user_mu, n));
+    let (vq, vu) = (fresnel_blocks3(&streams.mu, n), fresnel_blocks3(&streams.user_mu, n));
     let nadir_only = streams.user_mu.iter().all(|m| *m > 1.0 - 1e-12);
     let mut delta = vec![Vec::new(); streams.user_mu.len()];
     let mut d_ed = 0.0;
@@ -456,26 +412,8 @@ fn polarization_correction(
             break;
         }
         let ks: Kernel<1> = scalar_kernel(streams, &beta, m, mu0, n);
-        let fs = solve(
-            streams,
-            &layering,
-            &ks,
-            None,
-            &sq,
-            &su,
-            &Drive::Sun { mu0 },
-            acc.orders(),
-        );
-        let fv = solve(
-            streams,
-            &layering,
-            kv,
-            None,
-            &vq,
-            &vu,
-            &Drive::Sun { mu0 },
-            acc.orders(),
-        );
+        let fs = solve(streams, &layering, &ks, None, &sq, &su, &Drive::Sun { mu0 }, acc.orders());
+        let fv = solve(streams, &layering, kv, None, &vq, &vu, &Drive::Sun { mu0 }, acc.orders());
         for (i, d) in delta.iter_mut().enumerate() {
             let vector = fv.toa_user[i][0] + fv.toa_user_first[i][0];
             let scalar = fs.toa_user[i][0] + fs.toa_user_first[i][0];
@@ -503,27 +441,18 @@ pub struct Transmittance {
 
 /// Upward transmittance for `user_mu` and the spherical albedo (m = 0 problems).
 #[must_use]
-pub fn solve_transmittance(
-    column: &WavelengthColumn,
-    user_mu: &[f64],
-    acc: &RtAccuracy,
-) -> Transmittance {
+pub fn solve_transmittance(column: &WavelengthColumn, user_mu: &[f64], acc: &RtAccuracy) -> Transmittance {
     let streams = Streams::new(acc.streams, user_mu.to_vec());
     let (layering, beta_a) = column.scaled(acc);
     let n = column.water_index;
     let kr = scalar_kernel(
         &streams,
-        &PhaseFunction::Rayleigh {
-            depolarization: column.depolarization,
-        }
-        .moments(2),
+        &PhaseFunction::Rayleigh { depolarization: column.depolarization }.moments(2),
         0,
         0.5,
         n,
     );
-    let ka = beta_a
-        .as_ref()
-        .map(|b| scalar_kernel(&streams, b, 0, 0.5, n));
+    let ka = beta_a.as_ref().map(|b| scalar_kernel(&streams, b, 0, 0.5, n));
     let shape = |mu: f64| 1.0 - fresnel_reflectance(mu, n);
     let tau_scaled = layering.total();
     // Water-leaving radiance over the Fresnel surface.
@@ -549,28 +478,13 @@ pub fn solve_transmittance(
     // Isotropic unit source over a black surface: the fraction returned down is S.
     let black_q = vec![[[0.0]]; streams.n()];
     let black_u = vec![[[0.0]]; user_mu.len()];
-    let iso = Drive::Bottom {
-        quad: vec![[1.0]; streams.n()],
-        user: vec![[1.0]; user_mu.len()],
-    };
-    let g = solve(
-        &streams,
-        &layering,
-        &kr,
-        ka.as_ref(),
-        &black_q,
-        &black_u,
-        &iso,
-        acc.orders(),
-    );
+    let iso = Drive::Bottom { quad: vec![[1.0]; streams.n()], user: vec![[1.0]; user_mu.len()] };
+    let g = solve(&streams, &layering, &kr, ka.as_ref(), &black_q, &black_u, &iso, acc.orders());
     let spherical_albedo = irradiance(&streams, &g.surface_down) / std::f64::consts::PI;
     Transmittance {
         user_mu: user_mu.to_vec(),
         t_up,
-        t_up_direct: user_mu
-            .iter()
-            .map(|&mu| (-column.total_tau() / mu).exp())
-            .collect(),
+        t_up_direct: user_mu.iter().map(|&mu| (-column.total_tau() / mu).exp()).collect(),
         spherical_albedo,
     }
 }

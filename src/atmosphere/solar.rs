@@ -33,9 +33,5 @@ pub fn e0_on_grid(grid: &WavelengthGrid) -> Result<Vec<f64>, AtmosphereError> {
 #[must_use]
 pub fn sun_distance_factor(doy: u32) -> f64 {
     let g = 2.0 * std::f64::consts::PI * (f64::from(doy.clamp(1, 366)) - 1.0) / 365.0;
-    1.000_110
-        + 0.034_221 * g.cos()
-        + 0.001_280 * g.sin()
-        + 0.000_719 * (2.0 * g).cos()
-        + 0.000_077 * (2.0 * g).sin()
+    1.000_110 + 0.034_221 * g.cos() + 0.001_280 * g.sin() + 0.000_719 * (2.0 * g).cos() + 0.000_077 * (2.0 * g).sin()
 }

@@ -41,11 +41,7 @@ impl Streams {
     #[must_use]
     pub fn new(n: usize, user_mu: Vec<f64>) -> Self {
         let (mu, weight) = super::quadrature::gauss_half(n);
-        Self {
-            mu,
-            weight,
-            user_mu,
-        }
+        Self { mu, weight, user_mu }
     }
 
     /// Streams per hemisphere.
@@ -151,11 +147,8 @@ fn mat_vec<const S: usize>(m: &Block<S>, v: &[f64; S]) -> [f64; S] {
 fn transfer_coefficients(dtau: f64, mu: f64) -> (f64, f64, f64) {
     let x = dtau / mu;
     let e = (-x).exp();
-    let c_far = if x < 1e-3 {
-        x * (0.5 - x * (1.0 / 3.0 - x * (1.0 / 8.0 - x / 30.0)))
-    } else {
-        (1.0 - e * (1.0 + x)) / x
-    };
+    let c_far =
+        if x < 1e-3 { x * (0.5 - x * (1.0 / 3.0 - x * (1.0 / 8.0 - x / 30.0))) } else { (1.0 - e * (1.0 + x)) / x };
     (e, c_far, (1.0 - e) - c_far)
 }
 
@@ -170,11 +163,7 @@ impl Transfer {
         let coef = layering
             .tau
             .windows(2)
-            .map(|w| {
-                mus.iter()
-                    .map(|&mu| transfer_coefficients(w[1] - w[0], mu))
-                    .collect()
-            })
+            .map(|w| mus.iter().map(|&mu| transfer_coefficients(w[1] - w[0], mu)).collect())
             .collect();
         Self { coef }
     }
@@ -219,8 +208,7 @@ fn transfer<const S: usize>(
             let (e, c_far, c_near) = t.coef[k][d];
             let mut v = [0.0; S];
             for s in 0..S {
-                v[s] =
-                    out[k + 1][m + d][s] * e + j[k + 1][m + d][s] * c_far + j[k][m + d][s] * c_near;
+                v[s] = out[k + 1][m + d][s] * e + j[k + 1][m + d][s] * c_far + j[k][m + d][s] * c_near;
             }
             out[k][m + d] = v;
         }
@@ -308,8 +296,7 @@ pub fn solve<const S: usize>(
                 let att_r = (-(2.0 * total_tau - tau) / mu0).exp();
                 for i in 0..nq {
                     for s in 0..S {
-                        let mut v =
-                            wr * (rayleigh.sun[i][s] * att + rayleigh.sun_reflected[i][s] * att_r);
+                        let mut v = wr * (rayleigh.sun[i][s] * att + rayleigh.sun_reflected[i][s] * att_r);
                         if let Some(a) = aerosol {
                             v += wa * (a.sun[i][s] * att + a.sun_reflected[i][s] * att_r);
                         }
@@ -345,11 +332,7 @@ pub fn solve<const S: usize>(
             }
         }
     };
-    let norm = |f: &[Vec<[f64; S]>]| -> f64 {
-        (0..n)
-            .map(|j| f[0][n + j][0].abs() + f[kk][j][0].abs())
-            .sum()
-    };
+    let norm = |f: &[Vec<[f64; S]>]| -> f64 { (0..n).map(|j| f[0][n + j][0].abs() + f[kk][j][0].abs()).sum() };
     let mut emitted = None;
     if orders == 1 {
         add(&mut sum, &field, 1.0);
@@ -413,9 +396,7 @@ pub fn solve<const S: usize>(
         let mut out = vec![vec![[0.0; S]; 2 * u]; levels];
         // The directly transmitted emitted radiance is added by the caller.
         transfer(&tu, surface_user, &j_user, None, &mut out);
-        for i in 0..u {
-            toa_user[i] = out[0][u + i];
-        }
+        toa_user.copy_from_slice(&out[0][u..2 * u]);
     }
     let mut toa_user_first = vec![[0.0; S]; u];
     if let (Drive::Sun { mu0 }, true) = (drive, u > 0) {
@@ -427,8 +408,7 @@ pub fn solve<const S: usize>(
             for (i, v) in jk.iter_mut().enumerate() {
                 let row = nq + i;
                 for s in 0..S {
-                    v[s] =
-                        wr * (rayleigh.sun[row][s] * att + rayleigh.sun_reflected[row][s] * att_r);
+                    v[s] = wr * (rayleigh.sun[row][s] * att + rayleigh.sun_reflected[row][s] * att_r);
                     if let Some(a) = aerosol {
                         v[s] += wa * (a.sun[row][s] * att + a.sun_reflected[row][s] * att_r);
                     }
@@ -439,13 +419,7 @@ pub fn solve<const S: usize>(
         transfer(&tu, surface_user, &j1, None, &mut out);
         toa_user_first.copy_from_slice(&out[0][u..2 * u]);
     }
-    FourierField {
-        toa_user,
-        toa_user_first,
-        surface_down: sum[kk][..n].to_vec(),
-        toa_up: sum[0][n..].to_vec(),
-        orders,
-    }
+    FourierField { toa_user, toa_user_first, surface_down: sum[kk][..n].to_vec(), toa_up: sum[0][n..].to_vec(), orders }
 }
 
 #[cfg(test)]
@@ -465,28 +439,16 @@ mod tests {
             aerosol_scale_height_km: 2.0,
         };
         let layering = Layering::new(&column, 0.0, dtau, 1);
-        let beta = PhaseFunction::Rayleigh {
-            depolarization: 0.0279,
-        }
-        .moments(2);
+        let beta = PhaseFunction::Rayleigh { depolarization: 0.0279 }.moments(2);
         let k = scalar_kernel(&streams, &beta, 0, 0.6, 1.34);
         // Black surface: no Fresnel, and the reflected-sun source vanishes with it.
-        let k = Kernel {
-            sun_reflected: vec![[0.0]; k.sun.len()],
-            ..k
-        };
+        let k = Kernel { sun_reflected: vec![[0.0]; k.sun.len()], ..k };
         (streams, layering, k, vec![[[0.0]]; 16])
     }
 
     fn flux(streams: &Streams, radiance: &[[f64; 1]]) -> f64 {
         2.0 * std::f64::consts::PI
-            * streams
-                .mu
-                .iter()
-                .zip(&streams.weight)
-                .zip(radiance)
-                .map(|((m, w), v)| m * w * v[0])
-                .sum::<f64>()
+            * streams.mu.iter().zip(&streams.weight).zip(radiance).map(|((m, w), v)| m * w * v[0]).sum::<f64>()
     }
 
     #[test]
@@ -494,23 +456,11 @@ mod tests {
         // ω = 1 over a black surface: reflected + transmitted (direct + diffuse) = incident μ₀.
         // The linear-in-τ source is a second-order scheme: the energy defect must fall as Δτ².
         let mu0 = 0.6;
-        let settings = OrderSettings {
-            max_orders: 400,
-            tolerance: 1e-10,
-        };
+        let settings = OrderSettings { max_orders: 400, tolerance: 1e-10 };
         for tau in [0.05, 0.35, 1.0] {
             let defect = |dtau: f64| {
                 let (streams, layering, k, black) = setup(tau, dtau);
-                let f = solve(
-                    &streams,
-                    &layering,
-                    &k,
-                    None,
-                    &black,
-                    &[[[0.0]]; 3],
-                    &Drive::Sun { mu0 },
-                    settings,
-                );
+                let f = solve(&streams, &layering, &k, None, &black, &[[[0.0]]; 3], &Drive::Sun { mu0 }, settings);
                 let up = flux(&streams, &f.toa_up);
                 let down = flux(&streams, &f.surface_down) + mu0 * (-tau / mu0).exp();
                 ((up + down) / mu0 - 1.0).abs()
@@ -519,10 +469,7 @@ mod tests {
             assert!(fine < 2e-5, "τ={tau}: defect {fine:e} at Δτ = 0.0025");
             assert!(coarse < 2e-4, "τ={tau}: defect {coarse:e} at Δτ = 0.01");
             if coarse > 1e-6 {
-                assert!(
-                    coarse / fine > 8.0,
-                    "τ={tau}: {coarse:e} → {fine:e} is not second order"
-                );
+                assert!(coarse / fine > 8.0, "τ={tau}: {coarse:e} → {fine:e} is not second order");
             }
         }
     }
@@ -533,50 +480,17 @@ mod tests {
         // the TOA radiance from a unit isotropic source at the bottom, seen at μ.
         let tau = 0.35;
         let (streams, layering, k, black) = setup(tau, 0.01);
-        let settings = OrderSettings {
-            max_orders: 400,
-            tolerance: 1e-9,
-        };
-        let iso = Drive::Bottom {
-            quad: vec![[1.0]; 16],
-            user: vec![[1.0]; 3],
-        };
-        let up = solve(
-            &streams,
-            &layering,
-            &k,
-            None,
-            &black,
-            &[[[0.0]]; 3],
-            &iso,
-            settings,
-        );
+        let settings = OrderSettings { max_orders: 400, tolerance: 1e-9 };
+        let iso = Drive::Bottom { quad: vec![[1.0]; 16], user: vec![[1.0]; 3] };
+        let up = solve(&streams, &layering, &k, None, &black, &[[[0.0]]; 3], &iso, settings);
         for (i, &mu) in streams.user_mu.clone().iter().enumerate() {
             let t_up = (-tau / mu).exp() + up.toa_user[i][0];
-            let beta = PhaseFunction::Rayleigh {
-                depolarization: 0.0279,
-            }
-            .moments(2);
+            let beta = PhaseFunction::Rayleigh { depolarization: 0.0279 }.moments(2);
             let ks = scalar_kernel(&streams, &beta, 0, mu, 1.34);
-            let ks = Kernel {
-                sun_reflected: vec![[0.0]; ks.sun.len()],
-                ..ks
-            };
-            let d = solve(
-                &streams,
-                &layering,
-                &ks,
-                None,
-                &black,
-                &[[[0.0]]; 3],
-                &Drive::Sun { mu0: mu },
-                settings,
-            );
+            let ks = Kernel { sun_reflected: vec![[0.0]; ks.sun.len()], ..ks };
+            let d = solve(&streams, &layering, &ks, None, &black, &[[[0.0]]; 3], &Drive::Sun { mu0: mu }, settings);
             let t_down = (flux(&streams, &d.surface_down) + mu * (-tau / mu).exp()) / mu;
-            assert!(
-                (t_up / t_down - 1.0).abs() < 5e-4,
-                "μ={mu}: T_up {t_up} vs T_down {t_down}"
-            );
+            assert!((t_up / t_down - 1.0).abs() < 5e-4, "μ={mu}: T_up {t_up} vs T_down {t_down}");
         }
     }
 }

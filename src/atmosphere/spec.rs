@@ -19,6 +19,7 @@ use crate::spectral::{Extrapolation, Spectrum};
 
 /// The sea surface.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
 pub enum Surface {
     /// A flat Fresnel interface (no glint).
     #[default]
@@ -43,17 +44,14 @@ impl Surface {
             value: f64::NAN,
             allowed: format!("`flat` or `wind:SPEED` in m/s (got `{text}`)"),
         };
-        let speed = t
-            .strip_prefix("wind:")
-            .ok_or_else(bad)?
-            .parse::<f64>()
-            .map_err(|_| bad())?;
+        let speed = t.strip_prefix("wind:").ok_or_else(bad)?.parse::<f64>().map_err(|_| bad())?;
         Ok(Self::Wind { speed_m_s: speed })
     }
 }
 
 /// The atmosphere as written in a scene file or given on the command line.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 #[serde(default)]
 pub struct AtmosphereSpec {
     /// Aerosol model.
@@ -108,11 +106,7 @@ fn range(field: &str, value: f64, lo: f64, hi: f64, unit: &str) -> Result<(), At
     if value.is_finite() && (lo..=hi).contains(&value) {
         Ok(())
     } else {
-        Err(AtmosphereError::OutOfRange {
-            field: field.into(),
-            value,
-            allowed: format!("{lo} to {hi}{unit}"),
-        })
+        Err(AtmosphereError::OutOfRange { field: field.into(), value, allowed: format!("{lo} to {hi}{unit}") })
     }
 }
 
@@ -121,45 +115,15 @@ impl AtmosphereSpec {
     pub fn validate(&self) -> Result<(), AtmosphereError> {
         range("aot550", self.aot550, 0.0, 5.0, "")?;
         range("pressure_hpa", self.pressure_hpa, 500.0, 1100.0, " hPa")?;
-        range(
-            "gas_amounts.ozone_atm_cm",
-            self.gas_amounts.ozone_atm_cm,
-            0.0,
-            1.0,
-            " atm-cm",
-        )?;
-        range(
-            "gas_amounts.water_vapour_cm",
-            self.gas_amounts.water_vapour_cm,
-            0.0,
-            10.0,
-            " cm",
-        )?;
+        range("gas_amounts.ozone_atm_cm", self.gas_amounts.ozone_atm_cm, 0.0, 1.0, " atm-cm")?;
+        range("gas_amounts.water_vapour_cm", self.gas_amounts.water_vapour_cm, 0.0, 10.0, " cm")?;
         if let Surface::Wind { speed_m_s } = self.surface {
             range("surface wind speed_m_s", speed_m_s, 0.0, 30.0, " m/s")?;
         }
         range("latitude_deg", self.latitude_deg, -90.0, 90.0, " degrees")?;
-        range(
-            "rayleigh_scale_height_km",
-            self.rayleigh_scale_height_km,
-            1.0,
-            20.0,
-            " km",
-        )?;
-        range(
-            "aerosol_scale_height_km",
-            self.aerosol_scale_height_km,
-            0.1,
-            20.0,
-            " km",
-        )?;
-        range(
-            "water_refractive_index",
-            self.water_refractive_index,
-            1.0,
-            1.5,
-            "",
-        )?;
+        range("rayleigh_scale_height_km", self.rayleigh_scale_height_km, 1.0, 20.0, " km")?;
+        range("aerosol_scale_height_km", self.aerosol_scale_height_km, 0.1, 20.0, " km")?;
+        range("water_refractive_index", self.water_refractive_index, 1.0, 1.5, "")?;
         range("day_of_year", f64::from(self.day_of_year), 1.0, 366.0, "")?;
         self.accuracy.validate()
     }
@@ -167,10 +131,7 @@ impl AtmosphereSpec {
     /// Validate and bind the solar spectrum.
     pub fn build(&self) -> Result<Atmosphere, AtmosphereError> {
         self.validate()?;
-        Ok(Atmosphere {
-            spec: self.clone(),
-            e0: solar::tsis1()?,
-        })
+        Ok(Atmosphere { spec: self.clone(), e0: solar::tsis1()? })
     }
 }
 
@@ -199,27 +160,9 @@ impl Geometry {
     /// Sun zenith below 89° (the plane-parallel model has no meaning at the horizon), view
     /// zenith below 85°, finite azimuth.
     pub fn validate(&self) -> Result<(), AtmosphereError> {
-        range(
-            "sun_zenith (deg)",
-            self.sun_zenith_rad.to_degrees(),
-            0.0,
-            89.0,
-            " degrees",
-        )?;
-        range(
-            "view_zenith (deg)",
-            self.view_zenith_rad.to_degrees(),
-            0.0,
-            85.0,
-            " degrees",
-        )?;
-        range(
-            "relative_azimuth (deg)",
-            self.relative_azimuth_rad.to_degrees(),
-            -360.0,
-            360.0,
-            " degrees",
-        )
+        range("sun_zenith (deg)", self.sun_zenith_rad.to_degrees(), 0.0, 89.0, " degrees")?;
+        range("view_zenith (deg)", self.view_zenith_rad.to_degrees(), 0.0, 85.0, " degrees")?;
+        range("relative_azimuth (deg)", self.relative_azimuth_rad.to_degrees(), -360.0, 360.0, " degrees")
     }
 }
 
@@ -289,22 +232,17 @@ impl Atmosphere {
 
     /// Extraterrestrial irradiance at `wavelength_nm` on the spec's day, W m⁻² nm⁻¹.
     pub fn e0(&self, wavelength_nm: f64) -> Result<f64, AtmosphereError> {
-        Ok(self.e0.value_at(wavelength_nm, Extrapolation::Error)?
-            * solar::sun_distance_factor(self.spec.day_of_year))
+        Ok(self.e0.value_at(wavelength_nm, Extrapolation::Error)? * solar::sun_distance_factor(self.spec.day_of_year))
     }
 
     /// The optical column at `wavelength_nm` (350–1000 nm).
     pub fn column(&self, wavelength_nm: f64) -> Result<WavelengthColumn, AtmosphereError> {
         range("wavelength_nm", wavelength_nm, 325.0, 1025.0, " nm")?;
         let s = &self.spec;
-        let site = RayleighColumn {
-            pressure_hpa: s.pressure_hpa,
-            latitude_deg: s.latitude_deg,
-            ..RayleighColumn::default()
-        };
+        let site =
+            RayleighColumn { pressure_hpa: s.pressure_hpa, latitude_deg: s.latitude_deg, ..RayleighColumn::default() };
         let aerosol = if s.aot550 > 0.0 {
-            mixture_optics(s.aerosol, wavelength_nm)?
-                .map(|o| (s.aot550 * o.extinction_ratio, o.ssa, o.phase))
+            mixture_optics(s.aerosol, wavelength_nm)?.map(|o| (s.aot550 * o.extinction_ratio, o.ssa, o.phase))
         } else {
             None
         };
@@ -322,12 +260,7 @@ impl Atmosphere {
     /// One-way gas transmittance along zenith cosine `mu` (1 when gases are off).
     pub fn gas(&self, wavelength_nm: f64, mu: f64) -> Result<f64, AtmosphereError> {
         if self.spec.gases {
-            gas_transmittance(
-                wavelength_nm,
-                mu,
-                &self.spec.gas_amounts,
-                self.spec.pressure_hpa,
-            )
+            gas_transmittance(wavelength_nm, mu, &self.spec.gas_amounts, self.spec.pressure_hpa)
         } else {
             Ok(1.0)
         }
@@ -335,11 +268,7 @@ impl Atmosphere {
 
     /// All terms at one wavelength and geometry, by a direct RT solve (what `shoal atmosphere`
     /// prints; scenes use the LUT).
-    pub fn terms(
-        &self,
-        wavelength_nm: f64,
-        g: &Geometry,
-    ) -> Result<AtmosphereTerms, AtmosphereError> {
+    pub fn terms(&self, wavelength_nm: f64, g: &Geometry) -> Result<AtmosphereTerms, AtmosphereError> {
         g.validate()?;
         let column = self.column(wavelength_nm)?;
         let (mu0, muv) = (g.sun_zenith_rad.cos(), g.view_zenith_rad.cos());
@@ -379,10 +308,7 @@ impl Atmosphere {
     /// Combine normalised RT results with E₀ and gases into physical terms.
     pub(crate) fn assemble(&self, n: &Normalised) -> Result<AtmosphereTerms, AtmosphereError> {
         let e0 = self.e0(n.wavelength_nm)?;
-        let (tg0, tgv) = (
-            self.gas(n.wavelength_nm, n.mu0)?,
-            self.gas(n.wavelength_nm, n.muv)?,
-        );
+        let (tg0, tgv) = (self.gas(n.wavelength_nm, n.mu0)?, self.gas(n.wavelength_nm, n.muv)?);
         let t_gas = tg0 * tgv;
         let l_path = n.radiance * e0 * t_gas;
         Ok(AtmosphereTerms {

@@ -41,12 +41,7 @@ pub enum Component {
 
 impl Component {
     /// All components, in table order.
-    pub const ALL: [Self; 4] = [
-        Self::DustLike,
-        Self::WaterSoluble,
-        Self::Oceanic,
-        Self::Soot,
-    ];
+    pub const ALL: [Self; 4] = [Self::DustLike, Self::WaterSoluble, Self::Oceanic, Self::Soot];
 
     /// Short name used in the table file.
     #[must_use]
@@ -67,13 +62,11 @@ impl Component {
             Self::DustLike => (0.5, 0.47567, 4000.0),
             Self::WaterSoluble => (0.005, 0.47567, 50.0),
             Self::Oceanic => (0.3, 0.39967, 800.0),
+            // log₁₀ σ_g for σ_g = 2.00, as OSOAA's data file writes it (not the constant log₁₀ 2).
+            #[allow(clippy::approx_constant)]
             Self::Soot => (0.0118, 0.30103, 10.0),
         };
-        LogNormal {
-            mode_radius_um,
-            ln_sigma: log10_sigma * ln10,
-            alpha_max,
-        }
+        LogNormal { mode_radius_um, ln_sigma: log10_sigma * ln10, alpha_max }
     }
 
     /// Volume per particle V (µm³) as OSOAA uses it to turn volume into number fractions.
@@ -150,9 +143,7 @@ impl Component {
             ],
         };
         let w = wavelength_um.clamp(table[0].0, table[table.len() - 1].0);
-        let j = table
-            .partition_point(|t| t.0 <= w)
-            .clamp(1, table.len() - 1);
+        let j = table.partition_point(|t| t.0 <= w).clamp(1, table.len() - 1);
         let (a, b) = (table[j - 1], table[j]);
         let t = (w - a.0) / (b.0 - a.0);
         let re = a.1 + t * (b.1 - a.1);
@@ -182,9 +173,7 @@ impl AerosolType {
             "maritime" => Ok(Self::Maritime),
             "continental" => Ok(Self::Continental),
             "urban" => Ok(Self::Urban),
-            other => Err(format!(
-                "unknown aerosol model `{other}` (allowed: none, maritime, continental, urban)"
-            )),
+            other => Err(format!("unknown aerosol model `{other}` (allowed: none, maritime, continental, urban)")),
         }
     }
 
@@ -195,17 +184,9 @@ impl AerosolType {
             Self::None => vec![],
             Self::Maritime => vec![(Component::WaterSoluble, 0.05), (Component::Oceanic, 0.95)],
             Self::Continental => {
-                vec![
-                    (Component::DustLike, 0.70),
-                    (Component::WaterSoluble, 0.29),
-                    (Component::Soot, 0.01),
-                ]
+                vec![(Component::DustLike, 0.70), (Component::WaterSoluble, 0.29), (Component::Soot, 0.01)]
             }
-            Self::Urban => vec![
-                (Component::DustLike, 0.17),
-                (Component::WaterSoluble, 0.61),
-                (Component::Soot, 0.22),
-            ],
+            Self::Urban => vec![(Component::DustLike, 0.17), (Component::WaterSoluble, 0.61), (Component::Soot, 0.22)],
         }
     }
 
@@ -214,8 +195,6 @@ impl AerosolType {
     pub fn number_fractions(self) -> Vec<(Component, f64)> {
         let v = self.volume_fractions();
         let total: f64 = v.iter().map(|(c, f)| f / c.volume_um3()).sum();
-        v.iter()
-            .map(|(c, f)| (*c, f / c.volume_um3() / total))
-            .collect()
+        v.iter().map(|(c, f)| (*c, f / c.volume_um3() / total)).collect()
     }
 }

@@ -14,13 +14,12 @@ use serde::{Deserialize, Serialize};
 use super::CliError;
 use super::grid::{GridArgs, GridSpec};
 use super::output::{Csv, emit};
-use crate::atmosphere::{
-    AerosolType, AtmosphereSpec, AtmosphereTerms, Geometry, RayleighDepth, RtAccuracy, Surface,
-};
+use crate::atmosphere::{AerosolType, AtmosphereSpec, AtmosphereTerms, Geometry, RayleighDepth, RtAccuracy, Surface};
 use crate::spectral::{BandAverager, BandSetSpec};
 
 /// A `shoal atmosphere` run as a RON file (`presets/examples/atmosphere_lake_hume.ron`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 #[serde(default)]
 pub struct AtmosphereRun {
     /// The atmosphere.
@@ -109,30 +108,12 @@ fn day_of_year(date: &str) -> Result<u32, CliError> {
     let [y, m, d] = parts.as_slice() else {
         return Err(bad());
     };
-    let (y, m, d): (u32, u32, u32) = (
-        y.parse().map_err(|_| bad())?,
-        m.parse().map_err(|_| bad())?,
-        d.parse().map_err(|_| bad())?,
-    );
+    let (y, m, d): (u32, u32, u32) =
+        (y.parse().map_err(|_| bad())?, m.parse().map_err(|_| bad())?, d.parse().map_err(|_| bad())?);
     let leap = (y % 4 == 0 && y % 100 != 0) || y % 400 == 0;
-    let days = [
-        31,
-        if leap { 29 } else { 28 },
-        31,
-        30,
-        31,
-        30,
-        31,
-        31,
-        30,
-        31,
-        30,
-        31,
-    ];
+    let days = [31, if leap { 29 } else { 28 }, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31];
     if !(1..=12).contains(&m) || d == 0 || d > days[(m - 1) as usize] {
-        return Err(CliError::Input(format!(
-            "--date: `{date}` is not a calendar date"
-        )));
+        return Err(CliError::Input(format!("--date: `{date}` is not a calendar date")));
     }
     Ok(days[..(m - 1) as usize].iter().sum::<u32>() + d)
 }
@@ -155,9 +136,7 @@ fn merged(args: &AtmosphereArgs) -> Result<AtmosphereRun, CliError> {
             "on" => true,
             "off" => false,
             other => {
-                return Err(CliError::Input(format!(
-                    "--gases: `{other}` (allowed: on, off)"
-                )));
+                return Err(CliError::Input(format!("--gases: `{other}` (allowed: on, off)")));
             }
         };
     }
@@ -172,18 +151,13 @@ fn merged(args: &AtmosphereArgs) -> Result<AtmosphereRun, CliError> {
             "bodhaine" => RayleighDepth::Bodhaine,
             "osoaa" => RayleighDepth::OsoaaHansenTravis,
             other => {
-                return Err(CliError::Input(format!(
-                    "--rayleigh: `{other}` (allowed: bodhaine, osoaa)"
-                )));
+                return Err(CliError::Input(format!("--rayleigh: `{other}` (allowed: bodhaine, osoaa)")));
             }
         };
     }
     if let Some(p) = &args.accuracy {
-        a.accuracy = RtAccuracy::preset(p).ok_or_else(|| {
-            CliError::Input(format!(
-                "--accuracy: `{p}` (allowed: single, fast, default, high)"
-            ))
-        })?;
+        a.accuracy = RtAccuracy::preset(p)
+            .ok_or_else(|| CliError::Input(format!("--accuracy: `{p}` (allowed: single, fast, default, high)")))?;
     }
     run.sun_zenith_deg = args.sun_zenith.unwrap_or(run.sun_zenith_deg);
     run.view_zenith_deg = args.view_zenith.unwrap_or(run.view_zenith_deg);
@@ -192,8 +166,8 @@ fn merged(args: &AtmosphereArgs) -> Result<AtmosphereRun, CliError> {
 }
 
 fn read_spec(path: &Path) -> Result<AtmosphereRun, CliError> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| CliError::Input(format!("cannot read {}: {e}", path.display())))?;
+    let text =
+        std::fs::read_to_string(path).map_err(|e| CliError::Input(format!("cannot read {}: {e}", path.display())))?;
     ron::from_str(&text).map_err(|e| CliError::Input(format!("{}: {e}", path.display())))
 }
 
@@ -233,66 +207,39 @@ fn values(t: &AtmosphereTerms) -> [f64; 12] {
 pub fn run(args: &AtmosphereArgs) -> Result<(), CliError> {
     let run = merged(args)?;
     let atm = run.atmosphere.build()?;
-    let g = Geometry::from_degrees(
-        run.sun_zenith_deg,
-        run.view_zenith_deg,
-        run.relative_azimuth_deg,
-    );
+    let g = Geometry::from_degrees(run.sun_zenith_deg, run.view_zenith_deg, run.relative_azimuth_deg);
     g.validate()?;
     let band_mode = args.grid.bands.is_some() || run.bands.is_some();
-    let (grid, bands) = args
-        .grid
-        .resolve(run.grid.as_ref(), if band_mode { 1.0 } else { 5.0 })?;
+    let (grid, bands) = args.grid.resolve(run.grid.as_ref(), if band_mode { 1.0 } else { 5.0 })?;
     let bands = match (bands, &run.bands) {
         (Some(b), _) => Some(b),
         (None, Some(spec)) => Some(crate::spectral::BandSet::from_spec(spec)?),
         (None, None) => None,
     };
-    let averager = bands
-        .as_ref()
-        .map(|b| BandAverager::new(&grid, b))
-        .transpose()?;
+    let averager = bands.as_ref().map(|b| BandAverager::new(&grid, b)).transpose()?;
     // In band mode only the wavelengths some band responds to are solved.
     let needed: Vec<bool> = match &averager {
         None => vec![true; grid.len()],
         Some(a) => {
             let dense = a.to_dense();
-            (0..grid.len())
-                .map(|i| dense.column(i).iter().any(|w| *w != 0.0))
-                .collect()
+            (0..grid.len()).map(|i| dense.column(i).iter().any(|w| *w != 0.0)).collect()
         }
     };
     let wl = grid.wavelengths_nm();
     let terms: Vec<Option<AtmosphereTerms>> = (0..grid.len())
         .into_par_iter()
-        .map(|i| {
-            if needed[i] {
-                atm.terms(wl[i], &g).map(Some)
-            } else {
-                Ok(None)
-            }
-        })
+        .map(|i| if needed[i] { atm.terms(wl[i], &g).map(Some) } else { Ok(None) })
         .collect::<Result<_, _>>()?;
     let mut csv;
     match (&bands, &averager) {
         (Some(bands), Some(avg)) => {
-            csv = Csv::new(
-                ["band", "centre_nm"]
-                    .iter()
-                    .chain(COLUMNS.iter())
-                    .map(|s| (*s).to_string())
-                    .collect(),
-            );
+            csv = Csv::new(["band", "centre_nm"].iter().chain(COLUMNS.iter()).map(|s| (*s).to_string()).collect());
             let col = |f: &dyn Fn(&AtmosphereTerms) -> f64| -> Vec<f64> {
                 terms.iter().map(|t| t.as_ref().map_or(0.0, f)).collect()
             };
             let e0 = avg.apply(&col(&|t| t.e0_w_m2_nm));
             let weighted = |f: &dyn Fn(&AtmosphereTerms) -> f64| -> Vec<f64> {
-                avg.apply(&col(&|t| t.e0_w_m2_nm * f(t)))
-                    .iter()
-                    .zip(&e0)
-                    .map(|(a, b)| a / b)
-                    .collect()
+                avg.apply(&col(&|t| t.e0_w_m2_nm * f(t))).iter().zip(&e0).map(|(a, b)| a / b).collect()
             };
             let (l_path, ed, glint) = (
                 avg.apply(&col(&|t| t.l_path_w_m2_sr_nm)),
@@ -305,10 +252,7 @@ pub fn run(args: &AtmosphereArgs) -> Result<(), CliError> {
                 weighted(&|t| t.spherical_albedo),
                 weighted(&|t| t.t_gas),
             );
-            let (tau_r, tau_a) = (
-                avg.apply(&col(&|t| t.tau_rayleigh)),
-                avg.apply(&col(&|t| t.tau_aerosol)),
-            );
+            let (tau_r, tau_a) = (avg.apply(&col(&|t| t.tau_rayleigh)), avg.apply(&col(&|t| t.tau_aerosol)));
             let mu0 = g.sun_zenith_rad.cos();
             for (b, band) in bands.bands.iter().enumerate() {
                 let rho = std::f64::consts::PI * l_path[b] / (e0[b] * mu0);
@@ -332,12 +276,7 @@ pub fn run(args: &AtmosphereArgs) -> Result<(), CliError> {
             }
         }
         _ => {
-            csv = Csv::new(
-                std::iter::once("wavelength_nm")
-                    .chain(COLUMNS)
-                    .map(str::to_string)
-                    .collect(),
-            );
+            csv = Csv::new(std::iter::once("wavelength_nm").chain(COLUMNS).map(str::to_string).collect());
             for t in terms.iter().flatten() {
                 let mut row = vec![t.wavelength_nm];
                 row.extend(values(t));

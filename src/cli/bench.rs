@@ -11,9 +11,7 @@ use super::CliError;
 use crate::atmosphere::{AerosolType, AtmosphereLut, AtmosphereSpec, LutAxes, RtAccuracy};
 use crate::spectral::{BandSet, BandSetSpec, WavelengthGrid};
 use crate::validation::{Comparison, compare_paths, compare_water_runs};
-use crate::water::{
-    Bottom, SiopSpec, SubstrateLibrary, SubstrateMix, WaterColumn, WaterGeometry, WaterModel,
-};
+use crate::water::{Bottom, SiopSpec, SubstrateLibrary, SubstrateMix, WaterColumn, WaterGeometry, WaterModel};
 
 /// Flags of `shoal bench`.
 #[derive(Debug, Args)]
@@ -34,10 +32,7 @@ fn machine() -> String {
         })
         .unwrap_or_else(|| "unknown CPU".into());
     let threads = std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get);
-    format!(
-        "{cpu}, {threads} logical cores, rayon pool {} threads",
-        rayon::current_num_threads()
-    )
+    format!("{cpu}, {threads} logical cores, rayon pool {} threads", rayon::current_num_threads())
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -67,17 +62,11 @@ fn water_rows(quick: bool) -> Result<(), CliError> {
     // SAMBUCA's benchmark configuration: 350–800 nm at 1 nm (451 bands), its default SIOPs.
     let grid = WavelengthGrid::uniform(350.0, 800.0, 1.0)?;
     let model = WaterModel::new(SiopSpec::sambuca_default().resolve(&grid, None)?);
-    let rb = SubstrateLibrary::embedded()?.mix_on_grid(
-        &SubstrateMix::parse("ncc_sand:0.5,brown_acropora:0.5")?,
-        &grid,
-    )?;
+    let rb =
+        SubstrateLibrary::embedded()?.mix_on_grid(&SubstrateMix::parse("ncc_sand:0.5,brown_acropora:0.5")?, &grid)?;
     let geo = WaterGeometry::from_degrees(30.0, 0.0);
     let mut out = vec![0.0; grid.len()];
-    let (reps, each) = if quick {
-        (3, Duration::from_millis(100))
-    } else {
-        (7, Duration::from_millis(400))
-    };
+    let (reps, each) = if quick { (3, Duration::from_millis(100)) } else { (7, Duration::from_millis(400)) };
     let mut sink = 0.0;
     let column = |n: usize, bottom| WaterColumn {
         chl_mg_m3: 1.0 + (n % 7) as f64 * 0.1,
@@ -85,10 +74,7 @@ fn water_rows(quick: bool) -> Result<(), CliError> {
         nap_g_m3: 2.0,
         bottom,
     };
-    let shallow = |n: usize| Bottom::Shallow {
-        depth_m: 5.0 + (n % 5) as f64,
-        reflectance: &rb,
-    };
+    let shallow = |n: usize| Bottom::Shallow { depth_m: 5.0 + (n % 5) as f64, reflectance: &rb };
     let fast_shallow = rate(reps, each, |n| {
         let _ = model.rrs_above_into(&column(n, shallow(n)), &geo, &mut out);
         sink += out[100];
@@ -112,31 +98,21 @@ fn water_rows(quick: bool) -> Result<(), CliError> {
         ("optically deep, Rrs only", fast_deep),
         ("shallow, every intermediate", full),
     ] {
-        println!(
-            "| {label} | {:.0} | {:.0}–{:.0} |",
-            r,
-            r / 23_000.0,
-            r / 13_000.0
-        );
+        println!("| {label} | {:.0} | {:.0}–{:.0} |", r, r / 23_000.0, r / 13_000.0);
     }
     println!();
     Ok(())
 }
 
 fn max_abs(c: &[Comparison], keep: impl Fn(&Comparison) -> bool) -> f64 {
-    c.iter()
-        .filter(|x| keep(x))
-        .map(|x| x.error_pct().abs())
-        .fold(0.0, f64::max)
+    c.iter().filter(|x| keep(x)).map(|x| x.error_pct().abs()).fold(0.0, f64::max)
 }
 
 fn atmosphere_rows(quick: bool) -> Result<(), CliError> {
     let olci = BandSet::from_spec(&BandSetSpec::parse_cli("olci")?)?;
     let axes = LutAxes::covering(olci.centres_nm(), (55.0, 65.0), 40.0, (5.0, 5.0, 10.0));
     let nodes = axes.wavelengths_nm.len() * axes.sun_zenith_deg.len();
-    println!(
-        "## Atmosphere LUT, 19 OLCI bands (Lake Hume scene: continental AOT 0.1, sun 55–65°, view 0–40°)"
-    );
+    println!("## Atmosphere LUT, 19 OLCI bands (Lake Hume scene: continental AOT 0.1, sun 55–65°, view 0–40°)");
     println!();
     println!(
         "LUT nodes: {} wavelengths × {} sun × {} view × {} azimuth; OSOAA would need {nodes} runs × 1–3.5 s = {}–{} s.",
@@ -156,15 +132,10 @@ fn atmosphere_rows(quick: bool) -> Result<(), CliError> {
     );
     println!("|---|---|---|---|---|---|---|---|---|");
     for preset in ["single", "fast", "default", "high"] {
-        let acc =
-            RtAccuracy::preset(preset).ok_or_else(|| CliError::Run(format!("preset {preset}")))?;
-        let atm = AtmosphereSpec {
-            aerosol: AerosolType::Continental,
-            aot550: 0.1,
-            accuracy: acc,
-            ..Default::default()
-        }
-        .build()?;
+        let acc = RtAccuracy::preset(preset).ok_or_else(|| CliError::Run(format!("preset {preset}")))?;
+        let atm =
+            AtmosphereSpec { aerosol: AerosolType::Continental, aot550: 0.1, accuracy: acc, ..Default::default() }
+                .build()?;
         let reps = if quick { 1 } else { 5 };
         let times: Vec<f64> = (0..reps)
             .map(|_| {
@@ -199,6 +170,48 @@ fn atmosphere_rows(quick: bool) -> Result<(), CliError> {
     println!(
         "T_up columns use rows where the water-leaving radiance is above 10 % of the TOA radiance (OSOAA's T_up_eff is a difference of two large numbers otherwise). Hume's T_up_eff includes the bidirectional shape of that turbid water's radiance at 60° sun, which Shoal's Lambertian water-leaving radiance does not have: see README."
     );
+    Ok(())
+}
+
+/// Print the per-band comparison with OSOAA as a Markdown table (worst case over the reference
+/// geometries of each band), at default accuracy.
+pub fn osoaa_table() -> Result<(), CliError> {
+    let acc = RtAccuracy::default();
+    let paths = compare_paths(&acc)?;
+    let water = compare_water_runs(&acc)?;
+    println!(
+        "| band | nm | ρ_path Rayleigh (4 geometries) | ρ_path continental (sun 60°) | t_down (5) | Ed(0+) coupled Heron / Hume | T_up Heron / Hume | L_path Heron / Hume |"
+    );
+    println!("|---|---|---|---|---|---|---|---|");
+    let worst = |c: &[Comparison], keep: &dyn Fn(&Comparison) -> bool| -> String {
+        c.iter()
+            .filter(|x| keep(x))
+            .map(Comparison::error_pct)
+            .fold(None, |a: Option<f64>, e| Some(a.map_or(e, |a| if e.abs() > a.abs() { e } else { a })))
+            .map_or_else(|| "–".into(), |e| format!("{e:+.2} %"))
+    };
+    let olci = BandSet::from_spec(&BandSetSpec::parse_cli("olci")?)?;
+    let nominal = [
+        400.0, 411.8, 442.9, 490.5, 510.5, 560.5, 620.4, 665.3, 674.0, 681.6, 709.1, 754.2, 761.7, 764.8, 767.9, 779.2,
+        865.4, 884.3, 897.4,
+    ];
+    for (band, wl) in olci.bands.iter().zip(nominal) {
+        let at = |x: &Comparison| (x.wavelength_nm - wl).abs() < 0.05;
+        let scen = |x: &Comparison, s: &str| at(x) && x.case.starts_with(s);
+        println!(
+            "| {} | {wl} | {} | {} | {} | {} / {} | {} / {} | {} / {} |",
+            band.name,
+            worst(&paths, &|x| at(x) && x.quantity == "rho_path" && x.aerosol == AerosolType::None),
+            worst(&paths, &|x| at(x) && x.quantity == "rho_path" && x.aerosol != AerosolType::None),
+            worst(&paths, &|x| at(x) && x.quantity == "t_down"),
+            worst(&water, &|x| scen(x, "heron") && x.quantity == "ed_0plus"),
+            worst(&water, &|x| scen(x, "hume") && x.quantity == "ed_0plus"),
+            worst(&water, &|x| scen(x, "heron") && x.quantity == "t_up"),
+            worst(&water, &|x| scen(x, "hume") && x.quantity == "t_up"),
+            worst(&water, &|x| scen(x, "heron") && x.quantity == "l_path"),
+            worst(&water, &|x| scen(x, "hume") && x.quantity == "l_path"),
+        );
+    }
     Ok(())
 }
 

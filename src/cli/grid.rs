@@ -8,6 +8,7 @@ use crate::spectral::{BandSet, BandSetSpec, WavelengthGrid};
 
 /// Which wavelengths to compute, as written in a RON spec.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum GridSpec {
     /// A uniform grid.
     Range {
@@ -52,29 +53,21 @@ impl GridArgs {
             let (start, end) = match &self.range {
                 None => (350.0, 1000.0),
                 Some(r) => {
-                    let bad =
-                        || CliError::Input(format!("--range: expected START:END in nm, got `{r}`"));
+                    let bad = || CliError::Input(format!("--range: expected START:END in nm, got `{r}`"));
                     let (a, b) = r.split_once(':').ok_or_else(bad)?;
-                    (
-                        a.trim().parse().map_err(|_| bad())?,
-                        b.trim().parse().map_err(|_| bad())?,
-                    )
+                    (a.trim().parse().map_err(|_| bad())?, b.trim().parse().map_err(|_| bad())?)
                 }
             };
             let step = self.step.unwrap_or(default_step);
             if !(step.is_finite() && (0.1..=50.0).contains(&step)) {
-                return Err(CliError::Input(format!(
-                    "--step = {step} is out of range (allowed: 0.1 to 50 nm)"
-                )));
+                return Err(CliError::Input(format!("--step = {step} is out of range (allowed: 0.1 to 50 nm)")));
             }
             WavelengthGrid::uniform(start, end, step)?
         } else {
             match spec {
-                Some(GridSpec::Range {
-                    start_nm,
-                    end_nm,
-                    step_nm,
-                }) => WavelengthGrid::uniform(*start_nm, *end_nm, *step_nm)?,
+                Some(GridSpec::Range { start_nm, end_nm, step_nm }) => {
+                    WavelengthGrid::uniform(*start_nm, *end_nm, *step_nm)?
+                }
                 Some(GridSpec::List(list)) => WavelengthGrid::from_wavelengths(list.clone())?,
                 None => WavelengthGrid::uniform(350.0, 1000.0, default_step)?,
             }

@@ -43,6 +43,8 @@ enum Command {
 enum DevCommand {
     /// Print the WMO aerosol component Mie table (assets/atmosphere/wmo_aerosol_mie.csv).
     AerosolTable,
+    /// Print the per-band accuracy table against OSOAA (README).
+    OsoaaTable,
 }
 
 /// What went wrong, and which exit code it earns.
@@ -80,11 +82,7 @@ macro_rules! input_error {
         }
     )*};
 }
-input_error!(
-    crate::water::WaterError,
-    crate::atmosphere::AtmosphereError,
-    crate::spectral::SpectralError
-);
+input_error!(crate::water::WaterError, crate::atmosphere::AtmosphereError, crate::spectral::SpectralError);
 
 /// Entry point of the `shoal` binary.
 #[must_use]
@@ -93,20 +91,15 @@ pub fn main() -> ExitCode {
         Ok(c) => c,
         Err(e) => {
             let _ = e.print();
-            return if e.use_stderr() {
-                ExitCode::from(2)
-            } else {
-                ExitCode::SUCCESS
-            };
+            return if e.use_stderr() { ExitCode::from(2) } else { ExitCode::SUCCESS };
         }
     };
     let result = match cli.command {
         Command::Water(args) => water::run(&args),
         Command::Atmosphere(args) => atmosphere::run(&args),
         Command::Bench(args) => bench::run(&args),
-        Command::Dev(DevCommand::AerosolTable) => {
-            output::emit(&crate::atmosphere::component_table_csv(), None)
-        }
+        Command::Dev(DevCommand::AerosolTable) => output::emit(&crate::atmosphere::component_table_csv(), None),
+        Command::Dev(DevCommand::OsoaaTable) => bench::osoaa_table(),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -11,16 +11,15 @@ pub fn emit(text: &str, path: Option<&Path>) -> Result<(), CliError> {
     match path {
         None => {
             let mut out = std::io::stdout().lock();
-            out.write_all(text.as_bytes())
-                .map_err(|e| CliError::Run(format!("writing to standard output: {e}")))
+            match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+                // A reader that stops early (`| head`) is not an error.
+                Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+                r => r.map_err(|e| CliError::Run(format!("writing to standard output: {e}"))),
+            }
         }
         Some(p) => {
-            let tmp = p.with_extension(format!(
-                "{}.tmp",
-                p.extension().and_then(|e| e.to_str()).unwrap_or("")
-            ));
-            let fail =
-                |e: std::io::Error| CliError::Run(format!("cannot write {}: {e}", p.display()));
+            let tmp = p.with_extension(format!("{}.tmp", p.extension().and_then(|e| e.to_str()).unwrap_or("")));
+            let fail = |e: std::io::Error| CliError::Run(format!("cannot write {}: {e}", p.display()));
             std::fs::write(&tmp, text).map_err(fail)?;
             std::fs::rename(&tmp, p).map_err(|e| {
                 let _ = std::fs::remove_file(&tmp);
@@ -39,10 +38,7 @@ pub struct Csv {
 impl Csv {
     /// A table with these column names.
     pub fn new(header: Vec<String>) -> Self {
-        Self {
-            header,
-            rows: Vec::new(),
-        }
+        Self { header, rows: Vec::new() }
     }
 
     /// Add a row: a leading label (may be empty to omit) and numbers.

@@ -10,9 +10,7 @@ use super::CliError;
 use super::grid::{GridArgs, GridSpec};
 use super::output::{Csv, emit};
 use crate::spectral::{BandAverager, BandSetSpec, SpectrumSource};
-use crate::water::{
-    Bottom, SiopSpec, SubstrateLibrary, SubstrateMix, WaterColumn, WaterGeometry, WaterModel,
-};
+use crate::water::{Bottom, SiopSpec, SubstrateLibrary, SubstrateMix, WaterColumn, WaterGeometry, WaterModel};
 
 /// Where the SIOP set comes from.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -25,11 +23,12 @@ pub enum SiopChoice {
     /// a_nap_star, bb_nap_star (against `wavelength_nm`); the others come from `heron_island`.
     Csv(PathBuf),
     /// A SIOP set written in place.
-    Inline(SiopSpec),
+    Inline(Box<SiopSpec>),
 }
 
 /// A `shoal water` run as a RON file (`presets/examples/water_heron_sand.ron`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 #[serde(default)]
 pub struct WaterRun {
     /// SIOP set.
@@ -118,13 +117,15 @@ pub struct WaterArgs {
 }
 
 fn read_spec(path: &Path) -> Result<WaterRun, CliError> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| CliError::Input(format!("cannot read {}: {e}", path.display())))?;
+    let text =
+        std::fs::read_to_string(path).map_err(|e| CliError::Input(format!("cannot read {}: {e}", path.display())))?;
     ron::from_str(&text).map_err(|e| CliError::Input(format!("{}: {e}", path.display())))
 }
 
 fn siop_from_csv(path: &Path) -> Result<SiopSpec, CliError> {
     let table = crate::spectral::Table::from_file(path)?;
+    // Absolute, so that resolving the SIOP set does not join a base directory a second time.
+    let path = &std::fs::canonicalize(path).map_err(|e| CliError::Input(format!("{}: {e}", path.display())))?;
     let mut s = SiopSpec::preset("heron_island")?;
     s.name = format!("csv:{}", path.display());
     let slots: [(&str, &mut SpectrumSource); 7] = [
@@ -159,15 +160,12 @@ fn siop_from_csv(path: &Path) -> Result<SiopSpec, CliError> {
 }
 
 fn resolve_siop(choice: &SiopChoice, base: Option<&Path>) -> Result<SiopSpec, CliError> {
-    let rel = |p: &PathBuf| {
-        base.filter(|_| p.is_relative())
-            .map_or_else(|| p.clone(), |b| b.join(p))
-    };
+    let rel = |p: &PathBuf| base.filter(|_| p.is_relative()).map_or_else(|| p.clone(), |b| b.join(p));
     Ok(match choice {
         SiopChoice::Preset(name) => SiopSpec::preset(name)?,
         SiopChoice::File(p) => SiopSpec::from_file(&rel(p))?,
         SiopChoice::Csv(p) => siop_from_csv(&rel(p))?,
-        SiopChoice::Inline(s) => s.clone(),
+        SiopChoice::Inline(s) => (**s).clone(),
     })
 }
 
@@ -193,11 +191,10 @@ fn merged(args: &WaterArgs) -> Result<(WaterRun, Option<PathBuf>), CliError> {
         run.depth_m = if d.eq_ignore_ascii_case("deep") {
             None
         } else {
-            Some(d.parse::<f64>().map_err(|_| {
-                CliError::Input(format!(
-                    "--depth: `{d}` is not a number of metres or `deep`"
-                ))
-            })?)
+            Some(
+                d.parse::<f64>()
+                    .map_err(|_| CliError::Input(format!("--depth: `{d}` is not a number of metres or `deep`")))?,
+            )
         };
     }
     if let Some(s) = &args.substrate {
@@ -209,11 +206,7 @@ fn merged(args: &WaterArgs) -> Result<(WaterRun, Option<PathBuf>), CliError> {
     run.sun_zenith_deg = args.sun_zenith.unwrap_or(run.sun_zenith_deg);
     run.view_zenith_deg = args.view_zenith.unwrap_or(run.view_zenith_deg);
     // Flags given on the command line are relative to the working directory.
-    let base = if args.siop.is_some() || args.substrate_csv.is_some() {
-        None
-    } else {
-        base
-    };
+    let base = if args.siop.is_some() || args.substrate_csv.is_some() { None } else { base };
     Ok((run, base))
 }
 
@@ -225,10 +218,7 @@ pub fn run(args: &WaterArgs) -> Result<(), CliError> {
         for e in library.entries() {
             text.push_str(&format!("{},{}\n", e.name, e.description));
         }
-        text.push_str(&format!(
-            "# SIOP sets: {}\n",
-            SiopSpec::preset_names().join(", ")
-        ));
+        text.push_str(&format!("# SIOP sets: {}\n", SiopSpec::preset_names().join(", ")));
         return emit(&text, args.out.as_deref());
     }
     let (run, base) = merged(args)?;
@@ -240,30 +230,17 @@ pub fn run(args: &WaterArgs) -> Result<(), CliError> {
     };
     let siop = resolve_siop(&run.siop, base.as_deref())?.resolve(&grid, base.as_deref())?;
     if let Some(csv) = &run.substrate_csv {
-        library.add_csv(
-            &base
-                .as_deref()
-                .filter(|_| csv.is_relative())
-                .map_or_else(|| csv.clone(), |b| b.join(csv)),
-        )?;
+        library.add_csv(&base.as_deref().filter(|_| csv.is_relative()).map_or_else(|| csv.clone(), |b| b.join(csv)))?;
     }
     let reflectance;
     let bottom = match run.depth_m {
         None => Bottom::OpticallyDeep,
         Some(depth_m) => {
             reflectance = library.mix_on_grid(&SubstrateMix::parse(&run.substrate)?, &grid)?;
-            Bottom::Shallow {
-                depth_m,
-                reflectance: &reflectance,
-            }
+            Bottom::Shallow { depth_m, reflectance: &reflectance }
         }
     };
-    let column = WaterColumn {
-        chl_mg_m3: run.chl_mg_m3,
-        cdom_per_m: run.cdom_per_m,
-        nap_g_m3: run.nap_g_m3,
-        bottom,
-    };
+    let column = WaterColumn { chl_mg_m3: run.chl_mg_m3, cdom_per_m: run.cdom_per_m, nap_g_m3: run.nap_g_m3, bottom };
     let geometry = WaterGeometry::from_degrees(run.sun_zenith_deg, run.view_zenith_deg);
     let model = WaterModel::new(siop);
     let r = model.evaluate(&column, &geometry)?;
@@ -271,11 +248,7 @@ pub fn run(args: &WaterArgs) -> Result<(), CliError> {
     let names: Vec<String> = columns.iter().map(|(n, _)| (*n).to_string()).collect();
     let csv = match bands {
         None => {
-            let mut csv = Csv::new(
-                std::iter::once("wavelength_nm".to_string())
-                    .chain(names)
-                    .collect(),
-            );
+            let mut csv = Csv::new(std::iter::once("wavelength_nm".to_string()).chain(names).collect());
             for (i, w) in grid.wavelengths_nm().iter().enumerate() {
                 let mut row = vec![*w];
                 row.extend(columns.iter().map(|(_, v)| v[i]));
@@ -286,12 +259,7 @@ pub fn run(args: &WaterArgs) -> Result<(), CliError> {
         Some(bands) => {
             let avg = BandAverager::new(&grid, &bands)?;
             let averaged: Vec<Vec<f64>> = columns.iter().map(|(_, v)| avg.apply(v)).collect();
-            let mut csv = Csv::new(
-                ["band".to_string(), "centre_nm".to_string()]
-                    .into_iter()
-                    .chain(names)
-                    .collect(),
-            );
+            let mut csv = Csv::new(["band".to_string(), "centre_nm".to_string()].into_iter().chain(names).collect());
             for (b, band) in bands.bands.iter().enumerate() {
                 let mut row = vec![band.centre_nm];
                 row.extend(averaged.iter().map(|v| v[b]));

@@ -17,6 +17,7 @@ pub enum Platform {
 
 /// One Gaussian band: centre and full width at half maximum.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct GaussianBand {
     /// Band name; defaults to `B<centre>`.
     #[serde(default)]
@@ -29,6 +30,7 @@ pub struct GaussianBand {
 
 /// How a band set is described in RON and on the command line.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum BandSetSpec {
     /// Sentinel-3 OLCI mean SRFs (ESA 2016). Default bands Oa01–Oa19, the 19 bands of
     /// Matthews et al. (2023) Table 1 (Oa20/Oa21 lie at 940/1020 nm).
@@ -65,22 +67,10 @@ impl BandSetSpec {
     /// ```
     pub fn parse_cli(text: &str) -> Result<Self, SpectralError> {
         match text.trim().to_ascii_lowercase().as_str() {
-            "olci" | "olci-s3a" => Ok(Self::Olci {
-                platform: Platform::A,
-                bands: None,
-            }),
-            "olci-s3b" => Ok(Self::Olci {
-                platform: Platform::B,
-                bands: None,
-            }),
-            "msi" | "msi-s2a" => Ok(Self::Msi {
-                platform: Platform::A,
-                bands: None,
-            }),
-            "msi-s2b" => Ok(Self::Msi {
-                platform: Platform::B,
-                bands: None,
-            }),
+            "olci" | "olci-s3a" => Ok(Self::Olci { platform: Platform::A, bands: None }),
+            "olci-s3b" => Ok(Self::Olci { platform: Platform::B, bands: None }),
+            "msi" | "msi-s2a" => Ok(Self::Msi { platform: Platform::A, bands: None }),
+            "msi-s2b" => Ok(Self::Msi { platform: Platform::B, bands: None }),
             other => {
                 let Some(list) = other.strip_prefix("gauss:") else {
                     return Err(SpectralError::Bands(format!(
@@ -91,19 +81,15 @@ impl BandSetSpec {
                 let bands = list
                     .split(',')
                     .map(|pair| {
-                        let (c, w) = pair.split_once('/').ok_or_else(|| {
-                            SpectralError::Bands(format!("`{pair}`: expected CENTRE/FWHM in nm"))
-                        })?;
+                        let (c, w) = pair
+                            .split_once('/')
+                            .ok_or_else(|| SpectralError::Bands(format!("`{pair}`: expected CENTRE/FWHM in nm")))?;
                         let parse = |s: &str| {
-                            s.trim().parse::<f64>().map_err(|_| {
-                                SpectralError::Bands(format!("`{pair}`: `{s}` is not a number"))
-                            })
+                            s.trim()
+                                .parse::<f64>()
+                                .map_err(|_| SpectralError::Bands(format!("`{pair}`: `{s}` is not a number")))
                         };
-                        Ok(GaussianBand {
-                            name: None,
-                            centre_nm: parse(c)?,
-                            fwhm_nm: parse(w)?,
-                        })
+                        Ok(GaussianBand { name: None, centre_nm: parse(c)?, fwhm_nm: parse(w)? })
                     })
                     .collect::<Result<Vec<_>, SpectralError>>()?;
                 Ok(Self::Gaussian(bands))
@@ -159,19 +145,14 @@ impl BandSet {
                     .map(|n| {
                         let rows = table.filter_eq(key, n);
                         if rows.is_empty() {
-                            return Err(SpectralError::Bands(format!(
-                                "OLCI has no band `{n}` (Oa01–Oa21)"
-                            )));
+                            return Err(SpectralError::Bands(format!("OLCI has no band `{n}` (Oa01–Oa21)")));
                         }
                         let wl = rows.column_f64("wavelength_nm")?;
                         let r = rows.column_f64("response")?;
                         Band::from_srf(n, Spectrum::new(format!("{label} {n}"), wl, r)?)
                     })
                     .collect::<Result<Vec<_>, _>>()?;
-                Ok(Self {
-                    name: label.into(),
-                    bands,
-                })
+                Ok(Self { name: label.into(), bands })
             }
             BandSetSpec::Msi { platform, bands } => {
                 let (path, label) = match platform {
@@ -179,38 +160,25 @@ impl BandSet {
                     Platform::B => ("srf/srf_s2b_msi.csv", "MSI S2B"),
                 };
                 let default = ["B1", "B2", "B3", "B4", "B5", "B6", "B7", "B8", "B8A", "B9"];
-                let names: Vec<String> = bands
-                    .clone()
-                    .unwrap_or_else(|| default.iter().map(|s| (*s).to_string()).collect());
+                let names: Vec<String> =
+                    bands.clone().unwrap_or_else(|| default.iter().map(|s| (*s).to_string()).collect());
                 let table = Table::from_asset(path)?;
                 let bands = names
                     .iter()
                     .map(|n| {
-                        let srf = Spectrum::from_table(&table, n).map_err(|_| {
-                            SpectralError::Bands(format!("MSI has no band `{n}` (B1–B12, B8A)"))
-                        })?;
+                        let srf = Spectrum::from_table(&table, n)
+                            .map_err(|_| SpectralError::Bands(format!("MSI has no band `{n}` (B1–B12, B8A)")))?;
                         Band::from_srf(n, trim_zeros(srf)?)
                     })
                     .collect::<Result<Vec<_>, _>>()?;
-                Ok(Self {
-                    name: label.into(),
-                    bands,
-                })
+                Ok(Self { name: label.into(), bands })
             }
             BandSetSpec::Gaussian(list) => {
                 if list.is_empty() {
-                    return Err(SpectralError::Bands(
-                        "a Gaussian band set needs at least one band".into(),
-                    ));
+                    return Err(SpectralError::Bands("a Gaussian band set needs at least one band".into()));
                 }
-                let bands = list
-                    .iter()
-                    .map(Band::gaussian)
-                    .collect::<Result<Vec<_>, _>>()?;
-                Ok(Self {
-                    name: "Gaussian".into(),
-                    bands,
-                })
+                let bands = list.iter().map(Band::gaussian).collect::<Result<Vec<_>, _>>()?;
+                Ok(Self { name: "Gaussian".into(), bands })
             }
         }
     }
@@ -239,9 +207,7 @@ impl Band {
     pub fn from_srf(name: &str, srf: Spectrum) -> Result<Self, SpectralError> {
         let peak = srf.values.iter().copied().fold(0.0f64, f64::max);
         if !(peak > 0.0) || srf.values.iter().any(|v| *v < 0.0) {
-            return Err(SpectralError::Bands(format!(
-                "band `{name}`: SRF must be non-negative with a positive peak"
-            )));
+            return Err(SpectralError::Bands(format!("band `{name}`: SRF must be non-negative with a positive peak")));
         }
         let (mut s0, mut s1) = (0.0, 0.0);
         for w in srf.wavelength_nm.windows(2).zip(srf.values.windows(2)) {
@@ -254,83 +220,40 @@ impl Band {
         let first = srf.values.iter().position(|&v| v >= half).unwrap_or(0);
         let last = srf.values.iter().rposition(|&v| v >= half).unwrap_or(0);
         let cross = |i: usize, j: usize| {
-            let (x0, x1, y0, y1) = (
-                srf.wavelength_nm[i],
-                srf.wavelength_nm[j],
-                srf.values[i],
-                srf.values[j],
-            );
-            if (y1 - y0).abs() < f64::MIN_POSITIVE {
-                x0
-            } else {
-                x0 + (half - y0) * (x1 - x0) / (y1 - y0)
-            }
+            let (x0, x1, y0, y1) = (srf.wavelength_nm[i], srf.wavelength_nm[j], srf.values[i], srf.values[j]);
+            if (y1 - y0).abs() < f64::MIN_POSITIVE { x0 } else { x0 + (half - y0) * (x1 - x0) / (y1 - y0) }
         };
-        let left = if first > 0 {
-            cross(first - 1, first)
-        } else {
-            srf.wavelength_nm[0]
-        };
-        let right = if last + 1 < srf.values.len() {
-            cross(last, last + 1)
-        } else {
-            srf.wavelength_nm[last]
-        };
-        Ok(Self {
-            name: name.to_string(),
-            centre_nm: s1 / s0,
-            fwhm_nm: right - left,
-            srf,
-        })
+        let left = if first > 0 { cross(first - 1, first) } else { srf.wavelength_nm[0] };
+        let right = if last + 1 < srf.values.len() { cross(last, last + 1) } else { srf.wavelength_nm[last] };
+        Ok(Self { name: name.to_string(), centre_nm: s1 / s0, fwhm_nm: right - left, srf })
     }
 
     /// A Gaussian band: SRF = exp(−4 ln2 (λ−c)²/FWHM²), sampled to ±2.5 FWHM.
     pub fn gaussian(spec: &GaussianBand) -> Result<Self, SpectralError> {
         let (c, w) = (spec.centre_nm, spec.fwhm_nm);
         if !(c.is_finite() && (300.0..=2500.0).contains(&c)) {
-            return Err(SpectralError::Bands(format!(
-                "centre_nm = {c} is out of range (300 to 2500 nm)"
-            )));
+            return Err(SpectralError::Bands(format!("centre_nm = {c} is out of range (300 to 2500 nm)")));
         }
         if !(w.is_finite() && (0.1..=200.0).contains(&w)) {
-            return Err(SpectralError::Bands(format!(
-                "fwhm_nm = {w} is out of range (0.1 to 200 nm)"
-            )));
+            return Err(SpectralError::Bands(format!("fwhm_nm = {w} is out of range (0.1 to 200 nm)")));
         }
         let name = spec.name.clone().unwrap_or_else(|| format!("B{c:.0}"));
         let n = 201;
         let (wl, v): (Vec<f64>, Vec<f64>) = (0..n)
             .map(|i| {
                 let x = c - 2.5 * w + 5.0 * w * i as f64 / (n - 1) as f64;
-                (
-                    x,
-                    (-4.0 * std::f64::consts::LN_2 * ((x - c) / w).powi(2)).exp(),
-                )
+                (x, (-4.0 * std::f64::consts::LN_2 * ((x - c) / w).powi(2)).exp())
             })
             .unzip();
-        Ok(Self {
-            name: name.clone(),
-            centre_nm: c,
-            fwhm_nm: w,
-            srf: Spectrum::new(name, wl, v)?,
-        })
+        Ok(Self { name: name.clone(), centre_nm: c, fwhm_nm: w, srf: Spectrum::new(name, wl, v)? })
     }
 }
 
 /// Drop the leading and trailing zero samples of a 1-nm SRF column that spans the whole file.
 fn trim_zeros(s: Spectrum) -> Result<Spectrum, SpectralError> {
-    let first = s
-        .values
-        .iter()
-        .position(|&v| v > 0.0)
-        .unwrap_or(0)
-        .saturating_sub(1);
+    let first = s.values.iter().position(|&v| v > 0.0).unwrap_or(0).saturating_sub(1);
     let last = (s.values.iter().rposition(|&v| v > 0.0).unwrap_or(0) + 1).min(s.values.len() - 1);
-    Spectrum::new(
-        s.name.clone(),
-        s.wavelength_nm[first..=last].to_vec(),
-        s.values[first..=last].to_vec(),
-    )
+    Spectrum::new(s.name.clone(), s.wavelength_nm[first..=last].to_vec(), s.values[first..=last].to_vec())
 }
 
 /// `band_from_fine`: the matrix that averages a fine-grid spectrum over each band's SRF.
@@ -358,15 +281,8 @@ impl BandAverager {
     /// assert!((m.apply(&flat)[0] - 2.0).abs() < 1e-12);
     /// ```
     pub fn new(grid: &WavelengthGrid, bands: &BandSet) -> Result<Self, SpectralError> {
-        let rows = bands
-            .bands
-            .iter()
-            .map(|b| Self::row(grid, b))
-            .collect::<Result<_, _>>()?;
-        Ok(Self {
-            rows,
-            n_fine: grid.len(),
-        })
+        let rows = bands.bands.iter().map(|b| Self::row(grid, b)).collect::<Result<_, _>>()?;
+        Ok(Self { rows, n_fine: grid.len() })
     }
 
     fn row(grid: &WavelengthGrid, band: &Band) -> Result<(usize, Vec<f64>), SpectralError> {
@@ -377,13 +293,7 @@ impl BandAverager {
         let total = integrate_linear(&band.srf.wavelength_nm, &band.srf.values);
         // Breakpoints: SRF samples and grid nodes inside the overlap.
         let (a, b) = (s_lo.max(g_lo), s_hi.min(g_hi));
-        let mut xs: Vec<f64> = band
-            .srf
-            .wavelength_nm
-            .iter()
-            .copied()
-            .filter(|x| (a..=b).contains(x))
-            .collect();
+        let mut xs: Vec<f64> = band.srf.wavelength_nm.iter().copied().filter(|x| (a..=b).contains(x)).collect();
         xs.extend(g.iter().copied().filter(|x| (a..=b).contains(x)));
         xs.push(a);
         xs.push(b);
@@ -450,11 +360,7 @@ impl BandAverager {
     pub fn apply_into(&self, fine: &[f64], out: &mut [f64]) {
         debug_assert_eq!(fine.len(), self.n_fine);
         for ((first, w), o) in self.rows.iter().zip(out.iter_mut()) {
-            *o = w
-                .iter()
-                .zip(&fine[*first..*first + w.len()])
-                .map(|(a, b)| a * b)
-                .sum();
+            *o = w.iter().zip(&fine[*first..*first + w.len()]).map(|(a, b)| a * b).sum();
         }
     }
 
@@ -472,10 +378,7 @@ impl BandAverager {
 }
 
 fn integrate_linear(x: &[f64], y: &[f64]) -> f64 {
-    x.windows(2)
-        .zip(y.windows(2))
-        .map(|(x, y)| 0.5 * (x[1] - x[0]) * (y[0] + y[1]))
-        .sum()
+    x.windows(2).zip(y.windows(2)).map(|(x, y)| 0.5 * (x[1] - x[0]) * (y[0] + y[1])).sum()
 }
 
 #[cfg(test)]
@@ -485,29 +388,13 @@ mod tests {
     #[test]
     fn olci_centroids_match_the_esa_table() {
         // olci_bands.csv gives the S3A SRF centroids computed independently (PROVENANCE.md).
-        let olci = BandSet::from_spec(&BandSetSpec::Olci {
-            platform: Platform::A,
-            bands: None,
-        })
-        .unwrap();
+        let olci = BandSet::from_spec(&BandSetSpec::Olci { platform: Platform::A, bands: None }).unwrap();
         let t = Table::from_asset("srf/olci_bands.csv").unwrap();
         let centroids = t.column_f64("srf_centroid_nm").unwrap();
         let fwhm = t.column_f64("srf_fwhm_nm").unwrap();
         for (b, (c, w)) in olci.bands.iter().zip(centroids.iter().zip(&fwhm)) {
-            assert!(
-                (b.centre_nm - c).abs() < 0.01,
-                "{}: {} vs {}",
-                b.name,
-                b.centre_nm,
-                c
-            );
-            assert!(
-                (b.fwhm_nm - w).abs() < 0.05,
-                "{}: {} vs {}",
-                b.name,
-                b.fwhm_nm,
-                w
-            );
+            assert!((b.centre_nm - c).abs() < 0.01, "{}: {} vs {}", b.name, b.centre_nm, c);
+            assert!((b.fwhm_nm - w).abs() < 0.05, "{}: {} vs {}", b.name, b.fwhm_nm, w);
         }
     }
 
@@ -526,20 +413,10 @@ mod tests {
             .resample(&grid, Extrapolation::Error)
             .unwrap();
         let band = m.apply(&e0);
-        let expected = Table::from_asset("srf/olci_bands.csv")
-            .unwrap()
-            .column_f64("E0_tsis_W_m2_nm")
-            .unwrap();
+        let expected = Table::from_asset("srf/olci_bands.csv").unwrap().column_f64("E0_tsis_W_m2_nm").unwrap();
         for (i, (got, want)) in band.iter().zip(&expected).enumerate() {
-            let tolerance = if olci.bands[i].centre_nm < 450.0 {
-                2.5e-3
-            } else {
-                1e-3
-            };
-            assert!(
-                (got / want - 1.0).abs() < tolerance,
-                "band {i}: {got} vs {want}"
-            );
+            let tolerance = if olci.bands[i].centre_nm < 450.0 { 2.5e-3 } else { 1e-3 };
+            assert!((got / want - 1.0).abs() < tolerance, "band {i}: {got} vs {want}");
         }
     }
 
@@ -553,26 +430,16 @@ mod tests {
             let m = BandAverager::new(&grid, &olci).unwrap();
             let line: Vec<f64> = grid.wavelengths_nm().to_vec();
             for (b, v) in olci.bands.iter().zip(m.apply(&line)) {
-                assert!(
-                    (v - b.centre_nm).abs() < 1e-6,
-                    "step {step} {}: {v} vs {}",
-                    b.name,
-                    b.centre_nm
-                );
+                assert!((v - b.centre_nm).abs() < 1e-6, "step {step} {}: {v} vs {}", b.name, b.centre_nm);
             }
         }
     }
 
     #[test]
     fn bands_outside_the_grid_are_refused() {
-        let spec = BandSetSpec::Olci {
-            platform: Platform::A,
-            bands: Some(vec!["Oa21".into()]),
-        };
+        let spec = BandSetSpec::Olci { platform: Platform::A, bands: Some(vec!["Oa21".into()]) };
         let olci = BandSet::from_spec(&spec).unwrap();
-        let e = BandAverager::new(&WavelengthGrid::fine(), &olci)
-            .unwrap_err()
-            .to_string();
+        let e = BandAverager::new(&WavelengthGrid::fine(), &olci).unwrap_err().to_string();
         assert!(e.contains("Oa21") && e.contains("outside"), "{e}");
     }
 

@@ -33,11 +33,7 @@ impl WavelengthGrid {
     /// `350 + k·step` not above 1000 nm.
     pub fn fine_with_step(step_nm: f64) -> Result<Self, SpectralError> {
         if !(0.1..=50.0).contains(&step_nm) {
-            return Err(SpectralError::Grid {
-                field: "step_nm",
-                value: step_nm,
-                allowed: "0.1 to 50 nm".into(),
-            });
+            return Err(SpectralError::Grid { field: "step_nm", value: step_nm, allowed: "0.1 to 50 nm".into() });
         }
         Self::uniform(FINE_START_NM, FINE_END_NM, step_nm)
     }
@@ -145,11 +141,7 @@ fn check_wavelength(field: &'static str, value: f64) -> Result<(), SpectralError
     if value.is_finite() && (200.0..=3000.0).contains(&value) {
         Ok(())
     } else {
-        Err(SpectralError::Grid {
-            field,
-            value,
-            allowed: "200 to 3000 nm".into(),
-        })
+        Err(SpectralError::Grid { field, value, allowed: "200 to 3000 nm".into() })
     }
 }
 
@@ -160,10 +152,7 @@ mod tests {
     #[test]
     fn fine_grid_steps_land_on_the_end() {
         assert_eq!(WavelengthGrid::fine_with_step(5.0).unwrap().len(), 131);
-        assert_eq!(
-            WavelengthGrid::fine_with_step(0.5).unwrap().range_nm(),
-            (350.0, 1000.0)
-        );
+        assert_eq!(WavelengthGrid::fine_with_step(0.5).unwrap().range_nm(), (350.0, 1000.0));
         let g = WavelengthGrid::fine_with_step(3.0).unwrap();
         assert_eq!(g.range_nm().1, 998.0);
     }

@@ -14,6 +14,7 @@ fn one() -> f64 {
 /// A spectrum's source. Analytic shapes are exact at every wavelength; tabulated ones are
 /// linearly interpolated.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum SpectrumSource {
     /// Column of an embedded file (path relative to `assets/`), times `scale`.
     Asset {
@@ -93,60 +94,30 @@ impl SpectrumSource {
     ) -> Result<Vec<f64>, SpectralError> {
         let wl = grid.wavelengths_nm();
         match self {
-            Self::Asset {
-                file,
-                column,
-                scale,
-                outside,
-            } => {
+            Self::Asset { file, column, scale, outside } => {
                 let how = pick(*outside, extrapolation);
-                Ok(Spectrum::from_asset(file, column)?
-                    .scaled(*scale)
-                    .resample(grid, how)?)
+                Ok(Spectrum::from_asset(file, column)?.scaled(*scale).resample(grid, how)?)
             }
-            Self::Csv {
-                path,
-                column,
-                scale,
-                outside,
-            } => {
+            Self::Csv { path, column, scale, outside } => {
                 let how = pick(*outside, extrapolation);
                 let full = match base_dir {
                     Some(dir) if path.is_relative() => dir.join(path),
                     _ => path.clone(),
                 };
                 let table = Table::from_file(&full)?;
-                Ok(Spectrum::from_table(&table, column)?
-                    .scaled(*scale)
-                    .resample(grid, how)?)
+                Ok(Spectrum::from_table(&table, column)?.scaled(*scale).resample(grid, how)?)
             }
-            Self::Table {
-                wavelength_nm,
-                values,
-                outside,
-            } => Spectrum::new("inline table", wavelength_nm.clone(), values.clone())?
-                .resample(grid, pick(*outside, extrapolation)),
-            Self::PowerLaw {
-                coefficient,
-                reference_nm,
-                exponent,
-            } => {
+            Self::Table { wavelength_nm, values, outside } => {
+                Spectrum::new("inline table", wavelength_nm.clone(), values.clone())?
+                    .resample(grid, pick(*outside, extrapolation))
+            }
+            Self::PowerLaw { coefficient, reference_nm, exponent } => {
                 check_finite("PowerLaw", &[*coefficient, *reference_nm, *exponent])?;
-                Ok(wl
-                    .iter()
-                    .map(|l| coefficient * (reference_nm / l).powf(*exponent))
-                    .collect())
+                Ok(wl.iter().map(|l| coefficient * (reference_nm / l).powf(*exponent)).collect())
             }
-            Self::Exponential {
-                coefficient,
-                reference_nm,
-                slope_per_nm,
-            } => {
+            Self::Exponential { coefficient, reference_nm, slope_per_nm } => {
                 check_finite("Exponential", &[*coefficient, *reference_nm, *slope_per_nm])?;
-                Ok(wl
-                    .iter()
-                    .map(|l| coefficient * (-slope_per_nm * (l - reference_nm)).exp())
-                    .collect())
+                Ok(wl.iter().map(|l| coefficient * (-slope_per_nm * (l - reference_nm)).exp()).collect())
             }
             Self::Constant(c) => {
                 check_finite("Constant", &[*c])?;
@@ -157,11 +128,7 @@ impl SpectrumSource {
 }
 
 fn pick(own: Extrapolation, default: Extrapolation) -> Extrapolation {
-    if own == Extrapolation::Error {
-        default
-    } else {
-        own
-    }
+    if own == Extrapolation::Error { default } else { own }
 }
 
 fn check_finite(what: &str, values: &[f64]) -> Result<(), SpectralError> {

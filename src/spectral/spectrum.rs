@@ -38,44 +38,22 @@ impl Spectrum {
     /// assert_eq!(s.value_at(450.0, Extrapolation::Error).unwrap(), 2.0);
     /// assert!(s.value_at(600.0, Extrapolation::Error).is_err());
     /// ```
-    pub fn new(
-        name: impl Into<String>,
-        wavelength_nm: Vec<f64>,
-        values: Vec<f64>,
-    ) -> Result<Self, SpectralError> {
+    pub fn new(name: impl Into<String>, wavelength_nm: Vec<f64>, values: Vec<f64>) -> Result<Self, SpectralError> {
         let name = name.into();
-        let bad = |message: String| SpectralError::BadSpectrum {
-            name: name.clone(),
-            message,
-        };
+        let bad = |message: String| SpectralError::BadSpectrum { name: name.clone(), message };
         if wavelength_nm.len() != values.len() {
-            return Err(bad(format!(
-                "{} wavelengths but {} values",
-                wavelength_nm.len(),
-                values.len()
-            )));
+            return Err(bad(format!("{} wavelengths but {} values", wavelength_nm.len(), values.len())));
         }
         if wavelength_nm.len() < 2 {
             return Err(bad("needs at least two points".into()));
         }
         if let Some(p) = wavelength_nm.windows(2).find(|p| !(p[1] > p[0])) {
-            return Err(bad(format!(
-                "wavelengths must increase strictly ({} then {})",
-                p[0], p[1]
-            )));
+            return Err(bad(format!("wavelengths must increase strictly ({} then {})", p[0], p[1])));
         }
-        if let Some((w, v)) = wavelength_nm
-            .iter()
-            .zip(&values)
-            .find(|(_, v)| !v.is_finite())
-        {
+        if let Some((w, v)) = wavelength_nm.iter().zip(&values).find(|(_, v)| !v.is_finite()) {
             return Err(bad(format!("value at {w} nm is {v}")));
         }
-        Ok(Self {
-            name,
-            wavelength_nm,
-            values,
-        })
+        Ok(Self { name, wavelength_nm, values })
     }
 
     /// Column `column` of `table` against its `wavelength_nm` column. Rows holding the
@@ -83,11 +61,7 @@ impl Spectrum {
     pub fn from_table(table: &Table, column: &str) -> Result<Self, SpectralError> {
         let wl = table.column_f64("wavelength_nm")?;
         let v = table.column_f64(column)?;
-        let (wl, v): (Vec<f64>, Vec<f64>) = wl
-            .into_iter()
-            .zip(v)
-            .filter(|(_, v)| (*v - -999.0).abs() > 1e-9)
-            .unzip();
+        let (wl, v): (Vec<f64>, Vec<f64>) = wl.into_iter().zip(v).filter(|(_, v)| (*v - -999.0).abs() > 1e-9).unzip();
         Self::new(format!("{}:{column}", table.source), wl, v)
     }
 
@@ -104,39 +78,26 @@ impl Spectrum {
     /// Wavelength range covered, nm.
     #[must_use]
     pub fn range_nm(&self) -> (f64, f64) {
-        (
-            self.wavelength_nm[0],
-            self.wavelength_nm[self.wavelength_nm.len() - 1],
-        )
+        (self.wavelength_nm[0], self.wavelength_nm[self.wavelength_nm.len() - 1])
     }
 
     /// Linear interpolation at `wavelength_nm`.
-    pub fn value_at(
-        &self,
-        wavelength_nm: f64,
-        extrapolation: Extrapolation,
-    ) -> Result<f64, SpectralError> {
+    pub fn value_at(&self, wavelength_nm: f64, extrapolation: Extrapolation) -> Result<f64, SpectralError> {
         let (lo, hi) = self.range_nm();
         // Tolerate a rounding hair outside the range (grids built by repeated addition).
         let eps = 1e-9 * hi.abs();
         if wavelength_nm < lo - eps || wavelength_nm > hi + eps || wavelength_nm.is_nan() {
             return match extrapolation {
-                Extrapolation::Error => Err(SpectralError::OutOfRange {
-                    name: self.name.clone(),
-                    wavelength_nm,
-                    min_nm: lo,
-                    max_nm: hi,
-                }),
+                Extrapolation::Error => {
+                    Err(SpectralError::OutOfRange { name: self.name.clone(), wavelength_nm, min_nm: lo, max_nm: hi })
+                }
                 Extrapolation::Zero => Ok(0.0),
                 Extrapolation::Clamp if wavelength_nm < lo => Ok(self.values[0]),
                 Extrapolation::Clamp => Ok(self.values[self.values.len() - 1]),
             };
         }
         let x = wavelength_nm.clamp(lo, hi);
-        let j = self
-            .wavelength_nm
-            .partition_point(|&w| w <= x)
-            .clamp(1, self.wavelength_nm.len() - 1);
+        let j = self.wavelength_nm.partition_point(|&w| w <= x).clamp(1, self.wavelength_nm.len() - 1);
         let (x0, x1) = (self.wavelength_nm[j - 1], self.wavelength_nm[j]);
         let (y0, y1) = (self.values[j - 1], self.values[j]);
         let t = (x - x0) / (x1 - x0);
@@ -144,15 +105,8 @@ impl Spectrum {
     }
 
     /// Values on every wavelength of `grid`.
-    pub fn resample(
-        &self,
-        grid: &WavelengthGrid,
-        extrapolation: Extrapolation,
-    ) -> Result<Vec<f64>, SpectralError> {
-        grid.wavelengths_nm()
-            .iter()
-            .map(|&w| self.value_at(w, extrapolation))
-            .collect()
+    pub fn resample(&self, grid: &WavelengthGrid, extrapolation: Extrapolation) -> Result<Vec<f64>, SpectralError> {
+        grid.wavelengths_nm().iter().map(|&w| self.value_at(w, extrapolation)).collect()
     }
 
     /// The spectrum with every value multiplied by `factor`.
@@ -190,13 +144,7 @@ mod tests {
     #[test]
     fn out_of_range_message_names_spectrum_and_range() {
         let s = Spectrum::new("a_w", vec![400.0, 700.0], vec![0.0, 1.0]).unwrap();
-        let e = s
-            .value_at(900.0, Extrapolation::Error)
-            .unwrap_err()
-            .to_string();
-        assert!(
-            e.contains("a_w") && e.contains("400") && e.contains("700") && e.contains("900"),
-            "{e}"
-        );
+        let e = s.value_at(900.0, Extrapolation::Error).unwrap_err().to_string();
+        assert!(e.contains("a_w") && e.contains("400") && e.contains("700") && e.contains("900"), "{e}");
     }
 }

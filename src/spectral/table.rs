@@ -40,11 +40,7 @@ impl Table {
                         return Err(SpectralError::Table {
                             origin: source.to_string(),
                             line: line_no,
-                            message: format!(
-                                "row has {} cells but the header has {} columns",
-                                cells.len(),
-                                h.len()
-                            ),
+                            message: format!("row has {} cells but the header has {} columns", cells.len(), h.len()),
                         });
                     }
                     rows.push((line_no, cells));
@@ -56,11 +52,7 @@ impl Table {
             line: 0,
             message: "no header row (expected e.g. `wavelength_nm,value`)".into(),
         })?;
-        Ok(Self {
-            source: source.to_string(),
-            columns,
-            rows,
-        })
+        Ok(Self { source: source.to_string(), columns, rows })
     }
 
     /// Parse an embedded asset (path relative to `assets/`).
@@ -74,10 +66,8 @@ impl Table {
 
     /// Read a table from a file on disk.
     pub fn from_file(path: &std::path::Path) -> Result<Self, SpectralError> {
-        let text = std::fs::read_to_string(path).map_err(|e| SpectralError::Io {
-            path: path.display().to_string(),
-            message: e.to_string(),
-        })?;
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| SpectralError::Io { path: path.display().to_string(), message: e.to_string() })?;
         Self::parse(&text, &path.display().to_string())
     }
 
@@ -95,24 +85,17 @@ impl Table {
 
     /// Index of column `name`, or an error listing the columns there are.
     pub fn column_index(&self, name: &str) -> Result<usize, SpectralError> {
-        self.columns
-            .iter()
-            .position(|c| c == name)
-            .ok_or_else(|| SpectralError::UnknownColumn {
-                origin: self.source.clone(),
-                column: name.to_string(),
-                known: self.columns.join(", "),
-            })
+        self.columns.iter().position(|c| c == name).ok_or_else(|| SpectralError::UnknownColumn {
+            origin: self.source.clone(),
+            column: name.to_string(),
+            known: self.columns.join(", "),
+        })
     }
 
     /// Column `name` as text cells.
     pub fn column_str(&self, name: &str) -> Result<Vec<&str>, SpectralError> {
         let i = self.column_index(name)?;
-        Ok(self
-            .rows
-            .iter()
-            .map(|(_, cells)| cells[i].as_str())
-            .collect())
+        Ok(self.rows.iter().map(|(_, cells)| cells[i].as_str()).collect())
     }
 
     /// Column `name` as numbers; a cell that is not a finite number is an error naming its line.
@@ -122,14 +105,11 @@ impl Table {
             .iter()
             .map(|(line, cells)| {
                 let cell = &cells[i];
-                cell.parse::<f64>()
-                    .ok()
-                    .filter(|v| v.is_finite())
-                    .ok_or_else(|| SpectralError::Table {
-                        origin: self.source.clone(),
-                        line: *line,
-                        message: format!("column `{name}`: `{cell}` is not a finite number"),
-                    })
+                cell.parse::<f64>().ok().filter(|v| v.is_finite()).ok_or_else(|| SpectralError::Table {
+                    origin: self.source.clone(),
+                    line: *line,
+                    message: format!("column `{name}`: `{cell}` is not a finite number"),
+                })
             })
             .collect()
     }
@@ -141,12 +121,7 @@ impl Table {
         Self {
             source: self.source.clone(),
             columns: self.columns.clone(),
-            rows: self
-                .rows
-                .iter()
-                .filter(|(_, c)| c[key_index] == value)
-                .cloned()
-                .collect(),
+            rows: self.rows.iter().filter(|(_, c)| c[key_index] == value).cloned().collect(),
         }
     }
 }

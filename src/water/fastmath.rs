@@ -17,8 +17,10 @@
 //!   computer. Proc. Western Joint IRE-AIEE-ACM Computer Conference, 33–40.
 
 const LOG2_E: f64 = std::f64::consts::LOG2_E;
-const LN2_HI: f64 = 6.931_471_803_691_238_164_90e-1;
-const LN2_LO: f64 = 1.908_214_929_270_587_700_02e-10;
+// Cody–Waite split of ln 2 (fdlibm's e_exp.c values): LN2_HI has trailing zero bits so that
+// k·LN2_HI is exact for |k| < 2¹¹.
+const LN2_HI: f64 = 6.931_471_803_691_238e-1;
+const LN2_LO: f64 = 1.908_214_929_270_587_7e-10;
 /// 1.5·2⁵²: adding it rounds to an integer held in the low mantissa bits.
 const SHIFT: f64 = 6_755_399_441_055_744.0;
 
@@ -31,7 +33,7 @@ const SHIFT: f64 = 6_755_399_441_055_744.0;
 #[inline(always)]
 #[must_use]
 pub fn fast_exp(x: f64) -> f64 {
-    let x = x.max(-708.0).min(709.0);
+    let x = x.clamp(-708.0, 709.0);
     let t = x * LOG2_E + SHIFT;
     let k = t - SHIFT;
     let r = (x - k * LN2_HI) - k * LN2_LO;

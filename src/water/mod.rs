@@ -36,8 +36,7 @@ mod substrate;
 
 pub use fastmath::fast_exp;
 pub use model::{
-    Bottom, WaterColumn, WaterGeometry, WaterModel, WaterReflectance, rrs_above_from_below,
-    rrs_below_from_above,
+    Bottom, WaterColumn, WaterGeometry, WaterModel, WaterReflectance, rrs_above_from_below, rrs_below_from_above,
 };
 pub use siop::{Siop, SiopSpec};
 pub use substrate::{SubstrateEntry, SubstrateLibrary, SubstrateMix};

@@ -45,18 +45,12 @@ impl WaterGeometry {
     /// Geometry from angles in degrees (the edge unit).
     #[must_use]
     pub fn from_degrees(sun_zenith_deg: f64, view_zenith_deg: f64) -> Self {
-        Self {
-            sun_zenith_rad: sun_zenith_deg.to_radians(),
-            view_zenith_rad: view_zenith_deg.to_radians(),
-        }
+        Self { sun_zenith_rad: sun_zenith_deg.to_radians(), view_zenith_rad: view_zenith_deg.to_radians() }
     }
 
     /// Check both angles lie in [0, 90°).
     pub fn validate(&self) -> Result<(), WaterError> {
-        for (field, v) in [
-            ("sun_zenith", self.sun_zenith_rad),
-            ("view_zenith", self.view_zenith_rad),
-        ] {
+        for (field, v) in [("sun_zenith", self.sun_zenith_rad), ("view_zenith", self.view_zenith_rad)] {
             if !(v.is_finite() && (0.0..limits::MAX_ZENITH_RAD).contains(&v)) {
                 return Err(WaterError::OutOfRange {
                     field: format!("{field} (deg)"),
@@ -86,26 +80,13 @@ impl WaterColumn<'_> {
             if v.is_finite() && (0.0..=max).contains(&v) {
                 Ok(())
             } else {
-                Err(WaterError::OutOfRange {
-                    field: field.into(),
-                    value: v,
-                    allowed: format!("0 to {max} {unit}"),
-                })
+                Err(WaterError::OutOfRange { field: field.into(), value: v, allowed: format!("0 to {max} {unit}") })
             }
         };
-        check(
-            "chl (mg m-3)",
-            self.chl_mg_m3,
-            limits::MAX_CHL_MG_M3,
-            "mg m-3",
-        )?;
+        check("chl (mg m-3)", self.chl_mg_m3, limits::MAX_CHL_MG_M3, "mg m-3")?;
         check("cdom (m-1)", self.cdom_per_m, limits::MAX_CDOM_PER_M, "m-1")?;
         check("nap (g m-3)", self.nap_g_m3, limits::MAX_NAP_G_M3, "g m-3")?;
-        if let Bottom::Shallow {
-            depth_m,
-            reflectance,
-        } = self.bottom
-        {
+        if let Bottom::Shallow { depth_m, reflectance } = self.bottom {
             if !(depth_m.is_finite() && depth_m > 0.0 && depth_m <= limits::MAX_DEPTH_M) {
                 return Err(WaterError::OutOfRange {
                     field: "depth (m)".into(),
@@ -120,10 +101,7 @@ impl WaterColumn<'_> {
                     allowed: format!("{n_wavelengths} values, one per grid wavelength"),
                 });
             }
-            if let Some(r) = reflectance
-                .iter()
-                .find(|r| !(r.is_finite() && (0.0..=1.0).contains(*r)))
-            {
+            if let Some(r) = reflectance.iter().find(|r| !(r.is_finite() && (0.0..=1.0).contains(*r))) {
                 return Err(WaterError::OutOfRange {
                     field: "substrate reflectance".into(),
                     value: *r,
@@ -259,11 +237,7 @@ impl WaterModel {
     /// - κ = a + bb ; u = bb/κ ; rrs_dp = (0.084 + 0.170u)u
     /// - D_u^C = 1.03(1 + 2.4u)^½ ; D_u^B = 1.04(1 + 5.4u)^½
     /// - rrs = rrs_dp[1 − e^{−(1/cosθ_w + D_u^C/cosθ_o)κH}] + (ρ_b/π) e^{−(1/cosθ_w + D_u^B/cosθ_o)κH}
-    pub fn evaluate(
-        &self,
-        column: &WaterColumn<'_>,
-        geometry: &WaterGeometry,
-    ) -> Result<WaterReflectance, WaterError> {
+    pub fn evaluate(&self, column: &WaterColumn<'_>, geometry: &WaterGeometry) -> Result<WaterReflectance, WaterError> {
         let s = &self.siop;
         let n = s.grid.len();
         column.validate(n)?;
@@ -276,9 +250,7 @@ impl WaterModel {
         let a_nap = scale(&s.a_nap_star, nap);
         let bb_ph = scale(&s.bb_ph_star, chl);
         let bb_nap = scale(&s.bb_nap_star, nap);
-        let a: Vec<f64> = (0..n)
-            .map(|i| s.a_w[i] + a_ph[i] + a_cdom[i] + a_nap[i])
-            .collect();
+        let a: Vec<f64> = (0..n).map(|i| s.a_w[i] + a_ph[i] + a_cdom[i] + a_nap[i]).collect();
         let bb: Vec<f64> = (0..n).map(|i| s.bb_w[i] + bb_ph[i] + bb_nap[i]).collect();
         if let Some(i) = (0..n).find(|&i| !(a[i] > 0.0 && bb[i] > 0.0)) {
             return Err(self.non_physical(i, a[i], bb[i]));
@@ -289,22 +261,11 @@ impl WaterModel {
         let du_b: Vec<f64> = u.iter().map(|u| 1.04 * (1.0 + 5.4 * u).sqrt()).collect();
         let rrs_deep: Vec<f64> = u.iter().map(|u| (0.084 + 0.17 * u) * u).collect();
         let kd: Vec<f64> = kappa.iter().map(|k| k * inv_cos_w).collect();
-        let kuc: Vec<f64> = kappa
-            .iter()
-            .zip(&du_c)
-            .map(|(k, d)| k * d * inv_cos_o)
-            .collect();
-        let kub: Vec<f64> = kappa
-            .iter()
-            .zip(&du_b)
-            .map(|(k, d)| k * d * inv_cos_o)
-            .collect();
+        let kuc: Vec<f64> = kappa.iter().zip(&du_c).map(|(k, d)| k * d * inv_cos_o).collect();
+        let kub: Vec<f64> = kappa.iter().zip(&du_b).map(|(k, d)| k * d * inv_cos_o).collect();
         let (rrs, r_substratum) = match column.bottom {
             Bottom::OpticallyDeep => (rrs_deep.clone(), Vec::new()),
-            Bottom::Shallow {
-                depth_m,
-                reflectance,
-            } => {
+            Bottom::Shallow { depth_m, reflectance } => {
                 let rrs = (0..n)
                     .map(|i| {
                         let kh = kappa[i] * depth_m;
@@ -373,17 +334,8 @@ impl WaterModel {
         };
         match column.bottom {
             Bottom::OpticallyDeep => k.deep(&mut out[..n]),
-            Bottom::Shallow {
-                depth_m,
-                reflectance,
-            } => {
-                k.shallow(
-                    depth_m,
-                    inv_cos_w,
-                    inv_cos_o,
-                    &reflectance[..n],
-                    &mut out[..n],
-                );
+            Bottom::Shallow { depth_m, reflectance } => {
+                k.shallow(depth_m, inv_cos_w, inv_cos_o, &reflectance[..n], &mut out[..n]);
             }
         }
         // Only a SIOP set with strongly negative specific spectra can produce a ≤ 0; find where.
@@ -423,10 +375,7 @@ struct Kernel<'a> {
 
 impl Kernel<'_> {
     fn absorption(&self, i: usize) -> f64 {
-        self.a_w[i]
-            + self.chl * self.a_ph[i]
-            + self.cdom * self.a_cdom[i]
-            + self.nap * self.a_nap[i]
+        self.a_w[i] + self.chl * self.a_ph[i] + self.cdom * self.a_cdom[i] + self.nap * self.a_nap[i]
     }
 
     fn deep(&self, out: &mut [f64]) {
@@ -466,14 +415,7 @@ mod avx2 {
     }
 
     #[target_feature(enable = "avx2,fma")]
-    fn shallow_avx2(
-        k: &Kernel<'_>,
-        depth_m: f64,
-        inv_cos_w: f64,
-        inv_cos_o: f64,
-        rb: &[f64],
-        out: &mut [f64],
-    ) {
+    fn shallow_avx2(k: &Kernel<'_>, depth_m: f64, inv_cos_w: f64, inv_cos_o: f64, rb: &[f64], out: &mut [f64]) {
         shallow_kernel(k, depth_m, inv_cos_w, inv_cos_o, rb, out);
     }
 
@@ -486,14 +428,7 @@ mod avx2 {
         }
     }
 
-    pub fn shallow(
-        k: &Kernel<'_>,
-        depth_m: f64,
-        inv_cos_w: f64,
-        inv_cos_o: f64,
-        rb: &[f64],
-        out: &mut [f64],
-    ) {
+    pub fn shallow(k: &Kernel<'_>, depth_m: f64, inv_cos_w: f64, inv_cos_o: f64, rb: &[f64], out: &mut [f64]) {
         debug_assert!(available());
         // SAFETY: callers check `available()`: the CPU executes AVX2 and FMA instructions.
         #[allow(unsafe_code)]
@@ -508,15 +443,8 @@ mod avx2 {
 #[inline(always)]
 fn deep_kernel(k: &Kernel<'_>, out: &mut [f64]) {
     let n = out.len();
-    let (a_w, bb_w, a_ph, a_cdom, a_nap, bb_ph, bb_nap) = (
-        &k.a_w[..n],
-        &k.bb_w[..n],
-        &k.a_ph[..n],
-        &k.a_cdom[..n],
-        &k.a_nap[..n],
-        &k.bb_ph[..n],
-        &k.bb_nap[..n],
-    );
+    let (a_w, bb_w, a_ph, a_cdom, a_nap, bb_ph, bb_nap) =
+        (&k.a_w[..n], &k.bb_w[..n], &k.a_ph[..n], &k.a_cdom[..n], &k.a_nap[..n], &k.bb_ph[..n], &k.bb_nap[..n]);
     let (chl, cdom, nap) = (k.chl, k.cdom, k.nap);
     for i in 0..n {
         let a = a_w[i] + chl * a_ph[i] + cdom * a_cdom[i] + nap * a_nap[i];
@@ -528,14 +456,7 @@ fn deep_kernel(k: &Kernel<'_>, out: &mut [f64]) {
 
 /// Shallow-water Rrs (Lee et al. 1999 eq. 5 with the SAMBUCA attenuation factors).
 #[inline(always)]
-fn shallow_kernel(
-    k: &Kernel<'_>,
-    depth_m: f64,
-    inv_cos_w: f64,
-    inv_cos_o: f64,
-    rb: &[f64],
-    out: &mut [f64],
-) {
+fn shallow_kernel(k: &Kernel<'_>, depth_m: f64, inv_cos_w: f64, inv_cos_o: f64, rb: &[f64], out: &mut [f64]) {
     let n = out.len();
     let (a_w, bb_w, a_ph, a_cdom, a_nap, bb_ph, bb_nap, rb) = (
         &k.a_w[..n],

@@ -19,6 +19,7 @@ fn default_refractive_index() -> f64 {
 /// at the CDOM reference wavelength `cdom_per_m` (m⁻¹; 440 nm in Shoal's presets, 550 nm in
 /// SAMBUCA's defaults), non-algal particles `nap_g_m3` (g m⁻³ = mg L⁻¹).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct SiopSpec {
     /// Short name (`"heron_island"`).
     pub name: String,
@@ -48,18 +49,13 @@ impl SiopSpec {
     /// Read a SIOP set from RON text; `origin` names the file in errors and `base_dir`
     /// resolves relative CSV paths.
     pub fn from_ron(text: &str, origin: &str) -> Result<Self, WaterError> {
-        ron::from_str(text).map_err(|e| WaterError::Parse {
-            origin: origin.to_string(),
-            message: e.to_string(),
-        })
+        ron::from_str(text).map_err(|e| WaterError::Parse { origin: origin.to_string(), message: e.to_string() })
     }
 
     /// Read a SIOP set from a RON file.
     pub fn from_file(path: &Path) -> Result<Self, WaterError> {
-        let text = std::fs::read_to_string(path).map_err(|e| WaterError::Parse {
-            origin: path.display().to_string(),
-            message: e.to_string(),
-        })?;
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| WaterError::Parse { origin: path.display().to_string(), message: e.to_string() })?;
         Self::from_ron(&text, &path.display().to_string())
     }
 
@@ -76,9 +72,7 @@ impl SiopSpec {
         let y = 0.878_138;
         Self {
             name: "sambuca_default".into(),
-            description:
-                "SAMBUCA (sambuca_core 1.2.3) default SIOPs: Wallis Lake 2008 a*_ph, lw2002 a_w"
-                    .into(),
+            description: "SAMBUCA (sambuca_core 1.2.3) default SIOPs: Wallis Lake 2008 a*_ph, lw2002 a_w".into(),
             water_absorption: SpectrumSource::Asset {
                 file: "water/sambuca_aw_350_900_lw2002.csv".into(),
                 column: "a_water".into(),
@@ -112,11 +106,7 @@ impl SiopSpec {
                 reference_nm: 550.0,
                 slope_per_nm: 0.009_772_62,
             },
-            nap_backscatter: SpectrumSource::PowerLaw {
-                coefficient: 0.022_535_3,
-                reference_nm: 546.0,
-                exponent: y,
-            },
+            nap_backscatter: SpectrumSource::PowerLaw { coefficient: 0.022_535_3, reference_nm: 546.0, exponent: y },
             water_refractive_index: 1.337_84,
         }
     }
@@ -150,11 +140,7 @@ impl SiopSpec {
         names.extend(
             crate::assets::PRESETS
                 .iter()
-                .filter_map(|a| {
-                    a.path
-                        .strip_prefix("siop/")
-                        .and_then(|p| p.strip_suffix(".ron"))
-                })
+                .filter_map(|a| a.path.strip_prefix("siop/").and_then(|p| p.strip_suffix(".ron")))
                 .map(str::to_string),
         );
         names
@@ -165,11 +151,7 @@ impl SiopSpec {
     /// pure water). Specific spectra may dip slightly below zero: measured a*_ph spectra carry
     /// noise in the near-infrared (SAMBUCA's Wallis Lake spectrum reaches −4·10⁻⁴ m² mg⁻¹ at
     /// 749 nm) and SAMBUCA uses them as they are; the model checks a > 0 per evaluation.
-    pub fn resolve(
-        &self,
-        grid: &WavelengthGrid,
-        base_dir: Option<&Path>,
-    ) -> Result<Siop, WaterError> {
+    pub fn resolve(&self, grid: &WavelengthGrid, base_dir: Option<&Path>) -> Result<Siop, WaterError> {
         let n = self.water_refractive_index;
         if !(n.is_finite() && (1.0..=1.5).contains(&n)) {
             return Err(WaterError::OutOfRange {
@@ -179,25 +161,16 @@ impl SiopSpec {
             });
         }
         let take = |field: &str, src: &SpectrumSource, min: f64| -> Result<Vec<f64>, WaterError> {
-            let v = src
-                .sample(grid, Extrapolation::Error, base_dir)
-                .map_err(|e| WaterError::Siop {
-                    set: self.name.clone(),
-                    field: field.into(),
-                    message: e.to_string(),
-                })?;
-            if let Some((i, x)) = v
-                .iter()
-                .enumerate()
-                .find(|(_, x)| !(x.is_finite() && **x >= min))
-            {
+            let v = src.sample(grid, Extrapolation::Error, base_dir).map_err(|e| WaterError::Siop {
+                set: self.name.clone(),
+                field: field.into(),
+                message: e.to_string(),
+            })?;
+            if let Some((i, x)) = v.iter().enumerate().find(|(_, x)| !(x.is_finite() && **x >= min)) {
                 return Err(WaterError::Siop {
                     set: self.name.clone(),
                     field: field.into(),
-                    message: format!(
-                        "value {x} at {} nm; must be finite and ≥ {min}",
-                        grid.wavelength_nm(i)
-                    ),
+                    message: format!("value {x} at {} nm; must be finite and ≥ {min}", grid.wavelength_nm(i)),
                 });
             }
             Ok(v)
@@ -209,16 +182,8 @@ impl SiopSpec {
             grid: grid.clone(),
             a_w: take("water_absorption", &self.water_absorption, 0.0)?,
             bb_w: take("water_backscatter", &self.water_backscatter, 0.0)?,
-            a_ph_star: take(
-                "phytoplankton_absorption",
-                &self.phytoplankton_absorption,
-                noise,
-            )?,
-            bb_ph_star: take(
-                "phytoplankton_backscatter",
-                &self.phytoplankton_backscatter,
-                noise,
-            )?,
+            a_ph_star: take("phytoplankton_absorption", &self.phytoplankton_absorption, noise)?,
+            bb_ph_star: take("phytoplankton_backscatter", &self.phytoplankton_backscatter, noise)?,
             a_cdom_star: take("cdom_absorption", &self.cdom_absorption, noise)?,
             a_nap_star: take("nap_absorption", &self.nap_absorption, noise)?,
             bb_nap_star: take("nap_backscatter", &self.nap_backscatter, noise)?,
@@ -228,10 +193,7 @@ impl SiopSpec {
             return Err(WaterError::Siop {
                 set: self.name.clone(),
                 field: "water_backscatter".into(),
-                message: format!(
-                    "must be > 0 (pure water scatters) but is 0 at {} nm",
-                    grid.wavelength_nm(i)
-                ),
+                message: format!("must be > 0 (pure water scatters) but is 0 at {} nm", grid.wavelength_nm(i)),
             });
         }
         Ok(siop)

@@ -23,108 +23,23 @@ pub struct SubstrateEntry {
 
 /// Embedded substrate spectra: (name, asset file, column, description).
 const EMBEDDED: &[(&str, &str, &str, &str)] = &[
-    (
-        "acropora",
-        "benthic/sambuca_HI_3.csv",
-        "Acropora",
-        "Heron Island Acropora coral (SAMBUCA HI_3)",
-    ),
-    (
-        "sand",
-        "benthic/sambuca_HI_3.csv",
-        "sand",
-        "Heron Island coralline sand (SAMBUCA HI_3)",
-    ),
-    (
-        "turf_algae",
-        "benthic/sambuca_HI_3.csv",
-        "Turf Algae",
-        "Heron Island turf algae (SAMBUCA HI_3)",
-    ),
-    (
-        "seagrass",
-        "benthic/sambuca_NCC_3subs.csv",
-        "cymodocea.txt:C2",
-        "Cymodocea seagrass (SAMBUCA NCC_3subs)",
-    ),
-    (
-        "brown_acropora",
-        "benthic/sambuca_NCC_3subs.csv",
-        "brown_acropora",
-        "brown Acropora (SAMBUCA NCC_3subs)",
-    ),
-    (
-        "ncc_sand",
-        "benthic/sambuca_NCC_3subs.csv",
-        "sand",
-        "sand (SAMBUCA NCC_3subs)",
-    ),
-    (
-        "mb_white_sand",
-        "benthic/sambuca_Moreton_Bay.csv",
-        "white Sand",
-        "Moreton Bay white sand (SAMBUCA)",
-    ),
-    (
-        "mb_brown_mud",
-        "benthic/sambuca_Moreton_Bay.csv",
-        "brown Mud",
-        "Moreton Bay brown mud (SAMBUCA)",
-    ),
-    (
-        "mb_zostera",
-        "benthic/sambuca_Moreton_Bay.csv",
-        "Zostera muelleri",
-        "Moreton Bay Zostera muelleri (SAMBUCA)",
-    ),
-    (
-        "mb_green_algae",
-        "benthic/sambuca_Moreton_Bay.csv",
-        "green algae",
-        "Moreton Bay green algae (SAMBUCA)",
-    ),
-    (
-        "wl_bright_sand",
-        "benthic/sambuca_WL5_2008.csv",
-        "bright sand",
-        "Wallis Lake bright sand (SAMBUCA WL5_2008)",
-    ),
-    (
-        "wl_posidonia",
-        "benthic/sambuca_WL5_2008.csv",
-        "Posidonia",
-        "Wallis Lake Posidonia (SAMBUCA WL5_2008)",
-    ),
-    (
-        "wasi_sand",
-        "benthic/benthic_reflectance.csv",
-        "sand",
-        "sand, ASU in-water ASD (WASI6 R_b)",
-    ),
-    (
-        "wasi_coral",
-        "benthic/benthic_reflectance.csv",
-        "coral",
-        "coral, ASU in-water ASD (WASI6 R_b)",
-    ),
-    (
-        "wasi_cca",
-        "benthic/benthic_reflectance.csv",
-        "cca",
-        "crustose coralline algae (WASI6 R_b)",
-    ),
-    (
-        "wasi_macroalgae",
-        "benthic/benthic_reflectance.csv",
-        "macroalgae",
-        "macroalgae (WASI6 R_b)",
-    ),
-    (
-        "wasi_seagrass",
-        "benthic/benthic_reflectance.csv",
-        "seagrass",
-        "Zostera marina seagrass (WASI6 R_b)",
-    ),
+    ("acropora", "benthic/sambuca_HI_3.csv", "Acropora", "Heron Island Acropora coral (SAMBUCA HI_3)"),
+    ("sand", "benthic/sambuca_HI_3.csv", "sand", "Heron Island coralline sand (SAMBUCA HI_3)"),
+    ("turf_algae", "benthic/sambuca_HI_3.csv", "Turf Algae", "Heron Island turf algae (SAMBUCA HI_3)"),
+    ("seagrass", "benthic/sambuca_NCC_3subs.csv", "cymodocea.txt:C2", "Cymodocea seagrass (SAMBUCA NCC_3subs)"),
+    ("brown_acropora", "benthic/sambuca_NCC_3subs.csv", "brown_acropora", "brown Acropora (SAMBUCA NCC_3subs)"),
+    ("ncc_sand", "benthic/sambuca_NCC_3subs.csv", "sand", "sand (SAMBUCA NCC_3subs)"),
+    ("mb_white_sand", "benthic/sambuca_Moreton_Bay.csv", "white Sand", "Moreton Bay white sand (SAMBUCA)"),
+    ("mb_brown_mud", "benthic/sambuca_Moreton_Bay.csv", "brown Mud", "Moreton Bay brown mud (SAMBUCA)"),
+    ("mb_zostera", "benthic/sambuca_Moreton_Bay.csv", "Zostera muelleri", "Moreton Bay Zostera muelleri (SAMBUCA)"),
+    ("mb_green_algae", "benthic/sambuca_Moreton_Bay.csv", "green algae", "Moreton Bay green algae (SAMBUCA)"),
+    ("wl_bright_sand", "benthic/sambuca_WL5_2008.csv", "bright sand", "Wallis Lake bright sand (SAMBUCA WL5_2008)"),
+    ("wl_posidonia", "benthic/sambuca_WL5_2008.csv", "Posidonia", "Wallis Lake Posidonia (SAMBUCA WL5_2008)"),
+    ("wasi_sand", "benthic/benthic_reflectance.csv", "sand", "sand, ASU in-water ASD (WASI6 R_b)"),
+    ("wasi_coral", "benthic/benthic_reflectance.csv", "coral", "coral, ASU in-water ASD (WASI6 R_b)"),
+    ("wasi_cca", "benthic/benthic_reflectance.csv", "cca", "crustose coralline algae (WASI6 R_b)"),
+    ("wasi_macroalgae", "benthic/benthic_reflectance.csv", "macroalgae", "macroalgae (WASI6 R_b)"),
+    ("wasi_seagrass", "benthic/benthic_reflectance.csv", "seagrass", "Zostera marina seagrass (WASI6 R_b)"),
 ];
 
 /// Short names accepted for convenience.
@@ -162,11 +77,7 @@ impl SubstrateLibrary {
     /// named by its column header (lower-cased).
     pub fn add_csv(&mut self, path: &Path) -> Result<(), WaterError> {
         let table = Table::from_file(path)?;
-        for column in table
-            .columns
-            .iter()
-            .filter(|c| c.as_str() != "wavelength_nm")
-        {
+        for column in table.columns.iter().filter(|c| c.as_str() != "wavelength_nm") {
             let spectrum = Spectrum::from_table(&table, column)?;
             let name = column.to_ascii_lowercase();
             self.entries.retain(|e| e.name != name);
@@ -182,18 +93,12 @@ impl SubstrateLibrary {
     /// The entry called `name` (case-insensitive; `coral` and `algae` are aliases).
     pub fn get(&self, name: &str) -> Result<&SubstrateEntry, WaterError> {
         let lower = name.trim().to_ascii_lowercase();
-        let key = ALIASES
-            .iter()
-            .find(|(a, _)| *a == lower)
-            .map_or(lower.as_str(), |(_, t)| t);
-        self.entries
-            .iter()
-            .find(|e| e.name == key)
-            .ok_or_else(|| WaterError::UnknownName {
-                field: "substrate".into(),
-                name: name.to_string(),
-                known: self.names().join(", "),
-            })
+        let key = ALIASES.iter().find(|(a, _)| *a == lower).map_or(lower.as_str(), |(_, t)| t);
+        self.entries.iter().find(|e| e.name == key).ok_or_else(|| WaterError::UnknownName {
+            field: "substrate".into(),
+            name: name.to_string(),
+            known: self.names().join(", "),
+        })
     }
 
     /// All names, in library order.
@@ -209,19 +114,15 @@ impl SubstrateLibrary {
     }
 
     /// Reflectance of a mixture on `grid`: ρ_b = Σ fᵢ ρᵢ (linear areal mixing, as in SAMBUCA).
-    pub fn mix_on_grid(
-        &self,
-        mix: &SubstrateMix,
-        grid: &WavelengthGrid,
-    ) -> Result<Vec<f64>, WaterError> {
+    /// Measured spectra carry noise that dips below zero where the bottom is dark (HI_3
+    /// Acropora reaches −3·10⁻⁴ in the near-infrared); a reflectance cannot be negative, so such
+    /// values count as 0.
+    pub fn mix_on_grid(&self, mix: &SubstrateMix, grid: &WavelengthGrid) -> Result<Vec<f64>, WaterError> {
         let mut out = vec![0.0; grid.len()];
         for (name, fraction) in &mix.parts {
-            let r = self
-                .get(name)?
-                .spectrum
-                .resample(grid, Extrapolation::Clamp)?;
+            let r = self.get(name)?.spectrum.resample(grid, Extrapolation::Clamp)?;
             for (o, v) in out.iter_mut().zip(r) {
-                *o += fraction * v;
+                *o += fraction * v.max(0.0);
             }
         }
         Ok(out)
@@ -252,14 +153,11 @@ impl SubstrateMix {
             .map(|part| match part.split_once(':') {
                 None => Ok((part.trim().to_string(), 1.0)),
                 Some((name, f)) => {
-                    let value = f
-                        .trim()
-                        .parse::<f64>()
-                        .map_err(|_| WaterError::OutOfRange {
-                            field: format!("substrate fraction of `{}`", name.trim()),
-                            value: f64::NAN,
-                            allowed: format!("a number from 0 to 1 (got `{}`)", f.trim()),
-                        })?;
+                    let value = f.trim().parse::<f64>().map_err(|_| WaterError::OutOfRange {
+                        field: format!("substrate fraction of `{}`", name.trim()),
+                        value: f64::NAN,
+                        allowed: format!("a number from 0 to 1 (got `{}`)", f.trim()),
+                    })?;
                     Ok((name.trim().to_string(), value))
                 }
             })

@@ -18,9 +18,7 @@ struct Case {
 
 impl Case {
     fn f(&self, key: &str) -> f64 {
-        self.values[key]
-            .parse()
-            .unwrap_or_else(|_| panic!("{}: {key} = {}", self.id, self.values[key]))
+        self.values[key].parse().unwrap_or_else(|_| panic!("{}: {key} = {}", self.id, self.values[key]))
     }
     fn s(&self, key: &str) -> &str {
         self.values[key].as_str()
@@ -45,12 +43,8 @@ fn cases() -> Vec<Case> {
             }
             cells.push(cur);
             assert_eq!(cells.len(), header.len(), "{line}");
-            let values: std::collections::HashMap<_, _> =
-                header.iter().map(|h| (*h).to_string()).zip(cells).collect();
-            Case {
-                id: values["case_id"].clone(),
-                values,
-            }
+            let values: std::collections::HashMap<_, _> = header.iter().map(|h| (*h).to_string()).zip(cells).collect();
+            Case { id: values["case_id"].clone(), values }
         })
         .collect()
 }
@@ -63,11 +57,7 @@ fn siop_for(case: &Case, inputs: &Table) -> SiopSpec {
         outside: Default::default(),
     };
     let y_ph = case.f("bb_ph_slope");
-    let y_nap = if case.s("bb_nap_slope").is_empty() {
-        y_ph
-    } else {
-        case.f("bb_nap_slope")
-    };
+    let y_nap = if case.s("bb_nap_slope").is_empty() { y_ph } else { case.f("bb_nap_slope") };
     SiopSpec {
         name: format!("sambuca case {}", case.id),
         description: String::new(),
@@ -110,25 +100,14 @@ fn substrate(case: &Case, inputs: &Table) -> Vec<f64> {
     }
     let r2 = col(case.s("substrate2"));
     let f = case.f("substrate_fraction");
-    r1.iter()
-        .zip(&r2)
-        .map(|(a, b)| f * a + (1.0 - f) * b)
-        .collect()
+    r1.iter().zip(&r2).map(|(a, b)| f * a + (1.0 - f) * b).collect()
 }
 
 fn assert_close(case: &str, column: &str, wl: &[f64], got: &[f64], want: &[f64]) {
     assert_eq!(got.len(), want.len(), "{case}/{column}: length");
     for ((l, g), w) in wl.iter().zip(got).zip(want) {
-        let ok = if *w == 0.0 {
-            g.abs() < 1e-300
-        } else {
-            ((g - w) / w).abs() <= 1e-6
-        };
-        assert!(
-            ok,
-            "{case}/{column} at {l} nm: shoal {g:e} vs SAMBUCA {w:e} (rel {:e})",
-            (g - w) / w
-        );
+        let ok = if *w == 0.0 { g.abs() < 1e-300 } else { ((g - w) / w).abs() <= 1e-6 };
+        assert!(ok, "{case}/{column} at {l} nm: shoal {g:e} vs SAMBUCA {w:e} (rel {:e})", (g - w) / w);
     }
 }
 
@@ -143,22 +122,14 @@ fn matches_sambuca_forward_model_on_every_case_and_column() {
     assert_eq!(all.len(), 11);
     for case in &all {
         let reference = spectra.filter_eq(case_col, &case.id);
-        assert_eq!(
-            reference.column_f64("wavelength_nm").unwrap(),
-            wl,
-            "{}: grid",
-            case.id
-        );
+        assert_eq!(reference.column_f64("wavelength_nm").unwrap(), wl, "{}: grid", case.id);
         let model = WaterModel::new(siop_for(case, &inputs).resolve(&grid, None).unwrap());
         let rb = substrate(case, &inputs);
         let column = WaterColumn {
             chl_mg_m3: case.f("chl"),
             cdom_per_m: case.f("cdom"),
             nap_g_m3: case.f("nap"),
-            bottom: Bottom::Shallow {
-                depth_m: case.f("depth"),
-                reflectance: &rb,
-            },
+            bottom: Bottom::Shallow { depth_m: case.f("depth"), reflectance: &rb },
         };
         let geometry = WaterGeometry::from_degrees(case.f("theta_air"), case.f("off_nadir"));
         let r = model.evaluate(&column, &geometry).unwrap();
@@ -188,29 +159,13 @@ fn matches_sambuca_forward_model_on_every_case_and_column() {
             ("bb_water", r.bb_w.clone()),
             ("Rrs_above_lee2002_OURS", r.rrs_above.clone()),
         ];
-        assert_eq!(
-            checks.len() + 2,
-            reference.columns.len(),
-            "every reference column is checked"
-        );
+        assert_eq!(checks.len() + 2, reference.columns.len(), "every reference column is checked");
         for (name, got) in &checks {
-            assert_close(
-                &case.id,
-                name,
-                &wl,
-                got,
-                &reference.column_f64(name).unwrap(),
-            );
+            assert_close(&case.id, name, &wl, got, &reference.column_f64(name).unwrap());
         }
         // The per-pixel fast path (vectorised exp) must agree as well.
         let mut fast = vec![0.0; wl.len()];
         model.rrs_above_into(&column, &geometry, &mut fast).unwrap();
-        assert_close(
-            &case.id,
-            "fast Rrs",
-            &wl,
-            &fast,
-            &reference.column_f64("Rrs_above_lee2002_OURS").unwrap(),
-        );
+        assert_close(&case.id, "fast Rrs", &wl, &fast, &reference.column_f64("Rrs_above_lee2002_OURS").unwrap());
     }
 }

@@ -1,0 +1,165 @@
+//! The `shoal` binary: outputs, exit codes and messages, as a user sees them.
+
+use std::process::Command;
+
+fn shoal(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_shoal"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("run shoal");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn rows(csv: &str) -> Vec<Vec<String>> {
+    csv.lines().map(|l| l.split(',').map(str::to_string).collect()).collect()
+}
+
+#[test]
+fn water_prints_every_intermediate_per_band() {
+    let (code, out, err) = shoal(&[
+        "water",
+        "--chl",
+        "10",
+        "--cdom",
+        "1",
+        "--nap",
+        "10",
+        "--depth",
+        "3",
+        "--substrate",
+        "sand:0.5,coral:0.5",
+        "--sun-zenith",
+        "60",
+        "--view-zenith",
+        "30",
+        "--bands",
+        "olci",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let r = rows(&out);
+    assert_eq!(r.len(), 20, "header + 19 OLCI bands");
+    for name in [
+        "a_per_m",
+        "bb_per_m",
+        "kd_per_m",
+        "kuc_per_m",
+        "kub_per_m",
+        "rrs_deep_per_sr",
+        "r_substratum",
+        "rrs_above_per_sr",
+    ] {
+        assert!(r[0].iter().any(|c| c == name), "missing {name}");
+    }
+    for row in &r[1..] {
+        for cell in &row[1..] {
+            let v: f64 = cell.parse().unwrap();
+            assert!(v.is_finite());
+        }
+    }
+}
+
+#[test]
+fn atmosphere_prints_the_terms_per_wavelength() {
+    let (code, out, err) = shoal(&[
+        "atmosphere",
+        "--aerosol",
+        "continental",
+        "--aot550",
+        "0.1",
+        "--sun-zenith",
+        "60",
+        "--view-zenith",
+        "30",
+        "--rel-azimuth",
+        "90",
+        "--wavelengths",
+        "412.5,560,865",
+        "--accuracy",
+        "fast",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let r = rows(&out);
+    assert_eq!(r.len(), 4);
+    for name in ["e0_w_m2_nm", "l_path_w_m2_sr_nm", "t_up", "t_down", "spherical_albedo", "ed_0plus_w_m2_nm"] {
+        assert!(r[0].iter().any(|c| c == name), "missing {name}");
+    }
+}
+
+#[test]
+fn example_specs_run() {
+    for (cmd, file) in [
+        ("water", "presets/examples/water_heron_sand.ron"),
+        ("water", "presets/examples/water_lake_hume.ron"),
+        ("water", "presets/examples/water_custom_inputs.ron"),
+        ("atmosphere", "presets/examples/atmosphere_lake_hume.ron"),
+    ] {
+        let (code, out, err) = shoal(&[cmd, "--spec", file]);
+        assert_eq!(code, 0, "{file}: {err}");
+        assert!(out.lines().count() > 10, "{file}");
+    }
+}
+
+#[test]
+fn bad_input_exits_2_with_one_line_naming_the_field() {
+    let cases: &[(&[&str], &str)] = &[
+        (&["water", "--chl", "-1"], "chl"),
+        (&["water", "--nap", "-0.5"], "nap"),
+        (&["water", "--depth", "0"], "depth"),
+        (&["water", "--depth", "-3"], "depth"),
+        (&["water", "--sun-zenith", "90"], "sun_zenith"),
+        (&["water", "--depth", "2", "--substrate", "lava"], "lava"),
+        (&["water", "--substrate", "sand:0.7,coral:0.7", "--depth", "2"], "sum"),
+        (&["water", "--siop", "nile"], "nile"),
+        (&["atmosphere", "--aerosol", "volcanic"], "volcanic"),
+        (&["atmosphere", "--sun-zenith", "95"], "sun_zenith"),
+        (&["atmosphere", "--aot550", "-0.2"], "aot550"),
+        (&["atmosphere", "--surface", "wind:fast"], "surface"),
+        (&["atmosphere", "--bands", "landsat"], "landsat"),
+    ];
+    for (args, field) in cases {
+        let (code, out, err) = shoal(args);
+        assert_eq!(code, 2, "{args:?}: {err}");
+        assert!(out.is_empty(), "{args:?} printed output");
+        assert!(err.contains(field), "{args:?}: {err}");
+        assert_eq!(err.trim().lines().count(), 1, "{args:?}: one line, got {err}");
+        assert!(!err.contains("panicked"));
+    }
+}
+
+#[test]
+fn malformed_ron_names_the_line_and_the_field() {
+    let dir = std::env::temp_dir().join(format!("shoal-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let typo = dir.join("typo.ron");
+    std::fs::write(&typo, "AtmosphereRun(\n  atmosphere: AtmosphereSpec(aerosl: Maritime),\n)\n").unwrap();
+    let (code, _, err) = shoal(&["atmosphere", "--spec", typo.to_str().unwrap()]);
+    assert_eq!(code, 2);
+    assert!(err.contains("aerosl") && err.contains("2:"), "{err}");
+    let broken = dir.join("broken.ron");
+    std::fs::write(&broken, "WaterRun(chl_mg_m3: 1.0,\n depth_m: Some(3.0)\n").unwrap();
+    let (code, _, err) = shoal(&["water", "--spec", broken.to_str().unwrap()]);
+    assert_eq!(code, 2);
+    assert!(err.contains("broken.ron"), "{err}");
+    let (code, _, err) = shoal(&["water", "--spec", dir.join("missing.ron").to_str().unwrap()]);
+    assert_eq!(code, 2);
+    assert!(err.contains("missing.ron"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn out_file_is_written_whole() {
+    let dir = std::env::temp_dir().join(format!("shoal-out-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("rrs.csv");
+    let (code, out, err) = shoal(&["water", "--wavelengths", "443,560", "--out", path.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    assert!(out.is_empty());
+    assert_eq!(std::fs::read_to_string(&path).unwrap().lines().count(), 3);
+    assert!(std::fs::read_dir(&dir).unwrap().count() == 1, "no temporary file left behind");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
