@@ -183,6 +183,8 @@ pub struct AtmosphereTerms {
     pub rho_path: f64,
     /// Total downward transmittance Ed(0⁺)/(E₀ μ₀) (gases included).
     pub t_down: f64,
+    /// Direct downward transmittance e^{−τ/μ₀}·T_gas (the diffuse part is `t_down − t_down_direct`).
+    pub t_down_direct: f64,
     /// Total upward transmittance for uniform water-leaving radiance (gases included).
     pub t_up: f64,
     /// Direct upward transmittance e^{−τ/μ_v}·T_gas.
@@ -319,6 +321,7 @@ impl Atmosphere {
             l_path_w_m2_sr_nm: l_path,
             rho_path: std::f64::consts::PI * l_path / (e0 * n.mu0),
             t_down: n.ed / n.mu0 * tg0,
+            t_down_direct: (-(n.tau_rayleigh + n.tau_aerosol) / n.mu0).exp() * tg0,
             t_up: n.t_up * tgv,
             t_up_direct: n.t_up_direct * tgv,
             spherical_albedo: n.spherical_albedo,

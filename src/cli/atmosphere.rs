@@ -171,13 +171,14 @@ fn read_spec(path: &Path) -> Result<AtmosphereRun, CliError> {
     ron::from_str(&text).map_err(|e| CliError::Input(format!("{}: {e}", path.display())))
 }
 
-const COLUMNS: [&str; 12] = [
+const COLUMNS: [&str; 13] = [
     "e0_w_m2_nm",
     "l_path_w_m2_sr_nm",
     "rho_path",
     "t_up",
     "t_up_direct",
     "t_down",
+    "t_down_direct",
     "spherical_albedo",
     "ed_0plus_w_m2_nm",
     "tau_rayleigh",
@@ -186,7 +187,7 @@ const COLUMNS: [&str; 12] = [
     "l_glint_w_m2_sr_nm",
 ];
 
-fn values(t: &AtmosphereTerms) -> [f64; 12] {
+fn values(t: &AtmosphereTerms) -> [f64; 13] {
     [
         t.e0_w_m2_nm,
         t.l_path_w_m2_sr_nm,
@@ -194,6 +195,7 @@ fn values(t: &AtmosphereTerms) -> [f64; 12] {
         t.t_up,
         t.t_up_direct,
         t.t_down,
+        t.t_down_direct,
         t.spherical_albedo,
         t.ed_0plus_w_m2_nm,
         t.tau_rayleigh,

@@ -106,6 +106,10 @@ pub struct WaterArgs {
     /// View zenith angle in air, degrees (0 to below 90).
     #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
     pub view_zenith: Option<f64>,
+    /// Accepted for symmetry with `shoal atmosphere` (degrees, checked to lie within ±360); the
+    /// Lee et al. model has no azimuthal dependence, so it does not change the output.
+    #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
+    pub rel_azimuth: Option<f64>,
     #[command(flatten)]
     pub grid: GridArgs,
     /// Write the CSV to this file (atomically) instead of standard output.
@@ -222,6 +226,9 @@ pub fn run(args: &WaterArgs) -> Result<(), CliError> {
         return emit(&text, args.out.as_deref());
     }
     let (run, base) = merged(args)?;
+    if let Some(a) = args.rel_azimuth.filter(|a| !(a.is_finite() && a.abs() <= 360.0)) {
+        return Err(CliError::Input(format!("--rel-azimuth = {a} is out of range (allowed: -360 to 360 degrees)")));
+    }
     let (grid, bands) = args.grid.resolve(run.grid.as_ref(), 1.0)?;
     let bands = match (bands, &run.bands) {
         (Some(b), _) => Some(b),
