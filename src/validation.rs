@@ -7,7 +7,8 @@
 //! [`RayleighDepth::OsoaaHansenTravis`](crate::atmosphere::RayleighDepth), the aerosol at
 //! AOT(550) = 0.1, scale heights 8 km and 2 km, sea index 1.34, flat surface, no gases — the
 //! reference's settings. Quantities compared:
-//! - path reflectance ρ = I_toa/μ₀ over black water (`rho_osoaa_vec_flat`);
+//! - path reflectance ρ = π L_path/(E₀ μ₀) = I_toa/μ₀ with OSOAA's normalised radiance I = πL/E₀,
+//!   over black water (`rho_osoaa_vec_flat`);
 //! - t_down = Ed(0⁺)/(E₀μ₀) over black water (`t_down_osoaa_flat`);
 //! - Ed(0⁺) of the water runs, which OSOAA computes coupled with the water: Shoal's black-water
 //!   Ed(0⁺)/(1 − S·π·Rrs) with OSOAA's own Rrs;

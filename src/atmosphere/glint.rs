@@ -53,3 +53,21 @@ pub fn glint_reflectance(
     let (mu0, muv) = (s[2], v[2]);
     std::f64::consts::PI * fresnel_reflectance(cos_omega, n) * p / (4.0 * mu0 * muv * cos_beta.powi(4))
 }
+
+/// Glint radiance at TOA per unit solar flux (multiply by E₀ and gas transmittance):
+/// ρ_g μ₀ e^{−τ/μ₀} e^{−τ/μ_v}/π, with direct transmittances through the column of optical
+/// depth `tau`.
+#[must_use]
+pub fn glint_radiance_norm(
+    sun_zenith_rad: f64,
+    view_zenith_rad: f64,
+    relative_azimuth_rad: f64,
+    wind_m_s: f64,
+    n: f64,
+    tau: f64,
+) -> f64 {
+    let (mu0, muv) = (sun_zenith_rad.cos(), view_zenith_rad.cos());
+    glint_reflectance(sun_zenith_rad, view_zenith_rad, relative_azimuth_rad, wind_m_s, n) * mu0 / std::f64::consts::PI
+        * (-tau / mu0).exp()
+        * (-tau / muv).exp()
+}

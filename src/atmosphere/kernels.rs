@@ -240,9 +240,15 @@ mod tests {
             }
         }
         // Single scattering of unpolarised light at 90° is polarised perpendicular to the
-        // scattering plane: looking at the zenith with the sun on the horizon, −Q/I = (1−ρ)/(1+ρ)
-        // in the frame where the scattering plane is the meridian plane.
-        let z = rayleigh_z(-1.0 + 1e-9, 1e-9 - 0.0, 0.0, 0.0);
-        assert!((z[1][0] / z[0][0]).abs() > 0.99, "{:?}", z);
+        // scattering plane, with degree (1−ρ)/(1+ρ): Q = I_ℓ − I_r < 0 in the scattering-plane
+        // frame. Sunlight travelling horizontally (μ_in = 0, azimuth 0) scattered straight up
+        // (μ_out = −1, azimuth 0): the up direction's meridian plane is the scattering plane, so
+        // the meridian-frame Q/I must be −(1−ρ)/(1+ρ), sign included.
+        for rho in [0.0, 0.0279] {
+            let z = rayleigh_z(-1.0, 0.0, 0.0, rho);
+            let expected = -(1.0 - rho) / (1.0 + rho);
+            assert!((z[1][0] / z[0][0] - expected).abs() < 1e-9, "ρ={rho}: {:?}", z);
+            assert!(z[2][0].abs() < 1e-12, "no U for a symmetric geometry");
+        }
     }
 }

@@ -1,5 +1,5 @@
-//! The atmosphere look-up table: built once per scene over wavelength, sun zenith, view zenith
-//! and relative azimuth, then interpolated per pixel.
+//! The atmosphere look-up table: built once per scene over wavelength, sun zenith and view
+//! zenith, exact in relative azimuth, then evaluated per pixel.
 //!
 //! One SOS solve per (wavelength, sun zenith) node gives, at every view-zenith node, the Fourier
 //! coefficients of the multiple-scattered path radiance and the single-scattering coefficients;
@@ -15,9 +15,8 @@
 use rayon::prelude::*;
 
 use super::AtmosphereError;
-use super::glint::glint_reflectance;
 use super::rt::{Scatterers, SsCoefficients, fourier_sum, solve_sun, solve_transmittance};
-use super::spec::{Atmosphere, AtmosphereTerms, Geometry, Normalised, Surface};
+use super::spec::{Atmosphere, AtmosphereTerms, Geometry, Normalised};
 
 /// Node positions of the table (the azimuth axis sets where `shoal bench` and tests probe; the
 /// table itself is exact in azimuth).
@@ -36,13 +35,14 @@ pub struct LutAxes {
 
 impl LutAxes {
     /// Axes that cover sun zenith `sza_range` and view zenith up to `max_vza` (degrees), with
-    /// nodes every `sza_step`, `vza_step` and `raz_step` degrees.
+    /// nodes at most `steps` = (sun, view, azimuth) degrees apart; steps below 0.1° count as 0.1°.
     #[must_use]
     pub fn covering(wavelengths_nm: Vec<f64>, sza_range: (f64, f64), max_vza: f64, steps: (f64, f64, f64)) -> Self {
         let nodes = |lo: f64, hi: f64, step: f64| -> Vec<f64> {
-            if hi - lo < 1e-9 {
+            if !(hi - lo > 1e-9) {
                 return vec![lo];
             }
+            let step = if step.is_finite() { step.max(0.1) } else { hi - lo };
             let n = ((hi - lo) / step).ceil().max(1.0) as usize;
             (0..=n).map(|i| lo + (hi - lo) * i as f64 / n as f64).collect()
         };
@@ -89,17 +89,26 @@ pub struct AtmosphereLut {
     tau_rayleigh: Vec<f64>,
 }
 
-/// Bracketing nodes and weight for linear interpolation on `nodes` (clamped at the ends).
-fn bracket(nodes: &[f64], x: f64) -> (usize, usize, f64) {
-    if nodes.len() == 1 || x <= nodes[0] {
-        return (0, 0, 0.0);
+/// Bracketing nodes and weight for linear interpolation on `nodes`; `x` must lie within the
+/// nodes (0.01° of slack for rounding), or the table would silently extrapolate.
+fn bracket(name: &str, nodes: &[f64], x: f64) -> Result<(usize, usize, f64), AtmosphereError> {
+    let (first, last) = (nodes[0], nodes[nodes.len() - 1]);
+    if !(x >= first - 0.01 && x <= last + 0.01) {
+        return Err(AtmosphereError::OutOfRange {
+            field: format!("{name} (deg) for this LUT"),
+            value: x,
+            allowed: format!("{first} to {last} (the table's nodes; build it to cover the scene)"),
+        });
     }
-    let last = nodes.len() - 1;
-    if x >= nodes[last] {
-        return (last, last, 0.0);
+    if nodes.len() == 1 || x <= first {
+        return Ok((0, 0, 0.0));
     }
-    let j = nodes.partition_point(|&v| v <= x).clamp(1, last);
-    (j - 1, j, (x - nodes[j - 1]) / (nodes[j] - nodes[j - 1]))
+    let k = nodes.len() - 1;
+    if x >= last {
+        return Ok((k, k, 0.0));
+    }
+    let j = nodes.partition_point(|&v| v <= x).clamp(1, k);
+    Ok((j - 1, j, (x - nodes[j - 1]) / (nodes[j] - nodes[j - 1])))
 }
 
 impl AtmosphereLut {
@@ -158,8 +167,15 @@ impl AtmosphereLut {
         g.validate()?;
         let a = &self.axes;
         let (ns, nv, nf) = (a.sun_zenith_deg.len(), a.view_zenith_deg.len(), self.n_fourier);
-        let (s0, s1, ts) = bracket(&a.sun_zenith_deg, g.sun_zenith_rad.to_degrees());
-        let (v0, v1, tv) = bracket(&a.view_zenith_deg, g.view_zenith_rad.to_degrees());
+        let (s0, s1, ts) = bracket("sun_zenith", &a.sun_zenith_deg, g.sun_zenith_rad.to_degrees())?;
+        let (v0, v1, tv) = bracket("view_zenith", &a.view_zenith_deg, g.view_zenith_rad.to_degrees())?;
+        if w >= a.wavelengths_nm.len() {
+            return Err(AtmosphereError::OutOfRange {
+                field: "wavelength index".into(),
+                value: w as f64,
+                allowed: format!("0 to {}", a.wavelengths_nm.len() - 1),
+            });
+        }
         let corners = [
             (s0, v0, (1.0 - ts) * (1.0 - tv)),
             (s0, v1, (1.0 - ts) * tv),
@@ -192,19 +208,7 @@ impl AtmosphereLut {
         );
         let ed = ed * (mu0 * (-tau / mu0).exp()) / direct_nodes;
         let t_up_direct = (-tau / muv).exp();
-        let glint = match self.atmosphere.spec().surface {
-            Surface::Flat => 0.0,
-            Surface::Wind { speed_m_s } => {
-                let rho_g = glint_reflectance(
-                    g.sun_zenith_rad,
-                    g.view_zenith_rad,
-                    g.relative_azimuth_rad,
-                    speed_m_s,
-                    self.atmosphere.spec().water_refractive_index,
-                );
-                rho_g / std::f64::consts::PI * mu0 * (-tau / mu0).exp() * t_up_direct
-            }
-        };
+        let glint = self.atmosphere.glint(g, tau);
         self.atmosphere.assemble(&Normalised {
             wavelength_nm: a.wavelengths_nm[w],
             tau_rayleigh: self.tau_rayleigh[w],

@@ -41,7 +41,7 @@ pub use aerosol::{
 pub use complex::Complex;
 pub use fresnel::{SEA_REFRACTIVE_INDEX, fresnel_matrix, fresnel_reflectance};
 pub use gas::{GasAmounts, air_mass, transmittance as gas_transmittance};
-pub use glint::glint_reflectance;
+pub use glint::{glint_radiance_norm, glint_reflectance};
 pub use kernels::delta_m;
 pub use lut::{AtmosphereLut, LutAxes};
 pub use mie::{BulkOptics, LogNormal, MieSphere, SizeGrid, integrate_lognormal, mie_sphere};

@@ -152,13 +152,14 @@ impl AltitudeQuadrature {
         Self { tau, d_tau_rayleigh: d_r, d_tau_aerosol: d_a, total: column.tau_above(0.0, 1.0) }
     }
 
-    /// (∫ e^{−m τ} dτ_R, ∫ e^{−m τ} dτ_a) over the column.
+    /// (∫ e^{−c − m τ} dτ_R, ∫ e^{−c − m τ} dτ_a) over the column; the constant `offset` c is
+    /// folded into the exponent so that a large e^{−c} and a large e^{+|m|τ} never meet.
     #[must_use]
-    pub fn attenuated(&self, m: f64) -> (f64, f64) {
+    pub fn attenuated(&self, m: f64, offset: f64) -> (f64, f64) {
         let mut r = 0.0;
         let mut a = 0.0;
         for i in 0..self.tau.len() {
-            let e = (-m * self.tau[i]).exp();
+            let e = (-offset - m * self.tau[i]).exp();
             r += e * self.d_tau_rayleigh[i];
             a += e * self.d_tau_aerosol[i];
         }
@@ -184,13 +185,13 @@ mod tests {
     fn quadrature_integrates_the_column_and_an_exponential() {
         let c = column();
         let q = AltitudeQuadrature::new(&c);
-        let (r, a) = q.attenuated(0.0);
+        let (r, a) = q.attenuated(0.0, 0.0);
         assert!((r - 0.35).abs() < 1e-9 && (a - 0.14).abs() < 1e-9, "{r} {a}");
         // ∫ e^{−mτ} dτ over the whole column = (1 − e^{−mτ*})/m when both share one profile.
         let mut same = c;
         same.aerosol_scale_height_km = 8.0;
         let q = AltitudeQuadrature::new(&same);
-        let (r, a) = q.attenuated(2.0);
+        let (r, a) = q.attenuated(2.0, 0.0);
         let total: f64 = 0.49;
         let expected = (1.0 - (-2.0 * total).exp()) / 2.0;
         assert!(((r + a) - expected).abs() < 1e-9, "{} vs {expected}", r + a);

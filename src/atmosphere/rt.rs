@@ -9,15 +9,20 @@
 //!   a Fresnel surface (sun→view, sun→surface→view, surface→view, surface→surface→view): the TMS
 //!   correction of Nakajima & Tanaka (1988);
 //! - the scalar treatment of Rayleigh scattering errs by −7 % to +2.5 % in the path radiance
-//!   (worst in the blue at small sun zenith, OSOAA reference); a vector (I, Q, U) SOS run of the
-//!   Rayleigh-only column gives the correction ΔIᵐ = Iᵐ_vector − Iᵐ_scalar (m ≤ 2, all orders
-//!   including the first: skylight scattered once and reflected by the surface is polarised),
-//!   added to the mixture's scalar result (the polarisation error is dominated by molecular
-//!   scattering; Gordon, Brown & Evans 1988);
-//! - T_up(μ) is the ratio of the TOA radiance to the emitted radiance for water-leaving radiance
-//!   shaped like an isotropic in-water field transmitted through the surface, L ∝ 1 − R_F(μ),
-//!   over the Fresnel surface; S is the fraction of an isotropic upward source returned down to a
-//!   black surface.
+//!   (worst in the blue at small sun zenith, OSOAA reference); the same column is solved for
+//!   (I, Q, U) in the Fourier terms m ≤ 2 with the Rayleigh phase matrix and the aerosol as a
+//!   depolarising scatterer, and the difference ΔIᵐ = Iᵐ_vector − Iᵐ_scalar (all orders including
+//!   the first: skylight scattered once and reflected by the surface is polarised) corrects the
+//!   scalar result. Molecular scattering dominates the polarisation error (Gordon, Brown & Evans
+//!   1988), and computing it in the actual column dilutes it as aerosol loads grow;
+//! - T_up(μ) multiplies the water-leaving radiance the water model gives — Lee et al.'s
+//!   Rrs = 0.52 rrs/(1 − 1.7 rrs), whose 0.52 holds the surface transmission near nadir — to give
+//!   the water's TOA signal in the view μ. The water-leaving radiance is that of an isotropic
+//!   in-water field, L(μ) ∝ 1 − R_F(μ) (Mobley 1994, §4.2), over the Fresnel surface;
+//!   T_up(μ) = [s(μ)e^{−τ/μ} + diffuse(μ)]/s(1) with s(μ) = 1 − R_F(μ): at nadir this is the
+//!   ordinary (direct + diffuse) transmittance, and at grazing views it carries the Fresnel
+//!   falloff of Lw, so it never exceeds 1. S is the fraction of an isotropic upward source
+//!   returned down to a black surface.
 //!
 //! Radiances here are normalised to a solar flux of 1 normal to the beam: L = I·E₀.
 //!
@@ -161,10 +166,6 @@ impl WavelengthColumn {
         }
     }
 
-    fn rayleigh_only(&self) -> Self {
-        Self { aerosol: None, ..self.clone() }
-    }
-
     /// Layering and truncated aerosol moments for `n` streams: (layering, β′ or None).
     fn scaled(&self, acc: &RtAccuracy) -> (Layering, Option<Vec<f64>>) {
         let n_terms = 2 * acc.streams;
@@ -303,8 +304,9 @@ pub fn solve_sun(column: &WavelengthColumn, mu0: f64, user_mu: &[f64], acc: &RtA
     let (layering, beta_a) = column.scaled(acc);
     let rayleigh_phase = PhaseFunction::Rayleigh { depolarization: column.depolarization };
     let beta_r = rayleigh_phase.moments(2);
-    let surf_q = fresnel_blocks(&streams.mu, column.water_index);
-    let surf_u = fresnel_blocks(user_mu, column.water_index);
+    let n = column.water_index;
+    let surf_q = fresnel_blocks(&streams.mu, n);
+    let surf_u = fresnel_blocks(user_mu, n);
     let nadir_only = user_mu.iter().all(|m| *m > 1.0 - 1e-12);
     // Only m = 0 is needed when the views are all nadir (higher terms vanish there) or in the
     // single-scattering mode (the path radiance is then the exact single scattering alone, and
@@ -316,11 +318,14 @@ pub fn solve_sun(column: &WavelengthColumn, mu0: f64, user_mu: &[f64], acc: &RtA
     } else {
         2.min(acc.fourier_terms - 1)
     };
+    let polarize = acc.polarization_correction && acc.max_orders > 1;
+    let vector = if polarize { vector_rayleigh_kernels(&streams, column.depolarization, mu0, n) } else { Vec::new() };
+    let (vq, vu) = (fresnel_blocks3(&streams.mu, n), fresnel_blocks3(user_mu, n));
     let mut ms_fourier = vec![Vec::new(); user_mu.len()];
     let (mut ed_diffuse, mut orders, mut small) = (0.0, 0, 0);
     for m in 0..=m_max {
-        let kr = scalar_kernel(&streams, &beta_r, m, mu0, column.water_index);
-        let ka = beta_a.as_ref().map(|b| scalar_kernel(&streams, b, m, mu0, column.water_index));
+        let kr = scalar_kernel(&streams, &beta_r, m, mu0, n);
+        let ka = beta_a.as_ref().map(|b| scalar_kernel(&streams, b, m, mu0, n));
         let f = solve(&streams, &layering, &kr, ka.as_ref(), &surf_q, &surf_u, &Drive::Sun { mu0 }, acc.orders());
         if m == 0 {
             ed_diffuse = irradiance(&streams, &f.surface_down);
@@ -328,6 +333,23 @@ pub fn solve_sun(column: &WavelengthColumn, mu0: f64, user_mu: &[f64], acc: &RtA
         }
         for (coeffs, v) in ms_fourier.iter_mut().zip(&f.toa_user) {
             coeffs.push(v[0]);
+        }
+        // Polarisation (m ≤ 2): the same column solved for (I, Q, U), with the Rayleigh phase
+        // matrix and the aerosol as a depolarising scatterer (intensity kernel only). Only
+        // molecular scattering creates polarisation, so both solutions agree for m > 2; the
+        // difference, all orders including the first, corrects the scalar result.
+        if let Some(kv) = vector.get(m) {
+            let kav = ka.as_ref().map(embed_intensity);
+            let fv = solve(&streams, &layering, kv, kav.as_ref(), &vq, &vu, &Drive::Sun { mu0 }, acc.orders());
+            for (i, coeffs) in ms_fourier.iter_mut().enumerate() {
+                let delta = (fv.toa_user[i][0] + fv.toa_user_first[i][0]) - (f.toa_user[i][0] + f.toa_user_first[i][0]);
+                if let Some(c) = coeffs.last_mut() {
+                    *c += delta;
+                }
+            }
+            if m == 0 {
+                ed_diffuse += irradiance(&streams, &fv.surface_down) - irradiance(&streams, &f.surface_down);
+            }
         }
         // Stop once two successive terms are negligible against the m = 0 term.
         let peak0 = ms_fourier.iter().map(|c| c[0].abs()).fold(0.0, f64::max);
@@ -339,17 +361,13 @@ pub fn solve_sun(column: &WavelengthColumn, mu0: f64, user_mu: &[f64], acc: &RtA
             }
         }
     }
-    if acc.polarization_correction && acc.max_orders > 1 {
-        let (dm, de) = polarization_correction(column, mu0, &streams, acc);
-        for (coeffs, d) in ms_fourier.iter_mut().zip(dm) {
-            for (c, dv) in coeffs.iter_mut().zip(d) {
-                *c += dv;
-            }
-        }
-        ed_diffuse += de;
-    }
+    // Delta-M: the scaled direct beam μ₀e^{−τ′/μ₀} carries the truncated forward peak, so the
+    // total is scaled direct + scaled diffuse; the true direct beam uses the unscaled depth and
+    // the forward peak is reported as diffuse light.
+    let ed_direct = mu0 * (-column.total_tau() / mu0).exp();
+    let ed_total = mu0 * (-layering.total() / mu0).exp() + ed_diffuse;
     let quad = AltitudeQuadrature::new(&column.optics());
-    let ss = user_mu.iter().map(|&muv| ss_paths(&quad, mu0, muv, column.water_index)).collect();
+    let ss = user_mu.iter().map(|&muv| ss_paths(&quad, mu0, muv, n)).collect();
     SunSolution {
         mu0,
         user_mu: user_mu.to_vec(),
@@ -359,9 +377,21 @@ pub fn solve_sun(column: &WavelengthColumn, mu0: f64, user_mu: &[f64], acc: &RtA
             rayleigh: rayleigh_phase,
             aerosol: column.aerosol.as_ref().map(|(_, w, p)| (*w, p.clone())),
         },
-        ed_direct: mu0 * (-column.total_tau() / mu0).exp(),
-        ed_diffuse,
+        ed_direct,
+        ed_diffuse: ed_total - ed_direct,
         orders,
+    }
+}
+
+/// A scalar kernel as the intensity element of a (I, Q, U) kernel: a scatterer that neither
+/// creates nor carries polarisation.
+fn embed_intensity(k: &Kernel<1>) -> Kernel<3> {
+    let block = |v: f64| [[v, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]];
+    let vec3 = |v: f64| [v, 0.0, 0.0];
+    Kernel {
+        quad: k.quad.iter().map(|b| block(b[0][0])).collect(),
+        sun: k.sun.iter().map(|v| vec3(v[0])).collect(),
+        sun_reflected: k.sun_reflected.iter().map(|v| vec3(v[0])).collect(),
     }
 }
 
@@ -372,58 +402,24 @@ fn irradiance<const S: usize>(streams: &Streams, down: &[[f64; S]]) -> f64 {
 }
 
 /// The four single-scattering paths over a Fresnel surface for view cosine μ_v: attenuation
-/// exponents m_p and factors F_p (see the module docs), integrated over the profile.
+/// exponents m_p and factors F_p (see the module docs), integrated over the profile. The
+/// factors' exponentials are folded into the integrals (F_p e^{−m_p τ} = R·e^{−c_p − m_p τ}) so
+/// that no term underflows while its partner overflows.
 fn ss_paths(q: &AltitudeQuadrature, mu0: f64, muv: f64, n: f64) -> SsCoefficients {
     let t = q.total;
     let (r0, rv) = (fresnel_reflectance(mu0, n), fresnel_reflectance(muv, n));
     let specs = [
-        (1.0, 1.0 / mu0 + 1.0 / muv),
-        (rv * (-2.0 * t / muv).exp(), 1.0 / mu0 - 1.0 / muv),
-        (r0 * (-2.0 * t / mu0).exp(), 1.0 / muv - 1.0 / mu0),
-        (r0 * rv * (-2.0 * t * (1.0 / mu0 + 1.0 / muv)).exp(), -(1.0 / mu0 + 1.0 / muv)),
+        (1.0, 0.0, 1.0 / mu0 + 1.0 / muv),
+        (rv, 2.0 * t / muv, 1.0 / mu0 - 1.0 / muv),
+        (r0, 2.0 * t / mu0, 1.0 / muv - 1.0 / mu0),
+        (r0 * rv, 2.0 * t * (1.0 / mu0 + 1.0 / muv), -(1.0 / mu0 + 1.0 / muv)),
     ];
     let mut paths = [[0.0; 2]; 4];
-    for (p, (factor, m)) in paths.iter_mut().zip(specs) {
-        let (r, a) = q.attenuated(m);
-        *p = [factor * r, factor * a];
+    for (p, (reflectance, offset, m)) in paths.iter_mut().zip(specs) {
+        let (r, a) = q.attenuated(m, offset);
+        *p = [reflectance * r, reflectance * a];
     }
     SsCoefficients(paths)
-}
-
-/// ΔIᵐ (m ≤ 2) at the views and ΔEd from vector minus scalar SOS of the Rayleigh-only column.
-fn polarization_correction(
-    column: &WavelengthColumn,
-    mu0: f64,
-    streams: &Streams,
-    acc: &RtAccuracy,
-) -> (Vec<Vec<f64>>, f64) {
-    let ray = column.rayleigh_only();
-    let (layering, _) = ray.scaled(acc);
-    let beta = PhaseFunction::Rayleigh { depolarization: column.depolarization }.moments(2);
-    let n = column.water_index;
-    let vk = vector_rayleigh_kernels(streams, column.depolarization, mu0, n);
-    let (sq, su) = (fresnel_blocks(&streams.mu, n), fresnel_blocks(&streams.user_mu, n));
-    let (vq, vu) = (fresnel_blocks3(&streams.mu, n), fresnel_blocks3(&streams.user_mu, n));
-    let nadir_only = streams.user_mu.iter().all(|m| *m > 1.0 - 1e-12);
-    let mut delta = vec![Vec::new(); streams.user_mu.len()];
-    let mut d_ed = 0.0;
-    for (m, kv) in vk.iter().enumerate() {
-        if nadir_only && m > 0 {
-            break;
-        }
-        let ks: Kernel<1> = scalar_kernel(streams, &beta, m, mu0, n);
-        let fs = solve(streams, &layering, &ks, None, &sq, &su, &Drive::Sun { mu0 }, acc.orders());
-        let fv = solve(streams, &layering, kv, None, &vq, &vu, &Drive::Sun { mu0 }, acc.orders());
-        for (i, d) in delta.iter_mut().enumerate() {
-            let vector = fv.toa_user[i][0] + fv.toa_user_first[i][0];
-            let scalar = fs.toa_user[i][0] + fs.toa_user_first[i][0];
-            d.push(vector - scalar);
-        }
-        if m == 0 {
-            d_ed = irradiance(streams, &fv.surface_down) - irradiance(streams, &fs.surface_down);
-        }
-    }
-    (delta, d_ed)
 }
 
 /// Upward transmittance and spherical albedo.
@@ -431,9 +427,9 @@ fn polarization_correction(
 pub struct Transmittance {
     /// View cosines.
     pub user_mu: Vec<f64>,
-    /// Total (direct + diffuse) upward transmittance per view cosine.
+    /// Total (direct + diffuse) upward transmittance per view cosine (see the module docs).
     pub t_up: Vec<f64>,
-    /// Direct part e^{−τ/μ} (unscaled τ).
+    /// Direct part s(μ)/s(1)·e^{−τ/μ} (unscaled τ; s(μ)/s(1) ≈ 1 below 60° view).
     pub t_up_direct: Vec<f64>,
     /// Spherical albedo of the atmosphere.
     pub spherical_albedo: f64,
@@ -453,13 +449,10 @@ pub fn solve_transmittance(column: &WavelengthColumn, user_mu: &[f64], acc: &RtA
         n,
     );
     let ka = beta_a.as_ref().map(|b| scalar_kernel(&streams, b, 0, 0.5, n));
-    let shape = |mu: f64| 1.0 - fresnel_reflectance(mu, n);
     let tau_scaled = layering.total();
-    // Water-leaving radiance over the Fresnel surface.
-    let drive = Drive::Bottom {
-        quad: streams.mu.iter().map(|&m| [shape(m)]).collect(),
-        user: user_mu.iter().map(|&m| [shape(m)]).collect(),
-    };
+    // Water-leaving radiance of an isotropic in-water field, normalised to 1 at nadir.
+    let shape = |mu: f64| (1.0 - fresnel_reflectance(mu, n)) / (1.0 - fresnel_reflectance(1.0, n));
+    let drive = Drive::Bottom { quad: streams.mu.iter().map(|&m| [shape(m)]).collect() };
     let f = solve(
         &streams,
         &layering,
@@ -470,21 +463,17 @@ pub fn solve_transmittance(column: &WavelengthColumn, user_mu: &[f64], acc: &RtA
         &drive,
         acc.orders(),
     );
-    let t_up = user_mu
-        .iter()
-        .zip(&f.toa_user)
-        .map(|(&mu, v)| (shape(mu) * (-tau_scaled / mu).exp() + v[0]) / shape(mu))
-        .collect();
-    // Isotropic unit source over a black surface: the fraction returned down is S.
+    let t_up = user_mu.iter().zip(&f.toa_user).map(|(&mu, v)| shape(mu) * (-tau_scaled / mu).exp() + v[0]).collect();
+    // An isotropic unit source over a black surface: the fraction returned down is S.
     let black_q = vec![[[0.0]]; streams.n()];
     let black_u = vec![[[0.0]]; user_mu.len()];
-    let iso = Drive::Bottom { quad: vec![[1.0]; streams.n()], user: vec![[1.0]; user_mu.len()] };
+    let iso = Drive::Bottom { quad: vec![[1.0]; streams.n()] };
     let g = solve(&streams, &layering, &kr, ka.as_ref(), &black_q, &black_u, &iso, acc.orders());
     let spherical_albedo = irradiance(&streams, &g.surface_down) / std::f64::consts::PI;
     Transmittance {
         user_mu: user_mu.to_vec(),
         t_up,
-        t_up_direct: user_mu.iter().map(|&mu| (-column.total_tau() / mu).exp()).collect(),
+        t_up_direct: user_mu.iter().map(|&mu| shape(mu) * (-column.total_tau() / mu).exp()).collect(),
         spherical_albedo,
     }
 }

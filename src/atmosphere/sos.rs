@@ -6,9 +6,11 @@
 //! azimuth of travel measured from the solar beam's. For each m the source of order n + 1 is
 //! Jᵐ_{n+1}(τ, μ) = ω(τ) ∫ Kᵐ(τ; μ, μ′) Iᵐ_n(τ, μ′) dμ′ (Gauss quadrature in μ′), the first-order
 //! source is the attenuated solar beam (and its Fresnel reflection), and each order's radiance
-//! follows from the formal solution with J linear in τ between levels:
-//! I(τ_b) = I(τ_a)e^{−x} + J_a·c_a(x) + J_b·c_b(x), x = Δτ/|μ|, c_a = (1 − e^{−x}(1 + x))/x,
-//! c_b = 1 − e^{−x} − c_a. At the surface the upward radiance is the Fresnel reflection of the
+//! follows from the formal solution. The first-order source a(τ)·e^{−τ/μ₀} is integrated exactly
+//! for its exponential factor, with its smooth amplitude a(τ) linear between levels (at low sun
+//! the exponential varies much faster than the levels are spaced); higher orders use J linear in
+//! τ between levels: I(τ_b) = I(τ_a)e^{−x} + J_a·c_a(x) + J_b·c_b(x), x = Δτ/|μ|,
+//! c_a = (1 − e^{−x}(1 + x))/x, c_b = 1 − e^{−x} − c_a. At the surface the upward radiance is the Fresnel reflection of the
 //! downward radiance in the mirror direction (same Fourier term: specular reflection keeps the
 //! azimuth of travel). Orders are summed until an order adds less than `tolerance` of the sum,
 //! or a geometric tail I_n·r/(1 − r) closes the series once its estimated error is below that
@@ -88,17 +90,17 @@ pub struct Kernel<const S: usize> {
 /// What drives the radiation field.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Drive<const S: usize> {
-    /// The sun at cosine μ₀ (flux 1 normal to the beam); its Fresnel reflectance R_F(μ₀).
+    /// The sun at cosine μ₀, flux 1 normal to the beam (its Fresnel reflection is in the
+    /// kernels' `sun_reflected`).
     Sun {
         /// Cosine of the solar zenith angle.
         mu0: f64,
     },
-    /// Radiance emitted upward at the surface: per quadrature stream and per user direction.
+    /// Radiance emitted upward at the surface in the up quadrature directions (its direct
+    /// transmission to the user directions is added by the caller).
     Bottom {
-        /// Emitted radiance in the up quadrature directions.
+        /// Emitted radiance per quadrature stream.
         quad: Vec<[f64; S]>,
-        /// Emitted radiance in the up user directions.
-        user: Vec<[f64; S]>,
     },
 }
 
@@ -114,14 +116,15 @@ pub struct OrderSettings {
 /// Result of one Fourier term.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FourierField<const S: usize> {
-    /// Upward radiance at the top in the user directions from the diffuse field: orders ≥ 2 for
-    /// a solar drive (order 1 is left to the exact single-scattering term), all scattered orders
-    /// for a bottom drive. Direct and single-scattered parts are added by the caller.
+    /// Upward radiance at the top in the user directions from the diffuse field: orders 2 to
+    /// `max_orders` for a solar drive (order 1 is left to the exact single-scattering term),
+    /// scattered orders 1 to `max_orders` for a bottom drive. Direct and single-scattered parts
+    /// are added by the caller.
     pub toa_user: Vec<[f64; S]>,
-    /// For a solar drive, the first-order upward radiance at the top in the user directions as
-    /// this (layered, linear-source) model computes it, surface reflections included; zero for a
-    /// bottom drive. The polarisation correction needs it: light scattered once and reflected by
-    /// the surface is already polarised.
+    /// For a solar drive, the first-order upward radiance at the top in the user directions in
+    /// this layered model, surface reflections included; zero for a bottom drive. The
+    /// polarisation correction needs it: light scattered once and reflected by the surface is
+    /// already polarised.
     pub toa_user_first: Vec<[f64; S]>,
     /// Downward diffuse radiance at the surface in the quadrature directions (all orders ≥ 1).
     pub surface_down: Vec<[f64; S]>,
@@ -152,6 +155,17 @@ fn transfer_coefficients(dtau: f64, mu: f64) -> (f64, f64, f64) {
     (e, c_far, (1.0 - e) - c_far)
 }
 
+/// φ(x) = (eˣ − 1)/x and ψ(x) = ∫₀¹ t eˣᵗ dt = (eˣ(x − 1) + 1)/x², with series near 0.
+#[inline]
+fn phi_psi(x: f64) -> (f64, f64) {
+    if x.abs() < 1e-3 {
+        (1.0 + x * (0.5 + x * (1.0 / 6.0 + x / 24.0)), 0.5 + x * (1.0 / 3.0 + x * (0.125 + x / 30.0)))
+    } else {
+        let e = x.exp();
+        ((e - 1.0) / x, (e * (x - 1.0) + 1.0) / (x * x))
+    }
+}
+
 /// Per-layer transfer coefficients for a list of cosines.
 struct Transfer {
     /// [layer k (1..=K) − 1][stream] → (e, c_far, c_near)
@@ -169,16 +183,12 @@ impl Transfer {
     }
 }
 
-/// Formal solution for one order: given sources `j[k][d]` on the 2m directions of one set of
-/// streams (down 0..m, up m..2m), fill radiance `out[k][d]`; `bottom_up` adds emitted radiance at
-/// the surface; `surface[s]` reflects downward into upward radiance.
-fn transfer<const S: usize>(
-    t: &Transfer,
-    surface: &[Block<S>],
-    j: &[Vec<[f64; S]>],
-    bottom_up: Option<&[[f64; S]]>,
-    out: &mut [Vec<[f64; S]>],
-) {
+type Field<const S: usize> = Vec<Vec<[f64; S]>>;
+
+/// Formal solution for one order with sources linear in τ: given `j[k][d]` on the 2m directions
+/// of one set of streams (down 0..m, up m..2m), fill radiance `out[k][d]`; `surface[d]` reflects
+/// downward into upward radiance at the bottom.
+fn transfer<const S: usize>(t: &Transfer, surface: &[Block<S>], j: &[Vec<[f64; S]>], out: &mut [Vec<[f64; S]>]) {
     let k_max = j.len() - 1;
     let m = surface.len();
     for d in 0..m {
@@ -195,13 +205,7 @@ fn transfer<const S: usize>(
         }
     }
     for d in 0..m {
-        let mut up = mat_vec(&surface[d], &out[k_max][d]);
-        if let Some(b) = bottom_up {
-            for s in 0..S {
-                up[s] += b[d][s];
-            }
-        }
-        out[k_max][m + d] = up;
+        out[k_max][m + d] = mat_vec(&surface[d], &out[k_max][d]);
     }
     for k in (0..k_max).rev() {
         for d in 0..m {
@@ -211,6 +215,111 @@ fn transfer<const S: usize>(
                 v[s] = out[k + 1][m + d][s] * e + j[k + 1][m + d][s] * c_far + j[k][m + d][s] * c_near;
             }
             out[k][m + d] = v;
+        }
+    }
+}
+
+/// First-order radiance from the solar source J(τ) = a(τ)e^{−τ/μ₀} + b(τ)e^{−(2τ*−τ)/μ₀}
+/// (direct beam, and the beam reflected at the surface), with the amplitudes a, b linear in τ
+/// between levels and the exponentials integrated exactly. `a[k][d]`, `b[k][d]` on the 2m
+/// directions of `mus` (down 0..m, up m..2m).
+#[allow(clippy::too_many_arguments)]
+fn transfer_solar<const S: usize>(
+    layering: &Layering,
+    mus: &[f64],
+    mu0: f64,
+    surface: &[Block<S>],
+    a: &[Vec<[f64; S]>],
+    b: &[Vec<[f64; S]>],
+    out: &mut [Vec<[f64; S]>],
+) {
+    let tau = &layering.tau;
+    let k_max = tau.len() - 1;
+    let total = tau[k_max];
+    let m = mus.len();
+    // Layer integral ∫ (α + βs) e^{−c(τ_top + s)} w(s) ds/μ over s ∈ [0, Δ] for the two source
+    // terms (c = 1/μ₀ with amplitude a; c = −1/μ₀ with amplitude b·e^{−2τ*/μ₀}), w the path
+    // attenuation to the end of the layer.
+    let layer = |k_top: usize, d: usize, mu: f64, down: bool, s: usize| -> f64 {
+        let (t0, t1) = (tau[k_top], tau[k_top + 1]);
+        let delta = t1 - t0;
+        let mut sum = 0.0;
+        for (amp, c, scale) in [(a, 1.0 / mu0, 1.0), (b, -1.0 / mu0, (-2.0 * total / mu0).exp())] {
+            let alpha = amp[k_top][d][s];
+            let beta = amp[k_top + 1][d][s] - alpha;
+            if alpha == 0.0 && beta == 0.0 {
+                continue;
+            }
+            let (x, attenuation) = if down {
+                // Down: w(s) = e^{−(Δ−s)/μ}; ∫ (α+β s/Δ) e^{(1/μ − c)s} ds · e^{−Δ/μ}
+                ((1.0 / mu - c) * delta, (-delta / mu).exp())
+            } else {
+                // Up (towards τ_top): w(s) = e^{−s/μ}; ∫ (α+β s/Δ) e^{−(c + 1/μ)s} ds
+                (-(c + 1.0 / mu) * delta, 1.0)
+            };
+            let (f0, f1) = phi_psi(x);
+            sum += scale * (-c * t0).exp() * attenuation * delta / mu * (alpha * f0 + beta * f1);
+        }
+        sum
+    };
+    for d in 0..m {
+        out[0][d] = [0.0; S];
+    }
+    for k in 1..=k_max {
+        for d in 0..m {
+            let e = (-(tau[k] - tau[k - 1]) / mus[d]).exp();
+            for s in 0..S {
+                out[k][d][s] = out[k - 1][d][s] * e + layer(k - 1, d, mus[d], true, s);
+            }
+        }
+    }
+    for d in 0..m {
+        out[k_max][m + d] = mat_vec(&surface[d], &out[k_max][d]);
+    }
+    for k in (0..k_max).rev() {
+        for d in 0..m {
+            let e = (-(tau[k + 1] - tau[k]) / mus[d]).exp();
+            for s in 0..S {
+                out[k][m + d][s] = out[k + 1][m + d][s] * e + layer(k, m + d, mus[d], false, s);
+            }
+        }
+    }
+}
+
+/// Smooth amplitudes of the first-order solar source on directions `rows` (kernel row indices):
+/// a = ω(f_R K_R,sun + f_a K_a,sun), b = ω(f_R K_R,refl + f_a K_a,refl) per level.
+fn solar_amplitudes<const S: usize>(
+    layering: &Layering,
+    rayleigh: &Kernel<S>,
+    aerosol: Option<&Kernel<S>>,
+    rows: std::ops::Range<usize>,
+) -> (Field<S>, Field<S>) {
+    let levels = layering.tau.len();
+    let mut a = vec![vec![[0.0; S]; rows.len()]; levels];
+    let mut b = a.clone();
+    for k in 0..levels {
+        let w = layering.omega[k];
+        let (wr, wa) = (w * layering.rayleigh_fraction[k], w * (1.0 - layering.rayleigh_fraction[k]));
+        for (i, row) in rows.clone().enumerate() {
+            for s in 0..S {
+                a[k][i][s] = wr * rayleigh.sun[row][s];
+                b[k][i][s] = wr * rayleigh.sun_reflected[row][s];
+                if let Some(ak) = aerosol {
+                    a[k][i][s] += wa * ak.sun[row][s];
+                    b[k][i][s] += wa * ak.sun_reflected[row][s];
+                }
+            }
+        }
+    }
+    (a, b)
+}
+
+fn add<const S: usize>(acc: &mut [Vec<[f64; S]>], f: &[Vec<[f64; S]>], scale: f64) {
+    for (a_k, f_k) in acc.iter_mut().zip(f) {
+        for (a, v) in a_k.iter_mut().zip(f_k) {
+            for s in 0..S {
+                a[s] += scale * v[s];
+            }
         }
     }
 }
@@ -236,7 +345,6 @@ pub fn solve<const S: usize>(
     let kk = layering.n_layers();
     let levels = kk + 1;
     let tq = Transfer::new(layering, &streams.mu);
-    let tu = Transfer::new(layering, &streams.user_mu);
     let scat = |k: usize| -> (f64, f64) {
         let w = layering.omega[k];
         let fr = layering.rayleigh_fraction[k];
@@ -248,14 +356,12 @@ pub fn solve<const S: usize>(
             let (wr, wa) = scat(k);
             (0..nq * nq)
                 .map(|idx| {
-                    let i = idx / nq;
-                    let jj = idx % nq;
-                    let mut b = rayleigh.quad[i * nq + jj];
+                    let mut b = rayleigh.quad[idx];
                     for r in 0..S {
                         for c in 0..S {
                             b[r][c] *= wr;
                             if let Some(a) = aerosol {
-                                b[r][c] += wa * a.quad[i * nq + jj][r][c];
+                                b[r][c] += wa * a.quad[idx][r][c];
                             }
                         }
                     }
@@ -269,8 +375,7 @@ pub fn solve<const S: usize>(
             let kernel = &mixed[k];
             for i in 0..nq {
                 let mut acc = [0.0; S];
-                let row = &kernel[i * nq..(i + 1) * nq];
-                for (b, v) in row.iter().zip(&field[k]) {
+                for (b, v) in kernel[i * nq..(i + 1) * nq].iter().zip(&field[k]) {
                     let p = mat_vec(b, v);
                     for s in 0..S {
                         acc[s] += p[s];
@@ -280,35 +385,23 @@ pub fn solve<const S: usize>(
             }
         }
     };
-    let zero = vec![vec![[0.0; S]; nq]; levels];
+    let zero: Field<S> = vec![vec![[0.0; S]; nq]; levels];
     let mut j_cur = zero.clone();
     let mut field = zero.clone();
-    let mut sum = zero;
+    let mut sum = zero.clone();
+    // The summed field whose scattering feeds the user directions.
+    let mut feed = zero;
     let total_tau = layering.total();
-    // Order 1 (solar) or order 0 (bottom emission) field.
-    let mut orders = 0;
+    let mut orders;
     match drive {
         Drive::Sun { mu0 } => {
-            for k in 0..levels {
-                let (wr, wa) = scat(k);
-                let tau = layering.tau[k];
-                let att = (-tau / mu0).exp();
-                let att_r = (-(2.0 * total_tau - tau) / mu0).exp();
-                for i in 0..nq {
-                    for s in 0..S {
-                        let mut v = wr * (rayleigh.sun[i][s] * att + rayleigh.sun_reflected[i][s] * att_r);
-                        if let Some(a) = aerosol {
-                            v += wa * (a.sun[i][s] * att + a.sun_reflected[i][s] * att_r);
-                        }
-                        j_cur[k][i][s] = v;
-                    }
-                }
-            }
-            transfer(&tq, surface_quad, &j_cur, None, &mut field);
+            let (a, b) = solar_amplitudes(layering, rayleigh, aerosol, 0..nq);
+            transfer_solar(layering, &streams.mu, *mu0, surface_quad, &a, &b, &mut field);
             orders = 1;
+            add(&mut sum, &field, 1.0);
         }
-        Drive::Bottom { quad, .. } => {
-            // Order 0: emitted radiance attenuated upward (no downward part).
+        Drive::Bottom { quad } => {
+            // Order 0: emitted radiance attenuated upward; it scatters into order 1.
             for k in 0..levels {
                 for jdx in 0..n {
                     let att = (-(total_tau - layering.tau[k]) / streams.mu[jdx]).exp();
@@ -317,39 +410,25 @@ pub fn solve<const S: usize>(
                     }
                 }
             }
+            orders = 0;
         }
     }
-    // The user directions are fed by scattering of the summed field: for a solar drive that is
-    // Σ_{n≥1} Iₙ, whose scattering is orders ≥ 2 (order 1 at the user directions is the exact
-    // single scattering added by the caller); for a bottom drive the emitted field I₀ is
-    // included, giving every scattered order.
-    let add = |acc: &mut Vec<Vec<[f64; S]>>, f: &[Vec<[f64; S]>], scale: f64| {
-        for (a_k, f_k) in acc.iter_mut().zip(f) {
-            for (a, v) in a_k.iter_mut().zip(f_k) {
-                for s in 0..S {
-                    a[s] += scale * v[s];
-                }
-            }
-        }
-    };
+    // Orders below `max_orders` feed the user directions, so that these receive exactly orders
+    // up to `max_orders` (one more scattering happens on the way to them).
     let norm = |f: &[Vec<[f64; S]>]| -> f64 { (0..n).map(|j| f[0][n + j][0].abs() + f[kk][j][0].abs()).sum() };
-    let mut emitted = None;
-    if orders == 1 {
-        add(&mut sum, &field, 1.0);
-    } else {
-        emitted = Some(field.clone());
-    }
     let mut prev_norm = norm(&field);
     let mut prev_ratio = f64::NAN;
     let mut total_norm = if orders == 1 { prev_norm } else { 0.0 };
     while orders < settings.max_orders {
+        add(&mut feed, &field, 1.0);
         scatter_quad(&field, &mut j_cur);
-        transfer(&tq, surface_quad, &j_cur, None, &mut field);
+        transfer(&tq, surface_quad, &j_cur, &mut field);
         orders += 1;
         let this = norm(&field);
         add(&mut sum, &field, 1.0);
         total_norm += this;
         if total_norm <= 0.0 || this <= settings.tolerance * total_norm {
+            add(&mut feed, &field, 1.0);
             break;
         }
         // Geometric tail (OSOAA's test, `OSOAA_SOS_CORE.F`): with r₁, r₂ the last two ratios of
@@ -358,20 +437,18 @@ pub fn solve<const S: usize>(
         let ratio = this / prev_norm;
         let tail_error = (ratio - prev_ratio).abs() / (1.0 - ratio).powi(2) * this / total_norm;
         if orders >= 3 && ratio < 0.98 && tail_error < settings.tolerance {
-            add(&mut sum, &field, ratio / (1.0 - ratio));
+            let tail = ratio / (1.0 - ratio);
+            add(&mut sum, &field, tail);
+            add(&mut feed, &field, 1.0 + tail);
             break;
         }
         prev_ratio = ratio;
         prev_norm = this;
     }
-    let mut sum_for_user = sum.clone();
-    if let Some(e) = &emitted {
-        add(&mut sum_for_user, e, 1.0);
-    }
-    // User directions: source from the summed quadrature field, then one transfer.
-    let users = streams.user_mu.len();
     let mut toa_user = vec![[0.0; S]; u];
-    if users > 0 {
+    let mut toa_user_first = vec![[0.0; S]; u];
+    if u > 0 {
+        let tu = Transfer::new(layering, &streams.user_mu);
         let mut j_user = vec![vec![[0.0; S]; 2 * u]; levels];
         for k in 0..levels {
             let (wr, wa) = scat(k);
@@ -379,12 +456,12 @@ pub fn solve<const S: usize>(
                 let row = nq + i;
                 let mut acc = [0.0; S];
                 for jdx in 0..nq {
-                    let pr = mat_vec(&rayleigh.quad[row * nq + jdx], &sum_for_user[k][jdx]);
+                    let pr = mat_vec(&rayleigh.quad[row * nq + jdx], &feed[k][jdx]);
                     for s in 0..S {
                         acc[s] += wr * pr[s];
                     }
                     if let Some(a) = aerosol {
-                        let pa = mat_vec(&a.quad[row * nq + jdx], &sum_for_user[k][jdx]);
+                        let pa = mat_vec(&a.quad[row * nq + jdx], &feed[k][jdx]);
                         for s in 0..S {
                             acc[s] += wa * pa[s];
                         }
@@ -394,30 +471,13 @@ pub fn solve<const S: usize>(
             }
         }
         let mut out = vec![vec![[0.0; S]; 2 * u]; levels];
-        // The directly transmitted emitted radiance is added by the caller.
-        transfer(&tu, surface_user, &j_user, None, &mut out);
+        transfer(&tu, surface_user, &j_user, &mut out);
         toa_user.copy_from_slice(&out[0][u..2 * u]);
-    }
-    let mut toa_user_first = vec![[0.0; S]; u];
-    if let (Drive::Sun { mu0 }, true) = (drive, u > 0) {
-        let mut j1 = vec![vec![[0.0; S]; 2 * u]; levels];
-        for (k, jk) in j1.iter_mut().enumerate() {
-            let (wr, wa) = scat(k);
-            let tau = layering.tau[k];
-            let (att, att_r) = ((-tau / mu0).exp(), (-(2.0 * total_tau - tau) / mu0).exp());
-            for (i, v) in jk.iter_mut().enumerate() {
-                let row = nq + i;
-                for s in 0..S {
-                    v[s] = wr * (rayleigh.sun[row][s] * att + rayleigh.sun_reflected[row][s] * att_r);
-                    if let Some(a) = aerosol {
-                        v[s] += wa * (a.sun[row][s] * att + a.sun_reflected[row][s] * att_r);
-                    }
-                }
-            }
+        if let Drive::Sun { mu0 } = drive {
+            let (a, b) = solar_amplitudes(layering, rayleigh, aerosol, nq..nq + 2 * u);
+            transfer_solar(layering, &streams.user_mu, *mu0, surface_user, &a, &b, &mut out);
+            toa_user_first.copy_from_slice(&out[0][u..2 * u]);
         }
-        let mut out = vec![vec![[0.0; S]; 2 * u]; levels];
-        transfer(&tu, surface_user, &j1, None, &mut out);
-        toa_user_first.copy_from_slice(&out[0][u..2 * u]);
     }
     FourierField { toa_user, toa_user_first, surface_down: sum[kk][..n].to_vec(), toa_up: sum[0][n..].to_vec(), orders }
 }
@@ -481,7 +541,7 @@ mod tests {
         let tau = 0.35;
         let (streams, layering, k, black) = setup(tau, 0.01);
         let settings = OrderSettings { max_orders: 400, tolerance: 1e-9 };
-        let iso = Drive::Bottom { quad: vec![[1.0]; 16], user: vec![[1.0]; 3] };
+        let iso = Drive::Bottom { quad: vec![[1.0]; 16] };
         let up = solve(&streams, &layering, &k, None, &black, &[[[0.0]]; 3], &iso, settings);
         for (i, &mu) in streams.user_mu.clone().iter().enumerate() {
             let t_up = (-tau / mu).exp() + up.toa_user[i][0];

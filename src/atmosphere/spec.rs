@@ -10,7 +10,7 @@ use serde::{Deserialize, Serialize};
 use super::aerosol::mixture_optics;
 use super::fresnel::SEA_REFRACTIVE_INDEX;
 use super::gas::{GasAmounts, transmittance as gas_transmittance};
-use super::glint::glint_reflectance;
+use super::glint::glint_radiance_norm;
 use super::rayleigh::{AIR_DEPOLARIZATION, RayleighColumn, RayleighDepth, STANDARD_PRESSURE_HPA};
 use super::rt::{RtAccuracy, WavelengthColumn, solve_sun, solve_transmittance};
 use super::wmo::AerosolType;
@@ -138,9 +138,9 @@ impl AtmosphereSpec {
 /// Sun and view geometry in radians (degrees only at the edges).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Geometry {
-    /// Solar zenith angle, rad, in [0, 90°).
+    /// Solar zenith angle, rad, 0–89° (see [`Self::validate`]).
     pub sun_zenith_rad: f64,
-    /// View zenith angle, rad, in [0, 90°).
+    /// View zenith angle, rad, 0–85°.
     pub view_zenith_rad: f64,
     /// View azimuth minus sun azimuth, rad (0: sensor on the sun's side; π: glint side).
     pub relative_azimuth_rad: f64,
@@ -185,7 +185,8 @@ pub struct AtmosphereTerms {
     pub t_down: f64,
     /// Direct downward transmittance e^{−τ/μ₀}·T_gas (the diffuse part is `t_down − t_down_direct`).
     pub t_down_direct: f64,
-    /// Total upward transmittance for uniform water-leaving radiance (gases included).
+    /// Total upward transmittance of the water-leaving radiance (gases included; see
+    /// `rt::solve_transmittance`).
     pub t_up: f64,
     /// Direct upward transmittance e^{−τ/μ_v}·T_gas.
     pub t_up_direct: f64,
@@ -237,7 +238,7 @@ impl Atmosphere {
         Ok(self.e0.value_at(wavelength_nm, Extrapolation::Error)? * solar::sun_distance_factor(self.spec.day_of_year))
     }
 
-    /// The optical column at `wavelength_nm` (350–1000 nm).
+    /// The optical column at `wavelength_nm` (325–1025 nm, the aerosol table's range).
     pub fn column(&self, wavelength_nm: f64) -> Result<WavelengthColumn, AtmosphereError> {
         range("wavelength_nm", wavelength_nm, 325.0, 1025.0, " nm")?;
         let s = &self.spec;
@@ -278,19 +279,7 @@ impl Atmosphere {
         let sun = solve_sun(&column, mu0, &[muv], acc);
         let up = solve_transmittance(&column, &[muv], acc);
         let radiance = sun.radiance(0, g.relative_azimuth_rad);
-        let glint = match self.spec.surface {
-            Surface::Flat => 0.0,
-            Surface::Wind { speed_m_s } => {
-                let rho_g = glint_reflectance(
-                    g.sun_zenith_rad,
-                    g.view_zenith_rad,
-                    g.relative_azimuth_rad,
-                    speed_m_s,
-                    column.water_index,
-                );
-                rho_g * mu0 / std::f64::consts::PI * sun.ed_direct / mu0 * up.t_up_direct[0]
-            }
-        };
+        let glint = self.glint(g, column.total_tau());
         let n = Normalised {
             wavelength_nm,
             tau_rayleigh: column.tau_rayleigh,
@@ -305,6 +294,22 @@ impl Atmosphere {
             glint,
         };
         self.assemble(&n)
+    }
+
+    /// Sun glint per unit solar flux at `g` through a column of optical depth `tau` (0 for a
+    /// flat surface).
+    pub(crate) fn glint(&self, g: &Geometry, tau: f64) -> f64 {
+        match self.spec.surface {
+            Surface::Flat => 0.0,
+            Surface::Wind { speed_m_s } => glint_radiance_norm(
+                g.sun_zenith_rad,
+                g.view_zenith_rad,
+                g.relative_azimuth_rad,
+                speed_m_s,
+                self.spec.water_refractive_index,
+                tau,
+            ),
+        }
     }
 
     /// Combine normalised RT results with E₀ and gases into physical terms.

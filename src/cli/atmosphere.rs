@@ -254,6 +254,7 @@ pub fn run(args: &AtmosphereArgs) -> Result<(), CliError> {
                 weighted(&|t| t.spherical_albedo),
                 weighted(&|t| t.t_gas),
             );
+            let t_down_dir = weighted(&|t| t.t_down_direct);
             let (tau_r, tau_a) = (avg.apply(&col(&|t| t.tau_rayleigh)), avg.apply(&col(&|t| t.tau_aerosol)));
             let mu0 = g.sun_zenith_rad.cos();
             for (b, band) in bands.bands.iter().enumerate() {
@@ -267,6 +268,7 @@ pub fn run(args: &AtmosphereArgs) -> Result<(), CliError> {
                     t_up[b],
                     t_up_dir[b],
                     t_down,
+                    t_down_dir[b],
                     s[b],
                     ed[b],
                     tau_r[b],

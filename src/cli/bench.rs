@@ -7,7 +7,20 @@ use std::time::{Duration, Instant};
 
 use clap::Args;
 
+use std::fmt::Write as _;
+
 use super::CliError;
+
+/// Append a line to a report (writing to a `String` cannot fail).
+macro_rules! say {
+    ($out:expr) => {
+        $out.push('\n')
+    };
+    ($out:expr, $($t:tt)*) => {{
+        let _ = writeln!($out, $($t)*);
+    }};
+}
+use super::output::emit;
 use crate::atmosphere::{AerosolType, AtmosphereLut, AtmosphereSpec, LutAxes, RtAccuracy};
 use crate::spectral::{BandSet, BandSetSpec, WavelengthGrid};
 use crate::validation::{Comparison, compare_paths, compare_water_runs};
@@ -58,14 +71,14 @@ fn rate(reps: usize, each: Duration, mut f: impl FnMut(usize)) -> f64 {
     median(samples)
 }
 
-fn water_rows(quick: bool) -> Result<(), CliError> {
+fn water_rows(out: &mut String, quick: bool) -> Result<(), CliError> {
     // SAMBUCA's benchmark configuration: 350–800 nm at 1 nm (451 bands), its default SIOPs.
     let grid = WavelengthGrid::uniform(350.0, 800.0, 1.0)?;
     let model = WaterModel::new(SiopSpec::sambuca_default().resolve(&grid, None)?);
     let rb =
         SubstrateLibrary::embedded()?.mix_on_grid(&SubstrateMix::parse("ncc_sand:0.5,brown_acropora:0.5")?, &grid)?;
     let geo = WaterGeometry::from_degrees(30.0, 0.0);
-    let mut out = vec![0.0; grid.len()];
+    let mut rrs = vec![0.0; grid.len()];
     let (reps, each) = if quick { (3, Duration::from_millis(100)) } else { (7, Duration::from_millis(400)) };
     let mut sink = 0.0;
     let column = |n: usize, bottom| WaterColumn {
@@ -76,12 +89,12 @@ fn water_rows(quick: bool) -> Result<(), CliError> {
     };
     let shallow = |n: usize| Bottom::Shallow { depth_m: 5.0 + (n % 5) as f64, reflectance: &rb };
     let fast_shallow = rate(reps, each, |n| {
-        let _ = model.rrs_above_into(&column(n, shallow(n)), &geo, &mut out);
-        sink += out[100];
+        let _ = model.rrs_above_into(&column(n, shallow(n)), &geo, &mut rrs);
+        sink += rrs[100];
     });
     let fast_deep = rate(reps, each, |n| {
-        let _ = model.rrs_above_into(&column(n, Bottom::OpticallyDeep), &geo, &mut out);
-        sink += out[100];
+        let _ = model.rrs_above_into(&column(n, Bottom::OpticallyDeep), &geo, &mut rrs);
+        sink += rrs[100];
     });
     let full = rate(reps, each, |n| {
         if let Ok(r) = model.evaluate(&column(n, shallow(n)), &geo) {
@@ -89,18 +102,18 @@ fn water_rows(quick: bool) -> Result<(), CliError> {
         }
     });
     std::hint::black_box(sink);
-    println!("## Water model (Lee 1998/1999), 451 bands, one thread");
-    println!();
-    println!("| evaluation | evaluations/s | × SAMBUCA Python (13–23 k/s) |");
-    println!("|---|---|---|");
+    say!(out, "## Water model (Lee 1998/1999), 451 bands, one thread");
+    say!(out);
+    say!(out, "| evaluation | evaluations/s | × SAMBUCA Python (13–23 k/s) |");
+    say!(out, "|---|---|---|");
     for (label, r) in [
         ("shallow, Rrs only (per-pixel path)", fast_shallow),
         ("optically deep, Rrs only", fast_deep),
         ("shallow, every intermediate", full),
     ] {
-        println!("| {label} | {:.0} | {:.0}–{:.0} |", r, r / 23_000.0, r / 13_000.0);
+        say!(out, "| {label} | {:.0} | {:.0}–{:.0} |", r, r / 23_000.0, r / 13_000.0);
     }
-    println!();
+    say!(out);
     Ok(())
 }
 
@@ -108,13 +121,14 @@ fn max_abs(c: &[Comparison], keep: impl Fn(&Comparison) -> bool) -> f64 {
     c.iter().filter(|x| keep(x)).map(|x| x.error_pct().abs()).fold(0.0, f64::max)
 }
 
-fn atmosphere_rows(quick: bool) -> Result<(), CliError> {
+fn atmosphere_rows(out: &mut String, quick: bool) -> Result<(), CliError> {
     let olci = BandSet::from_spec(&BandSetSpec::parse_cli("olci")?)?;
     let axes = LutAxes::covering(olci.centres_nm(), (55.0, 65.0), 40.0, (5.0, 5.0, 10.0));
     let nodes = axes.wavelengths_nm.len() * axes.sun_zenith_deg.len();
-    println!("## Atmosphere LUT, 19 OLCI bands (Lake Hume scene: continental AOT 0.1, sun 55–65°, view 0–40°)");
-    println!();
-    println!(
+    say!(out, "## Atmosphere LUT, 19 OLCI bands (Lake Hume scene: continental AOT 0.1, sun 55–65°, view 0–40°)");
+    say!(out);
+    say!(
+        out,
         "LUT nodes: {} wavelengths × {} sun × {} view × {} azimuth; OSOAA would need {nodes} runs × 1–3.5 s = {}–{} s.",
         axes.wavelengths_nm.len(),
         axes.sun_zenith_deg.len(),
@@ -123,14 +137,16 @@ fn atmosphere_rows(quick: bool) -> Result<(), CliError> {
         nodes,
         (nodes as f64 * 3.5).round()
     );
-    println!(
+    say!(
+        out,
         "Errors are max |Shoal/OSOAA − 1| over the reference rows (OSOAA's Rayleigh depth, relative azimuth 90°)."
     );
-    println!();
-    println!(
+    say!(out);
+    say!(
+        out,
         "| accuracy | LUT build (median) | × faster than OSOAA | ρ_path Rayleigh | ρ_path aerosol | t_down | Ed(0+) coupled | T_up Heron | T_up Hume |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|");
+    say!(out, "|---|---|---|---|---|---|---|---|---|");
     for preset in ["single", "fast", "default", "high"] {
         let acc = RtAccuracy::preset(preset).ok_or_else(|| CliError::Run(format!("preset {preset}")))?;
         let atm =
@@ -149,7 +165,8 @@ fn atmosphere_rows(quick: bool) -> Result<(), CliError> {
         let paths = compare_paths(&acc)?;
         let water = compare_water_runs(&acc)?;
         let aerosol = |c: &Comparison| c.aerosol != AerosolType::None;
-        println!(
+        say!(
+            out,
             "| {preset} | {:.3} s | {:.0}–{:.0} | {:.2} % | {:.2} % | {:.2} % | {:.2} % | {:.2} % | {:.2} % |",
             t,
             nodes as f64 / t,
@@ -166,9 +183,10 @@ fn atmosphere_rows(quick: bool) -> Result<(), CliError> {
                 && c.lw_fraction.unwrap_or(0.0) > 0.1),
         );
     }
-    println!();
-    println!(
-        "T_up columns use rows where the water-leaving radiance is above 10 % of the TOA radiance (OSOAA's T_up_eff is a difference of two large numbers otherwise). Hume's T_up_eff includes the bidirectional shape of that turbid water's radiance at 60° sun, which Shoal's Lambertian water-leaving radiance does not have: see README."
+    say!(out);
+    say!(
+        out,
+        "T_up columns use rows where the water-leaving radiance is above 10 % of the TOA radiance (OSOAA's T_up_eff is a difference of two large numbers otherwise). Hume's T_up_eff includes the bidirectional shape of that turbid water's radiance at 60° sun, which Shoal's water-leaving radiance (an isotropic in-water field) does not have: see README."
     );
     Ok(())
 }
@@ -176,13 +194,15 @@ fn atmosphere_rows(quick: bool) -> Result<(), CliError> {
 /// Print the per-band comparison with OSOAA as a Markdown table (worst case over the reference
 /// geometries of each band), at default accuracy.
 pub fn osoaa_table() -> Result<(), CliError> {
+    let mut out = String::new();
     let acc = RtAccuracy::default();
     let paths = compare_paths(&acc)?;
     let water = compare_water_runs(&acc)?;
-    println!(
+    say!(
+        out,
         "| band | nm | ρ_path Rayleigh (4 geometries) | ρ_path continental (sun 60°) | t_down (5) | Ed(0+) coupled Heron / Hume | T_up Heron / Hume | L_path Heron / Hume |"
     );
-    println!("|---|---|---|---|---|---|---|---|");
+    say!(out, "|---|---|---|---|---|---|---|---|");
     let worst = |c: &[Comparison], keep: &dyn Fn(&Comparison) -> bool| -> String {
         c.iter()
             .filter(|x| keep(x))
@@ -198,7 +218,8 @@ pub fn osoaa_table() -> Result<(), CliError> {
     for (band, wl) in olci.bands.iter().zip(nominal) {
         let at = |x: &Comparison| (x.wavelength_nm - wl).abs() < 0.05;
         let scen = |x: &Comparison, s: &str| at(x) && x.case.starts_with(s);
-        println!(
+        say!(
+            out,
             "| {} | {wl} | {} | {} | {} | {} / {} | {} / {} | {} / {} |",
             band.name,
             worst(&paths, &|x| at(x) && x.quantity == "rho_path" && x.aerosol == AerosolType::None),
@@ -212,16 +233,19 @@ pub fn osoaa_table() -> Result<(), CliError> {
             worst(&water, &|x| scen(x, "hume") && x.quantity == "l_path"),
         );
     }
-    Ok(())
+    emit(&out, None)
 }
 
 /// Run `shoal bench`.
 pub fn run(args: &BenchArgs) -> Result<(), CliError> {
-    println!("# shoal bench");
-    println!();
-    println!("Machine: {}", machine());
-    println!();
-    water_rows(args.quick)?;
-    atmosphere_rows(args.quick)?;
-    Ok(())
+    let mut out = String::new();
+    say!(out, "# shoal bench");
+    say!(out);
+    say!(out, "Machine: {}", machine());
+    say!(out);
+    emit(&std::mem::take(&mut out), None)?;
+    water_rows(&mut out, args.quick)?;
+    emit(&std::mem::take(&mut out), None)?;
+    atmosphere_rows(&mut out, args.quick)?;
+    emit(&out, None)
 }

@@ -29,6 +29,13 @@ pub fn emit(text: &str, path: Option<&Path>) -> Result<(), CliError> {
     }
 }
 
+/// Shortest round-trip text of a finite number, in exponent form when it is very small or large
+/// (`{}` alone would print 1.6e-46 as 47 zeros).
+#[must_use]
+pub fn number(v: f64) -> String {
+    if v != 0.0 && !(1e-4..1e7).contains(&v.abs()) { format!("{v:e}") } else { format!("{v}") }
+}
+
 /// A CSV table built row by row; every value must be finite (NaN never reaches the output).
 pub struct Csv {
     header: Vec<String>,
@@ -41,8 +48,16 @@ impl Csv {
         Self { header, rows: Vec::new() }
     }
 
-    /// Add a row: a leading label (may be empty to omit) and numbers.
+    /// Add a row: a leading label (may be empty to omit) and numbers. The row must be as wide
+    /// as the header.
     pub fn row(&mut self, label: Option<&str>, values: &[f64]) -> Result<(), CliError> {
+        let width = values.len() + usize::from(label.is_some());
+        if width != self.header.len() {
+            return Err(CliError::Run(format!(
+                "internal error: a row of {width} cells under {} columns (please report this)",
+                self.header.len()
+            )));
+        }
         if let Some((i, v)) = values.iter().enumerate().find(|(_, v)| !v.is_finite()) {
             let offset = usize::from(label.is_some());
             return Err(CliError::Run(format!(
@@ -51,7 +66,7 @@ impl Csv {
             )));
         }
         let mut cells: Vec<String> = label.map(str::to_string).into_iter().collect();
-        cells.extend(values.iter().map(|v| format!("{v}")));
+        cells.extend(values.iter().map(|v| number(*v)));
         self.rows.push(cells);
         Ok(())
     }

@@ -120,15 +120,24 @@ pub struct WaterArgs {
     pub list_substrates: bool,
 }
 
-fn read_spec(path: &Path) -> Result<WaterRun, CliError> {
+/// Read a run file; its relative paths are taken relative to the file's own directory.
+fn read_spec(path: &Path) -> Result<(WaterRun, Option<PathBuf>), CliError> {
     let text =
         std::fs::read_to_string(path).map_err(|e| CliError::Input(format!("cannot read {}: {e}", path.display())))?;
-    ron::from_str(&text).map_err(|e| CliError::Input(format!("{}: {e}", path.display())))
+    let mut run: WaterRun = ron::from_str(&text).map_err(|e| CliError::Input(format!("{}: {e}", path.display())))?;
+    let dir = path.parent().map(Path::to_path_buf);
+    let near = |p: &PathBuf| dir.as_ref().filter(|_| p.is_relative()).map_or_else(|| p.clone(), |d| d.join(p));
+    match &mut run.siop {
+        SiopChoice::File(p) | SiopChoice::Csv(p) => *p = near(p),
+        SiopChoice::Preset(_) | SiopChoice::Inline(_) => {}
+    }
+    run.substrate_csv = run.substrate_csv.as_ref().map(near);
+    Ok((run, dir))
 }
 
 fn siop_from_csv(path: &Path) -> Result<SiopSpec, CliError> {
     let table = crate::spectral::Table::from_file(path)?;
-    // Absolute, so that resolving the SIOP set does not join a base directory a second time.
+    // Absolute, so that resolving the SIOP set never joins a base directory to it again.
     let path = &std::fs::canonicalize(path).map_err(|e| CliError::Input(format!("{}: {e}", path.display())))?;
     let mut s = SiopSpec::preset("heron_island")?;
     s.name = format!("csv:{}", path.display());
@@ -145,7 +154,7 @@ fn siop_from_csv(path: &Path) -> Result<SiopSpec, CliError> {
     for (column, slot) in slots {
         if table.columns.iter().any(|c| c == column) {
             *slot = SpectrumSource::Csv {
-                path: path.to_path_buf(),
+                path: path.clone(),
                 column: column.into(),
                 scale: 1.0,
                 outside: Default::default(),
@@ -163,20 +172,21 @@ fn siop_from_csv(path: &Path) -> Result<SiopSpec, CliError> {
     Ok(s)
 }
 
-fn resolve_siop(choice: &SiopChoice, base: Option<&Path>) -> Result<SiopSpec, CliError> {
-    let rel = |p: &PathBuf| base.filter(|_| p.is_relative()).map_or_else(|| p.clone(), |b| b.join(p));
+/// The SIOP set and the directory its own relative CSV paths are taken from.
+fn resolve_siop(choice: &SiopChoice, spec_dir: Option<&Path>) -> Result<(SiopSpec, Option<PathBuf>), CliError> {
     Ok(match choice {
-        SiopChoice::Preset(name) => SiopSpec::preset(name)?,
-        SiopChoice::File(p) => SiopSpec::from_file(&rel(p))?,
-        SiopChoice::Csv(p) => siop_from_csv(&rel(p))?,
-        SiopChoice::Inline(s) => (**s).clone(),
+        SiopChoice::Preset(name) => (SiopSpec::preset(name)?, None),
+        SiopChoice::File(p) => (SiopSpec::from_file(p)?, p.parent().map(Path::to_path_buf)),
+        SiopChoice::Csv(p) => (siop_from_csv(p)?, None),
+        SiopChoice::Inline(s) => ((**s).clone(), spec_dir.map(Path::to_path_buf)),
     })
 }
 
-/// Merge the flags over the spec file.
+/// Merge the flags over the spec file. Paths given as flags are relative to the working
+/// directory; paths in the spec file were made relative to the spec file when it was read.
 fn merged(args: &WaterArgs) -> Result<(WaterRun, Option<PathBuf>), CliError> {
-    let (mut run, base) = match &args.spec {
-        Some(p) => (read_spec(p)?, p.parent().map(Path::to_path_buf)),
+    let (mut run, spec_dir) = match &args.spec {
+        Some(p) => read_spec(p)?,
         None => (WaterRun::default(), None),
     };
     if let Some(s) = &args.siop {
@@ -209,9 +219,7 @@ fn merged(args: &WaterArgs) -> Result<(WaterRun, Option<PathBuf>), CliError> {
     }
     run.sun_zenith_deg = args.sun_zenith.unwrap_or(run.sun_zenith_deg);
     run.view_zenith_deg = args.view_zenith.unwrap_or(run.view_zenith_deg);
-    // Flags given on the command line are relative to the working directory.
-    let base = if args.siop.is_some() || args.substrate_csv.is_some() { None } else { base };
-    Ok((run, base))
+    Ok((run, spec_dir))
 }
 
 /// Run `shoal water`.
@@ -225,7 +233,7 @@ pub fn run(args: &WaterArgs) -> Result<(), CliError> {
         text.push_str(&format!("# SIOP sets: {}\n", SiopSpec::preset_names().join(", ")));
         return emit(&text, args.out.as_deref());
     }
-    let (run, base) = merged(args)?;
+    let (run, spec_dir) = merged(args)?;
     if let Some(a) = args.rel_azimuth.filter(|a| !(a.is_finite() && a.abs() <= 360.0)) {
         return Err(CliError::Input(format!("--rel-azimuth = {a} is out of range (allowed: -360 to 360 degrees)")));
     }
@@ -235,9 +243,10 @@ pub fn run(args: &WaterArgs) -> Result<(), CliError> {
         (None, Some(spec)) => Some(crate::spectral::BandSet::from_spec(spec)?),
         (None, None) => None,
     };
-    let siop = resolve_siop(&run.siop, base.as_deref())?.resolve(&grid, base.as_deref())?;
+    let (siop_spec, siop_dir) = resolve_siop(&run.siop, spec_dir.as_deref())?;
+    let siop = siop_spec.resolve(&grid, siop_dir.as_deref())?;
     if let Some(csv) = &run.substrate_csv {
-        library.add_csv(&base.as_deref().filter(|_| csv.is_relative()).map_or_else(|| csv.clone(), |b| b.join(csv)))?;
+        library.add_csv(csv)?;
     }
     let reflectance;
     let bottom = match run.depth_m {

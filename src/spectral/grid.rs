@@ -8,6 +8,8 @@ use super::SpectralError;
 pub const FINE_START_NM: f64 = 350.0;
 /// Longest wavelength of the default simulation grid, nm.
 pub const FINE_END_NM: f64 = 1000.0;
+/// Most wavelengths a grid may hold (0.1 nm over 200–3000 nm is 28 001).
+pub const MAX_POINTS: usize = 30_000;
 
 /// A strictly increasing set of wavelengths (nm). Usually uniform (`uniform`, `fine`), but any
 /// increasing list is allowed (band centres, a reference code's grid).
@@ -57,7 +59,15 @@ impl WavelengthGrid {
             });
         }
         // Rounding guard: 350 + 650·1.0 must land on 1000 exactly.
-        let n = ((end_nm - start_nm) / step_nm + 1e-9).floor() as usize + 1;
+        let count = ((end_nm - start_nm) / step_nm + 1e-9).floor() + 1.0;
+        if count > MAX_POINTS as f64 {
+            return Err(SpectralError::Grid {
+                field: "step_nm",
+                value: step_nm,
+                allowed: format!("a step giving at most {MAX_POINTS} wavelengths over {start_nm}–{end_nm} nm"),
+            });
+        }
+        let n = count as usize;
         let wavelengths_nm = (0..n).map(|i| start_nm + i as f64 * step_nm).collect();
         Ok(Self { wavelengths_nm })
     }
@@ -70,11 +80,11 @@ impl WavelengthGrid {
     /// assert!(shoal::spectral::WavelengthGrid::from_wavelengths(vec![500.0, 400.0]).is_err());
     /// ```
     pub fn from_wavelengths(wavelengths_nm: Vec<f64>) -> Result<Self, SpectralError> {
-        if wavelengths_nm.is_empty() {
+        if wavelengths_nm.is_empty() || wavelengths_nm.len() > MAX_POINTS {
             return Err(SpectralError::Grid {
                 field: "wavelengths_nm",
-                value: 0.0,
-                allowed: "at least one wavelength".into(),
+                value: wavelengths_nm.len() as f64,
+                allowed: format!("1 to {MAX_POINTS} wavelengths"),
             });
         }
         for &w in &wavelengths_nm {

@@ -5,7 +5,7 @@
 //! polynomial of e^r (truncation error r¹⁴/14! < 5·10⁻¹⁸) by Estrin's scheme (short dependency
 //! chains, so neighbouring wavelengths overlap in the pipeline), and builds 2^k from the bits of
 //! the rounding constant, so every step is plain arithmetic on f64 and u64 lanes.
-//! Accuracy: within 2 ulp of `f64::exp` on [−708, 709] (tested below); inputs below −708 return
+//! Accuracy: within 4.5·10⁻¹⁶ relative of `f64::exp` on [−708, 709] (tested below); inputs below −708 return
 //! e^−708 ≈ 3·10⁻³⁰⁸ (denormals are not produced), inputs above 709 return e^709.
 //!
 //! ## References
@@ -66,7 +66,7 @@ mod tests {
     use super::fast_exp;
 
     #[test]
-    fn matches_libm_within_two_ulp() {
+    fn matches_libm_to_4p5e_minus_16() {
         let mut worst = 0.0f64;
         let mut x = -708.0;
         while x < 709.0 {

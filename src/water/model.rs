@@ -300,8 +300,8 @@ impl WaterModel {
     }
 
     /// Above-surface Rrs only, without allocating: the per-pixel path. Same formulas as
-    /// [`Self::evaluate`]; the exponential is [`super::fast_exp`] (≤ 2 ulp) so the loop
-    /// vectorises. Inputs are validated as in `evaluate`.
+    /// [`Self::evaluate`]; the exponential is [`super::fast_exp`] (≤ 4.5·10⁻¹⁶ relative) so the
+    /// loop vectorises. Inputs are validated as in `evaluate`, including a > 0 and bb > 0.
     pub fn rrs_above_into(
         &self,
         column: &WaterColumn<'_>,
@@ -332,16 +332,16 @@ impl WaterModel {
             cdom: column.cdom_per_m,
             nap: column.nap_g_m3,
         };
+        // Only a SIOP set with strongly negative specific spectra can make a or bb ≤ 0; check
+        // before computing, as `evaluate` does (a cheap pass next to the kernel).
+        if let Some(i) = (0..n).find(|&i| !(k.absorption(i) > 0.0 && k.backscattering(i) > 0.0)) {
+            return Err(self.non_physical(i, k.absorption(i), k.backscattering(i)));
+        }
         match column.bottom {
             Bottom::OpticallyDeep => k.deep(&mut out[..n]),
             Bottom::Shallow { depth_m, reflectance } => {
                 k.shallow(depth_m, inv_cos_w, inv_cos_o, &reflectance[..n], &mut out[..n]);
             }
-        }
-        // Only a SIOP set with strongly negative specific spectra can produce a ≤ 0; find where.
-        if out.iter().any(|v| !(v.is_finite() && *v >= 0.0)) {
-            let i = (0..n).find(|&i| !(k.absorption(i) > 0.0)).unwrap_or(0);
-            return Err(self.non_physical(i, k.absorption(i), f64::NAN));
         }
         Ok(())
     }
@@ -376,6 +376,10 @@ struct Kernel<'a> {
 impl Kernel<'_> {
     fn absorption(&self, i: usize) -> f64 {
         self.a_w[i] + self.chl * self.a_ph[i] + self.cdom * self.a_cdom[i] + self.nap * self.a_nap[i]
+    }
+
+    fn backscattering(&self, i: usize) -> f64 {
+        self.bb_w[i] + self.chl * self.bb_ph[i] + self.nap * self.bb_nap[i]
     }
 
     fn deep(&self, out: &mut [f64]) {

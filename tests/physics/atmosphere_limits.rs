@@ -1,8 +1,6 @@
 //! Limits, determinism and bad input for the atmosphere.
 
-use shoal::atmosphere::{
-    AerosolType, AtmosphereLut, AtmosphereSpec, Geometry, LutAxes, RtAccuracy, Surface, gauss_half,
-};
+use shoal::atmosphere::{AerosolType, AtmosphereLut, AtmosphereSpec, Geometry, LutAxes, RtAccuracy, Surface};
 
 fn spec(aerosol: AerosolType, aot550: f64) -> AtmosphereSpec {
     AtmosphereSpec { aerosol, aot550, ..Default::default() }
@@ -35,10 +33,10 @@ fn thin_atmosphere_tends_to_single_scattering() {
 #[test]
 fn transmittances_and_albedo_are_physical() {
     for aerosol in [AerosolType::None, AerosolType::Maritime, AerosolType::Continental, AerosolType::Urban] {
-        for aot in [0.0, 0.3, 1.0] {
+        for aot in [0.0, 0.3, 1.0, 5.0] {
             let atm = spec(aerosol, aot).build().unwrap();
-            // Away from the flat sea's mirror direction (see the next test).
-            for (sza, vza) in [(10.0, 0.0), (60.0, 40.0), (85.0, 60.0)] {
+            // Away from the flat sea's mirror direction (see the next test), to the limits.
+            for (sza, vza) in [(10.0, 0.0), (60.0, 40.0), (85.0, 60.0), (89.0, 85.0)] {
                 let t = atm.terms(443.0, &Geometry::from_degrees(sza, vza, 45.0)).unwrap();
                 for (name, v) in
                     [("t_up", t.t_up), ("t_down", t.t_down), ("S", t.spherical_albedo), ("t_up_direct", t.t_up_direct)]
@@ -46,11 +44,13 @@ fn transmittances_and_albedo_are_physical() {
                     assert!(v.is_finite() && (0.0..=1.0).contains(&v), "{aerosol:?} {aot} {sza}/{vza}: {name} = {v}");
                 }
                 assert!(t.t_up >= t.t_up_direct, "{aerosol:?} {aot} {sza}/{vza}: {} < {}", t.t_up, t.t_up_direct);
-                assert!(
-                    t.l_path_w_m2_sr_nm > 0.0 && t.rho_path < 1.0,
-                    "{aerosol:?} {aot} {sza}/{vza}: ρ = {}",
-                    t.rho_path
-                );
+                // Path radiance is positive and finite; ρ = πL/(E₀μ₀) stays below 1 except at
+                // grazing geometry, where it legitimately exceeds 1 (a slant path of 11 air
+                // masses under a sun at 89°, normalised by the tiny horizontal irradiance).
+                assert!(t.l_path_w_m2_sr_nm > 0.0 && t.l_path_w_m2_sr_nm.is_finite(), "{aerosol:?} {aot} {sza}/{vza}");
+                if sza < 80.0 {
+                    assert!(t.rho_path < 1.0, "{aerosol:?} {aot} {sza}/{vza}: ρ = {}", t.rho_path);
+                }
             }
         }
     }
@@ -91,6 +91,65 @@ fn lut_interpolation_agrees_with_direct_solves() {
             assert!((a / b - 1.0).abs() < 3e-3, "{wl} nm {name}: LUT {a} vs direct {b}");
         }
     }
+}
+
+#[test]
+fn irradiance_does_not_depend_on_the_number_of_streams() {
+    // Delta-M moves the truncated forward peak into the direct beam; the total Ed(0+) must
+    // then be the same whatever the truncation order (6, 12, 24 streams): 0.3 % spread allowed
+    // for the quadrature of the diffuse part.
+    for (aerosol, aot, sza) in
+        [(AerosolType::Maritime, 0.3, 60.0), (AerosolType::Continental, 1.0, 30.0), (AerosolType::Urban, 0.5, 75.0)]
+    {
+        let t = |streams| {
+            let acc = RtAccuracy { streams, fourier_terms: 2 * streams, ..RtAccuracy::default() };
+            AtmosphereSpec { accuracy: acc, ..spec(aerosol, aot) }
+                .build()
+                .unwrap()
+                .terms(443.0, &Geometry::from_degrees(sza, 0.0, 0.0))
+                .unwrap()
+                .t_down
+        };
+        let (a, b, c) = (t(6), t(12), t(24));
+        assert!((a / c - 1.0).abs() < 3e-3 && (b / c - 1.0).abs() < 3e-3, "{aerosol:?}: {a} {b} {c}");
+    }
+}
+
+#[test]
+fn low_sun_converges_with_layer_thickness() {
+    // The first-order source e^{−τ/μ₀} is integrated exactly within layers, so even at 89°
+    // (μ₀ = 0.017, e-folding in 0.017 of optical depth) the default 0.02 layers are within
+    // 0.3 % of 0.001 layers.
+    for (aerosol, aot) in [(AerosolType::None, 0.0), (AerosolType::Continental, 0.3)] {
+        let run = |dtau| {
+            let acc = RtAccuracy { max_layer_depth: dtau, min_layers: 1, ..RtAccuracy::default() };
+            AtmosphereSpec { accuracy: acc, ..spec(aerosol, aot) }
+                .build()
+                .unwrap()
+                .terms(400.0, &Geometry::from_degrees(89.0, 30.0, 90.0))
+                .unwrap()
+        };
+        let (coarse, fine) = (run(0.02), run(0.001));
+        assert!((coarse.t_down / fine.t_down - 1.0).abs() < 3e-3, "{aerosol:?}: {} vs {}", coarse.t_down, fine.t_down);
+        assert!(
+            (coarse.rho_path / fine.rho_path - 1.0).abs() < 3e-3,
+            "{aerosol:?}: {} vs {}",
+            coarse.rho_path,
+            fine.rho_path
+        );
+    }
+}
+
+#[test]
+fn lut_refuses_geometry_outside_its_nodes() {
+    let atm = spec(AerosolType::Maritime, 0.1).build().unwrap();
+    let lut = AtmosphereLut::build(&atm, LutAxes::covering(vec![550.0], (30.0, 30.0), 10.0, (5.0, 5.0, 10.0))).unwrap();
+    assert!(lut.terms(0, &Geometry::from_degrees(30.0, 8.0, 0.0)).is_ok());
+    let e = lut.terms(0, &Geometry::from_degrees(60.0, 8.0, 0.0)).unwrap_err().to_string();
+    assert!(e.contains("sun_zenith") && e.contains("30"), "{e}");
+    let e = lut.terms(0, &Geometry::from_degrees(30.0, 40.0, 0.0)).unwrap_err().to_string();
+    assert!(e.contains("view_zenith"), "{e}");
+    assert!(lut.terms(3, &Geometry::from_degrees(30.0, 8.0, 0.0)).is_err());
 }
 
 #[test]
@@ -178,6 +237,4 @@ fn bad_inputs_name_the_field_and_range() {
     }
     let e = atm.terms(200.0, &Geometry::from_degrees(30.0, 0.0, 0.0)).unwrap_err().to_string();
     assert!(e.contains("wavelength"), "{e}");
-    // The quadrature helper used throughout is well formed at small sizes too.
-    assert_eq!(gauss_half(2).0.len(), 2);
 }

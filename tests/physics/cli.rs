@@ -91,6 +91,32 @@ fn atmosphere_prints_the_terms_per_wavelength() {
 }
 
 #[test]
+fn band_rows_are_as_wide_as_the_header() {
+    for args in [
+        &["atmosphere", "--aerosol", "maritime", "--bands", "olci", "--accuracy", "fast"][..],
+        &["water", "--depth", "4", "--bands", "msi"][..],
+        &["atmosphere", "--spec", "presets/examples/atmosphere_lake_hume.ron", "--accuracy", "fast"][..],
+    ] {
+        let (code, out, err) = shoal(args);
+        assert_eq!(code, 0, "{args:?}: {err}");
+        let r = rows(&out);
+        assert!(r.len() > 5);
+        for row in &r {
+            assert_eq!(row.len(), r[0].len(), "{args:?}: {row:?}");
+        }
+    }
+    // And the values sit under the right names: a transmittance, an albedo, an irradiance.
+    let (_, out, _) = shoal(&["atmosphere", "--aerosol", "maritime", "--bands", "olci", "--accuracy", "fast"]);
+    let r = rows(&out);
+    let col = |name: &str| r[0].iter().position(|c| c == name).unwrap();
+    for row in &r[1..] {
+        let v = |name: &str| row[col(name)].parse::<f64>().unwrap();
+        assert!(v("t_down_direct") < v("t_down") && v("t_down") < 1.0);
+        assert!(v("spherical_albedo") < 0.4 && v("ed_0plus_w_m2_nm") > 0.3);
+    }
+}
+
+#[test]
 fn example_specs_run() {
     for (cmd, file) in [
         ("water", "presets/examples/water_heron_sand.ron"),
@@ -120,6 +146,8 @@ fn bad_input_exits_2_with_one_line_naming_the_field() {
         (&["atmosphere", "--aot550", "-0.2"], "aot550"),
         (&["atmosphere", "--surface", "wind:fast"], "surface"),
         (&["atmosphere", "--bands", "landsat"], "landsat"),
+        (&["water", "--step", "0.0000001"], "step"),
+        (&["water", "--rel-azimuth", "400"], "rel-azimuth"),
     ];
     for (args, field) in cases {
         let (code, out, err) = shoal(args);

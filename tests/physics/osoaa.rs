@@ -34,7 +34,7 @@ fn path_reflectance_and_t_down_match_osoaa_vector() {
     assert!(e < 1.3, "Rayleigh path radiance regressed: {e:.2} % at {case}");
     let (e, case) = worst(&c, |x| x.quantity == "rho_path" && x.aerosol != AerosolType::None);
     assert!(e < 5.0, "aerosol path radiance target 5 %: {e:.2} % at {case}");
-    // Guard: 0.98 % measured.
+    // Guard: 1.15 % measured.
     assert!(e < 1.5, "aerosol path radiance regressed: {e:.2} % at {case}");
     let (e, case) = worst(&c, |x| x.quantity == "t_down");
     assert!(e < 2.0, "Ed(0+) target 2 %: {e:.2} % at {case}");
@@ -47,7 +47,7 @@ fn water_runs_match_osoaa_ed_and_heron_t_up() {
     let c = compare_water_runs(&RtAccuracy::default()).unwrap();
     let (e, case) = worst(&c, |x| x.quantity == "ed_0plus");
     assert!(e < 2.0, "coupled Ed(0+) target 2 %: {e:.2} % at {case}");
-    // Guard: 0.77 % measured.
+    // Guard: 0.70 % measured.
     assert!(e < 1.2, "coupled Ed(0+) regressed: {e:.2} % at {case}");
     // T_up_eff = (L_toa − L_path)/Lw is a small difference of large numbers where the water is
     // dark; OSOAA stops its orders at 0.1 % of the radiance, so where Lw < 10 % of L_toa its
@@ -63,8 +63,8 @@ fn water_runs_match_osoaa_ed_and_heron_t_up() {
 fn hume_t_up_differs_only_by_the_waters_bidirectional_shape() {
     // OSOAA's Lake Hume run (turbid water, sun at 60°) has an upwelling radiance that is brighter
     // away from nadir than at nadir, so its T_up_eff — which divides all transmitted water light
-    // by the nadir Lw — exceeds the transmittance of a uniform Lw. Shoal's water model has no
-    // bidirectional shape, so its T_up is that of uniform Lw. The signature of this cause is a
+    // by the nadir Lw — exceeds the transmittance of an isotropic in-water field's Lw. Shoal's
+    // water model has no bidirectional shape, so its T_up is that field's. The signature is a
     // near-constant ratio of the diffuse parts at every wavelength (1.14–1.19, mean 1.17; the
     // spread follows OSOAA's own convergence noise, largest where Lw is smallest), with direct
     // parts that agree exactly; an atmospheric error would not be a constant factor.
@@ -108,9 +108,11 @@ fn hume_t_up_differs_only_by_the_waters_bidirectional_shape() {
 
 #[test]
 fn t_up_matches_6s_for_a_uniform_water_leaving_radiance() {
-    // 6SV's upward transmittance assumes a uniform (Lambertian) source, as Shoal's does; with 6S's
-    // own optical depths the two agree to the difference of the aerosol phase functions
-    // (6S's continental model vs the OSOAA/WMO Mie mixture): 0.46 % measured.
+    // 6SV's upward transmittance assumes a uniform (Lambertian) source over a black surface;
+    // Shoal's source is an isotropic in-water field (within 0.1 % of uniform above water below
+    // 50°) over the Fresnel surface. With 6S's own optical depths the two agree to the
+    // difference of those choices and of the aerosol phase functions (6S's continental model vs
+    // the OSOAA/WMO Mie mixture): 0.46 % measured.
     let t = Table::from_file(&data("osoaa/path_compare.csv")).unwrap();
     let (wl, sza, vza) = (t.column_f64("wl_nm").unwrap(), t.column_f64("sza").unwrap(), t.column_f64("vza").unwrap());
     let aer = t.column_str("aer").unwrap();
