@@ -58,7 +58,19 @@ macro_rules! embed_presets {
 }
 
 /// Built-in presets (RON files under `presets/`), embedded so that names resolve anywhere.
-pub const PRESETS: &[Asset] = embed_presets!["siop/heron_island.ron", "siop/cyanobacteria_reservoir.ron",];
+pub const PRESETS: &[Asset] = embed_presets![
+    "siop/heron_island.ron",
+    "siop/cyanobacteria_reservoir.ron",
+    "scenes/lake_hume_bloom.ron",
+    "scenes/heron_island_reef.ron",
+    "scenes/aquaculture_turbidity.ron",
+    "scenes/reservoir_chl_cdom.ron",
+    "instruments/nominal.ron",
+    "instruments/cubesat.ron",
+    "instruments/smallsat.ron",
+    "instruments/hyperspectral.ron",
+    "instruments/filter_imager.ron",
+];
 
 /// The built-in preset at `path` (relative to `presets/`), if there is one.
 #[must_use]

@@ -17,16 +17,30 @@
 //! |---|---|
 //! | [`units`] | constants, unit conversions, angle helpers |
 //! | [`assets`] | cited spectra embedded in the binary |
+//! | [`control`] | cancellation and progress shared by a run and its watcher |
 //! | [`spectral`] | wavelength grid, spectra, band sets, `band_from_fine` |
 //! | [`water`] | SIOP sets, IOPs, deep/shallow reflectance (Lee et al. 1998/1999, SAMBUCA) |
 //! | [`atmosphere`] | Rayleigh, aerosols (Mie, WMO models), gases, SOS radiative transfer, LUT |
+//! | [`scene`] | scene files composing water, bottom, land, atmosphere and effects; maps |
+//! | [`toa`] | a scene's TOA radiance at any point and view: L_path + T_up·Lw (+ glint, adjacency) |
+//! | [`instrument`] | Table 1 instruments: response, pushbroom geometry, PSF, detector, SNR |
+//! | [`calibration`] | diffuser and dark frames → per-detector gain and offset; Level-0 → Level-1 |
+//! | [`correction`] | Level-1 → Rrs: exact per pixel, and the paper's per-scene approximation |
+//! | [`engine`] | the chain as cached stages; the worker thread the app talks to |
 //! | [`validation`] | comparisons with reference codes (OSOAA), shared by tests and `shoal bench` |
 //! | [`cli`] | the headless command line (`shoal water`, `shoal atmosphere`, `shoal bench`) |
 
 pub mod assets;
 pub mod atmosphere;
+pub mod calibration;
 pub mod cli;
+pub mod control;
+pub mod correction;
+pub mod engine;
+pub mod instrument;
+pub mod scene;
 pub mod spectral;
+pub mod toa;
 pub mod units;
 pub mod validation;
 pub mod water;

@@ -10,6 +10,10 @@
 pub const PLANCK_J_S: f64 = 6.626_070_15e-34;
 /// Speed of light in vacuum, m s⁻¹ (exact).
 pub const SPEED_OF_LIGHT_M_S: f64 = 299_792_458.0;
+/// Mean Earth radius, m (IUGG mean radius R₁, Moritz 2000, Geodetic Reference System 1980).
+pub const EARTH_RADIUS_M: f64 = 6_371_008.8;
+/// Earth's gravitational parameter GM, m³ s⁻² (WGS 84, NIMA TR8350.2).
+pub const EARTH_GM_M3_S2: f64 = 3.986_004_418e14;
 /// π as used throughout (re-exported for brevity in formulas).
 pub const PI: f64 = std::f64::consts::PI;
 

@@ -84,6 +84,7 @@ pub struct AtmosphereLut {
     scatterers: Vec<Scatterers>,
     ed: Vec<f64>,
     t_up: Vec<f64>,
+    t_up_direct: Vec<f64>,
     spherical_albedo: Vec<f64>,
     tau_total: Vec<f64>,
     tau_rayleigh: Vec<f64>,
@@ -140,6 +141,7 @@ impl AtmosphereLut {
         }
         let scatterers = (0..nw).map(|w| sun[w * ns].scatterers.clone()).collect();
         let t_up = up.iter().flat_map(|t| t.t_up.iter().copied()).collect();
+        let t_up_direct = up.iter().flat_map(|t| t.t_up_direct.iter().copied()).collect();
         let spherical_albedo = up.iter().map(|t| t.spherical_albedo).collect();
         Ok(Self {
             tau_total: columns.iter().map(|c| c.total_tau()).collect(),
@@ -152,6 +154,7 @@ impl AtmosphereLut {
             scatterers,
             ed,
             t_up,
+            t_up_direct,
             spherical_albedo,
         })
     }
@@ -162,8 +165,19 @@ impl AtmosphereLut {
         &self.axes
     }
 
-    /// All terms for wavelength node `w` at geometry `g`, interpolated.
+    /// All terms for wavelength node `w` at geometry `g`, interpolated, with E₀ and gases.
     pub fn terms(&self, w: usize, g: &Geometry) -> Result<AtmosphereTerms, AtmosphereError> {
+        self.atmosphere.assemble(&self.normalised(w, g)?)
+    }
+
+    /// The atmosphere this table was built for.
+    #[must_use]
+    pub fn atmosphere(&self) -> &Atmosphere {
+        &self.atmosphere
+    }
+
+    /// The gas-free terms per unit solar flux for wavelength node `w` at geometry `g`.
+    pub fn normalised(&self, w: usize, g: &Geometry) -> Result<Normalised, AtmosphereError> {
         g.validate()?;
         let a = &self.axes;
         let (ns, nv, nf) = (a.sun_zenith_deg.len(), a.view_zenith_deg.len(), self.n_fourier);
@@ -198,6 +212,7 @@ impl AtmosphereLut {
         let lerp = |x: f64, y: f64, t: f64| x + t * (y - x);
         let ed = lerp(self.ed[w * ns + s0], self.ed[w * ns + s1], ts);
         let t_up = lerp(self.t_up[w * nv + v0], self.t_up[w * nv + v1], tv);
+        let t_up_direct = lerp(self.t_up_direct[w * nv + v0], self.t_up_direct[w * nv + v1], tv);
         // Normalised quantities scale smoothly with μ₀ where the direct beam dominates; the
         // interpolated Ed is rescaled by the exact direct-beam ratio at this sun angle.
         let tau = self.tau_total[w];
@@ -207,9 +222,8 @@ impl AtmosphereLut {
             ts,
         );
         let ed = ed * (mu0 * (-tau / mu0).exp()) / direct_nodes;
-        let t_up_direct = (-tau / muv).exp();
         let glint = self.atmosphere.glint(g, tau);
-        self.atmosphere.assemble(&Normalised {
+        Ok(Normalised {
             wavelength_nm: a.wavelengths_nm[w],
             tau_rayleigh: self.tau_rayleigh[w],
             tau_aerosol: tau - self.tau_rayleigh[w],

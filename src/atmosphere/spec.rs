@@ -200,22 +200,32 @@ pub struct AtmosphereTerms {
     pub l_glint_w_m2_sr_nm: f64,
 }
 
-/// RT results per unit solar flux and without gases, for one wavelength and geometry.
+/// RT results per unit solar flux (normal to the beam) and without gases, for one wavelength
+/// and geometry: what a LUT stores and what scenes interpolate across wavelength before applying
+/// the 1-nm solar spectrum and the gases.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct Normalised {
+pub struct Normalised {
+    /// Wavelength, nm.
     pub wavelength_nm: f64,
+    /// Rayleigh optical depth.
     pub tau_rayleigh: f64,
+    /// Aerosol optical depth.
     pub tau_aerosol: f64,
+    /// Cosine of the sun zenith angle.
     pub mu0: f64,
+    /// Cosine of the view zenith angle.
     pub muv: f64,
     /// Path radiance I (L = I·E₀).
     pub radiance: f64,
-    /// Ed(0⁺) per unit flux.
+    /// Ed(0⁺) per unit flux (black water, Fresnel surface).
     pub ed: f64,
+    /// Upward transmittance (see `rt::solve_transmittance`).
     pub t_up: f64,
+    /// Its direct part.
     pub t_up_direct: f64,
+    /// Spherical albedo.
     pub spherical_albedo: f64,
-    /// Glint radiance per unit flux.
+    /// Glint radiance per unit flux (0 for a flat surface).
     pub glint: f64,
 }
 
@@ -298,7 +308,7 @@ impl Atmosphere {
 
     /// Sun glint per unit solar flux at `g` through a column of optical depth `tau` (0 for a
     /// flat surface).
-    pub(crate) fn glint(&self, g: &Geometry, tau: f64) -> f64 {
+    pub fn glint(&self, g: &Geometry, tau: f64) -> f64 {
         match self.spec.surface {
             Surface::Flat => 0.0,
             Surface::Wind { speed_m_s } => glint_radiance_norm(
@@ -313,7 +323,7 @@ impl Atmosphere {
     }
 
     /// Combine normalised RT results with E₀ and gases into physical terms.
-    pub(crate) fn assemble(&self, n: &Normalised) -> Result<AtmosphereTerms, AtmosphereError> {
+    pub fn assemble(&self, n: &Normalised) -> Result<AtmosphereTerms, AtmosphereError> {
         let e0 = self.e0(n.wavelength_nm)?;
         let (tg0, tgv) = (self.gas(n.wavelength_nm, n.mu0)?, self.gas(n.wavelength_nm, n.muv)?);
         let t_gas = tg0 * tgv;

@@ -9,22 +9,10 @@ use serde::{Deserialize, Serialize};
 use super::CliError;
 use super::grid::{GridArgs, GridSpec};
 use super::output::{Csv, emit};
-use crate::spectral::{BandAverager, BandSetSpec, SpectrumSource};
-use crate::water::{Bottom, SiopSpec, SubstrateLibrary, SubstrateMix, WaterColumn, WaterGeometry, WaterModel};
-
-/// Where the SIOP set comes from.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub enum SiopChoice {
-    /// A built-in set (`heron_island`, `cyanobacteria_reservoir`, `sambuca_default`).
-    Preset(String),
-    /// A SIOP RON file.
-    File(PathBuf),
-    /// A CSV file with any of the columns a_w, bb_w, a_ph_star, bb_ph_star, a_cdom_star,
-    /// a_nap_star, bb_nap_star (against `wavelength_nm`); the others come from `heron_island`.
-    Csv(PathBuf),
-    /// A SIOP set written in place.
-    Inline(Box<SiopSpec>),
-}
+use crate::spectral::{BandAverager, BandSetSpec};
+use crate::water::{
+    Bottom, SiopSource, SiopSpec, SubstrateLibrary, SubstrateMix, WaterColumn, WaterGeometry, WaterModel,
+};
 
 /// A `shoal water` run as a RON file (`presets/examples/water_heron_sand.ron`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -32,7 +20,7 @@ pub enum SiopChoice {
 #[serde(default)]
 pub struct WaterRun {
     /// SIOP set.
-    pub siop: SiopChoice,
+    pub siop: SiopSource,
     /// Chlorophyll-a, mg m⁻³.
     pub chl_mg_m3: f64,
     /// CDOM absorption at the SIOP set's reference wavelength (440 nm for the presets), m⁻¹.
@@ -58,7 +46,7 @@ pub struct WaterRun {
 impl Default for WaterRun {
     fn default() -> Self {
         Self {
-            siop: SiopChoice::Preset("heron_island".into()),
+            siop: SiopSource::Preset("heron_island".into()),
             chl_mg_m3: 1.0,
             cdom_per_m: 0.05,
             nap_g_m3: 1.0,
@@ -127,59 +115,9 @@ fn read_spec(path: &Path) -> Result<(WaterRun, Option<PathBuf>), CliError> {
     let mut run: WaterRun = ron::from_str(&text).map_err(|e| CliError::Input(format!("{}: {e}", path.display())))?;
     let dir = path.parent().map(Path::to_path_buf);
     let near = |p: &PathBuf| dir.as_ref().filter(|_| p.is_relative()).map_or_else(|| p.clone(), |d| d.join(p));
-    match &mut run.siop {
-        SiopChoice::File(p) | SiopChoice::Csv(p) => *p = near(p),
-        SiopChoice::Preset(_) | SiopChoice::Inline(_) => {}
-    }
+    run.siop = run.siop.relative_to(dir.as_deref());
     run.substrate_csv = run.substrate_csv.as_ref().map(near);
     Ok((run, dir))
-}
-
-fn siop_from_csv(path: &Path) -> Result<SiopSpec, CliError> {
-    let table = crate::spectral::Table::from_file(path)?;
-    // Absolute, so that resolving the SIOP set never joins a base directory to it again.
-    let path = &std::fs::canonicalize(path).map_err(|e| CliError::Input(format!("{}: {e}", path.display())))?;
-    let mut s = SiopSpec::preset("heron_island")?;
-    s.name = format!("csv:{}", path.display());
-    let slots: [(&str, &mut SpectrumSource); 7] = [
-        ("a_w", &mut s.water_absorption),
-        ("bb_w", &mut s.water_backscatter),
-        ("a_ph_star", &mut s.phytoplankton_absorption),
-        ("bb_ph_star", &mut s.phytoplankton_backscatter),
-        ("a_cdom_star", &mut s.cdom_absorption),
-        ("a_nap_star", &mut s.nap_absorption),
-        ("bb_nap_star", &mut s.nap_backscatter),
-    ];
-    let mut used = 0;
-    for (column, slot) in slots {
-        if table.columns.iter().any(|c| c == column) {
-            *slot = SpectrumSource::Csv {
-                path: path.clone(),
-                column: column.into(),
-                scale: 1.0,
-                outside: Default::default(),
-            };
-            used += 1;
-        }
-    }
-    if used == 0 {
-        return Err(CliError::Input(format!(
-            "{}: no SIOP column found (expected any of a_w, bb_w, a_ph_star, bb_ph_star, a_cdom_star, a_nap_star, bb_nap_star; found {})",
-            path.display(),
-            table.columns.join(", ")
-        )));
-    }
-    Ok(s)
-}
-
-/// The SIOP set and the directory its own relative CSV paths are taken from.
-fn resolve_siop(choice: &SiopChoice, spec_dir: Option<&Path>) -> Result<(SiopSpec, Option<PathBuf>), CliError> {
-    Ok(match choice {
-        SiopChoice::Preset(name) => (SiopSpec::preset(name)?, None),
-        SiopChoice::File(p) => (SiopSpec::from_file(p)?, p.parent().map(Path::to_path_buf)),
-        SiopChoice::Csv(p) => (siop_from_csv(p)?, None),
-        SiopChoice::Inline(s) => ((**s).clone(), spec_dir.map(Path::to_path_buf)),
-    })
 }
 
 /// Merge the flags over the spec file. Paths given as flags are relative to the working
@@ -191,11 +129,11 @@ fn merged(args: &WaterArgs) -> Result<(WaterRun, Option<PathBuf>), CliError> {
     };
     if let Some(s) = &args.siop {
         run.siop = if s.ends_with(".ron") {
-            SiopChoice::File(s.into())
+            SiopSource::File(s.into())
         } else if s.ends_with(".csv") {
-            SiopChoice::Csv(s.into())
+            SiopSource::Csv(s.into())
         } else {
-            SiopChoice::Preset(s.clone())
+            SiopSource::Preset(s.clone())
         };
     }
     run.chl_mg_m3 = args.chl.unwrap_or(run.chl_mg_m3);
@@ -243,7 +181,7 @@ pub fn run(args: &WaterArgs) -> Result<(), CliError> {
         (None, Some(spec)) => Some(crate::spectral::BandSet::from_spec(spec)?),
         (None, None) => None,
     };
-    let (siop_spec, siop_dir) = resolve_siop(&run.siop, spec_dir.as_deref())?;
+    let (siop_spec, siop_dir) = run.siop.load(spec_dir.as_deref())?;
     let siop = siop_spec.resolve(&grid, siop_dir.as_deref())?;
     if let Some(csv) = &run.substrate_csv {
         library.add_csv(csv)?;

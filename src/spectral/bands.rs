@@ -266,6 +266,7 @@ fn trim_zeros(s: Spectrum) -> Result<Spectrum, SpectralError> {
 #[derive(Debug, Clone, PartialEq)]
 pub struct BandAverager {
     rows: Vec<(usize, Vec<f64>)>,
+    areas_nm: Vec<f64>,
     n_fine: usize,
 }
 
@@ -281,11 +282,16 @@ impl BandAverager {
     /// assert!((m.apply(&flat)[0] - 2.0).abs() < 1e-12);
     /// ```
     pub fn new(grid: &WavelengthGrid, bands: &BandSet) -> Result<Self, SpectralError> {
-        let rows = bands.bands.iter().map(|b| Self::row(grid, b)).collect::<Result<_, _>>()?;
-        Ok(Self { rows, n_fine: grid.len() })
+        let rows: Vec<(usize, Vec<f64>, f64)> =
+            bands.bands.iter().map(|b| Self::build_row(grid, b)).collect::<Result<_, _>>()?;
+        Ok(Self {
+            areas_nm: rows.iter().map(|r| r.2).collect(),
+            rows: rows.into_iter().map(|(first, w, _)| (first, w)).collect(),
+            n_fine: grid.len(),
+        })
     }
 
-    fn row(grid: &WavelengthGrid, band: &Band) -> Result<(usize, Vec<f64>), SpectralError> {
+    fn build_row(grid: &WavelengthGrid, band: &Band) -> Result<(usize, Vec<f64>, f64), SpectralError> {
         let g = grid.wavelengths_nm();
         let (g_lo, g_hi) = grid.range_nm();
         let (s_lo, s_hi) = band.srf.range_nm();
@@ -333,7 +339,20 @@ impl BandAverager {
         let first = weights.iter().position(|&w| w != 0.0).unwrap_or(0);
         let last = weights.iter().rposition(|&w| w != 0.0).unwrap_or(0);
         let row = weights[first..=last].iter().map(|w| w / inside).collect();
-        Ok((first, row))
+        Ok((first, row, inside))
+    }
+
+    /// Row `b`: index of its first non-zero weight and the weights (summing to 1).
+    #[must_use]
+    pub fn row(&self, b: usize) -> (usize, &[f64]) {
+        let (first, w) = &self.rows[b];
+        (*first, w)
+    }
+
+    /// ∫ SRF dλ of band `b` over the grid, nm (the equivalent width of a peak-normalised SRF).
+    #[must_use]
+    pub fn srf_area_nm(&self, b: usize) -> f64 {
+        self.areas_nm[b]
     }
 
     /// Number of bands (rows).

@@ -22,7 +22,7 @@ mod source;
 mod spectrum;
 mod table;
 
-pub use bands::{Band, BandAverager, BandSet, BandSetSpec, Platform};
+pub use bands::{Band, BandAverager, BandSet, BandSetSpec, GaussianBand, Platform};
 pub use grid::WavelengthGrid;
 pub use source::SpectrumSource;
 pub use spectrum::{Extrapolation, Spectrum};

@@ -38,7 +38,7 @@ pub use fastmath::fast_exp;
 pub use model::{
     Bottom, WaterColumn, WaterGeometry, WaterModel, WaterReflectance, rrs_above_from_below, rrs_below_from_above,
 };
-pub use siop::{Siop, SiopSpec};
+pub use siop::{Siop, SiopSource, SiopSpec};
 pub use substrate::{SubstrateEntry, SubstrateLibrary, SubstrateMix};
 
 use crate::spectral::SpectralError;

@@ -225,3 +225,88 @@ pub struct Siop {
     /// Refractive index of water for Snell's law.
     pub water_refractive_index: f64,
 }
+
+/// Where a SIOP set comes from, as scene and run files write it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub enum SiopSource {
+    /// A built-in set (`heron_island`, `cyanobacteria_reservoir`, `sambuca_default`).
+    Preset(String),
+    /// A SIOP RON file; CSV paths inside it are relative to it.
+    File(std::path::PathBuf),
+    /// A CSV file with any of the columns a_w, bb_w, a_ph_star, bb_ph_star, a_cdom_star,
+    /// a_nap_star, bb_nap_star (against `wavelength_nm`); the others come from `heron_island`.
+    Csv(std::path::PathBuf),
+    /// A SIOP set written in place; CSV paths inside it are relative to the file that holds it.
+    Inline(Box<SiopSpec>),
+}
+
+impl SiopSource {
+    /// The SIOP set and the directory its own relative CSV paths are taken from. `spec_dir` is the
+    /// directory of the file that holds an `Inline` set.
+    pub fn load(&self, spec_dir: Option<&Path>) -> Result<(SiopSpec, Option<std::path::PathBuf>), WaterError> {
+        Ok(match self {
+            Self::Preset(name) => (SiopSpec::preset(name)?, None),
+            Self::File(p) => (SiopSpec::from_file(p)?, p.parent().map(Path::to_path_buf)),
+            Self::Csv(p) => (SiopSpec::from_csv_columns(p)?, None),
+            Self::Inline(s) => ((**s).clone(), spec_dir.map(Path::to_path_buf)),
+        })
+    }
+
+    /// Make relative paths relative to `dir` (the directory of the file that names them).
+    #[must_use]
+    pub fn relative_to(self, dir: Option<&Path>) -> Self {
+        let near = |p: std::path::PathBuf| match dir {
+            Some(d) if p.is_relative() => d.join(p),
+            _ => p,
+        };
+        match self {
+            Self::File(p) => Self::File(near(p)),
+            Self::Csv(p) => Self::Csv(near(p)),
+            other => other,
+        }
+    }
+}
+
+impl SiopSpec {
+    /// A SIOP set from a CSV whose columns (any of a_w, bb_w, a_ph_star, bb_ph_star, a_cdom_star,
+    /// a_nap_star, bb_nap_star, against `wavelength_nm`) replace those of `heron_island`.
+    pub fn from_csv_columns(path: &Path) -> Result<Self, WaterError> {
+        let table = crate::spectral::Table::from_file(path)?;
+        // Absolute, so that resolving the set never joins a base directory to it again.
+        let path = &std::fs::canonicalize(path)
+            .map_err(|e| WaterError::Parse { origin: path.display().to_string(), message: e.to_string() })?;
+        let mut s = Self::preset("heron_island")?;
+        s.name = format!("csv:{}", path.display());
+        let slots: [(&str, &mut SpectrumSource); 7] = [
+            ("a_w", &mut s.water_absorption),
+            ("bb_w", &mut s.water_backscatter),
+            ("a_ph_star", &mut s.phytoplankton_absorption),
+            ("bb_ph_star", &mut s.phytoplankton_backscatter),
+            ("a_cdom_star", &mut s.cdom_absorption),
+            ("a_nap_star", &mut s.nap_absorption),
+            ("bb_nap_star", &mut s.nap_backscatter),
+        ];
+        let mut used = 0;
+        for (column, slot) in slots {
+            if table.columns.iter().any(|c| c == column) {
+                *slot = SpectrumSource::Csv {
+                    path: path.clone(),
+                    column: column.into(),
+                    scale: 1.0,
+                    outside: Default::default(),
+                };
+                used += 1;
+            }
+        }
+        if used == 0 {
+            return Err(WaterError::Parse {
+                origin: path.display().to_string(),
+                message: format!(
+                    "no SIOP column found (expected any of a_w, bb_w, a_ph_star, bb_ph_star, a_cdom_star, a_nap_star, bb_nap_star; found {})",
+                    table.columns.join(", ")
+                ),
+            });
+        }
+        Ok(s)
+    }
+}

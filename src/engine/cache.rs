@@ -1,0 +1,174 @@
+//! The stage cache: products kept under a hash of exactly what they read.
+
+use std::any::Any;
+use std::collections::{HashMap, VecDeque};
+use std::hash::{DefaultHasher, Hash, Hasher};
+use std::sync::Arc;
+
+use serde::Serialize;
+
+/// The stages of the chain, in order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+pub enum Stage {
+    /// Scene maps.
+    Scene,
+    /// Spectral response.
+    Response,
+    /// Viewing geometry.
+    Geometry,
+    /// Atmosphere LUT.
+    Lut,
+    /// Scene bound to the grids and the LUT (water model, adjacency).
+    Optics,
+    /// Band-effective atmosphere per column.
+    BandAtmosphere,
+    /// Pupil radiance and truth.
+    Radiance,
+    /// Detector responsivity and fixed patterns.
+    Detector,
+    /// Electrons per pixel.
+    Electrons,
+    /// Level-0 counts.
+    Level0,
+    /// Calibration coefficients.
+    Calibration,
+    /// Level-1 radiance.
+    Level1,
+    /// Rrs.
+    Correction,
+    /// SNR table.
+    Snr,
+}
+
+impl Stage {
+    /// Every stage, in chain order.
+    pub const ALL: [Self; 14] = [
+        Self::Scene,
+        Self::Response,
+        Self::Geometry,
+        Self::Lut,
+        Self::Optics,
+        Self::BandAtmosphere,
+        Self::Radiance,
+        Self::Detector,
+        Self::Electrons,
+        Self::Level0,
+        Self::Calibration,
+        Self::Level1,
+        Self::Correction,
+        Self::Snr,
+    ];
+
+    /// Products kept per stage: two for the large cubes (instrument A and B of a comparison),
+    /// four for the small ones.
+    fn capacity(self) -> usize {
+        match self {
+            Self::Radiance | Self::Electrons | Self::Level0 | Self::Level1 | Self::Correction => 2,
+            _ => 4,
+        }
+    }
+}
+
+impl std::fmt::Display for Stage {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let name = match self {
+            Self::Scene => "scene",
+            Self::Response => "response",
+            Self::Geometry => "geometry",
+            Self::Lut => "atmosphere LUT",
+            Self::Optics => "optics",
+            Self::BandAtmosphere => "band atmosphere",
+            Self::Radiance => "radiance",
+            Self::Detector => "detector",
+            Self::Electrons => "electrons",
+            Self::Level0 => "level-0",
+            Self::Calibration => "calibration",
+            Self::Level1 => "level-1",
+            Self::Correction => "correction",
+            Self::Snr => "snr",
+        };
+        f.write_str(name)
+    }
+}
+
+/// A cache key: the hash of a stage's inputs and of its upstream keys.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct Key(pub u64);
+
+/// Builds a key from serialisable inputs (hashed through their exact RON text, which round-trips
+/// every f64) and upstream keys.
+#[derive(Debug)]
+pub struct KeyBuilder(DefaultHasher);
+
+impl KeyBuilder {
+    /// Start a key for `stage`.
+    #[must_use]
+    pub fn new(stage: Stage) -> Self {
+        let mut h = DefaultHasher::new();
+        stage.hash(&mut h);
+        Self(h)
+    }
+
+    /// Add a serialisable input.
+    #[must_use]
+    pub fn with<T: Serialize + ?Sized>(mut self, value: &T) -> Self {
+        match ron::to_string(value) {
+            Ok(s) => s.hash(&mut self.0),
+            // Unserialisable input: never reuse a product built from it.
+            Err(_) => std::time::Instant::now().hash(&mut self.0),
+        }
+        self
+    }
+
+    /// Add an upstream key.
+    #[must_use]
+    pub fn after(mut self, key: Key) -> Self {
+        key.0.hash(&mut self.0);
+        self
+    }
+
+    /// The key.
+    #[must_use]
+    pub fn finish(self) -> Key {
+        Key(self.0.finish())
+    }
+}
+
+type Product = Arc<dyn Any + Send + Sync>;
+
+/// Products by stage, most recent first, a few per stage.
+#[derive(Default)]
+pub struct Cache {
+    entries: HashMap<Stage, VecDeque<(Key, Product)>>,
+}
+
+impl std::fmt::Debug for Cache {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Cache").field("stages", &self.entries.len()).finish()
+    }
+}
+
+impl Cache {
+    /// The product of `stage` under `key`, if kept (and moves it to the front).
+    pub fn get<T: Send + Sync + 'static>(&mut self, stage: Stage, key: Key) -> Option<Arc<T>> {
+        let list = self.entries.get_mut(&stage)?;
+        let i = list.iter().position(|(k, _)| *k == key)?;
+        let entry = list.remove(i)?;
+        let product = entry.1.clone().downcast::<T>().ok();
+        list.push_front(entry);
+        product
+    }
+
+    /// Keep `product` of `stage` under `key`.
+    pub fn put<T: Send + Sync + 'static>(&mut self, stage: Stage, key: Key, product: Arc<T>) {
+        let list = self.entries.entry(stage).or_default();
+        list.retain(|(k, _)| *k != key);
+        list.push_front((key, product));
+        list.truncate(stage.capacity());
+    }
+
+    /// Drop everything.
+    pub fn clear(&mut self) {
+        self.entries.clear();
+    }
+}

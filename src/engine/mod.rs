@@ -1,0 +1,58 @@
+//! The engine: the chain as stages with typed products, each cached under a hash of exactly what
+//! it reads, so that a change re-runs only the stages downstream of it.
+//!
+//! ```text
+//! Scene ─┐
+//! Response ─ Geometry ─┐
+//! Lut ── Optics ──── BandAtmosphere ── Radiance ── Electrons ── Level0 ── Level1 ── Correction
+//!                                                    Detector ─ Calibration ─┘          Snr
+//! ```
+//!
+//! | stage | reads | product |
+//! |---|---|---|
+//! | `Scene` | scene file | maps (random fields, images rasterised) |
+//! | `Response` | bands, QE, spectral step | photon weights, simulation grids |
+//! | `Geometry` | orbit, optics, detectors, decimation, sun | ground points, view angles |
+//! | `Lut` | atmosphere, sun, view range | the SOS look-up table |
+//! | `Optics` | scene, LUT, grids | water model on the grid, adjacency PSF |
+//! | `BandAtmosphere` | optics, geometry | per-column band-effective atmosphere |
+//! | `Radiance` | the above, spatial response | pupil band radiance and the truth |
+//! | `Detector` | aperture, exposure, transmission, QE, dark, PRNU/DSNU, well, electronics | responsivity |
+//! | `Electrons` | radiance, photon side of the detector, seed | electrons per pixel |
+//! | `Level0` | electrons, read noise, gain, bias, ADC | counts and flags |
+//! | `Calibration` | detector, calibration settings, solar spectrum | gain and offset |
+//! | `Level1` | Level-0, calibration | calibrated radiance |
+//! | `Correction` | Level-1, band atmosphere | Rrs, flags, per-scene approximation |
+//! | `Snr` | detector, typical radiance | analytic and measured SNR |
+//!
+//! Changing the gain re-runs `Detector`, `Level0`, `Calibration`, `Level1`, `Correction` and
+//! `Snr`, never the scene, the atmosphere or the photon counts. Effects a scene does not ask for
+//! are never computed and the report lists them as skipped. [`worker`] runs the engine on its own
+//! thread with its own rayon pool for the app.
+
+mod cache;
+mod config;
+mod report;
+mod run;
+pub mod worker;
+
+pub use cache::Stage;
+pub use config::{Fidelity, RunConfig};
+pub use report::{RunReport, StageReport, StageStatus};
+pub use run::{Engine, RunOutput};
+
+/// An engine failure: the stage and what went wrong (the message names the field).
+#[derive(Debug, thiserror::Error, Clone, PartialEq)]
+pub enum EngineError {
+    /// A newer request superseded this run, or the user cancelled it.
+    #[error("cancelled")]
+    Cancelled,
+    /// A stage failed.
+    #[error("{stage}: {message}")]
+    Failed {
+        /// The stage.
+        stage: Stage,
+        /// What went wrong.
+        message: String,
+    },
+}

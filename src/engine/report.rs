@@ -1,0 +1,112 @@
+//! The run report: what ran, what came from the cache, what was skipped, and how long it took.
+
+use serde::Serialize;
+
+use super::Stage;
+use crate::correction::{BandDifference, SceneApproximation};
+
+/// What happened to a stage in a run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum StageStatus {
+    /// Computed in this run.
+    Ran,
+    /// Reused from an earlier run (its inputs had not changed).
+    Cached,
+}
+
+/// One stage of a run.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StageReport {
+    /// The stage.
+    pub stage: Stage,
+    /// Ran or cached.
+    pub status: StageStatus,
+    /// Wall time, s (0 when cached).
+    pub seconds: f64,
+}
+
+/// An effect and why it was not computed.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SkippedEffect {
+    /// The effect.
+    pub effect: crate::scene::Effect,
+    /// Why.
+    pub reason: String,
+}
+
+/// The report of one run.
+#[derive(Debug, Clone, PartialEq, Serialize, Default)]
+pub struct RunReport {
+    /// Scene and instrument names.
+    pub scene: String,
+    /// Instrument name.
+    pub instrument: String,
+    /// Image size simulated: rows, columns, bands.
+    pub shape: (usize, usize, usize),
+    /// Decimation factor.
+    pub decimation: usize,
+    /// Rows and columns not simulated because they look beyond the scene.
+    pub cropped: (usize, usize),
+    /// Stages in chain order.
+    pub stages: Vec<StageReport>,
+    /// Effects the scene did not ask for (never computed).
+    pub skipped_effects: Vec<SkippedEffect>,
+    /// Simulation-grid wavelengths per geometry group.
+    pub grid_points: Vec<usize>,
+    /// Water-model evaluations in the radiance stage (0 when cached).
+    pub water_evaluations: u64,
+    /// Of which with the bottom term.
+    pub bottom_evaluations: u64,
+    /// Spatial-response quadrature points per pixel.
+    pub spatial_samples: usize,
+    /// Level-0 pixel-bands flagged saturated.
+    pub saturated: usize,
+    /// Level-0 pixel-bands at zero counts.
+    pub zero_counts: usize,
+    /// Sun incidence on the calibration diffuser, degrees.
+    pub diffuser_incidence_deg: f64,
+    /// Calibration frames that saturated.
+    pub diffuser_saturated_frames: usize,
+    /// The paper's per-scene approximation terms.
+    pub approximation: Option<SceneApproximation>,
+    /// Per band: the per-scene approximation against the exact correction (same Level-1).
+    pub approximation_vs_exact: Vec<BandDifference>,
+    /// Per band: the delivered Rrs against the true band Rrs.
+    pub rrs_vs_truth: Vec<BandDifference>,
+    /// Line period and exposure, s.
+    pub line_period_s: f64,
+    /// Total wall time, s.
+    pub total_seconds: f64,
+}
+
+impl RunReport {
+    /// Seconds spent in `stage` (0 when cached or absent).
+    #[must_use]
+    pub fn seconds(&self, stage: Stage) -> f64 {
+        self.stages.iter().filter(|s| s.stage == stage).map(|s| s.seconds).sum()
+    }
+
+    /// Did `stage` run (rather than come from the cache)?
+    #[must_use]
+    pub fn ran(&self, stage: Stage) -> bool {
+        self.stages.iter().any(|s| s.stage == stage && s.status == StageStatus::Ran)
+    }
+
+    /// A plain-text table of the stages.
+    #[must_use]
+    pub fn table(&self) -> String {
+        let mut out = String::from("stage               status    seconds\n");
+        for s in &self.stages {
+            let status = match s.status {
+                StageStatus::Ran => "ran",
+                StageStatus::Cached => "cached",
+            };
+            out.push_str(&format!("{:<19} {:<9} {:>8.3}\n", s.stage.to_string(), status, s.seconds));
+        }
+        for e in &self.skipped_effects {
+            out.push_str(&format!("{:<19} skipped   ({})\n", format!("{:?}", e.effect), e.reason));
+        }
+        out.push_str(&format!("{:<19} {:<9} {:>8.3}\n", "total", "", self.total_seconds));
+        out
+    }
+}

@@ -1,0 +1,209 @@
+//! The engine on its own thread, for the app: requests in, events out, through bounded
+//! channels, with generation numbers so that stale work is abandoned and stale results dropped.
+//!
+//! The app owns the configuration and sends a snapshot with a new generation number each time it
+//! changes. The worker always runs the newest request it has: a newer one cancels the current
+//! run at its next row. Each request runs at each of its decimation factors in turn (a preview,
+//! then full resolution), through the same stage cache. The worker owns a rayon pool of its own,
+//! so the UI thread keeps a core.
+
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::mpsc::{Receiver, RecvTimeoutError, SyncSender, TryRecvError, TrySendError, sync_channel};
+use std::thread::JoinHandle;
+use std::time::Duration;
+
+use super::{Engine, EngineError, RunConfig, RunOutput};
+use crate::control::RunControl;
+
+/// A request: a configuration snapshot and the decimations to run it at, coarsest first.
+#[derive(Debug, Clone)]
+pub struct Request {
+    /// Generation number (increasing).
+    pub generation: u64,
+    /// The configuration.
+    pub config: RunConfig,
+    /// Decimation factors, e.g. `[4, 1]` for a preview then full resolution.
+    pub decimations: Vec<usize>,
+}
+
+/// What the worker reports.
+#[derive(Debug, Clone)]
+pub enum Event {
+    /// Progress of a run: units done of total (rows of the heavy stages).
+    Progress {
+        /// Generation.
+        generation: u64,
+        /// Decimation of the run in progress.
+        decimation: usize,
+        /// Units done.
+        done: u64,
+        /// Units in all (grows as stages start).
+        total: u64,
+    },
+    /// A run finished (or failed).
+    Finished {
+        /// Generation.
+        generation: u64,
+        /// Decimation of the run.
+        decimation: usize,
+        /// The output, or the error message.
+        result: Result<Arc<RunOutput>, EngineError>,
+    },
+}
+
+/// The app's handle on the engine thread.
+#[derive(Debug)]
+pub struct EngineHandle {
+    requests: Option<SyncSender<Request>>,
+    events: Receiver<Event>,
+    latest: Arc<AtomicU64>,
+    thread: Option<JoinHandle<()>>,
+}
+
+impl EngineHandle {
+    /// Start the worker with a rayon pool of `threads` threads.
+    pub fn spawn(threads: usize) -> std::io::Result<Self> {
+        let (request_tx, request_rx) = sync_channel::<Request>(4);
+        let (event_tx, event_rx) = sync_channel::<Event>(64);
+        let latest = Arc::new(AtomicU64::new(0));
+        let worker_latest = latest.clone();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads.max(1))
+            .thread_name(|i| format!("shoal-engine-{i}"))
+            .build()
+            .map_err(std::io::Error::other)?;
+        let thread = std::thread::Builder::new()
+            .name("shoal-engine".into())
+            .spawn(move || worker(&request_rx, &event_tx, &worker_latest, &pool))?;
+        Ok(Self { requests: Some(request_tx), events: event_rx, latest, thread: Some(thread) })
+    }
+
+    /// Submit a configuration snapshot; any run of an older generation is cancelled. Returns
+    /// false if the worker has stopped.
+    pub fn submit(&self, request: Request) -> bool {
+        self.latest.fetch_max(request.generation, Ordering::SeqCst);
+        let Some(tx) = &self.requests else { return false };
+        let mut pending = request;
+        // The queue is short; if it is full, the worker is busy and will skip to the newest
+        // request anyway, so wait briefly for room rather than drop the newest.
+        loop {
+            match tx.try_send(pending) {
+                Ok(()) => return true,
+                Err(TrySendError::Full(r)) => {
+                    pending = r;
+                    std::thread::sleep(Duration::from_millis(1));
+                }
+                Err(TrySendError::Disconnected(_)) => return false,
+            }
+        }
+    }
+
+    /// The newest generation submitted.
+    #[must_use]
+    pub fn latest_generation(&self) -> u64 {
+        self.latest.load(Ordering::SeqCst)
+    }
+
+    /// Next event, if any (never blocks). Results of stale generations are dropped here.
+    pub fn poll(&self) -> Option<Event> {
+        loop {
+            match self.events.try_recv() {
+                Ok(event) => {
+                    let generation = match &event {
+                        Event::Progress { generation, .. } | Event::Finished { generation, .. } => *generation,
+                    };
+                    if generation == self.latest_generation() {
+                        return Some(event);
+                    }
+                }
+                Err(TryRecvError::Empty | TryRecvError::Disconnected) => return None,
+            }
+        }
+    }
+
+    /// Wait up to `timeout` for the next current event.
+    pub fn wait(&self, timeout: Duration) -> Option<Event> {
+        let deadline = std::time::Instant::now() + timeout;
+        loop {
+            if let Some(e) = self.poll() {
+                return Some(e);
+            }
+            let left = deadline.saturating_duration_since(std::time::Instant::now());
+            if left.is_zero() {
+                return None;
+            }
+            match self.events.recv_timeout(left.min(Duration::from_millis(5))) {
+                Ok(event) => {
+                    let generation = match &event {
+                        Event::Progress { generation, .. } | Event::Finished { generation, .. } => *generation,
+                    };
+                    if generation == self.latest_generation() {
+                        return Some(event);
+                    }
+                }
+                Err(RecvTimeoutError::Timeout) => {}
+                Err(RecvTimeoutError::Disconnected) => return None,
+            }
+        }
+    }
+}
+
+impl Drop for EngineHandle {
+    fn drop(&mut self) {
+        // Cancel the current run and close the request channel; the worker then exits.
+        self.latest.fetch_add(1, Ordering::SeqCst);
+        self.requests = None;
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+    }
+}
+
+fn worker(requests: &Receiver<Request>, events: &SyncSender<Event>, latest: &Arc<AtomicU64>, pool: &rayon::ThreadPool) {
+    let mut engine = Engine::new();
+    while let Ok(mut request) = requests.recv() {
+        // Skip to the newest request queued.
+        while let Ok(newer) = requests.try_recv() {
+            request = newer;
+        }
+        for &decimation in &request.decimations {
+            if latest.load(Ordering::SeqCst) != request.generation {
+                break;
+            }
+            let mut config = request.config.clone();
+            config.fidelity.decimation = decimation;
+            let control = Arc::new(RunControl::for_generation(latest.clone(), request.generation));
+            let result = std::thread::scope(|s| {
+                let watcher = control.clone();
+                let done = Arc::new(std::sync::atomic::AtomicBool::new(false));
+                let done_flag = done.clone();
+                let generation = request.generation;
+                s.spawn(move || {
+                    while !done_flag.load(Ordering::Relaxed) {
+                        let (d, t) = watcher.progress();
+                        let _ = events.try_send(Event::Progress { generation, decimation, done: d, total: t });
+                        std::thread::sleep(Duration::from_millis(50));
+                    }
+                });
+                let result = pool.install(|| engine.run(&config, &control));
+                done.store(true, Ordering::Relaxed);
+                result
+            });
+            let cancelled = matches!(result, Err(EngineError::Cancelled));
+            if cancelled {
+                break;
+            }
+            let failed = result.is_err();
+            if events
+                .send(Event::Finished { generation: request.generation, decimation, result: result.map(Arc::new) })
+                .is_err()
+            {
+                return;
+            }
+            if failed {
+                break;
+            }
+        }
+    }
+}

@@ -1,0 +1,132 @@
+//! Whole-image exposure and readout: band radiance cube → electrons cube → Level-0.
+//!
+//! Two stages, so that a change of the electronics (gain, bias, ADC bits, read noise) re-runs
+//! only the readout and never the photon counts. Each pixel draws its noise from its own
+//! generator (see [`super::detector`]): results do not depend on the number of threads.
+
+use ndarray::Array3;
+use rayon::prelude::*;
+
+use super::InstrumentError;
+use super::detector::{Detector, Stream, pixel_rng};
+use super::geometry::Viewing;
+use crate::control::RunControl;
+
+/// Level-0: raw counts with flags.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Level0 {
+    /// Digital numbers, (row, column, band).
+    pub dn: Array3<u16>,
+    /// The analogue DN before quantisation, kept only when quantisation is off (the ideal-ADC
+    /// closure setting), so Level-1 can be computed without quantisation error.
+    pub analog: Option<Array3<f32>>,
+    /// [`super::Flags`] per pixel and band.
+    pub flags: Array3<u8>,
+}
+
+impl Level0 {
+    /// The value calibration uses at (row, column, band).
+    #[must_use]
+    pub fn value(&self, r: usize, c: usize, b: usize) -> f64 {
+        match &self.analog {
+            Some(a) => f64::from(a[[r, c, b]]),
+            None => f64::from(self.dn[[r, c, b]]),
+        }
+    }
+}
+
+fn shape_error(e: ndarray::ShapeError) -> InstrumentError {
+    InstrumentError::Invalid { field: "cube".into(), message: e.to_string() }
+}
+
+/// Electrons collected by every pixel from `radiance` (row, column, band) at the nominal
+/// exposure: photo-electrons, dark signal, shot noise, full well.
+pub fn expose_cube(
+    detector: &Detector,
+    radiance: &Array3<f32>,
+    viewing: &Viewing,
+    seed: u64,
+    control: &RunControl,
+) -> Result<Array3<f32>, InstrumentError> {
+    let (rows, cols, nb) = radiance.dim();
+    let t = detector.exposure_s();
+    let input = radiance.as_standard_layout();
+    let input = input
+        .as_slice()
+        .ok_or_else(|| InstrumentError::Invalid { field: "cube".into(), message: "not contiguous".into() })?;
+    let mut out = vec![0.0f32; rows * cols * nb];
+    control.add_total(rows as u64);
+    out.par_chunks_mut((cols * nb).max(1)).enumerate().try_for_each(|(r, row)| {
+        if control.cancelled() {
+            return Err(InstrumentError::Cancelled);
+        }
+        let line = viewing.line_index[r];
+        for c in 0..cols {
+            let j = viewing.detector_index[c];
+            let mut rng = pixel_rng(seed, Stream::Exposure, line, j);
+            for b in 0..nb {
+                let l = f64::from(input[(r * cols + c) * nb + b]);
+                row[c * nb + b] = detector.expose(j, b, l, t, &mut rng) as f32;
+            }
+        }
+        control.tick(1);
+        Ok(())
+    })?;
+    Array3::from_shape_vec((rows, cols, nb), out).map_err(shape_error)
+}
+
+/// Read out every pixel: read noise, gain, bias, ADC; flags for saturation and zero counts.
+pub fn digitise_cube(
+    detector: &Detector,
+    electrons: &Array3<f32>,
+    viewing: &Viewing,
+    seed: u64,
+    control: &RunControl,
+) -> Result<Level0, InstrumentError> {
+    let (rows, cols, nb) = electrons.dim();
+    let input = electrons.as_standard_layout();
+    let input = input
+        .as_slice()
+        .ok_or_else(|| InstrumentError::Invalid { field: "cube".into(), message: "not contiguous".into() })?;
+    let keep_analog = !detector.mode().quantise;
+    let n = rows * cols * nb;
+    let mut dn = vec![0u16; n];
+    let mut flags = vec![0u8; n];
+    let mut analog = vec![0.0f32; if keep_analog { n } else { 0 }];
+    let stride = (cols * nb).max(1);
+    control.add_total(rows as u64);
+    let analog_rows: Vec<&mut [f32]> = if keep_analog {
+        analog.chunks_mut(stride).collect()
+    } else {
+        (0..rows).map(|_| <&mut [f32]>::default()).collect()
+    };
+    dn.par_chunks_mut(stride).zip(flags.par_chunks_mut(stride)).zip(analog_rows).enumerate().try_for_each(
+        |(r, ((dn_row, flag_row), analog_row))| {
+            if control.cancelled() {
+                return Err(InstrumentError::Cancelled);
+            }
+            let line = viewing.line_index[r];
+            for c in 0..cols {
+                let j = viewing.detector_index[c];
+                let mut rng = pixel_rng(seed, Stream::Readout, line, j);
+                for b in 0..nb {
+                    let i = c * nb + b;
+                    let out = detector.read_out(f64::from(input[(r * cols + c) * nb + b]), &mut rng);
+                    dn_row[i] = out.dn;
+                    flag_row[i] = out.flags;
+                    if keep_analog {
+                        analog_row[i] = out.analog_dn;
+                    }
+                }
+            }
+            control.tick(1);
+            Ok(())
+        },
+    )?;
+    let shape = (rows, cols, nb);
+    Ok(Level0 {
+        dn: Array3::from_shape_vec(shape, dn).map_err(shape_error)?,
+        analog: if keep_analog { Some(Array3::from_shape_vec(shape, analog).map_err(shape_error)?) } else { None },
+        flags: Array3::from_shape_vec(shape, flags).map_err(shape_error)?,
+    })
+}

@@ -1,0 +1,76 @@
+//! Instruments: how a satellite imager turns the scene's top-of-atmosphere radiance into
+//! Level-0 counts.
+//!
+//! | part | module | what it models |
+//! |---|---|---|
+//! | the file | [`spec`] | every Table 1 parameter of Matthews et al. (2023) and the model kind |
+//! | spectral response | [`response`] | SRF × QE × photon weighting per band, smile, keystone |
+//! | viewing geometry | [`geometry`] | pushbroom ground points, view zenith and azimuth, spherical Earth |
+//! | spatial response | [`spatial`] | diffraction, detector footprint, along-track smear (when asked) |
+//! | sampling | [`sample`] | band radiance of every pixel from the scene, and its truth |
+//! | detector | [`detector`] | photo-electrons, shot/dark/read noise, PRNU/DSNU, full well, ADC |
+//! | Level-0 | [`level0`] | the whole image exposed and read out, with flags |
+//! | SNR | [`snr`] | analytic SNR and SNR measured on a simulated uniform patch |
+//!
+//! Four kinds (see [`InstrumentKind`]): a band-pass multispectral imager, an ideal radiometer
+//! for reference runs, a long-slit dispersive spectrograph (CHICO-like) and a gradient /
+//! linear-variable-filter imager (CyanoSat-like).
+//!
+//! ## References
+//! - Matthews, M. W. et al. (2023) Demonstration of a modular prototype end-to-end simulator for
+//!   aquatic remote sensing applications. Sensors 23, 7824 (§2.1.2, Table 1, Appendix A).
+//! - Janesick, J. R. (2007) Photon Transfer: DN → λ. SPIE Press, Bellingham (noise model,
+//!   photon transfer, quantisation noise gain²/12).
+//! - Schowengerdt, R. A. (2007) Remote Sensing: Models and Methods for Image Processing, 3rd ed.,
+//!   Academic Press, ch. 3 (pushbroom geometry, system PSF = optics ⊗ detector ⊗ motion).
+
+pub mod detector;
+pub mod geometry;
+pub mod level0;
+pub mod response;
+pub mod sample;
+pub mod snr;
+pub mod spatial;
+pub mod spec;
+
+pub use detector::{Detector, DetectorMode, Flags};
+pub use geometry::{Look, Viewing};
+pub use level0::{Level0, digitise_cube, expose_cube};
+pub use response::{GeometryGroup, Response};
+pub use sample::{BandAtmosphere, RadianceCube, SampleOptions, sample_radiance};
+pub use snr::{SnrRow, analytic_snr, measured_snr};
+pub use spatial::SpatialKernel;
+pub use spec::{InstrumentKind, InstrumentSpec, ground_speed_m_s};
+
+use crate::scene::SceneError;
+use crate::spectral::SpectralError;
+
+/// Errors from the instrument stage; each names the field and what is allowed.
+#[derive(Debug, thiserror::Error, Clone, PartialEq)]
+pub enum InstrumentError {
+    /// A field with an invalid value.
+    #[error("{field}: {message}")]
+    Invalid {
+        /// The field (`aperture_mm`).
+        field: String,
+        /// What is wrong and what is allowed.
+        message: String,
+    },
+    /// An instrument file that does not parse.
+    #[error("{origin}: {message}")]
+    Parse {
+        /// File name.
+        origin: String,
+        /// Parser message (line, column, field).
+        message: String,
+    },
+    /// From the spectral layer (bands, QE curve).
+    #[error(transparent)]
+    Spectral(#[from] SpectralError),
+    /// From the scene while sampling it.
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    /// The run was cancelled (a newer request superseded it).
+    #[error("cancelled")]
+    Cancelled,
+}

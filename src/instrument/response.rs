@@ -1,0 +1,223 @@
+//! The instrument's spectral response: its bands on the simulation grid, weighted for photon
+//! counting, and the geometry groups (bands that look at the ground from the same direction).
+//!
+//! A detector counts photons: electrons = t·τ·(πD²/4)·(p/f)²·∫ L(λ) QE(λ) SRF(λ) λ/(hc) dλ
+//! (Matthews et al. 2023, §2.1.2; DESIGN §2). With w_b(λ) = SRF·QE·λ/(hc), the band radiance
+//! the instrument measures is the response-weighted mean L_b = ∫L w_b/∫w_b, and electrons =
+//! K_b·L_b with K_b = t·τ·A·Ω·∫w_b. Calibrating against a diffuser with the same weighting
+//! recovers L_b exactly, so L_b is the band radiance Level-1 must return.
+
+use std::ops::Range;
+
+use super::InstrumentError;
+use super::spec::{InstrumentKind, InstrumentSpec};
+use crate::spectral::{Band, BandAverager, BandSet, Extrapolation, GaussianBand, Spectrum, WavelengthGrid};
+use crate::units::photon_energy_j;
+
+/// Bands that share a line of sight, and the simulation grid that covers their responses.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GeometryGroup {
+    /// Indices of the bands in this group.
+    pub bands: Vec<usize>,
+    /// Along- and across-track angles of the group's line of sight relative to the
+    /// instrument's, rad (focal-plane position of a filter row; 0 for imagers).
+    pub offset_rad: (f64, f64),
+    /// The simulation grid over the group's spectral support.
+    pub grid: WavelengthGrid,
+    /// Per band of the group (same order as `bands`): first grid index and photon weights
+    /// w_b(λᵢ)·Δλ in photons J⁻¹ (unnormalised; see the module docs). One set per smile class.
+    pub weights: Vec<Vec<(usize, Vec<f64>)>>,
+}
+
+/// The instrument's bands and how they respond.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Response {
+    /// Nominal bands (names, centres, FWHM, SRFs).
+    pub bands: BandSet,
+    /// Geometry groups.
+    pub groups: Vec<GeometryGroup>,
+    /// Detector → smile class (index into each group's `weights`).
+    pub smile_class: Vec<usize>,
+    /// Across-track keystone shift of each band, detector pixels.
+    pub keystone_px: Vec<f64>,
+}
+
+/// Number of smile classes a swath is split into (smile varies slowly across track).
+const SMILE_CLASSES: usize = 32;
+
+impl Response {
+    /// Build the response of `spec` on grids of step `step_nm`.
+    pub fn new(spec: &InstrumentSpec, step_nm: f64) -> Result<Self, InstrumentError> {
+        let bands = match &spec.kind {
+            InstrumentKind::Multispectral { bands }
+            | InstrumentKind::IdealRadiometer { bands }
+            | InstrumentKind::FilterImager { bands, .. } => BandSet::from_spec(bands)?,
+            InstrumentKind::Spectrograph { start_nm, end_nm, sampling_nm, resolution_nm, .. } => {
+                let n = ((end_nm - start_nm) / sampling_nm + 1e-9).floor() as usize + 1;
+                let list = (0..n)
+                    .map(|i| {
+                        let c = start_nm + i as f64 * sampling_nm;
+                        Band::gaussian(&GaussianBand {
+                            name: Some(format!("S{c:.1}")),
+                            centre_nm: c,
+                            fwhm_nm: *resolution_nm,
+                        })
+                    })
+                    .collect::<Result<Vec<_>, _>>()?;
+                BandSet { name: "spectrograph".into(), bands: list }
+            }
+        };
+        let qe_source = &spec.quantum_efficiency;
+        let (smile_nm, keystone) = match &spec.kind {
+            InstrumentKind::Spectrograph { smile_nm, keystone_px, .. } => (*smile_nm, *keystone_px),
+            _ => (0.0, 0.0),
+        };
+        let n_classes = if smile_nm == 0.0 { 1 } else { SMILE_CLASSES.min(spec.detectors) };
+        let smile_class = (0..spec.detectors).map(|j| j * n_classes / spec.detectors).collect();
+        // Smile shift of class c: quadratic in the normalised across-track position.
+        let class_shift = |c: usize| -> f64 {
+            if n_classes == 1 {
+                return 0.0;
+            }
+            let x = 2.0 * (c as f64 + 0.5) / n_classes as f64 - 1.0;
+            smile_nm * x * x
+        };
+        let focal_m = spec.focal_length_mm * 1e-3;
+        let group_sets: Vec<(Vec<usize>, (f64, f64))> = match &spec.kind {
+            InstrumentKind::FilterImager { rows_per_band, .. } => {
+                let nb = bands.len();
+                (0..nb)
+                    .map(|b| {
+                        let y =
+                            (b as f64 - 0.5 * (nb as f64 - 1.0)) * *rows_per_band as f64 * spec.pixel_pitch_um * 1e-6;
+                        (vec![b], ((y / focal_m).atan(), 0.0))
+                    })
+                    .collect()
+            }
+            _ => vec![((0..bands.len()).collect(), (0.0, 0.0))],
+        };
+        let groups = group_sets
+            .into_iter()
+            .map(|(members, offset_rad)| {
+                let margin = smile_nm.abs() + step_nm;
+                let supports: Vec<(f64, f64)> = members.iter().map(|&b| bands.bands[b].srf.range_nm()).collect();
+                let grid = support_grid(&supports, margin, step_nm)?;
+                let qe = qe_source.sample(&grid, Extrapolation::Clamp, None)?;
+                if let Some(q) = qe.iter().find(|q| !(q.is_finite() && (0.0..=1.0).contains(*q))) {
+                    return Err(InstrumentError::Invalid {
+                        field: "quantum_efficiency".into(),
+                        message: format!("value {q} is outside 0 to 1"),
+                    });
+                }
+                let weights = (0..n_classes)
+                    .map(|c| {
+                        let shifted = BandSet {
+                            name: bands.name.clone(),
+                            bands: members
+                                .iter()
+                                .map(|&b| shift(&bands.bands[b], class_shift(c)))
+                                .collect::<Result<_, _>>()?,
+                        };
+                        let avg = BandAverager::new(&grid, &shifted)?;
+                        Ok((0..members.len())
+                            .map(|k| {
+                                let (first, row) = avg.row(k);
+                                let area = avg.srf_area_nm(k);
+                                let w = row
+                                    .iter()
+                                    .enumerate()
+                                    .map(|(i, a)| {
+                                        let wl = grid.wavelength_nm(first + i);
+                                        a * area * qe[first + i] / photon_energy_j(wl)
+                                    })
+                                    .collect();
+                                (first, w)
+                            })
+                            .collect())
+                    })
+                    .collect::<Result<Vec<_>, InstrumentError>>()?;
+                Ok(GeometryGroup { bands: members, offset_rad, grid, weights })
+            })
+            .collect::<Result<Vec<_>, InstrumentError>>()?;
+        let nb = bands.len();
+        let keystone_px =
+            (0..nb).map(|b| if nb > 1 { keystone * (b as f64 / (nb - 1) as f64 - 0.5) } else { 0.0 }).collect();
+        Ok(Self { bands, groups, smile_class, keystone_px })
+    }
+
+    /// Number of bands.
+    #[must_use]
+    pub fn n_bands(&self) -> usize {
+        self.bands.len()
+    }
+
+    /// The band-`k` weights of group `g` for detector `detector` (its smile class).
+    #[must_use]
+    pub fn weights(&self, g: usize, k: usize, detector: usize) -> (usize, &[f64]) {
+        let group = &self.groups[g];
+        let class = self.smile_class.get(detector).copied().unwrap_or(0).min(group.weights.len() - 1);
+        let (first, w) = &group.weights[class][k];
+        (*first, w)
+    }
+
+    /// Photon response ∫w_b dλ of band `b` (photons J⁻¹), at the swath centre.
+    #[must_use]
+    pub fn photon_response(&self, b: usize) -> f64 {
+        for (gi, g) in self.groups.iter().enumerate() {
+            if let Some(k) = g.bands.iter().position(|&x| x == b) {
+                let centre = self.smile_class.len() / 2;
+                return self.weights(gi, k, centre).1.iter().sum();
+            }
+        }
+        0.0
+    }
+
+    /// Response-weighted band means of a spectrum on group `g`'s grid, for detector `detector`.
+    pub fn band_means(&self, g: usize, detector: usize, spectrum: &[f64], out: &mut [f64]) {
+        for (k, o) in out.iter_mut().enumerate().take(self.groups[g].bands.len()) {
+            let (first, w) = self.weights(g, k, detector);
+            let (mut num, mut den) = (0.0, 0.0);
+            for (wi, v) in w.iter().zip(&spectrum[first..first + w.len()]) {
+                num += wi * v;
+                den += wi;
+            }
+            *o = if den > 0.0 { num / den } else { 0.0 };
+        }
+    }
+
+    /// Wavelength ranges of the groups' grids (for reports).
+    #[must_use]
+    pub fn spans_nm(&self) -> Vec<Range<f64>> {
+        self.groups.iter().map(|g| g.grid.range_nm().0..g.grid.range_nm().1).collect()
+    }
+}
+
+/// The simulation grid of a group: every multiple of `step_nm` within `margin_nm` of a band's
+/// SRF support. Gaps between disjoint bands are left out (nothing there is seen), so a
+/// 19-band imager costs its bands' width, not the 400–900 nm span.
+fn support_grid(supports: &[(f64, f64)], margin_nm: f64, step_nm: f64) -> Result<WavelengthGrid, InstrumentError> {
+    let mut nodes: Vec<i64> = Vec::new();
+    for &(lo, hi) in supports {
+        let (a, b) = (((lo - margin_nm) / step_nm).floor() as i64, ((hi + margin_nm) / step_nm).ceil() as i64);
+        if (a as f64) * step_nm < 325.0 || (b as f64) * step_nm > 1025.0 {
+            return Err(InstrumentError::Invalid {
+                field: "bands".into(),
+                message: format!("spectral responses span {lo:.1}–{hi:.1} nm; Shoal simulates 325–1025 nm"),
+            });
+        }
+        nodes.extend(a..=b);
+    }
+    nodes.sort_unstable();
+    nodes.dedup();
+    Ok(WavelengthGrid::from_wavelengths(nodes.into_iter().map(|k| k as f64 * step_nm).collect())?)
+}
+
+/// A band with its SRF shifted by `d` nm (smile).
+fn shift(b: &Band, d: f64) -> Result<Band, InstrumentError> {
+    if d == 0.0 {
+        return Ok(b.clone());
+    }
+    let srf =
+        Spectrum::new(b.srf.name.clone(), b.srf.wavelength_nm.iter().map(|w| w + d).collect(), b.srf.values.clone())?;
+    Ok(Band { srf, centre_nm: b.centre_nm + d, ..b.clone() })
+}

@@ -1,0 +1,316 @@
+//! Sampling the scene: the band radiance every pixel sees, the band-effective atmosphere, and
+//! the truth the retrievals are scored against.
+//!
+//! For pixel (row, column) and band b of geometry group g, with photon weights w_b(λ) of the
+//! pixel's detector (see [`super::response`]) normalised to Σw = 1, and spatial quadrature
+//! points k with weights ω_{b,k} (see [`super::spatial`]; one point without spatial response):
+//!
+//! L_b = Σ_k ω_{b,k} Σ_λ w_b(λ) L_TOA(λ; x_k, y_k)
+//!
+//! The band-effective atmosphere of a detector uses the same weights:
+//! L_path,b = Σ w L_path, G_b = Σ w L_glint, (T·Ed)_b = Σ w T_up Ed, S_b = Σ w T_up Ed S / (T·Ed)_b,
+//! and the true band reflectance is the one this band integrates through the atmosphere,
+//! Rrs_b = Σ w T_up Ed Rrs / (T·Ed)_b: inverting L_b = L_path,b + G_b + (T·Ed)_b·Rrs_b/(1 − S_b π Rrs_b)
+//! returns it up to within-band covariance terms of order S·π·Rrs·var(Rrs)/Rrs² (< 10⁻⁴).
+//!
+//! A spectrograph's keystone shifts each band's image across track by a fraction of a pixel;
+//! it is applied to the sampled band radiance by linear interpolation across detectors (the
+//! pixel-integrated radiance of box pixels), and not to the truth, so it shows as error.
+
+use ndarray::{Array2, Array3};
+use rayon::prelude::*;
+
+use super::InstrumentError;
+use super::geometry::Viewing;
+use super::response::Response;
+use super::spatial::SpatialKernel;
+use crate::control::RunControl;
+use crate::scene::Scene;
+use crate::toa::{PathSpectrum, SceneOptics, Scratch, Surface};
+
+/// Rows per work block of [`sample_radiance`].
+const BLOCK_ROWS: usize = 32;
+
+/// Options of the sampling stage.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SampleOptions {
+    /// The spatial response quadrature ([`SpatialKernel::point`] without spatial response).
+    pub kernel: SpatialKernel,
+    /// Heading of the ground track, degrees clockwise from north (rotates the kernel).
+    pub heading_deg: f64,
+}
+
+/// Per band of a group: first grid index and weights on the grid from there.
+pub type BandWeights = Vec<(usize, Vec<f64>)>;
+
+/// The atmosphere seen by each output column through each band's response.
+#[derive(Debug, Clone)]
+pub struct BandAtmosphere {
+    /// Bands.
+    pub n_bands: usize,
+    /// Per group, per output column: the atmosphere on the group's grid.
+    pub paths: Vec<Vec<PathSpectrum>>,
+    /// Per column × band: band-effective path radiance, W m⁻² sr⁻¹ nm⁻¹.
+    pub l_path: Vec<f64>,
+    /// Per column × band: band-effective glint radiance.
+    pub glint: Vec<f64>,
+    /// Per column × band: band-effective Ed(0⁺), W m⁻² nm⁻¹.
+    pub ed: Vec<f64>,
+    /// Per column × band: (T_up·Ed)_b.
+    pub t_ed: Vec<f64>,
+    /// Per column × band: band-effective spherical albedo.
+    pub spherical_albedo: Vec<f64>,
+    /// Per group, per column: weights of the truth Rrs for each band of the group.
+    pub truth_weights: Vec<Vec<BandWeights>>,
+}
+
+impl BandAtmosphere {
+    /// Build the band-effective atmosphere of every output column.
+    pub fn new(optics: &[SceneOptics], viewing: &Viewing, response: &Response) -> Result<Self, InstrumentError> {
+        let nb = response.n_bands();
+        let nc = viewing.columns();
+        let mut out = Self {
+            n_bands: nb,
+            paths: Vec::new(),
+            l_path: vec![0.0; nc * nb],
+            glint: vec![0.0; nc * nb],
+            ed: vec![0.0; nc * nb],
+            t_ed: vec![0.0; nc * nb],
+            spherical_albedo: vec![0.0; nc * nb],
+            truth_weights: Vec::new(),
+        };
+        for (gi, group) in response.groups.iter().enumerate() {
+            let paths: Vec<PathSpectrum> = viewing.looks[gi]
+                .par_iter()
+                .map(|look| optics[gi].path_spectrum(&look.geometry))
+                .collect::<Result<_, _>>()
+                .map_err(|e| InstrumentError::Scene(e.into()))?;
+            let mut truth = Vec::with_capacity(nc);
+            for (c, path) in paths.iter().enumerate() {
+                let j = viewing.detector_index[c];
+                let mut per_band = Vec::with_capacity(group.bands.len());
+                for (k, &b) in group.bands.iter().enumerate() {
+                    let (first, w) = response.weights(gi, k, j);
+                    let total: f64 = w.iter().sum();
+                    let span = first..first + w.len();
+                    let dot = |v: &[f64]| w.iter().zip(&v[span.clone()]).map(|(a, x)| a * x).sum::<f64>() / total;
+                    let te: Vec<f64> = w
+                        .iter()
+                        .zip(&path.t_up[span.clone()])
+                        .zip(&path.ed[span.clone()])
+                        .map(|((a, t), e)| a * t * e)
+                        .collect();
+                    let te_sum: f64 = te.iter().sum();
+                    let i = c * nb + b;
+                    out.l_path[i] = dot(&path.l_path);
+                    out.glint[i] = dot(&path.glint);
+                    out.ed[i] = dot(&path.ed);
+                    out.t_ed[i] = te_sum / total;
+                    out.spherical_albedo[i] = if te_sum > 0.0 {
+                        te.iter().zip(&path.spherical_albedo[span.clone()]).map(|(a, s)| a * s).sum::<f64>() / te_sum
+                    } else {
+                        0.0
+                    };
+                    let tw = if te_sum > 0.0 {
+                        te.iter().map(|v| v / te_sum).collect()
+                    } else {
+                        vec![1.0 / w.len() as f64; w.len()]
+                    };
+                    per_band.push((first, tw));
+                }
+                truth.push(per_band);
+            }
+            out.paths.push(paths);
+            out.truth_weights.push(truth);
+        }
+        Ok(out)
+    }
+
+    /// Index of (column, band) in the per-column arrays.
+    #[must_use]
+    pub fn at(&self, column: usize, band: usize) -> usize {
+        column * self.n_bands + band
+    }
+}
+
+/// What the sampling stage produces: the radiance each pixel sees and the truth under it.
+#[derive(Debug, Clone)]
+pub struct RadianceCube {
+    /// Band radiance at the entrance pupil, W m⁻² sr⁻¹ nm⁻¹, (row, column, band).
+    pub radiance: Array3<f32>,
+    /// True band Rrs, sr⁻¹ (0 on land), (row, column, band).
+    pub rrs: Array3<f32>,
+    /// True chlorophyll-a at the pixel centre, mg m⁻³.
+    pub chl_mg_m3: Array2<f32>,
+    /// True NAP, g m⁻³.
+    pub nap_g_m3: Array2<f32>,
+    /// True CDOM absorption, m⁻¹.
+    pub cdom_per_m: Array2<f32>,
+    /// True depth, m (shallow scenes only).
+    pub depth_m: Option<Array2<f32>>,
+    /// True substrate fractions (row, column, substrate), normalised (shallow scenes only).
+    pub substrate_fractions: Option<Array3<f32>>,
+    /// 1 where the pixel centre is land.
+    pub land: Array2<u8>,
+    /// Water-model evaluations.
+    pub water_evaluations: u64,
+    /// Water-model evaluations that included the bottom term.
+    pub bottom_evaluations: u64,
+}
+
+/// Sample the scene through every pixel of `viewing`: `optics[g]` is the scene bound to group
+/// g's grid, `atmosphere` from [`BandAtmosphere::new`]. Checks `control` between rows.
+pub fn sample_radiance(
+    scene: &Scene,
+    optics: &[SceneOptics],
+    viewing: &Viewing,
+    response: &Response,
+    atmosphere: &BandAtmosphere,
+    options: &SampleOptions,
+    control: &RunControl,
+) -> Result<RadianceCube, InstrumentError> {
+    let (rows, cols, nb) = (viewing.lines(), viewing.columns(), response.n_bands());
+    let n_sub = scene.substrates.len();
+    let shallow = scene.depth.is_some();
+    let pixel = cols * nb;
+    let mut radiance = vec![0.0f32; rows * pixel];
+    let mut rrs_truth = vec![0.0f32; rows * pixel];
+    let mut maps = vec![0.0f32; rows * cols * 4];
+    // Without a bottom the fraction rows are one unused float each (keeps the row zip simple).
+    let frac_stride = if shallow { (cols * n_sub).max(1) } else { 1 };
+    let mut fractions = vec![0.0f32; rows * frac_stride];
+    let mut land = vec![0u8; rows * cols];
+    let (along, right) = {
+        let h = options.heading_deg.to_radians();
+        ((h.sin(), h.cos()), (h.cos(), -h.sin()))
+    };
+    let kernel = &options.kernel;
+    let offsets: Vec<(f64, f64)> =
+        kernel.offsets_m.iter().map(|&(a, c)| (a * along.0 + c * right.0, a * along.1 + c * right.1)).collect();
+    control.add_total(rows as u64);
+    // Blocks of rows, walked column by column: each column's atmosphere (a few kB per group)
+    // then stays in cache for the whole block instead of streaming from memory for every pixel.
+    let block = BLOCK_ROWS.min(rows.max(1));
+    let counters: Vec<(u64, u64)> = radiance
+        .par_chunks_mut((pixel * block).max(1))
+        .zip(rrs_truth.par_chunks_mut((pixel * block).max(1)))
+        .zip(maps.par_chunks_mut(cols * 4 * block))
+        .zip(land.par_chunks_mut(cols * block))
+        .zip(fractions.par_chunks_mut(frac_stride * block))
+        .enumerate()
+        .map(|(bi, ((((rad_block, rrs_block), map_block), land_block), frac_block))| {
+            if control.cancelled() {
+                return Err(InstrumentError::Cancelled);
+            }
+            let first_row = bi * block;
+            let n_rows = land_block.len() / cols.max(1);
+            let mut scratch = Scratch::default();
+            let mut spectra: Vec<(Vec<f64>, Vec<f64>)> =
+                optics.iter().map(|o| (vec![0.0; o.grid().len()], vec![0.0; o.grid().len()])).collect();
+            for c in 0..cols {
+                let j = viewing.detector_index[c];
+                for rr in 0..n_rows {
+                    let r = first_row + rr;
+                    let at = rr * pixel + c * nb;
+                    let out = &mut rad_block[at..at + nb];
+                    let truth = &mut rrs_block[at..at + nb];
+                    for (gi, group) in response.groups.iter().enumerate() {
+                        let (l_toa, rrs) = &mut spectra[gi];
+                        let look = &viewing.looks[gi][c];
+                        let path = &atmosphere.paths[gi][c];
+                        let (x0, y0) = viewing.ground_m(gi, r, c);
+                        for (k, &(dx, dy)) in offsets.iter().enumerate() {
+                            let surface = optics[gi].radiance(
+                                scene,
+                                x0 + dx,
+                                y0 + dy,
+                                &look.geometry,
+                                path,
+                                &mut scratch,
+                                l_toa,
+                                rrs,
+                            )?;
+                            for (kb, &b) in group.bands.iter().enumerate() {
+                                let (first, w) = response.weights(gi, kb, j);
+                                let (num, den) = w
+                                    .iter()
+                                    .zip(&l_toa[first..first + w.len()])
+                                    .fold((0.0, 0.0), |(n, d), (wi, v)| (n + wi * v, d + wi));
+                                let weight = kernel.weights[b][k];
+                                out[b] += (weight * num / den) as f32;
+                                if surface == Surface::Water {
+                                    let (tf, tw) = &atmosphere.truth_weights[gi][c][kb];
+                                    let t: f64 = tw.iter().zip(&rrs[*tf..*tf + tw.len()]).map(|(a, v)| a * v).sum();
+                                    truth[b] += (weight * t) as f32;
+                                }
+                            }
+                        }
+                    }
+                    let (x, y) = viewing.ground_m(0, r, c);
+                    let m = &mut map_block[(rr * cols + c) * 4..(rr * cols + c) * 4 + 4];
+                    m[0] = scene.chl.value_at(x, y) as f32;
+                    m[1] = scene.nap.value_at(x, y) as f32;
+                    m[2] = scene.cdom.value_at(x, y) as f32;
+                    m[3] = scene.depth.as_ref().map_or(0.0, |d| d.value_at(x, y)) as f32;
+                    land_block[rr * cols + c] = u8::from(scene.is_land(x, y));
+                    if shallow {
+                        let f = &mut frac_block[rr * frac_stride..(rr + 1) * frac_stride];
+                        let values: Vec<f64> =
+                            scene.substrates.iter().map(|(_, m)| m.value_at(x, y).max(0.0)).collect();
+                        let total: f64 = values.iter().sum();
+                        for (s, v) in values.iter().enumerate() {
+                            f[c * n_sub + s] = if total > 0.0 { (v / total) as f32 } else { 1.0 / n_sub as f32 };
+                        }
+                    }
+                }
+                if control.cancelled() {
+                    return Err(InstrumentError::Cancelled);
+                }
+            }
+            control.tick(n_rows as u64);
+            Ok((scratch.water_evaluations, scratch.bottom_evaluations))
+        })
+        .collect::<Result<Vec<_>, InstrumentError>>()?;
+    apply_keystone(&mut radiance, cols, nb, &response.keystone_px, viewing.decimation);
+    let shape3 = (rows, cols, nb);
+    let cube = |v: Vec<f32>| Array3::from_shape_vec(shape3, v);
+    let plane = |k: usize| Array2::from_shape_fn((rows, cols), |(r, c)| maps[(r * cols + c) * 4 + k]);
+    let bad = |e: ndarray::ShapeError| InstrumentError::Invalid { field: "cube".into(), message: e.to_string() };
+    Ok(RadianceCube {
+        radiance: cube(radiance).map_err(bad)?,
+        rrs: cube(rrs_truth).map_err(bad)?,
+        chl_mg_m3: plane(0),
+        nap_g_m3: plane(1),
+        cdom_per_m: plane(2),
+        depth_m: shallow.then(|| plane(3)),
+        substrate_fractions: if shallow {
+            Some(Array3::from_shape_vec((rows, cols, n_sub), fractions).map_err(bad)?)
+        } else {
+            None
+        },
+        land: Array2::from_shape_vec((rows, cols), land).map_err(bad)?,
+        water_evaluations: counters.iter().map(|c| c.0).sum(),
+        bottom_evaluations: counters.iter().map(|c| c.1).sum(),
+    })
+}
+
+/// Shift band b of every row by `keystone_px[b] / decimation` columns (linear interpolation,
+/// edges clamped).
+fn apply_keystone(cube: &mut [f32], cols: usize, nb: usize, keystone_px: &[f64], decimation: usize) {
+    if keystone_px.iter().all(|k| *k == 0.0) || cols < 2 {
+        return;
+    }
+    cube.par_chunks_mut(cols * nb).for_each(|row| {
+        let original = row.to_vec();
+        for (b, &k) in keystone_px.iter().enumerate() {
+            let shift = k / decimation as f64;
+            for c in 0..cols {
+                let pos = (c as f64 + shift).clamp(0.0, (cols - 1) as f64);
+                let c0 = pos.floor() as usize;
+                let c1 = (c0 + 1).min(cols - 1);
+                let f = (pos - c0 as f64) as f32;
+                row[c * nb + b] = original[c0 * nb + b] * (1.0 - f) + original[c1 * nb + b] * f;
+            }
+        }
+    });
+}

@@ -1,0 +1,96 @@
+//! Signal-to-noise ratio per band: the analytic value from the detector model, and the value
+//! measured on simulated Level-0 frames of a uniform patch, side by side.
+//!
+//! Analytic (Janesick 2007, eq. 2.14 with the quantisation term of §4.4):
+//! SNR = S / √(S + D + σ_read² + gain²/12), S = K·L photo-electrons, D dark electrons.
+//! Measured: `frames` exposures of a uniform radiance and as many dark exposures through the
+//! full detector model (shot, dark, read noise, full well, ADC); per detector, the temporal
+//! mean of light minus dark DN over the temporal standard deviation of the light DN; the
+//! detectors' mean. With 128 frames each detector's estimate has a 6 % standard error; the mean
+//! over 256 detectors has 0.4 %.
+//!
+//! ## References
+//! - Janesick, J. R. (2007) Photon Transfer: DN → λ. SPIE Press.
+
+use rayon::prelude::*;
+use serde::Serialize;
+
+use super::detector::{Detector, Stream, pixel_rng};
+
+/// One row of `snr.csv`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SnrRow {
+    /// Band name.
+    pub band: String,
+    /// Band centre, nm.
+    pub centre_nm: f64,
+    /// The radiance the SNR refers to (the scene's median water radiance), W m⁻² sr⁻¹ nm⁻¹.
+    pub radiance: f64,
+    /// Analytic SNR at the central detector.
+    pub snr_analytic: f64,
+    /// SNR measured on a simulated uniform patch.
+    pub snr_measured: f64,
+}
+
+/// Analytic SNR of detector `j`, band `b` at band radiance `radiance` (infinite without noise).
+#[must_use]
+pub fn analytic_snr(detector: &Detector, j: usize, b: usize, radiance: f64) -> f64 {
+    let signal = detector.responsivity(j, b) * radiance;
+    let dark = detector.dark_mean_e(j, b, nominal_exposure(detector));
+    let var = detector.variance_e2(signal, dark);
+    if var > 0.0 { signal / var.sqrt() } else { f64::INFINITY }
+}
+
+fn nominal_exposure(detector: &Detector) -> f64 {
+    detector.exposure_s()
+}
+
+/// SNR of every band measured on `frames` simulated exposures of the uniform band radiances
+/// `radiance` by each of `detectors` (light and dark frames, temporal statistics per detector,
+/// mean over detectors). Infinite when the detector has no noise.
+#[must_use]
+pub fn measured_snr(detector: &Detector, radiance: &[f64], detectors: &[usize], frames: usize, seed: u64) -> Vec<f64> {
+    let t = nominal_exposure(detector);
+    let nb = detector.n_bands();
+    let per_detector: Vec<Vec<f64>> = detectors
+        .par_iter()
+        .map(|&j| {
+            // Running sums per band: light Σx, Σx², dark Σx.
+            let (mut s1, mut s2, mut d1) = (vec![0.0; nb], vec![0.0; nb], vec![0.0; nb]);
+            for f in 0..frames {
+                let mut rng = pixel_rng(seed, Stream::SnrPatch, 2 * f, j);
+                for b in 0..nb {
+                    let e = detector.expose(j, b, radiance[b], t, &mut rng);
+                    let v = detector.level0_value(&detector.read_out(e, &mut rng));
+                    s1[b] += v;
+                    s2[b] += v * v;
+                }
+                let mut rng = pixel_rng(seed, Stream::SnrPatch, 2 * f + 1, j);
+                for d in d1.iter_mut().enumerate() {
+                    let e = detector.expose(j, d.0, 0.0, t, &mut rng);
+                    *d.1 += detector.level0_value(&detector.read_out(e, &mut rng));
+                }
+            }
+            let n = frames as f64;
+            (0..nb)
+                .map(|b| {
+                    let mean = s1[b] / n;
+                    let var = (s2[b] - n * mean * mean) / (n - 1.0).max(1.0);
+                    if var > 0.0 { (mean - d1[b] / n) / var.sqrt() } else { f64::INFINITY }
+                })
+                .collect()
+        })
+        .collect();
+    (0..nb)
+        .map(|b| {
+            let v: Vec<f64> = per_detector.iter().map(|d| d[b]).collect();
+            if v.is_empty() {
+                0.0
+            } else if v.iter().any(|x| x.is_infinite()) {
+                f64::INFINITY
+            } else {
+                v.iter().sum::<f64>() / v.len() as f64
+            }
+        })
+        .collect()
+}

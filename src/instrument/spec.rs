@@ -1,0 +1,253 @@
+//! The instrument as written in RON (`presets/instruments/`): every parameter of Matthews et al.
+//! (2023) Table 1, plus the model kind and its own parameters.
+
+use serde::{Deserialize, Serialize};
+
+use super::InstrumentError;
+use crate::spectral::{BandSetSpec, SpectrumSource};
+
+/// Which instrument model.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum InstrumentKind {
+    /// Band-pass multispectral imager: every band sees the same ground pixel through its SRF.
+    Multispectral {
+        /// Bands (OLCI, MSI or Gaussian).
+        bands: BandSetSpec,
+    },
+    /// Ideal radiometer for reference runs: the same bands, no noise, no quantisation, no
+    /// saturation.
+    IdealRadiometer {
+        /// Bands.
+        bands: BandSetSpec,
+    },
+    /// Long-slit dispersive spectrograph (CHICO-like): the spectrum is dispersed along one axis
+    /// of the detector, one row per spectral sample; Gaussian spectral response.
+    Spectrograph {
+        /// First band centre, nm.
+        start_nm: f64,
+        /// Last band centre (at most), nm.
+        end_nm: f64,
+        /// Spectral sampling (dispersion × pixel pitch), nm per row.
+        sampling_nm: f64,
+        /// Spectral resolution (FWHM), nm.
+        resolution_nm: f64,
+        /// Smile: shift of the band centres at the swath edges, nm (quadratic across track).
+        #[serde(default)]
+        smile_nm: f64,
+        /// Keystone: across-track misregistration between the first and last band, pixels.
+        #[serde(default)]
+        keystone_px: f64,
+    },
+    /// Gradient / linear-variable-filter imager (CyanoSat-like): the pass band changes along
+    /// track across the focal plane, so each band looks at the ground from a different along-track
+    /// angle and sees a point at a different time.
+    FilterImager {
+        /// Bands, in order along the focal plane.
+        bands: BandSetSpec,
+        /// Detector rows between successive band centres on the focal plane.
+        rows_per_band: usize,
+    },
+}
+
+fn default_qe() -> SpectrumSource {
+    SpectrumSource::Constant(0.7)
+}
+
+/// A Level-0 instrument (Table 1 of Matthews et al. 2023 and the model's parameters).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InstrumentSpec {
+    /// Short name.
+    pub name: String,
+    /// What it is.
+    #[serde(default)]
+    pub description: String,
+    /// Model kind and spectral configuration.
+    pub kind: InstrumentKind,
+    /// Orbit altitude, km (200–1500).
+    pub altitude_km: f64,
+    /// Orbital heading azimuth, degrees clockwise from north.
+    #[serde(default)]
+    pub heading_deg: f64,
+    /// Aperture diameter, mm (1–2000).
+    pub aperture_mm: f64,
+    /// Detector pixel pitch, µm (1–100).
+    pub pixel_pitch_um: f64,
+    /// Focal length, mm (1–10 000).
+    pub focal_length_mm: f64,
+    /// Detectors across track (1–20 000).
+    pub detectors: usize,
+    /// Exposure (integration) time, s.
+    pub exposure_s: f64,
+    /// Exposures (lines) along track (1–100 000).
+    pub exposures: usize,
+    /// Forward tilt of the line of sight, degrees (−60 to 60).
+    #[serde(default)]
+    pub forward_tilt_deg: f64,
+    /// Read noise, electrons rms.
+    pub read_noise_e: f64,
+    /// Full-well capacity, electrons.
+    pub well_depth_e: f64,
+    /// Conversion gain, electrons per DN.
+    pub gain_e_per_dn: f64,
+    /// Bias (offset), DN.
+    pub bias_dn: f64,
+    /// ADC resolution, bits (1–16).
+    pub adc_bits: u32,
+    /// Optical transmission of the telescope and filters (0–1).
+    pub optical_transmission: f64,
+    /// Detector quantum efficiency (0–1) against wavelength. Table 1 gives no curve; the presets
+    /// assume a flat 0.7 — supply the detector's own curve (CSV) for a real design.
+    #[serde(default = "default_qe")]
+    pub quantum_efficiency: SpectrumSource,
+    /// Dark current, electrons per second per pixel.
+    #[serde(default)]
+    pub dark_current_e_s: f64,
+    /// Photo-response non-uniformity, relative rms across detectors (fixed pattern).
+    #[serde(default)]
+    pub prnu: f64,
+    /// Dark-signal non-uniformity, electrons rms across detectors (fixed pattern).
+    #[serde(default)]
+    pub dsnu_e: f64,
+}
+
+/// Orbital ground speed for a circular orbit at `altitude_km`: v = √(GM/(R+h))·R/(R+h).
+#[must_use]
+pub fn ground_speed_m_s(altitude_km: f64) -> f64 {
+    use crate::units::{EARTH_GM_M3_S2, EARTH_RADIUS_M};
+    let a = EARTH_RADIUS_M + altitude_km * 1e3;
+    (EARTH_GM_M3_S2 / a).sqrt() * EARTH_RADIUS_M / a
+}
+
+impl InstrumentSpec {
+    /// Parse RON; `origin` names the file in errors.
+    pub fn from_ron(text: &str, origin: &str) -> Result<Self, InstrumentError> {
+        ron::from_str(text).map_err(|e| InstrumentError::Parse { origin: origin.into(), message: e.to_string() })
+    }
+
+    /// A built-in instrument by name (`presets/instruments/NAME.ron`).
+    pub fn preset(name: &str) -> Result<Self, InstrumentError> {
+        let path = format!("instruments/{name}.ron");
+        let asset = crate::assets::preset(&path).ok_or_else(|| InstrumentError::Invalid {
+            field: "instrument".into(),
+            message: format!("no built-in instrument `{name}` (known: {})", Self::preset_names().join(", ")),
+        })?;
+        Self::from_ron(asset.text, &format!("presets/{path}"))
+    }
+
+    /// Names of the built-in instruments.
+    #[must_use]
+    pub fn preset_names() -> Vec<String> {
+        crate::assets::PRESETS
+            .iter()
+            .filter_map(|a| a.path.strip_prefix("instruments/").and_then(|p| p.strip_suffix(".ron")))
+            .map(str::to_string)
+            .collect()
+    }
+
+    /// Check every number against its documented range; the message names field and range.
+    pub fn validate(&self) -> Result<(), InstrumentError> {
+        let range = |field: &str, v: f64, lo: f64, hi: f64, unit: &str| {
+            if v.is_finite() && (lo..=hi).contains(&v) {
+                Ok(())
+            } else {
+                Err(InstrumentError::Invalid {
+                    field: field.into(),
+                    message: format!("{v} is out of range (allowed: {lo} to {hi}{unit})"),
+                })
+            }
+        };
+        let above = |field: &str, v: f64, lo: f64, hi: f64, unit: &str| {
+            if v.is_finite() && v > lo && v <= hi {
+                Ok(())
+            } else {
+                Err(InstrumentError::Invalid {
+                    field: field.into(),
+                    message: format!("{v} is out of range (allowed: above {lo}, at most {hi}{unit})"),
+                })
+            }
+        };
+        range("altitude_km", self.altitude_km, 200.0, 1500.0, " km")?;
+        range("heading_deg", self.heading_deg, -360.0, 360.0, " degrees")?;
+        above("aperture_mm", self.aperture_mm, 0.0, 2000.0, " mm")?;
+        above("pixel_pitch_um", self.pixel_pitch_um, 0.0, 100.0, " µm")?;
+        above("focal_length_mm", self.focal_length_mm, 0.0, 10_000.0, " mm")?;
+        range("detectors", self.detectors as f64, 1.0, 20_000.0, "")?;
+        above("exposure_s", self.exposure_s, 0.0, 10.0, " s")?;
+        range("exposures", self.exposures as f64, 1.0, 100_000.0, "")?;
+        range("forward_tilt_deg", self.forward_tilt_deg, -60.0, 60.0, " degrees")?;
+        range("read_noise_e", self.read_noise_e, 0.0, 1e5, " e-")?;
+        above("well_depth_e", self.well_depth_e, 0.0, 1e9, " e-")?;
+        range("gain_e_per_dn", self.gain_e_per_dn, 0.01, 1e4, " e-/DN")?;
+        range("bias_dn", self.bias_dn, 0.0, 65_535.0, " DN")?;
+        range("adc_bits", f64::from(self.adc_bits), 1.0, 16.0, " bits")?;
+        above("optical_transmission", self.optical_transmission, 0.0, 1.0, "")?;
+        range("dark_current_e_s", self.dark_current_e_s, 0.0, 1e9, " e-/s")?;
+        range("prnu", self.prnu, 0.0, 0.5, "")?;
+        range("dsnu_e", self.dsnu_e, 0.0, 1e6, " e-")?;
+        if let InstrumentKind::Spectrograph { start_nm, end_nm, sampling_nm, resolution_nm, smile_nm, keystone_px } =
+            &self.kind
+        {
+            range("kind.start_nm", *start_nm, 350.0, 1000.0, " nm")?;
+            range("kind.end_nm", *end_nm, *start_nm, 1000.0, " nm")?;
+            above("kind.sampling_nm", *sampling_nm, 0.0, 100.0, " nm")?;
+            above("kind.resolution_nm", *resolution_nm, 0.0, 200.0, " nm")?;
+            range("kind.smile_nm", *smile_nm, -20.0, 20.0, " nm")?;
+            range("kind.keystone_px", *keystone_px, -20.0, 20.0, " pixels")?;
+            if (end_nm - start_nm) / sampling_nm > 2000.0 {
+                return Err(InstrumentError::Invalid {
+                    field: "kind.sampling_nm".into(),
+                    message: "more than 2000 spectral samples".into(),
+                });
+            }
+        }
+        if let InstrumentKind::FilterImager { rows_per_band, .. } = &self.kind {
+            range("kind.rows_per_band", *rows_per_band as f64, 1.0, 10_000.0, "")?;
+        }
+        Ok(())
+    }
+
+    /// Ground sampling distance at nadir, m: GSD = altitude · pitch / focal length.
+    ///
+    /// ```
+    /// let i = shoal::instrument::InstrumentSpec::preset("nominal").unwrap();
+    /// assert!((i.gsd_m() - 18.667).abs() < 1e-3);
+    /// ```
+    #[must_use]
+    pub fn gsd_m(&self) -> f64 {
+        self.altitude_km * 1e3 * self.pixel_pitch_um * 1e-6 / (self.focal_length_mm * 1e-3)
+    }
+
+    /// Swath width at nadir, m.
+    #[must_use]
+    pub fn swath_m(&self) -> f64 {
+        self.gsd_m() * self.detectors as f64
+    }
+
+    /// Focal ratio f/D.
+    #[must_use]
+    pub fn f_number(&self) -> f64 {
+        self.focal_length_mm / self.aperture_mm
+    }
+
+    /// Étendue of one pixel, m² sr: A·Ω = (πD²/4)·(p/f)².
+    #[must_use]
+    pub fn etendue_m2_sr(&self) -> f64 {
+        let d = self.aperture_mm * 1e-3;
+        let ifov = self.pixel_pitch_um * 1e-6 / (self.focal_length_mm * 1e-3);
+        std::f64::consts::PI * d * d / 4.0 * ifov * ifov
+    }
+
+    /// Largest DN the ADC produces, 2^bits − 1.
+    #[must_use]
+    pub fn dn_max(&self) -> f64 {
+        f64::from((1u32 << self.adc_bits.min(16)) - 1)
+    }
+
+    /// Is this the noise-free reference radiometer?
+    #[must_use]
+    pub fn is_ideal(&self) -> bool {
+        matches!(self.kind, InstrumentKind::IdealRadiometer { .. })
+    }
+}

@@ -1,0 +1,321 @@
+//! The scene file and its validated form.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use super::SceneError;
+use super::map::{Extent, Map, MapSpec};
+use crate::atmosphere::{AtmosphereSpec, Surface};
+use crate::spectral::SpectrumSource;
+use crate::water::SiopSource;
+
+/// Where the sun is.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SunSpec {
+    /// Solar zenith angle, degrees (0–85).
+    pub zenith_deg: f64,
+    /// Solar azimuth, degrees clockwise from north.
+    pub azimuth_deg: f64,
+}
+
+/// One substrate and where it lies: its areal fraction map (fractions are normalised to sum 1
+/// at every point).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SubstrateLayer {
+    /// Substrate name from the library (`shoal water --list-substrates`).
+    pub name: String,
+    /// Its fraction map.
+    pub fraction: MapSpec,
+}
+
+/// Land in the scene: where (mask ≥ 0.5) and what it reflects.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LandSpec {
+    /// Land where the map is ≥ 0.5.
+    pub mask: MapSpec,
+    /// Land surface reflectance (Lambertian, 0–1).
+    pub reflectance: SpectrumSource,
+}
+
+/// Effects a scene may call for; anything not listed is never computed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum Effect {
+    /// Bottom reflectance through the water column (needs `depth_m`).
+    ShallowBottom,
+    /// Cox–Munk sun glint (needs a wind-roughened surface in the atmosphere).
+    SunGlint,
+    /// Light from bright surroundings scattered into a pixel's path (needs `land`).
+    Adjacency,
+    /// The instrument's spatial response: diffraction, detector footprint, along-track smear.
+    SpatialResponse,
+}
+
+impl Effect {
+    /// All effects, for reports of what was skipped.
+    pub const ALL: [Self; 4] = [Self::ShallowBottom, Self::SunGlint, Self::Adjacency, Self::SpatialResponse];
+}
+
+/// A scene as written in RON (`presets/scenes/*.ron`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneSpec {
+    /// Short name.
+    pub name: String,
+    /// What it represents and where its numbers come from.
+    #[serde(default)]
+    pub description: String,
+    /// Cells along x (east), 1–20 000.
+    pub width: usize,
+    /// Cells along y (north), 1–20 000.
+    pub height: usize,
+    /// Ground size of a cell, m (0.1–10 000).
+    pub cell_m: f64,
+    /// The sun.
+    pub sun: SunSpec,
+    /// Date, YYYY-MM-DD (Sun–Earth distance).
+    pub date: String,
+    /// Local time, for the record (the sun position is given explicitly).
+    #[serde(default)]
+    pub time: String,
+    /// The atmosphere (its `day_of_year` is set from `date`).
+    pub atmosphere: AtmosphereSpec,
+    /// The scene's SIOP set.
+    pub siop: SiopSource,
+    /// Chlorophyll-a, mg m⁻³.
+    pub chl_mg_m3: MapSpec,
+    /// Non-algal particles, g m⁻³.
+    pub nap_g_m3: MapSpec,
+    /// CDOM absorption at the SIOP set's reference wavelength, m⁻¹.
+    pub cdom_per_m: MapSpec,
+    /// Depth, m; absent: optically deep everywhere.
+    #[serde(default)]
+    pub depth_m: Option<MapSpec>,
+    /// Substrates and their fraction maps (used with `ShallowBottom`).
+    #[serde(default)]
+    pub substrates: Vec<SubstrateLayer>,
+    /// Land, if any.
+    #[serde(default)]
+    pub land: Option<LandSpec>,
+    /// Effects the scene calls for.
+    #[serde(default)]
+    pub effects: Vec<Effect>,
+}
+
+/// Day of year of `YYYY-MM-DD`.
+pub fn day_of_year(date: &str) -> Result<u32, SceneError> {
+    let bad =
+        |m: &str| SceneError::Invalid { field: "date".into(), message: format!("`{date}`: {m} (expected YYYY-MM-DD)") };
+    let parts: Vec<&str> = date.trim().split('-').collect();
+    let [y, m, d] = parts.as_slice() else { return Err(bad("not a date")) };
+    let num = |s: &str| s.parse::<u32>().map_err(|_| bad("not a date"));
+    let (y, m, d) = (num(y)?, num(m)?, num(d)?);
+    let leap = (y % 4 == 0 && y % 100 != 0) || y % 400 == 0;
+    let days = [31, if leap { 29 } else { 28 }, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31];
+    if !(1..=12).contains(&m) || d == 0 || d > days[(m - 1) as usize] {
+        return Err(bad("no such calendar day"));
+    }
+    Ok(days[..(m - 1) as usize].iter().sum::<u32>() + d)
+}
+
+impl SceneSpec {
+    /// Parse RON; `origin` names the file in errors.
+    pub fn from_ron(text: &str, origin: &str) -> Result<Self, SceneError> {
+        ron::from_str(text).map_err(|e| SceneError::Parse { origin: origin.into(), message: e.to_string() })
+    }
+
+    /// A built-in scene by name (`presets/scenes/NAME.ron`).
+    pub fn preset(name: &str) -> Result<Self, SceneError> {
+        let path = format!("scenes/{name}.ron");
+        let asset = crate::assets::preset(&path).ok_or_else(|| SceneError::Invalid {
+            field: "scene".into(),
+            message: format!("no built-in scene `{name}` (known: {})", Self::preset_names().join(", ")),
+        })?;
+        Self::from_ron(asset.text, &format!("presets/{path}"))
+    }
+
+    /// Names of the built-in scenes.
+    #[must_use]
+    pub fn preset_names() -> Vec<String> {
+        crate::assets::PRESETS
+            .iter()
+            .filter_map(|a| a.path.strip_prefix("scenes/").and_then(|p| p.strip_suffix(".ron")))
+            .map(str::to_string)
+            .collect()
+    }
+
+    /// Check the numbers and that every effect has what it needs.
+    pub fn validate(&self) -> Result<(), SceneError> {
+        let bad = |field: &str, message: String| Err(SceneError::Invalid { field: field.into(), message });
+        if !(1..=20_000).contains(&self.width) {
+            return bad("width", format!("{} is out of range (allowed: 1 to 20000 cells)", self.width));
+        }
+        if !(1..=20_000).contains(&self.height) {
+            return bad("height", format!("{} is out of range (allowed: 1 to 20000 cells)", self.height));
+        }
+        if !(self.cell_m.is_finite() && (0.1..=10_000.0).contains(&self.cell_m)) {
+            return bad("cell_m", format!("{} is out of range (allowed: 0.1 to 10000 m)", self.cell_m));
+        }
+        if !(self.sun.zenith_deg.is_finite() && (0.0..=85.0).contains(&self.sun.zenith_deg)) {
+            return bad(
+                "sun.zenith_deg",
+                format!("{} is out of range (allowed: 0 to 85 degrees)", self.sun.zenith_deg),
+            );
+        }
+        if !self.sun.azimuth_deg.is_finite() {
+            return bad("sun.azimuth_deg", format!("{} is not a finite angle", self.sun.azimuth_deg));
+        }
+        day_of_year(&self.date)?;
+        let has = |e: Effect| self.effects.contains(&e);
+        if has(Effect::ShallowBottom) && self.depth_m.is_none() {
+            return bad("effects", "ShallowBottom needs a `depth_m` map".into());
+        }
+        if has(Effect::ShallowBottom) && self.substrates.is_empty() {
+            return bad("substrates", "ShallowBottom needs at least one substrate".into());
+        }
+        if has(Effect::SunGlint) && matches!(self.atmosphere.surface, Surface::Flat) {
+            return bad(
+                "effects",
+                "SunGlint needs a wind-roughened surface: atmosphere.surface: Wind(speed_m_s: ..)".into(),
+            );
+        }
+        if has(Effect::Adjacency) && self.land.is_none() {
+            return bad("effects", "Adjacency needs `land` (a mask and a reflectance)".into());
+        }
+        Ok(())
+    }
+}
+
+/// A validated scene with its maps ready to sample.
+#[derive(Debug, Clone)]
+pub struct Scene {
+    /// The spec it was built from (paths made relative to the scene file's directory).
+    pub spec: SceneSpec,
+    /// Raster extent of the maps.
+    pub extent: Extent,
+    /// Chlorophyll-a map, mg m⁻³.
+    pub chl: Map,
+    /// NAP map, g m⁻³.
+    pub nap: Map,
+    /// CDOM map, m⁻¹.
+    pub cdom: Map,
+    /// Depth map, m, when the bottom is simulated.
+    pub depth: Option<Map>,
+    /// Substrate fraction maps, by name.
+    pub substrates: Vec<(String, Map)>,
+    /// Land mask, when the scene has land.
+    pub land: Option<Map>,
+    /// Directory of the scene file (for relative paths), if any.
+    pub base_dir: Option<PathBuf>,
+    /// Day of year.
+    pub day_of_year: u32,
+}
+
+impl Scene {
+    /// Validate `spec` and build its maps; `base_dir` is the scene file's directory.
+    pub fn build(spec: &SceneSpec, base_dir: Option<&Path>) -> Result<Self, SceneError> {
+        spec.validate()?;
+        let mut spec = spec.clone();
+        spec.siop = spec.siop.relative_to(base_dir);
+        let day = day_of_year(&spec.date)?;
+        spec.atmosphere.day_of_year = day;
+        spec.atmosphere
+            .validate()
+            .map_err(|e| SceneError::Invalid { field: "atmosphere".into(), message: e.to_string() })?;
+        let extent = Extent { width: spec.width, height: spec.height, cell_m: spec.cell_m };
+        let map = |s: &MapSpec, field: &str| Map::build(s, extent, field, base_dir);
+        let chl = map(&spec.chl_mg_m3, "chl_mg_m3")?;
+        let nap = map(&spec.nap_g_m3, "nap_g_m3")?;
+        let cdom = map(&spec.cdom_per_m, "cdom_per_m")?;
+        let bottom = spec.effects.contains(&Effect::ShallowBottom);
+        let depth = match (&spec.depth_m, bottom) {
+            (Some(d), true) => Some(map(d, "depth_m")?),
+            _ => None,
+        };
+        let substrates = if bottom {
+            spec.substrates
+                .iter()
+                .map(|l| Ok((l.name.clone(), map(&l.fraction, &format!("substrates.{}", l.name))?)))
+                .collect::<Result<Vec<_>, SceneError>>()?
+        } else {
+            Vec::new()
+        };
+        let land = match &spec.land {
+            Some(l) => Some(map(&l.mask, "land.mask")?),
+            None => None,
+        };
+        let scene = Self {
+            spec,
+            extent,
+            chl,
+            nap,
+            cdom,
+            depth,
+            substrates,
+            land,
+            base_dir: base_dir.map(Path::to_path_buf),
+            day_of_year: day,
+        };
+        scene.check_ranges()?;
+        Ok(scene)
+    }
+
+    /// Every map within the water model's documented ranges (see `water::limits`).
+    fn check_ranges(&self) -> Result<(), SceneError> {
+        use crate::water::limits;
+        let check = |field: &str, m: &Map, lo: f64, hi: f64, unit: &str| {
+            let (a, b) = m.range();
+            if a < lo || b > hi || !a.is_finite() || !b.is_finite() {
+                Err(SceneError::Invalid {
+                    field: field.into(),
+                    message: format!("values span {a} to {b}; allowed {lo} to {hi} {unit}"),
+                })
+            } else {
+                Ok(())
+            }
+        };
+        check("chl_mg_m3", &self.chl, 0.0, limits::MAX_CHL_MG_M3, "mg m-3")?;
+        check("nap_g_m3", &self.nap, 0.0, limits::MAX_NAP_G_M3, "g m-3")?;
+        check("cdom_per_m", &self.cdom, 0.0, limits::MAX_CDOM_PER_M, "m-1")?;
+        if let Some(d) = &self.depth {
+            let (a, _) = d.range();
+            if !(a > 0.0) {
+                return Err(SceneError::Invalid {
+                    field: "depth_m".into(),
+                    message: format!("depth reaches {a} m; it must stay above 0 (land belongs in `land`)"),
+                });
+            }
+            check("depth_m", d, 0.0, limits::MAX_DEPTH_M, "m")?;
+        }
+        for (name, m) in &self.substrates {
+            check(&format!("substrates.{name}"), m, 0.0, 1.0, "(fraction)")?;
+        }
+        Ok(())
+    }
+
+    /// Is there land at (x, y)?
+    #[must_use]
+    pub fn is_land(&self, x_m: f64, y_m: f64) -> bool {
+        self.land.as_ref().is_some_and(|m| m.value_at(x_m, y_m) >= 0.5)
+    }
+
+    /// Effects the scene calls for.
+    #[must_use]
+    pub fn wants(&self, effect: Effect) -> bool {
+        self.spec.effects.contains(&effect)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dates() {
+        assert_eq!(day_of_year("2023-06-21").unwrap(), 172);
+        assert!(day_of_year("2023-13-01").is_err());
+    }
+}

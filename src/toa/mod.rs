@@ -1,0 +1,284 @@
+//! Top-of-atmosphere radiance of a scene: the water model at each ground point, coupled to the
+//! atmosphere LUT, with the effects the scene calls for — and nothing else.
+//!
+//! Per wavelength of the simulation grid, for water (Vermote et al. 1997; Gordon & Wang 1994):
+//!
+//! L_TOA = L_path + T_up·Lw + L_glint + L_adj,  Lw = Rrs·Ed(0⁺)/(1 − S·π·Rrs)
+//!
+//! with L_path, T_up, S and Ed(0⁺) from the LUT (interpolated across its wavelength nodes,
+//! log–log, then multiplied by the 1-nm solar spectrum and the gas transmittances), Rrs from the
+//! Lee et al. model at the point's concentrations, depth and substrate mixture. Land reflects
+//! Lambertian: L = L_path + T_up·ρ·Ed/(π(1 − Sρ)). Adjacency adds the diffuse part of the
+//! upward transmittance seeing the environment's reflectance instead of the target's (see
+//! [`adjacency`]).
+//!
+//! ## References
+//! - Vermote, E. F., Tanré, D., Deuzé, J. L., Herman, M., Morcrette, J.-J. (1997) Second
+//!   simulation of the satellite signal in the solar spectrum, 6S: an overview. IEEE TGRS 35,
+//!   675–686.
+//! - Gordon, H. R. & Wang, M. (1994) Retrieval of water-leaving radiance and aerosol optical
+//!   thickness over the oceans with SeaWiFS: a preliminary algorithm. Appl. Opt. 33, 443–452.
+
+pub mod adjacency;
+
+use std::sync::Arc;
+
+use crate::atmosphere::{AtmosphereError, AtmosphereLut, Geometry};
+use crate::scene::{Effect, Scene, SceneError};
+use crate::spectral::{Extrapolation, WavelengthGrid};
+use crate::water::{Bottom, SubstrateLibrary, SubstrateMix, WaterColumn, WaterGeometry, WaterModel};
+
+pub use adjacency::Adjacency;
+
+/// The atmosphere on the simulation grid for one sun/view geometry (physical units:
+/// W m⁻² sr⁻¹ nm⁻¹ for radiances, W m⁻² nm⁻¹ for irradiances; gases included).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PathSpectrum {
+    /// Path radiance.
+    pub l_path: Vec<f64>,
+    /// Downwelling irradiance just above the surface (black water).
+    pub ed: Vec<f64>,
+    /// Upward transmittance (direct + diffuse).
+    pub t_up: Vec<f64>,
+    /// Diffuse part of the upward transmittance.
+    pub t_up_diffuse: Vec<f64>,
+    /// Spherical albedo.
+    pub spherical_albedo: Vec<f64>,
+    /// Sun-glint radiance (zeros unless the scene calls for glint).
+    pub glint: Vec<f64>,
+    /// Share of the diffuse transmittance due to molecules (the rest is aerosol), for adjacency.
+    pub rayleigh_share: Vec<f64>,
+}
+
+/// Everything needed to turn a ground point into TOA radiance, built once per scene and grid.
+#[derive(Debug, Clone)]
+pub struct SceneOptics {
+    grid: WavelengthGrid,
+    water: WaterModel,
+    substrates: Vec<Vec<f64>>,
+    land: Option<Vec<f64>>,
+    e0: Vec<f64>,
+    lut: Arc<AtmosphereLut>,
+    /// Per grid wavelength: bracketing LUT nodes and the weight in ln λ.
+    nodes: Vec<(usize, usize, f64)>,
+    adjacency: Option<Adjacency>,
+    glint: bool,
+}
+
+/// Per-thread working memory of [`SceneOptics::radiance`].
+#[derive(Debug, Clone, Default)]
+pub struct Scratch {
+    mix: Vec<f64>,
+    rho_target: Vec<f64>,
+    /// Water evaluations with a bottom term (shallow), counted for tests and run reports.
+    pub bottom_evaluations: u64,
+    /// Water evaluations in all.
+    pub water_evaluations: u64,
+}
+
+/// What [`SceneOptics::radiance`] found at a point.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Surface {
+    /// Water: `rrs` holds its above-surface remote-sensing reflectance.
+    Water,
+    /// Land: `rrs` holds zeros.
+    Land,
+}
+
+impl SceneOptics {
+    /// Bind a scene to a simulation grid and an atmosphere LUT built for that scene (its
+    /// wavelength nodes must bracket the grid).
+    pub fn new(scene: &Scene, grid: &WavelengthGrid, lut: Arc<AtmosphereLut>) -> Result<Self, SceneError> {
+        let (spec, dir) = scene.spec.siop.load(scene.base_dir.as_deref())?;
+        let water = WaterModel::new(spec.resolve(grid, dir.as_deref())?);
+        let library = SubstrateLibrary::embedded()?;
+        let substrates = scene
+            .substrates
+            .iter()
+            .map(|(name, _)| library.mix_on_grid(&SubstrateMix { parts: vec![(name.clone(), 1.0)] }, grid))
+            .collect::<Result<Vec<_>, _>>()?;
+        let land = match &scene.spec.land {
+            Some(l) => Some(
+                l.reflectance
+                    .sample(grid, Extrapolation::Clamp, scene.base_dir.as_deref())?
+                    .into_iter()
+                    .map(|r| r.clamp(0.0, 1.0))
+                    .collect(),
+            ),
+            None => None,
+        };
+        let atmosphere = lut.atmosphere();
+        let e0 = grid.wavelengths_nm().iter().map(|&w| atmosphere.e0(w)).collect::<Result<Vec<_>, _>>()?;
+        let node_wl = &lut.axes().wavelengths_nm;
+        let nodes = grid
+            .wavelengths_nm()
+            .iter()
+            .map(|&w| {
+                let (first, last) = (node_wl[0], node_wl[node_wl.len() - 1]);
+                if w < first - 1e-9 || w > last + 1e-9 {
+                    return Err(SceneError::Atmosphere(AtmosphereError::OutOfRange {
+                        field: "wavelength_nm (LUT nodes)".into(),
+                        value: w,
+                        allowed: format!("{first} to {last} nm"),
+                    }));
+                }
+                if node_wl.len() == 1 {
+                    return Ok((0, 0, 0.0));
+                }
+                let j = node_wl.partition_point(|&v| v <= w).clamp(1, node_wl.len() - 1);
+                let t = (w / node_wl[j - 1]).ln() / (node_wl[j] / node_wl[j - 1]).ln();
+                Ok((j - 1, j, t.clamp(0.0, 1.0)))
+            })
+            .collect::<Result<Vec<_>, SceneError>>()?;
+        let adjacency = if scene.wants(Effect::Adjacency) { Some(Adjacency::new(scene)) } else { None };
+        Ok(Self {
+            grid: grid.clone(),
+            water,
+            substrates,
+            land,
+            e0,
+            lut,
+            nodes,
+            adjacency,
+            glint: scene.wants(Effect::SunGlint),
+        })
+    }
+
+    /// The simulation grid.
+    #[must_use]
+    pub fn grid(&self) -> &WavelengthGrid {
+        &self.grid
+    }
+
+    /// The water model (SIOP set on the grid).
+    #[must_use]
+    pub fn water(&self) -> &WaterModel {
+        &self.water
+    }
+
+    /// Extraterrestrial irradiance on the grid at the scene's date, W m⁻² nm⁻¹.
+    #[must_use]
+    pub fn e0(&self) -> &[f64] {
+        &self.e0
+    }
+
+    /// The atmosphere on the grid for geometry `g` (LUT nodes interpolated log–log in λ, then
+    /// the 1-nm solar spectrum and the gases applied).
+    pub fn path_spectrum(&self, g: &Geometry) -> Result<PathSpectrum, AtmosphereError> {
+        let n_nodes = self.lut.axes().wavelengths_nm.len();
+        let norm = (0..n_nodes).map(|w| self.lut.normalised(w, g)).collect::<Result<Vec<_>, _>>()?;
+        let atmosphere = self.lut.atmosphere();
+        let (mu0, muv) = (g.sun_zenith_rad.cos(), g.view_zenith_rad.cos());
+        let n = self.grid.len();
+        let mut p = PathSpectrum {
+            l_path: vec![0.0; n],
+            ed: vec![0.0; n],
+            t_up: vec![0.0; n],
+            t_up_diffuse: vec![0.0; n],
+            spherical_albedo: vec![0.0; n],
+            glint: vec![0.0; n],
+            rayleigh_share: vec![0.0; n],
+        };
+        let loglin = |a: f64, b: f64, t: f64| {
+            if a > 0.0 && b > 0.0 { (a.ln() + t * (b.ln() - a.ln())).exp() } else { a + t * (b - a) }
+        };
+        let lin = |a: f64, b: f64, t: f64| a + t * (b - a);
+        for (i, &wl) in self.grid.wavelengths_nm().iter().enumerate() {
+            let (j0, j1, t) = self.nodes[i];
+            let (a, b) = (&norm[j0], &norm[j1]);
+            let (tg0, tgv) = (atmosphere.gas(wl, mu0)?, atmosphere.gas(wl, muv)?);
+            let e0 = self.e0[i];
+            p.l_path[i] = loglin(a.radiance, b.radiance, t) * e0 * tg0 * tgv;
+            p.ed[i] = loglin(a.ed, b.ed, t) * e0 * tg0;
+            let t_up = lin(a.t_up, b.t_up, t);
+            let t_dir = lin(a.t_up_direct, b.t_up_direct, t);
+            p.t_up[i] = t_up * tgv;
+            p.t_up_diffuse[i] = (t_up - t_dir).max(0.0) * tgv;
+            p.spherical_albedo[i] = loglin(a.spherical_albedo, b.spherical_albedo, t);
+            if self.glint {
+                p.glint[i] = loglin(a.glint, b.glint, t) * e0 * tg0 * tgv;
+            }
+            // Diffuse transmission by molecules vs aerosols, in proportion to their scattering
+            // depths sending light forward (half of Rayleigh's; most of the aerosol's).
+            let (tr, ta) = (lin(a.tau_rayleigh, b.tau_rayleigh, t), lin(a.tau_aerosol, b.tau_aerosol, t));
+            let (dr, da) = (0.5 * tr, 0.85 * ta);
+            p.rayleigh_share[i] = if dr + da > 0.0 { dr / (dr + da) } else { 1.0 };
+        }
+        Ok(p)
+    }
+
+    /// TOA radiance (`l_toa`, W m⁻² sr⁻¹ nm⁻¹) and, over water, Rrs (`rrs`, sr⁻¹) at scene point
+    /// (x, y) m, seen along `g` through `path`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn radiance(
+        &self,
+        scene: &Scene,
+        x_m: f64,
+        y_m: f64,
+        g: &Geometry,
+        path: &PathSpectrum,
+        scratch: &mut Scratch,
+        l_toa: &mut [f64],
+        rrs: &mut [f64],
+    ) -> Result<Surface, SceneError> {
+        let n = self.grid.len();
+        let surface = if scene.is_land(x_m, y_m) {
+            let Some(rho) = &self.land else {
+                return Err(SceneError::Invalid {
+                    field: "land".into(),
+                    message: "land mask without reflectance".into(),
+                });
+            };
+            for i in 0..n {
+                let lw = rho[i] * path.ed[i] / (std::f64::consts::PI * (1.0 - path.spherical_albedo[i] * rho[i]));
+                l_toa[i] = path.l_path[i] + path.t_up[i] * lw;
+                rrs[i] = 0.0;
+            }
+            Surface::Land
+        } else {
+            let bottom = match &scene.depth {
+                Some(depth) => {
+                    let fractions: Vec<f64> =
+                        scene.substrates.iter().map(|(_, m)| m.value_at(x_m, y_m).max(0.0)).collect();
+                    let total: f64 = fractions.iter().sum();
+                    scratch.mix.clear();
+                    scratch.mix.resize(n, 0.0);
+                    for (f, r) in fractions.iter().zip(&self.substrates) {
+                        // Fractions are normalised to sum 1; where all vanish the first substrate covers.
+                        let w = if total > 0.0 { f / total } else { 1.0 / self.substrates.len() as f64 };
+                        for (m, v) in scratch.mix.iter_mut().zip(r) {
+                            *m += w * v;
+                        }
+                    }
+                    scratch.bottom_evaluations += 1;
+                    Bottom::Shallow { depth_m: depth.value_at(x_m, y_m), reflectance: &scratch.mix }
+                }
+                None => Bottom::OpticallyDeep,
+            };
+            let column = WaterColumn {
+                chl_mg_m3: scene.chl.value_at(x_m, y_m),
+                cdom_per_m: scene.cdom.value_at(x_m, y_m),
+                nap_g_m3: scene.nap.value_at(x_m, y_m),
+                bottom,
+            };
+            let geometry = WaterGeometry { sun_zenith_rad: g.sun_zenith_rad, view_zenith_rad: g.view_zenith_rad };
+            scratch.water_evaluations += 1;
+            self.water.rrs_above_into(&column, &geometry, rrs)?;
+            for i in 0..n {
+                let lw = rrs[i] * path.ed[i] / (1.0 - path.spherical_albedo[i] * std::f64::consts::PI * rrs[i]);
+                l_toa[i] = path.l_path[i] + path.t_up[i] * lw + path.glint[i];
+            }
+            Surface::Water
+        };
+        if let Some(adj) = &self.adjacency {
+            let land = self.land.as_deref().unwrap_or(&[]);
+            scratch.rho_target.clear();
+            match surface {
+                Surface::Water => scratch.rho_target.extend(rrs.iter().map(|r| std::f64::consts::PI * r)),
+                Surface::Land => scratch.rho_target.extend_from_slice(land),
+            }
+            adj.add(x_m, y_m, g, path, land, &scratch.rho_target, l_toa);
+        }
+        Ok(surface)
+    }
+}
