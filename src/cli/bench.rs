@@ -1,7 +1,7 @@
 //! `shoal bench`: what Shoal's physics costs in time and what it buys in accuracy, side by side
 //! with the reference codes' figures measured on this machine class (SAMBUCA Python forward
 //! model: 13–23 thousand evaluations/s at 451 bands on one core; OSOAA: 1–3.5 s per wavelength
-//! and geometry).
+//! and geometry), and the whole chain against its targets ([`super::bench_chain`]).
 
 use std::time::{Duration, Instant};
 
@@ -247,5 +247,7 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
     water_rows(&mut out, args.quick)?;
     emit(&std::mem::take(&mut out), None)?;
     atmosphere_rows(&mut out, args.quick)?;
+    emit(&std::mem::take(&mut out), None)?;
+    super::bench_chain::chain_rows(&mut out, args.quick)?;
     emit(&out, None)
 }

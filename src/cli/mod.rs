@@ -5,12 +5,15 @@
 //! |---|---|
 //! | `shoal water` | the water model alone: CSV of every intermediate per wavelength (or band) |
 //! | `shoal atmosphere` | the atmosphere alone: CSV of E₀, L_path, T_up, T_down, S, Ed(0⁺) |
+//! | `shoal simulate` | scene × instrument → Level-0, Level-1, Rrs cubes, SNR, report, config |
 //! | `shoal bench` | performance and accuracy figures (water evaluations/s, LUT build time vs OSOAA) |
 
 mod atmosphere;
 mod bench;
+mod bench_chain;
 mod grid;
 mod output;
+pub mod simulate;
 mod water;
 
 use std::process::ExitCode;
@@ -31,6 +34,9 @@ enum Command {
     Water(water::WaterArgs),
     /// Evaluate the atmosphere (successive orders of scattering) and print CSV.
     Atmosphere(atmosphere::AtmosphereArgs),
+    /// Fly an instrument over a scene: Level-0, Level-1 and Rrs cubes (.npy), the truth, the SNR
+    /// table, the run report and the resolved configuration.
+    Simulate(simulate::SimulateArgs),
     /// Measure speed and accuracy: water evaluations per second, atmosphere LUT build times
     /// with their errors against OSOAA.
     Bench(bench::BenchArgs),
@@ -97,6 +103,7 @@ pub fn main() -> ExitCode {
     let result = match cli.command {
         Command::Water(args) => water::run(&args),
         Command::Atmosphere(args) => atmosphere::run(&args),
+        Command::Simulate(args) => simulate::run(&args),
         Command::Bench(args) => bench::run(&args),
         Command::Dev(DevCommand::AerosolTable) => output::emit(&crate::atmosphere::component_table_csv(), None),
         Command::Dev(DevCommand::OsoaaTable) => bench::osoaa_table(),

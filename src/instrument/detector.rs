@@ -110,7 +110,7 @@ fn shot<R: rand::Rng + ?Sized>(mean: f64, rng: &mut R) -> f64 {
 /// baseline x86-64 target; the truncating conversion is one instruction.)
 #[inline]
 fn round_non_negative(x: f64) -> f64 {
-    if x > 0.0 { (x + 0.5) as u64 as f64 } else { 0.0 }
+    if x > 0.0 { (x + 0.5) as i64 as f64 } else { 0.0 }
 }
 
 /// A standard normal draw.

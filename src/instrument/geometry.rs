@@ -146,6 +146,24 @@ impl Viewing {
         let along_of = |g: &[Look]| g.get(g.len() / 2).map_or(0.0, |l| l.dx_m * along.0 + l.dy_m * along.1);
         let first = looks.first().map_or(0.0, |g| along_of(g));
         let time_offset_s = looks.iter().map(|g| (first - along_of(g)) / speed).collect();
+        // Co-registration: every group reports the ground point of the reference look (the mean
+        // focal-plane offset) — the rows of the delivered cube are ground lines — while keeping
+        // its own view geometry.
+        if looks.len() > 1 {
+            let reference = detector_index
+                .iter()
+                .map(|&j| {
+                    let alpha = ((j as f64 - 0.5 * (n as f64 - 1.0)) * pitch_over_f).atan();
+                    look(tilt + mean_offset, alpha).map(|(dx, dy, _)| (dx - cx, dy - cy))
+                })
+                .collect::<Result<Vec<_>, InstrumentError>>()?;
+            for group in &mut looks {
+                for (l, &(dx, dy)) in group.iter_mut().zip(&reference) {
+                    l.dx_m = dx;
+                    l.dy_m = dy;
+                }
+            }
+        }
         let n_lines = spec.exposures as f64;
         let track_m = line_index
             .iter()

@@ -1,0 +1,70 @@
+//! `shoal simulate` end to end: files, formats, exit codes, and the resolved configuration.
+
+use std::path::Path;
+use std::process::Command;
+
+fn shoal() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_shoal"))
+}
+
+/// Shape of a version-1 .npy file (from its header).
+fn npy_shape(path: &Path) -> Vec<usize> {
+    let bytes = std::fs::read(path).unwrap();
+    assert_eq!(&bytes[..6], b"\x93NUMPY");
+    let len = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
+    let header = std::str::from_utf8(&bytes[10..10 + len]).unwrap();
+    let shape = header.split("'shape': (").nth(1).unwrap().split(')').next().unwrap();
+    shape.split(',').filter(|s| !s.trim().is_empty()).map(|s| s.trim().parse().unwrap()).collect()
+}
+
+#[test]
+fn simulate_writes_cubes_tables_report_and_config() {
+    let dir = std::env::temp_dir().join(format!("shoal-sim-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let status = shoal()
+        .args(["simulate", "--scene", "heron_island_reef", "--instrument", "nominal", "--decimation", "8", "--out"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(status.status.success(), "{}", String::from_utf8_lossy(&status.stderr));
+    let shape = npy_shape(&dir.join("level0_dn.npy"));
+    assert_eq!(shape.len(), 3);
+    assert_eq!(shape[2], 19);
+    for f in ["level1_radiance.npy", "rrs.npy", "rrs_flags.npy", "truth_rrs.npy", "pupil_radiance.npy"] {
+        assert_eq!(npy_shape(&dir.join(f)), shape, "{f}");
+    }
+    assert_eq!(npy_shape(&dir.join("truth_depth_m.npy")), shape[..2].to_vec());
+    assert_eq!(npy_shape(&dir.join("truth_substrate_fractions.npy")), vec![shape[0], shape[1], 3]);
+    let snr = std::fs::read_to_string(dir.join("snr.csv")).unwrap();
+    assert!(snr.starts_with("band,centre_nm,radiance_w_m2_sr_nm,snr_analytic,snr_measured\n"));
+    assert_eq!(snr.lines().count(), 20);
+    let report = std::fs::read_to_string(dir.join("report.json")).unwrap();
+    assert!(report.contains("\"stages\"") && report.contains("SunGlint"));
+    // The resolved configuration reruns to the same counts.
+    let again = dir.join("again");
+    let status =
+        shoal().args(["simulate", "--config"]).arg(dir.join("config.ron")).arg("--out").arg(&again).output().unwrap();
+    assert!(status.status.success(), "{}", String::from_utf8_lossy(&status.stderr));
+    assert_eq!(std::fs::read(dir.join("level0_dn.npy")).unwrap(), std::fs::read(again.join("level0_dn.npy")).unwrap());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn simulate_refuses_bad_input_with_exit_code_2() {
+    let dir = std::env::temp_dir().join(format!("shoal-bad-{}", std::process::id()));
+    let bad = dir.join("bad.ron");
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut text =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/presets/instruments/nominal.ron")).unwrap();
+    text = text.replace("aperture_mm: 120.0", "aperture_mm: 0.0");
+    std::fs::write(&bad, text).unwrap();
+    let out = shoal().args(["simulate", "--instrument"]).arg(&bad).arg("--out").arg(dir.join("o")).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("aperture_mm") && err.lines().count() <= 2, "{err}");
+    assert!(!dir.join("o").exists(), "no output for a refused run");
+    let out = shoal().args(["simulate", "--scene", "atlantis", "--out"]).arg(dir.join("o")).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("lake_hume_bloom"));
+    let _ = std::fs::remove_dir_all(&dir);
+}

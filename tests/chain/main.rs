@@ -1,0 +1,41 @@
+//! The chain from scene to Rrs: closure, noise statistics, saturation, SNR trade-off,
+//! incremental re-runs, determinism, bad input, and `shoal simulate`.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+mod bad_input;
+mod cli;
+mod closure;
+mod determinism;
+mod incremental;
+mod noise;
+
+use shoal::control::RunControl;
+use shoal::engine::{Engine, RunConfig, RunOutput};
+use shoal::instrument::InstrumentSpec;
+use shoal::scene::SceneSpec;
+
+/// Lake Hume's bloom on a 12 × 8 km patch (same maps and atmosphere as the preset).
+pub fn small_lake() -> SceneSpec {
+    let mut s = SceneSpec::preset("lake_hume_bloom").unwrap();
+    s.width = 600;
+    s.height = 400;
+    s
+}
+
+/// Heron Island's reef, unchanged (it is small).
+pub fn reef() -> SceneSpec {
+    SceneSpec::preset("heron_island_reef").unwrap()
+}
+
+/// A Table 1 instrument cut to `detectors` × `lines`.
+pub fn small(name: &str, detectors: usize, lines: usize) -> InstrumentSpec {
+    let mut i = InstrumentSpec::preset(name).unwrap();
+    i.detectors = detectors;
+    i.exposures = lines;
+    i
+}
+
+/// Run `config` in a fresh engine.
+pub fn run(config: &RunConfig) -> RunOutput {
+    Engine::new().run(config, &RunControl::new()).unwrap()
+}
