@@ -221,3 +221,72 @@ fn shift(b: &Band, d: f64) -> Result<Band, InstrumentError> {
         Spectrum::new(b.srf.name.clone(), b.srf.wavelength_nm.iter().map(|w| w + d).collect(), b.srf.values.clone())?;
     Ok(Band { srf, centre_nm: b.centre_nm + d, ..b.clone() })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::spectral::{BandSetSpec, GaussianBand};
+
+    fn spec_with(kind: InstrumentKind) -> InstrumentSpec {
+        let mut s = InstrumentSpec::preset("nominal").unwrap();
+        s.kind = kind;
+        s
+    }
+
+    #[test]
+    fn photon_response_of_a_gaussian_band() {
+        // ∫ SRF·QE·λ/(hc) dλ ≈ QE·λc/(hc)·1.0645·FWHM for a narrow Gaussian band.
+        let bands = BandSetSpec::Gaussian(vec![GaussianBand { name: None, centre_nm: 500.0, fwhm_nm: 10.0 }]);
+        let r = Response::new(&spec_with(InstrumentKind::Multispectral { bands }), 0.5).unwrap();
+        let expected = 0.7 / photon_energy_j(500.0) * 1.064_467 * 10.0;
+        assert!((r.photon_response(0) / expected - 1.0).abs() < 5e-3, "{} vs {expected}", r.photon_response(0));
+    }
+
+    #[test]
+    fn olci_grid_covers_only_the_bands() {
+        let r = Response::new(&InstrumentSpec::preset("nominal").unwrap(), 1.0).unwrap();
+        assert_eq!(r.n_bands(), 19);
+        assert_eq!(r.groups.len(), 1);
+        // Gaps between bands are left out: fewer points than the 400–910 nm span.
+        let g = &r.groups[0].grid;
+        assert!(g.len() < 450 && g.len() > 200, "{}", g.len());
+    }
+
+    #[test]
+    fn spectrograph_bands_smile_and_keystone() {
+        let kind = InstrumentKind::Spectrograph {
+            start_nm: 400.0,
+            end_nm: 900.0,
+            sampling_nm: 5.0,
+            resolution_nm: 7.0,
+            smile_nm: 1.0,
+            keystone_px: 0.4,
+        };
+        let r = Response::new(&spec_with(kind), 0.5).unwrap();
+        assert_eq!(r.n_bands(), 101);
+        assert!((r.keystone_px[0] + 0.2).abs() < 1e-12 && (r.keystone_px[100] - 0.2).abs() < 1e-12);
+        // Smile: the edge detector's band 0 is centred 1 nm (×(31/32)²) redder than the centre's.
+        let centroid = |j: usize| {
+            let (first, w) = r.weights(0, 0, j);
+            let grid = &r.groups[0].grid;
+            let (num, den) =
+                w.iter().enumerate().fold((0.0, 0.0), |(n, d), (i, v)| (n + v * grid.wavelength_nm(first + i), d + v));
+            num / den
+        };
+        let shift = centroid(0) - centroid(512);
+        let x: f64 = 2.0 * 0.5 / 32.0 - 1.0;
+        let expected = 1.0 * x * x - 1.0 * (2.0 * 16.5 / 32.0 - 1.0_f64).powi(2);
+        assert!((shift - expected).abs() < 0.02, "{shift} vs {expected}");
+    }
+
+    #[test]
+    fn filter_imager_bands_look_from_their_own_angles() {
+        let r = Response::new(&InstrumentSpec::preset("filter_imager").unwrap(), 1.0).unwrap();
+        assert_eq!(r.groups.len(), 10);
+        let offsets: Vec<f64> = r.groups.iter().map(|g| g.offset_rad.0).collect();
+        // 64 rows of 5.5 µm at 165 mm between bands, symmetric about the boresight.
+        let step = (64.0 * 5.5e-6 / 0.165_f64).atan();
+        assert!((offsets[1] - offsets[0] - step).abs() < 1e-6);
+        assert!((offsets[0] + offsets[9]).abs() < 1e-12);
+    }
+}

@@ -8,6 +8,8 @@ mod closure;
 mod determinism;
 mod incremental;
 mod noise;
+mod spatial;
+mod worker;
 
 use shoal::control::RunControl;
 use shoal::engine::{Engine, RunConfig, RunOutput};
