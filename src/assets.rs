@@ -61,6 +61,14 @@ macro_rules! embed_presets {
 pub const PRESETS: &[Asset] = embed_presets![
     "siop/heron_island.ron",
     "siop/cyanobacteria_reservoir.ron",
+    "siop/almi_1.ron",
+    "siop/almi_2.ron",
+    "siop/almi_3.ron",
+    "siop/almi_4.ron",
+    "siop/almi_5.ron",
+    "siop/almi_6.ron",
+    "siop/almi_7.ron",
+    "siop/almi_8.ron",
     "scenes/lake_hume_bloom.ron",
     "scenes/heron_island_reef.ron",
     "scenes/aquaculture_turbidity.ron",
@@ -70,6 +78,9 @@ pub const PRESETS: &[Asset] = embed_presets![
     "instruments/smallsat.ron",
     "instruments/hyperspectral.ron",
     "instruments/filter_imager.ron",
+    "studies/cubesat_vs_smallsat.ron",
+    "studies/lake_hume_nominal.ron",
+    "studies/heron_island_depth.ron",
 ];
 
 /// The built-in preset at `path` (relative to `presets/`), if there is one.

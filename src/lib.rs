@@ -15,6 +15,7 @@
 //!
 //! | module | what it holds |
 //! |---|---|
+//! | [`colormap`] | viridis, diverging and class colours, value scales (figures and app) |
 //! | [`units`] | constants, unit conversions, angle helpers |
 //! | [`assets`] | cited spectra embedded in the binary |
 //! | [`control`] | cancellation and progress shared by a run and its watcher |
@@ -26,7 +27,10 @@
 //! | [`instrument`] | Table 1 instruments: response, pushbroom geometry, PSF, detector, SNR |
 //! | [`calibration`] | diffuser and dark frames → per-detector gain and offset; Level-0 → Level-1 |
 //! | [`correction`] | Level-1 → Rrs: exact per pixel, and the paper's per-scene approximation |
+//! | [`retrieval`] | aLMI and SAMBUCA-style inversions of band Rrs |
+//! | [`metrics`] | log-space MAE and bias (Seegers et al. 2018), RMSE, R², histograms |
 //! | [`engine`] | the chain as cached stages; the worker thread the app talks to |
+//! | [`study`] | studies: runs per instrument and seed, metrics tables, figures (PNG/SVG), cubes |
 //! | [`validation`] | comparisons with reference codes (OSOAA), shared by tests and `shoal bench` |
 //! | [`cli`] | the headless command line (`shoal water`, `shoal atmosphere`, `shoal bench`) |
 
@@ -34,12 +38,16 @@ pub mod assets;
 pub mod atmosphere;
 pub mod calibration;
 pub mod cli;
+pub mod colormap;
 pub mod control;
 pub mod correction;
 pub mod engine;
 pub mod instrument;
+pub mod metrics;
+pub mod retrieval;
 pub mod scene;
 pub mod spectral;
+pub mod study;
 pub mod toa;
 pub mod units;
 pub mod validation;

@@ -6,6 +6,7 @@
 //! | `shoal water` | the water model alone: CSV of every intermediate per wavelength (or band) |
 //! | `shoal atmosphere` | the atmosphere alone: CSV of E₀, L_path, T_up, T_down, S, Ed(0⁺) |
 //! | `shoal simulate` | scene × instrument → Level-0, Level-1, Rrs cubes, SNR, report, config |
+//! | `shoal study` | a study: instruments × seeds × retrievals → metrics.csv/json, figures, cubes |
 //! | `shoal bench` | performance and accuracy figures (water evaluations/s, LUT build time vs OSOAA) |
 
 mod atmosphere;
@@ -14,6 +15,7 @@ mod bench_chain;
 mod grid;
 mod output;
 pub mod simulate;
+mod study;
 mod water;
 
 use std::process::ExitCode;
@@ -37,6 +39,9 @@ enum Command {
     /// Fly an instrument over a scene: Level-0, Level-1 and Rrs cubes (.npy), the truth, the SNR
     /// table, the run report and the resolved configuration.
     Simulate(simulate::SimulateArgs),
+    /// Run a study (default: CubeSat vs SmallSat over Lake Hume): metrics table, figures,
+    /// cubes and the resolved configuration.
+    Study(study::StudyArgs),
     /// Measure speed and accuracy: water evaluations per second, atmosphere LUT build times
     /// with their errors against OSOAA.
     Bench(bench::BenchArgs),
@@ -51,6 +56,11 @@ enum DevCommand {
     AerosolTable,
     /// Print the per-band accuracy table against OSOAA (README).
     OsoaaTable,
+    /// Regenerate the eight aLMI SIOP sets (presets/siop/almi_*.ron) into DIR.
+    AlmiSets {
+        /// Directory to write into.
+        dir: std::path::PathBuf,
+    },
 }
 
 /// What went wrong, and which exit code it earns.
@@ -90,6 +100,17 @@ macro_rules! input_error {
 }
 input_error!(crate::water::WaterError, crate::atmosphere::AtmosphereError, crate::spectral::SpectralError);
 
+/// `shoal dev almi-sets DIR`.
+fn almi_sets(dir: &std::path::Path) -> Result<(), CliError> {
+    use crate::retrieval::sets::{ALMI_SETS, almi_clusters, set_ron};
+    let clusters = almi_clusters().map_err(|e| CliError::Run(e.to_string()))?;
+    let total: usize = clusters.iter().map(|c| c.stations).sum();
+    for (i, c) in clusters.iter().enumerate() {
+        output::emit(&set_ron(i, c, total), Some(&dir.join(format!("{}.ron", ALMI_SETS[i]))))?;
+    }
+    Ok(())
+}
+
 /// Entry point of the `shoal` binary.
 #[must_use]
 pub fn main() -> ExitCode {
@@ -104,9 +125,11 @@ pub fn main() -> ExitCode {
         Command::Water(args) => water::run(&args),
         Command::Atmosphere(args) => atmosphere::run(&args),
         Command::Simulate(args) => simulate::run(&args),
+        Command::Study(args) => study::run(&args),
         Command::Bench(args) => bench::run(&args),
         Command::Dev(DevCommand::AerosolTable) => output::emit(&crate::atmosphere::component_table_csv(), None),
         Command::Dev(DevCommand::OsoaaTable) => bench::osoaa_table(),
+        Command::Dev(DevCommand::AlmiSets { dir }) => almi_sets(&dir),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,16 +1,14 @@
 //! `shoal simulate`: fly an instrument over a scene and write what it delivers — Level-0,
 //! Level-1 and Rrs cubes (.npy), the truth, the SNR table, the run report and the fully
-//! resolved configuration.
+//! resolved configuration (see [`crate::study::write_run`]).
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Duration;
 
 use clap::Args;
-use ndarray_npy::WriteNpyExt;
 
 use super::CliError;
-use super::output::{Csv, emit};
 use crate::control::RunControl;
 use crate::engine::{Engine, EngineError, RunConfig, RunOutput};
 use crate::instrument::{InstrumentError, InstrumentSpec};
@@ -172,89 +170,12 @@ pub fn run_with_progress(config: &RunConfig, threads: Option<usize>, label: &str
     })
 }
 
-/// Write `array` as .npy to `dir/name` atomically.
-fn write_npy<A: WriteNpyExt + ?Sized>(dir: &Path, name: &str, array: &A) -> Result<(), CliError> {
-    let path = dir.join(name);
-    let mut bytes = Vec::new();
-    array.write_npy(&mut bytes).map_err(|e| CliError::Run(format!("cannot encode {name}: {e}")))?;
-    write_bytes(&path, &bytes)
-}
-
-/// Write bytes atomically (temporary file beside the target, then rename).
-pub fn write_bytes(path: &Path, bytes: &[u8]) -> Result<(), CliError> {
-    let tmp = path.with_extension("partial");
-    let fail = |e: std::io::Error| CliError::Run(format!("cannot write {}: {e}", path.display()));
-    std::fs::write(&tmp, bytes).map_err(fail)?;
-    std::fs::rename(&tmp, path).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        fail(e)
-    })
-}
-
-/// The SNR table as CSV.
-#[must_use]
-pub fn snr_csv(out: &RunOutput) -> String {
-    let mut s = String::from("band,centre_nm,radiance_w_m2_sr_nm,snr_analytic,snr_measured\n");
-    for r in out.snr.iter() {
-        let f = |v: f64| if v.is_finite() { super::output::number(v) } else { "inf".into() };
-        s.push_str(&format!(
-            "{},{},{},{},{}\n",
-            r.band,
-            f(r.centre_nm),
-            f(r.radiance),
-            f(r.snr_analytic),
-            f(r.snr_measured)
-        ));
-    }
-    s
-}
-
-/// Write every product of `out` into `dir`.
-pub fn write_outputs(out: &RunOutput, dir: &Path) -> Result<Vec<String>, CliError> {
-    std::fs::create_dir_all(dir).map_err(|e| CliError::Run(format!("cannot create {}: {e}", dir.display())))?;
-    let mut written = Vec::new();
-    let mut npy = |name: &str, r: Result<(), CliError>| -> Result<(), CliError> {
-        r?;
-        written.push(name.to_string());
-        Ok(())
-    };
-    let rad = &out.radiance;
-    npy("level0_dn.npy", write_npy(dir, "level0_dn.npy", &out.level0.dn))?;
-    npy("level0_flags.npy", write_npy(dir, "level0_flags.npy", &out.level0.flags))?;
-    npy("level1_radiance.npy", write_npy(dir, "level1_radiance.npy", &out.level1.radiance))?;
-    npy("rrs.npy", write_npy(dir, "rrs.npy", &out.correction.rrs.rrs))?;
-    npy("rrs_flags.npy", write_npy(dir, "rrs_flags.npy", &out.correction.rrs.flags))?;
-    npy("pupil_radiance.npy", write_npy(dir, "pupil_radiance.npy", &rad.radiance))?;
-    npy("truth_rrs.npy", write_npy(dir, "truth_rrs.npy", &rad.rrs))?;
-    npy("truth_chl_mg_m3.npy", write_npy(dir, "truth_chl_mg_m3.npy", &rad.chl_mg_m3))?;
-    npy("truth_nap_g_m3.npy", write_npy(dir, "truth_nap_g_m3.npy", &rad.nap_g_m3))?;
-    npy("truth_cdom_per_m.npy", write_npy(dir, "truth_cdom_per_m.npy", &rad.cdom_per_m))?;
-    npy("land_mask.npy", write_npy(dir, "land_mask.npy", &rad.land))?;
-    if let Some(d) = &rad.depth_m {
-        npy("truth_depth_m.npy", write_npy(dir, "truth_depth_m.npy", d))?;
-    }
-    if let Some(f) = &rad.substrate_fractions {
-        npy("truth_substrate_fractions.npy", write_npy(dir, "truth_substrate_fractions.npy", f))?;
-    }
-    let mut bands = Csv::new(vec!["band".into(), "centre_nm".into(), "fwhm_nm".into()]);
-    for b in &out.response.bands.bands {
-        bands.row(Some(&b.name), &[b.centre_nm, b.fwhm_nm])?;
-    }
-    emit(&bands.render(), Some(&dir.join("bands.csv")))?;
-    emit(&snr_csv(out), Some(&dir.join("snr.csv")))?;
-    let report = serde_json::to_string_pretty(&out.report).map_err(|e| CliError::Run(format!("report: {e}")))?;
-    emit(&report, Some(&dir.join("report.json")))?;
-    emit(&out.config.to_ron()?, Some(&dir.join("config.ron")))?;
-    written.extend(["bands.csv", "snr.csv", "report.json", "config.ron"].map(str::to_string));
-    Ok(written)
-}
-
 /// `shoal simulate`.
 pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     let config = config_from(args)?;
     let label = format!("{} over {}", config.instrument.name, config.scene.name);
     let out = run_with_progress(&config, args.threads, &label)?;
-    let written = write_outputs(&out, &args.out)?;
+    let written = crate::study::write_run(&out, &args.out).map_err(|e| CliError::Run(e.to_string()))?.files;
     let (rows, cols, nb) = out.report.shape;
     eprintln!("{label}: {rows} lines × {cols} detectors × {nb} bands in {:.2} s", out.report.total_seconds);
     eprint!("{}", out.report.table());

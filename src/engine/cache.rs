@@ -38,11 +38,13 @@ pub enum Stage {
     Correction,
     /// SNR table.
     Snr,
+    /// A retrieval and its metrics.
+    Retrieval,
 }
 
 impl Stage {
     /// Every stage, in chain order.
-    pub const ALL: [Self; 14] = [
+    pub const ALL: [Self; 15] = [
         Self::Scene,
         Self::Response,
         Self::Geometry,
@@ -57,6 +59,7 @@ impl Stage {
         Self::Level1,
         Self::Correction,
         Self::Snr,
+        Self::Retrieval,
     ];
 
     /// Products kept per stage: two for the large cubes (instrument A and B of a comparison),
@@ -86,6 +89,7 @@ impl std::fmt::Display for Stage {
             Self::Level1 => "level-1",
             Self::Correction => "correction",
             Self::Snr => "snr",
+            Self::Retrieval => "retrieval",
         };
         f.write_str(name)
     }

@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 use crate::calibration::CalibrationSpec;
 use crate::correction::CorrectionSpec;
 use crate::instrument::{DetectorMode, InstrumentError, InstrumentSpec};
+use crate::retrieval::RetrievalSpec;
 use crate::scene::SceneSpec;
 
 /// Fidelity settings: what accuracy is bought with time.
@@ -109,6 +110,9 @@ pub struct RunConfig {
     /// Atmospheric correction settings.
     #[serde(default)]
     pub correction: CorrectionSpec,
+    /// Retrievals to run on the Rrs (none: the chain stops at Rrs).
+    #[serde(default)]
+    pub retrievals: Vec<RetrievalSpec>,
     /// Fidelity settings.
     #[serde(default)]
     pub fidelity: Fidelity,
@@ -129,6 +133,7 @@ impl RunConfig {
             detector: DetectorMode::default(),
             calibration: CalibrationSpec::default(),
             correction: CorrectionSpec::default(),
+            retrievals: Vec::new(),
             fidelity: Fidelity::default(),
             seed: 1,
         }

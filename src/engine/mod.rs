@@ -24,6 +24,7 @@
 //! | `Level1` | Level-0, calibration | calibrated radiance |
 //! | `Correction` | Level-1, band atmosphere | Rrs, flags, per-scene approximation |
 //! | `Snr` | detector, typical radiance | analytic and measured SNR |
+//! | `Retrieval` | Rrs, band atmosphere, noise, retrieval settings | products and their metrics |
 //!
 //! Changing the gain re-runs `Detector`, `Level0`, `Calibration`, `Level1`, `Correction` and
 //! `Snr`, never the scene, the atmosphere or the photon counts. Effects a scene does not ask for
@@ -32,12 +33,14 @@
 
 mod cache;
 mod config;
+mod products;
 mod report;
 mod run;
 pub mod worker;
 
 pub use cache::Stage;
 pub use config::{Fidelity, RunConfig};
+pub use products::RetrievalOutput;
 pub use report::{RunReport, StageReport, StageStatus};
 pub use run::{Engine, RunOutput};
 

@@ -47,6 +47,8 @@ pub struct RunOutput {
     pub response: Arc<Response>,
     /// The viewing geometry.
     pub viewing: Arc<Viewing>,
+    /// The band-effective atmosphere of each column (what the exact correction used).
+    pub band_atmosphere: Arc<BandAtmosphere>,
     /// Pupil radiance and truth.
     pub radiance: Arc<RadianceCube>,
     /// Level-0.
@@ -59,6 +61,8 @@ pub struct RunOutput {
     pub correction: Arc<CorrectionProduct>,
     /// SNR per band.
     pub snr: Arc<Vec<SnrRow>>,
+    /// Retrieved products and their metrics, one per configured retrieval.
+    pub retrievals: Vec<Arc<super::products::RetrievalOutput>>,
     /// The report.
     pub report: RunReport,
 }
@@ -142,7 +146,7 @@ impl Engine {
 
     /// Serve `stage` from the cache under `key`, or compute it with `f` (timed, counted, and
     /// guarded: a panic inside a stage becomes an error naming the stage).
-    fn stage<T, F>(
+    pub(super) fn stage<T, F>(
         &mut self,
         stage: Stage,
         key: Key,
@@ -195,20 +199,32 @@ impl Engine {
         let side = self.scene_side(config, control, &mut report)?;
         let (radiance, radiance_key) = self.radiance_stage(config, &side, control, &mut report)?;
         let inst = self.instrument_side(config, &side, &radiance, radiance_key, control, &mut report)?;
-        let correction = self.correction_stage(config, &side, &radiance, radiance_key, &inst, control, &mut report)?;
-        let snr = self.snr_stage(config, &side, &radiance, &inst, control, &mut report)?;
+        let (correction, correction_key) =
+            self.correction_stage(config, &side, &radiance, radiance_key, &inst, control, &mut report)?;
+        let (snr, typical) = self.snr_stage(config, &side, &radiance, &inst, control, &mut report)?;
+        let retrievals = self.retrieval_stage(
+            config,
+            &side,
+            &radiance,
+            (&correction, correction_key),
+            &typical,
+            control,
+            &mut report,
+        )?;
         report.total_seconds = start.elapsed().as_secs_f64();
         Ok(RunOutput {
             config: config.clone(),
             scene: side.scene,
             response: side.response,
-            viewing: side.viewing,
+            viewing: side.viewing.clone(),
+            band_atmosphere: side.band_atmosphere.clone(),
             radiance,
             level0: inst.level0,
             calibration: inst.calibration,
             level1: inst.level1,
             correction,
             snr,
+            retrievals,
             report,
         })
     }
@@ -437,7 +453,7 @@ impl Engine {
         inst: &InstrumentSide,
         control: &RunControl,
         report: &mut RunReport,
-    ) -> Result<Arc<CorrectionProduct>, EngineError> {
+    ) -> Result<(Arc<CorrectionProduct>, Key), EngineError> {
         let fid = &config.fidelity;
         let (band_atmosphere, band_key, level1, level1_key) =
             (&side.band_atmosphere, side.band_key, &inst.level1, inst.level1_key);
@@ -492,8 +508,7 @@ impl Engine {
         report.approximation = Some(correction.approximation.clone());
         report.approximation_vs_exact = correction.approximation_vs_exact.clone();
         report.rrs_vs_truth = correction.rrs_vs_truth.clone();
-
-        Ok(correction)
+        Ok((correction, correction_key))
     }
 
     /// SNR at the scene's typical (median water) radiance.
@@ -505,7 +520,7 @@ impl Engine {
         inst: &InstrumentSide,
         control: &RunControl,
         report: &mut RunReport,
-    ) -> Result<Arc<Vec<SnrRow>>, EngineError> {
+    ) -> Result<(Arc<Vec<SnrRow>>, Vec<f64>), EngineError> {
         let (instrument, fid, response) = (&config.instrument, &config.fidelity, &side.response);
         let (detector, detector_key) = (&inst.detector, inst.detector_key);
         let nb = response.n_bands();
@@ -534,19 +549,19 @@ impl Engine {
                 })
                 .collect::<Vec<_>>())
         })?;
-        Ok(snr)
+        Ok((snr, typical))
     }
 }
 
 /// Products of the scene side of the chain and their keys.
-struct SceneSide {
-    scene: Arc<Scene>,
-    response: Arc<Response>,
-    response_key: Key,
-    viewing: Arc<Viewing>,
-    optics: Arc<Vec<SceneOptics>>,
-    band_atmosphere: Arc<BandAtmosphere>,
-    band_key: Key,
+pub(super) struct SceneSide {
+    pub(super) scene: Arc<Scene>,
+    pub(super) response: Arc<Response>,
+    pub(super) response_key: Key,
+    pub(super) viewing: Arc<Viewing>,
+    pub(super) optics: Arc<Vec<SceneOptics>>,
+    pub(super) band_atmosphere: Arc<BandAtmosphere>,
+    pub(super) band_key: Key,
 }
 
 /// Products of the instrument side and the keys later stages build on.

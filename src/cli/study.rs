@@ -1,0 +1,142 @@
+//! `shoal study`: run a study (a scene, instruments, retrievals, seeds) and write its metrics
+//! table, figures, cubes and resolved configuration. With no study named, the built-in
+//! CubeSat vs SmallSat study over Lake Hume runs, so a new user sees a result at once.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Duration;
+
+use clap::Args;
+
+use super::CliError;
+use crate::control::RunControl;
+use crate::study::{StudyError, StudySpec, run_study, write_run, write_study};
+
+/// Arguments of `shoal study`.
+#[derive(Debug, Args)]
+pub struct StudyArgs {
+    /// A study RON file or a built-in study name (default: cubesat_vs_smallsat).
+    study: Option<String>,
+    /// Output directory.
+    #[arg(long, default_value = "results/study")]
+    out: PathBuf,
+    /// Simulate every n-th line and detector (overrides the study's fidelity).
+    #[arg(long)]
+    decimation: Option<usize>,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Do not write the per-instrument cubes (tables and figures only).
+    #[arg(long)]
+    no_cubes: bool,
+    /// Do not draw figures.
+    #[arg(long)]
+    no_figures: bool,
+}
+
+impl From<StudyError> for CliError {
+    fn from(e: StudyError) -> Self {
+        match e {
+            StudyError::Io(m) => Self::Run(m),
+            StudyError::Cancelled => Self::Run("cancelled".into()),
+            other => Self::Input(other.to_string()),
+        }
+    }
+}
+
+fn load(arg: Option<&str>) -> Result<(StudySpec, Option<PathBuf>), CliError> {
+    match arg {
+        None => Ok((StudySpec::default_study()?, None)),
+        Some(a) if a.ends_with(".ron") || Path::new(a).exists() => {
+            let text = std::fs::read_to_string(a).map_err(|e| CliError::Input(format!("{a}: {e}")))?;
+            Ok((StudySpec::from_ron(&text, a)?, Path::new(a).parent().map(Path::to_path_buf)))
+        }
+        Some(name) => Ok((StudySpec::preset(name)?, None)),
+    }
+}
+
+/// `shoal study`.
+pub fn run(args: &StudyArgs) -> Result<(), CliError> {
+    let (spec, dir) = load(args.study.as_deref())?;
+    let mut resolved = spec.resolve(dir.as_deref())?;
+    if let Some(d) = args.decimation {
+        for (_, _, c) in &mut resolved.runs {
+            c.fidelity.decimation = d;
+        }
+    }
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(args.threads.unwrap_or(0))
+        .build()
+        .map_err(|e| CliError::Run(format!("cannot start worker threads: {e}")))?;
+    let n = resolved.runs.len();
+    let bar = indicatif::ProgressBar::new(n as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{prefix} [{bar:30}] run {pos}/{len}, {elapsed} {msg}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
+            .progress_chars("=> "),
+    );
+    bar.set_prefix(spec.name.clone());
+    let control = Arc::new(RunControl::new());
+    let start = std::time::Instant::now();
+    let result = std::thread::scope(|s| {
+        let done = Arc::new(AtomicBool::new(false));
+        let (watch, flag, progress) = (control.clone(), done.clone(), bar.clone());
+        s.spawn(move || {
+            while !flag.load(Ordering::Relaxed) {
+                let (d, t) = watch.progress();
+                if t > 0 {
+                    progress.set_message(format!("({:.0} % of rows)", 100.0 * d as f64 / t as f64));
+                }
+                std::thread::sleep(Duration::from_millis(200));
+            }
+        });
+        let result = pool.install(|| {
+            run_study(&resolved, &control, |i, out| {
+                let (label, seed, _) = &resolved.runs[i];
+                if !args.no_cubes {
+                    let sub = if spec.seeds.len() > 1 { format!("{label}_seed{seed}") } else { label.clone() };
+                    write_run(out, &args.out.join(sub))?;
+                }
+                bar.inc(1);
+                Ok(())
+            })
+        });
+        done.store(true, Ordering::Relaxed);
+        result
+    });
+    bar.finish_and_clear();
+    let result = result?;
+    let outputs = pool.install(|| write_study(&result, &args.out, !args.no_figures))?;
+    eprintln!("{}: {n} runs in {:.1} s", spec.name, start.elapsed().as_secs_f64());
+    eprintln!(
+        "{:<12} {:<8} {:<24} {:>9} {:>9} {:>10}",
+        "instrument", "product", "variable", "MAE %", "bias %", "returned %"
+    );
+    for run in &result.runs {
+        for ret in &run.retrievals {
+            for v in &ret.metrics.variables {
+                eprintln!(
+                    "{:<12} {:<8} {:<24} {:>9.1} {:>+9.1} {:>10.2}",
+                    run.label,
+                    ret.metrics.product,
+                    v.variable,
+                    v.metrics.mae_pct(),
+                    v.metrics.bias_pct(),
+                    v.metrics.returned_pct
+                );
+            }
+            if !ret.metrics.siop_set_counts.is_empty() {
+                eprintln!(
+                    "{:<12} {:<8} SIOP sets used: {} of {}",
+                    run.label,
+                    ret.metrics.product,
+                    ret.metrics.siop_sets_used,
+                    ret.metrics.siop_set_counts.len()
+                );
+            }
+        }
+    }
+    eprintln!("wrote {} files to {}", outputs.files.len(), args.out.display());
+    Ok(())
+}

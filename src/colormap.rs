@@ -1,0 +1,156 @@
+//! Colour maps for product maps and figures, shared by the study figures and the app.
+//!
+//! - [`viridis`]: perceptually uniform, readable in greyscale and by colour-blind readers; the
+//!   matplotlib default (van der Walt & Smith 2015; Nuñez, Anderton & Renslow 2018). Eight anchor
+//!   colours at k/7, linearly interpolated in sRGB.
+//! - [`diverging`]: ColorBrewer RdBu reversed (Brewer 2002), blue below zero, red above, for
+//!   differences (A − B, retrieved − true).
+//! - [`categorical`]: ColorBrewer Set1 and Dark2 colours for classes (SIOP sets, substrates).
+//!
+//! ## References
+//! - Nuñez, J. R., Anderton, C. R., Renslow, R. S. (2018) Optimizing colormaps with consideration
+//!   for color vision deficiency to enable accurate interpretation of scientific data. PLoS ONE
+//!   13, e0199239.
+//! - Brewer, C. A. (2002) ColorBrewer, www.ColorBrewer.org (Apache-2.0-style licence).
+
+/// An sRGB colour.
+pub type Rgb = [u8; 3];
+
+const VIRIDIS: [Rgb; 8] = [
+    [68, 1, 84],
+    [70, 50, 127],
+    [54, 92, 141],
+    [39, 127, 143],
+    [31, 162, 136],
+    [74, 194, 110],
+    [160, 219, 57],
+    [254, 232, 37],
+];
+
+const RDBU_R: [Rgb; 11] = [
+    [5, 48, 97],
+    [33, 102, 172],
+    [67, 147, 195],
+    [146, 197, 222],
+    [209, 229, 240],
+    [247, 247, 247],
+    [253, 219, 199],
+    [244, 165, 130],
+    [214, 96, 77],
+    [178, 24, 43],
+    [103, 0, 31],
+];
+
+const CLASSES: [Rgb; 12] = [
+    [228, 26, 28],
+    [55, 126, 184],
+    [77, 175, 74],
+    [152, 78, 163],
+    [255, 127, 0],
+    [166, 86, 40],
+    [247, 129, 191],
+    [153, 153, 153],
+    [27, 158, 119],
+    [217, 95, 2],
+    [117, 112, 179],
+    [102, 166, 30],
+];
+
+fn interpolate(anchors: &[Rgb], t: f64) -> Rgb {
+    let t = if t.is_finite() { t.clamp(0.0, 1.0) } else { 0.0 };
+    let x = t * (anchors.len() - 1) as f64;
+    let i = (x.floor() as usize).min(anchors.len() - 2);
+    let f = x - i as f64;
+    let (a, b) = (anchors[i], anchors[i + 1]);
+    std::array::from_fn(|k| (f64::from(a[k]) + f * (f64::from(b[k]) - f64::from(a[k]))).round() as u8)
+}
+
+/// Viridis at t ∈ [0, 1] (clamped; NaN gives the low end).
+#[must_use]
+pub fn viridis(t: f64) -> Rgb {
+    interpolate(&VIRIDIS, t)
+}
+
+/// Diverging blue–white–red at t ∈ [−1, 1] (0 is white).
+#[must_use]
+pub fn diverging(t: f64) -> Rgb {
+    interpolate(&RDBU_R, 0.5 * (t + 1.0))
+}
+
+/// The colour of class `i` (cycling after twelve).
+#[must_use]
+pub fn categorical(i: usize) -> Rgb {
+    CLASSES[i % CLASSES.len()]
+}
+
+/// A value scale: linear or logarithmic between `lo` and `hi`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Scale {
+    /// Low end.
+    pub lo: f64,
+    /// High end.
+    pub hi: f64,
+    /// Logarithmic (both ends > 0).
+    pub log: bool,
+}
+
+impl Scale {
+    /// Where `v` falls on the scale, 0–1 (not clamped).
+    #[must_use]
+    pub fn position(&self, v: f64) -> f64 {
+        if self.log {
+            let (a, b) = (self.lo.max(f64::MIN_POSITIVE).ln(), self.hi.max(f64::MIN_POSITIVE).ln());
+            if b > a { (v.max(f64::MIN_POSITIVE).ln() - a) / (b - a) } else { 0.5 }
+        } else if self.hi > self.lo {
+            (v - self.lo) / (self.hi - self.lo)
+        } else {
+            0.5
+        }
+    }
+
+    /// The value at position `t` (0–1).
+    #[must_use]
+    pub fn value(&self, t: f64) -> f64 {
+        if self.log {
+            (self.lo.ln() + t * (self.hi.ln() - self.lo.ln())).exp()
+        } else {
+            self.lo + t * (self.hi - self.lo)
+        }
+    }
+
+    /// A scale covering the 1st–99th percentiles of the finite (and, for log, positive) values,
+    /// logarithmic when they span more than a decade and are all positive.
+    #[must_use]
+    pub fn robust(values: impl IntoIterator<Item = f64>) -> Self {
+        let mut v: Vec<f64> = values.into_iter().filter(|x| x.is_finite()).collect();
+        if v.is_empty() {
+            return Self { lo: 0.0, hi: 1.0, log: false };
+        }
+        v.sort_by(f64::total_cmp);
+        let at = |q: f64| v[((v.len() - 1) as f64 * q).round() as usize];
+        let (lo, hi) = (at(0.01), at(0.99));
+        let positive = v[0] > 0.0;
+        let log = positive && hi > 10.0 * lo;
+        let (lo, hi) =
+            if hi > lo { (lo, hi) } else { (lo - 0.5 * lo.abs().max(1e-12), hi + 0.5 * hi.abs().max(1e-12)) };
+        Self { lo, hi, log }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ends_and_middle() {
+        assert_eq!(viridis(0.0), [68, 1, 84]);
+        assert_eq!(viridis(1.0), [254, 232, 37]);
+        assert_eq!(viridis(f64::NAN), [68, 1, 84]);
+        assert_eq!(diverging(0.0), [247, 247, 247]);
+        let s = Scale { lo: 1.0, hi: 100.0, log: true };
+        assert!((s.position(10.0) - 0.5).abs() < 1e-12);
+        assert!((s.value(0.5) - 10.0).abs() < 1e-9);
+        let r = Scale::robust((1..=1000).map(f64::from));
+        assert!(r.log && (r.lo - 11.0).abs() < 1.0 && (r.hi - 990.0).abs() < 2.0);
+    }
+}

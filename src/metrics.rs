@@ -1,0 +1,302 @@
+//! Validation metrics of a retrieved product against the truth (Seegers et al. 2018).
+//!
+//! In log space, over pixels where both the retrieval M and the truth O are positive and finite:
+//!
+//! MAE = 10^(mean |log10 M − log10 O|),  bias = 10^(mean (log10 M − log10 O)),
+//!
+//! so MAE = 1.14 reads "typically a factor 1.14 (14 %) off" and bias = 0.9 "10 % low on the
+//! (geometric) average". Alongside: N (pixels compared), the share of pixels the retrieval
+//! returned, linear RMSE, and R² of log10 M against log10 O (the squared Pearson correlation).
+//! Pixels with a non-positive or failed retrieval are excluded and counted (`excluded`), never
+//! turned into NaN; pixels without truth (land, or no bottom in a deep scene) are not candidates.
+//!
+//! ## References
+//! - Seegers, B. N., Stumpf, R. P., Schaeffer, B. A., Loftin, K. A., Werdell, P. J. (2018)
+//!   Performance metrics for the assessment of satellite data products: an ocean color case
+//!   study. Opt. Express 26, 7404–7422.
+
+use serde::Serialize;
+
+use crate::instrument::RadianceCube;
+use crate::retrieval::{Product, ProductFlags};
+
+/// The metrics of one product.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Metrics {
+    /// Pixels compared (both positive and finite).
+    pub n: usize,
+    /// Candidate pixels (with a truth).
+    pub candidates: usize,
+    /// Candidates whose retrieval failed or was not positive (excluded from the statistics).
+    pub excluded: usize,
+    /// Share of candidates returned, %.
+    pub returned_pct: f64,
+    /// 10^mean|log10 M − log10 O| (≥ 1; `mae_pct` = 100·(MAE − 1)).
+    pub mae: f64,
+    /// 10^mean(log10 M − log10 O).
+    pub bias: f64,
+    /// Linear root-mean-square error, product units.
+    pub rmse: f64,
+    /// Coefficient of determination of log10 M against log10 O (squared Pearson correlation).
+    pub r2: f64,
+}
+
+impl Metrics {
+    /// MAE as a percentage: 14 means "a factor 1.14".
+    #[must_use]
+    pub fn mae_pct(&self) -> f64 {
+        100.0 * (self.mae - 1.0)
+    }
+
+    /// Bias as a signed percentage.
+    #[must_use]
+    pub fn bias_pct(&self) -> f64 {
+        100.0 * (self.bias - 1.0)
+    }
+}
+
+/// Metrics of `retrieved` against `truth`; `None` entries of `retrieved` are failed retrievals,
+/// and `None` entries of `truth` are not candidates.
+#[must_use]
+pub fn compare(retrieved: &[Option<f64>], truth: &[Option<f64>]) -> Metrics {
+    let mut n = 0usize;
+    let mut candidates = 0usize;
+    let (mut s_abs, mut s_dif, mut s_sq) = (0.0, 0.0, 0.0);
+    let (mut sx, mut sy, mut sxx, mut syy, mut sxy) = (0.0, 0.0, 0.0, 0.0, 0.0);
+    for (m, o) in retrieved.iter().zip(truth) {
+        let Some(o) = o.filter(|o| o.is_finite() && *o > 0.0) else { continue };
+        candidates += 1;
+        let Some(m) = m.filter(|m| m.is_finite() && *m > 0.0) else { continue };
+        n += 1;
+        let (lm, lo) = (m.log10(), o.log10());
+        s_abs += (lm - lo).abs();
+        s_dif += lm - lo;
+        s_sq += (m - o) * (m - o);
+        sx += lo;
+        sy += lm;
+        sxx += lo * lo;
+        syy += lm * lm;
+        sxy += lo * lm;
+    }
+    let nf = n as f64;
+    let r2 = if n > 1 {
+        let cov = sxy - sx * sy / nf;
+        let (vx, vy) = (sxx - sx * sx / nf, syy - sy * sy / nf);
+        if vx > 0.0 && vy > 0.0 { (cov * cov / (vx * vy)).clamp(0.0, 1.0) } else { 0.0 }
+    } else {
+        0.0
+    };
+    Metrics {
+        n,
+        candidates,
+        excluded: candidates - n,
+        returned_pct: if candidates > 0 { 100.0 * nf / candidates as f64 } else { 0.0 },
+        mae: if n > 0 { 10f64.powf(s_abs / nf) } else { 1.0 },
+        bias: if n > 0 { 10f64.powf(s_dif / nf) } else { 1.0 },
+        rmse: if n > 0 { (s_sq / nf).sqrt() } else { 0.0 },
+        r2,
+    }
+}
+
+/// A histogram over fixed bins (log10 or linear edges).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Histogram {
+    /// Bin edges (one more than the counts).
+    pub edges: Vec<f64>,
+    /// Counts per bin (values outside the edges are not counted).
+    pub counts: Vec<usize>,
+}
+
+/// `bins` logarithmically spaced edges spanning `lo`–`hi` (both > 0).
+#[must_use]
+pub fn log_edges(lo: f64, hi: f64, bins: usize) -> Vec<f64> {
+    let (a, b) = (lo.max(f64::MIN_POSITIVE).log10(), hi.max(lo * 1.0001).log10());
+    (0..=bins).map(|i| 10f64.powf(a + (b - a) * i as f64 / bins.max(1) as f64)).collect()
+}
+
+/// Bin index of `v` among `edges` (increasing), if inside.
+#[must_use]
+pub fn bin_of(edges: &[f64], v: f64) -> Option<usize> {
+    if !(v.is_finite() && v >= edges[0] && v <= edges[edges.len() - 1]) {
+        return None;
+    }
+    Some(edges.partition_point(|&e| e <= v).saturating_sub(1).min(edges.len() - 2))
+}
+
+/// Histogram of the finite values of `values` over `edges`.
+#[must_use]
+pub fn histogram(values: impl IntoIterator<Item = f64>, edges: &[f64]) -> Histogram {
+    let mut counts = vec![0; edges.len().saturating_sub(1)];
+    for v in values {
+        if let Some(b) = bin_of(edges, v) {
+            counts[b] += 1;
+        }
+    }
+    Histogram { edges: edges.to_vec(), counts }
+}
+
+/// 2-D histogram (truth on x, retrieval on y) over the same edges on both axes: `counts[y][x]`.
+#[must_use]
+pub fn histogram_2d(pairs: impl IntoIterator<Item = (f64, f64)>, edges: &[f64]) -> Vec<Vec<usize>> {
+    let n = edges.len().saturating_sub(1);
+    let mut counts = vec![vec![0; n]; n];
+    for (x, y) in pairs {
+        if let (Some(i), Some(j)) = (bin_of(edges, x), bin_of(edges, y)) {
+            counts[j][i] += 1;
+        }
+    }
+    counts
+}
+
+/// The metrics of one variable of a product.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct VariableMetrics {
+    /// Variable name with its unit (`chl_mg_m3`).
+    pub variable: String,
+    /// The metrics.
+    pub metrics: Metrics,
+}
+
+/// Everything a study reports about one product.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ProductMetrics {
+    /// Product name (aLMI, SAMBUCA).
+    pub product: String,
+    /// Per variable.
+    pub variables: Vec<VariableMetrics>,
+    /// SAMBUCA: % of returned shallow pixels whose dominant substrate is the true dominant one.
+    pub substrate_agreement_pct: Option<f64>,
+    /// aLMI: how many pixels chose each SIOP set.
+    pub siop_set_counts: Vec<usize>,
+    /// aLMI: how many distinct SIOP sets were chosen.
+    pub siop_sets_used: usize,
+    /// Water pixels the retrieval did not return (failed).
+    pub failed: usize,
+}
+
+impl ProductMetrics {
+    /// Metrics of `variable`, if the product has it.
+    #[must_use]
+    pub fn get(&self, variable: &str) -> Option<&Metrics> {
+        self.variables.iter().find(|v| v.variable == variable).map(|v| &v.metrics)
+    }
+}
+
+/// Score `product` against the `truth` under the same pixels.
+#[must_use]
+pub fn evaluate(product: &Product, truth: &RadianceCube) -> ProductMetrics {
+    let (rows, cols) = product.flags.dim();
+    let water: Vec<(usize, usize)> =
+        (0..rows).flat_map(|r| (0..cols).map(move |c| (r, c))).filter(|&(r, c)| truth.land[[r, c]] == 0).collect();
+    let got = |map: &ndarray::Array2<f32>, keep: &dyn Fn(usize, usize) -> bool| -> Vec<Option<f64>> {
+        water
+            .iter()
+            .filter(|&&(r, c)| keep(r, c))
+            .map(|&(r, c)| product.returned(r, c).then(|| f64::from(map[[r, c]])))
+            .collect()
+    };
+    let want = |map: &ndarray::Array2<f32>, keep: &dyn Fn(usize, usize) -> bool| -> Vec<Option<f64>> {
+        water.iter().filter(|&&(r, c)| keep(r, c)).map(|&(r, c)| Some(f64::from(map[[r, c]]))).collect()
+    };
+    let all = |_: usize, _: usize| true;
+    let mut variables = vec![
+        VariableMetrics {
+            variable: "chl_mg_m3".into(),
+            metrics: compare(&got(&product.chl_mg_m3, &all), &want(&truth.chl_mg_m3, &all)),
+        },
+        VariableMetrics {
+            variable: "nap_g_m3".into(),
+            metrics: compare(&got(&product.nap_g_m3, &all), &want(&truth.nap_g_m3, &all)),
+        },
+        VariableMetrics {
+            variable: "cdom_per_m".into(),
+            metrics: compare(&got(&product.cdom_per_m, &all), &want(&truth.cdom_per_m, &all)),
+        },
+    ];
+    let mut substrate_agreement_pct = None;
+    if let (Some(depth), Some(true_depth)) = (&product.depth_m, &truth.depth_m) {
+        variables.push(VariableMetrics {
+            variable: "depth_m".into(),
+            metrics: compare(&got(depth, &all), &want(true_depth, &all)),
+        });
+        let visible = |r: usize, c: usize| product.flags[[r, c]] & ProductFlags::BOTTOM_VISIBLE != 0;
+        variables.push(VariableMetrics {
+            variable: "depth_m_bottom_visible".into(),
+            metrics: compare(&got(depth, &visible), &want(true_depth, &visible)),
+        });
+        if let (Some(f), Some(tf)) = (&product.substrate_fractions, &truth.substrate_fractions) {
+            let dominant = |a: &ndarray::Array3<f32>, r: usize, c: usize, names: usize| -> usize {
+                (0..names).max_by(|&i, &j| a[[r, c, i]].total_cmp(&a[[r, c, j]])).unwrap_or(0)
+            };
+            let n = product.substrate_names.len().min(f.dim().2).min(tf.dim().2);
+            let returned: Vec<&(usize, usize)> = water.iter().filter(|&&(r, c)| product.returned(r, c)).collect();
+            if n > 0 && !returned.is_empty() {
+                let agree = returned.iter().filter(|&&&(r, c)| dominant(f, r, c, n) == dominant(tf, r, c, n)).count();
+                substrate_agreement_pct = Some(100.0 * agree as f64 / returned.len() as f64);
+            }
+        }
+    }
+    let mut siop_set_counts = vec![0; product.siop_set_names.len()];
+    if let Some(sets) = &product.siop_set {
+        for &(r, c) in &water {
+            if let Ok(i) = usize::try_from(sets[[r, c]])
+                && product.returned(r, c)
+                && i < siop_set_counts.len()
+            {
+                siop_set_counts[i] += 1;
+            }
+        }
+    }
+    ProductMetrics {
+        product: product.name.clone(),
+        variables,
+        substrate_agreement_pct,
+        siop_sets_used: siop_set_counts.iter().filter(|&&n| n > 0).count(),
+        siop_set_counts,
+        failed: water.iter().filter(|&&(r, c)| product.flags[[r, c]] & ProductFlags::FAILED != 0).count(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_constant_factor_gives_mae_and_bias_of_that_factor() {
+        let truth: Vec<Option<f64>> = (1..=100).map(|i| Some(f64::from(i))).collect();
+        let high: Vec<Option<f64>> = truth.iter().map(|t| t.map(|v| 1.2 * v)).collect();
+        let m = compare(&high, &truth);
+        assert!((m.mae - 1.2).abs() < 1e-12 && (m.bias - 1.2).abs() < 1e-12);
+        assert!((m.mae_pct() - 20.0).abs() < 1e-9);
+        assert!((m.r2 - 1.0).abs() < 1e-12);
+        // Half high, half low by the same factor: MAE 1.2, bias 1.
+        let mixed: Vec<Option<f64>> =
+            truth.iter().enumerate().map(|(i, t)| t.map(|v| if i % 2 == 0 { 1.2 * v } else { v / 1.2 })).collect();
+        let m = compare(&mixed, &truth);
+        assert!((m.mae - 1.2).abs() < 1e-12 && (m.bias - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn failed_and_non_positive_retrievals_are_excluded_and_counted() {
+        let truth = vec![Some(1.0), Some(2.0), Some(3.0), None, Some(4.0)];
+        let got = vec![Some(1.0), None, Some(-1.0), Some(5.0), Some(f64::NAN)];
+        let m = compare(&got, &truth);
+        assert_eq!((m.n, m.candidates, m.excluded), (1, 4, 3));
+        assert!((m.returned_pct - 25.0).abs() < 1e-12);
+        assert!(m.mae.is_finite() && m.rmse.is_finite() && m.r2.is_finite());
+        // Nothing returned: finite numbers, zero returned.
+        let m = compare(&[None, None], &[Some(1.0), Some(2.0)]);
+        assert_eq!(m.n, 0);
+        assert!(m.mae.is_finite() && m.bias.is_finite());
+    }
+
+    #[test]
+    fn histograms_bin_inclusively() {
+        let e = log_edges(1.0, 100.0, 2);
+        assert!((e[1] - 10.0).abs() < 1e-9);
+        let h = histogram([1.0, 5.0, 10.0, 99.0, 100.0, 1000.0, f64::NAN], &e);
+        assert_eq!(h.counts, vec![2, 3]);
+        let h2 = histogram_2d([(2.0, 50.0), (50.0, 50.0)], &e);
+        assert_eq!(h2, vec![vec![0, 0], vec![1, 1]]);
+    }
+}

@@ -1,0 +1,49 @@
+//! Retrievals: from band Rrs back to chlorophyll-a, CDOM, NAP, depth and bottom type.
+//!
+//! | part | module | what it does |
+//! |---|---|---|
+//! | band forward model | [`band_model`] | the Lee/SAMBUCA model at the instrument's bands, with its Jacobian |
+//! | Gauss rules | [`quadrature`] | K nodes per band that integrate its response |
+//! | aLMI | [`almi`] | linear matrix inversion over SIOP sets (Brando et al. 2012), non-negative |
+//! | SAMBUCA | [`sambuca`] | bounded nonlinear least squares over depth and substrate pairs (Brando et al. 2009) |
+//! | solvers | [`nnls`], [`optimise`] | exact small NNLS; bounded Levenberg–Marquardt and BFGS |
+//! | images | [`run`] | a retrieval over a whole Rrs cube, the products and their flags |
+
+pub mod almi;
+pub mod band_model;
+pub mod nnls;
+pub mod optimise;
+pub mod quadrature;
+pub mod run;
+pub mod sambuca;
+pub mod sets;
+
+pub use almi::{AlmiFlags, AlmiSettings};
+pub use band_model::{BandModel, BandResponse, ModelScratch, Parameters};
+pub use run::{Product, ProductFlags, RetrievalInputs, RetrievalSpec, retrieve};
+pub use sambuca::{Objective, SambucaSettings, Starts};
+
+use crate::spectral::SpectralError;
+use crate::water::WaterError;
+
+/// Errors from the retrievals; each names the field.
+#[derive(Debug, thiserror::Error, Clone, PartialEq)]
+pub enum RetrievalError {
+    /// A setting with an invalid value.
+    #[error("{field}: {message}")]
+    Invalid {
+        /// The field.
+        field: String,
+        /// What is wrong and what is allowed.
+        message: String,
+    },
+    /// From the water stage (SIOP sets, substrates).
+    #[error(transparent)]
+    Water(#[from] WaterError),
+    /// From the spectral layer.
+    #[error(transparent)]
+    Spectral(#[from] SpectralError),
+    /// The run was cancelled.
+    #[error("cancelled")]
+    Cancelled,
+}

@@ -1,0 +1,436 @@
+//! A retrieval over a whole Rrs image: the products, per-pixel flags, and what it was given.
+
+use std::path::{Path, PathBuf};
+
+use ndarray::{Array2, Array3};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use super::RetrievalError;
+use super::almi::{AlmiFlags, AlmiSet, AlmiSettings, invert as almi_invert};
+use super::band_model::{BandModel, BandResponse};
+use super::sambuca::{Observation, SambucaSettings, invert as sambuca_invert};
+use super::sets::default_almi_sets;
+use crate::control::RunControl;
+use crate::correction::RrsFlags;
+use crate::instrument::BandAtmosphere;
+use crate::instrument::Response;
+use crate::water::{SiopSource, SiopSpec, SubstrateLibrary, WaterGeometry};
+
+/// Which retrieval, with its settings, as a study file writes it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum RetrievalSpec {
+    /// aLMI over a list of SIOP sets (default: the eight built-in sets).
+    Almi {
+        /// The SIOP sets to choose from.
+        #[serde(default = "default_almi_sets")]
+        siop_sets: Vec<SiopSource>,
+        /// Settings.
+        #[serde(default)]
+        settings: AlmiSettings,
+    },
+    /// SAMBUCA-style inversion with one SIOP set and a substrate library.
+    Sambuca {
+        /// SIOP set (default: the scene's).
+        #[serde(default)]
+        siop: Option<SiopSource>,
+        /// Substrates to unmix, in pairs (default: the scene's).
+        #[serde(default)]
+        substrates: Option<Vec<String>>,
+        /// Settings.
+        #[serde(default)]
+        settings: SambucaSettings,
+    },
+}
+
+impl RetrievalSpec {
+    /// Short name for reports and file names.
+    #[must_use]
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Almi { .. } => "alm",
+            Self::Sambuca { .. } => "sambuca",
+        }
+    }
+}
+
+/// Per-pixel flags of a product.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ProductFlags;
+
+impl ProductFlags {
+    /// A value was returned.
+    pub const RETURNED: u8 = 1;
+    /// aLMI: the unconstrained solution was non-negative.
+    pub const PHYSICAL: u8 = 2;
+    /// A constituent sits on a bound.
+    pub const AT_BOUND: u8 = 4;
+    /// The optimiser converged.
+    pub const CONVERGED: u8 = 8;
+    /// SAMBUCA: the bottom is detectable (SDI ≥ 1).
+    pub const BOTTOM_VISIBLE: u8 = 16;
+    /// No solution (too few valid bands, or none fitted).
+    pub const FAILED: u8 = 32;
+    /// Land: not retrieved.
+    pub const LAND: u8 = 64;
+}
+
+/// A retrieval's products over the image.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Product {
+    /// "aLMI" or "SAMBUCA".
+    pub name: String,
+    /// Chlorophyll-a, mg m⁻³ (0 where not returned).
+    pub chl_mg_m3: Array2<f32>,
+    /// CDOM absorption at the reference wavelength, m⁻¹.
+    pub cdom_per_m: Array2<f32>,
+    /// NAP, g m⁻³.
+    pub nap_g_m3: Array2<f32>,
+    /// Depth, m (SAMBUCA).
+    pub depth_m: Option<Array2<f32>>,
+    /// Substrate names of `substrate_fractions`.
+    pub substrate_names: Vec<String>,
+    /// Fraction of each substrate (SAMBUCA), (row, column, substrate).
+    pub substrate_fractions: Option<Array3<f32>>,
+    /// Names of the SIOP sets (aLMI).
+    pub siop_set_names: Vec<String>,
+    /// Index of the chosen SIOP set (aLMI), −1 where none.
+    pub siop_set: Option<Array2<i16>>,
+    /// Cost (aLMI) or objective (SAMBUCA) at the solution.
+    pub cost: Array2<f32>,
+    /// Substrate detectability index (SAMBUCA).
+    pub sdi: Option<Array2<f32>>,
+    /// Iterations (SAMBUCA).
+    pub iterations: Option<Array2<u16>>,
+    /// [`ProductFlags`].
+    pub flags: Array2<u8>,
+}
+
+impl Product {
+    /// Did the retrieval return a value at (row, column)?
+    #[must_use]
+    pub fn returned(&self, r: usize, c: usize) -> bool {
+        self.flags[[r, c]] & ProductFlags::RETURNED != 0
+    }
+}
+
+/// Everything a retrieval reads besides its own settings.
+#[derive(Debug, Clone)]
+pub struct RetrievalInputs<'a> {
+    /// Rrs, (row, column, band).
+    pub rrs: &'a Array3<f32>,
+    /// Rrs flags.
+    pub flags: &'a Array3<u8>,
+    /// Land mask.
+    pub land: &'a Array2<u8>,
+    /// The bands' responses (what a band Rrs averages over).
+    pub bands: Vec<BandResponse>,
+    /// Per column: sun and view zenith at the ground.
+    pub geometry: Vec<WaterGeometry>,
+    /// Noise-equivalent ΔRrs per band, sr⁻¹.
+    pub nedr: Vec<f64>,
+    /// The scene's SIOP set and the directory its CSV paths are relative to.
+    pub scene_siop: (SiopSpec, Option<PathBuf>),
+    /// The scene's substrates.
+    pub scene_substrates: Vec<String>,
+    /// Directory relative paths in the retrieval's own settings are taken from.
+    pub base_dir: Option<&'a Path>,
+}
+
+/// The bands' responses as the chain's truth weights them (photon weights × T_up·Ed) at output
+/// column `column` of `atmosphere`.
+#[must_use]
+pub fn band_responses(response: &Response, atmosphere: &BandAtmosphere, column: usize) -> Vec<BandResponse> {
+    let mut out: Vec<Option<BandResponse>> = vec![None; response.n_bands()];
+    for (gi, group) in response.groups.iter().enumerate() {
+        for (k, &b) in group.bands.iter().enumerate() {
+            let (first, w) = &atmosphere.truth_weights[gi][column][k];
+            out[b] = Some(BandResponse {
+                name: response.bands.bands[b].name.clone(),
+                wavelengths_nm: (0..w.len()).map(|i| group.grid.wavelength_nm(first + i)).collect(),
+                weights: w.clone(),
+            });
+        }
+    }
+    out.into_iter().flatten().collect()
+}
+
+/// Default aLMI bands: centroids 400–780 nm outside the O₂ A band (759–771 nm).
+fn default_almi_bands(bands: &[BandResponse]) -> Vec<usize> {
+    (0..bands.len())
+        .filter(|&b| {
+            let c = bands[b].centroid_nm();
+            (400.0..=780.0).contains(&c) && !(759.0..=771.0).contains(&c)
+        })
+        .collect()
+}
+
+/// Run `spec` over the image.
+pub fn retrieve(
+    spec: &RetrievalSpec,
+    inputs: &RetrievalInputs<'_>,
+    control: &RunControl,
+) -> Result<Product, RetrievalError> {
+    match spec {
+        RetrievalSpec::Almi { siop_sets, settings } => retrieve_almi(siop_sets, settings, inputs, control),
+        RetrievalSpec::Sambuca { siop, substrates, settings } => {
+            retrieve_sambuca(siop.as_ref(), substrates.as_deref(), settings, inputs, control)
+        }
+    }
+}
+
+/// One aLMI pixel as stored: (chl, cdom, nap, set, cost, flags).
+type AlmiRow = (f32, f32, f32, i16, f32, u8);
+
+fn retrieve_almi(
+    sources: &[SiopSource],
+    settings: &AlmiSettings,
+    inputs: &RetrievalInputs<'_>,
+    control: &RunControl,
+) -> Result<Product, RetrievalError> {
+    if sources.is_empty() || sources.len() > 64 {
+        return Err(RetrievalError::Invalid {
+            field: "siop_sets".into(),
+            message: format!("{} sets (allowed: 1 to 64)", sources.len()),
+        });
+    }
+    let used: Vec<usize> = match &settings.bands {
+        None => default_almi_bands(&inputs.bands),
+        Some(names) => names
+            .iter()
+            .map(|n| {
+                inputs.bands.iter().position(|b| &b.name == n).ok_or_else(|| RetrievalError::Invalid {
+                    field: "settings.bands".into(),
+                    message: format!(
+                        "no band `{n}` (this instrument has {})",
+                        inputs.bands.iter().map(|b| b.name.as_str()).collect::<Vec<_>>().join(", ")
+                    ),
+                })
+            })
+            .collect::<Result<_, _>>()?,
+    };
+    if used.len() < 3 || used.len() > super::almi::MAX_BANDS {
+        return Err(RetrievalError::Invalid {
+            field: "settings.bands".into(),
+            message: format!("{} bands (aLMI takes 3 to {})", used.len(), super::almi::MAX_BANDS),
+        });
+    }
+    let bands: Vec<BandResponse> = used.iter().map(|&b| inputs.bands[b].clone()).collect();
+    let library = SubstrateLibrary::embedded()?;
+    let sets = sources
+        .iter()
+        .map(|src| {
+            let (spec, dir) = src.load(inputs.base_dir)?;
+            let model = BandModel::new(&spec, dir.as_deref(), &library, &[], &bands, 4)?;
+            Ok(AlmiSet { name: spec.name.clone(), iops: model.band_iops() })
+        })
+        .collect::<Result<Vec<_>, RetrievalError>>()?;
+    let (rows, cols, nb) = inputs.rrs.dim();
+    let results: Vec<Vec<AlmiRow>> = (0..rows)
+        .into_par_iter()
+        .map(|r| {
+            if control.cancelled() {
+                return Err(RetrievalError::Cancelled);
+            }
+            let mut obs = vec![0.0; used.len()];
+            let mut valid = vec![false; used.len()];
+            let nedr: Vec<f64> = used.iter().map(|&b| inputs.nedr[b]).collect();
+            let row = (0..cols)
+                .map(|c| {
+                    if inputs.land[[r, c]] != 0 {
+                        return (0.0, 0.0, 0.0, -1, 0.0, ProductFlags::LAND);
+                    }
+                    for (k, &b) in used.iter().enumerate() {
+                        debug_assert!(b < nb);
+                        obs[k] = f64::from(inputs.rrs[[r, c, b]]);
+                        valid[k] = inputs.flags[[r, c, b]] & (RrsFlags::INVALID | RrsFlags::SATURATED) == 0;
+                    }
+                    let p = almi_invert(&sets, settings, &obs, &valid, &nedr);
+                    if p.flags & AlmiFlags::FAILED != 0 || p.set.is_none() {
+                        return (0.0, 0.0, 0.0, -1, 0.0, ProductFlags::FAILED);
+                    }
+                    let mut flags = ProductFlags::RETURNED;
+                    if p.flags & AlmiFlags::PHYSICAL != 0 {
+                        flags |= ProductFlags::PHYSICAL;
+                    }
+                    if p.flags & AlmiFlags::AT_BOUND != 0 {
+                        flags |= ProductFlags::AT_BOUND;
+                    }
+                    (p.chl as f32, p.cdom as f32, p.nap as f32, p.set.map_or(-1, i16::from), p.cost as f32, flags)
+                })
+                .collect();
+            control.tick(1);
+            Ok(row)
+        })
+        .collect::<Result<_, RetrievalError>>()?;
+    let plane = |k: fn(&AlmiRow) -> f32| Array2::from_shape_fn((rows, cols), |(r, c)| k(&results[r][c]));
+    Ok(Product {
+        name: "aLMI".into(),
+        chl_mg_m3: plane(|p| p.0),
+        cdom_per_m: plane(|p| p.1),
+        nap_g_m3: plane(|p| p.2),
+        depth_m: None,
+        substrate_names: Vec::new(),
+        substrate_fractions: None,
+        siop_set_names: sets.iter().map(|s| s.name.clone()).collect(),
+        siop_set: Some(Array2::from_shape_fn((rows, cols), |(r, c)| results[r][c].3)),
+        cost: plane(|p| p.4),
+        sdi: None,
+        iterations: None,
+        flags: Array2::from_shape_fn((rows, cols), |(r, c)| results[r][c].5),
+    })
+}
+
+/// One SAMBUCA pixel as stored: (chl, cdom, nap, depth, q, pair, objective, sdi, iterations, flags).
+type SambucaRow = (f32, f32, f32, f32, f32, (u8, u8), f32, f32, u16, u8);
+
+/// Check SAMBUCA's bounds and quadrature setting; the message names the field.
+fn validate_sambuca(settings: &SambucaSettings) -> Result<(), RetrievalError> {
+    let b = &settings.bounds;
+    for (field, (lo, hi)) in
+        [("chl_mg_m3", b.chl_mg_m3), ("cdom_per_m", b.cdom_per_m), ("nap_g_m3", b.nap_g_m3), ("depth_m", b.depth_m)]
+    {
+        if !(lo.is_finite() && hi.is_finite() && lo > 0.0 && hi > lo) {
+            return Err(RetrievalError::Invalid {
+                field: format!("settings.bounds.{field}"),
+                message: format!("({lo}, {hi}): bounds must be finite with 0 < min < max"),
+            });
+        }
+    }
+    if !(1..=8).contains(&settings.nodes_per_band) {
+        return Err(RetrievalError::Invalid {
+            field: "settings.nodes_per_band".into(),
+            message: format!("{} is out of range (allowed: 1 to 8)", settings.nodes_per_band),
+        });
+    }
+    if !(1..=10_000).contains(&settings.max_iterations) {
+        return Err(RetrievalError::Invalid {
+            field: "settings.max_iterations".into(),
+            message: format!("{} is out of range (allowed: 1 to 10000)", settings.max_iterations),
+        });
+    }
+    Ok(())
+}
+
+/// Per-substrate fractions from each pixel's pair and fraction.
+fn substrate_fractions(results: &[Vec<SambucaRow>], n_sub: usize) -> Array3<f32> {
+    let (rows, cols) = (results.len(), results.first().map_or(0, Vec::len));
+    let mut fractions = Array3::<f32>::zeros((rows, cols, n_sub));
+    for r in 0..rows {
+        for c in 0..cols {
+            let p = &results[r][c];
+            if p.9 & ProductFlags::RETURNED == 0 {
+                continue;
+            }
+            let (i, j) = (usize::from(p.5.0), usize::from(p.5.1));
+            if i < n_sub {
+                fractions[[r, c, i]] = if j < n_sub { p.4 } else { 1.0 };
+            }
+            if j < n_sub {
+                fractions[[r, c, j]] = 1.0 - p.4;
+            }
+        }
+    }
+    fractions
+}
+
+fn retrieve_sambuca(
+    siop: Option<&SiopSource>,
+    substrates: Option<&[String]>,
+    settings: &SambucaSettings,
+    inputs: &RetrievalInputs<'_>,
+    control: &RunControl,
+) -> Result<Product, RetrievalError> {
+    let (spec, dir) = match siop {
+        Some(src) => src.load(inputs.base_dir)?,
+        None => inputs.scene_siop.clone(),
+    };
+    let names: Vec<String> = substrates.map_or_else(|| inputs.scene_substrates.clone(), <[String]>::to_vec);
+    if names.is_empty() {
+        return Err(RetrievalError::Invalid {
+            field: "substrates".into(),
+            message: "SAMBUCA needs at least one substrate".into(),
+        });
+    }
+    validate_sambuca(settings)?;
+    let b = &settings.bounds;
+    let library = SubstrateLibrary::embedded()?;
+    let model = BandModel::new(&spec, dir.as_deref(), &library, &names, &inputs.bands, settings.nodes_per_band)?;
+    let (rows, cols, nb) = inputs.rrs.dim();
+    let inv_cos: Vec<(f64, f64)> =
+        inputs.geometry.iter().map(|g| g.inverse_cosines_in_water(model.refractive_index)).collect();
+    let results: Vec<Vec<SambucaRow>> = (0..rows)
+        .into_par_iter()
+        .map(|r| {
+            if control.cancelled() {
+                return Err(RetrievalError::Cancelled);
+            }
+            let mut obs = vec![0.0; nb];
+            let mut valid = vec![false; nb];
+            let row = (0..cols)
+                .map(|c| {
+                    let failed = (0.0, 0.0, 0.0, 0.0, 0.0, (0, 0), 0.0, 0.0, 0, ProductFlags::FAILED);
+                    if inputs.land[[r, c]] != 0 {
+                        return (0.0, 0.0, 0.0, 0.0, 0.0, (0, 0), 0.0, 0.0, 0, ProductFlags::LAND);
+                    }
+                    for k in 0..nb {
+                        obs[k] = f64::from(inputs.rrs[[r, c, k]]);
+                        valid[k] = inputs.flags[[r, c, k]] & (RrsFlags::INVALID | RrsFlags::SATURATED) == 0;
+                    }
+                    let o = Observation { rrs: &obs, valid: &valid, nedr: &inputs.nedr, inv_cos: inv_cos[c] };
+                    let p = sambuca_invert(&model, settings, &o);
+                    if !p.ok {
+                        return failed;
+                    }
+                    let mut flags = ProductFlags::RETURNED;
+                    if p.converged {
+                        flags |= ProductFlags::CONVERGED;
+                    }
+                    if p.sdi >= 1.0 {
+                        flags |= ProductFlags::BOTTOM_VISIBLE;
+                    }
+                    let near = |v: f64, (lo, hi): (f64, f64)| v <= lo * (1.0 + 1e-9) || v >= hi * (1.0 - 1e-9);
+                    if near(p.chl, b.chl_mg_m3)
+                        || near(p.cdom, b.cdom_per_m)
+                        || near(p.nap, b.nap_g_m3)
+                        || near(p.depth_m, b.depth_m)
+                    {
+                        flags |= ProductFlags::AT_BOUND;
+                    }
+                    (
+                        p.chl as f32,
+                        p.cdom as f32,
+                        p.nap as f32,
+                        p.depth_m as f32,
+                        p.fraction as f32,
+                        p.pair,
+                        p.objective as f32,
+                        p.sdi as f32,
+                        u16::try_from(p.iterations).unwrap_or(u16::MAX),
+                        flags,
+                    )
+                })
+                .collect();
+            control.tick(1);
+            Ok(row)
+        })
+        .collect::<Result<_, RetrievalError>>()?;
+    let fractions = substrate_fractions(&results, names.len());
+    let plane = |k: fn(&SambucaRow) -> f32| Array2::from_shape_fn((rows, cols), |(r, c)| k(&results[r][c]));
+    Ok(Product {
+        name: "SAMBUCA".into(),
+        chl_mg_m3: plane(|p| p.0),
+        cdom_per_m: plane(|p| p.1),
+        nap_g_m3: plane(|p| p.2),
+        depth_m: Some(plane(|p| p.3)),
+        substrate_names: names,
+        substrate_fractions: Some(fractions),
+        siop_set_names: vec![spec.name.clone()],
+        siop_set: None,
+        cost: plane(|p| p.6),
+        sdi: Some(plane(|p| p.7)),
+        iterations: Some(Array2::from_shape_fn((rows, cols), |(r, c)| results[r][c].8)),
+        flags: Array2::from_shape_fn((rows, cols), |(r, c)| results[r][c].9),
+    })
+}

@@ -1,0 +1,653 @@
+//! Study figures, each as PNG and SVG: truth and retrieved maps side by side with one shared
+//! colour scale and a colour bar; truth-vs-retrieved density scatter plots; and histograms of the
+//! retrieved values stacked by the chosen SIOP set (aLMI) or dominant substrate (SAMBUCA), with
+//! the truth's histogram outlined — as in Figures 4–7 of Matthews et al. (2023).
+//!
+//! Drawing uses plotters with fonts from the embedded DejaVu Sans (no system fonts). Map rasters
+//! are painted into the PNG directly and embedded in the SVG as PNG images, so the SVG stays small
+//! and its text and axes stay vector.
+
+use std::sync::OnceLock;
+
+use ndarray::Array2;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::{StudyError, StudyResult, StudyRun};
+use crate::colormap::{Scale, categorical, viridis};
+use crate::metrics::{Metrics, bin_of, histogram_2d, log_edges};
+use crate::retrieval::ProductFlags;
+
+/// One figure in both formats.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Figure {
+    /// File stem.
+    pub name: String,
+    /// PNG bytes.
+    pub png: Vec<u8>,
+    /// SVG text.
+    pub svg: String,
+}
+
+const FONT_BYTES: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
+const FONT: &str = "sans-serif";
+
+fn fonts() -> Result<(), StudyError> {
+    static REGISTERED: OnceLock<bool> = OnceLock::new();
+    let ok = *REGISTERED.get_or_init(|| plotters::style::register_font(FONT, FontStyle::Normal, FONT_BYTES).is_ok());
+    if ok { Ok(()) } else { Err(StudyError::Io("the embedded font does not load".into())) }
+}
+
+/// A raster placed on the figure (painted into the PNG, embedded in the SVG).
+struct Placed {
+    x: i32,
+    y: i32,
+    w: u32,
+    h: u32,
+    rgb: Vec<u8>,
+}
+
+trait Draw {
+    fn size(&self) -> (u32, u32);
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<Vec<Placed>, String>;
+}
+
+fn err<E: std::fmt::Debug>(e: E) -> String {
+    format!("{e:?}")
+}
+
+fn base64(bytes: &[u8]) -> String {
+    const T: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut s = String::with_capacity(bytes.len().div_ceil(3) * 4);
+    for chunk in bytes.chunks(3) {
+        let b = [chunk[0], *chunk.get(1).unwrap_or(&0), *chunk.get(2).unwrap_or(&0)];
+        let n = (u32::from(b[0]) << 16) | (u32::from(b[1]) << 8) | u32::from(b[2]);
+        for i in 0..4 {
+            if i <= chunk.len() {
+                s.push(T[((n >> (18 - 6 * i)) & 63) as usize] as char);
+            } else {
+                s.push('=');
+            }
+        }
+    }
+    s
+}
+
+fn png(rgb: &[u8], w: u32, h: u32) -> Result<Vec<u8>, StudyError> {
+    use image::ImageEncoder;
+    let mut out = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut out)
+        .write_image(rgb, w, h, image::ExtendedColorType::Rgb8)
+        .map_err(|e| StudyError::Io(format!("PNG: {e}")))?;
+    Ok(out)
+}
+
+fn render(name: &str, fig: &impl Draw) -> Result<Figure, StudyError> {
+    fonts()?;
+    let (w, h) = fig.size();
+    let fail = |e: String| StudyError::Io(format!("figure {name}: {e}"));
+    let mut buf = vec![255u8; (w * h * 3) as usize];
+    let placed = {
+        let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
+        let placed = fig.draw(&root).map_err(fail)?;
+        root.present().map_err(|e| fail(err(e)))?;
+        placed
+    };
+    for p in &placed {
+        for row in 0..p.h {
+            for col in 0..p.w {
+                let (x, y) = (p.x + col as i32, p.y + row as i32);
+                if x >= 0 && y >= 0 && (x as u32) < w && (y as u32) < h {
+                    let dst = ((y as u32 * w + x as u32) * 3) as usize;
+                    let src = ((row * p.w + col) * 3) as usize;
+                    buf[dst..dst + 3].copy_from_slice(&p.rgb[src..src + 3]);
+                }
+            }
+        }
+    }
+    let png_bytes = png(&buf, w, h)?;
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (w, h)).into_drawing_area();
+        fig.draw(&root).map_err(fail)?;
+        root.present().map_err(|e| fail(err(e)))?;
+    }
+    let mut images = String::new();
+    for p in &placed {
+        let data = base64(&png(&p.rgb, p.w, p.h)?);
+        images.push_str(&format!(
+            "<image x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" style=\"image-rendering:pixelated\" href=\"data:image/png;base64,{data}\"/>\n",
+            p.x, p.y, p.w, p.h
+        ));
+    }
+    if let Some(end) = svg.rfind("</svg>") {
+        svg.insert_str(end, &images);
+    }
+    Ok(Figure { name: name.to_string(), png: png_bytes, svg })
+}
+
+/// A variable of a product, with how to read it from truth and retrieval.
+#[derive(Clone, Copy)]
+struct Variable {
+    key: &'static str,
+    label: &'static str,
+}
+
+const VARIABLES: [Variable; 4] = [
+    Variable { key: "chl_mg_m3", label: "chl-a (mg m⁻³)" },
+    Variable { key: "nap_g_m3", label: "NAP (g m⁻³)" },
+    Variable { key: "cdom_per_m", label: "a_CDOM(440) (m⁻¹)" },
+    Variable { key: "depth_m", label: "depth (m)" },
+];
+
+fn truth_map<'a>(run: &'a StudyRun, key: &str) -> Option<&'a Array2<f32>> {
+    match key {
+        "chl_mg_m3" => Some(&run.truth.chl_mg_m3),
+        "nap_g_m3" => Some(&run.truth.nap_g_m3),
+        "cdom_per_m" => Some(&run.truth.cdom_per_m),
+        "depth_m" => run.truth.depth_m.as_ref(),
+        _ => None,
+    }
+}
+
+fn product_map<'a>(p: &'a crate::retrieval::Product, key: &str) -> Option<&'a Array2<f32>> {
+    match key {
+        "chl_mg_m3" => Some(&p.chl_mg_m3),
+        "nap_g_m3" => Some(&p.nap_g_m3),
+        "cdom_per_m" => Some(&p.cdom_per_m),
+        "depth_m" => p.depth_m.as_ref(),
+        _ => None,
+    }
+}
+
+/// A map panel: values with a validity mask.
+struct Panel {
+    title: String,
+    values: Array2<f32>,
+    valid: Array2<bool>,
+}
+
+struct Maps {
+    title: String,
+    label: String,
+    scale: Scale,
+    panels: Vec<Panel>,
+}
+
+const PANEL_W: u32 = 300;
+const PANEL_H: u32 = 340;
+const BAR_W: u32 = 110;
+const TITLE_H: u32 = 34;
+const CAPTION_H: u32 = 26;
+
+/// Rasterise `panel` into `w × h` pixels (block means in scale space; grey where invalid).
+fn raster(panel: &Panel, scale: &Scale, w: u32, h: u32) -> Vec<u8> {
+    let (rows, cols) = panel.values.dim();
+    let mut rgb = vec![0u8; (w * h * 3) as usize];
+    for y in 0..h {
+        for x in 0..w {
+            // Row 0 (the first line) at the bottom: the image reads in the flight direction.
+            let yf = h - 1 - y;
+            let (r0, r1) = (
+                (yf as usize * rows) / h as usize,
+                (((yf + 1) as usize * rows) / h as usize).max(yf as usize * rows / h as usize + 1),
+            );
+            let (c0, c1) = (
+                (x as usize * cols) / w as usize,
+                (((x + 1) as usize * cols) / w as usize).max(x as usize * cols / w as usize + 1),
+            );
+            let (mut sum, mut n) = (0.0, 0usize);
+            for r in r0..r1.min(rows) {
+                for c in c0..c1.min(cols) {
+                    if panel.valid[[r, c]] {
+                        sum += scale.position(f64::from(panel.values[[r, c]]));
+                        n += 1;
+                    }
+                }
+            }
+            let colour = if n > 0 { viridis(sum / n as f64) } else { [200, 200, 200] };
+            let i = ((y * w + x) * 3) as usize;
+            rgb[i..i + 3].copy_from_slice(&colour);
+        }
+    }
+    rgb
+}
+
+/// Round tick values inside the scale: 1-2-5 per decade on a log scale (or decades alone when
+/// the scale spans many), five round steps on a linear one.
+fn nice_ticks(scale: &Scale) -> Vec<f64> {
+    let (lo, hi) = (scale.lo.min(scale.hi), scale.hi.max(scale.lo));
+    let inside = |v: &f64| *v >= lo * (1.0 - 1e-9) && *v <= hi * (1.0 + 1e-9);
+    if scale.log && lo > 0.0 {
+        let decades = (hi / lo).log10();
+        let mults: &[f64] = if decades > 3.0 {
+            &[1.0]
+        } else if decades > 1.5 {
+            &[1.0, 3.0]
+        } else {
+            &[1.0, 2.0, 5.0]
+        };
+        let (d0, d1) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+        (d0..=d1).flat_map(|d| mults.iter().map(move |m| m * 10f64.powi(d))).filter(inside).collect()
+    } else {
+        let raw = (hi - lo) / 5.0;
+        let mag = 10f64.powf(raw.log10().floor());
+        let step = [1.0, 2.0, 5.0, 10.0].iter().map(|m| m * mag).find(|s| *s >= raw).unwrap_or(raw);
+        let first = (lo / step).ceil() as i64;
+        (first..).map(|k| k as f64 * step).take_while(|v| *v <= hi * (1.0 + 1e-9)).collect()
+    }
+}
+
+fn tick_label(v: f64) -> String {
+    if v == 0.0 {
+        "0".into()
+    } else if v.abs() >= 100.0 {
+        format!("{v:.0}")
+    } else if v.abs() >= 1.0 {
+        format!("{v:.3}").trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        let digits = (-v.abs().log10()).ceil() as usize + 1;
+        format!("{v:.digits$}")
+    }
+}
+
+impl Draw for Maps {
+    fn size(&self) -> (u32, u32) {
+        (PANEL_W * self.panels.len() as u32 + BAR_W, TITLE_H + PANEL_H + CAPTION_H)
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<Vec<Placed>, String> {
+        root.fill(&WHITE).map_err(err)?;
+        root.draw_text(&self.title, &(FONT, 17).into_font().color(&BLACK), (10, 8)).map_err(err)?;
+        let mut placed = Vec::new();
+        for (i, p) in self.panels.iter().enumerate() {
+            let x0 = (i as u32 * PANEL_W) as i32;
+            let y0 = TITLE_H as i32;
+            root.draw_text(&p.title, &(FONT, 13).into_font().color(&BLACK), (x0 + 10, y0 + 4)).map_err(err)?;
+            // Fit the map in the panel, keeping its aspect ratio.
+            let (rows, cols) = p.values.dim();
+            let (bw, bh) = (PANEL_W - 20, PANEL_H - 36);
+            let aspect = cols as f64 / rows.max(1) as f64;
+            let (w, h) = if aspect >= f64::from(bw) / f64::from(bh) {
+                (bw, ((f64::from(bw) / aspect).round() as u32).max(1))
+            } else {
+                (((f64::from(bh) * aspect).round() as u32).max(1), bh)
+            };
+            let (mx, my) = (x0 + 10 + ((bw - w) / 2) as i32, y0 + 26);
+            root.draw(&Rectangle::new([(mx - 1, my - 1), (mx + w as i32, my + h as i32)], BLACK.stroke_width(1)))
+                .map_err(err)?;
+            placed.push(Placed { x: mx, y: my, w, h, rgb: raster(p, &self.scale, w, h) });
+        }
+        // Colour bar.
+        let bx = (self.panels.len() as u32 * PANEL_W) as i32 + 12;
+        let (by0, by1) = (TITLE_H as i32 + 26, (TITLE_H + PANEL_H) as i32 - 12);
+        let steps = 120;
+        for k in 0..steps {
+            let t0 = k as f64 / steps as f64;
+            let ya = by1 - ((by1 - by0) as f64 * (k + 1) as f64 / steps as f64).round() as i32;
+            let yb = by1 - ((by1 - by0) as f64 * t0).round() as i32;
+            let c = viridis(t0 + 0.5 / steps as f64);
+            root.draw(&Rectangle::new([(bx, ya), (bx + 18, yb)], RGBColor(c[0], c[1], c[2]).filled())).map_err(err)?;
+        }
+        root.draw(&Rectangle::new([(bx, by0), (bx + 18, by1)], BLACK.stroke_width(1))).map_err(err)?;
+        for v in nice_ticks(&self.scale) {
+            let t = self.scale.position(v);
+            let y = by1 - ((by1 - by0) as f64 * t).round() as i32;
+            root.draw(&PathElement::new(vec![(bx + 18, y), (bx + 23, y)], BLACK)).map_err(err)?;
+            root.draw_text(&tick_label(v), &(FONT, 11).into_font().color(&BLACK), (bx + 26, y - 6)).map_err(err)?;
+        }
+        root.draw_text(&self.label, &(FONT, 12).into_font().color(&BLACK), (bx - 4, TITLE_H as i32 + 6))
+            .map_err(err)?;
+        let caption = format!(
+            "One colour scale for every panel ({}); grey: land, or not returned; flight direction up.",
+            if self.scale.log { "logarithmic" } else { "linear" }
+        );
+        root.draw_text(
+            &caption,
+            &(FONT, 12).into_font().color(&RGBColor(60, 60, 60)),
+            (10, (TITLE_H + PANEL_H) as i32 + 6),
+        )
+        .map_err(err)?;
+        Ok(placed)
+    }
+}
+
+struct Scatter {
+    title: String,
+    label: String,
+    edges: Vec<f64>,
+    panels: Vec<(String, Vec<Vec<usize>>)>,
+}
+
+impl Draw for Scatter {
+    fn size(&self) -> (u32, u32) {
+        (340 * self.panels.len() as u32, 380)
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<Vec<Placed>, String> {
+        root.fill(&WHITE).map_err(err)?;
+        let (top, rest) = root.split_vertically(TITLE_H);
+        top.draw_text(&self.title, &(FONT, 17).into_font().color(&BLACK), (10, 8)).map_err(err)?;
+        let (lo, hi) = (self.edges[0], self.edges[self.edges.len() - 1]);
+        for (area, (title, counts)) in rest.split_evenly((1, self.panels.len())).iter().zip(&self.panels) {
+            let mut chart = ChartBuilder::on(area)
+                .caption(title, (FONT, 12))
+                .margin(8)
+                .x_label_area_size(34)
+                .y_label_area_size(48)
+                .build_cartesian_2d((lo..hi).log_scale(), (lo..hi).log_scale())
+                .map_err(err)?;
+            chart
+                .configure_mesh()
+                .disable_mesh()
+                .x_desc(format!("true {}", self.label))
+                .y_desc("retrieved")
+                .x_label_formatter(&|v| tick_label(*v))
+                .y_label_formatter(&|v| tick_label(*v))
+                .label_style((FONT, 10))
+                .axis_desc_style((FONT, 11))
+                .draw()
+                .map_err(err)?;
+            let max = counts.iter().flatten().copied().max().unwrap_or(1).max(1) as f64;
+            let mut cells = Vec::new();
+            for (j, row) in counts.iter().enumerate() {
+                for (i, &n) in row.iter().enumerate() {
+                    if n > 0 {
+                        let c = viridis((n as f64).ln_1p() / max.ln_1p());
+                        cells.push(Rectangle::new(
+                            [(self.edges[i], self.edges[j]), (self.edges[i + 1], self.edges[j + 1])],
+                            RGBColor(c[0], c[1], c[2]).filled(),
+                        ));
+                    }
+                }
+            }
+            chart.draw_series(cells).map_err(err)?;
+            chart.draw_series(LineSeries::new(vec![(lo, lo), (hi, hi)], BLACK.stroke_width(1))).map_err(err)?;
+        }
+        Ok(Vec::new())
+    }
+}
+
+struct Histograms {
+    title: String,
+    label: String,
+    edges: Vec<f64>,
+    categories: Vec<String>,
+    /// Per panel: title, counts[category][bin], truth counts[bin].
+    panels: Vec<(String, Vec<Vec<usize>>, Vec<usize>)>,
+}
+
+impl Draw for Histograms {
+    fn size(&self) -> (u32, u32) {
+        (380 * self.panels.len() as u32, 380)
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<Vec<Placed>, String> {
+        root.fill(&WHITE).map_err(err)?;
+        let (top, rest) = root.split_vertically(TITLE_H);
+        top.draw_text(&self.title, &(FONT, 17).into_font().color(&BLACK), (10, 8)).map_err(err)?;
+        let (lo, hi) = (self.edges[0], self.edges[self.edges.len() - 1]);
+        let nb = self.edges.len() - 1;
+        let ymax = self
+            .panels
+            .iter()
+            .map(|(_, c, t)| (0..nb).map(|b| c.iter().map(|row| row[b]).sum::<usize>().max(t[b])).max().unwrap_or(0))
+            .max()
+            .unwrap_or(1)
+            .max(1) as f64
+            * 1.08;
+        for (area, (title, counts, truth)) in rest.split_evenly((1, self.panels.len())).iter().zip(&self.panels) {
+            let mut chart = ChartBuilder::on(area)
+                .caption(title, (FONT, 12))
+                .margin(8)
+                .x_label_area_size(34)
+                .y_label_area_size(52)
+                .build_cartesian_2d((lo..hi).log_scale(), 0.0..ymax)
+                .map_err(err)?;
+            chart
+                .configure_mesh()
+                .disable_mesh()
+                .x_desc(self.label.clone())
+                .y_desc("pixels")
+                .x_label_formatter(&|v| tick_label(*v))
+                .y_label_formatter(&|v| format!("{v:.0}"))
+                .label_style((FONT, 10))
+                .axis_desc_style((FONT, 11))
+                .draw()
+                .map_err(err)?;
+            let mut base = vec![0usize; nb];
+            for (k, row) in counts.iter().enumerate() {
+                if row.iter().all(|&n| n == 0) {
+                    continue;
+                }
+                let c = categorical(k);
+                let colour = RGBColor(c[0], c[1], c[2]);
+                let bars: Vec<_> = (0..nb)
+                    .filter(|&b| row[b] > 0)
+                    .map(|b| {
+                        Rectangle::new(
+                            [(self.edges[b], base[b] as f64), (self.edges[b + 1], (base[b] + row[b]) as f64)],
+                            colour.filled(),
+                        )
+                    })
+                    .collect();
+                chart
+                    .draw_series(bars)
+                    .map_err(err)?
+                    .label(self.categories.get(k).cloned().unwrap_or_default())
+                    .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 10, y + 5)], colour.filled()));
+                for b in 0..nb {
+                    base[b] += row[b];
+                }
+            }
+            let outline: Vec<(f64, f64)> = (0..nb)
+                .flat_map(|b| [(self.edges[b], truth[b] as f64), (self.edges[b + 1], truth[b] as f64)])
+                .collect();
+            chart
+                .draw_series(LineSeries::new(outline, BLACK.stroke_width(2)))
+                .map_err(err)?
+                .label("truth")
+                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 12, y)], BLACK.stroke_width(2)));
+            chart
+                .configure_series_labels()
+                .label_font((FONT, 10))
+                .background_style(WHITE.mix(0.85))
+                .border_style(BLACK)
+                .position(SeriesLabelPosition::UpperRight)
+                .draw()
+                .map_err(err)?;
+        }
+        Ok(Vec::new())
+    }
+}
+
+fn metric_line(m: Option<&Metrics>) -> String {
+    m.map_or_else(String::new, |m| {
+        format!("MAE {:.0} %, bias {:+.0} %, {:.1} % returned", m.mae_pct(), m.bias_pct(), m.returned_pct)
+    })
+}
+
+/// What the figures of one retrieval and variable draw from.
+struct Context<'a> {
+    runs: &'a [&'a StudyRun],
+    index: usize,
+    var: Variable,
+    scale: Scale,
+    title: String,
+}
+
+/// One scale over the truth and every instrument's returned values (log for concentrations).
+fn shared_scale(runs: &[&StudyRun], index: usize, var: Variable) -> Option<Scale> {
+    let first = runs.first()?;
+    let truth = truth_map(first, var.key)?;
+    let mut values: Vec<f64> = truth
+        .indexed_iter()
+        .filter(|((r, c), _)| first.truth.land[[*r, *c]] == 0)
+        .map(|(_, v)| f64::from(*v))
+        .collect();
+    for run in runs {
+        if let Some(ret) = run.retrievals.get(index)
+            && let Some(map) = product_map(&ret.product, var.key)
+        {
+            values.extend(
+                map.indexed_iter().filter(|((r, c), _)| ret.product.returned(*r, *c)).map(|(_, v)| f64::from(*v)),
+            );
+        }
+    }
+    let mut scale = Scale::robust(values.iter().copied().filter(|v| *v > 0.0));
+    if !scale.log && scale.lo > 0.0 && var.key != "depth_m" {
+        scale.log = true;
+    }
+    Some(scale)
+}
+
+fn maps_figure(ctx: &Context<'_>) -> Option<Maps> {
+    let first = ctx.runs.first()?;
+    let truth = truth_map(first, ctx.var.key)?;
+    let mut panels =
+        vec![Panel { title: "truth".into(), values: truth.clone(), valid: first.truth.land.mapv(|l| l == 0) }];
+    for run in ctx.runs {
+        let Some(ret) = run.retrievals.get(ctx.index) else { continue };
+        let Some(map) = product_map(&ret.product, ctx.var.key) else { continue };
+        panels.push(Panel {
+            title: format!("{}: {}", run.label, metric_line(ret.metrics.get(ctx.var.key))),
+            values: map.clone(),
+            valid: Array2::from_shape_fn(map.dim(), |(r, c)| ret.product.returned(r, c) && map[[r, c]] > 0.0),
+        });
+    }
+    Some(Maps { title: ctx.title.clone(), label: ctx.var.label.into(), scale: ctx.scale, panels })
+}
+
+/// The class of a returned pixel for the histograms: chosen SIOP set, or dominant substrate.
+fn category(p: &crate::retrieval::Product, r: usize, c: usize) -> usize {
+    if let Some(s) = &p.siop_set {
+        usize::try_from(s[[r, c]]).unwrap_or(0)
+    } else if let Some(f) = &p.substrate_fractions {
+        (0..f.dim().2).max_by(|&a, &b| f[[r, c, a]].total_cmp(&f[[r, c, b]])).unwrap_or(0)
+    } else {
+        0
+    }
+}
+
+fn scatter_and_histograms(ctx: &Context<'_>) -> Option<(Scatter, Histograms)> {
+    let ret0 = ctx.runs.first()?.retrievals.get(ctx.index)?;
+    let (lo, hi) = (ctx.scale.lo.max(1e-6), ctx.scale.hi.max(ctx.scale.lo * 1.01));
+    let edges = log_edges(lo, hi, 60);
+    let hist_edges = log_edges(lo, hi, 36);
+    let categories: Vec<String> = if ret0.product.siop_set.is_some() {
+        ret0.product.siop_set_names.clone()
+    } else if ret0.product.substrate_fractions.is_some() {
+        ret0.product.substrate_names.iter().map(|n| format!("{n} dominant")).collect()
+    } else {
+        vec![ret0.metrics.product.clone()]
+    };
+    let mut scatter_panels = Vec::new();
+    let mut hist_panels = Vec::new();
+    for run in ctx.runs {
+        let (Some(ret), Some(truth)) = (run.retrievals.get(ctx.index), truth_map(run, ctx.var.key)) else { continue };
+        let Some(map) = product_map(&ret.product, ctx.var.key) else { continue };
+        let p = &ret.product;
+        let water_returned = |r: usize, c: usize| run.truth.land[[r, c]] == 0 && p.returned(r, c);
+        let pairs = map
+            .indexed_iter()
+            .filter(|((r, c), _)| water_returned(*r, *c))
+            .map(|((r, c), v)| (f64::from(truth[[r, c]]), f64::from(*v)));
+        let caption = ret.metrics.get(ctx.var.key).map_or_else(String::new, |m| {
+            format!("{}: N {}, MAE {:.0} %, bias {:+.0} %, R² {:.2}", run.label, m.n, m.mae_pct(), m.bias_pct(), m.r2)
+        });
+        scatter_panels.push((caption, histogram_2d(pairs, &edges)));
+        let nb = hist_edges.len() - 1;
+        let mut counts = vec![vec![0usize; nb]; categories.len().max(1)];
+        let mut truth_counts = vec![0usize; nb];
+        for ((r, c), v) in map.indexed_iter() {
+            if run.truth.land[[r, c]] != 0 {
+                continue;
+            }
+            if let Some(b) = bin_of(&hist_edges, f64::from(truth[[r, c]])) {
+                truth_counts[b] += 1;
+            }
+            if p.returned(r, c)
+                && let (Some(b), Some(row)) = (bin_of(&hist_edges, f64::from(*v)), counts.get_mut(category(p, r, c)))
+            {
+                row[b] += 1;
+            }
+        }
+        let note = if p.flags.iter().any(|f| f & ProductFlags::FAILED != 0) { " (failures excluded)" } else { "" };
+        hist_panels.push((format!("{}{note}", run.label), counts, truth_counts));
+    }
+    Some((
+        Scatter { title: ctx.title.clone(), label: ctx.var.label.into(), edges, panels: scatter_panels },
+        Histograms {
+            title: ctx.title.clone(),
+            label: ctx.var.label.into(),
+            edges: hist_edges,
+            categories,
+            panels: hist_panels,
+        },
+    ))
+}
+
+/// Every figure of a study: for each retrieval and each variable it retrieves with a truth —
+/// maps, a density scatter and histograms (the first seed of each instrument).
+pub fn figure_set(result: &StudyResult) -> Result<Vec<Figure>, StudyError> {
+    let mut seen = Vec::new();
+    let runs: Vec<&StudyRun> = result
+        .runs
+        .iter()
+        .filter(|r| {
+            let first = !seen.contains(&r.label);
+            seen.push(r.label.clone());
+            first
+        })
+        .collect();
+    let Some(first) = runs.first() else { return Ok(Vec::new()) };
+    let mut figures = Vec::new();
+    for (index, ret0) in first.retrievals.iter().enumerate() {
+        for var in VARIABLES {
+            if truth_map(first, var.key).is_none() || product_map(&ret0.product, var.key).is_none() {
+                continue;
+            }
+            let Some(scale) = shared_scale(&runs, index, var) else { continue };
+            let title = format!("{} — {} {}", result.study.spec.name, ret0.metrics.product, var.label);
+            let ctx = Context { runs: &runs, index, var, scale, title };
+            let name = format!("{}_{}", ret0.spec.name(), var.key);
+            if let Some(maps) = maps_figure(&ctx) {
+                figures.push(render(&format!("maps_{name}"), &maps)?);
+            }
+            if let Some((scatter, histograms)) = scatter_and_histograms(&ctx) {
+                figures.push(render(&format!("scatter_{name}"), &scatter)?);
+                figures.push(render(&format!("histogram_{name}"), &histograms)?);
+            }
+        }
+    }
+    Ok(figures)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn base64_matches_rfc4648_vectors() {
+        assert_eq!(base64(b""), "");
+        assert_eq!(base64(b"f"), "Zg==");
+        assert_eq!(base64(b"fo"), "Zm8=");
+        assert_eq!(base64(b"foo"), "Zm9v");
+        assert_eq!(base64(b"foobar"), "Zm9vYmFy");
+    }
+
+    #[test]
+    fn a_map_figure_renders_to_png_and_svg() {
+        let values = Array2::from_shape_fn((40, 60), |(r, c)| 1.0 + (r * c) as f32 / 10.0);
+        let valid = Array2::from_shape_fn((40, 60), |(r, _)| r > 2);
+        let fig = Maps {
+            title: "test".into(),
+            label: "chl-a (mg m⁻³)".into(),
+            scale: Scale { lo: 1.0, hi: 240.0, log: true },
+            panels: vec![Panel { title: "truth".into(), values, valid }],
+        };
+        let f = render("t", &fig).unwrap();
+        assert_eq!(&f.png[1..4], b"PNG");
+        assert!(f.svg.contains("<image") && f.svg.contains("chl-a"));
+    }
+}

@@ -1,0 +1,240 @@
+//! Studies: a scene, one or more instruments, the retrievals and their settings, and seeds —
+//! run through the whole chain and reported side by side (metrics tables, figures, cubes).
+//!
+//! A study file (`presets/studies/*.ron`) names its scene and instruments by built-in name or
+//! file, and may override the chain's settings for every run:
+//!
+//! ```text
+//! StudySpec(
+//!     name: "cubesat_vs_smallsat",
+//!     scene: Preset("lake_hume_bloom"),
+//!     instruments: [Preset("cubesat"), Preset("smallsat")],
+//!     retrievals: [Almi()],
+//!     seeds: [1],
+//! )
+//! ```
+
+mod figures;
+mod output;
+mod run;
+
+pub use figures::{Figure, figure_set};
+pub use output::{Outputs, metrics_csv, write_bytes, write_run, write_study};
+pub use run::{StudyResult, StudyRun, run_study};
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use crate::calibration::CalibrationSpec;
+use crate::correction::CorrectionSpec;
+use crate::engine::{Fidelity, RunConfig};
+use crate::instrument::{DetectorMode, InstrumentSpec};
+use crate::retrieval::RetrievalSpec;
+use crate::scene::SceneSpec;
+
+/// Errors of a study, each naming the field or file.
+#[derive(Debug, thiserror::Error, Clone, PartialEq)]
+pub enum StudyError {
+    /// A setting with an invalid value.
+    #[error("{field}: {message}")]
+    Invalid {
+        /// The field.
+        field: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// A file that does not parse.
+    #[error("{origin}: {message}")]
+    Parse {
+        /// File name.
+        origin: String,
+        /// Parser message (line, column, field).
+        message: String,
+    },
+    /// A run failed.
+    #[error("{instrument}: {message}")]
+    Run {
+        /// Instrument name.
+        instrument: String,
+        /// The engine's message.
+        message: String,
+    },
+    /// Writing an output failed.
+    #[error("{0}")]
+    Io(String),
+    /// Cancelled.
+    #[error("cancelled")]
+    Cancelled,
+}
+
+/// A scene or instrument by built-in name, by file, or written in place.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub enum Source<T> {
+    /// A built-in preset by name.
+    Preset(String),
+    /// A RON file (relative to the study file).
+    File(PathBuf),
+    /// Written in place.
+    Inline(Box<T>),
+}
+
+/// A study as written in RON.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StudySpec {
+    /// Short name (file names).
+    pub name: String,
+    /// What it asks.
+    #[serde(default)]
+    pub description: String,
+    /// The scene.
+    pub scene: Source<SceneSpec>,
+    /// The instruments compared.
+    pub instruments: Vec<Source<InstrumentSpec>>,
+    /// The retrievals run on each instrument's Rrs.
+    pub retrievals: Vec<RetrievalSpec>,
+    /// Instrument noise seeds (one run per instrument and seed).
+    #[serde(default = "default_seeds")]
+    pub seeds: Vec<u64>,
+    /// Noise and quantisation switches for every run.
+    #[serde(default)]
+    pub detector: Option<DetectorMode>,
+    /// Calibration settings for every run.
+    #[serde(default)]
+    pub calibration: Option<CalibrationSpec>,
+    /// Correction settings for every run.
+    #[serde(default)]
+    pub correction: Option<CorrectionSpec>,
+    /// Fidelity settings for every run.
+    #[serde(default)]
+    pub fidelity: Option<Fidelity>,
+}
+
+fn default_seeds() -> Vec<u64> {
+    vec![1]
+}
+
+/// A study with its files read: the run configurations, one per instrument and seed.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ResolvedStudy {
+    /// The study as written.
+    pub spec: StudySpec,
+    /// (instrument label, seed, configuration) per run.
+    pub runs: Vec<(String, u64, RunConfig)>,
+}
+
+fn load<T: serde::de::DeserializeOwned + Clone>(
+    source: &Source<T>,
+    dir: Option<&Path>,
+    preset: impl Fn(&str) -> Result<T, String>,
+    field: &str,
+) -> Result<(T, Option<PathBuf>), StudyError> {
+    match source {
+        Source::Preset(name) => {
+            preset(name).map(|t| (t, None)).map_err(|m| StudyError::Invalid { field: field.into(), message: m })
+        }
+        Source::File(path) => {
+            let full = match dir {
+                Some(d) if path.is_relative() => d.join(path),
+                _ => path.clone(),
+            };
+            let text = std::fs::read_to_string(&full).map_err(|e| StudyError::Invalid {
+                field: field.into(),
+                message: format!("{}: {e}", full.display()),
+            })?;
+            let value = ron::from_str(&text)
+                .map_err(|e| StudyError::Parse { origin: full.display().to_string(), message: e.to_string() })?;
+            Ok((value, full.parent().map(Path::to_path_buf)))
+        }
+        Source::Inline(t) => Ok(((**t).clone(), dir.map(Path::to_path_buf))),
+    }
+}
+
+impl StudySpec {
+    /// Parse RON; `origin` names the file in errors.
+    pub fn from_ron(text: &str, origin: &str) -> Result<Self, StudyError> {
+        ron::from_str(text).map_err(|e| StudyError::Parse { origin: origin.into(), message: e.to_string() })
+    }
+
+    /// A built-in study by name (`presets/studies/NAME.ron`).
+    pub fn preset(name: &str) -> Result<Self, StudyError> {
+        let path = format!("studies/{name}.ron");
+        let asset = crate::assets::preset(&path).ok_or_else(|| StudyError::Invalid {
+            field: "study".into(),
+            message: format!("no built-in study `{name}` (known: {})", Self::preset_names().join(", ")),
+        })?;
+        Self::from_ron(asset.text, &format!("presets/{path}"))
+    }
+
+    /// Names of the built-in studies.
+    #[must_use]
+    pub fn preset_names() -> Vec<String> {
+        crate::assets::PRESETS
+            .iter()
+            .filter_map(|a| a.path.strip_prefix("studies/").and_then(|p| p.strip_suffix(".ron")))
+            .map(str::to_string)
+            .collect()
+    }
+
+    /// The built-in default: CubeSat vs SmallSat over Lake Hume.
+    pub fn default_study() -> Result<Self, StudyError> {
+        Self::preset("cubesat_vs_smallsat")
+    }
+
+    /// Read the scene and instruments (`dir`: the study file's directory) and build the runs.
+    pub fn resolve(&self, dir: Option<&Path>) -> Result<ResolvedStudy, StudyError> {
+        if self.instruments.is_empty() || self.instruments.len() > 16 {
+            return Err(StudyError::Invalid {
+                field: "instruments".into(),
+                message: format!("{} (allowed: 1 to 16)", self.instruments.len()),
+            });
+        }
+        if self.seeds.is_empty() || self.seeds.len() > 1000 {
+            return Err(StudyError::Invalid {
+                field: "seeds".into(),
+                message: format!("{} seeds (allowed: 1 to 1000)", self.seeds.len()),
+            });
+        }
+        let (scene, scene_dir) = load(&self.scene, dir, |n| SceneSpec::preset(n).map_err(|e| e.to_string()), "scene")?;
+        let mut runs = Vec::new();
+        let mut labels: Vec<String> = Vec::new();
+        for (i, source) in self.instruments.iter().enumerate() {
+            let (instrument, _) = load(
+                source,
+                dir,
+                |n| InstrumentSpec::preset(n).map_err(|e| e.to_string()),
+                &format!("instruments[{i}]"),
+            )?;
+            instrument.validate().map_err(|e| StudyError::Invalid {
+                field: format!("instruments[{i}] ({})", instrument.name),
+                message: e.to_string(),
+            })?;
+            let mut label = instrument.name.clone();
+            if labels.contains(&label) {
+                label = format!("{label}_{}", i + 1);
+            }
+            labels.push(label.clone());
+            for &seed in &self.seeds {
+                let mut config = RunConfig::new(scene.clone(), instrument.clone());
+                config.scene_dir.clone_from(&scene_dir);
+                config.seed = seed;
+                config.retrievals.clone_from(&self.retrievals);
+                if let Some(d) = self.detector {
+                    config.detector = d;
+                }
+                if let Some(c) = &self.calibration {
+                    config.calibration = c.clone();
+                }
+                if let Some(c) = &self.correction {
+                    config.correction = c.clone();
+                }
+                if let Some(f) = &self.fidelity {
+                    config.fidelity = f.clone();
+                }
+                runs.push((label.clone(), seed, config));
+            }
+        }
+        Ok(ResolvedStudy { spec: self.clone(), runs })
+    }
+}

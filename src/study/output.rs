@@ -1,0 +1,231 @@
+//! Writing runs and studies to disk: cubes as .npy, tables as CSV and JSON, figures as PNG and
+//! SVG, and the resolved configuration as RON. Every file is written atomically (a temporary
+//! file beside it, then a rename), so a failed or cancelled run never leaves half a file.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use ndarray_npy::WriteNpyExt;
+use serde::Serialize;
+
+use super::figures::figure_set;
+use super::{StudyError, StudyResult};
+use crate::engine::RunOutput;
+
+/// What was written, relative to the output directory.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Outputs {
+    /// File paths.
+    pub files: Vec<String>,
+}
+
+/// Write `bytes` to `path` atomically; the message names the file and the reason.
+pub fn write_bytes(path: &Path, bytes: &[u8]) -> Result<(), StudyError> {
+    let tmp = path.with_extension(format!("{}.partial", path.extension().and_then(|e| e.to_str()).unwrap_or("")));
+    let fail = |e: std::io::Error| StudyError::Io(format!("cannot write {}: {e}", path.display()));
+    if let Some(parent) = path.parent() {
+        std::fs::create_dir_all(parent)
+            .map_err(|e| StudyError::Io(format!("cannot create {}: {e}", parent.display())))?;
+    }
+    std::fs::write(&tmp, bytes).map_err(fail)?;
+    std::fs::rename(&tmp, path).map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        fail(e)
+    })
+}
+
+fn npy<A: WriteNpyExt + ?Sized>(dir: &Path, name: &str, array: &A, out: &mut Outputs) -> Result<(), StudyError> {
+    let mut bytes = Vec::new();
+    array.write_npy(&mut bytes).map_err(|e| StudyError::Io(format!("cannot encode {name}: {e}")))?;
+    write_bytes(&dir.join(name), &bytes)?;
+    out.files.push(name.to_string());
+    Ok(())
+}
+
+fn text(dir: &Path, name: &str, content: &str, out: &mut Outputs) -> Result<(), StudyError> {
+    write_bytes(&dir.join(name), content.as_bytes())?;
+    out.files.push(name.to_string());
+    Ok(())
+}
+
+fn json<T: Serialize>(value: &T) -> Result<String, StudyError> {
+    serde_json::to_string_pretty(value).map_err(|e| StudyError::Io(format!("JSON: {e}")))
+}
+
+fn number(v: f64) -> String {
+    if !v.is_finite() {
+        "inf".into()
+    } else if v != 0.0 && !(1e-4..1e7).contains(&v.abs()) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
+    }
+}
+
+/// The SNR table of a run as CSV.
+#[must_use]
+pub fn snr_csv(out: &RunOutput) -> String {
+    let mut s = String::from("band,centre_nm,radiance_w_m2_sr_nm,snr_analytic,snr_measured\n");
+    for r in out.snr.iter() {
+        let _ = writeln!(
+            s,
+            "{},{},{},{},{}",
+            r.band,
+            number(r.centre_nm),
+            number(r.radiance),
+            number(r.snr_analytic),
+            number(r.snr_measured)
+        );
+    }
+    s
+}
+
+/// Write every product of one run into `dir`: Level-0, Level-1, Rrs, the truth, the retrievals'
+/// maps, the SNR table, the report and the resolved configuration.
+pub fn write_run(out: &RunOutput, dir: &Path) -> Result<Outputs, StudyError> {
+    std::fs::create_dir_all(dir).map_err(|e| StudyError::Io(format!("cannot create {}: {e}", dir.display())))?;
+    let mut o = Outputs::default();
+    let r = &out.radiance;
+    npy(dir, "level0_dn.npy", &out.level0.dn, &mut o)?;
+    npy(dir, "level0_flags.npy", &out.level0.flags, &mut o)?;
+    npy(dir, "level1_radiance.npy", &out.level1.radiance, &mut o)?;
+    npy(dir, "rrs.npy", &out.correction.rrs.rrs, &mut o)?;
+    npy(dir, "rrs_flags.npy", &out.correction.rrs.flags, &mut o)?;
+    npy(dir, "pupil_radiance.npy", &r.radiance, &mut o)?;
+    npy(dir, "truth_rrs.npy", &r.rrs, &mut o)?;
+    npy(dir, "truth_chl_mg_m3.npy", &r.chl_mg_m3, &mut o)?;
+    npy(dir, "truth_nap_g_m3.npy", &r.nap_g_m3, &mut o)?;
+    npy(dir, "truth_cdom_per_m.npy", &r.cdom_per_m, &mut o)?;
+    npy(dir, "land_mask.npy", &r.land, &mut o)?;
+    if let Some(d) = &r.depth_m {
+        npy(dir, "truth_depth_m.npy", d, &mut o)?;
+    }
+    if let Some(f) = &r.substrate_fractions {
+        npy(dir, "truth_substrate_fractions.npy", f, &mut o)?;
+    }
+    for ret in &out.retrievals {
+        let p = &ret.product;
+        let stem = ret.spec.name();
+        npy(dir, &format!("{stem}_chl_mg_m3.npy"), &p.chl_mg_m3, &mut o)?;
+        npy(dir, &format!("{stem}_nap_g_m3.npy"), &p.nap_g_m3, &mut o)?;
+        npy(dir, &format!("{stem}_cdom_per_m.npy"), &p.cdom_per_m, &mut o)?;
+        npy(dir, &format!("{stem}_flags.npy"), &p.flags, &mut o)?;
+        npy(dir, &format!("{stem}_cost.npy"), &p.cost, &mut o)?;
+        if let Some(d) = &p.depth_m {
+            npy(dir, &format!("{stem}_depth_m.npy"), d, &mut o)?;
+        }
+        if let Some(f) = &p.substrate_fractions {
+            npy(dir, &format!("{stem}_substrate_fractions.npy"), f, &mut o)?;
+        }
+        if let Some(s) = &p.sdi {
+            npy(dir, &format!("{stem}_sdi.npy"), s, &mut o)?;
+        }
+        if let Some(s) = &p.siop_set {
+            npy(dir, &format!("{stem}_siop_set.npy"), s, &mut o)?;
+        }
+    }
+    let mut bands = String::from("band,centre_nm,fwhm_nm\n");
+    for b in &out.response.bands.bands {
+        let _ = writeln!(bands, "{},{},{}", b.name, number(b.centre_nm), number(b.fwhm_nm));
+    }
+    text(dir, "bands.csv", &bands, &mut o)?;
+    text(dir, "snr.csv", &snr_csv(out), &mut o)?;
+    text(dir, "report.json", &json(&out.report)?, &mut o)?;
+    let config = out.config.to_ron().map_err(|e| StudyError::Io(e.to_string()))?;
+    text(dir, "config.ron", &config, &mut o)?;
+    Ok(o)
+}
+
+/// One row per run, product and variable.
+#[derive(Debug, Clone, Serialize)]
+struct MetricsRow<'a> {
+    instrument: &'a str,
+    seed: u64,
+    product: &'a str,
+    variable: &'a str,
+    #[serde(flatten)]
+    metrics: &'a crate::metrics::Metrics,
+    mae_pct: f64,
+    bias_pct: f64,
+}
+
+/// The metrics table as CSV: instrument, seed, product, variable, mae, bias, n, returned_pct,
+/// rmse, r2 (MAE and bias as factors; mae_pct, bias_pct as percentages).
+#[must_use]
+pub fn metrics_csv(result: &StudyResult) -> String {
+    let mut s =
+        String::from("instrument,seed,product,variable,mae,bias,mae_pct,bias_pct,n,candidates,returned_pct,rmse,r2\n");
+    for run in &result.runs {
+        for ret in &run.retrievals {
+            for v in &ret.metrics.variables {
+                let m = &v.metrics;
+                let _ = writeln!(
+                    s,
+                    "{},{},{},{},{},{},{},{},{},{},{},{},{}",
+                    run.label,
+                    run.seed,
+                    ret.metrics.product,
+                    v.variable,
+                    number(m.mae),
+                    number(m.bias),
+                    number(m.mae_pct()),
+                    number(m.bias_pct()),
+                    m.n,
+                    m.candidates,
+                    number(m.returned_pct),
+                    number(m.rmse),
+                    number(m.r2)
+                );
+            }
+        }
+    }
+    s
+}
+
+/// Write a study's tables, figures and resolved configuration into `dir` (the runs' cubes are
+/// written as they finish, by [`write_run`]).
+pub fn write_study(result: &StudyResult, dir: &Path, figures: bool) -> Result<Outputs, StudyError> {
+    let mut o = Outputs::default();
+    text(dir, "metrics.csv", &metrics_csv(result), &mut o)?;
+    let mut rows = Vec::new();
+    let mut extra = Vec::new();
+    for run in &result.runs {
+        for ret in &run.retrievals {
+            for v in &ret.metrics.variables {
+                rows.push(MetricsRow {
+                    instrument: &run.label,
+                    seed: run.seed,
+                    product: &ret.metrics.product,
+                    variable: &v.variable,
+                    metrics: &v.metrics,
+                    mae_pct: v.metrics.mae_pct(),
+                    bias_pct: v.metrics.bias_pct(),
+                });
+            }
+            extra.push(serde_json::json!({
+                "instrument": run.label,
+                "seed": run.seed,
+                "product": ret.metrics.product,
+                "siop_sets": ret.product.siop_set_names,
+                "siop_set_counts": ret.metrics.siop_set_counts,
+                "siop_sets_used": ret.metrics.siop_sets_used,
+                "substrate_agreement_pct": ret.metrics.substrate_agreement_pct,
+                "failed": ret.metrics.failed,
+            }));
+        }
+    }
+    let doc = serde_json::json!({ "study": result.study.spec.name, "metrics": rows, "retrievals": extra });
+    text(dir, "metrics.json", &json(&doc)?, &mut o)?;
+    let spec = ron::ser::to_string_pretty(&result.study.spec, ron::ser::PrettyConfig::default().struct_names(true))
+        .map_err(|e| StudyError::Io(format!("study RON: {e}")))?;
+    text(dir, "study.ron", &spec, &mut o)?;
+    if figures {
+        for f in figure_set(result)? {
+            write_bytes(&dir.join("figures").join(format!("{}.png", f.name)), &f.png)?;
+            write_bytes(&dir.join("figures").join(format!("{}.svg", f.name)), f.svg.as_bytes())?;
+            o.files.push(format!("figures/{}.png", f.name));
+            o.files.push(format!("figures/{}.svg", f.name));
+        }
+    }
+    Ok(o)
+}
