@@ -166,6 +166,9 @@ pub struct ProductMetrics {
     pub variables: Vec<VariableMetrics>,
     /// SAMBUCA: % of returned shallow pixels whose dominant substrate is the true dominant one.
     pub substrate_agreement_pct: Option<f64>,
+    /// SAMBUCA: depth metrics over the pixels where each substrate truly dominates (where a
+    /// substrate the retrieval does not know biases the depth, this shows it).
+    pub depth_by_true_substrate: Vec<VariableMetrics>,
     /// aLMI: how many pixels chose each SIOP set.
     pub siop_set_counts: Vec<usize>,
     /// aLMI: how many distinct SIOP sets were chosen.
@@ -214,7 +217,20 @@ pub fn evaluate(product: &Product, truth: &RadianceCube) -> ProductMetrics {
         },
     ];
     let mut substrate_agreement_pct = None;
+    let mut depth_by_true_substrate = Vec::new();
     if let (Some(depth), Some(true_depth)) = (&product.depth_m, &truth.depth_m) {
+        if let Some(tf) = &truth.substrate_fractions {
+            let n = tf.dim().2;
+            let dominant =
+                |r: usize, c: usize| (0..n).max_by(|&i, &j| tf[[r, c, i]].total_cmp(&tf[[r, c, j]])).unwrap_or(0);
+            for (s, name) in truth.substrate_names.iter().enumerate().take(n) {
+                let here = |r: usize, c: usize| dominant(r, c) == s;
+                depth_by_true_substrate.push(VariableMetrics {
+                    variable: format!("depth_m_over_{name}"),
+                    metrics: compare(&got(depth, &here), &want(true_depth, &here)),
+                });
+            }
+        }
         variables.push(VariableMetrics {
             variable: "depth_m".into(),
             metrics: compare(&got(depth, &all), &want(true_depth, &all)),
@@ -225,13 +241,21 @@ pub fn evaluate(product: &Product, truth: &RadianceCube) -> ProductMetrics {
             metrics: compare(&got(depth, &visible), &want(true_depth, &visible)),
         });
         if let (Some(f), Some(tf)) = (&product.substrate_fractions, &truth.substrate_fractions) {
-            let dominant = |a: &ndarray::Array3<f32>, r: usize, c: usize, names: usize| -> usize {
-                (0..names).max_by(|&i, &j| a[[r, c, i]].total_cmp(&a[[r, c, j]])).unwrap_or(0)
+            // Compared by name: the retrieval's library need not be the scene's.
+            let dominant = |a: &ndarray::Array3<f32>, names: &[String], r: usize, c: usize| -> Option<String> {
+                (0..names.len().min(a.dim().2))
+                    .max_by(|&i, &j| a[[r, c, i]].total_cmp(&a[[r, c, j]]))
+                    .map(|i| names[i].clone())
             };
-            let n = product.substrate_names.len().min(f.dim().2).min(tf.dim().2);
             let returned: Vec<&(usize, usize)> = water.iter().filter(|&&(r, c)| product.returned(r, c)).collect();
-            if n > 0 && !returned.is_empty() {
-                let agree = returned.iter().filter(|&&&(r, c)| dominant(f, r, c, n) == dominant(tf, r, c, n)).count();
+            if !returned.is_empty() {
+                let agree = returned
+                    .iter()
+                    .filter(|&&&(r, c)| {
+                        let got = dominant(f, &product.substrate_names, r, c);
+                        got.is_some() && got == dominant(tf, &truth.substrate_names, r, c)
+                    })
+                    .count();
                 substrate_agreement_pct = Some(100.0 * agree as f64 / returned.len() as f64);
             }
         }
@@ -251,6 +275,7 @@ pub fn evaluate(product: &Product, truth: &RadianceCube) -> ProductMetrics {
         product: product.name.clone(),
         variables,
         substrate_agreement_pct,
+        depth_by_true_substrate,
         siop_sets_used: siop_set_counts.iter().filter(|&&n| n > 0).count(),
         siop_set_counts,
         failed: water.iter().filter(|&&(r, c)| product.flags[[r, c]] & ProductFlags::FAILED != 0).count(),

@@ -249,5 +249,7 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
     atmosphere_rows(&mut out, args.quick)?;
     emit(&std::mem::take(&mut out), None)?;
     super::bench_chain::chain_rows(&mut out, args.quick)?;
+    emit(&std::mem::take(&mut out), None)?;
+    super::bench_retrieval::retrieval_rows(&mut out, args.quick)?;
     emit(&out, None)
 }

@@ -12,6 +12,7 @@
 mod atmosphere;
 mod bench;
 mod bench_chain;
+mod bench_retrieval;
 mod grid;
 mod output;
 pub mod simulate;

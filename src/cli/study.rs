@@ -126,6 +126,23 @@ pub fn run(args: &StudyArgs) -> Result<(), CliError> {
                     v.metrics.returned_pct
                 );
             }
+            for v in &ret.metrics.depth_by_true_substrate {
+                eprintln!(
+                    "{:<12} {:<8} {:<24} {:>9.1} {:>+9.1} {:>10.2}",
+                    run.label,
+                    ret.metrics.product,
+                    v.variable,
+                    v.metrics.mae_pct(),
+                    v.metrics.bias_pct(),
+                    v.metrics.returned_pct
+                );
+            }
+            if let Some(a) = ret.metrics.substrate_agreement_pct {
+                eprintln!(
+                    "{:<12} {:<8} dominant substrate right in {a:.1} % of pixels",
+                    run.label, ret.metrics.product
+                );
+            }
             if !ret.metrics.siop_set_counts.is_empty() {
                 eprintln!(
                     "{:<12} {:<8} SIOP sets used: {} of {}",

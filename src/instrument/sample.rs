@@ -150,6 +150,8 @@ pub struct RadianceCube {
     pub depth_m: Option<Array2<f32>>,
     /// True substrate fractions (row, column, substrate), normalised (shallow scenes only).
     pub substrate_fractions: Option<Array3<f32>>,
+    /// Names of the substrates of `substrate_fractions`.
+    pub substrate_names: Vec<String>,
     /// 1 where the pixel centre is land.
     pub land: Array2<u8>,
     /// Water-model evaluations.
@@ -247,21 +249,13 @@ pub fn sample_radiance(
                         }
                     }
                     let (x, y) = viewing.ground_m(0, r, c);
-                    let m = &mut map_block[(rr * cols + c) * 4..(rr * cols + c) * 4 + 4];
-                    m[0] = scene.chl.value_at(x, y) as f32;
-                    m[1] = scene.nap.value_at(x, y) as f32;
-                    m[2] = scene.cdom.value_at(x, y) as f32;
-                    m[3] = scene.depth.as_ref().map_or(0.0, |d| d.value_at(x, y)) as f32;
-                    land_block[rr * cols + c] = u8::from(scene.is_land(x, y));
-                    if shallow {
-                        let f = &mut frac_block[rr * frac_stride..(rr + 1) * frac_stride];
-                        let values: Vec<f64> =
-                            scene.substrates.iter().map(|(_, m)| m.value_at(x, y).max(0.0)).collect();
-                        let total: f64 = values.iter().sum();
-                        for (s, v) in values.iter().enumerate() {
-                            f[c * n_sub + s] = if total > 0.0 { (v / total) as f32 } else { 1.0 / n_sub as f32 };
-                        }
-                    }
+                    let at = rr * cols + c;
+                    let fractions = if shallow {
+                        Some(&mut frac_block[rr * frac_stride + c * n_sub..rr * frac_stride + (c + 1) * n_sub])
+                    } else {
+                        None
+                    };
+                    truth_at(scene, x, y, &mut map_block[at * 4..at * 4 + 4], &mut land_block[at], fractions);
                 }
                 if control.cancelled() {
                     return Err(InstrumentError::Cancelled);
@@ -289,9 +283,28 @@ pub fn sample_radiance(
             None
         },
         land: Array2::from_shape_vec((rows, cols), land).map_err(bad)?,
+        substrate_names: scene.substrates.iter().map(|(n, _)| n.clone()).collect(),
         water_evaluations: counters.iter().map(|c| c.0).sum(),
         bottom_evaluations: counters.iter().map(|c| c.1).sum(),
     })
+}
+
+/// The truth maps at scene point (x, y): chl, NAP, CDOM, depth into `maps`, the land flag, and
+/// the normalised substrate fractions.
+fn truth_at(scene: &Scene, x: f64, y: f64, maps: &mut [f32], land: &mut u8, fractions: Option<&mut [f32]>) {
+    maps[0] = scene.chl.value_at(x, y) as f32;
+    maps[1] = scene.nap.value_at(x, y) as f32;
+    maps[2] = scene.cdom.value_at(x, y) as f32;
+    maps[3] = scene.depth.as_ref().map_or(0.0, |d| d.value_at(x, y)) as f32;
+    *land = u8::from(scene.is_land(x, y));
+    if let Some(f) = fractions {
+        let n = f.len();
+        let values: Vec<f64> = scene.substrates.iter().map(|(_, m)| m.value_at(x, y).max(0.0)).collect();
+        let total: f64 = values.iter().sum();
+        for (s, v) in values.iter().enumerate().take(n) {
+            f[s] = if total > 0.0 { (v / total) as f32 } else { 1.0 / n as f32 };
+        }
+    }
 }
 
 /// Shift band b of every row by `keystone_px[b] / decimation` columns (linear interpolation,

@@ -15,7 +15,11 @@ fn a_gain_change_reruns_only_digitisation_onward() {
     let mut config = RunConfig::new(small_lake(), small("nominal", 64, 48));
     let first = engine.run(&config, &RunControl::new()).unwrap();
     // Every stage ran once, except the retrieval: none is configured.
-    assert!(Stage::ALL.iter().all(|&s| engine.executions(s) == u64::from(s != Stage::Retrieval)), "{:?}", counts(&engine));
+    assert!(
+        Stage::ALL.iter().all(|&s| engine.executions(s) == u64::from(s != Stage::Retrieval)),
+        "{:?}",
+        counts(&engine)
+    );
 
     config.instrument.gain_e_per_dn = 2.0;
     let second = engine.run(&config, &RunControl::new()).unwrap();

@@ -8,7 +8,9 @@ mod closure;
 mod determinism;
 mod incremental;
 mod noise;
+mod retrieval;
 mod spatial;
+mod study;
 mod worker;
 
 use shoal::control::RunControl;

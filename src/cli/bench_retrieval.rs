@@ -1,0 +1,215 @@
+//! `shoal bench` rows for the retrievals, side by side with the reference codes measured on this
+//! machine class: DEA aLMI (Python) about 6 000 pixels/s per core at 8 bands and 8 SIOP sets;
+//! SAMBUCA (Python) 13–18 pixels/s per core at 28 bands and 3 substrate pairs, 46–58 at 4 bands
+//! and 1 pair. Single-threaded, on synthetic pixels drawn from the same ranges as the scenes,
+//! with the instrument-like noise the study runs see; and the full Lake Hume study end to end.
+
+use std::fmt::Write as _;
+use std::time::Instant;
+
+use rand::rngs::Xoshiro256PlusPlus;
+use rand::{RngExt, SeedableRng};
+
+use super::CliError;
+use crate::control::RunControl;
+use crate::retrieval::almi::{AlmiSet, AlmiSettings, invert as almi_invert};
+use crate::retrieval::sambuca::{Observation, SambucaSettings, invert as sambuca_invert, objective_value};
+use crate::retrieval::sets::ALMI_SETS;
+use crate::retrieval::{BandModel, BandResponse, Parameters};
+use crate::study::{StudySpec, run_study};
+use crate::water::{SiopSpec, SubstrateLibrary, rrs_above_from_below};
+
+fn gaussian_bands(centres_fwhm: &[(f64, f64)]) -> Vec<BandResponse> {
+    centres_fwhm
+        .iter()
+        .map(|&(c, w)| {
+            let s = w / 2.354_820_045;
+            let x: Vec<f64> =
+                (0..=(6.0 * s).ceil() as i32 * 2).map(|i| (c - 3.0 * s).round() + f64::from(i) * 0.5).collect();
+            let weights = x.iter().map(|x| (-0.5 * ((x - c) / s).powi(2)).exp()).collect();
+            BandResponse { name: format!("B{c:.0}"), wavelengths_nm: x, weights }
+        })
+        .collect()
+}
+
+fn err<E: std::fmt::Display>(e: E) -> CliError {
+    CliError::Run(e.to_string())
+}
+
+/// aLMI pixels per second on one core, (noise-weighted, unweighted as the reference).
+fn almi_rate(quick: bool) -> Result<(f64, f64, usize), CliError> {
+    // The 8 MODIS-like bands of the reference's configuration, as 10 nm Gaussians.
+    let bands = gaussian_bands(&[
+        (411.5, 10.0),
+        (441.5, 10.0),
+        (486.5, 10.0),
+        (528.5, 10.0),
+        (551.0, 10.0),
+        (665.5, 10.0),
+        (676.5, 10.0),
+        (746.5, 10.0),
+    ]);
+    let lib = SubstrateLibrary::embedded().map_err(err)?;
+    let sets: Vec<AlmiSet> = ALMI_SETS
+        .iter()
+        .map(|n| {
+            let spec = SiopSpec::preset(n).map_err(err)?;
+            Ok(AlmiSet {
+                name: (*n).into(),
+                iops: BandModel::new(&spec, None, &lib, &[], &bands, 3).map_err(err)?.band_iops(),
+            })
+        })
+        .collect::<Result<_, CliError>>()?;
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(7);
+    let n = if quick { 20_000 } else { 100_000 };
+    let o = &sets[4].iops;
+    let pixels: Vec<Vec<f64>> = (0..n)
+        .map(|_| {
+            let chl = 10f64.powf(rng.random_range(0.0..2.0));
+            (0..bands.len())
+                .map(|k| {
+                    let a = o.a_w[k] + chl * o.a_ph[k] + o.a_cdom[k] + 10.0 * o.a_nap[k];
+                    let bb = o.bb_w[k] + chl * o.bb_ph[k] + 10.0 * o.bb_nap[k];
+                    let u = bb / (a + bb);
+                    rrs_above_from_below((0.084 + 0.17 * u) * u) * (1.0 + 0.02 * (rng.random::<f64>() - 0.5))
+                })
+                .collect()
+        })
+        .collect();
+    let valid = vec![true; bands.len()];
+    let nedr = vec![1e-4; bands.len()];
+    let rate = |weighting: bool| {
+        let settings = AlmiSettings { noise_weighting: weighting, ..AlmiSettings::default() };
+        let start = Instant::now();
+        let mut sink = 0.0;
+        for p in &pixels {
+            sink += almi_invert(&sets, &settings, p, &valid, &nedr).chl;
+        }
+        std::hint::black_box(sink);
+        pixels.len() as f64 / start.elapsed().as_secs_f64()
+    };
+    Ok((rate(true), rate(false), bands.len()))
+}
+
+/// SAMBUCA pixels per second on one core, and closure: share of noise-free pixels fitted at least
+/// as well as the truth, and share within 1 % of the true depth.
+fn sambuca_rate(bands: &[BandResponse], substrates: &[&str], n: usize) -> Result<(f64, f64, f64), CliError> {
+    let spec = SiopSpec::preset("heron_island").map_err(err)?;
+    let lib = SubstrateLibrary::embedded().map_err(err)?;
+    let names: Vec<String> = substrates.iter().map(|s| (*s).to_string()).collect();
+    let settings = SambucaSettings::default();
+    let model = BandModel::new(&spec, None, &lib, &names, bands, settings.nodes_per_band).map_err(err)?;
+    let nb = model.n_bands();
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(11);
+    let inv = (1.0 / 0.95, 1.0 / 0.999);
+    let pairs: Vec<(usize, usize)> = if names.len() > 1 {
+        (0..names.len()).flat_map(|i| (i + 1..names.len()).map(move |j| (i, j))).collect()
+    } else {
+        vec![(0, usize::MAX)]
+    };
+    let truths: Vec<Parameters> = (0..n)
+        .map(|_| Parameters {
+            chl: 10f64.powf(rng.random_range(-1.5..0.5)),
+            cdom: 10f64.powf(rng.random_range(-3.0..-1.0)),
+            nap: 10f64.powf(rng.random_range(-0.5..0.7)),
+            depth_m: Some(rng.random_range(0.5..8.0)),
+            substrates: {
+                let (i, j) = pairs[rng.random_range(0..pairs.len())];
+                (i, j, rng.random_range(0.0..1.0))
+            },
+        })
+        .collect();
+    // NEΔRrs of the nominal instrument over bright reef water: ~1 % of Rrs.
+    let observed: Vec<Vec<f64>> = truths
+        .iter()
+        .map(|p| {
+            let mut m = vec![0.0; nb];
+            model.evaluate(p, inv, &mut m, None);
+            m
+        })
+        .collect();
+    let valid = vec![true; nb];
+    let start = Instant::now();
+    let results: Vec<_> = observed
+        .iter()
+        .map(|o| {
+            let nedr: Vec<f64> = o.iter().map(|v| (0.01 * v).max(1e-5)).collect();
+            let obs = Observation { rrs: o, valid: &valid, nedr: &nedr, inv_cos: inv };
+            (sambuca_invert(&model, &settings, &obs), nedr)
+        })
+        .collect();
+    let rate = n as f64 / start.elapsed().as_secs_f64();
+    let (mut no_worse, mut depth_ok) = (0usize, 0usize);
+    for ((res, nedr), (truth, o)) in results.iter().zip(truths.iter().zip(&observed)) {
+        let weights: Vec<f64> = nedr.iter().map(|v| 1.0 / v).collect();
+        let obs = Observation { rrs: o, valid: &valid, nedr, inv_cos: inv };
+        let mut m = vec![0.0; nb];
+        model.evaluate(truth, inv, &mut m, None);
+        let at_truth = objective_value(settings.objective, &obs, &weights, &m);
+        no_worse += usize::from(res.objective <= at_truth * (1.0 + 1e-9) + 1e-12);
+        depth_ok += usize::from((res.depth_m / truth.depth_m.unwrap_or(1.0) - 1.0).abs() < 0.01);
+    }
+    Ok((rate, 100.0 * no_worse as f64 / n as f64, 100.0 * depth_ok as f64 / n as f64))
+}
+
+/// Append the retrieval rows to `out`.
+pub fn retrieval_rows(out: &mut String, quick: bool) -> Result<(), CliError> {
+    let _ = writeln!(out, "## Retrievals, one core (synthetic pixels)");
+    let _ = writeln!(out);
+    let _ = writeln!(
+        out,
+        "| retrieval | bands | pixels/s per core | reference (Python) | × reference | closure (noise-free) |"
+    );
+    let _ = writeln!(out, "|---|---|---|---|---|---|");
+    let (weighted, unweighted, nb) = almi_rate(quick)?;
+    let _ = writeln!(
+        out,
+        "| aLMI, 8 SIOP sets, noise-weighted | {nb} | {weighted:.0} | DEA aLMI ~6 000 | {:.0} | 1e-6 (test) |",
+        weighted / 6000.0
+    );
+    let _ = writeln!(
+        out,
+        "| aLMI, 8 SIOP sets, unweighted (as DEA) | {nb} | {unweighted:.0} | DEA aLMI ~6 000 | {:.0} | 1e-6 (test) |",
+        unweighted / 6000.0
+    );
+    let casi: Vec<(f64, f64)> = (0..28).map(|i| (430.0 + 15.0 * f64::from(i), 10.0)).collect();
+    let alos = [(460.0, 70.0), (560.0, 70.0), (650.0, 60.0), (825.0, 120.0)];
+    let n = if quick { 200 } else { 1000 };
+    for (label, bands, subs, lo, hi) in [
+        ("SAMBUCA-style, 3 substrate pairs", gaussian_bands(&casi), vec!["acropora", "sand", "turf_algae"], 13.0, 18.0),
+        ("SAMBUCA-style, 1 substrate pair", gaussian_bands(&alos), vec!["sand", "seagrass"], 46.0, 58.0),
+    ] {
+        let (rate, no_worse, depth_ok) = sambuca_rate(&bands, &subs, n)?;
+        let _ = writeln!(
+            out,
+            "| {label} | {} | {rate:.0} | SAMBUCA {lo:.0}–{hi:.0} | {:.0}–{:.0} | {no_worse:.1} % no worse than truth; depth within 1 % in {depth_ok:.1} % |",
+            bands.len(),
+            rate / hi,
+            rate / lo
+        );
+    }
+    let _ = writeln!(out);
+    // The whole default study.
+    let spec = StudySpec::default_study().map_err(err)?;
+    let mut resolved = spec.resolve(None).map_err(err)?;
+    if quick {
+        for (_, _, c) in &mut resolved.runs {
+            c.fidelity.decimation = 4;
+        }
+    }
+    let start = Instant::now();
+    let result = run_study(&resolved, &RunControl::new(), |_, _| Ok(())).map_err(err)?;
+    let seconds = start.elapsed().as_secs_f64();
+    let pixels: usize = result.runs.iter().map(|r| r.report.shape.0 * r.report.shape.1).sum();
+    let _ = writeln!(
+        out,
+        "Full study `{}` ({} runs, {} pixels{}): {seconds:.1} s on {} threads, chain and aLMI, without writing files.",
+        spec.name,
+        result.runs.len(),
+        pixels,
+        if quick { ", decimation 4" } else { "" },
+        rayon::current_num_threads()
+    );
+    let _ = writeln!(out);
+    Ok(())
+}

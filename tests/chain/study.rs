@@ -1,0 +1,89 @@
+//! Studies: a small CubeSat vs SmallSat study end to end, through the library and the CLI.
+
+use std::process::Command;
+
+use shoal::control::RunControl;
+use shoal::study::{Source, StudySpec, run_study, write_study};
+
+use super::small_lake;
+
+fn tiny_study() -> StudySpec {
+    let mut spec = StudySpec::default_study().unwrap();
+    let mut scene = small_lake();
+    scene.width = 300;
+    scene.height = 300;
+    spec.scene = Source::Inline(Box::new(scene));
+    spec
+}
+
+#[test]
+fn a_study_writes_tables_and_figures() {
+    let mut resolved = tiny_study().resolve(None).unwrap();
+    for (_, _, c) in &mut resolved.runs {
+        c.fidelity.decimation = 8;
+    }
+    let result = run_study(&resolved, &RunControl::new(), |_, _| Ok(())).unwrap();
+    assert_eq!(result.runs.len(), 2);
+    let dir = std::env::temp_dir().join(format!("shoal-study-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let outputs = write_study(&result, &dir, true).unwrap();
+    let csv = std::fs::read_to_string(dir.join("metrics.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(
+        lines.next().unwrap(),
+        "instrument,seed,product,variable,mae,bias,mae_pct,bias_pct,n,candidates,returned_pct,rmse,r2"
+    );
+    let rows: Vec<&str> = lines.collect();
+    assert_eq!(rows.len(), 6, "2 instruments × 3 variables");
+    assert!(rows.iter().any(|r| r.starts_with("cubesat,1,aLMI,chl_mg_m3,")));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("metrics.json")).unwrap()).unwrap();
+    assert_eq!(json["metrics"].as_array().unwrap().len(), 6);
+    for kind in ["maps", "scatter", "histogram"] {
+        let png = std::fs::read(dir.join("figures").join(format!("{kind}_alm_chl_mg_m3.png"))).unwrap();
+        assert_eq!(&png[1..4], b"PNG");
+        let svg = std::fs::read_to_string(dir.join("figures").join(format!("{kind}_alm_chl_mg_m3.svg"))).unwrap();
+        assert!(svg.starts_with("<svg") && svg.contains("chl-a"));
+    }
+    assert!(outputs.files.iter().any(|f| f == "study.ron"));
+    // The SmallSat's chl is better than the CubeSat's, as Table 1 predicts.
+    let mae = |label: &str| {
+        let run = result.runs.iter().find(|r| r.label == label).unwrap();
+        run.retrievals[0].metrics.get("chl_mg_m3").unwrap().mae
+    };
+    assert!(mae("smallsat") < mae("cubesat"), "{} vs {}", mae("smallsat"), mae("cubesat"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn the_study_command_runs_a_file_and_refuses_a_broken_one() {
+    let dir = std::env::temp_dir().join(format!("shoal-study-cli-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("tiny.ron");
+    let text = ron::ser::to_string_pretty(&tiny_study(), ron::ser::PrettyConfig::default().struct_names(true)).unwrap();
+    std::fs::write(&file, &text).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_shoal"))
+        .args(["study"])
+        .arg(&file)
+        .args(["--decimation", "10", "--out"])
+        .arg(dir.join("out"))
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(dir.join("out/cubesat/level0_dn.npy").exists());
+    assert!(dir.join("out/smallsat/alm_chl_mg_m3.npy").exists());
+    assert!(dir.join("out/figures/maps_alm_chl_mg_m3.png").exists());
+    std::fs::write(&file, text.replace("instruments:", "instrumentz:")).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_shoal"))
+        .args(["study"])
+        .arg(&file)
+        .arg("--out")
+        .arg(dir.join("bad"))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("instrumentz") && err.contains("tiny.ron"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
