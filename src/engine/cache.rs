@@ -62,12 +62,12 @@ impl Stage {
         Self::Retrieval,
     ];
 
-    /// Products kept per stage: two for the large cubes (instrument A and B of a comparison),
-    /// four for the small ones.
+    /// Products kept per stage: four for the large cubes (instruments A and B of a comparison,
+    /// each as a preview and at full resolution), eight for the small ones.
     fn capacity(self) -> usize {
         match self {
-            Self::Radiance | Self::Electrons | Self::Level0 | Self::Level1 | Self::Correction => 2,
-            _ => 4,
+            Self::Radiance | Self::Electrons | Self::Level0 | Self::Level1 | Self::Correction | Self::Retrieval => 4,
+            _ => 8,
         }
     }
 }

@@ -16,13 +16,15 @@ use std::time::Duration;
 use super::{Engine, EngineError, RunConfig, RunOutput};
 use crate::control::RunControl;
 
-/// A request: a configuration snapshot and the decimations to run it at, coarsest first.
+/// A request: configuration snapshots (instrument A, instrument B, …) and the decimations to run
+/// them at, coarsest first. Each decimation runs every configuration before the next finer one.
 #[derive(Debug, Clone)]
 pub struct Request {
     /// Generation number (increasing).
     pub generation: u64,
-    /// The configuration.
-    pub config: RunConfig,
+    /// The configurations; `None` at an index the caller already holds a final result for
+    /// (unchanged since its previous request): nothing is run or reported for it.
+    pub configs: Vec<Option<RunConfig>>,
     /// Decimation factors, e.g. `[4, 1]` for a preview then full resolution.
     pub decimations: Vec<usize>,
 }
@@ -34,6 +36,8 @@ pub enum Event {
     Progress {
         /// Generation.
         generation: u64,
+        /// Which configuration of the request.
+        index: usize,
         /// Decimation of the run in progress.
         decimation: usize,
         /// Units done.
@@ -45,12 +49,17 @@ pub enum Event {
     Finished {
         /// Generation.
         generation: u64,
+        /// Which configuration of the request.
+        index: usize,
         /// Decimation of the run.
         decimation: usize,
         /// The output, or the error message.
         result: Result<Arc<RunOutput>, EngineError>,
     },
 }
+
+/// Called by the worker after it sends an event.
+pub type Wake = Arc<dyn Fn() + Send + Sync>;
 
 /// The app's handle on the engine thread.
 #[derive(Debug)]
@@ -64,6 +73,12 @@ pub struct EngineHandle {
 impl EngineHandle {
     /// Start the worker with a rayon pool of `threads` threads.
     pub fn spawn(threads: usize) -> std::io::Result<Self> {
+        Self::spawn_with_wake(threads, Arc::new(|| {}))
+    }
+
+    /// As [`EngineHandle::spawn`], calling `wake` after every event it sends (the app passes
+    /// "request a repaint", so a result is drawn the moment it arrives, not at the next poll).
+    pub fn spawn_with_wake(threads: usize, wake: Wake) -> std::io::Result<Self> {
         let (request_tx, request_rx) = sync_channel::<Request>(4);
         let (event_tx, event_rx) = sync_channel::<Event>(64);
         let latest = Arc::new(AtomicU64::new(0));
@@ -75,7 +90,7 @@ impl EngineHandle {
             .map_err(std::io::Error::other)?;
         let thread = std::thread::Builder::new()
             .name("shoal-engine".into())
-            .spawn(move || worker(&request_rx, &event_tx, &worker_latest, &pool))?;
+            .spawn(move || worker(&request_rx, &event_tx, &worker_latest, &pool, &wake))?;
         Ok(Self { requests: Some(request_tx), events: event_rx, latest, thread: Some(thread) })
     }
 
@@ -160,49 +175,64 @@ impl Drop for EngineHandle {
     }
 }
 
-fn worker(requests: &Receiver<Request>, events: &SyncSender<Event>, latest: &Arc<AtomicU64>, pool: &rayon::ThreadPool) {
+fn worker(
+    requests: &Receiver<Request>,
+    events: &SyncSender<Event>,
+    latest: &Arc<AtomicU64>,
+    pool: &rayon::ThreadPool,
+    wake: &Wake,
+) {
     let mut engine = Engine::new();
     while let Ok(mut request) = requests.recv() {
         // Skip to the newest request queued.
         while let Ok(newer) = requests.try_recv() {
             request = newer;
         }
-        for &decimation in &request.decimations {
-            if latest.load(Ordering::SeqCst) != request.generation {
-                break;
-            }
-            let mut config = request.config.clone();
-            config.fidelity.decimation = decimation;
-            let control = Arc::new(RunControl::for_generation(latest.clone(), request.generation));
-            let result = std::thread::scope(|s| {
-                let watcher = control.clone();
-                let done = Arc::new(std::sync::atomic::AtomicBool::new(false));
-                let done_flag = done.clone();
+        'levels: for &decimation in &request.decimations {
+            for (index, base) in request.configs.iter().enumerate() {
+                let Some(base) = base else { continue };
+                if latest.load(Ordering::SeqCst) != request.generation {
+                    break 'levels;
+                }
+                let mut config = base.clone();
+                config.fidelity.decimation = decimation;
+                let control = Arc::new(RunControl::for_generation(latest.clone(), request.generation));
                 let generation = request.generation;
-                s.spawn(move || {
-                    while !done_flag.load(Ordering::Relaxed) {
-                        let (d, t) = watcher.progress();
-                        let _ = events.try_send(Event::Progress { generation, decimation, done: d, total: t });
-                        std::thread::sleep(Duration::from_millis(50));
-                    }
+                let result = std::thread::scope(|s| {
+                    let watcher = control.clone();
+                    let done = Arc::new(std::sync::atomic::AtomicBool::new(false));
+                    let done_flag = done.clone();
+                    let reporter = s.spawn(move || {
+                        while !done_flag.load(Ordering::Acquire) {
+                            let (d, t) = watcher.progress();
+                            if events
+                                .try_send(Event::Progress { generation, index, decimation, done: d, total: t })
+                                .is_ok()
+                            {
+                                wake();
+                            }
+                            // Parked, not asleep: the run's end unparks it at once, so a fast
+                            // (cached) run is not held up by the reporting interval.
+                            std::thread::park_timeout(Duration::from_millis(50));
+                        }
+                    });
+                    let result = pool.install(|| engine.run(&config, &control));
+                    done.store(true, Ordering::Release);
+                    reporter.thread().unpark();
+                    result
                 });
-                let result = pool.install(|| engine.run(&config, &control));
-                done.store(true, Ordering::Relaxed);
-                result
-            });
-            let cancelled = matches!(result, Err(EngineError::Cancelled));
-            if cancelled {
-                break;
-            }
-            let failed = result.is_err();
-            if events
-                .send(Event::Finished { generation: request.generation, decimation, result: result.map(Arc::new) })
-                .is_err()
-            {
-                return;
-            }
-            if failed {
-                break;
+                if matches!(result, Err(EngineError::Cancelled)) {
+                    break 'levels;
+                }
+                let failed = result.is_err();
+                if events.send(Event::Finished { generation, index, decimation, result: result.map(Arc::new) }).is_err()
+                {
+                    return;
+                }
+                wake();
+                if failed {
+                    break 'levels;
+                }
             }
         }
     }
