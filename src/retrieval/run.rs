@@ -218,8 +218,10 @@ fn retrieve_almi(
     }
     let bands: Vec<BandResponse> = used.iter().map(|&b| inputs.bands[b].clone()).collect();
     let library = SubstrateLibrary::embedded()?;
+    // One band model per set; independent, so built in parallel (this is most of a small
+    // preview's retrieval time).
     let sets = sources
-        .iter()
+        .par_iter()
         .map(|src| {
             let (spec, dir) = src.load(inputs.base_dir)?;
             let model = BandModel::new(&spec, dir.as_deref(), &library, &[], &bands, 4)?;

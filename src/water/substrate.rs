@@ -60,6 +60,13 @@ impl SubstrateLibrary {
     /// assert!(lib.get("lava").is_err());
     /// ```
     pub fn embedded() -> Result<Self, WaterError> {
+        // Parsed once per process (the files are compiled in and never change); each call
+        // returns a copy the caller may extend with its own spectra.
+        static PARSED: std::sync::OnceLock<Result<SubstrateLibrary, WaterError>> = std::sync::OnceLock::new();
+        PARSED.get_or_init(Self::parse_embedded).clone()
+    }
+
+    fn parse_embedded() -> Result<Self, WaterError> {
         let entries = EMBEDDED
             .iter()
             .map(|(name, file, column, description)| {
