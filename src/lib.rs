@@ -31,9 +31,13 @@
 //! | [`metrics`] | log-space MAE and bias (Seegers et al. 2018), RMSE, R², histograms |
 //! | [`engine`] | the chain as cached stages; the worker thread the app talks to |
 //! | [`study`] | studies: runs per instrument and seed, metrics tables, figures (PNG/SVG), cubes |
+//! | [`library`] | the preset library: built-ins and the user's own; atomic saves |
 //! | [`validation`] | comparisons with reference codes (OSOAA), shared by tests and `shoal bench` |
+//! | `app` | the desktop app (the `gui` feature; the only module that uses egui) |
 //! | [`cli`] | the headless command line (`shoal water`, `shoal atmosphere`, `shoal bench`) |
 
+#[cfg(feature = "gui")]
+pub mod app;
 pub mod assets;
 pub mod atmosphere;
 pub mod calibration;
@@ -43,7 +47,9 @@ pub mod control;
 pub mod correction;
 pub mod engine;
 pub mod instrument;
+pub mod library;
 pub mod metrics;
+pub mod parse;
 pub mod retrieval;
 pub mod scene;
 pub mod spectral;

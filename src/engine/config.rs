@@ -141,7 +141,8 @@ impl RunConfig {
 
     /// Parse RON; `origin` names the file in errors.
     pub fn from_ron(text: &str, origin: &str) -> Result<Self, InstrumentError> {
-        ron::from_str(text).map_err(|e| InstrumentError::Parse { origin: origin.into(), message: e.to_string() })
+        ron::from_str(text)
+            .map_err(|e| InstrumentError::Parse { origin: origin.into(), message: crate::parse::describe(text, &e) })
     }
 
     /// Pretty RON (the resolved configuration written beside outputs).

@@ -123,7 +123,8 @@ pub fn ground_speed_m_s(altitude_km: f64) -> f64 {
 impl InstrumentSpec {
     /// Parse RON; `origin` names the file in errors.
     pub fn from_ron(text: &str, origin: &str) -> Result<Self, InstrumentError> {
-        ron::from_str(text).map_err(|e| InstrumentError::Parse { origin: origin.into(), message: e.to_string() })
+        ron::from_str(text)
+            .map_err(|e| InstrumentError::Parse { origin: origin.into(), message: crate::parse::describe(text, &e) })
     }
 
     /// A built-in instrument by name (`presets/instruments/NAME.ron`).

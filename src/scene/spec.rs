@@ -124,7 +124,8 @@ pub fn day_of_year(date: &str) -> Result<u32, SceneError> {
 impl SceneSpec {
     /// Parse RON; `origin` names the file in errors.
     pub fn from_ron(text: &str, origin: &str) -> Result<Self, SceneError> {
-        ron::from_str(text).map_err(|e| SceneError::Parse { origin: origin.into(), message: e.to_string() })
+        ron::from_str(text)
+            .map_err(|e| SceneError::Parse { origin: origin.into(), message: crate::parse::describe(text, &e) })
     }
 
     /// A built-in scene by name (`presets/scenes/NAME.ron`).

@@ -18,7 +18,7 @@ mod figures;
 mod output;
 mod run;
 
-pub use figures::{Figure, figure_set};
+pub use figures::{ComparisonPanel, Figure, comparison_figure, figure_set};
 pub use output::{Outputs, metrics_csv, write_bytes, write_run, write_study};
 pub use run::{StudyResult, StudyRun, run_study};
 
@@ -143,8 +143,10 @@ fn load<T: serde::de::DeserializeOwned + Clone>(
                 field: field.into(),
                 message: format!("{}: {e}", full.display()),
             })?;
-            let value = ron::from_str(&text)
-                .map_err(|e| StudyError::Parse { origin: full.display().to_string(), message: e.to_string() })?;
+            let value = ron::from_str(&text).map_err(|e| StudyError::Parse {
+                origin: full.display().to_string(),
+                message: crate::parse::describe(&text, &e),
+            })?;
             Ok((value, full.parent().map(Path::to_path_buf)))
         }
         Source::Inline(t) => Ok(((**t).clone(), dir.map(Path::to_path_buf))),
@@ -154,7 +156,8 @@ fn load<T: serde::de::DeserializeOwned + Clone>(
 impl StudySpec {
     /// Parse RON; `origin` names the file in errors.
     pub fn from_ron(text: &str, origin: &str) -> Result<Self, StudyError> {
-        ron::from_str(text).map_err(|e| StudyError::Parse { origin: origin.into(), message: e.to_string() })
+        ron::from_str(text)
+            .map_err(|e| StudyError::Parse { origin: origin.into(), message: crate::parse::describe(text, &e) })
     }
 
     /// A built-in study by name (`presets/studies/NAME.ron`).

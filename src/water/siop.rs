@@ -49,7 +49,8 @@ impl SiopSpec {
     /// Read a SIOP set from RON text; `origin` names the file in errors. Relative CSV paths in
     /// it are resolved later, by [`Self::resolve`]'s `base_dir` (the file's directory).
     pub fn from_ron(text: &str, origin: &str) -> Result<Self, WaterError> {
-        ron::from_str(text).map_err(|e| WaterError::Parse { origin: origin.to_string(), message: e.to_string() })
+        ron::from_str(text)
+            .map_err(|e| WaterError::Parse { origin: origin.to_string(), message: crate::parse::describe(text, &e) })
     }
 
     /// Read a SIOP set from a RON file.

@@ -1,0 +1,85 @@
+//! Messages for malformed RON files: where (line and column), which field was being read, and
+//! what was wrong — so that a broken preset can be fixed from the message alone.
+
+/// Describe a RON error in `text`: `line 12, column 17, field `aperture_mm`: Expected float`.
+///
+/// The field is the nearest `name:` before the error position (on its line or an earlier one);
+/// it is left out when none is found or the message already names it.
+#[must_use]
+pub fn describe(text: &str, error: &ron::error::SpannedError) -> String {
+    let pos = error.span.start;
+    let message = error.code.to_string();
+    let mut out = format!("line {}, column {}", pos.line, pos.col);
+    if let Some(field) = field_before(text, pos.line, pos.col)
+        && !message.contains(&format!("`{field}`"))
+    {
+        out.push_str(&format!(", field `{field}`"));
+    }
+    out.push_str(": ");
+    out.push_str(&message);
+    out
+}
+
+/// The last `identifier:` before line `line` (1-based), column `col` (1-based, characters).
+fn field_before(text: &str, line: usize, col: usize) -> Option<String> {
+    let lines: Vec<&str> = text.lines().take(line.max(1)).collect();
+    for (i, l) in lines.iter().enumerate().rev() {
+        let part: String =
+            if i + 1 == line { l.chars().take(col.saturating_sub(1)).collect() } else { (*l).to_string() };
+        // Ignore comments.
+        let part = part.split("//").next().unwrap_or_default();
+        if let Some(name) = last_key(part) {
+            return Some(name);
+        }
+    }
+    None
+}
+
+/// The last `name:` in `s` (a Rust-style identifier followed by optional spaces and a colon).
+fn last_key(s: &str) -> Option<String> {
+    let chars: Vec<char> = s.chars().collect();
+    let mut found = None;
+    for (i, &c) in chars.iter().enumerate() {
+        if c != ':' {
+            continue;
+        }
+        let mut end = i;
+        while end > 0 && chars[end - 1] == ' ' {
+            end -= 1;
+        }
+        let mut start = end;
+        while start > 0 && (chars[start - 1].is_ascii_alphanumeric() || chars[start - 1] == '_') {
+            start -= 1;
+        }
+        if start < end && !chars[start].is_ascii_digit() {
+            found = Some(chars[start..end].iter().collect());
+        }
+    }
+    found
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    #[test]
+    fn names_the_line_and_the_field() {
+        #[derive(Debug, serde::Deserialize)]
+        #[allow(dead_code)]
+        struct S {
+            name: String,
+            aperture_mm: f64,
+        }
+        let text = "(\n    name: \"a\", // a comment: here\n    aperture_mm: \"wide\",\n)";
+        let e = ron::from_str::<S>(text).unwrap_err();
+        let m = describe(text, &e);
+        assert!(m.starts_with("line 3, column 17, field `aperture_mm`: "), "{m}");
+    }
+
+    #[test]
+    fn finds_the_field_on_an_earlier_line() {
+        assert_eq!(field_before("(\n  bands: [\n    1.0,\n    x\n", 4, 5).as_deref(), Some("bands"));
+        assert_eq!(field_before("(1, 2)", 1, 3), None);
+    }
+}
