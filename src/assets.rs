@@ -104,3 +104,7 @@ pub fn find(path: &str) -> Option<&'static Asset> {
 pub fn paths() -> impl Iterator<Item = &'static str> {
     ALL.iter().map(|a| a.path)
 }
+
+/// DejaVu Sans (Bitstream Vera licence, assets/fonts), the one font of the figures and the
+/// app's fallback for the glyphs egui's default font lacks (superscripts such as m⁻³, e⁻).
+pub const DEJAVU_SANS_TTF: &[u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");

@@ -32,6 +32,9 @@ pub struct BenchArgs {
     /// Fewer repetitions (a smoke run; figures are noisier).
     #[arg(long)]
     pub quick: bool,
+    /// Skip the app rows (slider-to-preview latency and frame time; only with the `gui` feature).
+    #[arg(long)]
+    pub no_app: bool,
 }
 
 fn machine() -> String {
@@ -251,5 +254,11 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
     super::bench_chain::chain_rows(&mut out, args.quick)?;
     emit(&std::mem::take(&mut out), None)?;
     super::bench_retrieval::retrieval_rows(&mut out, args.quick)?;
+    emit(&std::mem::take(&mut out), None)?;
+    // The app rows need egui, which only the `gui` build has.
+    #[cfg(feature = "gui")]
+    if !args.no_app {
+        out = crate::app::bench::rows(args.quick).map_err(CliError::Run)?;
+    }
     emit(&out, None)
 }

@@ -29,7 +29,7 @@ pub struct Figure {
     pub svg: String,
 }
 
-const FONT_BYTES: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
+const FONT_BYTES: &[u8] = crate::assets::DEJAVU_SANS_TTF;
 const FONT: &str = "sans-serif";
 
 fn fonts() -> Result<(), StudyError> {
@@ -172,6 +172,7 @@ struct Maps {
     label: String,
     scale: Scale,
     panels: Vec<Panel>,
+    diverging: bool,
 }
 
 const PANEL_W: u32 = 300;
@@ -180,8 +181,13 @@ const BAR_W: u32 = 110;
 const TITLE_H: u32 = 34;
 const CAPTION_H: u32 = 26;
 
+/// The colour of scale position `t` (0–1) on the viridis or the diverging palette.
+fn colour(t: f64, diverging: bool) -> [u8; 3] {
+    if diverging { crate::colormap::diverging(2.0 * t - 1.0) } else { viridis(t) }
+}
+
 /// Rasterise `panel` into `w × h` pixels (block means in scale space; grey where invalid).
-fn raster(panel: &Panel, scale: &Scale, w: u32, h: u32) -> Vec<u8> {
+fn raster(panel: &Panel, scale: &Scale, w: u32, h: u32, diverging: bool) -> Vec<u8> {
     let (rows, cols) = panel.values.dim();
     let mut rgb = vec![0u8; (w * h * 3) as usize];
     for y in 0..h {
@@ -205,7 +211,7 @@ fn raster(panel: &Panel, scale: &Scale, w: u32, h: u32) -> Vec<u8> {
                     }
                 }
             }
-            let colour = if n > 0 { viridis(sum / n as f64) } else { [200, 200, 200] };
+            let colour = if n > 0 { colour(sum / n as f64, diverging) } else { [200, 200, 200] };
             let i = ((y * w + x) * 3) as usize;
             rgb[i..i + 3].copy_from_slice(&colour);
         }
@@ -276,7 +282,7 @@ impl Draw for Maps {
             let (mx, my) = (x0 + 10 + ((bw - w) / 2) as i32, y0 + 26);
             root.draw(&Rectangle::new([(mx - 1, my - 1), (mx + w as i32, my + h as i32)], BLACK.stroke_width(1)))
                 .map_err(err)?;
-            placed.push(Placed { x: mx, y: my, w, h, rgb: raster(p, &self.scale, w, h) });
+            placed.push(Placed { x: mx, y: my, w, h, rgb: raster(p, &self.scale, w, h, self.diverging) });
         }
         // Colour bar.
         let bx = (self.panels.len() as u32 * PANEL_W) as i32 + 12;
@@ -286,7 +292,7 @@ impl Draw for Maps {
             let t0 = k as f64 / steps as f64;
             let ya = by1 - ((by1 - by0) as f64 * (k + 1) as f64 / steps as f64).round() as i32;
             let yb = by1 - ((by1 - by0) as f64 * t0).round() as i32;
-            let c = viridis(t0 + 0.5 / steps as f64);
+            let c = colour(t0 + 0.5 / steps as f64, self.diverging);
             root.draw(&Rectangle::new([(bx, ya), (bx + 18, yb)], RGBColor(c[0], c[1], c[2]).filled())).map_err(err)?;
         }
         root.draw(&Rectangle::new([(bx, by0), (bx + 18, by1)], BLACK.stroke_width(1))).map_err(err)?;
@@ -467,6 +473,88 @@ fn metric_line(m: Option<&Metrics>) -> String {
     })
 }
 
+/// A map of a comparison figure.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ComparisonPanel {
+    /// Title above the map.
+    pub title: String,
+    /// Values.
+    pub values: Array2<f32>,
+    /// Where values are valid (elsewhere grey).
+    pub valid: Array2<bool>,
+}
+
+/// A comparison figure: maps side by side on one scale, then a table and a caption.
+struct Comparison {
+    maps: Maps,
+    table: Vec<Vec<String>>,
+    caption: Vec<String>,
+}
+
+const ROW_H: u32 = 18;
+
+impl Draw for Comparison {
+    fn size(&self) -> (u32, u32) {
+        let (w, h) = self.maps.size();
+        (w.max(760), h + ROW_H * (self.table.len() as u32 + 1) + 16 * self.caption.len() as u32 + 12)
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<Vec<Placed>, String> {
+        root.fill(&WHITE).map_err(err)?;
+        let placed = self.maps.draw(root)?;
+        let (_, maps_h) = self.maps.size();
+        let columns = self.table.first().map_or(0, Vec::len);
+        let widths: Vec<i32> = (0..columns)
+            .map(|c| {
+                self.table.iter().map(|row| row.get(c).map_or(0, |s| s.chars().count())).max().unwrap_or(0) as i32 * 8
+                    + 18
+            })
+            .collect();
+        for (r, row) in self.table.iter().enumerate() {
+            let y = (maps_h + 6 + ROW_H * r as u32) as i32;
+            let mut x = 10;
+            let style = if r == 0 {
+                (FONT, 12).into_font().color(&BLACK)
+            } else {
+                (FONT, 12).into_font().color(&RGBColor(30, 30, 30))
+            };
+            for (c, cell) in row.iter().enumerate() {
+                root.draw_text(cell, &style, (x, y)).map_err(err)?;
+                x += widths.get(c).copied().unwrap_or(80);
+            }
+            if r == 0 {
+                let line_y = y + ROW_H as i32 - 3;
+                root.draw(&PathElement::new(vec![(10, line_y), (x, line_y)], BLACK)).map_err(err)?;
+            }
+        }
+        let table_end = maps_h + ROW_H * (self.table.len() as u32 + 1);
+        for (i, line) in self.caption.iter().enumerate() {
+            let y = (table_end + 4 + 16 * i as u32) as i32;
+            root.draw_text(line, &(FONT, 11).into_font().color(&RGBColor(60, 60, 60)), (10, y)).map_err(err)?;
+        }
+        Ok(placed)
+    }
+}
+
+/// A comparison figure (PNG and SVG): `panels` side by side on one `scale` (viridis, or the
+/// diverging palette for differences) with a colour bar labelled `label`, a table (first row the
+/// header) and caption lines — what the app exports for a design review.
+#[allow(clippy::too_many_arguments)]
+pub fn comparison_figure(
+    name: &str,
+    title: &str,
+    label: &str,
+    scale: Scale,
+    diverging: bool,
+    panels: Vec<ComparisonPanel>,
+    table: Vec<Vec<String>>,
+    caption: Vec<String>,
+) -> Result<Figure, StudyError> {
+    let panels = panels.into_iter().map(|p| Panel { title: p.title, values: p.values, valid: p.valid }).collect();
+    let maps = Maps { title: title.into(), label: label.into(), scale, panels, diverging };
+    render(name, &Comparison { maps, table, caption })
+}
+
 /// What the figures of one retrieval and variable draw from.
 struct Context<'a> {
     runs: &'a [&'a StudyRun],
@@ -515,7 +603,7 @@ fn maps_figure(ctx: &Context<'_>) -> Option<Maps> {
             valid: Array2::from_shape_fn(map.dim(), |(r, c)| ret.product.returned(r, c) && map[[r, c]] > 0.0),
         });
     }
-    Some(Maps { title: ctx.title.clone(), label: ctx.var.label.into(), scale: ctx.scale, panels })
+    Some(Maps { title: ctx.title.clone(), label: ctx.var.label.into(), scale: ctx.scale, panels, diverging: false })
 }
 
 /// The class of a returned pixel for the histograms: chosen SIOP set, or dominant substrate.
@@ -645,6 +733,7 @@ mod tests {
             label: "chl-a (mg m⁻³)".into(),
             scale: Scale { lo: 1.0, hi: 240.0, log: true },
             panels: vec![Panel { title: "truth".into(), values, valid }],
+            diverging: false,
         };
         let f = render("t", &fig).unwrap();
         assert_eq!(&f.png[1..4], b"PNG");

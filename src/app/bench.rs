@@ -1,0 +1,158 @@
+//! `shoal bench`'s app rows: the latency from a slider change to the updated preview on screen,
+//! and the UI thread's frame time while the engine works.
+//!
+//! Headless: the app draws into an egui context with no window, exactly as the eframe loop calls
+//! it (`draw`, then tessellation); what the GPU does with the triangles is not counted (the glow
+//! back end uploads a few textures and draws one mesh list, well under a millisecond). Frames are
+//! paced as on a 60 Hz display, so a result waits up to one refresh (16.7 ms) to be drawn, as it
+//! would on screen.
+//!
+//! "Updated preview on screen" means: both instruments show a result of the new generation and
+//! the map textures built from those results are loaded (the frame that draws them is the one
+//! timed last).
+
+use std::time::{Duration, Instant};
+
+use super::model::AppState;
+use super::{AppOptions, ShoalApp};
+
+/// Display refresh interval, ms (60 Hz).
+const REFRESH_MS: f64 = 1000.0 / 60.0;
+
+/// One frame: run the UI and tessellate its shapes. Returns the time taken, ms.
+fn frame(ctx: &egui::Context, app: &mut ShoalApp) -> f64 {
+    let input = egui::RawInput {
+        screen_rect: Some(egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(1500.0, 960.0))),
+        ..Default::default()
+    };
+    let start = Instant::now();
+    let out = ctx.run_ui(input, |ui| app.draw(ui));
+    let _ = ctx.tessellate(out.shapes, out.pixels_per_point);
+    start.elapsed().as_secs_f64() * 1e3
+}
+
+/// Is the current generation's result at decimation `level` or finer on screen for A and B?
+fn on_screen(app: &ShoalApp, level: usize) -> bool {
+    let generation = app.link.generation();
+    (0..2).all(|i| app.link.shown[i].as_ref().is_some_and(|s| s.generation == generation && s.decimation <= level))
+        && app.images.ready()
+}
+
+/// Draw frames until `done(app)` or `timeout`; returns the frame times, ms.
+fn frames_until(
+    ctx: &egui::Context,
+    app: &mut ShoalApp,
+    timeout: Duration,
+    done: impl Fn(&ShoalApp) -> bool,
+) -> Result<Vec<f64>, String> {
+    let deadline = Instant::now() + timeout;
+    let mut times = Vec::new();
+    loop {
+        times.push(frame(ctx, app));
+        if done(app) {
+            return Ok(times);
+        }
+        if let Some(e) = app.link.errors.iter().flatten().next() {
+            return Err(format!("the engine failed: {e}"));
+        }
+        if Instant::now() > deadline {
+            return Err(format!("no result within {} s", timeout.as_secs()));
+        }
+        // Paced like a 60 Hz display: the next frame starts one refresh after this one did.
+        std::thread::sleep(Duration::from_secs_f64((REFRESH_MS - times.last().copied().unwrap_or(0.0)).max(0.0) / 1e3));
+    }
+}
+
+fn percentile(mut v: Vec<f64>, q: f64) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    v.sort_by(f64::total_cmp);
+    let i = ((v.len() - 1) as f64 * q).round() as usize;
+    v[i]
+}
+
+/// One parameter moved like a slider: `steps` distinct values (so no run is served from the cache).
+struct Sweep {
+    label: &'static str,
+    set: fn(&mut AppState, usize),
+}
+
+const SWEEPS: [Sweep; 2] = [
+    Sweep { label: "aperture", set: |s, k| s.a.spec.aperture_mm *= 1.0 + 0.02 * (k as f64 + 1.0) },
+    Sweep { label: "pixel pitch", set: |s, k| s.a.spec.pixel_pitch_um *= 1.0 + 0.02 * (k as f64 + 1.0) },
+];
+
+/// Latency and frame times of `steps` changes of `sweep`, refining to 1/`finest` after each.
+fn sweep_row(
+    ctx: &egui::Context,
+    app: &mut ShoalApp,
+    sweep: &Sweep,
+    steps: usize,
+    preview: usize,
+    finest: usize,
+) -> Result<String, String> {
+    let mut latencies = Vec::new();
+    let mut busy_frames = Vec::new();
+    for k in 0..steps {
+        (sweep.set)(&mut app.state, k);
+        let start = Instant::now();
+        let first = frames_until(ctx, app, Duration::from_secs(120), |a| on_screen(a, preview))?;
+        latencies.push(start.elapsed().as_secs_f64() * 1e3);
+        busy_frames.extend(first);
+        // Let it refine to the end, drawing meanwhile: these are frames during engine work.
+        busy_frames
+            .extend(frames_until(ctx, app, Duration::from_secs(600), |a| !a.link.busy() && on_screen(a, finest))?);
+    }
+    let lat_min = latencies.iter().copied().fold(f64::INFINITY, f64::min);
+    let lat_max = latencies.iter().copied().fold(0.0, f64::max);
+    let n = busy_frames.len();
+    Ok(format!(
+        "| {} | 1/{preview} → 1/{finest} | {steps} | {:.0} ({lat_min:.0}–{lat_max:.0}) | < 100 | {:.1} / {:.1} / {:.1} | {n} |\n",
+        sweep.label,
+        percentile(latencies.clone(), 0.5),
+        percentile(busy_frames.clone(), 0.5),
+        percentile(busy_frames.clone(), 0.95),
+        percentile(busy_frames, 1.0),
+    ))
+}
+
+/// The app rows of `shoal bench` (Markdown, with a heading).
+///
+/// The app starts on the default study and refines to full resolution (1/4 in the quick run);
+/// then each parameter is moved `steps` times at the default preview (1/24) and at 1/16,
+/// refining to 1/4 after each change (the frames then are frames while the engine works).
+pub fn rows(quick: bool) -> Result<String, String> {
+    let ctx = egui::Context::default();
+    let mut state = AppState::default();
+    if quick {
+        state.levels.retain(|&d| d >= 4);
+    }
+    let preview = state.levels()[0];
+    let finest = state.levels().last().copied().unwrap_or(1);
+    let steps = if quick { 3 } else { 7 };
+    let mut app = ShoalApp::with_state(state, &ctx, AppOptions::default());
+    let cold = Instant::now();
+    frames_until(&ctx, &mut app, Duration::from_secs(600), |a| on_screen(a, preview))?;
+    let cold_preview_s = cold.elapsed().as_secs_f64();
+    frames_until(&ctx, &mut app, Duration::from_secs(600), |a| on_screen(a, finest) && !a.link.busy())?;
+    let cold_final_s = cold.elapsed().as_secs_f64();
+
+    let mut out = String::new();
+    out.push_str("\n## App (headless egui frames, default study: CubeSat vs SmallSat over Lake Hume)\n\n");
+    out.push_str(&format!(
+        "Engine threads {}. From start: first preview (1/{preview}) on screen {cold_preview_s:.2} s, final (1/{finest}) {cold_final_s:.1} s.\n\n",
+        super::engine_threads(0)
+    ));
+    out.push_str("| change to A | levels | changes | slider → preview on screen, median (min–max) ms | target | frame ms while engine runs, median / p95 / max | frames |\n|---|---|---|---|---|---|---|\n");
+    let previews: &[usize] = if quick { &[24] } else { &[24, 16] };
+    for &p in previews {
+        app.state.levels = vec![p, 4];
+        frames_until(&ctx, &mut app, Duration::from_secs(600), |a| on_screen(a, 4) && !a.link.busy())?;
+        for sweep in &SWEEPS {
+            out.push_str(&sweep_row(&ctx, &mut app, sweep, steps, p, 4)?);
+        }
+    }
+    out.push_str("\nFrame target 16 ms. Latency counts from the state change (the slider's value) to the end of the frame that draws the new maps; frames are paced at 60 Hz. Only A changes, so only A re-runs (B's result is kept).\n");
+    Ok(out)
+}

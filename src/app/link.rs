@@ -1,0 +1,200 @@
+//! The app's side of the engine thread: it submits the configuration snapshots of A and B with a
+//! new generation whenever they change, and keeps, per instrument, the newest result of the
+//! newest generation (a coarser preview never replaces a finer result of the same generation;
+//! an older generation's result is shown only until the new one's first preview arrives, and is
+//! marked stale meanwhile).
+
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use crate::engine::worker::{EngineHandle, Event, Request, Wake};
+use crate::engine::{EngineError, RunConfig, RunOutput};
+
+/// A result on display.
+#[derive(Debug, Clone)]
+pub struct Shown {
+    /// Its generation.
+    pub generation: u64,
+    /// Its decimation.
+    pub decimation: usize,
+    /// The run.
+    pub output: Arc<RunOutput>,
+}
+
+/// Progress of the run in flight.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Progress {
+    /// Instrument (0 = A, 1 = B).
+    pub index: usize,
+    /// Decimation.
+    pub decimation: usize,
+    /// Rows done.
+    pub done: u64,
+    /// Rows in all.
+    pub total: u64,
+}
+
+/// The engine link.
+#[derive(Debug)]
+pub struct EngineLink {
+    handle: EngineHandle,
+    generation: u64,
+    submitted: Vec<RunConfig>,
+    levels: Vec<usize>,
+    submitted_at: Instant,
+    /// Per instrument: the result shown.
+    pub shown: [Option<Shown>; 2],
+    /// Per instrument: the last error of the current generation.
+    pub errors: [Option<String>; 2],
+    /// The run in flight, if any.
+    pub progress: Option<Progress>,
+    /// Has the current generation's finest level finished for both instruments?
+    finished: [bool; 2],
+    /// Seconds from each submission to its first preview arriving (for the latency figure).
+    pub latencies: Vec<f64>,
+    latency_pending: bool,
+}
+
+impl EngineLink {
+    /// Start the engine thread with `threads` rayon threads; it calls `wake` after each event.
+    pub fn new(threads: usize, wake: Wake) -> std::io::Result<Self> {
+        Ok(Self {
+            handle: EngineHandle::spawn_with_wake(threads, wake)?,
+            generation: 0,
+            submitted: Vec::new(),
+            levels: Vec::new(),
+            submitted_at: Instant::now(),
+            shown: [None, None],
+            errors: [None, None],
+            progress: None,
+            finished: [false, false],
+            latencies: Vec::new(),
+            latency_pending: false,
+        })
+    }
+
+    /// The newest generation submitted.
+    #[must_use]
+    pub fn generation(&self) -> u64 {
+        self.generation
+    }
+
+    /// Submit `configs` at `levels` if they differ from what is running; true if submitted.
+    ///
+    /// An instrument whose configuration and levels did not change and whose final result is
+    /// already shown is not run again: its result is carried over to the new generation (moving
+    /// one slider of A re-runs only A).
+    pub fn submit_if_changed(&mut self, configs: Vec<RunConfig>, levels: Vec<usize>) -> bool {
+        if configs == self.submitted && levels == self.levels {
+            return false;
+        }
+        let finest = levels.last().copied().unwrap_or(1);
+        let keep: Vec<bool> = (0..configs.len())
+            .map(|i| {
+                i < 2
+                    && levels == self.levels
+                    && self.submitted.get(i) == configs.get(i)
+                    && self.finished[i]
+                    && self.errors[i].is_none()
+                    && self.shown[i].as_ref().is_some_and(|s| s.generation == self.generation && s.decimation == finest)
+            })
+            .collect();
+        self.generation += 1;
+        self.submitted.clone_from(&configs);
+        self.levels.clone_from(&levels);
+        self.errors = [None, None];
+        self.finished = [false, false];
+        for (i, kept) in keep.iter().enumerate() {
+            if *kept && let Some(shown) = self.shown[i].as_mut() {
+                shown.generation = self.generation;
+                self.finished[i] = true;
+            }
+        }
+        self.submitted_at = Instant::now();
+        self.latency_pending = true;
+        let configs = configs.into_iter().zip(&keep).map(|(c, kept)| (!kept).then_some(c)).collect();
+        self.handle.submit(Request { generation: self.generation, configs, decimations: levels })
+    }
+
+    /// Take the engine's events; true if anything shown changed.
+    pub fn poll(&mut self) -> bool {
+        let mut changed = false;
+        while let Some(event) = self.handle.poll() {
+            match event {
+                Event::Progress { index, decimation, done, total, .. } => {
+                    self.progress = Some(Progress { index, decimation, done, total });
+                }
+                Event::Finished { generation, index, decimation, result } => {
+                    let finest = self.levels.last().copied().unwrap_or(1);
+                    if index < 2 && decimation == finest {
+                        self.finished[index] = true;
+                    }
+                    match result {
+                        Ok(output) if index < 2 => {
+                            let replace = match &self.shown[index] {
+                                None => true,
+                                Some(s) => s.generation < generation || s.decimation >= decimation,
+                            };
+                            if replace {
+                                self.shown[index] = Some(Shown { generation, decimation, output });
+                                changed = true;
+                                if self.latency_pending
+                                    && self
+                                        .shown
+                                        .iter()
+                                        .all(|s| s.as_ref().is_some_and(|s| s.generation == self.generation))
+                                {
+                                    self.latencies.push(self.submitted_at.elapsed().as_secs_f64());
+                                    self.latency_pending = false;
+                                }
+                            }
+                        }
+                        Ok(_) => {}
+                        Err(EngineError::Cancelled) => {}
+                        Err(e) if index < 2 => {
+                            self.errors[index] = Some(e.to_string());
+                            self.finished[index] = true;
+                            changed = true;
+                        }
+                        Err(_) => {}
+                    }
+                    if self.finished.iter().all(|f| *f) {
+                        self.progress = None;
+                    }
+                }
+            }
+        }
+        changed
+    }
+
+    /// Is the engine still working on the current generation?
+    #[must_use]
+    pub fn busy(&self) -> bool {
+        !self.finished.iter().all(|f| *f)
+    }
+
+    /// Is instrument `index`'s shown result from an older generation than the newest?
+    #[must_use]
+    pub fn stale(&self, index: usize) -> bool {
+        self.shown[index].as_ref().is_none_or(|s| s.generation != self.generation)
+    }
+
+    /// Wait (blocking, for tests and the bench) until both instruments show the current
+    /// generation at `decimation` or finer, or `timeout` passes; true if they do.
+    pub fn wait_for(&mut self, decimation: usize, timeout: Duration) -> bool {
+        let deadline = Instant::now() + timeout;
+        loop {
+            self.poll();
+            let ready = (0..2).all(|i| {
+                self.shown[i].as_ref().is_some_and(|s| s.generation == self.generation && s.decimation <= decimation)
+            }) || self.errors.iter().any(Option::is_some);
+            if ready {
+                return self.errors.iter().all(Option::is_none);
+            }
+            if Instant::now() >= deadline {
+                return false;
+            }
+            std::thread::sleep(Duration::from_millis(2));
+        }
+    }
+}

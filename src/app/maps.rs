@@ -1,0 +1,296 @@
+//! The central area: the product maps side by side (truth | A | B, or A | B | A − B) on one
+//! colour scale with a colour bar, zoomed and panned together, with the values under the cursor.
+
+use std::hash::{DefaultHasher, Hash, Hasher};
+
+use egui::{Color32, Pos2, Rect, Sense, Vec2};
+
+use super::ShoalApp;
+use super::link::EngineLink;
+use super::model::{AppState, Layout, ProductKind};
+use super::raster::{Done, Job, Palette, PanelImage, RasterThread};
+use crate::colormap::{categorical, diverging, viridis};
+
+/// Zoom and pan shared by every map: the visible part of the image in 0–1 coordinates.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct View {
+    /// Centre of the visible part.
+    pub centre: Pos2,
+    /// Magnification (1 = whole map).
+    pub zoom: f32,
+}
+
+impl Default for View {
+    fn default() -> Self {
+        Self { centre: Pos2::new(0.5, 0.5), zoom: 1.0 }
+    }
+}
+
+impl View {
+    fn uv(&self) -> Rect {
+        let half = 0.5 / self.zoom;
+        let c = Pos2::new(self.centre.x.clamp(half, 1.0 - half), self.centre.y.clamp(half, 1.0 - half));
+        Rect::from_center_size(c, Vec2::splat(2.0 * half))
+    }
+}
+
+/// The textures on display and the request behind them.
+#[derive(Default)]
+pub struct Images {
+    requested: Option<u64>,
+    shown: Option<u64>,
+    panels: Vec<(PanelImage, egui::TextureHandle)>,
+    palette: Option<Palette>,
+    difference_palette: Option<Palette>,
+}
+
+impl Images {
+    /// The runs changed: the next frame asks for new images.
+    pub fn invalidate(&mut self) {
+        self.requested = None;
+    }
+
+    /// Are the newest images on display?
+    #[must_use]
+    pub fn ready(&self) -> bool {
+        self.requested.is_some() && self.requested == self.shown
+    }
+
+    /// Ask the raster thread for the images of the current state, if not already asked.
+    pub fn request(&mut self, state: &AppState, link: &EngineLink, raster: &RasterThread) {
+        let mut h = DefaultHasher::new();
+        state.product.hash(&mut h);
+        state.band.hash(&mut h);
+        state.layout.hash(&mut h);
+        // The results themselves, not their generation: a result carried over to a new
+        // generation (the instrument did not change) keeps its images.
+        for s in &link.shown {
+            s.as_ref().map(|s| std::sync::Arc::as_ptr(&s.output)).hash(&mut h);
+        }
+        let key = h.finish();
+        if self.requested == Some(key) {
+            return;
+        }
+        let runs = [link.shown[0].as_ref().map(|s| s.output.clone()), link.shown[1].as_ref().map(|s| s.output.clone())];
+        if runs.iter().all(Option::is_none) {
+            return;
+        }
+        if raster.request(Job { key, runs, kind: state.product, band: state.band, layout: state.layout, max_side: 720 })
+        {
+            self.requested = Some(key);
+        }
+    }
+
+    /// Upload the raster thread's answer if it is the newest.
+    pub fn receive(&mut self, ctx: &egui::Context, done: Done) {
+        if Some(done.key) != self.requested {
+            return;
+        }
+        self.panels = done
+            .panels
+            .into_iter()
+            .map(|p| {
+                let img = egui::ColorImage::from_rgba_unmultiplied([p.image.width, p.image.height], &p.image.rgba);
+                let tex = ctx.load_texture(format!("map-{}", p.title), img, egui::TextureOptions::NEAREST);
+                (p, tex)
+            })
+            .collect();
+        self.palette = Some(done.palette);
+        self.difference_palette = done.difference_palette;
+        self.shown = Some(done.key);
+    }
+}
+
+fn product_menu(app: &mut ShoalApp, ui: &mut egui::Ui) {
+    let state = &mut app.state;
+    ui.horizontal(|ui| {
+        egui::ComboBox::from_label("Product").selected_text(state.product.label()).show_ui(ui, |ui| {
+            for kind in ProductKind::ALL {
+                ui.selectable_value(&mut state.product, kind, kind.label());
+            }
+        });
+        if state.product.per_band() {
+            let names: Vec<String> = app.link.shown[0]
+                .as_ref()
+                .map(|s| {
+                    s.output
+                        .response
+                        .bands
+                        .bands
+                        .iter()
+                        .map(|b| format!("{} ({:.0} nm)", b.name, b.centre_nm))
+                        .collect()
+                })
+                .unwrap_or_default();
+            let current = names.get(state.band).cloned().unwrap_or_else(|| format!("band {}", state.band + 1));
+            egui::ComboBox::from_label("Band").selected_text(current).show_ui(ui, |ui| {
+                for (i, n) in names.iter().enumerate() {
+                    ui.selectable_value(&mut state.band, i, n);
+                }
+            });
+        }
+        ui.separator();
+        ui.selectable_value(&mut state.layout, Layout::TruthAB, "truth | A | B");
+        ui.selectable_value(&mut state.layout, Layout::AbDifference, "A | B | A − B");
+        ui.separator();
+        if ui.button("Reset zoom").clicked() {
+            app.ui.zoom = View::default();
+        }
+    });
+}
+
+fn colour_bar(ui: &mut egui::Ui, palette: Palette, height: f32, label: &str) {
+    let (rect, _) = ui.allocate_exact_size(Vec2::new(86.0, height), Sense::hover());
+    let painter = ui.painter_at(rect);
+    let bar = Rect::from_min_size(rect.min + Vec2::new(4.0, 16.0), Vec2::new(16.0, height - 28.0));
+    let steps = 64;
+    let text = ui.visuals().text_color();
+    painter.text(rect.min, egui::Align2::LEFT_TOP, label, egui::FontId::proportional(11.0), text);
+    if let Palette::Classes = palette {
+        for k in 0..8 {
+            let c = categorical(k);
+            let r = Rect::from_min_size(bar.min + Vec2::new(0.0, k as f32 * 16.0), Vec2::splat(12.0));
+            painter.rect_filled(r, 0.0, Color32::from_rgb(c[0], c[1], c[2]));
+            painter.text(
+                r.right_center() + Vec2::new(4.0, 0.0),
+                egui::Align2::LEFT_CENTER,
+                format!("{}", k + 1),
+                egui::FontId::proportional(10.0),
+                text,
+            );
+        }
+        return;
+    }
+    for k in 0..steps {
+        let t = (k as f64 + 0.5) / steps as f64;
+        let c = match palette {
+            Palette::Sequential(_) => viridis(t),
+            Palette::Diverging(_) => diverging(2.0 * t - 1.0),
+            Palette::Classes => [0, 0, 0],
+        };
+        let y1 = bar.max.y - bar.height() * k as f32 / steps as f32;
+        let y0 = bar.max.y - bar.height() * (k + 1) as f32 / steps as f32;
+        painter.rect_filled(Rect::from_x_y_ranges(bar.x_range(), y0..=y1), 0.0, Color32::from_rgb(c[0], c[1], c[2]));
+    }
+    for k in 0..=4 {
+        let t = f64::from(k) / 4.0;
+        let v = match palette {
+            Palette::Sequential(s) => s.value(t),
+            Palette::Diverging(b) => (2.0 * t - 1.0) * b,
+            Palette::Classes => 0.0,
+        };
+        let y = bar.max.y - bar.height() * t as f32;
+        painter.text(
+            Pos2::new(bar.max.x + 4.0, y),
+            egui::Align2::LEFT_CENTER,
+            format_value(v),
+            egui::FontId::proportional(10.0),
+            text,
+        );
+    }
+}
+
+fn format_value(v: f64) -> String {
+    let a = v.abs();
+    if a == 0.0 {
+        "0".into()
+    } else if !(1e-3..1e4).contains(&a) {
+        format!("{v:.2e}")
+    } else if a >= 100.0 {
+        format!("{v:.0}")
+    } else if a >= 1.0 {
+        format!("{v:.2}")
+    } else {
+        format!("{v:.4}")
+    }
+}
+
+/// The central panel.
+pub fn central(app: &mut ShoalApp, ui: &mut egui::Ui) {
+    product_menu(app, ui);
+    if app.images.panels.is_empty() {
+        ui.add_space(40.0);
+        ui.vertical_centered(|ui| {
+            ui.spinner();
+            ui.label("Running the chain: the first preview appears within seconds.");
+        });
+        return;
+    }
+    let n = app.images.panels.len();
+    let avail = ui.available_size();
+    let bar_w = 96.0;
+    let width = ((avail.x - bar_w - 8.0 * n as f32) / n as f32).max(60.0);
+    let mut hovered: Option<Pos2> = None;
+    let mut view = app.ui.zoom;
+    let stale: Vec<bool> = (0..2).map(|i| app.link.stale(i)).collect();
+    ui.horizontal(|ui| {
+        for (panel, tex) in &app.images.panels {
+            ui.vertical(|ui| {
+                let title = match panel.title.as_str() {
+                    "A" if stale[0] => "A (updating)".to_string(),
+                    "B" if stale[1] => "B (updating)".to_string(),
+                    t => t.to_string(),
+                };
+                ui.label(title);
+                let img = &panel.image;
+                let aspect = img.width as f32 / img.height.max(1) as f32;
+                let height = (width / aspect).min(avail.y - 40.0).max(40.0);
+                let w = (height * aspect).min(width);
+                let (rect, resp) = ui.allocate_exact_size(Vec2::new(w, height), Sense::click_and_drag());
+                let painter = ui.painter_at(rect);
+                painter.rect_filled(rect, 0.0, ui.visuals().extreme_bg_color);
+                painter.image(tex.id(), rect, view.uv(), Color32::WHITE);
+                if resp.dragged() {
+                    view.centre -= resp.drag_delta() / rect.size() / view.zoom;
+                }
+                if resp.hovered() {
+                    let scroll = ui.input_mut(|i| {
+                        let s = i.smooth_scroll_delta;
+                        i.smooth_scroll_delta = Vec2::ZERO;
+                        (s.y, i.zoom_delta())
+                    });
+                    view.zoom = (view.zoom * scroll.1 * (scroll.0 * 0.003).exp()).clamp(1.0, 64.0);
+                    if let Some(p) = resp.hover_pos() {
+                        let uv = view.uv();
+                        let f = (p - rect.min) / rect.size();
+                        hovered = Some(Pos2::new(uv.min.x + f.x * uv.width(), uv.min.y + f.y * uv.height()));
+                    }
+                }
+            });
+        }
+        let palette = app.images.palette;
+        let label = app.state.product.label().split(" (").next().unwrap_or("").to_string();
+        ui.vertical(|ui| {
+            if let Some(p) = palette {
+                colour_bar(ui, p, 220.0, &label);
+            }
+            if let Some(p) = app.images.difference_palette {
+                colour_bar(ui, p, 160.0, "A − B");
+            }
+        });
+    });
+    app.ui.zoom = view;
+    // Value under the cursor, in every panel (rows are drawn bottom-up).
+    if let Some(uv) = hovered {
+        let mut parts = Vec::new();
+        let mut cell = None;
+        for (panel, _) in &app.images.panels {
+            let (rows, cols) = panel.data.values.dim();
+            let c = ((uv.x * cols as f32) as usize).min(cols.saturating_sub(1));
+            let r = (((1.0 - uv.y) * rows as f32) as usize).min(rows.saturating_sub(1));
+            cell.get_or_insert((r, c));
+            let text = if panel.data.valid[[r, c]] {
+                format_value(f64::from(panel.data.values[[r, c]]))
+            } else {
+                "–".into()
+            };
+            parts.push(format!("{}: {text}", panel.title));
+        }
+        app.ui.hover = cell;
+        if let Some((r, c)) = cell {
+            ui.label(format!("row {r}, column {c}   {}", parts.join("   ")));
+        }
+    } else {
+        ui.label("Drag to pan, scroll to zoom; the maps move together.");
+    }
+}

@@ -1,0 +1,343 @@
+//! The desktop app: a live trade-off explorer. Two instruments (A and B) over one scene, edited
+//! with sliders; the engine thread reruns the chain at preview resolution while a slider moves
+//! and refines; maps, metrics, histograms, scatter and SNR side by side; figure and data export.
+//!
+//! The UI thread only draws: the chain runs on the engine thread (its own rayon pool), and the
+//! colour mapping of maps on a raster thread. This is the only module that uses egui.
+//!
+//! | part | file |
+//! |---|---|
+//! | persisted state, A/B configurations | [`model`] |
+//! | the engine thread's results | [`link`] |
+//! | product maps, colours, A − B | [`raster`] |
+//! | presets and instrument editor | `panels` |
+//! | maps with zoom, pan and hover | `maps` |
+//! | metrics table and plots | `plots` |
+//! | figure and data export | `export` |
+
+pub mod bench;
+mod export;
+pub mod link;
+mod maps;
+pub mod model;
+mod panels;
+mod plots;
+pub mod raster;
+
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use crate::library::Library;
+use link::EngineLink;
+use model::AppState;
+
+/// How the app is started.
+#[derive(Debug, Clone, Default)]
+pub struct AppOptions {
+    /// Save a screenshot of the window here once the first full set of results is shown, then quit.
+    pub screenshot: Option<PathBuf>,
+    /// Engine threads (0: all cores but one, at least one).
+    pub engine_threads: usize,
+    /// Start from the built-in default instead of the saved session.
+    pub fresh: bool,
+}
+
+/// Transient UI state (not persisted).
+#[derive(Default)]
+struct UiState {
+    error: Option<String>,
+    message: Option<String>,
+    preset_name: String,
+    export_path: String,
+    frame_times_ms: Vec<f32>,
+    last_frame: Option<Instant>,
+    zoom: maps::View,
+    hover: Option<(usize, usize)>,
+}
+
+/// The app.
+pub struct ShoalApp {
+    /// The persisted state.
+    pub state: AppState,
+    /// The engine link.
+    pub link: EngineLink,
+    library: Library,
+    images: maps::Images,
+    raster: Option<raster::RasterThread>,
+    ui: UiState,
+    options: AppOptions,
+    screenshot_taken: Arc<std::sync::Mutex<Option<Arc<egui::ColorImage>>>>,
+    screenshot_requested: bool,
+    applied_theme: Option<bool>,
+}
+
+/// Storage key of the session.
+const STATE_KEY: &str = "shoal-session";
+
+fn engine_threads(requested: usize) -> usize {
+    if requested > 0 {
+        return requested;
+    }
+    std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
+}
+
+impl ShoalApp {
+    /// The app with `state` (tests and the eframe creator).
+    pub fn with_state(state: AppState, ctx: &egui::Context, options: AppOptions) -> Self {
+        install_fonts(ctx);
+        let engine_wake = ctx.clone();
+        let link =
+            EngineLink::new(engine_threads(options.engine_threads), Arc::new(move || engine_wake.request_repaint()))
+                .unwrap_or_else(|e| {
+                    // Without an engine thread (the OS refused a thread) nothing can run: say why and stop.
+                    eprintln!("error: cannot start the engine thread: {e}");
+                    std::process::exit(1);
+                });
+        let wake = ctx.clone();
+        let raster = raster::RasterThread::spawn(move || wake.request_repaint()).ok();
+        let export_path = crate::library::home_dir().join("exports").join("comparison").display().to_string();
+        Self {
+            state,
+            link,
+            library: Library::user(),
+            images: maps::Images::default(),
+            raster,
+            ui: UiState { preset_name: "my_instrument".into(), export_path, ..UiState::default() },
+            options,
+            screenshot_taken: Arc::default(),
+            screenshot_requested: false,
+            applied_theme: None,
+        }
+    }
+
+    /// The app as eframe creates it: the saved session, or the default study.
+    #[must_use]
+    pub fn new(cc: &eframe::CreationContext<'_>, options: AppOptions) -> Self {
+        let state =
+            if options.fresh { None } else { cc.storage.and_then(|s| eframe::get_value::<AppState>(s, STATE_KEY)) };
+        Self::with_state(state.unwrap_or_default(), &cc.egui_ctx, options)
+    }
+
+    /// Use `library` for presets (tests).
+    pub fn set_library(&mut self, library: Library) {
+        self.library = library;
+    }
+
+    /// The last error shown to the user, if any.
+    #[must_use]
+    pub fn error(&self) -> Option<&str> {
+        self.ui.error.as_deref()
+    }
+
+    /// Median frame time of the last frames, ms (UI thread, CPU).
+    #[must_use]
+    pub fn median_frame_ms(&self) -> Option<f32> {
+        let mut v = self.ui.frame_times_ms.clone();
+        if v.is_empty() {
+            return None;
+        }
+        v.sort_by(f32::total_cmp);
+        Some(v[v.len() / 2])
+    }
+
+    /// Per frame, before drawing: submit changed configurations, take results and images.
+    fn tick(&mut self, ctx: &egui::Context) {
+        if self.applied_theme != Some(self.state.dark) {
+            ctx.set_theme(if self.state.dark { egui::Theme::Dark } else { egui::Theme::Light });
+            self.applied_theme = Some(self.state.dark);
+        }
+        self.link.submit_if_changed(self.state.configs(), self.state.levels());
+        if self.link.poll() {
+            self.images.invalidate();
+        }
+        if let Some(r) = &self.raster {
+            self.images.request(&self.state, &self.link, r);
+            if let Some(done) = r.poll() {
+                self.images.receive(ctx, done);
+            }
+        }
+        if self.link.busy() {
+            ctx.request_repaint_after(Duration::from_millis(30));
+        }
+    }
+
+    /// Draw one frame into `ui` (everything but the eframe plumbing).
+    pub fn draw(&mut self, ui: &mut egui::Ui) {
+        let now = Instant::now();
+        if let Some(last) = self.ui.last_frame {
+            let ms = now.duration_since(last).as_secs_f32() * 1e3;
+            self.ui.frame_times_ms.push(ms);
+            if self.ui.frame_times_ms.len() > 240 {
+                self.ui.frame_times_ms.remove(0);
+            }
+        }
+        let ctx = ui.ctx().clone();
+        self.tick(&ctx);
+        egui::Panel::top("top").show(ui, |ui| self.top_bar(ui));
+        egui::Panel::left("left").resizable(true).default_size(340.0).show(ui, |ui| {
+            egui::ScrollArea::vertical().show(ui, |ui| panels::left(self, ui));
+        });
+        egui::Panel::bottom("bottom").resizable(true).default_size(300.0).show(ui, |ui| plots::bottom(self, ui));
+        egui::CentralPanel::default().show(ui, |ui| maps::central(self, ui));
+        self.dialogs(&ctx);
+        self.ui.last_frame = Some(Instant::now());
+        let _ = now;
+    }
+
+    fn top_bar(&mut self, ui: &mut egui::Ui) {
+        ui.horizontal(|ui| {
+            ui.heading("Shoal");
+            let mark =
+                |s: &model::Slot| if s.modified() { format!("{} (modified)", s.preset) } else { s.preset.clone() };
+            ui.label(format!(
+                "A: {}   B: {}   scene: {}",
+                mark(&self.state.a),
+                mark(&self.state.b),
+                self.state.scene_name
+            ));
+            ui.separator();
+            if ui
+                .button("Export figure")
+                .on_hover_text("Write the comparison figure (PNG and SVG) and the configurations")
+                .clicked()
+            {
+                export::figure(self);
+            }
+            if ui
+                .button("Export data")
+                .on_hover_text("Write the cubes and metrics of A and B, as `shoal study` does")
+                .clicked()
+            {
+                export::data(self);
+            }
+            ui.separator();
+            ui.selectable_value(&mut self.state.dark, false, "Light");
+            ui.selectable_value(&mut self.state.dark, true, "Dark");
+            ui.separator();
+            self.status(ui);
+        });
+    }
+
+    fn status(&mut self, ui: &mut egui::Ui) {
+        match self.link.progress {
+            Some(p) if self.link.busy() => {
+                let fraction = if p.total > 0 { p.done as f32 / p.total as f32 } else { 0.0 };
+                let which = if p.index == 0 { "A" } else { "B" };
+                let level = if p.decimation == 1 {
+                    "full resolution".to_string()
+                } else {
+                    format!("preview 1/{}", p.decimation)
+                };
+                ui.add(
+                    egui::ProgressBar::new(fraction.min(1.0)).desired_width(140.0).text(format!("{which}: {level}")),
+                );
+            }
+            _ if self.link.busy() => {
+                ui.add(egui::ProgressBar::new(0.0).desired_width(140.0).text("starting"));
+            }
+            _ => {
+                ui.label("up to date");
+            }
+        }
+        if let Some(ms) = self.median_frame_ms() {
+            ui.label(format!("frame {ms:.1} ms"));
+        }
+    }
+
+    fn dialogs(&mut self, ctx: &egui::Context) {
+        if let Some(msg) = self.ui.error.clone() {
+            let r = egui::Modal::new(egui::Id::unique("shoal-error")).show(ctx, |ui| {
+                ui.heading("Problem");
+                ui.label(msg);
+                ui.button("OK").clicked()
+            });
+            if r.inner || r.should_close() {
+                self.ui.error = None;
+            }
+        }
+    }
+
+    /// Screenshot mode: once both instruments show their final results, grab the window.
+    fn screenshot(&mut self, ctx: &egui::Context) {
+        let Some(path) = self.options.screenshot.clone() else { return };
+        let finest = self.state.levels().last().copied().unwrap_or(1);
+        let ready = !self.link.busy()
+            && (0..2).all(|i| self.link.shown[i].as_ref().is_some_and(|s| s.decimation == finest))
+            && self.images.ready();
+        if ready && !self.screenshot_requested {
+            self.screenshot_requested = true;
+            let (slot, wake) = (self.screenshot_taken.clone(), ctx.clone());
+            ctx.request_screenshot(move |img| {
+                if let Ok(mut s) = slot.lock() {
+                    *s = Some(img);
+                }
+                wake.request_repaint();
+            });
+        }
+        let taken = self.screenshot_taken.lock().ok().and_then(|mut s| s.take());
+        if let Some(img) = taken {
+            if let Err(e) = export::write_screenshot(&path, &img) {
+                eprintln!("error: {e}");
+            }
+            ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+        }
+        if self.options.screenshot.is_some() {
+            ctx.request_repaint_after(Duration::from_millis(100));
+        }
+    }
+}
+
+impl eframe::App for ShoalApp {
+    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+        self.draw(ui);
+        let ctx = ui.ctx().clone();
+        self.screenshot(&ctx);
+    }
+
+    fn save(&mut self, storage: &mut dyn eframe::Storage) {
+        eframe::set_value(storage, STATE_KEY, &self.state);
+    }
+}
+
+/// Add DejaVu Sans after egui's default fonts: units need glyphs they lack (m⁻³, e⁻, µm).
+fn install_fonts(ctx: &egui::Context) {
+    use egui::epaint::text::{FontInsert, FontPriority, InsertFontFamily};
+    let families = [egui::FontFamily::Proportional, egui::FontFamily::Monospace]
+        .into_iter()
+        .map(|family| InsertFontFamily { family, priority: FontPriority::Lowest })
+        .collect();
+    ctx.add_font(FontInsert::new("dejavu-sans", egui::FontData::from_static(crate::assets::DEJAVU_SANS_TTF), families));
+}
+
+/// The app icon: a sine swell over a depth gradient, drawn here (no image file).
+fn icon() -> egui::IconData {
+    let n = 64u32;
+    let mut rgba = Vec::with_capacity((n * n * 4) as usize);
+    for y in 0..n {
+        for x in 0..n {
+            let wave = 24.0 + 6.0 * (f64::from(x) / 64.0 * std::f64::consts::TAU).sin();
+            let c = if f64::from(y) < wave {
+                [240, 246, 250]
+            } else {
+                crate::colormap::viridis(0.15 + 0.6 * f64::from(y) / 64.0)
+            };
+            rgba.extend_from_slice(&[c[0], c[1], c[2], 255]);
+        }
+    }
+    egui::IconData { rgba, width: n, height: n }
+}
+
+/// Open the app window (blocks until it closes).
+pub fn run(options: AppOptions) -> Result<(), String> {
+    let native = eframe::NativeOptions {
+        viewport: egui::ViewportBuilder::default()
+            .with_title("Shoal — instrument trade-offs over water")
+            .with_inner_size([1500.0, 960.0])
+            .with_min_inner_size([900.0, 600.0])
+            .with_icon(icon()),
+        ..Default::default()
+    };
+    eframe::run_native("shoal", native, Box::new(move |cc| Ok(Box::new(ShoalApp::new(cc, options)))))
+        .map_err(|e| format!("cannot open the app window: {e} (no display? run `shoal study` for the headless study)"))
+}

@@ -1,0 +1,445 @@
+//! What the app holds and persists: instruments A and B, the scene, the retrieval, seeds,
+//! preview settings, requirements and the view. Nothing here draws.
+
+use serde::{Deserialize, Serialize};
+
+use crate::engine::RunConfig;
+use crate::instrument::InstrumentSpec;
+use crate::retrieval::{AlmiSettings, RetrievalSpec, SambucaSettings};
+use crate::scene::{MapSpec, SceneSpec};
+use crate::study::{Source, StudySpec};
+
+/// One instrument slot: the instrument being edited and the preset it came from.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Slot {
+    /// Preset name it was loaded from.
+    pub preset: String,
+    /// The preset as loaded (to mark edits).
+    pub original: InstrumentSpec,
+    /// The instrument as edited.
+    pub spec: InstrumentSpec,
+}
+
+impl Slot {
+    /// A slot holding `spec` loaded from preset `name`.
+    #[must_use]
+    pub fn new(name: &str, spec: InstrumentSpec) -> Self {
+        Self { preset: name.into(), original: spec.clone(), spec }
+    }
+
+    /// Has the instrument been edited since it was loaded?
+    #[must_use]
+    pub fn modified(&self) -> bool {
+        self.spec != self.original
+    }
+}
+
+/// Which product the maps show.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum ProductKind {
+    /// Chlorophyll-a.
+    Chl,
+    /// Non-algal particles.
+    Nap,
+    /// CDOM absorption.
+    Cdom,
+    /// Depth (SAMBUCA).
+    Depth,
+    /// Dominant substrate (SAMBUCA).
+    Substrate,
+    /// Chosen SIOP set (aLMI).
+    SiopSet,
+    /// Rrs of the selected band.
+    Rrs,
+    /// Level-1 radiance of the selected band.
+    Level1,
+    /// Per-pixel SNR of the selected band (analytic, at the pixel's radiance).
+    Snr,
+}
+
+impl ProductKind {
+    /// Every product, in menu order.
+    pub const ALL: [Self; 9] = [
+        Self::Chl,
+        Self::Nap,
+        Self::Cdom,
+        Self::Depth,
+        Self::Substrate,
+        Self::SiopSet,
+        Self::Rrs,
+        Self::Level1,
+        Self::Snr,
+    ];
+
+    /// Menu text.
+    #[must_use]
+    pub fn label(self) -> &'static str {
+        match self {
+            Self::Chl => "chl-a (mg m⁻³)",
+            Self::Nap => "NAP (g m⁻³)",
+            Self::Cdom => "a_CDOM(440) (m⁻¹)",
+            Self::Depth => "depth (m)",
+            Self::Substrate => "dominant substrate",
+            Self::SiopSet => "chosen SIOP set",
+            Self::Rrs => "Rrs (sr⁻¹)",
+            Self::Level1 => "Level-1 radiance (W m⁻² sr⁻¹ nm⁻¹)",
+            Self::Snr => "SNR",
+        }
+    }
+
+    /// Does it need a band?
+    #[must_use]
+    pub fn per_band(self) -> bool {
+        matches!(self, Self::Rrs | Self::Level1 | Self::Snr)
+    }
+
+    /// Is it a class map (no colour scale)?
+    #[must_use]
+    pub fn categorical(self) -> bool {
+        matches!(self, Self::Substrate | Self::SiopSet)
+    }
+
+    /// The metrics variable it corresponds to.
+    #[must_use]
+    pub fn variable(self) -> Option<&'static str> {
+        match self {
+            Self::Chl => Some("chl_mg_m3"),
+            Self::Nap => Some("nap_g_m3"),
+            Self::Cdom => Some("cdom_per_m"),
+            Self::Depth => Some("depth_m"),
+            _ => None,
+        }
+    }
+}
+
+/// How the three maps are arranged.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum Layout {
+    /// Truth | A | B.
+    TruthAB,
+    /// A | B | A − B.
+    AbDifference,
+}
+
+/// Requirements the metrics and SNR are judged against.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Requirements {
+    /// Largest acceptable chl MAE, %.
+    pub chl_mae_pct: f64,
+    /// Largest acceptable NAP MAE, %.
+    pub nap_mae_pct: f64,
+    /// Largest acceptable CDOM MAE, %.
+    pub cdom_mae_pct: f64,
+    /// Largest acceptable depth MAE, %.
+    pub depth_mae_pct: f64,
+    /// Smallest acceptable SNR (at the scene's median radiance).
+    pub snr: f64,
+}
+
+impl Default for Requirements {
+    fn default() -> Self {
+        Self { chl_mae_pct: 20.0, nap_mae_pct: 30.0, cdom_mae_pct: 50.0, depth_mae_pct: 10.0, snr: 100.0 }
+    }
+}
+
+impl Requirements {
+    /// The MAE limit of a metrics variable, %.
+    #[must_use]
+    pub fn mae_limit(&self, variable: &str) -> Option<f64> {
+        match variable {
+            "chl_mg_m3" => Some(self.chl_mae_pct),
+            "nap_g_m3" => Some(self.nap_mae_pct),
+            "cdom_per_m" => Some(self.cdom_mae_pct),
+            "depth_m" | "depth_m_bottom_visible" => Some(self.depth_mae_pct),
+            _ => None,
+        }
+    }
+}
+
+/// Which retrieval the app runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum RetrievalKind {
+    /// aLMI with the eight built-in SIOP sets.
+    Almi,
+    /// SAMBUCA-style with the scene's SIOP set and substrates.
+    Sambuca,
+}
+
+/// The whole persisted state of the app.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct AppState {
+    /// Instrument A.
+    pub a: Slot,
+    /// Instrument B.
+    pub b: Slot,
+    /// Parameters linked across A and B (field names).
+    pub linked: Vec<String>,
+    /// Which instrument the editor shows (0 = A, 1 = B).
+    pub editing: usize,
+    /// Scene preset name.
+    pub scene_name: String,
+    /// The scene.
+    pub scene: SceneSpec,
+    /// Added to every random-field seed of the scene.
+    pub scene_seed: u64,
+    /// Instrument noise seed.
+    pub noise_seed: u64,
+    /// The retrieval.
+    pub retrieval: RetrievalKind,
+    /// aLMI settings.
+    pub almi: AlmiSettings,
+    /// SAMBUCA settings.
+    pub sambuca: SambucaSettings,
+    /// Preview decimations, coarsest first; the last is the final resolution.
+    pub levels: Vec<usize>,
+    /// Product shown.
+    pub product: ProductKind,
+    /// Band of band products.
+    pub band: usize,
+    /// Map arrangement.
+    pub layout: Layout,
+    /// Requirements.
+    pub requirements: Requirements,
+    /// Dark theme.
+    pub dark: bool,
+    /// Study name for captions.
+    pub study_name: String,
+}
+
+impl Default for AppState {
+    fn default() -> Self {
+        Self::from_study(&fallback_study()).unwrap_or_else(|_| {
+            let cubesat = InstrumentSpec::preset("cubesat").unwrap_or_else(|_| unreachable!("built-in preset"));
+            let smallsat = InstrumentSpec::preset("smallsat").unwrap_or_else(|_| unreachable!("built-in preset"));
+            let scene = SceneSpec::preset("lake_hume_bloom").unwrap_or_else(|_| unreachable!("built-in preset"));
+            Self::new(Slot::new("cubesat", cubesat), Slot::new("smallsat", smallsat), "lake_hume_bloom", scene)
+        })
+    }
+}
+
+fn fallback_study() -> StudySpec {
+    StudySpec::default_study().unwrap_or_else(|_| StudySpec {
+        name: "cubesat_vs_smallsat".into(),
+        description: String::new(),
+        scene: Source::Preset("lake_hume_bloom".into()),
+        instruments: vec![Source::Preset("cubesat".into()), Source::Preset("smallsat".into())],
+        retrievals: vec![],
+        seeds: vec![1],
+        detector: None,
+        calibration: None,
+        correction: None,
+        fidelity: None,
+    })
+}
+
+impl AppState {
+    fn new(a: Slot, b: Slot, scene_name: &str, scene: SceneSpec) -> Self {
+        Self {
+            a,
+            b,
+            linked: Vec::new(),
+            editing: 0,
+            scene_name: scene_name.into(),
+            scene,
+            scene_seed: 0,
+            noise_seed: 1,
+            retrieval: RetrievalKind::Almi,
+            almi: AlmiSettings::default(),
+            sambuca: SambucaSettings::default(),
+            levels: vec![24, 4, 1],
+            product: ProductKind::Chl,
+            band: 3,
+            layout: Layout::TruthAB,
+            requirements: Requirements::default(),
+            dark: false,
+            study_name: "cubesat_vs_smallsat".into(),
+        }
+    }
+
+    /// The state of a study: its first two instruments as A and B (the first twice if it has
+    /// one), its scene and its first retrieval.
+    pub fn from_study(study: &StudySpec) -> Result<Self, String> {
+        let resolved = study.resolve(None).map_err(|e| e.to_string())?;
+        let label = |i: usize| match study.instruments.get(i) {
+            Some(Source::Preset(n)) => n.clone(),
+            _ => format!("{} instrument {}", study.name, i + 1),
+        };
+        let first = resolved.runs.first().ok_or("the study has no run")?;
+        let second = resolved.runs.iter().find(|r| r.0 != first.0).unwrap_or(first);
+        let scene_name = match &study.scene {
+            Source::Preset(n) => n.clone(),
+            _ => first.2.scene.name.clone(),
+        };
+        let mut s = Self::new(
+            Slot::new(&label(0), first.2.instrument.clone()),
+            Slot::new(&label(usize::from(second.0 != first.0)), second.2.instrument.clone()),
+            &scene_name,
+            first.2.scene.clone(),
+        );
+        s.study_name.clone_from(&study.name);
+        match study.retrievals.first() {
+            Some(RetrievalSpec::Sambuca { settings, .. }) => {
+                s.retrieval = RetrievalKind::Sambuca;
+                s.sambuca = settings.clone();
+                s.product = ProductKind::Depth;
+            }
+            Some(RetrievalSpec::Almi { settings, .. }) => {
+                s.retrieval = RetrievalKind::Almi;
+                s.almi = settings.clone();
+            }
+            None => {}
+        }
+        Ok(s)
+    }
+
+    /// The slot being edited.
+    pub fn editing_mut(&mut self) -> &mut Slot {
+        if self.editing == 0 { &mut self.a } else { &mut self.b }
+    }
+
+    /// The retrieval as the engine runs it.
+    #[must_use]
+    pub fn retrieval_spec(&self) -> RetrievalSpec {
+        match self.retrieval {
+            RetrievalKind::Almi => RetrievalSpec::Almi {
+                siop_sets: crate::retrieval::sets::default_almi_sets(),
+                settings: self.almi.clone(),
+            },
+            RetrievalKind::Sambuca => {
+                RetrievalSpec::Sambuca { siop: None, substrates: None, settings: self.sambuca.clone() }
+            }
+        }
+    }
+
+    /// The scene with the scene seed added to its random fields.
+    #[must_use]
+    pub fn seeded_scene(&self) -> SceneSpec {
+        let mut scene = self.scene.clone();
+        if self.scene_seed != 0 {
+            let bump = |m: &mut MapSpec, k: u64| {
+                if let MapSpec::RandomField { seed, .. } = m {
+                    *seed = seed.wrapping_add(self.scene_seed.wrapping_mul(1_000_003).wrapping_add(k));
+                }
+            };
+            bump(&mut scene.chl_mg_m3, 1);
+            bump(&mut scene.nap_g_m3, 2);
+            bump(&mut scene.cdom_per_m, 3);
+            if let Some(d) = scene.depth_m.as_mut() {
+                bump(d, 4);
+            }
+            for (k, layer) in scene.substrates.iter_mut().enumerate() {
+                bump(&mut layer.fraction, 5 + k as u64);
+            }
+        }
+        scene
+    }
+
+    /// The run configurations of A and B.
+    #[must_use]
+    pub fn configs(&self) -> Vec<RunConfig> {
+        let scene = self.seeded_scene();
+        [&self.a, &self.b]
+            .iter()
+            .map(|slot| {
+                let mut c = RunConfig::new(scene.clone(), slot.spec.clone());
+                c.seed = self.noise_seed;
+                c.retrievals = vec![self.retrieval_spec()];
+                c
+            })
+            .collect()
+    }
+
+    /// Preview levels, coarsest first, validated (1–64, decreasing, ending at the final one).
+    #[must_use]
+    pub fn levels(&self) -> Vec<usize> {
+        let mut l: Vec<usize> = self.levels.iter().copied().filter(|d| (1..=64).contains(d)).collect();
+        l.sort_unstable_by(|a, b| b.cmp(a));
+        l.dedup();
+        if l.is_empty() { vec![24, 4, 1] } else { l }
+    }
+
+    /// The parameters edited away from each slot's preset, for captions ("A aperture_mm 60 → 80").
+    #[must_use]
+    pub fn changes(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        for (name, slot) in [("A", &self.a), ("B", &self.b)] {
+            let (Ok(now), Ok(then)) = (ron::to_string(&slot.spec), ron::to_string(&slot.original)) else { continue };
+            if now == then {
+                continue;
+            }
+            let fields = |s: &str| -> Vec<(String, String)> {
+                let body = s.trim_start_matches("(").trim_end_matches(')');
+                split_top_level(body)
+                    .into_iter()
+                    .filter_map(|f| f.split_once(':').map(|(k, v)| (k.trim().to_string(), v.trim().to_string())))
+                    .collect()
+            };
+            let (n, t) = (fields(&now), fields(&then));
+            for (k, v) in &n {
+                if let Some((_, old)) = t.iter().find(|(kk, _)| kk == k)
+                    && old != v
+                {
+                    out.push(format!("{name} {k} {old} → {v}"));
+                }
+            }
+        }
+        out
+    }
+}
+
+/// Split `a:1,b:(c,d),e:[f,g]` at top-level commas.
+fn split_top_level(s: &str) -> Vec<&str> {
+    let mut out = Vec::new();
+    let (mut depth, mut start, mut in_str) = (0i32, 0usize, false);
+    for (i, ch) in s.char_indices() {
+        match ch {
+            '"' => in_str = !in_str,
+            '(' | '[' | '{' if !in_str => depth += 1,
+            ')' | ']' | '}' if !in_str => depth -= 1,
+            ',' if depth == 0 && !in_str => {
+                out.push(&s[start..i]);
+                start = i + 1;
+            }
+            _ => {}
+        }
+    }
+    if start < s.len() {
+        out.push(&s[start..]);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn default_is_the_cubesat_vs_smallsat_study() {
+        let s = AppState::default();
+        assert_eq!(
+            (s.a.preset.as_str(), s.b.preset.as_str(), s.scene_name.as_str()),
+            ("cubesat", "smallsat", "lake_hume_bloom")
+        );
+        assert_eq!(s.configs().len(), 2);
+        assert!(!s.a.modified());
+    }
+
+    #[test]
+    fn edits_are_listed_for_captions() {
+        let mut s = AppState::default();
+        s.a.spec.aperture_mm = 80.0;
+        assert!(s.a.modified());
+        assert_eq!(s.changes(), vec!["A aperture_mm 60.0 → 80.0".to_string()]);
+    }
+
+    #[test]
+    fn the_scene_seed_moves_every_random_field() {
+        let mut s = AppState::default();
+        let before = s.seeded_scene();
+        s.scene_seed = 3;
+        assert_ne!(s.seeded_scene().chl_mg_m3, before.chl_mg_m3);
+        assert_eq!(s.seeded_scene().nap_g_m3, before.nap_g_m3, "constant maps have no seed");
+    }
+}

@@ -1,0 +1,532 @@
+//! The left panel: the preset library (instruments A and B, scene, study), the instrument editor
+//! with units, tooltips and A/B links, the band editor, derived figures, and the retrieval,
+//! seeds, preview and requirement settings.
+
+use super::ShoalApp;
+use super::model::{AppState, RetrievalKind, Slot};
+use crate::instrument::{InstrumentKind, InstrumentSpec};
+use crate::library::{Entry, Kind};
+use crate::retrieval::{Objective, Starts};
+use crate::spectral::{BandSetSpec, GaussianBand, Platform};
+
+/// One numeric instrument parameter as the editor shows it.
+struct Param {
+    key: &'static str,
+    label: &'static str,
+    unit: &'static str,
+    range: (f64, f64),
+    log: bool,
+    /// Display = stored × scale (exposure in ms).
+    scale: f64,
+    tip: &'static str,
+    get: fn(&InstrumentSpec) -> f64,
+    set: fn(&mut InstrumentSpec, f64),
+}
+
+const PARAMS: [Param; 13] = [
+    Param {
+        key: "aperture_mm",
+        label: "Aperture",
+        unit: " mm",
+        range: (10.0, 500.0),
+        log: true,
+        scale: 1.0,
+        tip: "Entrance pupil diameter: photons grow with its square",
+        get: |s| s.aperture_mm,
+        set: |s, v| s.aperture_mm = v,
+    },
+    Param {
+        key: "pixel_pitch_um",
+        label: "Pixel pitch",
+        unit: " µm",
+        range: (1.0, 30.0),
+        log: false,
+        scale: 1.0,
+        tip: "Detector pixel size: sets GSD with altitude and focal length",
+        get: |s| s.pixel_pitch_um,
+        set: |s, v| s.pixel_pitch_um = v,
+    },
+    Param {
+        key: "focal_length_mm",
+        label: "Focal length",
+        unit: " mm",
+        range: (20.0, 2000.0),
+        log: true,
+        scale: 1.0,
+        tip: "GSD = altitude × pitch / focal length",
+        get: |s| s.focal_length_mm,
+        set: |s, v| s.focal_length_mm = v,
+    },
+    Param {
+        key: "detectors",
+        label: "Detectors",
+        unit: "",
+        range: (16.0, 4096.0),
+        log: true,
+        scale: 1.0,
+        tip: "Detectors across track (swath = detectors × GSD)",
+        get: |s| s.detectors as f64,
+        set: |s, v| s.detectors = v.round() as usize,
+    },
+    Param {
+        key: "exposures",
+        label: "Lines",
+        unit: "",
+        range: (16.0, 4000.0),
+        log: true,
+        scale: 1.0,
+        tip: "Exposures along track",
+        get: |s| s.exposures as f64,
+        set: |s, v| s.exposures = v.round() as usize,
+    },
+    Param {
+        key: "exposure_s",
+        label: "Exposure",
+        unit: " ms",
+        range: (0.1, 20.0),
+        log: true,
+        scale: 1000.0,
+        tip: "Integration time per line",
+        get: |s| s.exposure_s,
+        set: |s, v| s.exposure_s = v,
+    },
+    Param {
+        key: "well_depth_e",
+        label: "Well depth",
+        unit: " e⁻",
+        range: (1000.0, 2_000_000.0),
+        log: true,
+        scale: 1.0,
+        tip: "Full-well capacity: saturation above it",
+        get: |s| s.well_depth_e,
+        set: |s, v| s.well_depth_e = v,
+    },
+    Param {
+        key: "gain_e_per_dn",
+        label: "Gain",
+        unit: " e⁻/DN",
+        range: (0.1, 100.0),
+        log: true,
+        scale: 1.0,
+        tip: "Conversion gain: quantisation noise gain²/12",
+        get: |s| s.gain_e_per_dn,
+        set: |s, v| s.gain_e_per_dn = v,
+    },
+    Param {
+        key: "read_noise_e",
+        label: "Read noise",
+        unit: " e⁻",
+        range: (0.0, 100.0),
+        log: false,
+        scale: 1.0,
+        tip: "Readout noise, electrons rms",
+        get: |s| s.read_noise_e,
+        set: |s, v| s.read_noise_e = v,
+    },
+    Param {
+        key: "bias_dn",
+        label: "Bias",
+        unit: " DN",
+        range: (0.0, 1000.0),
+        log: false,
+        scale: 1.0,
+        tip: "ADC offset",
+        get: |s| s.bias_dn,
+        set: |s, v| s.bias_dn = v,
+    },
+    Param {
+        key: "adc_bits",
+        label: "ADC bits",
+        unit: "",
+        range: (4.0, 16.0),
+        log: false,
+        scale: 1.0,
+        tip: "Converter resolution: 2^bits − 1 is the largest count",
+        get: |s| f64::from(s.adc_bits),
+        set: |s, v| s.adc_bits = v.round() as u32,
+    },
+    Param {
+        key: "optical_transmission",
+        label: "Optical transmission",
+        unit: "",
+        range: (0.1, 1.0),
+        log: false,
+        scale: 1.0,
+        tip: "Throughput of the optics and filters",
+        get: |s| s.optical_transmission,
+        set: |s, v| s.optical_transmission = v,
+    },
+    Param {
+        key: "altitude_km",
+        label: "Altitude",
+        unit: " km",
+        range: (200.0, 1500.0),
+        log: false,
+        scale: 1.0,
+        tip: "Orbit altitude: GSD and ground speed",
+        get: |s| s.altitude_km,
+        set: |s, v| s.altitude_km = v,
+    },
+];
+
+fn library_combo(ui: &mut egui::Ui, label: &str, current: &str, entries: &[Entry]) -> Option<Entry> {
+    let mut picked = None;
+    egui::ComboBox::from_label(label).selected_text(current).show_ui(ui, |ui| {
+        for e in entries {
+            let text = if e.builtin { e.name.clone() } else { format!("{} (mine)", e.name) };
+            if ui.selectable_label(e.name == current, text).clicked() {
+                picked = Some(e.clone());
+            }
+        }
+    });
+    picked
+}
+
+fn presets(app: &mut ShoalApp, ui: &mut egui::Ui) {
+    ui.heading("Presets");
+    let instruments = app.library.list(Kind::Instrument);
+    for (i, label) in [(0, "Instrument A"), (1, "Instrument B")] {
+        let current = if i == 0 { app.state.a.preset.clone() } else { app.state.b.preset.clone() };
+        if let Some(e) = library_combo(ui, label, &current, &instruments) {
+            match app.library.load_instrument(&e) {
+                Ok(spec) => {
+                    let slot = Slot::new(&e.name, spec);
+                    if i == 0 {
+                        app.state.a = slot;
+                    } else {
+                        app.state.b = slot;
+                    }
+                }
+                Err(err) => app.ui.error = Some(format!("Cannot load instrument `{}`: {err}", e.name)),
+            }
+        }
+    }
+    let scenes = app.library.list(Kind::Scene);
+    if let Some(e) = library_combo(ui, "Scene", &app.state.scene_name.clone(), &scenes) {
+        match app.library.load_scene(&e) {
+            Ok(spec) => {
+                app.state.scene = spec;
+                app.state.scene_name = e.name;
+            }
+            Err(err) => app.ui.error = Some(format!("Cannot load scene `{}`: {err}", e.name)),
+        }
+    }
+    let studies = app.library.list(Kind::Study);
+    if let Some(e) = library_combo(ui, "Study", &app.state.study_name.clone(), &studies) {
+        match app.library.load_study(&e).map_err(|e| e.to_string()).and_then(|s| AppState::from_study(&s)) {
+            Ok(mut s) => {
+                s.dark = app.state.dark;
+                s.requirements = app.state.requirements.clone();
+                app.state = s;
+            }
+            Err(err) => app.ui.error = Some(format!("Cannot load study `{}`: {err}", e.name)),
+        }
+    }
+}
+
+fn save_presets(app: &mut ShoalApp, ui: &mut egui::Ui) {
+    ui.horizontal(|ui| {
+        let l = ui.label("Preset name");
+        ui.add(egui::TextEdit::singleline(&mut app.ui.preset_name).desired_width(130.0)).labelled_by(l.id);
+    });
+    ui.horizontal(|ui| {
+        for (i, label) in [(0, "Save A"), (1, "Save B")] {
+            if ui.button(label).on_hover_text("Save this instrument in your preset library").clicked() {
+                let name = app.ui.preset_name.trim().to_string();
+                let spec = if i == 0 { app.state.a.spec.clone() } else { app.state.b.spec.clone() };
+                match app.library.save_instrument(&name, &spec, true) {
+                    Ok(path) => {
+                        let slot = Slot::new(&name, spec);
+                        if i == 0 {
+                            app.state.a = slot;
+                        } else {
+                            app.state.b = slot;
+                        }
+                        app.ui.message = Some(format!("saved {}", path.display()));
+                    }
+                    Err(e) => app.ui.error = Some(format!("Cannot save: {e}")),
+                }
+            }
+        }
+        if ui.button("Save study").clicked() {
+            let name = app.ui.preset_name.trim().to_string();
+            let study = crate::study::StudySpec {
+                name: name.clone(),
+                description: format!(
+                    "saved from the app: A {} vs B {} over {}",
+                    app.state.a.preset, app.state.b.preset, app.state.scene_name
+                ),
+                scene: crate::study::Source::Inline(Box::new(app.state.seeded_scene())),
+                instruments: vec![
+                    crate::study::Source::Inline(Box::new(app.state.a.spec.clone())),
+                    crate::study::Source::Inline(Box::new(app.state.b.spec.clone())),
+                ],
+                retrievals: vec![app.state.retrieval_spec()],
+                seeds: vec![app.state.noise_seed],
+                detector: None,
+                calibration: None,
+                correction: None,
+                fidelity: None,
+            };
+            match app.library.save_study(&name, &study, true) {
+                Ok(path) => app.ui.message = Some(format!("saved {}", path.display())),
+                Err(e) => app.ui.error = Some(format!("Cannot save: {e}")),
+            }
+        }
+    });
+    if let Some(m) = &app.ui.message {
+        ui.small(m.as_str());
+    }
+}
+
+fn band_editor(slot: &mut Slot, ui: &mut egui::Ui) {
+    let bands = match &mut slot.spec.kind {
+        InstrumentKind::Multispectral { bands }
+        | InstrumentKind::IdealRadiometer { bands }
+        | InstrumentKind::FilterImager { bands, .. } => bands,
+        InstrumentKind::Spectrograph { start_nm, end_nm, sampling_nm, resolution_nm, .. } => {
+            ui.add(egui::Slider::new(start_nm, 350.0..=700.0).text("First band").suffix(" nm"));
+            ui.add(egui::Slider::new(end_nm, 500.0..=1000.0).text("Last band").suffix(" nm"));
+            ui.add(egui::Slider::new(sampling_nm, 1.0..=30.0).text("Sampling").suffix(" nm"));
+            ui.add(egui::Slider::new(resolution_nm, 1.0..=50.0).text("Resolution").suffix(" nm"));
+            return;
+        }
+    };
+    let name = match bands {
+        BandSetSpec::Olci { platform: Platform::A, .. } => "OLCI S3A",
+        BandSetSpec::Olci { .. } => "OLCI S3B",
+        BandSetSpec::Msi { platform: Platform::A, .. } => "MSI S2A",
+        BandSetSpec::Msi { .. } => "MSI S2B",
+        BandSetSpec::Gaussian(_) => "Custom (Gaussian)",
+    };
+    let mut choice: Option<BandSetSpec> = None;
+    egui::ComboBox::from_label("Band set").selected_text(name).show_ui(ui, |ui| {
+        if ui.selectable_label(name == "OLCI S3A", "OLCI S3A").clicked() {
+            choice = Some(BandSetSpec::Olci { platform: Platform::A, bands: None });
+        }
+        if ui.selectable_label(name == "OLCI S3B", "OLCI S3B").clicked() {
+            choice = Some(BandSetSpec::Olci { platform: Platform::B, bands: None });
+        }
+        if ui.selectable_label(name == "MSI S2A", "MSI S2A").clicked() {
+            choice = Some(BandSetSpec::Msi { platform: Platform::A, bands: None });
+        }
+        if ui.selectable_label(name == "MSI S2B", "MSI S2B").clicked() {
+            choice = Some(BandSetSpec::Msi { platform: Platform::B, bands: None });
+        }
+        if ui.selectable_label(name.starts_with("Custom"), "Custom (Gaussian)").clicked() {
+            // Start from the current bands' centres and widths.
+            let list = crate::spectral::BandSet::from_spec(bands)
+                .map(|set| {
+                    set.bands
+                        .iter()
+                        .map(|b| GaussianBand {
+                            name: Some(b.name.clone()),
+                            centre_nm: b.centre_nm,
+                            fwhm_nm: b.fwhm_nm,
+                        })
+                        .collect()
+                })
+                .unwrap_or_default();
+            choice = Some(BandSetSpec::Gaussian(list));
+        }
+    });
+    if let Some(c) = choice {
+        *bands = c;
+    }
+    if let BandSetSpec::Gaussian(list) = bands {
+        let mut remove = None;
+        egui::Grid::new("bands").num_columns(4).striped(true).show(ui, |ui| {
+            ui.label("band");
+            ui.label("centre nm");
+            ui.label("FWHM nm");
+            ui.label("");
+            ui.end_row();
+            for (i, b) in list.iter_mut().enumerate() {
+                ui.label(format!("{}", i + 1));
+                ui.add(egui::DragValue::new(&mut b.centre_nm).range(380.0..=1000.0).speed(0.5).suffix(" c"));
+                ui.add(egui::DragValue::new(&mut b.fwhm_nm).range(1.0..=100.0).speed(0.2).suffix(" w"));
+                if ui.small_button("remove").clicked() {
+                    remove = Some(i);
+                }
+                ui.end_row();
+            }
+        });
+        if let Some(i) = remove {
+            list.remove(i);
+        }
+        if ui.button("Add band").clicked() {
+            let c = list.last().map_or(560.0, |b| (b.centre_nm + 20.0).min(990.0));
+            list.push(GaussianBand { name: None, centre_nm: c, fwhm_nm: 10.0 });
+        }
+    }
+}
+
+fn editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
+    ui.heading("Instrument");
+    ui.horizontal(|ui| {
+        ui.selectable_value(&mut app.state.editing, 0, "Edit A");
+        ui.selectable_value(&mut app.state.editing, 1, "Edit B");
+    });
+    let editing = app.state.editing;
+    let mut changed: Vec<(&'static str, f64)> = Vec::new();
+    egui::Grid::new("params").num_columns(2).show(ui, |ui| {
+        for p in &PARAMS {
+            let slot = if editing == 0 { &mut app.state.a } else { &mut app.state.b };
+            let mut v = (p.get)(&slot.spec) * p.scale;
+            let before = v;
+            let slider =
+                egui::Slider::new(&mut v, p.range.0..=p.range.1).text(p.label).suffix(p.unit).logarithmic(p.log);
+            let slider =
+                if matches!(p.key, "detectors" | "exposures" | "adc_bits") { slider.integer() } else { slider };
+            ui.add(slider).on_hover_text(p.tip);
+            let mut linked = app.state.linked.iter().any(|k| k == p.key);
+            if ui
+                .checkbox(&mut linked, "link")
+                .on_hover_text(format!("Link {} across A and B", p.label.to_lowercase()))
+                .changed()
+            {
+                if linked {
+                    app.state.linked.push(p.key.to_string());
+                } else {
+                    app.state.linked.retain(|k| k != p.key);
+                }
+            }
+            ui.end_row();
+            if v != before {
+                let slot = if editing == 0 { &mut app.state.a } else { &mut app.state.b };
+                (p.set)(&mut slot.spec, v / p.scale);
+                changed.push((p.key, v / p.scale));
+            }
+        }
+    });
+    // Linked parameters follow to the other instrument.
+    for (key, value) in changed {
+        if app.state.linked.iter().any(|k| k == key)
+            && let Some(p) = PARAMS.iter().find(|p| p.key == key)
+        {
+            let other = if editing == 0 { &mut app.state.b } else { &mut app.state.a };
+            (p.set)(&mut other.spec, value);
+        }
+    }
+    let slot = if editing == 0 { &mut app.state.a } else { &mut app.state.b };
+    egui::CollapsingHeader::new("Bands").default_open(false).show(ui, |ui| band_editor(slot, ui));
+    derived(app, ui);
+}
+
+/// A derived figure: its name and how to compute it from an instrument.
+type DerivedRow = (&'static str, fn(&InstrumentSpec) -> String);
+
+fn derived(app: &ShoalApp, ui: &mut egui::Ui) {
+    egui::CollapsingHeader::new("Derived").default_open(true).show(ui, |ui| {
+        egui::Grid::new("derived").num_columns(3).striped(true).show(ui, |ui| {
+            ui.label("");
+            ui.label("A");
+            ui.label("B");
+            ui.end_row();
+            let rows: [DerivedRow; 5] = [
+                ("GSD", |s| format!("{:.1} m", s.gsd_m())),
+                ("Swath", |s| format!("{:.1} km", s.swath_m() / 1000.0)),
+                ("f-number", |s| format!("f/{:.2}", s.f_number())),
+                ("Étendue", |s| format!("{:.2e} m² sr", s.etendue_m2_sr())),
+                ("Line period", |s| {
+                    format!("{:.2} ms", 1e3 * s.gsd_m() / crate::instrument::ground_speed_m_s(s.altitude_km))
+                }),
+            ];
+            for (name, f) in rows {
+                ui.label(name);
+                ui.label(f(&app.state.a.spec));
+                ui.label(f(&app.state.b.spec));
+                ui.end_row();
+            }
+            ui.label("Peak SNR");
+            for i in 0..2 {
+                let snr = app.link.shown[i]
+                    .as_ref()
+                    .map(|s| s.output.snr.iter().map(|r| r.snr_analytic).fold(0.0, f64::max))
+                    .map_or_else(|| "–".to_string(), |v| format!("{v:.0}"));
+                ui.label(snr);
+            }
+            ui.end_row();
+        });
+        ui.small("Peak SNR: the best band at the scene's median radiance.");
+    });
+}
+
+fn settings(app: &mut ShoalApp, ui: &mut egui::Ui) {
+    egui::CollapsingHeader::new("Retrieval, seeds, preview").default_open(true).show(ui, |ui| {
+        let s = &mut app.state;
+        ui.horizontal(|ui| {
+            ui.selectable_value(&mut s.retrieval, RetrievalKind::Almi, "aLMI");
+            ui.selectable_value(&mut s.retrieval, RetrievalKind::Sambuca, "SAMBUCA");
+        });
+        match s.retrieval {
+            RetrievalKind::Almi => {
+                ui.checkbox(&mut s.almi.noise_weighting, "Noise weighting")
+                    .on_hover_text("Weight each band by its noise (off: as the reference code)");
+            }
+            RetrievalKind::Sambuca => {
+                egui::ComboBox::from_label("Objective").selected_text(format!("{:?}", s.sambuca.objective)).show_ui(
+                    ui,
+                    |ui| {
+                        ui.selectable_value(&mut s.sambuca.objective, Objective::F, "F");
+                        ui.selectable_value(&mut s.sambuca.objective, Objective::AlphaF, "AlphaF");
+                        ui.selectable_value(&mut s.sambuca.objective, Objective::Lsq, "Lsq");
+                    },
+                );
+                egui::ComboBox::from_label("Starts").selected_text(format!("{:?}", s.sambuca.starts)).show_ui(
+                    ui,
+                    |ui| {
+                        ui.selectable_value(&mut s.sambuca.starts, Starts::Adaptive, "Adaptive");
+                        ui.selectable_value(&mut s.sambuca.starts, Starts::Shallow, "Shallow");
+                        ui.selectable_value(&mut s.sambuca.starts, Starts::ShallowAndDeep, "ShallowAndDeep");
+                    },
+                );
+            }
+        }
+        ui.horizontal(|ui| {
+            let l = ui.label("Scene seed");
+            ui.add(egui::DragValue::new(&mut s.scene_seed).range(0..=1_000_000).speed(1.0)).labelled_by(l.id);
+            let l = ui.label("Noise seed");
+            ui.add(egui::DragValue::new(&mut s.noise_seed).range(0..=1_000_000).speed(1.0)).labelled_by(l.id);
+        });
+        let levels = s.levels();
+        let (preview, finest) = (levels[0], levels.last().copied().unwrap_or(1));
+        let (mut pre, mut fin) = (preview, finest);
+        ui.horizontal(|ui| {
+            egui::ComboBox::from_label("Preview").selected_text(format!("1/{pre}")).show_ui(ui, |ui| {
+                for d in [8, 16, 24, 32] {
+                    ui.selectable_value(&mut pre, d, format!("1/{d}"));
+                }
+            });
+            egui::ComboBox::from_label("Final")
+                .selected_text(if fin == 1 { "full".to_string() } else { format!("1/{fin}") })
+                .show_ui(ui, |ui| {
+                    ui.selectable_value(&mut fin, 1, "full");
+                    ui.selectable_value(&mut fin, 2, "1/2");
+                    ui.selectable_value(&mut fin, 4, "1/4");
+                });
+        });
+        if (pre, fin) != (preview, finest) {
+            // Preview first, then 1/4 while the final level is finer, then the final level.
+            s.levels = [pre, 4, fin].into_iter().filter(|&d| d <= pre).collect();
+        }
+    });
+    egui::CollapsingHeader::new("Requirements").default_open(false).show(ui, |ui| {
+        let r = &mut app.state.requirements;
+        ui.add(egui::Slider::new(&mut r.chl_mae_pct, 1.0..=200.0).text("chl MAE at most").suffix(" %"));
+        ui.add(egui::Slider::new(&mut r.nap_mae_pct, 1.0..=200.0).text("NAP MAE at most").suffix(" %"));
+        ui.add(egui::Slider::new(&mut r.cdom_mae_pct, 1.0..=300.0).text("CDOM MAE at most").suffix(" %"));
+        ui.add(egui::Slider::new(&mut r.depth_mae_pct, 1.0..=200.0).text("depth MAE at most").suffix(" %"));
+        ui.add(egui::Slider::new(&mut r.snr, 1.0..=2000.0).logarithmic(true).text("SNR at least"));
+    });
+}
+
+/// The left panel.
+pub fn left(app: &mut ShoalApp, ui: &mut egui::Ui) {
+    presets(app, ui);
+    save_presets(app, ui);
+    ui.separator();
+    editor(app, ui);
+    ui.separator();
+    settings(app, ui);
+}

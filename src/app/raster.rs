@@ -1,0 +1,393 @@
+//! Product maps for display: the values of a product from a run (or its truth), the A − B
+//! difference on A's pixels, colour mapping and downsampling — computed on a raster thread so
+//! the UI thread only uploads the finished images.
+
+use std::sync::Arc;
+use std::sync::mpsc::{Receiver, SyncSender, TrySendError, sync_channel};
+
+use ndarray::Array2;
+
+use super::model::ProductKind;
+use crate::colormap::{Scale, categorical, diverging, viridis};
+use crate::engine::RunOutput;
+use crate::instrument::{Detector, DetectorMode, Viewing};
+
+/// A map's values and where they are valid.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MapData {
+    /// Values (row, column).
+    pub values: Array2<f32>,
+    /// Valid pixels.
+    pub valid: Array2<bool>,
+}
+
+/// The product `kind` (band `band`) of `out`; `truth` takes the scene's truth instead of the
+/// retrieval where there is one. `None` when the run has no such product.
+#[must_use]
+pub fn product_map(out: &RunOutput, kind: ProductKind, band: usize, truth: bool) -> Option<MapData> {
+    let r = &out.radiance;
+    let water = r.land.mapv(|l| l == 0);
+    let ret = out.retrievals.first();
+    let returned = |p: &crate::retrieval::Product| Array2::from_shape_fn(p.flags.dim(), |(i, j)| p.returned(i, j));
+    let product_or_truth =
+        |t: &Array2<f32>, pick: fn(&crate::retrieval::Product) -> Option<&Array2<f32>>| -> Option<MapData> {
+            if truth {
+                return Some(MapData { values: t.clone(), valid: water.clone() });
+            }
+            let p = &ret?.product;
+            let map = pick(p)?;
+            let ok = returned(p);
+            Some(MapData {
+                valid: Array2::from_shape_fn(map.dim(), |(i, j)| ok[[i, j]] && map[[i, j]] > 0.0),
+                values: map.clone(),
+            })
+        };
+    let nb = r.radiance.dim().2;
+    let band = band.min(nb.saturating_sub(1));
+    match kind {
+        ProductKind::Chl => product_or_truth(&r.chl_mg_m3, |p| Some(&p.chl_mg_m3)),
+        ProductKind::Nap => product_or_truth(&r.nap_g_m3, |p| Some(&p.nap_g_m3)),
+        ProductKind::Cdom => product_or_truth(&r.cdom_per_m, |p| Some(&p.cdom_per_m)),
+        ProductKind::Depth => product_or_truth(r.depth_m.as_ref()?, |p| p.depth_m.as_ref()),
+        ProductKind::Substrate => {
+            let (f, names) = if truth {
+                (r.substrate_fractions.as_ref()?, &r.substrate_names)
+            } else {
+                let p = &ret?.product;
+                (p.substrate_fractions.as_ref()?, &p.substrate_names)
+            };
+            let dominant = Array2::from_shape_fn((f.dim().0, f.dim().1), |(i, j)| {
+                (0..f.dim().2).max_by(|&a, &b| f[[i, j, a]].total_cmp(&f[[i, j, b]])).unwrap_or(0) as f32
+            });
+            let _ = names;
+            let valid = if truth { water } else { returned(&ret?.product) };
+            Some(MapData { values: dominant, valid })
+        }
+        ProductKind::SiopSet => {
+            if truth {
+                return None;
+            }
+            let p = &ret?.product;
+            let s = p.siop_set.as_ref()?;
+            Some(MapData {
+                values: s.mapv(f32::from),
+                valid: Array2::from_shape_fn(s.dim(), |(i, j)| s[[i, j]] >= 0 && p.returned(i, j)),
+            })
+        }
+        ProductKind::Rrs => {
+            let cube = if truth { &r.rrs } else { &out.correction.rrs.rrs };
+            let values = cube.index_axis(ndarray::Axis(2), band).to_owned();
+            let flags = &out.correction.rrs.flags;
+            let valid =
+                Array2::from_shape_fn(values.dim(), |(i, j)| water[[i, j]] && (truth || flags[[i, j, band]] == 0));
+            Some(MapData { values, valid })
+        }
+        ProductKind::Level1 => {
+            let cube = if truth { &r.radiance } else { &out.level1.radiance };
+            let values = cube.index_axis(ndarray::Axis(2), band).to_owned();
+            Some(MapData { valid: values.mapv(|v| v.is_finite() && v > 0.0), values })
+        }
+        ProductKind::Snr => {
+            // Analytic SNR at each pixel's own radiance (detector noise model, noise on).
+            let detector =
+                Detector::new(&out.config.instrument, &out.response, DetectorMode::default(), out.config.seed);
+            let l = r.radiance.index_axis(ndarray::Axis(2), band);
+            let values = Array2::from_shape_fn(l.dim(), |(i, j)| {
+                let d = out.viewing.detector_index[j];
+                crate::instrument::analytic_snr(&detector, d, band, f64::from(l[[i, j]])) as f32
+            });
+            Some(MapData { valid: values.mapv(|v| v.is_finite() && v > 0.0), values })
+        }
+    }
+}
+
+/// Ground position (x, y) of each row and column's pixel, and the inverse: the nearest pixel of a
+/// viewing to a ground point, along and across track.
+fn nearest(v: &Viewing, x: f64, y: f64, heading_deg: f64) -> Option<(usize, usize)> {
+    let (rows, cols) = (v.lines(), v.columns());
+    if rows == 0 || cols == 0 {
+        return None;
+    }
+    let h = heading_deg.to_radians();
+    let (along, right) = ((h.sin(), h.cos()), (h.cos(), -h.sin()));
+    let proj = |p: (f64, f64), u: (f64, f64)| p.0 * u.0 + p.1 * u.1;
+    let a = |r: usize| proj(v.ground_m(0, r, cols / 2), along);
+    let c = |col: usize| proj(v.ground_m(0, rows / 2, col), right);
+    let (a0, a1, c0, c1) = (a(0), a(rows - 1), c(0), c(cols - 1));
+    let (pa, pc) = (proj((x, y), along), proj((x, y), right));
+    let fr = if rows > 1 { (pa - a0) / (a1 - a0) * (rows - 1) as f64 } else { 0.0 };
+    let fc = if cols > 1 { (pc - c0) / (c1 - c0) * (cols - 1) as f64 } else { 0.0 };
+    let (r, col) = (fr.round(), fc.round());
+    (r >= 0.0 && col >= 0.0 && r < rows as f64 && col < cols as f64).then_some((r as usize, col as usize))
+}
+
+/// A − B on A's pixels: B is sampled at the pixel nearest each of A's ground points.
+#[must_use]
+pub fn difference(a: &MapData, a_out: &RunOutput, b: &MapData, b_out: &RunOutput) -> MapData {
+    let (rows, cols) = a.values.dim();
+    let mut values = Array2::zeros((rows, cols));
+    let mut valid = Array2::from_elem((rows, cols), false);
+    for r in 0..rows {
+        for c in 0..cols {
+            let (x, y) = a_out.viewing.ground_m(0, r, c);
+            if let Some((rb, cb)) = nearest(&b_out.viewing, x, y, b_out.config.instrument.heading_deg)
+                && rb < b.values.dim().0
+                && cb < b.values.dim().1
+                && a.valid[[r, c]]
+                && b.valid[[rb, cb]]
+            {
+                values[[r, c]] = a.values[[r, c]] - b.values[[rb, cb]];
+                valid[[r, c]] = true;
+            }
+        }
+    }
+    MapData { values, valid }
+}
+
+/// How a map is coloured.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Palette {
+    /// Viridis on a scale.
+    Sequential(Scale),
+    /// Blue–white–red symmetric about zero, ± this bound.
+    Diverging(f64),
+    /// Class colours.
+    Classes,
+}
+
+/// An RGBA image ready to upload.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Image {
+    /// Width, px.
+    pub width: usize,
+    /// Height, px.
+    pub height: usize,
+    /// Unmultiplied RGBA.
+    pub rgba: Vec<u8>,
+}
+
+/// Colour `map` with `palette`, block-averaged down to at most `max_side` pixels on its long side,
+/// the first row at the bottom (flight direction up). Invalid pixels are transparent grey.
+#[must_use]
+pub fn colorize(map: &MapData, palette: Palette, max_side: usize) -> Image {
+    let (rows, cols) = map.values.dim();
+    let step = rows.max(cols).div_ceil(max_side.max(1)).max(1);
+    let (h, w) = (rows.div_ceil(step).max(1), cols.div_ceil(step).max(1));
+    let mut rgba = vec![0u8; w * h * 4];
+    for y in 0..h {
+        for x in 0..w {
+            let (mut sum, mut n, mut first) = (0.0, 0usize, None);
+            for r in y * step..((y + 1) * step).min(rows) {
+                for c in x * step..((x + 1) * step).min(cols) {
+                    if map.valid[[r, c]] {
+                        let v = f64::from(map.values[[r, c]]);
+                        first.get_or_insert(v);
+                        sum += match palette {
+                            Palette::Sequential(s) => s.position(v),
+                            _ => v,
+                        };
+                        n += 1;
+                    }
+                }
+            }
+            let i = ((h - 1 - y) * w + x) * 4;
+            let colour = if n == 0 {
+                [160, 160, 160, 90]
+            } else {
+                let c = match palette {
+                    Palette::Sequential(_) => viridis(sum / n as f64),
+                    Palette::Diverging(bound) => diverging((sum / n as f64) / bound.max(f64::MIN_POSITIVE)),
+                    Palette::Classes => categorical(first.unwrap_or(0.0).max(0.0) as usize),
+                };
+                [c[0], c[1], c[2], 255]
+            };
+            rgba[i..i + 4].copy_from_slice(&colour);
+        }
+    }
+    Image { width: w, height: h, rgba }
+}
+
+/// The palette shared by a set of maps: a robust scale over all valid values (log when they span
+/// a decade), ± the 99th percentile of |value| for differences, or classes.
+#[must_use]
+pub fn shared_palette(maps: &[&MapData], kind: ProductKind, difference: bool) -> Palette {
+    if kind.categorical() {
+        return Palette::Classes;
+    }
+    let mut values: Vec<f64> = Vec::new();
+    for m in maps {
+        let step = (m.values.len() / 50_000).max(1);
+        values.extend(
+            m.values.iter().zip(m.valid.iter()).step_by(step).filter(|(_, ok)| **ok).map(|(v, _)| f64::from(*v)),
+        );
+    }
+    if difference {
+        let mut abs: Vec<f64> = values.iter().map(|v| v.abs()).filter(|v| v.is_finite()).collect();
+        abs.sort_by(f64::total_cmp);
+        let bound = abs.get(abs.len().saturating_sub(1) * 99 / 100).copied().unwrap_or(1.0);
+        return Palette::Diverging(if bound > 0.0 { bound } else { 1.0 });
+    }
+    let mut scale = Scale::robust(
+        values
+            .iter()
+            .copied()
+            .filter(|v| *v > 0.0 || !matches!(kind, ProductKind::Chl | ProductKind::Nap | ProductKind::Cdom)),
+    );
+    if matches!(kind, ProductKind::Chl | ProductKind::Nap | ProductKind::Cdom) && scale.lo > 0.0 {
+        scale.log = true;
+    }
+    Palette::Sequential(scale)
+}
+
+/// A request to the raster thread: the runs of A and B and what to show of them.
+#[derive(Debug, Clone)]
+pub struct Job {
+    /// Identifies the request (the app shows the images of the newest key).
+    pub key: u64,
+    /// The runs of A and B (either may be missing).
+    pub runs: [Option<Arc<RunOutput>>; 2],
+    /// The product.
+    pub kind: ProductKind,
+    /// The band of band products.
+    pub band: usize,
+    /// Truth | A | B, or A | B | A − B.
+    pub layout: super::model::Layout,
+    /// Longest side of each image.
+    pub max_side: usize,
+}
+
+/// One map panel, ready to show.
+#[derive(Debug, Clone)]
+pub struct PanelImage {
+    /// Title ("truth", "A", "B", "A − B").
+    pub title: String,
+    /// The values (for the value under the cursor).
+    pub data: Arc<MapData>,
+    /// The coloured image.
+    pub image: Image,
+}
+
+/// The raster thread's answer.
+#[derive(Debug, Clone)]
+pub struct Done {
+    /// The request's key.
+    pub key: u64,
+    /// The panels, in display order.
+    pub panels: Vec<PanelImage>,
+    /// The palette they share (for the colour bar).
+    pub palette: Palette,
+    /// The differences' palette, when the layout has one.
+    pub difference_palette: Option<Palette>,
+}
+
+/// Compute the panels of `job`.
+#[must_use]
+pub fn panels(job: &Job) -> Done {
+    use super::model::Layout;
+    let get = |i: usize, truth: bool| {
+        job.runs[i].as_ref().and_then(|o| product_map(o, job.kind, job.band, truth)).map(Arc::new)
+    };
+    let (a, b) = (get(0, false), get(1, false));
+    let mut named: Vec<(String, Arc<MapData>)> = Vec::new();
+    let mut diff = None;
+    match job.layout {
+        Layout::TruthAB => {
+            if let Some(t) = get(0, true) {
+                named.push(("truth".into(), t));
+            }
+            if let Some(a) = &a {
+                named.push(("A".into(), a.clone()));
+            }
+            if let Some(b) = &b {
+                named.push(("B".into(), b.clone()));
+            }
+        }
+        Layout::AbDifference => {
+            if let Some(a) = &a {
+                named.push(("A".into(), a.clone()));
+            }
+            if let Some(b) = &b {
+                named.push(("B".into(), b.clone()));
+            }
+            if let (Some(a), Some(b), Some(ra), Some(rb)) = (&a, &b, &job.runs[0], &job.runs[1]) {
+                diff = Some(Arc::new(difference(a, ra, b, rb)));
+            }
+        }
+    }
+    let refs: Vec<&MapData> = named.iter().map(|(_, m)| m.as_ref()).collect();
+    let palette = shared_palette(&refs, job.kind, false);
+    let difference_palette = diff.as_ref().map(|d| shared_palette(&[d.as_ref()], job.kind, true));
+    let mut panels: Vec<PanelImage> = named
+        .into_iter()
+        .map(|(title, data)| PanelImage { image: colorize(&data, palette, job.max_side), title, data })
+        .collect();
+    if let (Some(d), Some(p)) = (diff, difference_palette) {
+        panels.push(PanelImage { title: "A − B".into(), image: colorize(&d, p, job.max_side), data: d });
+    }
+    Done { key: job.key, panels, palette, difference_palette }
+}
+
+/// A thread that prepares map panels off the UI thread, always working on the newest request.
+#[derive(Debug)]
+pub struct RasterThread {
+    jobs: SyncSender<Job>,
+    done: Receiver<Done>,
+}
+
+impl RasterThread {
+    /// Start the thread; `wake` is called when an answer is ready (to request a repaint).
+    pub fn spawn(wake: impl Fn() + Send + 'static) -> std::io::Result<Self> {
+        // Short queues: the thread skips to the newest job, and the UI takes every answer each frame.
+        let (jobs, job_rx) = sync_channel::<Job>(4);
+        let (done_tx, done) = sync_channel::<Done>(2);
+        std::thread::Builder::new().name("shoal-raster".into()).spawn(move || {
+            while let Ok(mut job) = job_rx.recv() {
+                while let Ok(newer) = job_rx.try_recv() {
+                    job = newer;
+                }
+                if done_tx.send(panels(&job)).is_err() {
+                    return;
+                }
+                wake();
+            }
+        })?;
+        Ok(Self { jobs, done })
+    }
+
+    /// Ask for panels (returns false if the thread has stopped).
+    ///
+    /// Never blocks: with the queue full it returns false and the caller asks again next frame.
+    pub fn request(&self, job: Job) -> bool {
+        match self.jobs.try_send(job) {
+            Ok(()) => true,
+            Err(TrySendError::Full(_) | TrySendError::Disconnected(_)) => false,
+        }
+    }
+
+    /// The newest answer, if any.
+    pub fn poll(&self) -> Option<Done> {
+        let mut last = None;
+        while let Ok(d) = self.done.try_recv() {
+            last = Some(d);
+        }
+        last
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn colorize_downsamples_and_flips() {
+        let values = Array2::from_shape_fn((4, 2), |(r, _)| r as f32);
+        let valid = Array2::from_elem((4, 2), true);
+        let img = colorize(&MapData { values, valid }, Palette::Sequential(Scale { lo: 0.0, hi: 3.0, log: false }), 2);
+        assert_eq!((img.width, img.height), (1, 2));
+        // Bottom image row holds rows 0–1 (mean 0.5 of 3), top holds rows 2–3.
+        let bottom = &img.rgba[4..8];
+        let top = &img.rgba[0..4];
+        assert_eq!(&bottom[..3], &viridis(0.5 / 3.0));
+        assert_eq!(&top[..3], &viridis(2.5 / 3.0));
+    }
+}
