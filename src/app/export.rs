@@ -2,31 +2,57 @@
 //! the presets and the changed parameters) with the resolved configurations beside it; and the
 //! data (cubes and metrics of A and B, as `shoal study` writes them). Every file is written
 //! atomically; a failed write says why in the app.
+//!
+//! Off the UI thread: the save dialog (rfd, through the desktop's file-chooser portal) and the
+//! writing run on a helper thread and report back through a channel the app polls each frame.
+//! Desktops without a portal get no dialog; the app then offers the typed path.
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 
 use super::ShoalApp;
+use super::model::AppState;
 use super::raster::{Palette, product_map};
 use crate::colormap::Scale;
+use crate::engine::RunOutput;
 use crate::study::{ComparisonPanel, comparison_figure, write_bytes, write_run};
 
-/// Where exports go: the path typed in the app, or chosen in a save dialog.
-fn target(app: &ShoalApp) -> PathBuf {
-    PathBuf::from(app.ui.export_path.trim())
+/// What an export needs: the results on display and the state that made them.
+#[derive(Clone)]
+pub struct Snapshot {
+    /// The app state.
+    pub state: AppState,
+    /// A's and B's results.
+    pub runs: [Option<Arc<RunOutput>>; 2],
+    /// A's decimation.
+    pub decimation: usize,
+}
+
+impl Snapshot {
+    /// The snapshot of `app` now.
+    #[must_use]
+    pub fn of(app: &ShoalApp) -> Self {
+        Self {
+            state: app.state.clone(),
+            runs: [0, 1].map(|i| app.link.shown[i].as_ref().map(|s| s.output.clone())),
+            decimation: app.link.shown[0].as_ref().map_or(1, |s| s.decimation),
+        }
+    }
 }
 
 /// Write the comparison figure and the configurations next to `stem`.
-pub fn write_figure(app: &ShoalApp, stem: &Path) -> Result<Vec<PathBuf>, String> {
-    let runs: Vec<_> = app.link.shown.iter().map(|s| s.as_ref().map(|s| s.output.clone())).collect();
-    let (Some(a), Some(b)) = (&runs[0], &runs[1]) else { return Err("no results to export yet".into()) };
-    let kind = app.state.product;
+pub fn write_figure(snap: &Snapshot, stem: &Path) -> Result<Vec<PathBuf>, String> {
+    let state = &snap.state;
+    let (Some(a), Some(b)) = (&snap.runs[0], &snap.runs[1]) else { return Err("no results to export yet".into()) };
+    let kind = state.product;
     let mut panels = Vec::new();
     for (title, out, truth) in [("truth", a, true), ("A", a, false), ("B", b, false)] {
-        if let Some(m) = product_map(out, kind, app.state.band, truth) {
+        if let Some(m) = product_map(out, kind, state.band, truth) {
             let label = if truth {
                 title.to_string()
             } else {
-                format!("{title}: {}", if title == "A" { &app.state.a.preset } else { &app.state.b.preset })
+                format!("{title}: {}", if title == "A" { &state.a.preset } else { &state.b.preset })
             };
             panels.push(ComparisonPanel { title: label, values: m.values, valid: m.valid });
         }
@@ -53,7 +79,7 @@ pub fn write_figure(app: &ShoalApp, stem: &Path) -> Result<Vec<PathBuf>, String>
         for ret in &out.retrievals {
             for v in &ret.metrics.variables {
                 let m = &v.metrics;
-                let req = app.state.requirements.mae_limit(&v.variable).map_or(String::new(), |l| {
+                let req = state.requirements.mae_limit(&v.variable).map_or(String::new(), |l| {
                     format!("MAE ≤ {l:.0} %: {}", if m.mae_pct() <= l { "pass" } else { "FAIL" })
                 });
                 table.push(vec![
@@ -67,21 +93,17 @@ pub fn write_figure(app: &ShoalApp, stem: &Path) -> Result<Vec<PathBuf>, String>
             }
         }
     }
-    let changes = app.state.changes();
+    let changes = state.changes();
     let caption = vec![
         format!(
             "A: {}   B: {}   scene: {}   retrieval: {:?}   resolution 1/{}",
-            app.state.a.preset,
-            app.state.b.preset,
-            app.state.scene_name,
-            app.state.retrieval,
-            app.link.shown[0].as_ref().map_or(1, |s| s.decimation)
+            state.a.preset, state.b.preset, state.scene_name, state.retrieval, snap.decimation
         ),
         if changes.is_empty() { "Presets unchanged.".into() } else { format!("Changed: {}", changes.join("; ")) },
         "Shoal: one colour scale for all panels; grey: land or not returned; metrics after Seegers et al. (2018)."
             .into(),
     ];
-    let title = format!("{} — {}", app.state.study_name, kind.label());
+    let title = format!("{} — {}", state.study_name, kind.label());
     let fig = comparison_figure("comparison", &title, kind.label(), scale, false, panels, table, caption)
         .map_err(|e| e.to_string())?;
     let png = stem.with_extension("png");
@@ -99,35 +121,127 @@ pub fn write_figure(app: &ShoalApp, stem: &Path) -> Result<Vec<PathBuf>, String>
 }
 
 /// Write both runs' cubes and metrics under `dir`.
-pub fn write_data(app: &ShoalApp, dir: &Path) -> Result<usize, String> {
+pub fn write_data(snap: &Snapshot, dir: &Path) -> Result<usize, String> {
     let mut n = 0;
-    for (name, s) in ["A", "B"].iter().zip(&app.link.shown) {
-        let Some(s) = s else { return Err("no results to export yet".into()) };
-        let sub = dir.join(format!("{name}_{}", s.output.config.instrument.name));
-        n += write_run(&s.output, &sub).map_err(|e| e.to_string())?.files.len();
+    for (name, run) in ["A", "B"].iter().zip(&snap.runs) {
+        let Some(out) = run else { return Err("no results to export yet".into()) };
+        let sub = dir.join(format!("{name}_{}", out.config.instrument.name));
+        n += write_run(out, &sub).map_err(|e| e.to_string())?.files.len();
     }
     Ok(n)
 }
 
-/// Export the figure to the typed path (a save dialog needs a desktop portal; the typed path
-/// always works, and the files are named after it).
-pub fn figure(app: &mut ShoalApp) {
-    let stem = target(app);
-    match write_figure(app, &stem) {
-        Ok(files) => {
-            app.ui.message =
-                Some(format!("wrote {}", files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>().join(", ")))
-        }
-        Err(e) => app.ui.error = Some(format!("Export failed: {e}")),
+/// Which export.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum What {
+    /// The comparison figure (PNG, SVG, configurations).
+    Figure,
+    /// Cubes and metrics.
+    Data,
+}
+
+/// News from an export thread.
+#[derive(Debug)]
+pub enum News {
+    /// The dialog closed without a choice (cancelled, or no file-chooser portal).
+    NoChoice(What),
+    /// Written: the message to show.
+    Written(String),
+    /// Failed: why.
+    Failed(String),
+}
+
+/// The channel export threads report on.
+pub struct Exports {
+    tx: SyncSender<News>,
+    rx: Receiver<News>,
+    /// Exports in flight.
+    pub running: usize,
+}
+
+impl Default for Exports {
+    fn default() -> Self {
+        let (tx, rx) = sync_channel(8);
+        Self { tx, rx, running: 0 }
     }
 }
 
-/// Export the data to the typed path.
-pub fn data(app: &mut ShoalApp) {
-    let dir = target(app);
-    match write_data(app, &dir) {
-        Ok(n) => app.ui.message = Some(format!("wrote {n} files under {}", dir.display())),
-        Err(e) => app.ui.error = Some(format!("Export failed: {e}")),
+impl Exports {
+    /// Ask for a place in a save dialog (a folder for data), then write `snap` there. Both
+    /// happen on a helper thread.
+    pub fn with_dialog(&mut self, what: What, snap: Snapshot, start: &Path) {
+        let tx = self.tx.clone();
+        let start = start.to_path_buf();
+        let spawned = std::thread::Builder::new().name("shoal-export".into()).spawn(move || {
+            let dir = start.parent().map(Path::to_path_buf).unwrap_or_default();
+            let name = start.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+            let choice = match what {
+                What::Figure => rfd::FileDialog::new()
+                    .set_title("Export the comparison figure")
+                    .set_directory(&dir)
+                    .set_file_name(format!("{name}.png"))
+                    .add_filter("PNG and SVG figure", &["png", "svg"])
+                    .save_file(),
+                What::Data => rfd::FileDialog::new()
+                    .set_title("Export cubes and metrics to a folder")
+                    .set_directory(&dir)
+                    .pick_folder(),
+            };
+            let news = match choice {
+                None => News::NoChoice(what),
+                Some(path) => write(what, &snap, &path),
+            };
+            let _ = tx.send(news);
+        });
+        match spawned {
+            Ok(_) => self.running += 1,
+            Err(e) => {
+                self.running +=
+                    usize::from(self.tx.try_send(News::Failed(format!("cannot start the export: {e}"))).is_ok())
+            }
+        }
+    }
+
+    /// Write `snap` to `path` on a helper thread (the typed path).
+    pub fn write_to(&mut self, what: What, snap: Snapshot, path: PathBuf) {
+        let tx = self.tx.clone();
+        let spawned = std::thread::Builder::new().name("shoal-export".into()).spawn(move || {
+            let _ = tx.send(write(what, &snap, &path));
+        });
+        match spawned {
+            Ok(_) => self.running += 1,
+            Err(e) => {
+                self.running +=
+                    usize::from(self.tx.try_send(News::Failed(format!("cannot start the export: {e}"))).is_ok())
+            }
+        }
+    }
+
+    /// The next news, if any.
+    pub fn poll(&mut self) -> Option<News> {
+        let news = self.rx.try_recv().ok()?;
+        self.running = self.running.saturating_sub(1);
+        Some(news)
+    }
+}
+
+fn write(what: What, snap: &Snapshot, path: &Path) -> News {
+    match what {
+        What::Figure => {
+            // The dialog may return `name.png` or `name.svg`: both files go next to its stem.
+            let stem = path.with_extension("");
+            match write_figure(snap, &stem) {
+                Ok(files) => News::Written(format!(
+                    "wrote {}",
+                    files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>().join(", ")
+                )),
+                Err(e) => News::Failed(format!("Export failed: {e}")),
+            }
+        }
+        What::Data => match write_data(snap, path) {
+            Ok(n) => News::Written(format!("wrote {n} files under {}", path.display())),
+            Err(e) => News::Failed(format!("Export failed: {e}")),
+        },
     }
 }
 

@@ -24,7 +24,7 @@ mod panels;
 mod plots;
 pub mod raster;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -50,8 +50,9 @@ struct UiState {
     message: Option<String>,
     preset_name: String,
     export_path: String,
+    typed_export: bool,
+    exports: export::Exports,
     frame_times_ms: Vec<f32>,
-    last_frame: Option<Instant>,
     zoom: maps::View,
     hover: Option<(usize, usize)>,
 }
@@ -130,7 +131,7 @@ impl ShoalApp {
         self.ui.error.as_deref()
     }
 
-    /// Median frame time of the last frames, ms (UI thread, CPU).
+    /// Median time the UI thread spent drawing each of the last frames, ms.
     #[must_use]
     pub fn median_frame_ms(&self) -> Option<f32> {
         let mut v = self.ui.frame_times_ms.clone();
@@ -157,32 +158,49 @@ impl ShoalApp {
                 self.images.receive(ctx, done);
             }
         }
-        if self.link.busy() {
+        while let Some(news) = self.ui.exports.poll() {
+            match news {
+                export::News::Written(m) => self.ui.message = Some(m),
+                export::News::Failed(e) => self.ui.error = Some(e),
+                export::News::NoChoice(what) => {
+                    let what = if what == export::What::Figure { "figure" } else { "data" };
+                    self.ui.message = Some(format!(
+                        "No {what} exported: no file was chosen. If no dialog appeared, this desktop has no file-chooser portal; use Path to type one."
+                    ));
+                    self.ui.typed_export = true;
+                }
+            }
+        }
+        if self.link.busy() || self.ui.exports.running > 0 {
             ctx.request_repaint_after(Duration::from_millis(30));
         }
     }
 
     /// Draw one frame into `ui` (everything but the eframe plumbing).
     pub fn draw(&mut self, ui: &mut egui::Ui) {
-        let now = Instant::now();
-        if let Some(last) = self.ui.last_frame {
-            let ms = now.duration_since(last).as_secs_f32() * 1e3;
-            self.ui.frame_times_ms.push(ms);
-            if self.ui.frame_times_ms.len() > 240 {
-                self.ui.frame_times_ms.remove(0);
-            }
-        }
+        let start = Instant::now();
         let ctx = ui.ctx().clone();
         self.tick(&ctx);
-        egui::Panel::top("top").show(ui, |ui| self.top_bar(ui));
+        egui::Panel::top("top").show(ui, |ui| {
+            self.top_bar(ui);
+            if self.ui.typed_export {
+                self.typed_export(ui);
+            }
+            if let Some(m) = &self.ui.message {
+                ui.small(m.as_str());
+            }
+        });
         egui::Panel::left("left").resizable(true).default_size(340.0).show(ui, |ui| {
             egui::ScrollArea::vertical().show(ui, |ui| panels::left(self, ui));
         });
         egui::Panel::bottom("bottom").resizable(true).default_size(300.0).show(ui, |ui| plots::bottom(self, ui));
         egui::CentralPanel::default().show(ui, |ui| maps::central(self, ui));
         self.dialogs(&ctx);
-        self.ui.last_frame = Some(Instant::now());
-        let _ = now;
+        // The UI thread's work for this frame (layout; not the GPU, not the wait for vsync).
+        self.ui.frame_times_ms.push(start.elapsed().as_secs_f32() * 1e3);
+        if self.ui.frame_times_ms.len() > 240 {
+            self.ui.frame_times_ms.remove(0);
+        }
     }
 
     fn top_bar(&mut self, ui: &mut egui::Ui) {
@@ -198,24 +216,52 @@ impl ShoalApp {
             ));
             ui.separator();
             if ui
-                .button("Export figure")
-                .on_hover_text("Write the comparison figure (PNG and SVG) and the configurations")
+                .button("Export figure…")
+                .on_hover_text("Choose where to write the comparison figure (PNG and SVG) and the configurations")
                 .clicked()
             {
-                export::figure(self);
+                self.ui.exports.with_dialog(
+                    export::What::Figure,
+                    export::Snapshot::of(self),
+                    Path::new(self.ui.export_path.trim()),
+                );
             }
             if ui
-                .button("Export data")
-                .on_hover_text("Write the cubes and metrics of A and B, as `shoal study` does")
+                .button("Export data…")
+                .on_hover_text("Choose a folder for the cubes and metrics of A and B, as `shoal study` writes them")
                 .clicked()
             {
-                export::data(self);
+                self.ui.exports.with_dialog(
+                    export::What::Data,
+                    export::Snapshot::of(self),
+                    Path::new(self.ui.export_path.trim()),
+                );
+            }
+            ui.toggle_value(&mut self.ui.typed_export, "Path")
+                .on_hover_text("Export to a typed path (for desktops without a file-chooser portal)");
+            if self.ui.exports.running > 0 {
+                ui.spinner();
             }
             ui.separator();
             ui.selectable_value(&mut self.state.dark, false, "Light");
             ui.selectable_value(&mut self.state.dark, true, "Dark");
             ui.separator();
             self.status(ui);
+        });
+    }
+
+    /// The typed-path export row (shown on request, or when a dialog could not be used).
+    fn typed_export(&mut self, ui: &mut egui::Ui) {
+        ui.horizontal(|ui| {
+            let l = ui.label("Export to");
+            ui.add(egui::TextEdit::singleline(&mut self.ui.export_path).desired_width(420.0)).labelled_by(l.id);
+            let path = PathBuf::from(self.ui.export_path.trim());
+            if ui.button("Write figure").on_hover_text("NAME.png, NAME.svg and NAME_config_A/B.ron").clicked() {
+                self.ui.exports.write_to(export::What::Figure, export::Snapshot::of(self), path.clone());
+            }
+            if ui.button("Write data").on_hover_text("A folder NAME with one sub-folder per instrument").clicked() {
+                self.ui.exports.write_to(export::What::Data, export::Snapshot::of(self), path);
+            }
         });
     }
 
@@ -241,7 +287,9 @@ impl ShoalApp {
             }
         }
         if let Some(ms) = self.median_frame_ms() {
-            ui.label(format!("frame {ms:.1} ms"));
+            ui.label(format!("UI {ms:.1} ms/frame")).on_hover_text(
+                "Median time the UI thread spends laying out a frame (the engine works on its own threads)",
+            );
         }
     }
 

@@ -274,9 +274,6 @@ fn save_presets(app: &mut ShoalApp, ui: &mut egui::Ui) {
             }
         }
     });
-    if let Some(m) = &app.ui.message {
-        ui.small(m.as_str());
-    }
 }
 
 fn band_editor(slot: &mut Slot, ui: &mut egui::Ui) {

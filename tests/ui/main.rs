@@ -160,3 +160,35 @@ fn a_malformed_preset_shows_an_error_and_the_app_goes_on() {
     assert!((h.state().state.a.spec.aperture_mm - 90.0).abs() < 1e-6);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn the_comparison_figure_exports_to_a_typed_path() {
+    let dir = temp_library("export");
+    let mut h = harness("cubesat", 16, &dir);
+    wait_for_engine(&mut h);
+    h.get_by_label("Path").click();
+    h.step();
+    h.step();
+    let stem = dir.join("review").join("comparison");
+    h.get_by_role_and_label(Role::TextInput, "Export to").set_text_value_accesskit(stem.to_str().unwrap());
+    h.step();
+    h.get_by_label("Write figure").click();
+    let start = Instant::now();
+    let files = ["comparison.png", "comparison.svg", "comparison_config_A.ron", "comparison_config_B.ron"].map(|f| dir.join("review").join(f));
+    while !files.iter().all(|f| f.is_file()) {
+        assert!(start.elapsed() < Duration::from_secs(120), "the figure was not written");
+        assert_eq!(h.state().error(), None);
+        std::thread::sleep(Duration::from_millis(20));
+        h.step();
+    }
+    h.step();
+    h.step();
+    let png = std::fs::read(&files[0]).unwrap();
+    assert_eq!(&png[1..4], b"PNG");
+    let svg = std::fs::read_to_string(&files[1]).unwrap();
+    assert!(svg.contains("cubesat") && svg.contains("smallsat"), "the caption names the presets");
+    // The configuration beside the figure is the one that ran, and loads back.
+    let config = std::fs::read_to_string(&files[2]).unwrap();
+    assert!(shoal::engine::RunConfig::from_ron(&config, "A").is_ok());
+    let _ = std::fs::remove_dir_all(&dir);
+}
