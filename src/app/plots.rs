@@ -101,9 +101,12 @@ fn histograms_and_scatter(app: &ShoalApp, ui: &mut egui::Ui, width: f32) {
     let (lo, hi) = all.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(*v), b.max(*v)));
     ui.vertical(|ui| {
         ui.label(format!("{variable}: histograms (log10)"));
-        Plot::new("hist").width(width).height(170.0).legend(Legend::default()).x_axis_label("log10 value").show(
-            ui,
-            |p| {
+        Plot::new("hist")
+            .width(width)
+            .height(170.0)
+            .legend(Legend::default().position(egui_plot::Corner::LeftTop))
+            .x_axis_label("log10 value")
+            .show(ui, |p| {
                 if lo.is_finite() && hi > lo {
                     let edges = log_edges(10f64.powf(lo), 10f64.powf(hi), 30);
                     let centre = |b: usize| 0.5 * (edges[b].log10() + edges[b + 1].log10());
@@ -131,51 +134,62 @@ fn histograms_and_scatter(app: &ShoalApp, ui: &mut egui::Ui, width: f32) {
                         p.bar_chart(BarChart::new(if i == 0 { "A" } else { "B" }, bars).color(COLOURS[i]));
                     }
                 }
-            },
-        );
+            });
     });
     ui.vertical(|ui| {
         ui.label(format!("{variable}: retrieved vs true (log10)"));
-        Plot::new("scatter").width(width).height(170.0).data_aspect(1.0).legend(Legend::default()).show(ui, |p| {
-            for (i, d) in data.iter().enumerate() {
-                let pts: Vec<[f64; 2]> = d.iter().map(|(t, g)| [*t, *g]).collect();
-                p.points(
-                    Points::new(if i == 0 { "A" } else { "B" }, pts).radius(1.2).color(COLOURS[i].gamma_multiply(0.6)),
-                );
-            }
-            if lo.is_finite() && hi > lo {
-                p.line(Line::new("1:1", PlotPoints::from(vec![[lo, lo], [hi, hi]])).color(Color32::DARK_GRAY));
-            }
-        });
+        Plot::new("scatter")
+            .width(width)
+            .height(170.0)
+            .data_aspect(1.0)
+            .legend(Legend::default().position(egui_plot::Corner::LeftTop))
+            .show(ui, |p| {
+                for (i, d) in data.iter().enumerate() {
+                    let pts: Vec<[f64; 2]> = d.iter().map(|(t, g)| [*t, *g]).collect();
+                    p.points(
+                        Points::new(if i == 0 { "A" } else { "B" }, pts)
+                            .radius(1.2)
+                            .color(COLOURS[i].gamma_multiply(0.6)),
+                    );
+                }
+                if lo.is_finite() && hi > lo {
+                    p.line(Line::new("1:1", PlotPoints::from(vec![[lo, lo], [hi, hi]])).color(Color32::DARK_GRAY));
+                }
+            });
     });
 }
 
 fn snr_plot(app: &ShoalApp, ui: &mut egui::Ui, width: f32) {
     ui.vertical(|ui| {
         ui.label("SNR per band (line: analytic, dots: measured)");
-        Plot::new("snr").width(width).height(170.0).legend(Legend::default()).x_axis_label("nm").show(ui, |p| {
-            for (i, s) in app.link.shown.iter().enumerate() {
-                let Some(s) = s else { continue };
-                let name = if i == 0 { "A" } else { "B" };
-                let line: Vec<[f64; 2]> = s
-                    .output
-                    .snr
-                    .iter()
-                    .filter(|r| r.snr_analytic.is_finite())
-                    .map(|r| [r.centre_nm, r.snr_analytic])
-                    .collect();
-                let dots: Vec<[f64; 2]> = s
-                    .output
-                    .snr
-                    .iter()
-                    .filter(|r| r.snr_measured.is_finite())
-                    .map(|r| [r.centre_nm, r.snr_measured])
-                    .collect();
-                p.line(Line::new(name, PlotPoints::from(line)).color(COLOURS[i]).width(2.0));
-                p.points(Points::new(format!("{name} measured"), dots).radius(2.5).color(COLOURS[i]));
-            }
-            p.hline(HLine::new("requirement", app.state.requirements.snr).color(Color32::from_rgb(40, 150, 40)));
-        });
+        Plot::new("snr")
+            .width(width)
+            .height(170.0)
+            .legend(Legend::default().position(egui_plot::Corner::RightBottom))
+            .x_axis_label("nm")
+            .show(ui, |p| {
+                for (i, s) in app.link.shown.iter().enumerate() {
+                    let Some(s) = s else { continue };
+                    let name = if i == 0 { "A" } else { "B" };
+                    let line: Vec<[f64; 2]> = s
+                        .output
+                        .snr
+                        .iter()
+                        .filter(|r| r.snr_analytic.is_finite())
+                        .map(|r| [r.centre_nm, r.snr_analytic])
+                        .collect();
+                    let dots: Vec<[f64; 2]> = s
+                        .output
+                        .snr
+                        .iter()
+                        .filter(|r| r.snr_measured.is_finite())
+                        .map(|r| [r.centre_nm, r.snr_measured])
+                        .collect();
+                    p.line(Line::new(name, PlotPoints::from(line)).color(COLOURS[i]).width(2.0));
+                    p.points(Points::new(format!("{name} measured"), dots).radius(2.5).color(COLOURS[i]));
+                }
+                p.hline(HLine::new("requirement", app.state.requirements.snr).color(Color32::from_rgb(40, 150, 40)));
+            });
     });
 }
 
