@@ -174,7 +174,8 @@ fn the_comparison_figure_exports_to_a_typed_path() {
     h.step();
     h.get_by_label("Write figure").click();
     let start = Instant::now();
-    let files = ["comparison.png", "comparison.svg", "comparison_config_A.ron", "comparison_config_B.ron"].map(|f| dir.join("review").join(f));
+    let files = ["comparison.png", "comparison.svg", "comparison_config_A.ron", "comparison_config_B.ron"]
+        .map(|f| dir.join("review").join(f));
     while !files.iter().all(|f| f.is_file()) {
         assert!(start.elapsed() < Duration::from_secs(120), "the figure was not written");
         assert_eq!(h.state().error(), None);
