@@ -81,6 +81,7 @@ pub const PRESETS: &[Asset] = embed_presets![
     "studies/cubesat_vs_smallsat.ron",
     "studies/lake_hume_nominal.ron",
     "studies/heron_island_depth.ron",
+    "sweeps/aperture_lake_hume.ron",
 ];
 
 /// The built-in preset at `path` (relative to `presets/`), if there is one.

@@ -54,6 +54,7 @@ pub mod retrieval;
 pub mod scene;
 pub mod spectral;
 pub mod study;
+pub mod sweep;
 pub mod toa;
 pub mod units;
 pub mod validation;

@@ -17,6 +17,7 @@ mod grid;
 mod output;
 pub mod simulate;
 mod study;
+mod sweep;
 mod water;
 
 use std::process::ExitCode;
@@ -43,6 +44,11 @@ enum Command {
     /// Run a study (default: CubeSat vs SmallSat over Lake Hume): metrics table, figures,
     /// cubes and the resolved configuration.
     Study(study::StudyArgs),
+    /// Run a sweep: a study repeated over one parameter (or a grid of two) with several noise
+    /// seeds per point; writes the table and the curves with the requirement's crossing.
+    Sweep(sweep::SweepArgs),
+    /// Join the tables of `shoal sweep --shard` slices into the table one run writes.
+    Merge(sweep::MergeArgs),
     /// Measure speed and accuracy: water evaluations per second, atmosphere LUT build times
     /// with their errors against OSOAA.
     Bench(bench::BenchArgs),
@@ -127,6 +133,8 @@ pub fn main() -> ExitCode {
         Command::Atmosphere(args) => atmosphere::run(&args),
         Command::Simulate(args) => simulate::run(&args),
         Command::Study(args) => study::run(&args),
+        Command::Sweep(args) => sweep::run(&args),
+        Command::Merge(args) => sweep::merge_run(&args),
         Command::Bench(args) => bench::run(&args),
         Command::Dev(DevCommand::AerosolTable) => output::emit(&crate::atmosphere::component_table_csv(), None),
         Command::Dev(DevCommand::OsoaaTable) => bench::osoaa_table(),

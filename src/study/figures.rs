@@ -30,7 +30,7 @@ pub struct Figure {
 }
 
 const FONT_BYTES: &[u8] = crate::assets::DEJAVU_SANS_TTF;
-const FONT: &str = "sans-serif";
+pub(super) const FONT: &str = "sans-serif";
 
 fn fonts() -> Result<(), StudyError> {
     static REGISTERED: OnceLock<bool> = OnceLock::new();
@@ -39,7 +39,7 @@ fn fonts() -> Result<(), StudyError> {
 }
 
 /// A raster placed on the figure (painted into the PNG, embedded in the SVG).
-struct Placed {
+pub(super) struct Placed {
     x: i32,
     y: i32,
     w: u32,
@@ -47,12 +47,12 @@ struct Placed {
     rgb: Vec<u8>,
 }
 
-trait Draw {
+pub(super) trait Draw {
     fn size(&self) -> (u32, u32);
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<Vec<Placed>, String>;
 }
 
-fn err<E: std::fmt::Debug>(e: E) -> String {
+pub(super) fn err<E: std::fmt::Debug>(e: E) -> String {
     format!("{e:?}")
 }
 
@@ -82,7 +82,7 @@ fn png(rgb: &[u8], w: u32, h: u32) -> Result<Vec<u8>, StudyError> {
     Ok(out)
 }
 
-fn render(name: &str, fig: &impl Draw) -> Result<Figure, StudyError> {
+pub(super) fn render(name: &str, fig: &impl Draw) -> Result<Figure, StudyError> {
     fonts()?;
     let (w, h) = fig.size();
     let fail = |e: String| StudyError::Io(format!("figure {name}: {e}"));
@@ -244,7 +244,7 @@ fn nice_ticks(scale: &Scale) -> Vec<f64> {
     }
 }
 
-fn tick_label(v: f64) -> String {
+pub(super) fn tick_label(v: f64) -> String {
     if v == 0.0 {
         "0".into()
     } else if v.abs() >= 100.0 {

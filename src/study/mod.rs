@@ -14,10 +14,12 @@
 //! )
 //! ```
 
+mod curves;
 mod figures;
 mod output;
 mod run;
 
+pub use curves::{CurvePoint, CurveSeries, Curves, curve_figure, first_crossing};
 pub use figures::{ComparisonPanel, Figure, comparison_figure, figure_set};
 pub use output::{Outputs, metrics_csv, write_bytes, write_run, write_study};
 pub use run::{StudyResult, StudyRun, run_study};

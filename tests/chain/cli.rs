@@ -68,3 +68,44 @@ fn simulate_refuses_bad_input_with_exit_code_2() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("lake_hume_bloom"));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn sweep_shards_and_merge_on_the_command_line() {
+    let dir = std::env::temp_dir().join(format!("shoal-sweep-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("tiny.ron");
+    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/presets/sweeps/aperture_lake_hume.ron"))
+        .unwrap()
+        .replace("Range(from: 40, to: 300, steps: 8, log: true)", "List([50, 250])")
+        .replace("seeds: [1, 2, 3, 4, 5]", "seeds: [1, 2]");
+    std::fs::write(&file, text).unwrap();
+    let run = |extra: &[&str], out: &str| {
+        let o = shoal()
+            .args(["sweep", file.to_str().unwrap(), "--decimation", "32", "--no-figures", "--out"])
+            .arg(dir.join(out))
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    };
+    run(&[], "whole");
+    run(&["--shard", "0/2"], "s0");
+    run(&["--shard", "1/2"], "s1");
+    let o = shoal()
+        .args(["merge", "--no-figures", "--out"])
+        .arg(dir.join("merged"))
+        .arg(dir.join("s1"))
+        .arg(dir.join("s0"))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let whole = std::fs::read(dir.join("whole/table.csv")).unwrap();
+    assert_eq!(std::fs::read(dir.join("merged/table.csv")).unwrap(), whole);
+    assert!(String::from_utf8_lossy(&whole).lines().count() > 4);
+    // A bad shard is one line naming it, exit code 2.
+    let o = shoal().args(["sweep", file.to_str().unwrap(), "--shard", "2/2"]).output().unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("shard `2/2`"));
+    let _ = std::fs::remove_dir_all(&dir);
+}

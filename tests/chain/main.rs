@@ -11,6 +11,7 @@ mod noise;
 mod retrieval;
 mod spatial;
 mod study;
+mod sweep;
 mod worker;
 
 use shoal::control::RunControl;

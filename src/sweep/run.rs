@@ -1,0 +1,105 @@
+//! Running a sweep (or one shard of it) on one cached engine.
+
+use crate::control::RunControl;
+use crate::engine::{Engine, EngineError};
+use crate::study::StudyError;
+
+use super::table::{Row, Table};
+use super::{ResolvedSweep, Shard, apply};
+
+/// One run of a sweep.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Job {
+    /// Index in the sweep's fixed order.
+    pub index: usize,
+    /// Point index.
+    pub point: usize,
+    /// The parameters' values.
+    pub values: Vec<f64>,
+    /// Instrument (index into the study's instruments).
+    pub instrument: usize,
+    /// Noise seed.
+    pub seed: u64,
+}
+
+/// A sweep's (or shard's) result: the table, and each run's wall time (kept apart from the
+/// table so that the table depends on the inputs alone).
+#[derive(Debug, Clone)]
+pub struct SweepResult {
+    /// The table.
+    pub table: Table,
+    /// (run index, seconds).
+    pub seconds: Vec<(usize, f64)>,
+}
+
+/// FNV-1a, 64 bit: a fingerprint that is the same on every machine and toolchain.
+fn fnv1a(text: &str) -> u64 {
+    text.bytes().fold(0xcbf2_9ce4_8422_2325, |h, b| (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3))
+}
+
+impl ResolvedSweep {
+    /// The fingerprint of everything that decides the table: the sweep and every base run.
+    #[must_use]
+    pub fn key(&self) -> String {
+        let mut text = ron::to_string(&self.spec).unwrap_or_default();
+        for (label, c) in &self.bases {
+            text.push_str(label);
+            text.push_str(&c.to_ron().unwrap_or_default());
+        }
+        format!("{:016x}", fnv1a(&text))
+    }
+}
+
+/// Run the jobs `shard` owns, in order; `on_job` hears of each as it finishes (index, seconds).
+pub fn run_sweep(
+    sweep: &ResolvedSweep,
+    shard: Shard,
+    control: &RunControl,
+    mut on_job: impl FnMut(usize, f64),
+) -> Result<SweepResult, StudyError> {
+    let mut engine = Engine::new();
+    let paths: Vec<&str> = sweep.spec.parameters.iter().map(|p| p.path.as_str()).collect();
+    let mut rows = Vec::new();
+    let mut seconds = Vec::new();
+    for job in sweep.jobs.iter().filter(|j| shard.owns(j.index)) {
+        let (label, base) = &sweep.bases[job.instrument];
+        let settings: Vec<(&str, f64)> = paths.iter().copied().zip(job.values.iter().copied()).collect();
+        let mut config =
+            apply(base, &settings).map_err(|m| StudyError::Invalid { field: "parameters".into(), message: m })?;
+        config.seed = job.seed;
+        let start = std::time::Instant::now();
+        let out = engine.run(&config, control).map_err(|e| match e {
+            EngineError::Cancelled => StudyError::Cancelled,
+            other => StudyError::Run { instrument: format!("{label} at {settings:?}"), message: other.to_string() },
+        })?;
+        let secs = start.elapsed().as_secs_f64();
+        for ret in &out.retrievals {
+            for v in &ret.metrics.variables {
+                rows.push(Row {
+                    job: job.index,
+                    point: job.point,
+                    values: job.values.clone(),
+                    instrument: label.clone(),
+                    seed: job.seed,
+                    product: ret.metrics.product.clone(),
+                    variable: v.variable.clone(),
+                    mae_pct: v.metrics.mae_pct(),
+                    bias_pct: v.metrics.bias_pct(),
+                    returned_pct: v.metrics.returned_pct,
+                    n: v.metrics.n,
+                });
+            }
+        }
+        seconds.push((job.index, secs));
+        on_job(job.index, secs);
+    }
+    let table = Table {
+        name: sweep.spec.name.clone(),
+        key: sweep.key(),
+        jobs: sweep.jobs.len(),
+        shard: (shard.count > 1).then_some((shard.index, shard.count)),
+        parameters: paths.iter().map(ToString::to_string).collect(),
+        rows,
+    };
+    Ok(SweepResult { table, seconds })
+}
