@@ -13,6 +13,7 @@ mod atmosphere;
 mod bench;
 mod bench_chain;
 mod bench_retrieval;
+mod budget;
 mod grid;
 mod output;
 pub mod simulate;
@@ -47,6 +48,9 @@ enum Command {
     /// Run a sweep: a study repeated over one parameter (or a grid of two) with several noise
     /// seeds per point; writes the table and the curves with the requirement's crossing.
     Sweep(sweep::SweepArgs),
+    /// Error budget of a study: how much of each product's error each stage contributes
+    /// (noise, calibration, atmospheric correction, SIOP set choice).
+    Budget(budget::BudgetArgs),
     /// Join the tables of `shoal sweep --shard` slices into the table one run writes.
     Merge(sweep::MergeArgs),
     /// Measure speed and accuracy: water evaluations per second, atmosphere LUT build times
@@ -135,6 +139,7 @@ pub fn main() -> ExitCode {
         Command::Study(args) => study::run(&args),
         Command::Sweep(args) => sweep::run(&args),
         Command::Merge(args) => sweep::merge_run(&args),
+        Command::Budget(args) => budget::run(&args),
         Command::Bench(args) => bench::run(&args),
         Command::Dev(DevCommand::AerosolTable) => output::emit(&crate::atmosphere::component_table_csv(), None),
         Command::Dev(DevCommand::OsoaaTable) => bench::osoaa_table(),

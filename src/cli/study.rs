@@ -45,7 +45,7 @@ impl From<StudyError> for CliError {
     }
 }
 
-fn load(arg: Option<&str>) -> Result<(StudySpec, Option<PathBuf>), CliError> {
+pub(super) fn load(arg: Option<&str>) -> Result<(StudySpec, Option<PathBuf>), CliError> {
     match arg {
         None => Ok((StudySpec::default_study()?, None)),
         Some(a) if a.ends_with(".ron") || Path::new(a).exists() => {

@@ -14,11 +14,13 @@
 //! )
 //! ```
 
+mod budget;
 mod curves;
 mod figures;
 mod output;
 mod run;
 
+pub use budget::{Budget, BudgetLine, Stage, budget_table, error_budget};
 pub use curves::{CurvePoint, CurveSeries, Curves, curve_figure, first_crossing};
 pub use figures::{ComparisonPanel, Figure, comparison_figure, figure_set};
 pub use output::{Outputs, metrics_csv, write_bytes, write_run, write_study};

@@ -120,3 +120,24 @@ fn bad_sweeps_are_refused_by_name() {
     let e = s.resolve(None).unwrap_err().to_string();
     assert!(e.contains("aperture_mm") && e.contains("-10"), "{e}");
 }
+
+#[test]
+fn the_cubesat_error_budget_adds_up_and_noise_leads_it() {
+    let study = shoal::study::StudySpec::default_study().unwrap().resolve(None).unwrap();
+    let (label, _, config) = &study.runs[0];
+    assert_eq!(label, "cubesat");
+    let mut config = config.clone();
+    config.fidelity.decimation = 16;
+    let budgets = shoal::study::error_budget(label, &config, &[1, 2], &RunControl::new()).unwrap();
+    let chl = budgets.iter().find(|b| b.variable == "chl_mg_m3").unwrap();
+    eprintln!("{}", shoal::study::budget_table(&budgets));
+    // Sequential shares and the floor add up to the full error (by construction, to rounding).
+    let sum: f64 = chl.lines.iter().map(|l| l.sequential_pct).sum();
+    assert!((sum + chl.floor_pct - chl.full_pct).abs() < 1e-9);
+    // The CubeSat is noise-limited: noise is the largest share of its chl error, and with every
+    // stage perfect only the band-averaging floor of a few percent is left.
+    let noise = chl.lines.iter().find(|l| l.stage == shoal::study::Stage::Noise).unwrap();
+    assert!(chl.lines.iter().all(|l| l.sequential_pct <= noise.sequential_pct), "{chl:?}");
+    assert!(noise.sequential_pct > 0.4 * chl.full_pct, "{chl:?}");
+    assert!(chl.floor_pct < 5.0, "{chl:?}");
+}
