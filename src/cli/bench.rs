@@ -32,6 +32,10 @@ pub struct BenchArgs {
     /// Fewer repetitions (a smoke run; figures are noisier).
     #[arg(long)]
     pub quick: bool,
+    /// Only the cost-of-accuracy table: time and error of each fidelity setting against the
+    /// full-fidelity run.
+    #[arg(long)]
+    pub accuracy: bool,
     /// Skip the app rows (slider-to-preview latency and frame time; only with the `gui` feature).
     #[arg(long)]
     pub no_app: bool,
@@ -247,6 +251,10 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
     say!(out, "Machine: {}", machine());
     say!(out);
     emit(&std::mem::take(&mut out), None)?;
+    if args.accuracy {
+        super::bench_accuracy::accuracy_rows(&mut out, args.quick)?;
+        return emit(&out, None);
+    }
     water_rows(&mut out, args.quick)?;
     emit(&std::mem::take(&mut out), None)?;
     atmosphere_rows(&mut out, args.quick)?;

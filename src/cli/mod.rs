@@ -11,6 +11,7 @@
 
 mod atmosphere;
 mod bench;
+mod bench_accuracy;
 mod bench_chain;
 mod bench_retrieval;
 mod budget;
