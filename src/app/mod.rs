@@ -14,8 +14,10 @@
 //! | maps with zoom, pan and hover | `maps` |
 //! | metrics table and plots | `plots` |
 //! | figure and data export | `export` |
+//! | sweep and cost-of-accuracy windows | `explore` |
 
 pub mod bench;
+pub mod explore;
 mod export;
 pub mod link;
 mod maps;
@@ -52,6 +54,7 @@ struct UiState {
     export_path: String,
     typed_export: bool,
     exports: export::Exports,
+    explore: explore::Explore,
     frame_times_ms: Vec<f32>,
     zoom: maps::View,
     hover: Option<(usize, usize)>,
@@ -125,6 +128,12 @@ impl ShoalApp {
         self.library = library;
     }
 
+    /// The sweep and cost windows' state.
+    #[must_use]
+    pub fn explore(&self) -> &explore::Explore {
+        &self.ui.explore
+    }
+
     /// The last error shown to the user, if any.
     #[must_use]
     pub fn error(&self) -> Option<&str> {
@@ -171,7 +180,8 @@ impl ShoalApp {
                 }
             }
         }
-        if self.link.busy() || self.ui.exports.running > 0 {
+        self.ui.explore.poll();
+        if self.link.busy() || self.ui.exports.running > 0 || self.ui.explore.busy() {
             ctx.request_repaint_after(Duration::from_millis(30));
         }
     }
@@ -195,6 +205,12 @@ impl ShoalApp {
         });
         egui::Panel::bottom("bottom").resizable(true).default_size(300.0).show(ui, |ui| plots::bottom(self, ui));
         egui::CentralPanel::default().show(ui, |ui| maps::central(self, ui));
+        if self.ui.explore.sweep_open {
+            explore::sweep_window(self, &ctx);
+        }
+        if self.ui.explore.cost_open {
+            explore::cost_window(self, &ctx);
+        }
         self.dialogs(&ctx);
         // The UI thread's work for this frame (layout; not the GPU, not the wait for vsync).
         self.ui.frame_times_ms.push(start.elapsed().as_secs_f32() * 1e3);
@@ -237,6 +253,12 @@ impl ShoalApp {
                     Path::new(self.ui.export_path.trim()),
                 );
             }
+            ui.separator();
+            ui.toggle_value(&mut self.ui.explore.sweep_open, "Sweep")
+                .on_hover_text("A curve: one parameter of A and B over a range, with noise seeds");
+            ui.toggle_value(&mut self.ui.explore.cost_open, "Cost")
+                .on_hover_text("Time against error for each fidelity setting");
+            ui.separator();
             ui.toggle_value(&mut self.ui.typed_export, "Path")
                 .on_hover_text("Export to a typed path (for desktops without a file-chooser portal)");
             if self.ui.exports.running > 0 {

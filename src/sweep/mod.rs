@@ -20,13 +20,15 @@
 //! ```
 
 mod apply;
+mod cost;
 pub mod figure;
 mod run;
 mod table;
 
 pub use apply::apply;
+pub use cost::{CostRow, Setting, cost_of_accuracy, settings};
 pub use figure::sweep_figure;
-pub use run::{Job, SweepResult, run_sweep};
+pub use run::{Job, SweepResult, empty_table, run_job, run_sweep};
 pub use table::{Row, Table, merge};
 
 use std::path::{Path, PathBuf};

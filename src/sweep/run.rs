@@ -50,6 +50,59 @@ impl ResolvedSweep {
     }
 }
 
+/// Run one job on `engine`: its rows and its wall time, s.
+pub fn run_job(
+    engine: &mut Engine,
+    sweep: &ResolvedSweep,
+    job: &Job,
+    control: &RunControl,
+) -> Result<(Vec<Row>, f64), StudyError> {
+    let paths: Vec<&str> = sweep.spec.parameters.iter().map(|p| p.path.as_str()).collect();
+    let (label, base) = &sweep.bases[job.instrument];
+    let settings: Vec<(&str, f64)> = paths.iter().copied().zip(job.values.iter().copied()).collect();
+    let mut config =
+        apply(base, &settings).map_err(|m| StudyError::Invalid { field: "parameters".into(), message: m })?;
+    config.seed = job.seed;
+    let start = std::time::Instant::now();
+    let out = engine.run(&config, control).map_err(|e| match e {
+        EngineError::Cancelled => StudyError::Cancelled,
+        other => StudyError::Run { instrument: format!("{label} at {settings:?}"), message: other.to_string() },
+    })?;
+    let secs = start.elapsed().as_secs_f64();
+    let mut rows = Vec::new();
+    for ret in &out.retrievals {
+        for v in &ret.metrics.variables {
+            rows.push(Row {
+                job: job.index,
+                point: job.point,
+                values: job.values.clone(),
+                instrument: label.clone(),
+                seed: job.seed,
+                product: ret.metrics.product.clone(),
+                variable: v.variable.clone(),
+                mae_pct: v.metrics.mae_pct(),
+                bias_pct: v.metrics.bias_pct(),
+                returned_pct: v.metrics.returned_pct,
+                n: v.metrics.n,
+            });
+        }
+    }
+    Ok((rows, secs))
+}
+
+/// An empty table for `sweep` (its identity and columns), holding shard `shard`.
+#[must_use]
+pub fn empty_table(sweep: &ResolvedSweep, shard: Shard) -> Table {
+    Table {
+        name: sweep.spec.name.clone(),
+        key: sweep.key(),
+        jobs: sweep.jobs.len(),
+        shard: (shard.count > 1).then_some((shard.index, shard.count)),
+        parameters: sweep.spec.parameters.iter().map(|p| p.path.clone()).collect(),
+        rows: Vec::new(),
+    }
+}
+
 /// Run the jobs `shard` owns, in order; `on_job` hears of each as it finishes (index, seconds).
 pub fn run_sweep(
     sweep: &ResolvedSweep,
@@ -58,48 +111,13 @@ pub fn run_sweep(
     mut on_job: impl FnMut(usize, f64),
 ) -> Result<SweepResult, StudyError> {
     let mut engine = Engine::new();
-    let paths: Vec<&str> = sweep.spec.parameters.iter().map(|p| p.path.as_str()).collect();
-    let mut rows = Vec::new();
+    let mut table = empty_table(sweep, shard);
     let mut seconds = Vec::new();
     for job in sweep.jobs.iter().filter(|j| shard.owns(j.index)) {
-        let (label, base) = &sweep.bases[job.instrument];
-        let settings: Vec<(&str, f64)> = paths.iter().copied().zip(job.values.iter().copied()).collect();
-        let mut config =
-            apply(base, &settings).map_err(|m| StudyError::Invalid { field: "parameters".into(), message: m })?;
-        config.seed = job.seed;
-        let start = std::time::Instant::now();
-        let out = engine.run(&config, control).map_err(|e| match e {
-            EngineError::Cancelled => StudyError::Cancelled,
-            other => StudyError::Run { instrument: format!("{label} at {settings:?}"), message: other.to_string() },
-        })?;
-        let secs = start.elapsed().as_secs_f64();
-        for ret in &out.retrievals {
-            for v in &ret.metrics.variables {
-                rows.push(Row {
-                    job: job.index,
-                    point: job.point,
-                    values: job.values.clone(),
-                    instrument: label.clone(),
-                    seed: job.seed,
-                    product: ret.metrics.product.clone(),
-                    variable: v.variable.clone(),
-                    mae_pct: v.metrics.mae_pct(),
-                    bias_pct: v.metrics.bias_pct(),
-                    returned_pct: v.metrics.returned_pct,
-                    n: v.metrics.n,
-                });
-            }
-        }
+        let (rows, secs) = run_job(&mut engine, sweep, job, control)?;
+        table.rows.extend(rows);
         seconds.push((job.index, secs));
         on_job(job.index, secs);
     }
-    let table = Table {
-        name: sweep.spec.name.clone(),
-        key: sweep.key(),
-        jobs: sweep.jobs.len(),
-        shard: (shard.count > 1).then_some((shard.index, shard.count)),
-        parameters: paths.iter().map(ToString::to_string).collect(),
-        rows,
-    };
     Ok(SweepResult { table, seconds })
 }

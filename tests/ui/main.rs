@@ -193,3 +193,32 @@ fn the_comparison_figure_exports_to_a_typed_path() {
     assert!(shoal::engine::RunConfig::from_ron(&config, "A").is_ok());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn the_sweep_window_draws_a_curve_for_a_and_b() {
+    let dir = temp_library("sweep");
+    let mut h = harness("cubesat", 24, &dir);
+    h.get_by_label("Sweep").click();
+    h.step();
+    h.step();
+    h.get_by_role_and_label(Role::Slider, "Points").set_value_accesskit(2.0);
+    h.get_by_role_and_label(Role::Slider, "Seeds").set_value_accesskit(1.0);
+    h.step();
+    pick(&mut h, "Resolution", "1/24");
+    h.get_by_label("Run sweep").click();
+    h.step();
+    let start = Instant::now();
+    while h.state().explore().busy() {
+        assert!(start.elapsed() < Duration::from_secs(300), "the sweep did not finish");
+        std::thread::sleep(Duration::from_millis(20));
+        h.step();
+    }
+    h.step();
+    h.step();
+    // 2 points × 2 instruments × 1 seed, three variables each (chl, NAP, CDOM).
+    assert_eq!(h.state().explore().sweep_rows(), 12);
+    assert!(h.query_by_label_contains("done: 4 runs").is_some());
+    // Each instrument's line says whether it meets the chl requirement.
+    assert!(h.query_all_by_label_contains("chl MAE ≤").count() >= 2);
+    let _ = std::fs::remove_dir_all(&dir);
+}

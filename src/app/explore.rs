@@ -1,0 +1,414 @@
+//! Trade-off windows. **Sweep**: one instrument parameter of A and B over a range with several
+//! noise seeds; the chl MAE curve of each instrument grows point by point, with the seeds' range,
+//! the requirement and where it is first met. **Cost**: every fidelity setting's time against its
+//! error from the full-fidelity run (`sweep::cost`), to pick the cheapest setting whose error is
+//! acceptable.
+//!
+//! Both run on a helper thread (not the engine thread, whose pool serves the maps) and stream
+//! their results; a new run or closing the window cancels the old one.
+
+use std::sync::Arc;
+use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
+
+use egui_plot::{HLine, Legend, Line, Plot, PlotPoints, Points};
+
+use super::model::AppState;
+use crate::control::RunControl;
+use crate::engine::{Engine, RunConfig};
+use crate::study::{Source, StudySpec};
+use crate::sweep::{
+    CostRow, Parameter, Requirement, Row, SweepSpec, Table, Values, cost_of_accuracy, empty_table, run_job,
+};
+
+/// Messages from a helper thread.
+enum Msg<T> {
+    Item(T),
+    Done(Result<(), String>),
+}
+
+/// A helper thread's channel and its cancel switch.
+struct Task<T> {
+    rx: Receiver<Msg<T>>,
+    control: Arc<RunControl>,
+}
+
+impl<T: Send + 'static> Task<T> {
+    fn spawn(
+        ctx: &egui::Context,
+        work: impl FnOnce(&RunControl, &dyn Fn(T)) -> Result<(), String> + Send + 'static,
+    ) -> Result<Self, String> {
+        let (tx, rx): (SyncSender<Msg<T>>, _) = sync_channel(64);
+        let control = Arc::new(RunControl::new());
+        let (c, wake) = (control.clone(), ctx.clone());
+        std::thread::Builder::new()
+            .name("shoal-explore".into())
+            .spawn(move || {
+                let send = |item: T| {
+                    let _ = tx.send(Msg::Item(item));
+                    wake.request_repaint();
+                };
+                let result = work(&c, &send);
+                let _ = tx.send(Msg::Done(result));
+                wake.request_repaint();
+            })
+            .map_err(|e| format!("cannot start a helper thread: {e}"))?;
+        Ok(Self { rx, control })
+    }
+}
+
+impl<T> Drop for Task<T> {
+    fn drop(&mut self) {
+        self.control.cancel();
+    }
+}
+
+/// Parameters the sweep window offers: (label, path below `instrument.`, unit, default range).
+const SWEEPABLE: [(&str, &str, &str, f64, f64); 8] = [
+    ("Aperture", "aperture_mm", "mm", 40.0, 300.0),
+    ("Exposure", "exposure_s", "s", 0.0005, 0.005),
+    ("Read noise", "read_noise_e", "e⁻", 1.0, 80.0),
+    ("Well depth", "well_depth_e", "e⁻", 10_000.0, 400_000.0),
+    ("Gain", "gain_e_per_dn", "e⁻/DN", 0.5, 20.0),
+    ("Optical transmission", "optical_transmission", "", 0.3, 1.0),
+    ("Focal length", "focal_length_mm", "mm", 80.0, 400.0),
+    ("Altitude", "altitude_km", "km", 400.0, 800.0),
+];
+
+/// The windows' state (not persisted: results belong to the session).
+pub struct Explore {
+    /// Is the sweep window open?
+    pub sweep_open: bool,
+    /// Is the cost window open?
+    pub cost_open: bool,
+    param: usize,
+    from: f64,
+    to: f64,
+    steps: usize,
+    log: bool,
+    seeds: u64,
+    decimation: usize,
+    sweep_task: Option<Task<Vec<Row>>>,
+    table: Option<Table>,
+    sweep_total: usize,
+    sweep_status: String,
+    cost_decimation: usize,
+    cost_task: Option<Task<CostRow>>,
+    cost_rows: Vec<CostRow>,
+    cost_status: String,
+}
+
+impl Default for Explore {
+    fn default() -> Self {
+        Self {
+            sweep_open: false,
+            cost_open: false,
+            param: 0,
+            from: SWEEPABLE[0].3,
+            to: SWEEPABLE[0].4,
+            steps: 6,
+            log: true,
+            seeds: 3,
+            decimation: 8,
+            sweep_task: None,
+            table: None,
+            sweep_total: 0,
+            sweep_status: String::new(),
+            cost_decimation: 4,
+            cost_task: None,
+            cost_rows: Vec::new(),
+            cost_status: String::new(),
+        }
+    }
+}
+
+impl Explore {
+    /// Is a helper thread working?
+    #[must_use]
+    pub fn busy(&self) -> bool {
+        self.sweep_task.is_some() || self.cost_task.is_some()
+    }
+
+    /// Rows of the sweep so far.
+    #[must_use]
+    pub fn sweep_rows(&self) -> usize {
+        self.table.as_ref().map_or(0, |t| t.rows.len())
+    }
+
+    /// Take what the helper threads sent.
+    pub fn poll(&mut self) {
+        if let Some(task) = &self.sweep_task {
+            let mut finished = None;
+            while let Ok(msg) = task.rx.try_recv() {
+                match msg {
+                    Msg::Item(rows) => {
+                        if let Some(t) = &mut self.table {
+                            t.rows.extend(rows);
+                        }
+                    }
+                    Msg::Done(r) => finished = Some(r),
+                }
+            }
+            if let Some(r) = finished {
+                self.sweep_status = match r {
+                    Ok(()) => format!("done: {} runs", self.sweep_total),
+                    Err(e) => e,
+                };
+                self.sweep_task = None;
+            }
+        }
+        if let Some(task) = &self.cost_task {
+            let mut finished = None;
+            while let Ok(msg) = task.rx.try_recv() {
+                match msg {
+                    Msg::Item(row) => self.cost_rows.push(row),
+                    Msg::Done(r) => finished = Some(r),
+                }
+            }
+            if let Some(r) = finished {
+                self.cost_status = match r {
+                    Ok(()) => format!("done: {} settings", self.cost_rows.len()),
+                    Err(e) => e,
+                };
+                self.cost_task = None;
+            }
+        }
+    }
+
+    /// Start the sweep of the chosen parameter over A and B as they are now.
+    pub fn start_sweep(&mut self, ctx: &egui::Context, state: &AppState) {
+        let (_, key, _, _, _) = SWEEPABLE[self.param];
+        let study = StudySpec {
+            name: "app".into(),
+            description: String::new(),
+            scene: Source::Inline(Box::new(state.seeded_scene())),
+            instruments: vec![
+                Source::Inline(Box::new(state.a.spec.clone())),
+                Source::Inline(Box::new(state.b.spec.clone())),
+            ],
+            retrievals: vec![state.retrieval_spec()],
+            seeds: vec![1],
+            detector: None,
+            calibration: None,
+            correction: None,
+            fidelity: None,
+        };
+        let spec = SweepSpec {
+            name: format!("app_{key}"),
+            description: String::new(),
+            study: Source::Inline(Box::new(study)),
+            parameters: vec![Parameter {
+                path: format!("instrument.{key}"),
+                values: Values::Range { from: self.from, to: self.to, steps: self.steps, log: self.log },
+            }],
+            seeds: (1..=self.seeds).collect(),
+            requirement: Some(Requirement { variable: "chl_mg_m3".into(), mae_pct: state.requirements.chl_mae_pct }),
+        };
+        let mut sweep = match spec.resolve(None) {
+            Ok(s) => s,
+            Err(e) => {
+                self.sweep_status = e.to_string();
+                return;
+            }
+        };
+        for (_, c) in &mut sweep.bases {
+            c.fidelity.decimation = self.decimation;
+        }
+        self.table = Some(empty_table(&sweep, crate::sweep::Shard::ALL));
+        self.sweep_total = sweep.jobs.len();
+        self.sweep_status = format!("running {} runs at 1/{}", sweep.jobs.len(), self.decimation);
+        let task = Task::spawn(ctx, move |control, send| {
+            let mut engine = Engine::new();
+            for job in &sweep.jobs {
+                let (rows, _) = run_job(&mut engine, &sweep, job, control).map_err(|e| e.to_string())?;
+                send(rows);
+            }
+            Ok(())
+        });
+        match task {
+            Ok(t) => self.sweep_task = Some(t),
+            Err(e) => self.sweep_status = e,
+        }
+    }
+
+    /// Start measuring the cost of accuracy for instrument A at 1/`cost_decimation`.
+    pub fn start_cost(&mut self, ctx: &egui::Context, config: RunConfig) {
+        let mut base = config;
+        base.fidelity.decimation = self.cost_decimation;
+        self.cost_rows.clear();
+        self.cost_status = format!("measuring at 1/{} …", self.cost_decimation);
+        let task = Task::spawn(ctx, move |control, send| {
+            cost_of_accuracy(&base, control, |row| send(row.clone())).map(|_| ()).map_err(|e| e.to_string())
+        });
+        match task {
+            Ok(t) => self.cost_task = Some(t),
+            Err(e) => self.cost_status = e,
+        }
+    }
+}
+
+fn labelled_drag(ui: &mut egui::Ui, label: &str, value: &mut f64, speed: f64) {
+    let l = ui.label(label);
+    ui.add(egui::DragValue::new(value).speed(speed)).labelled_by(l.id);
+}
+
+/// The sweep window.
+pub fn sweep_window(app: &mut super::ShoalApp, ctx: &egui::Context) {
+    let mut open = app.ui.explore.sweep_open;
+    let mut start = false;
+    egui::Window::new("Sweep").open(&mut open).default_size([620.0, 460.0]).show(ctx, |ui| {
+        let e = &mut app.ui.explore;
+        ui.horizontal(|ui| {
+            let before = e.param;
+            egui::ComboBox::from_label("Parameter").selected_text(SWEEPABLE[e.param].0).show_ui(ui, |ui| {
+                for (i, p) in SWEEPABLE.iter().enumerate() {
+                    ui.selectable_value(&mut e.param, i, p.0);
+                }
+            });
+            if e.param != before {
+                (e.from, e.to) = (SWEEPABLE[e.param].3, SWEEPABLE[e.param].4);
+            }
+            let (from_speed, to_speed) = (0.01 * e.from.abs().max(1e-3), 0.01 * e.to.abs().max(1e-3));
+            labelled_drag(ui, "From", &mut e.from, from_speed);
+            labelled_drag(ui, "To", &mut e.to, to_speed);
+            ui.label(SWEEPABLE[e.param].2);
+        });
+        ui.horizontal(|ui| {
+            ui.add(egui::Slider::new(&mut e.steps, 2..=20).text("Points"));
+            ui.checkbox(&mut e.log, "Log spacing");
+            ui.add(egui::Slider::new(&mut e.seeds, 1..=10).text("Seeds"));
+        });
+        ui.horizontal(|ui| {
+            egui::ComboBox::from_label("Resolution").selected_text(format!("1/{}", e.decimation)).show_ui(ui, |ui| {
+                for d in [2, 4, 8, 16, 24] {
+                    ui.selectable_value(&mut e.decimation, d, format!("1/{d}"));
+                }
+            });
+            let runs = 2 * e.steps * e.seeds as usize;
+            if ui.button("Run sweep").on_hover_text(format!("{runs} runs of A and B")).clicked() {
+                start = true;
+            }
+        });
+        if e.sweep_task.is_some() && ui.button("Stop").clicked() {
+            e.sweep_task = None;
+            e.sweep_status = "stopped".into();
+        }
+        let done = e.table.as_ref().map_or(0, |t| {
+            let mut jobs: Vec<usize> = t.rows.iter().map(|r| r.job).collect();
+            jobs.dedup();
+            jobs.len()
+        });
+        ui.label(format!("{} ({done}/{} runs)", e.sweep_status, e.sweep_total));
+        let requirement = Requirement { variable: "chl_mg_m3".into(), mae_pct: app.state.requirements.chl_mae_pct };
+        if let Some(table) = &e.table {
+            let curves = crate::sweep::figure::curves(table, "chl_mg_m3", Some(&requirement), false);
+            for s in &curves.series {
+                match s.crossing {
+                    Some(x) => ui.label(format!(
+                        "{}: meets chl MAE ≤ {:.0} % from {} = {x:.3}",
+                        s.label, requirement.mae_pct, curves.x_label
+                    )),
+                    None => {
+                        ui.label(format!("{}: does not meet chl MAE ≤ {:.0} % (so far)", s.label, requirement.mae_pct))
+                    }
+                };
+            }
+            Plot::new("sweep-plot")
+                .legend(Legend::default())
+                .x_axis_label(curves.x_label.clone())
+                .y_axis_label("chl MAE %")
+                .show(ui, |p| {
+                    for (k, s) in curves.series.iter().enumerate() {
+                        let c = crate::colormap::categorical(k);
+                        let colour = egui::Color32::from_rgb(c[0], c[1], c[2]);
+                        p.line(
+                            Line::new(s.label.clone(), PlotPoints::from_iter(s.points.iter().map(|q| [q.x, q.mean])))
+                                .color(colour)
+                                .width(2.0),
+                        );
+                        p.line(
+                            Line::new(
+                                format!("{} lowest seed", s.label),
+                                PlotPoints::from_iter(s.points.iter().map(|q| [q.x, q.lo])),
+                            )
+                            .color(colour.gamma_multiply(0.4)),
+                        );
+                        p.line(
+                            Line::new(
+                                format!("{} highest seed", s.label),
+                                PlotPoints::from_iter(s.points.iter().map(|q| [q.x, q.hi])),
+                            )
+                            .color(colour.gamma_multiply(0.4)),
+                        );
+                        if let Some(x) = s.crossing {
+                            p.points(
+                                Points::new(format!("{} meets", s.label), vec![[x, requirement.mae_pct]])
+                                    .radius(6.0)
+                                    .color(colour),
+                            );
+                        }
+                    }
+                    p.hline(HLine::new("requirement", requirement.mae_pct).color(egui::Color32::from_rgb(40, 150, 40)));
+                });
+        }
+    });
+    if start {
+        let state = app.state.clone();
+        app.ui.explore.start_sweep(ctx, &state);
+    }
+    if !open {
+        app.ui.explore.sweep_task = None;
+    }
+    app.ui.explore.sweep_open = open;
+}
+
+/// The cost-of-accuracy window.
+pub fn cost_window(app: &mut super::ShoalApp, ctx: &egui::Context) {
+    let mut open = app.ui.explore.cost_open;
+    let mut start = false;
+    egui::Window::new("Cost of accuracy").open(&mut open).default_size([640.0, 520.0]).show(ctx, |ui| {
+        ui.label("Time of the whole chain for instrument A against the error each fidelity setting makes (a fresh engine per setting).");
+        ui.horizontal(|ui| {
+            let e = &mut app.ui.explore;
+            egui::ComboBox::from_label("Reference resolution").selected_text(format!("1/{}", e.cost_decimation)).show_ui(ui, |ui| {
+                for d in [1, 2, 4, 8] {
+                    ui.selectable_value(&mut e.cost_decimation, d, if d == 1 { "full".to_string() } else { format!("1/{d}") });
+                }
+            });
+            if ui.button("Measure").clicked() {
+                start = true;
+            }
+        });
+        let e = &app.ui.explore;
+        ui.label(format!("{} ({}/{} settings)", e.cost_status, e.cost_rows.len(), crate::sweep::settings(e.cost_decimation).len()));
+        Plot::new("cost-plot").height(220.0).legend(Legend::default()).x_axis_label("time, s").y_axis_label("error, %").show(ui, |p| {
+            let same: Vec<[f64; 2]> = e.cost_rows.iter().filter_map(|r| r.chl_pixel_pct.map(|v| [r.seconds, v])).collect();
+            let other: Vec<[f64; 2]> = e.cost_rows.iter().filter(|r| r.chl_pixel_pct.is_none()).map(|r| [r.seconds, r.delta_mae_pct.abs()]).collect();
+            p.points(Points::new("chl per pixel vs reference (median %)", same).radius(4.0));
+            p.points(Points::new("previews: |ΔMAE| (points)", other).radius(4.0).shape(egui_plot::MarkerShape::Diamond));
+        });
+        egui::ScrollArea::vertical().show(ui, |ui| {
+            egui::Grid::new("cost-table").striped(true).num_columns(5).show(ui, |ui| {
+                for h in ["setting", "time s", "× ref", "ΔMAE", "chl per pixel %"] {
+                    ui.strong(h);
+                }
+                ui.end_row();
+                for r in &e.cost_rows {
+                    ui.label(r.label.as_str());
+                    ui.label(format!("{:.2}", r.seconds));
+                    ui.label(format!("{:.2}", r.ratio));
+                    ui.label(format!("{:+.2}", r.delta_mae_pct));
+                    ui.label(r.chl_pixel_pct.map_or_else(|| "other grid".into(), |v| format!("{v:.3}")));
+                    ui.end_row();
+                }
+            });
+        });
+    });
+    if start {
+        let config = app.state.configs().swap_remove(0);
+        app.ui.explore.start_cost(ctx, config);
+    }
+    if !open {
+        app.ui.explore.cost_task = None;
+    }
+    app.ui.explore.cost_open = open;
+}
