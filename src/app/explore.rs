@@ -191,6 +191,7 @@ impl Explore {
             calibration: None,
             correction: None,
             fidelity: None,
+            requirements: None,
         };
         let spec = SweepSpec {
             name: format!("app_{key}"),

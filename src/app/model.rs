@@ -231,6 +231,7 @@ fn fallback_study() -> StudySpec {
         calibration: None,
         correction: None,
         fidelity: None,
+        requirements: None,
     })
 }
 
@@ -290,6 +291,21 @@ impl AppState {
                 s.almi = settings.clone();
             }
             None => {}
+        }
+        if let Some(r) = &study.requirements {
+            for p in &r.products {
+                let Some(limit) = p.mae_pct else { continue };
+                match p.variable.as_str() {
+                    "chl_mg_m3" => s.requirements.chl_mae_pct = limit,
+                    "nap_g_m3" => s.requirements.nap_mae_pct = limit,
+                    "cdom_per_m" => s.requirements.cdom_mae_pct = limit,
+                    "depth_m" => s.requirements.depth_mae_pct = limit,
+                    _ => {}
+                }
+            }
+            if let Some(snr) = r.snr {
+                s.requirements.snr = snr;
+            }
         }
         Ok(s)
     }

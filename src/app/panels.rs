@@ -267,6 +267,7 @@ fn save_presets(app: &mut ShoalApp, ui: &mut egui::Ui) {
                 calibration: None,
                 correction: None,
                 fidelity: None,
+                requirements: None,
             };
             match app.library.save_study(&name, &study, true) {
                 Ok(path) => app.ui.message = Some(format!("saved {}", path.display())),

@@ -47,7 +47,10 @@ fn metrics_table(app: &ShoalApp, ui: &mut egui::Ui) {
                         ui.label(format!("{:.1} %", m.returned_pct));
                         match app.state.requirements.mae_limit(v) {
                             Some(limit) => {
-                                ui.label(pass(m.mae_pct() <= limit)).on_hover_text(format!("MAE at most {limit:.0} %"));
+                                ui.label(pass(m.mae_pct() <= limit)).on_hover_text(format!(
+                                    "MAE at most {limit:.0} %: margin {:+.1} points",
+                                    limit - m.mae_pct()
+                                ));
                             }
                             None => {
                                 ui.label("");

@@ -154,6 +154,23 @@ pub fn run(args: &StudyArgs) -> Result<(), CliError> {
             }
         }
     }
+    if let Some(r) = &spec.requirements {
+        eprintln!(
+            "{:<12} {:<28} {:>10} {:>10} {:>6} {:>10}",
+            "instrument", "requirement", "value", "limit", "", "margin"
+        );
+        for c in r.check(&result) {
+            eprintln!(
+                "{:<12} {:<28} {:>10.1} {:>10.1} {:>6} {:>+10.1}",
+                c.instrument,
+                c.what,
+                c.value,
+                c.limit,
+                if c.pass { "pass" } else { "FAIL" },
+                c.margin
+            );
+        }
+    }
     eprintln!("wrote {} files to {}", outputs.files.len(), args.out.display());
     Ok(())
 }

@@ -18,12 +18,14 @@ mod budget;
 mod curves;
 mod figures;
 mod output;
+mod requirements;
 mod run;
 
 pub use budget::{Budget, BudgetLine, Stage, budget_table, error_budget};
 pub use curves::{CurvePoint, CurveSeries, Curves, curve_figure, first_crossing};
 pub use figures::{ComparisonPanel, Figure, comparison_figure, figure_set};
 pub use output::{Outputs, metrics_csv, write_bytes, write_run, write_study};
+pub use requirements::{Check, ProductRequirement, Requirements, checks_csv};
 pub use run::{StudyResult, StudyRun, run_study};
 
 use std::path::{Path, PathBuf};
@@ -113,6 +115,9 @@ pub struct StudySpec {
     /// Fidelity settings for every run.
     #[serde(default)]
     pub fidelity: Option<Fidelity>,
+    /// What the products and bands must achieve (checked and reported with margins).
+    #[serde(default)]
+    pub requirements: Option<Requirements>,
 }
 
 fn default_seeds() -> Vec<u64> {
@@ -202,6 +207,9 @@ impl StudySpec {
                 field: "seeds".into(),
                 message: format!("{} seeds (allowed: 1 to 1000)", self.seeds.len()),
             });
+        }
+        if let Some(r) = &self.requirements {
+            r.validate()?;
         }
         let (scene, scene_dir) = load(&self.scene, dir, |n| SceneSpec::preset(n).map_err(|e| e.to_string()), "scene")?;
         let mut runs = Vec::new();

@@ -187,6 +187,9 @@ pub fn metrics_csv(result: &StudyResult) -> String {
 pub fn write_study(result: &StudyResult, dir: &Path, figures: bool) -> Result<Outputs, StudyError> {
     let mut o = Outputs::default();
     text(dir, "metrics.csv", &metrics_csv(result), &mut o)?;
+    if let Some(r) = &result.study.spec.requirements {
+        text(dir, "requirements.csv", &super::checks_csv(&r.check(result)), &mut o)?;
+    }
     let mut rows = Vec::new();
     let mut extra = Vec::new();
     for run in &result.runs {

@@ -141,3 +141,34 @@ fn the_cubesat_error_budget_adds_up_and_noise_leads_it() {
     assert!(noise.sequential_pct > 0.4 * chl.full_pct, "{chl:?}");
     assert!(chl.floor_pct < 5.0, "{chl:?}");
 }
+
+#[test]
+fn the_default_study_checks_its_requirements_with_margins() {
+    let spec = shoal::study::StudySpec::default_study().unwrap();
+    let req = spec.requirements.clone().expect("the default study states requirements");
+    let mut study = spec.resolve(None).unwrap();
+    for (_, _, c) in &mut study.runs {
+        c.fidelity.decimation = 16;
+    }
+    let result = shoal::study::run_study(&study, &RunControl::new(), |_, _| Ok(())).unwrap();
+    let checks = req.check(&result);
+    let find = |inst: &str, what: &str| checks.iter().find(|c| c.instrument == inst && c.what == what).unwrap().clone();
+    // The paper's finding, as a requirement: the CubeSat misses chl MAE ≤ 20 %, the SmallSat meets it.
+    let cube = find("cubesat", "chl_mg_m3 MAE %");
+    let small = find("smallsat", "chl_mg_m3 MAE %");
+    assert!(!cube.pass && cube.margin < -5.0, "{cube:?}");
+    assert!(small.pass && small.margin > 2.0, "{small:?}");
+    assert!((cube.margin - (cube.limit - cube.value)).abs() < 1e-12);
+    // One SNR check per band and instrument.
+    let bands: usize = result.runs.iter().map(|r| r.snr.len()).sum();
+    assert!(bands >= 2 * 16);
+    assert_eq!(checks.iter().filter(|c| c.what.starts_with("SNR")).count(), bands);
+    let csv = shoal::study::checks_csv(&checks);
+    assert!(csv.contains("cubesat,1,chl_mg_m3 MAE %") && csv.contains("FAIL"));
+
+    // Bad requirements are refused by name.
+    let mut bad = shoal::study::StudySpec::default_study().unwrap();
+    bad.requirements.as_mut().unwrap().products[0].returned_pct = Some(140.0);
+    let e = bad.resolve(None).unwrap_err().to_string();
+    assert!(e.contains("requirements.products[0].returned_pct") && e.contains("140"), "{e}");
+}
