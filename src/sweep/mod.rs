@@ -78,7 +78,12 @@ impl Values {
                 (0..steps)
                     .map(|i| {
                         let t = i as f64 / (steps - 1) as f64;
-                        if log {
+                        // The ends exactly as written (powf would give 40.000000000000014).
+                        if i == 0 {
+                            from
+                        } else if i == steps - 1 {
+                            to
+                        } else if log {
                             10f64.powf(from.log10() + t * (to.log10() - from.log10()))
                         } else {
                             from + t * (to - from)
@@ -298,5 +303,23 @@ impl Shard {
     #[must_use]
     pub fn owns(&self, index: usize) -> bool {
         index % self.count == self.index
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    #[test]
+    fn a_log_range_keeps_its_ends_and_is_geometric() {
+        let v = Values::Range { from: 40.0, to: 300.0, steps: 8, log: true }.resolve("v").unwrap();
+        assert_eq!((v[0], v[7]), (40.0, 300.0));
+        let ratio = (300.0f64 / 40.0).powf(1.0 / 7.0);
+        for w in v.windows(2) {
+            assert!((w[1] / w[0] - ratio).abs() < 1e-12);
+        }
+        let lin = Values::Range { from: 1.0, to: 2.0, steps: 3, log: false }.resolve("v").unwrap();
+        assert_eq!(lin, vec![1.0, 1.5, 2.0]);
     }
 }
