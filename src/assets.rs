@@ -84,6 +84,18 @@ pub const PRESETS: &[Asset] = embed_presets![
     "sweeps/aperture_lake_hume.ron",
 ];
 
+/// Names of the built-in presets in `folder` (`"instruments"`, `"scenes"`, …), in embedding order.
+#[must_use]
+pub fn preset_names(folder: &str) -> Vec<String> {
+    PRESETS
+        .iter()
+        .filter_map(|a| {
+            a.path.strip_prefix(folder).and_then(|p| p.strip_prefix('/')).and_then(|p| p.strip_suffix(".ron"))
+        })
+        .map(str::to_string)
+        .collect()
+}
+
 /// The built-in preset at `path` (relative to `presets/`), if there is one.
 #[must_use]
 pub fn preset(path: &str) -> Option<&'static Asset> {

@@ -50,8 +50,8 @@ pub struct EngineLink {
     pub progress: Option<Progress>,
     /// Has the current generation's finest level finished for both instruments?
     finished: [bool; 2],
-    /// Seconds from each submission to its first preview arriving (for the latency figure).
-    pub latencies: Vec<f64>,
+    /// Seconds from the last submission to its first results of A and B arriving.
+    pub last_latency_s: Option<f64>,
     latency_pending: bool,
 }
 
@@ -68,7 +68,7 @@ impl EngineLink {
             errors: [None, None],
             progress: None,
             finished: [false, false],
-            latencies: Vec::new(),
+            last_latency_s: None,
             latency_pending: false,
         })
     }
@@ -144,7 +144,7 @@ impl EngineLink {
                                         .iter()
                                         .all(|s| s.as_ref().is_some_and(|s| s.generation == self.generation))
                                 {
-                                    self.latencies.push(self.submitted_at.elapsed().as_secs_f64());
+                                    self.last_latency_s = Some(self.submitted_at.elapsed().as_secs_f64());
                                     self.latency_pending = false;
                                 }
                             }

@@ -219,7 +219,7 @@ fn timings(app: &ShoalApp, ui: &mut egui::Ui) {
                 if skipped.is_empty() { "none".into() } else { skipped.join(", ") }
             ));
         }
-        if let Some(l) = app.link.latencies.last() {
+        if let Some(l) = app.link.last_latency_s {
             ui.label(format!("last change → preview: {:.0} ms", l * 1e3));
         }
     });

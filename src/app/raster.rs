@@ -280,13 +280,46 @@ pub struct Done {
     pub difference_palette: Option<Palette>,
 }
 
+/// One cached map: its run, product, band, truth flag and the map (`None`: the run has none).
+type CachedMap = (Arc<RunOutput>, ProductKind, usize, bool, Option<Arc<MapData>>);
+
+/// Product maps already extracted, by run (kept alive here, so pointer equality is identity),
+/// product, band and truth, least recently used first: when only A changes, B's map is not
+/// rebuilt.
+#[derive(Default)]
+pub struct MapCache {
+    entries: Vec<CachedMap>,
+}
+
+impl MapCache {
+    /// Maps kept: A, A's truth, B and one more. Few, because each entry keeps its run (cubes
+    /// and all) alive.
+    const CAPACITY: usize = 4;
+
+    fn get(&mut self, out: &Arc<RunOutput>, kind: ProductKind, band: usize, truth: bool) -> Option<Arc<MapData>> {
+        if let Some(i) =
+            self.entries.iter().position(|e| Arc::ptr_eq(&e.0, out) && e.1 == kind && e.2 == band && e.3 == truth)
+        {
+            // Most recently used last: what is shown now stays, old runs leave first.
+            let e = self.entries.remove(i);
+            let map = e.4.clone();
+            self.entries.push(e);
+            return map;
+        }
+        let map = product_map(out, kind, band, truth).map(Arc::new);
+        if self.entries.len() == Self::CAPACITY {
+            self.entries.remove(0);
+        }
+        self.entries.push((out.clone(), kind, band, truth, map.clone()));
+        map
+    }
+}
+
 /// Compute the panels of `job`.
 #[must_use]
-pub fn panels(job: &Job) -> Done {
+pub fn panels(job: &Job, cache: &mut MapCache) -> Done {
     use super::model::Layout;
-    let get = |i: usize, truth: bool| {
-        job.runs[i].as_ref().and_then(|o| product_map(o, job.kind, job.band, truth)).map(Arc::new)
-    };
+    let mut get = |i: usize, truth: bool| job.runs[i].as_ref().and_then(|o| cache.get(o, job.kind, job.band, truth));
     let (a, b) = (get(0, false), get(1, false));
     let mut named: Vec<(String, Arc<MapData>)> = Vec::new();
     let mut diff = None;
@@ -341,11 +374,12 @@ impl RasterThread {
         let (jobs, job_rx) = sync_channel::<Job>(4);
         let (done_tx, done) = sync_channel::<Done>(2);
         std::thread::Builder::new().name("shoal-raster".into()).spawn(move || {
+            let mut cache = MapCache::default();
             while let Ok(mut job) = job_rx.recv() {
                 while let Ok(newer) = job_rx.try_recv() {
                     job = newer;
                 }
-                if done_tx.send(panels(&job)).is_err() {
+                if done_tx.send(panels(&job, &mut cache)).is_err() {
                     return;
                 }
                 wake();

@@ -115,18 +115,7 @@ pub fn run(args: &StudyArgs) -> Result<(), CliError> {
     );
     for run in &result.runs {
         for ret in &run.retrievals {
-            for v in &ret.metrics.variables {
-                eprintln!(
-                    "{:<12} {:<8} {:<24} {:>9.1} {:>+9.1} {:>10.2}",
-                    run.label,
-                    ret.metrics.product,
-                    v.variable,
-                    v.metrics.mae_pct(),
-                    v.metrics.bias_pct(),
-                    v.metrics.returned_pct
-                );
-            }
-            for v in &ret.metrics.depth_by_true_substrate {
+            for v in ret.metrics.variables.iter().chain(&ret.metrics.depth_by_true_substrate) {
                 eprintln!(
                     "{:<12} {:<8} {:<24} {:>9.1} {:>+9.1} {:>10.2}",
                     run.label,

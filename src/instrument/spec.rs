@@ -140,11 +140,7 @@ impl InstrumentSpec {
     /// Names of the built-in instruments.
     #[must_use]
     pub fn preset_names() -> Vec<String> {
-        crate::assets::PRESETS
-            .iter()
-            .filter_map(|a| a.path.strip_prefix("instruments/").and_then(|p| p.strip_suffix(".ron")))
-            .map(str::to_string)
-            .collect()
+        crate::assets::preset_names("instruments")
     }
 
     /// Check every number against its documented range; the message names field and range.

@@ -141,11 +141,7 @@ impl SceneSpec {
     /// Names of the built-in scenes.
     #[must_use]
     pub fn preset_names() -> Vec<String> {
-        crate::assets::PRESETS
-            .iter()
-            .filter_map(|a| a.path.strip_prefix("scenes/").and_then(|p| p.strip_suffix(".ron")))
-            .map(str::to_string)
-            .collect()
+        crate::assets::preset_names("scenes")
     }
 
     /// Check the numbers and that every effect has what it needs.

@@ -133,7 +133,9 @@ pub struct ResolvedStudy {
     pub runs: Vec<(String, u64, RunConfig)>,
 }
 
-fn load<T: serde::de::DeserializeOwned + Clone>(
+/// Read a scene, instrument or study source: a built-in by name, a RON file relative to `dir`, or
+/// inline. Returns the value and the directory its own relative paths are read from.
+pub(crate) fn load<T: serde::de::DeserializeOwned + Clone>(
     source: &Source<T>,
     dir: Option<&Path>,
     preset: impl Fn(&str) -> Result<T, String>,
@@ -182,11 +184,7 @@ impl StudySpec {
     /// Names of the built-in studies.
     #[must_use]
     pub fn preset_names() -> Vec<String> {
-        crate::assets::PRESETS
-            .iter()
-            .filter_map(|a| a.path.strip_prefix("studies/").and_then(|p| p.strip_suffix(".ron")))
-            .map(str::to_string)
-            .collect()
+        crate::assets::preset_names("studies")
     }
 
     /// The built-in default: CubeSat vs SmallSat over Lake Hume.

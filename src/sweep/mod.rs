@@ -31,7 +31,7 @@ pub use figure::sweep_figure;
 pub use run::{Job, SweepResult, empty_table, run_job, run_sweep};
 pub use table::{Row, Table, merge};
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
@@ -175,11 +175,7 @@ impl SweepSpec {
     /// Names of the built-in sweeps.
     #[must_use]
     pub fn preset_names() -> Vec<String> {
-        crate::assets::PRESETS
-            .iter()
-            .filter_map(|a| a.path.strip_prefix("sweeps/").and_then(|p| p.strip_suffix(".ron")))
-            .map(str::to_string)
-            .collect()
+        crate::assets::preset_names("sweeps")
     }
 
     /// Read the study (`dir`: the sweep file's directory), check every parameter against every
@@ -205,21 +201,8 @@ impl SweepSpec {
                 message: format!("{} (allowed: a positive number of percent)", r.mae_pct),
             });
         }
-        let (mut study, study_dir) = match &self.study {
-            Source::Preset(n) => (StudySpec::preset(n)?, dir.map(Path::to_path_buf)),
-            Source::File(p) => {
-                let full: PathBuf = match dir {
-                    Some(d) if p.is_relative() => d.join(p),
-                    _ => p.clone(),
-                };
-                let text = std::fs::read_to_string(&full).map_err(|e| StudyError::Invalid {
-                    field: "study".into(),
-                    message: format!("{}: {e}", full.display()),
-                })?;
-                (StudySpec::from_ron(&text, &full.display().to_string())?, full.parent().map(Path::to_path_buf))
-            }
-            Source::Inline(s) => ((**s).clone(), dir.map(Path::to_path_buf)),
-        };
+        let (mut study, study_dir) =
+            crate::study::load(&self.study, dir, |n| StudySpec::preset(n).map_err(|e| e.to_string()), "study")?;
         study.seeds = vec![self.seeds[0]];
         let resolved = study.resolve(study_dir.as_deref())?;
         let bases: Vec<(String, RunConfig)> = resolved.runs.into_iter().map(|(label, _, c)| (label, c)).collect();

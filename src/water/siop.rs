@@ -138,12 +138,7 @@ impl SiopSpec {
     #[must_use]
     pub fn preset_names() -> Vec<String> {
         let mut names = vec!["sambuca_default".to_string()];
-        names.extend(
-            crate::assets::PRESETS
-                .iter()
-                .filter_map(|a| a.path.strip_prefix("siop/").and_then(|p| p.strip_suffix(".ron")))
-                .map(str::to_string),
-        );
+        names.extend(crate::assets::preset_names("siop"));
         names
     }
 
