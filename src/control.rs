@@ -1,18 +1,90 @@
 //! Cancellation and progress shared between a running chain and whoever watches it (the CLI's
 //! progress bar, the app's engine thread). Heavy stages check [`RunControl::cancelled`] between
 //! rows and report rows done; nothing here blocks.
+//!
+//! It also knows where a stage was working: per-pixel loops hold a [`RowGuard`] for the row
+//! they are on, and a guard dropped by a panic records its row and column, so that a failure
+//! is reported with the pixel it happened at. Tests arm an injected panic at one pixel
+//! ([`RunControl::arm_panic`]) to prove that path.
 
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex, PoisonError};
+
+/// A pixel of the simulated image (row, column), as reported with a failure.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PixelSite {
+    /// Row (line) of the simulated image.
+    pub row: usize,
+    /// Column (detector) of the simulated image, when the loop had reached one.
+    pub column: Option<usize>,
+}
+
+impl std::fmt::Display for PixelSite {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.column {
+            Some(c) => write!(f, "row {}, column {c}", self.row),
+            None => write!(f, "row {}", self.row),
+        }
+    }
+}
+
+const UNARMED: usize = usize::MAX;
 
 /// Cancellation flag and progress counters of one run.
-#[derive(Debug, Default)]
+#[derive(Debug)]
 pub struct RunControl {
     cancel: Arc<AtomicBool>,
     /// The newest generation requested and this run's: the run is stale once they differ.
     generation: Option<(Arc<AtomicU64>, u64)>,
     done: AtomicU64,
     total: AtomicU64,
+    /// Injected panic: (row, column), `UNARMED` when none.
+    armed: (AtomicUsize, AtomicUsize),
+    /// Where the first panicking row guard was.
+    site: Mutex<Option<PixelSite>>,
+}
+
+impl Default for RunControl {
+    fn default() -> Self {
+        Self {
+            cancel: Arc::default(),
+            generation: None,
+            done: AtomicU64::default(),
+            total: AtomicU64::default(),
+            armed: (AtomicUsize::new(UNARMED), AtomicUsize::new(UNARMED)),
+            site: Mutex::new(None),
+        }
+    }
+}
+
+/// The row a per-pixel loop is working on; see the module documentation.
+#[derive(Debug)]
+pub struct RowGuard<'a> {
+    control: &'a RunControl,
+    row: usize,
+    column: Option<usize>,
+    /// The column at which an injected panic fires on this row.
+    armed_column: Option<usize>,
+}
+
+impl RowGuard<'_> {
+    /// The loop moves to `column`. Panics there if a test armed a panic at this pixel.
+    #[inline]
+    pub fn column(&mut self, column: usize) {
+        self.column = Some(column);
+        if self.armed_column == Some(column) {
+            panic!("injected fault at row {}, column {column}", self.row);
+        }
+    }
+}
+
+impl Drop for RowGuard<'_> {
+    fn drop(&mut self) {
+        if std::thread::panicking() {
+            let mut site = self.control.site.lock().unwrap_or_else(PoisonError::into_inner);
+            site.get_or_insert(PixelSite { row: self.row, column: self.column });
+        }
+    }
 }
 
 impl RunControl {
@@ -61,5 +133,30 @@ impl RunControl {
     #[must_use]
     pub fn progress(&self) -> (u64, u64) {
         (self.done.load(Ordering::Relaxed), self.total.load(Ordering::Relaxed))
+    }
+
+    /// Enter `row` of a per-pixel loop (see [`RowGuard`]).
+    #[inline]
+    #[must_use]
+    pub fn row(&self, row: usize) -> RowGuard<'_> {
+        let armed_column = (self.armed.0.load(Ordering::Relaxed) == row).then(|| self.armed.1.load(Ordering::Relaxed));
+        RowGuard { control: self, row, column: None, armed_column }
+    }
+
+    /// Make the per-pixel loop that next reaches (`row`, `column`) panic (fault injection for
+    /// tests of the failure path; the engine arms it for one stage only).
+    pub fn arm_panic(&self, row: usize, column: usize) {
+        self.armed.1.store(column, Ordering::Relaxed);
+        self.armed.0.store(row, Ordering::Relaxed);
+    }
+
+    /// Disarm an injected panic.
+    pub fn disarm(&self) {
+        self.armed.0.store(UNARMED, Ordering::Relaxed);
+    }
+
+    /// Where a per-pixel loop panicked, if one did (and forget it).
+    pub fn take_site(&self) -> Option<PixelSite> {
+        self.site.lock().unwrap_or_else(PoisonError::into_inner).take()
     }
 }

@@ -120,6 +120,25 @@ pub fn write_figure(snap: &Snapshot, stem: &Path) -> Result<Vec<PathBuf>, String
     Ok(written)
 }
 
+/// Files an export to `path` would replace (empty: nothing of the user's is overwritten).
+#[must_use]
+pub fn existing(what: What, snap: &Snapshot, path: &Path) -> Vec<PathBuf> {
+    let candidates: Vec<PathBuf> = match what {
+        What::Figure => {
+            let stem = path.with_extension("");
+            let mut v = vec![stem.with_extension("png"), stem.with_extension("svg")];
+            v.extend(["A", "B"].map(|n| PathBuf::from(format!("{}_config_{n}.ron", stem.display()))));
+            v
+        }
+        What::Data => ["A", "B"]
+            .iter()
+            .zip(&snap.runs)
+            .filter_map(|(name, run)| run.as_ref().map(|o| path.join(format!("{name}_{}", o.config.instrument.name))))
+            .collect(),
+    };
+    candidates.into_iter().filter(|p| p.exists()).collect()
+}
+
 /// Write both runs' cubes and metrics under `dir`.
 pub fn write_data(snap: &Snapshot, dir: &Path) -> Result<usize, String> {
     let mut n = 0;

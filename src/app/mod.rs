@@ -45,6 +45,16 @@ pub struct AppOptions {
     pub fresh: bool,
 }
 
+/// A write that would replace a file of the user's, waiting for "Replace" or "Cancel".
+enum Confirm {
+    /// Save instrument A (0) or B (1) under `name`.
+    Instrument { slot: usize, name: String, spec: Box<crate::instrument::InstrumentSpec> },
+    /// Save the study under `name`.
+    Study { name: String, study: Box<crate::study::StudySpec> },
+    /// A typed-path export over existing files.
+    Export { what: export::What, path: PathBuf, existing: Vec<PathBuf> },
+}
+
 /// Transient UI state (not persisted).
 #[derive(Default)]
 struct UiState {
@@ -58,6 +68,10 @@ struct UiState {
     frame_times_ms: Vec<f32>,
     zoom: maps::View,
     hover: Option<(usize, usize)>,
+    /// A fault injected into A's runs (tests; `SHOAL_FAULT` at start).
+    fault: Option<crate::engine::Fault>,
+    /// A save or export that asks before replacing a file.
+    confirm: Option<Confirm>,
 }
 
 /// The app.
@@ -120,7 +134,17 @@ impl ShoalApp {
     pub fn new(cc: &eframe::CreationContext<'_>, options: AppOptions) -> Self {
         let state =
             if options.fresh { None } else { cc.storage.and_then(|s| eframe::get_value::<AppState>(s, STATE_KEY)) };
-        Self::with_state(state.unwrap_or_default(), &cc.egui_ctx, options)
+        let mut app = Self::with_state(state.unwrap_or_default(), &cc.egui_ctx, options);
+        match crate::engine::Fault::from_env() {
+            Ok(fault) => app.ui.fault = fault,
+            Err(e) => app.ui.error = Some(e),
+        }
+        app
+    }
+
+    /// Inject `fault` into A's runs (tests of the failure path); `None` removes it.
+    pub fn inject_fault(&mut self, fault: Option<crate::engine::Fault>) {
+        self.ui.fault = fault;
     }
 
     /// Use `library` for presets (tests).
@@ -157,7 +181,11 @@ impl ShoalApp {
             ctx.set_theme(if self.state.dark { egui::Theme::Dark } else { egui::Theme::Light });
             self.applied_theme = Some(self.state.dark);
         }
-        self.link.submit_if_changed(self.state.configs(), self.state.levels());
+        let mut configs = self.state.configs();
+        if let Some(a) = configs.first_mut() {
+            a.fault = self.ui.fault;
+        }
+        self.link.submit_if_changed(configs, self.state.levels());
         if self.link.poll() {
             self.images.invalidate();
         }
@@ -279,12 +307,78 @@ impl ShoalApp {
             ui.add(egui::TextEdit::singleline(&mut self.ui.export_path).desired_width(420.0)).labelled_by(l.id);
             let path = PathBuf::from(self.ui.export_path.trim());
             if ui.button("Write figure").on_hover_text("NAME.png, NAME.svg and NAME_config_A/B.ron").clicked() {
-                self.ui.exports.write_to(export::What::Figure, export::Snapshot::of(self), path.clone());
+                self.export_to(export::What::Figure, path.clone());
             }
             if ui.button("Write data").on_hover_text("A folder NAME with one sub-folder per instrument").clicked() {
-                self.ui.exports.write_to(export::What::Data, export::Snapshot::of(self), path);
+                self.export_to(export::What::Data, path);
             }
         });
+    }
+
+    /// Export to a typed path, asking first if that would replace existing files.
+    fn export_to(&mut self, what: export::What, path: PathBuf) {
+        let snap = export::Snapshot::of(self);
+        let existing = export::existing(what, &snap, &path);
+        if existing.is_empty() {
+            self.ui.exports.write_to(what, snap, path);
+        } else {
+            self.ui.confirm = Some(Confirm::Export { what, path, existing });
+        }
+    }
+
+    /// Save A or B, or the study, in the library; asks before replacing a preset of that name.
+    fn save(&mut self, confirm: Confirm, overwrite: bool) {
+        let result = match &confirm {
+            Confirm::Instrument { name, spec, .. } => self.library.save_instrument(name, spec, overwrite),
+            Confirm::Study { name, study } => self.library.save_study(name, study, overwrite),
+            Confirm::Export { .. } => return,
+        };
+        match result {
+            Ok(path) => {
+                if let Confirm::Instrument { slot, name, spec } = confirm {
+                    let slot_state = model::Slot::new(&name, *spec);
+                    if slot == 0 {
+                        self.state.a = slot_state;
+                    } else {
+                        self.state.b = slot_state;
+                    }
+                }
+                self.ui.message = Some(format!("saved {}", path.display()));
+            }
+            Err(crate::library::LibraryError::Exists(_)) if !overwrite => self.ui.confirm = Some(confirm),
+            Err(e) => self.ui.error = Some(format!("Cannot save: {e}")),
+        }
+    }
+
+    /// The "replace?" question, when a save or export would overwrite a file.
+    fn confirm_dialog(&mut self, ctx: &egui::Context) {
+        let Some(confirm) = &self.ui.confirm else { return };
+        let question = match confirm {
+            Confirm::Instrument { name, .. } => format!("Your library already has an instrument `{name}`."),
+            Confirm::Study { name, .. } => format!("Your library already has a study `{name}`."),
+            Confirm::Export { existing, .. } => format!(
+                "These already exist: {}",
+                existing.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ")
+            ),
+        };
+        let r = egui::Modal::new(egui::Id::unique("shoal-confirm")).show(ctx, |ui| {
+            ui.heading("Replace?");
+            ui.label(question);
+            ui.horizontal(|ui| (ui.button("Replace").clicked(), ui.button("Cancel").clicked())).inner
+        });
+        let (replace, cancel) = r.inner;
+        if replace {
+            match self.ui.confirm.take() {
+                Some(Confirm::Export { what, path, .. }) => {
+                    self.ui.exports.write_to(what, export::Snapshot::of(self), path);
+                }
+                Some(save) => self.save(save, true),
+                None => {}
+            }
+        } else if cancel || r.should_close() {
+            self.ui.confirm = None;
+            self.ui.message = Some("nothing replaced".into());
+        }
     }
 
     fn status(&mut self, ui: &mut egui::Ui) {
@@ -316,6 +410,7 @@ impl ShoalApp {
     }
 
     fn dialogs(&mut self, ctx: &egui::Context) {
+        self.confirm_dialog(ctx);
         if let Some(msg) = self.ui.error.clone() {
             let r = egui::Modal::new(egui::Id::unique("shoal-error")).show(ctx, |ui| {
                 ui.heading("Problem");

@@ -234,18 +234,7 @@ fn save_presets(app: &mut ShoalApp, ui: &mut egui::Ui) {
             if ui.button(label).on_hover_text("Save this instrument in your preset library").clicked() {
                 let name = app.ui.preset_name.trim().to_string();
                 let spec = if i == 0 { app.state.a.spec.clone() } else { app.state.b.spec.clone() };
-                match app.library.save_instrument(&name, &spec, true) {
-                    Ok(path) => {
-                        let slot = Slot::new(&name, spec);
-                        if i == 0 {
-                            app.state.a = slot;
-                        } else {
-                            app.state.b = slot;
-                        }
-                        app.ui.message = Some(format!("saved {}", path.display()));
-                    }
-                    Err(e) => app.ui.error = Some(format!("Cannot save: {e}")),
-                }
+                app.save(super::Confirm::Instrument { slot: i, name, spec: Box::new(spec) }, false);
             }
         }
         if ui.button("Save study").clicked() {
@@ -269,10 +258,7 @@ fn save_presets(app: &mut ShoalApp, ui: &mut egui::Ui) {
                 fidelity: None,
                 requirements: None,
             };
-            match app.library.save_study(&name, &study, true) {
-                Ok(path) => app.ui.message = Some(format!("saved {}", path.display())),
-                Err(e) => app.ui.error = Some(format!("Cannot save: {e}")),
-            }
+            app.save(super::Confirm::Study { name, study: Box::new(study) }, false);
         }
     });
 }

@@ -5,8 +5,7 @@ use std::path::Path;
 
 use super::CliError;
 
-/// Write `text` to `path` (write a temporary file beside it, then rename, so that a failure
-/// never leaves a half-written file) or to standard output.
+/// Write `text` to `path` (atomically: [`crate::study::write_bytes`]) or to standard output.
 pub fn emit(text: &str, path: Option<&Path>) -> Result<(), CliError> {
     match path {
         None => {
@@ -17,15 +16,7 @@ pub fn emit(text: &str, path: Option<&Path>) -> Result<(), CliError> {
                 r => r.map_err(|e| CliError::Run(format!("writing to standard output: {e}"))),
             }
         }
-        Some(p) => {
-            let tmp = p.with_extension(format!("{}.tmp", p.extension().and_then(|e| e.to_str()).unwrap_or("")));
-            let fail = |e: std::io::Error| CliError::Run(format!("cannot write {}: {e}", p.display()));
-            std::fs::write(&tmp, text).map_err(fail)?;
-            std::fs::rename(&tmp, p).map_err(|e| {
-                let _ = std::fs::remove_file(&tmp);
-                fail(e)
-            })
-        }
+        Some(p) => crate::study::write_bytes(p, text.as_bytes()).map_err(|e| CliError::Run(e.to_string())),
     }
 }
 

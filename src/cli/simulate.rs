@@ -106,6 +106,7 @@ pub fn config_from(args: &SimulateArgs) -> Result<RunConfig, CliError> {
     if let Some(d) = args.decimation {
         config.fidelity.decimation = d;
     }
+    config.fault = crate::engine::Fault::from_env().map_err(CliError::Input)?;
     if let Some(s) = args.seed {
         config.seed = s;
     }
@@ -167,6 +168,7 @@ pub fn run_with_progress(config: &RunConfig, threads: Option<usize>, label: &str
     result.map_err(|e| match e {
         EngineError::Cancelled => CliError::Run("cancelled".into()),
         EngineError::Failed { stage, message } => CliError::Input(format!("{stage}: {message}")),
+        internal @ EngineError::Internal { .. } => CliError::Run(internal.to_string()),
     })
 }
 

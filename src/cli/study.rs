@@ -39,6 +39,7 @@ impl From<StudyError> for CliError {
     fn from(e: StudyError) -> Self {
         match e {
             StudyError::Io(m) => Self::Run(m),
+            internal @ StudyError::Internal { .. } => Self::Run(internal.to_string()),
             StudyError::Cancelled => Self::Run("cancelled".into()),
             other => Self::Input(other.to_string()),
         }
@@ -60,10 +61,12 @@ pub(super) fn load(arg: Option<&str>) -> Result<(StudySpec, Option<PathBuf>), Cl
 pub fn run(args: &StudyArgs) -> Result<(), CliError> {
     let (spec, dir) = load(args.study.as_deref())?;
     let mut resolved = spec.resolve(dir.as_deref())?;
-    if let Some(d) = args.decimation {
-        for (_, _, c) in &mut resolved.runs {
+    let fault = crate::engine::Fault::from_env().map_err(CliError::Input)?;
+    for (_, _, c) in &mut resolved.runs {
+        if let Some(d) = args.decimation {
             c.fidelity.decimation = d;
         }
+        c.fault = fault;
     }
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.threads.unwrap_or(0))

@@ -133,7 +133,9 @@ pub fn correct_exact(
                 return Err(InstrumentError::Cancelled);
             }
             let base = r * stride;
+            let mut at = control.row(r);
             for c in 0..cols {
+                at.column(c);
                 let is_land = land[r * cols + c] != 0;
                 for b in 0..nb {
                     let i = atmosphere.at(c, b);
@@ -221,7 +223,9 @@ impl SceneApproximation {
                     return Err(InstrumentError::Cancelled);
                 }
                 let base = r * stride;
+                let mut at = control.row(r);
                 for c in 0..cols {
+                    at.column(c);
                     for b in 0..nb {
                         let k = c * nb + b;
                         let lw = (f64::from(l1[base + k]) - self.l_path[b]) / self.t_up[b];

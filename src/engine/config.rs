@@ -120,6 +120,9 @@ pub struct RunConfig {
     /// the approximation's sample points). The scene's maps have their own seeds.
     #[serde(default)]
     pub seed: u64,
+    /// A fault to inject (tests of the failure path; never written to or read from files).
+    #[serde(skip)]
+    pub fault: Option<super::Fault>,
 }
 
 impl RunConfig {
@@ -136,6 +139,7 @@ impl RunConfig {
             retrievals: Vec::new(),
             fidelity: Fidelity::default(),
             seed: 1,
+            fault: None,
         }
     }
 

@@ -33,6 +33,7 @@
 
 mod cache;
 mod config;
+mod fault;
 mod products;
 mod report;
 mod run;
@@ -40,6 +41,7 @@ pub mod worker;
 
 pub use cache::Stage;
 pub use config::{Fidelity, RunConfig};
+pub use fault::{Fault, FaultKind};
 pub use products::RetrievalOutput;
 pub use report::{RunReport, StageReport, StageStatus};
 pub use run::{Engine, RunOutput};
@@ -56,6 +58,17 @@ pub enum EngineError {
         /// The stage.
         stage: Stage,
         /// What went wrong.
+        message: String,
+    },
+    /// A stage broke: a panic caught at the stage boundary, or an injected fault. Not the
+    /// user's input; the pixel is where the stage's per-pixel loop was, when it had one.
+    #[error("{stage}: internal error{}: {message}", site.map(|p| format!(" at {p}")).unwrap_or_default())]
+    Internal {
+        /// The stage.
+        stage: Stage,
+        /// The pixel the stage was working on.
+        site: Option<crate::control::PixelSite>,
+        /// What went wrong (the panic's message).
         message: String,
     },
 }

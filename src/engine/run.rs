@@ -10,10 +10,10 @@ use serde::Serialize;
 
 use super::cache::{Cache, Key, KeyBuilder, Stage};
 use super::report::{RunReport, SkippedEffect, StageReport, StageStatus};
-use super::{EngineError, RunConfig};
+use super::{EngineError, Fault, FaultKind, RunConfig};
 use crate::atmosphere::{AtmosphereLut, LutAxes};
 use crate::calibration::{Calibration, Level1, band_e0, calibrate};
-use crate::control::RunControl;
+use crate::control::{PixelSite, RunControl};
 use crate::correction::{Reflectance, SceneApproximation, compare, correct_exact};
 use crate::instrument::sample::BandAtmosphere;
 use crate::instrument::{
@@ -72,7 +72,13 @@ pub struct RunOutput {
 pub struct Engine {
     cache: Cache,
     executions: HashMap<Stage, u64>,
+    /// The fault the current run injects, if any.
+    fault: Option<Fault>,
 }
+
+/// Stages whose per-pixel loops report the pixel they fail at (an injected panic fires there).
+const PIXEL_STAGES: [Stage; 5] =
+    [Stage::Radiance, Stage::Electrons, Stage::Level0, Stage::Correction, Stage::Retrieval];
 
 /// The part of an instrument that decides photon counts (a change re-runs `Electrons`).
 #[derive(Serialize)]
@@ -166,7 +172,23 @@ impl Engine {
             return Ok(product);
         }
         let start = Instant::now();
-        let product = match catch_unwind(AssertUnwindSafe(f)) {
+        let fault = self.fault.filter(|f| f.stage == stage);
+        if let Some(f) = fault {
+            match f.kind {
+                FaultKind::Error => {
+                    let site = Some(PixelSite { row: f.row, column: Some(f.column) });
+                    return Err(EngineError::Internal { stage, site, message: "injected error".into() });
+                }
+                FaultKind::Panic => control.arm_panic(f.row, f.column),
+            }
+        }
+        let pixel_loops = PIXEL_STAGES.contains(&stage);
+        let guarded = catch_unwind(AssertUnwindSafe(|| {
+            assert!(fault.is_none() || pixel_loops, "injected fault on entry to {stage}");
+            f()
+        }));
+        control.disarm();
+        let product = match guarded {
             Ok(result) => Arc::new(result?),
             Err(panic) => {
                 let message = panic
@@ -174,7 +196,7 @@ impl Engine {
                     .map(|s| (*s).to_string())
                     .or_else(|| panic.downcast_ref::<String>().cloned())
                     .unwrap_or_else(|| "unknown panic".into());
-                return Err(EngineError::Failed { stage, message: format!("internal error (panic): {message}") });
+                return Err(EngineError::Internal { stage, site: control.take_site(), message });
             }
         };
         *self.executions.entry(stage).or_default() += 1;
@@ -187,6 +209,7 @@ impl Engine {
     /// `control` between stages and between rows of the heavy ones.
     pub fn run(&mut self, config: &RunConfig, control: &RunControl) -> Result<RunOutput, EngineError> {
         let start = Instant::now();
+        self.fault = config.fault;
         config.instrument.validate().map_err(failed(Stage::Response))?;
         config.fidelity.validate().map_err(failed(Stage::Response))?;
         config.calibration.validate().map_err(failed(Stage::Calibration))?;

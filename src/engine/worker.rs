@@ -188,9 +188,15 @@ fn worker(
         while let Ok(newer) = requests.try_recv() {
             request = newer;
         }
+        // A configuration that failed is not run at finer levels; the others go on (one
+        // broken instrument does not hide the other's results).
+        let mut failed = vec![false; request.configs.len()];
         'levels: for &decimation in &request.decimations {
             for (index, base) in request.configs.iter().enumerate() {
                 let Some(base) = base else { continue };
+                if failed[index] {
+                    continue;
+                }
                 if latest.load(Ordering::SeqCst) != request.generation {
                     break 'levels;
                 }
@@ -224,15 +230,12 @@ fn worker(
                 if matches!(result, Err(EngineError::Cancelled)) {
                     break 'levels;
                 }
-                let failed = result.is_err();
+                failed[index] = result.is_err();
                 if events.send(Event::Finished { generation, index, decimation, result: result.map(Arc::new) }).is_err()
                 {
                     return;
                 }
                 wake();
-                if failed {
-                    break 'levels;
-                }
             }
         }
     }

@@ -61,7 +61,9 @@ pub fn expose_cube(
             return Err(InstrumentError::Cancelled);
         }
         let line = viewing.line_index[r];
+        let mut at = control.row(r);
         for c in 0..cols {
+            at.column(c);
             let j = viewing.detector_index[c];
             let mut rng = pixel_rng(seed, Stream::Exposure, line, j);
             for b in 0..nb {
@@ -106,7 +108,9 @@ pub fn digitise_cube(
                 return Err(InstrumentError::Cancelled);
             }
             let line = viewing.line_index[r];
+            let mut at = control.row(r);
             for c in 0..cols {
+                at.column(c);
                 let j = viewing.detector_index[c];
                 let mut rng = pixel_rng(seed, Stream::Readout, line, j);
                 for b in 0..nb {

@@ -213,6 +213,8 @@ pub fn sample_radiance(
                 let j = viewing.detector_index[c];
                 for rr in 0..n_rows {
                     let r = first_row + rr;
+                    let mut at = control.row(r);
+                    at.column(c);
                     let at = rr * pixel + c * nb;
                     let out = &mut rad_block[at..at + nb];
                     let truth = &mut rrs_block[at..at + nb];

@@ -238,8 +238,10 @@ fn retrieve_almi(
             let mut obs = vec![0.0; used.len()];
             let mut valid = vec![false; used.len()];
             let nedr: Vec<f64> = used.iter().map(|&b| inputs.nedr[b]).collect();
+            let mut at = control.row(r);
             let row = (0..cols)
                 .map(|c| {
+                    at.column(c);
                     if inputs.land[[r, c]] != 0 {
                         return (0.0, 0.0, 0.0, -1, 0.0, ProductFlags::LAND);
                     }
@@ -370,8 +372,10 @@ fn retrieve_sambuca(
             }
             let mut obs = vec![0.0; nb];
             let mut valid = vec![false; nb];
+            let mut at = control.row(r);
             let row = (0..cols)
                 .map(|c| {
+                    at.column(c);
                     let failed = (0.0, 0.0, 0.0, 0.0, 0.0, (0, 0), 0.0, 0.0, 0, ProductFlags::FAILED);
                     if inputs.land[[r, c]] != 0 {
                         return (0.0, 0.0, 0.0, 0.0, 0.0, (0, 0), 0.0, 0.0, 0, ProductFlags::LAND);

@@ -66,6 +66,14 @@ pub enum StudyError {
         /// The engine's message.
         message: String,
     },
+    /// A stage broke (a panic or an injected fault): not the user's input.
+    #[error("{instrument}: {message}")]
+    Internal {
+        /// Instrument name.
+        instrument: String,
+        /// The engine's message (stage and pixel).
+        message: String,
+    },
     /// Writing an output failed.
     #[error("{0}")]
     Io(String),

@@ -19,19 +19,28 @@ pub struct Outputs {
     pub files: Vec<String>,
 }
 
-/// Write `bytes` to `path` atomically; the message names the file and the reason.
+/// Write `bytes` to `path` atomically: a temporary file beside it, flushed to disk, then renamed
+/// over `path`. A failure (full disk, read-only directory) removes the temporary file and names
+/// the file and the reason; `path` then still holds what it held before.
 pub fn write_bytes(path: &Path, bytes: &[u8]) -> Result<(), StudyError> {
     let tmp = path.with_extension(format!("{}.partial", path.extension().and_then(|e| e.to_str()).unwrap_or("")));
     let fail = |e: std::io::Error| StudyError::Io(format!("cannot write {}: {e}", path.display()));
-    if let Some(parent) = path.parent() {
+    if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
         std::fs::create_dir_all(parent)
             .map_err(|e| StudyError::Io(format!("cannot create {}: {e}", parent.display())))?;
     }
-    std::fs::write(&tmp, bytes).map_err(fail)?;
-    std::fs::rename(&tmp, path).map_err(|e| {
+    let written = std::fs::File::create(&tmp).and_then(|mut file| write_synced(&mut file, bytes));
+    written.and_then(|()| std::fs::rename(&tmp, path)).map_err(|e| {
         let _ = std::fs::remove_file(&tmp);
         fail(e)
     })
+}
+
+/// Write everything and flush it to the device (so that the rename publishes complete data).
+fn write_synced(file: &mut std::fs::File, bytes: &[u8]) -> std::io::Result<()> {
+    use std::io::Write as _;
+    file.write_all(bytes)?;
+    file.sync_all()
 }
 
 fn npy<A: WriteNpyExt + ?Sized>(dir: &Path, name: &str, array: &A, out: &mut Outputs) -> Result<(), StudyError> {
@@ -232,4 +241,44 @@ pub fn write_study(result: &StudyResult, dir: &Path, figures: bool) -> Result<Ou
         }
     }
     Ok(o)
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    #[test]
+    fn a_full_disk_is_an_error_not_a_short_file() {
+        // /dev/full accepts the open and fails every write with ENOSPC, as a full disk does.
+        let mut full = std::fs::OpenOptions::new().write(true).open("/dev/full").unwrap();
+        let e = write_synced(&mut full, &[0u8; 4096]).unwrap_err();
+        assert_eq!(e.kind(), std::io::ErrorKind::StorageFull, "{e}");
+    }
+
+    #[test]
+    fn an_unwritable_directory_names_the_file_and_leaves_nothing() {
+        // procfs refuses new files even to root (CI runs as root, so a chmod-ed folder would not).
+        let e = write_bytes(Path::new("/proc/shoal-test/figure.png"), b"png").unwrap_err().to_string();
+        assert!(e.contains("/proc/shoal-test") && e.contains("cannot create"), "{e}");
+        assert!(!Path::new("/proc/shoal-test").exists());
+    }
+
+    #[test]
+    fn a_failed_replace_keeps_the_old_file() {
+        let dir = std::env::temp_dir().join(format!("shoal-atomic-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("table.csv");
+        write_bytes(&path, b"old").unwrap();
+        // A directory where the temporary file would go makes the write fail after the check.
+        std::fs::create_dir_all(dir.join("table.csv.partial")).unwrap();
+        assert!(write_bytes(&path, b"new").is_err());
+        assert_eq!(std::fs::read(&path).unwrap(), b"old");
+        std::fs::remove_dir_all(dir.join("table.csv.partial")).unwrap();
+        write_bytes(&path, b"new").unwrap();
+        assert_eq!(std::fs::read(&path).unwrap(), b"new");
+        let names: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name()).collect();
+        assert_eq!(names.len(), 1, "{names:?}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 }

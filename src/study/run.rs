@@ -67,6 +67,9 @@ pub fn run_study(
     for (i, (label, seed, config)) in study.runs.iter().enumerate() {
         let out = engine.run(config, control).map_err(|e| match e {
             EngineError::Cancelled => StudyError::Cancelled,
+            internal @ EngineError::Internal { .. } => {
+                StudyError::Internal { instrument: label.clone(), message: internal.to_string() }
+            }
             other => StudyError::Run { instrument: label.clone(), message: other.to_string() },
         })?;
         on_run(i, &out)?;

@@ -222,3 +222,35 @@ fn the_sweep_window_draws_a_curve_for_a_and_b() {
     assert!(h.query_all_by_label_contains("chl MAE ≤").count() >= 2);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A panic inside A's Level-0 stage at one pixel: the app names the stage and the pixel under
+/// the metrics table, B's results still arrive, and once the fault is gone A runs again.
+#[test]
+fn a_stage_that_panics_is_reported_and_the_app_goes_on() {
+    use shoal::engine::{Fault, FaultKind, Stage};
+    let lib = temp_library("fault");
+    let mut h = harness("cubesat", 8, &lib);
+    h.state_mut().inject_fault(Some(Fault { stage: Stage::Level0, row: 7, column: 11, kind: FaultKind::Panic }));
+    let start = Instant::now();
+    loop {
+        h.step();
+        let app = h.state();
+        if app.link.errors[0].is_some() && !app.link.busy() {
+            break;
+        }
+        assert!(start.elapsed() < Duration::from_secs(300), "no error reported for A");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    h.step();
+    h.step();
+    let error = h.state().link.errors[0].clone().unwrap();
+    assert!(error.contains("level-0") && error.contains("row 7, column 11"), "{error}");
+    let shown = format!("A: {error}");
+    assert!(h.query_all_by_label(&shown).next().is_some(), "the error is not on screen: {shown}");
+    assert!(h.state().link.errors[1].is_none(), "B failed too: {:?}", h.state().link.errors[1]);
+    // The fault removed, the same configuration runs to the end.
+    h.state_mut().inject_fault(None);
+    wait_for_engine(&mut h);
+    assert!(displayed_chl_mae(&h) > 0.0);
+    let _ = std::fs::remove_dir_all(&lib);
+}
