@@ -15,7 +15,7 @@
 use rayon::prelude::*;
 use serde::Serialize;
 
-use super::detector::{Detector, Stream, pixel_rng};
+use super::detector::{Detector, Flags, Stream, pixel_rng};
 
 /// One row of `snr.csv`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -48,6 +48,11 @@ fn nominal_exposure(detector: &Detector) -> f64 {
 /// SNR of every band measured on `frames` simulated exposures of the uniform band radiances
 /// `radiance` by each of `detectors` (light and dark frames, temporal statistics per detector,
 /// mean over detectors). Infinite when the detector has no noise.
+///
+/// Two converter limits are reported, not hidden behind a zero variance: a patch that
+/// saturates in any frame carries no information about the radiance (SNR 0), and a noisy signal
+/// that the ADC rounds to one constant value has the uniform quantiser's error, 1/√12 DN rms
+/// (Widrow & Kollár 2008, *Quantization Noise*, ch. 4), in place of its zero sample variance.
 #[must_use]
 pub fn measured_snr(detector: &Detector, radiance: &[f64], detectors: &[usize], frames: usize, seed: u64) -> Vec<f64> {
     let t = nominal_exposure(detector);
@@ -57,11 +62,14 @@ pub fn measured_snr(detector: &Detector, radiance: &[f64], detectors: &[usize], 
         .map(|&j| {
             // Running sums per band: light Σx, Σx², dark Σx.
             let (mut s1, mut s2, mut d1) = (vec![0.0; nb], vec![0.0; nb], vec![0.0; nb]);
+            let mut saturated = vec![false; nb];
             for f in 0..frames {
                 let mut rng = pixel_rng(seed, Stream::SnrPatch, 2 * f, j);
                 for b in 0..nb {
                     let e = detector.expose(j, b, radiance[b], t, &mut rng);
-                    let v = detector.level0_value(&detector.read_out(e, &mut rng));
+                    let out = detector.read_out(e, &mut rng);
+                    saturated[b] |= out.flags & Flags::SATURATED != 0;
+                    let v = detector.level0_value(&out);
                     s1[b] += v;
                     s2[b] += v * v;
                 }
@@ -76,7 +84,18 @@ pub fn measured_snr(detector: &Detector, radiance: &[f64], detectors: &[usize], 
                 .map(|b| {
                     let mean = s1[b] / n;
                     let var = (s2[b] - n * mean * mean) / (n - 1.0).max(1.0);
-                    if var > 0.0 { (mean - d1[b] / n) / var.sqrt() } else { f64::INFINITY }
+                    // Below the dark level on average: no measurable signal (0, not negative).
+                    let signal = (mean - d1[b] / n).max(0.0);
+                    let noisy = detector.mode().noise;
+                    if noisy && saturated[b] {
+                        0.0
+                    } else if var > 0.0 {
+                        signal / var.sqrt()
+                    } else if noisy && detector.mode().quantise {
+                        signal * 12f64.sqrt()
+                    } else {
+                        f64::INFINITY
+                    }
                 })
                 .collect()
         })
