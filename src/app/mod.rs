@@ -72,6 +72,8 @@ struct UiState {
     fault: Option<crate::engine::Fault>,
     /// A save or export that asks before replacing a file.
     confirm: Option<Confirm>,
+    /// An instrument value refused by its range: (parameter key, message), shown inline.
+    param_error: Option<(&'static str, String)>,
 }
 
 /// The app.
@@ -156,6 +158,12 @@ impl ShoalApp {
     #[must_use]
     pub fn explore(&self) -> &explore::Explore {
         &self.ui.explore
+    }
+
+    /// The inline message of a refused instrument value, if one is shown.
+    #[must_use]
+    pub fn refused_value(&self) -> Option<&str> {
+        self.ui.param_error.as_ref().map(|(_, m)| m.as_str())
     }
 
     /// The last error shown to the user, if any.

@@ -358,8 +358,13 @@ fn editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
             let slot = if editing == 0 { &mut app.state.a } else { &mut app.state.b };
             let mut v = (p.get)(&slot.spec) * p.scale;
             let before = v;
-            let slider =
-                egui::Slider::new(&mut v, p.range.0..=p.range.1).text(p.label).suffix(p.unit).logarithmic(p.log);
+            // Never clamped: a preset outside the slider's span keeps its value, and a typed
+            // value outside it is checked against the instrument's documented range below.
+            let slider = egui::Slider::new(&mut v, p.range.0..=p.range.1)
+                .text(p.label)
+                .suffix(p.unit)
+                .logarithmic(p.log)
+                .clamping(egui::SliderClamping::Never);
             let slider =
                 if matches!(p.key, "detectors" | "exposures" | "adc_bits") { slider.integer() } else { slider };
             ui.add(slider).on_hover_text(p.tip);
@@ -376,10 +381,25 @@ fn editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
                 }
             }
             ui.end_row();
+            if let Some((key, message)) = &app.ui.param_error
+                && *key == p.key
+            {
+                ui.colored_label(egui::Color32::from_rgb(200, 40, 40), format!("refused: {message}"));
+                ui.end_row();
+            }
             if v != before {
                 let slot = if editing == 0 { &mut app.state.a } else { &mut app.state.b };
-                (p.set)(&mut slot.spec, v / p.scale);
-                changed.push((p.key, v / p.scale));
+                let mut candidate = slot.spec.clone();
+                (p.set)(&mut candidate, v / p.scale);
+                match candidate.validate() {
+                    Ok(()) => {
+                        slot.spec = candidate;
+                        changed.push((p.key, v / p.scale));
+                        app.ui.param_error = None;
+                    }
+                    // The value is refused and the instrument keeps its last valid one.
+                    Err(e) => app.ui.param_error = Some((p.key, e.to_string())),
+                }
             }
         }
     });
