@@ -58,10 +58,6 @@ fn apply(text: &str, edits: &[Edit]) -> String {
     s.into_iter().collect()
 }
 
-fn cases() -> u32 {
-    std::env::var("PROPTEST_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(256)
-}
-
 fn insertion() -> impl Strategy<Value = String> {
     prop_oneof![
         Just(String::new()),
@@ -82,7 +78,7 @@ fn insertion() -> impl Strategy<Value = String> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(cases()))]
+    #![proptest_config(ProptestConfig::with_cases(super::proptest_cases(256)))]
 
     #[test]
     fn mutated_presets_never_panic(

@@ -156,3 +156,8 @@ pub fn check(out: &RunOutput, case: &str) -> Degraded {
 pub fn run(config: &RunConfig) -> RunOutput {
     shoal::engine::Engine::new().run(config, &shoal::control::RunControl::new()).unwrap()
 }
+
+/// Cases per property: `PROPTEST_CASES` when set (a long run), else `default` (CI).
+pub fn proptest_cases(default: u32) -> u32 {
+    std::env::var("PROPTEST_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(default)
+}

@@ -17,10 +17,6 @@ use shoal::scene::{Effect, MapSpec, SubstrateLayer};
 
 use super::{check, instrument, uniform};
 
-fn cases() -> u32 {
-    std::env::var("PROPTEST_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(16)
-}
-
 /// Log-uniform in [lo, hi].
 fn log_uniform(lo: f64, hi: f64) -> impl Strategy<Value = f64> {
     (lo.ln()..=hi.ln()).prop_map(f64::exp)
@@ -100,7 +96,7 @@ fn run_on(threads: usize, config: &RunConfig) -> RunOutput {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(cases()))]
+    #![proptest_config(ProptestConfig::with_cases(super::proptest_cases(16)))]
 
     #[test]
     fn any_valid_scene_and_instrument_is_finite_bounded_and_thread_independent(
