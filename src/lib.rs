@@ -21,6 +21,7 @@
 //! | [`control`] | cancellation and progress shared by a run and its watcher |
 //! | [`spectral`] | wavelength grid, spectra, band sets, `band_from_fine` |
 //! | [`water`] | SIOP sets, IOPs, deep/shallow reflectance (Lee et al. 1998/1999, SAMBUCA) |
+//! | [`ranges`] | the documented range of every number a user sets: one table the validators use |
 //! | [`atmosphere`] | Rayleigh, aerosols (Mie, WMO models), gases, SOS radiative transfer, LUT |
 //! | [`scene`] | scene files composing water, bottom, land, atmosphere and effects; maps |
 //! | [`toa`] | a scene's TOA radiance at any point and view: L_path + T_up·Lw (+ glint, adjacency) |
@@ -50,6 +51,7 @@ pub mod instrument;
 pub mod library;
 pub mod metrics;
 pub mod parse;
+pub mod ranges;
 pub mod retrieval;
 pub mod scene;
 pub mod spectral;

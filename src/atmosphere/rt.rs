@@ -104,30 +104,16 @@ impl RtAccuracy {
         }
     }
 
-    /// Check ranges; the message names the field and the allowed range.
+    /// Check ranges ([`crate::ranges`]); the message names the field and the allowed range.
     pub fn validate(&self) -> Result<(), super::AtmosphereError> {
-        let bad = |field: &str, value: f64, allowed: &str| {
-            Err(super::AtmosphereError::OutOfRange { field: field.into(), value, allowed: allowed.into() })
-        };
-        if !(2..=48).contains(&self.streams) {
-            return bad("streams", self.streams as f64, "2 to 48");
-        }
-        if !(1..=500).contains(&self.max_orders) {
-            return bad("max_orders", self.max_orders as f64, "1 to 500");
-        }
-        if !(1..=96).contains(&self.fourier_terms) {
-            return bad("fourier_terms", self.fourier_terms as f64, "1 to 96");
-        }
-        if !(self.max_layer_depth > 0.0 && self.max_layer_depth <= 1.0) {
-            return bad("max_layer_depth", self.max_layer_depth, "above 0, at most 1");
-        }
-        if !(1..=500).contains(&self.min_layers) {
-            return bad("min_layers", self.min_layers as f64, "1 to 500");
-        }
-        if !(self.order_tolerance > 0.0 && self.order_tolerance < 0.1) {
-            return bad("order_tolerance", self.order_tolerance, "above 0, below 0.1");
-        }
-        Ok(())
+        use super::spec::check;
+        use crate::ranges as r;
+        check("accuracy.streams", &r::ACCURACY_STREAMS, self.streams as f64)?;
+        check("accuracy.max_orders", &r::ACCURACY_MAX_ORDERS, self.max_orders as f64)?;
+        check("accuracy.fourier_terms", &r::ACCURACY_FOURIER_TERMS, self.fourier_terms as f64)?;
+        check("accuracy.max_layer_depth", &r::ACCURACY_MAX_LAYER_DEPTH, self.max_layer_depth)?;
+        check("accuracy.min_layers", &r::ACCURACY_MIN_LAYERS, self.min_layers as f64)?;
+        check("accuracy.order_tolerance", &r::ACCURACY_ORDER_TOLERANCE, self.order_tolerance)
     }
 
     fn orders(&self) -> OrderSettings {

@@ -110,20 +110,30 @@ fn range(field: &str, value: f64, lo: f64, hi: f64, unit: &str) -> Result<(), At
     }
 }
 
+/// `value` against `range`; the error names `field`, the value and the range.
+pub(crate) fn check(field: &str, range: &crate::ranges::Range, value: f64) -> Result<(), AtmosphereError> {
+    if range.contains(value) {
+        Ok(())
+    } else {
+        Err(AtmosphereError::OutOfRange { field: field.into(), value, allowed: range.allowed() })
+    }
+}
+
 impl AtmosphereSpec {
-    /// Check every field against its documented range.
+    /// Check every field against its documented range ([`crate::ranges`]).
     pub fn validate(&self) -> Result<(), AtmosphereError> {
-        range("aot550", self.aot550, 0.0, 5.0, "")?;
-        range("pressure_hpa", self.pressure_hpa, 500.0, 1100.0, " hPa")?;
-        range("gas_amounts.ozone_atm_cm", self.gas_amounts.ozone_atm_cm, 0.0, 1.0, " atm-cm")?;
-        range("gas_amounts.water_vapour_cm", self.gas_amounts.water_vapour_cm, 0.0, 10.0, " cm")?;
+        use crate::ranges as r;
+        check("aot550", &r::ATMOSPHERE_AOT550, self.aot550)?;
+        check("pressure_hpa", &r::ATMOSPHERE_PRESSURE_HPA, self.pressure_hpa)?;
+        check("gas_amounts.ozone_atm_cm", &r::ATMOSPHERE_OZONE_ATM_CM, self.gas_amounts.ozone_atm_cm)?;
+        check("gas_amounts.water_vapour_cm", &r::ATMOSPHERE_WATER_VAPOUR_CM, self.gas_amounts.water_vapour_cm)?;
         if let Surface::Wind { speed_m_s } = self.surface {
-            range("surface wind speed_m_s", speed_m_s, 0.0, 30.0, " m/s")?;
+            check("surface.Wind.speed_m_s", &r::ATMOSPHERE_WIND_SPEED_M_S, speed_m_s)?;
         }
-        range("latitude_deg", self.latitude_deg, -90.0, 90.0, " degrees")?;
-        range("rayleigh_scale_height_km", self.rayleigh_scale_height_km, 1.0, 20.0, " km")?;
-        range("aerosol_scale_height_km", self.aerosol_scale_height_km, 0.1, 20.0, " km")?;
-        range("water_refractive_index", self.water_refractive_index, 1.0, 1.5, "")?;
+        check("latitude_deg", &r::ATMOSPHERE_LATITUDE_DEG, self.latitude_deg)?;
+        check("rayleigh_scale_height_km", &r::ATMOSPHERE_RAYLEIGH_SCALE_HEIGHT_KM, self.rayleigh_scale_height_km)?;
+        check("aerosol_scale_height_km", &r::ATMOSPHERE_AEROSOL_SCALE_HEIGHT_KM, self.aerosol_scale_height_km)?;
+        check("water_refractive_index", &r::ATMOSPHERE_WATER_REFRACTIVE_INDEX, self.water_refractive_index)?;
         range("day_of_year", f64::from(self.day_of_year), 1.0, 366.0, "")?;
         self.accuracy.validate()
     }

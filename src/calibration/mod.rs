@@ -68,44 +68,23 @@ impl Default for CalibrationSpec {
 }
 
 impl CalibrationSpec {
-    /// Check every number; the message names the field and the range.
+    /// Check every number against [`crate::ranges`]; the message names field, value and range.
     pub fn validate(&self) -> Result<(), InstrumentError> {
-        let bad = |field: &str, message: String| {
-            Err(InstrumentError::Invalid { field: format!("calibration.{field}"), message })
+        use crate::ranges as r;
+        let check = |field: &str, range: &r::Range, v: f64| {
+            range
+                .check(v)
+                .map_err(|message| InstrumentError::Invalid { field: format!("calibration.{field}"), message })
         };
-        if !(1..=10_000).contains(&self.light_frames) {
-            return bad("light_frames", format!("{} is out of range (allowed: 1 to 10000)", self.light_frames));
+        check("light_frames", &r::CALIBRATION_LIGHT_FRAMES, self.light_frames as f64)?;
+        check("dark_frames", &r::CALIBRATION_DARK_FRAMES, self.dark_frames as f64)?;
+        check("dark_exposure_s", &r::CALIBRATION_DARK_EXPOSURE_S, self.dark_exposure_s)?;
+        check("diffuser_reflectance", &r::CALIBRATION_DIFFUSER_REFLECTANCE, self.diffuser_reflectance)?;
+        if let Some(a) = self.sun_incidence_deg {
+            check("sun_incidence_deg", &r::CALIBRATION_SUN_INCIDENCE_DEG, a)?;
         }
-        if !(1..=10_000).contains(&self.dark_frames) {
-            return bad("dark_frames", format!("{} is out of range (allowed: 1 to 10000)", self.dark_frames));
-        }
-        if !(self.dark_exposure_s.is_finite() && (0.0..=10.0).contains(&self.dark_exposure_s)) {
-            return bad("dark_exposure_s", format!("{} is out of range (allowed: 0 to 10 s)", self.dark_exposure_s));
-        }
-        if !(self.diffuser_reflectance.is_finite()
-            && self.diffuser_reflectance > 0.0
-            && self.diffuser_reflectance <= 1.0)
-        {
-            return bad(
-                "diffuser_reflectance",
-                format!("{} is out of range (allowed: above 0, at most 1)", self.diffuser_reflectance),
-            );
-        }
-        if let Some(a) = self.sun_incidence_deg
-            && !(a.is_finite() && (0.0..89.0).contains(&a))
-        {
-            return bad("sun_incidence_deg", format!("{a} is out of range (allowed: 0 to 89 degrees)"));
-        }
-        if !(self.diffuser_bias_pct.is_finite() && (-50.0..=50.0).contains(&self.diffuser_bias_pct)) {
-            return bad(
-                "diffuser_bias_pct",
-                format!("{} is out of range (allowed: -50 to 50 %)", self.diffuser_bias_pct),
-            );
-        }
-        if !(self.gain_drift_pct.is_finite() && (-50.0..=50.0).contains(&self.gain_drift_pct)) {
-            return bad("gain_drift_pct", format!("{} is out of range (allowed: -50 to 50 %)", self.gain_drift_pct));
-        }
-        Ok(())
+        check("diffuser_bias_pct", &r::CALIBRATION_DIFFUSER_BIAS_PCT, self.diffuser_bias_pct)?;
+        check("gain_drift_pct", &r::CALIBRATION_GAIN_DRIFT_PCT, self.gain_drift_pct)
     }
 }
 

@@ -57,6 +57,8 @@ enum Command {
     /// Measure speed and accuracy: water evaluations per second, atmosphere LUT build times
     /// with their errors against OSOAA.
     Bench(bench::BenchArgs),
+    /// Print the allowed range of every number a user sets (Markdown table; README "Ranges").
+    Ranges,
     /// Developer tools that regenerate computed assets.
     #[command(subcommand, hide = true)]
     Dev(DevCommand),
@@ -142,6 +144,7 @@ pub fn main() -> ExitCode {
         Command::Merge(args) => sweep::merge_run(&args),
         Command::Budget(args) => budget::run(&args),
         Command::Bench(args) => bench::run(&args),
+        Command::Ranges => output::emit(&crate::ranges::markdown_table(), None),
         Command::Dev(DevCommand::AerosolTable) => output::emit(&crate::atmosphere::component_table_csv(), None),
         Command::Dev(DevCommand::OsoaaTable) => bench::osoaa_table(),
         Command::Dev(DevCommand::AlmiSets { dir }) => almi_sets(&dir),

@@ -60,6 +60,15 @@ impl Default for CorrectionSpec {
     }
 }
 
+impl CorrectionSpec {
+    /// Check `approx_points` against [`crate::ranges::CORRECTION_APPROX_POINTS`].
+    pub fn validate(&self) -> Result<(), InstrumentError> {
+        crate::ranges::CORRECTION_APPROX_POINTS
+            .check(self.approx_points as f64)
+            .map_err(|message| InstrumentError::Invalid { field: "correction.approx_points".into(), message })
+    }
+}
+
 /// Remote-sensing reflectance with flags.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Reflectance {

@@ -48,45 +48,19 @@ impl Default for Fidelity {
 }
 
 impl Fidelity {
-    /// Check every number; the message names the field and the range.
+    /// Check every number against [`crate::ranges`]; the message names field, value and range.
     pub fn validate(&self) -> Result<(), InstrumentError> {
-        let bad = |field: &str, message: String| {
-            Err(InstrumentError::Invalid { field: format!("fidelity.{field}"), message })
+        use crate::ranges as r;
+        let check = |field: &str, range: &r::Range, v: f64| {
+            range.check(v).map_err(|message| InstrumentError::Invalid { field: format!("fidelity.{field}"), message })
         };
-        if !(self.spectral_step_nm.is_finite() && (0.1..=10.0).contains(&self.spectral_step_nm)) {
-            return bad(
-                "spectral_step_nm",
-                format!("{} is out of range (allowed: 0.1 to 10 nm)", self.spectral_step_nm),
-            );
-        }
-        if !(1..=8).contains(&self.spatial_samples_per_gsd) {
-            return bad(
-                "spatial_samples_per_gsd",
-                format!("{} is out of range (allowed: 1 to 8)", self.spatial_samples_per_gsd),
-            );
-        }
-        if !(1..=1000).contains(&self.decimation) {
-            return bad("decimation", format!("{} is out of range (allowed: 1 to 1000)", self.decimation));
-        }
-        if !(self.lut_wavelength_step_nm.is_finite() && (5.0..=50.0).contains(&self.lut_wavelength_step_nm)) {
-            return bad(
-                "lut_wavelength_step_nm",
-                format!("{} is out of range (allowed: 5 to 50 nm)", self.lut_wavelength_step_nm),
-            );
-        }
-        if !(self.lut_view_step_deg.is_finite() && (1.0..=20.0).contains(&self.lut_view_step_deg)) {
-            return bad(
-                "lut_view_step_deg",
-                format!("{} is out of range (allowed: 1 to 20 degrees)", self.lut_view_step_deg),
-            );
-        }
-        if !(2..=10_000).contains(&self.snr_frames) {
-            return bad("snr_frames", format!("{} is out of range (allowed: 2 to 10000)", self.snr_frames));
-        }
-        if !(1..=20_000).contains(&self.snr_detectors) {
-            return bad("snr_detectors", format!("{} is out of range (allowed: 1 to 20000)", self.snr_detectors));
-        }
-        Ok(())
+        check("spectral_step_nm", &r::FIDELITY_SPECTRAL_STEP_NM, self.spectral_step_nm)?;
+        check("spatial_samples_per_gsd", &r::FIDELITY_SPATIAL_SAMPLES_PER_GSD, self.spatial_samples_per_gsd as f64)?;
+        check("decimation", &r::FIDELITY_DECIMATION, self.decimation as f64)?;
+        check("lut_wavelength_step_nm", &r::FIDELITY_LUT_WAVELENGTH_STEP_NM, self.lut_wavelength_step_nm)?;
+        check("lut_view_step_deg", &r::FIDELITY_LUT_VIEW_STEP_DEG, self.lut_view_step_deg)?;
+        check("snr_frames", &r::FIDELITY_SNR_FRAMES, self.snr_frames as f64)?;
+        check("snr_detectors", &r::FIDELITY_SNR_DETECTORS, self.snr_detectors as f64)
     }
 }
 
@@ -141,6 +115,29 @@ impl RunConfig {
             seed: 1,
             fault: None,
         }
+    }
+
+    /// Check every setting that needs no built stage against [`crate::ranges`] — instrument,
+    /// fidelity, calibration, correction, the scene's numbers and atmosphere, the retrievals'
+    /// settings — so a bad value is refused before any stage runs, named with the stage that
+    /// owns it. (The maps' values are checked when the scene stage builds them.)
+    pub fn validate(&self) -> Result<(), super::EngineError> {
+        use super::{EngineError, Stage};
+        fn at<E: std::fmt::Display>(stage: Stage) -> impl Fn(E) -> EngineError {
+            move |e| EngineError::Failed { stage, message: e.to_string() }
+        }
+        self.instrument.validate().map_err(at(Stage::Response))?;
+        self.fidelity.validate().map_err(at(Stage::Response))?;
+        self.calibration.validate().map_err(at(Stage::Calibration))?;
+        self.correction.validate().map_err(at(Stage::Correction))?;
+        self.scene.validate().map_err(at(Stage::Scene))?;
+        let mut atmosphere = self.scene.atmosphere.clone();
+        atmosphere.day_of_year = crate::scene::day_of_year(&self.scene.date).map_err(at(Stage::Scene))?;
+        atmosphere.validate().map_err(|e| at(Stage::Scene)(format!("atmosphere: {e}")))?;
+        for r in &self.retrievals {
+            r.validate().map_err(|e| at(Stage::Retrieval)(format!("{}: {e}", r.name())))?;
+        }
+        Ok(())
     }
 
     /// Parse RON; `origin` names the file in errors.

@@ -210,9 +210,7 @@ impl Engine {
     pub fn run(&mut self, config: &RunConfig, control: &RunControl) -> Result<RunOutput, EngineError> {
         let start = Instant::now();
         self.fault = config.fault;
-        config.instrument.validate().map_err(failed(Stage::Response))?;
-        config.fidelity.validate().map_err(failed(Stage::Response))?;
-        config.calibration.validate().map_err(failed(Stage::Calibration))?;
+        config.validate()?;
         let mut report = RunReport {
             scene: config.scene.name.clone(),
             instrument: config.instrument.name.clone(),

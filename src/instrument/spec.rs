@@ -143,64 +143,59 @@ impl InstrumentSpec {
         crate::assets::preset_names("instruments")
     }
 
-    /// Check every number against its documented range; the message names field and range.
+    /// Check every number against its documented range ([`crate::ranges`]); the message names
+    /// field, value and range.
     pub fn validate(&self) -> Result<(), InstrumentError> {
-        let range = |field: &str, v: f64, lo: f64, hi: f64, unit: &str| {
-            if v.is_finite() && (lo..=hi).contains(&v) {
-                Ok(())
-            } else {
-                Err(InstrumentError::Invalid {
-                    field: field.into(),
-                    message: format!("{v} is out of range (allowed: {lo} to {hi}{unit})"),
-                })
-            }
+        use crate::ranges as r;
+        let check = |field: &str, range: &r::Range, v: f64| {
+            range.check(v).map_err(|message| InstrumentError::Invalid { field: field.into(), message })
         };
-        let above = |field: &str, v: f64, lo: f64, hi: f64, unit: &str| {
-            if v.is_finite() && v > lo && v <= hi {
-                Ok(())
-            } else {
-                Err(InstrumentError::Invalid {
-                    field: field.into(),
-                    message: format!("{v} is out of range (allowed: above {lo}, at most {hi}{unit})"),
-                })
-            }
-        };
-        range("altitude_km", self.altitude_km, 200.0, 1500.0, " km")?;
-        range("heading_deg", self.heading_deg, -360.0, 360.0, " degrees")?;
-        above("aperture_mm", self.aperture_mm, 0.0, 2000.0, " mm")?;
-        above("pixel_pitch_um", self.pixel_pitch_um, 0.0, 100.0, " µm")?;
-        above("focal_length_mm", self.focal_length_mm, 0.0, 10_000.0, " mm")?;
-        range("detectors", self.detectors as f64, 1.0, 20_000.0, "")?;
-        above("exposure_s", self.exposure_s, 0.0, 10.0, " s")?;
-        range("exposures", self.exposures as f64, 1.0, 100_000.0, "")?;
-        range("forward_tilt_deg", self.forward_tilt_deg, -60.0, 60.0, " degrees")?;
-        range("read_noise_e", self.read_noise_e, 0.0, 1e5, " e-")?;
-        above("well_depth_e", self.well_depth_e, 0.0, 1e9, " e-")?;
-        range("gain_e_per_dn", self.gain_e_per_dn, 0.01, 1e4, " e-/DN")?;
-        range("bias_dn", self.bias_dn, 0.0, 65_535.0, " DN")?;
-        range("adc_bits", f64::from(self.adc_bits), 1.0, 16.0, " bits")?;
-        above("optical_transmission", self.optical_transmission, 0.0, 1.0, "")?;
-        range("dark_current_e_s", self.dark_current_e_s, 0.0, 1e9, " e-/s")?;
-        range("prnu", self.prnu, 0.0, 0.5, "")?;
-        range("dsnu_e", self.dsnu_e, 0.0, 1e6, " e-")?;
+        let count = |n: usize| n as f64;
+        check("altitude_km", &r::INSTRUMENT_ALTITUDE_KM, self.altitude_km)?;
+        check("heading_deg", &r::INSTRUMENT_HEADING_DEG, self.heading_deg)?;
+        check("aperture_mm", &r::INSTRUMENT_APERTURE_MM, self.aperture_mm)?;
+        check("pixel_pitch_um", &r::INSTRUMENT_PIXEL_PITCH_UM, self.pixel_pitch_um)?;
+        check("focal_length_mm", &r::INSTRUMENT_FOCAL_LENGTH_MM, self.focal_length_mm)?;
+        check("detectors", &r::INSTRUMENT_DETECTORS, count(self.detectors))?;
+        check("exposure_s", &r::INSTRUMENT_EXPOSURE_S, self.exposure_s)?;
+        check("exposures", &r::INSTRUMENT_EXPOSURES, count(self.exposures))?;
+        check("forward_tilt_deg", &r::INSTRUMENT_FORWARD_TILT_DEG, self.forward_tilt_deg)?;
+        check("read_noise_e", &r::INSTRUMENT_READ_NOISE_E, self.read_noise_e)?;
+        check("well_depth_e", &r::INSTRUMENT_WELL_DEPTH_E, self.well_depth_e)?;
+        check("gain_e_per_dn", &r::INSTRUMENT_GAIN_E_PER_DN, self.gain_e_per_dn)?;
+        check("bias_dn", &r::INSTRUMENT_BIAS_DN, self.bias_dn)?;
+        check("adc_bits", &r::INSTRUMENT_ADC_BITS, f64::from(self.adc_bits))?;
+        check("optical_transmission", &r::INSTRUMENT_OPTICAL_TRANSMISSION, self.optical_transmission)?;
+        check("dark_current_e_s", &r::INSTRUMENT_DARK_CURRENT_E_S, self.dark_current_e_s)?;
+        check("prnu", &r::INSTRUMENT_PRNU, self.prnu)?;
+        check("dsnu_e", &r::INSTRUMENT_DSNU_E, self.dsnu_e)?;
         if let InstrumentKind::Spectrograph { start_nm, end_nm, sampling_nm, resolution_nm, smile_nm, keystone_px } =
             &self.kind
         {
-            range("kind.start_nm", *start_nm, 350.0, 1000.0, " nm")?;
-            range("kind.end_nm", *end_nm, *start_nm, 1000.0, " nm")?;
-            above("kind.sampling_nm", *sampling_nm, 0.0, 100.0, " nm")?;
-            above("kind.resolution_nm", *resolution_nm, 0.0, 200.0, " nm")?;
-            range("kind.smile_nm", *smile_nm, -20.0, 20.0, " nm")?;
-            range("kind.keystone_px", *keystone_px, -20.0, 20.0, " pixels")?;
-            if (end_nm - start_nm) / sampling_nm > 2000.0 {
+            check("kind.start_nm", &r::SPECTROGRAPH_START_NM, *start_nm)?;
+            check("kind.end_nm", &r::SPECTROGRAPH_END_NM, *end_nm)?;
+            check("kind.sampling_nm", &r::SPECTROGRAPH_SAMPLING_NM, *sampling_nm)?;
+            check("kind.resolution_nm", &r::SPECTROGRAPH_RESOLUTION_NM, *resolution_nm)?;
+            check("kind.smile_nm", &r::SPECTROGRAPH_SMILE_NM, *smile_nm)?;
+            check("kind.keystone_px", &r::SPECTROGRAPH_KEYSTONE_PX, *keystone_px)?;
+            if end_nm < start_nm {
+                return Err(InstrumentError::Invalid {
+                    field: "kind.end_nm".into(),
+                    message: format!("{end_nm} is below start_nm = {start_nm} (allowed: start_nm to 1000 nm)"),
+                });
+            }
+            let samples = (end_nm - start_nm) / sampling_nm;
+            if samples > 2000.0 {
                 return Err(InstrumentError::Invalid {
                     field: "kind.sampling_nm".into(),
-                    message: "more than 2000 spectral samples".into(),
+                    message: format!(
+                        "{sampling_nm} gives {samples:.0} spectral samples from start_nm to end_nm (allowed: at most 2000)"
+                    ),
                 });
             }
         }
         if let InstrumentKind::FilterImager { rows_per_band, .. } = &self.kind {
-            range("kind.rows_per_band", *rows_per_band as f64, 1.0, 10_000.0, "")?;
+            check("kind.rows_per_band", &r::FILTER_ROWS_PER_BAND, count(*rows_per_band))?;
         }
         Ok(())
     }

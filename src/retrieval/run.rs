@@ -53,6 +53,28 @@ impl RetrievalSpec {
             Self::Sambuca { .. } => "sambuca",
         }
     }
+
+    /// Check the settings that need no image (counts, coefficients, bounds) against
+    /// [`crate::ranges`], so a run can refuse them before any stage runs.
+    pub fn validate(&self) -> Result<(), RetrievalError> {
+        use crate::ranges as r;
+        match self {
+            Self::Almi { siop_sets, settings } => {
+                if siop_sets.is_empty() || siop_sets.len() > 64 {
+                    return Err(RetrievalError::Invalid {
+                        field: "siop_sets".into(),
+                        message: format!("{} sets (allowed: 1 to 64)", siop_sets.len()),
+                    });
+                }
+                let check = |field: &str, range: &r::Range, v: f64| {
+                    range.check(v).map_err(|message| RetrievalError::Invalid { field: field.into(), message })
+                };
+                check("settings.g0", &r::ALMI_G0, settings.g0)?;
+                check("settings.g1", &r::ALMI_G1, settings.g1)
+            }
+            Self::Sambuca { settings, .. } => validate_sambuca(settings),
+        }
+    }
 }
 
 /// Per-pixel flags of a product.
@@ -172,6 +194,7 @@ pub fn retrieve(
     inputs: &RetrievalInputs<'_>,
     control: &RunControl,
 ) -> Result<Product, RetrievalError> {
+    spec.validate()?;
     match spec {
         RetrievalSpec::Almi { siop_sets, settings } => retrieve_almi(siop_sets, settings, inputs, control),
         RetrievalSpec::Sambuca { siop, substrates, settings } => {
@@ -189,12 +212,6 @@ fn retrieve_almi(
     inputs: &RetrievalInputs<'_>,
     control: &RunControl,
 ) -> Result<Product, RetrievalError> {
-    if sources.is_empty() || sources.len() > 64 {
-        return Err(RetrievalError::Invalid {
-            field: "siop_sets".into(),
-            message: format!("{} sets (allowed: 1 to 64)", sources.len()),
-        });
-    }
     let used: Vec<usize> = match &settings.bands {
         None => default_almi_bands(&inputs.bands),
         Some(names) => names
@@ -302,19 +319,11 @@ fn validate_sambuca(settings: &SambucaSettings) -> Result<(), RetrievalError> {
             });
         }
     }
-    if !(1..=8).contains(&settings.nodes_per_band) {
-        return Err(RetrievalError::Invalid {
-            field: "settings.nodes_per_band".into(),
-            message: format!("{} is out of range (allowed: 1 to 8)", settings.nodes_per_band),
-        });
-    }
-    if !(1..=10_000).contains(&settings.max_iterations) {
-        return Err(RetrievalError::Invalid {
-            field: "settings.max_iterations".into(),
-            message: format!("{} is out of range (allowed: 1 to 10000)", settings.max_iterations),
-        });
-    }
-    Ok(())
+    let check = |field: &str, range: &crate::ranges::Range, v: f64| {
+        range.check(v).map_err(|message| RetrievalError::Invalid { field: field.into(), message })
+    };
+    check("settings.nodes_per_band", &crate::ranges::SAMBUCA_NODES_PER_BAND, settings.nodes_per_band as f64)?;
+    check("settings.max_iterations", &crate::ranges::SAMBUCA_MAX_ITERATIONS, f64::from(settings.max_iterations))
 }
 
 /// Per-substrate fractions from each pixel's pair and fraction.
@@ -357,7 +366,6 @@ fn retrieve_sambuca(
             message: "SAMBUCA needs at least one substrate".into(),
         });
     }
-    validate_sambuca(settings)?;
     let b = &settings.bounds;
     let library = SubstrateLibrary::embedded()?;
     let model = BandModel::new(&spec, dir.as_deref(), &library, &names, &inputs.bands, settings.nodes_per_band)?;

@@ -16,7 +16,7 @@ mod spec;
 
 pub use grf::gaussian_random_field;
 pub use map::{Distribution, Extent, Map, MapSpec, Shape};
-pub use spec::{Effect, LandSpec, Scene, SceneSpec, SubstrateLayer, SunSpec};
+pub use spec::{Effect, LandSpec, Scene, SceneSpec, SubstrateLayer, SunSpec, day_of_year};
 
 use crate::atmosphere::AtmosphereError;
 use crate::spectral::SpectralError;

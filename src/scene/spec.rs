@@ -146,22 +146,15 @@ impl SceneSpec {
 
     /// Check the numbers and that every effect has what it needs.
     pub fn validate(&self) -> Result<(), SceneError> {
+        use crate::ranges as r;
         let bad = |field: &str, message: String| Err(SceneError::Invalid { field: field.into(), message });
-        if !(1..=20_000).contains(&self.width) {
-            return bad("width", format!("{} is out of range (allowed: 1 to 20000 cells)", self.width));
-        }
-        if !(1..=20_000).contains(&self.height) {
-            return bad("height", format!("{} is out of range (allowed: 1 to 20000 cells)", self.height));
-        }
-        if !(self.cell_m.is_finite() && (0.1..=10_000.0).contains(&self.cell_m)) {
-            return bad("cell_m", format!("{} is out of range (allowed: 0.1 to 10000 m)", self.cell_m));
-        }
-        if !(self.sun.zenith_deg.is_finite() && (0.0..=85.0).contains(&self.sun.zenith_deg)) {
-            return bad(
-                "sun.zenith_deg",
-                format!("{} is out of range (allowed: 0 to 85 degrees)", self.sun.zenith_deg),
-            );
-        }
+        let check = |field: &str, range: &r::Range, v: f64| {
+            range.check(v).map_err(|message| SceneError::Invalid { field: field.into(), message })
+        };
+        check("width", &r::SCENE_WIDTH, self.width as f64)?;
+        check("height", &r::SCENE_HEIGHT, self.height as f64)?;
+        check("cell_m", &r::SCENE_CELL_M, self.cell_m)?;
+        check("sun.zenith_deg", &r::SCENE_SUN_ZENITH_DEG, self.sun.zenith_deg)?;
         if !self.sun.azimuth_deg.is_finite() {
             return bad("sun.azimuth_deg", format!("{} is not a finite angle", self.sun.azimuth_deg));
         }
@@ -261,34 +254,32 @@ impl Scene {
     }
 
     /// Every map within the water model's documented ranges (see `water::limits`).
+    /// Every value of every map within its range ([`crate::ranges`]).
     fn check_ranges(&self) -> Result<(), SceneError> {
-        use crate::water::limits;
-        let check = |field: &str, m: &Map, lo: f64, hi: f64, unit: &str| {
+        use crate::ranges as r;
+        let check = |field: &str, m: &Map, range: &r::Range| {
             let (a, b) = m.range();
-            if a < lo || b > hi || !a.is_finite() || !b.is_finite() {
-                Err(SceneError::Invalid {
+            match [a, b].into_iter().find(|v| !range.contains(*v)) {
+                Some(v) => Err(SceneError::Invalid {
                     field: field.into(),
-                    message: format!("values span {a} to {b}; allowed {lo} to {hi} {unit}"),
-                })
-            } else {
-                Ok(())
+                    message: format!("{v} is out of range (the map spans {a} to {b}; allowed: {})", range.allowed()),
+                }),
+                None => Ok(()),
             }
         };
-        check("chl_mg_m3", &self.chl, 0.0, limits::MAX_CHL_MG_M3, "mg m-3")?;
-        check("nap_g_m3", &self.nap, 0.0, limits::MAX_NAP_G_M3, "g m-3")?;
-        check("cdom_per_m", &self.cdom, 0.0, limits::MAX_CDOM_PER_M, "m-1")?;
+        check("chl_mg_m3", &self.chl, &r::SCENE_CHL_MG_M3)?;
+        check("nap_g_m3", &self.nap, &r::SCENE_NAP_G_M3)?;
+        check("cdom_per_m", &self.cdom, &r::SCENE_CDOM_PER_M)?;
         if let Some(d) = &self.depth {
-            let (a, _) = d.range();
-            if !(a > 0.0) {
-                return Err(SceneError::Invalid {
-                    field: "depth_m".into(),
-                    message: format!("depth reaches {a} m; it must stay above 0 (land belongs in `land`)"),
-                });
-            }
-            check("depth_m", d, 0.0, limits::MAX_DEPTH_M, "m")?;
+            check("depth_m", d, &r::SCENE_DEPTH_M).map_err(|e| match e {
+                SceneError::Invalid { field, message } if d.range().0 <= 0.0 => {
+                    SceneError::Invalid { field, message: format!("{message}; land belongs in `land`") }
+                }
+                other => other,
+            })?;
         }
         for (name, m) in &self.substrates {
-            check(&format!("substrates.{name}"), m, 0.0, 1.0, "(fraction)")?;
+            check(&format!("substrates.{name}.fraction"), m, &r::SCENE_SUBSTRATE_FRACTION)?;
         }
         Ok(())
     }

@@ -75,20 +75,22 @@ impl Requirements {
                     format!("`{}` (allowed: chl_mg_m3, nap_g_m3, cdom_per_m, depth_m)", p.variable),
                 );
             }
-            for (name, v, hi) in
-                [("mae_pct", p.mae_pct, 1e4), ("bias_pct", p.bias_pct, 1e4), ("returned_pct", p.returned_pct, 100.0)]
-            {
+            for (name, v, range) in [
+                ("mae_pct", p.mae_pct, &crate::ranges::REQUIREMENT_MAE_PCT),
+                ("bias_pct", p.bias_pct, &crate::ranges::REQUIREMENT_BIAS_PCT),
+                ("returned_pct", p.returned_pct, &crate::ranges::REQUIREMENT_RETURNED_PCT),
+            ] {
                 if let Some(v) = v
-                    && !(v >= 0.0 && v <= hi)
+                    && let Err(message) = range.check(v)
                 {
-                    return bad(format!("requirements.products[{i}].{name}"), format!("{v} (allowed: 0 to {hi})"));
+                    return bad(format!("requirements.products[{i}].{name}"), message);
                 }
             }
         }
         if let Some(s) = self.snr
-            && !(s > 0.0 && s < 1e6)
+            && let Err(message) = crate::ranges::REQUIREMENT_SNR.check(s)
         {
-            return bad("requirements.snr".into(), format!("{s} (allowed: above 0, below 1e6)"));
+            return bad("requirements.snr".into(), message);
         }
         Ok(())
     }

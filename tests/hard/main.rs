@@ -11,6 +11,7 @@ mod chain;
 mod faults;
 mod loaders;
 mod properties;
+mod ranges;
 mod water;
 
 use shoal::correction::RrsFlags;

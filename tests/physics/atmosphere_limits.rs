@@ -218,7 +218,7 @@ fn bad_inputs_name_the_field_and_range() {
         (spec(AerosolType::Maritime, -0.1), "aot550"),
         (spec(AerosolType::Maritime, f64::NAN), "aot550"),
         (AtmosphereSpec { pressure_hpa: 20.0, ..Default::default() }, "pressure_hpa"),
-        (AtmosphereSpec { surface: Surface::Wind { speed_m_s: 80.0 }, ..Default::default() }, "wind"),
+        (AtmosphereSpec { surface: Surface::Wind { speed_m_s: 80.0 }, ..Default::default() }, "surface.Wind.speed_m_s"),
         (AtmosphereSpec { accuracy: RtAccuracy { streams: 0, ..Default::default() }, ..Default::default() }, "streams"),
         (AtmosphereSpec { day_of_year: 0, ..Default::default() }, "day_of_year"),
     ];

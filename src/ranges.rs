@@ -1,0 +1,350 @@
+//! The documented range of every number a user sets — one table.
+//!
+//! Each validator checks its fields against the entries here, so a message and its check cannot
+//! drift apart; `shoal ranges` prints the table, and README's "Ranges" section is that output (a
+//! unit test keeps the two equal). A value outside its range is refused with the field, the value
+//! and the range ("aperture_mm: 5000 is out of range (allowed: above 0, at most 2000 mm)"): exit
+//! code 2 in the CLI, an inline refusal in the app.
+//!
+//! Paths are those of the run configuration as files and sweeps spell them
+//! (`instrument.aperture_mm`; `[i]` stands for a list index; an enum variant's fields follow its
+//! name, `instrument.kind.Spectrograph.start_nm`). The study section holds the requirement
+//! thresholds of a study file.
+
+use crate::water::limits;
+
+/// The allowed values of one numeric field.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Range {
+    /// Where the field lives (see the module documentation).
+    pub path: &'static str,
+    /// Lower end.
+    pub lo: f64,
+    /// `lo` itself is refused.
+    pub lo_open: bool,
+    /// Upper end.
+    pub hi: f64,
+    /// `hi` itself is refused.
+    pub hi_open: bool,
+    /// Unit (empty: dimensionless or a count).
+    pub unit: &'static str,
+    /// Only whole numbers (counts, bits).
+    pub whole: bool,
+    /// What the field is.
+    pub meaning: &'static str,
+}
+
+impl Range {
+    /// `lo` to `hi`, both allowed.
+    #[must_use]
+    pub const fn closed(path: &'static str, lo: f64, hi: f64, unit: &'static str, meaning: &'static str) -> Self {
+        Self { path, lo, lo_open: false, hi, hi_open: false, unit, whole: false, meaning }
+    }
+
+    /// Above `lo`, at most `hi`.
+    #[must_use]
+    pub const fn above(path: &'static str, lo: f64, hi: f64, unit: &'static str, meaning: &'static str) -> Self {
+        Self { path, lo, lo_open: true, hi, hi_open: false, unit, whole: false, meaning }
+    }
+
+    /// Whole numbers from `lo` to `hi`.
+    #[must_use]
+    pub const fn count(path: &'static str, lo: f64, hi: f64, unit: &'static str, meaning: &'static str) -> Self {
+        Self { path, lo, lo_open: false, hi, hi_open: false, unit, whole: true, meaning }
+    }
+
+    /// The same range with `hi` refused.
+    #[must_use]
+    pub const fn below_hi(self) -> Self {
+        Self { hi_open: true, ..self }
+    }
+
+    /// Is `value` allowed?
+    ///
+    /// ```
+    /// use shoal::ranges::INSTRUMENT_APERTURE_MM as r;
+    /// assert!(r.contains(2000.0) && !r.contains(0.0) && !r.contains(f64::NAN));
+    /// ```
+    #[must_use]
+    pub fn contains(&self, value: f64) -> bool {
+        let lo_ok = if self.lo_open { value > self.lo } else { value >= self.lo };
+        let hi_ok = if self.hi_open { value < self.hi } else { value <= self.hi };
+        value.is_finite() && lo_ok && hi_ok && (!self.whole || value.fract() == 0.0)
+    }
+
+    /// The range in words: "0.01 to 10000 e-/DN", "above 0, at most 2000 mm".
+    #[must_use]
+    pub fn allowed(&self) -> String {
+        let unit = if self.unit.is_empty() { String::new() } else { format!(" {}", self.unit) };
+        let whole = if self.whole { " (whole number)" } else { "" };
+        let (lo, hi) = (number(self.lo), number(self.hi));
+        match (self.lo_open, self.hi_open) {
+            (false, false) => format!("{lo} to {hi}{unit}{whole}"),
+            (true, false) => format!("above {lo}, at most {hi}{unit}{whole}"),
+            (false, true) => format!("{lo} to below {hi}{unit}{whole}"),
+            (true, true) => format!("above {lo}, below {hi}{unit}{whole}"),
+        }
+    }
+
+    /// `Ok` when allowed, else the message "VALUE is out of range (allowed: RANGE)".
+    pub fn check(&self, value: f64) -> Result<(), String> {
+        if self.contains(value) {
+            Ok(())
+        } else {
+            Err(format!("{value} is out of range (allowed: {})", self.allowed()))
+        }
+    }
+
+    /// The field's own name: the path's last part (`aperture_mm`).
+    #[must_use]
+    pub fn name(&self) -> &'static str {
+        self.path.rsplit('.').next().unwrap_or(self.path)
+    }
+
+    /// Values just outside the range (for tests): the open end itself, or one step past a
+    /// closed end (1 for whole numbers; 1 % of the end, or 0.01, otherwise). Values a field's
+    /// type cannot hold (a negative count) are left out.
+    #[must_use]
+    pub fn just_outside(&self) -> Vec<f64> {
+        let step = |end: f64| if self.whole { 1.0 } else { (end.abs() * 0.01).max(0.01) };
+        let below = if self.lo_open { self.lo } else { self.lo - step(self.lo) };
+        let above = if self.hi_open { self.hi } else { self.hi + step(self.hi) };
+        let mut out = Vec::new();
+        if !(self.whole && below < 0.0) {
+            out.push(below);
+        }
+        out.push(above);
+        out
+    }
+}
+
+/// A range end as written: plain up to 65 535, powers of ten from 10⁵ as `1e5`.
+fn number(v: f64) -> String {
+    if v.abs() >= 1e5 { format!("{v:e}") } else { format!("{v}") }
+}
+
+macro_rules! ranges {
+    ($( $(#[$doc:meta])* $name:ident = $range:expr; )*) => {
+        $( $(#[$doc])* pub const $name: Range = $range; )*
+        /// Every range, in table order.
+        pub const ALL: &[Range] = &[$($name),*];
+    };
+}
+
+ranges! {
+    // Instrument (InstrumentSpec::validate).
+    /// Orbit altitude.
+    INSTRUMENT_ALTITUDE_KM = Range::closed("instrument.altitude_km", 200.0, 1500.0, "km", "orbit altitude");
+    /// Orbital heading.
+    INSTRUMENT_HEADING_DEG = Range::closed("instrument.heading_deg", -360.0, 360.0, "degrees", "ground-track azimuth, clockwise from north");
+    /// Entrance aperture.
+    INSTRUMENT_APERTURE_MM = Range::above("instrument.aperture_mm", 0.0, 2000.0, "mm", "entrance pupil diameter");
+    /// Pixel pitch.
+    INSTRUMENT_PIXEL_PITCH_UM = Range::above("instrument.pixel_pitch_um", 0.0, 100.0, "µm", "detector pixel pitch");
+    /// Focal length.
+    INSTRUMENT_FOCAL_LENGTH_MM = Range::above("instrument.focal_length_mm", 0.0, 10_000.0, "mm", "effective focal length");
+    /// Detectors across track.
+    INSTRUMENT_DETECTORS = Range::count("instrument.detectors", 1.0, 20_000.0, "", "detectors across track (swath = detectors · GSD)");
+    /// Exposure.
+    INSTRUMENT_EXPOSURE_S = Range::above("instrument.exposure_s", 0.0, 10.0, "s", "integration time of one frame");
+    /// Frames along track.
+    INSTRUMENT_EXPOSURES = Range::count("instrument.exposures", 1.0, 100_000.0, "", "frames (lines) along track");
+    /// Forward tilt.
+    INSTRUMENT_FORWARD_TILT_DEG = Range::closed("instrument.forward_tilt_deg", -60.0, 60.0, "degrees", "pointing along track (positive: forward)");
+    /// Read noise.
+    INSTRUMENT_READ_NOISE_E = Range::closed("instrument.read_noise_e", 0.0, 1e5, "e-", "read noise, rms");
+    /// Full well.
+    INSTRUMENT_WELL_DEPTH_E = Range::above("instrument.well_depth_e", 0.0, 1e9, "e-", "full-well capacity");
+    /// Conversion gain.
+    INSTRUMENT_GAIN_E_PER_DN = Range::closed("instrument.gain_e_per_dn", 0.01, 1e4, "e-/DN", "conversion gain");
+    /// ADC offset.
+    INSTRUMENT_BIAS_DN = Range::closed("instrument.bias_dn", 0.0, 65_535.0, "DN", "ADC offset");
+    /// ADC resolution.
+    INSTRUMENT_ADC_BITS = Range::count("instrument.adc_bits", 1.0, 16.0, "bits", "ADC resolution");
+    /// Optics transmission.
+    INSTRUMENT_OPTICAL_TRANSMISSION = Range::above("instrument.optical_transmission", 0.0, 1.0, "", "optics transmission (spectrally flat factor)");
+    /// Dark current.
+    INSTRUMENT_DARK_CURRENT_E_S = Range::closed("instrument.dark_current_e_s", 0.0, 1e9, "e-/s", "dark current per pixel");
+    /// Photo-response non-uniformity.
+    INSTRUMENT_PRNU = Range::closed("instrument.prnu", 0.0, 0.5, "", "photo-response non-uniformity, relative rms");
+    /// Dark-signal non-uniformity.
+    INSTRUMENT_DSNU_E = Range::closed("instrument.dsnu_e", 0.0, 1e6, "e-", "dark-signal non-uniformity, rms");
+    /// Spectrograph: first band centre.
+    SPECTROGRAPH_START_NM = Range::closed("instrument.kind.Spectrograph.start_nm", 350.0, 1000.0, "nm", "first band centre");
+    /// Spectrograph: last band centre.
+    SPECTROGRAPH_END_NM = Range::closed("instrument.kind.Spectrograph.end_nm", 350.0, 1000.0, "nm", "last band centre (and not below start_nm)");
+    /// Spectrograph: sampling.
+    SPECTROGRAPH_SAMPLING_NM = Range::above("instrument.kind.Spectrograph.sampling_nm", 0.0, 100.0, "nm", "spectral sampling per detector row (at most 2000 samples)");
+    /// Spectrograph: resolution.
+    SPECTROGRAPH_RESOLUTION_NM = Range::above("instrument.kind.Spectrograph.resolution_nm", 0.0, 200.0, "nm", "spectral resolution, FWHM");
+    /// Spectrograph: smile.
+    SPECTROGRAPH_SMILE_NM = Range::closed("instrument.kind.Spectrograph.smile_nm", -20.0, 20.0, "nm", "band-centre shift at the swath edges");
+    /// Spectrograph: keystone.
+    SPECTROGRAPH_KEYSTONE_PX = Range::closed("instrument.kind.Spectrograph.keystone_px", -20.0, 20.0, "pixels", "across-track misregistration, first to last band");
+    /// Filter imager: rows per band.
+    FILTER_ROWS_PER_BAND = Range::count("instrument.kind.FilterImager.rows_per_band", 1.0, 10_000.0, "", "detector rows between band centres");
+
+    // Scene (SceneSpec::validate and the maps' values in Scene::build).
+    /// Scene width.
+    SCENE_WIDTH = Range::count("scene.width", 1.0, 20_000.0, "cells", "cells along x (east)");
+    /// Scene height.
+    SCENE_HEIGHT = Range::count("scene.height", 1.0, 20_000.0, "cells", "cells along y (north)");
+    /// Cell size.
+    SCENE_CELL_M = Range::closed("scene.cell_m", 0.1, 10_000.0, "m", "ground size of a cell");
+    /// Sun zenith.
+    SCENE_SUN_ZENITH_DEG = Range::closed("scene.sun.zenith_deg", 0.0, 85.0, "degrees", "solar zenith angle");
+    /// Chlorophyll-a map values.
+    SCENE_CHL_MG_M3 = Range::closed("scene.chl_mg_m3", 0.0, limits::MAX_CHL_MG_M3, "mg m-3", "chlorophyll-a (every value of the map)");
+    /// NAP map values.
+    SCENE_NAP_G_M3 = Range::closed("scene.nap_g_m3", 0.0, limits::MAX_NAP_G_M3, "g m-3", "non-algal particles (every value of the map)");
+    /// CDOM map values.
+    SCENE_CDOM_PER_M = Range::closed("scene.cdom_per_m", 0.0, limits::MAX_CDOM_PER_M, "m-1", "CDOM absorption at the reference wavelength (every value)");
+    /// Depth map values.
+    SCENE_DEPTH_M = Range::above("scene.depth_m", 0.0, limits::MAX_DEPTH_M, "m", "water depth (every value of the map)");
+    /// Substrate fraction map values.
+    SCENE_SUBSTRATE_FRACTION = Range::closed("scene.substrates[i].fraction", 0.0, 1.0, "", "areal fraction of a substrate (every value)");
+
+    // Atmosphere (AtmosphereSpec::validate, RtAccuracy::validate).
+    /// Aerosol optical thickness.
+    ATMOSPHERE_AOT550 = Range::closed("scene.atmosphere.aot550", 0.0, 5.0, "", "aerosol optical thickness at 550 nm");
+    /// Surface pressure.
+    ATMOSPHERE_PRESSURE_HPA = Range::closed("scene.atmosphere.pressure_hpa", 500.0, 1100.0, "hPa", "surface pressure");
+    /// Ozone column.
+    ATMOSPHERE_OZONE_ATM_CM = Range::closed("scene.atmosphere.gas_amounts.ozone_atm_cm", 0.0, 1.0, "atm-cm", "ozone column");
+    /// Water-vapour column.
+    ATMOSPHERE_WATER_VAPOUR_CM = Range::closed("scene.atmosphere.gas_amounts.water_vapour_cm", 0.0, 10.0, "cm", "precipitable water");
+    /// Wind speed of a rough surface.
+    ATMOSPHERE_WIND_SPEED_M_S = Range::closed("scene.atmosphere.surface.Wind.speed_m_s", 0.0, 30.0, "m/s", "wind speed (Cox–Munk surface)");
+    /// Latitude.
+    ATMOSPHERE_LATITUDE_DEG = Range::closed("scene.atmosphere.latitude_deg", -90.0, 90.0, "degrees", "latitude (gravity in the Rayleigh depth)");
+    /// Molecular scale height.
+    ATMOSPHERE_RAYLEIGH_SCALE_HEIGHT_KM = Range::closed("scene.atmosphere.rayleigh_scale_height_km", 1.0, 20.0, "km", "molecular scale height");
+    /// Aerosol scale height.
+    ATMOSPHERE_AEROSOL_SCALE_HEIGHT_KM = Range::closed("scene.atmosphere.aerosol_scale_height_km", 0.1, 20.0, "km", "aerosol scale height");
+    /// Water refractive index.
+    ATMOSPHERE_WATER_REFRACTIVE_INDEX = Range::closed("scene.atmosphere.water_refractive_index", 1.0, 1.5, "", "refractive index of the water surface");
+    /// Discrete-ordinate streams.
+    ACCURACY_STREAMS = Range::count("scene.atmosphere.accuracy.streams", 2.0, 48.0, "", "quadrature streams per hemisphere");
+    /// Scattering orders.
+    ACCURACY_MAX_ORDERS = Range::count("scene.atmosphere.accuracy.max_orders", 1.0, 500.0, "", "most orders of scattering");
+    /// Fourier terms.
+    ACCURACY_FOURIER_TERMS = Range::count("scene.atmosphere.accuracy.fourier_terms", 1.0, 96.0, "", "azimuthal Fourier terms");
+    /// Layer optical depth.
+    ACCURACY_MAX_LAYER_DEPTH = Range::above("scene.atmosphere.accuracy.max_layer_depth", 0.0, 1.0, "", "largest optical depth of one layer");
+    /// Fewest layers.
+    ACCURACY_MIN_LAYERS = Range::count("scene.atmosphere.accuracy.min_layers", 1.0, 500.0, "", "fewest layers");
+    /// Order tolerance.
+    ACCURACY_ORDER_TOLERANCE = Range::above("scene.atmosphere.accuracy.order_tolerance", 0.0, 0.1, "", "stop when an order adds less than this fraction").below_hi();
+
+    // Fidelity (Fidelity::validate).
+    /// Spectral step.
+    FIDELITY_SPECTRAL_STEP_NM = Range::closed("fidelity.spectral_step_nm", 0.1, 10.0, "nm", "spectral step of the simulation grids");
+    /// Spatial-response quadrature.
+    FIDELITY_SPATIAL_SAMPLES_PER_GSD = Range::count("fidelity.spatial_samples_per_gsd", 1.0, 8.0, "", "spatial-response points per GSD and axis");
+    /// Preview decimation.
+    FIDELITY_DECIMATION = Range::count("fidelity.decimation", 1.0, 1000.0, "", "every n-th line and detector (1: full resolution)");
+    /// LUT wavelength spacing.
+    FIDELITY_LUT_WAVELENGTH_STEP_NM = Range::closed("fidelity.lut_wavelength_step_nm", 5.0, 50.0, "nm", "wavelength spacing of the atmosphere LUT");
+    /// LUT view spacing.
+    FIDELITY_LUT_VIEW_STEP_DEG = Range::closed("fidelity.lut_view_step_deg", 1.0, 20.0, "degrees", "view-zenith spacing of the atmosphere LUT");
+    /// SNR frames.
+    FIDELITY_SNR_FRAMES = Range::count("fidelity.snr_frames", 2.0, 10_000.0, "", "frames of the uniform patch that measures SNR");
+    /// SNR detectors.
+    FIDELITY_SNR_DETECTORS = Range::count("fidelity.snr_detectors", 1.0, 20_000.0, "", "detectors of the SNR patch, at most");
+
+    // Calibration (CalibrationSpec::validate).
+    /// Flat-field frames.
+    CALIBRATION_LIGHT_FRAMES = Range::count("calibration.light_frames", 1.0, 10_000.0, "", "diffuser frames averaged");
+    /// Dark frames.
+    CALIBRATION_DARK_FRAMES = Range::count("calibration.dark_frames", 1.0, 10_000.0, "", "dark frames averaged");
+    /// Dark exposure.
+    CALIBRATION_DARK_EXPOSURE_S = Range::closed("calibration.dark_exposure_s", 0.0, 10.0, "s", "exposure of the dark frames (0: the scene's)");
+    /// Diffuser reflectance.
+    CALIBRATION_DIFFUSER_REFLECTANCE = Range::above("calibration.diffuser_reflectance", 0.0, 1.0, "", "diffuser reflectance");
+    /// Sun incidence on the diffuser.
+    CALIBRATION_SUN_INCIDENCE_DEG = Range::closed("calibration.sun_incidence_deg", 0.0, 89.0, "degrees", "sun incidence on the diffuser").below_hi();
+    /// Diffuser error.
+    CALIBRATION_DIFFUSER_BIAS_PCT = Range::closed("calibration.diffuser_bias_pct", -50.0, 50.0, "%", "injected error of the diffuser's reflectance");
+    /// Gain drift.
+    CALIBRATION_GAIN_DRIFT_PCT = Range::closed("calibration.gain_drift_pct", -50.0, 50.0, "%", "injected gain drift after calibration");
+
+    // Atmospheric correction (CorrectionSpec::validate).
+    /// Approximation sample points.
+    CORRECTION_APPROX_POINTS = Range::count("correction.approx_points", 1.0, 10_000.0, "", "water pixels of the per-scene approximation (paper: 20)");
+
+    // Retrievals (RetrievalSpec::validate).
+    /// aLMI rrs(u) linear coefficient.
+    ALMI_G0 = Range::above("retrievals[i].Almi.settings.g0", 0.0, 1.0, "sr-1", "rrs(u) linear coefficient (Lee et al. 1999: 0.084)");
+    /// aLMI rrs(u) quadratic coefficient.
+    ALMI_G1 = Range::closed("retrievals[i].Almi.settings.g1", 0.0, 1.0, "sr-1", "rrs(u) quadratic coefficient (Lee et al. 1999: 0.17)");
+    /// SAMBUCA iteration limit.
+    SAMBUCA_MAX_ITERATIONS = Range::count("retrievals[i].Sambuca.settings.max_iterations", 1.0, 10_000.0, "", "iterations per start");
+    /// SAMBUCA quadrature.
+    SAMBUCA_NODES_PER_BAND = Range::count("retrievals[i].Sambuca.settings.nodes_per_band", 1.0, 8.0, "", "Gauss nodes per band in the forward model");
+
+    // Study requirements (Requirements::validate).
+    /// Largest allowed MAE.
+    REQUIREMENT_MAE_PCT = Range::closed("requirements.products[i].mae_pct", 0.0, 1e4, "%", "largest log-space MAE a product may have");
+    /// Largest allowed bias.
+    REQUIREMENT_BIAS_PCT = Range::closed("requirements.products[i].bias_pct", 0.0, 1e4, "%", "largest log-space bias, either sign");
+    /// Smallest returned share.
+    REQUIREMENT_RETURNED_PCT = Range::closed("requirements.products[i].returned_pct", 0.0, 100.0, "%", "smallest share of water pixels retrieved");
+    /// Smallest SNR.
+    REQUIREMENT_SNR = Range::above("requirements.snr", 0.0, 1e6, "", "smallest SNR of every band at the typical radiance").below_hi();
+}
+
+/// The table as Markdown (`shoal ranges`; README's "Ranges" section).
+#[must_use]
+pub fn markdown_table() -> String {
+    let mut out = String::from("| field | allowed | what |\n|---|---|---|\n");
+    for r in ALL {
+        out.push_str(&format!("| `{}` | {} | {} |\n", r.path, r.allowed(), r.meaning));
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn words_and_bounds() {
+        assert_eq!(INSTRUMENT_APERTURE_MM.allowed(), "above 0, at most 2000 mm");
+        assert_eq!(INSTRUMENT_ADC_BITS.allowed(), "1 to 16 bits (whole number)");
+        assert_eq!(ACCURACY_ORDER_TOLERANCE.allowed(), "above 0, below 0.1");
+        assert_eq!(CALIBRATION_SUN_INCIDENCE_DEG.allowed(), "0 to below 89 degrees");
+        assert_eq!(
+            INSTRUMENT_GAIN_E_PER_DN.check(0.001),
+            Err("0.001 is out of range (allowed: 0.01 to 10000 e-/DN)".into())
+        );
+        assert!(INSTRUMENT_ADC_BITS.check(12.5).is_err() && INSTRUMENT_ADC_BITS.check(12.0).is_ok());
+        assert!(!CALIBRATION_SUN_INCIDENCE_DEG.contains(89.0) && CALIBRATION_SUN_INCIDENCE_DEG.contains(88.9));
+        assert_eq!(INSTRUMENT_APERTURE_MM.just_outside(), vec![0.0, 2020.0]);
+        assert_eq!(INSTRUMENT_ADC_BITS.just_outside(), vec![0.0, 17.0]);
+        assert_eq!(CALIBRATION_DIFFUSER_BIAS_PCT.just_outside(), vec![-50.5, 50.5]);
+        assert_eq!(INSTRUMENT_APERTURE_MM.name(), "aperture_mm");
+    }
+
+    #[test]
+    fn every_range_is_well_formed_and_named_once() {
+        let mut paths: Vec<&str> = ALL.iter().map(|r| r.path).collect();
+        paths.sort_unstable();
+        paths.dedup();
+        assert_eq!(paths.len(), ALL.len(), "a path is listed twice");
+        for r in ALL {
+            assert!(r.lo < r.hi && r.lo.is_finite() && r.hi.is_finite(), "{}", r.path);
+            for v in r.just_outside() {
+                assert!(!r.contains(v), "{}: {v}", r.path);
+            }
+            assert!(!r.contains(f64::NAN) && !r.contains(f64::INFINITY), "{}", r.path);
+        }
+    }
+
+    /// README's table is `shoal ranges`'s output, so the documentation is the code's.
+    #[test]
+    fn readme_shows_the_table() {
+        let readme = include_str!("../README.md");
+        let table = markdown_table();
+        assert!(readme.contains(&table), "README.md's Ranges table differs from `shoal ranges`; paste this:\n{table}");
+    }
+}

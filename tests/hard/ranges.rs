@@ -1,0 +1,137 @@
+//! Every entry of `shoal::ranges` is enforced where users meet it: a value just outside the range
+//! (the open end itself, or one step past a closed end) is refused before any stage runs, and
+//! the message names the field, the value and the range; both ends that are allowed pass. The
+//! CLI turns a refusal into exit code 2.
+
+use std::process::Command;
+
+use shoal::engine::{EngineError, RunConfig};
+use shoal::instrument::InstrumentSpec;
+use shoal::ranges::{self, Range};
+use shoal::retrieval::RetrievalSpec;
+use shoal::scene::{MapSpec, Scene, SceneSpec};
+use shoal::study::Requirements;
+
+/// A configuration in which every path of the table exists: both retrievals, a sun incidence,
+/// a wind-roughened surface; a spectrograph or filter imager for their `kind` fields.
+fn base(path: &str) -> RunConfig {
+    let name = if path.contains("Spectrograph") {
+        "hyperspectral"
+    } else if path.contains("FilterImager") {
+        "filter_imager"
+    } else {
+        "cubesat"
+    };
+    let mut c = RunConfig::new(SceneSpec::preset("lake_hume_bloom").unwrap(), InstrumentSpec::preset(name).unwrap());
+    c.retrievals = vec![ron::from_str::<RetrievalSpec>("Almi()").unwrap(), ron::from_str("Sambuca()").unwrap()];
+    c.calibration.sun_incidence_deg = Some(30.0);
+    c.scene.atmosphere.surface = shoal::atmosphere::Surface::Wind { speed_m_s: 5.0 };
+    c.validate().unwrap();
+    c
+}
+
+/// The path as `sweep::apply` walks it (list index of the retrieval the path names).
+fn sweep_path(path: &str) -> String {
+    let index = if path.contains("Sambuca") { ".1" } else { ".0" };
+    path.replace("[i]", index)
+}
+
+/// The refusal of `value` at `range`, or `None` if it was accepted.
+fn refusal(range: &Range, value: f64) -> Option<String> {
+    let map = |spec: &mut SceneSpec, v: f64| {
+        let m = MapSpec::Constant(v);
+        match range.path {
+            "scene.chl_mg_m3" => spec.chl_mg_m3 = m,
+            "scene.nap_g_m3" => spec.nap_g_m3 = m,
+            "scene.cdom_per_m" => spec.cdom_per_m = m,
+            "scene.depth_m" => spec.depth_m = Some(m),
+            _ => spec.substrates[0].fraction = m,
+        }
+    };
+    if range.path.starts_with("requirements.") {
+        let mut r: Requirements = ron::from_str("(products: [(variable: \"chl_mg_m3\")])").unwrap();
+        match range.name() {
+            "mae_pct" => r.products[0].mae_pct = Some(value),
+            "bias_pct" => r.products[0].bias_pct = Some(value),
+            "returned_pct" => r.products[0].returned_pct = Some(value),
+            _ => r.snr = Some(value),
+        }
+        return r.validate().err().map(|e| e.to_string());
+    }
+    let map_field = ["scene.chl_mg_m3", "scene.nap_g_m3", "scene.cdom_per_m", "scene.depth_m"].contains(&range.path)
+        || range.path.starts_with("scene.substrates");
+    if map_field {
+        // Map values are checked when the scene stage builds the maps.
+        let mut spec = SceneSpec::preset("heron_island_reef").unwrap();
+        (spec.width, spec.height) = (4, 4);
+        map(&mut spec, value);
+        return Scene::build(&spec, None).err().map(|e| e.to_string());
+    }
+    let config = shoal::sweep::apply(&base(range.path), &[(&sweep_path(range.path), value)]).unwrap();
+    match config.validate() {
+        Ok(()) => None,
+        Err(EngineError::Failed { message, .. }) => Some(message),
+        Err(other) => panic!("{}: not a refusal: {other}", range.path),
+    }
+}
+
+#[test]
+fn every_range_refuses_just_outside_and_names_field_value_and_range() {
+    let mut refused = 0;
+    for range in ranges::ALL {
+        for v in range.just_outside() {
+            let message = refusal(range, v).unwrap_or_else(|| panic!("{} = {v} was accepted", range.path));
+            for part in [range.name().to_string(), v.to_string(), range.allowed()] {
+                assert!(message.contains(&part), "{} = {v}: `{message}` does not say `{part}`", range.path);
+            }
+            refused += 1;
+        }
+    }
+    // No whole-number range starts at 0, so every entry has a value on each side.
+    assert_eq!(refused, 2 * ranges::ALL.len(), "every entry refused on both sides");
+}
+
+#[test]
+fn the_allowed_ends_pass() {
+    for range in ranges::ALL {
+        let inside = |end: f64, open: bool, toward: f64| {
+            if !open {
+                end
+            } else if range.whole {
+                end + toward
+            } else {
+                end + toward * (end.abs() * 1e-6).max(1e-9)
+            }
+        };
+        let mut ends = vec![inside(range.lo, range.lo_open, 1.0), inside(range.hi, range.hi_open, -1.0)];
+        if range.path == "instrument.kind.Spectrograph.start_nm" {
+            ends.pop(); // start_nm = 1000 would put it above end_nm; the end is checked there.
+        }
+        if range.path == "instrument.kind.Spectrograph.end_nm" {
+            ends.remove(0); // end_nm = 350 would be below start_nm (refused with its own message).
+        }
+        if range.path == "instrument.kind.Spectrograph.sampling_nm" {
+            ends.remove(0); // A tiny step would give more than 2000 samples (its own message).
+        }
+        for v in ends {
+            assert_eq!(refusal(range, v), None, "{} = {v} is inside its range", range.path);
+        }
+    }
+}
+
+#[test]
+fn the_cli_refuses_an_out_of_range_flag_with_exit_code_2() {
+    let dir = std::env::temp_dir().join(format!("shoal-range-{}", std::process::id()));
+    let out = Command::new(env!("CARGO_BIN_EXE_shoal"))
+        .args(["simulate", "--gain-drift-pct", "80", "--out"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("calibration.gain_drift_pct: 80 is out of range (allowed: -50 to 50 %)"), "{stderr}");
+    assert!(!dir.exists(), "nothing written");
+    let table = Command::new(env!("CARGO_BIN_EXE_shoal")).arg("ranges").output().unwrap();
+    assert!(table.status.success());
+    assert_eq!(String::from_utf8_lossy(&table.stdout), ranges::markdown_table());
+}
