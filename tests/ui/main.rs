@@ -254,3 +254,25 @@ fn a_stage_that_panics_is_reported_and_the_app_goes_on() {
     assert!(displayed_chl_mae(&h) > 0.0);
     let _ = std::fs::remove_dir_all(&lib);
 }
+
+/// A typed aperture outside the documented range is refused inline, naming field, value and
+/// range; the instrument keeps its value, and a valid value afterwards clears the message.
+#[test]
+fn an_out_of_range_slider_value_is_refused_inline() {
+    let lib = temp_library("range");
+    let mut h = harness("cubesat", 8, &lib);
+    h.step();
+    h.get_by_role_and_label(Role::Slider, "Aperture").set_value_accesskit(5000.0);
+    h.step();
+    h.step();
+    let expected = "aperture_mm: 5000 is out of range (allowed: above 0, at most 2000 mm)";
+    assert_eq!(h.state().refused_value(), Some(expected));
+    assert!(h.query_all_by_label(&format!("refused: {expected}")).next().is_some(), "not on screen");
+    assert!((h.state().state.a.spec.aperture_mm - 60.0).abs() < 1e-9, "the instrument keeps 60 mm");
+    h.get_by_role_and_label(Role::Slider, "Aperture").set_value_accesskit(100.0);
+    h.step();
+    h.step();
+    assert_eq!(h.state().refused_value(), None);
+    assert!((h.state().state.a.spec.aperture_mm - 100.0).abs() < 1e-9);
+    let _ = std::fs::remove_dir_all(&lib);
+}
