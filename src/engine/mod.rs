@@ -37,6 +37,7 @@ mod fault;
 mod products;
 mod report;
 mod run;
+mod stages;
 pub mod worker;
 
 pub use cache::Stage;

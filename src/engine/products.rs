@@ -4,7 +4,8 @@ use std::sync::Arc;
 
 use super::cache::{Key, KeyBuilder, Stage};
 use super::report::RunReport;
-use super::run::{CorrectionProduct, Engine, SceneSide};
+use super::run::{CorrectionProduct, Engine};
+use super::stages::SceneSide;
 use super::{EngineError, RunConfig};
 use crate::control::RunControl;
 use crate::instrument::{Detector, DetectorMode, RadianceCube};

@@ -6,7 +6,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::StudyError;
-use super::figures::{Draw, FONT, Figure, Placed, err, render, tick_label};
+use super::render::{Draw, FONT, Figure, Placed, err, render, tick_label};
 use crate::colormap::categorical;
 
 /// One point of a series: the parameter, the seeds' mean, and their minimum and maximum.

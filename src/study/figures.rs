@@ -7,124 +7,15 @@
 //! are painted into the PNG directly and embedded in the SVG as PNG images, so the SVG stays small
 //! and its text and axes stay vector.
 
-use std::sync::OnceLock;
-
 use ndarray::Array2;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use super::render::{Draw, FONT, Figure, Placed, err, render, tick_label};
 use super::{StudyError, StudyResult, StudyRun};
 use crate::colormap::{Scale, categorical, viridis};
 use crate::metrics::{Metrics, bin_of, histogram_2d, log_edges};
 use crate::retrieval::ProductFlags;
-
-/// One figure in both formats.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Figure {
-    /// File stem.
-    pub name: String,
-    /// PNG bytes.
-    pub png: Vec<u8>,
-    /// SVG text.
-    pub svg: String,
-}
-
-const FONT_BYTES: &[u8] = crate::assets::DEJAVU_SANS_TTF;
-pub(super) const FONT: &str = "sans-serif";
-
-fn fonts() -> Result<(), StudyError> {
-    static REGISTERED: OnceLock<bool> = OnceLock::new();
-    let ok = *REGISTERED.get_or_init(|| plotters::style::register_font(FONT, FontStyle::Normal, FONT_BYTES).is_ok());
-    if ok { Ok(()) } else { Err(StudyError::Io("the embedded font does not load".into())) }
-}
-
-/// A raster placed on the figure (painted into the PNG, embedded in the SVG).
-pub(super) struct Placed {
-    x: i32,
-    y: i32,
-    w: u32,
-    h: u32,
-    rgb: Vec<u8>,
-}
-
-pub(super) trait Draw {
-    fn size(&self) -> (u32, u32);
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<Vec<Placed>, String>;
-}
-
-pub(super) fn err<E: std::fmt::Debug>(e: E) -> String {
-    format!("{e:?}")
-}
-
-fn base64(bytes: &[u8]) -> String {
-    const T: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    let mut s = String::with_capacity(bytes.len().div_ceil(3) * 4);
-    for chunk in bytes.chunks(3) {
-        let b = [chunk[0], *chunk.get(1).unwrap_or(&0), *chunk.get(2).unwrap_or(&0)];
-        let n = (u32::from(b[0]) << 16) | (u32::from(b[1]) << 8) | u32::from(b[2]);
-        for i in 0..4 {
-            if i <= chunk.len() {
-                s.push(T[((n >> (18 - 6 * i)) & 63) as usize] as char);
-            } else {
-                s.push('=');
-            }
-        }
-    }
-    s
-}
-
-fn png(rgb: &[u8], w: u32, h: u32) -> Result<Vec<u8>, StudyError> {
-    use image::ImageEncoder;
-    let mut out = Vec::new();
-    image::codecs::png::PngEncoder::new(&mut out)
-        .write_image(rgb, w, h, image::ExtendedColorType::Rgb8)
-        .map_err(|e| StudyError::Io(format!("PNG: {e}")))?;
-    Ok(out)
-}
-
-pub(super) fn render(name: &str, fig: &impl Draw) -> Result<Figure, StudyError> {
-    fonts()?;
-    let (w, h) = fig.size();
-    let fail = |e: String| StudyError::Io(format!("figure {name}: {e}"));
-    let mut buf = vec![255u8; (w * h * 3) as usize];
-    let placed = {
-        let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
-        let placed = fig.draw(&root).map_err(fail)?;
-        root.present().map_err(|e| fail(err(e)))?;
-        placed
-    };
-    for p in &placed {
-        for row in 0..p.h {
-            for col in 0..p.w {
-                let (x, y) = (p.x + col as i32, p.y + row as i32);
-                if x >= 0 && y >= 0 && (x as u32) < w && (y as u32) < h {
-                    let dst = ((y as u32 * w + x as u32) * 3) as usize;
-                    let src = ((row * p.w + col) * 3) as usize;
-                    buf[dst..dst + 3].copy_from_slice(&p.rgb[src..src + 3]);
-                }
-            }
-        }
-    }
-    let png_bytes = png(&buf, w, h)?;
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, (w, h)).into_drawing_area();
-        fig.draw(&root).map_err(fail)?;
-        root.present().map_err(|e| fail(err(e)))?;
-    }
-    let mut images = String::new();
-    for p in &placed {
-        let data = base64(&png(&p.rgb, p.w, p.h)?);
-        images.push_str(&format!(
-            "<image x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" style=\"image-rendering:pixelated\" href=\"data:image/png;base64,{data}\"/>\n",
-            p.x, p.y, p.w, p.h
-        ));
-    }
-    if let Some(end) = svg.rfind("</svg>") {
-        svg.insert_str(end, &images);
-    }
-    Ok(Figure { name: name.to_string(), png: png_bytes, svg })
-}
 
 /// A variable of a product, with how to read it from truth and retrieval.
 #[derive(Clone, Copy)]
@@ -161,18 +52,20 @@ fn product_map<'a>(p: &'a crate::retrieval::Product, key: &str) -> Option<&'a Ar
 }
 
 /// A map panel: values with a validity mask.
-struct Panel {
-    title: String,
-    values: Array2<f32>,
-    valid: Array2<bool>,
+/// One map of a figure: values and where they are valid (elsewhere grey).
+pub(super) struct Panel {
+    pub(super) title: String,
+    pub(super) values: Array2<f32>,
+    pub(super) valid: Array2<bool>,
 }
 
-struct Maps {
-    title: String,
-    label: String,
-    scale: Scale,
-    panels: Vec<Panel>,
-    diverging: bool,
+/// Maps side by side on one colour scale, with a colour bar labelled `label`.
+pub(super) struct Maps {
+    pub(super) title: String,
+    pub(super) label: String,
+    pub(super) scale: Scale,
+    pub(super) panels: Vec<Panel>,
+    pub(super) diverging: bool,
 }
 
 const PANEL_W: u32 = 300;
@@ -241,19 +134,6 @@ fn nice_ticks(scale: &Scale) -> Vec<f64> {
         let step = [1.0, 2.0, 5.0, 10.0].iter().map(|m| m * mag).find(|s| *s >= raw).unwrap_or(raw);
         let first = (lo / step).ceil() as i64;
         (first..).map(|k| k as f64 * step).take_while(|v| *v <= hi * (1.0 + 1e-9)).collect()
-    }
-}
-
-pub(super) fn tick_label(v: f64) -> String {
-    if v == 0.0 {
-        "0".into()
-    } else if v.abs() >= 100.0 {
-        format!("{v:.0}")
-    } else if v.abs() >= 1.0 {
-        format!("{v:.3}").trim_end_matches('0').trim_end_matches('.').to_string()
-    } else {
-        let digits = (-v.abs().log10()).ceil() as usize + 1;
-        format!("{v:.digits$}")
     }
 }
 
@@ -473,88 +353,6 @@ fn metric_line(m: Option<&Metrics>) -> String {
     })
 }
 
-/// A map of a comparison figure.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ComparisonPanel {
-    /// Title above the map.
-    pub title: String,
-    /// Values.
-    pub values: Array2<f32>,
-    /// Where values are valid (elsewhere grey).
-    pub valid: Array2<bool>,
-}
-
-/// A comparison figure: maps side by side on one scale, then a table and a caption.
-struct Comparison {
-    maps: Maps,
-    table: Vec<Vec<String>>,
-    caption: Vec<String>,
-}
-
-const ROW_H: u32 = 18;
-
-impl Draw for Comparison {
-    fn size(&self) -> (u32, u32) {
-        let (w, h) = self.maps.size();
-        (w.max(760), h + ROW_H * (self.table.len() as u32 + 1) + 16 * self.caption.len() as u32 + 12)
-    }
-
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<Vec<Placed>, String> {
-        root.fill(&WHITE).map_err(err)?;
-        let placed = self.maps.draw(root)?;
-        let (_, maps_h) = self.maps.size();
-        let columns = self.table.first().map_or(0, Vec::len);
-        let widths: Vec<i32> = (0..columns)
-            .map(|c| {
-                self.table.iter().map(|row| row.get(c).map_or(0, |s| s.chars().count())).max().unwrap_or(0) as i32 * 8
-                    + 18
-            })
-            .collect();
-        for (r, row) in self.table.iter().enumerate() {
-            let y = (maps_h + 6 + ROW_H * r as u32) as i32;
-            let mut x = 10;
-            let style = if r == 0 {
-                (FONT, 12).into_font().color(&BLACK)
-            } else {
-                (FONT, 12).into_font().color(&RGBColor(30, 30, 30))
-            };
-            for (c, cell) in row.iter().enumerate() {
-                root.draw_text(cell, &style, (x, y)).map_err(err)?;
-                x += widths.get(c).copied().unwrap_or(80);
-            }
-            if r == 0 {
-                let line_y = y + ROW_H as i32 - 3;
-                root.draw(&PathElement::new(vec![(10, line_y), (x, line_y)], BLACK)).map_err(err)?;
-            }
-        }
-        let table_end = maps_h + ROW_H * (self.table.len() as u32 + 1);
-        for (i, line) in self.caption.iter().enumerate() {
-            let y = (table_end + 4 + 16 * i as u32) as i32;
-            root.draw_text(line, &(FONT, 11).into_font().color(&RGBColor(60, 60, 60)), (10, y)).map_err(err)?;
-        }
-        Ok(placed)
-    }
-}
-
-/// A comparison figure (PNG and SVG): `panels` side by side on one `scale` (viridis, or the
-/// diverging palette for differences) with a colour bar labelled `label`, a table (first row the
-/// header) and caption lines — what the app exports for a design review.
-#[allow(clippy::too_many_arguments)]
-pub fn comparison_figure(
-    name: &str,
-    title: &str,
-    label: &str,
-    scale: Scale,
-    diverging: bool,
-    panels: Vec<ComparisonPanel>,
-    table: Vec<Vec<String>>,
-    caption: Vec<String>,
-) -> Result<Figure, StudyError> {
-    let panels = panels.into_iter().map(|p| Panel { title: p.title, values: p.values, valid: p.valid }).collect();
-    let maps = Maps { title: title.into(), label: label.into(), scale, panels, diverging };
-    render(name, &Comparison { maps, table, caption })
-}
-
 /// What the figures of one retrieval and variable draw from.
 struct Context<'a> {
     runs: &'a [&'a StudyRun],
@@ -714,15 +512,6 @@ pub fn figure_set(result: &StudyResult) -> Result<Vec<Figure>, StudyError> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn base64_matches_rfc4648_vectors() {
-        assert_eq!(base64(b""), "");
-        assert_eq!(base64(b"f"), "Zg==");
-        assert_eq!(base64(b"fo"), "Zm8=");
-        assert_eq!(base64(b"foo"), "Zm9v");
-        assert_eq!(base64(b"foobar"), "Zm9vYmFy");
-    }
 
     #[test]
     fn a_map_figure_renders_to_png_and_svg() {

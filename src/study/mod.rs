@@ -15,16 +15,20 @@
 //! ```
 
 mod budget;
+mod comparison;
 mod curves;
 mod figures;
 mod output;
+mod render;
 mod requirements;
 mod run;
 
 pub use budget::{Budget, BudgetLine, Stage, budget_table, error_budget};
+pub use comparison::{ComparisonPanel, comparison_figure};
 pub use curves::{CurvePoint, CurveSeries, Curves, curve_figure, first_crossing};
-pub use figures::{ComparisonPanel, Figure, comparison_figure, figure_set};
+pub use figures::figure_set;
 pub use output::{Outputs, metrics_csv, write_bytes, write_run, write_study};
+pub use render::Figure;
 pub use requirements::{Check, ProductRequirement, Requirements, checks_csv};
 pub use run::{StudyResult, StudyRun, run_study};
 

@@ -1,0 +1,150 @@
+//! Drawing a figure once to PNG and once to SVG. Plotters draws text and axes with the embedded
+//! DejaVu Sans (no system fonts); map rasters are painted into the PNG directly and embedded in
+//! the SVG as base64 PNG images, so the SVG stays small and its text stays vector.
+
+use std::sync::OnceLock;
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::StudyError;
+
+/// One figure in both formats.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Figure {
+    /// File stem.
+    pub name: String,
+    /// PNG bytes.
+    pub png: Vec<u8>,
+    /// SVG text.
+    pub svg: String,
+}
+
+const FONT_BYTES: &[u8] = crate::assets::DEJAVU_SANS_TTF;
+pub(super) const FONT: &str = "sans-serif";
+
+fn fonts() -> Result<(), StudyError> {
+    static REGISTERED: OnceLock<bool> = OnceLock::new();
+    let ok = *REGISTERED.get_or_init(|| plotters::style::register_font(FONT, FontStyle::Normal, FONT_BYTES).is_ok());
+    if ok { Ok(()) } else { Err(StudyError::Io("the embedded font does not load".into())) }
+}
+
+/// A raster placed on the figure (painted into the PNG, embedded in the SVG).
+pub(super) struct Placed {
+    /// Left edge, px.
+    pub(super) x: i32,
+    /// Top edge, px.
+    pub(super) y: i32,
+    /// Width, px.
+    pub(super) w: u32,
+    /// Height, px.
+    pub(super) h: u32,
+    /// Row-major RGB bytes, `w · h · 3`.
+    pub(super) rgb: Vec<u8>,
+}
+
+pub(super) trait Draw {
+    fn size(&self) -> (u32, u32);
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<Vec<Placed>, String>;
+}
+
+pub(super) fn err<E: std::fmt::Debug>(e: E) -> String {
+    format!("{e:?}")
+}
+
+fn base64(bytes: &[u8]) -> String {
+    const T: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut s = String::with_capacity(bytes.len().div_ceil(3) * 4);
+    for chunk in bytes.chunks(3) {
+        let b = [chunk[0], *chunk.get(1).unwrap_or(&0), *chunk.get(2).unwrap_or(&0)];
+        let n = (u32::from(b[0]) << 16) | (u32::from(b[1]) << 8) | u32::from(b[2]);
+        for i in 0..4 {
+            if i <= chunk.len() {
+                s.push(T[((n >> (18 - 6 * i)) & 63) as usize] as char);
+            } else {
+                s.push('=');
+            }
+        }
+    }
+    s
+}
+
+fn png(rgb: &[u8], w: u32, h: u32) -> Result<Vec<u8>, StudyError> {
+    use image::ImageEncoder;
+    let mut out = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut out)
+        .write_image(rgb, w, h, image::ExtendedColorType::Rgb8)
+        .map_err(|e| StudyError::Io(format!("PNG: {e}")))?;
+    Ok(out)
+}
+
+pub(super) fn render(name: &str, fig: &impl Draw) -> Result<Figure, StudyError> {
+    fonts()?;
+    let (w, h) = fig.size();
+    let fail = |e: String| StudyError::Io(format!("figure {name}: {e}"));
+    let mut buf = vec![255u8; (w * h * 3) as usize];
+    let placed = {
+        let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
+        let placed = fig.draw(&root).map_err(fail)?;
+        root.present().map_err(|e| fail(err(e)))?;
+        placed
+    };
+    for p in &placed {
+        for row in 0..p.h {
+            for col in 0..p.w {
+                let (x, y) = (p.x + col as i32, p.y + row as i32);
+                if x >= 0 && y >= 0 && (x as u32) < w && (y as u32) < h {
+                    let dst = ((y as u32 * w + x as u32) * 3) as usize;
+                    let src = ((row * p.w + col) * 3) as usize;
+                    buf[dst..dst + 3].copy_from_slice(&p.rgb[src..src + 3]);
+                }
+            }
+        }
+    }
+    let png_bytes = png(&buf, w, h)?;
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (w, h)).into_drawing_area();
+        fig.draw(&root).map_err(fail)?;
+        root.present().map_err(|e| fail(err(e)))?;
+    }
+    let mut images = String::new();
+    for p in &placed {
+        let data = base64(&png(&p.rgb, p.w, p.h)?);
+        images.push_str(&format!(
+            "<image x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" style=\"image-rendering:pixelated\" href=\"data:image/png;base64,{data}\"/>\n",
+            p.x, p.y, p.w, p.h
+        ));
+    }
+    if let Some(end) = svg.rfind("</svg>") {
+        svg.insert_str(end, &images);
+    }
+    Ok(Figure { name: name.to_string(), png: png_bytes, svg })
+}
+
+pub(super) fn tick_label(v: f64) -> String {
+    if v == 0.0 {
+        "0".into()
+    } else if v.abs() >= 100.0 {
+        format!("{v:.0}")
+    } else if v.abs() >= 1.0 {
+        format!("{v:.3}").trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        let digits = (-v.abs().log10()).ceil() as usize + 1;
+        format!("{v:.digits$}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn base64_matches_rfc4648_vectors() {
+        assert_eq!(base64(b""), "");
+        assert_eq!(base64(b"f"), "Zg==");
+        assert_eq!(base64(b"fo"), "Zm8=");
+        assert_eq!(base64(b"foo"), "Zm9v");
+        assert_eq!(base64(b"foobar"), "Zm9vYmFy");
+    }
+}
