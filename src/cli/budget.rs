@@ -5,7 +5,6 @@ use std::path::PathBuf;
 use clap::Args;
 
 use super::CliError;
-use crate::control::RunControl;
 use crate::study::{budget_table, error_budget, write_bytes};
 
 /// Arguments of `shoal budget`.
@@ -39,7 +38,7 @@ pub fn run(args: &BudgetArgs) -> Result<(), CliError> {
         .build()
         .map_err(|e| CliError::Run(format!("cannot start worker threads: {e}")))?;
     let seeds: Vec<u64> = (1..=args.seeds).collect();
-    let control = RunControl::new();
+    let control = super::interrupt::control();
     let start = std::time::Instant::now();
     let mut budgets = Vec::new();
     let mut seen = Vec::new();

@@ -16,6 +16,7 @@ mod bench_chain;
 mod bench_retrieval;
 mod budget;
 mod grid;
+mod interrupt;
 mod output;
 pub mod simulate;
 mod study;
@@ -84,6 +85,8 @@ pub enum CliError {
     Input(String),
     /// Something failed while running (exit code 1), e.g. writing the output.
     Run(String),
+    /// Ctrl-C or SIGTERM stopped the run (exit code 130); nothing half-written was left.
+    Interrupted,
 }
 
 impl CliError {
@@ -91,6 +94,7 @@ impl CliError {
         match self {
             Self::Input(_) => ExitCode::from(2),
             Self::Run(_) => ExitCode::from(1),
+            Self::Interrupted => ExitCode::from(interrupt::EXIT_INTERRUPTED),
         }
     }
 }
@@ -99,6 +103,9 @@ impl std::fmt::Display for CliError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             Self::Input(m) | Self::Run(m) => f.write_str(m),
+            Self::Interrupted => {
+                f.write_str("interrupted: the run stopped; finished files are whole, nothing partial was left")
+            }
         }
     }
 }

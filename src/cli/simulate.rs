@@ -9,7 +9,6 @@ use std::time::Duration;
 use clap::Args;
 
 use super::CliError;
-use crate::control::RunControl;
 use crate::engine::{Engine, EngineError, RunConfig, RunOutput};
 use crate::instrument::{InstrumentError, InstrumentSpec};
 use crate::scene::{SceneError, SceneSpec};
@@ -140,7 +139,7 @@ pub fn run_with_progress(config: &RunConfig, threads: Option<usize>, label: &str
         .num_threads(threads.unwrap_or(0))
         .build()
         .map_err(|e| CliError::Run(format!("cannot start worker threads: {e}")))?;
-    let control = Arc::new(RunControl::new());
+    let control = Arc::new(super::interrupt::control());
     let bar = indicatif::ProgressBar::new(1);
     bar.set_style(
         indicatif::ProgressStyle::with_template("{prefix} [{bar:30}] {pos}/{len} rows, {elapsed}")
@@ -166,7 +165,7 @@ pub fn run_with_progress(config: &RunConfig, threads: Option<usize>, label: &str
     });
     bar.finish_and_clear();
     result.map_err(|e| match e {
-        EngineError::Cancelled => CliError::Run("cancelled".into()),
+        EngineError::Cancelled => CliError::Interrupted,
         EngineError::Failed { stage, message } => CliError::Input(format!("{stage}: {message}")),
         internal @ EngineError::Internal { .. } => CliError::Run(internal.to_string()),
     })

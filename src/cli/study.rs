@@ -10,7 +10,6 @@ use std::time::Duration;
 use clap::Args;
 
 use super::CliError;
-use crate::control::RunControl;
 use crate::study::{StudyError, StudySpec, run_study, write_run, write_study};
 
 /// Arguments of `shoal study`.
@@ -40,7 +39,7 @@ impl From<StudyError> for CliError {
         match e {
             StudyError::Io(m) => Self::Run(m),
             internal @ StudyError::Internal { .. } => Self::Run(internal.to_string()),
-            StudyError::Cancelled => Self::Run("cancelled".into()),
+            StudyError::Cancelled => Self::Interrupted,
             other => Self::Input(other.to_string()),
         }
     }
@@ -80,7 +79,7 @@ pub fn run(args: &StudyArgs) -> Result<(), CliError> {
             .progress_chars("=> "),
     );
     bar.set_prefix(spec.name.clone());
-    let control = Arc::new(RunControl::new());
+    let control = Arc::new(super::interrupt::control());
     let start = std::time::Instant::now();
     let result = std::thread::scope(|s| {
         let done = Arc::new(AtomicBool::new(false));

@@ -6,7 +6,6 @@ use std::path::{Path, PathBuf};
 use clap::Args;
 
 use super::CliError;
-use crate::control::RunControl;
 use crate::study::write_bytes;
 use crate::sweep::{Shard, SweepSpec, Table, Values, merge, run_sweep, sweep_figure};
 
@@ -114,7 +113,7 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
             .progress_chars("=> "),
     );
     bar.set_prefix(spec.name.clone());
-    let control = RunControl::new();
+    let control = super::interrupt::control();
     let start = std::time::Instant::now();
     let result = pool.install(|| run_sweep(&sweep, shard, &control, |_, _| bar.inc(1)))?;
     bar.finish_and_clear();

@@ -132,3 +132,42 @@ fn cancelling_mid_stage_leaves_only_whole_files_of_finished_runs() {
     assert_eq!(names, vec!["run0".to_string()], "only the finished run has files");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Ctrl-C (SIGINT) and a batch scheduler's SIGTERM during `shoal study`: the run stops, the
+/// command exits 130 saying so, and no `.partial` file is left anywhere under the output.
+#[test]
+fn an_interrupted_cli_study_exits_130_and_leaves_nothing_partial() {
+    for signal in ["INT", "TERM"] {
+        let dir = std::env::temp_dir().join(format!("shoal-interrupt-{signal}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        // The full-resolution default study takes ~40 s; the signal comes 3 s in.
+        let child = Command::new(env!("CARGO_BIN_EXE_shoal"))
+            .args(["study", "--out"])
+            .arg(&dir)
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(std::time::Duration::from_secs(3));
+        let sent = Command::new("kill").args([&format!("-{signal}"), &child.id().to_string()]).status().unwrap();
+        assert!(sent.success());
+        let started = std::time::Instant::now();
+        let out = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(130), "SIG{signal}: {stderr}");
+        assert!(stderr.contains("interrupted"), "{stderr}");
+        assert!(started.elapsed().as_secs() < 20, "SIG{signal}: took {:?} to stop", started.elapsed());
+        let mut stack = vec![dir.clone()];
+        while let Some(d) = stack.pop() {
+            let Ok(entries) = std::fs::read_dir(&d) else { continue };
+            for e in entries {
+                let path = e.unwrap().path();
+                assert!(!path.to_string_lossy().ends_with(".partial"), "left behind: {}", path.display());
+                if path.is_dir() {
+                    stack.push(path);
+                }
+            }
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}
