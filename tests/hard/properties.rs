@@ -3,7 +3,14 @@
 //! - every run passes [`check`] (finite, within physical bounds, degraded pixels flagged);
 //! - one and two threads give bit-identical products;
 //! - noise-free, in water where chl-a shapes the signal, aLMI with the scene's own SIOP set gets
-//!   chl-a back within 10 % (its band-averaging error is ~1 %, tests/chain/retrieval.rs).
+//!   chl-a back within 10 % (its band-averaging error is ~1 %, tests/chain/retrieval.rs) at every
+//!   pixel no band of which saturated. A saturated band is dropped from the fit (and `check`
+//!   asserts it is flagged and counted), so such a pixel is either FAILED or fitted from fewer
+//!   bands and is not held to the 10 %. The nominal instrument saturates in every band under a
+//!   zenith sun at nadir with AOT ≈ 0.44: the flat sea mirrors the sun's aerosol aureole into
+//!   the view (ρ_path = 1.98 at 412 nm, against 0.18 with the sun at 5°; see
+//!   tests/physics/atmosphere_limits.rs). Found by a 300-case run, kept in
+//!   tests/proptest-regressions.
 //!
 //! CI runs `PROPTEST_CASES` cases per property (default 16: about a minute on 2 cores). A long
 //! run: `PROPTEST_CASES=1000 cargo test --release --test hard properties`.
@@ -140,9 +147,16 @@ proptest! {
         let out = super::run(&c);
         check(&out, "closure");
         let p = &out.retrievals[0].product;
-        for (got, f) in p.chl_mg_m3.iter().zip(&p.flags) {
+        let rrs_flags = &out.correction.rrs.flags;
+        for ((r, c), f) in p.flags.indexed_iter() {
+            let saturated = (0..rrs_flags.dim().2)
+                .any(|b| rrs_flags[[r, c, b]] & shoal::correction::RrsFlags::SATURATED != 0);
+            if saturated {
+                continue;
+            }
             prop_assert!(f & shoal::retrieval::ProductFlags::RETURNED != 0, "not returned: flags {}", f);
-            let err = (f64::from(*got) / chl - 1.0).abs();
+            let got = f64::from(p.chl_mg_m3[[r, c]]);
+            let err = (got / chl - 1.0).abs();
             prop_assert!(err < 0.10, "chl {} retrieved {} ({:.1} %)", chl, got, 100.0 * err);
         }
     }
