@@ -13,7 +13,7 @@ fn load_all(text: &str) {
         let _ = s.validate();
     }
     if let Ok(c) = shoal::engine::RunConfig::from_ron(text, "t") {
-        let _ = (c.instrument.validate(), c.fidelity.validate(), c.calibration.validate(), c.scene.validate());
+        let _ = c.validate();
     }
     if let Ok(s) = shoal::study::StudySpec::from_ron(text, "t") {
         let _ = s.resolve(None);

@@ -16,10 +16,9 @@ fuzz_target!(|data: &[u8]| {
         let _ = s.validate();
     }
     if let Ok(c) = shoal::engine::RunConfig::from_ron(text, "fuzz") {
-        let _ = c.instrument.validate();
-        let _ = c.fidelity.validate();
-        let _ = c.calibration.validate();
-        let _ = c.scene.validate();
+        // Every range of the configuration (instrument, scene, atmosphere, fidelity, calibration,
+        // correction, retrievals).
+        let _ = c.validate();
     }
     if let Ok(s) = shoal::study::StudySpec::from_ron(text, "fuzz") {
         // Resolving reads only embedded presets (no directory is given).
