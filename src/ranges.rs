@@ -101,6 +101,13 @@ impl Range {
         self.path.rsplit('.').next().unwrap_or(self.path)
     }
 
+    /// The field as a validator reports it: the path without `section` (`instrument.` →
+    /// `aperture_mm`; `kind.Spectrograph.start_nm` keeps its variant).
+    #[must_use]
+    pub fn field(&self, section: &str) -> &'static str {
+        self.path.strip_prefix(section).unwrap_or(self.path)
+    }
+
     /// Values just outside the range (for tests): the open end itself, or one step past a
     /// closed end (1 for whole numbers; 1 % of the end, or 0.01, otherwise). Values a field's
     /// type cannot hold (a negative count) are left out.

@@ -367,13 +367,14 @@ fn editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
                 .clamping(egui::SliderClamping::Never);
             let slider =
                 if matches!(p.key, "detectors" | "exposures" | "adc_bits") { slider.integer() } else { slider };
-            // The hover text states the documented range (src/ranges.rs) a typed value must meet.
-            let path = format!("instrument.{}", p.key);
-            let tip = match crate::ranges::ALL.iter().find(|r| r.path == path) {
-                Some(r) => format!("{}\nAllowed: {} (`{}`)", p.tip, r.allowed(), p.key),
-                None => p.tip.to_string(),
-            };
-            ui.add(slider).on_hover_text(tip);
+            // The hover text states the documented range (src/ranges.rs) a typed value must meet;
+            // built only while the pointer is on the slider.
+            ui.add(slider).on_hover_ui(|ui| {
+                ui.label(p.tip);
+                if let Some(r) = crate::ranges::ALL.iter().find(|r| r.field("instrument.") == p.key) {
+                    ui.label(format!("Allowed: {} (`{}`)", r.allowed(), p.key));
+                }
+            });
             let mut linked = app.state.linked.iter().any(|k| k == p.key);
             if ui
                 .checkbox(&mut linked, "link")

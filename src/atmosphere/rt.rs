@@ -108,12 +108,12 @@ impl RtAccuracy {
     pub fn validate(&self) -> Result<(), super::AtmosphereError> {
         use super::spec::check;
         use crate::ranges as r;
-        check("accuracy.streams", &r::ACCURACY_STREAMS, self.streams as f64)?;
-        check("accuracy.max_orders", &r::ACCURACY_MAX_ORDERS, self.max_orders as f64)?;
-        check("accuracy.fourier_terms", &r::ACCURACY_FOURIER_TERMS, self.fourier_terms as f64)?;
-        check("accuracy.max_layer_depth", &r::ACCURACY_MAX_LAYER_DEPTH, self.max_layer_depth)?;
-        check("accuracy.min_layers", &r::ACCURACY_MIN_LAYERS, self.min_layers as f64)?;
-        check("accuracy.order_tolerance", &r::ACCURACY_ORDER_TOLERANCE, self.order_tolerance)
+        check(&r::ACCURACY_STREAMS, self.streams as f64)?;
+        check(&r::ACCURACY_MAX_ORDERS, self.max_orders as f64)?;
+        check(&r::ACCURACY_FOURIER_TERMS, self.fourier_terms as f64)?;
+        check(&r::ACCURACY_MAX_LAYER_DEPTH, self.max_layer_depth)?;
+        check(&r::ACCURACY_MIN_LAYERS, self.min_layers as f64)?;
+        check(&r::ACCURACY_ORDER_TOLERANCE, self.order_tolerance)
     }
 
     fn orders(&self) -> OrderSettings {

@@ -110,12 +110,14 @@ fn range(field: &str, value: f64, lo: f64, hi: f64, unit: &str) -> Result<(), At
     }
 }
 
-/// `value` against `range`; the error names `field`, the value and the range.
-pub(crate) fn check(field: &str, range: &crate::ranges::Range, value: f64) -> Result<(), AtmosphereError> {
+/// `value` against `range`; the error names the field (its path below `scene.atmosphere.`),
+/// the value and the range.
+pub(crate) fn check(range: &crate::ranges::Range, value: f64) -> Result<(), AtmosphereError> {
     if range.contains(value) {
         Ok(())
     } else {
-        Err(AtmosphereError::OutOfRange { field: field.into(), value, allowed: range.allowed() })
+        let field = range.field("scene.atmosphere.").into();
+        Err(AtmosphereError::OutOfRange { field, value, allowed: range.allowed() })
     }
 }
 
@@ -123,17 +125,17 @@ impl AtmosphereSpec {
     /// Check every field against its documented range ([`crate::ranges`]).
     pub fn validate(&self) -> Result<(), AtmosphereError> {
         use crate::ranges as r;
-        check("aot550", &r::ATMOSPHERE_AOT550, self.aot550)?;
-        check("pressure_hpa", &r::ATMOSPHERE_PRESSURE_HPA, self.pressure_hpa)?;
-        check("gas_amounts.ozone_atm_cm", &r::ATMOSPHERE_OZONE_ATM_CM, self.gas_amounts.ozone_atm_cm)?;
-        check("gas_amounts.water_vapour_cm", &r::ATMOSPHERE_WATER_VAPOUR_CM, self.gas_amounts.water_vapour_cm)?;
+        check(&r::ATMOSPHERE_AOT550, self.aot550)?;
+        check(&r::ATMOSPHERE_PRESSURE_HPA, self.pressure_hpa)?;
+        check(&r::ATMOSPHERE_OZONE_ATM_CM, self.gas_amounts.ozone_atm_cm)?;
+        check(&r::ATMOSPHERE_WATER_VAPOUR_CM, self.gas_amounts.water_vapour_cm)?;
         if let Surface::Wind { speed_m_s } = self.surface {
-            check("surface.Wind.speed_m_s", &r::ATMOSPHERE_WIND_SPEED_M_S, speed_m_s)?;
+            check(&r::ATMOSPHERE_WIND_SPEED_M_S, speed_m_s)?;
         }
-        check("latitude_deg", &r::ATMOSPHERE_LATITUDE_DEG, self.latitude_deg)?;
-        check("rayleigh_scale_height_km", &r::ATMOSPHERE_RAYLEIGH_SCALE_HEIGHT_KM, self.rayleigh_scale_height_km)?;
-        check("aerosol_scale_height_km", &r::ATMOSPHERE_AEROSOL_SCALE_HEIGHT_KM, self.aerosol_scale_height_km)?;
-        check("water_refractive_index", &r::ATMOSPHERE_WATER_REFRACTIVE_INDEX, self.water_refractive_index)?;
+        check(&r::ATMOSPHERE_LATITUDE_DEG, self.latitude_deg)?;
+        check(&r::ATMOSPHERE_RAYLEIGH_SCALE_HEIGHT_KM, self.rayleigh_scale_height_km)?;
+        check(&r::ATMOSPHERE_AEROSOL_SCALE_HEIGHT_KM, self.aerosol_scale_height_km)?;
+        check(&r::ATMOSPHERE_WATER_REFRACTIVE_INDEX, self.water_refractive_index)?;
         range("day_of_year", f64::from(self.day_of_year), 1.0, 366.0, "")?;
         self.accuracy.validate()
     }

@@ -71,20 +71,18 @@ impl CalibrationSpec {
     /// Check every number against [`crate::ranges`]; the message names field, value and range.
     pub fn validate(&self) -> Result<(), InstrumentError> {
         use crate::ranges as r;
-        let check = |field: &str, range: &r::Range, v: f64| {
-            range
-                .check(v)
-                .map_err(|message| InstrumentError::Invalid { field: format!("calibration.{field}"), message })
+        let check = |range: &r::Range, v: f64| {
+            range.check(v).map_err(|message| InstrumentError::Invalid { field: range.path.into(), message })
         };
-        check("light_frames", &r::CALIBRATION_LIGHT_FRAMES, self.light_frames as f64)?;
-        check("dark_frames", &r::CALIBRATION_DARK_FRAMES, self.dark_frames as f64)?;
-        check("dark_exposure_s", &r::CALIBRATION_DARK_EXPOSURE_S, self.dark_exposure_s)?;
-        check("diffuser_reflectance", &r::CALIBRATION_DIFFUSER_REFLECTANCE, self.diffuser_reflectance)?;
+        check(&r::CALIBRATION_LIGHT_FRAMES, self.light_frames as f64)?;
+        check(&r::CALIBRATION_DARK_FRAMES, self.dark_frames as f64)?;
+        check(&r::CALIBRATION_DARK_EXPOSURE_S, self.dark_exposure_s)?;
+        check(&r::CALIBRATION_DIFFUSER_REFLECTANCE, self.diffuser_reflectance)?;
         if let Some(a) = self.sun_incidence_deg {
-            check("sun_incidence_deg", &r::CALIBRATION_SUN_INCIDENCE_DEG, a)?;
+            check(&r::CALIBRATION_SUN_INCIDENCE_DEG, a)?;
         }
-        check("diffuser_bias_pct", &r::CALIBRATION_DIFFUSER_BIAS_PCT, self.diffuser_bias_pct)?;
-        check("gain_drift_pct", &r::CALIBRATION_GAIN_DRIFT_PCT, self.gain_drift_pct)
+        check(&r::CALIBRATION_DIFFUSER_BIAS_PCT, self.diffuser_bias_pct)?;
+        check(&r::CALIBRATION_GAIN_DRIFT_PCT, self.gain_drift_pct)
     }
 }
 

@@ -63,9 +63,10 @@ impl Default for CorrectionSpec {
 impl CorrectionSpec {
     /// Check `approx_points` against [`crate::ranges::CORRECTION_APPROX_POINTS`].
     pub fn validate(&self) -> Result<(), InstrumentError> {
-        crate::ranges::CORRECTION_APPROX_POINTS
+        let range = &crate::ranges::CORRECTION_APPROX_POINTS;
+        range
             .check(self.approx_points as f64)
-            .map_err(|message| InstrumentError::Invalid { field: "correction.approx_points".into(), message })
+            .map_err(|message| InstrumentError::Invalid { field: range.path.into(), message })
     }
 }
 

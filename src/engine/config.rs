@@ -51,16 +51,16 @@ impl Fidelity {
     /// Check every number against [`crate::ranges`]; the message names field, value and range.
     pub fn validate(&self) -> Result<(), InstrumentError> {
         use crate::ranges as r;
-        let check = |field: &str, range: &r::Range, v: f64| {
-            range.check(v).map_err(|message| InstrumentError::Invalid { field: format!("fidelity.{field}"), message })
+        let check = |range: &r::Range, v: f64| {
+            range.check(v).map_err(|message| InstrumentError::Invalid { field: range.path.into(), message })
         };
-        check("spectral_step_nm", &r::FIDELITY_SPECTRAL_STEP_NM, self.spectral_step_nm)?;
-        check("spatial_samples_per_gsd", &r::FIDELITY_SPATIAL_SAMPLES_PER_GSD, self.spatial_samples_per_gsd as f64)?;
-        check("decimation", &r::FIDELITY_DECIMATION, self.decimation as f64)?;
-        check("lut_wavelength_step_nm", &r::FIDELITY_LUT_WAVELENGTH_STEP_NM, self.lut_wavelength_step_nm)?;
-        check("lut_view_step_deg", &r::FIDELITY_LUT_VIEW_STEP_DEG, self.lut_view_step_deg)?;
-        check("snr_frames", &r::FIDELITY_SNR_FRAMES, self.snr_frames as f64)?;
-        check("snr_detectors", &r::FIDELITY_SNR_DETECTORS, self.snr_detectors as f64)
+        check(&r::FIDELITY_SPECTRAL_STEP_NM, self.spectral_step_nm)?;
+        check(&r::FIDELITY_SPATIAL_SAMPLES_PER_GSD, self.spatial_samples_per_gsd as f64)?;
+        check(&r::FIDELITY_DECIMATION, self.decimation as f64)?;
+        check(&r::FIDELITY_LUT_WAVELENGTH_STEP_NM, self.lut_wavelength_step_nm)?;
+        check(&r::FIDELITY_LUT_VIEW_STEP_DEG, self.lut_view_step_deg)?;
+        check(&r::FIDELITY_SNR_FRAMES, self.snr_frames as f64)?;
+        check(&r::FIDELITY_SNR_DETECTORS, self.snr_detectors as f64)
     }
 }
 

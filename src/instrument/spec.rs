@@ -147,47 +147,49 @@ impl InstrumentSpec {
     /// field, value and range.
     pub fn validate(&self) -> Result<(), InstrumentError> {
         use crate::ranges as r;
-        let check = |field: &str, range: &r::Range, v: f64| {
-            range.check(v).map_err(|message| InstrumentError::Invalid { field: field.into(), message })
+        let check = |range: &r::Range, v: f64| {
+            range
+                .check(v)
+                .map_err(|message| InstrumentError::Invalid { field: range.field("instrument.").into(), message })
         };
         let count = |n: usize| n as f64;
-        check("altitude_km", &r::INSTRUMENT_ALTITUDE_KM, self.altitude_km)?;
-        check("heading_deg", &r::INSTRUMENT_HEADING_DEG, self.heading_deg)?;
-        check("aperture_mm", &r::INSTRUMENT_APERTURE_MM, self.aperture_mm)?;
-        check("pixel_pitch_um", &r::INSTRUMENT_PIXEL_PITCH_UM, self.pixel_pitch_um)?;
-        check("focal_length_mm", &r::INSTRUMENT_FOCAL_LENGTH_MM, self.focal_length_mm)?;
-        check("detectors", &r::INSTRUMENT_DETECTORS, count(self.detectors))?;
-        check("exposure_s", &r::INSTRUMENT_EXPOSURE_S, self.exposure_s)?;
-        check("exposures", &r::INSTRUMENT_EXPOSURES, count(self.exposures))?;
-        check("forward_tilt_deg", &r::INSTRUMENT_FORWARD_TILT_DEG, self.forward_tilt_deg)?;
-        check("read_noise_e", &r::INSTRUMENT_READ_NOISE_E, self.read_noise_e)?;
-        check("well_depth_e", &r::INSTRUMENT_WELL_DEPTH_E, self.well_depth_e)?;
-        check("gain_e_per_dn", &r::INSTRUMENT_GAIN_E_PER_DN, self.gain_e_per_dn)?;
-        check("bias_dn", &r::INSTRUMENT_BIAS_DN, self.bias_dn)?;
-        check("adc_bits", &r::INSTRUMENT_ADC_BITS, f64::from(self.adc_bits))?;
-        check("optical_transmission", &r::INSTRUMENT_OPTICAL_TRANSMISSION, self.optical_transmission)?;
-        check("dark_current_e_s", &r::INSTRUMENT_DARK_CURRENT_E_S, self.dark_current_e_s)?;
-        check("prnu", &r::INSTRUMENT_PRNU, self.prnu)?;
-        check("dsnu_e", &r::INSTRUMENT_DSNU_E, self.dsnu_e)?;
+        check(&r::INSTRUMENT_ALTITUDE_KM, self.altitude_km)?;
+        check(&r::INSTRUMENT_HEADING_DEG, self.heading_deg)?;
+        check(&r::INSTRUMENT_APERTURE_MM, self.aperture_mm)?;
+        check(&r::INSTRUMENT_PIXEL_PITCH_UM, self.pixel_pitch_um)?;
+        check(&r::INSTRUMENT_FOCAL_LENGTH_MM, self.focal_length_mm)?;
+        check(&r::INSTRUMENT_DETECTORS, count(self.detectors))?;
+        check(&r::INSTRUMENT_EXPOSURE_S, self.exposure_s)?;
+        check(&r::INSTRUMENT_EXPOSURES, count(self.exposures))?;
+        check(&r::INSTRUMENT_FORWARD_TILT_DEG, self.forward_tilt_deg)?;
+        check(&r::INSTRUMENT_READ_NOISE_E, self.read_noise_e)?;
+        check(&r::INSTRUMENT_WELL_DEPTH_E, self.well_depth_e)?;
+        check(&r::INSTRUMENT_GAIN_E_PER_DN, self.gain_e_per_dn)?;
+        check(&r::INSTRUMENT_BIAS_DN, self.bias_dn)?;
+        check(&r::INSTRUMENT_ADC_BITS, f64::from(self.adc_bits))?;
+        check(&r::INSTRUMENT_OPTICAL_TRANSMISSION, self.optical_transmission)?;
+        check(&r::INSTRUMENT_DARK_CURRENT_E_S, self.dark_current_e_s)?;
+        check(&r::INSTRUMENT_PRNU, self.prnu)?;
+        check(&r::INSTRUMENT_DSNU_E, self.dsnu_e)?;
         if let InstrumentKind::Spectrograph { start_nm, end_nm, sampling_nm, resolution_nm, smile_nm, keystone_px } =
             &self.kind
         {
-            check("kind.start_nm", &r::SPECTROGRAPH_START_NM, *start_nm)?;
-            check("kind.end_nm", &r::SPECTROGRAPH_END_NM, *end_nm)?;
-            check("kind.sampling_nm", &r::SPECTROGRAPH_SAMPLING_NM, *sampling_nm)?;
-            check("kind.resolution_nm", &r::SPECTROGRAPH_RESOLUTION_NM, *resolution_nm)?;
-            check("kind.smile_nm", &r::SPECTROGRAPH_SMILE_NM, *smile_nm)?;
-            check("kind.keystone_px", &r::SPECTROGRAPH_KEYSTONE_PX, *keystone_px)?;
+            check(&r::SPECTROGRAPH_START_NM, *start_nm)?;
+            check(&r::SPECTROGRAPH_END_NM, *end_nm)?;
+            check(&r::SPECTROGRAPH_SAMPLING_NM, *sampling_nm)?;
+            check(&r::SPECTROGRAPH_RESOLUTION_NM, *resolution_nm)?;
+            check(&r::SPECTROGRAPH_SMILE_NM, *smile_nm)?;
+            check(&r::SPECTROGRAPH_KEYSTONE_PX, *keystone_px)?;
             if end_nm < start_nm {
                 return Err(InstrumentError::Invalid {
-                    field: "kind.end_nm".into(),
+                    field: r::SPECTROGRAPH_END_NM.field("instrument.").into(),
                     message: format!("{end_nm} is below start_nm = {start_nm} (allowed: start_nm to 1000 nm)"),
                 });
             }
             let samples = (end_nm - start_nm) / sampling_nm;
             if samples > 2000.0 {
                 return Err(InstrumentError::Invalid {
-                    field: "kind.sampling_nm".into(),
+                    field: r::SPECTROGRAPH_SAMPLING_NM.field("instrument.").into(),
                     message: format!(
                         "{sampling_nm} gives {samples:.0} spectral samples from start_nm to end_nm (allowed: at most 2000)"
                     ),
@@ -195,7 +197,7 @@ impl InstrumentSpec {
             }
         }
         if let InstrumentKind::FilterImager { rows_per_band, .. } = &self.kind {
-            check("kind.rows_per_band", &r::FILTER_ROWS_PER_BAND, count(*rows_per_band))?;
+            check(&r::FILTER_ROWS_PER_BAND, count(*rows_per_band))?;
         }
         Ok(())
     }

@@ -66,11 +66,12 @@ impl RetrievalSpec {
                         message: format!("{} sets (allowed: 1 to 64)", siop_sets.len()),
                     });
                 }
-                let check = |field: &str, range: &r::Range, v: f64| {
-                    range.check(v).map_err(|message| RetrievalError::Invalid { field: field.into(), message })
+                let check = |range: &r::Range, v: f64| {
+                    let field = range.field("retrievals[i].Almi.").into();
+                    range.check(v).map_err(|message| RetrievalError::Invalid { field, message })
                 };
-                check("settings.g0", &r::ALMI_G0, settings.g0)?;
-                check("settings.g1", &r::ALMI_G1, settings.g1)
+                check(&r::ALMI_G0, settings.g0)?;
+                check(&r::ALMI_G1, settings.g1)
             }
             Self::Sambuca { settings, .. } => validate_sambuca(settings),
         }
@@ -319,11 +320,12 @@ fn validate_sambuca(settings: &SambucaSettings) -> Result<(), RetrievalError> {
             });
         }
     }
-    let check = |field: &str, range: &crate::ranges::Range, v: f64| {
-        range.check(v).map_err(|message| RetrievalError::Invalid { field: field.into(), message })
+    let check = |range: &crate::ranges::Range, v: f64| {
+        let field = range.field("retrievals[i].Sambuca.").into();
+        range.check(v).map_err(|message| RetrievalError::Invalid { field, message })
     };
-    check("settings.nodes_per_band", &crate::ranges::SAMBUCA_NODES_PER_BAND, settings.nodes_per_band as f64)?;
-    check("settings.max_iterations", &crate::ranges::SAMBUCA_MAX_ITERATIONS, f64::from(settings.max_iterations))
+    check(&crate::ranges::SAMBUCA_NODES_PER_BAND, settings.nodes_per_band as f64)?;
+    check(&crate::ranges::SAMBUCA_MAX_ITERATIONS, f64::from(settings.max_iterations))
 }
 
 /// Per-substrate fractions from each pixel's pair and fraction.

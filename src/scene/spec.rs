@@ -148,13 +148,13 @@ impl SceneSpec {
     pub fn validate(&self) -> Result<(), SceneError> {
         use crate::ranges as r;
         let bad = |field: &str, message: String| Err(SceneError::Invalid { field: field.into(), message });
-        let check = |field: &str, range: &r::Range, v: f64| {
-            range.check(v).map_err(|message| SceneError::Invalid { field: field.into(), message })
+        let check = |range: &r::Range, v: f64| {
+            range.check(v).map_err(|message| SceneError::Invalid { field: range.field("scene.").into(), message })
         };
-        check("width", &r::SCENE_WIDTH, self.width as f64)?;
-        check("height", &r::SCENE_HEIGHT, self.height as f64)?;
-        check("cell_m", &r::SCENE_CELL_M, self.cell_m)?;
-        check("sun.zenith_deg", &r::SCENE_SUN_ZENITH_DEG, self.sun.zenith_deg)?;
+        check(&r::SCENE_WIDTH, self.width as f64)?;
+        check(&r::SCENE_HEIGHT, self.height as f64)?;
+        check(&r::SCENE_CELL_M, self.cell_m)?;
+        check(&r::SCENE_SUN_ZENITH_DEG, self.sun.zenith_deg)?;
         if !self.sun.azimuth_deg.is_finite() {
             return bad("sun.azimuth_deg", format!("{} is not a finite angle", self.sun.azimuth_deg));
         }
