@@ -38,6 +38,8 @@ pub struct RunControl {
     generation: Option<(Arc<AtomicU64>, u64)>,
     done: AtomicU64,
     total: AtomicU64,
+    /// Units ticked while the run was already cancelled (work a cancel did not stop in time).
+    after_cancel: AtomicU64,
     /// Injected panic: (row, column), `UNARMED` when none.
     armed: (AtomicUsize, AtomicUsize),
     /// Where the first panicking row guard was.
@@ -51,6 +53,7 @@ impl Default for RunControl {
             generation: None,
             done: AtomicU64::default(),
             total: AtomicU64::default(),
+            after_cancel: AtomicU64::default(),
             armed: (AtomicUsize::new(UNARMED), AtomicUsize::new(UNARMED)),
             site: Mutex::new(None),
         }
@@ -127,6 +130,16 @@ impl RunControl {
     /// Record `units` units done.
     pub fn tick(&self, units: u64) {
         self.done.fetch_add(units, Ordering::Relaxed);
+        if self.cancelled() {
+            self.after_cancel.fetch_add(units, Ordering::Relaxed);
+        }
+    }
+
+    /// Units (rows) completed after the run was cancelled: the rows a cancel could not stop
+    /// because they had already started (at most one per worker thread and stage).
+    #[must_use]
+    pub fn done_after_cancel(&self) -> u64 {
+        self.after_cancel.load(Ordering::Relaxed)
     }
 
     /// (done, total) units so far.

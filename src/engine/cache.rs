@@ -64,7 +64,8 @@ impl Stage {
 
     /// Products kept per stage: four for the large cubes (instruments A and B of a comparison,
     /// each as a preview and at full resolution), eight for the small ones.
-    fn capacity(self) -> usize {
+    #[must_use]
+    pub fn capacity(self) -> usize {
         match self {
             Self::Radiance | Self::Electrons | Self::Level0 | Self::Level1 | Self::Correction | Self::Retrieval => 4,
             _ => 8,
@@ -169,6 +170,12 @@ impl Cache {
         list.retain(|(k, _)| *k != key);
         list.push_front((key, product));
         list.truncate(stage.capacity());
+    }
+
+    /// Products kept, over all stages (at most the sum of [`Stage::capacity`]).
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.entries.values().map(VecDeque::len).sum()
     }
 
     /// Drop everything.

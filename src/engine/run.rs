@@ -85,6 +85,12 @@ impl Engine {
         self.executions.get(&stage).copied().unwrap_or(0)
     }
 
+    /// Products the cache holds now (bounded by the sum of [`Stage::capacity`]).
+    #[must_use]
+    pub fn cached_products(&self) -> usize {
+        self.cache.len()
+    }
+
     /// Forget every cached product.
     pub fn clear(&mut self) {
         self.cache.clear();

@@ -61,12 +61,52 @@ pub enum Event {
 /// Called by the worker after it sends an event.
 pub type Wake = Arc<dyn Fn() + Send + Sync>;
 
+/// What became of the runs and results since the worker started (for tests and diagnostics):
+/// a stale result (a run that finished after a newer request was submitted, dropped by
+/// [`EngineHandle::poll`]) is told apart from a cancelled run (stopped before it finished,
+/// never reported) and from a request superseded before it started.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct WorkerStats {
+    /// `Finished` events the worker sent (current or stale when they arrive).
+    pub results_sent: u64,
+    /// Runs stopped by cancellation (a newer generation); these send no `Finished` event.
+    pub runs_cancelled: u64,
+    /// Requests superseded before any of their runs started (replaced in the queue, or found
+    /// stale when taken from it).
+    pub requests_skipped: u64,
+    /// `Finished` events of an older generation that `poll`/`wait` dropped.
+    pub stale_results_dropped: u64,
+}
+
+/// How much work and memory the worker has used (for the soak test and diagnostics).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct WorkerLoad {
+    /// Rows (progress units) the cancelled runs completed after their cancel: work already
+    /// started when a newer request arrived (see [`RunControl::done_after_cancel`]).
+    pub rows_after_cancel: u64,
+    /// The most products the engine's stage cache held after any run (bounded by the sum of
+    /// the stages' capacities).
+    pub max_cached_products: u64,
+}
+
+/// The counters behind [`WorkerStats`], shared by the worker and the handle.
+#[derive(Debug, Default)]
+struct Counters {
+    results_sent: AtomicU64,
+    runs_cancelled: AtomicU64,
+    requests_skipped: AtomicU64,
+    stale_results_dropped: AtomicU64,
+    rows_after_cancel: AtomicU64,
+    max_cached_products: AtomicU64,
+}
+
 /// The app's handle on the engine thread.
 #[derive(Debug)]
 pub struct EngineHandle {
     requests: Option<SyncSender<Request>>,
     events: Receiver<Event>,
     latest: Arc<AtomicU64>,
+    counters: Arc<Counters>,
     thread: Option<JoinHandle<()>>,
 }
 
@@ -83,6 +123,8 @@ impl EngineHandle {
         let (event_tx, event_rx) = sync_channel::<Event>(64);
         let latest = Arc::new(AtomicU64::new(0));
         let worker_latest = latest.clone();
+        let counters = Arc::new(Counters::default());
+        let worker_counters = counters.clone();
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads.max(1))
             .thread_name(|i| format!("shoal-engine-{i}"))
@@ -90,8 +132,8 @@ impl EngineHandle {
             .map_err(std::io::Error::other)?;
         let thread = std::thread::Builder::new()
             .name("shoal-engine".into())
-            .spawn(move || worker(&request_rx, &event_tx, &worker_latest, &pool, &wake))?;
-        Ok(Self { requests: Some(request_tx), events: event_rx, latest, thread: Some(thread) })
+            .spawn(move || worker(&request_rx, &event_tx, &worker_latest, &worker_counters, &pool, &wake))?;
+        Ok(Self { requests: Some(request_tx), events: event_rx, latest, counters, thread: Some(thread) })
     }
 
     /// Submit a configuration snapshot; any run of an older generation is cancelled. Returns
@@ -120,16 +162,51 @@ impl EngineHandle {
         self.latest.load(Ordering::SeqCst)
     }
 
+    /// What became of the runs and results so far (see [`WorkerStats`]).
+    #[must_use]
+    pub fn stats(&self) -> WorkerStats {
+        let c = &self.counters;
+        WorkerStats {
+            results_sent: c.results_sent.load(Ordering::SeqCst),
+            runs_cancelled: c.runs_cancelled.load(Ordering::SeqCst),
+            requests_skipped: c.requests_skipped.load(Ordering::SeqCst),
+            stale_results_dropped: c.stale_results_dropped.load(Ordering::SeqCst),
+        }
+    }
+
+    /// Work done after cancels and the cache's high-water mark (see [`WorkerLoad`]).
+    #[must_use]
+    pub fn load(&self) -> WorkerLoad {
+        let c = &self.counters;
+        WorkerLoad {
+            rows_after_cancel: c.rows_after_cancel.load(Ordering::SeqCst),
+            max_cached_products: c.max_cached_products.load(Ordering::SeqCst),
+        }
+    }
+
+    /// `event` if it belongs to the newest generation; otherwise `None`, counting a dropped
+    /// stale result.
+    fn current(&self, event: Event) -> Option<Event> {
+        let (generation, finished) = match &event {
+            Event::Progress { generation, .. } => (*generation, false),
+            Event::Finished { generation, .. } => (*generation, true),
+        };
+        if generation == self.latest_generation() {
+            return Some(event);
+        }
+        if finished {
+            self.counters.stale_results_dropped.fetch_add(1, Ordering::SeqCst);
+        }
+        None
+    }
+
     /// Next event, if any (never blocks). Results of stale generations are dropped here.
     pub fn poll(&self) -> Option<Event> {
         loop {
             match self.events.try_recv() {
                 Ok(event) => {
-                    let generation = match &event {
-                        Event::Progress { generation, .. } | Event::Finished { generation, .. } => *generation,
-                    };
-                    if generation == self.latest_generation() {
-                        return Some(event);
+                    if let Some(e) = self.current(event) {
+                        return Some(e);
                     }
                 }
                 Err(TryRecvError::Empty | TryRecvError::Disconnected) => return None,
@@ -150,11 +227,8 @@ impl EngineHandle {
             }
             match self.events.recv_timeout(left.min(Duration::from_millis(5))) {
                 Ok(event) => {
-                    let generation = match &event {
-                        Event::Progress { generation, .. } | Event::Finished { generation, .. } => *generation,
-                    };
-                    if generation == self.latest_generation() {
-                        return Some(event);
+                    if let Some(e) = self.current(event) {
+                        return Some(e);
                     }
                 }
                 Err(RecvTimeoutError::Timeout) => {}
@@ -179,6 +253,7 @@ fn worker(
     requests: &Receiver<Request>,
     events: &SyncSender<Event>,
     latest: &Arc<AtomicU64>,
+    counters: &Counters,
     pool: &rayon::ThreadPool,
     wake: &Wake,
 ) {
@@ -186,11 +261,13 @@ fn worker(
     while let Ok(mut request) = requests.recv() {
         // Skip to the newest request queued.
         while let Ok(newer) = requests.try_recv() {
+            counters.requests_skipped.fetch_add(1, Ordering::SeqCst);
             request = newer;
         }
         // A configuration that failed is not run at finer levels; the others go on (one
         // broken instrument does not hide the other's results).
         let mut failed = vec![false; request.configs.len()];
+        let mut started = false;
         'levels: for &decimation in &request.decimations {
             for (index, base) in request.configs.iter().enumerate() {
                 let Some(base) = base else { continue };
@@ -198,8 +275,12 @@ fn worker(
                     continue;
                 }
                 if latest.load(Ordering::SeqCst) != request.generation {
+                    if !started {
+                        counters.requests_skipped.fetch_add(1, Ordering::SeqCst);
+                    }
                     break 'levels;
                 }
+                started = true;
                 let mut config = base.clone();
                 config.fidelity.decimation = decimation;
                 let control = Arc::new(RunControl::for_generation(latest.clone(), request.generation));
@@ -227,10 +308,15 @@ fn worker(
                     reporter.thread().unpark();
                     result
                 });
+                counters.max_cached_products.fetch_max(engine.cached_products() as u64, Ordering::SeqCst);
                 if matches!(result, Err(EngineError::Cancelled)) {
+                    counters.rows_after_cancel.fetch_add(control.done_after_cancel(), Ordering::SeqCst);
+                    counters.runs_cancelled.fetch_add(1, Ordering::SeqCst);
                     break 'levels;
                 }
                 failed[index] = result.is_err();
+                // Counted before it is sent, so a reader that has the event sees it counted.
+                counters.results_sent.fetch_add(1, Ordering::SeqCst);
                 if events.send(Event::Finished { generation, index, decimation, result: result.map(Arc::new) }).is_err()
                 {
                     return;

@@ -183,7 +183,9 @@ impl Detector {
             dark_e,
             dark_current_e_s: spec.dark_current_e_s,
             exposure_s: spec.exposure_s,
-            well_e: spec.well_depth_e,
+            // In f32 precision: the electrons cube is stored as f32 (level0.rs), and a pixel
+            // clipped at the well must still compare ≥ the well when read out and be flagged.
+            well_e: f64::from(spec.well_depth_e as f32),
             read_noise_e: spec.read_noise_e,
             gain_e_per_dn: spec.gain_e_per_dn,
             dn_per_e: 1.0 / spec.gain_e_per_dn,
@@ -204,6 +206,12 @@ impl Detector {
     #[must_use]
     pub fn n_bands(&self) -> usize {
         self.n_bands
+    }
+
+    /// Detectors across track.
+    #[must_use]
+    pub fn detectors(&self) -> usize {
+        self.responsivity.len() / self.n_bands.max(1)
     }
 
     /// Mean electrons per unit band radiance at the nominal exposure, detector `j`, band `b`.

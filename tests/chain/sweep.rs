@@ -1,8 +1,16 @@
 //! Sweeps: the aperture curve falls with aperture and meets the requirement; shards merged equal
-//! one run byte for byte; a table reads back as written; bad sweeps are refused by name.
+//! one run byte for byte; a table reads back as written; bad sweeps are refused by name. The
+//! error budget and the requirement checks against numbers computed here from the runs' maps.
 
+use ndarray::Array2;
 use shoal::control::RunControl;
+use shoal::engine::{Engine, RunConfig};
+use shoal::instrument::DetectorMode;
+use shoal::retrieval::RetrievalSpec;
+use shoal::study::Stage;
 use shoal::sweep::{Parameter, Shard, SweepSpec, Table, Values, merge, run_sweep};
+
+use super::noise::Table1;
 
 /// The built-in aperture sweep on a reduced grid: 1/16 resolution, four apertures, three seeds.
 fn aperture_sweep(decimation: usize, apertures: Vec<f64>, seeds: Vec<u64>) -> shoal::sweep::ResolvedSweep {
@@ -121,22 +129,90 @@ fn bad_sweeps_are_refused_by_name() {
     assert!(e.contains("aperture_mm") && e.contains("-10"), "{e}");
 }
 
+/// chl-a MAE in %, 100·(10^mean|log10 M − log10 O| − 1) (Seegers et al. 2018, Opt. Express 26,
+/// 7404, as Matthews et al. 2023 eq. 1), over the water pixels whose truth is positive and whose
+/// retrieval was returned positive: computed here from the maps, not by `shoal::metrics`. Also
+/// the number of pixels compared.
+fn chl_mae_pct(product: &shoal::retrieval::Product, truth: &Array2<f32>, land: &Array2<u8>) -> (f64, usize) {
+    let (mut sum, mut n) = (0.0, 0usize);
+    for ((r, c), &o) in truth.indexed_iter() {
+        let m = product.chl_mg_m3[[r, c]];
+        if land[[r, c]] == 0 && o > 0.0 && product.returned(r, c) && m > 0.0 && m.is_finite() {
+            sum += (f64::from(m).log10() - f64::from(o).log10()).abs();
+            n += 1;
+        }
+    }
+    (100.0 * (10f64.powf(sum / n as f64) - 1.0), n)
+}
+
 #[test]
-fn the_cubesat_error_budget_adds_up_and_noise_leads_it() {
+fn the_cubesat_error_budget_matches_runs_with_each_stage_made_perfect() {
     let study = shoal::study::StudySpec::default_study().unwrap().resolve(None).unwrap();
     let (label, _, config) = &study.runs[0];
     assert_eq!(label, "cubesat");
     let mut config = config.clone();
     config.fidelity.decimation = 16;
-    let budgets = shoal::study::error_budget(label, &config, &[1, 2], &RunControl::new()).unwrap();
+    let seeds = [1, 2];
+    let budgets = shoal::study::error_budget(label, &config, &seeds, &RunControl::new()).unwrap();
     let chl = budgets.iter().find(|b| b.variable == "chl_mg_m3").unwrap();
     eprintln!("{}", shoal::study::budget_table(&budgets));
-    // Sequential shares and the floor add up to the full error (by construction, to rounding).
-    let sum: f64 = chl.lines.iter().map(|l| l.sequential_pct).sum();
-    assert!((sum + chl.floor_pct - chl.full_pct).abs() < 1e-9);
+    // The oracle: the budget's definition (src/study/budget.rs) carried out here with runs of
+    // our own. Make the stages perfect one after another in chain order — noise and
+    // quantisation off, calibration perfect, the exact atmospheric correction, aLMI given the
+    // scene's own SIOP set — and take the seeds' mean chl MAE after each step from the maps.
+    // Step k's sequential share is the drop from step k to k + 1, the floor the last step.
+    let perfect = |c: &mut RunConfig, stage: usize| match stage {
+        0 => c.detector = DetectorMode { noise: false, quantise: false },
+        1 => c.calibration.perfect = true,
+        2 => c.correction.use_approximation = false,
+        _ => {
+            let own = c.scene.siop.clone();
+            for r in &mut c.retrievals {
+                if let RetrievalSpec::Almi { siop_sets, .. } = r {
+                    *siop_sets = vec![own.clone()];
+                }
+            }
+        }
+    };
+    let mut engine = Engine::new();
+    let mut mean_mae = |c: &RunConfig| -> f64 {
+        let mut sum = 0.0;
+        for &seed in &seeds {
+            let mut c = c.clone();
+            c.seed = seed;
+            let out = engine.run(&c, &RunControl::new()).unwrap();
+            let (mae, n) = chl_mae_pct(&out.retrievals[0].product, &out.radiance.chl_mg_m3, &out.radiance.land);
+            assert!(n > 1000, "{n} pixels compared");
+            sum += mae;
+        }
+        sum / seeds.len() as f64
+    };
+    let mut steps = vec![mean_mae(&config)];
+    let mut cumulative = config.clone();
+    for stage in 0..4 {
+        perfect(&mut cumulative, stage);
+        steps.push(mean_mae(&cumulative));
+    }
+    // Noise alone imperfect: every other stage perfect.
+    let mut noise_only = config.clone();
+    (1..4).for_each(|stage| perfect(&mut noise_only, stage));
+    let noise_alone = mean_mae(&noise_only) - steps[4];
+    eprintln!("chl MAE % after each step: {steps:?}; noise alone {noise_alone:.3}");
+    // The same f32 maps and the same formula on both sides; only the order of the sums differs
+    // (rounding ~1e-13 of a few tens of %): 1e-9 points of %.
+    let close = |a: f64, b: f64| (a - b).abs() < 1e-9;
+    assert!(close(chl.full_pct, steps[0]), "full {} vs {}", chl.full_pct, steps[0]);
+    assert!(close(chl.floor_pct, steps[4]), "floor {} vs {}", chl.floor_pct, steps[4]);
+    let stages = [Stage::Noise, Stage::Calibration, Stage::Correction, Stage::SiopChoice];
+    assert_eq!(chl.lines.iter().map(|l| l.stage).collect::<Vec<_>>(), stages);
+    for (k, line) in chl.lines.iter().enumerate() {
+        let want = steps[k] - steps[k + 1];
+        assert!(close(line.sequential_pct, want), "{:?}: {} vs {want}", line.stage, line.sequential_pct);
+    }
+    assert!(close(chl.lines[0].alone_pct, noise_alone), "noise alone {} vs {noise_alone}", chl.lines[0].alone_pct);
     // The CubeSat is noise-limited: noise is the largest share of its chl error, and with every
     // stage perfect only the band-averaging floor of a few percent is left.
-    let noise = chl.lines.iter().find(|l| l.stage == shoal::study::Stage::Noise).unwrap();
+    let noise = &chl.lines[0];
     assert!(chl.lines.iter().all(|l| l.sequential_pct <= noise.sequential_pct), "{chl:?}");
     assert!(noise.sequential_pct > 0.4 * chl.full_pct, "{chl:?}");
     assert!(chl.floor_pct < 5.0, "{chl:?}");
@@ -153,12 +229,42 @@ fn the_default_study_checks_its_requirements_with_margins() {
     let result = shoal::study::run_study(&study, &RunControl::new(), |_, _| Ok(())).unwrap();
     let checks = req.check(&result);
     let find = |inst: &str, what: &str| checks.iter().find(|c| c.instrument == inst && c.what == what).unwrap().clone();
-    // The paper's finding, as a requirement: the CubeSat misses chl MAE ≤ 20 %, the SmallSat meets it.
-    let cube = find("cubesat", "chl_mg_m3 MAE %");
-    let small = find("smallsat", "chl_mg_m3 MAE %");
-    assert!(!cube.pass && cube.margin < -5.0, "{cube:?}");
-    assert!(small.pass && small.margin > 2.0, "{small:?}");
-    assert!((cube.margin - (cube.limit - cube.value)).abs() < 1e-12);
+    // The paper's finding, as a requirement: the CubeSat misses chl MAE ≤ 20 %
+    // (presets/studies/cubesat_vs_smallsat.ron), the SmallSat meets it. Each value is the MAE
+    // computed here from the run's maps, and the margin is how far below 20 % it is.
+    for (inst, passes) in [("cubesat", false), ("smallsat", true)] {
+        let run = result.runs.iter().find(|r| r.label == inst).unwrap();
+        let (mae, n) = chl_mae_pct(&run.retrievals[0].product, &run.truth.chl_mg_m3, &run.truth.land);
+        assert!(n > 1000, "{inst}: {n} pixels compared");
+        let check = find(inst, "chl_mg_m3 MAE %");
+        // Same maps and formula; only the order of the sums differs: 1e-9 points of %.
+        assert!((check.value - mae).abs() < 1e-9, "{inst}: MAE {} vs {mae} computed from the maps", check.value);
+        assert_eq!(check.limit, 20.0, "{inst}");
+        assert!((check.margin - (20.0 - mae)).abs() < 1e-9, "{inst}: margin {} vs {}", check.margin, 20.0 - mae);
+        assert_eq!(check.pass, passes, "{inst}: MAE {mae:.2} %");
+    }
+    assert!(find("cubesat", "chl_mg_m3 MAE %").margin < -5.0);
+    assert!(find("smallsat", "chl_mg_m3 MAE %").margin > 2.0);
+    // The SNR floor of 100 is a lower limit: the margin is how far above it the SNR is. Each
+    // value is the instrument equation's SNR with Table 1's parameters at the run's reference
+    // radiance (tests/chain/noise.rs, which finds the engine within 2e-10 of it; 1e-8 here).
+    let srf = super::noise::olci_srf_lambda_integrals();
+    let mut below = 0;
+    for run in &result.runs {
+        let t1 = if run.label == "cubesat" { Table1::CUBESAT } else { Table1::SMALLSAT };
+        for row in run.snr.iter() {
+            let snr = t1.snr(row.radiance, srf.iter().find(|(n, _)| *n == row.band).unwrap().1);
+            let check = find(&run.label, &format!("SNR {} ({:.0} nm)", row.band, row.centre_nm));
+            assert!((check.value / snr - 1.0).abs() < 1e-8, "{check:?} vs SNR {snr}");
+            assert_eq!(check.limit, 100.0);
+            assert!((check.margin - (snr - 100.0)).abs() < 1e-8 * snr, "{check:?} vs SNR {snr}");
+            assert_eq!(check.pass, snr >= 100.0, "{check:?} vs SNR {snr}");
+            below += usize::from(snr < 100.0);
+        }
+    }
+    // Both sides of the floor are exercised (the CubeSat is below it in every band, the
+    // SmallSat only in its dimmest).
+    assert!(below > 0 && below < checks.iter().filter(|c| c.what.starts_with("SNR")).count(), "{below}");
     // One SNR check per band and instrument.
     let bands: usize = result.runs.iter().map(|r| r.snr.len()).sum();
     assert!(bands >= 2 * 16);

@@ -1,17 +1,18 @@
-//! The engine thread: previews before full resolution, stale generations dropped, a newer
-//! request supersedes the running one.
+//! The engine thread: previews before full resolution, a stale result dropped (told apart from a
+//! cancelled run by the worker's counters, [`WorkerStats`]), a newer request cancelling the
+//! running one.
 
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use shoal::engine::RunConfig;
-use shoal::engine::worker::{EngineHandle, Event, Request};
+use shoal::engine::worker::{EngineHandle, Event, Request, WorkerStats};
 
 use super::{small, small_lake};
 
 fn finished(handle: &EngineHandle, timeout: Duration) -> Vec<(u64, usize, bool)> {
     let mut out = Vec::new();
-    let deadline = std::time::Instant::now() + timeout;
-    while std::time::Instant::now() < deadline {
+    let deadline = Instant::now() + timeout;
+    while Instant::now() < deadline {
         match handle.wait(Duration::from_millis(100)) {
             Some(Event::Finished { generation, decimation, result, .. }) => {
                 out.push((generation, decimation, result.is_ok()));
@@ -25,19 +26,86 @@ fn finished(handle: &EngineHandle, timeout: Duration) -> Vec<(u64, usize, bool)>
     out
 }
 
+/// Wait, without reading any event, until `done(stats)` holds.
+fn until(handle: &EngineHandle, timeout: Duration, done: impl Fn(&WorkerStats) -> bool) -> WorkerStats {
+    let deadline = Instant::now() + timeout;
+    loop {
+        let s = handle.stats();
+        if done(&s) {
+            return s;
+        }
+        assert!(Instant::now() < deadline, "worker stuck: {s:?}");
+        std::thread::sleep(Duration::from_millis(5));
+    }
+}
+
 #[test]
-fn preview_then_full_and_stale_results_dropped() {
+fn preview_then_full_for_the_newest_generation() {
     let handle = EngineHandle::spawn(1).unwrap();
     let config = RunConfig::new(small_lake(), small("nominal", 64, 64));
-    // Generation 1 is superseded at once by generation 2 (another gain): only 2 is reported.
+    // Generation 1 is superseded at once by generation 2 (another gain).
     assert!(handle.submit(Request { generation: 1, configs: vec![Some(config.clone())], decimations: vec![4, 1] }));
     let mut newer = config;
     newer.instrument.gain_e_per_dn = 2.5;
     assert!(handle.submit(Request { generation: 2, configs: vec![Some(newer)], decimations: vec![4, 1] }));
     let events = finished(&handle, Duration::from_secs(120));
-    assert!(events.iter().all(|e| e.0 == 2), "stale results reached the app: {events:?}");
-    assert_eq!(events.iter().map(|e| e.1).collect::<Vec<_>>(), vec![4, 1], "preview first, then full");
-    assert!(events.iter().all(|e| e.2));
+    assert_eq!(events, vec![(2, 4, true), (2, 1, true)], "preview first, then full, of generation 2 only");
+    // Generation 1 went one of three ways, and the counters say which: skipped before it ran,
+    // cancelled while running its preview, or its preview finished and was dropped as stale
+    // (then its full run was cancelled or never started). Every result sent either reached the
+    // app (the two above) or was dropped: the channel is FIFO and generation 1's events all
+    // precede generation 2's final one, so none is still queued.
+    let s = handle.stats();
+    assert_eq!(s.results_sent, 2 + s.stale_results_dropped, "{s:?}");
+    assert!(s.runs_cancelled <= 1 && s.stale_results_dropped <= 1, "{s:?}");
+    assert_eq!(s.requests_skipped + u64::from(s.runs_cancelled + s.stale_results_dropped > 0), 1, "{s:?}");
+}
+
+#[test]
+fn a_stale_result_is_dropped_not_cancelled() {
+    // Generation 1 runs to the end before generation 2 is submitted: its result sits in the
+    // event queue, stale, and `wait` must drop it (counted), while no run was cancelled.
+    let handle = EngineHandle::spawn(1).unwrap();
+    let config = RunConfig::new(small_lake(), small("nominal", 16, 16));
+    assert!(handle.submit(Request { generation: 1, configs: vec![Some(config.clone())], decimations: vec![1] }));
+    let s = until(&handle, Duration::from_secs(120), |s| s.results_sent == 1);
+    assert_eq!(s, WorkerStats { results_sent: 1, ..WorkerStats::default() });
+    let mut newer = config;
+    newer.instrument.gain_e_per_dn = 2.5;
+    assert!(handle.submit(Request { generation: 2, configs: vec![Some(newer)], decimations: vec![1] }));
+    assert_eq!(finished(&handle, Duration::from_secs(120)), vec![(2, 1, true)]);
+    assert_eq!(
+        handle.stats(),
+        WorkerStats { results_sent: 2, runs_cancelled: 0, requests_skipped: 0, stale_results_dropped: 1 }
+    );
+}
+
+#[test]
+fn a_newer_request_cancels_the_running_one_which_reports_nothing() {
+    // Generation 1 is a full-resolution run of the nominal instrument's whole 1024-detector swath
+    // over 512 lines (428 × 642 pixels cropped to the lake, 3.2 s on two threads, longer on the
+    // worker's one); generation 2 arrives once it is under way (a progress event with rows
+    // done, reported every 50 ms). Generation 1 must be cancelled: no result sent, none dropped.
+    let handle = EngineHandle::spawn(1).unwrap();
+    let big = RunConfig::new(small_lake(), small("nominal", 1024, 512));
+    assert!(handle.submit(Request { generation: 1, configs: vec![Some(big)], decimations: vec![1] }));
+    let deadline = Instant::now() + Duration::from_secs(120);
+    loop {
+        assert!(Instant::now() < deadline, "generation 1 never reported progress");
+        if let Some(Event::Progress { generation: 1, done, .. }) = handle.wait(Duration::from_millis(100))
+            && done > 0
+        {
+            break;
+        }
+    }
+    assert_eq!(handle.stats(), WorkerStats::default(), "generation 1 finished before it could be cancelled");
+    let light = RunConfig::new(small_lake(), small("nominal", 16, 16));
+    assert!(handle.submit(Request { generation: 2, configs: vec![Some(light)], decimations: vec![1] }));
+    assert_eq!(finished(&handle, Duration::from_secs(120)), vec![(2, 1, true)]);
+    assert_eq!(
+        handle.stats(),
+        WorkerStats { results_sent: 1, runs_cancelled: 1, requests_skipped: 0, stale_results_dropped: 0 }
+    );
 }
 
 #[test]
@@ -46,7 +114,7 @@ fn a_failed_run_is_reported_and_the_worker_survives() {
     let mut bad = RunConfig::new(small_lake(), small("nominal", 16, 16));
     bad.instrument.aperture_mm = 0.0;
     assert!(handle.submit(Request { generation: 1, configs: vec![Some(bad)], decimations: vec![1] }));
-    let deadline = std::time::Instant::now() + Duration::from_secs(60);
+    let deadline = Instant::now() + Duration::from_secs(60);
     loop {
         match handle.wait(Duration::from_millis(100)) {
             Some(Event::Finished { result: Err(e), .. }) => {
@@ -54,9 +122,7 @@ fn a_failed_run_is_reported_and_the_worker_survives() {
                 break;
             }
             Some(Event::Finished { result: Ok(_), .. }) => panic!("a zero aperture was accepted"),
-            Some(Event::Progress { .. }) | None => {
-                assert!(std::time::Instant::now() < deadline, "no answer from the worker")
-            }
+            Some(Event::Progress { .. }) | None => assert!(Instant::now() < deadline, "no answer from the worker"),
         }
     }
     let good = RunConfig::new(small_lake(), small("nominal", 16, 16));
@@ -72,8 +138,8 @@ fn a_and_b_run_at_each_level_before_the_next() {
     let b = RunConfig::new(small_lake(), small("smallsat", 32, 32));
     assert!(handle.submit(Request { generation: 1, configs: vec![Some(a), Some(b)], decimations: vec![4, 1] }));
     let mut order = Vec::new();
-    let deadline = std::time::Instant::now() + Duration::from_secs(120);
-    while order.len() < 4 && std::time::Instant::now() < deadline {
+    let deadline = Instant::now() + Duration::from_secs(120);
+    while order.len() < 4 && Instant::now() < deadline {
         if let Some(Event::Finished { index, decimation, result, .. }) = handle.wait(Duration::from_millis(100)) {
             assert!(result.is_ok());
             order.push((decimation, index));

@@ -16,8 +16,8 @@ mod water;
 
 use shoal::correction::RrsFlags;
 use shoal::engine::{RunConfig, RunOutput};
-use shoal::instrument::InstrumentSpec;
-use shoal::retrieval::ProductFlags;
+use shoal::instrument::{Detector, Flags, InstrumentSpec};
+use shoal::retrieval::{ProductFlags, RetrievalSpec};
 use shoal::scene::{MapSpec, SceneSpec};
 
 /// 1/π, sr⁻¹: Rrs of a perfect Lambertian reflector.
@@ -84,23 +84,27 @@ pub fn check(out: &RunOutput, case: &str) -> Degraded {
         assert!(v.iter().all(|x| x.is_finite() && *x >= 0.0), "{case}: band {name} not finite");
     }
     assert!(atm.spherical_albedo.iter().all(|s| (0.0..=1.0).contains(s)), "{case}: spherical albedo out of 0–1");
-    // Level-0: counts within the converter's range; the flags and the report agree.
+    // Level-0, recounted from the counts and the mean photo-electrons rather than from the flags.
     let l0 = &out.level0;
-    let dn_max = if c.detector.quantise { c.instrument.dn_max() } else { f64::from(u16::MAX) };
-    assert!(l0.dn.iter().all(|&d| f64::from(d) <= dn_max), "{case}: DN above {dn_max}");
-    if let Some(a) = &l0.analog {
-        assert!(a.iter().all(|x| x.is_finite()), "{case}: analog DN not finite");
-    }
-    let count = |flags: &ndarray::Array3<u8>, bit: u8| flags.iter().filter(|f| **f & bit != 0).count();
     let (rows, cols, nb) = l0.dn.dim();
+    let count = |flags: &ndarray::Array3<u8>, bit: u8| flags.iter().filter(|f| **f & bit != 0).count();
     let mut d = Degraded {
         pixels: rows * cols,
         pixel_bands: rows * cols * nb,
-        saturated: count(&l0.flags, shoal::instrument::Flags::SATURATED),
-        zero: count(&l0.flags, shoal::instrument::Flags::ZERO),
+        saturated: count(&l0.flags, Flags::SATURATED),
+        zero: count(&l0.flags, Flags::ZERO),
         ..Degraded::default()
     };
+    let (sure, possible, zero) = level0_recount(out, case);
+    // The run's report counts what the flags say; both lie between the pixel-bands that surely
+    // saturated and those that may have.
     assert_eq!((d.saturated, d.zero), (out.report.saturated, out.report.zero_counts), "{case}: report vs flags");
+    assert!(
+        sure <= d.saturated && d.saturated <= possible,
+        "{case}: {} saturated, recount {sure}–{possible}",
+        d.saturated
+    );
+    assert_eq!(d.zero, zero, "{case}: zero counts flagged vs counted from the DN");
     assert!(out.level1.radiance.iter().all(|x| x.is_finite()), "{case}: Level-1 not finite");
     // Rrs: finite everywhere; a pixel-band made invalid is flagged, never a silent number.
     let rrs = &out.correction.rrs;
@@ -119,27 +123,88 @@ pub fn check(out: &RunOutput, case: &str) -> Degraded {
             assert!(v >= 0.0 && (v.is_finite() || !c.detector.noise), "{case}: SNR {s:?}");
         }
     }
+    d.failed = check_retrievals(out, case);
+    d
+}
+
+/// The retrievals' part of [`check`]; returns the failed pixels of all retrievals.
+fn check_retrievals(out: &RunOutput, case: &str) -> usize {
+    let c = &out.config;
+    let rrs = &out.correction.rrs;
+    let nb = rrs.rrs.dim().2;
+    let mut total_failed = 0;
     // Retrievals: returned pixels are finite and non-negative; failures are flagged, counted
-    // in the metrics, and excluded from them.
-    for ret in &out.retrievals {
+    // in the metrics, and excluded from them. Recounted from the Rrs: both retrievals need three
+    // usable bands (src/retrieval/almi.rs, sambuca.rs `MIN_BANDS`) — a band is usable unless
+    // flagged INVALID or SATURATED, and for aLMI only with a positive Rrs — so a water pixel
+    // with fewer than three usable bands among those the retrieval fits must be FAILED (in every
+    // case of tests/hard/chain.rs the aLMI failures are exactly these pixels). Every water pixel
+    // (the truth's land mask) is either FAILED or RETURNED, never both.
+    let land = &out.radiance.land;
+    let water = land.iter().filter(|l| **l == 0).count();
+    for (ret, spec) in out.retrievals.iter().zip(&c.retrievals) {
         let p = &ret.product;
-        let mut failed = 0;
+        // The bands each retrieval fits: aLMI's are its settings' or, by default, those centred
+        // in 400–780 nm outside the O₂ A band, 759–771 nm (`AlmiSettings::bands`); SAMBUCA
+        // fits every band.
+        let (almi, fitted): (bool, Vec<bool>) = match spec {
+            RetrievalSpec::Almi { settings, .. } => (
+                true,
+                out.response
+                    .bands
+                    .bands
+                    .iter()
+                    .map(|band| match &settings.bands {
+                        Some(names) => names.contains(&band.name),
+                        None => (400.0..=780.0).contains(&band.centre_nm) && !(759.0..=771.0).contains(&band.centre_nm),
+                    })
+                    .collect(),
+            ),
+            RetrievalSpec::Sambuca { .. } => (false, vec![true; nb]),
+        };
+        let (mut failed, mut returned, mut too_few) = (0, 0, 0);
         for ((r, col), f) in p.flags.indexed_iter() {
+            if land[[r, col]] != 0 {
+                assert!(f & (ProductFlags::FAILED | ProductFlags::RETURNED) == 0, "{case}: land at ({r}, {col}): {f}");
+                continue;
+            }
+            let usable = (0..nb)
+                .filter(|&b| fitted[b])
+                .filter(|&b| {
+                    let x = rrs.rrs[[r, col, b]];
+                    rrs.flags[[r, col, b]] & (RrsFlags::INVALID | RrsFlags::SATURATED) == 0
+                        && x.is_finite()
+                        && (!almi || x > 0.0)
+                })
+                .count();
+            assert!(
+                (f & ProductFlags::FAILED != 0) != (f & ProductFlags::RETURNED != 0),
+                "{case}: water pixel ({r}, {col}) neither or both failed and returned: {f}"
+            );
+            if usable < 3 {
+                too_few += 1;
+                assert!(
+                    f & ProductFlags::FAILED != 0,
+                    "{case}: {}: {usable} usable bands at ({r}, {col}) but returned",
+                    p.name
+                );
+            }
             if f & ProductFlags::FAILED != 0 {
                 failed += 1;
                 continue;
             }
-            if f & ProductFlags::RETURNED != 0 {
-                for (name, v) in
-                    [("chl", p.chl_mg_m3[[r, col]]), ("nap", p.nap_g_m3[[r, col]]), ("cdom", p.cdom_per_m[[r, col]])]
-                {
-                    assert!(v.is_finite() && v >= 0.0, "{case}: {name} {v} at ({r}, {col})");
-                }
-                if let Some(depth) = &p.depth_m {
-                    assert!(depth[[r, col]].is_finite(), "{case}: depth at ({r}, {col})");
-                }
+            returned += 1;
+            for (name, v) in
+                [("chl", p.chl_mg_m3[[r, col]]), ("nap", p.nap_g_m3[[r, col]]), ("cdom", p.cdom_per_m[[r, col]])]
+            {
+                assert!(v.is_finite() && v >= 0.0, "{case}: {name} {v} at ({r}, {col})");
+            }
+            if let Some(depth) = &p.depth_m {
+                assert!(depth[[r, col]].is_finite(), "{case}: depth at ({r}, {col})");
             }
         }
+        assert!(too_few <= failed, "{case}: {}: {too_few} pixels with too few bands, {failed} failed", p.name);
+        assert_eq!(failed + returned, water, "{case}: {}: {failed} failed + {returned} returned", p.name);
         assert_eq!(failed, ret.metrics.failed, "{case}: failed pixels vs metrics");
         for v in &ret.metrics.variables {
             let m = &v.metrics;
@@ -148,9 +213,91 @@ pub fn check(out: &RunOutput, case: &str) -> Degraded {
                 assert!(m.mae.is_finite() && m.bias.is_finite(), "{case}: {} metrics {m:?}", v.variable);
             }
         }
-        d.failed += failed;
+        total_failed += failed;
     }
-    d
+    total_failed
+}
+
+/// Level-0 recounted independently of its flags, asserting per pixel-band that the flags agree:
+/// returns (pixel-bands that surely saturated, pixel-bands that may have, pixel-bands at zero
+/// counts), and asserts every DN and analogue value within the converter's range.
+///
+/// The detector model (src/instrument/detector.rs; Janesick 2007 ch. 2–3): electrons
+/// e ~ Poisson(μ) with μ = K·L + D (K the responsivity of the pixel's detector and band, L its
+/// band radiance, D the dark electrons), clipped at the well W; then DN = round(e/g + bias + n),
+/// n the read noise σ_r/g DN rms, clipped to 0 … 2^bits − 1. A pixel-band saturates when e ≥ W
+/// (not for the ideal radiometer, which has no well) or, with quantisation, when the DN reaches
+/// 2^bits − 1; it reads zero counts, with quantisation, when the DN is 0.
+///
+/// Without shot noise e = min(μ, W) exactly (to the f32 storage, 1e-6 here). With it, the
+/// Poisson draw is below μ − 8√μ − 1 or above μ + 8√μ + 8 with probability under 1e-12 per
+/// pixel-band (normal tail at 8σ; the +8 covers small μ, where P(e ≥ μ + 8√μ + 8) < 1e-12 for
+/// every μ ≥ 0): so e ≥ W surely when μ − 8√μ − 1 ≥ W and surely not when μ + 8√μ + 8 < W.
+/// Read noise beyond 8σ_r is as unlikely, which bounds the counts of a full well.
+fn level0_recount(out: &RunOutput, case: &str) -> (usize, usize, usize) {
+    let c = &out.config;
+    let spec = &c.instrument;
+    let l0 = &out.level0;
+    let det = Detector::new(spec, &out.response, c.detector, c.seed);
+    let mode = det.mode();
+    let ideal = spec.is_ideal();
+    // The converter's ceiling, 2^bits − 1, from the bit count (the ADC clips whether or not
+    // Level-1 uses the quantised value).
+    let adc_max = f64::from((1u32 << spec.adc_bits) - 1);
+    let read_dn = if mode.noise { 8.0 * spec.read_noise_e / spec.gain_e_per_dn } else { 0.0 };
+    // A full well reads at most (W/g + bias + 8σ_r/g), rounded.
+    let full_well_dn = spec.well_depth_e / spec.gain_e_per_dn + spec.bias_dn + read_dn;
+    let dn_ceiling = if ideal { adc_max } else { adc_max.min((full_well_dn + 0.5).floor()) };
+    let t = det.exposure_s();
+    let well = spec.well_depth_e;
+    let (rows, cols, nb) = l0.dn.dim();
+    let (mut sure, mut possible, mut zero) = (0, 0, 0);
+    for r in 0..rows {
+        for col in 0..cols {
+            let j = out.viewing.detector_index[col];
+            for b in 0..nb {
+                let dn = f64::from(l0.dn[[r, col, b]]);
+                assert!(dn <= dn_ceiling, "{case}: DN {dn} above {dn_ceiling} at ({r},{col},{b})");
+                if let Some(a) = &l0.analog {
+                    // Quantisation off: the analogue value is e/g + bias + noise, clipped at the
+                    // ADC's ceiling (never for the ideal radiometer); e ≥ 0.
+                    let a = f64::from(a[[r, col, b]]);
+                    let lo = spec.bias_dn - read_dn;
+                    let hi = if ideal { f64::INFINITY } else { adc_max.min(full_well_dn) };
+                    // f32 storage: 1e-6 relative.
+                    let slack = 1e-6 * (lo.abs() + hi.min(adc_max).abs() + 1.0);
+                    assert!(
+                        a.is_finite() && a >= lo - slack && a <= hi + slack,
+                        "{case}: analog DN {a} at ({r},{col},{b})"
+                    );
+                }
+                let l = f64::from(out.radiance.radiance[[r, col, b]]).max(0.0);
+                let mu = det.responsivity(j, b) * l + det.dark_mean_e(j, b, t);
+                let (well_sure, well_possible) = if ideal {
+                    (false, false)
+                } else if mode.noise {
+                    (mu - 8.0 * mu.sqrt() - 1.0 >= well, mu + 8.0 * mu.sqrt() + 8.0 >= well)
+                } else {
+                    (mu >= well * (1.0 + 1e-6), mu >= well * (1.0 - 1e-6))
+                };
+                let adc_full = mode.quantise && dn >= adc_max;
+                let flagged = l0.flags[[r, col, b]] & Flags::SATURATED != 0;
+                if well_sure || adc_full {
+                    sure += 1;
+                    assert!(flagged, "{case}: ({r},{col},{b}) saturated (μ {mu:.0} e-, DN {dn}) but not flagged");
+                }
+                if well_possible || adc_full {
+                    possible += 1;
+                } else {
+                    assert!(!flagged, "{case}: ({r},{col},{b}) flagged saturated at μ {mu:.0} e-, DN {dn}");
+                }
+                let at_zero = mode.quantise && dn == 0.0;
+                zero += usize::from(at_zero);
+                assert_eq!(l0.flags[[r, col, b]] & Flags::ZERO != 0, at_zero, "{case}: ZERO flag at ({r},{col},{b})");
+            }
+        }
+    }
+    (sure, possible, zero)
 }
 
 /// A run that must succeed.
