@@ -252,6 +252,10 @@ impl Engine {
         let detector = self.stage(Stage::Detector, detector_key, report, control, || {
             Ok(Detector::new(instrument, response, config.detector, config.seed))
         })?;
+        let names: Vec<String> = response.bands.bands.iter().map(|b| b.name.clone()).collect();
+        let brightest = crate::instrument::plausibility::brightest_water(&radiance.radiance, &radiance.land);
+        report.warnings =
+            crate::instrument::plausibility::assess(instrument, &detector, &names, &brightest, viewing.line_period_s);
         let electrons_key = KeyBuilder::new(Stage::Electrons).after(radiance_key).after(photon_key).finish();
         let electrons = self.stage(Stage::Electrons, electrons_key, report, control, || {
             expose_cube(&detector, &radiance.radiance, viewing, config.seed, control).map_err(failed(Stage::Electrons))

@@ -10,6 +10,7 @@
 //! | sampling | [`sample`] | band radiance of every pixel from the scene, and its truth |
 //! | detector | [`detector`] | photo-electrons, shot/dark/read noise, PRNU/DSNU, full well, ADC |
 //! | Level-0 | [`level0`] | the whole image exposed and read out, with flags |
+//! | plausibility | [`plausibility`] | saturation at the brightest water, smear, f-number warnings |
 //! | SNR | [`snr`] | analytic SNR and SNR measured on a simulated uniform patch |
 //!
 //! Four kinds (see [`InstrumentKind`]): a band-pass multispectral imager, an ideal radiometer
@@ -27,6 +28,7 @@
 pub mod detector;
 pub mod geometry;
 pub mod level0;
+pub mod plausibility;
 pub mod response;
 pub mod sample;
 pub mod snr;

@@ -227,7 +227,17 @@ pub fn write_study(result: &StudyResult, dir: &Path, figures: bool) -> Result<Ou
             }));
         }
     }
-    let doc = serde_json::json!({ "study": result.study.spec.name, "metrics": rows, "retrievals": extra });
+    // Plausibility warnings once per instrument (they do not depend on the noise seed).
+    let mut warnings = serde_json::Map::new();
+    for run in &result.runs {
+        warnings.entry(run.label.clone()).or_insert_with(|| serde_json::json!(run.report.warnings));
+    }
+    let doc = serde_json::json!({
+        "study": result.study.spec.name,
+        "metrics": rows,
+        "retrievals": extra,
+        "warnings": warnings,
+    });
     text(dir, "metrics.json", &json(&doc)?, &mut o)?;
     let spec = ron::ser::to_string_pretty(&result.study.spec, ron::ser::PrettyConfig::default().struct_names(true))
         .map_err(|e| StudyError::Io(format!("study RON: {e}")))?;

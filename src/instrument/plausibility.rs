@@ -1,0 +1,162 @@
+//! Plausibility guards: designs the chain will simulate but an engineer should be told about —
+//! a detector that saturates at the scene's brightest water radiance, an exposure longer than the
+//! line period (along-track smear), and an f-number below 1 (no real telescope). The CLI prints
+//! them and writes them into `report.json`; the app shows the same list.
+//!
+//! ## References
+//! - Matthews, M. W. et al. (2023) Sensors 23, 7824, §2.1.2 and Table 1 (exposure, line period,
+//!   well depth, gain).
+//! - Janesick, J. R. (2007) Photon Transfer: DN → λ. SPIE Press (full well, ADC full scale:
+//!   the signal clips at min(well, (2^bits − 1 − bias)·gain) electrons).
+//! - Schowengerdt, R. A. (2007) Remote Sensing: Models and Methods for Image Processing, 3rd ed.,
+//!   §3.4 (pushbroom smear: the ground moves v·t during an exposure t, i.e. t / t_line pixels).
+//! - Smith, W. J. (2008) Modern Optical Engineering, 4th ed., §6.3 (N = f/D; the aplanatic limit
+//!   of a lens in air is N = 0.5, practical telescopes stay well above 1).
+
+use serde::Serialize;
+
+use super::{Detector, InstrumentSpec};
+
+/// Which guard a warning comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum Guard {
+    /// The brightest water pixel fills the well or the ADC.
+    Saturation,
+    /// The exposure is longer than the line period.
+    Smear,
+    /// Focal length over aperture below 1.
+    FNumber,
+}
+
+/// One warning: what, how far, and the limit.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Warning {
+    /// The guard.
+    pub guard: Guard,
+    /// The value checked (peak signal as a fraction of full scale; smear in pixels; f-number).
+    pub value: f64,
+    /// The limit it crossed (1 full scale; 1 pixel; f/1).
+    pub limit: f64,
+    /// One sentence for people.
+    pub message: String,
+}
+
+/// Smallest f-number accepted without a warning.
+pub const MIN_F_NUMBER: f64 = 1.0;
+/// Largest along-track smear accepted without a warning, pixels.
+pub const MAX_SMEAR_PX: f64 = 1.0;
+
+/// Full scale of detector `detector` in electrons: the well, or the ADC's top code if that clips
+/// first: min(well, (DN_max − bias)·gain).
+#[must_use]
+pub fn full_scale_e(detector: &Detector) -> f64 {
+    detector.well_e().min((detector.dn_max() - detector.bias_dn()).max(0.0) * detector.gain_e_per_dn())
+}
+
+/// The guards for `spec` flown over a scene whose brightest water radiance per band is
+/// `brightest_w_m2_sr_nm` (band names in `bands`), with the run's line period.
+#[must_use]
+pub fn assess(
+    spec: &InstrumentSpec,
+    detector: &Detector,
+    bands: &[String],
+    brightest_w_m2_sr_nm: &[f64],
+    line_period_s: f64,
+) -> Vec<Warning> {
+    let mut out = Vec::new();
+    let f_number = spec.focal_length_mm / spec.aperture_mm;
+    if f_number < MIN_F_NUMBER {
+        out.push(Warning {
+            guard: Guard::FNumber,
+            value: f_number,
+            limit: MIN_F_NUMBER,
+            message: format!(
+                "f-number f/{f_number:.2} (focal length {} mm / aperture {} mm) is below f/1: no real \
+                 telescope is that fast, so its signal and SNR are not achievable",
+                spec.focal_length_mm, spec.aperture_mm
+            ),
+        });
+    }
+    if line_period_s > 0.0 {
+        let smear_px = spec.exposure_s / line_period_s;
+        if smear_px > MAX_SMEAR_PX {
+            out.push(Warning {
+                guard: Guard::Smear,
+                value: smear_px,
+                limit: MAX_SMEAR_PX,
+                message: format!(
+                    "exposure {:.3} ms is longer than the line period {:.3} ms: the image smears over \
+                     {smear_px:.1} pixels along track (the signal and SNR of a longer exposure are \
+                     only reached by giving up along-track resolution)",
+                    spec.exposure_s * 1e3,
+                    line_period_s * 1e3
+                ),
+            });
+        }
+    }
+    if !spec.is_ideal() {
+        out.extend(saturation(detector, bands, brightest_w_m2_sr_nm));
+    }
+    out
+}
+
+/// The worst band's peak signal against full scale, over every detector (PRNU included).
+fn saturation(detector: &Detector, bands: &[String], brightest: &[f64]) -> Option<Warning> {
+    let full = full_scale_e(detector);
+    let detectors = detector.detectors();
+    let peak_e = |b: usize| {
+        (0..detectors)
+            .map(|j| detector.responsivity(j, b) * brightest[b] + detector.dark_mean_e(j, b, detector.exposure_s()))
+            .fold(0.0f64, f64::max)
+    };
+    let peaks: Vec<f64> = (0..brightest.len().min(detector.n_bands())).map(peak_e).collect();
+    let over: Vec<usize> = (0..peaks.len()).filter(|&b| peaks[b] >= full).collect();
+    let worst = (0..peaks.len()).max_by(|&a, &b| peaks[a].total_cmp(&peaks[b]))?;
+    if over.is_empty() {
+        return None;
+    }
+    let name = |b: usize| bands.get(b).cloned().unwrap_or_else(|| format!("band {}", b + 1));
+    let listed: Vec<String> = over.iter().take(6).map(|&b| name(b)).collect();
+    let more = if over.len() > 6 { format!(" and {} more", over.len() - 6) } else { String::new() };
+    Some(Warning {
+        guard: Guard::Saturation,
+        value: peaks[worst] / full,
+        limit: 1.0,
+        message: format!(
+            "saturates at the scene's brightest water radiance in {} of {} bands ({}{more}): {} needs \
+             {:.3e} e⁻ against a full scale of {:.3e} e⁻ ({:.0} % of it)",
+            over.len(),
+            peaks.len(),
+            listed.join(", "),
+            name(worst),
+            peaks[worst],
+            full,
+            100.0 * peaks[worst] / full
+        ),
+    })
+}
+
+/// Brightest radiance per band over water pixels (`land` = 0) of a (rows, cols, bands) cube.
+#[must_use]
+pub fn brightest_water(radiance: &ndarray::Array3<f32>, land: &ndarray::Array2<u8>) -> Vec<f64> {
+    let nb = radiance.dim().2;
+    let mut out = vec![0.0f32; nb];
+    if let (Some(rad), Some(land)) = (radiance.as_slice(), land.as_slice()) {
+        for (values, &l) in rad.chunks_exact(nb.max(1)).zip(land) {
+            if l == 0 {
+                for (o, &v) in out.iter_mut().zip(values) {
+                    *o = o.max(v);
+                }
+            }
+        }
+    } else {
+        for ((r, c), &l) in land.indexed_iter() {
+            if l == 0 {
+                for (b, o) in out.iter_mut().enumerate() {
+                    *o = o.max(radiance[[r, c, b]]);
+                }
+            }
+        }
+    }
+    out.into_iter().map(f64::from).collect()
+}
