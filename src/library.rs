@@ -25,7 +25,23 @@ pub enum Kind {
     Study,
 }
 
+fn builtin_names(kind: Kind) -> Vec<String> {
+    match kind {
+        Kind::Instrument => InstrumentSpec::preset_names(),
+        Kind::Scene => SceneSpec::preset_names(),
+        Kind::Study => StudySpec::preset_names(),
+    }
+}
+
 impl Kind {
+    fn noun(self) -> &'static str {
+        match self {
+            Self::Instrument => "instrument",
+            Self::Scene => "scene",
+            Self::Study => "study",
+        }
+    }
+
     fn folder(self) -> &'static str {
         match self {
             Self::Instrument => "instruments",
@@ -58,6 +74,14 @@ pub enum LibraryError {
     /// Reading or writing failed.
     #[error("{0}")]
     Io(String),
+    /// A name a built-in preset already has (saving it would hide the built-in).
+    #[error("`{name}` is a built-in {kind}; save yours under another name")]
+    Builtin {
+        /// The name asked for.
+        name: String,
+        /// "instrument", "scene" or "study".
+        kind: &'static str,
+    },
     /// A name that cannot be a file name.
     #[error("preset name `{0}`: use letters, digits, `-` and `_` (1 to 64 characters)")]
     BadName(String),
@@ -99,14 +123,12 @@ impl Library {
         Self { dir: dir.to_path_buf() }
     }
 
-    /// Built-in names of `kind`, then the user's, sorted within each.
+    /// Built-in names of `kind`, then the user's, sorted within each. The user's file wins: a
+    /// file called like a built-in preset (left by an older Shoal, or copied in by hand) takes
+    /// the built-in's place in the list, so a name always means one preset.
     #[must_use]
     pub fn list(&self, kind: Kind) -> Vec<Entry> {
-        let builtin = match kind {
-            Kind::Instrument => InstrumentSpec::preset_names(),
-            Kind::Scene => SceneSpec::preset_names(),
-            Kind::Study => StudySpec::preset_names(),
-        };
+        let builtin = builtin_names(kind);
         let mut out: Vec<Entry> = builtin.into_iter().map(|name| Entry { name, builtin: true, path: None }).collect();
         let mut user: Vec<Entry> = std::fs::read_dir(self.dir.join(kind.folder()))
             .into_iter()
@@ -126,8 +148,15 @@ impl Library {
             })
             .collect();
         user.sort_by(|a, b| a.name.cmp(&b.name));
+        out.retain(|b| !user.iter().any(|u| u.name == b.name));
         out.extend(user);
         out
+    }
+
+    /// The entry `name` of `kind` as [`Self::list`] resolves it (the user's file first).
+    #[must_use]
+    pub fn find(&self, kind: Kind, name: &str) -> Option<Entry> {
+        self.list(kind).into_iter().find(|e| e.name == name)
     }
 
     fn read(entry: &Entry) -> Result<(String, String), LibraryError> {
@@ -173,6 +202,9 @@ impl Library {
     fn save<T: Serialize>(&self, kind: Kind, name: &str, value: &T, overwrite: bool) -> Result<PathBuf, LibraryError> {
         if !valid_name(name) {
             return Err(LibraryError::BadName(name.to_string()));
+        }
+        if builtin_names(kind).iter().any(|b| b == name) {
+            return Err(LibraryError::Builtin { name: name.to_string(), kind: kind.noun() });
         }
         let path = self.dir.join(kind.folder()).join(format!("{name}.ron"));
         if path.exists() && !overwrite {

@@ -90,6 +90,10 @@ pub struct ShoalApp {
     screenshot_taken: Arc<std::sync::Mutex<Option<Arc<egui::ColorImage>>>>,
     screenshot_requested: bool,
     applied_theme: Option<bool>,
+    /// Where the session is saved (`None` in tests: nothing is written).
+    session_path: Option<PathBuf>,
+    /// The state last written there.
+    saved_state: Option<AppState>,
 }
 
 /// Storage key of the session.
@@ -128,15 +132,34 @@ impl ShoalApp {
             screenshot_taken: Arc::default(),
             screenshot_requested: false,
             applied_theme: None,
+            session_path: None,
+            saved_state: None,
         }
     }
 
     /// The app as eframe creates it: the saved session, or the default study.
     #[must_use]
     pub fn new(cc: &eframe::CreationContext<'_>, options: AppOptions) -> Self {
-        let state =
-            if options.fresh { None } else { cc.storage.and_then(|s| eframe::get_value::<AppState>(s, STATE_KEY)) };
+        let path = model::session_path(&crate::library::home_dir());
+        let (state, problem) = match (options.fresh, model::load_session(&path)) {
+            (true, _) => (None, None),
+            (false, model::SavedSession::Restored(s)) => (Some(*s), None),
+            // A session saved by an earlier Shoal in eframe's own storage (outside SHOAL_HOME).
+            (false, model::SavedSession::None) => {
+                (cc.storage.and_then(|s| eframe::get_value::<AppState>(s, STATE_KEY)), None)
+            }
+            (false, model::SavedSession::Unreadable { message, kept_at }) => (
+                None,
+                Some(format!(
+                    "The saved session could not be read ({message}); it is kept at {} and the app \
+                     starts from the default study.",
+                    kept_at.display()
+                )),
+            ),
+        };
         let mut app = Self::with_state(state.unwrap_or_default(), &cc.egui_ctx, options);
+        app.session_path = Some(path);
+        app.ui.error = problem;
         match crate::engine::Fault::from_env() {
             Ok(fault) => app.ui.fault = fault,
             Err(e) => app.ui.error = Some(e),
@@ -468,8 +491,17 @@ impl eframe::App for ShoalApp {
         self.screenshot(&ctx);
     }
 
-    fn save(&mut self, storage: &mut dyn eframe::Storage) {
-        eframe::set_value(storage, STATE_KEY, &self.state);
+    /// Called by eframe on quit and every 30 s: the session goes to our own file (atomic, under
+    /// `SHOAL_HOME` when set), only when it changed.
+    fn save(&mut self, _storage: &mut dyn eframe::Storage) {
+        let Some(path) = &self.session_path else { return };
+        if self.saved_state.as_ref() == Some(&self.state) {
+            return;
+        }
+        match model::save_session(path, &self.state) {
+            Ok(()) => self.saved_state = Some(self.state.clone()),
+            Err(e) => self.ui.error = Some(format!("The session was not saved: {e}")),
+        }
     }
 }
 
@@ -509,6 +541,9 @@ pub fn run(options: AppOptions) -> Result<(), String> {
             .with_inner_size([1500.0, 960.0])
             .with_min_inner_size([900.0, 600.0])
             .with_icon(icon()),
+        // eframe's own file (window size and egui's memory) beside the session, so that with
+        // SHOAL_HOME set nothing is written outside it.
+        persistence_path: Some(crate::library::home_dir().join("window.ron")),
         ..Default::default()
     };
     eframe::run_native("shoal", native, Box::new(move |cc| Ok(Box::new(ShoalApp::new(cc, options)))))

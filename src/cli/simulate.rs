@@ -11,6 +11,7 @@ use clap::Args;
 use super::CliError;
 use crate::engine::{Engine, EngineError, RunConfig, RunOutput};
 use crate::instrument::{InstrumentError, InstrumentSpec};
+use crate::library::{Kind, Library};
 use crate::scene::{SceneError, SceneSpec};
 
 /// Arguments of `shoal simulate`.
@@ -68,22 +69,33 @@ impl From<SceneError> for CliError {
     }
 }
 
-/// A built-in name or a RON file: the parsed spec and the file's directory.
+/// A RON file, or a preset name as the app's library resolves it (the user's own preset in
+/// `SHOAL_HOME/presets` first, then the built-in): the parsed spec and the file's directory.
 fn load_scene(arg: &str) -> Result<(SceneSpec, Option<PathBuf>), CliError> {
     if arg.ends_with(".ron") || Path::new(arg).exists() {
         let text = std::fs::read_to_string(arg).map_err(|e| CliError::Input(format!("--scene {arg}: {e}")))?;
-        Ok((SceneSpec::from_ron(&text, arg)?, Path::new(arg).parent().map(Path::to_path_buf)))
-    } else {
-        Ok((SceneSpec::preset(arg)?, None))
+        return Ok((SceneSpec::from_ron(&text, arg)?, Path::new(arg).parent().map(Path::to_path_buf)));
+    }
+    let library = Library::user();
+    match library.find(Kind::Scene, arg) {
+        Some(entry) => {
+            let dir = entry.path.as_deref().and_then(Path::parent).map(Path::to_path_buf);
+            let spec = library.load_scene(&entry).map_err(|e| CliError::Input(format!("--scene {arg}: {e}")))?;
+            Ok((spec, dir))
+        }
+        None => Ok((SceneSpec::preset(arg)?, None)),
     }
 }
 
 fn load_instrument(arg: &str) -> Result<InstrumentSpec, CliError> {
     if arg.ends_with(".ron") || Path::new(arg).exists() {
         let text = std::fs::read_to_string(arg).map_err(|e| CliError::Input(format!("--instrument {arg}: {e}")))?;
-        Ok(InstrumentSpec::from_ron(&text, arg)?)
-    } else {
-        Ok(InstrumentSpec::preset(arg)?)
+        return Ok(InstrumentSpec::from_ron(&text, arg)?);
+    }
+    let library = Library::user();
+    match library.find(Kind::Instrument, arg) {
+        Some(entry) => library.load_instrument(&entry).map_err(|e| CliError::Input(format!("--instrument {arg}: {e}"))),
+        None => Ok(InstrumentSpec::preset(arg)?),
     }
 }
 
@@ -180,6 +192,9 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     let (rows, cols, nb) = out.report.shape;
     eprintln!("{label}: {rows} lines × {cols} detectors × {nb} bands in {:.2} s", out.report.total_seconds);
     eprint!("{}", out.report.table());
+    for w in &out.report.warnings {
+        eprintln!("warning: {}: {}", out.config.instrument.name, w.message);
+    }
     eprintln!("wrote {} files to {}", written.len(), args.out.display());
     Ok(())
 }

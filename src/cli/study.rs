@@ -52,7 +52,18 @@ pub(super) fn load(arg: Option<&str>) -> Result<(StudySpec, Option<PathBuf>), Cl
             let text = std::fs::read_to_string(a).map_err(|e| CliError::Input(format!("{a}: {e}")))?;
             Ok((StudySpec::from_ron(&text, a)?, Path::new(a).parent().map(Path::to_path_buf)))
         }
-        Some(name) => Ok((StudySpec::preset(name)?, None)),
+        Some(name) => {
+            // The user's own study in the library first (as the app lists it), then the built-in.
+            let library = crate::library::Library::user();
+            match library.find(crate::library::Kind::Study, name) {
+                Some(entry) => {
+                    let dir = entry.path.as_deref().and_then(Path::parent).map(Path::to_path_buf);
+                    let spec = library.load_study(&entry).map_err(|e| CliError::Input(format!("{name}: {e}")))?;
+                    Ok((spec, dir))
+                }
+                None => Ok((StudySpec::preset(name)?, None)),
+            }
+        }
     }
 }
 
@@ -160,6 +171,15 @@ pub fn run(args: &StudyArgs) -> Result<(), CliError> {
                 if c.pass { "pass" } else { "FAIL" },
                 c.margin
             );
+        }
+    }
+    let mut warned: Vec<&str> = Vec::new();
+    for run in &result.runs {
+        if !warned.contains(&run.label.as_str()) {
+            warned.push(&run.label);
+            for w in &run.report.warnings {
+                eprintln!("warning: {}: {}", run.label, w.message);
+            }
         }
     }
     eprintln!("wrote {} files to {}", outputs.files.len(), args.out.display());

@@ -192,6 +192,12 @@ impl Response {
     }
 }
 
+/// Shortest wavelength Shoal simulates, nm.
+pub const MIN_SIMULATED_NM: f64 = 325.0;
+/// Longest wavelength Shoal simulates, nm: the end of the gas-absorption table
+/// (`assets/atmosphere/atmosphere_gas_absorption_wasi6.csv`, 300–1000 nm).
+pub const MAX_SIMULATED_NM: f64 = 1000.0;
+
 /// The simulation grid of a group: every multiple of `step_nm` within `margin_nm` of a band's
 /// SRF support. Gaps between disjoint bands are left out (nothing there is seen), so a
 /// 19-band imager costs its bands' width, not the 400–900 nm span.
@@ -199,10 +205,14 @@ fn support_grid(supports: &[(f64, f64)], margin_nm: f64, step_nm: f64) -> Result
     let mut nodes: Vec<i64> = Vec::new();
     for &(lo, hi) in supports {
         let (a, b) = (((lo - margin_nm) / step_nm).floor() as i64, ((hi + margin_nm) / step_nm).ceil() as i64);
-        if (a as f64) * step_nm < 325.0 || (b as f64) * step_nm > 1025.0 {
+        let (from, to) = ((a as f64) * step_nm, (b as f64) * step_nm);
+        if from < MIN_SIMULATED_NM || to > MAX_SIMULATED_NM {
             return Err(InstrumentError::Invalid {
                 field: "bands".into(),
-                message: format!("spectral responses span {lo:.1}–{hi:.1} nm; Shoal simulates 325–1025 nm"),
+                message: format!(
+                    "spectral responses span {lo:.1}–{hi:.1} nm, simulated over {from:.1}–{to:.1} nm with the \
+                     grid's margin; Shoal simulates {MIN_SIMULATED_NM}–{MAX_SIMULATED_NM} nm (the atmospheric data)"
+                ),
             });
         }
         nodes.extend(a..=b);

@@ -186,6 +186,32 @@ impl InstrumentSpec {
                     message: format!("{end_nm} is below start_nm = {start_nm} (allowed: start_nm to 1000 nm)"),
                 });
             }
+            // Each band's Gaussian response is tabulated over centre ± 2.5 FWHM (Band::gaussian),
+            // shifted by up to |smile|; it must lie where Shoal has atmospheric data.
+            let reach = 2.5 * resolution_nm + smile_nm.abs();
+            if end_nm + reach > crate::instrument::response::MAX_SIMULATED_NM {
+                return Err(InstrumentError::Invalid {
+                    field: r::SPECTROGRAPH_END_NM.field("instrument.").into(),
+                    message: format!(
+                        "{end_nm} with resolution_nm = {resolution_nm} and smile_nm = {smile_nm} puts the last band's \
+                         response at {:.1} nm (allowed: end_nm + 2.5·resolution_nm + |smile_nm| ≤ {} nm, the end \
+                         of Shoal's gas-absorption data)",
+                        end_nm + reach,
+                        crate::instrument::response::MAX_SIMULATED_NM
+                    ),
+                });
+            }
+            if start_nm - reach < crate::instrument::response::MIN_SIMULATED_NM {
+                return Err(InstrumentError::Invalid {
+                    field: r::SPECTROGRAPH_START_NM.field("instrument.").into(),
+                    message: format!(
+                        "{start_nm} with resolution_nm = {resolution_nm} and smile_nm = {smile_nm} puts the first \
+                         band's response at {:.1} nm (allowed: start_nm − 2.5·resolution_nm − |smile_nm| ≥ {} nm)",
+                        start_nm - reach,
+                        crate::instrument::response::MIN_SIMULATED_NM
+                    ),
+                });
+            }
             let samples = (end_nm - start_nm) / sampling_nm;
             if samples > 2000.0 {
                 return Err(InstrumentError::Invalid {

@@ -181,12 +181,19 @@ pub fn band_responses(response: &Response, atmosphere: &BandAtmosphere, column: 
 
 /// Default aLMI bands: centroids 400–780 nm outside the O₂ A band (759–771 nm).
 fn default_almi_bands(bands: &[BandResponse]) -> Vec<usize> {
-    (0..bands.len())
+    let usable: Vec<usize> = (0..bands.len())
         .filter(|&b| {
             let c = bands[b].centroid_nm();
             (400.0..=780.0).contains(&c) && !(759.0..=771.0).contains(&c)
         })
-        .collect()
+        .collect();
+    // A spectrograph has more usable bands than aLMI's linear system takes: keep an evenly
+    // spaced subset of at most MAX_BANDS, first and last included.
+    let max = super::almi::MAX_BANDS;
+    if usable.len() <= max {
+        return usable;
+    }
+    (0..max).map(|k| usable[k * (usable.len() - 1) / (max - 1)]).collect()
 }
 
 /// Run `spec` over the image.
@@ -246,6 +253,16 @@ fn retrieve_almi(
             Ok(AlmiSet { name: spec.name.clone(), iops: model.band_iops() })
         })
         .collect::<Result<Vec<_>, RetrievalError>>()?;
+    // The chosen-set map and the reports name sets: two of one name (a user's file called like a
+    // built-in set, or two files with one `name`) could not be told apart there.
+    for (i, set) in sets.iter().enumerate() {
+        if sets[..i].iter().any(|s| s.name == set.name) {
+            return Err(RetrievalError::Invalid {
+                field: "siop_sets".into(),
+                message: format!("two SIOP sets are called `{}`; give each set its own `name`", set.name),
+            });
+        }
+    }
     let (rows, cols, nb) = inputs.rrs.dim();
     let results: Vec<Vec<AlmiRow>> = (0..rows)
         .into_par_iter()

@@ -130,6 +130,21 @@ impl BandSet {
     /// assert!((olci.bands[7].centre_nm - 665.0).abs() < 1.5);
     /// ```
     pub fn from_spec(spec: &BandSetSpec) -> Result<Self, SpectralError> {
+        let set = Self::build(spec)?;
+        // Retrieval settings, cubes and reports address bands by name: two bands of one name
+        // would make the second unreachable (a look-up takes the first).
+        for (i, b) in set.bands.iter().enumerate() {
+            if set.bands[..i].iter().any(|a| a.name == b.name) {
+                return Err(SpectralError::Bands(format!(
+                    "two bands are called `{}`; band names must be unique (name Gaussian bands with `name: Some(\"…\")`)",
+                    b.name
+                )));
+            }
+        }
+        Ok(set)
+    }
+
+    fn build(spec: &BandSetSpec) -> Result<Self, SpectralError> {
         match spec {
             BandSetSpec::Olci { platform, bands } => {
                 let (path, label) = match platform {

@@ -52,6 +52,17 @@ impl Table {
             line: 0,
             message: "no header row (expected e.g. `wavelength_nm,value`)".into(),
         })?;
+        // Two columns of one name: a look-up would silently take the first.
+        for (i, c) in columns.iter().enumerate() {
+            if columns[..i].contains(c) {
+                let line = text.lines().position(|l| !l.trim().is_empty() && !l.trim().starts_with('#')).unwrap_or(0);
+                return Err(SpectralError::Table {
+                    origin: source.to_string(),
+                    line: line + 1,
+                    message: format!("column `{c}` appears twice in the header; column names must be unique"),
+                });
+            }
+        }
         Ok(Self { source: source.to_string(), columns, rows })
     }
 

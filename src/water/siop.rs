@@ -282,6 +282,21 @@ impl SiopSpec {
             ("a_nap_star", &mut s.nap_absorption),
             ("bb_nap_star", &mut s.nap_backscatter),
         ];
+        // A column the set does not know is refused, not skipped: a misspelt `aph_star` would
+        // otherwise leave heron_island's a*_ph in the user's set without a word.
+        let known: Vec<&str> = slots.iter().map(|(c, _)| *c).collect();
+        if let Some(stray) =
+            table.columns.iter().find(|c| c.as_str() != "wavelength_nm" && !known.contains(&c.as_str()))
+        {
+            return Err(WaterError::Parse {
+                origin: path.display().to_string(),
+                message: format!(
+                    "unknown SIOP column `{stray}` (allowed: wavelength_nm, {}); the set's other spectra \
+                     come from heron_island, so a misspelt column would silently be replaced",
+                    known.join(", ")
+                ),
+            });
+        }
         let mut used = 0;
         for (column, slot) in slots {
             if table.columns.iter().any(|c| c == column) {

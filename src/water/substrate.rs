@@ -42,7 +42,8 @@ const EMBEDDED: &[(&str, &str, &str, &str)] = &[
     ("wasi_seagrass", "benthic/benthic_reflectance.csv", "seagrass", "Zostera marina seagrass (WASI6 R_b)"),
 ];
 
-/// Short names accepted for convenience.
+/// Short names accepted for convenience, used only when no entry has the typed name itself: a
+/// user's own `coral` column always wins over the alias.
 const ALIASES: &[(&str, &str)] = &[("coral", "acropora"), ("algae", "turf_algae")];
 
 /// A set of named substrate spectra.
@@ -81,27 +82,56 @@ impl SubstrateLibrary {
     }
 
     /// Add every value column of a user CSV (`wavelength_nm` plus one column per substrate),
-    /// named by its column header (lower-cased).
+    /// named by its column header (lower-cased). The user's names win: a column called like a
+    /// built-in entry (`sand`) or an alias (`coral`) replaces it for every later look-up, and
+    /// its description says so. Two columns that are the same name once lower-cased are refused
+    /// (which one was meant cannot be known).
     pub fn add_csv(&mut self, path: &Path) -> Result<(), WaterError> {
         let table = Table::from_file(path)?;
-        for column in table.columns.iter().filter(|c| c.as_str() != "wavelength_nm") {
+        let columns: Vec<&String> = table.columns.iter().filter(|c| c.as_str() != "wavelength_nm").collect();
+        for (i, a) in columns.iter().enumerate() {
+            if let Some(b) = columns[..i].iter().find(|b| b.eq_ignore_ascii_case(a)) {
+                return Err(WaterError::Parse {
+                    origin: path.display().to_string(),
+                    message: format!(
+                        "columns `{b}` and `{a}` name the same substrate (names are case-insensitive); rename one"
+                    ),
+                });
+            }
+        }
+        for column in columns {
             let spectrum = Spectrum::from_table(&table, column)?;
             let name = column.to_ascii_lowercase();
-            self.entries.retain(|e| e.name != name);
-            self.entries.push(SubstrateEntry {
+            let replaced = self.entries.iter().position(|e| e.name == name);
+            let alias = ALIASES.iter().find(|(a, _)| *a == name).map(|(_, t)| *t);
+            let note = match (replaced, alias) {
+                (Some(_), _) => format!(" (replaces the built-in `{name}`)"),
+                (None, Some(target)) => format!(" (replaces the alias `{name}` for `{target}`)"),
+                (None, None) => String::new(),
+            };
+            let entry = SubstrateEntry {
                 name,
-                description: format!("user spectrum {}:{column}", path.display()),
+                description: format!("user spectrum {}:{column}{note}", path.display()),
                 spectrum,
-            });
+            };
+            match replaced {
+                Some(i) => self.entries[i] = entry,
+                None => self.entries.push(entry),
+            }
         }
         Ok(())
     }
 
-    /// The entry called `name` (case-insensitive; `coral` and `algae` are aliases).
+    /// The entry called `name` (case-insensitive). An entry of that very name wins; only when
+    /// there is none are `coral` and `algae` read as aliases of `acropora` and `turf_algae`.
     pub fn get(&self, name: &str) -> Result<&SubstrateEntry, WaterError> {
         let lower = name.trim().to_ascii_lowercase();
-        let key = ALIASES.iter().find(|(a, _)| *a == lower).map_or(lower.as_str(), |(_, t)| t);
-        self.entries.iter().find(|e| e.name == key).ok_or_else(|| WaterError::UnknownName {
+        let exact = self.entries.iter().find(|e| e.name == lower);
+        let aliased = || {
+            let target = ALIASES.iter().find(|(a, _)| *a == lower).map(|(_, t)| *t)?;
+            self.entries.iter().find(|e| e.name == target)
+        };
+        exact.or_else(aliased).ok_or_else(|| WaterError::UnknownName {
             field: "substrate".into(),
             name: name.to_string(),
             known: self.names().join(", "),
