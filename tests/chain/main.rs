@@ -5,13 +5,17 @@
 mod bad_input;
 mod cli;
 mod closure;
+mod coherence;
 mod determinism;
 mod incremental;
 mod noise;
+mod plausibility;
 mod retrieval;
+mod soak;
 mod spatial;
 mod study;
 mod sweep;
+mod user_data;
 mod worker;
 
 use shoal::control::RunControl;

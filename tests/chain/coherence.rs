@@ -1,0 +1,432 @@
+//! Cache coherence: the stage cache never serves a stale product.
+//!
+//! The oracle is a fresh engine: whatever a cached engine returns after an edit must equal, bit
+//! for bit, what an engine with an empty cache returns for the same configuration. And every input
+//! a user can set must either change what a run produces or be listed in [`NO_EFFECT`] with the
+//! reason — so a new field that never reaches a cache key (or a stage) cannot go unnoticed.
+//!
+//! The base configuration asks for everything a field could act on: a shallow reef with land
+//! (adjacency), a wind-roughened surface with `SunGlint`, the spatial response, both retrievals, a
+//! diffuser incidence; a spectrograph or filter imager for their `kind` fields. It is small (a
+//! 16 × 12 image) so that each edit costs two short runs.
+
+use std::hash::{Hash, Hasher};
+
+use shoal::control::RunControl;
+use shoal::engine::{Engine, RunConfig, RunOutput};
+use shoal::instrument::InstrumentSpec;
+use shoal::ranges::{self, Range};
+use shoal::retrieval::RetrievalSpec;
+use shoal::scene::{Effect, MapSpec, SceneSpec};
+
+/// Inputs that do not change a run's output, and why. Everything else must.
+const NO_EFFECT: &[(&str, &str)] = &[
+    ("requirements.", "a study's pass/fail threshold: read after the runs, never by a stage"),
+    ("instrument.name", "a label for reports and file names"),
+    ("instrument.description", "a label"),
+];
+
+fn documented(what: &str) -> Option<&'static str> {
+    NO_EFFECT.iter().find(|(p, _)| what.starts_with(p)).map(|(_, why)| *why)
+}
+
+/// The base configuration for a field: every path of the range table exists in it.
+fn base(path: &str) -> RunConfig {
+    let name = if path.contains("Spectrograph") {
+        "hyperspectral"
+    } else if path.contains("FilterImager") {
+        "filter_imager"
+    } else {
+        "cubesat"
+    };
+    let mut instrument = InstrumentSpec::preset(name).unwrap();
+    instrument.detectors = 16;
+    instrument.exposures = 12;
+    // A dark current and fixed patterns, so that the dark frames and their exposure matter.
+    instrument.dark_current_e_s = 200.0;
+    instrument.prnu = 0.01;
+    instrument.dsnu_e = 5.0;
+    // Heron Island's reef cut to 2.4 × 1.6 km around the swath, with its cay moved 700 m west of
+    // it (the adjacency FFT then runs on 240 × 160 cells instead of 1100 × 600).
+    let mut scene = SceneSpec::preset("heron_island_reef").unwrap();
+    (scene.width, scene.height) = (240, 160);
+    if let Some(land) = &mut scene.land {
+        land.mask = ron::from_str(
+            "Shapes(background: 0.0, shapes: [Ellipse(centre_m: (-700.0, 0.0), radii_m: (200.0, 100.0), \
+             angle_deg: 10.0, value: 1.0)])",
+        )
+        .unwrap();
+    }
+    scene.atmosphere.surface = shoal::atmosphere::Surface::Wind { speed_m_s: 5.0 };
+    for e in [Effect::SunGlint, Effect::SpatialResponse] {
+        if !scene.effects.contains(&e) {
+            scene.effects.push(e);
+        }
+    }
+    let mut c = RunConfig::new(scene, instrument);
+    c.retrievals = vec![ron::from_str::<RetrievalSpec>("Almi()").unwrap(), ron::from_str("Sambuca()").unwrap()];
+    c.calibration.sun_incidence_deg = Some(30.0);
+    // Coarse LUT nodes keep each run short; they are inputs like any other.
+    c.fidelity.lut_wavelength_step_nm = 40.0;
+    c.fidelity.lut_view_step_deg = 10.0;
+    c.validate().unwrap();
+    c
+}
+
+/// Hashes of a run's products (name, hash of the exact bits).
+type Fingerprint = Vec<(String, u64)>;
+
+/// What a run produces, product by product, as hashes of the exact bits.
+fn fingerprint(out: &RunOutput) -> Fingerprint {
+    fn h<T: Hash + ?Sized>(v: &T) -> u64 {
+        let mut s = std::hash::DefaultHasher::new();
+        v.hash(&mut s);
+        s.finish()
+    }
+    let bits = |a: &ndarray::Array3<f32>| h(&a.iter().map(|v| v.to_bits()).collect::<Vec<_>>());
+    let bits2 = |a: &ndarray::Array2<f32>| h(&a.iter().map(|v| v.to_bits()).collect::<Vec<_>>());
+    let mut f = vec![
+        ("pupil radiance".to_string(), bits(&out.radiance.radiance)),
+        ("true Rrs".into(), bits(&out.radiance.rrs)),
+        ("true chl".into(), bits2(&out.radiance.chl_mg_m3)),
+        ("level-0 DN".into(), h(&out.level0.dn.iter().collect::<Vec<_>>())),
+        ("level-0 flags".into(), h(&out.level0.flags.iter().collect::<Vec<_>>())),
+        ("level-1".into(), bits(&out.level1.radiance)),
+        ("Rrs".into(), bits(&out.correction.rrs.rrs)),
+        ("Rrs flags".into(), h(&out.correction.rrs.flags.iter().collect::<Vec<_>>())),
+        ("correction diagnostics".into(), h(&format!("{:?}", out.report.approximation))),
+        ("SNR".into(), h(&format!("{:?}", out.snr))),
+        ("warnings".into(), h(&format!("{:?}", out.report.warnings))),
+    ];
+    for r in &out.retrievals {
+        let p = &r.product;
+        f.push((
+            format!("{} maps", p.name),
+            h(&format!("{:?}", (&p.chl_mg_m3, &p.nap_g_m3, &p.cdom_per_m, &p.depth_m))),
+        ));
+        f.push((
+            format!("{} rest", p.name),
+            h(&format!("{:?}", (&p.substrate_fractions, &p.siop_set, &p.cost, &p.flags, &p.iterations, &p.sdi))),
+        ));
+        f.push((format!("{} metrics", p.name), h(&format!("{:?}", r.metrics))));
+    }
+    f
+}
+
+fn fresh(config: &RunConfig) -> Fingerprint {
+    fingerprint(&Engine::new().run(config, &RunControl::new()).unwrap())
+}
+
+/// Products that differ between two fingerprints.
+fn differing(a: &[(String, u64)], b: &[(String, u64)]) -> Vec<String> {
+    if a.len() != b.len() {
+        return vec![format!("{} products against {}", a.len(), b.len())];
+    }
+    a.iter().zip(b).filter(|(x, y)| x != y).map(|(x, _)| x.0.clone()).collect()
+}
+
+/// Values inside `range` near `current` (so the run stays small), in the order to try: one
+/// more or one fewer for counts, 10 % more or less otherwise (1 % of the span around 0).
+fn other_values(range: &Range, current: f64) -> Vec<f64> {
+    let candidates = if range.whole {
+        [current + 1.0, current - 1.0]
+    } else if current == 0.0 {
+        let step = 0.01 * (range.hi - range.lo);
+        [current + step, current - step]
+    } else {
+        [current * 1.1, current / 1.1]
+    };
+    candidates.into_iter().filter(|v| range.contains(*v)).collect()
+}
+
+/// Field-specific values where a quarter of the way would not reach the code path (clamped or
+/// capped by the small image, or a bound the base sits at).
+fn chosen_value(path: &str) -> Option<f64> {
+    Some(match path {
+        // Clamped to the 16 detectors of the base: any value above 16 is the same patch.
+        "fidelity.snr_detectors" => 6.0,
+        // Decimation 2: a preview of the 16 × 12 image.
+        "fidelity.decimation" => 2.0,
+        // Orders: the base converges in fewer than the default cap; a cap of 2 stops it early.
+        "scene.atmosphere.accuracy.max_orders" => 2.0,
+        // A well and an ADC only act when they clip: 2000 e-, or 10 bits at 3 e-/DN (3069 e-),
+        // are below the base's brightest water signal; 10 % changes are not.
+        "instrument.well_depth_e" => 2000.0,
+        "instrument.adc_bits" => 10.0,
+        // Fourier terms: the azimuthal series is complete before the default's 24 terms; two
+        // terms cut it.
+        "scene.atmosphere.accuracy.fourier_terms" => 2.0,
+        // SAMBUCA's fits converge in fewer than 100 iterations; 3 stops them early.
+        "retrievals[i].Sambuca.settings.max_iterations" => 3.0,
+        _ => return None,
+    })
+}
+
+/// `config` with the field at `path` set to `value` (map values as constant maps).
+fn set(config: &RunConfig, path: &str, value: f64) -> RunConfig {
+    let mut c = config.clone();
+    let m = MapSpec::Constant(value);
+    match path {
+        "scene.chl_mg_m3" => c.scene.chl_mg_m3 = m,
+        "scene.nap_g_m3" => c.scene.nap_g_m3 = m,
+        "scene.cdom_per_m" => c.scene.cdom_per_m = m,
+        "scene.depth_m" => c.scene.depth_m = Some(m),
+        "scene.substrates[i].fraction" => c.scene.substrates[0].fraction = m,
+        _ => {
+            let index = if path.contains("Sambuca") { ".1" } else { ".0" };
+            c = shoal::sweep::apply(config, &[(&path.replace("[i]", index), value)]).unwrap();
+        }
+    }
+    c
+}
+
+/// The value of a numeric field in `config` (maps: the value their constant would take).
+fn current(config: &RunConfig, path: &str) -> f64 {
+    let tree = serde_json::to_value(config).unwrap();
+    let mut node = &tree;
+    for key in path.replace("[i]", if path.contains("Sambuca") { ".1" } else { ".0" }).split('.') {
+        node = match node {
+            serde_json::Value::Array(items) => &items[key.parse::<usize>().unwrap()],
+            other => match other.get(key) {
+                Some(n) => n,
+                None => return 1.0, // a map (not a number): any constant differs from it
+            },
+        };
+    }
+    node.as_f64().unwrap_or(1.0)
+}
+
+#[test]
+fn every_range_field_changes_the_output_or_is_documented_and_the_cache_follows() {
+    let mut checked = 0;
+    let mut documented_count = 0;
+    let mut not_run_inputs = 0;
+    let mut failures = Vec::new();
+    // One cached engine per base instrument, with its base run's fingerprint.
+    let mut engines: Vec<(String, Engine, Fingerprint)> = Vec::new();
+    for range in ranges::ALL {
+        if range.path.starts_with("requirements.") {
+            not_run_inputs += 1; // see NO_EFFECT
+            continue;
+        }
+        let config = base(range.path);
+        // One cached engine per base instrument, warmed on its base run.
+        let key = config.instrument.name.clone();
+        if !engines.iter().any(|(k, _, _)| *k == key) {
+            let mut e = Engine::new();
+            let before = fingerprint(&e.run(&config, &RunControl::new()).unwrap());
+            engines.push((key.clone(), e, before));
+        }
+        let (_, engine, before) = engines.iter_mut().find(|(k, _, _)| *k == key).unwrap();
+        // The first nearby value the configuration accepts (a cross-field rule may refuse one).
+        let tries =
+            chosen_value(range.path).map_or_else(|| other_values(range, current(&config, range.path)), |v| vec![v]);
+        let Some((value, edited)) =
+            tries.into_iter().map(|v| (v, set(&config, range.path, v))).find(|(_, c)| c.validate().is_ok())
+        else {
+            failures.push(format!("{}: no nearby value is accepted", range.path));
+            continue;
+        };
+        let cached = fingerprint(&engine.run(&edited, &RunControl::new()).unwrap());
+        let truth = fresh(&edited);
+        let stale = differing(&cached, &truth);
+        if !stale.is_empty() {
+            failures.push(format!("{} = {value}: the cached engine served stale {stale:?}", range.path));
+        }
+        match (differing(&truth, before).is_empty(), documented(range.path)) {
+            (true, None) => failures.push(format!(
+                "{} = {value} changed nothing a run produces (list it in NO_EFFECT with the reason, or find why)",
+                range.path
+            )),
+            (false, Some(why)) => {
+                failures.push(format!("{} = {value} changed the output, but NO_EFFECT says: {why}", range.path))
+            }
+            (true, Some(_)) => documented_count += 1,
+            (false, None) => checked += 1,
+        }
+        // Back to the base: the cache must serve the base again, exactly.
+        let back = fingerprint(&engine.run(&config, &RunControl::new()).unwrap());
+        if !differing(&back, before).is_empty() {
+            failures.push(format!("{}: returning to the base is not the base", range.path));
+        }
+    }
+    assert!(failures.is_empty(), "{} failures:\n{}", failures.len(), failures.join("\n"));
+    eprintln!(
+        "coherence: {checked} range fields change the output; {documented_count} checked to change nothing \
+         (NO_EFFECT); {not_run_inputs} are study thresholds, not run inputs"
+    );
+    assert_eq!(checked + documented_count + not_run_inputs, ranges::ALL.len());
+    assert!(checked >= 60, "only {checked} fields checked");
+}
+
+/// An edit of a configuration, with the description a failure prints.
+type Edit = (&'static str, fn(&mut RunConfig));
+
+/// Edits of the fields the range table does not hold (enums, lists, names, switches).
+fn structural_edits() -> Vec<Edit> {
+    vec![
+        ("instrument bands: an OLCI subset", |c| {
+            let bands = (1..=12).map(|i| format!("Oa{i:02}")).collect();
+            c.instrument.kind = shoal::instrument::InstrumentKind::Multispectral {
+                bands: shoal::spectral::BandSetSpec::Olci { platform: Default::default(), bands: Some(bands) },
+            };
+        }),
+        ("instrument bands: OLCI S3B", |c| {
+            c.instrument.kind = shoal::instrument::InstrumentKind::Multispectral {
+                bands: shoal::spectral::BandSetSpec::Olci { platform: shoal::spectral::Platform::B, bands: None },
+            };
+        }),
+        ("instrument quantum efficiency", |c| {
+            c.instrument.quantum_efficiency = shoal::spectral::SpectrumSource::Constant(0.5);
+        }),
+        ("detector noise off", |c| c.detector.noise = false),
+        ("quantisation off", |c| c.detector.quantise = false),
+        ("calibration perfect", |c| c.calibration.perfect = true),
+        ("correction uses the approximation", |c| c.correction.use_approximation = true),
+        ("aerosol continental", |c| c.scene.atmosphere.aerosol = shoal::atmosphere::AerosolType::Continental),
+        ("flat surface (and so no glint)", |c| {
+            c.scene.atmosphere.surface = shoal::atmosphere::Surface::Flat;
+            c.scene.effects.retain(|e| *e != Effect::SunGlint);
+        }),
+        ("gases off", |c| c.scene.atmosphere.gases = false),
+        ("OSOAA Rayleigh depth", |c| {
+            c.scene.atmosphere.rayleigh = shoal::atmosphere::RayleighDepth::OsoaaHansenTravis;
+        }),
+        ("sun azimuth", |c| c.scene.sun.azimuth_deg += 40.0),
+        ("date", |c| c.scene.date = "2018-06-27".into()),
+        ("no adjacency", |c| c.scene.effects.retain(|e| *e != Effect::Adjacency)),
+        ("no glint", |c| c.scene.effects.retain(|e| *e != Effect::SunGlint)),
+        ("no spatial response", |c| c.scene.effects.retain(|e| *e != Effect::SpatialResponse)),
+        ("no shallow bottom", |c| c.scene.effects.retain(|e| *e != Effect::ShallowBottom)),
+        ("scene SIOP set", |c| c.scene.siop = shoal::water::SiopSource::Preset("cyanobacteria_reservoir".into())),
+        ("a substrate renamed", |c| c.scene.substrates[0].name = "brown_acropora".into()),
+        ("depth map replaced by a constant 3 m", |c| c.scene.depth_m = Some(MapSpec::Constant(3.0))),
+        ("noise seed", |c| c.seed += 1),
+        ("aLMI with four sets", |c| {
+            if let RetrievalSpec::Almi { siop_sets, .. } = &mut c.retrievals[0] {
+                siop_sets.truncate(4);
+            }
+        }),
+        ("aLMI without noise weighting", |c| {
+            if let RetrievalSpec::Almi { settings, .. } = &mut c.retrievals[0] {
+                settings.noise_weighting = !settings.noise_weighting;
+            }
+        }),
+        ("aLMI bands", |c| {
+            if let RetrievalSpec::Almi { settings, .. } = &mut c.retrievals[0] {
+                settings.bands = Some(["Oa03", "Oa05", "Oa06", "Oa08", "Oa11"].map(String::from).to_vec());
+            }
+        }),
+        ("SAMBUCA substrates", |c| {
+            if let RetrievalSpec::Sambuca { substrates, .. } = &mut c.retrievals[1] {
+                *substrates = Some(vec!["sand".into(), "acropora".into()]);
+            }
+        }),
+        ("SAMBUCA SIOP set", |c| {
+            if let RetrievalSpec::Sambuca { siop, .. } = &mut c.retrievals[1] {
+                *siop = Some(shoal::water::SiopSource::Preset("cyanobacteria_reservoir".into()));
+            }
+        }),
+        ("SAMBUCA objective", |c| {
+            if let RetrievalSpec::Sambuca { settings, .. } = &mut c.retrievals[1] {
+                settings.objective = shoal::retrieval::Objective::Lsq;
+            }
+        }),
+        ("SAMBUCA starts", |c| {
+            // Deep starts on every pixel (the base's Adaptive never needs them on a 1.5 m flat).
+            if let RetrievalSpec::Sambuca { settings, .. } = &mut c.retrievals[1] {
+                settings.starts = shoal::retrieval::Starts::ShallowAndDeep;
+            }
+        }),
+        ("SAMBUCA depth bounds", |c| {
+            if let RetrievalSpec::Sambuca { settings, .. } = &mut c.retrievals[1] {
+                settings.bounds.depth_m.1 = 12.0;
+            }
+        }),
+        ("one retrieval only", |c| {
+            c.retrievals.truncate(1);
+        }),
+        ("instrument.name", |c| c.instrument.name = "renamed".into()),
+        ("instrument.description", |c| c.instrument.description = "described".into()),
+    ]
+}
+
+#[test]
+fn every_enum_and_list_field_changes_the_output_and_the_cache_follows() {
+    let config = base("");
+    let mut engine = Engine::new();
+    let before = fingerprint(&engine.run(&config, &RunControl::new()).unwrap());
+    let edits = structural_edits();
+    for (what, edit) in &edits {
+        let mut edited = config.clone();
+        edit(&mut edited);
+        edited.validate().unwrap_or_else(|e| panic!("{what}: {e}"));
+        let cached = fingerprint(&engine.run(&edited, &RunControl::new()).unwrap());
+        let truth = fresh(&edited);
+        let stale = differing(&cached, &truth);
+        assert!(stale.is_empty(), "{what}: the cached engine served stale {stale:?}");
+        let changed = !differing(&truth, &before).is_empty();
+        match documented(what) {
+            None => assert!(changed, "{what} changed nothing a run produces"),
+            Some(why) => assert!(!changed, "{what} changed the output, but NO_EFFECT says: {why}"),
+        }
+    }
+    assert!(edits.len() >= 25);
+}
+
+/// Random sequences of edits (range fields at random allowed values, and the structural edits)
+/// through one cached engine: after every edit its output equals a fresh engine's, bit for bit.
+#[test]
+fn a_cached_engine_after_random_edits_matches_a_fresh_engine() {
+    use rand::{RngExt, SeedableRng};
+    let mut rng = rand::rngs::Xoshiro256PlusPlus::seed_from_u64(16);
+    // Random values near the current one (a factor 0.5–2, or ±2 for counts): far-off values of
+    // sizes (detectors, scene cells, streams) would make single runs minutes long.
+    let fields: Vec<&Range> = ranges::ALL
+        .iter()
+        .filter(|r| documented(r.path).is_none() && !r.path.contains("kind.") && r.path != "fidelity.decimation")
+        .collect();
+    let edits = structural_edits();
+    let mut config = base("");
+    let mut engine = Engine::new();
+    let steps = 24;
+    for step in 0..steps {
+        let what = if rng.random_bool(0.7) {
+            let range = fields[rng.random_range(0..fields.len())];
+            let now = current(&config, range.path);
+            let mut v = if range.whole {
+                now + f64::from(rng.random_range(-2i32..=2))
+            } else if now == 0.0 {
+                range.lo + 0.05 * (range.hi - range.lo) * rng.random::<f64>()
+            } else {
+                now * 2f64.powf(rng.random_range(-1.0..1.0))
+            };
+            if !range.contains(v) || v == now {
+                let Some(&near) = other_values(range, now).first() else { continue };
+                v = near;
+            }
+            let next = set(&config, range.path, v);
+            if next.validate().is_err() {
+                continue; // a cross-field rule (e.g. a detector count the image cannot hold)
+            }
+            config = next;
+            format!("{} = {v}", range.path)
+        } else {
+            let (what, edit) = &edits[rng.random_range(0..edits.len())];
+            let mut next = config.clone();
+            edit(&mut next);
+            if next.validate().is_err() {
+                continue;
+            }
+            config = next;
+            (*what).to_string()
+        };
+        let Ok(out) = engine.run(&config, &RunControl::new()) else {
+            // An edit the chain refuses at run time must be refused by a fresh engine too.
+            assert!(Engine::new().run(&config, &RunControl::new()).is_err(), "step {step} ({what})");
+            continue;
+        };
+        let stale = differing(&fingerprint(&out), &fresh(&config));
+        assert!(stale.is_empty(), "step {step} ({what}): stale {stale:?}");
+    }
+}
