@@ -43,11 +43,24 @@ pub struct AlmiSettings {
     /// reweighting pass, generalised least squares), and rank SIOP sets by the noise-normalised
     /// rrs misfit. Off: the reference's unweighted solve and relative-RMSE ranking.
     pub noise_weighting: bool,
+    /// Shoal's inversion (`Improved`, the design default) or the reference code's, step for step
+    /// (`Reference`: [`super::almi_reference`]; `noise_weighting` is then ignored).
+    pub mode: Mode,
+}
+
+/// Which inversion a retrieval runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+pub enum Mode {
+    /// Shoal's inversion: what a design study should use.
+    #[default]
+    Improved,
+    /// The published code's behaviour, to reproduce published numbers.
+    Reference,
 }
 
 impl Default for AlmiSettings {
     fn default() -> Self {
-        Self { g0: 0.084, g1: 0.17, bands: None, noise_weighting: true }
+        Self { g0: 0.084, g1: 0.17, bands: None, noise_weighting: true, mode: Mode::Improved }
     }
 }
 
@@ -62,6 +75,10 @@ impl AlmiFlags {
     pub const AT_BOUND: u8 = 2;
     /// No solution: too few valid bands or no finite system.
     pub const FAILED: u8 = 4;
+    /// Reference mode: a band failed the Rrs > 1e-6 screen (with `FAILED`).
+    pub const SCREENED: u8 = 8;
+    /// Reference mode: every SIOP set was dropped (with `FAILED`).
+    pub const NO_VALID_SET: u8 = 16;
 }
 
 /// One SIOP set as aLMI sees it: band-averaged IOPs of the bands in use.

@@ -5,11 +5,13 @@
 //! | band forward model | [`band_model`] | the Lee/SAMBUCA model at the instrument's bands, with its Jacobian |
 //! | Gauss rules | [`quadrature`] | K nodes per band that integrate its response |
 //! | aLMI | [`almi`] | linear matrix inversion over SIOP sets (Brando et al. 2012), non-negative |
+//! | aLMI, reference mode | [`almi_reference`] | the DEA code's inversion step for step (set dropping, screening) |
 //! | SAMBUCA | [`sambuca`] | bounded nonlinear least squares over depth and substrate pairs (Brando et al. 2009) |
 //! | solvers | [`nnls`], [`optimise`] | exact small NNLS; bounded Levenberg–Marquardt and BFGS |
 //! | images | [`run`] | a retrieval over a whole Rrs cube, the products and their flags |
 
 pub mod almi;
+pub mod almi_reference;
 pub mod band_model;
 pub mod nnls;
 pub mod optimise;
@@ -18,7 +20,7 @@ pub mod run;
 pub mod sambuca;
 pub mod sets;
 
-pub use almi::{AlmiFlags, AlmiSettings};
+pub use almi::{AlmiFlags, AlmiSettings, Mode};
 pub use band_model::{BandModel, BandResponse, ModelScratch, Parameters};
 pub use run::{Product, ProductFlags, RetrievalInputs, RetrievalSpec, retrieve};
 pub use sambuca::{Objective, SambucaSettings, Starts};

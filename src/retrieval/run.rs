@@ -7,7 +7,8 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::RetrievalError;
-use super::almi::{AlmiFlags, AlmiSet, AlmiSettings, invert as almi_invert};
+use super::almi::{AlmiFlags, AlmiSet, AlmiSettings, Mode, invert as almi_invert};
+use super::almi_reference::invert_reference;
 use super::band_model::{BandModel, BandResponse};
 use super::sambuca::{Observation, SambucaSettings, invert as sambuca_invert};
 use super::sets::default_almi_sets;
@@ -285,7 +286,10 @@ fn retrieve_almi(
                         obs[k] = f64::from(inputs.rrs[[r, c, b]]);
                         valid[k] = inputs.flags[[r, c, b]] & (RrsFlags::INVALID | RrsFlags::SATURATED) == 0;
                     }
-                    let p = almi_invert(&sets, settings, &obs, &valid, &nedr);
+                    let p = match settings.mode {
+                        Mode::Improved => almi_invert(&sets, settings, &obs, &valid, &nedr),
+                        Mode::Reference => invert_reference(&sets, settings.g0, settings.g1, &obs, &valid),
+                    };
                     if p.flags & AlmiFlags::FAILED != 0 || p.set.is_none() {
                         return (0.0, 0.0, 0.0, -1, 0.0, ProductFlags::FAILED);
                     }

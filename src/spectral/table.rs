@@ -16,12 +16,37 @@ pub struct Table {
     rows: Vec<(usize, Vec<String>)>,
 }
 
+/// The cells of one CSV line, trimmed; a cell in double quotes may hold commas, and `""` inside
+/// it is one quote (RFC 4180).
+fn split_cells(line: &str) -> Vec<String> {
+    let mut cells = Vec::new();
+    let mut cell = String::new();
+    let mut quoted = false;
+    let mut chars = line.chars().peekable();
+    while let Some(ch) = chars.next() {
+        match (ch, quoted) {
+            ('"', true) if chars.peek() == Some(&'"') => {
+                cell.push('"');
+                chars.next();
+            }
+            ('"', _) => quoted = !quoted,
+            (',', false) => cells.push(std::mem::take(&mut cell).trim().to_string()),
+            (c, _) => cell.push(c),
+        }
+    }
+    cells.push(cell.trim().to_string());
+    cells
+}
+
 impl Table {
     /// Parse `text`; `source` names it in errors.
     ///
     /// ```
     /// let t = shoal::spectral::Table::parse("# comment\nwavelength_nm,x\n400,1\n500,2\n", "demo").unwrap();
     /// assert_eq!(t.column_f64("x").unwrap(), vec![1.0, 2.0]);
+    /// // A quoted cell may hold commas.
+    /// let t = shoal::spectral::Table::parse("id,note\n1,\"clear, deep\"\n", "demo").unwrap();
+    /// assert_eq!(t.column_str("note").unwrap(), vec!["clear, deep"]);
     /// ```
     pub fn parse(text: &str, source: &str) -> Result<Self, SpectralError> {
         let mut header: Option<Vec<String>> = None;
@@ -32,7 +57,7 @@ impl Table {
             if trimmed.is_empty() || trimmed.starts_with('#') {
                 continue;
             }
-            let cells: Vec<String> = trimmed.split(',').map(|c| c.trim().to_string()).collect();
+            let cells = split_cells(trimmed);
             match &header {
                 None => header = Some(cells),
                 Some(h) => {

@@ -5,6 +5,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 mod aerosol;
+mod almi_reference;
 mod atmosphere_limits;
 mod cli;
 mod osoaa;
