@@ -176,8 +176,15 @@ impl AtmosphereLut {
         &self.atmosphere
     }
 
-    /// The gas-free terms per unit solar flux for wavelength node `w` at geometry `g`.
+    /// The gas-free terms per unit solar flux for wavelength node `w` at geometry `g`, sun glint
+    /// included (over a wind-roughened surface).
     pub fn normalised(&self, w: usize, g: &Geometry) -> Result<Normalised, AtmosphereError> {
+        self.normalised_with(w, g, true)
+    }
+
+    /// As [`Self::normalised`]; the Cox–Munk glint term is computed only when `glint` is true
+    /// (a scene that does not ask for `SunGlint` gets 0 without the cost).
+    pub fn normalised_with(&self, w: usize, g: &Geometry, glint: bool) -> Result<Normalised, AtmosphereError> {
         g.validate()?;
         let a = &self.axes;
         let (ns, nv, nf) = (a.sun_zenith_deg.len(), a.view_zenith_deg.len(), self.n_fourier);
@@ -222,7 +229,7 @@ impl AtmosphereLut {
             ts,
         );
         let ed = ed * (mu0 * (-tau / mu0).exp()) / direct_nodes;
-        let glint = self.atmosphere.glint(g, tau);
+        let glint = if glint { self.atmosphere.glint(g, tau) } else { 0.0 };
         Ok(Normalised {
             wavelength_nm: a.wavelengths_nm[w],
             tau_rayleigh: self.tau_rayleigh[w],

@@ -166,7 +166,7 @@ impl SceneOptics {
     /// the 1-nm solar spectrum and the gases applied).
     pub fn path_spectrum(&self, g: &Geometry) -> Result<PathSpectrum, AtmosphereError> {
         let n_nodes = self.lut.axes().wavelengths_nm.len();
-        let norm = (0..n_nodes).map(|w| self.lut.normalised(w, g)).collect::<Result<Vec<_>, _>>()?;
+        let norm = (0..n_nodes).map(|w| self.lut.normalised_with(w, g, self.glint)).collect::<Result<Vec<_>, _>>()?;
         let atmosphere = self.lut.atmosphere();
         let (mu0, muv) = (g.sun_zenith_rad.cos(), g.view_zenith_rad.cos());
         let n = self.grid.len();

@@ -2,6 +2,7 @@
 //! incremental re-runs, determinism, bad input, and `shoal simulate`.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+mod adjacency;
 mod bad_input;
 mod cli;
 mod closure;
