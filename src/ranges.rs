@@ -179,11 +179,11 @@ ranges! {
     /// Spectrograph: first band centre.
     SPECTROGRAPH_START_NM = Range::closed("instrument.kind.Spectrograph.start_nm", 350.0, 1000.0, "nm", "first band centre");
     /// Spectrograph: last band centre.
-    SPECTROGRAPH_END_NM = Range::closed("instrument.kind.Spectrograph.end_nm", 350.0, 1000.0, "nm", "last band centre (and not below start_nm)");
+    SPECTROGRAPH_END_NM = Range::closed("instrument.kind.Spectrograph.end_nm", 350.0, 1000.0, "nm", "last band centre (not below start_nm; end_nm + 2.5·resolution_nm + abs(smile_nm) ≤ 1000 nm)");
     /// Spectrograph: sampling.
     SPECTROGRAPH_SAMPLING_NM = Range::above("instrument.kind.Spectrograph.sampling_nm", 0.0, 100.0, "nm", "spectral sampling per detector row (at most 2000 samples)");
     /// Spectrograph: resolution.
-    SPECTROGRAPH_RESOLUTION_NM = Range::above("instrument.kind.Spectrograph.resolution_nm", 0.0, 200.0, "nm", "spectral resolution, FWHM");
+    SPECTROGRAPH_RESOLUTION_NM = Range::above("instrument.kind.Spectrograph.resolution_nm", 0.0, 100.0, "nm", "spectral resolution, FWHM (every band's response, centre ± 2.5 FWHM, within 325–1000 nm)");
     /// Spectrograph: smile.
     SPECTROGRAPH_SMILE_NM = Range::closed("instrument.kind.Spectrograph.smile_nm", -20.0, 20.0, "nm", "band-centre shift at the swath edges");
     /// Spectrograph: keystone.

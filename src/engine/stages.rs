@@ -381,6 +381,9 @@ impl Engine {
             .with(&typical)
             .with(&fid.snr_frames)
             .with(&fid.snr_detectors)
+            // A preview measures on snr_detectors / decimation detectors: the typical radiance
+            // alone would not tell two decimations of a uniform scene apart.
+            .with(&fid.decimation)
             .with(&config.seed)
             .finish();
         let snr = self.stage(Stage::Snr, snr_key, report, control, || {

@@ -312,6 +312,11 @@ fn structural_edits() -> Vec<Edit> {
                 settings.noise_weighting = !settings.noise_weighting;
             }
         }),
+        ("aLMI reference mode", |c| {
+            if let RetrievalSpec::Almi { settings, .. } = &mut c.retrievals[0] {
+                settings.mode = shoal::retrieval::Mode::Reference;
+            }
+        }),
         ("aLMI bands", |c| {
             if let RetrievalSpec::Almi { settings, .. } = &mut c.retrievals[0] {
                 settings.bands = Some(["Oa03", "Oa05", "Oa06", "Oa08", "Oa11"].map(String::from).to_vec());

@@ -108,7 +108,13 @@ fn the_allowed_ends_pass() {
             ends.pop(); // start_nm = 1000 would put it above end_nm; the end is checked there.
         }
         if range.path == "instrument.kind.Spectrograph.end_nm" {
-            ends.remove(0); // end_nm = 350 would be below start_nm (refused with its own message).
+            // end_nm = 350 would be below start_nm, and end_nm = 1000 puts the last band's
+            // response past 1000 nm (end_nm + 2.5·resolution ≤ 1000): each refused with its own
+            // message, tested below.
+            ends.clear();
+        }
+        if range.path == "instrument.kind.Spectrograph.resolution_nm" {
+            ends.pop(); // 100 nm puts the 900 nm band's response past 1000 nm (its own message).
         }
         if range.path == "instrument.kind.Spectrograph.sampling_nm" {
             ends.remove(0); // A tiny step would give more than 2000 samples (its own message).
@@ -134,4 +140,24 @@ fn the_cli_refuses_an_out_of_range_flag_with_exit_code_2() {
     let table = Command::new(env!("CARGO_BIN_EXE_shoal")).arg("ranges").output().unwrap();
     assert!(table.status.success());
     assert_eq!(String::from_utf8_lossy(&table.stdout), ranges::markdown_table());
+}
+
+#[test]
+fn a_spectrograph_reaching_past_the_data_is_refused_by_name() {
+    let base = base("instrument.kind.Spectrograph.end_nm");
+    let with_end = |end: f64| {
+        let mut c = base.clone();
+        if let shoal::instrument::InstrumentKind::Spectrograph { end_nm, .. } = &mut c.instrument.kind {
+            *end_nm = end;
+        }
+        c
+    };
+    let shoal::instrument::InstrumentKind::Spectrograph { resolution_nm, smile_nm, .. } = base.instrument.kind else {
+        panic!("not a spectrograph")
+    };
+    // The last band's response reaches end + 2.5·FWHM + |smile|: allowed up to exactly 1000 nm.
+    let last = 1000.0 - 2.5 * resolution_nm - smile_nm.abs();
+    assert!(with_end(last).validate().is_ok());
+    let e = with_end(last + 0.5).validate().unwrap_err().to_string();
+    assert!(e.contains("kind.Spectrograph.end_nm") && e.contains("≤ 1000 nm"), "{e}");
 }

@@ -131,6 +131,26 @@ fn a_saved_preset_reloads_with_its_edits() {
 }
 
 #[test]
+fn saving_under_a_built_in_name_is_refused_inline() {
+    let dir = temp_library("builtin-name");
+    let mut h = harness("cubesat", 16, &dir);
+    h.get_by_role_and_label(Role::Slider, "Aperture").set_value_accesskit(77.0);
+    h.step();
+    h.get_by_role_and_label(Role::TextInput, "Preset name").set_text_value_accesskit("smallsat");
+    h.step();
+    h.get_by_label("Save A").click();
+    h.step();
+    h.step();
+    let error = h.state().error().unwrap_or_default().to_string();
+    assert!(error.contains("`smallsat` is a built-in instrument; save yours under another name"), "{error}");
+    assert!(!dir.join("instruments").join("smallsat.ron").exists());
+    // The edit is kept, still marked as modified, and B's built-in smallsat is untouched.
+    assert!((h.state().state.a.spec.aperture_mm - 77.0).abs() < 1e-9);
+    assert!(h.state().state.a.modified());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn a_malformed_preset_shows_an_error_and_the_app_goes_on() {
     let dir = temp_library("broken");
     let instruments = dir.join("instruments");
