@@ -117,7 +117,7 @@ pub fn not_returned(p: &AlmiPixel) -> Option<NotReturned> {
 }
 
 /// The minimum-norm least-squares solution of rows·x = y through the truncated SVD: with
-/// AᵀA = V Λ Vᵀ (Jacobi), singular values σᵢ = √λᵢ, x = Σ_{σᵢ > rcond·σ_max} vᵢ (vᵢ·Aᵀy)/λᵢ.
+/// AᵀA = V Λ Vᵀ (cyclic Jacobi, Golub & Van Loan §8.5), singular values σᵢ = √λᵢ, x = Σ_{σᵢ > rcond·σ_max} vᵢ (vᵢ·Aᵀy)/λᵢ.
 /// `None` when the system has no finite solution.
 fn lstsq3(rows: &[[f64; 3]], y: &[f64]) -> Option<[f64; 3]> {
     let mut g = [[0.0; 3]; 3];
@@ -130,7 +130,7 @@ fn lstsq3(rows: &[[f64; 3]], y: &[f64]) -> Option<[f64; 3]> {
             }
         }
     }
-    let (lambda, v) = jacobi3(g);
+    let (lambda, v) = super::quadrature::symmetric_eigen(g.iter().map(|r| r.to_vec()).collect());
     let max = lambda.iter().copied().fold(0.0f64, f64::max);
     if !(max > 0.0) || !max.is_finite() {
         return None;
@@ -146,45 +146,6 @@ fn lstsq3(rows: &[[f64; 3]], y: &[f64]) -> Option<[f64; 3]> {
         }
     }
     x.iter().all(|v| v.is_finite()).then_some(x)
-}
-
-/// Eigenvalues and eigenvectors (columns of the second result) of a symmetric 3×3 matrix by
-/// cyclic Jacobi rotations (Golub & Van Loan §8.5.2), to full f64 precision.
-fn jacobi3(mut a: [[f64; 3]; 3]) -> ([f64; 3], [[f64; 3]; 3]) {
-    let mut v = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-    for _sweep in 0..50 {
-        let off = a[0][1].powi(2) + a[0][2].powi(2) + a[1][2].powi(2);
-        let diag = a[0][0].powi(2) + a[1][1].powi(2) + a[2][2].powi(2);
-        if off <= 1e-32 * diag || off == 0.0 {
-            break;
-        }
-        for (p, q) in [(0, 1), (0, 2), (1, 2)] {
-            if a[p][q] == 0.0 {
-                continue;
-            }
-            let theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
-            let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
-            let t = if theta == 0.0 { 1.0 } else { t };
-            let c = 1.0 / (t * t + 1.0).sqrt();
-            let s = t * c;
-            for k in 0..3 {
-                let (akp, akq) = (a[k][p], a[k][q]);
-                a[k][p] = c * akp - s * akq;
-                a[k][q] = s * akp + c * akq;
-            }
-            for k in 0..3 {
-                let (apk, aqk) = (a[p][k], a[q][k]);
-                a[p][k] = c * apk - s * aqk;
-                a[q][k] = s * apk + c * aqk;
-            }
-            for row in &mut v {
-                let (vp, vq) = (row[p], row[q]);
-                row[p] = c * vp - s * vq;
-                row[q] = s * vp + c * vq;
-            }
-        }
-    }
-    ([a[0][0], a[1][1], a[2][2]], v)
 }
 
 #[cfg(test)]

@@ -68,7 +68,7 @@ pub fn gauss_rule(x: &[f64], w: &[f64], k: usize) -> (Vec<f64>, Vec<f64>) {
 
 /// Eigenvalues and eigenvectors (columns) of a small symmetric matrix by cyclic Jacobi
 /// rotations (Golub & Van Loan 2013, §8.5).
-fn symmetric_eigen(mut a: Vec<Vec<f64>>) -> (Vec<f64>, Vec<Vec<f64>>) {
+pub(crate) fn symmetric_eigen(mut a: Vec<Vec<f64>>) -> (Vec<f64>, Vec<Vec<f64>>) {
     let n = a.len();
     let mut v: Vec<Vec<f64>> = (0..n).map(|i| (0..n).map(|j| f64::from(u8::from(i == j))).collect()).collect();
     for _sweep in 0..64 {
