@@ -15,7 +15,7 @@
 use rayon::prelude::*;
 
 use super::AtmosphereError;
-use super::rt::{Scatterers, SsCoefficients, fourier_sum, solve_sun, solve_transmittance};
+use super::rt::{Scatterers, SsCoefficients, WavelengthColumn, fourier_sum, solve_sun, solve_transmittance};
 use super::spec::{Atmosphere, AtmosphereTerms, Geometry, Normalised};
 
 /// Node positions of the table (the azimuth axis sets where `shoal bench` and tests probe; the
@@ -88,6 +88,7 @@ pub struct AtmosphereLut {
     spherical_albedo: Vec<f64>,
     tau_total: Vec<f64>,
     tau_rayleigh: Vec<f64>,
+    forward_scattering: Vec<(f64, f64)>,
 }
 
 /// Bracketing nodes and weight for linear interpolation on `nodes`; `x` must lie within the
@@ -146,6 +147,7 @@ impl AtmosphereLut {
         Ok(Self {
             tau_total: columns.iter().map(|c| c.total_tau()).collect(),
             tau_rayleigh: columns.iter().map(|c| c.tau_rayleigh).collect(),
+            forward_scattering: columns.iter().map(WavelengthColumn::forward_scattering).collect(),
             axes,
             atmosphere: atmosphere.clone(),
             ms,
@@ -242,6 +244,7 @@ impl AtmosphereLut {
             t_up_direct,
             spherical_albedo: self.spherical_albedo[w],
             glint,
+            forward_scattering: self.forward_scattering[w],
         })
     }
 }

@@ -106,6 +106,38 @@ impl PhaseFunction {
         }
     }
 
+    /// The share of scattered light sent into the forward hemisphere, η = ½∫₀¹ P(μ) dμ
+    /// (μ = cosΘ; ½ for any phase function symmetric about 90°, Rayleigh's included).
+    ///
+    /// ```
+    /// use shoal::atmosphere::PhaseFunction;
+    /// let r = PhaseFunction::Rayleigh { depolarization: 0.0279 };
+    /// assert!((r.forward_fraction() - 0.5).abs() < 1e-12);
+    /// ```
+    #[must_use]
+    pub fn forward_fraction(&self) -> f64 {
+        match self {
+            // ∫₀¹ P₂(μ) dμ = 0.
+            Self::Rayleigh { .. } => 0.5,
+            Self::Tabulated { angles_rad, .. } => {
+                let (gx, gw) = gauss_legendre(12);
+                let half = std::f64::consts::FRAC_PI_2;
+                let mut sum = 0.0;
+                for w in angles_rad.windows(2) {
+                    let (a, b) = (w[0], w[1].min(half));
+                    if a >= half {
+                        break;
+                    }
+                    for (x, wt) in gx.iter().zip(&gw) {
+                        let theta = 0.5 * (a + b) + 0.5 * (b - a) * x;
+                        sum += wt * 0.5 * (b - a) * theta.sin() * self.value(theta.cos());
+                    }
+                }
+                0.5 * sum
+            }
+        }
+    }
+
     /// Asymmetry parameter g = β₁/3.
     #[must_use]
     pub fn asymmetry(&self) -> f64 {
@@ -138,5 +170,24 @@ mod tests {
         }
         // OSOAA: β₂ = A/2, A = 2(1−δ)/(2+δ) with δ = 0.0279 → 0.479363.
         assert!((br[2] - 0.479_363).abs() < 1e-6, "OSOAA's β₂ for air: {}", br[2]);
+    }
+
+    #[test]
+    fn forward_fraction_of_isotropic_and_henyey_greenstein_phase_functions() {
+        // Isotropic: exactly half forward.
+        let angles: Vec<f64> = (0..=90).map(|i| 2.0 * f64::from(i)).collect();
+        let iso = PhaseFunction::from_table(&angles, &vec![1.0; angles.len()]).unwrap();
+        assert!((iso.forward_fraction() - 0.5).abs() < 1e-12);
+        // Henyey–Greenstein, g = 0.7 (normalised ½∫P dμ = 1): ½∫₀¹ P dμ =
+        // (1+g)/(2g) − (1−g²)/(2g√(1+g²)) = 0.915851 (integrated by hand from P = (1−g²)/(1+g²−2gμ)^{3/2}).
+        let g: f64 = 0.7;
+        let fine: Vec<f64> = (0..=1800).map(|i| 0.1 * f64::from(i)).collect();
+        let hg: Vec<f64> =
+            fine.iter().map(|a| (1.0 - g * g) / (1.0 + g * g - 2.0 * g * a.to_radians().cos()).powf(1.5)).collect();
+        let p = PhaseFunction::from_table(&fine, &hg).unwrap();
+        let exact = (1.0 + g) / (2.0 * g) - (1.0 - g * g) / (2.0 * g * (1.0 + g * g).sqrt());
+        assert!((exact - 0.915_851).abs() < 1e-6, "{exact}");
+        // 1e-4: ln-linear interpolation on a 0.1° table and 12-point Gauss–Legendre per interval.
+        assert!((p.forward_fraction() - exact).abs() < 1e-4, "{} vs {exact}", p.forward_fraction());
     }
 }

@@ -141,6 +141,18 @@ pub struct WavelengthColumn {
 }
 
 impl WavelengthColumn {
+    /// Forward-scattering optical depths (molecules, aerosols): ω·η·τ, with η the share of each
+    /// phase function in the forward hemisphere ([`PhaseFunction::forward_fraction`]; ½ for
+    /// molecules, whose ω is 1). In the single-scattering limit the diffuse part of a beam's
+    /// transmission is Σ ω·η·τ/μ over the scatterers (Liou 2002, *An Introduction to Atmospheric
+    /// Radiation*, 2nd ed., §6.3; the split 6S makes between Rayleigh and aerosol diffuse
+    /// transmittances, Vermote et al. 1997), so these weigh the two environment functions.
+    #[must_use]
+    pub fn forward_scattering(&self) -> (f64, f64) {
+        let aerosol = self.aerosol.as_ref().map_or(0.0, |(tau, ssa, phase)| ssa * phase.forward_fraction() * tau);
+        (0.5 * self.tau_rayleigh, aerosol)
+    }
+
     fn optics(&self) -> ColumnOptics {
         let (tau_a, ssa) = self.aerosol.as_ref().map_or((0.0, 1.0), |(t, w, _)| (*t, *w));
         ColumnOptics {

@@ -239,6 +239,10 @@ pub struct Normalised {
     pub spherical_albedo: f64,
     /// Glint radiance per unit flux (0 for a flat surface).
     pub glint: f64,
+    /// Molecules' and aerosols' forward-scattering optical depths, ω·η·τ with η the phase
+    /// function's forward-hemisphere share: the single-scattering weights of their diffuse
+    /// transmission (the adjacency effect mixes their environment functions by these).
+    pub forward_scattering: (f64, f64),
 }
 
 /// A validated atmosphere.
@@ -314,6 +318,7 @@ impl Atmosphere {
             t_up_direct: up.t_up_direct[0],
             spherical_albedo: up.spherical_albedo,
             glint,
+            forward_scattering: column.forward_scattering(),
         };
         self.assemble(&n)
     }

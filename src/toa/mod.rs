@@ -198,10 +198,11 @@ impl SceneOptics {
             if self.glint {
                 p.glint[i] = loglin(a.glint, b.glint, t) * e0 * tg0 * tgv;
             }
-            // Diffuse transmission by molecules vs aerosols, in proportion to their scattering
-            // depths sending light forward (half of Rayleigh's; most of the aerosol's).
-            let (tr, ta) = (lin(a.tau_rayleigh, b.tau_rayleigh, t), lin(a.tau_aerosol, b.tau_aerosol, t));
-            let (dr, da) = (0.5 * tr, 0.85 * ta);
+            // Diffuse transmission by molecules vs aerosols, in proportion to their forward-
+            // scattering depths ω·η·τ (η from each phase function: ½ for molecules, the Mie
+            // table's forward share for the aerosol; see WavelengthColumn::forward_scattering).
+            let dr = lin(a.forward_scattering.0, b.forward_scattering.0, t);
+            let da = lin(a.forward_scattering.1, b.forward_scattering.1, t);
             p.rayleigh_share[i] = if dr + da > 0.0 { dr / (dr + da) } else { 1.0 };
         }
         Ok(p)
