@@ -192,6 +192,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     let (rows, cols, nb) = out.report.shape;
     eprintln!("{label}: {rows} lines × {cols} detectors × {nb} bands in {:.2} s", out.report.total_seconds);
     eprint!("{}", out.report.table());
+    eprint!("{}", out.report.truth_shares.table());
     for w in &out.report.warnings {
         eprintln!("warning: {}: {}", out.config.instrument.name, w.message);
     }

@@ -37,6 +37,7 @@ mod fault;
 mod products;
 mod report;
 mod run;
+pub mod shares;
 mod stages;
 pub mod worker;
 

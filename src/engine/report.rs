@@ -75,6 +75,8 @@ pub struct RunReport {
     pub rrs_vs_truth: Vec<BandDifference>,
     /// Line period and exposure, s.
     pub line_period_s: f64,
+    /// The truth's depth and substrate shares over the water pixels seen.
+    pub truth_shares: super::shares::SceneShares,
     /// Plausibility warnings: saturation at the brightest water radiance, smear, f-number.
     pub warnings: Vec<crate::instrument::plausibility::Warning>,
     /// Total wall time, s.

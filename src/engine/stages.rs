@@ -206,6 +206,7 @@ impl Engine {
         }
         let (rows, cols, nb) = radiance.radiance.dim();
         report.shape = (rows, cols, nb);
+        report.truth_shares = super::shares::SceneShares::of(&radiance);
 
         Ok((radiance, radiance_key))
     }

@@ -227,16 +227,19 @@ pub fn write_study(result: &StudyResult, dir: &Path, figures: bool) -> Result<Ou
             }));
         }
     }
-    // Plausibility warnings once per instrument (they do not depend on the noise seed).
-    let mut warnings = serde_json::Map::new();
+    // Plausibility warnings and the truth's shares once per instrument (neither depends on the
+    // noise seed).
+    let (mut warnings, mut shares) = (serde_json::Map::new(), serde_json::Map::new());
     for run in &result.runs {
         warnings.entry(run.label.clone()).or_insert_with(|| serde_json::json!(run.report.warnings));
+        shares.entry(run.label.clone()).or_insert_with(|| serde_json::json!(run.report.truth_shares));
     }
     let doc = serde_json::json!({
         "study": result.study.spec.name,
         "metrics": rows,
         "retrievals": extra,
         "warnings": warnings,
+        "truth_shares": shares,
     });
     text(dir, "metrics.json", &json(&doc)?, &mut o)?;
     let spec = ron::ser::to_string_pretty(&result.study.spec, ron::ser::PrettyConfig::default().struct_names(true))

@@ -126,3 +126,36 @@ fn the_cli_prints_the_warnings_and_writes_them_into_report_json() {
         report["warnings"].as_array().unwrap().iter().map(|w| w["guard"].as_str().unwrap()).collect();
     assert_eq!(guards, ["FNumber", "Saturation"]);
 }
+
+#[test]
+fn the_report_counts_the_truths_depth_and_substrate_shares() {
+    let mut c = RunConfig::new(super::reef(), small("cubesat", 64, 48));
+    c.fidelity.decimation = 1;
+    let out = run(&c);
+    let s = &out.report.truth_shares;
+    let depth = out.radiance.depth_m.as_ref().unwrap();
+    let fractions = out.radiance.substrate_fractions.as_ref().unwrap();
+    // Independent count: water pixels and, per substrate, the pixels where it is the largest.
+    let water: Vec<(usize, usize)> =
+        out.radiance.land.indexed_iter().filter(|(_, l)| **l == 0).map(|(rc, _)| rc).collect();
+    assert_eq!(s.water_pixels, water.len());
+    let (lo, hi) = water
+        .iter()
+        .map(|&(r, c)| f64::from(depth[[r, c]]))
+        .fold((f64::MAX, f64::MIN), |(a, b), d| (a.min(d), b.max(d)));
+    assert_eq!(s.depth_range_m, Some((lo, hi)));
+    let bins: f64 = s.depth_bins.iter().map(|b| b.share_pct).sum();
+    assert!((bins - 100.0).abs() < 1e-9, "{bins}");
+    for (k, sub) in s.substrates.iter().enumerate() {
+        let dominant = water
+            .iter()
+            .filter(|&&(r, c)| {
+                let v = fractions[[r, c, k]];
+                (0..fractions.dim().2).all(|j| fractions[[r, c, j]] <= v)
+            })
+            .count();
+        // Ties (two equal fractions) go to one substrate in the report and to both here.
+        assert!((sub.dominant_pct - 100.0 * dominant as f64 / water.len() as f64).abs() < 1.0, "{}", sub.name);
+    }
+    assert!(out.report.truth_shares.table().contains("depth"));
+}
