@@ -73,6 +73,8 @@ pub const PRESETS: &[Asset] = embed_presets![
     "scenes/heron_island_reef.ron",
     "scenes/aquaculture_turbidity.ron",
     "scenes/reservoir_chl_cdom.ron",
+    "scenes/paper_heron_island.ron",
+    "scenes/paper_lake_hume.ron",
     "instruments/nominal.ron",
     "instruments/cubesat.ron",
     "instruments/smallsat.ron",
@@ -81,6 +83,8 @@ pub const PRESETS: &[Asset] = embed_presets![
     "studies/cubesat_vs_smallsat.ron",
     "studies/lake_hume_nominal.ron",
     "studies/heron_island_depth.ron",
+    "studies/paper_heron_island.ron",
+    "studies/paper_lake_hume.ron",
     "sweeps/aperture_lake_hume.ron",
 ];
 

@@ -17,8 +17,9 @@ use crate::scene::{SceneError, SceneSpec};
 /// Arguments of `shoal simulate`.
 #[derive(Debug, Args)]
 pub struct SimulateArgs {
-    /// Scene: a built-in name (lake_hume_bloom, heron_island_reef, aquaculture_turbidity,
-    /// reservoir_chl_cdom) or a scene RON file.
+    /// Scene: a preset name (yours in the library first, then the built-ins lake_hume_bloom,
+    /// heron_island_reef, aquaculture_turbidity, reservoir_chl_cdom, paper_lake_hume,
+    /// paper_heron_island) or a scene RON file.
     #[arg(long, default_value = "lake_hume_bloom")]
     scene: String,
     /// Instrument: a built-in name (nominal, cubesat, smallsat, hyperspectral, filter_imager) or
