@@ -37,7 +37,6 @@ mod fault;
 mod products;
 mod report;
 mod run;
-pub mod shares;
 mod stages;
 pub mod worker;
 

@@ -76,7 +76,7 @@ pub struct RunReport {
     /// Line period and exposure, s.
     pub line_period_s: f64,
     /// The truth's depth and substrate shares over the water pixels seen.
-    pub truth_shares: super::shares::SceneShares,
+    pub truth_shares: crate::instrument::shares::SceneShares,
     /// Plausibility warnings: saturation at the brightest water radiance, smear, f-number.
     pub warnings: Vec<crate::instrument::plausibility::Warning>,
     /// Total wall time, s.

@@ -206,7 +206,7 @@ impl Engine {
         }
         let (rows, cols, nb) = radiance.radiance.dim();
         report.shape = (rows, cols, nb);
-        report.truth_shares = super::shares::SceneShares::of(&radiance);
+        report.truth_shares = radiance.truth_shares.clone();
 
         Ok((radiance, radiance_key))
     }
@@ -254,9 +254,13 @@ impl Engine {
             Ok(Detector::new(instrument, response, config.detector, config.seed))
         })?;
         let names: Vec<String> = response.bands.bands.iter().map(|b| b.name.clone()).collect();
-        let brightest = crate::instrument::plausibility::brightest_water(&radiance.radiance, &radiance.land);
-        report.warnings =
-            crate::instrument::plausibility::assess(instrument, &detector, &names, &brightest, viewing.line_period_s);
+        report.warnings = crate::instrument::plausibility::assess(
+            instrument,
+            &detector,
+            &names,
+            &radiance.brightest_water_w_m2_sr_nm,
+            viewing.line_period_s,
+        );
         let electrons_key = KeyBuilder::new(Stage::Electrons).after(radiance_key).after(photon_key).finish();
         let electrons = self.stage(Stage::Electrons, electrons_key, report, control, || {
             expose_cube(&detector, &radiance.radiance, viewing, config.seed, control).map_err(failed(Stage::Electrons))

@@ -11,6 +11,7 @@
 //! | detector | [`detector`] | photo-electrons, shot/dark/read noise, PRNU/DSNU, full well, ADC |
 //! | Level-0 | [`level0`] | the whole image exposed and read out, with flags |
 //! | plausibility | [`plausibility`] | saturation at the brightest water, smear, f-number warnings |
+//! | truth shares | [`shares`] | depth bins and substrate shares of the water pixels seen |
 //! | SNR | [`snr`] | analytic SNR and SNR measured on a simulated uniform patch |
 //!
 //! Four kinds (see [`InstrumentKind`]): a band-pass multispectral imager, an ideal radiometer
@@ -31,6 +32,7 @@ pub mod level0;
 pub mod plausibility;
 pub mod response;
 pub mod sample;
+pub mod shares;
 pub mod snr;
 pub mod spatial;
 pub mod spec;

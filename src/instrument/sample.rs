@@ -158,6 +158,11 @@ pub struct RadianceCube {
     pub water_evaluations: u64,
     /// Water-model evaluations that included the bottom term.
     pub bottom_evaluations: u64,
+    /// Brightest band radiance over the water pixels (what the plausibility guard checks the
+    /// detector's full scale against), W m⁻² sr⁻¹ nm⁻¹.
+    pub brightest_water_w_m2_sr_nm: Vec<f64>,
+    /// The truth's depth and substrate shares over the water pixels.
+    pub truth_shares: super::shares::SceneShares,
 }
 
 /// Sample the scene through every pixel of `viewing`: `optics[g]` is the scene bound to group
@@ -272,7 +277,7 @@ pub fn sample_radiance(
     let cube = |v: Vec<f32>| Array3::from_shape_vec(shape3, v);
     let plane = |k: usize| Array2::from_shape_fn((rows, cols), |(r, c)| maps[(r * cols + c) * 4 + k]);
     let bad = |e: ndarray::ShapeError| InstrumentError::Invalid { field: "cube".into(), message: e.to_string() };
-    Ok(RadianceCube {
+    let mut out = RadianceCube {
         radiance: cube(radiance).map_err(bad)?,
         rrs: cube(rrs_truth).map_err(bad)?,
         chl_mg_m3: plane(0),
@@ -288,7 +293,13 @@ pub fn sample_radiance(
         substrate_names: scene.substrates.iter().map(|(n, _)| n.clone()).collect(),
         water_evaluations: counters.iter().map(|c| c.0).sum(),
         bottom_evaluations: counters.iter().map(|c| c.1).sum(),
-    })
+        brightest_water_w_m2_sr_nm: Vec::new(),
+        truth_shares: super::shares::SceneShares::default(),
+    };
+    // Summaries of the cube, once per cube (runs that reuse it from the cache reuse them).
+    out.brightest_water_w_m2_sr_nm = super::plausibility::brightest_water(&out.radiance, &out.land);
+    out.truth_shares = super::shares::SceneShares::of(&out);
+    Ok(out)
 }
 
 /// The truth maps at scene point (x, y): chl, NAP, CDOM, depth into `maps`, the land flag, and

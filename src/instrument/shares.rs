@@ -5,7 +5,7 @@
 
 use serde::Serialize;
 
-use crate::instrument::RadianceCube;
+use super::RadianceCube;
 
 /// One 1-m depth bin.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -44,52 +44,68 @@ pub struct SceneShares {
 }
 
 impl SceneShares {
-    /// Count the shares of `cube`'s truth.
+    /// Count the shares of `cube`'s truth in one pass over its pixels (the radiance stage does it
+    /// once per cube; runs that reuse the cube reuse the count).
     #[must_use]
     pub fn of(cube: &RadianceCube) -> Self {
-        let water: Vec<(usize, usize)> = cube.land.indexed_iter().filter(|(_, l)| **l == 0).map(|(rc, _)| rc).collect();
-        let n = water.len();
-        let mut out = Self { water_pixels: n, ..Self::default() };
-        if n == 0 {
+        let land = cube.land.as_slice().unwrap_or(&[]);
+        let depth = cube.depth_m.as_ref().and_then(|d| d.as_slice());
+        let fractions = cube.substrate_fractions.as_ref().and_then(|f| f.as_slice());
+        let n_sub = if fractions.is_some() { cube.substrate_names.len() } else { 0 };
+        let water = land.iter().filter(|&&l| l == 0).count();
+        let mut out = Self { water_pixels: water, ..Self::default() };
+        if water == 0 {
             return out;
         }
-        let pct = |k: usize, of: usize| if of == 0 { 0.0 } else { 100.0 * k as f64 / of as f64 };
-        let dominant = |r: usize, c: usize| -> Option<usize> {
-            let f = cube.substrate_fractions.as_ref()?;
-            (0..f.dim().2).max_by(|&a, &b| f[[r, c, a]].total_cmp(&f[[r, c, b]]))
-        };
-        let n_sub = cube.substrate_names.len();
-        if let Some(f) = &cube.substrate_fractions {
-            for (s, name) in cube.substrate_names.iter().enumerate() {
-                let mean = water.iter().map(|&(r, c)| f64::from(f[[r, c, s]])).sum::<f64>() / n as f64;
-                let dom = water.iter().filter(|&&(r, c)| dominant(r, c) == Some(s)).count();
-                out.substrates.push(SubstrateShare {
-                    name: name.clone(),
-                    mean_fraction_pct: 100.0 * mean,
-                    dominant_pct: pct(dom, n),
-                });
-            }
-        }
-        if let Some(depth) = &cube.depth_m {
-            let d: Vec<f64> = water.iter().map(|&(r, c)| f64::from(depth[[r, c]])).collect();
-            let (lo, hi) = d.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
-            out.depth_range_m = Some((lo, hi));
-            let first = lo.floor();
-            let bins = ((hi - first).floor() as usize + 1).min(1000);
-            let mut counts = vec![0usize; bins];
-            let mut dom = vec![vec![0usize; n_sub]; bins];
-            for (i, &(r, c)) in water.iter().enumerate() {
-                let b = ((d[i] - first).floor() as usize).min(bins - 1);
-                counts[b] += 1;
-                if let Some(s) = dominant(r, c) {
-                    dom[b][s] += 1;
+        let (lo, hi) = depth.map_or((0.0, 0.0), |d| {
+            d.iter()
+                .zip(land)
+                .filter(|(_, l)| **l == 0)
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), (&v, _)| (a.min(f64::from(v)), b.max(f64::from(v))))
+        });
+        let first = lo.floor();
+        let bins = if depth.is_some() { ((hi - first).floor() as usize + 1).min(1000) } else { 0 };
+        let mut bin_count = vec![0usize; bins];
+        let mut bin_dominant = vec![vec![0usize; n_sub]; bins];
+        let mut fraction_sum = vec![0.0f64; n_sub];
+        let mut dominant_count = vec![0usize; n_sub];
+        for (p, _) in land.iter().enumerate().filter(|(_, l)| **l == 0) {
+            // The largest fraction (the first of equals).
+            let dominant = fractions.map(|f| {
+                let here = &f[p * n_sub..(p + 1) * n_sub];
+                let mut best = 0;
+                for (s, &v) in here.iter().enumerate() {
+                    fraction_sum[s] += f64::from(v);
+                    if v > here[best] {
+                        best = s;
+                    }
+                }
+                dominant_count[best] += 1;
+                best
+            });
+            if let Some(d) = depth {
+                let b = ((f64::from(d[p]) - first).floor() as usize).min(bins - 1);
+                bin_count[b] += 1;
+                if let Some(s) = dominant {
+                    bin_dominant[b][s] += 1;
                 }
             }
+        }
+        let pct = |k: usize, of: usize| if of == 0 { 0.0 } else { 100.0 * k as f64 / of as f64 };
+        out.substrates = (0..n_sub)
+            .map(|s| SubstrateShare {
+                name: cube.substrate_names[s].clone(),
+                mean_fraction_pct: 100.0 * fraction_sum[s] / water as f64,
+                dominant_pct: pct(dominant_count[s], water),
+            })
+            .collect();
+        if depth.is_some() {
+            out.depth_range_m = Some((lo, hi));
             out.depth_bins = (0..bins)
                 .map(|b| DepthBin {
                     from_m: first + b as f64,
-                    share_pct: pct(counts[b], n),
-                    dominant_pct: dom[b].iter().map(|&k| pct(k, counts[b])).collect(),
+                    share_pct: pct(bin_count[b], water),
+                    dominant_pct: bin_dominant[b].iter().map(|&k| pct(k, bin_count[b])).collect(),
                 })
                 .collect();
         }
