@@ -94,6 +94,8 @@ pub struct ShoalApp {
     session_path: Option<PathBuf>,
     /// The state last written there.
     saved_state: Option<AppState>,
+    /// The session write in progress (on its own thread: the UI thread never touches the disk).
+    session_writer: Option<std::thread::JoinHandle<Result<(), String>>>,
 }
 
 /// Storage key of the session.
@@ -134,6 +136,7 @@ impl ShoalApp {
             applied_theme: None,
             session_path: None,
             saved_state: None,
+            session_writer: None,
         }
     }
 
@@ -484,6 +487,15 @@ impl ShoalApp {
     }
 }
 
+impl Drop for ShoalApp {
+    /// The last session write finishes before the app goes (eframe saves on quit, then drops).
+    fn drop(&mut self) {
+        if let Some(handle) = self.session_writer.take() {
+            let _ = handle.join();
+        }
+    }
+}
+
 impl eframe::App for ShoalApp {
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         self.draw(ui);
@@ -494,13 +506,24 @@ impl eframe::App for ShoalApp {
     /// Called by eframe on quit and every 30 s: the session goes to our own file (atomic, under
     /// `SHOAL_HOME` when set), only when it changed.
     fn save(&mut self, _storage: &mut dyn eframe::Storage) {
-        let Some(path) = &self.session_path else { return };
+        let Some(path) = self.session_path.clone() else { return };
+        // The previous write first (it is long done: saves come every 30 s), so writes never
+        // overlap and a failure is reported.
+        if let Some(Ok(Err(e))) = self.session_writer.take().map(std::thread::JoinHandle::join) {
+            self.saved_state = None;
+            self.ui.error = Some(format!("The session was not saved: {e}"));
+        }
         if self.saved_state.as_ref() == Some(&self.state) {
             return;
         }
-        match model::save_session(path, &self.state) {
-            Ok(()) => self.saved_state = Some(self.state.clone()),
-            Err(e) => self.ui.error = Some(format!("The session was not saved: {e}")),
+        let state = self.state.clone();
+        match std::thread::Builder::new().name("shoal-session".into()).spawn(move || model::save_session(&path, &state))
+        {
+            Ok(handle) => {
+                self.session_writer = Some(handle);
+                self.saved_state = Some(self.state.clone());
+            }
+            Err(e) => self.ui.error = Some(format!("The session was not saved: cannot start a thread: {e}")),
         }
     }
 }
