@@ -18,7 +18,9 @@ pub mod optimise;
 pub mod quadrature;
 pub mod run;
 pub mod sambuca;
+pub mod sambuca_reference;
 pub mod sets;
+pub mod slsqp;
 
 pub use almi::{AlmiFlags, AlmiSettings, Mode};
 pub use band_model::{BandModel, BandResponse, ModelScratch, Parameters};

@@ -10,6 +10,7 @@ mod atmosphere_limits;
 mod cli;
 mod osoaa;
 mod sambuca;
+mod sambuca_reference;
 mod water_limits;
 
 /// Path of a file under `tests/data/`.
