@@ -175,6 +175,9 @@ pub struct ProductMetrics {
     pub siop_sets_used: usize,
     /// Water pixels the retrieval did not return (failed).
     pub failed: usize,
+    /// SAMBUCA reference mode: water pixels whose kept fit stalled (success reported with the
+    /// depth still at its start).
+    pub stalled: usize,
 }
 
 impl ProductMetrics {
@@ -261,6 +264,10 @@ pub fn evaluate(product: &Product, truth: &RadianceCube) -> ProductMetrics {
         }
     }
     let mut siop_set_counts = vec![0; product.siop_set_names.len()];
+    if product.siop_set.is_none() && siop_set_counts.len() == 1 {
+        // One set (SAMBUCA): every returned pixel used it.
+        siop_set_counts[0] = water.iter().filter(|&&(r, c)| product.returned(r, c)).count();
+    }
     if let Some(sets) = &product.siop_set {
         for &(r, c) in &water {
             if let Ok(i) = usize::try_from(sets[[r, c]])
@@ -279,6 +286,7 @@ pub fn evaluate(product: &Product, truth: &RadianceCube) -> ProductMetrics {
         siop_sets_used: siop_set_counts.iter().filter(|&&n| n > 0).count(),
         siop_set_counts,
         failed: water.iter().filter(|&&(r, c)| product.flags[[r, c]] & ProductFlags::FAILED != 0).count(),
+        stalled: water.iter().filter(|&&(r, c)| product.flags[[r, c]] & ProductFlags::STALLED != 0).count(),
     }
 }
 

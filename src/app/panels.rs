@@ -6,7 +6,7 @@ use super::ShoalApp;
 use super::model::{AppState, RetrievalKind, Slot};
 use crate::instrument::{InstrumentKind, InstrumentSpec};
 use crate::library::{Entry, Kind};
-use crate::retrieval::{Objective, Starts};
+use crate::retrieval::{Mode, Objective, Starts};
 use crate::spectral::{BandSetSpec, GaussianBand, Platform};
 
 /// One numeric instrument parameter as the editor shows it.
@@ -470,7 +470,29 @@ fn settings(app: &mut ShoalApp, ui: &mut egui::Ui) {
             ui.selectable_value(&mut s.retrieval, RetrievalKind::Almi, "aLMI");
             ui.selectable_value(&mut s.retrieval, RetrievalKind::Sambuca, "SAMBUCA");
         });
+        // Reference: the published code's behaviour, to reproduce published numbers; Improved:
+        // Shoal's inversion, the design default.
+        let mode = match s.retrieval {
+            RetrievalKind::Almi => &mut s.almi.mode,
+            RetrievalKind::Sambuca => &mut s.sambuca.mode,
+        };
+        ui.horizontal(|ui| {
+            ui.label("Mode");
+            ui.selectable_value(mode, Mode::Improved, "Improved")
+                .on_hover_text("Shoal's inversion: what a design study should use");
+            ui.selectable_value(mode, Mode::Reference, "Reference").on_hover_text(
+                "The published code step for step (DEA aLMI; CSIRO SAMBUCA with SLSQP from one start), \
+                 to reproduce the paper's numbers",
+            );
+        });
+        let reference = *mode == Mode::Reference;
         match s.retrieval {
+            RetrievalKind::Almi if reference => {
+                ui.small("As DEA's code: unweighted least squares per set, a set dropped below 1e-5.");
+            }
+            RetrievalKind::Sambuca if reference => {
+                ui.small("As the CSIRO package: distance f with NEDR, one start at (max − min)/2, SLSQP; stalls kept.");
+            }
             RetrievalKind::Almi => {
                 ui.checkbox(&mut s.almi.noise_weighting, "Noise weighting")
                     .on_hover_text("Weight each band by its noise (off: as the reference code)");

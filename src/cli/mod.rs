@@ -18,6 +18,7 @@ mod budget;
 mod grid;
 mod interrupt;
 mod output;
+mod reproduce;
 pub mod simulate;
 mod study;
 mod sweep;
@@ -47,6 +48,9 @@ enum Command {
     /// Run a study (default: CubeSat vs SmallSat over Lake Hume): metrics table, figures,
     /// cubes and the resolved configuration.
     Study(study::StudyArgs),
+    /// Reproduce Matthews et al. (2023): the paper's studies with the retrievals as the published
+    /// codes run them and as Shoal improves them, beside the published numbers.
+    Reproduce(reproduce::ReproduceArgs),
     /// Run a sweep: a study repeated over one parameter (or a grid of two) with several noise
     /// seeds per point; writes the table and the curves with the requirement's crossing.
     Sweep(sweep::SweepArgs),
@@ -148,6 +152,7 @@ pub fn main() -> ExitCode {
         Command::Simulate(args) => simulate::run(&args),
         Command::Study(args) => study::run(&args),
         Command::Sweep(args) => sweep::run(&args),
+        Command::Reproduce(args) => reproduce::run(&args),
         Command::Merge(args) => sweep::merge_run(&args),
         Command::Budget(args) => budget::run(&args),
         Command::Bench(args) => bench::run(&args),

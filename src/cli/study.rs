@@ -122,40 +122,7 @@ pub fn run(args: &StudyArgs) -> Result<(), CliError> {
     let result = result?;
     let outputs = pool.install(|| write_study(&result, &args.out, !args.no_figures))?;
     eprintln!("{}: {n} runs in {:.1} s", spec.name, start.elapsed().as_secs_f64());
-    eprintln!(
-        "{:<12} {:<8} {:<24} {:>9} {:>9} {:>10}",
-        "instrument", "product", "variable", "MAE %", "bias %", "returned %"
-    );
-    for run in &result.runs {
-        for ret in &run.retrievals {
-            for v in ret.metrics.variables.iter().chain(&ret.metrics.depth_by_true_substrate) {
-                eprintln!(
-                    "{:<12} {:<8} {:<24} {:>9.1} {:>+9.1} {:>10.2}",
-                    run.label,
-                    ret.metrics.product,
-                    v.variable,
-                    v.metrics.mae_pct(),
-                    v.metrics.bias_pct(),
-                    v.metrics.returned_pct
-                );
-            }
-            if let Some(a) = ret.metrics.substrate_agreement_pct {
-                eprintln!(
-                    "{:<12} {:<8} dominant substrate right in {a:.1} % of pixels",
-                    run.label, ret.metrics.product
-                );
-            }
-            if !ret.metrics.siop_set_counts.is_empty() {
-                eprintln!(
-                    "{:<12} {:<8} SIOP sets used: {} of {}",
-                    run.label,
-                    ret.metrics.product,
-                    ret.metrics.siop_sets_used,
-                    ret.metrics.siop_set_counts.len()
-                );
-            }
-        }
-    }
+    print_metrics(&result);
     if let Some(r) = &spec.requirements {
         eprintln!(
             "{:<12} {:<28} {:>10} {:>10} {:>6} {:>10}",
@@ -184,4 +151,48 @@ pub fn run(args: &StudyArgs) -> Result<(), CliError> {
     }
     eprintln!("wrote {} files to {}", outputs.files.len(), args.out.display());
     Ok(())
+}
+
+/// The metrics table on stderr: per instrument, product and variable; pixel accounting.
+fn print_metrics(result: &crate::study::StudyResult) {
+    eprintln!(
+        "{:<12} {:<8} {:<24} {:>9} {:>9} {:>10}",
+        "instrument", "product", "variable", "MAE %", "bias %", "returned %"
+    );
+    for run in &result.runs {
+        for ret in &run.retrievals {
+            for v in ret.metrics.variables.iter().chain(&ret.metrics.depth_by_true_substrate) {
+                eprintln!(
+                    "{:<12} {:<8} {:<24} {:>9.1} {:>+9.1} {:>10.2}",
+                    run.label,
+                    ret.metrics.product,
+                    v.variable,
+                    v.metrics.mae_pct(),
+                    v.metrics.bias_pct(),
+                    v.metrics.returned_pct
+                );
+            }
+            if let Some(a) = ret.metrics.substrate_agreement_pct {
+                eprintln!(
+                    "{:<12} {:<8} dominant substrate right in {a:.1} % of pixels",
+                    run.label, ret.metrics.product
+                );
+            }
+            if ret.metrics.failed > 0 || ret.metrics.stalled > 0 {
+                eprintln!(
+                    "{:<12} {:<8} water pixels not returned: {}; stalled at the start depth: {}",
+                    run.label, ret.metrics.product, ret.metrics.failed, ret.metrics.stalled
+                );
+            }
+            if !ret.metrics.siop_set_counts.is_empty() {
+                eprintln!(
+                    "{:<12} {:<8} SIOP sets used: {} of {}",
+                    run.label,
+                    ret.metrics.product,
+                    ret.metrics.siop_sets_used,
+                    ret.metrics.siop_set_counts.len()
+                );
+            }
+        }
+    }
 }

@@ -25,6 +25,7 @@
 
 use serde::{Deserialize, Serialize};
 
+pub use super::Mode;
 use super::band_model::BandIops;
 use super::nnls::nnls3;
 use crate::water::rrs_below_from_above;
@@ -46,16 +47,6 @@ pub struct AlmiSettings {
     /// Shoal's inversion (`Improved`, the design default) or the reference code's, step for step
     /// (`Reference`: [`super::almi_reference`]; `noise_weighting` is then ignored).
     pub mode: Mode,
-}
-
-/// Which inversion a retrieval runs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
-pub enum Mode {
-    /// Shoal's inversion: what a design study should use.
-    #[default]
-    Improved,
-    /// The published code's behaviour, to reproduce published numbers.
-    Reference,
 }
 
 impl Default for AlmiSettings {

@@ -7,7 +7,8 @@
 //! | aLMI | [`almi`] | linear matrix inversion over SIOP sets (Brando et al. 2012), non-negative |
 //! | aLMI, reference mode | [`almi_reference`] | the DEA code's inversion step for step (set dropping, screening) |
 //! | SAMBUCA | [`sambuca`] | bounded nonlinear least squares over depth and substrate pairs (Brando et al. 2009) |
-//! | solvers | [`nnls`], [`optimise`] | exact small NNLS; bounded Levenberg–Marquardt and BFGS |
+//! | SAMBUCA, reference mode | [`sambuca_reference`] | the CSIRO package's fit: one start, SLSQP, the stall kept |
+//! | solvers | [`nnls`], [`optimise`], [`slsqp`] | exact small NNLS; bounded Levenberg–Marquardt and BFGS; SciPy's SLSQP for bounds |
 //! | images | [`run`] | a retrieval over a whole Rrs cube, the products and their flags |
 
 pub mod almi;
@@ -22,13 +23,25 @@ pub mod sambuca_reference;
 pub mod sets;
 pub mod slsqp;
 
-pub use almi::{AlmiFlags, AlmiSettings, Mode};
+pub use almi::{AlmiFlags, AlmiSettings};
 pub use band_model::{BandModel, BandResponse, ModelScratch, Parameters};
 pub use run::{Product, ProductFlags, RetrievalInputs, RetrievalSpec, retrieve};
 pub use sambuca::{Objective, SambucaSettings, Starts};
 
+use serde::{Deserialize, Serialize};
+
 use crate::spectral::SpectralError;
 use crate::water::WaterError;
+
+/// Which inversion a retrieval runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+pub enum Mode {
+    /// Shoal's inversion: what a design study should use.
+    #[default]
+    Improved,
+    /// The published code's behaviour, to reproduce published numbers.
+    Reference,
+}
 
 /// Errors from the retrievals; each names the field.
 #[derive(Debug, thiserror::Error, Clone, PartialEq)]

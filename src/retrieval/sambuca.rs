@@ -98,6 +98,13 @@ pub struct SambucaSettings {
     pub nodes_per_band: usize,
     /// Which starts each pair gets.
     pub starts: Starts,
+    /// Shoal's inversion (`Improved`, the design default) or the CSIRO package's
+    /// (`Reference`: [`super::sambuca_reference`]). The reference mode fixes what the package
+    /// fixes — objective `distance_f` with the noise-equivalent ΔRrs, one start at
+    /// (p_max − p_min)/2, SLSQP with 500 iterations, the full band sum — so `objective`,
+    /// `noise_weighting`, `max_iterations`, `nodes_per_band` and `starts` are then ignored; the
+    /// bounds are used.
+    pub mode: super::Mode,
 }
 
 impl Default for SambucaSettings {
@@ -109,6 +116,7 @@ impl Default for SambucaSettings {
             max_iterations: 100,
             nodes_per_band: 3,
             starts: Starts::Adaptive,
+            mode: super::Mode::Improved,
         }
     }
 }

@@ -293,6 +293,7 @@ impl<const N: usize> Ldl<N> {
     }
 
     /// B as a dense matrix.
+    #[cfg(test)]
     fn matrix(&self) -> [[f64; N]; N] {
         let mut b = [[0.0; N]; N];
         for i in 0..N {

@@ -20,6 +20,7 @@ mod curves;
 mod figures;
 mod output;
 mod render;
+pub mod reproduction;
 mod requirements;
 mod run;
 

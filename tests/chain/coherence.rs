@@ -322,6 +322,11 @@ fn structural_edits() -> Vec<Edit> {
                 settings.bands = Some(["Oa03", "Oa05", "Oa06", "Oa08", "Oa11"].map(String::from).to_vec());
             }
         }),
+        ("SAMBUCA reference mode", |c| {
+            if let RetrievalSpec::Sambuca { settings, .. } = &mut c.retrievals[1] {
+                settings.mode = shoal::retrieval::Mode::Reference;
+            }
+        }),
         ("SAMBUCA substrates", |c| {
             if let RetrievalSpec::Sambuca { substrates, .. } = &mut c.retrievals[1] {
                 *substrates = Some(vec!["sand".into(), "acropora".into()]);

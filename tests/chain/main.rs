@@ -11,6 +11,7 @@ mod determinism;
 mod incremental;
 mod noise;
 mod plausibility;
+mod reproduction;
 mod retrieval;
 mod soak;
 mod spatial;
