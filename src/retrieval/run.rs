@@ -463,9 +463,15 @@ fn retrieve_sambuca(
             Ok(row)
         })
         .collect::<Result<_, RetrievalError>>()?;
-    let fractions = substrate_fractions(&results, names.len());
+    Ok(sambuca_product(&results, names, &spec.name))
+}
+
+/// The SAMBUCA product from its per-pixel rows.
+fn sambuca_product(results: &[Vec<SambucaRow>], names: Vec<String>, siop_name: &str) -> Product {
+    let (rows, cols) = (results.len(), results.first().map_or(0, Vec::len));
+    let fractions = substrate_fractions(results, names.len());
     let plane = |k: fn(&SambucaRow) -> f32| Array2::from_shape_fn((rows, cols), |(r, c)| k(&results[r][c]));
-    Ok(Product {
+    Product {
         name: "SAMBUCA".into(),
         chl_mg_m3: plane(|p| p.0),
         cdom_per_m: plane(|p| p.1),
@@ -473,13 +479,13 @@ fn retrieve_sambuca(
         depth_m: Some(plane(|p| p.3)),
         substrate_names: names,
         substrate_fractions: Some(fractions),
-        siop_set_names: vec![spec.name.clone()],
+        siop_set_names: vec![siop_name.to_string()],
         siop_set: None,
         cost: plane(|p| p.6),
         sdi: Some(plane(|p| p.7)),
         iterations: Some(Array2::from_shape_fn((rows, cols), |(r, c)| results[r][c].8)),
         flags: Array2::from_shape_fn((rows, cols), |(r, c)| results[r][c].9),
-    })
+    }
 }
 
 /// SAMBUCA's reference mode over the image: every water pixel fitted as the CSIRO package fits
@@ -574,21 +580,5 @@ fn retrieve_sambuca_reference(
             Ok(row)
         })
         .collect::<Result<_, RetrievalError>>()?;
-    let fractions = substrate_fractions(&results, names.len());
-    let plane = |k: fn(&SambucaRow) -> f32| Array2::from_shape_fn((rows, cols), |(r, c)| k(&results[r][c]));
-    Ok(Product {
-        name: "SAMBUCA".into(),
-        chl_mg_m3: plane(|p| p.0),
-        cdom_per_m: plane(|p| p.1),
-        nap_g_m3: plane(|p| p.2),
-        depth_m: Some(plane(|p| p.3)),
-        substrate_names: names,
-        substrate_fractions: Some(fractions),
-        siop_set_names: vec![siop_name.to_string()],
-        siop_set: None,
-        cost: plane(|p| p.6),
-        sdi: Some(plane(|p| p.7)),
-        iterations: Some(Array2::from_shape_fn((rows, cols), |(r, c)| results[r][c].8)),
-        flags: Array2::from_shape_fn((rows, cols), |(r, c)| results[r][c].9),
-    })
+    Ok(sambuca_product(&results, names, siop_name))
 }

@@ -156,14 +156,7 @@ pub fn slsqp<const N: usize>(
         if gs >= 0.0 {
             resets += 1;
             if resets > 5 {
-                // SLSQP's relaxed test, as SciPy ≥ 1.16 runs it (no constraint violation to
-                // test): f − f0 is 0 here, so it passes.
-                let status = if (fx - f0).abs() < relaxed || norm(&s) < relaxed {
-                    SlsqpStatus::Converged
-                } else {
-                    SlsqpStatus::PositiveDirectionalDerivative
-                };
-                return done(x, fx, status, nit, nfev);
+                return done(x, fx, relaxed_test(fx - f0, &s, relaxed), nit, nfev);
             }
             ldl = Ldl::identity();
             continue;
@@ -213,12 +206,7 @@ pub fn slsqp<const N: usize>(
             g = g_new;
             resets += 1;
             if resets > 5 {
-                let status = if (fx - f0).abs() < relaxed || norm(&s) < relaxed {
-                    SlsqpStatus::Converged
-                } else {
-                    SlsqpStatus::PositiveDirectionalDerivative
-                };
-                return done(x, fx, status, nit, nfev);
+                return done(x, fx, relaxed_test(fx - f0, &s, relaxed), nit, nfev);
             }
             ldl = Ldl::identity();
             continue;
@@ -226,6 +214,17 @@ pub fn slsqp<const N: usize>(
         ldl.rank_one(&y, 1.0 / sy);
         ldl.rank_one(&bs, -1.0 / sbs);
         g = g_new;
+    }
+}
+
+/// SLSQP's relaxed test after five resets, as SciPy ≥ 1.16 runs it (no constraint violation to
+/// test): success if f changed by less than 10·acc (on the reset path f − f0 is 0, so it passes)
+/// or the step is that short.
+fn relaxed_test<const N: usize>(df: f64, s: &[f64; N], relaxed: f64) -> SlsqpStatus {
+    if df.abs() < relaxed || norm(s) < relaxed {
+        SlsqpStatus::Converged
+    } else {
+        SlsqpStatus::PositiveDirectionalDerivative
     }
 }
 
