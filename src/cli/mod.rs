@@ -17,6 +17,7 @@ mod bench_retrieval;
 mod budget;
 mod grid;
 mod interrupt;
+mod lookup;
 mod output;
 mod reproduce;
 pub mod simulate;

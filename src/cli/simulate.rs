@@ -2,13 +2,14 @@
 //! Level-1 and Rrs cubes (.npy), the truth, the SNR table, the run report and the fully
 //! resolved configuration (see [`crate::study::write_run`]).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Duration;
 
 use clap::Args;
 
 use super::CliError;
+use super::lookup::Lookup;
 use crate::engine::{Engine, EngineError, RunConfig, RunOutput};
 use crate::instrument::{InstrumentError, InstrumentSpec};
 use crate::library::{Kind, Library};
@@ -72,33 +73,23 @@ impl From<SceneError> for CliError {
 
 /// A RON file, or a preset name as the app's library resolves it (the user's own preset in
 /// `SHOAL_HOME/presets` first, then the built-in): the parsed spec and the file's directory.
-fn load_scene(arg: &str) -> Result<(SceneSpec, Option<PathBuf>), CliError> {
-    if arg.ends_with(".ron") || Path::new(arg).exists() {
-        let text = std::fs::read_to_string(arg).map_err(|e| CliError::Input(format!("--scene {arg}: {e}")))?;
-        return Ok((SceneSpec::from_ron(&text, arg)?, Path::new(arg).parent().map(Path::to_path_buf)));
-    }
-    let library = Library::user();
-    match library.find(Kind::Scene, arg) {
-        Some(entry) => {
-            let dir = entry.path.as_deref().and_then(Path::parent).map(Path::to_path_buf);
-            let spec = library.load_scene(&entry).map_err(|e| CliError::Input(format!("--scene {arg}: {e}")))?;
-            Ok((spec, dir))
-        }
-        None => Ok((SceneSpec::preset(arg)?, None)),
-    }
-}
+/// `--scene`: a file, the user's library, or a built-in.
+const SCENES: Lookup<SceneSpec> = Lookup {
+    kind: Kind::Scene,
+    flag: "--scene",
+    from_ron: |text, origin| Ok(SceneSpec::from_ron(text, origin)?),
+    from_library: Library::load_scene,
+    preset: |name| Ok(SceneSpec::preset(name)?),
+};
 
-fn load_instrument(arg: &str) -> Result<InstrumentSpec, CliError> {
-    if arg.ends_with(".ron") || Path::new(arg).exists() {
-        let text = std::fs::read_to_string(arg).map_err(|e| CliError::Input(format!("--instrument {arg}: {e}")))?;
-        return Ok(InstrumentSpec::from_ron(&text, arg)?);
-    }
-    let library = Library::user();
-    match library.find(Kind::Instrument, arg) {
-        Some(entry) => library.load_instrument(&entry).map_err(|e| CliError::Input(format!("--instrument {arg}: {e}"))),
-        None => Ok(InstrumentSpec::preset(arg)?),
-    }
-}
+/// `--instrument`: a file, the user's library, or a built-in.
+const INSTRUMENTS: Lookup<InstrumentSpec> = Lookup {
+    kind: Kind::Instrument,
+    flag: "--instrument",
+    from_ron: |text, origin| Ok(InstrumentSpec::from_ron(text, origin)?),
+    from_library: Library::load_instrument,
+    preset: |name| Ok(InstrumentSpec::preset(name)?),
+};
 
 /// The run configuration the arguments describe.
 pub fn config_from(args: &SimulateArgs) -> Result<RunConfig, CliError> {
@@ -109,8 +100,8 @@ pub fn config_from(args: &SimulateArgs) -> Result<RunConfig, CliError> {
             RunConfig::from_ron(&text, &path.display().to_string())?
         }
         None => {
-            let (scene, dir) = load_scene(&args.scene)?;
-            let mut c = RunConfig::new(scene, load_instrument(&args.instrument)?);
+            let (scene, dir) = SCENES.resolve(&args.scene)?;
+            let mut c = RunConfig::new(scene, INSTRUMENTS.resolve(&args.instrument)?.0);
             c.scene_dir = dir;
             c
         }

@@ -2,7 +2,7 @@
 //! table, figures, cubes and resolved configuration. With no study named, the built-in
 //! CubeSat vs SmallSat study over Lake Hume runs, so a new user sees a result at once.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
@@ -10,6 +10,7 @@ use std::time::Duration;
 use clap::Args;
 
 use super::CliError;
+use super::lookup::Lookup;
 use crate::study::{StudyError, StudySpec, run_study, write_run, write_study};
 
 /// Arguments of `shoal study`.
@@ -45,25 +46,18 @@ impl From<StudyError> for CliError {
     }
 }
 
+/// A study argument: a file, the user's library, or a built-in; none: the default study.
 pub(super) fn load(arg: Option<&str>) -> Result<(StudySpec, Option<PathBuf>), CliError> {
+    const STUDIES: Lookup<StudySpec> = Lookup {
+        kind: crate::library::Kind::Study,
+        flag: "study",
+        from_ron: |text, origin| Ok(StudySpec::from_ron(text, origin)?),
+        from_library: crate::library::Library::load_study,
+        preset: |name| Ok(StudySpec::preset(name)?),
+    };
     match arg {
         None => Ok((StudySpec::default_study()?, None)),
-        Some(a) if a.ends_with(".ron") || Path::new(a).exists() => {
-            let text = std::fs::read_to_string(a).map_err(|e| CliError::Input(format!("{a}: {e}")))?;
-            Ok((StudySpec::from_ron(&text, a)?, Path::new(a).parent().map(Path::to_path_buf)))
-        }
-        Some(name) => {
-            // The user's own study in the library first (as the app lists it), then the built-in.
-            let library = crate::library::Library::user();
-            match library.find(crate::library::Kind::Study, name) {
-                Some(entry) => {
-                    let dir = entry.path.as_deref().and_then(Path::parent).map(Path::to_path_buf);
-                    let spec = library.load_study(&entry).map_err(|e| CliError::Input(format!("{name}: {e}")))?;
-                    Ok((spec, dir))
-                }
-                None => Ok((StudySpec::preset(name)?, None)),
-            }
-        }
+        Some(a) => STUDIES.resolve(a),
     }
 }
 
