@@ -39,7 +39,7 @@ use model::AppState;
 pub struct AppOptions {
     /// Save a screenshot of the window here once the first full set of results is shown, then quit.
     pub screenshot: Option<PathBuf>,
-    /// Engine threads (0: all cores but one, at least one).
+    /// Engine threads (0: all cores).
     pub engine_threads: usize,
     /// Start from the built-in default instead of the saved session.
     pub fresh: bool,
