@@ -28,14 +28,16 @@
 //! | [`instrument`] | Table 1 instruments: response, pushbroom geometry, PSF, detector, SNR |
 //! | [`calibration`] | diffuser and dark frames → per-detector gain and offset; Level-0 → Level-1 |
 //! | [`correction`] | Level-1 → Rrs: exact per pixel, and the paper's per-scene approximation |
-//! | [`retrieval`] | aLMI and SAMBUCA-style inversions of band Rrs |
+//! | [`retrieval`] | aLMI and SAMBUCA inversions of band Rrs, improved and as the published codes run |
 //! | [`metrics`] | log-space MAE and bias (Seegers et al. 2018), RMSE, R², histograms |
 //! | [`engine`] | the chain as cached stages; the worker thread the app talks to |
-//! | [`study`] | studies: runs per instrument and seed, metrics tables, figures (PNG/SVG), cubes |
+//! | [`study`] | studies: runs per instrument and seed, metrics tables, figures (PNG/SVG), cubes; the paper reproduced |
+//! | [`sweep`] | sweeps: a study over one parameter or a grid of two, with seeds; shards and merge |
 //! | [`library`] | the preset library: built-ins and the user's own; atomic saves |
+//! | [`parse`] | RON parse errors described with line, column and field |
 //! | [`validation`] | comparisons with reference codes (OSOAA), shared by tests and `shoal bench` |
 //! | `app` | the desktop app (the `gui` feature; the only module that uses egui) |
-//! | [`cli`] | the headless command line (`shoal water`, `shoal atmosphere`, `shoal bench`) |
+//! | [`cli`] | the headless command line (`shoal water`, `atmosphere`, `simulate`, `study`, `reproduce`, `sweep`, `merge`, `budget`, `bench`, `ranges`) |
 
 #[cfg(feature = "gui")]
 pub mod app;
