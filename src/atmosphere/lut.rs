@@ -72,7 +72,7 @@ impl LutAxes {
     }
 }
 
-/// The table. Index order: [wavelength][sun][view].
+/// The table. Index order: `[wavelength][sun][view]`.
 #[derive(Debug, Clone)]
 pub struct AtmosphereLut {
     axes: LutAxes,

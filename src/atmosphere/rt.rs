@@ -251,7 +251,7 @@ pub struct SunSolution {
     pub mu0: f64,
     /// View cosines.
     pub user_mu: Vec<f64>,
-    /// Fourier coefficients of the multiple-scattered TOA radiance, [view][m] (polarisation
+    /// Fourier coefficients of the multiple-scattered TOA radiance, `[view][m]` (polarisation
     /// correction included), normalised to a unit solar flux.
     pub ms_fourier: Vec<Vec<f64>>,
     /// Single-scattering coefficients per view.

@@ -8,7 +8,7 @@
 //!    B = LDLᵀ is the quasi-Newton matrix (B = I at the start and after a reset). SLSQP solves
 //!    this QP as a least-distance problem (LSQ → LSEI → LSI → NNLS); the QP is strictly convex, so
 //!    its solution is unique and any exact method gives it: here a primal active-set method
-//!    ([`box_qp`]). The step is then clipped into the box, as SciPy's SLSQP does.
+//!    (`box_qp`). The step is then clipped into the box, as SciPy's SLSQP does.
 //! 2. **Stationarity.** If |gᵀs| < acc the run ends with success (mode 0).
 //! 3. **Descent.** If gᵀs ≥ 0, B is reset to I (at most 5 times; then SLSQP's relaxed test,
 //!    |f − f0| < 10·acc or ‖s‖ < 10·acc, which passes since f − f0 = 0 there).
