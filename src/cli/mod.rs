@@ -37,8 +37,22 @@ struct Cli {
     command: Command,
 }
 
+/// Arguments of `shoal app` (the binary runs the app; the command line only parses them).
+#[derive(Debug, Clone, Default, clap::Args)]
+pub struct AppArgs {
+    /// Start from the built-in default study, not the saved session.
+    #[arg(long)]
+    pub fresh: bool,
+    /// Save the window once the results are in, then quit (implies --fresh).
+    #[arg(long, value_name = "FILE.png")]
+    pub screenshot: Option<std::path::PathBuf>,
+}
+
 #[derive(Debug, Subcommand)]
 enum Command {
+    /// Open the desktop app on the saved session or the built-in default study (also what
+    /// `shoal` with no command does; needs a display and the `gui` feature).
+    App(AppArgs),
     /// Evaluate the water model (Lee et al. 1998/1999, SAMBUCA) and print CSV.
     Water(water::WaterArgs),
     /// Evaluate the atmosphere (successive orders of scattering) and print CSV.
@@ -137,9 +151,10 @@ fn almi_sets(dir: &std::path::Path) -> Result<(), CliError> {
     Ok(())
 }
 
-/// Entry point of the `shoal` binary.
+/// Entry point of the `shoal` binary; `app` opens the desktop app (the binary passes it, so that
+/// the command line never imports the app).
 #[must_use]
-pub fn main() -> ExitCode {
+pub fn main(app: impl FnOnce(&AppArgs) -> ExitCode) -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(c) => c,
         Err(e) => {
@@ -148,6 +163,7 @@ pub fn main() -> ExitCode {
         }
     };
     let result = match cli.command {
+        Command::App(args) => return app(&args),
         Command::Water(args) => water::run(&args),
         Command::Atmosphere(args) => atmosphere::run(&args),
         Command::Simulate(args) => simulate::run(&args),
