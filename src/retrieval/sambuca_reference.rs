@@ -261,7 +261,11 @@ impl ReferenceModel {
         let s = &self.spectra;
         let n = s.wavelengths_nm.len();
         scratch.rrs.resize(n, 0.0);
-        scratch.deep.resize(n, 0.0);
+        // The deep-water sums are only for the SDI, once per pixel; the fit's evaluations skip them.
+        let want_deep = deep.is_some();
+        if want_deep {
+            scratch.deep.resize(n, 0.0);
+        }
         let [chl, cdom, nap, depth, q] = *p;
         let (r1, r2) = (&s.substrates[pair.0], &s.substrates[pair.1]);
         let (mu_w, mu_o) = inv_cos;
@@ -276,7 +280,9 @@ impl ReferenceModel {
             let bottom = q * r1[i] + (1.0 - q) * r2[i];
             scratch.rrs[i] = rrs_dp * (1.0 - (-(mu_w + du_column) * kappa * depth).exp())
                 + (1.0 / std::f64::consts::PI) * bottom * (-(mu_w + du_bottom) * kappa * depth).exp();
-            scratch.deep[i] = rrs_dp;
+            if want_deep {
+                scratch.deep[i] = rrs_dp;
+            }
         }
         let band_sum =
             |v: &[f64], b: &Band| -> f64 { b.weights.iter().enumerate().map(|(k, w)| w * v[b.first + k]).sum() };
