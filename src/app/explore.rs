@@ -202,7 +202,7 @@ impl Explore {
                 values: Values::Range { from: self.from, to: self.to, steps: self.steps, log: self.log },
             }],
             seeds: (1..=self.seeds).collect(),
-            requirement: Some(Requirement { variable: "chl_mg_m3".into(), mae_pct: state.requirements.chl_mae_pct }),
+            requirement: chl_requirement(state),
         };
         let mut sweep = match spec.resolve(None) {
             Ok(s) => s,
@@ -299,18 +299,19 @@ pub fn sweep_window(app: &mut super::ShoalApp, ctx: &egui::Context) {
             jobs.len()
         });
         ui.label(format!("{} ({done}/{} runs)", e.sweep_status, e.sweep_total));
-        let requirement = Requirement { variable: "chl_mg_m3".into(), mae_pct: app.state.requirements.chl_mae_pct };
+        let requirement = chl_requirement(&app.state);
         if let Some(table) = &e.table {
-            let curves = crate::sweep::figure::curves(table, "chl_mg_m3", Some(&requirement), false);
+            let curves = crate::sweep::figure::curves(table, "chl_mg_m3", requirement.as_ref(), false);
             for s in &curves.series {
-                match s.crossing {
-                    Some(x) => ui.label(format!(
+                match (&requirement, s.crossing) {
+                    (Some(r), Some(x)) => ui.label(format!(
                         "{}: meets chl MAE ≤ {:.0} % from {} = {x:.3}",
-                        s.label, requirement.mae_pct, curves.x_label
+                        s.label, r.mae_pct, curves.x_label
                     )),
-                    None => {
-                        ui.label(format!("{}: does not meet chl MAE ≤ {:.0} % (so far)", s.label, requirement.mae_pct))
+                    (Some(r), None) => {
+                        ui.label(format!("{}: does not meet chl MAE ≤ {:.0} % (so far)", s.label, r.mae_pct))
                     }
+                    (None, _) => ui.label(format!("{}: no chl MAE requirement set", s.label)),
                 };
             }
             Plot::new("sweep-plot")
@@ -340,15 +341,17 @@ pub fn sweep_window(app: &mut super::ShoalApp, ctx: &egui::Context) {
                             )
                             .color(colour.gamma_multiply(0.4)),
                         );
-                        if let Some(x) = s.crossing {
+                        if let (Some(r), Some(x)) = (&requirement, s.crossing) {
                             p.points(
-                                Points::new(format!("{} meets", s.label), vec![[x, requirement.mae_pct]])
+                                Points::new(format!("{} meets", s.label), vec![[x, r.mae_pct]])
                                     .radius(6.0)
                                     .color(colour),
                             );
                         }
                     }
-                    p.hline(HLine::new("requirement", requirement.mae_pct).color(egui::Color32::from_rgb(40, 150, 40)));
+                    if let Some(r) = &requirement {
+                        p.hline(HLine::new("requirement", r.mae_pct).color(egui::Color32::from_rgb(40, 150, 40)));
+                    }
                 });
         }
     });
@@ -412,4 +415,10 @@ pub fn cost_window(app: &mut super::ShoalApp, ctx: &egui::Context) {
         app.ui.explore.cost_task = None;
     }
     app.ui.explore.cost_open = open;
+}
+
+/// The sweep's requirement: the chl MAE limit in use, when there is one.
+fn chl_requirement(state: &AppState) -> Option<Requirement> {
+    let mae_pct = state.requirements.for_variable("chl_mg_m3")?.mae_pct?;
+    Some(Requirement { variable: "chl_mg_m3".into(), mae_pct })
 }

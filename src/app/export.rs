@@ -77,16 +77,30 @@ pub fn write_figure(snap: &Snapshot, stem: &Path) -> Result<Vec<PathBuf>, String
     ]];
     for (name, out) in [("A", a), ("B", b)] {
         for ret in &out.retrievals {
+            // The app's and `shoal study`'s judgement: `Requirements::check_run`.
+            let checks =
+                state.requirements.check_run(&out.config.instrument.name, out.config.seed, Some(&ret.metrics), &[]);
             for v in &ret.metrics.variables {
                 let m = &v.metrics;
-                let req = state.requirements.mae_limit(&v.variable).map_or(String::new(), |l| {
-                    format!("MAE ≤ {l:.0} %: {}", if m.mae_pct() <= l { "pass" } else { "FAIL" })
-                });
+                let mine: Vec<&crate::study::Check> =
+                    checks.iter().filter(|c| c.variable.as_deref() == Some(v.variable.as_str())).collect();
+                let req = match crate::study::verdict(mine.iter().copied()) {
+                    Some(ok) => {
+                        let failed: Vec<&str> = mine.iter().filter(|c| !c.pass).map(|c| c.what.as_str()).collect();
+                        if ok { "pass".into() } else { format!("FAIL: {}", failed.join(", ")) }
+                    }
+                    None => String::new(),
+                };
+                let (mae, bias) = if m.n == 0 {
+                    ("–".into(), "–".into())
+                } else {
+                    (format!("{:.1}", m.mae_pct()), format!("{:+.1}", m.bias_pct()))
+                };
                 table.push(vec![
                     format!("{name} ({})", out.config.instrument.name),
                     format!("{} {}", ret.metrics.product, v.variable),
-                    format!("{:.1}", m.mae_pct()),
-                    format!("{:+.1}", m.bias_pct()),
+                    mae,
+                    bias,
                     format!("{:.1}", m.returned_pct),
                     req,
                 ]);

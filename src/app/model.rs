@@ -7,7 +7,7 @@ use crate::engine::RunConfig;
 use crate::instrument::InstrumentSpec;
 use crate::retrieval::{AlmiSettings, RetrievalSpec, SambucaSettings};
 use crate::scene::{MapSpec, SceneSpec};
-use crate::study::{Source, StudySpec};
+use crate::study::{ProductRequirement, Requirements, Source, StudySpec};
 
 /// One instrument slot: the instrument being edited and the preset it came from.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -121,40 +121,29 @@ pub enum Layout {
     AbDifference,
 }
 
-/// Requirements the metrics and SNR are judged against.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
-pub struct Requirements {
-    /// Largest acceptable chl MAE, %.
-    pub chl_mae_pct: f64,
-    /// Largest acceptable NAP MAE, %.
-    pub nap_mae_pct: f64,
-    /// Largest acceptable CDOM MAE, %.
-    pub cdom_mae_pct: f64,
-    /// Largest acceptable depth MAE, %.
-    pub depth_mae_pct: f64,
-    /// Smallest acceptable SNR (at the scene's median radiance).
-    pub snr: f64,
-}
-
-impl Default for Requirements {
-    fn default() -> Self {
-        Self { chl_mae_pct: 20.0, nap_mae_pct: 30.0, cdom_mae_pct: 50.0, depth_mae_pct: 10.0, snr: 100.0 }
+/// The limits the app judges by when the study states none: the default study's (chl MAE ≤ 20 %,
+/// |bias| ≤ 10 %, ≥ 95 % returned; NAP and CDOM looser) plus depth MAE ≤ 10 %, SNR ≥ 100.
+#[must_use]
+pub fn fallback_requirements() -> Requirements {
+    let p = |variable: &str, mae: f64, bias: Option<f64>, returned: Option<f64>| ProductRequirement {
+        variable: variable.into(),
+        mae_pct: Some(mae),
+        bias_pct: bias,
+        returned_pct: returned,
+    };
+    Requirements {
+        products: vec![
+            p("chl_mg_m3", 20.0, Some(10.0), Some(95.0)),
+            p("nap_g_m3", 30.0, None, None),
+            p("cdom_per_m", 50.0, None, None),
+            p("depth_m", 10.0, None, None),
+        ],
+        snr: Some(100.0),
     }
 }
 
-impl Requirements {
-    /// The MAE limit of a metrics variable, %.
-    #[must_use]
-    pub fn mae_limit(&self, variable: &str) -> Option<f64> {
-        match variable {
-            "chl_mg_m3" => Some(self.chl_mae_pct),
-            "nap_g_m3" => Some(self.nap_mae_pct),
-            "cdom_per_m" => Some(self.cdom_mae_pct),
-            "depth_m" | "depth_m_bottom_visible" => Some(self.depth_mae_pct),
-            _ => None,
-        }
-    }
+fn default_requirements() -> Requirements {
+    fallback_requirements()
 }
 
 /// Which retrieval the app runs.
@@ -200,7 +189,10 @@ pub struct AppState {
     pub band: usize,
     /// Map arrangement.
     pub layout: Layout,
-    /// Requirements.
+    /// Requirements: the study's, as `shoal study` checks them (the same [`Requirements::check_run`]).
+    /// Saved as `product_requirements`: sessions from before this format kept MAE limits only,
+    /// and are read with these defaults rather than refused.
+    #[serde(rename = "product_requirements", default = "default_requirements")]
     pub requirements: Requirements,
     /// Dark theme.
     pub dark: bool,
@@ -253,7 +245,7 @@ impl AppState {
             product: ProductKind::Chl,
             band: 3,
             layout: Layout::TruthAB,
-            requirements: Requirements::default(),
+            requirements: fallback_requirements(),
             dark: false,
             study_name: "cubesat_vs_smallsat".into(),
         }
@@ -293,19 +285,7 @@ impl AppState {
             None => {}
         }
         if let Some(r) = &study.requirements {
-            for p in &r.products {
-                let Some(limit) = p.mae_pct else { continue };
-                match p.variable.as_str() {
-                    "chl_mg_m3" => s.requirements.chl_mae_pct = limit,
-                    "nap_g_m3" => s.requirements.nap_mae_pct = limit,
-                    "cdom_per_m" => s.requirements.cdom_mae_pct = limit,
-                    "depth_m" => s.requirements.depth_mae_pct = limit,
-                    _ => {}
-                }
-            }
-            if let Some(snr) = r.snr {
-                s.requirements.snr = snr;
-            }
+            s.requirements = r.clone();
         }
         Ok(s)
     }

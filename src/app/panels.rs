@@ -213,10 +213,14 @@ fn presets(app: &mut ShoalApp, ui: &mut egui::Ui) {
     }
     let studies = app.library.list(Kind::Study);
     if let Some(e) = library_combo(ui, "Study", &app.state.study_name.clone(), &studies) {
-        match app.library.load_study(&e).map_err(|e| e.to_string()).and_then(|s| AppState::from_study(&s)) {
-            Ok(mut s) => {
+        let loaded = app.library.load_study(&e).map_err(|e| e.to_string());
+        match loaded.and_then(|study| AppState::from_study(&study).map(|s| (s, study.requirements.is_some()))) {
+            Ok((mut s, requirements_from_study)) => {
                 s.dark = app.state.dark;
-                s.requirements = app.state.requirements.clone();
+                // The study's own requirements when it states them, else the ones in use.
+                if !requirements_from_study {
+                    s.requirements = app.state.requirements.clone();
+                }
                 app.state = s;
             }
             Err(err) => app.ui.error = Some(format!("Cannot load study `{}`: {err}", e.name)),
@@ -544,13 +548,53 @@ fn settings(app: &mut ShoalApp, ui: &mut egui::Ui) {
             s.levels = [pre, 4, fin].into_iter().filter(|&d| d <= pre).collect();
         }
     });
-    egui::CollapsingHeader::new("Requirements").default_open(false).show(ui, |ui| {
-        let r = &mut app.state.requirements;
-        ui.add(egui::Slider::new(&mut r.chl_mae_pct, 1.0..=200.0).text("chl MAE at most").suffix(" %"));
-        ui.add(egui::Slider::new(&mut r.nap_mae_pct, 1.0..=200.0).text("NAP MAE at most").suffix(" %"));
-        ui.add(egui::Slider::new(&mut r.cdom_mae_pct, 1.0..=300.0).text("CDOM MAE at most").suffix(" %"));
-        ui.add(egui::Slider::new(&mut r.depth_mae_pct, 1.0..=200.0).text("depth MAE at most").suffix(" %"));
-        ui.add(egui::Slider::new(&mut r.snr, 1.0..=2000.0).logarithmic(true).text("SNR at least"));
+    egui::CollapsingHeader::new("Requirements").default_open(false).show(ui, |ui| requirements_editor(app, ui));
+}
+
+/// Per product: largest MAE and |bias| (log-space, %) and smallest share returned; the SNR floor.
+/// An unticked limit is not checked. The verdicts use these, as `shoal study` does.
+fn requirements_editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
+    let r = &mut app.state.requirements;
+    egui::Grid::new("requirements").num_columns(4).show(ui, |ui| {
+        for h in ["", "MAE ≤ %", "|bias| ≤ %", "returned ≥ %"] {
+            ui.strong(h);
+        }
+        ui.end_row();
+        for (variable, label) in
+            [("chl_mg_m3", "chl-a"), ("nap_g_m3", "NAP"), ("cdom_per_m", "CDOM"), ("depth_m", "depth")]
+        {
+            if r.for_variable(variable).is_none() {
+                r.products.push(crate::study::ProductRequirement {
+                    variable: variable.into(),
+                    mae_pct: None,
+                    bias_pct: None,
+                    returned_pct: None,
+                });
+            }
+            let Some(p) = r.products.iter_mut().find(|p| p.variable == variable) else { continue };
+            ui.label(label);
+            optional_limit(ui, &mut p.mae_pct, 20.0, &crate::ranges::REQUIREMENT_MAE_PCT);
+            optional_limit(ui, &mut p.bias_pct, 10.0, &crate::ranges::REQUIREMENT_BIAS_PCT);
+            optional_limit(ui, &mut p.returned_pct, 95.0, &crate::ranges::REQUIREMENT_RETURNED_PCT);
+            ui.end_row();
+        }
+        ui.label("SNR ≥");
+        optional_limit(ui, &mut r.snr, 100.0, &crate::ranges::REQUIREMENT_SNR);
+        ui.end_row();
+    });
+    r.products.retain(|p| p.mae_pct.is_some() || p.bias_pct.is_some() || p.returned_pct.is_some());
+}
+
+/// A ticked limit with its value, clamped to the range's bounds; unticked: not checked.
+fn optional_limit(ui: &mut egui::Ui, value: &mut Option<f64>, default: f64, range: &crate::ranges::Range) {
+    ui.horizontal(|ui| {
+        let mut on = value.is_some();
+        if ui.checkbox(&mut on, "").on_hover_text(range.meaning).changed() {
+            *value = on.then_some(value.unwrap_or(default));
+        }
+        if let Some(v) = value {
+            ui.add(egui::DragValue::new(v).range(range.lo..=range.hi.min(1e4)).speed(0.5).max_decimals(1));
+        }
     });
 }
 

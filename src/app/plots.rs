@@ -8,6 +8,7 @@ use egui_plot::{Bar, BarChart, HLine, Legend, Line, Plot, PlotPoints, Points};
 use super::ShoalApp;
 use crate::engine::{RunOutput, StageStatus};
 use crate::metrics::{Metrics, bin_of, log_edges};
+use crate::study::Check;
 
 const COLOURS: [Color32; 2] = [Color32::from_rgb(228, 26, 28), Color32::from_rgb(55, 126, 184)];
 
@@ -19,8 +20,31 @@ fn pass(ok: bool) -> egui::RichText {
     }
 }
 
+/// The verdict cell of a set of checks, the checks listed on hover.
+fn verdict_cell(ui: &mut egui::Ui, checks: &[&Check]) {
+    match crate::study::verdict(checks.iter().copied()) {
+        Some(ok) => {
+            let text = checks.iter().map(|c| c.describe()).collect::<Vec<_>>().join("\n");
+            ui.label(pass(ok)).on_hover_text(text);
+        }
+        None => {
+            ui.label("").on_hover_text("no requirement on this product (Requirements, left panel)");
+        }
+    }
+}
+
 fn metrics_table(app: &ShoalApp, ui: &mut egui::Ui) {
     let runs: Vec<Option<&RunOutput>> = app.link.shown.iter().map(|s| s.as_ref().map(|s| s.output.as_ref())).collect();
+    // One judgement for app, export and CLI: `Requirements::check_run`.
+    let checks: Vec<Vec<Check>> = runs
+        .iter()
+        .map(|run| {
+            run.map_or_else(Vec::new, |o| {
+                let metrics = o.retrievals.first().map(|r| &r.metrics);
+                app.state.requirements.check_run(&o.config.instrument.name, o.config.seed, metrics, &o.snr)
+            })
+        })
+        .collect();
     egui::Grid::new("metrics").num_columns(9).striped(true).show(ui, |ui| {
         for h in ["product", "A MAE", "A bias", "A returned", "A", "B MAE", "B bias", "B returned", "B"] {
             ui.strong(h);
@@ -38,31 +62,40 @@ fn metrics_table(app: &ShoalApp, ui: &mut egui::Ui) {
             });
         for v in &variables {
             ui.label(v.as_str());
-            for run in &runs {
+            for (run, checks) in runs.iter().zip(&checks) {
                 let m: Option<&Metrics> = run.and_then(|o| o.retrievals.first()).and_then(|r| r.metrics.get(v));
                 match m {
+                    Some(m) if m.n == 0 => {
+                        // Nothing returned: no MAE or bias to show (never "0.0 %").
+                        ui.label("–").on_hover_text("no pixel returned");
+                        ui.label("–").on_hover_text("no pixel returned");
+                        ui.label(format!("{:.1} %", m.returned_pct));
+                    }
                     Some(m) => {
                         ui.label(format!("{:.1} %", m.mae_pct()));
                         ui.label(format!("{:+.1} %", m.bias_pct()));
                         ui.label(format!("{:.1} %", m.returned_pct));
-                        match app.state.requirements.mae_limit(v) {
-                            Some(limit) => {
-                                ui.label(pass(m.mae_pct() <= limit)).on_hover_text(format!(
-                                    "MAE at most {limit:.0} %: margin {:+.1} points",
-                                    limit - m.mae_pct()
-                                ));
-                            }
-                            None => {
-                                ui.label("");
-                            }
-                        }
                     }
                     None => {
-                        for _ in 0..4 {
+                        for _ in 0..3 {
                             ui.label("–");
                         }
                     }
                 }
+                let mine: Vec<&Check> = checks.iter().filter(|c| c.variable.as_deref() == Some(v.as_str())).collect();
+                verdict_cell(ui, &mine);
+            }
+            ui.end_row();
+        }
+        if app.state.requirements.snr.is_some() && runs.iter().any(Option::is_some) {
+            ui.label("SNR, every band");
+            for (run, checks) in runs.iter().zip(&checks) {
+                let lowest = run.and_then(|o| o.snr.iter().map(|r| r.snr_analytic).reduce(f64::min));
+                ui.label(lowest.map_or_else(|| "–".into(), |s| format!("lowest {s:.0}")));
+                ui.label("");
+                ui.label("");
+                let mine: Vec<&Check> = checks.iter().filter(|c| c.variable.is_none()).collect();
+                verdict_cell(ui, &mine);
             }
             ui.end_row();
         }
@@ -191,7 +224,9 @@ fn snr_plot(app: &ShoalApp, ui: &mut egui::Ui, width: f32) {
                     p.line(Line::new(name, PlotPoints::from(line)).color(COLOURS[i]).width(2.0));
                     p.points(Points::new(format!("{name} measured"), dots).radius(2.5).color(COLOURS[i]));
                 }
-                p.hline(HLine::new("requirement", app.state.requirements.snr).color(Color32::from_rgb(40, 150, 40)));
+                if let Some(snr) = app.state.requirements.snr {
+                    p.hline(HLine::new("requirement", snr).color(Color32::from_rgb(40, 150, 40)));
+                }
             });
     });
 }

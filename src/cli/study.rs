@@ -124,13 +124,13 @@ pub fn run(args: &StudyArgs) -> Result<(), CliError> {
         );
         for c in r.check(&result) {
             eprintln!(
-                "{:<12} {:<28} {:>10.1} {:>10.1} {:>6} {:>+10.1}",
+                "{:<12} {:<28} {:>10} {:>10.1} {:>6} {:>10}",
                 c.instrument,
                 c.what,
-                c.value,
+                c.value.map_or_else(|| "none".into(), |v| format!("{v:.1}")),
                 c.limit,
                 if c.pass { "pass" } else { "FAIL" },
-                c.margin
+                c.margin.map_or_else(|| "no pixel".into(), |m| format!("{m:+.1}"))
             );
         }
     }

@@ -30,7 +30,7 @@ pub use curves::{CurvePoint, CurveSeries, Curves, curve_figure, first_crossing};
 pub use figures::figure_set;
 pub use output::{Outputs, metrics_csv, write_bytes, write_run, write_study};
 pub use render::Figure;
-pub use requirements::{Check, ProductRequirement, Requirements, checks_csv};
+pub use requirements::{Check, ProductRequirement, Requirements, checks_csv, verdict};
 pub use run::{StudyResult, StudyRun, run_study};
 
 use std::path::{Path, PathBuf};

@@ -1,7 +1,9 @@
 //! Requirements a study checks: per product variable a largest MAE, a largest |bias| and a
 //! smallest share of pixels returned; per band a smallest SNR at the scene's reference radiance.
 //! Each check reports the value, pass or fail, and the margin (how far inside the limit —
-//! negative when it fails).
+//! negative when it fails). A product with no pixel returned has no MAE or bias: those checks
+//! have no value and fail (an empty product is never a pass). The app, its exported figure and
+//! `shoal study` all judge through [`Requirements::check_run`], so they cannot disagree.
 //!
 //! ```text
 //! requirements: Some((
@@ -15,6 +17,8 @@ use std::fmt::Write as _;
 use serde::{Deserialize, Serialize};
 
 use super::{StudyError, StudyResult};
+use crate::instrument::SnrRow;
+use crate::metrics::ProductMetrics;
 
 /// Limits on one variable (`None`: not required).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -54,14 +58,40 @@ pub struct Check {
     pub seed: u64,
     /// What is checked (`chl_mg_m3 MAE`, `SNR Oa03`).
     pub what: String,
-    /// The value.
-    pub value: f64,
+    /// The product variable checked (`None`: an SNR check).
+    pub variable: Option<String>,
+    /// The value; `None` when there is none to judge (no pixel returned), which fails.
+    pub value: Option<f64>,
     /// The limit.
     pub limit: f64,
     /// Met?
     pub pass: bool,
-    /// Distance inside the limit (negative: outside), in the value's unit.
-    pub margin: f64,
+    /// Distance inside the limit (negative: outside), in the value's unit; `None` with the value.
+    pub margin: Option<f64>,
+}
+
+impl Check {
+    /// The value for a table: `"–"` when there is none.
+    #[must_use]
+    pub fn value_text(&self, decimals: usize) -> String {
+        self.value.map_or_else(|| "–".into(), |v| format!("{v:.decimals$}"))
+    }
+
+    /// One line a reviewer can read: "chl_mg_m3 MAE % 12.3 ≤ 20: pass (margin 7.7)".
+    #[must_use]
+    pub fn describe(&self) -> String {
+        let verdict = if self.pass { "pass" } else { "FAIL" };
+        match (self.value, self.margin) {
+            (Some(v), Some(m)) => format!("{} {v:.1} vs limit {}: {verdict} (margin {m:+.1})", self.what, self.limit),
+            _ => format!("{} (limit {}): {verdict}, no pixel returned", self.what, self.limit),
+        }
+    }
+}
+
+/// The verdict of a set of checks: `None` when nothing was checked.
+#[must_use]
+pub fn verdict<'a>(checks: impl IntoIterator<Item = &'a Check>) -> Option<bool> {
+    checks.into_iter().fold(None, |acc, c| Some(acc.unwrap_or(true) && c.pass))
 }
 
 impl Requirements {
@@ -95,39 +125,68 @@ impl Requirements {
         Ok(())
     }
 
-    /// Check every run of `result`.
+    /// The limits of one variable (`depth_m_bottom_visible` is judged as `depth_m`).
+    #[must_use]
+    pub fn for_variable(&self, variable: &str) -> Option<&ProductRequirement> {
+        let variable = if variable == "depth_m_bottom_visible" { "depth_m" } else { variable };
+        self.products.iter().find(|p| p.variable == variable)
+    }
+
+    /// Check every run of `result` (its first retrieval, as the tables show it).
     #[must_use]
     pub fn check(&self, result: &StudyResult) -> Vec<Check> {
+        result
+            .runs
+            .iter()
+            .flat_map(|run| {
+                let metrics = run.retrievals.first().map(|r| &r.metrics);
+                self.check_run(&run.label, run.seed, metrics, &run.snr)
+            })
+            .collect()
+    }
+
+    /// Check one run: every product limit against `metrics` (a required variable the retrieval
+    /// does not make is skipped: it has no candidate pixels to judge), and the SNR floor against
+    /// every band of `snr`.
+    #[must_use]
+    pub fn check_run(&self, label: &str, seed: u64, metrics: Option<&ProductMetrics>, snr: &[SnrRow]) -> Vec<Check> {
         let mut out = Vec::new();
-        for run in &result.runs {
-            let mut push = |what: String, value: f64, limit: f64, upper: bool| {
-                let margin = if upper { limit - value } else { value - limit };
-                out.push(Check {
-                    instrument: run.label.clone(),
-                    seed: run.seed,
-                    what,
-                    value,
-                    limit,
-                    pass: margin >= 0.0,
-                    margin,
-                });
-            };
-            for p in &self.products {
-                let Some(m) = run.retrievals.first().and_then(|r| r.metrics.get(&p.variable)) else { continue };
-                if let Some(l) = p.mae_pct {
-                    push(format!("{} MAE %", p.variable), m.mae_pct(), l, true);
-                }
-                if let Some(l) = p.bias_pct {
-                    push(format!("{} |bias| %", p.variable), m.bias_pct().abs(), l, true);
-                }
-                if let Some(l) = p.returned_pct {
-                    push(format!("{} returned %", p.variable), m.returned_pct, l, false);
-                }
+        let mut push = |variable: Option<&str>, what: String, value: Option<f64>, limit: f64, upper: bool| {
+            let margin = value.map(|v| if upper { limit - v } else { v - limit });
+            out.push(Check {
+                instrument: label.into(),
+                seed,
+                what,
+                variable: variable.map(Into::into),
+                value,
+                limit,
+                pass: margin.is_some_and(|m| m >= 0.0),
+                margin,
+            });
+        };
+        for p in &self.products {
+            let Some(m) = metrics.and_then(|m| m.get(&p.variable)) else { continue };
+            // With nothing returned the MAE and bias are undefined (metrics reports 0 %).
+            let returned = m.n > 0;
+            if let Some(l) = p.mae_pct {
+                push(Some(&p.variable), format!("{} MAE %", p.variable), returned.then(|| m.mae_pct()), l, true);
             }
-            if let Some(l) = self.snr {
-                for row in run.snr.iter() {
-                    push(format!("SNR {} ({:.0} nm)", row.band, row.centre_nm), row.snr_analytic, l, false);
-                }
+            if let Some(l) = p.bias_pct {
+                push(
+                    Some(&p.variable),
+                    format!("{} |bias| %", p.variable),
+                    returned.then(|| m.bias_pct().abs()),
+                    l,
+                    true,
+                );
+            }
+            if let Some(l) = p.returned_pct {
+                push(Some(&p.variable), format!("{} returned %", p.variable), Some(m.returned_pct), l, false);
+            }
+        }
+        if let Some(l) = self.snr {
+            for row in snr {
+                push(None, format!("SNR {} ({:.0} nm)", row.band, row.centre_nm), Some(row.snr_analytic), l, false);
             }
         }
         out
@@ -141,15 +200,78 @@ pub fn checks_csv(checks: &[Check]) -> String {
     for c in checks {
         let _ = writeln!(
             s,
-            "{},{},{},{:.4},{},{},{:.4}",
+            "{},{},{},{},{},{},{}",
             c.instrument,
             c.seed,
             c.what,
-            c.value,
+            c.value.map_or_else(String::new, |v| format!("{v:.4}")),
             c.limit,
             if c.pass { "pass" } else { "FAIL" },
-            c.margin
+            c.margin.map_or_else(String::new, |m| format!("{m:.4}")),
         );
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::metrics::{VariableMetrics, compare};
+
+    fn product(variable: &str, metrics: crate::metrics::Metrics) -> ProductMetrics {
+        ProductMetrics {
+            product: "aLMI".into(),
+            variables: vec![VariableMetrics { variable: variable.into(), metrics }],
+            substrate_agreement_pct: None,
+            depth_by_true_substrate: Vec::new(),
+            siop_set_counts: Vec::new(),
+            siop_sets_used: 0,
+            failed: 0,
+            stalled: 0,
+        }
+    }
+
+    fn chl_limits(returned_pct: Option<f64>) -> Requirements {
+        Requirements {
+            products: vec![ProductRequirement {
+                variable: "chl_mg_m3".into(),
+                mae_pct: Some(20.0),
+                bias_pct: Some(10.0),
+                returned_pct,
+            }],
+            snr: None,
+        }
+    }
+
+    #[test]
+    fn a_product_with_no_pixel_returned_fails_every_check_even_without_a_returned_limit() {
+        // The metrics of an empty product read MAE 0 %, bias 0 %: the false pass this guards.
+        let empty = product("chl_mg_m3", compare(&[None, None, None], &[Some(1.0), Some(2.0), Some(3.0)]));
+        assert_eq!(empty.get("chl_mg_m3").unwrap().mae_pct(), 0.0);
+        let checks = chl_limits(None).check_run("A", 1, Some(&empty), &[]);
+        assert_eq!(checks.len(), 2);
+        for c in &checks {
+            assert!(!c.pass && c.value.is_none() && c.margin.is_none(), "{c:?}");
+            assert!(c.describe().contains("no pixel returned"), "{}", c.describe());
+        }
+        assert_eq!(verdict(&checks), Some(false));
+        let csv = checks_csv(&checks);
+        assert!(csv.lines().nth(1).unwrap().starts_with("A,1,chl_mg_m3 MAE %,,20,FAIL,"), "{csv}");
+    }
+
+    #[test]
+    fn a_returned_product_is_judged_by_mae_bias_and_share_with_margins() {
+        // Retrieved 1.05× the truth on 3 of 4 pixels: MAE = bias = 5 %, 75 % returned.
+        let m = compare(&[Some(1.05), Some(2.1), Some(3.15), None], &[Some(1.0), Some(2.0), Some(3.0), Some(4.0)]);
+        let p = product("chl_mg_m3", m);
+        let checks = chl_limits(Some(70.0)).check_run("A", 1, Some(&p), &[]);
+        let values: Vec<(bool, f64)> = checks.iter().map(|c| (c.pass, c.margin.unwrap())).collect();
+        assert!((values[0].1 - 15.0).abs() < 1e-9 && values[0].0, "MAE 5 % under 20 %: {values:?}");
+        assert!((values[1].1 - 5.0).abs() < 1e-9 && values[1].0, "|bias| 5 % under 10 %: {values:?}");
+        assert!((values[2].1 - 5.0).abs() < 1e-9 && values[2].0, "75 % returned over 70 %: {values:?}");
+        assert_eq!(verdict(&checks), Some(true));
+        let checks = chl_limits(Some(80.0)).check_run("A", 1, Some(&p), &[]);
+        assert_eq!(verdict(&checks), Some(false), "75 % returned under an 80 % floor fails");
+        assert_eq!(verdict(&[]), None, "nothing checked: no verdict");
+    }
 }

@@ -313,3 +313,36 @@ fn the_reference_mode_selector_reruns_alm_as_the_published_code() {
     // against 38 %, `tests/chain/reproduction.rs`).
     assert!(reference > 2.0 * improved, "chl MAE improved {improved:.1} %, reference {reference:.1} %");
 }
+
+#[test]
+fn an_instrument_that_returns_no_pixel_is_never_a_pass() {
+    // A 10 e⁻ well saturates on every water pixel: nothing is retrieved. The metrics of an empty
+    // product read MAE 0 %, bias 0 %; before the verdicts were shared with `shoal study` the table
+    // said "pass" for chl, NAP and CDOM here (issue 14).
+    let dir = temp_library("nothing");
+    let mut broken = InstrumentSpec::preset("cubesat").unwrap();
+    broken.well_depth_e = 10.0;
+    let state = AppState {
+        a: Slot::new("cubesat", broken.clone()),
+        b: Slot::new("cubesat", broken),
+        levels: vec![16],
+        ..AppState::default()
+    };
+    let library = Library::at(&dir);
+    let mut h = Harness::builder().with_size(egui::vec2(1500.0, 960.0)).build_eframe(move |cc| {
+        let mut app =
+            ShoalApp::with_state(state, &cc.egui_ctx, AppOptions { engine_threads: 2, ..AppOptions::default() });
+        app.set_library(library);
+        app
+    });
+    wait_for_engine(&mut h);
+    let shown = h.state().link.shown[0].as_ref().unwrap();
+    let chl = shown.output.retrievals[0].metrics.get("chl_mg_m3").unwrap();
+    assert_eq!(chl.n, 0, "the saturated instrument returns no chl pixel");
+    assert_eq!(chl.mae_pct(), 0.0, "the empty metrics the old verdict took for a pass");
+    assert!(h.query_all_by_label("pass").next().is_none(), "a verdict of `pass` is on screen");
+    // chl, NAP and CDOM for A and B, and the SNR row.
+    let fails = h.query_all_by_label("FAIL").count();
+    assert!(fails >= 6, "{fails} FAIL verdicts on screen");
+    let _ = std::fs::remove_dir_all(&dir);
+}
