@@ -96,14 +96,20 @@ impl std::fmt::Display for Stage {
     }
 }
 
-/// A cache key: the hash of a stage's inputs and of its upstream keys.
+/// A cache key: the stage it belongs to and the hash of its inputs and upstream keys. The stage
+/// travels with the key, so a product is stored and looked up under the stage that built the
+/// key and under no other.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub struct Key(pub u64);
+pub struct Key {
+    /// The stage whose product the key names.
+    pub stage: Stage,
+    hash: u64,
+}
 
 /// Builds a key from serialisable inputs (hashed through their exact RON text, which round-trips
 /// every f64) and upstream keys.
 #[derive(Debug)]
-pub struct KeyBuilder(DefaultHasher);
+pub struct KeyBuilder(Stage, DefaultHasher);
 
 impl KeyBuilder {
     /// Start a key for `stage`.
@@ -111,16 +117,16 @@ impl KeyBuilder {
     pub fn new(stage: Stage) -> Self {
         let mut h = DefaultHasher::new();
         stage.hash(&mut h);
-        Self(h)
+        Self(stage, h)
     }
 
     /// Add a serialisable input.
     #[must_use]
     pub fn with<T: Serialize + ?Sized>(mut self, value: &T) -> Self {
         match ron::to_string(value) {
-            Ok(s) => s.hash(&mut self.0),
+            Ok(s) => s.hash(&mut self.1),
             // Unserialisable input: never reuse a product built from it.
-            Err(_) => std::time::Instant::now().hash(&mut self.0),
+            Err(_) => std::time::Instant::now().hash(&mut self.1),
         }
         self
     }
@@ -128,14 +134,14 @@ impl KeyBuilder {
     /// Add an upstream key.
     #[must_use]
     pub fn after(mut self, key: Key) -> Self {
-        key.0.hash(&mut self.0);
+        key.hash(&mut self.1);
         self
     }
 
     /// The key.
     #[must_use]
     pub fn finish(self) -> Key {
-        Key(self.0.finish())
+        Key { stage: self.0, hash: self.1.finish() }
     }
 }
 
@@ -154,9 +160,9 @@ impl std::fmt::Debug for Cache {
 }
 
 impl Cache {
-    /// The product of `stage` under `key`, if kept (and moves it to the front).
-    pub fn get<T: Send + Sync + 'static>(&mut self, stage: Stage, key: Key) -> Option<Arc<T>> {
-        let list = self.entries.get_mut(&stage)?;
+    /// The product under `key`, if kept (and moves it to the front).
+    pub fn get<T: Send + Sync + 'static>(&mut self, key: Key) -> Option<Arc<T>> {
+        let list = self.entries.get_mut(&key.stage)?;
         let i = list.iter().position(|(k, _)| *k == key)?;
         let entry = list.remove(i)?;
         let product = entry.1.clone().downcast::<T>().ok();
@@ -164,8 +170,9 @@ impl Cache {
         product
     }
 
-    /// Keep `product` of `stage` under `key`.
-    pub fn put<T: Send + Sync + 'static>(&mut self, stage: Stage, key: Key, product: Arc<T>) {
+    /// Keep `product` under `key`.
+    pub fn put<T: Send + Sync + 'static>(&mut self, key: Key, product: Arc<T>) {
+        let stage = key.stage;
         let list = self.entries.entry(stage).or_default();
         list.retain(|(k, _)| *k != key);
         list.push_front((key, product));

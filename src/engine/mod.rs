@@ -34,6 +34,7 @@
 mod cache;
 mod config;
 mod fault;
+mod keys;
 mod products;
 mod report;
 mod run;

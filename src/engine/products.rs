@@ -99,7 +99,7 @@ impl Engine {
                 scene_substrates: scene_substrates.clone(),
                 base_dir: config.scene_dir.as_deref(),
             };
-            let result = self.stage(Stage::Retrieval, key, report, control, || {
+            let result = self.stage(key, report, control, || {
                 let product = retrieve(spec, &inputs, control).map_err(fail)?;
                 let metrics = evaluate(&product, radiance);
                 Ok(RetrievalOutput {

@@ -96,11 +96,10 @@ impl Engine {
         self.cache.clear();
     }
 
-    /// Serve `stage` from the cache under `key`, or compute it with `f` (timed, counted, and
+    /// Serve the product of `key`'s stage from the cache, or compute it with `f` (timed, counted, and
     /// guarded: a panic inside a stage becomes an error naming the stage).
     pub(super) fn stage<T, F>(
         &mut self,
-        stage: Stage,
         key: Key,
         report: &mut RunReport,
         control: &RunControl,
@@ -113,7 +112,8 @@ impl Engine {
         if control.cancelled() {
             return Err(EngineError::Cancelled);
         }
-        if let Some(product) = self.cache.get::<T>(stage, key) {
+        let stage = key.stage;
+        if let Some(product) = self.cache.get::<T>(key) {
             report.stages.push(StageReport { stage, status: StageStatus::Cached, seconds: 0.0 });
             return Ok(product);
         }
@@ -147,7 +147,7 @@ impl Engine {
         };
         *self.executions.entry(stage).or_default() += 1;
         report.stages.push(StageReport { stage, status: StageStatus::Ran, seconds: start.elapsed().as_secs_f64() });
-        self.cache.put(stage, key, product.clone());
+        self.cache.put(key, product.clone());
         Ok(product)
     }
 

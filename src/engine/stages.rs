@@ -4,10 +4,8 @@
 
 use std::sync::Arc;
 
-use ndarray::Array3;
-use serde::Serialize;
-
 use super::cache::{Key, KeyBuilder, Stage};
+use super::keys::Inputs;
 use super::report::{RunReport, SkippedEffect};
 use super::run::{CorrectionProduct, Engine};
 use super::{EngineError, RunConfig};
@@ -17,52 +15,12 @@ use crate::control::RunControl;
 use crate::correction::{SceneApproximation, compare, correct_exact};
 use crate::instrument::sample::BandAtmosphere;
 use crate::instrument::{
-    Detector, InstrumentError, InstrumentKind, Level0, RadianceCube, Response, SampleOptions, SnrRow, SpatialKernel,
-    Viewing, analytic_snr, digitise_cube, expose_cube, measured_snr, sample_radiance,
+    Detector, InstrumentError, Level0, RadianceCube, Response, SampleOptions, SnrRow, SpatialKernel, Viewing,
+    analytic_snr, digitise_cube, expose_cube, measured_snr, sample_radiance,
 };
 use crate::scene::{Effect, Scene};
 use crate::toa::SceneOptics;
-
-/// The part of an instrument that decides photon counts (a change re-runs `Electrons`).
-#[derive(Serialize)]
-struct PhotonSide<'a> {
-    kind: &'a InstrumentKind,
-    aperture_mm: f64,
-    pixel_pitch_um: f64,
-    focal_length_mm: f64,
-    detectors: usize,
-    exposure_s: f64,
-    optical_transmission: f64,
-    quantum_efficiency: &'a crate::spectral::SpectrumSource,
-    dark_current_e_s: f64,
-    prnu: f64,
-    dsnu_e: f64,
-    well_depth_e: f64,
-    noise: bool,
-    seed: u64,
-}
-
-/// The readout electronics (a change re-runs `Level0` onward only).
-#[derive(Serialize)]
-struct Electronics {
-    read_noise_e: f64,
-    gain_e_per_dn: f64,
-    bias_dn: f64,
-    adc_bits: u32,
-    quantise: bool,
-}
-
-/// The geometry an instrument flies (a change re-runs `Geometry` onward).
-#[derive(Serialize)]
-struct Orbit {
-    altitude_km: f64,
-    heading_deg: f64,
-    pixel_pitch_um: f64,
-    focal_length_mm: f64,
-    detectors: usize,
-    exposures: usize,
-    forward_tilt_deg: f64,
-}
+use ndarray::Array3;
 
 fn failed(stage: Stage) -> impl Fn(InstrumentError) -> EngineError {
     move |e| match e {
@@ -85,9 +43,10 @@ impl Engine {
     ) -> Result<SceneSide, EngineError> {
         let instrument = &config.instrument;
         let fid = &config.fidelity;
+        let inputs = Inputs::of(config);
         // Scene.
         let scene_key = KeyBuilder::new(Stage::Scene).with(&config.scene).with(&config.scene_dir).finish();
-        let scene = self.stage(Stage::Scene, scene_key, report, control, || {
+        let scene = self.stage(scene_key, report, control, || {
             Scene::build(&config.scene, config.scene_dir.as_deref()).map_err(failed_any(Stage::Scene))
         })?;
         for effect in Effect::ALL {
@@ -97,35 +56,17 @@ impl Engine {
         }
 
         // Spectral response.
-        let response_key = KeyBuilder::new(Stage::Response)
-            .with(&instrument.kind)
-            .with(&instrument.quantum_efficiency)
-            .with(&instrument.detectors)
-            .with(&fid.spectral_step_nm)
-            .finish();
-        let response = self.stage(Stage::Response, response_key, report, control, || {
+        let response_key = KeyBuilder::new(Stage::Response).with(&inputs.response).finish();
+        let response = self.stage(response_key, report, control, || {
             Response::new(instrument, fid.spectral_step_nm).map_err(failed(Stage::Response))
         })?;
         report.grid_points = response.groups.iter().map(|g| g.grid.len()).collect();
 
         // Geometry.
         let sun = config.scene.sun;
-        let orbit = Orbit {
-            altitude_km: instrument.altitude_km,
-            heading_deg: instrument.heading_deg,
-            pixel_pitch_um: instrument.pixel_pitch_um,
-            focal_length_mm: instrument.focal_length_mm,
-            detectors: instrument.detectors,
-            exposures: instrument.exposures,
-            forward_tilt_deg: instrument.forward_tilt_deg,
-        };
-        let geometry_key = KeyBuilder::new(Stage::Geometry)
-            .after(response_key)
-            .after(scene_key)
-            .with(&orbit)
-            .with(&fid.decimation)
-            .finish();
-        let viewing = self.stage(Stage::Geometry, geometry_key, report, control, || {
+        let geometry_key =
+            KeyBuilder::new(Stage::Geometry).after(response_key).after(scene_key).with(&inputs.orbit).finish();
+        let viewing = self.stage(geometry_key, report, control, || {
             Viewing::new(
                 instrument,
                 &response,
@@ -145,14 +86,14 @@ impl Engine {
         let mut atmosphere_spec = config.scene.atmosphere.clone();
         atmosphere_spec.day_of_year = scene.day_of_year;
         let lut_key = KeyBuilder::new(Stage::Lut).with(&atmosphere_spec).with(&axes).finish();
-        let lut = self.stage(Stage::Lut, lut_key, report, control, || {
+        let lut = self.stage(lut_key, report, control, || {
             let atmosphere = atmosphere_spec.build().map_err(failed_any(Stage::Lut))?;
             AtmosphereLut::build(&atmosphere, axes.clone()).map_err(failed_any(Stage::Lut))
         })?;
 
         // Optics: the scene on each group's grid.
         let optics_key = KeyBuilder::new(Stage::Optics).after(scene_key).after(lut_key).after(response_key).finish();
-        let optics = self.stage(Stage::Optics, optics_key, report, control, || {
+        let optics = self.stage(optics_key, report, control, || {
             response
                 .groups
                 .iter()
@@ -162,7 +103,7 @@ impl Engine {
         })?;
 
         let band_key = KeyBuilder::new(Stage::BandAtmosphere).after(optics_key).after(geometry_key).finish();
-        let band_atmosphere = self.stage(Stage::BandAtmosphere, band_key, report, control, || {
+        let band_atmosphere = self.stage(band_key, report, control, || {
             BandAtmosphere::new(&optics, &viewing, &response).map_err(failed(Stage::BandAtmosphere))
         })?;
 
@@ -192,10 +133,10 @@ impl Engine {
             .after(band_key)
             .with(&kernel.offsets_m)
             .with(&kernel.weights)
-            .with(&instrument.heading_deg)
+            .with(&Inputs::of(config).heading_deg)
             .finish();
         let executed_before = self.executions(Stage::Radiance);
-        let radiance = self.stage(Stage::Radiance, radiance_key, report, control, || {
+        let radiance = self.stage(radiance_key, report, control, || {
             let options = SampleOptions { kernel: kernel.clone(), heading_deg: instrument.heading_deg };
             sample_radiance(scene, optics, viewing, response, band_atmosphere, &options, control)
                 .map_err(failed(Stage::Radiance))
@@ -225,32 +166,13 @@ impl Engine {
         let SceneSide { scene, response, response_key, viewing, optics, .. } = side;
         let response_key = *response_key;
         // Detector, electrons, Level-0.
-        let photon = PhotonSide {
-            kind: &instrument.kind,
-            aperture_mm: instrument.aperture_mm,
-            pixel_pitch_um: instrument.pixel_pitch_um,
-            focal_length_mm: instrument.focal_length_mm,
-            detectors: instrument.detectors,
-            exposure_s: instrument.exposure_s,
-            optical_transmission: instrument.optical_transmission,
-            quantum_efficiency: &instrument.quantum_efficiency,
-            dark_current_e_s: instrument.dark_current_e_s,
-            prnu: instrument.prnu,
-            dsnu_e: instrument.dsnu_e,
-            well_depth_e: instrument.well_depth_e,
-            noise: config.detector.noise,
-            seed: config.seed,
-        };
-        let electronics = Electronics {
-            read_noise_e: instrument.read_noise_e,
-            gain_e_per_dn: instrument.gain_e_per_dn,
-            bias_dn: instrument.bias_dn,
-            adc_bits: instrument.adc_bits,
-            quantise: config.detector.quantise,
-        };
-        let photon_key = KeyBuilder::new(Stage::Detector).after(response_key).with(&photon).finish();
-        let detector_key = KeyBuilder::new(Stage::Detector).after(photon_key).with(&electronics).finish();
-        let detector = self.stage(Stage::Detector, detector_key, report, control, || {
+        let inputs = Inputs::of(config);
+        let detector_key = KeyBuilder::new(Stage::Detector)
+            .after(response_key)
+            .with(&inputs.photon)
+            .with(&inputs.electronics)
+            .finish();
+        let detector = self.stage(detector_key, report, control, || {
             Ok(Detector::new(instrument, response, config.detector, config.seed))
         })?;
         let names: Vec<String> = response.bands.bands.iter().map(|b| b.name.clone()).collect();
@@ -261,12 +183,13 @@ impl Engine {
             &radiance.brightest_water_w_m2_sr_nm,
             viewing.line_period_s,
         );
-        let electrons_key = KeyBuilder::new(Stage::Electrons).after(radiance_key).after(photon_key).finish();
-        let electrons = self.stage(Stage::Electrons, electrons_key, report, control, || {
+        let electrons_key =
+            KeyBuilder::new(Stage::Electrons).after(radiance_key).after(response_key).with(&inputs.photon).finish();
+        let electrons = self.stage(electrons_key, report, control, || {
             expose_cube(&detector, &radiance.radiance, viewing, config.seed, control).map_err(failed(Stage::Electrons))
         })?;
-        let level0_key = KeyBuilder::new(Stage::Level0).after(electrons_key).with(&electronics).finish();
-        let level0 = self.stage(Stage::Level0, level0_key, report, control, || {
+        let level0_key = KeyBuilder::new(Stage::Level0).after(electrons_key).with(&inputs.electronics).finish();
+        let level0 = self.stage(level0_key, report, control, || {
             digitise_cube(&detector, &electrons, viewing, config.seed, control).map_err(failed(Stage::Level0))
         })?;
         drop(electrons);
@@ -279,10 +202,10 @@ impl Engine {
             .after(detector_key)
             .with(&config.calibration)
             .with(&scene.day_of_year)
-            .with(&config.seed)
+            .with(&inputs.seed)
             .with(&viewing.detector_index)
             .finish();
-        let calibration = self.stage(Stage::Calibration, calibration_key, report, control, || {
+        let calibration = self.stage(calibration_key, report, control, || {
             let e0: Vec<Vec<f64>> = optics.iter().map(|o| o.e0().to_vec()).collect();
             let e0_band = band_e0(response, instrument.detectors, &e0);
             Calibration::derive(&config.calibration, &detector, &e0_band, &viewing.detector_index, config.seed)
@@ -291,7 +214,7 @@ impl Engine {
         report.diffuser_incidence_deg = calibration.sun_incidence_deg;
         report.diffuser_saturated_frames = calibration.saturated_frames;
         let level1_key = KeyBuilder::new(Stage::Level1).after(level0_key).after(calibration_key).finish();
-        let level1 = self.stage(Stage::Level1, level1_key, report, control, || {
+        let level1 = self.stage(level1_key, report, control, || {
             calibrate(&level0, &calibration, viewing, control).map_err(failed(Stage::Level1))
         })?;
 
@@ -319,10 +242,10 @@ impl Engine {
             .after(band_key)
             .after(radiance_key)
             .with(&config.correction)
-            .with(&config.seed)
-            .with(&fid.decimation)
+            .with(&Inputs::of(config).seed)
+            .with(&Inputs::of(config).decimation)
             .finish();
-        let correction = self.stage(Stage::Correction, correction_key, report, control, || {
+        let correction = self.stage(correction_key, report, control, || {
             let fail = failed(Stage::Correction);
             let approximation = SceneApproximation::new(
                 &radiance.radiance,
@@ -381,17 +304,9 @@ impl Engine {
         let (detector, detector_key) = (&inst.detector, inst.detector_key);
         let nb = response.n_bands();
         let typical = typical_radiance(&radiance.radiance, &radiance.land);
-        let snr_key = KeyBuilder::new(Stage::Snr)
-            .after(detector_key)
-            .with(&typical)
-            .with(&fid.snr_frames)
-            .with(&fid.snr_detectors)
-            // A preview measures on snr_detectors / decimation detectors: the typical radiance
-            // alone would not tell two decimations of a uniform scene apart.
-            .with(&fid.decimation)
-            .with(&config.seed)
-            .finish();
-        let snr = self.stage(Stage::Snr, snr_key, report, control, || {
+        let snr_key =
+            KeyBuilder::new(Stage::Snr).after(detector_key).with(&typical).with(&Inputs::of(config).snr).finish();
+        let snr = self.stage(snr_key, report, control, || {
             // A preview measures on fewer detectors (the estimate's spread grows as √decimation).
             let n = instrument.detectors;
             let m = (fid.snr_detectors / fid.decimation).clamp(1, n);

@@ -83,3 +83,70 @@ fn a_cancelled_run_stops_and_leaves_the_engine_usable() {
     assert_eq!(engine.run(&config, &control).unwrap_err(), shoal::engine::EngineError::Cancelled);
     assert!(engine.run(&config, &RunControl::new()).is_ok());
 }
+
+/// Every product a run hands on, for bit-wise comparison.
+fn fingerprint(
+    out: &shoal::engine::RunOutput,
+) -> (Vec<f32>, Vec<u16>, Vec<f32>, Vec<f32>, Vec<shoal::instrument::SnrRow>) {
+    (
+        out.radiance.radiance.iter().copied().collect(),
+        out.level0.dn.iter().copied().collect(),
+        out.level1.radiance.iter().copied().collect(),
+        out.correction.rrs.rrs.iter().copied().collect(),
+        out.snr.as_ref().clone(),
+    )
+}
+
+#[test]
+fn after_a_change_of_any_one_field_a_warm_engine_returns_what_a_fresh_one_does() {
+    // The cache serves a product only under the key of everything it was computed from; a field
+    // missing from a key would make the warm engine serve the old product. Every numeric field of
+    // the instrument, the detector switches and the fidelity settings is changed in turn on the
+    // filter imager (whose band view angles depend on the focal plane: the response key lacked
+    // the focal length and pixel pitch until the keys were built by exhaustive destructuring,
+    // `src/engine/keys.rs`). The comparison is exact: the same inputs give the same bits.
+    let base = {
+        let mut c = RunConfig::new(small_lake(), small("filter_imager", 48, 40));
+        c.fidelity.snr_frames = 20;
+        c
+    };
+    type Change = (&'static str, fn(&mut RunConfig));
+    let changes: [Change; 24] = [
+        ("altitude_km", |c| c.instrument.altitude_km *= 1.1),
+        ("heading_deg", |c| c.instrument.heading_deg += 20.0),
+        ("aperture_mm", |c| c.instrument.aperture_mm *= 1.2),
+        ("pixel_pitch_um", |c| c.instrument.pixel_pitch_um *= 1.2),
+        ("focal_length_mm", |c| c.instrument.focal_length_mm *= 1.2),
+        ("detectors", |c| c.instrument.detectors += 8),
+        ("exposure_s", |c| c.instrument.exposure_s *= 0.8),
+        ("exposures", |c| c.instrument.exposures += 8),
+        ("forward_tilt_deg", |c| c.instrument.forward_tilt_deg += 5.0),
+        ("read_noise_e", |c| c.instrument.read_noise_e *= 2.0),
+        ("well_depth_e", |c| c.instrument.well_depth_e *= 0.5),
+        ("gain_e_per_dn", |c| c.instrument.gain_e_per_dn *= 1.5),
+        ("bias_dn", |c| c.instrument.bias_dn += 10.0),
+        ("adc_bits", |c| c.instrument.adc_bits -= 2),
+        ("optical_transmission", |c| c.instrument.optical_transmission *= 0.9),
+        ("dark_current_e_s", |c| c.instrument.dark_current_e_s *= 3.0),
+        ("prnu", |c| c.instrument.prnu += 0.01),
+        ("dsnu_e", |c| c.instrument.dsnu_e += 5.0),
+        ("detector.noise", |c| c.detector.noise = !c.detector.noise),
+        ("detector.quantise", |c| c.detector.quantise = !c.detector.quantise),
+        ("seed", |c| c.seed += 1),
+        ("fidelity.spectral_step_nm", |c| c.fidelity.spectral_step_nm = 2.0),
+        ("fidelity.decimation", |c| c.fidelity.decimation = 2),
+        ("fidelity.snr_frames", |c| c.fidelity.snr_frames += 5),
+    ];
+    let mut warm = Engine::new();
+    let before = fingerprint(&warm.run(&base, &RunControl::new()).unwrap());
+    for (field, change) in changes {
+        let mut config = base.clone();
+        change(&mut config);
+        let from_warm = fingerprint(&warm.run(&config, &RunControl::new()).unwrap());
+        let from_fresh = fingerprint(&Engine::new().run(&config, &RunControl::new()).unwrap());
+        assert!(from_warm == from_fresh, "{field}: the warm engine served a stale product");
+        assert!(from_fresh != before, "{field}: the change changed nothing (the test would not see a stale key)");
+        // And back: the base products again, from the cache.
+        assert!(fingerprint(&warm.run(&base, &RunControl::new()).unwrap()) == before, "{field}: back to the base");
+    }
+}
