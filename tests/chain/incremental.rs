@@ -84,10 +84,11 @@ fn a_cancelled_run_stops_and_leaves_the_engine_usable() {
     assert!(engine.run(&config, &RunControl::new()).is_ok());
 }
 
+/// Pupil radiance, Level-0 DN, Level-1 radiance, Rrs and the SNR table of a run.
+type Fingerprint = (Vec<f32>, Vec<u16>, Vec<f32>, Vec<f32>, Vec<shoal::instrument::SnrRow>);
+
 /// Every product a run hands on, for bit-wise comparison.
-fn fingerprint(
-    out: &shoal::engine::RunOutput,
-) -> (Vec<f32>, Vec<u16>, Vec<f32>, Vec<f32>, Vec<shoal::instrument::SnrRow>) {
+fn fingerprint(out: &shoal::engine::RunOutput) -> Fingerprint {
     (
         out.radiance.radiance.iter().copied().collect(),
         out.level0.dn.iter().copied().collect(),
