@@ -13,6 +13,12 @@
 
 use crate::water::limits;
 
+/// Shortest wavelength Shoal simulates, nm.
+pub const MIN_SIMULATED_NM: f64 = 325.0;
+/// Longest wavelength Shoal simulates, nm: the end of the gas-absorption table
+/// (`assets/atmosphere/atmosphere_gas_absorption_wasi6.csv`, 300–1000 nm).
+pub const MAX_SIMULATED_NM: f64 = 1000.0;
+
 /// The allowed values of one numeric field.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Range {

@@ -80,3 +80,14 @@ pub enum AtmosphereError {
     #[error(transparent)]
     Spectral(#[from] SpectralError),
 }
+
+/// `value` against `range`; the error names the field (its path below `scene.atmosphere.`),
+/// the value and the range.
+pub(crate) fn check(range: &crate::ranges::Range, value: f64) -> Result<(), AtmosphereError> {
+    if range.contains(value) {
+        Ok(())
+    } else {
+        let field = range.field("scene.atmosphere.").into();
+        Err(AtmosphereError::OutOfRange { field, value, allowed: range.allowed() })
+    }
+}

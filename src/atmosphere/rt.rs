@@ -106,7 +106,7 @@ impl RtAccuracy {
 
     /// Check ranges ([`crate::ranges`]); the message names the field and the allowed range.
     pub fn validate(&self) -> Result<(), super::AtmosphereError> {
-        use super::spec::check;
+        use super::check;
         use crate::ranges as r;
         check(&r::ACCURACY_STREAMS, self.streams as f64)?;
         check(&r::ACCURACY_MAX_ORDERS, self.max_orders as f64)?;

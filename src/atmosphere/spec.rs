@@ -8,6 +8,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::aerosol::mixture_optics;
+use super::check;
 use super::fresnel::SEA_REFRACTIVE_INDEX;
 use super::gas::{GasAmounts, transmittance as gas_transmittance};
 use super::glint::glint_radiance_norm;
@@ -107,17 +108,6 @@ fn range(field: &str, value: f64, lo: f64, hi: f64, unit: &str) -> Result<(), At
         Ok(())
     } else {
         Err(AtmosphereError::OutOfRange { field: field.into(), value, allowed: format!("{lo} to {hi}{unit}") })
-    }
-}
-
-/// `value` against `range`; the error names the field (its path below `scene.atmosphere.`),
-/// the value and the range.
-pub(crate) fn check(range: &crate::ranges::Range, value: f64) -> Result<(), AtmosphereError> {
-    if range.contains(value) {
-        Ok(())
-    } else {
-        let field = range.field("scene.atmosphere.").into();
-        Err(AtmosphereError::OutOfRange { field, value, allowed: range.allowed() })
     }
 }
 

@@ -37,6 +37,7 @@ mod fault;
 mod keys;
 mod products;
 mod report;
+mod retrieval_stage;
 mod run;
 mod stages;
 pub mod worker;
@@ -44,9 +45,9 @@ pub mod worker;
 pub use cache::Stage;
 pub use config::{Fidelity, RunConfig};
 pub use fault::{Fault, FaultKind};
-pub use products::RetrievalOutput;
+pub use products::{CorrectionProduct, RetrievalOutput, RunOutput};
 pub use report::{RunReport, StageReport, StageStatus};
-pub use run::{Engine, RunOutput};
+pub use run::Engine;
 
 /// An engine failure: the stage and what went wrong (the message names the field).
 #[derive(Debug, thiserror::Error, Clone, PartialEq)]

@@ -1,18 +1,65 @@
-//! The retrieval stage: each configured retrieval over the Rrs image, scored against the truth.
+//! The products of the chain's stages, as they travel between stages and out of a run: the
+//! correction's and the retrievals' products, the whole run's output, and the groups of products
+//! (with their keys) that one group of stages hands to the next. Data only; the stages that make
+//! them are in `stages.rs` and `retrieval_stage.rs`.
 
 use std::sync::Arc;
 
-use super::cache::{Key, KeyBuilder, Stage};
+use super::RunConfig;
+use super::cache::Key;
 use super::report::RunReport;
-use super::run::{CorrectionProduct, Engine};
-use super::stages::SceneSide;
-use super::{EngineError, RunConfig};
-use crate::control::RunControl;
-use crate::instrument::{Detector, DetectorMode, RadianceCube};
-use crate::metrics::{ProductMetrics, evaluate};
-use crate::retrieval::run::band_responses;
-use crate::retrieval::{Product, RetrievalError, RetrievalInputs, RetrievalSpec, retrieve};
-use crate::water::WaterGeometry;
+use crate::calibration::{Calibration, Level1};
+use crate::correction::{Reflectance, SceneApproximation};
+use crate::instrument::sample::BandAtmosphere;
+use crate::instrument::{Detector, Level0, RadianceCube, Response, SnrRow, Viewing};
+use crate::metrics::ProductMetrics;
+use crate::retrieval::{Product, RetrievalSpec};
+use crate::scene::Scene;
+use crate::toa::SceneOptics;
+
+/// The atmospheric correction stage's product.
+#[derive(Debug, Clone)]
+pub struct CorrectionProduct {
+    /// The delivered Rrs (exact, or the approximation when the config asks for it).
+    pub rrs: Reflectance,
+    /// The paper's per-scene approximation terms.
+    pub approximation: SceneApproximation,
+    /// Per band: approximation against exact correction.
+    pub approximation_vs_exact: Vec<crate::correction::BandDifference>,
+    /// Per band: delivered Rrs against the truth.
+    pub rrs_vs_truth: Vec<crate::correction::BandDifference>,
+}
+
+/// Everything a run produced (shared with the cache: cheap to clone).
+#[derive(Debug, Clone)]
+pub struct RunOutput {
+    /// The configuration it ran.
+    pub config: RunConfig,
+    /// The scene.
+    pub scene: Arc<Scene>,
+    /// The instrument's spectral response.
+    pub response: Arc<Response>,
+    /// The viewing geometry.
+    pub viewing: Arc<Viewing>,
+    /// The band-effective atmosphere of each column (what the exact correction used).
+    pub band_atmosphere: Arc<BandAtmosphere>,
+    /// Pupil radiance and truth.
+    pub radiance: Arc<RadianceCube>,
+    /// Level-0.
+    pub level0: Arc<Level0>,
+    /// Calibration coefficients.
+    pub calibration: Arc<Calibration>,
+    /// Level-1.
+    pub level1: Arc<Level1>,
+    /// Rrs and the correction's diagnostics.
+    pub correction: Arc<CorrectionProduct>,
+    /// SNR per band.
+    pub snr: Arc<Vec<SnrRow>>,
+    /// Retrieved products and their metrics, one per configured retrieval.
+    pub retrievals: Vec<Arc<RetrievalOutput>>,
+    /// The report.
+    pub report: RunReport,
+}
 
 /// One retrieval's product and its metrics.
 #[derive(Debug, Clone)]
@@ -29,89 +76,23 @@ pub struct RetrievalOutput {
     pub nedr: Vec<f64>,
 }
 
-/// Noise-equivalent ΔRrs per band at the typical radiance: the detector's noise (on, whatever
-/// the run's switches: it characterises the instrument) in radiance, over the band's T_up·Ed
-/// at the central column. Ideal instruments get a flat 1e-6 sr⁻¹ (uniform weighting).
-fn nedr(config: &RunConfig, side: &SceneSide, typical: &[f64]) -> Vec<f64> {
-    let detector = Detector::new(&config.instrument, &side.response, DetectorMode::default(), config.seed);
-    let j = config.instrument.detectors / 2;
-    let column = side.viewing.columns() / 2;
-    (0..typical.len())
-        .map(|b| {
-            let k = detector.responsivity(j, b);
-            let signal = k * typical[b];
-            let noise = detector.variance_e2(signal, detector.dark_mean_e(j, b, detector.exposure_s())).sqrt();
-            let t_ed = side.band_atmosphere.t_ed[side.band_atmosphere.at(column, b)];
-            let v = noise / k / t_ed;
-            if v.is_finite() && v > 0.0 { v } else { 1e-6 }
-        })
-        .collect()
+/// Products of the scene side of the chain and their keys.
+pub(super) struct SceneSide {
+    pub(super) scene: Arc<Scene>,
+    pub(super) response: Arc<Response>,
+    pub(super) response_key: Key,
+    pub(super) viewing: Arc<Viewing>,
+    pub(super) optics: Arc<Vec<SceneOptics>>,
+    pub(super) band_atmosphere: Arc<BandAtmosphere>,
+    pub(super) band_key: Key,
 }
 
-impl Engine {
-    /// Run every configured retrieval (cached under the Rrs it reads and its own settings).
-    #[allow(clippy::too_many_arguments)]
-    pub(super) fn retrieval_stage(
-        &mut self,
-        config: &RunConfig,
-        side: &SceneSide,
-        radiance: &Arc<RadianceCube>,
-        (correction, correction_key): (&Arc<CorrectionProduct>, Key),
-        typical: &[f64],
-        control: &RunControl,
-        report: &mut RunReport,
-    ) -> Result<Vec<Arc<RetrievalOutput>>, EngineError> {
-        if config.retrievals.is_empty() {
-            return Ok(Vec::new());
-        }
-        let nedr = nedr(config, side, typical);
-        let column = side.viewing.columns() / 2;
-        let bands = band_responses(&side.response, &side.band_atmosphere, column);
-        let geometry: Vec<WaterGeometry> = side.viewing.looks[0]
-            .iter()
-            .map(|l| WaterGeometry {
-                sun_zenith_rad: l.geometry.sun_zenith_rad,
-                view_zenith_rad: l.geometry.view_zenith_rad,
-            })
-            .collect();
-        let fail = |e: RetrievalError| match e {
-            RetrievalError::Cancelled => EngineError::Cancelled,
-            other => EngineError::Failed { stage: Stage::Retrieval, message: other.to_string() },
-        };
-        let scene_siop = side.scene.spec.siop.load(side.scene.base_dir.as_deref()).map_err(|e| fail(e.into()))?;
-        let scene_substrates: Vec<String> = side.scene.spec.substrates.iter().map(|s| s.name.clone()).collect();
-        let mut out = Vec::with_capacity(config.retrievals.len());
-        for spec in &config.retrievals {
-            let key = KeyBuilder::new(Stage::Retrieval)
-                .after(correction_key)
-                .after(side.band_key)
-                .with(&nedr)
-                .with(spec)
-                .finish();
-            let inputs = RetrievalInputs {
-                rrs: &correction.rrs.rrs,
-                flags: &correction.rrs.flags,
-                land: &radiance.land,
-                bands: bands.clone(),
-                geometry: geometry.clone(),
-                nedr: nedr.clone(),
-                scene_siop: scene_siop.clone(),
-                scene_substrates: scene_substrates.clone(),
-                base_dir: config.scene_dir.as_deref(),
-            };
-            let result = self.stage(key, report, control, || {
-                let product = retrieve(spec, &inputs, control).map_err(fail)?;
-                let metrics = evaluate(&product, radiance);
-                Ok(RetrievalOutput {
-                    spec: spec.clone(),
-                    product,
-                    metrics,
-                    bands: inputs.bands.clone(),
-                    nedr: inputs.nedr.clone(),
-                })
-            })?;
-            out.push(result);
-        }
-        Ok(out)
-    }
+/// Products of the instrument side and the keys later stages build on.
+pub(super) struct InstrumentSide {
+    pub(super) detector: Arc<Detector>,
+    pub(super) detector_key: Key,
+    pub(super) level0: Arc<Level0>,
+    pub(super) calibration: Arc<Calibration>,
+    pub(super) level1: Arc<Level1>,
+    pub(super) level1_key: Key,
 }

@@ -6,58 +6,10 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use super::cache::{Cache, Key, Stage};
+use super::products::RunOutput;
 use super::report::{RunReport, StageReport, StageStatus};
 use super::{EngineError, Fault, FaultKind, RunConfig};
-use crate::calibration::{Calibration, Level1};
 use crate::control::{PixelSite, RunControl};
-use crate::correction::{Reflectance, SceneApproximation};
-use crate::instrument::sample::BandAtmosphere;
-use crate::instrument::{Level0, RadianceCube, Response, SnrRow, Viewing};
-use crate::scene::Scene;
-
-/// The atmospheric correction stage's product.
-#[derive(Debug, Clone)]
-pub struct CorrectionProduct {
-    /// The delivered Rrs (exact, or the approximation when the config asks for it).
-    pub rrs: Reflectance,
-    /// The paper's per-scene approximation terms.
-    pub approximation: SceneApproximation,
-    /// Per band: approximation against exact correction.
-    pub approximation_vs_exact: Vec<crate::correction::BandDifference>,
-    /// Per band: delivered Rrs against the truth.
-    pub rrs_vs_truth: Vec<crate::correction::BandDifference>,
-}
-
-/// Everything a run produced (shared with the cache: cheap to clone).
-#[derive(Debug, Clone)]
-pub struct RunOutput {
-    /// The configuration it ran.
-    pub config: RunConfig,
-    /// The scene.
-    pub scene: Arc<Scene>,
-    /// The instrument's spectral response.
-    pub response: Arc<Response>,
-    /// The viewing geometry.
-    pub viewing: Arc<Viewing>,
-    /// The band-effective atmosphere of each column (what the exact correction used).
-    pub band_atmosphere: Arc<BandAtmosphere>,
-    /// Pupil radiance and truth.
-    pub radiance: Arc<RadianceCube>,
-    /// Level-0.
-    pub level0: Arc<Level0>,
-    /// Calibration coefficients.
-    pub calibration: Arc<Calibration>,
-    /// Level-1.
-    pub level1: Arc<Level1>,
-    /// Rrs and the correction's diagnostics.
-    pub correction: Arc<CorrectionProduct>,
-    /// SNR per band.
-    pub snr: Arc<Vec<SnrRow>>,
-    /// Retrieved products and their metrics, one per configured retrieval.
-    pub retrievals: Vec<Arc<super::products::RetrievalOutput>>,
-    /// The report.
-    pub report: RunReport,
-}
 
 /// The engine: a stage cache and execution counters.
 #[derive(Debug, Default)]

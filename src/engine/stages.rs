@@ -6,17 +6,18 @@ use std::sync::Arc;
 
 use super::cache::{Key, KeyBuilder, Stage};
 use super::keys::Inputs;
+use super::products::{CorrectionProduct, InstrumentSide, SceneSide};
 use super::report::{RunReport, SkippedEffect};
-use super::run::{CorrectionProduct, Engine};
+use super::run::Engine;
 use super::{EngineError, RunConfig};
 use crate::atmosphere::{AtmosphereLut, LutAxes};
-use crate::calibration::{Calibration, Level1, band_e0, calibrate};
+use crate::calibration::{Calibration, band_e0, calibrate};
 use crate::control::RunControl;
 use crate::correction::{SceneApproximation, compare, correct_exact};
 use crate::instrument::sample::BandAtmosphere;
 use crate::instrument::{
-    Detector, InstrumentError, Level0, RadianceCube, Response, SampleOptions, SnrRow, SpatialKernel, Viewing,
-    analytic_snr, digitise_cube, expose_cube, measured_snr, sample_radiance,
+    Detector, InstrumentError, RadianceCube, Response, SampleOptions, SnrRow, SpatialKernel, Viewing, analytic_snr,
+    digitise_cube, expose_cube, measured_snr, sample_radiance,
 };
 use crate::scene::{Effect, Scene};
 use crate::toa::SceneOptics;
@@ -325,27 +326,6 @@ impl Engine {
         })?;
         Ok((snr, typical))
     }
-}
-
-/// Products of the scene side of the chain and their keys.
-pub(super) struct SceneSide {
-    pub(super) scene: Arc<Scene>,
-    pub(super) response: Arc<Response>,
-    pub(super) response_key: Key,
-    pub(super) viewing: Arc<Viewing>,
-    pub(super) optics: Arc<Vec<SceneOptics>>,
-    pub(super) band_atmosphere: Arc<BandAtmosphere>,
-    pub(super) band_key: Key,
-}
-
-/// Products of the instrument side and the keys later stages build on.
-pub(super) struct InstrumentSide {
-    detector: Arc<Detector>,
-    detector_key: Key,
-    pub(super) level0: Arc<Level0>,
-    pub(super) calibration: Arc<Calibration>,
-    pub(super) level1: Arc<Level1>,
-    level1_key: Key,
 }
 
 /// LUT axes: wavelength nodes on a fixed lattice covering the grids (so a change of bands rarely

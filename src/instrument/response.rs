@@ -192,11 +192,7 @@ impl Response {
     }
 }
 
-/// Shortest wavelength Shoal simulates, nm.
-pub const MIN_SIMULATED_NM: f64 = 325.0;
-/// Longest wavelength Shoal simulates, nm: the end of the gas-absorption table
-/// (`assets/atmosphere/atmosphere_gas_absorption_wasi6.csv`, 300–1000 nm).
-pub const MAX_SIMULATED_NM: f64 = 1000.0;
+pub use crate::ranges::{MAX_SIMULATED_NM, MIN_SIMULATED_NM};
 
 /// The simulation grid of a group: every multiple of `step_nm` within `margin_nm` of a band's
 /// SRF support. Gaps between disjoint bands are left out (nothing there is seen), so a

@@ -189,7 +189,7 @@ impl InstrumentSpec {
             // Each band's Gaussian response is tabulated over centre ± 2.5 FWHM (Band::gaussian),
             // shifted by up to |smile|; it must lie where Shoal has atmospheric data.
             let reach = 2.5 * resolution_nm + smile_nm.abs();
-            if end_nm + reach > crate::instrument::response::MAX_SIMULATED_NM {
+            if end_nm + reach > crate::ranges::MAX_SIMULATED_NM {
                 return Err(InstrumentError::Invalid {
                     field: r::SPECTROGRAPH_END_NM.field("instrument.").into(),
                     message: format!(
@@ -197,18 +197,18 @@ impl InstrumentSpec {
                          response at {:.1} nm (allowed: end_nm + 2.5·resolution_nm + |smile_nm| ≤ {} nm, the end \
                          of Shoal's gas-absorption data)",
                         end_nm + reach,
-                        crate::instrument::response::MAX_SIMULATED_NM
+                        crate::ranges::MAX_SIMULATED_NM
                     ),
                 });
             }
-            if start_nm - reach < crate::instrument::response::MIN_SIMULATED_NM {
+            if start_nm - reach < crate::ranges::MIN_SIMULATED_NM {
                 return Err(InstrumentError::Invalid {
                     field: r::SPECTROGRAPH_START_NM.field("instrument.").into(),
                     message: format!(
                         "{start_nm} with resolution_nm = {resolution_nm} and smile_nm = {smile_nm} puts the first \
                          band's response at {:.1} nm (allowed: start_nm − 2.5·resolution_nm − |smile_nm| ≥ {} nm)",
                         start_nm - reach,
-                        crate::instrument::response::MIN_SIMULATED_NM
+                        crate::ranges::MIN_SIMULATED_NM
                     ),
                 });
             }
