@@ -1,7 +1,7 @@
 //! The documented range of every number a user sets — one table.
 //!
 //! Each validator checks its fields against the entries here, so a message and its check cannot
-//! drift apart; `shoal ranges` prints the table, and README's "Ranges" section is that output (a
+//! drift apart; `shoal ranges` prints the table, and docs/MANUAL.md's "Ranges" section is that output (a
 //! unit test keeps the two equal). A value outside its range is refused with the field, the value
 //! and the range ("aperture_mm: 5000 is out of range (allowed: above 0, at most 2000 mm)"): exit
 //! code 2 in the CLI, an inline refusal in the app.
@@ -306,7 +306,7 @@ ranges! {
     REQUIREMENT_SNR = Range::above("requirements.snr", 0.0, 1e6, "", "smallest SNR of every band at the typical radiance").below_hi();
 }
 
-/// The table as Markdown (`shoal ranges`; README's "Ranges" section).
+/// The table as Markdown (`shoal ranges`; docs/MANUAL.md's "Ranges" section).
 #[must_use]
 pub fn markdown_table() -> String {
     let mut out = String::from("| field | allowed | what |\n|---|---|---|\n");
@@ -353,11 +353,11 @@ mod tests {
         }
     }
 
-    /// README's table is `shoal ranges`'s output, so the documentation is the code's.
+    /// docs/MANUAL.md's table is `shoal ranges`'s output, so the documentation is the code's.
     #[test]
-    fn readme_shows_the_table() {
-        let readme = include_str!("../README.md");
+    fn manual_shows_the_table() {
+        let manual = include_str!("../docs/MANUAL.md");
         let table = markdown_table();
-        assert!(readme.contains(&table), "README.md's Ranges table differs from `shoal ranges`; paste this:\n{table}");
+        assert!(manual.contains(&table), "docs/MANUAL.md's table differs from `shoal ranges`; paste this:\n{table}");
     }
 }

@@ -77,7 +77,7 @@ enum Command {
     /// Measure speed and accuracy: water evaluations per second, atmosphere LUT build times
     /// with their errors against OSOAA.
     Bench(bench::BenchArgs),
-    /// Print the allowed range of every number a user sets (Markdown table; README "Ranges").
+    /// Print the allowed range of every number a user sets (Markdown table; docs/MANUAL.md "Ranges").
     Ranges,
     /// Developer tools that regenerate computed assets.
     #[command(subcommand, hide = true)]
