@@ -19,6 +19,7 @@
 //! | [`units`] | constants, unit conversions, angle helpers |
 //! | [`assets`] | cited spectra embedded in the binary |
 //! | [`control`] | cancellation and progress shared by a run and its watcher |
+//! | [`jobs`] | background work: the newest-request-wins mailbox and the one rayon pool builder |
 //! | [`spectral`] | wavelength grid, spectra, band sets, `band_from_fine` |
 //! | [`water`] | SIOP sets, IOPs, deep/shallow reflectance (Lee et al. 1998/1999, SAMBUCA) |
 //! | [`ranges`] | the documented range of every number a user sets: one table the validators use |
@@ -50,6 +51,7 @@ pub mod control;
 pub mod correction;
 pub mod engine;
 pub mod instrument;
+pub mod jobs;
 pub mod library;
 pub mod metrics;
 pub mod parse;

@@ -26,7 +26,9 @@ enum Msg<T> {
     Done(Result<(), String>),
 }
 
-/// A helper thread's channel and its cancel switch.
+/// A helper thread's channel and its cancel switch. The work runs in a pool of its own (all cores
+/// but one, at least one), so a sweep or a cost measurement neither queues behind the engine's
+/// runs in a shared pool nor takes every core from the maps the engine is refining.
 struct Task<T> {
     rx: Receiver<Msg<T>>,
     control: Arc<RunControl>,
@@ -40,6 +42,8 @@ impl<T: Send + 'static> Task<T> {
         let (tx, rx): (SyncSender<Msg<T>>, _) = sync_channel(64);
         let control = Arc::new(RunControl::new());
         let (c, wake) = (control.clone(), ctx.clone());
+        let cores = std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get);
+        let pool = crate::jobs::pool(cores.saturating_sub(1).max(1), "shoal-explore").map_err(|e| e.to_string())?;
         std::thread::Builder::new()
             .name("shoal-explore".into())
             .spawn(move || {
@@ -47,7 +51,7 @@ impl<T: Send + 'static> Task<T> {
                     let _ = tx.send(Msg::Item(item));
                     wake.request_repaint();
                 };
-                let result = work(&c, &send);
+                let result = pool.install(|| work(&c, &send));
                 let _ = tx.send(Msg::Done(result));
                 wake.request_repaint();
             })

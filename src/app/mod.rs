@@ -20,6 +20,7 @@ pub mod bench;
 pub mod explore;
 mod export;
 pub mod link;
+mod listing;
 mod maps;
 pub mod model;
 mod panels;
@@ -83,6 +84,8 @@ pub struct ShoalApp {
     /// The engine link.
     pub link: EngineLink,
     library: Library,
+    /// The library's listing, kept so that frames never read the disk.
+    listing: listing::Listing,
     images: maps::Images,
     raster: Option<raster::RasterThread>,
     ui: UiState,
@@ -126,6 +129,7 @@ impl ShoalApp {
         Self {
             state,
             link,
+            listing: listing::Listing::new(&Library::user()),
             library: Library::user(),
             images: maps::Images::default(),
             raster,
@@ -177,6 +181,7 @@ impl ShoalApp {
 
     /// Use `library` for presets (tests).
     pub fn set_library(&mut self, library: Library) {
+        self.listing.reread(&library);
         self.library = library;
     }
 
@@ -220,6 +225,8 @@ impl ShoalApp {
             a.fault = self.ui.fault;
         }
         self.link.submit_if_changed(configs, self.state.levels());
+        let wake = ctx.clone();
+        self.listing.poll(&self.library, move || wake.request_repaint());
         if self.link.poll() {
             self.images.invalidate();
         }
@@ -369,6 +376,7 @@ impl ShoalApp {
         };
         match result {
             Ok(path) => {
+                self.listing.reread(&self.library);
                 if let Confirm::Instrument { slot, name, spec } = confirm {
                     let slot_state = model::Slot::new(&name, *spec);
                     if slot == 0 {

@@ -184,7 +184,7 @@ fn library_combo(ui: &mut egui::Ui, label: &str, current: &str, entries: &[Entry
 
 fn presets(app: &mut ShoalApp, ui: &mut egui::Ui) {
     ui.heading("Presets");
-    let instruments = app.library.list(Kind::Instrument);
+    let instruments = app.listing.get(Kind::Instrument).to_vec();
     for (i, label) in [(0, "Instrument A"), (1, "Instrument B")] {
         let current = if i == 0 { app.state.a.preset.clone() } else { app.state.b.preset.clone() };
         if let Some(e) = library_combo(ui, label, &current, &instruments) {
@@ -201,7 +201,7 @@ fn presets(app: &mut ShoalApp, ui: &mut egui::Ui) {
             }
         }
     }
-    let scenes = app.library.list(Kind::Scene);
+    let scenes = app.listing.get(Kind::Scene).to_vec();
     if let Some(e) = library_combo(ui, "Scene", &app.state.scene_name.clone(), &scenes) {
         match app.library.load_scene(&e) {
             Ok(spec) => {
@@ -211,7 +211,7 @@ fn presets(app: &mut ShoalApp, ui: &mut egui::Ui) {
             Err(err) => app.ui.error = Some(format!("Cannot load scene `{}`: {err}", e.name)),
         }
     }
-    let studies = app.library.list(Kind::Study);
+    let studies = app.listing.get(Kind::Study).to_vec();
     if let Some(e) = library_combo(ui, "Study", &app.state.study_name.clone(), &studies) {
         let loaded = app.library.load_study(&e).map_err(|e| e.to_string());
         match loaded.and_then(|study| AppState::from_study(&study).map(|s| (s, study.requirements.is_some()))) {

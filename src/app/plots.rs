@@ -120,12 +120,15 @@ fn pairs(out: &RunOutput, variable: &str) -> Vec<(f64, f64)> {
         },
         _ => return Vec::new(),
     };
+    // A strided sample of at most ~4000 pixels, visited directly: a frame never walks the whole
+    // truth array (2 M pixels at full resolution).
+    let cols = truth.ncols().max(1);
     let step = (truth.len() / 4000).max(1);
-    truth
-        .indexed_iter()
+    (0..truth.len())
         .step_by(step)
-        .filter(|((i, j), t)| r.land[[*i, *j]] == 0 && p.returned(*i, *j) && **t > 0.0 && got[[*i, *j]] > 0.0)
-        .map(|((i, j), t)| (f64::from(*t).log10(), f64::from(got[[i, j]]).log10()))
+        .map(|k| (k / cols, k % cols))
+        .filter(|&(i, j)| r.land[[i, j]] == 0 && p.returned(i, j) && truth[[i, j]] > 0.0 && got[[i, j]] > 0.0)
+        .map(|(i, j)| (f64::from(truth[[i, j]]).log10(), f64::from(got[[i, j]]).log10()))
         .collect()
 }
 

@@ -3,7 +3,7 @@
 //! the UI thread only uploads the finished images.
 
 use std::sync::Arc;
-use std::sync::mpsc::{Receiver, SyncSender, TrySendError, sync_channel};
+use std::sync::mpsc::{Receiver, sync_channel};
 
 use ndarray::Array2;
 
@@ -11,6 +11,7 @@ use super::model::ProductKind;
 use crate::colormap::{Scale, categorical, diverging, viridis};
 use crate::engine::RunOutput;
 use crate::instrument::{Detector, DetectorMode, Viewing};
+use crate::jobs::{Mailbox, Put};
 
 /// A map's values and where they are valid.
 #[derive(Debug, Clone, PartialEq)]
@@ -360,42 +361,38 @@ pub fn panels(job: &Job, cache: &mut MapCache) -> Done {
     Done { key: job.key, panels, palette, difference_palette }
 }
 
-/// A thread that prepares map panels off the UI thread, always working on the newest request.
+/// A thread that prepares map panels off the UI thread, always working on the newest request
+/// (a [`Mailbox`]: asking never blocks, and a request not yet started is replaced by a newer one).
 #[derive(Debug)]
 pub struct RasterThread {
-    jobs: SyncSender<Job>,
+    jobs: Arc<Mailbox<Job>>,
     done: Receiver<Done>,
 }
 
 impl RasterThread {
     /// Start the thread; `wake` is called when an answer is ready (to request a repaint).
     pub fn spawn(wake: impl Fn() + Send + 'static) -> std::io::Result<Self> {
-        // Short queues: the thread skips to the newest job, and the UI takes every answer each frame.
-        let (jobs, job_rx) = sync_channel::<Job>(4);
+        // The UI takes every answer each frame: a short answer queue is enough.
+        let jobs = Arc::new(Mailbox::<Job>::new());
         let (done_tx, done) = sync_channel::<Done>(2);
+        let job_rx = jobs.clone();
         std::thread::Builder::new().name("shoal-raster".into()).spawn(move || {
             let mut cache = MapCache::default();
-            while let Ok(mut job) = job_rx.recv() {
-                while let Ok(newer) = job_rx.try_recv() {
-                    job = newer;
-                }
+            while let Some(job) = job_rx.take() {
                 if done_tx.send(panels(&job, &mut cache)).is_err() {
-                    return;
+                    break;
                 }
                 wake();
             }
+            job_rx.close();
         })?;
         Ok(Self { jobs, done })
     }
 
-    /// Ask for panels (returns false if the thread has stopped).
-    ///
-    /// Never blocks: with the queue full it returns false and the caller asks again next frame.
+    /// Ask for panels, replacing a request not yet started (returns false if the thread has
+    /// stopped). Never blocks.
     pub fn request(&self, job: Job) -> bool {
-        match self.jobs.try_send(job) {
-            Ok(()) => true,
-            Err(TrySendError::Full(_) | TrySendError::Disconnected(_)) => false,
-        }
+        !matches!(self.jobs.put(job), Put::Closed(_))
     }
 
     /// The newest answer, if any.
@@ -405,6 +402,12 @@ impl RasterThread {
             last = Some(d);
         }
         last
+    }
+}
+
+impl Drop for RasterThread {
+    fn drop(&mut self) {
+        self.jobs.close();
     }
 }
 

@@ -193,7 +193,7 @@ fn atmosphere_rows(out: &mut String, quick: bool) -> Result<(), CliError> {
     say!(out);
     say!(
         out,
-        "T_up columns use rows where the water-leaving radiance is above 10 % of the TOA radiance (OSOAA's T_up_eff is a difference of two large numbers otherwise). Hume's T_up_eff includes the bidirectional shape of that turbid water's radiance at 60° sun, which Shoal's water-leaving radiance (an isotropic in-water field) does not have: see README."
+        "T_up columns use rows where the water-leaving radiance is above 10 % of the TOA radiance (OSOAA's T_up_eff is a difference of two large numbers otherwise). Hume's T_up_eff includes the bidirectional shape of that turbid water's radiance at 60° sun, which Shoal's water-leaving radiance (an isotropic in-water field) does not have: see docs/PHYSICS.md, \"Accuracy against OSOAA\"."
     );
     Ok(())
 }

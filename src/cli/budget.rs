@@ -33,10 +33,8 @@ pub fn run(args: &BudgetArgs) -> Result<(), CliError> {
     }
     let (spec, dir) = super::study::load(args.study.as_deref())?;
     let resolved = spec.resolve(dir.as_deref())?;
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(args.threads.unwrap_or(0))
-        .build()
-        .map_err(|e| CliError::Run(format!("cannot start worker threads: {e}")))?;
+    let pool =
+        crate::jobs::pool(args.threads.unwrap_or(0), "shoal-budget").map_err(|e| CliError::Run(e.to_string()))?;
     let seeds: Vec<u64> = (1..=args.seeds).collect();
     let control = super::interrupt::control();
     let start = std::time::Instant::now();

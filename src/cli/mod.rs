@@ -88,7 +88,7 @@ enum Command {
 enum DevCommand {
     /// Print the WMO aerosol component Mie table (assets/atmosphere/wmo_aerosol_mie.csv).
     AerosolTable,
-    /// Print the per-band accuracy table against OSOAA (README).
+    /// Print the per-band accuracy table against OSOAA (docs/PHYSICS.md).
     OsoaaTable,
     /// Regenerate the eight aLMI SIOP sets (presets/siop/almi_*.ron) into DIR.
     AlmiSets {

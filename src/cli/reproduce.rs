@@ -47,10 +47,8 @@ pub fn run(args: &ReproduceArgs) -> Result<(), CliError> {
             .check(d as f64)
             .map_err(|m| CliError::Input(format!("--decimation: {m}")))?;
     }
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(args.threads.unwrap_or(0))
-        .build()
-        .map_err(|e| CliError::Run(format!("cannot start worker threads: {e}")))?;
+    let pool =
+        crate::jobs::pool(args.threads.unwrap_or(0), "shoal-reproduce").map_err(|e| CliError::Run(e.to_string()))?;
     let start = Instant::now();
     let (lake, heron) = pool.install(|| -> Result<_, CliError> {
         Ok((run_one(LAKE_HUME, args.decimation)?, run_one(HERON_ISLAND, args.decimation)?))

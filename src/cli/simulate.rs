@@ -139,10 +139,7 @@ pub fn config_from(args: &SimulateArgs) -> Result<RunConfig, CliError> {
 
 /// Run `config` on `threads` threads with a progress bar on standard error.
 pub fn run_with_progress(config: &RunConfig, threads: Option<usize>, label: &str) -> Result<RunOutput, CliError> {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads.unwrap_or(0))
-        .build()
-        .map_err(|e| CliError::Run(format!("cannot start worker threads: {e}")))?;
+    let pool = crate::jobs::pool(threads.unwrap_or(0), "shoal-simulate").map_err(|e| CliError::Run(e.to_string()))?;
     let control = Arc::new(super::interrupt::control());
     let bar = indicatif::ProgressBar::new(1);
     bar.set_style(

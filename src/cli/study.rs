@@ -72,10 +72,7 @@ pub fn run(args: &StudyArgs) -> Result<(), CliError> {
         }
         c.fault = fault;
     }
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(args.threads.unwrap_or(0))
-        .build()
-        .map_err(|e| CliError::Run(format!("cannot start worker threads: {e}")))?;
+    let pool = crate::jobs::pool(args.threads.unwrap_or(0), "shoal-study").map_err(|e| CliError::Run(e.to_string()))?;
     let n = resolved.runs.len();
     let bar = indicatif::ProgressBar::new(n as u64);
     bar.set_style(

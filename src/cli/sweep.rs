@@ -101,10 +101,7 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
             c.fidelity.decimation = d;
         }
     }
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(args.threads.unwrap_or(0))
-        .build()
-        .map_err(|e| CliError::Run(format!("cannot start worker threads: {e}")))?;
+    let pool = crate::jobs::pool(args.threads.unwrap_or(0), "shoal-sweep").map_err(|e| CliError::Run(e.to_string()))?;
     let mine = sweep.jobs.iter().filter(|j| shard.owns(j.index)).count();
     let bar = indicatif::ProgressBar::new(mine as u64);
     bar.set_style(

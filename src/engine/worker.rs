@@ -1,5 +1,7 @@
-//! The engine on its own thread, for the app: requests in, events out, through bounded
-//! channels, with generation numbers so that stale work is abandoned and stale results dropped.
+//! The engine on its own thread, for the app: requests in through a single-slot
+//! [`Mailbox`](crate::jobs::Mailbox) (the newest wins; submitting never blocks), events out
+//! through a bounded channel, with generation numbers so that stale work is abandoned and stale
+//! results dropped.
 //!
 //! The app owns the configuration and sends a snapshot with a new generation number each time it
 //! changes. The worker always runs the newest request it has: a newer one cancels the current
@@ -9,12 +11,13 @@
 
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::mpsc::{Receiver, RecvTimeoutError, SyncSender, TryRecvError, TrySendError, sync_channel};
+use std::sync::mpsc::{Receiver, RecvTimeoutError, SyncSender, TryRecvError, sync_channel};
 use std::thread::JoinHandle;
 use std::time::Duration;
 
 use super::{Engine, EngineError, RunConfig, RunOutput};
 use crate::control::RunControl;
+use crate::jobs::{Mailbox, Put};
 
 /// A request: configuration snapshots (instrument A, instrument B, …) and the decimations to run
 /// them at, coarsest first. Each decimation runs every configuration before the next finer one.
@@ -71,7 +74,7 @@ pub struct WorkerStats {
     pub results_sent: u64,
     /// Runs stopped by cancellation (a newer generation); these send no `Finished` event.
     pub runs_cancelled: u64,
-    /// Requests superseded before any of their runs started (replaced in the queue, or found
+    /// Requests superseded before any of their runs started (replaced in the mailbox, or found
     /// stale when taken from it).
     pub requests_skipped: u64,
     /// `Finished` events of an older generation that `poll`/`wait` dropped.
@@ -103,7 +106,7 @@ struct Counters {
 /// The app's handle on the engine thread.
 #[derive(Debug)]
 pub struct EngineHandle {
-    requests: Option<SyncSender<Request>>,
+    requests: Arc<Mailbox<Request>>,
     events: Receiver<Event>,
     latest: Arc<AtomicU64>,
     counters: Arc<Counters>,
@@ -119,40 +122,33 @@ impl EngineHandle {
     /// As [`EngineHandle::spawn`], calling `wake` after every event it sends (the app passes
     /// "request a repaint", so a result is drawn the moment it arrives, not at the next poll).
     pub fn spawn_with_wake(threads: usize, wake: Wake) -> std::io::Result<Self> {
-        let (request_tx, request_rx) = sync_channel::<Request>(4);
+        let requests = Arc::new(Mailbox::new());
+        let worker_requests = requests.clone();
         let (event_tx, event_rx) = sync_channel::<Event>(64);
         let latest = Arc::new(AtomicU64::new(0));
         let worker_latest = latest.clone();
         let counters = Arc::new(Counters::default());
         let worker_counters = counters.clone();
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads.max(1))
-            .thread_name(|i| format!("shoal-engine-{i}"))
-            .build()
-            .map_err(std::io::Error::other)?;
-        let thread = std::thread::Builder::new()
-            .name("shoal-engine".into())
-            .spawn(move || worker(&request_rx, &event_tx, &worker_latest, &worker_counters, &pool, &wake))?;
-        Ok(Self { requests: Some(request_tx), events: event_rx, latest, counters, thread: Some(thread) })
+        let pool = crate::jobs::pool(threads.max(1), "shoal-engine")?;
+        let thread = std::thread::Builder::new().name("shoal-engine".into()).spawn(move || {
+            worker(&worker_requests, &event_tx, &worker_latest, &worker_counters, &pool, &wake);
+            // However the worker ended, later submissions are refused rather than left waiting.
+            worker_requests.close();
+        })?;
+        Ok(Self { requests, events: event_rx, latest, counters, thread: Some(thread) })
     }
 
     /// Submit a configuration snapshot; any run of an older generation is cancelled. Returns
     /// false if the worker has stopped.
     pub fn submit(&self, request: Request) -> bool {
         self.latest.fetch_max(request.generation, Ordering::SeqCst);
-        let Some(tx) = &self.requests else { return false };
-        let mut pending = request;
-        // The queue is short; if it is full, the worker is busy and will skip to the newest
-        // request anyway, so wait briefly for room rather than drop the newest.
-        loop {
-            match tx.try_send(pending) {
-                Ok(()) => return true,
-                Err(TrySendError::Full(r)) => {
-                    pending = r;
-                    std::thread::sleep(Duration::from_millis(1));
-                }
-                Err(TrySendError::Disconnected(_)) => return false,
+        match self.requests.put(request) {
+            Put::Queued => true,
+            Put::Replaced(_) => {
+                self.counters.requests_skipped.fetch_add(1, Ordering::SeqCst);
+                true
             }
+            Put::Closed(_) => false,
         }
     }
 
@@ -240,9 +236,9 @@ impl EngineHandle {
 
 impl Drop for EngineHandle {
     fn drop(&mut self) {
-        // Cancel the current run and close the request channel; the worker then exits.
+        // Cancel the current run and close the mailbox; the worker then exits.
         self.latest.fetch_add(1, Ordering::SeqCst);
-        self.requests = None;
+        self.requests.close();
         if let Some(t) = self.thread.take() {
             let _ = t.join();
         }
@@ -250,7 +246,7 @@ impl Drop for EngineHandle {
 }
 
 fn worker(
-    requests: &Receiver<Request>,
+    requests: &Mailbox<Request>,
     events: &SyncSender<Event>,
     latest: &Arc<AtomicU64>,
     counters: &Counters,
@@ -258,12 +254,8 @@ fn worker(
     wake: &Wake,
 ) {
     let mut engine = Engine::new();
-    while let Ok(mut request) = requests.recv() {
-        // Skip to the newest request queued.
-        while let Ok(newer) = requests.try_recv() {
-            counters.requests_skipped.fetch_add(1, Ordering::SeqCst);
-            request = newer;
-        }
+    // The mailbox holds only the newest request: an older one was replaced (and counted) there.
+    while let Some(request) = requests.take() {
         // A configuration that failed is not run at finer levels; the others go on (one
         // broken instrument does not hide the other's results).
         let mut failed = vec![false; request.configs.len()];

@@ -1,6 +1,6 @@
 //! The loaders against hostile text: mutated presets and arbitrary strings never panic, and the
 //! crashes the fuzzer found stay fixed (regressions at the end). The coverage-guided fuzzer
-//! itself lives in tests/fuzz (README, "Fuzzing").
+//! itself lives in tests/fuzz (docs/ARCHITECTURE.md, "Fuzzing").
 
 use proptest::prelude::*;
 

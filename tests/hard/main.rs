@@ -1,6 +1,6 @@
 //! Hard cases: every stage at its extremes, random valid inputs (proptest), injected faults,
 //! and the loaders against hostile text. Each test asserts finiteness, physical bounds and that
-//! degraded results are flagged and counted (never silently replaced); see README "Hard cases".
+//! degraded results are flagged and counted (never silently replaced); see docs/ARCHITECTURE.md, "Hard cases".
 //!
 //! The bounds: 0 ≤ Rrs ≤ 1/π sr⁻¹ (a Lambertian reflector of albedo 1 has Rrs = 1/π),
 //! 0 ≤ T ≤ 1 for every transmittance and the spherical albedo, 0 ≤ DN ≤ 2^bits − 1.

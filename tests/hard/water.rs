@@ -64,7 +64,7 @@ fn a_white_bottom_under_no_water_is_the_lambertian_limit() {
     // Above the surface, Lee et al. (2002)'s empirical conversion Rrs = 0.52 rrs/(1 − 1.7 rrs)
     // was fitted to natural waters and does not conserve energy at this limit: it gives
     // 0.52/(π − 1.7) = 0.3607 sr⁻¹, 13.3 % above 1/π. Kept (it is SAMBUCA's, which the reference
-    // tests match to 1e-6) and stated here and in README; it stays below 1/π for rrs < 0.2998,
+    // tests match to 1e-6) and stated here and in docs/ARCHITECTURE.md ("Hard cases"); it stays below 1/π for rrs < 0.2998,
     // i.e. any bottom darker than ρ_b ≈ 0.94 (see the test above).
     let grid = WavelengthGrid::uniform(400.0, 800.0, 10.0).unwrap();
     let model = WaterModel::new(SiopSpec::sambuca_default().resolve(&grid, None).unwrap());

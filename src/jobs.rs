@@ -1,0 +1,163 @@
+//! Background work, in one place: the single-slot [`Mailbox`] where the newest request wins (the
+//! engine thread, the app's map colouring, its sweep/cost and export jobs all take work from
+//! one), and [`pool`], the one way Shoal builds a rayon pool (named threads, a bounded size).
+//!
+//! A mailbox is the right shape for interactive work: the producer (the UI thread) never blocks
+//! and never sleeps — `put` replaces whatever request is waiting, which is by construction older
+//! than the new one and no longer wanted — and the consumer blocks in `take` until there is
+//! work or the mailbox is closed.
+
+use std::sync::{Condvar, Mutex, PoisonError};
+
+/// One waiting request at most; a newer one replaces it.
+#[derive(Debug)]
+pub struct Mailbox<T> {
+    slot: Mutex<Slot<T>>,
+    ready: Condvar,
+}
+
+#[derive(Debug)]
+struct Slot<T> {
+    waiting: Option<T>,
+    closed: bool,
+}
+
+/// What became of a `put`.
+#[derive(Debug, PartialEq, Eq)]
+pub enum Put<T> {
+    /// Waiting for the consumer; nothing was waiting before.
+    Queued,
+    /// Waiting; it replaced this older request, which will never be taken.
+    Replaced(T),
+    /// The mailbox is closed (its consumer has stopped): the request is handed back.
+    Closed(T),
+}
+
+impl<T> Default for Mailbox<T> {
+    fn default() -> Self {
+        Self { slot: Mutex::new(Slot { waiting: None, closed: false }), ready: Condvar::new() }
+    }
+}
+
+impl<T> Mailbox<T> {
+    /// An empty, open mailbox.
+    #[must_use]
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    fn lock(&self) -> std::sync::MutexGuard<'_, Slot<T>> {
+        // A panic elsewhere while holding the lock leaves the slot consistent (an Option and a
+        // flag): go on with it.
+        self.slot.lock().unwrap_or_else(PoisonError::into_inner)
+    }
+
+    /// Leave `value` for the consumer, replacing any request still waiting. Never blocks.
+    pub fn put(&self, value: T) -> Put<T> {
+        let mut slot = self.lock();
+        if slot.closed {
+            return Put::Closed(value);
+        }
+        let old = slot.waiting.replace(value);
+        drop(slot);
+        self.ready.notify_one();
+        old.map_or(Put::Queued, Put::Replaced)
+    }
+
+    /// The waiting request, waiting for one if there is none; `None` once the mailbox is closed
+    /// (a request left when it closed is dropped: nobody wants it any more).
+    pub fn take(&self) -> Option<T> {
+        let mut slot = self.lock();
+        loop {
+            if slot.closed {
+                return None;
+            }
+            if let Some(v) = slot.waiting.take() {
+                return Some(v);
+            }
+            slot = self.ready.wait(slot).unwrap_or_else(PoisonError::into_inner);
+        }
+    }
+
+    /// The waiting request, if any (never blocks).
+    pub fn try_take(&self) -> Option<T> {
+        self.lock().waiting.take()
+    }
+
+    /// Close: `take` returns `None` from now on and `put` hands requests back.
+    pub fn close(&self) {
+        self.lock().closed = true;
+        self.ready.notify_all();
+    }
+
+    /// Closed?
+    #[must_use]
+    pub fn is_closed(&self) -> bool {
+        self.lock().closed
+    }
+}
+
+/// A rayon pool of `threads` threads (0: one per available core) named `name-0`, `name-1`, …
+/// Every pool in Shoal is built here, so each job's threads are bounded and show in a profiler
+/// under the job's name.
+pub fn pool(threads: usize, name: &'static str) -> std::io::Result<rayon::ThreadPool> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .thread_name(move |i| format!("{name}-{i}"))
+        .build()
+        .map_err(|e| std::io::Error::other(format!("cannot start the {name} threads: {e}")))
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::Arc;
+    use std::time::Duration;
+
+    use super::*;
+
+    #[test]
+    fn the_newest_request_wins_and_put_never_blocks() {
+        let m = Mailbox::new();
+        assert_eq!(m.put(1), Put::Queued);
+        assert_eq!(m.put(2), Put::Replaced(1));
+        assert_eq!(m.put(3), Put::Replaced(2));
+        assert_eq!(m.take(), Some(3));
+        assert_eq!(m.try_take(), None);
+    }
+
+    #[test]
+    fn take_waits_for_work_and_ends_when_closed() {
+        let m = Arc::new(Mailbox::new());
+        let consumer = {
+            let m = m.clone();
+            std::thread::Builder::new()
+                .name("mailbox-test".into())
+                .spawn(move || {
+                    let mut got = Vec::new();
+                    while let Some(v) = m.take() {
+                        got.push(v);
+                    }
+                    got
+                })
+                .unwrap()
+        };
+        std::thread::sleep(Duration::from_millis(20));
+        assert_eq!(m.put(7), Put::Queued);
+        // Wait until the consumer has it, then close.
+        while m.lock().waiting.is_some() {
+            std::thread::yield_now();
+        }
+        m.close();
+        assert_eq!(consumer.join().unwrap(), vec![7]);
+        assert_eq!(m.put(8), Put::Closed(8), "a closed mailbox hands the request back");
+        assert!(m.is_closed());
+    }
+
+    #[test]
+    fn pools_have_the_size_and_names_asked_for() {
+        let p = pool(2, "shoal-test").unwrap();
+        assert_eq!(p.current_num_threads(), 2);
+        let name = p.install(|| std::thread::current().name().map(str::to_string));
+        assert!(name.is_some_and(|n| n.starts_with("shoal-test-")));
+    }
+}
