@@ -58,6 +58,54 @@ fn last_key(s: &str) -> Option<String> {
     found
 }
 
+/// A type read from RON files and shipped as built-in presets (`presets/FOLDER/NAME.ron`,
+/// embedded by [`crate::assets`]). Implementing it gives the type [`from_ron`], [`preset`] and
+/// [`preset_names`], with the same messages as every other preset kind: the file and line of a
+/// parse error, the known names after an unknown one.
+pub trait Preset: serde::de::DeserializeOwned {
+    /// Folder below `presets/` (`"scenes"`).
+    const FOLDER: &'static str;
+    /// The type's error.
+    type Error;
+    /// The error for text from `origin` that does not parse (`message` from [`describe`]).
+    fn parse_error(origin: &str, message: String) -> Self::Error;
+    /// The error for a built-in name that does not exist; `known` lists those that do.
+    fn unknown(name: &str, known: &[String]) -> Self::Error;
+    /// Built-in presets that are not files (none unless a type says so), listed first.
+    fn built_in(_name: &str) -> Option<Self> {
+        None
+    }
+    /// The names of [`Preset::built_in`]'s presets.
+    fn built_in_names() -> Vec<String> {
+        Vec::new()
+    }
+}
+
+/// Parse `text` as a `T`; `origin` names the file in errors.
+pub fn from_ron<T: Preset>(text: &str, origin: &str) -> Result<T, T::Error> {
+    ron::from_str(text).map_err(|e| T::parse_error(origin, describe(text, &e)))
+}
+
+/// The built-in `T` called `name`.
+pub fn preset<T: Preset>(name: &str) -> Result<T, T::Error> {
+    if let Some(p) = T::built_in(name) {
+        return Ok(p);
+    }
+    let path = format!("{}/{name}.ron", T::FOLDER);
+    match crate::assets::preset(&path) {
+        Some(asset) => from_ron(asset.text, &format!("presets/{path}")),
+        None => Err(T::unknown(name, &preset_names::<T>())),
+    }
+}
+
+/// The names of the built-in `T`s.
+#[must_use]
+pub fn preset_names<T: Preset>() -> Vec<String> {
+    let mut names = T::built_in_names();
+    names.extend(crate::assets::preset_names(T::FOLDER));
+    names
+}
+
 #[cfg(test)]
 mod tests {
     #![allow(clippy::unwrap_used)]

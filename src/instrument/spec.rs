@@ -123,24 +123,18 @@ pub fn ground_speed_m_s(altitude_km: f64) -> f64 {
 impl InstrumentSpec {
     /// Parse RON; `origin` names the file in errors.
     pub fn from_ron(text: &str, origin: &str) -> Result<Self, InstrumentError> {
-        ron::from_str(text)
-            .map_err(|e| InstrumentError::Parse { origin: origin.into(), message: crate::parse::describe(text, &e) })
+        crate::parse::from_ron(text, origin)
     }
 
     /// A built-in instrument by name (`presets/instruments/NAME.ron`).
     pub fn preset(name: &str) -> Result<Self, InstrumentError> {
-        let path = format!("instruments/{name}.ron");
-        let asset = crate::assets::preset(&path).ok_or_else(|| InstrumentError::Invalid {
-            field: "instrument".into(),
-            message: format!("no built-in instrument `{name}` (known: {})", Self::preset_names().join(", ")),
-        })?;
-        Self::from_ron(asset.text, &format!("presets/{path}"))
+        crate::parse::preset(name)
     }
 
     /// Names of the built-in instruments.
     #[must_use]
     pub fn preset_names() -> Vec<String> {
-        crate::assets::preset_names("instruments")
+        crate::parse::preset_names::<Self>()
     }
 
     /// Check every number against its documented range ([`crate::ranges`]); the message names
@@ -269,5 +263,19 @@ impl InstrumentSpec {
     #[must_use]
     pub fn is_ideal(&self) -> bool {
         matches!(self.kind, InstrumentKind::IdealRadiometer { .. })
+    }
+}
+
+impl crate::parse::Preset for InstrumentSpec {
+    const FOLDER: &'static str = "instruments";
+    type Error = InstrumentError;
+    fn parse_error(origin: &str, message: String) -> InstrumentError {
+        InstrumentError::Parse { origin: origin.into(), message }
+    }
+    fn unknown(name: &str, known: &[String]) -> InstrumentError {
+        InstrumentError::Invalid {
+            field: "instrument".into(),
+            message: format!("no built-in instrument `{name}` (known: {})", known.join(", ")),
+        }
     }
 }

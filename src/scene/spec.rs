@@ -124,24 +124,18 @@ pub fn day_of_year(date: &str) -> Result<u32, SceneError> {
 impl SceneSpec {
     /// Parse RON; `origin` names the file in errors.
     pub fn from_ron(text: &str, origin: &str) -> Result<Self, SceneError> {
-        ron::from_str(text)
-            .map_err(|e| SceneError::Parse { origin: origin.into(), message: crate::parse::describe(text, &e) })
+        crate::parse::from_ron(text, origin)
     }
 
     /// A built-in scene by name (`presets/scenes/NAME.ron`).
     pub fn preset(name: &str) -> Result<Self, SceneError> {
-        let path = format!("scenes/{name}.ron");
-        let asset = crate::assets::preset(&path).ok_or_else(|| SceneError::Invalid {
-            field: "scene".into(),
-            message: format!("no built-in scene `{name}` (known: {})", Self::preset_names().join(", ")),
-        })?;
-        Self::from_ron(asset.text, &format!("presets/{path}"))
+        crate::parse::preset(name)
     }
 
     /// Names of the built-in scenes.
     #[must_use]
     pub fn preset_names() -> Vec<String> {
-        crate::assets::preset_names("scenes")
+        crate::parse::preset_names::<Self>()
     }
 
     /// Check the numbers and that every effect has what it needs.
@@ -294,6 +288,20 @@ impl Scene {
     #[must_use]
     pub fn wants(&self, effect: Effect) -> bool {
         self.spec.effects.contains(&effect)
+    }
+}
+
+impl crate::parse::Preset for SceneSpec {
+    const FOLDER: &'static str = "scenes";
+    type Error = SceneError;
+    fn parse_error(origin: &str, message: String) -> SceneError {
+        SceneError::Parse { origin: origin.into(), message }
+    }
+    fn unknown(name: &str, known: &[String]) -> SceneError {
+        SceneError::Invalid {
+            field: "scene".into(),
+            message: format!("no built-in scene `{name}` (known: {})", known.join(", ")),
+        }
     }
 }
 

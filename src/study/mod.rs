@@ -180,24 +180,18 @@ pub(crate) fn load<T: serde::de::DeserializeOwned + Clone>(
 impl StudySpec {
     /// Parse RON; `origin` names the file in errors.
     pub fn from_ron(text: &str, origin: &str) -> Result<Self, StudyError> {
-        ron::from_str(text)
-            .map_err(|e| StudyError::Parse { origin: origin.into(), message: crate::parse::describe(text, &e) })
+        crate::parse::from_ron(text, origin)
     }
 
     /// A built-in study by name (`presets/studies/NAME.ron`).
     pub fn preset(name: &str) -> Result<Self, StudyError> {
-        let path = format!("studies/{name}.ron");
-        let asset = crate::assets::preset(&path).ok_or_else(|| StudyError::Invalid {
-            field: "study".into(),
-            message: format!("no built-in study `{name}` (known: {})", Self::preset_names().join(", ")),
-        })?;
-        Self::from_ron(asset.text, &format!("presets/{path}"))
+        crate::parse::preset(name)
     }
 
     /// Names of the built-in studies.
     #[must_use]
     pub fn preset_names() -> Vec<String> {
-        crate::assets::preset_names("studies")
+        crate::parse::preset_names::<Self>()
     }
 
     /// The built-in default: CubeSat vs SmallSat over Lake Hume.
@@ -262,5 +256,19 @@ impl StudySpec {
             }
         }
         Ok(ResolvedStudy { spec: self.clone(), runs })
+    }
+}
+
+impl crate::parse::Preset for StudySpec {
+    const FOLDER: &'static str = "studies";
+    type Error = StudyError;
+    fn parse_error(origin: &str, message: String) -> StudyError {
+        StudyError::Parse { origin: origin.into(), message }
+    }
+    fn unknown(name: &str, known: &[String]) -> StudyError {
+        StudyError::Invalid {
+            field: "study".into(),
+            message: format!("no built-in study `{name}` (known: {})", known.join(", ")),
+        }
     }
 }

@@ -158,24 +158,18 @@ pub struct ResolvedSweep {
 impl SweepSpec {
     /// Parse RON; `origin` names the file in errors.
     pub fn from_ron(text: &str, origin: &str) -> Result<Self, StudyError> {
-        ron::from_str(text)
-            .map_err(|e| StudyError::Parse { origin: origin.into(), message: crate::parse::describe(text, &e) })
+        crate::parse::from_ron(text, origin)
     }
 
     /// A built-in sweep by name (`presets/sweeps/NAME.ron`).
     pub fn preset(name: &str) -> Result<Self, StudyError> {
-        let path = format!("sweeps/{name}.ron");
-        let asset = crate::assets::preset(&path).ok_or_else(|| StudyError::Invalid {
-            field: "sweep".into(),
-            message: format!("no built-in sweep `{name}` (known: {})", Self::preset_names().join(", ")),
-        })?;
-        Self::from_ron(asset.text, &format!("presets/{path}"))
+        crate::parse::preset(name)
     }
 
     /// Names of the built-in sweeps.
     #[must_use]
     pub fn preset_names() -> Vec<String> {
-        crate::assets::preset_names("sweeps")
+        crate::parse::preset_names::<Self>()
     }
 
     /// Read the study (`dir`: the sweep file's directory), check every parameter against every
@@ -286,6 +280,20 @@ impl Shard {
     #[must_use]
     pub fn owns(&self, index: usize) -> bool {
         index % self.count == self.index
+    }
+}
+
+impl crate::parse::Preset for SweepSpec {
+    const FOLDER: &'static str = "sweeps";
+    type Error = StudyError;
+    fn parse_error(origin: &str, message: String) -> StudyError {
+        StudyError::Parse { origin: origin.into(), message }
+    }
+    fn unknown(name: &str, known: &[String]) -> StudyError {
+        StudyError::Invalid {
+            field: "sweep".into(),
+            message: format!("no built-in sweep `{name}` (known: {})", known.join(", ")),
+        }
     }
 }
 

@@ -49,8 +49,7 @@ impl SiopSpec {
     /// Read a SIOP set from RON text; `origin` names the file in errors. Relative CSV paths in
     /// it are resolved later, by [`Self::resolve`]'s `base_dir` (the file's directory).
     pub fn from_ron(text: &str, origin: &str) -> Result<Self, WaterError> {
-        ron::from_str(text)
-            .map_err(|e| WaterError::Parse { origin: origin.to_string(), message: crate::parse::describe(text, &e) })
+        crate::parse::from_ron(text, origin)
     }
 
     /// Read a SIOP set from a RON file.
@@ -120,26 +119,13 @@ impl SiopSpec {
     /// assert!(shoal::water::SiopSpec::preset("nile").is_err());
     /// ```
     pub fn preset(name: &str) -> Result<Self, WaterError> {
-        if name == "sambuca_default" {
-            return Ok(Self::sambuca_default());
-        }
-        let path = format!("siop/{name}.ron");
-        match crate::assets::preset(&path) {
-            Some(a) => Self::from_ron(a.text, &format!("presets/{path}")),
-            None => Err(WaterError::UnknownName {
-                field: "SIOP set".into(),
-                name: name.into(),
-                known: Self::preset_names().join(", "),
-            }),
-        }
+        crate::parse::preset(name)
     }
 
-    /// Names of the built-in SIOP sets.
+    /// Names of the built-in SIOP sets (`sambuca_default` first: it is built in code).
     #[must_use]
     pub fn preset_names() -> Vec<String> {
-        let mut names = vec!["sambuca_default".to_string()];
-        names.extend(crate::assets::preset_names("siop"));
-        names
+        crate::parse::preset_names::<Self>()
     }
 
     /// Resolve onto `grid`. Every spectrum must cover the grid (or say what to do outside its
@@ -319,5 +305,22 @@ impl SiopSpec {
             });
         }
         Ok(s)
+    }
+}
+
+impl crate::parse::Preset for SiopSpec {
+    const FOLDER: &'static str = "siop";
+    type Error = WaterError;
+    fn parse_error(origin: &str, message: String) -> WaterError {
+        WaterError::Parse { origin: origin.into(), message }
+    }
+    fn unknown(name: &str, known: &[String]) -> WaterError {
+        WaterError::UnknownName { field: "SIOP set".into(), name: name.into(), known: known.join(", ") }
+    }
+    fn built_in(name: &str) -> Option<Self> {
+        (name == "sambuca_default").then(Self::sambuca_default)
+    }
+    fn built_in_names() -> Vec<String> {
+        vec!["sambuca_default".into()]
     }
 }
