@@ -6,9 +6,56 @@
 //! they are on, and a guard dropped by a panic records its row and column, so that a failure
 //! is reported with the pixel it happened at. Tests arm an injected panic at one pixel
 //! ([`RunControl::arm_panic`]) to prove that path.
+//!
+//! Every per-pixel stage runs its rows through one executor, [`RunControl::fill_rows`] (rows of
+//! output buffers) or [`RunControl::map_rows`] (a value per row): rows in parallel, each checking
+//! for cancellation first, holding its guard, and counting one unit of progress when done. A
+//! stage writes only what one pixel needs.
 
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, PoisonError};
+
+use rayon::prelude::*;
+
+/// A stage's error for "the run was cancelled", so the executor can stop a stage in its own terms.
+pub trait Cancellable {
+    /// The cancellation error.
+    fn cancelled() -> Self;
+}
+
+/// Output buffers the executor splits into rows: one `&mut [T]`, or a tuple of them (row `r` of
+/// each, together). An empty buffer (an optional output that is off) gives empty rows.
+pub trait RowSplit<'a> {
+    /// One row of every buffer.
+    type Row: Send;
+    /// The buffers as `rows` rows of `stride` elements each.
+    fn split(self, rows: usize, stride: usize) -> Vec<Self::Row>;
+}
+
+impl<'a, T: Send> RowSplit<'a> for &'a mut [T] {
+    type Row = &'a mut [T];
+    fn split(self, rows: usize, stride: usize) -> Vec<Self::Row> {
+        if self.is_empty() {
+            return (0..rows).map(|_| <&mut [T]>::default()).collect();
+        }
+        self.chunks_mut(stride.max(1)).collect()
+    }
+}
+
+impl<'a, A: RowSplit<'a>, B: RowSplit<'a>> RowSplit<'a> for (A, B) {
+    type Row = (A::Row, B::Row);
+    fn split(self, rows: usize, stride: usize) -> Vec<Self::Row> {
+        self.0.split(rows, stride).into_iter().zip(self.1.split(rows, stride)).collect()
+    }
+}
+
+impl<'a, A: RowSplit<'a>, B: RowSplit<'a>, C: RowSplit<'a>> RowSplit<'a> for (A, B, C) {
+    type Row = (A::Row, B::Row, C::Row);
+    fn split(self, rows: usize, stride: usize) -> Vec<Self::Row> {
+        let ab = (self.0, self.1).split(rows, stride);
+        ab.into_iter().zip(self.2.split(rows, stride)).map(|((a, b), c)| (a, b, c)).collect()
+    }
+}
 
 /// A pixel of the simulated image (row, column), as reported with a failure.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -71,6 +118,12 @@ pub struct RowGuard<'a> {
 }
 
 impl RowGuard<'_> {
+    /// The row.
+    #[must_use]
+    pub const fn index(&self) -> usize {
+        self.row
+    }
+
     /// The loop moves to `column`. Panics there if a test armed a panic at this pixel.
     #[inline]
     pub fn column(&mut self, column: usize) {
@@ -146,6 +199,58 @@ impl RunControl {
     #[must_use]
     pub fn progress(&self) -> (u64, u64) {
         (self.done.load(Ordering::Relaxed), self.total.load(Ordering::Relaxed))
+    }
+
+    /// Fill `outputs` (see [`RowSplit`]) row by row: `f(guard, row)` writes row `guard.index()`
+    /// of every buffer, `stride` elements each. Rows run in parallel; each checks for
+    /// cancellation first and counts one unit of progress (`rows` are added to the total).
+    pub fn fill_rows<'a, O, E>(
+        &self,
+        outputs: O,
+        rows: usize,
+        stride: usize,
+        f: impl Fn(&mut RowGuard<'_>, O::Row) -> Result<(), E> + Sync + Send,
+    ) -> Result<(), E>
+    where
+        O: RowSplit<'a>,
+        E: Cancellable + Send,
+    {
+        self.add_total(rows as u64);
+        outputs.split(rows, stride).into_par_iter().enumerate().try_for_each(|(r, row)| {
+            if self.cancelled() {
+                return Err(E::cancelled());
+            }
+            let mut guard = self.row(r);
+            f(&mut guard, row)?;
+            self.tick(1);
+            Ok(())
+        })
+    }
+
+    /// `f(guard)` for every row `0..rows`, in parallel, collected in row order; cancellation
+    /// and progress as [`Self::fill_rows`].
+    pub fn map_rows<T, E>(
+        &self,
+        rows: usize,
+        f: impl Fn(&mut RowGuard<'_>) -> Result<T, E> + Sync + Send,
+    ) -> Result<Vec<T>, E>
+    where
+        T: Send,
+        E: Cancellable + Send,
+    {
+        self.add_total(rows as u64);
+        (0..rows)
+            .into_par_iter()
+            .map(|r| {
+                if self.cancelled() {
+                    return Err(E::cancelled());
+                }
+                let mut guard = self.row(r);
+                let value = f(&mut guard)?;
+                self.tick(1);
+                Ok(value)
+            })
+            .collect()
     }
 
     /// Enter `row` of a per-pixel loop (see [`RowGuard`]).

@@ -233,17 +233,16 @@ pub fn calibrate(
 ) -> Result<Level1, InstrumentError> {
     let (rows, cols, nb) = level0.dn.dim();
     let mut out = vec![0.0f32; rows * cols * nb];
-    out.par_chunks_mut((cols * nb).max(1)).enumerate().try_for_each(|(r, row)| {
-        if control.cancelled() {
-            return Err(InstrumentError::Cancelled);
-        }
+    control.fill_rows(out.as_mut_slice(), rows, cols * nb, |at, row| {
+        let r = at.index();
         for c in 0..cols {
+            at.column(c);
             let j = viewing.detector_index[c];
             for b in 0..nb {
                 row[c * nb + b] = calibration.radiance(j, b, level0.value(r, c, b)) as f32;
             }
         }
-        Ok(())
+        Ok::<_, InstrumentError>(())
     })?;
     Ok(Level1 {
         radiance: Array3::from_shape_vec((rows, cols, nb), out)

@@ -136,30 +136,25 @@ pub fn correct_exact(
     let (l1, l0_flags, land) = (slice(&level1.radiance)?, slice(&level1.flags)?, slice(land)?);
     let mut rrs = vec![0.0f32; rows * cols * nb];
     let mut flags = vec![0u8; rows * cols * nb];
-    let stride = (cols * nb).max(1);
-    rrs.par_chunks_mut(stride).zip(flags.par_chunks_mut(stride)).enumerate().try_for_each(
-        |(r, (rrs_row, flag_row))| {
-            if control.cancelled() {
-                return Err(InstrumentError::Cancelled);
+    let stride = cols * nb;
+    control.fill_rows((rrs.as_mut_slice(), flags.as_mut_slice()), rows, stride, |at, (rrs_row, flag_row)| {
+        let r = at.index();
+        let base = r * stride;
+        for c in 0..cols {
+            at.column(c);
+            let is_land = land[r * cols + c] != 0;
+            for b in 0..nb {
+                let i = atmosphere.at(c, b);
+                let k = c * nb + b;
+                let y = (f64::from(l1[base + k]) - atmosphere.l_path[i] - atmosphere.glint[i]) / atmosphere.t_ed[i];
+                let value = y / (1.0 + atmosphere.spherical_albedo[i] * std::f64::consts::PI * y);
+                let f = flag_for(l0_flags[base + k], is_land, value);
+                flag_row[k] = f;
+                rrs_row[k] = if f & RrsFlags::INVALID != 0 { 0.0 } else { value as f32 };
             }
-            let base = r * stride;
-            let mut at = control.row(r);
-            for c in 0..cols {
-                at.column(c);
-                let is_land = land[r * cols + c] != 0;
-                for b in 0..nb {
-                    let i = atmosphere.at(c, b);
-                    let k = c * nb + b;
-                    let y = (f64::from(l1[base + k]) - atmosphere.l_path[i] - atmosphere.glint[i]) / atmosphere.t_ed[i];
-                    let value = y / (1.0 + atmosphere.spherical_albedo[i] * std::f64::consts::PI * y);
-                    let f = flag_for(l0_flags[base + k], is_land, value);
-                    flag_row[k] = f;
-                    rrs_row[k] = if f & RrsFlags::INVALID != 0 { 0.0 } else { value as f32 };
-                }
-            }
-            Ok(())
-        },
-    )?;
+        }
+        Ok::<_, InstrumentError>(())
+    })?;
     assemble(rows, cols, nb, rrs, flags)
 }
 
@@ -226,28 +221,23 @@ impl SceneApproximation {
         let (l1, l0_flags, land) = (slice(&level1.radiance)?, slice(&level1.flags)?, slice(land)?);
         let mut rrs = vec![0.0f32; rows * cols * nb];
         let mut flags = vec![0u8; rows * cols * nb];
-        let stride = (cols * nb).max(1);
-        rrs.par_chunks_mut(stride).zip(flags.par_chunks_mut(stride)).enumerate().try_for_each(
-            |(r, (rrs_row, flag_row))| {
-                if control.cancelled() {
-                    return Err(InstrumentError::Cancelled);
+        let stride = cols * nb;
+        control.fill_rows((rrs.as_mut_slice(), flags.as_mut_slice()), rows, stride, |at, (rrs_row, flag_row)| {
+            let r = at.index();
+            let base = r * stride;
+            for c in 0..cols {
+                at.column(c);
+                for b in 0..nb {
+                    let k = c * nb + b;
+                    let lw = (f64::from(l1[base + k]) - self.l_path[b]) / self.t_up[b];
+                    let value = lw / self.ed[b];
+                    let f = flag_for(l0_flags[base + k], land[r * cols + c] != 0, value);
+                    flag_row[k] = f;
+                    rrs_row[k] = if f & RrsFlags::INVALID != 0 { 0.0 } else { value as f32 };
                 }
-                let base = r * stride;
-                let mut at = control.row(r);
-                for c in 0..cols {
-                    at.column(c);
-                    for b in 0..nb {
-                        let k = c * nb + b;
-                        let lw = (f64::from(l1[base + k]) - self.l_path[b]) / self.t_up[b];
-                        let value = lw / self.ed[b];
-                        let f = flag_for(l0_flags[base + k], land[r * cols + c] != 0, value);
-                        flag_row[k] = f;
-                        rrs_row[k] = if f & RrsFlags::INVALID != 0 { 0.0 } else { value as f32 };
-                    }
-                }
-                Ok(())
-            },
-        )?;
+            }
+            Ok::<_, InstrumentError>(())
+        })?;
         assemble(rows, cols, nb, rrs, flags)
     }
 }

@@ -21,8 +21,8 @@ pub struct Engine {
 }
 
 /// Stages whose per-pixel loops report the pixel they fail at (an injected panic fires there).
-const PIXEL_STAGES: [Stage; 5] =
-    [Stage::Radiance, Stage::Electrons, Stage::Level0, Stage::Correction, Stage::Retrieval];
+const PIXEL_STAGES: [Stage; 6] =
+    [Stage::Radiance, Stage::Electrons, Stage::Level0, Stage::Level1, Stage::Correction, Stage::Retrieval];
 
 impl Engine {
     /// An engine with an empty cache.

@@ -5,7 +5,6 @@
 //! generator (see [`super::detector`]): results do not depend on the number of threads.
 
 use ndarray::Array3;
-use rayon::prelude::*;
 
 use super::InstrumentError;
 use super::detector::{Detector, Stream, pixel_rng};
@@ -55,13 +54,9 @@ pub fn expose_cube(
         .as_slice()
         .ok_or_else(|| InstrumentError::Invalid { field: "cube".into(), message: "not contiguous".into() })?;
     let mut out = vec![0.0f32; rows * cols * nb];
-    control.add_total(rows as u64);
-    out.par_chunks_mut((cols * nb).max(1)).enumerate().try_for_each(|(r, row)| {
-        if control.cancelled() {
-            return Err(InstrumentError::Cancelled);
-        }
+    control.fill_rows(out.as_mut_slice(), rows, cols * nb, |at, row| {
+        let r = at.index();
         let line = viewing.line_index[r];
-        let mut at = control.row(r);
         for c in 0..cols {
             at.column(c);
             let j = viewing.detector_index[c];
@@ -71,8 +66,7 @@ pub fn expose_cube(
                 row[c * nb + b] = detector.expose(j, b, l, t, &mut rng) as f32;
             }
         }
-        control.tick(1);
-        Ok(())
+        Ok::<_, InstrumentError>(())
     })?;
     Array3::from_shape_vec((rows, cols, nb), out).map_err(shape_error)
 }
@@ -95,38 +89,26 @@ pub fn digitise_cube(
     let mut dn = vec![0u16; n];
     let mut flags = vec![0u8; n];
     let mut analog = vec![0.0f32; if keep_analog { n } else { 0 }];
-    let stride = (cols * nb).max(1);
-    control.add_total(rows as u64);
-    let analog_rows: Vec<&mut [f32]> = if keep_analog {
-        analog.chunks_mut(stride).collect()
-    } else {
-        (0..rows).map(|_| <&mut [f32]>::default()).collect()
-    };
-    dn.par_chunks_mut(stride).zip(flags.par_chunks_mut(stride)).zip(analog_rows).enumerate().try_for_each(
-        |(r, ((dn_row, flag_row), analog_row))| {
-            if control.cancelled() {
-                return Err(InstrumentError::Cancelled);
-            }
-            let line = viewing.line_index[r];
-            let mut at = control.row(r);
-            for c in 0..cols {
-                at.column(c);
-                let j = viewing.detector_index[c];
-                let mut rng = pixel_rng(seed, Stream::Readout, line, j);
-                for b in 0..nb {
-                    let i = c * nb + b;
-                    let out = detector.read_out(f64::from(input[(r * cols + c) * nb + b]), &mut rng);
-                    dn_row[i] = out.dn;
-                    flag_row[i] = out.flags;
-                    if keep_analog {
-                        analog_row[i] = out.analog_dn;
-                    }
+    let outputs = (dn.as_mut_slice(), flags.as_mut_slice(), analog.as_mut_slice());
+    control.fill_rows(outputs, rows, cols * nb, |at, (dn_row, flag_row, analog_row)| {
+        let r = at.index();
+        let line = viewing.line_index[r];
+        for c in 0..cols {
+            at.column(c);
+            let j = viewing.detector_index[c];
+            let mut rng = pixel_rng(seed, Stream::Readout, line, j);
+            for b in 0..nb {
+                let i = c * nb + b;
+                let out = detector.read_out(f64::from(input[(r * cols + c) * nb + b]), &mut rng);
+                dn_row[i] = out.dn;
+                flag_row[i] = out.flags;
+                if keep_analog {
+                    analog_row[i] = out.analog_dn;
                 }
             }
-            control.tick(1);
-            Ok(())
-        },
-    )?;
+        }
+        Ok::<_, InstrumentError>(())
+    })?;
     let shape = (rows, cols, nb);
     Ok(Level0 {
         dn: Array3::from_shape_vec(shape, dn).map_err(shape_error)?,

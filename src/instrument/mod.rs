@@ -78,3 +78,9 @@ pub enum InstrumentError {
     #[error("cancelled")]
     Cancelled,
 }
+
+impl crate::control::Cancellable for InstrumentError {
+    fn cancelled() -> Self {
+        Self::Cancelled
+    }
+}

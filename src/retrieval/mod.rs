@@ -64,3 +64,9 @@ pub enum RetrievalError {
     #[error("cancelled")]
     Cancelled,
 }
+
+impl crate::control::Cancellable for RetrievalError {
+    fn cancelled() -> Self {
+        Self::Cancelled
+    }
+}

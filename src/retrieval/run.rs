@@ -270,48 +270,41 @@ fn retrieve_almi(
         }
     }
     let (rows, cols, nb) = inputs.rrs.dim();
-    let results: Vec<Vec<AlmiRow>> = (0..rows)
-        .into_par_iter()
-        .map(|r| {
-            if control.cancelled() {
-                return Err(RetrievalError::Cancelled);
-            }
-            let mut obs = vec![0.0; used.len()];
-            let mut valid = vec![false; used.len()];
-            let nedr: Vec<f64> = used.iter().map(|&b| inputs.nedr[b]).collect();
-            let mut at = control.row(r);
-            let row = (0..cols)
-                .map(|c| {
-                    at.column(c);
-                    if inputs.land[[r, c]] != 0 {
-                        return (0.0, 0.0, 0.0, -1, 0.0, ProductFlags::LAND);
-                    }
-                    for (k, &b) in used.iter().enumerate() {
-                        debug_assert!(b < nb);
-                        obs[k] = f64::from(inputs.rrs[[r, c, b]]);
-                        valid[k] = inputs.flags[[r, c, b]] & (RrsFlags::INVALID | RrsFlags::SATURATED) == 0;
-                    }
-                    let p = match settings.mode {
-                        Mode::Improved => almi_invert(&sets, settings, &obs, &valid, &nedr),
-                        Mode::Reference => invert_reference(&sets, settings.g0, settings.g1, &obs, &valid),
-                    };
-                    if p.flags & AlmiFlags::FAILED != 0 || p.set.is_none() {
-                        return (0.0, 0.0, 0.0, -1, 0.0, ProductFlags::FAILED);
-                    }
-                    let mut flags = ProductFlags::RETURNED;
-                    if p.flags & AlmiFlags::PHYSICAL != 0 {
-                        flags |= ProductFlags::PHYSICAL;
-                    }
-                    if p.flags & AlmiFlags::AT_BOUND != 0 {
-                        flags |= ProductFlags::AT_BOUND;
-                    }
-                    (p.chl as f32, p.cdom as f32, p.nap as f32, p.set.map_or(-1, i16::from), p.cost as f32, flags)
-                })
-                .collect();
-            control.tick(1);
-            Ok(row)
-        })
-        .collect::<Result<_, RetrievalError>>()?;
+    let results: Vec<Vec<AlmiRow>> = control.map_rows(rows, |at| {
+        let r = at.index();
+        let mut obs = vec![0.0; used.len()];
+        let mut valid = vec![false; used.len()];
+        let nedr: Vec<f64> = used.iter().map(|&b| inputs.nedr[b]).collect();
+        let row = (0..cols)
+            .map(|c| {
+                at.column(c);
+                if inputs.land[[r, c]] != 0 {
+                    return (0.0, 0.0, 0.0, -1, 0.0, ProductFlags::LAND);
+                }
+                for (k, &b) in used.iter().enumerate() {
+                    debug_assert!(b < nb);
+                    obs[k] = f64::from(inputs.rrs[[r, c, b]]);
+                    valid[k] = inputs.flags[[r, c, b]] & (RrsFlags::INVALID | RrsFlags::SATURATED) == 0;
+                }
+                let p = match settings.mode {
+                    Mode::Improved => almi_invert(&sets, settings, &obs, &valid, &nedr),
+                    Mode::Reference => invert_reference(&sets, settings.g0, settings.g1, &obs, &valid),
+                };
+                if p.flags & AlmiFlags::FAILED != 0 || p.set.is_none() {
+                    return (0.0, 0.0, 0.0, -1, 0.0, ProductFlags::FAILED);
+                }
+                let mut flags = ProductFlags::RETURNED;
+                if p.flags & AlmiFlags::PHYSICAL != 0 {
+                    flags |= ProductFlags::PHYSICAL;
+                }
+                if p.flags & AlmiFlags::AT_BOUND != 0 {
+                    flags |= ProductFlags::AT_BOUND;
+                }
+                (p.chl as f32, p.cdom as f32, p.nap as f32, p.set.map_or(-1, i16::from), p.cost as f32, flags)
+            })
+            .collect();
+        Ok::<_, RetrievalError>(row)
+    })?;
     let plane = |k: fn(&AlmiRow) -> f32| Array2::from_shape_fn((rows, cols), |(r, c)| k(&results[r][c]));
     Ok(Product {
         name: "aLMI".into(),
@@ -405,64 +398,57 @@ fn retrieve_sambuca(
     let (rows, cols, nb) = inputs.rrs.dim();
     let inv_cos: Vec<(f64, f64)> =
         inputs.geometry.iter().map(|g| g.inverse_cosines_in_water(model.refractive_index)).collect();
-    let results: Vec<Vec<SambucaRow>> = (0..rows)
-        .into_par_iter()
-        .map(|r| {
-            if control.cancelled() {
-                return Err(RetrievalError::Cancelled);
-            }
-            let mut obs = vec![0.0; nb];
-            let mut valid = vec![false; nb];
-            let mut at = control.row(r);
-            let row = (0..cols)
-                .map(|c| {
-                    at.column(c);
-                    let failed = (0.0, 0.0, 0.0, 0.0, 0.0, (0, 0), 0.0, 0.0, 0, ProductFlags::FAILED);
-                    if inputs.land[[r, c]] != 0 {
-                        return (0.0, 0.0, 0.0, 0.0, 0.0, (0, 0), 0.0, 0.0, 0, ProductFlags::LAND);
-                    }
-                    for k in 0..nb {
-                        obs[k] = f64::from(inputs.rrs[[r, c, k]]);
-                        valid[k] = inputs.flags[[r, c, k]] & (RrsFlags::INVALID | RrsFlags::SATURATED) == 0;
-                    }
-                    let o = Observation { rrs: &obs, valid: &valid, nedr: &inputs.nedr, inv_cos: inv_cos[c] };
-                    let p = sambuca_invert(&model, settings, &o);
-                    if !p.ok {
-                        return failed;
-                    }
-                    let mut flags = ProductFlags::RETURNED;
-                    if p.converged {
-                        flags |= ProductFlags::CONVERGED;
-                    }
-                    if p.sdi >= 1.0 {
-                        flags |= ProductFlags::BOTTOM_VISIBLE;
-                    }
-                    let near = |v: f64, (lo, hi): (f64, f64)| v <= lo * (1.0 + 1e-9) || v >= hi * (1.0 - 1e-9);
-                    if near(p.chl, b.chl_mg_m3)
-                        || near(p.cdom, b.cdom_per_m)
-                        || near(p.nap, b.nap_g_m3)
-                        || near(p.depth_m, b.depth_m)
-                    {
-                        flags |= ProductFlags::AT_BOUND;
-                    }
-                    (
-                        p.chl as f32,
-                        p.cdom as f32,
-                        p.nap as f32,
-                        p.depth_m as f32,
-                        p.fraction as f32,
-                        p.pair,
-                        p.objective as f32,
-                        p.sdi as f32,
-                        u16::try_from(p.iterations).unwrap_or(u16::MAX),
-                        flags,
-                    )
-                })
-                .collect();
-            control.tick(1);
-            Ok(row)
-        })
-        .collect::<Result<_, RetrievalError>>()?;
+    let results: Vec<Vec<SambucaRow>> = control.map_rows(rows, |at| {
+        let r = at.index();
+        let mut obs = vec![0.0; nb];
+        let mut valid = vec![false; nb];
+        let row = (0..cols)
+            .map(|c| {
+                at.column(c);
+                let failed = (0.0, 0.0, 0.0, 0.0, 0.0, (0, 0), 0.0, 0.0, 0, ProductFlags::FAILED);
+                if inputs.land[[r, c]] != 0 {
+                    return (0.0, 0.0, 0.0, 0.0, 0.0, (0, 0), 0.0, 0.0, 0, ProductFlags::LAND);
+                }
+                for k in 0..nb {
+                    obs[k] = f64::from(inputs.rrs[[r, c, k]]);
+                    valid[k] = inputs.flags[[r, c, k]] & (RrsFlags::INVALID | RrsFlags::SATURATED) == 0;
+                }
+                let o = Observation { rrs: &obs, valid: &valid, nedr: &inputs.nedr, inv_cos: inv_cos[c] };
+                let p = sambuca_invert(&model, settings, &o);
+                if !p.ok {
+                    return failed;
+                }
+                let mut flags = ProductFlags::RETURNED;
+                if p.converged {
+                    flags |= ProductFlags::CONVERGED;
+                }
+                if p.sdi >= 1.0 {
+                    flags |= ProductFlags::BOTTOM_VISIBLE;
+                }
+                let near = |v: f64, (lo, hi): (f64, f64)| v <= lo * (1.0 + 1e-9) || v >= hi * (1.0 - 1e-9);
+                if near(p.chl, b.chl_mg_m3)
+                    || near(p.cdom, b.cdom_per_m)
+                    || near(p.nap, b.nap_g_m3)
+                    || near(p.depth_m, b.depth_m)
+                {
+                    flags |= ProductFlags::AT_BOUND;
+                }
+                (
+                    p.chl as f32,
+                    p.cdom as f32,
+                    p.nap as f32,
+                    p.depth_m as f32,
+                    p.fraction as f32,
+                    p.pair,
+                    p.objective as f32,
+                    p.sdi as f32,
+                    u16::try_from(p.iterations).unwrap_or(u16::MAX),
+                    flags,
+                )
+            })
+            .collect();
+        Ok::<_, RetrievalError>(row)
+    })?;
     Ok(sambuca_product(&results, names, &spec.name))
 }
 
@@ -511,74 +497,67 @@ fn retrieve_sambuca_reference(
     let inv_cos: Vec<(f64, f64)> =
         inputs.geometry.iter().map(|g| g.inverse_cosines_in_water(refractive_index)).collect();
     let pairs = model.pairs().to_vec();
-    let results: Vec<Vec<SambucaRow>> = (0..rows)
-        .into_par_iter()
-        .map(|r| {
-            if control.cancelled() {
-                return Err(RetrievalError::Cancelled);
-            }
-            let (mut obs, mut nedr) = (vec![0.0; nb], vec![0.0; nb]);
-            let mut at = control.row(r);
-            let row = (0..cols)
-                .map(|c| {
-                    at.column(c);
-                    let failed = (0.0, 0.0, 0.0, 0.0, 0.0, (0, 0), 0.0, 0.0, 0, ProductFlags::FAILED);
-                    if inputs.land[[r, c]] != 0 {
-                        return (0.0, 0.0, 0.0, 0.0, 0.0, (0, 0), 0.0, 0.0, 0, ProductFlags::LAND);
-                    }
-                    let mut usable = true;
-                    for k in 0..nb {
-                        let above = f64::from(inputs.rrs[[r, c, k]]);
-                        let flagged = inputs.flags[[r, c, k]] & (RrsFlags::INVALID | RrsFlags::SATURATED) != 0;
-                        let denominator = 0.52 + 1.7 * above;
-                        usable &= !flagged && above.is_finite() && denominator > 0.0 && inputs.nedr[k] > 0.0;
-                        obs[k] = rrs_below_from_above(above);
-                        nedr[k] = inputs.nedr[k] * 0.52 / (denominator * denominator);
-                    }
-                    let weighted: f64 = obs.iter().zip(&nedr).map(|(o, e)| o / e).sum();
-                    if !usable || !(weighted > 0.0) {
-                        return failed;
-                    }
-                    let p = reference::invert(model, &p_min, &p_max, &obs, &nedr, inv_cos[c]);
-                    if !p.fun.is_finite() {
-                        return failed;
-                    }
-                    let pair = pairs[p.kept.unwrap_or(pairs.len() - 1)];
-                    let sdi = reference::sdi(model, &p.x, pair, &nedr, inv_cos[c]);
-                    let mut flags = ProductFlags::RETURNED;
-                    if p.success {
-                        flags |= ProductFlags::CONVERGED;
-                    }
-                    if p.stalled {
-                        flags |= ProductFlags::STALLED;
-                    }
-                    if sdi >= 1.0 {
-                        flags |= ProductFlags::BOTTOM_VISIBLE;
-                    }
-                    let near = |v: f64, k: usize| v <= p_min[k] * (1.0 + 1e-9) || v >= p_max[k] * (1.0 - 1e-9);
-                    if (0..4).any(|k| near(p.x[k], k)) {
-                        flags |= ProductFlags::AT_BOUND;
-                    }
-                    let narrow = |i: usize| u8::try_from(i).unwrap_or(u8::MAX);
-                    // One substrate: the package's single-substrate model, stored as (0, none).
-                    let stored = if pair.0 == pair.1 { (0, u8::MAX) } else { (narrow(pair.0), narrow(pair.1)) };
-                    (
-                        p.x[0] as f32,
-                        p.x[1] as f32,
-                        p.x[2] as f32,
-                        p.x[3] as f32,
-                        p.x[4] as f32,
-                        stored,
-                        p.fun as f32,
-                        sdi as f32,
-                        u16::try_from(p.nit).unwrap_or(u16::MAX),
-                        flags,
-                    )
-                })
-                .collect();
-            control.tick(1);
-            Ok(row)
-        })
-        .collect::<Result<_, RetrievalError>>()?;
+    let results: Vec<Vec<SambucaRow>> = control.map_rows(rows, |at| {
+        let r = at.index();
+        let (mut obs, mut nedr) = (vec![0.0; nb], vec![0.0; nb]);
+        let row = (0..cols)
+            .map(|c| {
+                at.column(c);
+                let failed = (0.0, 0.0, 0.0, 0.0, 0.0, (0, 0), 0.0, 0.0, 0, ProductFlags::FAILED);
+                if inputs.land[[r, c]] != 0 {
+                    return (0.0, 0.0, 0.0, 0.0, 0.0, (0, 0), 0.0, 0.0, 0, ProductFlags::LAND);
+                }
+                let mut usable = true;
+                for k in 0..nb {
+                    let above = f64::from(inputs.rrs[[r, c, k]]);
+                    let flagged = inputs.flags[[r, c, k]] & (RrsFlags::INVALID | RrsFlags::SATURATED) != 0;
+                    let denominator = 0.52 + 1.7 * above;
+                    usable &= !flagged && above.is_finite() && denominator > 0.0 && inputs.nedr[k] > 0.0;
+                    obs[k] = rrs_below_from_above(above);
+                    nedr[k] = inputs.nedr[k] * 0.52 / (denominator * denominator);
+                }
+                let weighted: f64 = obs.iter().zip(&nedr).map(|(o, e)| o / e).sum();
+                if !usable || !(weighted > 0.0) {
+                    return failed;
+                }
+                let p = reference::invert(model, &p_min, &p_max, &obs, &nedr, inv_cos[c]);
+                if !p.fun.is_finite() {
+                    return failed;
+                }
+                let pair = pairs[p.kept.unwrap_or(pairs.len() - 1)];
+                let sdi = reference::sdi(model, &p.x, pair, &nedr, inv_cos[c]);
+                let mut flags = ProductFlags::RETURNED;
+                if p.success {
+                    flags |= ProductFlags::CONVERGED;
+                }
+                if p.stalled {
+                    flags |= ProductFlags::STALLED;
+                }
+                if sdi >= 1.0 {
+                    flags |= ProductFlags::BOTTOM_VISIBLE;
+                }
+                let near = |v: f64, k: usize| v <= p_min[k] * (1.0 + 1e-9) || v >= p_max[k] * (1.0 - 1e-9);
+                if (0..4).any(|k| near(p.x[k], k)) {
+                    flags |= ProductFlags::AT_BOUND;
+                }
+                let narrow = |i: usize| u8::try_from(i).unwrap_or(u8::MAX);
+                // One substrate: the package's single-substrate model, stored as (0, none).
+                let stored = if pair.0 == pair.1 { (0, u8::MAX) } else { (narrow(pair.0), narrow(pair.1)) };
+                (
+                    p.x[0] as f32,
+                    p.x[1] as f32,
+                    p.x[2] as f32,
+                    p.x[3] as f32,
+                    p.x[4] as f32,
+                    stored,
+                    p.fun as f32,
+                    sdi as f32,
+                    u16::try_from(p.nit).unwrap_or(u16::MAX),
+                    flags,
+                )
+            })
+            .collect();
+        Ok::<_, RetrievalError>(row)
+    })?;
     Ok(sambuca_product(&results, names, siop_name))
 }

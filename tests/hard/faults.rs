@@ -26,7 +26,8 @@ fn a_panic_in_any_pixel_stage_names_the_stage_and_pixel_and_the_engine_recovers(
     let clean = config();
     let reference = super::run(&clean);
     let mut engine = Engine::new();
-    for stage in [Stage::Radiance, Stage::Electrons, Stage::Level0, Stage::Correction, Stage::Retrieval] {
+    for stage in [Stage::Radiance, Stage::Electrons, Stage::Level0, Stage::Level1, Stage::Correction, Stage::Retrieval]
+    {
         for kind in [FaultKind::Panic, FaultKind::Error] {
             let mut c = clean.clone();
             c.fault = Some(Fault { stage, row: 9, column: 4, kind });
