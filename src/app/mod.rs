@@ -21,6 +21,7 @@ pub mod explore;
 mod export;
 pub mod link;
 mod listing;
+mod logic;
 mod maps;
 pub mod model;
 mod panels;
@@ -48,8 +49,8 @@ pub struct AppOptions {
 
 /// A write that would replace a file of the user's, waiting for "Replace" or "Cancel".
 enum Confirm {
-    /// Save instrument A (0) or B (1) under `name`.
-    Instrument { slot: usize, name: String, spec: Box<crate::instrument::InstrumentSpec> },
+    /// Save instrument A or B under `name`.
+    Instrument { ab: model::Ab, name: String, spec: Box<crate::instrument::InstrumentSpec> },
     /// Save the study under `name`.
     Study { name: String, study: Box<crate::study::StudySpec> },
     /// A typed-path export over existing files.
@@ -75,6 +76,8 @@ struct UiState {
     confirm: Option<Confirm>,
     /// An instrument value refused by its range: (parameter key, message), shown inline.
     param_error: Option<(&'static str, String)>,
+    /// What the panels asked for this frame, applied after it is drawn (`logic.rs`).
+    commands: Vec<logic::UiCommand>,
 }
 
 /// The app.
@@ -215,46 +218,6 @@ impl ShoalApp {
     }
 
     /// Per frame, before drawing: submit changed configurations, take results and images.
-    fn tick(&mut self, ctx: &egui::Context) {
-        if self.applied_theme != Some(self.state.dark) {
-            ctx.set_theme(if self.state.dark { egui::Theme::Dark } else { egui::Theme::Light });
-            self.applied_theme = Some(self.state.dark);
-        }
-        let mut configs = self.state.configs();
-        if let Some(a) = configs.first_mut() {
-            a.fault = self.ui.fault;
-        }
-        self.link.submit_if_changed(configs, self.state.levels());
-        let wake = ctx.clone();
-        self.listing.poll(&self.library, move || wake.request_repaint());
-        if self.link.poll() {
-            self.images.invalidate();
-        }
-        if let Some(r) = &self.raster {
-            self.images.request(&self.state, &self.link, r);
-            if let Some(done) = r.poll() {
-                self.images.receive(ctx, done);
-            }
-        }
-        while let Some(news) = self.ui.exports.poll() {
-            match news {
-                export::News::Written(m) => self.ui.message = Some(m),
-                export::News::Failed(e) => self.ui.error = Some(e),
-                export::News::NoChoice(what) => {
-                    let what = if what == export::What::Figure { "figure" } else { "data" };
-                    self.ui.message = Some(format!(
-                        "No {what} exported: no file was chosen. If no dialog appeared, this desktop has no file-chooser portal; use Path to type one."
-                    ));
-                    self.ui.typed_export = true;
-                }
-            }
-        }
-        self.ui.explore.poll();
-        if self.link.busy() || self.ui.exports.running > 0 || self.ui.explore.busy() {
-            ctx.request_repaint_after(Duration::from_millis(30));
-        }
-    }
-
     /// Draw one frame into `ui` (everything but the eframe plumbing).
     pub fn draw(&mut self, ui: &mut egui::Ui) {
         let start = Instant::now();
@@ -279,6 +242,10 @@ impl ShoalApp {
         }
         if self.ui.explore.cost_open {
             explore::cost_window(self, &ctx);
+        }
+        // Commands after the panels that asked for them, before the dialogs that may report them.
+        for command in std::mem::take(&mut self.ui.commands) {
+            self.apply(command);
         }
         self.dialogs(&ctx);
         // The UI thread's work for this frame (layout; not the GPU, not the wait for vsync).
@@ -354,42 +321,6 @@ impl ShoalApp {
                 self.export_to(export::What::Data, path);
             }
         });
-    }
-
-    /// Export to a typed path, asking first if that would replace existing files.
-    fn export_to(&mut self, what: export::What, path: PathBuf) {
-        let snap = export::Snapshot::of(self);
-        let existing = export::existing(what, &snap, &path);
-        if existing.is_empty() {
-            self.ui.exports.write_to(what, snap, path);
-        } else {
-            self.ui.confirm = Some(Confirm::Export { what, path, existing });
-        }
-    }
-
-    /// Save A or B, or the study, in the library; asks before replacing a preset of that name.
-    fn save(&mut self, confirm: Confirm, overwrite: bool) {
-        let result = match &confirm {
-            Confirm::Instrument { name, spec, .. } => self.library.save_instrument(name, spec, overwrite),
-            Confirm::Study { name, study } => self.library.save_study(name, study, overwrite),
-            Confirm::Export { .. } => return,
-        };
-        match result {
-            Ok(path) => {
-                self.listing.reread(&self.library);
-                if let Confirm::Instrument { slot, name, spec } = confirm {
-                    let slot_state = model::Slot::new(&name, *spec);
-                    if slot == 0 {
-                        self.state.a = slot_state;
-                    } else {
-                        self.state.b = slot_state;
-                    }
-                }
-                self.ui.message = Some(format!("saved {}", path.display()));
-            }
-            Err(crate::library::LibraryError::Exists(_)) if !overwrite => self.ui.confirm = Some(confirm),
-            Err(e) => self.ui.error = Some(format!("Cannot save: {e}")),
-        }
     }
 
     /// The "replace?" question, when a save or export would overwrite a file.

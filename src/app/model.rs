@@ -146,6 +146,48 @@ fn default_requirements() -> Requirements {
     fallback_requirements()
 }
 
+/// One of the two instruments the app compares.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+pub enum Ab {
+    /// Instrument A (index 0 of the engine link's results).
+    #[default]
+    A,
+    /// Instrument B (index 1).
+    B,
+}
+
+impl Ab {
+    /// A, then B.
+    pub const BOTH: [Self; 2] = [Self::A, Self::B];
+
+    /// The index of its configuration and results (A 0, B 1).
+    #[must_use]
+    pub const fn index(self) -> usize {
+        match self {
+            Self::A => 0,
+            Self::B => 1,
+        }
+    }
+
+    /// "A" or "B".
+    #[must_use]
+    pub const fn label(self) -> &'static str {
+        match self {
+            Self::A => "A",
+            Self::B => "B",
+        }
+    }
+
+    /// The other one.
+    #[must_use]
+    pub const fn other(self) -> Self {
+        match self {
+            Self::A => Self::B,
+            Self::B => Self::A,
+        }
+    }
+}
+
 /// Which retrieval the app runs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub enum RetrievalKind {
@@ -165,8 +207,10 @@ pub struct AppState {
     pub b: Slot,
     /// Parameters linked across A and B (field names).
     pub linked: Vec<String>,
-    /// Which instrument the editor shows (0 = A, 1 = B).
-    pub editing: usize,
+    /// Which instrument the editor shows. (Saved as `editing_instrument`: sessions from before
+    /// [`Ab`] saved a number, and are read with A rather than refused.)
+    #[serde(rename = "editing_instrument")]
+    pub editing: Ab,
     /// Scene preset name.
     pub scene_name: String,
     /// The scene.
@@ -233,7 +277,7 @@ impl AppState {
             a,
             b,
             linked: Vec::new(),
-            editing: 0,
+            editing: Ab::A,
             scene_name: scene_name.into(),
             scene,
             scene_seed: 0,
@@ -292,7 +336,24 @@ impl AppState {
 
     /// The slot being edited.
     pub fn editing_mut(&mut self) -> &mut Slot {
-        if self.editing == 0 { &mut self.a } else { &mut self.b }
+        self.slot_mut(self.editing)
+    }
+
+    /// Instrument `ab`.
+    #[must_use]
+    pub const fn slot(&self, ab: Ab) -> &Slot {
+        match ab {
+            Ab::A => &self.a,
+            Ab::B => &self.b,
+        }
+    }
+
+    /// Instrument `ab`, to edit.
+    pub const fn slot_mut(&mut self, ab: Ab) -> &mut Slot {
+        match ab {
+            Ab::A => &mut self.a,
+            Ab::B => &mut self.b,
+        }
     }
 
     /// The retrieval as the engine runs it.

@@ -3,7 +3,8 @@
 //! seeds, preview and requirement settings.
 
 use super::ShoalApp;
-use super::model::{AppState, RetrievalKind, Slot};
+use super::logic::UiCommand;
+use super::model::{Ab, RetrievalKind, Slot};
 use crate::instrument::{InstrumentKind, InstrumentSpec};
 use crate::library::{Entry, Kind};
 use crate::retrieval::{Mode, Objective, Starts};
@@ -185,46 +186,19 @@ fn library_combo(ui: &mut egui::Ui, label: &str, current: &str, entries: &[Entry
 fn presets(app: &mut ShoalApp, ui: &mut egui::Ui) {
     ui.heading("Presets");
     let instruments = app.listing.get(Kind::Instrument).to_vec();
-    for (i, label) in [(0, "Instrument A"), (1, "Instrument B")] {
-        let current = if i == 0 { app.state.a.preset.clone() } else { app.state.b.preset.clone() };
-        if let Some(e) = library_combo(ui, label, &current, &instruments) {
-            match app.library.load_instrument(&e) {
-                Ok(spec) => {
-                    let slot = Slot::new(&e.name, spec);
-                    if i == 0 {
-                        app.state.a = slot;
-                    } else {
-                        app.state.b = slot;
-                    }
-                }
-                Err(err) => app.ui.error = Some(format!("Cannot load instrument `{}`: {err}", e.name)),
-            }
+    for ab in Ab::BOTH {
+        let current = app.state.slot(ab).preset.clone();
+        if let Some(entry) = library_combo(ui, &format!("Instrument {}", ab.label()), &current, &instruments) {
+            app.ui.commands.push(UiCommand::LoadInstrument { ab, entry });
         }
     }
     let scenes = app.listing.get(Kind::Scene).to_vec();
-    if let Some(e) = library_combo(ui, "Scene", &app.state.scene_name.clone(), &scenes) {
-        match app.library.load_scene(&e) {
-            Ok(spec) => {
-                app.state.scene = spec;
-                app.state.scene_name = e.name;
-            }
-            Err(err) => app.ui.error = Some(format!("Cannot load scene `{}`: {err}", e.name)),
-        }
+    if let Some(entry) = library_combo(ui, "Scene", &app.state.scene_name.clone(), &scenes) {
+        app.ui.commands.push(UiCommand::LoadScene(entry));
     }
     let studies = app.listing.get(Kind::Study).to_vec();
-    if let Some(e) = library_combo(ui, "Study", &app.state.study_name.clone(), &studies) {
-        let loaded = app.library.load_study(&e).map_err(|e| e.to_string());
-        match loaded.and_then(|study| AppState::from_study(&study).map(|s| (s, study.requirements.is_some()))) {
-            Ok((mut s, requirements_from_study)) => {
-                s.dark = app.state.dark;
-                // The study's own requirements when it states them, else the ones in use.
-                if !requirements_from_study {
-                    s.requirements = app.state.requirements.clone();
-                }
-                app.state = s;
-            }
-            Err(err) => app.ui.error = Some(format!("Cannot load study `{}`: {err}", e.name)),
-        }
+    if let Some(entry) = library_combo(ui, "Study", &app.state.study_name.clone(), &studies) {
+        app.ui.commands.push(UiCommand::LoadStudy(entry));
     }
 }
 
@@ -234,35 +208,16 @@ fn save_presets(app: &mut ShoalApp, ui: &mut egui::Ui) {
         ui.add(egui::TextEdit::singleline(&mut app.ui.preset_name).desired_width(130.0)).labelled_by(l.id);
     });
     ui.horizontal(|ui| {
-        for (i, label) in [(0, "Save A"), (1, "Save B")] {
+        for ab in Ab::BOTH {
+            let label = format!("Save {}", ab.label());
             if ui.button(label).on_hover_text("Save this instrument in your preset library").clicked() {
                 let name = app.ui.preset_name.trim().to_string();
-                let spec = if i == 0 { app.state.a.spec.clone() } else { app.state.b.spec.clone() };
-                app.save(super::Confirm::Instrument { slot: i, name, spec: Box::new(spec) }, false);
+                app.ui.commands.push(UiCommand::SaveInstrument { ab, name });
             }
         }
         if ui.button("Save study").clicked() {
             let name = app.ui.preset_name.trim().to_string();
-            let study = crate::study::StudySpec {
-                name: name.clone(),
-                description: format!(
-                    "saved from the app: A {} vs B {} over {}",
-                    app.state.a.preset, app.state.b.preset, app.state.scene_name
-                ),
-                scene: crate::study::Source::Inline(Box::new(app.state.seeded_scene())),
-                instruments: vec![
-                    crate::study::Source::Inline(Box::new(app.state.a.spec.clone())),
-                    crate::study::Source::Inline(Box::new(app.state.b.spec.clone())),
-                ],
-                retrievals: vec![app.state.retrieval_spec()],
-                seeds: vec![app.state.noise_seed],
-                detector: None,
-                calibration: None,
-                correction: None,
-                fidelity: None,
-                requirements: None,
-            };
-            app.save(super::Confirm::Study { name, study: Box::new(study) }, false);
+            app.ui.commands.push(UiCommand::SaveStudy { name });
         }
     });
 }
@@ -352,14 +307,14 @@ fn band_editor(slot: &mut Slot, ui: &mut egui::Ui) {
 fn editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
     ui.heading("Instrument");
     ui.horizontal(|ui| {
-        ui.selectable_value(&mut app.state.editing, 0, "Edit A");
-        ui.selectable_value(&mut app.state.editing, 1, "Edit B");
+        ui.selectable_value(&mut app.state.editing, Ab::A, "Edit A");
+        ui.selectable_value(&mut app.state.editing, Ab::B, "Edit B");
     });
     let editing = app.state.editing;
     let mut changed: Vec<(&'static str, f64)> = Vec::new();
     egui::Grid::new("params").num_columns(2).show(ui, |ui| {
         for p in &PARAMS {
-            let slot = if editing == 0 { &mut app.state.a } else { &mut app.state.b };
+            let slot = app.state.slot_mut(editing);
             let mut v = (p.get)(&slot.spec) * p.scale;
             let before = v;
             // Never clamped: a preset outside the slider's span keeps its value, and a typed
@@ -399,7 +354,7 @@ fn editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
                 ui.end_row();
             }
             if v != before {
-                let slot = if editing == 0 { &mut app.state.a } else { &mut app.state.b };
+                let slot = app.state.slot_mut(editing);
                 let mut candidate = slot.spec.clone();
                 (p.set)(&mut candidate, v / p.scale);
                 match candidate.validate() {
@@ -419,11 +374,11 @@ fn editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
         if app.state.linked.iter().any(|k| k == key)
             && let Some(p) = PARAMS.iter().find(|p| p.key == key)
         {
-            let other = if editing == 0 { &mut app.state.b } else { &mut app.state.a };
+            let other = app.state.slot_mut(editing.other());
             (p.set)(&mut other.spec, value);
         }
     }
-    let slot = if editing == 0 { &mut app.state.a } else { &mut app.state.b };
+    let slot = app.state.slot_mut(editing);
     egui::CollapsingHeader::new("Bands").default_open(false).show(ui, |ui| band_editor(slot, ui));
     derived(app, ui);
 }

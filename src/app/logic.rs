@@ -1,0 +1,175 @@
+//! What the app does, as opposed to what it draws: the per-frame bookkeeping ([`ShoalApp::tick`])
+//! and the [`UiCommand`]s the panels return, applied after the frame ([`ShoalApp::apply`]).
+//! Panels read the state and change plain fields (a slider moves a number); anything that loads,
+//! saves, writes or replaces a whole part of the state is a command, applied in one place.
+
+use std::path::PathBuf;
+use std::time::Duration;
+
+use super::model::{Ab, AppState, Slot};
+use super::{Confirm, ShoalApp, model};
+use crate::library::{Entry, LibraryError};
+
+/// Something a panel asked for, applied after the frame.
+#[derive(Debug, Clone)]
+pub enum UiCommand {
+    /// Load a library instrument into A or B.
+    LoadInstrument {
+        /// Which.
+        ab: Ab,
+        /// The library entry.
+        entry: Entry,
+    },
+    /// Load a library scene.
+    LoadScene(Entry),
+    /// Load a library study (instruments, scene, retrieval, requirements).
+    LoadStudy(Entry),
+    /// Save A or B in the library under `name`.
+    SaveInstrument {
+        /// Which.
+        ab: Ab,
+        /// The preset name.
+        name: String,
+    },
+    /// Save the study (A, B, the scene, the retrieval and the requirements) under `name`.
+    SaveStudy {
+        /// The preset name.
+        name: String,
+    },
+}
+
+impl ShoalApp {
+    /// Apply one command.
+    pub(super) fn apply(&mut self, command: UiCommand) {
+        match command {
+            UiCommand::LoadInstrument { ab, entry } => match self.library.load_instrument(&entry) {
+                Ok(spec) => *self.state.slot_mut(ab) = Slot::new(&entry.name, spec),
+                Err(err) => self.ui.error = Some(format!("Cannot load instrument `{}`: {err}", entry.name)),
+            },
+            UiCommand::LoadScene(entry) => match self.library.load_scene(&entry) {
+                Ok(spec) => {
+                    self.state.scene = spec;
+                    self.state.scene_name = entry.name;
+                }
+                Err(err) => self.ui.error = Some(format!("Cannot load scene `{}`: {err}", entry.name)),
+            },
+            UiCommand::LoadStudy(entry) => {
+                let loaded = self.library.load_study(&entry).map_err(|e| e.to_string());
+                match loaded.and_then(|study| AppState::from_study(&study).map(|s| (s, study.requirements.is_some()))) {
+                    Ok((mut s, requirements_from_study)) => {
+                        s.dark = self.state.dark;
+                        // The study's own requirements when it states them, else the ones in use.
+                        if !requirements_from_study {
+                            s.requirements = self.state.requirements.clone();
+                        }
+                        self.state = s;
+                    }
+                    Err(err) => self.ui.error = Some(format!("Cannot load study `{}`: {err}", entry.name)),
+                }
+            }
+            UiCommand::SaveInstrument { ab, name } => {
+                let spec = Box::new(self.state.slot(ab).spec.clone());
+                self.save(Confirm::Instrument { ab, name, spec }, false);
+            }
+            UiCommand::SaveStudy { name } => {
+                let study = Box::new(self.study_to_save(&name));
+                self.save(Confirm::Study { name, study }, false);
+            }
+        }
+    }
+
+    /// The study the app shows, as `shoal study` would run it: A and B, the scene with its seed,
+    /// the retrieval, the noise seed and the requirements in use.
+    fn study_to_save(&self, name: &str) -> crate::study::StudySpec {
+        let s = &self.state;
+        crate::study::StudySpec {
+            name: name.into(),
+            description: format!("saved from the app: A {} vs B {} over {}", s.a.preset, s.b.preset, s.scene_name),
+            scene: crate::study::Source::Inline(Box::new(s.seeded_scene())),
+            instruments: vec![
+                crate::study::Source::Inline(Box::new(s.a.spec.clone())),
+                crate::study::Source::Inline(Box::new(s.b.spec.clone())),
+            ],
+            retrievals: vec![s.retrieval_spec()],
+            seeds: vec![s.noise_seed],
+            detector: None,
+            calibration: None,
+            correction: None,
+            fidelity: None,
+            requirements: Some(s.requirements.clone()),
+        }
+    }
+
+    /// The per-frame logic before drawing: submit changed configurations, take results, maps
+    /// and export news.
+    pub(super) fn tick(&mut self, ctx: &egui::Context) {
+        if self.applied_theme != Some(self.state.dark) {
+            ctx.set_theme(if self.state.dark { egui::Theme::Dark } else { egui::Theme::Light });
+            self.applied_theme = Some(self.state.dark);
+        }
+        let mut configs = self.state.configs();
+        if let Some(a) = configs.first_mut() {
+            a.fault = self.ui.fault;
+        }
+        self.link.submit_if_changed(configs, self.state.levels());
+        let wake = ctx.clone();
+        self.listing.poll(&self.library, move || wake.request_repaint());
+        if self.link.poll() {
+            self.images.invalidate();
+        }
+        if let Some(r) = &self.raster {
+            self.images.request(&self.state, &self.link, r);
+            if let Some(done) = r.poll() {
+                self.images.receive(ctx, done);
+            }
+        }
+        while let Some(news) = self.ui.exports.poll() {
+            match news {
+                super::export::News::Written(m) => self.ui.message = Some(m),
+                super::export::News::Failed(e) => self.ui.error = Some(e),
+                super::export::News::NoChoice(what) => {
+                    let what = if what == super::export::What::Figure { "figure" } else { "data" };
+                    self.ui.message = Some(format!(
+                        "No {what} exported: no file was chosen. If no dialog appeared, this desktop has no file-chooser portal; use Path to type one."
+                    ));
+                    self.ui.typed_export = true;
+                }
+            }
+        }
+        self.ui.explore.poll();
+        if self.link.busy() || self.ui.exports.running > 0 || self.ui.explore.busy() {
+            ctx.request_repaint_after(Duration::from_millis(30));
+        }
+    }
+
+    /// Export to a typed path, asking first if that would replace existing files.
+    pub(super) fn export_to(&mut self, what: super::export::What, path: PathBuf) {
+        let snap = super::export::Snapshot::of(self);
+        let existing = super::export::existing(what, &snap, &path);
+        if existing.is_empty() {
+            self.ui.exports.write_to(what, snap, path);
+        } else {
+            self.ui.confirm = Some(Confirm::Export { what, path, existing });
+        }
+    }
+
+    /// Save A or B, or the study, in the library; asks before replacing a preset of that name.
+    pub(super) fn save(&mut self, confirm: Confirm, overwrite: bool) {
+        let result = match &confirm {
+            Confirm::Instrument { name, spec, .. } => self.library.save_instrument(name, spec, overwrite),
+            Confirm::Study { name, study } => self.library.save_study(name, study, overwrite),
+            Confirm::Export { .. } => return,
+        };
+        match result {
+            Ok(path) => {
+                self.listing.reread(&self.library);
+                if let Confirm::Instrument { ab, name, spec } = confirm {
+                    *self.state.slot_mut(ab) = model::Slot::new(&name, *spec);
+                }
+                self.ui.message = Some(format!("saved {}", path.display()));
+            }
+            Err(LibraryError::Exists(_)) if !overwrite => self.ui.confirm = Some(confirm),
+            Err(e) => self.ui.error = Some(format!("Cannot save: {e}")),
+        }
+    }
+}
