@@ -37,6 +37,10 @@ pub struct Metrics {
     pub bias: f64,
     /// Linear root-mean-square error, product units.
     pub rmse: f64,
+    /// Mean absolute error mean|M − O|, product units (a depth error in metres).
+    pub mean_abs_error: f64,
+    /// Mean error mean(M − O), product units (signed: positive when retrieved too high).
+    pub mean_error: f64,
     /// Coefficient of determination of log10 M against log10 O (squared Pearson correlation).
     pub r2: f64,
 }
@@ -55,13 +59,25 @@ impl Metrics {
     }
 }
 
+/// The unit of a metrics variable, for people (`depth_m` → "m").
+#[must_use]
+pub fn unit(variable: &str) -> &'static str {
+    match variable {
+        "chl_mg_m3" => "mg m⁻³",
+        "nap_g_m3" => "g m⁻³",
+        "cdom_per_m" => "m⁻¹",
+        v if v.starts_with("depth_m") => "m",
+        _ => "",
+    }
+}
+
 /// Metrics of `retrieved` against `truth`; `None` entries of `retrieved` are failed retrievals,
 /// and `None` entries of `truth` are not candidates.
 #[must_use]
 pub fn compare(retrieved: &[Option<f64>], truth: &[Option<f64>]) -> Metrics {
     let mut n = 0usize;
     let mut candidates = 0usize;
-    let (mut s_abs, mut s_dif, mut s_sq) = (0.0, 0.0, 0.0);
+    let (mut s_abs, mut s_dif, mut s_sq, mut s_lin_abs, mut s_lin) = (0.0, 0.0, 0.0, 0.0, 0.0);
     let (mut sx, mut sy, mut sxx, mut syy, mut sxy) = (0.0, 0.0, 0.0, 0.0, 0.0);
     for (m, o) in retrieved.iter().zip(truth) {
         let Some(o) = o.filter(|o| o.is_finite() && *o > 0.0) else { continue };
@@ -72,6 +88,8 @@ pub fn compare(retrieved: &[Option<f64>], truth: &[Option<f64>]) -> Metrics {
         s_abs += (lm - lo).abs();
         s_dif += lm - lo;
         s_sq += (m - o) * (m - o);
+        s_lin_abs += (m - o).abs();
+        s_lin += m - o;
         sx += lo;
         sy += lm;
         sxx += lo * lo;
@@ -94,6 +112,8 @@ pub fn compare(retrieved: &[Option<f64>], truth: &[Option<f64>]) -> Metrics {
         mae: if n > 0 { 10f64.powf(s_abs / nf) } else { 1.0 },
         bias: if n > 0 { 10f64.powf(s_dif / nf) } else { 1.0 },
         rmse: if n > 0 { (s_sq / nf).sqrt() } else { 0.0 },
+        mean_abs_error: if n > 0 { s_lin_abs / nf } else { 0.0 },
+        mean_error: if n > 0 { s_lin / nf } else { 0.0 },
         r2,
     }
 }
@@ -317,6 +337,11 @@ mod tests {
         assert_eq!((m.n, m.candidates, m.excluded), (1, 4, 3));
         assert!((m.returned_pct - 25.0).abs() < 1e-12);
         assert!(m.mae.is_finite() && m.rmse.is_finite() && m.r2.is_finite());
+        // Errors in product units: retrieved 1.1 and 1.8 against 1 and 2 (the fourth pixel failed):
+        // mean |M − O| = (0.1 + 0.2)/2 = 0.15, mean (M − O) = (0.1 − 0.2)/2 = −0.05.
+        let m = compare(&[Some(1.1), Some(1.8), None], &[Some(1.0), Some(2.0), Some(3.0)]);
+        assert!((m.mean_abs_error - 0.15).abs() < 1e-12 && (m.mean_error + 0.05).abs() < 1e-12, "{m:?}");
+        assert_eq!((unit("depth_m"), unit("depth_m_bottom_visible"), unit("chl_mg_m3")), ("m", "m", "mg m⁻³"));
         // Nothing returned: finite numbers, zero returned.
         let m = compare(&[None, None], &[Some(1.0), Some(2.0)]);
         assert_eq!(m.n, 0);

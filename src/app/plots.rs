@@ -72,7 +72,21 @@ fn metrics_table(app: &ShoalApp, ui: &mut egui::Ui) {
                         ui.label(format!("{:.1} %", m.returned_pct));
                     }
                     Some(m) => {
-                        ui.label(format!("{:.1} %", m.mae_pct()));
+                        let unit = crate::metrics::unit(v);
+                        let in_units = format!(
+                            "log-space MAE {:.1} %; mean |error| {:.3} {unit}, mean error {:+.3} {unit}, RMSE {:.3} {unit} ({} pixels)",
+                            m.mae_pct(),
+                            m.mean_abs_error,
+                            m.mean_error,
+                            m.rmse,
+                            m.n
+                        );
+                        // Depth errors read in metres too (a log-space % alone hides whether 10 % is 0.2 m or 2 m).
+                        if unit == "m" {
+                            ui.label(format!("{:.1} % ({:.2} m)", m.mae_pct(), m.mean_abs_error)).on_hover_text(in_units);
+                        } else {
+                            ui.label(format!("{:.1} %", m.mae_pct())).on_hover_text(in_units);
+                        }
                         ui.label(format!("{:+.1} %", m.bias_pct()));
                         ui.label(format!("{:.1} %", m.returned_pct));
                     }

@@ -147,20 +147,22 @@ pub fn run(args: &StudyArgs) -> Result<(), CliError> {
 /// The metrics table on stderr: per instrument, product and variable; pixel accounting.
 fn print_metrics(result: &crate::study::StudyResult) {
     eprintln!(
-        "{:<12} {:<8} {:<24} {:>9} {:>9} {:>10}",
+        "{:<12} {:<8} {:<24} {:>9} {:>9} {:>10}  mean |error|, units",
         "instrument", "product", "variable", "MAE %", "bias %", "returned %"
     );
     for run in &result.runs {
         for ret in &run.retrievals {
             for v in ret.metrics.variables.iter().chain(&ret.metrics.depth_by_true_substrate) {
                 eprintln!(
-                    "{:<12} {:<8} {:<24} {:>9.1} {:>+9.1} {:>10.2}",
+                    "{:<12} {:<8} {:<24} {:>9.1} {:>+9.1} {:>10.2}  {:.3} {}",
                     run.label,
                     ret.metrics.product,
                     v.variable,
                     v.metrics.mae_pct(),
                     v.metrics.bias_pct(),
-                    v.metrics.returned_pct
+                    v.metrics.returned_pct,
+                    v.metrics.mean_abs_error,
+                    crate::metrics::unit(&v.variable)
                 );
             }
             if let Some(a) = ret.metrics.substrate_agreement_pct {

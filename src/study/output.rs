@@ -159,18 +159,20 @@ struct MetricsRow<'a> {
 }
 
 /// The metrics table as CSV: instrument, seed, product, variable, mae, bias, n, returned_pct,
-/// rmse, r2 (MAE and bias as factors; mae_pct, bias_pct as percentages).
+/// rmse, r2 (MAE and bias as factors; mae_pct, bias_pct as percentages), and the mean absolute
+/// and mean error in the product's units (`unit`: a depth error in metres).
 #[must_use]
 pub fn metrics_csv(result: &StudyResult) -> String {
-    let mut s =
-        String::from("instrument,seed,product,variable,mae,bias,mae_pct,bias_pct,n,candidates,returned_pct,rmse,r2\n");
+    let mut s = String::from(
+        "instrument,seed,product,variable,mae,bias,mae_pct,bias_pct,n,candidates,returned_pct,rmse,r2,mean_abs_error,mean_error,unit\n",
+    );
     for run in &result.runs {
         for ret in &run.retrievals {
             for v in &ret.metrics.variables {
                 let m = &v.metrics;
                 let _ = writeln!(
                     s,
-                    "{},{},{},{},{},{},{},{},{},{},{},{},{}",
+                    "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
                     run.label,
                     run.seed,
                     ret.metrics.product,
@@ -183,7 +185,10 @@ pub fn metrics_csv(result: &StudyResult) -> String {
                     m.candidates,
                     number(m.returned_pct),
                     number(m.rmse),
-                    number(m.r2)
+                    number(m.r2),
+                    number(m.mean_abs_error),
+                    number(m.mean_error),
+                    crate::metrics::unit(&v.variable)
                 );
             }
         }

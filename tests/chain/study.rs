@@ -31,7 +31,7 @@ fn a_study_writes_tables_and_figures() {
     let mut lines = csv.lines();
     assert_eq!(
         lines.next().unwrap(),
-        "instrument,seed,product,variable,mae,bias,mae_pct,bias_pct,n,candidates,returned_pct,rmse,r2"
+        "instrument,seed,product,variable,mae,bias,mae_pct,bias_pct,n,candidates,returned_pct,rmse,r2,mean_abs_error,mean_error,unit"
     );
     let rows: Vec<&str> = lines.collect();
     assert_eq!(rows.len(), 6, "2 instruments × 3 variables");
