@@ -25,8 +25,14 @@ mod logic;
 mod maps;
 pub mod model;
 mod panels;
+mod params;
 mod plots;
 pub mod raster;
+mod session;
+mod view;
+mod window;
+
+pub use window::run;
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -117,7 +123,7 @@ fn engine_threads(requested: usize) -> usize {
 impl ShoalApp {
     /// The app with `state` (tests and the eframe creator).
     pub fn with_state(state: AppState, ctx: &egui::Context, options: AppOptions) -> Self {
-        install_fonts(ctx);
+        window::install_fonts(ctx);
         let engine_wake = ctx.clone();
         let link =
             EngineLink::new(engine_threads(options.engine_threads), Arc::new(move || engine_wake.request_repaint()))
@@ -150,15 +156,15 @@ impl ShoalApp {
     /// The app as eframe creates it: the saved session, or the default study.
     #[must_use]
     pub fn new(cc: &eframe::CreationContext<'_>, options: AppOptions) -> Self {
-        let path = model::session_path(&crate::library::home_dir());
-        let (state, problem) = match (options.fresh, model::load_session(&path)) {
+        let path = session::session_path(&crate::library::home_dir());
+        let (state, problem) = match (options.fresh, session::load_session(&path)) {
             (true, _) => (None, None),
-            (false, model::SavedSession::Restored(s)) => (Some(*s), None),
+            (false, session::SavedSession::Restored(s)) => (Some(*s), None),
             // A session saved by an earlier Shoal in eframe's own storage (outside SHOAL_HOME).
-            (false, model::SavedSession::None) => {
+            (false, session::SavedSession::None) => {
                 (cc.storage.and_then(|s| eframe::get_value::<AppState>(s, STATE_KEY)), None)
             }
-            (false, model::SavedSession::Unreadable { message, kept_at }) => (
+            (false, session::SavedSession::Unreadable { message, kept_at }) => (
                 None,
                 Some(format!(
                     "The saved session could not be read ({message}); it is kept at {} and the app \
@@ -456,7 +462,9 @@ impl eframe::App for ShoalApp {
             return;
         }
         let state = self.state.clone();
-        match std::thread::Builder::new().name("shoal-session".into()).spawn(move || model::save_session(&path, &state))
+        match std::thread::Builder::new()
+            .name("shoal-session".into())
+            .spawn(move || session::save_session(&path, &state))
         {
             Ok(handle) => {
                 self.session_writer = Some(handle);
@@ -465,49 +473,4 @@ impl eframe::App for ShoalApp {
             Err(e) => self.ui.error = Some(format!("The session was not saved: cannot start a thread: {e}")),
         }
     }
-}
-
-/// Add DejaVu Sans after egui's default fonts: units need glyphs they lack (m⁻³, e⁻, µm).
-fn install_fonts(ctx: &egui::Context) {
-    use egui::epaint::text::{FontInsert, FontPriority, InsertFontFamily};
-    let families = [egui::FontFamily::Proportional, egui::FontFamily::Monospace]
-        .into_iter()
-        .map(|family| InsertFontFamily { family, priority: FontPriority::Lowest })
-        .collect();
-    ctx.add_font(FontInsert::new("dejavu-sans", egui::FontData::from_static(crate::assets::DEJAVU_SANS_TTF), families));
-}
-
-/// The app icon: a sine swell over a depth gradient, drawn here (no image file).
-fn icon() -> egui::IconData {
-    let n = 64u32;
-    let mut rgba = Vec::with_capacity((n * n * 4) as usize);
-    for y in 0..n {
-        for x in 0..n {
-            let wave = 24.0 + 6.0 * (f64::from(x) / 64.0 * std::f64::consts::TAU).sin();
-            let c = if f64::from(y) < wave {
-                [240, 246, 250]
-            } else {
-                crate::colormap::viridis(0.15 + 0.6 * f64::from(y) / 64.0)
-            };
-            rgba.extend_from_slice(&[c[0], c[1], c[2], 255]);
-        }
-    }
-    egui::IconData { rgba, width: n, height: n }
-}
-
-/// Open the app window (blocks until it closes).
-pub fn run(options: AppOptions) -> Result<(), String> {
-    let native = eframe::NativeOptions {
-        viewport: egui::ViewportBuilder::default()
-            .with_title("Shoal — instrument trade-offs over water")
-            .with_inner_size([1500.0, 960.0])
-            .with_min_inner_size([900.0, 600.0])
-            .with_icon(icon()),
-        // eframe's own file (window size and egui's memory) beside the session, so that with
-        // SHOAL_HOME set nothing is written outside it.
-        persistence_path: Some(crate::library::home_dir().join("window.ron")),
-        ..Default::default()
-    };
-    eframe::run_native("shoal", native, Box::new(move |cc| Ok(Box::new(ShoalApp::new(cc, options)))))
-        .map_err(|e| format!("cannot open the app window: {e} (no display? run `shoal study` for the headless study)"))
 }

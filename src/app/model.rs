@@ -3,6 +3,8 @@
 
 use serde::{Deserialize, Serialize};
 
+pub use super::view::{Layout, ProductKind};
+
 use crate::engine::RunConfig;
 use crate::instrument::InstrumentSpec;
 use crate::retrieval::{AlmiSettings, RetrievalSpec, SambucaSettings};
@@ -32,93 +34,6 @@ impl Slot {
     pub fn modified(&self) -> bool {
         self.spec != self.original
     }
-}
-
-/// Which product the maps show.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-pub enum ProductKind {
-    /// Chlorophyll-a.
-    Chl,
-    /// Non-algal particles.
-    Nap,
-    /// CDOM absorption.
-    Cdom,
-    /// Depth (SAMBUCA).
-    Depth,
-    /// Dominant substrate (SAMBUCA).
-    Substrate,
-    /// Chosen SIOP set (aLMI).
-    SiopSet,
-    /// Rrs of the selected band.
-    Rrs,
-    /// Level-1 radiance of the selected band.
-    Level1,
-    /// Per-pixel SNR of the selected band (analytic, at the pixel's radiance).
-    Snr,
-}
-
-impl ProductKind {
-    /// Every product, in menu order.
-    pub const ALL: [Self; 9] = [
-        Self::Chl,
-        Self::Nap,
-        Self::Cdom,
-        Self::Depth,
-        Self::Substrate,
-        Self::SiopSet,
-        Self::Rrs,
-        Self::Level1,
-        Self::Snr,
-    ];
-
-    /// Menu text.
-    #[must_use]
-    pub fn label(self) -> &'static str {
-        match self {
-            Self::Chl => "chl-a (mg m⁻³)",
-            Self::Nap => "NAP (g m⁻³)",
-            Self::Cdom => "a_CDOM(440) (m⁻¹)",
-            Self::Depth => "depth (m)",
-            Self::Substrate => "dominant substrate",
-            Self::SiopSet => "chosen SIOP set",
-            Self::Rrs => "Rrs (sr⁻¹)",
-            Self::Level1 => "Level-1 radiance (W m⁻² sr⁻¹ nm⁻¹)",
-            Self::Snr => "SNR",
-        }
-    }
-
-    /// Does it need a band?
-    #[must_use]
-    pub fn per_band(self) -> bool {
-        matches!(self, Self::Rrs | Self::Level1 | Self::Snr)
-    }
-
-    /// Is it a class map (no colour scale)?
-    #[must_use]
-    pub fn categorical(self) -> bool {
-        matches!(self, Self::Substrate | Self::SiopSet)
-    }
-
-    /// The metrics variable it corresponds to.
-    #[must_use]
-    pub fn variable(self) -> Option<&'static str> {
-        match self {
-            Self::Chl => Some("chl_mg_m3"),
-            Self::Nap => Some("nap_g_m3"),
-            Self::Cdom => Some("cdom_per_m"),
-            Self::Depth => Some("depth_m"),
-            _ => None,
-        }
-    }
-}
-
-/// How the three maps are arranged.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-pub enum Layout {
-    /// Truth | A | B.
-    TruthAB,
-    /// A | B | A − B.
-    AbDifference,
 }
 
 /// The limits the app judges by when the study states none: the default study's (chl MAE ≤ 20 %,
@@ -468,59 +383,6 @@ fn split_top_level(s: &str) -> Vec<&str> {
     out
 }
 
-/// Where the session is kept: `session.ron` in the user's Shoal directory (`SHOAL_HOME` when it
-/// is set; see [`crate::library::home_dir`]), beside the preset library and the exports.
-#[must_use]
-pub fn session_path(home: &std::path::Path) -> std::path::PathBuf {
-    home.join("session.ron")
-}
-
-/// What reading the saved session found.
-#[derive(Debug)]
-pub enum SavedSession {
-    /// No session file: the first start.
-    None,
-    /// The session as saved.
-    Restored(Box<AppState>),
-    /// A file that does not parse (an older or damaged session). It has been moved aside to
-    /// the path given, so the next save cannot overwrite what the user made; the message says
-    /// what was wrong.
-    Unreadable {
-        /// Why it could not be read.
-        message: String,
-        /// Where the file now is.
-        kept_at: std::path::PathBuf,
-    },
-}
-
-/// Read the session at `path`; a file that does not parse is renamed to `*.unreadable`.
-#[must_use]
-pub fn load_session(path: &std::path::Path) -> SavedSession {
-    let Ok(text) = std::fs::read_to_string(path) else { return SavedSession::None };
-    match ron::from_str::<AppState>(&text) {
-        Ok(state) => SavedSession::Restored(Box::new(state)),
-        Err(e) => {
-            let kept_at = path.with_extension("ron.unreadable");
-            let message = crate::parse::describe(&text, &e);
-            let moved = std::fs::rename(path, &kept_at);
-            SavedSession::Unreadable {
-                message: match moved {
-                    Ok(()) => message,
-                    Err(m) => format!("{message} (and it could not be moved aside: {m})"),
-                },
-                kept_at,
-            }
-        }
-    }
-}
-
-/// Write the session to `path` atomically (a temporary file, synced, then a rename).
-pub fn save_session(path: &std::path::Path, state: &AppState) -> Result<(), String> {
-    let text = ron::ser::to_string_pretty(state, ron::ser::PrettyConfig::default())
-        .map_err(|e| format!("cannot encode the session: {e}"))?;
-    crate::study::write_bytes(path, text.as_bytes()).map_err(|e| e.to_string())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -551,30 +413,5 @@ mod tests {
         s.scene_seed = 3;
         assert_ne!(s.seeded_scene().chl_mg_m3, before.chl_mg_m3);
         assert_eq!(s.seeded_scene().nap_g_m3, before.nap_g_m3, "constant maps have no seed");
-    }
-
-    #[test]
-    fn the_session_round_trips_and_a_broken_one_is_kept_aside() {
-        let home = std::env::temp_dir().join(format!("shoal-session-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&home);
-        let path = session_path(&home);
-        assert!(path.starts_with(&home));
-        assert!(matches!(load_session(&path), SavedSession::None));
-        let mut s = AppState::default();
-        s.a.spec.aperture_mm = 77.0;
-        save_session(&path, &s).unwrap();
-        match load_session(&path) {
-            SavedSession::Restored(back) => assert_eq!(*back, s),
-            other => panic!("{other:?}"),
-        }
-        std::fs::write(&path, "AppState(a: 3").unwrap();
-        match load_session(&path) {
-            SavedSession::Unreadable { kept_at, .. } => {
-                assert_eq!(std::fs::read_to_string(&kept_at).unwrap(), "AppState(a: 3");
-                assert!(!path.exists(), "the broken file is moved, not left to be overwritten");
-            }
-            other => panic!("{other:?}"),
-        }
-        let _ = std::fs::remove_dir_all(&home);
     }
 }

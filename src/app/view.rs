@@ -1,0 +1,90 @@
+//! What the maps show: the product and the arrangement of the panels (saved with the session).
+
+use serde::{Deserialize, Serialize};
+
+/// Which product the maps show.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum ProductKind {
+    /// Chlorophyll-a.
+    Chl,
+    /// Non-algal particles.
+    Nap,
+    /// CDOM absorption.
+    Cdom,
+    /// Depth (SAMBUCA).
+    Depth,
+    /// Dominant substrate (SAMBUCA).
+    Substrate,
+    /// Chosen SIOP set (aLMI).
+    SiopSet,
+    /// Rrs of the selected band.
+    Rrs,
+    /// Level-1 radiance of the selected band.
+    Level1,
+    /// Per-pixel SNR of the selected band (analytic, at the pixel's radiance).
+    Snr,
+}
+
+impl ProductKind {
+    /// Every product, in menu order.
+    pub const ALL: [Self; 9] = [
+        Self::Chl,
+        Self::Nap,
+        Self::Cdom,
+        Self::Depth,
+        Self::Substrate,
+        Self::SiopSet,
+        Self::Rrs,
+        Self::Level1,
+        Self::Snr,
+    ];
+
+    /// Menu text.
+    #[must_use]
+    pub fn label(self) -> &'static str {
+        match self {
+            Self::Chl => "chl-a (mg m⁻³)",
+            Self::Nap => "NAP (g m⁻³)",
+            Self::Cdom => "a_CDOM(440) (m⁻¹)",
+            Self::Depth => "depth (m)",
+            Self::Substrate => "dominant substrate",
+            Self::SiopSet => "chosen SIOP set",
+            Self::Rrs => "Rrs (sr⁻¹)",
+            Self::Level1 => "Level-1 radiance (W m⁻² sr⁻¹ nm⁻¹)",
+            Self::Snr => "SNR",
+        }
+    }
+
+    /// Does it need a band?
+    #[must_use]
+    pub fn per_band(self) -> bool {
+        matches!(self, Self::Rrs | Self::Level1 | Self::Snr)
+    }
+
+    /// Is it a class map (no colour scale)?
+    #[must_use]
+    pub fn categorical(self) -> bool {
+        matches!(self, Self::Substrate | Self::SiopSet)
+    }
+
+    /// The metrics variable it corresponds to.
+    #[must_use]
+    pub fn variable(self) -> Option<&'static str> {
+        match self {
+            Self::Chl => Some("chl_mg_m3"),
+            Self::Nap => Some("nap_g_m3"),
+            Self::Cdom => Some("cdom_per_m"),
+            Self::Depth => Some("depth_m"),
+            _ => None,
+        }
+    }
+}
+
+/// How the three maps are arranged.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum Layout {
+    /// Truth | A | B.
+    TruthAB,
+    /// A | B | A − B.
+    AbDifference,
+}
