@@ -18,6 +18,7 @@ pub mod nnls;
 pub mod optimise;
 pub mod quadrature;
 pub mod run;
+mod run_sambuca;
 pub mod sambuca;
 pub mod sambuca_reference;
 pub mod sets;
@@ -25,7 +26,7 @@ pub mod slsqp;
 
 pub use almi::{AlmiFlags, AlmiSettings};
 pub use band_model::{BandModel, BandResponse, ModelScratch, Parameters};
-pub use run::{Product, ProductFlags, RetrievalInputs, RetrievalSpec, retrieve};
+pub use run::{Product, ProductFlags, RetrievalInputs, RetrievalSpec};
 pub use sambuca::{Objective, SambucaSettings, Starts};
 
 use serde::{Deserialize, Serialize};
@@ -68,5 +69,20 @@ pub enum RetrievalError {
 impl crate::control::Cancellable for RetrievalError {
     fn cancelled() -> Self {
         Self::Cancelled
+    }
+}
+
+/// Run `spec` over the image.
+pub fn retrieve(
+    spec: &RetrievalSpec,
+    inputs: &RetrievalInputs<'_>,
+    control: &crate::control::RunControl,
+) -> Result<Product, RetrievalError> {
+    spec.validate()?;
+    match spec {
+        RetrievalSpec::Almi { siop_sets, settings } => run::retrieve_almi(siop_sets, settings, inputs, control),
+        RetrievalSpec::Sambuca { siop, substrates, settings } => {
+            run_sambuca::retrieve_sambuca(siop.as_ref(), substrates.as_deref(), settings, inputs, control)
+        }
     }
 }

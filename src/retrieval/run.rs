@@ -11,14 +11,13 @@ use super::RetrievalError;
 use super::almi::{AlmiFlags, AlmiSet, AlmiSettings, invert as almi_invert};
 use super::almi_reference::invert_reference;
 use super::band_model::{BandModel, BandResponse};
-use super::sambuca::{Observation, SambucaSettings, invert as sambuca_invert};
-use super::sambuca_reference::{self as reference, ReferenceModel};
+use super::sambuca::SambucaSettings;
 use super::sets::default_almi_sets;
 use crate::control::RunControl;
 use crate::correction::RrsFlags;
 use crate::instrument::BandAtmosphere;
 use crate::instrument::Response;
-use crate::water::{SiopSource, SiopSpec, SubstrateLibrary, WaterGeometry, rrs_below_from_above};
+use crate::water::{SiopSource, SiopSpec, SubstrateLibrary, WaterGeometry};
 
 /// Which retrieval, with its settings, as a study file writes it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -202,25 +201,10 @@ fn default_almi_bands(bands: &[BandResponse]) -> Vec<usize> {
     (0..max).map(|k| usable[k * (usable.len() - 1) / (max - 1)]).collect()
 }
 
-/// Run `spec` over the image.
-pub fn retrieve(
-    spec: &RetrievalSpec,
-    inputs: &RetrievalInputs<'_>,
-    control: &RunControl,
-) -> Result<Product, RetrievalError> {
-    spec.validate()?;
-    match spec {
-        RetrievalSpec::Almi { siop_sets, settings } => retrieve_almi(siop_sets, settings, inputs, control),
-        RetrievalSpec::Sambuca { siop, substrates, settings } => {
-            retrieve_sambuca(siop.as_ref(), substrates.as_deref(), settings, inputs, control)
-        }
-    }
-}
-
 /// One aLMI pixel as stored: (chl, cdom, nap, set, cost, flags).
 type AlmiRow = (f32, f32, f32, i16, f32, u8);
 
-fn retrieve_almi(
+pub(super) fn retrieve_almi(
     sources: &[SiopSource],
     settings: &AlmiSettings,
     inputs: &RetrievalInputs<'_>,
@@ -323,9 +307,6 @@ fn retrieve_almi(
     })
 }
 
-/// One SAMBUCA pixel as stored: (chl, cdom, nap, depth, q, pair, objective, sdi, iterations, flags).
-type SambucaRow = (f32, f32, f32, f32, f32, (u8, u8), f32, f32, u16, u8);
-
 /// Check SAMBUCA's bounds and quadrature setting; the message names the field.
 fn validate_sambuca(settings: &SambucaSettings) -> Result<(), RetrievalError> {
     let b = &settings.bounds;
@@ -345,219 +326,4 @@ fn validate_sambuca(settings: &SambucaSettings) -> Result<(), RetrievalError> {
     };
     check(&crate::ranges::SAMBUCA_NODES_PER_BAND, settings.nodes_per_band as f64)?;
     check(&crate::ranges::SAMBUCA_MAX_ITERATIONS, f64::from(settings.max_iterations))
-}
-
-/// Per-substrate fractions from each pixel's pair and fraction.
-fn substrate_fractions(results: &[Vec<SambucaRow>], n_sub: usize) -> Array3<f32> {
-    let (rows, cols) = (results.len(), results.first().map_or(0, Vec::len));
-    let mut fractions = Array3::<f32>::zeros((rows, cols, n_sub));
-    for r in 0..rows {
-        for c in 0..cols {
-            let p = &results[r][c];
-            if p.9 & ProductFlags::RETURNED == 0 {
-                continue;
-            }
-            let (i, j) = (usize::from(p.5.0), usize::from(p.5.1));
-            if i < n_sub {
-                fractions[[r, c, i]] = if j < n_sub { p.4 } else { 1.0 };
-            }
-            if j < n_sub {
-                fractions[[r, c, j]] = 1.0 - p.4;
-            }
-        }
-    }
-    fractions
-}
-
-fn retrieve_sambuca(
-    siop: Option<&SiopSource>,
-    substrates: Option<&[String]>,
-    settings: &SambucaSettings,
-    inputs: &RetrievalInputs<'_>,
-    control: &RunControl,
-) -> Result<Product, RetrievalError> {
-    let (spec, dir) = match siop {
-        Some(src) => src.load(inputs.base_dir)?,
-        None => inputs.scene_siop.clone(),
-    };
-    let names: Vec<String> = substrates.map_or_else(|| inputs.scene_substrates.clone(), <[String]>::to_vec);
-    if names.is_empty() {
-        return Err(RetrievalError::Invalid {
-            field: "substrates".into(),
-            message: "SAMBUCA needs at least one substrate".into(),
-        });
-    }
-    let b = &settings.bounds;
-    let library = SubstrateLibrary::embedded()?;
-    if settings.mode == Mode::Reference {
-        let model = ReferenceModel::from_siop(&spec, dir.as_deref(), &library, &names, &inputs.bands)?;
-        let siop = (spec.name.as_str(), spec.water_refractive_index);
-        return retrieve_sambuca_reference(&model, siop, names, settings, inputs, control);
-    }
-    let model = BandModel::new(&spec, dir.as_deref(), &library, &names, &inputs.bands, settings.nodes_per_band)?;
-    let (rows, cols, nb) = inputs.rrs.dim();
-    let inv_cos: Vec<(f64, f64)> =
-        inputs.geometry.iter().map(|g| g.inverse_cosines_in_water(model.refractive_index)).collect();
-    let results: Vec<Vec<SambucaRow>> = control.map_rows(rows, |at| {
-        let r = at.index();
-        let mut obs = vec![0.0; nb];
-        let mut valid = vec![false; nb];
-        let row = (0..cols)
-            .map(|c| {
-                at.column(c);
-                let failed = (0.0, 0.0, 0.0, 0.0, 0.0, (0, 0), 0.0, 0.0, 0, ProductFlags::FAILED);
-                if inputs.land[[r, c]] != 0 {
-                    return (0.0, 0.0, 0.0, 0.0, 0.0, (0, 0), 0.0, 0.0, 0, ProductFlags::LAND);
-                }
-                for k in 0..nb {
-                    obs[k] = f64::from(inputs.rrs[[r, c, k]]);
-                    valid[k] = inputs.flags[[r, c, k]] & (RrsFlags::INVALID | RrsFlags::SATURATED) == 0;
-                }
-                let o = Observation { rrs: &obs, valid: &valid, nedr: &inputs.nedr, inv_cos: inv_cos[c] };
-                let p = sambuca_invert(&model, settings, &o);
-                if !p.ok {
-                    return failed;
-                }
-                let mut flags = ProductFlags::RETURNED;
-                if p.converged {
-                    flags |= ProductFlags::CONVERGED;
-                }
-                if p.sdi >= 1.0 {
-                    flags |= ProductFlags::BOTTOM_VISIBLE;
-                }
-                let near = |v: f64, (lo, hi): (f64, f64)| v <= lo * (1.0 + 1e-9) || v >= hi * (1.0 - 1e-9);
-                if near(p.chl, b.chl_mg_m3)
-                    || near(p.cdom, b.cdom_per_m)
-                    || near(p.nap, b.nap_g_m3)
-                    || near(p.depth_m, b.depth_m)
-                {
-                    flags |= ProductFlags::AT_BOUND;
-                }
-                (
-                    p.chl as f32,
-                    p.cdom as f32,
-                    p.nap as f32,
-                    p.depth_m as f32,
-                    p.fraction as f32,
-                    p.pair,
-                    p.objective as f32,
-                    p.sdi as f32,
-                    u16::try_from(p.iterations).unwrap_or(u16::MAX),
-                    flags,
-                )
-            })
-            .collect();
-        Ok::<_, RetrievalError>(row)
-    })?;
-    Ok(sambuca_product(&results, names, &spec.name))
-}
-
-/// The SAMBUCA product from its per-pixel rows.
-fn sambuca_product(results: &[Vec<SambucaRow>], names: Vec<String>, siop_name: &str) -> Product {
-    let (rows, cols) = (results.len(), results.first().map_or(0, Vec::len));
-    let fractions = substrate_fractions(results, names.len());
-    let plane = |k: fn(&SambucaRow) -> f32| Array2::from_shape_fn((rows, cols), |(r, c)| k(&results[r][c]));
-    Product {
-        name: "SAMBUCA".into(),
-        chl_mg_m3: plane(|p| p.0),
-        cdom_per_m: plane(|p| p.1),
-        nap_g_m3: plane(|p| p.2),
-        depth_m: Some(plane(|p| p.3)),
-        substrate_names: names,
-        substrate_fractions: Some(fractions),
-        siop_set_names: vec![siop_name.to_string()],
-        siop_set: None,
-        cost: plane(|p| p.6),
-        sdi: Some(plane(|p| p.7)),
-        iterations: Some(Array2::from_shape_fn((rows, cols), |(r, c)| results[r][c].8)),
-        flags: Array2::from_shape_fn((rows, cols), |(r, c)| results[r][c].9),
-    }
-}
-
-/// SAMBUCA's reference mode over the image: every water pixel fitted as the CSIRO package fits
-/// it ([`super::sambuca_reference`]). The package works in sub-surface rrs: each band's corrected
-/// Rrs is taken below the surface with rrs = Rrs/(0.52 + 1.7·Rrs) (Lee et al. 2002) and its
-/// noise-equivalent ΔRrs with the same map's slope, 0.52/(0.52 + 1.7·Rrs)². A pixel with an
-/// invalid, saturated or non-finite band, or Σ(rrs/NEDR) ≤ 0, is not fitted (the package would
-/// carry the NaN or a negative f through); every other pixel is returned, as the package writes
-/// every pixel's x, with `CONVERGED` where it reported success and `STALLED` where that success
-/// left the depth at its start.
-fn retrieve_sambuca_reference(
-    model: &ReferenceModel,
-    (siop_name, refractive_index): (&str, f64),
-    names: Vec<String>,
-    settings: &SambucaSettings,
-    inputs: &RetrievalInputs<'_>,
-    control: &RunControl,
-) -> Result<Product, RetrievalError> {
-    let bnd = &settings.bounds;
-    let p_min = [bnd.chl_mg_m3.0, bnd.cdom_per_m.0, bnd.nap_g_m3.0, bnd.depth_m.0, 0.0];
-    let p_max = [bnd.chl_mg_m3.1, bnd.cdom_per_m.1, bnd.nap_g_m3.1, bnd.depth_m.1, 1.0];
-    let (rows, cols, nb) = inputs.rrs.dim();
-    let inv_cos: Vec<(f64, f64)> =
-        inputs.geometry.iter().map(|g| g.inverse_cosines_in_water(refractive_index)).collect();
-    let pairs = model.pairs().to_vec();
-    let results: Vec<Vec<SambucaRow>> = control.map_rows(rows, |at| {
-        let r = at.index();
-        let (mut obs, mut nedr) = (vec![0.0; nb], vec![0.0; nb]);
-        let row = (0..cols)
-            .map(|c| {
-                at.column(c);
-                let failed = (0.0, 0.0, 0.0, 0.0, 0.0, (0, 0), 0.0, 0.0, 0, ProductFlags::FAILED);
-                if inputs.land[[r, c]] != 0 {
-                    return (0.0, 0.0, 0.0, 0.0, 0.0, (0, 0), 0.0, 0.0, 0, ProductFlags::LAND);
-                }
-                let mut usable = true;
-                for k in 0..nb {
-                    let above = f64::from(inputs.rrs[[r, c, k]]);
-                    let flagged = inputs.flags[[r, c, k]] & (RrsFlags::INVALID | RrsFlags::SATURATED) != 0;
-                    let denominator = 0.52 + 1.7 * above;
-                    usable &= !flagged && above.is_finite() && denominator > 0.0 && inputs.nedr[k] > 0.0;
-                    obs[k] = rrs_below_from_above(above);
-                    nedr[k] = inputs.nedr[k] * 0.52 / (denominator * denominator);
-                }
-                let weighted: f64 = obs.iter().zip(&nedr).map(|(o, e)| o / e).sum();
-                if !usable || !(weighted > 0.0) {
-                    return failed;
-                }
-                let p = reference::invert(model, &p_min, &p_max, &obs, &nedr, inv_cos[c]);
-                if !p.fun.is_finite() {
-                    return failed;
-                }
-                let pair = pairs[p.kept.unwrap_or(pairs.len() - 1)];
-                let sdi = reference::sdi(model, &p.x, pair, &nedr, inv_cos[c]);
-                let mut flags = ProductFlags::RETURNED;
-                if p.success {
-                    flags |= ProductFlags::CONVERGED;
-                }
-                if p.stalled {
-                    flags |= ProductFlags::STALLED;
-                }
-                if sdi >= 1.0 {
-                    flags |= ProductFlags::BOTTOM_VISIBLE;
-                }
-                let near = |v: f64, k: usize| v <= p_min[k] * (1.0 + 1e-9) || v >= p_max[k] * (1.0 - 1e-9);
-                if (0..4).any(|k| near(p.x[k], k)) {
-                    flags |= ProductFlags::AT_BOUND;
-                }
-                let narrow = |i: usize| u8::try_from(i).unwrap_or(u8::MAX);
-                // One substrate: the package's single-substrate model, stored as (0, none).
-                let stored = if pair.0 == pair.1 { (0, u8::MAX) } else { (narrow(pair.0), narrow(pair.1)) };
-                (
-                    p.x[0] as f32,
-                    p.x[1] as f32,
-                    p.x[2] as f32,
-                    p.x[3] as f32,
-                    p.x[4] as f32,
-                    stored,
-                    p.fun as f32,
-                    sdi as f32,
-                    u16::try_from(p.nit).unwrap_or(u16::MAX),
-                    flags,
-                )
-            })
-            .collect();
-        Ok::<_, RetrievalError>(row)
-    })?;
-    Ok(sambuca_product(&results, names, siop_name))
 }
