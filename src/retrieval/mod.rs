@@ -23,6 +23,7 @@ pub mod sambuca;
 pub mod sambuca_reference;
 pub mod sets;
 pub mod slsqp;
+mod slsqp_qp;
 
 pub use almi::{AlmiFlags, AlmiSettings};
 pub use band_model::{BandModel, BandResponse, ModelScratch, Parameters};
