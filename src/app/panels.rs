@@ -261,6 +261,84 @@ fn derived(app: &ShoalApp, ui: &mut egui::Ui) {
         });
         ui.small("Peak SNR: the best band at the scene's median radiance.");
     });
+    feasibility(app, ui);
+}
+
+/// A value coloured by how far it is from sensible: red past a hard limit, amber near one.
+fn graded(ui: &mut egui::Ui, text: String, level: u8, why: &str) {
+    let colour = match level {
+        0 => ui.visuals().text_color(),
+        1 => egui::Color32::from_rgb(200, 130, 0),
+        _ => egui::Color32::from_rgb(200, 40, 40),
+    };
+    ui.colored_label(colour, text).on_hover_text(why);
+}
+
+/// The engine's `Feasibility` stage for A and B over this scene (src/instrument/feasibility.rs).
+fn feasibility(app: &ShoalApp, ui: &mut egui::Ui) {
+    use crate::instrument::feasibility::{Q_DETECTOR_LIMITED, Q_OPTICS_LIMITED, SATURATION_HEADROOM};
+    egui::CollapsingHeader::new("Feasibility").default_open(true).show(ui, |ui| {
+        let figures: Vec<_> =
+            app.link.shown.iter().map(|s| s.as_ref().map(|s| s.output.feasibility.clone())).collect();
+        egui::Grid::new("feasibility").num_columns(3).striped(true).show(ui, |ui| {
+            ui.label("");
+            ui.label("A");
+            ui.label("B");
+            ui.end_row();
+            type Row = (&'static str, fn(&crate::instrument::feasibility::Feasibility) -> (String, u8), &'static str);
+            let rows: [Row; 4] = [
+                (
+                    "Peak / full scale",
+                    |f| {
+                        let peak = f.bands.iter().map(|b| b.peak_fraction_of_full_scale).fold(0.0, f64::max);
+                        (format!("{:.0} %", 100.0 * peak), u8::from(peak >= SATURATION_HEADROOM) + u8::from(peak >= 1.0))
+                    },
+                    "Brightest water pixel's signal over full scale, worst band and detector: 100 % saturates",
+                ),
+                (
+                    "Smear",
+                    |f| (format!("{:.2} px", f.smear_px), 2 * u8::from(f.smear_px > 1.0)),
+                    "Exposure over line period: the ground moves this many pixels during one exposure",
+                ),
+                (
+                    "Optical Q",
+                    |f| {
+                        let (lo, hi) = f.bands.iter().fold((f64::INFINITY, 0.0f64), |(a, b), x| (a.min(x.q), b.max(x.q)));
+                        (format!("{lo:.2}–{hi:.2}"), u8::from(lo < Q_DETECTOR_LIMITED || hi > Q_OPTICS_LIMITED))
+                    },
+                    "Q = λN/p over the bands (Fiete 1999): below 0.5 the pixel limits resolution (aliasing); above 2 the optics blur over two pixels",
+                ),
+                (
+                    "ADC step / read noise",
+                    |f| {
+                        let r = f.quantisation_noise_e / f.read_noise_e.max(1e-9);
+                        (format!("{:.2}", r), u8::from(r > 0.5))
+                    },
+                    "Quantisation noise gain/√12 over the read noise: above 0.5 the ADC step adds to the noise floor",
+                ),
+            ];
+            for (name, f, why) in rows {
+                ui.label(name).on_hover_text(why);
+                for figure in &figures {
+                    match figure {
+                        Some(fig) => {
+                            let (text, level) = f(fig);
+                            graded(ui, text, level, why);
+                        }
+                        None => {
+                            ui.label("–");
+                        }
+                    }
+                }
+                ui.end_row();
+            }
+        });
+        for (ab, figure) in Ab::BOTH.iter().zip(&figures) {
+            for w in figure.iter().flat_map(|f| &f.warnings) {
+                ui.colored_label(egui::Color32::from_rgb(200, 40, 40), format!("{}: {}", ab.label(), w.message));
+            }
+        }
+    });
 }
 
 fn settings(app: &mut ShoalApp, ui: &mut egui::Ui) {

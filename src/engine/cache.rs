@@ -26,6 +26,9 @@ pub enum Stage {
     Radiance,
     /// Detector responsivity and fixed patterns.
     Detector,
+    /// Feasibility figures: f-number, Q, Airy disc, smear, peak signal against full scale,
+    /// quantisation against read noise (and the plausibility warnings).
+    Feasibility,
     /// Electrons per pixel.
     Electrons,
     /// Level-0 counts.
@@ -44,7 +47,7 @@ pub enum Stage {
 
 impl Stage {
     /// Every stage, in chain order.
-    pub const ALL: [Self; 15] = [
+    pub const ALL: [Self; 16] = [
         Self::Scene,
         Self::Response,
         Self::Geometry,
@@ -53,6 +56,7 @@ impl Stage {
         Self::BandAtmosphere,
         Self::Radiance,
         Self::Detector,
+        Self::Feasibility,
         Self::Electrons,
         Self::Level0,
         Self::Calibration,
@@ -84,6 +88,7 @@ impl std::fmt::Display for Stage {
             Self::BandAtmosphere => "band atmosphere",
             Self::Radiance => "radiance",
             Self::Detector => "detector",
+            Self::Feasibility => "feasibility",
             Self::Electrons => "electrons",
             Self::Level0 => "level-0",
             Self::Calibration => "calibration",

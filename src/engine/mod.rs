@@ -18,6 +18,7 @@
 //! | `BandAtmosphere` | optics, geometry | per-column band-effective atmosphere |
 //! | `Radiance` | the above, spatial response | pupil band radiance and the truth |
 //! | `Detector` | aperture, exposure, transmission, QE, dark, PRNU/DSNU, well, electronics | responsivity |
+//! | `Feasibility` | detector, brightest water radiance, line period | f-number, Q, Airy disc, smear, peak/full scale, warnings |
 //! | `Electrons` | radiance, photon side of the detector, seed | electrons per pixel |
 //! | `Level0` | electrons, read noise, gain, bias, ADC | counts and flags |
 //! | `Calibration` | detector, calibration settings, solar spectrum | gain and offset |
@@ -26,8 +27,8 @@
 //! | `Snr` | detector, typical radiance | analytic and measured SNR |
 //! | `Retrieval` | Rrs, band atmosphere, noise, retrieval settings | products and their metrics |
 //!
-//! Changing the gain re-runs `Detector`, `Level0`, `Calibration`, `Level1`, `Correction` and
-//! `Snr`, never the scene, the atmosphere or the photon counts. Effects a scene does not ask for
+//! Changing the gain re-runs `Detector`, `Feasibility`, `Level0`, `Calibration`, `Level1`,
+//! `Correction` and `Snr`, never the scene, the atmosphere or the photon counts. Effects a scene does not ask for
 //! are never computed and the report lists them as skipped. [`worker`] runs the engine on its own
 //! thread with its own rayon pool for the app.
 

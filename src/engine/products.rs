@@ -10,6 +10,7 @@ use super::cache::Key;
 use super::report::RunReport;
 use crate::calibration::{Calibration, Level1};
 use crate::correction::{Reflectance, SceneApproximation};
+use crate::instrument::feasibility::Feasibility;
 use crate::instrument::sample::BandAtmosphere;
 use crate::instrument::{Detector, Level0, RadianceCube, Response, SnrRow, Viewing};
 use crate::metrics::ProductMetrics;
@@ -55,6 +56,8 @@ pub struct RunOutput {
     pub correction: Arc<CorrectionProduct>,
     /// SNR per band.
     pub snr: Arc<Vec<SnrRow>>,
+    /// Feasibility figures of the design over this scene (f-number, Q, smear, peak signal).
+    pub feasibility: Arc<Feasibility>,
     /// Retrieved products and their metrics, one per configured retrieval.
     pub retrievals: Vec<Arc<RetrievalOutput>>,
     /// The report.
@@ -91,6 +94,7 @@ pub(super) struct SceneSide {
 pub(super) struct InstrumentSide {
     pub(super) detector: Arc<Detector>,
     pub(super) detector_key: Key,
+    pub(super) feasibility: Arc<Feasibility>,
     pub(super) level0: Arc<Level0>,
     pub(super) calibration: Arc<Calibration>,
     pub(super) level1: Arc<Level1>,

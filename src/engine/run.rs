@@ -143,6 +143,7 @@ impl Engine {
             level1: inst.level1,
             correction,
             snr,
+            feasibility: inst.feasibility,
             retrievals,
             report,
         })

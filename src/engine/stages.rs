@@ -14,6 +14,7 @@ use crate::atmosphere::{AtmosphereLut, LutAxes};
 use crate::calibration::{Calibration, band_e0, calibrate};
 use crate::control::RunControl;
 use crate::correction::{SceneApproximation, compare, correct_exact};
+use crate::instrument::feasibility::Feasibility;
 use crate::instrument::sample::BandAtmosphere;
 use crate::instrument::{
     Detector, InstrumentError, RadianceCube, Response, SampleOptions, SnrRow, SpatialKernel, Viewing, analytic_snr,
@@ -176,14 +177,20 @@ impl Engine {
         let detector = self.stage(detector_key, report, control, || {
             Ok(Detector::new(instrument, response, config.detector, config.seed))
         })?;
-        let names: Vec<String> = response.bands.bands.iter().map(|b| b.name.clone()).collect();
-        report.warnings = crate::instrument::plausibility::assess(
-            instrument,
-            &detector,
-            &names,
-            &radiance.brightest_water_w_m2_sr_nm,
-            viewing.line_period_s,
-        );
+        // Feasibility: the detector over this scene's brightest water, at this line period.
+        let feasibility_key = KeyBuilder::new(Stage::Feasibility).after(detector_key).after(radiance_key).finish();
+        let feasibility = self.stage(feasibility_key, report, control, || {
+            let names: Vec<String> = response.bands.bands.iter().map(|b| b.name.clone()).collect();
+            Ok(Feasibility::assess(
+                instrument,
+                &detector,
+                &names,
+                &response.bands.centres_nm(),
+                &radiance.brightest_water_w_m2_sr_nm,
+                viewing.line_period_s,
+            ))
+        })?;
+        report.warnings.clone_from(&feasibility.warnings);
         let electrons_key =
             KeyBuilder::new(Stage::Electrons).after(radiance_key).after(response_key).with(&inputs.photon).finish();
         let electrons = self.stage(electrons_key, report, control, || {
@@ -219,7 +226,7 @@ impl Engine {
             calibrate(&level0, &calibration, viewing, control).map_err(failed(Stage::Level1))
         })?;
 
-        Ok(InstrumentSide { detector, detector_key, level0, calibration, level1, level1_key })
+        Ok(InstrumentSide { detector, detector_key, feasibility, level0, calibration, level1, level1_key })
     }
 
     /// Atmospheric correction: the delivered Rrs and the diagnostics.

@@ -27,6 +27,7 @@
 //!   Academic Press, ch. 3 (pushbroom geometry, system PSF = optics ⊗ detector ⊗ motion).
 
 pub mod detector;
+pub mod feasibility;
 pub mod geometry;
 pub mod level0;
 pub mod plausibility;

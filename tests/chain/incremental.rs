@@ -25,8 +25,15 @@ fn a_gain_change_reruns_only_digitisation_onward() {
     let second = engine.run(&config, &RunControl::new()).unwrap();
     for stage in Stage::ALL {
         let expected = match stage {
-            // The electronics: the detector model, counts, calibration and everything after.
-            Stage::Detector | Stage::Level0 | Stage::Calibration | Stage::Level1 | Stage::Correction | Stage::Snr => 2,
+            // The electronics: the detector model (and its feasibility figures: the ADC's full
+            // scale and step), counts, calibration and everything after.
+            Stage::Detector
+            | Stage::Feasibility
+            | Stage::Level0
+            | Stage::Calibration
+            | Stage::Level1
+            | Stage::Correction
+            | Stage::Snr => 2,
             Stage::Retrieval => 0,
             // Never the scene, the atmosphere or the photon counts.
             _ => 1,
