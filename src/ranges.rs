@@ -236,6 +236,18 @@ ranges! {
     ATMOSPHERE_AEROSOL_SCALE_HEIGHT_KM = Range::closed("scene.atmosphere.aerosol_scale_height_km", 0.1, 20.0, "km", "aerosol scale height");
     /// Water refractive index.
     ATMOSPHERE_WATER_REFRACTIVE_INDEX = Range::closed("scene.atmosphere.water_refractive_index", 1.0, 1.5, "", "refractive index of the water surface");
+
+    // `shoal atmosphere` runs (AtmosphereRun: the atmosphere alone, at a geometry given in
+    // degrees). A scene sets the day from its date and stops the sun at 85°; the radiative
+    // transfer itself accepts the sun down to 89°.
+    /// Day of the year of a `shoal atmosphere` run.
+    ATMOSPHERE_DAY_OF_YEAR = Range::count("atmosphere_run.atmosphere.day_of_year", 1.0, 366.0, "", "day of the year (Sun–Earth distance); a scene sets it from its date");
+    /// Sun zenith of a `shoal atmosphere` run.
+    GEOMETRY_SUN_ZENITH_DEG = Range::closed("atmosphere_run.sun_zenith_deg", 0.0, 89.0, "degrees", "solar zenith (the plane-parallel model has no meaning at the horizon)");
+    /// View zenith of a `shoal atmosphere` run.
+    GEOMETRY_VIEW_ZENITH_DEG = Range::closed("atmosphere_run.view_zenith_deg", 0.0, 85.0, "degrees", "view zenith");
+    /// Relative azimuth of a `shoal atmosphere` run.
+    GEOMETRY_RELATIVE_AZIMUTH_DEG = Range::closed("atmosphere_run.relative_azimuth_deg", -360.0, 360.0, "degrees", "view azimuth minus sun azimuth");
     /// Discrete-ordinate streams.
     ACCURACY_STREAMS = Range::count("scene.atmosphere.accuracy.streams", 2.0, 48.0, "", "quadrature streams per hemisphere");
     /// Scattering orders.

@@ -66,8 +66,9 @@ impl LutAxes {
             Ok(())
         };
         check("wavelengths_nm", &self.wavelengths_nm, 325.0, 1025.0)?;
-        check("sun_zenith_deg", &self.sun_zenith_deg, 0.0, 89.0)?;
-        check("view_zenith_deg", &self.view_zenith_deg, 0.0, 85.0)?;
+        let (sun, view) = (&crate::ranges::GEOMETRY_SUN_ZENITH_DEG, &crate::ranges::GEOMETRY_VIEW_ZENITH_DEG);
+        check("sun_zenith_deg", &self.sun_zenith_deg, sun.lo, sun.hi)?;
+        check("view_zenith_deg", &self.view_zenith_deg, view.lo, view.hi)?;
         check("relative_azimuth_deg", &self.relative_azimuth_deg, 0.0, 180.0)
     }
 }

@@ -87,7 +87,8 @@ pub(crate) fn check(range: &crate::ranges::Range, value: f64) -> Result<(), Atmo
     if range.contains(value) {
         Ok(())
     } else {
-        let field = range.field("scene.atmosphere.").into();
+        let field = range.field("scene.atmosphere.");
+        let field = field.strip_prefix("atmosphere_run.atmosphere.").unwrap_or(field).into();
         Err(AtmosphereError::OutOfRange { field, value, allowed: range.allowed() })
     }
 }

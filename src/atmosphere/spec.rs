@@ -126,7 +126,7 @@ impl AtmosphereSpec {
         check(&r::ATMOSPHERE_RAYLEIGH_SCALE_HEIGHT_KM, self.rayleigh_scale_height_km)?;
         check(&r::ATMOSPHERE_AEROSOL_SCALE_HEIGHT_KM, self.aerosol_scale_height_km)?;
         check(&r::ATMOSPHERE_WATER_REFRACTIVE_INDEX, self.water_refractive_index)?;
-        range("day_of_year", f64::from(self.day_of_year), 1.0, 366.0, "")?;
+        check(&r::ATMOSPHERE_DAY_OF_YEAR, f64::from(self.day_of_year))?;
         self.accuracy.validate()
     }
 
@@ -159,12 +159,23 @@ impl Geometry {
         }
     }
 
-    /// Sun zenith below 89° (the plane-parallel model has no meaning at the horizon), view
-    /// zenith below 85°, finite azimuth.
+    /// Sun zenith at most 89° (the plane-parallel model has no meaning at the horizon), view
+    /// zenith at most 85°, azimuth within ±360° ([`crate::ranges`]: `GEOMETRY_*`).
     pub fn validate(&self) -> Result<(), AtmosphereError> {
-        range("sun_zenith (deg)", self.sun_zenith_rad.to_degrees(), 0.0, 89.0, " degrees")?;
-        range("view_zenith (deg)", self.view_zenith_rad.to_degrees(), 0.0, 85.0, " degrees")?;
-        range("relative_azimuth (deg)", self.relative_azimuth_rad.to_degrees(), -360.0, 360.0, " degrees")
+        use crate::ranges as r;
+        let in_degrees = |range: &crate::ranges::Range, rad: f64| {
+            // Degrees as the user wrote them: the radian round trip's last-digit noise removed.
+            let value = (rad.to_degrees() * 1e9).round() / 1e9;
+            if range.contains(value) {
+                Ok(())
+            } else {
+                let field = range.field("atmosphere_run.").into();
+                Err(AtmosphereError::OutOfRange { field, value, allowed: range.allowed() })
+            }
+        };
+        in_degrees(&r::GEOMETRY_SUN_ZENITH_DEG, self.sun_zenith_rad)?;
+        in_degrees(&r::GEOMETRY_VIEW_ZENITH_DEG, self.view_zenith_rad)?;
+        in_degrees(&r::GEOMETRY_RELATIVE_AZIMUTH_DEG, self.relative_azimuth_rad)
     }
 }
 

@@ -353,8 +353,8 @@ fn lut_axes(response: &Response, viewing: &Viewing, sun_zenith_deg: f64, fid: &s
     }
     nodes.push(last);
     nodes.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
-    let max_vza =
-        ((viewing.max_view_zenith_deg / fid.lut_view_step_deg).ceil().max(1.0) * fid.lut_view_step_deg).min(85.0);
+    let max_vza = ((viewing.max_view_zenith_deg / fid.lut_view_step_deg).ceil().max(1.0) * fid.lut_view_step_deg)
+        .min(crate::ranges::GEOMETRY_VIEW_ZENITH_DEG.hi);
     LutAxes::covering(nodes, (sun_zenith_deg, sun_zenith_deg), max_vza, (1.0, fid.lut_view_step_deg, 30.0))
 }
 

@@ -58,6 +58,19 @@ fn refusal(range: &Range, value: f64) -> Option<String> {
         }
         return r.validate().err().map(|e| e.to_string());
     }
+    if let Some(field) = range.path.strip_prefix("atmosphere_run.") {
+        // `shoal atmosphere`'s own inputs: the atmosphere's day and the geometry in degrees.
+        let mut atmosphere = shoal::atmosphere::AtmosphereSpec::default();
+        let (mut sun, mut view, mut azimuth) = (30.0, 0.0, 90.0);
+        match field {
+            "atmosphere.day_of_year" => atmosphere.day_of_year = value as u32,
+            "sun_zenith_deg" => sun = value,
+            "view_zenith_deg" => view = value,
+            _ => azimuth = value,
+        }
+        let geometry = shoal::atmosphere::Geometry::from_degrees(sun, view, azimuth);
+        return atmosphere.validate().err().or_else(|| geometry.validate().err()).map(|e| e.to_string());
+    }
     let map_field = ["scene.chl_mg_m3", "scene.nap_g_m3", "scene.cdom_per_m", "scene.depth_m"].contains(&range.path)
         || range.path.starts_with("scene.substrates");
     if map_field {
