@@ -139,22 +139,32 @@ fn product_menu(app: &mut ShoalApp, ui: &mut egui::Ui) {
     });
 }
 
-fn colour_bar(ui: &mut egui::Ui, palette: Palette, height: f32, label: &str) {
+fn colour_bar(ui: &mut egui::Ui, palette: Palette, height: f32, label: &str, classes: &[String]) {
     let (rect, _) = ui.allocate_exact_size(Vec2::new(86.0, height), Sense::hover());
     let painter = ui.painter_at(rect);
     let bar = Rect::from_min_size(rect.min + Vec2::new(4.0, 16.0), Vec2::new(16.0, height - 28.0));
     let steps = 64;
     let text = ui.visuals().text_color();
     painter.text(rect.min, egui::Align2::LEFT_TOP, label, egui::FontId::proportional(11.0), text);
-    if let Palette::Classes = palette {
-        for k in 0..8 {
-            let c = categorical(k);
+    // Classes by name (substrates, SIOP sets); A − B of classes as agree / differ.
+    let named: Option<Vec<([u8; 3], String)>> = match palette {
+        Palette::Classes => {
+            Some(classes.iter().take(12).enumerate().map(|(k, n)| (categorical(k), n.replace('_', " "))).collect())
+        }
+        Palette::Agreement => Some(vec![
+            (super::raster::AGREEMENT_COLOURS[0], "same".into()),
+            (super::raster::AGREEMENT_COLOURS[1], "different".into()),
+        ]),
+        _ => None,
+    };
+    if let Some(named) = named {
+        for (k, (c, name)) in named.iter().enumerate() {
             let r = Rect::from_min_size(bar.min + Vec2::new(0.0, k as f32 * 16.0), Vec2::splat(12.0));
             painter.rect_filled(r, 0.0, Color32::from_rgb(c[0], c[1], c[2]));
             painter.text(
                 r.right_center() + Vec2::new(4.0, 0.0),
                 egui::Align2::LEFT_CENTER,
-                format!("{}", k + 1),
+                name,
                 egui::FontId::proportional(10.0),
                 text,
             );
@@ -166,7 +176,7 @@ fn colour_bar(ui: &mut egui::Ui, palette: Palette, height: f32, label: &str) {
         let c = match palette {
             Palette::Sequential(_) => viridis(t),
             Palette::Diverging(_) => diverging(2.0 * t - 1.0),
-            Palette::Classes => [0, 0, 0],
+            Palette::Classes | Palette::Agreement => [0, 0, 0],
         };
         let y1 = bar.max.y - bar.height() * k as f32 / steps as f32;
         let y0 = bar.max.y - bar.height() * (k + 1) as f32 / steps as f32;
@@ -177,7 +187,7 @@ fn colour_bar(ui: &mut egui::Ui, palette: Palette, height: f32, label: &str) {
         let v = match palette {
             Palette::Sequential(s) => s.value(t),
             Palette::Diverging(b) => (2.0 * t - 1.0) * b,
-            Palette::Classes => 0.0,
+            Palette::Classes | Palette::Agreement => 0.0,
         };
         let y = bar.max.y - bar.height() * t as f32;
         painter.text(
@@ -260,12 +270,13 @@ pub fn central(app: &mut ShoalApp, ui: &mut egui::Ui) {
         }
         let palette = app.images.palette;
         let label = app.state.product.label().split(" (").next().unwrap_or("").to_string();
+        let classes = class_names(app);
         ui.vertical(|ui| {
             if let Some(p) = palette {
-                colour_bar(ui, p, 220.0, &label);
+                colour_bar(ui, p, 220.0, &label, &classes);
             }
             if let Some(p) = app.images.difference_palette {
-                colour_bar(ui, p, 160.0, "A − B");
+                colour_bar(ui, p, 160.0, "A − B", &classes);
             }
         });
     });
@@ -292,5 +303,15 @@ pub fn central(app: &mut ShoalApp, ui: &mut egui::Ui) {
         }
     } else {
         ui.label("Drag to pan, scroll to zoom; the maps move together.");
+    }
+}
+
+/// The names of the shown product's classes, in colour order (substrates or SIOP sets).
+fn class_names(app: &ShoalApp) -> Vec<String> {
+    let Some(out) = app.link.shown.iter().flatten().next().map(|s| &s.output) else { return Vec::new() };
+    match app.state.product {
+        ProductKind::Substrate => super::raster::substrate_classes(out),
+        ProductKind::SiopSet => out.retrievals.first().map(|r| r.product.siop_set_names.clone()).unwrap_or_default(),
+        _ => Vec::new(),
     }
 }

@@ -57,10 +57,14 @@ pub fn product_map(out: &RunOutput, kind: ProductKind, band: usize, truth: bool)
                 let p = &ret?.product;
                 (p.substrate_fractions.as_ref()?, &p.substrate_names)
             };
+            // The truth and the retrieval may list substrates in different orders: every map is
+            // coloured by its class's place in one list (`substrate_classes`), so one colour is
+            // one substrate in every panel and in the legend.
+            let class_of = class_indices(names, &substrate_classes(out));
             let dominant = Array2::from_shape_fn((f.dim().0, f.dim().1), |(i, j)| {
-                (0..f.dim().2).max_by(|&a, &b| f[[i, j, a]].total_cmp(&f[[i, j, b]])).unwrap_or(0) as f32
+                let k = (0..f.dim().2).max_by(|&a, &b| f[[i, j, a]].total_cmp(&f[[i, j, b]])).unwrap_or(0);
+                class_of.get(k).copied().unwrap_or(0.0)
             });
-            let _ = names;
             let valid = if truth { water } else { returned(&ret?.product) };
             Some(MapData { values: dominant, valid })
         }
@@ -145,6 +149,35 @@ pub fn difference(a: &MapData, a_out: &RunOutput, b: &MapData, b_out: &RunOutput
     MapData { values, valid }
 }
 
+/// The substrate classes of a run's maps, in legend order: the scene's substrates, then any the
+/// retrieval unmixes that the scene does not have.
+#[must_use]
+pub fn substrate_classes(out: &RunOutput) -> Vec<String> {
+    let mut classes = out.radiance.substrate_names.clone();
+    for r in &out.retrievals {
+        for n in &r.product.substrate_names {
+            if !classes.contains(n) {
+                classes.push(n.clone());
+            }
+        }
+    }
+    classes
+}
+
+/// The legend position of each of `names` in `classes` (past the end when absent).
+#[must_use]
+pub fn class_indices(names: &[String], classes: &[String]) -> Vec<f32> {
+    names.iter().map(|n| classes.iter().position(|c| c == n).unwrap_or(classes.len()) as f32).collect()
+}
+
+/// Where two class maps agree (0) or not (1), A's pixels against B's nearest ground point.
+#[must_use]
+pub fn agreement(a: &MapData, a_out: &RunOutput, b: &MapData, b_out: &RunOutput) -> MapData {
+    let mut d = difference(a, a_out, b, b_out);
+    d.values.mapv_inplace(|v| if v == 0.0 { 0.0 } else { 1.0 });
+    d
+}
+
 /// How a map is coloured.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Palette {
@@ -154,7 +187,12 @@ pub enum Palette {
     Diverging(f64),
     /// Class colours.
     Classes,
+    /// Two classes of A against B: the same (0) or different (1).
+    Agreement,
 }
+
+/// The colours of [`Palette::Agreement`]: same, different.
+pub const AGREEMENT_COLOURS: [[u8; 3]; 2] = [[170, 200, 170], [215, 48, 39]];
 
 /// An RGBA image ready to upload.
 #[derive(Debug, Clone, PartialEq)]
@@ -199,6 +237,8 @@ pub fn colorize(map: &MapData, palette: Palette, max_side: usize) -> Image {
                     Palette::Sequential(_) => viridis(sum / n as f64),
                     Palette::Diverging(bound) => diverging((sum / n as f64) / bound.max(f64::MIN_POSITIVE)),
                     Palette::Classes => categorical(first.unwrap_or(0.0).max(0.0) as usize),
+                    // Any disagreement in the block shows (a mean above 0).
+                    Palette::Agreement => AGREEMENT_COLOURS[usize::from(sum > 0.0)],
                 };
                 [c[0], c[1], c[2], 255]
             };
@@ -344,13 +384,20 @@ pub fn panels(job: &Job, cache: &mut MapCache) -> Done {
                 named.push(("B".into(), b.clone()));
             }
             if let (Some(a), Some(b), Some(ra), Some(rb)) = (&a, &b, &job.runs[0], &job.runs[1]) {
-                diff = Some(Arc::new(difference(a, ra, b, rb)));
+                // Classes have no difference: A − B of a class map is where they agree.
+                diff = Some(Arc::new(if job.kind.categorical() {
+                    agreement(a, ra, b, rb)
+                } else {
+                    difference(a, ra, b, rb)
+                }));
             }
         }
     }
     let refs: Vec<&MapData> = named.iter().map(|(_, m)| m.as_ref()).collect();
     let palette = shared_palette(&refs, job.kind, false);
-    let difference_palette = diff.as_ref().map(|d| shared_palette(&[d.as_ref()], job.kind, true));
+    let difference_palette = diff.as_ref().map(|d| {
+        if job.kind.categorical() { Palette::Agreement } else { shared_palette(&[d.as_ref()], job.kind, true) }
+    });
     let mut panels: Vec<PanelImage> = named
         .into_iter()
         .map(|(title, data)| PanelImage { image: colorize(&data, palette, job.max_side), title, data })
@@ -414,6 +461,16 @@ impl Drop for RasterThread {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_substrate_is_one_colour_whatever_order_a_product_lists_it_in() {
+        // The scene lists sand, seagrass, coral; a retrieval unmixing coral and sand (and mud,
+        // which the scene lacks) must colour its coral as the truth's coral.
+        let classes: Vec<String> = ["sand", "seagrass", "coral", "mud"].map(String::from).to_vec();
+        let product: Vec<String> = ["coral", "sand", "mud"].map(String::from).to_vec();
+        assert_eq!(class_indices(&product, &classes), vec![2.0, 0.0, 3.0]);
+        assert_eq!(class_indices(&["kelp".to_string()], &classes), vec![4.0], "unknown: past the legend");
+    }
 
     #[test]
     fn colorize_downsamples_and_flips() {
