@@ -277,9 +277,14 @@ fn graded(ui: &mut egui::Ui, text: String, level: u8, why: &str) {
 /// The engine's `Feasibility` stage for A and B over this scene (src/instrument/feasibility.rs).
 fn feasibility(app: &ShoalApp, ui: &mut egui::Ui) {
     use crate::instrument::feasibility::{Q_DETECTOR_LIMITED, Q_OPTICS_LIMITED, SATURATION_HEADROOM};
-    egui::CollapsingHeader::new("Feasibility").default_open(true).show(ui, |ui| {
-        let figures: Vec<_> =
-            app.link.shown.iter().map(|s| s.as_ref().map(|s| s.output.feasibility.clone())).collect();
+    let figures: Vec<_> = app.link.shown.iter().map(|s| s.as_ref().map(|s| s.output.feasibility.clone())).collect();
+    // The warnings stay in sight; the figures behind them fold away.
+    for (ab, figure) in Ab::BOTH.iter().zip(&figures) {
+        for w in figure.iter().flat_map(|f| &f.warnings) {
+            ui.colored_label(egui::Color32::from_rgb(200, 40, 40), format!("{}: {}", ab.label(), w.message));
+        }
+    }
+    egui::CollapsingHeader::new("Feasibility").default_open(false).show(ui, |ui| {
         egui::Grid::new("feasibility").num_columns(3).striped(true).show(ui, |ui| {
             ui.label("");
             ui.label("A");
@@ -333,11 +338,6 @@ fn feasibility(app: &ShoalApp, ui: &mut egui::Ui) {
                 ui.end_row();
             }
         });
-        for (ab, figure) in Ab::BOTH.iter().zip(&figures) {
-            for w in figure.iter().flat_map(|f| &f.warnings) {
-                ui.colored_label(egui::Color32::from_rgb(200, 40, 40), format!("{}: {}", ab.label(), w.message));
-            }
-        }
     });
 }
 
