@@ -22,6 +22,7 @@ use shoal::scene::{Effect, MapSpec, SceneSpec};
 /// Inputs that do not change a run's output, and why. Everything else must.
 const NO_EFFECT: &[(&str, &str)] = &[
     ("requirements.", "a study's pass/fail threshold: read after the runs, never by a stage"),
+    ("atmosphere_run.", "`shoal atmosphere`'s own inputs (its day and geometry): not part of a run"),
     ("instrument.name", "a label for reports and file names"),
     ("instrument.description", "a label"),
 ];
