@@ -6,7 +6,7 @@
 use std::path::PathBuf;
 use std::time::Duration;
 
-use super::model::{Ab, AppState, Slot};
+use super::model::{Ab, AppState, ProductKind, RetrievalKind, Slot};
 use super::{Confirm, ShoalApp, model};
 use crate::library::{Entry, LibraryError};
 
@@ -36,6 +36,8 @@ pub enum UiCommand {
         /// The preset name.
         name: String,
     },
+    /// Run this retrieval (the scene/retrieval banner's switch), showing its main product.
+    UseRetrieval(RetrievalKind),
 }
 
 impl ShoalApp {
@@ -70,6 +72,13 @@ impl ShoalApp {
             UiCommand::SaveInstrument { ab, name } => {
                 let spec = Box::new(self.state.slot(ab).spec.clone());
                 self.save(Confirm::Instrument { ab, name, spec }, false);
+            }
+            UiCommand::UseRetrieval(kind) => {
+                self.state.retrieval = kind;
+                self.state.product = match kind {
+                    RetrievalKind::Sambuca => ProductKind::Depth,
+                    RetrievalKind::Almi => ProductKind::Chl,
+                };
             }
             UiCommand::SaveStudy { name } => {
                 let study = Box::new(self.study_to_save(&name));

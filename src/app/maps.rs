@@ -215,9 +215,52 @@ fn format_value(v: f64) -> String {
     }
 }
 
+/// The scene ↔ retrieval banner: a scene whose bottom shows needs a retrieval that models one.
+fn retrieval_banner(app: &mut ShoalApp, ui: &mut egui::Ui) {
+    use super::logic::UiCommand;
+    use super::model::RetrievalKind;
+    if app.state.retrieval == RetrievalKind::Almi && app.state.scene.needs_bottom_model() {
+        ui.horizontal_wrapped(|ui| {
+            ui.colored_label(
+                Color32::from_rgb(200, 90, 0),
+                format!(
+                    "`{}` has a visible bottom (ShallowBottom). aLMI assumes optically deep water: its \
+                     concentrations are biased by the bottom, and it retrieves no depth or substrate.",
+                    app.state.scene_name
+                ),
+            );
+            if ui.button("Use SAMBUCA").on_hover_text("Retrieve depth, substrate and water together").clicked() {
+                app.ui.commands.push(UiCommand::UseRetrieval(RetrievalKind::Sambuca));
+            }
+        });
+    }
+}
+
+/// What the shown product is when the retrieval does not make it.
+fn product_note(app: &ShoalApp) -> Option<String> {
+    use super::model::RetrievalKind;
+    let retrieval = match app.state.retrieval {
+        RetrievalKind::Almi => "aLMI",
+        RetrievalKind::Sambuca => "SAMBUCA",
+    };
+    let missing = match (app.state.retrieval, app.state.product) {
+        (RetrievalKind::Almi, ProductKind::Depth | ProductKind::Substrate) => true,
+        (RetrievalKind::Sambuca, ProductKind::SiopSet) => true,
+        _ => false,
+    };
+    missing.then(|| {
+        let product = app.state.product.label().split(" (").next().unwrap_or_default();
+        format!("{retrieval} does not retrieve the {product}: A and B have no map of it.")
+    })
+}
+
 /// The central panel.
 pub fn central(app: &mut ShoalApp, ui: &mut egui::Ui) {
+    retrieval_banner(app, ui);
     product_menu(app, ui);
+    if let Some(note) = product_note(app) {
+        ui.label(note);
+    }
     if app.images.panels.is_empty() {
         ui.add_space(40.0);
         ui.vertical_centered(|ui| {

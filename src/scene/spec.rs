@@ -138,6 +138,14 @@ impl SceneSpec {
         crate::parse::preset_names::<Self>()
     }
 
+    /// Does the bottom show through the water (the scene asks for `ShallowBottom`)? Then only a
+    /// retrieval that models a bottom (SAMBUCA) can be right here: aLMI assumes optically deep
+    /// water and retrieves no depth or substrate.
+    #[must_use]
+    pub fn needs_bottom_model(&self) -> bool {
+        self.effects.contains(&Effect::ShallowBottom)
+    }
+
     /// Check the numbers and that every effect has what it needs.
     pub fn validate(&self) -> Result<(), SceneError> {
         use crate::ranges as r;

@@ -346,3 +346,23 @@ fn an_instrument_that_returns_no_pixel_is_never_a_pass() {
     assert!(fails >= 6, "{fails} FAIL verdicts on screen");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn a_shallow_scene_under_alm_shows_a_banner_whose_button_switches_to_sambuca() {
+    // Issue 14: loading the Heron Island reef kept aLMI (chl MAE ~985 %, all FAIL, no hint).
+    let dir = temp_library("banner");
+    let mut h = harness("cubesat", 16, &dir);
+    h.step();
+    let banner = "has a visible bottom";
+    assert!(h.query_by_label_contains(banner).is_none(), "Lake Hume (deep) shows no banner");
+    pick(&mut h, "Scene", "heron_island_reef");
+    assert_eq!(h.state().state.scene_name, "heron_island_reef");
+    assert!(h.query_by_label_contains(banner).is_some(), "no banner over a shallow scene under aLMI");
+    h.get_by_label("Use SAMBUCA").click();
+    h.step();
+    h.step();
+    assert_eq!(h.state().state.retrieval, shoal::app::model::RetrievalKind::Sambuca);
+    assert_eq!(h.state().state.product, shoal::app::model::ProductKind::Depth, "the depth map is shown");
+    assert!(h.query_by_label_contains(banner).is_none(), "the banner goes once SAMBUCA runs");
+    let _ = std::fs::remove_dir_all(&dir);
+}
