@@ -243,11 +243,11 @@ fn product_note(app: &ShoalApp) -> Option<String> {
         RetrievalKind::Almi => "aLMI",
         RetrievalKind::Sambuca => "SAMBUCA",
     };
-    let missing = match (app.state.retrieval, app.state.product) {
-        (RetrievalKind::Almi, ProductKind::Depth | ProductKind::Substrate) => true,
-        (RetrievalKind::Sambuca, ProductKind::SiopSet) => true,
-        _ => false,
-    };
+    let missing = matches!(
+        (app.state.retrieval, app.state.product),
+        (RetrievalKind::Almi, ProductKind::Depth | ProductKind::Substrate)
+            | (RetrievalKind::Sambuca, ProductKind::SiopSet)
+    );
     missing.then(|| {
         let product = app.state.product.label().split(" (").next().unwrap_or_default();
         format!("{retrieval} does not retrieve the {product}: A and B have no map of it.")
