@@ -80,7 +80,7 @@ pub fn product_map(out: &RunOutput, kind: ProductKind, band: usize, truth: bool)
             })
         }
         ProductKind::Rrs => {
-            let cube = if truth { &r.rrs } else { &out.correction.rrs.rrs };
+            let cube = if truth { &r.rrs_above } else { &out.correction.rrs.rrs };
             let values = cube.index_axis(ndarray::Axis(2), band).to_owned();
             let flags = &out.correction.rrs.flags;
             let valid =

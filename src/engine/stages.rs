@@ -257,7 +257,7 @@ impl Engine {
             let fail = failed(Stage::Correction);
             let approximation = SceneApproximation::new(
                 &radiance.radiance,
-                &radiance.rrs,
+                &radiance.rrs_above,
                 band_atmosphere,
                 &radiance.land,
                 config.correction.approx_points,
@@ -289,7 +289,7 @@ impl Engine {
                     return Err(EngineError::Failed { stage: Stage::Correction, message: "no correction ran".into() });
                 }
             };
-            let rrs_vs_truth = if diagnostics { compare(&rrs, &radiance.rrs, None) } else { Vec::new() };
+            let rrs_vs_truth = if diagnostics { compare(&rrs, &radiance.rrs_above, None) } else { Vec::new() };
             Ok(CorrectionProduct { rrs, approximation, approximation_vs_exact, rrs_vs_truth })
         })?;
         report.approximation = Some(correction.approximation.clone());

@@ -138,8 +138,9 @@ impl BandAtmosphere {
 pub struct RadianceCube {
     /// Band radiance at the entrance pupil, W m⁻² sr⁻¹ nm⁻¹, (row, column, band).
     pub radiance: Array3<f32>,
-    /// True band Rrs, sr⁻¹ (0 on land), (row, column, band).
-    pub rrs: Array3<f32>,
+    /// True band remote-sensing reflectance above the surface, Rrs(0+), sr⁻¹ (0 on land),
+    /// (row, column, band). (The water model's `rrs` is below the surface, rrs(0−).)
+    pub rrs_above: Array3<f32>,
     /// True chlorophyll-a at the pixel centre, mg m⁻³.
     pub chl_mg_m3: Array2<f32>,
     /// True NAP, g m⁻³.
@@ -279,7 +280,7 @@ pub fn sample_radiance(
     let bad = |e: ndarray::ShapeError| InstrumentError::Invalid { field: "cube".into(), message: e.to_string() };
     let mut out = RadianceCube {
         radiance: cube(radiance).map_err(bad)?,
-        rrs: cube(rrs_truth).map_err(bad)?,
+        rrs_above: cube(rrs_truth).map_err(bad)?,
         chl_mg_m3: plane(0),
         nap_g_m3: plane(1),
         cdom_per_m: plane(2),

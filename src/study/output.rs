@@ -101,7 +101,7 @@ pub fn write_run(out: &RunOutput, dir: &Path) -> Result<Outputs, StudyError> {
     npy(dir, "rrs.npy", &out.correction.rrs.rrs, &mut o)?;
     npy(dir, "rrs_flags.npy", &out.correction.rrs.flags, &mut o)?;
     npy(dir, "pupil_radiance.npy", &r.radiance, &mut o)?;
-    npy(dir, "truth_rrs.npy", &r.rrs, &mut o)?;
+    npy(dir, "truth_rrs.npy", &r.rrs_above, &mut o)?;
     npy(dir, "truth_chl_mg_m3.npy", &r.chl_mg_m3, &mut o)?;
     npy(dir, "truth_nap_g_m3.npy", &r.nap_g_m3, &mut o)?;
     npy(dir, "truth_cdom_per_m.npy", &r.cdom_per_m, &mut o)?;

@@ -52,7 +52,7 @@ fn noise_free_level1_returns_pupil_radiance_and_rrs() {
         // Exact correction: within-band covariance of order S·π·Rrs·var(Rrs)/Rrs² (module docs)
         // plus f32 rounding amplified by L_TOA/Lw; 1e-4 is the target.
         let land = &rad.land;
-        let rrs = max_rel(&out.correction.rrs.rrs, &rad.rrs, |r, c, _| land[[r, c]] != 0, 1e-5);
+        let rrs = max_rel(&out.correction.rrs.rrs, &rad.rrs_above, |r, c, _| land[[r, c]] != 0, 1e-5);
         assert!(rrs < 1e-4, "{instrument} over {}: exact AC vs truth {rrs:e}", config.scene.name);
         // No water pixel is flagged.
         for ((r, c, _), f) in out.correction.rrs.flags.indexed_iter() {

@@ -70,10 +70,10 @@ pub struct Degraded {
 pub fn check(out: &RunOutput, case: &str) -> Degraded {
     let c = &out.config;
     let rad = &out.radiance;
-    for (name, v) in [("radiance", &rad.radiance), ("true Rrs", &rad.rrs)] {
+    for (name, v) in [("radiance", &rad.radiance), ("true Rrs", &rad.rrs_above)] {
         assert!(v.iter().all(|x| x.is_finite() && *x >= 0.0), "{case}: {name} not finite or negative");
     }
-    for ((r, col, _), x) in rad.rrs.indexed_iter() {
+    for ((r, col, _), x) in rad.rrs_above.indexed_iter() {
         if rad.land[[r, col]] == 0 {
             assert!(f64::from(*x) <= RRS_MAX, "{case}: true Rrs {x} above 1/π");
         }
