@@ -19,6 +19,8 @@ use shoal::ranges::{self, Range};
 use shoal::retrieval::RetrievalSpec;
 use shoal::scene::{Effect, MapSpec, SceneSpec};
 
+use crate::common::{both_retrievals, instrument_for, sweep_path};
+
 /// Inputs that do not change a run's output, and why. Everything else must.
 const NO_EFFECT: &[(&str, &str)] = &[
     ("requirements.", "a study's pass/fail threshold: read after the runs, never by a stage"),
@@ -33,14 +35,7 @@ fn documented(what: &str) -> Option<&'static str> {
 
 /// The base configuration for a field: every path of the range table exists in it.
 fn base(path: &str) -> RunConfig {
-    let name = if path.contains("Spectrograph") {
-        "hyperspectral"
-    } else if path.contains("FilterImager") {
-        "filter_imager"
-    } else {
-        "cubesat"
-    };
-    let mut instrument = InstrumentSpec::preset(name).unwrap();
+    let mut instrument = InstrumentSpec::preset(instrument_for(path)).unwrap();
     instrument.detectors = 16;
     instrument.exposures = 12;
     // A dark current and fixed patterns, so that the dark frames and their exposure matter.
@@ -65,7 +60,7 @@ fn base(path: &str) -> RunConfig {
         }
     }
     let mut c = RunConfig::new(scene, instrument);
-    c.retrievals = vec![ron::from_str::<RetrievalSpec>("Almi()").unwrap(), ron::from_str("Sambuca()").unwrap()];
+    c.retrievals = both_retrievals();
     c.calibration.sun_incidence_deg = Some(30.0);
     // Coarse LUT nodes keep each run short; they are inputs like any other.
     c.fidelity.lut_wavelength_step_nm = 40.0;
@@ -174,8 +169,7 @@ fn set(config: &RunConfig, path: &str, value: f64) -> RunConfig {
         "scene.depth_m" => c.scene.depth_m = Some(m),
         "scene.substrates[i].fraction" => c.scene.substrates[0].fraction = m,
         _ => {
-            let index = if path.contains("Sambuca") { ".1" } else { ".0" };
-            c = shoal::sweep::apply(config, &[(&path.replace("[i]", index), value)]).unwrap();
+            c = shoal::sweep::apply(config, &[(&sweep_path(path), value)]).unwrap();
         }
     }
     c
@@ -185,7 +179,7 @@ fn set(config: &RunConfig, path: &str, value: f64) -> RunConfig {
 fn current(config: &RunConfig, path: &str) -> f64 {
     let tree = serde_json::to_value(config).unwrap();
     let mut node = &tree;
-    for key in path.replace("[i]", if path.contains("Sambuca") { ".1" } else { ".0" }).split('.') {
+    for key in sweep_path(path).split('.') {
         node = match node {
             serde_json::Value::Array(items) => &items[key.parse::<usize>().unwrap()],
             other => match other.get(key) {

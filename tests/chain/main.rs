@@ -7,6 +7,8 @@ mod bad_input;
 mod cli;
 mod closure;
 mod coherence;
+#[path = "../common/mod.rs"]
+mod common;
 mod determinism;
 mod incremental;
 mod noise;

@@ -8,6 +8,8 @@
 
 mod atmosphere;
 mod chain;
+#[path = "../common/mod.rs"]
+mod common;
 mod faults;
 mod loaders;
 mod properties;

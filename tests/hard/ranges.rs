@@ -8,32 +8,21 @@ use std::process::Command;
 use shoal::engine::{EngineError, RunConfig};
 use shoal::instrument::InstrumentSpec;
 use shoal::ranges::{self, Range};
-use shoal::retrieval::RetrievalSpec;
 use shoal::scene::{MapSpec, Scene, SceneSpec};
 use shoal::study::Requirements;
+
+use crate::common::{both_retrievals, instrument_for, sweep_path};
 
 /// A configuration in which every path of the table exists: both retrievals, a sun incidence,
 /// a wind-roughened surface; a spectrograph or filter imager for their `kind` fields.
 fn base(path: &str) -> RunConfig {
-    let name = if path.contains("Spectrograph") {
-        "hyperspectral"
-    } else if path.contains("FilterImager") {
-        "filter_imager"
-    } else {
-        "cubesat"
-    };
-    let mut c = RunConfig::new(SceneSpec::preset("lake_hume_bloom").unwrap(), InstrumentSpec::preset(name).unwrap());
-    c.retrievals = vec![ron::from_str::<RetrievalSpec>("Almi()").unwrap(), ron::from_str("Sambuca()").unwrap()];
+    let instrument = InstrumentSpec::preset(instrument_for(path)).unwrap();
+    let mut c = RunConfig::new(SceneSpec::preset("lake_hume_bloom").unwrap(), instrument);
+    c.retrievals = both_retrievals();
     c.calibration.sun_incidence_deg = Some(30.0);
     c.scene.atmosphere.surface = shoal::atmosphere::Surface::Wind { speed_m_s: 5.0 };
     c.validate().unwrap();
     c
-}
-
-/// The path as `sweep::apply` walks it (list index of the retrieval the path names).
-fn sweep_path(path: &str) -> String {
-    let index = if path.contains("Sambuca") { ".1" } else { ".0" };
-    path.replace("[i]", index)
 }
 
 /// The refusal of `value` at `range`, or `None` if it was accepted.
