@@ -57,10 +57,6 @@ pub fn fallback_requirements() -> Requirements {
     }
 }
 
-fn default_requirements() -> Requirements {
-    fallback_requirements()
-}
-
 /// One of the two instruments the app compares.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
 pub enum Ab {
@@ -151,7 +147,7 @@ pub struct AppState {
     /// Requirements: the study's, as `shoal study` checks them (the same [`Requirements::check_run`]).
     /// Saved as `product_requirements`: sessions from before this format kept MAE limits only,
     /// and are read with these defaults rather than refused.
-    #[serde(rename = "product_requirements", default = "default_requirements")]
+    #[serde(rename = "product_requirements", default = "fallback_requirements")]
     pub requirements: Requirements,
     /// Dark theme.
     pub dark: bool,

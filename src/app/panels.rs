@@ -437,26 +437,31 @@ fn requirements_editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
         for (variable, label) in
             [("chl_mg_m3", "chl-a"), ("nap_g_m3", "NAP"), ("cdom_per_m", "CDOM"), ("depth_m", "depth")]
         {
-            if r.for_variable(variable).is_none() {
-                r.products.push(crate::study::ProductRequirement {
-                    variable: variable.into(),
-                    mae_pct: None,
-                    bias_pct: None,
-                    returned_pct: None,
-                });
-            }
-            let Some(p) = r.products.iter_mut().find(|p| p.variable == variable) else { continue };
+            // Edit a copy; the study's list changes only when a limit does (a product with no
+            // limit left is dropped from it).
+            let before = r.for_variable(variable).cloned();
+            let mut p = before.clone().unwrap_or(crate::study::ProductRequirement {
+                variable: variable.into(),
+                mae_pct: None,
+                bias_pct: None,
+                returned_pct: None,
+            });
             ui.label(label);
             optional_limit(ui, &mut p.mae_pct, 20.0, &crate::ranges::REQUIREMENT_MAE_PCT);
             optional_limit(ui, &mut p.bias_pct, 10.0, &crate::ranges::REQUIREMENT_BIAS_PCT);
             optional_limit(ui, &mut p.returned_pct, 95.0, &crate::ranges::REQUIREMENT_RETURNED_PCT);
             ui.end_row();
+            if before.as_ref() != Some(&p) {
+                r.products.retain(|q| q.variable != variable);
+                if p.mae_pct.is_some() || p.bias_pct.is_some() || p.returned_pct.is_some() {
+                    r.products.push(p);
+                }
+            }
         }
         ui.label("SNR ≥");
         optional_limit(ui, &mut r.snr, 100.0, &crate::ranges::REQUIREMENT_SNR);
         ui.end_row();
     });
-    r.products.retain(|p| p.mae_pct.is_some() || p.bias_pct.is_some() || p.returned_pct.is_some());
 }
 
 /// A ticked limit with its value, clamped to the range's bounds; unticked: not checked.

@@ -81,14 +81,16 @@ pub enum AtmosphereError {
     Spectral(#[from] SpectralError),
 }
 
-/// `value` against `range`; the error names the field (its path below `scene.atmosphere.`),
-/// the value and the range.
+/// `value` against `range`; the error names the field (its path below `scene.atmosphere.` for a
+/// scene's atmosphere, below `atmosphere_run.` for `shoal atmosphere`'s own inputs), the value
+/// and the range.
 pub(crate) fn check(range: &crate::ranges::Range, value: f64) -> Result<(), AtmosphereError> {
     if range.contains(value) {
-        Ok(())
-    } else {
-        let field = range.field("scene.atmosphere.");
-        let field = field.strip_prefix("atmosphere_run.atmosphere.").unwrap_or(field).into();
-        Err(AtmosphereError::OutOfRange { field, value, allowed: range.allowed() })
+        return Ok(());
     }
+    let field = ["scene.atmosphere.", "atmosphere_run.atmosphere.", "atmosphere_run."]
+        .iter()
+        .find_map(|section| range.path.strip_prefix(section))
+        .unwrap_or(range.path);
+    Err(AtmosphereError::OutOfRange { field: field.into(), value, allowed: range.allowed() })
 }

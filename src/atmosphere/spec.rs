@@ -163,16 +163,8 @@ impl Geometry {
     /// zenith at most 85°, azimuth within ±360° ([`crate::ranges`]: `GEOMETRY_*`).
     pub fn validate(&self) -> Result<(), AtmosphereError> {
         use crate::ranges as r;
-        let in_degrees = |range: &crate::ranges::Range, rad: f64| {
-            // Degrees as the user wrote them: the radian round trip's last-digit noise removed.
-            let value = (rad.to_degrees() * 1e9).round() / 1e9;
-            if range.contains(value) {
-                Ok(())
-            } else {
-                let field = range.field("atmosphere_run.").into();
-                Err(AtmosphereError::OutOfRange { field, value, allowed: range.allowed() })
-            }
-        };
+        // Degrees as the user wrote them: the radian round trip's last-digit noise removed.
+        let in_degrees = |range: &crate::ranges::Range, rad: f64| check(range, (rad.to_degrees() * 1e9).round() / 1e9);
         in_degrees(&r::GEOMETRY_SUN_ZENITH_DEG, self.sun_zenith_rad)?;
         in_degrees(&r::GEOMETRY_VIEW_ZENITH_DEG, self.view_zenith_rad)?;
         in_degrees(&r::GEOMETRY_RELATIVE_AZIMUTH_DEG, self.relative_azimuth_rad)

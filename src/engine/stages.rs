@@ -122,6 +122,7 @@ impl Engine {
     ) -> Result<(Arc<RadianceCube>, Key), EngineError> {
         let instrument = &config.instrument;
         let fid = &config.fidelity;
+        let inputs = Inputs::of(config);
         let SceneSide { scene, response, viewing, optics, band_atmosphere, band_key, .. } = side;
         let band_key = *band_key;
         let spatial = scene.wants(Effect::SpatialResponse);
@@ -135,7 +136,7 @@ impl Engine {
             .after(band_key)
             .with(&kernel.offsets_m)
             .with(&kernel.weights)
-            .with(&Inputs::of(config).heading_deg)
+            .with(&inputs.heading_deg)
             .finish();
         let executed_before = self.executions(Stage::Radiance);
         let radiance = self.stage(radiance_key, report, control, || {
@@ -242,6 +243,7 @@ impl Engine {
         report: &mut RunReport,
     ) -> Result<(Arc<CorrectionProduct>, Key), EngineError> {
         let fid = &config.fidelity;
+        let inputs = Inputs::of(config);
         let (band_atmosphere, band_key, level1, level1_key) =
             (&side.band_atmosphere, side.band_key, &inst.level1, inst.level1_key);
         // Atmospheric correction.
@@ -250,8 +252,8 @@ impl Engine {
             .after(band_key)
             .after(radiance_key)
             .with(&config.correction)
-            .with(&Inputs::of(config).seed)
-            .with(&Inputs::of(config).decimation)
+            .with(&inputs.seed)
+            .with(&inputs.decimation)
             .finish();
         let correction = self.stage(correction_key, report, control, || {
             let fail = failed(Stage::Correction);
@@ -309,11 +311,11 @@ impl Engine {
         report: &mut RunReport,
     ) -> Result<(Arc<Vec<SnrRow>>, Vec<f64>), EngineError> {
         let (instrument, fid, response) = (&config.instrument, &config.fidelity, &side.response);
+        let inputs = Inputs::of(config);
         let (detector, detector_key) = (&inst.detector, inst.detector_key);
         let nb = response.n_bands();
         let typical = typical_radiance(&radiance.radiance, &radiance.land);
-        let snr_key =
-            KeyBuilder::new(Stage::Snr).after(detector_key).with(&typical).with(&Inputs::of(config).snr).finish();
+        let snr_key = KeyBuilder::new(Stage::Snr).after(detector_key).with(&typical).with(&inputs.snr).finish();
         let snr = self.stage(snr_key, report, control, || {
             // A preview measures on fewer detectors (the estimate's spread grows as √decimation).
             let n = instrument.detectors;

@@ -28,7 +28,7 @@
 
 use serde::Serialize;
 
-use super::plausibility::{Warning, assess, full_scale_e};
+use super::plausibility::{Warning, assess, full_scale_e, peak_signal_e};
 use super::{Detector, InstrumentSpec};
 
 /// Q below which the pixel, not the optics, sets the resolution (aliasing; Fiete 1999).
@@ -91,12 +91,7 @@ impl Feasibility {
             .enumerate()
             .map(|(b, (name, &centre_nm))| {
                 let lambda_um = centre_nm * 1e-3;
-                let peak_e = (0..detector.detectors())
-                    .map(|j| {
-                        detector.responsivity(j, b) * brightest_w_m2_sr_nm.get(b).copied().unwrap_or(0.0)
-                            + detector.dark_mean_e(j, b, detector.exposure_s())
-                    })
-                    .fold(0.0f64, f64::max);
+                let peak_e = peak_signal_e(detector, b, brightest_w_m2_sr_nm.get(b).copied().unwrap_or(0.0));
                 BandFeasibility {
                     band: name.clone(),
                     centre_nm,

@@ -100,16 +100,20 @@ pub fn assess(
     out
 }
 
+/// The largest signal of band `b` over every detector (PRNU included), electrons, at radiance
+/// `radiance_w_m2_sr_nm`: responsivity · L plus the dark signal of one exposure.
+#[must_use]
+pub fn peak_signal_e(detector: &Detector, b: usize, radiance_w_m2_sr_nm: f64) -> f64 {
+    (0..detector.detectors())
+        .map(|j| detector.responsivity(j, b) * radiance_w_m2_sr_nm + detector.dark_mean_e(j, b, detector.exposure_s()))
+        .fold(0.0f64, f64::max)
+}
+
 /// The worst band's peak signal against full scale, over every detector (PRNU included).
 fn saturation(detector: &Detector, bands: &[String], brightest: &[f64]) -> Option<Warning> {
     let full = full_scale_e(detector);
-    let detectors = detector.detectors();
-    let peak_e = |b: usize| {
-        (0..detectors)
-            .map(|j| detector.responsivity(j, b) * brightest[b] + detector.dark_mean_e(j, b, detector.exposure_s()))
-            .fold(0.0f64, f64::max)
-    };
-    let peaks: Vec<f64> = (0..brightest.len().min(detector.n_bands())).map(peak_e).collect();
+    let peaks: Vec<f64> =
+        (0..brightest.len().min(detector.n_bands())).map(|b| peak_signal_e(detector, b, brightest[b])).collect();
     let over: Vec<usize> = (0..peaks.len()).filter(|&b| peaks[b] >= full).collect();
     let worst = (0..peaks.len()).max_by(|&a, &b| peaks[a].total_cmp(&peaks[b]))?;
     if over.is_empty() {
