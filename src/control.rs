@@ -21,6 +21,8 @@ use rayon::prelude::*;
 pub trait Cancellable {
     /// The cancellation error.
     fn cancelled() -> Self;
+    /// Is this error the cancellation (not a failure to report)?
+    fn is_cancelled(&self) -> bool;
 }
 
 /// Output buffers the executor splits into rows: one `&mut [T]`, or a tuple of them (row `r` of

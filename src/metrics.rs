@@ -17,7 +17,7 @@
 
 use serde::Serialize;
 
-use crate::instrument::RadianceCube;
+use crate::instrument::Truth;
 use crate::retrieval::{Product, ProductFlags};
 
 /// The metrics of one product.
@@ -210,7 +210,7 @@ impl ProductMetrics {
 
 /// Score `product` against the `truth` under the same pixels.
 #[must_use]
-pub fn evaluate(product: &Product, truth: &RadianceCube) -> ProductMetrics {
+pub fn evaluate(product: &Product, truth: &Truth) -> ProductMetrics {
     let (rows, cols) = product.flags.dim();
     let water: Vec<(usize, usize)> =
         (0..rows).flat_map(|r| (0..cols).map(move |c| (r, c))).filter(|&(r, c)| truth.land[[r, c]] == 0).collect();

@@ -58,6 +58,28 @@ fn last_key(s: &str) -> Option<String> {
     found
 }
 
+/// A field with an invalid value: the field's path and what is wrong and allowed. Every stage's
+/// error carries it as its `Invalid` variant, so a message reads the same wherever it comes from.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{field}: {message}")]
+pub struct FieldError {
+    /// The field (`aperture_mm`, `maps.depth_m`).
+    pub field: String,
+    /// What is wrong and what is allowed.
+    pub message: String,
+}
+
+/// A file that does not parse: its name and the parser's message (line, column, field, from
+/// [`describe`]). Every loader's error carries it as its `Parse` variant.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{origin}: {message}")]
+pub struct ParseError {
+    /// File name.
+    pub origin: String,
+    /// Parser message (line, column, field).
+    pub message: String,
+}
+
 /// A type read from RON files and shipped as built-in presets (`presets/FOLDER/NAME.ron`,
 /// embedded by [`crate::assets`]). Implementing it gives the type [`from_ron`], [`preset`] and
 /// [`preset_names`], with the same messages as every other preset kind: the file and line of a

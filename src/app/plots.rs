@@ -124,16 +124,7 @@ fn pairs(out: &RunOutput, variable: &str) -> Vec<(f64, f64)> {
     let Some(ret) = out.retrievals.first() else { return Vec::new() };
     let p = &ret.product;
     let r = &out.radiance;
-    let (truth, got) = match variable {
-        "chl_mg_m3" => (&r.chl_mg_m3, &p.chl_mg_m3),
-        "nap_g_m3" => (&r.nap_g_m3, &p.nap_g_m3),
-        "cdom_per_m" => (&r.cdom_per_m, &p.cdom_per_m),
-        "depth_m" => match (&r.depth_m, &p.depth_m) {
-            (Some(t), Some(g)) => (t, g),
-            _ => return Vec::new(),
-        },
-        _ => return Vec::new(),
-    };
+    let (Some(truth), Some(got)) = (out.radiance.truth.map(variable), p.map(variable)) else { return Vec::new() };
     // A strided sample of at most ~4000 pixels, visited directly: a frame never walks the whole
     // truth array (2 M pixels at full resolution).
     let cols = truth.ncols().max(1);
@@ -141,7 +132,7 @@ fn pairs(out: &RunOutput, variable: &str) -> Vec<(f64, f64)> {
     (0..truth.len())
         .step_by(step)
         .map(|k| (k / cols, k % cols))
-        .filter(|&(i, j)| r.land[[i, j]] == 0 && p.returned(i, j) && truth[[i, j]] > 0.0 && got[[i, j]] > 0.0)
+        .filter(|&(i, j)| r.truth.land[[i, j]] == 0 && p.returned(i, j) && truth[[i, j]] > 0.0 && got[[i, j]] > 0.0)
         .map(|(i, j)| (f64::from(truth[[i, j]]).log10(), f64::from(got[[i, j]]).log10()))
         .collect()
 }

@@ -27,7 +27,7 @@ pub struct MapData {
 #[must_use]
 pub fn product_map(out: &RunOutput, kind: ProductKind, band: usize, truth: bool) -> Option<MapData> {
     let r = &out.radiance;
-    let water = r.land.mapv(|l| l == 0);
+    let water = r.truth.land.mapv(|l| l == 0);
     let ret = out.retrievals.first();
     let returned = |p: &crate::retrieval::Product| Array2::from_shape_fn(p.flags.dim(), |(i, j)| p.returned(i, j));
     let product_or_truth =
@@ -46,13 +46,13 @@ pub fn product_map(out: &RunOutput, kind: ProductKind, band: usize, truth: bool)
     let nb = r.radiance.dim().2;
     let band = band.min(nb.saturating_sub(1));
     match kind {
-        ProductKind::Chl => product_or_truth(&r.chl_mg_m3, |p| Some(&p.chl_mg_m3)),
-        ProductKind::Nap => product_or_truth(&r.nap_g_m3, |p| Some(&p.nap_g_m3)),
-        ProductKind::Cdom => product_or_truth(&r.cdom_per_m, |p| Some(&p.cdom_per_m)),
-        ProductKind::Depth => product_or_truth(r.depth_m.as_ref()?, |p| p.depth_m.as_ref()),
+        ProductKind::Chl => product_or_truth(&r.truth.chl_mg_m3, |p| Some(&p.chl_mg_m3)),
+        ProductKind::Nap => product_or_truth(&r.truth.nap_g_m3, |p| Some(&p.nap_g_m3)),
+        ProductKind::Cdom => product_or_truth(&r.truth.cdom_per_m, |p| Some(&p.cdom_per_m)),
+        ProductKind::Depth => product_or_truth(r.truth.depth_m.as_ref()?, |p| p.depth_m.as_ref()),
         ProductKind::Substrate => {
             let (f, names) = if truth {
-                (r.substrate_fractions.as_ref()?, &r.substrate_names)
+                (r.truth.substrate_fractions.as_ref()?, &r.truth.substrate_names)
             } else {
                 let p = &ret?.product;
                 (p.substrate_fractions.as_ref()?, &p.substrate_names)
@@ -80,7 +80,7 @@ pub fn product_map(out: &RunOutput, kind: ProductKind, band: usize, truth: bool)
             })
         }
         ProductKind::Rrs => {
-            let cube = if truth { &r.rrs_above } else { &out.correction.rrs.rrs };
+            let cube = if truth { &r.truth.rrs_above } else { &out.correction.rrs.rrs };
             let values = cube.index_axis(ndarray::Axis(2), band).to_owned();
             let flags = &out.correction.rrs.flags;
             let valid =
@@ -153,7 +153,7 @@ pub fn difference(a: &MapData, a_out: &RunOutput, b: &MapData, b_out: &RunOutput
 /// retrieval unmixes that the scene does not have.
 #[must_use]
 pub fn substrate_classes(out: &RunOutput) -> Vec<String> {
-    let mut classes = out.radiance.substrate_names.clone();
+    let mut classes = out.radiance.truth.substrate_names.clone();
     for r in &out.retrievals {
         for n in &r.product.substrate_names {
             if !classes.contains(n) {

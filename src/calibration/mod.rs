@@ -27,7 +27,29 @@ use serde::{Deserialize, Serialize};
 
 use crate::control::RunControl;
 use crate::instrument::detector::{Detector, Stream, pixel_rng};
-use crate::instrument::{Flags, InstrumentError, Level0, Response, Viewing};
+use crate::instrument::{Flags, Level0, Response, Viewing};
+use crate::parse::FieldError;
+
+/// Errors from the calibration stage; each names the field and what is allowed.
+#[derive(Debug, thiserror::Error, Clone, PartialEq)]
+pub enum CalibrationError {
+    /// A setting or an input with an invalid value.
+    #[error(transparent)]
+    Invalid(#[from] FieldError),
+    /// The run was cancelled (a newer request superseded it).
+    #[error("cancelled")]
+    Cancelled,
+}
+
+impl crate::control::Cancellable for CalibrationError {
+    fn cancelled() -> Self {
+        Self::Cancelled
+    }
+
+    fn is_cancelled(&self) -> bool {
+        matches!(self, Self::Cancelled)
+    }
+}
 
 /// Calibration settings and injected systematic errors.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -69,10 +91,12 @@ impl Default for CalibrationSpec {
 
 impl CalibrationSpec {
     /// Check every number against [`crate::ranges`]; the message names field, value and range.
-    pub fn validate(&self) -> Result<(), InstrumentError> {
+    pub fn validate(&self) -> Result<(), CalibrationError> {
         use crate::ranges as r;
         let check = |range: &r::Range, v: f64| {
-            range.check(v).map_err(|message| InstrumentError::Invalid { field: range.path.into(), message })
+            range
+                .check(v)
+                .map_err(|message| CalibrationError::Invalid(FieldError { field: range.path.into(), message }))
         };
         check(&r::CALIBRATION_LIGHT_FRAMES, self.light_frames as f64)?;
         check(&r::CALIBRATION_DARK_FRAMES, self.dark_frames as f64)?;
@@ -131,7 +155,7 @@ impl Calibration {
         e0_band: &[f64],
         used: &[usize],
         seed: u64,
-    ) -> Result<Self, InstrumentError> {
+    ) -> Result<Self, CalibrationError> {
         spec.validate()?;
         let nb = detector.n_bands();
         let nd = e0_band.len() / nb.max(1);
@@ -230,7 +254,7 @@ pub fn calibrate(
     calibration: &Calibration,
     viewing: &Viewing,
     control: &RunControl,
-) -> Result<Level1, InstrumentError> {
+) -> Result<Level1, CalibrationError> {
     let (rows, cols, nb) = level0.dn.dim();
     let mut out = vec![0.0f32; rows * cols * nb];
     control.fill_rows(out.as_mut_slice(), rows, cols * nb, |at, row| {
@@ -242,11 +266,11 @@ pub fn calibrate(
                 row[c * nb + b] = calibration.radiance(j, b, level0.value(r, c, b)) as f32;
             }
         }
-        Ok::<_, InstrumentError>(())
+        Ok::<_, CalibrationError>(())
     })?;
     Ok(Level1 {
         radiance: Array3::from_shape_vec((rows, cols, nb), out)
-            .map_err(|e| InstrumentError::Invalid { field: "cube".into(), message: e.to_string() })?,
+            .map_err(|e| CalibrationError::Invalid(FieldError { field: "cube".into(), message: e.to_string() }))?,
         flags: level0.flags.clone(),
     })
 }

@@ -29,7 +29,29 @@ use serde::{Deserialize, Serialize};
 
 use crate::calibration::Level1;
 use crate::control::RunControl;
-use crate::instrument::{BandAtmosphere, Flags, InstrumentError};
+use crate::instrument::{BandAtmosphere, Flags};
+use crate::parse::FieldError;
+
+/// Errors from the atmospheric correction stage; each names the field and what is allowed.
+#[derive(Debug, thiserror::Error, Clone, PartialEq)]
+pub enum CorrectionError {
+    /// A setting or an input with an invalid value.
+    #[error(transparent)]
+    Invalid(#[from] FieldError),
+    /// The run was cancelled (a newer request superseded it).
+    #[error("cancelled")]
+    Cancelled,
+}
+
+impl crate::control::Cancellable for CorrectionError {
+    fn cancelled() -> Self {
+        Self::Cancelled
+    }
+
+    fn is_cancelled(&self) -> bool {
+        matches!(self, Self::Cancelled)
+    }
+}
 
 /// Flags of the Rrs product (per pixel and band).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -62,11 +84,11 @@ impl Default for CorrectionSpec {
 
 impl CorrectionSpec {
     /// Check `approx_points` against [`crate::ranges::CORRECTION_APPROX_POINTS`].
-    pub fn validate(&self) -> Result<(), InstrumentError> {
+    pub fn validate(&self) -> Result<(), CorrectionError> {
         let range = &crate::ranges::CORRECTION_APPROX_POINTS;
         range
             .check(self.approx_points as f64)
-            .map_err(|message| InstrumentError::Invalid { field: range.path.into(), message })
+            .map_err(|message| CorrectionError::Invalid(FieldError { field: range.path.into(), message }))
     }
 }
 
@@ -106,9 +128,10 @@ fn flag_for(level0_flags: u8, land: bool, value: f64) -> u8 {
 }
 
 /// The contiguous data of a standard-layout array.
-fn slice<T, D: ndarray::Dimension>(a: &ndarray::Array<T, D>) -> Result<&[T], InstrumentError> {
-    a.as_slice()
-        .ok_or_else(|| InstrumentError::Invalid { field: "cube".into(), message: "not in standard layout".into() })
+fn slice<T, D: ndarray::Dimension>(a: &ndarray::Array<T, D>) -> Result<&[T], CorrectionError> {
+    a.as_slice().ok_or_else(|| {
+        CorrectionError::Invalid(FieldError { field: "cube".into(), message: "not in standard layout".into() })
+    })
 }
 
 fn assemble(
@@ -117,8 +140,9 @@ fn assemble(
     nb: usize,
     rrs: Vec<f32>,
     flags: Vec<u8>,
-) -> Result<Reflectance, InstrumentError> {
-    let bad = |e: ndarray::ShapeError| InstrumentError::Invalid { field: "cube".into(), message: e.to_string() };
+) -> Result<Reflectance, CorrectionError> {
+    let bad =
+        |e: ndarray::ShapeError| CorrectionError::Invalid(FieldError { field: "cube".into(), message: e.to_string() });
     Ok(Reflectance {
         rrs: Array3::from_shape_vec((rows, cols, nb), rrs).map_err(bad)?,
         flags: Array3::from_shape_vec((rows, cols, nb), flags).map_err(bad)?,
@@ -131,7 +155,7 @@ pub fn correct_exact(
     atmosphere: &BandAtmosphere,
     land: &Array2<u8>,
     control: &RunControl,
-) -> Result<Reflectance, InstrumentError> {
+) -> Result<Reflectance, CorrectionError> {
     let (rows, cols, nb) = level1.radiance.dim();
     let (l1, l0_flags, land) = (slice(&level1.radiance)?, slice(&level1.flags)?, slice(land)?);
     let mut rrs = vec![0.0f32; rows * cols * nb];
@@ -153,7 +177,7 @@ pub fn correct_exact(
                 rrs_row[k] = if f & RrsFlags::INVALID != 0 { 0.0 } else { value as f32 };
             }
         }
-        Ok::<_, InstrumentError>(())
+        Ok::<_, CorrectionError>(())
     })?;
     assemble(rows, cols, nb, rrs, flags)
 }
@@ -168,14 +192,14 @@ impl SceneApproximation {
         land: &Array2<u8>,
         points: usize,
         seed: u64,
-    ) -> Result<Self, InstrumentError> {
+    ) -> Result<Self, CorrectionError> {
         let (rows, cols, nb) = toa_radiance.dim();
         let n_water = land.iter().filter(|&&l| l == 0).count();
         if n_water == 0 || points == 0 {
-            return Err(InstrumentError::Invalid {
+            return Err(CorrectionError::Invalid(FieldError {
                 field: "correction.approx_points".into(),
                 message: "the image holds no water pixel to sample (or approx_points is 0)".into(),
-            });
+            }));
         }
         // Distinct water pixels drawn uniformly: indices among the water pixels, then located.
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed ^ 0xA7C0_11EC);
@@ -216,7 +240,7 @@ impl SceneApproximation {
         level1: &Level1,
         land: &Array2<u8>,
         control: &RunControl,
-    ) -> Result<Reflectance, InstrumentError> {
+    ) -> Result<Reflectance, CorrectionError> {
         let (rows, cols, nb) = level1.radiance.dim();
         let (l1, l0_flags, land) = (slice(&level1.radiance)?, slice(&level1.flags)?, slice(land)?);
         let mut rrs = vec![0.0f32; rows * cols * nb];
@@ -236,7 +260,7 @@ impl SceneApproximation {
                     rrs_row[k] = if f & RrsFlags::INVALID != 0 { 0.0 } else { value as f32 };
                 }
             }
-            Ok::<_, InstrumentError>(())
+            Ok::<_, CorrectionError>(())
         })?;
         assemble(rows, cols, nb, rrs, flags)
     }

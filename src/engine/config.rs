@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 use crate::calibration::CalibrationSpec;
 use crate::correction::CorrectionSpec;
 use crate::instrument::{DetectorMode, InstrumentError, InstrumentSpec};
+use crate::parse::{FieldError, ParseError};
 use crate::retrieval::RetrievalSpec;
 use crate::scene::SceneSpec;
 
@@ -52,7 +53,7 @@ impl Fidelity {
     pub fn validate(&self) -> Result<(), InstrumentError> {
         use crate::ranges as r;
         let check = |range: &r::Range, v: f64| {
-            range.check(v).map_err(|message| InstrumentError::Invalid { field: range.path.into(), message })
+            range.check(v).map_err(|message| InstrumentError::Invalid(FieldError { field: range.path.into(), message }))
         };
         check(&r::FIDELITY_SPECTRAL_STEP_NM, self.spectral_step_nm)?;
         check(&r::FIDELITY_SPATIAL_SAMPLES_PER_GSD, self.spatial_samples_per_gsd as f64)?;
@@ -142,13 +143,14 @@ impl RunConfig {
 
     /// Parse RON; `origin` names the file in errors.
     pub fn from_ron(text: &str, origin: &str) -> Result<Self, InstrumentError> {
-        ron::from_str(text)
-            .map_err(|e| InstrumentError::Parse { origin: origin.into(), message: crate::parse::describe(text, &e) })
+        ron::from_str(text).map_err(|e| {
+            InstrumentError::Parse(ParseError { origin: origin.into(), message: crate::parse::describe(text, &e) })
+        })
     }
 
     /// Pretty RON (the resolved configuration written beside outputs).
     pub fn to_ron(&self) -> Result<String, InstrumentError> {
         ron::ser::to_string_pretty(self, ron::ser::PrettyConfig::default().struct_names(true))
-            .map_err(|e| InstrumentError::Invalid { field: "config".into(), message: e.to_string() })
+            .map_err(|e| InstrumentError::Invalid(FieldError { field: "config".into(), message: e.to_string() }))
     }
 }

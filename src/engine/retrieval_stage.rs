@@ -76,7 +76,7 @@ impl Engine {
             let inputs = RetrievalInputs {
                 rrs: &correction.rrs.rrs,
                 flags: &correction.rrs.flags,
-                land: &radiance.land,
+                land: &radiance.truth.land,
                 bands: bands.clone(),
                 geometry: geometry.clone(),
                 nedr: nedr.clone(),
@@ -86,7 +86,7 @@ impl Engine {
             };
             let result = self.stage(key, report, control, || {
                 let product = retrieve(spec, &inputs, control).map_err(fail)?;
-                let metrics = evaluate(&product, radiance);
+                let metrics = evaluate(&product, &radiance.truth);
                 Ok(RetrievalOutput {
                     spec: spec.clone(),
                     product,

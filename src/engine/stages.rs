@@ -12,22 +12,24 @@ use super::run::Engine;
 use super::{EngineError, RunConfig};
 use crate::atmosphere::{AtmosphereLut, LutAxes};
 use crate::calibration::{Calibration, band_e0, calibrate};
+use crate::control::Cancellable;
 use crate::control::RunControl;
 use crate::correction::{SceneApproximation, compare, correct_exact};
 use crate::instrument::feasibility::Feasibility;
 use crate::instrument::sample::BandAtmosphere;
 use crate::instrument::{
-    Detector, InstrumentError, RadianceCube, Response, SampleOptions, SnrRow, SpatialKernel, Viewing, analytic_snr,
-    digitise_cube, expose_cube, measured_snr, sample_radiance,
+    Detector, RadianceCube, Response, SampleOptions, SnrRow, SpatialKernel, Viewing, analytic_snr, digitise_cube,
+    expose_cube, measured_snr, sample_radiance,
 };
 use crate::scene::{Effect, Scene};
 use crate::toa::SceneOptics;
 use ndarray::Array3;
 
-fn failed(stage: Stage) -> impl Fn(InstrumentError) -> EngineError {
-    move |e| match e {
-        InstrumentError::Cancelled => EngineError::Cancelled,
-        other => EngineError::Failed { stage, message: other.to_string() },
+/// A stage's error as the engine reports it: cancellation stays cancellation, anything else
+/// names the stage.
+fn failed<E: Cancellable + std::fmt::Display>(stage: Stage) -> impl Fn(E) -> EngineError {
+    move |e| {
+        if e.is_cancelled() { EngineError::Cancelled } else { EngineError::Failed { stage, message: e.to_string() } }
     }
 }
 
@@ -150,7 +152,7 @@ impl Engine {
         }
         let (rows, cols, nb) = radiance.radiance.dim();
         report.shape = (rows, cols, nb);
-        report.truth_shares = radiance.truth_shares.clone();
+        report.truth_shares = radiance.truth.shares.clone();
 
         Ok((radiance, radiance_key))
     }
@@ -259,9 +261,9 @@ impl Engine {
             let fail = failed(Stage::Correction);
             let approximation = SceneApproximation::new(
                 &radiance.radiance,
-                &radiance.rrs_above,
+                &radiance.truth.rrs_above,
                 band_atmosphere,
-                &radiance.land,
+                &radiance.truth.land,
                 config.correction.approx_points,
                 config.seed,
             )
@@ -270,12 +272,12 @@ impl Engine {
             // against the exact correction, and both against the truth) come with full resolution.
             let diagnostics = fid.decimation == 1;
             let exact = if diagnostics || !config.correction.use_approximation {
-                Some(correct_exact(level1, band_atmosphere, &radiance.land, control).map_err(&fail)?)
+                Some(correct_exact(level1, band_atmosphere, &radiance.truth.land, control).map_err(&fail)?)
             } else {
                 None
             };
             let approx = if diagnostics || config.correction.use_approximation {
-                Some(approximation.correct(level1, &radiance.land, control).map_err(&fail)?)
+                Some(approximation.correct(level1, &radiance.truth.land, control).map_err(&fail)?)
             } else {
                 None
             };
@@ -291,7 +293,7 @@ impl Engine {
                     return Err(EngineError::Failed { stage: Stage::Correction, message: "no correction ran".into() });
                 }
             };
-            let rrs_vs_truth = if diagnostics { compare(&rrs, &radiance.rrs_above, None) } else { Vec::new() };
+            let rrs_vs_truth = if diagnostics { compare(&rrs, &radiance.truth.rrs_above, None) } else { Vec::new() };
             Ok(CorrectionProduct { rrs, approximation, approximation_vs_exact, rrs_vs_truth })
         })?;
         report.approximation = Some(correction.approximation.clone());
@@ -314,7 +316,7 @@ impl Engine {
         let inputs = Inputs::of(config);
         let (detector, detector_key) = (&inst.detector, inst.detector_key);
         let nb = response.n_bands();
-        let typical = typical_radiance(&radiance.radiance, &radiance.land);
+        let typical = typical_radiance(&radiance.radiance, &radiance.truth.land);
         let snr_key = KeyBuilder::new(Stage::Snr).after(detector_key).with(&typical).with(&inputs.snr).finish();
         let snr = self.stage(snr_key, report, control, || {
             // A preview measures on fewer detectors (the estimate's spread grows as √decimation).

@@ -19,6 +19,7 @@ use super::InstrumentError;
 use super::response::Response;
 use super::spec::{InstrumentSpec, ground_speed_m_s};
 use crate::atmosphere::Geometry;
+use crate::parse::FieldError;
 use crate::units::EARTH_RADIUS_M;
 
 /// One detector's line of sight in one geometry group.
@@ -77,10 +78,10 @@ impl Viewing {
     ) -> Result<Self, InstrumentError> {
         spec.validate()?;
         if decimation == 0 || decimation > 1000 {
-            return Err(InstrumentError::Invalid {
+            return Err(InstrumentError::Invalid(FieldError {
                 field: "decimation".into(),
                 message: format!("{decimation} is out of range (allowed: 1 to 1000)"),
-            });
+            }));
         }
         let h = spec.altitude_km * 1e3;
         let pitch_over_f = spec.pixel_pitch_um * 1e-6 / (spec.focal_length_mm * 1e-3);
@@ -101,14 +102,14 @@ impl Viewing {
             let gamma = (1.0 / norm).acos();
             let sin_vza = (EARTH_RADIUS_M + h) / EARTH_RADIUS_M * gamma.sin();
             if !(sin_vza < MAX_VIEW_ZENITH_DEG.to_radians().sin()) {
-                return Err(InstrumentError::Invalid {
+                return Err(InstrumentError::Invalid(FieldError {
                     field: "detectors".into(),
                     message: format!(
                         "the swath edge is seen at a view zenith above {MAX_VIEW_ZENITH_DEG}° (off-nadir {:.1}°); reduce detectors, \
                          pixel pitch or forward tilt, or lengthen the focal length",
                         gamma.to_degrees()
                     ),
-                });
+                }));
             }
             let vza = sin_vza.asin();
             let s = EARTH_RADIUS_M * (vza - gamma);
@@ -199,12 +200,12 @@ impl Viewing {
         let keep_rows: Vec<usize> = (0..rows).filter(|&r| inside(self.ground_m(0, r, cols / 2))).collect();
         let keep_cols: Vec<usize> = (0..cols).filter(|&c| inside(self.ground_m(0, rows / 2, c))).collect();
         if keep_rows.is_empty() || keep_cols.is_empty() {
-            return Err(InstrumentError::Invalid {
+            return Err(InstrumentError::Invalid(FieldError {
                 field: "scene".into(),
                 message:
                     "the instrument's image does not overlap the scene (check forward_tilt_deg and the scene size)"
                         .into(),
-            });
+            }));
         }
         self.cropped = (rows - keep_rows.len(), cols - keep_cols.len());
         self.line_index = keep_rows.iter().map(|&r| self.line_index[r]).collect();

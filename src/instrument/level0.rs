@@ -10,6 +10,7 @@ use super::InstrumentError;
 use super::detector::{Detector, Stream, pixel_rng};
 use super::geometry::Viewing;
 use crate::control::RunControl;
+use crate::parse::FieldError;
 
 /// Level-0: raw counts with flags.
 #[derive(Debug, Clone, PartialEq)]
@@ -35,7 +36,7 @@ impl Level0 {
 }
 
 fn shape_error(e: ndarray::ShapeError) -> InstrumentError {
-    InstrumentError::Invalid { field: "cube".into(), message: e.to_string() }
+    InstrumentError::Invalid(FieldError { field: "cube".into(), message: e.to_string() })
 }
 
 /// Electrons collected by every pixel from `radiance` (row, column, band) at the nominal
@@ -50,9 +51,9 @@ pub fn expose_cube(
     let (rows, cols, nb) = radiance.dim();
     let t = detector.exposure_s();
     let input = radiance.as_standard_layout();
-    let input = input
-        .as_slice()
-        .ok_or_else(|| InstrumentError::Invalid { field: "cube".into(), message: "not contiguous".into() })?;
+    let input = input.as_slice().ok_or_else(|| {
+        InstrumentError::Invalid(FieldError { field: "cube".into(), message: "not contiguous".into() })
+    })?;
     let mut out = vec![0.0f32; rows * cols * nb];
     control.fill_rows(out.as_mut_slice(), rows, cols * nb, |at, row| {
         let r = at.index();
@@ -81,9 +82,9 @@ pub fn digitise_cube(
 ) -> Result<Level0, InstrumentError> {
     let (rows, cols, nb) = electrons.dim();
     let input = electrons.as_standard_layout();
-    let input = input
-        .as_slice()
-        .ok_or_else(|| InstrumentError::Invalid { field: "cube".into(), message: "not contiguous".into() })?;
+    let input = input.as_slice().ok_or_else(|| {
+        InstrumentError::Invalid(FieldError { field: "cube".into(), message: "not contiguous".into() })
+    })?;
     let keep_analog = !detector.mode().quantise;
     let n = rows * cols * nb;
     let mut dn = vec![0u16; n];

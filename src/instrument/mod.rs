@@ -11,6 +11,7 @@
 //! | detector | [`detector`] | photo-electrons, shot/dark/read noise, PRNU/DSNU, full well, ADC |
 //! | Level-0 | [`level0`] | the whole image exposed and read out, with flags |
 //! | plausibility | [`plausibility`] | saturation at the brightest water, smear, f-number warnings |
+//! | truth | [`truth`] | the scene's values under every pixel, scored against by the metrics |
 //! | truth shares | [`shares`] | depth bins and substrate shares of the water pixels seen |
 //! | SNR | [`snr`] | analytic SNR and SNR measured on a simulated uniform patch |
 //!
@@ -37,6 +38,7 @@ pub mod shares;
 pub mod snr;
 pub mod spatial;
 pub mod spec;
+pub mod truth;
 
 pub use detector::{Detector, DetectorMode, Flags};
 pub use geometry::{Look, Viewing};
@@ -46,7 +48,9 @@ pub use sample::{BandAtmosphere, RadianceCube, SampleOptions, sample_radiance};
 pub use snr::{SnrRow, analytic_snr, measured_snr};
 pub use spatial::SpatialKernel;
 pub use spec::{InstrumentKind, InstrumentSpec, ground_speed_m_s};
+pub use truth::Truth;
 
+use crate::parse::{FieldError, ParseError};
 use crate::scene::SceneError;
 use crate::spectral::SpectralError;
 
@@ -54,21 +58,11 @@ use crate::spectral::SpectralError;
 #[derive(Debug, thiserror::Error, Clone, PartialEq)]
 pub enum InstrumentError {
     /// A field with an invalid value.
-    #[error("{field}: {message}")]
-    Invalid {
-        /// The field (`aperture_mm`).
-        field: String,
-        /// What is wrong and what is allowed.
-        message: String,
-    },
-    /// An instrument file that does not parse.
-    #[error("{origin}: {message}")]
-    Parse {
-        /// File name.
-        origin: String,
-        /// Parser message (line, column, field).
-        message: String,
-    },
+    #[error(transparent)]
+    Invalid(#[from] FieldError),
+    /// A file that does not parse.
+    #[error(transparent)]
+    Parse(#[from] ParseError),
     /// From the spectral layer (bands, QE curve).
     #[error(transparent)]
     Spectral(#[from] SpectralError),
@@ -83,5 +77,9 @@ pub enum InstrumentError {
 impl crate::control::Cancellable for InstrumentError {
     fn cancelled() -> Self {
         Self::Cancelled
+    }
+
+    fn is_cancelled(&self) -> bool {
+        matches!(self, Self::Cancelled)
     }
 }

@@ -11,6 +11,7 @@ use std::ops::Range;
 
 use super::InstrumentError;
 use super::spec::{InstrumentKind, InstrumentSpec};
+use crate::parse::FieldError;
 use crate::spectral::{Band, BandAverager, BandSet, Extrapolation, GaussianBand, Spectrum, WavelengthGrid};
 use crate::units::photon_energy_j;
 
@@ -104,10 +105,10 @@ impl Response {
                 let grid = support_grid(&supports, margin, step_nm)?;
                 let qe = qe_source.sample(&grid, Extrapolation::Clamp, None)?;
                 if let Some(q) = qe.iter().find(|q| !(q.is_finite() && (0.0..=1.0).contains(*q))) {
-                    return Err(InstrumentError::Invalid {
+                    return Err(InstrumentError::Invalid(FieldError {
                         field: "quantum_efficiency".into(),
                         message: format!("value {q} is outside 0 to 1"),
-                    });
+                    }));
                 }
                 let weights = (0..n_classes)
                     .map(|c| {
@@ -203,13 +204,13 @@ fn support_grid(supports: &[(f64, f64)], margin_nm: f64, step_nm: f64) -> Result
         let (a, b) = (((lo - margin_nm) / step_nm).floor() as i64, ((hi + margin_nm) / step_nm).ceil() as i64);
         let (from, to) = ((a as f64) * step_nm, (b as f64) * step_nm);
         if from < MIN_SIMULATED_NM || to > MAX_SIMULATED_NM {
-            return Err(InstrumentError::Invalid {
+            return Err(InstrumentError::Invalid(FieldError {
                 field: "bands".into(),
                 message: format!(
                     "spectral responses span {lo:.1}–{hi:.1} nm, simulated over {from:.1}–{to:.1} nm with the \
                      grid's margin; Shoal simulates {MIN_SIMULATED_NM}–{MAX_SIMULATED_NM} nm (the atmospheric data)"
                 ),
-            });
+            }));
         }
         nodes.extend(a..=b);
     }

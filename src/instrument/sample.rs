@@ -17,6 +17,8 @@
 //! it is applied to the sampled band radiance by linear interpolation across detectors (the
 //! pixel-integrated radiance of box pixels), and not to the truth, so it shows as error.
 
+use std::sync::Arc;
+
 use ndarray::{Array2, Array3};
 use rayon::prelude::*;
 
@@ -24,7 +26,9 @@ use super::InstrumentError;
 use super::geometry::Viewing;
 use super::response::Response;
 use super::spatial::SpatialKernel;
+use super::truth::Truth;
 use crate::control::RunControl;
+use crate::parse::FieldError;
 use crate::scene::Scene;
 use crate::toa::{PathSpectrum, SceneOptics, Scratch, Surface};
 
@@ -138,23 +142,8 @@ impl BandAtmosphere {
 pub struct RadianceCube {
     /// Band radiance at the entrance pupil, W m⁻² sr⁻¹ nm⁻¹, (row, column, band).
     pub radiance: Array3<f32>,
-    /// True band remote-sensing reflectance above the surface, Rrs(0+), sr⁻¹ (0 on land),
-    /// (row, column, band). (The water model's `rrs` is below the surface, rrs(0−).)
-    pub rrs_above: Array3<f32>,
-    /// True chlorophyll-a at the pixel centre, mg m⁻³.
-    pub chl_mg_m3: Array2<f32>,
-    /// True NAP, g m⁻³.
-    pub nap_g_m3: Array2<f32>,
-    /// True CDOM absorption, m⁻¹.
-    pub cdom_per_m: Array2<f32>,
-    /// True depth, m (shallow scenes only).
-    pub depth_m: Option<Array2<f32>>,
-    /// True substrate fractions (row, column, substrate), normalised (shallow scenes only).
-    pub substrate_fractions: Option<Array3<f32>>,
-    /// Names of the substrates of `substrate_fractions`.
-    pub substrate_names: Vec<String>,
-    /// 1 where the pixel centre is land.
-    pub land: Array2<u8>,
+    /// The scene's truth under each pixel.
+    pub truth: Arc<Truth>,
     /// Water-model evaluations.
     pub water_evaluations: u64,
     /// Water-model evaluations that included the bottom term.
@@ -162,8 +151,6 @@ pub struct RadianceCube {
     /// Brightest band radiance over the water pixels (what the plausibility guard checks the
     /// detector's full scale against), W m⁻² sr⁻¹ nm⁻¹.
     pub brightest_water_w_m2_sr_nm: Vec<f64>,
-    /// The truth's depth and substrate shares over the water pixels.
-    pub truth_shares: super::shares::SceneShares,
 }
 
 /// Sample the scene through every pixel of `viewing`: `optics[g]` is the scene bound to group
@@ -274,33 +261,59 @@ pub fn sample_radiance(
         })
         .collect::<Result<Vec<_>, InstrumentError>>()?;
     apply_keystone(&mut radiance, cols, nb, &response.keystone_px, viewing.decimation);
-    let shape3 = (rows, cols, nb);
-    let cube = |v: Vec<f32>| Array3::from_shape_vec(shape3, v);
-    let plane = |k: usize| Array2::from_shape_fn((rows, cols), |(r, c)| maps[(r * cols + c) * 4 + k]);
-    let bad = |e: ndarray::ShapeError| InstrumentError::Invalid { field: "cube".into(), message: e.to_string() };
-    let mut out = RadianceCube {
-        radiance: cube(radiance).map_err(bad)?,
-        rrs_above: cube(rrs_truth).map_err(bad)?,
-        chl_mg_m3: plane(0),
-        nap_g_m3: plane(1),
-        cdom_per_m: plane(2),
-        depth_m: shallow.then(|| plane(3)),
-        substrate_fractions: if shallow {
-            Some(Array3::from_shape_vec((rows, cols, n_sub), fractions).map_err(bad)?)
-        } else {
-            None
-        },
-        land: Array2::from_shape_vec((rows, cols), land).map_err(bad)?,
-        substrate_names: scene.substrates.iter().map(|(n, _)| n.clone()).collect(),
+    let bad =
+        |e: ndarray::ShapeError| InstrumentError::Invalid(FieldError { field: "cube".into(), message: e.to_string() });
+    let radiance = Array3::from_shape_vec((rows, cols, nb), radiance).map_err(bad)?;
+    let truth = TruthBuffers { rrs: rrs_truth, maps, fractions, land }.into_truth(scene, (rows, cols, nb))?;
+    Ok(RadianceCube {
+        brightest_water_w_m2_sr_nm: super::plausibility::brightest_water(&radiance, &truth.land),
+        radiance,
+        truth: Arc::new(truth),
         water_evaluations: counters.iter().map(|c| c.0).sum(),
         bottom_evaluations: counters.iter().map(|c| c.1).sum(),
-        brightest_water_w_m2_sr_nm: Vec::new(),
-        truth_shares: super::shares::SceneShares::default(),
-    };
-    // Summaries of the cube, once per cube (runs that reuse it from the cache reuse them).
-    out.brightest_water_w_m2_sr_nm = super::plausibility::brightest_water(&out.radiance, &out.land);
-    out.truth_shares = super::shares::SceneShares::of(&out);
-    Ok(out)
+    })
+}
+
+/// The truth as the sampling loop writes it: flat row-major buffers.
+struct TruthBuffers {
+    /// Band Rrs(0+), (row, column, band).
+    rrs: Vec<f32>,
+    /// chl, NAP, CDOM, depth per pixel, (row, column, 4).
+    maps: Vec<f32>,
+    /// Substrate fractions, (row, column, substrate) when the scene is shallow.
+    fractions: Vec<f32>,
+    /// Land flags, (row, column).
+    land: Vec<u8>,
+}
+
+impl TruthBuffers {
+    /// Shape the buffers into a [`Truth`] and count its shares (once per cube: runs that reuse
+    /// the cube from the cache reuse them).
+    fn into_truth(self, scene: &Scene, (rows, cols, nb): (usize, usize, usize)) -> Result<Truth, InstrumentError> {
+        let bad = |e: ndarray::ShapeError| {
+            InstrumentError::Invalid(FieldError { field: "truth".into(), message: e.to_string() })
+        };
+        let shallow = scene.depth.is_some();
+        let maps = self.maps;
+        let plane = |k: usize| Array2::from_shape_fn((rows, cols), |(r, c)| maps[(r * cols + c) * 4 + k]);
+        let mut truth = Truth {
+            rrs_above: Array3::from_shape_vec((rows, cols, nb), self.rrs).map_err(bad)?,
+            chl_mg_m3: plane(0),
+            nap_g_m3: plane(1),
+            cdom_per_m: plane(2),
+            depth_m: shallow.then(|| plane(3)),
+            substrate_fractions: if shallow {
+                Some(Array3::from_shape_vec((rows, cols, scene.substrates.len()), self.fractions).map_err(bad)?)
+            } else {
+                None
+            },
+            land: Array2::from_shape_vec((rows, cols), self.land).map_err(bad)?,
+            substrate_names: scene.substrates.iter().map(|(n, _)| n.clone()).collect(),
+            shares: super::shares::SceneShares::default(),
+        };
+        truth.shares = super::shares::SceneShares::of(&truth);
+        Ok(truth)
+    }
 }
 
 /// The truth maps at scene point (x, y): chl, NAP, CDOM, depth into `maps`, the land flag, and

@@ -5,7 +5,7 @@
 
 use serde::Serialize;
 
-use super::RadianceCube;
+use super::truth::Truth;
 
 /// One 1-m depth bin.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -44,14 +44,14 @@ pub struct SceneShares {
 }
 
 impl SceneShares {
-    /// Count the shares of `cube`'s truth in one pass over its pixels (the radiance stage does it
+    /// Count the shares of `truth` in one pass over its pixels (the radiance stage does it
     /// once per cube; runs that reuse the cube reuse the count).
     #[must_use]
-    pub fn of(cube: &RadianceCube) -> Self {
-        let land = cube.land.as_slice().unwrap_or(&[]);
-        let depth = cube.depth_m.as_ref().and_then(|d| d.as_slice());
-        let fractions = cube.substrate_fractions.as_ref().and_then(|f| f.as_slice());
-        let n_sub = if fractions.is_some() { cube.substrate_names.len() } else { 0 };
+    pub fn of(truth: &Truth) -> Self {
+        let land = truth.land.as_slice().unwrap_or(&[]);
+        let depth = truth.depth_m.as_ref().and_then(|d| d.as_slice());
+        let fractions = truth.substrate_fractions.as_ref().and_then(|f| f.as_slice());
+        let n_sub = if fractions.is_some() { truth.substrate_names.len() } else { 0 };
         let water = land.iter().filter(|&&l| l == 0).count();
         let mut out = Self { water_pixels: water, ..Self::default() };
         if water == 0 {
@@ -94,7 +94,7 @@ impl SceneShares {
         let pct = |k: usize, of: usize| if of == 0 { 0.0 } else { 100.0 * k as f64 / of as f64 };
         out.substrates = (0..n_sub)
             .map(|s| SubstrateShare {
-                name: cube.substrate_names[s].clone(),
+                name: truth.substrate_names[s].clone(),
                 mean_fraction_pct: 100.0 * fraction_sum[s] / water as f64,
                 dominant_pct: pct(dominant_count[s], water),
             })

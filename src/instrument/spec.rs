@@ -4,6 +4,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::InstrumentError;
+use crate::parse::{FieldError, ParseError};
 use crate::spectral::{BandSetSpec, SpectrumSource};
 
 /// Which instrument model.
@@ -142,9 +143,9 @@ impl InstrumentSpec {
     pub fn validate(&self) -> Result<(), InstrumentError> {
         use crate::ranges as r;
         let check = |range: &r::Range, v: f64| {
-            range
-                .check(v)
-                .map_err(|message| InstrumentError::Invalid { field: range.field("instrument.").into(), message })
+            range.check(v).map_err(|message| {
+                InstrumentError::Invalid(FieldError { field: range.field("instrument.").into(), message })
+            })
         };
         let count = |n: usize| n as f64;
         check(&r::INSTRUMENT_ALTITUDE_KM, self.altitude_km)?;
@@ -175,16 +176,16 @@ impl InstrumentSpec {
             check(&r::SPECTROGRAPH_SMILE_NM, *smile_nm)?;
             check(&r::SPECTROGRAPH_KEYSTONE_PX, *keystone_px)?;
             if end_nm < start_nm {
-                return Err(InstrumentError::Invalid {
+                return Err(InstrumentError::Invalid(FieldError {
                     field: r::SPECTROGRAPH_END_NM.field("instrument.").into(),
                     message: format!("{end_nm} is below start_nm = {start_nm} (allowed: start_nm to 1000 nm)"),
-                });
+                }));
             }
             // Each band's Gaussian response is tabulated over centre ± 2.5 FWHM (Band::gaussian),
             // shifted by up to |smile|; it must lie where Shoal has atmospheric data.
             let reach = 2.5 * resolution_nm + smile_nm.abs();
             if end_nm + reach > crate::ranges::MAX_SIMULATED_NM {
-                return Err(InstrumentError::Invalid {
+                return Err(InstrumentError::Invalid(FieldError {
                     field: r::SPECTROGRAPH_END_NM.field("instrument.").into(),
                     message: format!(
                         "{end_nm} with resolution_nm = {resolution_nm} and smile_nm = {smile_nm} puts the last band's \
@@ -193,10 +194,10 @@ impl InstrumentSpec {
                         end_nm + reach,
                         crate::ranges::MAX_SIMULATED_NM
                     ),
-                });
+                }));
             }
             if start_nm - reach < crate::ranges::MIN_SIMULATED_NM {
-                return Err(InstrumentError::Invalid {
+                return Err(InstrumentError::Invalid(FieldError {
                     field: r::SPECTROGRAPH_START_NM.field("instrument.").into(),
                     message: format!(
                         "{start_nm} with resolution_nm = {resolution_nm} and smile_nm = {smile_nm} puts the first \
@@ -204,16 +205,16 @@ impl InstrumentSpec {
                         start_nm - reach,
                         crate::ranges::MIN_SIMULATED_NM
                     ),
-                });
+                }));
             }
             let samples = (end_nm - start_nm) / sampling_nm;
             if samples > 2000.0 {
-                return Err(InstrumentError::Invalid {
+                return Err(InstrumentError::Invalid(FieldError {
                     field: r::SPECTROGRAPH_SAMPLING_NM.field("instrument.").into(),
                     message: format!(
                         "{sampling_nm} gives {samples:.0} spectral samples from start_nm to end_nm (allowed: at most 2000)"
                     ),
-                });
+                }));
             }
         }
         if let InstrumentKind::FilterImager { rows_per_band, .. } = &self.kind {
@@ -270,12 +271,12 @@ impl crate::parse::Preset for InstrumentSpec {
     const FOLDER: &'static str = "instruments";
     type Error = InstrumentError;
     fn parse_error(origin: &str, message: String) -> InstrumentError {
-        InstrumentError::Parse { origin: origin.into(), message }
+        InstrumentError::Parse(ParseError { origin: origin.into(), message })
     }
     fn unknown(name: &str, known: &[String]) -> InstrumentError {
-        InstrumentError::Invalid {
+        InstrumentError::Invalid(FieldError {
             field: "instrument".into(),
             message: format!("no built-in instrument `{name}` (known: {})", known.join(", ")),
-        }
+        })
     }
 }

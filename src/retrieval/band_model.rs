@@ -20,6 +20,7 @@ use std::path::Path;
 
 use super::RetrievalError;
 use super::quadrature::gauss_rule;
+use crate::parse::FieldError;
 use crate::spectral::WavelengthGrid;
 use crate::water::{SiopSpec, SubstrateLibrary, SubstrateMix, fast_exp};
 
@@ -161,7 +162,10 @@ impl BandModel {
         nodes_per_band: usize,
     ) -> Result<Self, RetrievalError> {
         if bands.is_empty() {
-            return Err(RetrievalError::Invalid { field: "bands".into(), message: "no band to retrieve from".into() });
+            return Err(RetrievalError::Invalid(FieldError {
+                field: "bands".into(),
+                message: "no band to retrieve from".into(),
+            }));
         }
         let mut ranges = Vec::with_capacity(bands.len());
         let mut nodes = Vec::new();
@@ -169,10 +173,10 @@ impl BandModel {
         for b in bands {
             let (x, w) = gauss_rule(&b.wavelengths_nm, &b.weights, nodes_per_band);
             if x.is_empty() {
-                return Err(RetrievalError::Invalid {
+                return Err(RetrievalError::Invalid(FieldError {
                     field: format!("band {}", b.name),
                     message: "the band has no response".into(),
-                });
+                }));
             }
             let total: f64 = w.iter().sum();
             ranges.push(nodes.len()..nodes.len() + x.len());

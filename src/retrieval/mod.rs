@@ -32,6 +32,7 @@ pub use sambuca::{Objective, SambucaSettings, Starts};
 
 use serde::{Deserialize, Serialize};
 
+use crate::parse::FieldError;
 use crate::spectral::SpectralError;
 use crate::water::WaterError;
 
@@ -48,14 +49,9 @@ pub enum Mode {
 /// Errors from the retrievals; each names the field.
 #[derive(Debug, thiserror::Error, Clone, PartialEq)]
 pub enum RetrievalError {
-    /// A setting with an invalid value.
-    #[error("{field}: {message}")]
-    Invalid {
-        /// The field.
-        field: String,
-        /// What is wrong and what is allowed.
-        message: String,
-    },
+    /// A field with an invalid value.
+    #[error(transparent)]
+    Invalid(#[from] FieldError),
     /// From the water stage (SIOP sets, substrates).
     #[error(transparent)]
     Water(#[from] WaterError),
@@ -70,6 +66,10 @@ pub enum RetrievalError {
 impl crate::control::Cancellable for RetrievalError {
     fn cancelled() -> Self {
         Self::Cancelled
+    }
+
+    fn is_cancelled(&self) -> bool {
+        matches!(self, Self::Cancelled)
     }
 }
 

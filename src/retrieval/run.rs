@@ -17,6 +17,7 @@ use crate::control::RunControl;
 use crate::correction::RrsFlags;
 use crate::instrument::BandAtmosphere;
 use crate::instrument::Response;
+use crate::parse::FieldError;
 use crate::water::{SiopSource, SiopSpec, SubstrateLibrary, WaterGeometry};
 
 /// Which retrieval, with its settings, as a study file writes it.
@@ -63,14 +64,14 @@ impl RetrievalSpec {
         match self {
             Self::Almi { siop_sets, settings } => {
                 if siop_sets.is_empty() || siop_sets.len() > 64 {
-                    return Err(RetrievalError::Invalid {
+                    return Err(RetrievalError::Invalid(FieldError {
                         field: "siop_sets".into(),
                         message: format!("{} sets (allowed: 1 to 64)", siop_sets.len()),
-                    });
+                    }));
                 }
                 let check = |range: &r::Range, v: f64| {
                     let field = range.field("retrievals[i].Almi.").into();
-                    range.check(v).map_err(|message| RetrievalError::Invalid { field, message })
+                    range.check(v).map_err(|message| RetrievalError::Invalid(FieldError { field, message }))
                 };
                 check(&r::ALMI_G0, settings.g0)?;
                 check(&r::ALMI_G1, settings.g1)
@@ -140,6 +141,19 @@ impl Product {
     #[must_use]
     pub fn returned(&self, r: usize, c: usize) -> bool {
         self.flags[[r, c]] & ProductFlags::RETURNED != 0
+    }
+
+    /// The map of a scalar variable (`chl_mg_m3`, `nap_g_m3`, `cdom_per_m`, `depth_m`), if
+    /// this product has it (the same names as `instrument::Truth::map`).
+    #[must_use]
+    pub fn map(&self, variable: &str) -> Option<&Array2<f32>> {
+        match variable {
+            "chl_mg_m3" => Some(&self.chl_mg_m3),
+            "nap_g_m3" => Some(&self.nap_g_m3),
+            "cdom_per_m" => Some(&self.cdom_per_m),
+            "depth_m" => self.depth_m.as_ref(),
+            _ => None,
+        }
     }
 }
 
@@ -215,21 +229,23 @@ pub(super) fn retrieve_almi(
         Some(names) => names
             .iter()
             .map(|n| {
-                inputs.bands.iter().position(|b| &b.name == n).ok_or_else(|| RetrievalError::Invalid {
-                    field: "settings.bands".into(),
-                    message: format!(
-                        "no band `{n}` (this instrument has {})",
-                        inputs.bands.iter().map(|b| b.name.as_str()).collect::<Vec<_>>().join(", ")
-                    ),
+                inputs.bands.iter().position(|b| &b.name == n).ok_or_else(|| {
+                    RetrievalError::Invalid(FieldError {
+                        field: "settings.bands".into(),
+                        message: format!(
+                            "no band `{n}` (this instrument has {})",
+                            inputs.bands.iter().map(|b| b.name.as_str()).collect::<Vec<_>>().join(", ")
+                        ),
+                    })
                 })
             })
             .collect::<Result<_, _>>()?,
     };
     if used.len() < 3 || used.len() > super::almi::MAX_BANDS {
-        return Err(RetrievalError::Invalid {
+        return Err(RetrievalError::Invalid(FieldError {
             field: "settings.bands".into(),
             message: format!("{} bands (aLMI takes 3 to {})", used.len(), super::almi::MAX_BANDS),
-        });
+        }));
     }
     let bands: Vec<BandResponse> = used.iter().map(|&b| inputs.bands[b].clone()).collect();
     let library = SubstrateLibrary::embedded()?;
@@ -247,10 +263,10 @@ pub(super) fn retrieve_almi(
     // built-in set, or two files with one `name`) could not be told apart there.
     for (i, set) in sets.iter().enumerate() {
         if sets[..i].iter().any(|s| s.name == set.name) {
-            return Err(RetrievalError::Invalid {
+            return Err(RetrievalError::Invalid(FieldError {
                 field: "siop_sets".into(),
                 message: format!("two SIOP sets are called `{}`; give each set its own `name`", set.name),
-            });
+            }));
         }
     }
     let (rows, cols, nb) = inputs.rrs.dim();
@@ -314,15 +330,15 @@ fn validate_sambuca(settings: &SambucaSettings) -> Result<(), RetrievalError> {
         [("chl_mg_m3", b.chl_mg_m3), ("cdom_per_m", b.cdom_per_m), ("nap_g_m3", b.nap_g_m3), ("depth_m", b.depth_m)]
     {
         if !(lo.is_finite() && hi.is_finite() && lo > 0.0 && hi > lo) {
-            return Err(RetrievalError::Invalid {
+            return Err(RetrievalError::Invalid(FieldError {
                 field: format!("settings.bounds.{field}"),
                 message: format!("({lo}, {hi}): bounds must be finite with 0 < min < max"),
-            });
+            }));
         }
     }
     let check = |range: &crate::ranges::Range, v: f64| {
         let field = range.field("retrievals[i].Sambuca.").into();
-        range.check(v).map_err(|message| RetrievalError::Invalid { field, message })
+        range.check(v).map_err(|message| RetrievalError::Invalid(FieldError { field, message }))
     };
     check(&crate::ranges::SAMBUCA_NODES_PER_BAND, settings.nodes_per_band as f64)?;
     check(&crate::ranges::SAMBUCA_MAX_ITERATIONS, f64::from(settings.max_iterations))

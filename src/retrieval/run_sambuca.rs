@@ -11,6 +11,7 @@ use super::sambuca::{Observation, SambucaSettings, invert as sambuca_invert};
 use super::sambuca_reference::{self as reference, ReferenceModel};
 use crate::control::RunControl;
 use crate::correction::RrsFlags;
+use crate::parse::FieldError;
 use crate::water::{SiopSource, SubstrateLibrary, rrs_below_from_above};
 
 /// One SAMBUCA pixel as stored: (chl, cdom, nap, depth, q, pair, objective, sdi, iterations, flags).
@@ -51,10 +52,10 @@ pub(super) fn retrieve_sambuca(
     };
     let names: Vec<String> = substrates.map_or_else(|| inputs.scene_substrates.clone(), <[String]>::to_vec);
     if names.is_empty() {
-        return Err(RetrievalError::Invalid {
+        return Err(RetrievalError::Invalid(FieldError {
             field: "substrates".into(),
             message: "SAMBUCA needs at least one substrate".into(),
-        });
+        }));
     }
     let b = &settings.bounds;
     let library = SubstrateLibrary::embedded()?;

@@ -37,6 +37,7 @@ use std::path::Path;
 use super::RetrievalError;
 use super::band_model::BandResponse;
 use super::slsqp::{SlsqpOptions, SlsqpStatus, slsqp};
+use crate::parse::FieldError;
 use crate::spectral::WavelengthGrid;
 use crate::water::{SiopSpec, SubstrateLibrary, SubstrateMix};
 
@@ -133,7 +134,8 @@ impl ReferenceModel {
     /// does).
     pub fn new(spectra: ReferenceSpectra, filters: &[Vec<f64>]) -> Result<Self, RetrievalError> {
         let n = spectra.wavelengths_nm.len();
-        let invalid = |field: &str, message: String| RetrievalError::Invalid { field: field.into(), message };
+        let invalid =
+            |field: &str, message: String| RetrievalError::Invalid(FieldError { field: field.into(), message });
         for (name, v) in [
             ("a_w", &spectra.a_w),
             ("bb_w", &spectra.bb_w),
@@ -191,7 +193,10 @@ impl ReferenceModel {
         grid.sort_by(f64::total_cmp);
         grid.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
         if grid.is_empty() {
-            return Err(RetrievalError::Invalid { field: "bands".into(), message: "no band to retrieve from".into() });
+            return Err(RetrievalError::Invalid(FieldError {
+                field: "bands".into(),
+                message: "no band to retrieve from".into(),
+            }));
         }
         let wgrid = WavelengthGrid::from_wavelengths(grid.clone())?;
         let s = siop.resolve(&wgrid, siop_dir)?;

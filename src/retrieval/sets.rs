@@ -21,6 +21,7 @@ use rand::rngs::Xoshiro256PlusPlus;
 use rand::{RngExt, SeedableRng};
 
 use super::RetrievalError;
+use crate::parse::FieldError;
 use crate::spectral::Table;
 use crate::water::SiopSource;
 
@@ -130,10 +131,10 @@ pub fn kmeans(points: &[[f64; 5]], k: usize, restarts: usize, seed: u64) -> Vec<
 pub fn almi_clusters() -> Result<Vec<ClusterSiop>, RetrievalError> {
     let raw = station_features()?;
     if raw.len() < 8 {
-        return Err(RetrievalError::Invalid {
+        return Err(RetrievalError::Invalid(FieldError {
             field: "SIOP table".into(),
             message: format!("only {} valid stations", raw.len()),
-        });
+        }));
     }
     // Standardise each feature so none dominates the distance.
     let mut mean = [0.0; 5];

@@ -11,6 +11,7 @@ use serde::{Deserialize, Serialize};
 
 use super::SceneError;
 use super::grf::gaussian_random_field;
+use crate::parse::FieldError;
 
 /// The statistical distribution of a random field's values.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -165,7 +166,7 @@ fn finite(field: &str, v: f64) -> Result<(), SceneError> {
     if v.is_finite() {
         Ok(())
     } else {
-        Err(SceneError::Invalid { field: field.into(), message: format!("{v} is not a finite number") })
+        Err(SceneError::Invalid(FieldError { field: field.into(), message: format!("{v} is not a finite number") }))
     }
 }
 
@@ -190,7 +191,7 @@ impl Map {
                 Kind::Gradient { from: *from, to: *to, dir: (a.cos(), a.sin()) }
             }
             MapSpec::RandomField { distribution, correlation_m, seed, clamp } => {
-                let bad = |m: String| SceneError::Invalid { field: field.into(), message: m };
+                let bad = |m: String| SceneError::Invalid(FieldError { field: field.into(), message: m });
                 if !(correlation_m.is_finite() && *correlation_m > 0.0) {
                     return Err(bad(format!("correlation_m = {correlation_m} must be above 0")));
                 }
@@ -240,9 +241,11 @@ impl Map {
                     Some(d) if path.is_relative() => d.join(path),
                     _ => path.clone(),
                 };
-                let img = image::open(&full).map_err(|e| SceneError::Invalid {
-                    field: field.into(),
-                    message: format!("image file `{}`: {e}", full.display()),
+                let img = image::open(&full).map_err(|e| {
+                    SceneError::Invalid(FieldError {
+                        field: field.into(),
+                        message: format!("image file `{}`: {e}", full.display()),
+                    })
                 })?;
                 let grey = img.to_luma16();
                 let (iw, ih) = grey.dimensions();
@@ -348,7 +351,10 @@ fn validate_shape(field: &str, s: &Shape) -> Result<(), SceneError> {
         if v.is_finite() && v > 0.0 {
             Ok(())
         } else {
-            Err(SceneError::Invalid { field: format!("{field}: {name}"), message: format!("{v} must be above 0") })
+            Err(SceneError::Invalid(FieldError {
+                field: format!("{field}: {name}"),
+                message: format!("{v} must be above 0"),
+            }))
         }
     };
     match s {

@@ -19,6 +19,7 @@ pub use map::{Distribution, Extent, Map, MapSpec, Shape};
 pub use spec::{Effect, LandSpec, Scene, SceneSpec, SubstrateLayer, SunSpec, day_of_year};
 
 use crate::atmosphere::AtmosphereError;
+use crate::parse::{FieldError, ParseError};
 use crate::spectral::SpectralError;
 use crate::water::WaterError;
 
@@ -26,21 +27,11 @@ use crate::water::WaterError;
 #[derive(Debug, thiserror::Error, Clone, PartialEq)]
 pub enum SceneError {
     /// A field with an invalid value.
-    #[error("{field}: {message}")]
-    Invalid {
-        /// The field (`maps.depth_m`).
-        field: String,
-        /// What is wrong and what is allowed.
-        message: String,
-    },
-    /// A scene file that does not parse.
-    #[error("{origin}: {message}")]
-    Parse {
-        /// File name.
-        origin: String,
-        /// Parser message (line, column, field).
-        message: String,
-    },
+    #[error(transparent)]
+    Invalid(#[from] FieldError),
+    /// A file that does not parse.
+    #[error(transparent)]
+    Parse(#[from] ParseError),
     /// From the water stage (SIOP set, substrates).
     #[error(transparent)]
     Water(#[from] WaterError),

@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 use super::SceneError;
 use super::map::{Extent, Map, MapSpec};
 use crate::atmosphere::{AtmosphereSpec, Surface};
+use crate::parse::{FieldError, ParseError};
 use crate::spectral::SpectrumSource;
 use crate::water::SiopSource;
 
@@ -107,8 +108,12 @@ pub struct SceneSpec {
 
 /// Day of year of `YYYY-MM-DD`.
 pub fn day_of_year(date: &str) -> Result<u32, SceneError> {
-    let bad =
-        |m: &str| SceneError::Invalid { field: "date".into(), message: format!("`{date}`: {m} (expected YYYY-MM-DD)") };
+    let bad = |m: &str| {
+        SceneError::Invalid(FieldError {
+            field: "date".into(),
+            message: format!("`{date}`: {m} (expected YYYY-MM-DD)"),
+        })
+    };
     let parts: Vec<&str> = date.trim().split('-').collect();
     let [y, m, d] = parts.as_slice() else { return Err(bad("not a date")) };
     let num = |s: &str| s.parse::<u32>().map_err(|_| bad("not a date"));
@@ -149,9 +154,11 @@ impl SceneSpec {
     /// Check the numbers and that every effect has what it needs.
     pub fn validate(&self) -> Result<(), SceneError> {
         use crate::ranges as r;
-        let bad = |field: &str, message: String| Err(SceneError::Invalid { field: field.into(), message });
+        let bad = |field: &str, message: String| Err(SceneError::Invalid(FieldError { field: field.into(), message }));
         let check = |range: &r::Range, v: f64| {
-            range.check(v).map_err(|message| SceneError::Invalid { field: range.field("scene.").into(), message })
+            range
+                .check(v)
+                .map_err(|message| SceneError::Invalid(FieldError { field: range.field("scene.").into(), message }))
         };
         check(&r::SCENE_WIDTH, self.width as f64)?;
         check(&r::SCENE_HEIGHT, self.height as f64)?;
@@ -216,7 +223,7 @@ impl Scene {
         spec.atmosphere.day_of_year = day;
         spec.atmosphere
             .validate()
-            .map_err(|e| SceneError::Invalid { field: "atmosphere".into(), message: e.to_string() })?;
+            .map_err(|e| SceneError::Invalid(FieldError { field: "atmosphere".into(), message: e.to_string() }))?;
         let extent = Extent { width: spec.width, height: spec.height, cell_m: spec.cell_m };
         let map = |s: &MapSpec, field: &str| Map::build(s, extent, field, base_dir);
         let chl = map(&spec.chl_mg_m3, "chl_mg_m3")?;
@@ -262,10 +269,10 @@ impl Scene {
         let check = |field: &str, m: &Map, range: &r::Range| {
             let (a, b) = m.range();
             match [a, b].into_iter().find(|v| !range.contains(*v)) {
-                Some(v) => Err(SceneError::Invalid {
+                Some(v) => Err(SceneError::Invalid(FieldError {
                     field: field.into(),
                     message: format!("{v} is out of range (the map spans {a} to {b}; allowed: {})", range.allowed()),
-                }),
+                })),
                 None => Ok(()),
             }
         };
@@ -274,8 +281,8 @@ impl Scene {
         check("cdom_per_m", &self.cdom, &r::SCENE_CDOM_PER_M)?;
         if let Some(d) = &self.depth {
             check("depth_m", d, &r::SCENE_DEPTH_M).map_err(|e| match e {
-                SceneError::Invalid { field, message } if d.range().0 <= 0.0 => {
-                    SceneError::Invalid { field, message: format!("{message}; land belongs in `land`") }
+                SceneError::Invalid(FieldError { field, message }) if d.range().0 <= 0.0 => {
+                    SceneError::Invalid(FieldError { field, message: format!("{message}; land belongs in `land`") })
                 }
                 other => other,
             })?;
@@ -303,13 +310,13 @@ impl crate::parse::Preset for SceneSpec {
     const FOLDER: &'static str = "scenes";
     type Error = SceneError;
     fn parse_error(origin: &str, message: String) -> SceneError {
-        SceneError::Parse { origin: origin.into(), message }
+        SceneError::Parse(ParseError { origin: origin.into(), message })
     }
     fn unknown(name: &str, known: &[String]) -> SceneError {
-        SceneError::Invalid {
+        SceneError::Invalid(FieldError {
             field: "scene".into(),
             message: format!("no built-in scene `{name}` (known: {})", known.join(", ")),
-        }
+        })
     }
 }
 

@@ -17,6 +17,7 @@
 
 use crate::control::RunControl;
 use crate::engine::{Engine, EngineError, RunConfig};
+use crate::parse::FieldError;
 use crate::retrieval::RetrievalSpec;
 
 use super::StudyError;
@@ -114,10 +115,10 @@ fn mae(
             other => StudyError::Run { instrument: c.instrument.name.clone(), message: other.to_string() },
         })?;
         let Some(ret) = run.retrievals.first() else {
-            return Err(StudyError::Invalid {
+            return Err(StudyError::Invalid(FieldError {
                 field: "retrievals".into(),
                 message: "an error budget needs a retrieval".into(),
-            });
+            }));
         };
         for v in &ret.metrics.variables {
             match out.iter_mut().find(|(name, _)| *name == v.variable) {
@@ -146,7 +147,7 @@ pub fn error_budget(
     control: &RunControl,
 ) -> Result<Vec<Budget>, StudyError> {
     if seeds.is_empty() {
-        return Err(StudyError::Invalid { field: "seeds".into(), message: "at least one seed".into() });
+        return Err(StudyError::Invalid(FieldError { field: "seeds".into(), message: "at least one seed".into() }));
     }
     let mut engine = Engine::new();
     let full = mae(&mut engine, config, seeds, control)?;

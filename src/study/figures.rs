@@ -31,26 +31,6 @@ const VARIABLES: [Variable; 4] = [
     Variable { key: "depth_m", label: "depth (m)" },
 ];
 
-fn truth_map<'a>(run: &'a StudyRun, key: &str) -> Option<&'a Array2<f32>> {
-    match key {
-        "chl_mg_m3" => Some(&run.truth.chl_mg_m3),
-        "nap_g_m3" => Some(&run.truth.nap_g_m3),
-        "cdom_per_m" => Some(&run.truth.cdom_per_m),
-        "depth_m" => run.truth.depth_m.as_ref(),
-        _ => None,
-    }
-}
-
-fn product_map<'a>(p: &'a crate::retrieval::Product, key: &str) -> Option<&'a Array2<f32>> {
-    match key {
-        "chl_mg_m3" => Some(&p.chl_mg_m3),
-        "nap_g_m3" => Some(&p.nap_g_m3),
-        "cdom_per_m" => Some(&p.cdom_per_m),
-        "depth_m" => p.depth_m.as_ref(),
-        _ => None,
-    }
-}
-
 /// A map panel: values with a validity mask.
 /// One map of a figure: values and where they are valid (elsewhere grey).
 pub(super) struct Panel {
@@ -365,7 +345,7 @@ struct Context<'a> {
 /// One scale over the truth and every instrument's returned values (log for concentrations).
 fn shared_scale(runs: &[&StudyRun], index: usize, var: Variable) -> Option<Scale> {
     let first = runs.first()?;
-    let truth = truth_map(first, var.key)?;
+    let truth = first.truth.map(var.key)?;
     let mut values: Vec<f64> = truth
         .indexed_iter()
         .filter(|((r, c), _)| first.truth.land[[*r, *c]] == 0)
@@ -373,7 +353,7 @@ fn shared_scale(runs: &[&StudyRun], index: usize, var: Variable) -> Option<Scale
         .collect();
     for run in runs {
         if let Some(ret) = run.retrievals.get(index)
-            && let Some(map) = product_map(&ret.product, var.key)
+            && let Some(map) = ret.product.map(var.key)
         {
             values.extend(
                 map.indexed_iter().filter(|((r, c), _)| ret.product.returned(*r, *c)).map(|(_, v)| f64::from(*v)),
@@ -389,12 +369,12 @@ fn shared_scale(runs: &[&StudyRun], index: usize, var: Variable) -> Option<Scale
 
 fn maps_figure(ctx: &Context<'_>) -> Option<Maps> {
     let first = ctx.runs.first()?;
-    let truth = truth_map(first, ctx.var.key)?;
+    let truth = first.truth.map(ctx.var.key)?;
     let mut panels =
         vec![Panel { title: "truth".into(), values: truth.clone(), valid: first.truth.land.mapv(|l| l == 0) }];
     for run in ctx.runs {
         let Some(ret) = run.retrievals.get(ctx.index) else { continue };
-        let Some(map) = product_map(&ret.product, ctx.var.key) else { continue };
+        let Some(map) = ret.product.map(ctx.var.key) else { continue };
         panels.push(Panel {
             title: format!("{}: {}", run.label, metric_line(ret.metrics.get(ctx.var.key))),
             values: map.clone(),
@@ -430,8 +410,8 @@ fn scatter_and_histograms(ctx: &Context<'_>) -> Option<(Scatter, Histograms)> {
     let mut scatter_panels = Vec::new();
     let mut hist_panels = Vec::new();
     for run in ctx.runs {
-        let (Some(ret), Some(truth)) = (run.retrievals.get(ctx.index), truth_map(run, ctx.var.key)) else { continue };
-        let Some(map) = product_map(&ret.product, ctx.var.key) else { continue };
+        let (Some(ret), Some(truth)) = (run.retrievals.get(ctx.index), run.truth.map(ctx.var.key)) else { continue };
+        let Some(map) = ret.product.map(ctx.var.key) else { continue };
         let p = &ret.product;
         let water_returned = |r: usize, c: usize| run.truth.land[[r, c]] == 0 && p.returned(r, c);
         let pairs = map
@@ -490,7 +470,7 @@ pub fn figure_set(result: &StudyResult) -> Result<Vec<Figure>, StudyError> {
     let mut figures = Vec::new();
     for (index, ret0) in first.retrievals.iter().enumerate() {
         for var in VARIABLES {
-            if truth_map(first, var.key).is_none() || product_map(&ret0.product, var.key).is_none() {
+            if first.truth.map(var.key).is_none() || ret0.product.map(var.key).is_none() {
                 continue;
             }
             let Some(scale) = shared_scale(&runs, index, var) else { continue };

@@ -41,28 +41,19 @@ use crate::calibration::CalibrationSpec;
 use crate::correction::CorrectionSpec;
 use crate::engine::{Fidelity, RunConfig};
 use crate::instrument::{DetectorMode, InstrumentSpec};
+use crate::parse::{FieldError, ParseError};
 use crate::retrieval::RetrievalSpec;
 use crate::scene::SceneSpec;
 
 /// Errors of a study, each naming the field or file.
 #[derive(Debug, thiserror::Error, Clone, PartialEq)]
 pub enum StudyError {
-    /// A setting with an invalid value.
-    #[error("{field}: {message}")]
-    Invalid {
-        /// The field.
-        field: String,
-        /// What is wrong.
-        message: String,
-    },
+    /// A field with an invalid value.
+    #[error(transparent)]
+    Invalid(#[from] FieldError),
     /// A file that does not parse.
-    #[error("{origin}: {message}")]
-    Parse {
-        /// File name.
-        origin: String,
-        /// Parser message (line, column, field).
-        message: String,
-    },
+    #[error(transparent)]
+    Parse(#[from] ParseError),
     /// A run failed.
     #[error("{instrument}: {message}")]
     Run {
@@ -155,21 +146,22 @@ pub(crate) fn load<T: serde::de::DeserializeOwned + Clone>(
     field: &str,
 ) -> Result<(T, Option<PathBuf>), StudyError> {
     match source {
-        Source::Preset(name) => {
-            preset(name).map(|t| (t, None)).map_err(|m| StudyError::Invalid { field: field.into(), message: m })
-        }
+        Source::Preset(name) => preset(name)
+            .map(|t| (t, None))
+            .map_err(|m| StudyError::Invalid(FieldError { field: field.into(), message: m })),
         Source::File(path) => {
             let full = match dir {
                 Some(d) if path.is_relative() => d.join(path),
                 _ => path.clone(),
             };
-            let text = std::fs::read_to_string(&full).map_err(|e| StudyError::Invalid {
-                field: field.into(),
-                message: format!("{}: {e}", full.display()),
+            let text = std::fs::read_to_string(&full).map_err(|e| {
+                StudyError::Invalid(FieldError { field: field.into(), message: format!("{}: {e}", full.display()) })
             })?;
-            let value = ron::from_str(&text).map_err(|e| StudyError::Parse {
-                origin: full.display().to_string(),
-                message: crate::parse::describe(&text, &e),
+            let value = ron::from_str(&text).map_err(|e| {
+                StudyError::Parse(ParseError {
+                    origin: full.display().to_string(),
+                    message: crate::parse::describe(&text, &e),
+                })
             })?;
             Ok((value, full.parent().map(Path::to_path_buf)))
         }
@@ -202,16 +194,16 @@ impl StudySpec {
     /// Read the scene and instruments (`dir`: the study file's directory) and build the runs.
     pub fn resolve(&self, dir: Option<&Path>) -> Result<ResolvedStudy, StudyError> {
         if self.instruments.is_empty() || self.instruments.len() > 16 {
-            return Err(StudyError::Invalid {
+            return Err(StudyError::Invalid(FieldError {
                 field: "instruments".into(),
                 message: format!("{} (allowed: 1 to 16)", self.instruments.len()),
-            });
+            }));
         }
         if self.seeds.is_empty() || self.seeds.len() > 1000 {
-            return Err(StudyError::Invalid {
+            return Err(StudyError::Invalid(FieldError {
                 field: "seeds".into(),
                 message: format!("{} seeds (allowed: 1 to 1000)", self.seeds.len()),
-            });
+            }));
         }
         if let Some(r) = &self.requirements {
             r.validate()?;
@@ -226,9 +218,11 @@ impl StudySpec {
                 |n| InstrumentSpec::preset(n).map_err(|e| e.to_string()),
                 &format!("instruments[{i}]"),
             )?;
-            instrument.validate().map_err(|e| StudyError::Invalid {
-                field: format!("instruments[{i}] ({})", instrument.name),
-                message: e.to_string(),
+            instrument.validate().map_err(|e| {
+                StudyError::Invalid(FieldError {
+                    field: format!("instruments[{i}] ({})", instrument.name),
+                    message: e.to_string(),
+                })
             })?;
             let mut label = instrument.name.clone();
             if labels.contains(&label) {
@@ -263,12 +257,12 @@ impl crate::parse::Preset for StudySpec {
     const FOLDER: &'static str = "studies";
     type Error = StudyError;
     fn parse_error(origin: &str, message: String) -> StudyError {
-        StudyError::Parse { origin: origin.into(), message }
+        StudyError::Parse(ParseError { origin: origin.into(), message })
     }
     fn unknown(name: &str, known: &[String]) -> StudyError {
-        StudyError::Invalid {
+        StudyError::Invalid(FieldError {
             field: "study".into(),
             message: format!("no built-in study `{name}` (known: {})", known.join(", ")),
-        }
+        })
     }
 }

@@ -94,13 +94,13 @@ pub fn snr_csv(out: &RunOutput) -> String {
 pub fn write_run(out: &RunOutput, dir: &Path) -> Result<Outputs, StudyError> {
     std::fs::create_dir_all(dir).map_err(|e| StudyError::Io(format!("cannot create {}: {e}", dir.display())))?;
     let mut o = Outputs::default();
-    let r = &out.radiance;
+    let r = &out.radiance.truth;
     npy(dir, "level0_dn.npy", &out.level0.dn, &mut o)?;
     npy(dir, "level0_flags.npy", &out.level0.flags, &mut o)?;
     npy(dir, "level1_radiance.npy", &out.level1.radiance, &mut o)?;
     npy(dir, "rrs.npy", &out.correction.rrs.rrs, &mut o)?;
     npy(dir, "rrs_flags.npy", &out.correction.rrs.flags, &mut o)?;
-    npy(dir, "pupil_radiance.npy", &r.radiance, &mut o)?;
+    npy(dir, "pupil_radiance.npy", &out.radiance.radiance, &mut o)?;
     npy(dir, "truth_rrs.npy", &r.rrs_above, &mut o)?;
     npy(dir, "truth_chl_mg_m3.npy", &r.chl_mg_m3, &mut o)?;
     npy(dir, "truth_nap_g_m3.npy", &r.nap_g_m3, &mut o)?;

@@ -12,6 +12,7 @@ use plotters::prelude::*;
 use super::render::{Draw, FONT, Figure, Placed, err, render, tick_label};
 use super::{StudyError, StudyResult, StudyRun, StudySpec};
 use crate::colormap::viridis;
+use crate::parse::FieldError;
 use crate::retrieval::{Mode, RetrievalSpec};
 
 /// The built-in studies reproduced.
@@ -28,9 +29,11 @@ pub const SHALLOW_START_DEPTH_M: (f64, f64) = (0.1, 7.0);
 /// [`SHALLOW_START_DEPTH_M`] (index 2).
 pub fn both_modes(name: &str) -> Result<StudySpec, StudyError> {
     let mut spec = StudySpec::preset(name)?;
-    let first = spec.retrievals.first().cloned().ok_or_else(|| StudyError::Invalid {
-        field: "retrievals".into(),
-        message: format!("the study `{name}` has no retrieval"),
+    let first = spec.retrievals.first().cloned().ok_or_else(|| {
+        StudyError::Invalid(FieldError {
+            field: "retrievals".into(),
+            message: format!("the study `{name}` has no retrieval"),
+        })
     })?;
     let with_mode = |mode: Mode| {
         let mut r = first.clone();
@@ -92,9 +95,11 @@ pub struct Numbers {
 }
 
 fn run<'a>(result: &'a StudyResult, label: &str) -> Result<&'a StudyRun, StudyError> {
-    result.runs.iter().find(|r| r.label == label).ok_or_else(|| StudyError::Invalid {
-        field: "instruments".into(),
-        message: format!("the reproduction needs a `{label}` run"),
+    result.runs.iter().find(|r| r.label == label).ok_or_else(|| {
+        StudyError::Invalid(FieldError {
+            field: "instruments".into(),
+            message: format!("the reproduction needs a `{label}` run"),
+        })
     })
 }
 

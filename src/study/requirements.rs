@@ -19,6 +19,7 @@ use serde::{Deserialize, Serialize};
 use super::{StudyError, StudyResult};
 use crate::instrument::SnrRow;
 use crate::metrics::ProductMetrics;
+use crate::parse::FieldError;
 
 /// Limits on one variable (`None`: not required).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -97,7 +98,7 @@ pub fn verdict<'a>(checks: impl IntoIterator<Item = &'a Check>) -> Option<bool> 
 impl Requirements {
     /// Every number positive and finite, every variable known.
     pub fn validate(&self) -> Result<(), StudyError> {
-        let bad = |field: String, message: String| Err(StudyError::Invalid { field, message });
+        let bad = |field: String, message: String| Err(StudyError::Invalid(FieldError { field, message }));
         for (i, p) in self.products.iter().enumerate() {
             if !["chl_mg_m3", "nap_g_m3", "cdom_per_m", "depth_m"].contains(&p.variable.as_str()) {
                 return bad(

@@ -3,31 +3,10 @@
 
 use std::sync::Arc;
 
-use ndarray::{Array2, Array3};
-
 use super::{ResolvedStudy, StudyError};
 use crate::control::RunControl;
 use crate::engine::{Engine, EngineError, RetrievalOutput, RunOutput, RunReport};
-use crate::instrument::SnrRow;
-
-/// The truth under each pixel of a run (the small 2-D maps; the cubes stay with the run).
-#[derive(Debug, Clone, PartialEq)]
-pub struct Truth {
-    /// Chlorophyll-a, mg m⁻³.
-    pub chl_mg_m3: Array2<f32>,
-    /// NAP, g m⁻³.
-    pub nap_g_m3: Array2<f32>,
-    /// CDOM, m⁻¹.
-    pub cdom_per_m: Array2<f32>,
-    /// Depth, m (shallow scenes).
-    pub depth_m: Option<Array2<f32>>,
-    /// Substrate fractions (shallow scenes).
-    pub substrate_fractions: Option<Array3<f32>>,
-    /// Substrate names.
-    pub substrate_names: Vec<String>,
-    /// Land mask.
-    pub land: Array2<u8>,
-}
+use crate::instrument::{SnrRow, Truth};
 
 /// One run of a study, kept for its tables and figures.
 #[derive(Debug, Clone)]
@@ -43,7 +22,7 @@ pub struct StudyRun {
     /// Retrieval products and metrics.
     pub retrievals: Vec<Arc<RetrievalOutput>>,
     /// The truth maps.
-    pub truth: Truth,
+    pub truth: Arc<Truth>,
 }
 
 /// All runs of a study.
@@ -73,22 +52,13 @@ pub fn run_study(
             other => StudyError::Run { instrument: label.clone(), message: other.to_string() },
         })?;
         on_run(i, &out)?;
-        let r = &out.radiance;
         runs.push(StudyRun {
             label: label.clone(),
             seed: *seed,
             report: out.report.clone(),
             snr: out.snr.clone(),
             retrievals: out.retrievals.clone(),
-            truth: Truth {
-                chl_mg_m3: r.chl_mg_m3.clone(),
-                nap_g_m3: r.nap_g_m3.clone(),
-                cdom_per_m: r.cdom_per_m.clone(),
-                depth_m: r.depth_m.clone(),
-                substrate_fractions: r.substrate_fractions.clone(),
-                substrate_names: out.scene.substrates.iter().map(|(n, _)| n.clone()).collect(),
-                land: r.land.clone(),
-            },
+            truth: Arc::clone(&out.radiance.truth),
         });
     }
     Ok(StudyResult { study: study.clone(), runs })

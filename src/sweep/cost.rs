@@ -11,6 +11,7 @@ use std::time::Instant;
 
 use crate::control::RunControl;
 use crate::engine::{Engine, EngineError, RunConfig, RunOutput};
+use crate::parse::FieldError;
 use crate::study::StudyError;
 
 use super::apply;
@@ -118,7 +119,7 @@ fn per_pixel(out: &RunOutput, reference: &RunOutput) -> (Option<f64>, Option<f64
                     chl.push((x / y - 1.0).abs());
                 }
             }
-            if out.radiance.land[[r, c]] == 0 {
+            if out.radiance.truth.land[[r, c]] == 0 {
                 let (x, y) = (
                     f64::from(out.correction.rrs.rrs[[r, c, band]]),
                     f64::from(reference.correction.rrs.rrs[[r, c, band]]),
@@ -142,8 +143,8 @@ pub fn cost_of_accuracy(
     let mut rows = Vec::new();
     let mut reference: Option<(RunOutput, f64)> = None;
     for setting in settings(base.fidelity.decimation) {
-        let config =
-            apply(base, &setting.set).map_err(|m| StudyError::Invalid { field: setting.label.clone(), message: m })?;
+        let config = apply(base, &setting.set)
+            .map_err(|m| StudyError::Invalid(FieldError { field: setting.label.clone(), message: m }))?;
         let mut engine = Engine::new();
         let start = Instant::now();
         let run = engine.run(&config, control).map_err(|e| match e {

@@ -36,6 +36,7 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use crate::engine::RunConfig;
+use crate::parse::{FieldError, ParseError};
 use crate::study::{Source, StudyError, StudySpec};
 
 /// The values a parameter takes.
@@ -60,7 +61,7 @@ pub enum Values {
 impl Values {
     /// The values, checked (finite; a range has 2–200 steps and positive ends when `log`).
     pub fn resolve(&self, field: &str) -> Result<Vec<f64>, StudyError> {
-        let bad = |message: String| StudyError::Invalid { field: field.into(), message };
+        let bad = |message: String| StudyError::Invalid(FieldError { field: field.into(), message });
         let v = match self {
             Self::List(v) => {
                 if v.is_empty() || v.len() > 200 {
@@ -176,24 +177,24 @@ impl SweepSpec {
     /// instrument's configuration, and lay out the runs.
     pub fn resolve(&self, dir: Option<&Path>) -> Result<ResolvedSweep, StudyError> {
         if self.parameters.is_empty() || self.parameters.len() > 2 {
-            return Err(StudyError::Invalid {
+            return Err(StudyError::Invalid(FieldError {
                 field: "parameters".into(),
                 message: format!("{} (allowed: 1, or 2 for a grid)", self.parameters.len()),
-            });
+            }));
         }
         if self.seeds.is_empty() || self.seeds.len() > 1000 {
-            return Err(StudyError::Invalid {
+            return Err(StudyError::Invalid(FieldError {
                 field: "seeds".into(),
                 message: format!("{} seeds (allowed: 1 to 1000)", self.seeds.len()),
-            });
+            }));
         }
         if let Some(r) = &self.requirement
             && !(r.mae_pct > 0.0 && r.mae_pct.is_finite())
         {
-            return Err(StudyError::Invalid {
+            return Err(StudyError::Invalid(FieldError {
                 field: "requirement.mae_pct".into(),
                 message: format!("{} (allowed: a positive number of percent)", r.mae_pct),
-            });
+            }));
         }
         let (mut study, study_dir) =
             crate::study::load(&self.study, dir, |n| StudySpec::preset(n).map_err(|e| e.to_string()), "study")?;
@@ -209,9 +210,11 @@ impl SweepSpec {
         // Every parameter must name a number in every instrument's configuration.
         for (i, p) in self.parameters.iter().enumerate() {
             for (label, base) in &bases {
-                apply(base, &[(p.path.as_str(), axes[i][0])]).map_err(|m| StudyError::Invalid {
-                    field: format!("parameters[{i}].path"),
-                    message: format!("{label}: {m}"),
+                apply(base, &[(p.path.as_str(), axes[i][0])]).map_err(|m| {
+                    StudyError::Invalid(FieldError {
+                        field: format!("parameters[{i}].path"),
+                        message: format!("{label}: {m}"),
+                    })
                 })?;
             }
         }
@@ -225,18 +228,19 @@ impl SweepSpec {
         for values in &points {
             let settings: Vec<(&str, f64)> = paths.iter().copied().zip(values.iter().copied()).collect();
             for (label, base) in &bases {
-                let config = apply(base, &settings).map_err(|m| StudyError::Invalid {
-                    field: "parameters".into(),
-                    message: format!("{label}: {m}"),
+                let config = apply(base, &settings).map_err(|m| {
+                    StudyError::Invalid(FieldError { field: "parameters".into(), message: format!("{label}: {m}") })
                 })?;
                 let checked = config
                     .instrument
                     .validate()
                     .map_err(|e| e.to_string())
                     .and_then(|()| config.scene.validate().map_err(|e| e.to_string()));
-                checked.map_err(|e| StudyError::Invalid {
-                    field: "parameters".into(),
-                    message: format!("{label} at {settings:?}: {e}"),
+                checked.map_err(|e| {
+                    StudyError::Invalid(FieldError {
+                        field: "parameters".into(),
+                        message: format!("{label} at {settings:?}: {e}"),
+                    })
                 })?;
             }
         }
@@ -287,13 +291,13 @@ impl crate::parse::Preset for SweepSpec {
     const FOLDER: &'static str = "sweeps";
     type Error = StudyError;
     fn parse_error(origin: &str, message: String) -> StudyError {
-        StudyError::Parse { origin: origin.into(), message }
+        StudyError::Parse(ParseError { origin: origin.into(), message })
     }
     fn unknown(name: &str, known: &[String]) -> StudyError {
-        StudyError::Invalid {
+        StudyError::Invalid(FieldError {
             field: "sweep".into(),
             message: format!("no built-in sweep `{name}` (known: {})", known.join(", ")),
-        }
+        })
     }
 }
 

@@ -2,6 +2,7 @@
 
 use crate::control::RunControl;
 use crate::engine::{Engine, EngineError};
+use crate::parse::FieldError;
 use crate::study::StudyError;
 
 use super::table::{Row, Table};
@@ -60,8 +61,8 @@ pub fn run_job(
     let paths: Vec<&str> = sweep.spec.parameters.iter().map(|p| p.path.as_str()).collect();
     let (label, base) = &sweep.bases[job.instrument];
     let settings: Vec<(&str, f64)> = paths.iter().copied().zip(job.values.iter().copied()).collect();
-    let mut config =
-        apply(base, &settings).map_err(|m| StudyError::Invalid { field: "parameters".into(), message: m })?;
+    let mut config = apply(base, &settings)
+        .map_err(|m| StudyError::Invalid(FieldError { field: "parameters".into(), message: m }))?;
     config.seed = job.seed;
     let start = std::time::Instant::now();
     let out = engine.run(&config, control).map_err(|e| match e {

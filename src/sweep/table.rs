@@ -4,6 +4,7 @@
 //! form, rows in run order, so the same runs always give the same bytes — which is what lets
 //! `shoal merge` prove that n shards equal one run.
 
+use crate::parse::{FieldError, ParseError};
 use crate::study::StudyError;
 
 /// One row: a run's metrics for one variable of one retrieval.
@@ -79,8 +80,9 @@ impl Table {
 
     /// Read a table written by [`Table::to_csv`]; `origin` names it in errors.
     pub fn from_csv(text: &str, origin: &str) -> Result<Self, StudyError> {
-        let bad =
-            |line: usize, m: String| StudyError::Parse { origin: origin.into(), message: format!("line {line}: {m}") };
+        let bad = |line: usize, m: String| {
+            StudyError::Parse(ParseError { origin: origin.into(), message: format!("line {line}: {m}") })
+        };
         let mut lines = text.lines().enumerate();
         let (_, head) = lines.next().ok_or_else(|| bad(1, "empty file".into()))?;
         let fields: Vec<&str> = head.trim_start_matches("# sweep ").split(" | ").collect();
@@ -145,18 +147,18 @@ impl Table {
 /// Join shard tables into the whole sweep's table. Refuses tables of different sweeps, runs
 /// present twice, and missing runs (naming the first few).
 pub fn merge(parts: &[Table]) -> Result<Table, StudyError> {
-    let first = parts
-        .first()
-        .ok_or_else(|| StudyError::Invalid { field: "tables".into(), message: "nothing to merge".into() })?;
+    let first = parts.first().ok_or_else(|| {
+        StudyError::Invalid(FieldError { field: "tables".into(), message: "nothing to merge".into() })
+    })?;
     for p in parts {
         if p.key != first.key || p.name != first.name || p.jobs != first.jobs || p.parameters != first.parameters {
-            return Err(StudyError::Invalid {
+            return Err(StudyError::Invalid(FieldError {
                 field: "tables".into(),
                 message: format!(
                     "`{}` (key {}) and `{}` (key {}) are different sweeps",
                     first.name, first.key, p.name, p.key
                 ),
-            });
+            }));
         }
     }
     let mut owner: Vec<Option<usize>> = vec![None; first.jobs];
@@ -164,15 +166,17 @@ pub fn merge(parts: &[Table]) -> Result<Table, StudyError> {
         let mut jobs: Vec<usize> = p.rows.iter().map(|r| r.job).collect();
         jobs.dedup();
         for j in jobs {
-            let slot = owner.get_mut(j).ok_or_else(|| StudyError::Invalid {
-                field: "tables".into(),
-                message: format!("run {j} is outside the sweep's {} runs", first.jobs),
+            let slot = owner.get_mut(j).ok_or_else(|| {
+                StudyError::Invalid(FieldError {
+                    field: "tables".into(),
+                    message: format!("run {j} is outside the sweep's {} runs", first.jobs),
+                })
             })?;
             if let Some(other) = slot {
-                return Err(StudyError::Invalid {
+                return Err(StudyError::Invalid(FieldError {
                     field: "tables".into(),
                     message: format!("run {j} is in table {other} and table {t}"),
-                });
+                }));
             }
             *slot = Some(t);
         }
@@ -180,7 +184,7 @@ pub fn merge(parts: &[Table]) -> Result<Table, StudyError> {
     let missing: Vec<usize> = owner.iter().enumerate().filter(|(_, o)| o.is_none()).map(|(j, _)| j).collect();
     if !missing.is_empty() {
         let shown: Vec<String> = missing.iter().take(8).map(ToString::to_string).collect();
-        return Err(StudyError::Invalid {
+        return Err(StudyError::Invalid(FieldError {
             field: "tables".into(),
             message: format!(
                 "{} of {} runs missing (runs {}{})",
@@ -189,7 +193,7 @@ pub fn merge(parts: &[Table]) -> Result<Table, StudyError> {
                 shown.join(", "),
                 if missing.len() > 8 { ", …" } else { "" }
             ),
-        });
+        }));
     }
     let mut rows: Vec<Row> = parts.iter().flat_map(|p| p.rows.iter().cloned()).collect();
     // Stable: rows of one run keep their order.

@@ -24,6 +24,7 @@ pub mod adjacency;
 use std::sync::Arc;
 
 use crate::atmosphere::{AtmosphereError, AtmosphereLut, Geometry};
+use crate::parse::FieldError;
 use crate::scene::{Effect, Scene, SceneError};
 use crate::spectral::{Extrapolation, WavelengthGrid};
 use crate::water::{Bottom, SubstrateLibrary, SubstrateMix, WaterColumn, WaterGeometry, WaterModel};
@@ -225,10 +226,10 @@ impl SceneOptics {
         let n = self.grid.len();
         let surface = if scene.is_land(x_m, y_m) {
             let Some(rho) = &self.land else {
-                return Err(SceneError::Invalid {
+                return Err(SceneError::Invalid(FieldError {
                     field: "land".into(),
                     message: "land mask without reflectance".into(),
-                });
+                }));
             };
             for i in 0..n {
                 let lw = rho[i] * path.ed[i] / (std::f64::consts::PI * (1.0 - path.spherical_albedo[i] * rho[i]));

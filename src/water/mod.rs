@@ -41,6 +41,7 @@ pub use model::{
 pub use siop::{Siop, SiopSource, SiopSpec};
 pub use substrate::{SubstrateEntry, SubstrateLibrary, SubstrateMix};
 
+use crate::parse::ParseError;
 use crate::spectral::SpectralError;
 
 /// Errors from the water stage; each names the field and the allowed range.
@@ -76,14 +77,9 @@ pub enum WaterError {
         /// What went wrong.
         message: String,
     },
-    /// A RON file that does not parse.
-    #[error("{origin}: {message}")]
-    Parse {
-        /// File name.
-        origin: String,
-        /// Parser message (line, column, field).
-        message: String,
-    },
+    /// A file that does not parse.
+    #[error(transparent)]
+    Parse(#[from] ParseError),
     /// An error from the spectral layer.
     #[error(transparent)]
     Spectral(#[from] SpectralError),

@@ -7,6 +7,7 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use super::WaterError;
+use crate::parse::ParseError;
 use crate::spectral::{Extrapolation, SpectrumSource, WavelengthGrid};
 
 fn default_refractive_index() -> f64 {
@@ -54,8 +55,9 @@ impl SiopSpec {
 
     /// Read a SIOP set from a RON file.
     pub fn from_file(path: &Path) -> Result<Self, WaterError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| WaterError::Parse { origin: path.display().to_string(), message: e.to_string() })?;
+        let text = std::fs::read_to_string(path).map_err(|e| {
+            WaterError::Parse(ParseError { origin: path.display().to_string(), message: e.to_string() })
+        })?;
         Self::from_ron(&text, &path.display().to_string())
     }
 
@@ -255,8 +257,9 @@ impl SiopSpec {
     pub fn from_csv_columns(path: &Path) -> Result<Self, WaterError> {
         let table = crate::spectral::Table::from_file(path)?;
         // Absolute, so that resolving the set never joins a base directory to it again.
-        let path = &std::fs::canonicalize(path)
-            .map_err(|e| WaterError::Parse { origin: path.display().to_string(), message: e.to_string() })?;
+        let path = &std::fs::canonicalize(path).map_err(|e| {
+            WaterError::Parse(ParseError { origin: path.display().to_string(), message: e.to_string() })
+        })?;
         let mut s = Self::preset("heron_island")?;
         s.name = format!("csv:{}", path.display());
         let slots: [(&str, &mut SpectrumSource); 7] = [
@@ -274,14 +277,14 @@ impl SiopSpec {
         if let Some(stray) =
             table.columns.iter().find(|c| c.as_str() != "wavelength_nm" && !known.contains(&c.as_str()))
         {
-            return Err(WaterError::Parse {
+            return Err(WaterError::Parse(ParseError {
                 origin: path.display().to_string(),
                 message: format!(
                     "unknown SIOP column `{stray}` (allowed: wavelength_nm, {}); the set's other spectra \
                      come from heron_island, so a misspelt column would silently be replaced",
                     known.join(", ")
                 ),
-            });
+            }));
         }
         let mut used = 0;
         for (column, slot) in slots {
@@ -296,13 +299,13 @@ impl SiopSpec {
             }
         }
         if used == 0 {
-            return Err(WaterError::Parse {
+            return Err(WaterError::Parse(ParseError {
                 origin: path.display().to_string(),
                 message: format!(
                     "no SIOP column found (expected any of a_w, bb_w, a_ph_star, bb_ph_star, a_cdom_star, a_nap_star, bb_nap_star; found {})",
                     table.columns.join(", ")
                 ),
-            });
+            }));
         }
         Ok(s)
     }
@@ -312,7 +315,7 @@ impl crate::parse::Preset for SiopSpec {
     const FOLDER: &'static str = "siop";
     type Error = WaterError;
     fn parse_error(origin: &str, message: String) -> WaterError {
-        WaterError::Parse { origin: origin.into(), message }
+        WaterError::Parse(ParseError { origin: origin.into(), message })
     }
     fn unknown(name: &str, known: &[String]) -> WaterError {
         WaterError::UnknownName { field: "SIOP set".into(), name: name.into(), known: known.join(", ") }

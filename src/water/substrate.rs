@@ -8,6 +8,7 @@
 use std::path::Path;
 
 use super::WaterError;
+use crate::parse::ParseError;
 use crate::spectral::{Extrapolation, Spectrum, Table, WavelengthGrid};
 
 /// One library entry: the name users type and where the spectrum lives.
@@ -91,12 +92,12 @@ impl SubstrateLibrary {
         let columns: Vec<&String> = table.columns.iter().filter(|c| c.as_str() != "wavelength_nm").collect();
         for (i, a) in columns.iter().enumerate() {
             if let Some(b) = columns[..i].iter().find(|b| b.eq_ignore_ascii_case(a)) {
-                return Err(WaterError::Parse {
+                return Err(WaterError::Parse(ParseError {
                     origin: path.display().to_string(),
                     message: format!(
                         "columns `{b}` and `{a}` name the same substrate (names are case-insensitive); rename one"
                     ),
-                });
+                }));
             }
         }
         for column in columns {

@@ -83,8 +83,8 @@ fn fingerprint(out: &RunOutput) -> Fingerprint {
     let bits2 = |a: &ndarray::Array2<f32>| h(&a.iter().map(|v| v.to_bits()).collect::<Vec<_>>());
     let mut f = vec![
         ("pupil radiance".to_string(), bits(&out.radiance.radiance)),
-        ("true Rrs".into(), bits(&out.radiance.rrs_above)),
-        ("true chl".into(), bits2(&out.radiance.chl_mg_m3)),
+        ("true Rrs".into(), bits(&out.radiance.truth.rrs_above)),
+        ("true chl".into(), bits2(&out.radiance.truth.chl_mg_m3)),
         ("level-0 DN".into(), h(&out.level0.dn.iter().collect::<Vec<_>>())),
         ("level-0 flags".into(), h(&out.level0.flags.iter().collect::<Vec<_>>())),
         ("level-1".into(), bits(&out.level1.radiance)),

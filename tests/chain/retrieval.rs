@@ -116,14 +116,14 @@ fn sambuca_noise_free_closure_on_the_reef() {
     )
     .unwrap();
     let truth = &out.radiance;
-    let fractions = truth.substrate_fractions.as_ref().unwrap();
+    let fractions = truth.truth.substrate_fractions.as_ref().unwrap();
     let (rows, cols, nb) = out.correction.rrs.rrs.dim();
     let weights: Vec<f64> = ret.nedr.iter().map(|v| 1.0 / v).collect();
     let (mut pixels, mut worse, mut visible, mut depth_off, mut three_way) = (0, 0, 0, 0, 0);
     let mut m = vec![0.0; nb];
     for r in 0..rows {
         for c in 0..cols {
-            if truth.land[[r, c]] != 0 {
+            if truth.truth.land[[r, c]] != 0 {
                 continue;
             }
             let mut order: Vec<usize> = (0..names.len()).collect();
@@ -134,11 +134,11 @@ fn sambuca_noise_free_closure_on_the_reef() {
             }
             let (i, j) = (order[0].min(order[1]), order[0].max(order[1]));
             let q = f64::from(fractions[[r, c, i]]) / f64::from(fractions[[r, c, i]] + fractions[[r, c, j]]);
-            let depth = f64::from(truth.depth_m.as_ref().unwrap()[[r, c]]);
+            let depth = f64::from(truth.truth.depth_m.as_ref().unwrap()[[r, c]]);
             let p = Parameters {
-                chl: f64::from(truth.chl_mg_m3[[r, c]]),
-                cdom: f64::from(truth.cdom_per_m[[r, c]]),
-                nap: f64::from(truth.nap_g_m3[[r, c]]),
+                chl: f64::from(truth.truth.chl_mg_m3[[r, c]]),
+                cdom: f64::from(truth.truth.cdom_per_m[[r, c]]),
+                nap: f64::from(truth.truth.nap_g_m3[[r, c]]),
                 depth_m: Some(depth),
                 substrates: (i, j, q),
             };
@@ -238,7 +238,7 @@ fn hard_cases_are_finite_or_flagged() {
             let p = &out.retrievals[0].product;
             let (mut water, mut returned, mut at_zero) = (0, 0, 0);
             for ((r, c), f) in p.flags.indexed_iter() {
-                if out.radiance.land[[r, c]] != 0 {
+                if out.radiance.truth.land[[r, c]] != 0 {
                     continue;
                 }
                 water += 1;
@@ -265,7 +265,7 @@ fn hard_cases_are_finite_or_flagged() {
     let p = &out.retrievals[0].product;
     let mut pixels = 0;
     for ((r, c), f) in p.flags.indexed_iter() {
-        if out.radiance.land[[r, c]] != 0 {
+        if out.radiance.truth.land[[r, c]] != 0 {
             continue;
         }
         assert!(f & ProductFlags::RETURNED != 0, "no NAP, noise-free: ({r},{c}) not returned, flags {f}");

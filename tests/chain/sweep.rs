@@ -181,7 +181,8 @@ fn the_cubesat_error_budget_matches_runs_with_each_stage_made_perfect() {
             let mut c = c.clone();
             c.seed = seed;
             let out = engine.run(&c, &RunControl::new()).unwrap();
-            let (mae, n) = chl_mae_pct(&out.retrievals[0].product, &out.radiance.chl_mg_m3, &out.radiance.land);
+            let (mae, n) =
+                chl_mae_pct(&out.retrievals[0].product, &out.radiance.truth.chl_mg_m3, &out.radiance.truth.land);
             assert!(n > 1000, "{n} pixels compared");
             sum += mae;
         }

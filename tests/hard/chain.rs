@@ -190,7 +190,7 @@ fn noise_free_closure_holds_at_the_extremes() {
     for (case, c, tolerance) in cases {
         let out = engine.run(&c, &RunControl::new()).unwrap();
         check(&out, &case);
-        let (got, want) = (&out.correction.rrs.rrs, &out.radiance.rrs_above);
+        let (got, want) = (&out.correction.rrs.rrs, &out.radiance.truth.rrs_above);
         let mut worst: f64 = 0.0;
         for (g, w) in got.iter().zip(want) {
             if *w > 1e-5 {
