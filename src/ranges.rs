@@ -161,7 +161,7 @@ ranges! {
     /// Exposure.
     INSTRUMENT_EXPOSURE_S = Range::above("instrument.exposure_s", 0.0, 10.0, "s", "integration time of one frame");
     /// Frames along track.
-    INSTRUMENT_EXPOSURES = Range::count("instrument.exposures", 1.0, 100_000.0, "", "frames (lines) along track");
+    INSTRUMENT_LINES = Range::count("instrument.lines", 1.0, 100_000.0, "", "lines (exposures) along track");
     /// Forward tilt.
     INSTRUMENT_FORWARD_TILT_DEG = Range::closed("instrument.forward_tilt_deg", -60.0, 60.0, "degrees", "pointing along track (positive: forward)");
     /// Read noise.

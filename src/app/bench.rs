@@ -126,10 +126,10 @@ pub fn rows(quick: bool) -> Result<String, String> {
     let ctx = egui::Context::default();
     let mut state = AppState::default();
     if quick {
-        state.levels.retain(|&d| d >= 4);
+        state.decimations.retain(|&d| d >= 4);
     }
-    let preview = state.levels()[0];
-    let finest = state.levels().last().copied().unwrap_or(1);
+    let preview = state.decimations()[0];
+    let finest = state.decimations().last().copied().unwrap_or(1);
     let steps = if quick { 3 } else { 7 };
     let mut app = ShoalApp::with_state(state, &ctx, AppOptions::default());
     let cold = Instant::now();
@@ -144,10 +144,10 @@ pub fn rows(quick: bool) -> Result<String, String> {
         "Engine threads {}. From start: first preview (1/{preview}) on screen {cold_preview_s:.2} s, final (1/{finest}) {cold_final_s:.1} s.\n\n",
         super::engine_threads(0)
     ));
-    out.push_str("| change to A | levels | changes | slider → preview on screen, median (min–max) ms | target | frame ms while engine runs, median / p95 / max | frames |\n|---|---|---|---|---|---|---|\n");
+    out.push_str("| change to A | decimations | changes | slider → preview on screen, median (min–max) ms | target | frame ms while engine runs, median / p95 / max | frames |\n|---|---|---|---|---|---|---|\n");
     let previews: &[usize] = if quick { &[24] } else { &[24, 16] };
     for &p in previews {
-        app.state.levels = vec![p, 4];
+        app.state.decimations = vec![p, 4];
         frames_until(&ctx, &mut app, Duration::from_secs(600), |a| on_screen(a, 4) && !a.link.busy())?;
         for sweep in &SWEEPS {
             out.push_str(&sweep_row(&ctx, &mut app, sweep, steps, p, 4)?);

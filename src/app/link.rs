@@ -40,7 +40,7 @@ pub struct EngineLink {
     handle: EngineHandle,
     generation: u64,
     submitted: Vec<RunConfig>,
-    levels: Vec<usize>,
+    decimations: Vec<usize>,
     submitted_at: Instant,
     /// Per instrument: the result shown.
     pub shown: [Option<Shown>; 2],
@@ -62,7 +62,7 @@ impl EngineLink {
             handle: EngineHandle::spawn_with_wake(threads, wake)?,
             generation: 0,
             submitted: Vec::new(),
-            levels: Vec::new(),
+            decimations: Vec::new(),
             submitted_at: Instant::now(),
             shown: [None, None],
             errors: [None, None],
@@ -79,20 +79,20 @@ impl EngineLink {
         self.generation
     }
 
-    /// Submit `configs` at `levels` if they differ from what is running; true if submitted.
+    /// Submit `configs` at `decimations` if they differ from what is running; true if submitted.
     ///
-    /// An instrument whose configuration and levels did not change and whose final result is
+    /// An instrument whose configuration and decimations did not change and whose final result is
     /// already shown is not run again: its result is carried over to the new generation (moving
     /// one slider of A re-runs only A).
-    pub fn submit_if_changed(&mut self, configs: Vec<RunConfig>, levels: Vec<usize>) -> bool {
-        if configs == self.submitted && levels == self.levels {
+    pub fn submit_if_changed(&mut self, configs: Vec<RunConfig>, decimations: Vec<usize>) -> bool {
+        if configs == self.submitted && decimations == self.decimations {
             return false;
         }
-        let finest = levels.last().copied().unwrap_or(1);
+        let finest = decimations.last().copied().unwrap_or(1);
         let keep: Vec<bool> = (0..configs.len())
             .map(|i| {
                 i < 2
-                    && levels == self.levels
+                    && decimations == self.decimations
                     && self.submitted.get(i) == configs.get(i)
                     && self.finished[i]
                     && self.errors[i].is_none()
@@ -101,7 +101,7 @@ impl EngineLink {
             .collect();
         self.generation += 1;
         self.submitted.clone_from(&configs);
-        self.levels.clone_from(&levels);
+        self.decimations.clone_from(&decimations);
         self.errors = [None, None];
         self.finished = [false, false];
         for (i, kept) in keep.iter().enumerate() {
@@ -113,7 +113,7 @@ impl EngineLink {
         self.submitted_at = Instant::now();
         self.latency_pending = true;
         let configs = configs.into_iter().zip(&keep).map(|(c, kept)| (!kept).then_some(c)).collect();
-        self.handle.submit(Request { generation: self.generation, configs, decimations: levels })
+        self.handle.submit(Request { generation: self.generation, configs, decimations })
     }
 
     /// Take the engine's events; true if anything shown changed.
@@ -125,7 +125,7 @@ impl EngineLink {
                     self.progress = Some(Progress { index, decimation, done, total });
                 }
                 Event::Finished { generation, index, decimation, result } => {
-                    let finest = self.levels.last().copied().unwrap_or(1);
+                    let finest = self.decimations.last().copied().unwrap_or(1);
                     if index < 2 && decimation == finest {
                         self.finished[index] = true;
                     }

@@ -120,7 +120,7 @@ impl ShoalApp {
         if let Some(a) = configs.first_mut() {
             a.fault = self.ui.fault;
         }
-        self.link.submit_if_changed(configs, self.state.levels());
+        self.link.submit_if_changed(configs, self.state.decimations());
         let wake = ctx.clone();
         self.listing.poll(&self.library, move || wake.request_repaint());
         if self.link.poll() {

@@ -405,7 +405,7 @@ impl ShoalApp {
     /// Screenshot mode: once both instruments show their final results, grab the window.
     fn screenshot(&mut self, ctx: &egui::Context) {
         let Some(path) = self.options.screenshot.clone() else { return };
-        let finest = self.state.levels().last().copied().unwrap_or(1);
+        let finest = self.state.decimations().last().copied().unwrap_or(1);
         let ready = !self.link.busy()
             && (0..2).all(|i| self.link.shown[i].as_ref().is_some_and(|s| s.decimation == finest))
             && self.images.ready();

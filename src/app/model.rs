@@ -136,8 +136,10 @@ pub struct AppState {
     pub almi: AlmiSettings,
     /// SAMBUCA settings.
     pub sambuca: SambucaSettings,
-    /// Preview decimations, coarsest first; the last is the final resolution.
-    pub levels: Vec<usize>,
+    /// Preview decimations, coarsest first; the last is the final resolution (saved states
+    /// before the rename call it `levels`, still read).
+    #[serde(alias = "levels")]
+    pub decimations: Vec<usize>,
     /// Product shown.
     pub product: ProductKind,
     /// Band of band products.
@@ -196,7 +198,7 @@ impl AppState {
             retrieval: RetrievalKind::Almi,
             almi: AlmiSettings::default(),
             sambuca: SambucaSettings::default(),
-            levels: vec![24, 4, 1],
+            decimations: vec![24, 4, 1],
             product: ProductKind::Chl,
             band: 3,
             layout: Layout::TruthAB,
@@ -319,10 +321,10 @@ impl AppState {
             .collect()
     }
 
-    /// Preview levels, coarsest first, validated (1–64, decreasing, ending at the final one).
+    /// Preview decimations, coarsest first, validated (1–64, decreasing, ending at the final one).
     #[must_use]
-    pub fn levels(&self) -> Vec<usize> {
-        let mut l: Vec<usize> = self.levels.iter().copied().filter(|d| (1..=64).contains(d)).collect();
+    pub fn decimations(&self) -> Vec<usize> {
+        let mut l: Vec<usize> = self.decimations.iter().copied().filter(|d| (1..=64).contains(d)).collect();
         l.sort_unstable_by(|a, b| b.cmp(a));
         l.dedup();
         if l.is_empty() { vec![24, 4, 1] } else { l }

@@ -165,8 +165,7 @@ fn editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
                 .suffix(p.unit)
                 .logarithmic(p.log)
                 .clamping(egui::SliderClamping::Never);
-            let slider =
-                if matches!(p.key, "detectors" | "exposures" | "adc_bits") { slider.integer() } else { slider };
+            let slider = if matches!(p.key, "detectors" | "lines" | "adc_bits") { slider.integer() } else { slider };
             // The hover text states the documented range (src/ranges.rs) a typed value must meet;
             // built only while the pointer is on the slider.
             ui.add(slider).on_hover_ui(|ui| {
@@ -400,8 +399,8 @@ fn settings(app: &mut ShoalApp, ui: &mut egui::Ui) {
             let l = ui.label("Noise seed");
             ui.add(egui::DragValue::new(&mut s.noise_seed).range(0..=1_000_000).speed(1.0)).labelled_by(l.id);
         });
-        let levels = s.levels();
-        let (preview, finest) = (levels[0], levels.last().copied().unwrap_or(1));
+        let decimations = s.decimations();
+        let (preview, finest) = (decimations[0], decimations.last().copied().unwrap_or(1));
         let (mut pre, mut fin) = (preview, finest);
         ui.horizontal(|ui| {
             egui::ComboBox::from_label("Preview").selected_text(format!("1/{pre}")).show_ui(ui, |ui| {
@@ -419,7 +418,7 @@ fn settings(app: &mut ShoalApp, ui: &mut egui::Ui) {
         });
         if (pre, fin) != (preview, finest) {
             // Preview first, then 1/4 while the final level is finer, then the final level.
-            s.levels = [pre, 4, fin].into_iter().filter(|&d| d <= pre).collect();
+            s.decimations = [pre, 4, fin].into_iter().filter(|&d| d <= pre).collect();
         }
     });
     egui::CollapsingHeader::new("Requirements").default_open(false).show(ui, |ui| requirements_editor(app, ui));

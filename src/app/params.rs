@@ -72,15 +72,15 @@ pub const PARAMS: [Param; 13] = [
         set: |s, v| s.detectors = v.round() as usize,
     },
     Param {
-        key: "exposures",
+        key: "lines",
         label: "Lines",
         unit: "",
         range: (16.0, 4000.0),
         log: true,
         scale: 1.0,
         tip: "Exposures along track",
-        get: |s| s.exposures as f64,
-        set: |s, v| s.exposures = v.round() as usize,
+        get: |s| s.lines as f64,
+        set: |s, v| s.lines = v.round() as usize,
     },
     Param {
         key: "exposure_s",

@@ -115,7 +115,7 @@ impl<'a> Inputs<'a> {
             focal_length_mm,
             detectors,
             exposure_s,
-            exposures: lines,
+            lines,
             forward_tilt_deg,
             read_noise_e,
             well_depth_e,

@@ -260,7 +260,7 @@ fn worker(
         // broken instrument does not hide the other's results).
         let mut failed = vec![false; request.configs.len()];
         let mut started = false;
-        'levels: for &decimation in &request.decimations {
+        'decimations: for &decimation in &request.decimations {
             for (index, base) in request.configs.iter().enumerate() {
                 let Some(base) = base else { continue };
                 if failed[index] {
@@ -270,7 +270,7 @@ fn worker(
                     if !started {
                         counters.requests_skipped.fetch_add(1, Ordering::SeqCst);
                     }
-                    break 'levels;
+                    break 'decimations;
                 }
                 started = true;
                 let mut config = base.clone();
@@ -304,7 +304,7 @@ fn worker(
                 if matches!(result, Err(EngineError::Cancelled)) {
                     counters.rows_after_cancel.fetch_add(control.done_after_cancel(), Ordering::SeqCst);
                     counters.runs_cancelled.fetch_add(1, Ordering::SeqCst);
-                    break 'levels;
+                    break 'decimations;
                 }
                 failed[index] = result.is_err();
                 // Counted before it is sent, so a reader that has the event sees it counted.

@@ -93,7 +93,7 @@ impl Viewing {
         let tilt = spec.forward_tilt_deg.to_radians();
         let n = spec.detectors;
         let detector_index: Vec<usize> = (0..n).step_by(decimation).collect();
-        let line_index: Vec<usize> = (0..spec.exposures).step_by(decimation).collect();
+        let line_index: Vec<usize> = (0..spec.lines).step_by(decimation).collect();
         let mut max_vza: f64 = 0.0;
         // Ground offset (along, across) and geometry of a look at angles (β, α).
         let look = |beta: f64, alpha: f64| -> Result<(f64, f64, Geometry), InstrumentError> {
@@ -165,7 +165,7 @@ impl Viewing {
                 }
             }
         }
-        let n_lines = spec.exposures as f64;
+        let n_lines = spec.lines as f64;
         let track_m = line_index
             .iter()
             .map(|&l| {

@@ -81,8 +81,10 @@ pub struct InstrumentSpec {
     pub detectors: usize,
     /// Exposure (integration) time, s.
     pub exposure_s: f64,
-    /// Exposures (lines) along track (1–100 000).
-    pub exposures: usize,
+    /// Lines (exposures) along track (1–100 000). Files written before the rename say
+    /// `exposures`, which is still read.
+    #[serde(alias = "exposures")]
+    pub lines: usize,
     /// Forward tilt of the line of sight, degrees (−60 to 60).
     #[serde(default)]
     pub forward_tilt_deg: f64,
@@ -155,7 +157,7 @@ impl InstrumentSpec {
         check(&r::INSTRUMENT_FOCAL_LENGTH_MM, self.focal_length_mm)?;
         check(&r::INSTRUMENT_DETECTORS, count(self.detectors))?;
         check(&r::INSTRUMENT_EXPOSURE_S, self.exposure_s)?;
-        check(&r::INSTRUMENT_EXPOSURES, count(self.exposures))?;
+        check(&r::INSTRUMENT_LINES, count(self.lines))?;
         check(&r::INSTRUMENT_FORWARD_TILT_DEG, self.forward_tilt_deg)?;
         check(&r::INSTRUMENT_READ_NOISE_E, self.read_noise_e)?;
         check(&r::INSTRUMENT_WELL_DEPTH_E, self.well_depth_e)?;
@@ -278,5 +280,22 @@ impl crate::parse::Preset for InstrumentSpec {
             field: "instrument".into(),
             message: format!("no built-in instrument `{name}` (known: {})", known.join(", ")),
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Files written before `exposures` became `lines` still load, with the same value.
+    #[test]
+    fn an_instrument_file_that_says_exposures_still_loads() {
+        let text = crate::assets::preset("instruments/cubesat.ron").expect("the CubeSat preset").text;
+        assert!(text.contains("    lines: "), "the preset says `lines`");
+        let old = text.replace("    lines: ", "    exposures: ");
+        let new_spec: InstrumentSpec = crate::parse::from_ron(text, "cubesat.ron").expect("parses");
+        let old_spec: InstrumentSpec = crate::parse::from_ron(&old, "old.ron").expect("the old name parses");
+        assert_eq!(old_spec, new_spec);
+        assert_eq!(new_spec.lines, 2000);
     }
 }

@@ -36,7 +36,7 @@ fn island_scene(size_m: f64, adjacency: bool) -> SceneSpec {
 /// island's shore, W m⁻² sr⁻¹ nm⁻¹.
 fn adjacency_radiance(size_m: f64) -> (f64, f64) {
     let mut instrument = InstrumentSpec::preset("cubesat").unwrap();
-    (instrument.detectors, instrument.exposures) = (40, 3);
+    (instrument.detectors, instrument.lines) = (40, 3);
     let radiance = |adjacency: bool| {
         let mut c = RunConfig::new(island_scene(size_m, adjacency), instrument.clone());
         c.detector.noise = false;

@@ -37,7 +37,7 @@ fn documented(what: &str) -> Option<&'static str> {
 fn base(path: &str) -> RunConfig {
     let mut instrument = InstrumentSpec::preset(instrument_for(path)).unwrap();
     instrument.detectors = 16;
-    instrument.exposures = 12;
+    instrument.lines = 12;
     // A dark current and fixed patterns, so that the dark frames and their exposure matter.
     instrument.dark_current_e_s = 200.0;
     instrument.prnu = 0.01;

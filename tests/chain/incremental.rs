@@ -127,7 +127,7 @@ fn after_a_change_of_any_one_field_a_warm_engine_returns_what_a_fresh_one_does()
         ("focal_length_mm", |c| c.instrument.focal_length_mm *= 1.2),
         ("detectors", |c| c.instrument.detectors += 8),
         ("exposure_s", |c| c.instrument.exposure_s *= 0.8),
-        ("exposures", |c| c.instrument.exposures += 8),
+        ("lines", |c| c.instrument.lines += 8),
         ("forward_tilt_deg", |c| c.instrument.forward_tilt_deg += 5.0),
         ("read_noise_e", |c| c.instrument.read_noise_e *= 2.0),
         ("well_depth_e", |c| c.instrument.well_depth_e *= 0.5),

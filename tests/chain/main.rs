@@ -44,7 +44,7 @@ pub fn reef() -> SceneSpec {
 pub fn small(name: &str, detectors: usize, lines: usize) -> InstrumentSpec {
     let mut i = InstrumentSpec::preset(name).unwrap();
     i.detectors = detectors;
-    i.exposures = lines;
+    i.lines = lines;
     i
 }
 

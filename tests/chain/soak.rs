@@ -27,7 +27,7 @@ const THREADS: usize = 2;
 fn base(name: &str) -> RunConfig {
     let mut instrument = InstrumentSpec::preset(name).unwrap();
     instrument.detectors = 48;
-    instrument.exposures = 32;
+    instrument.lines = 32;
     let mut c = RunConfig::new(small_lake(), instrument);
     c.retrievals = vec![ron::from_str("Almi()").unwrap()];
     c

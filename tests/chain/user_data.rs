@@ -107,7 +107,7 @@ fn two_siop_sets_of_one_name_are_refused_by_almi() {
     let mut c =
         RunConfig::new(SceneSpec::preset("lake_hume_bloom").unwrap(), InstrumentSpec::preset("cubesat").unwrap());
     c.instrument.detectors = 8;
-    c.instrument.exposures = 6;
+    c.instrument.lines = 6;
     c.retrievals = vec![RetrievalSpec::Almi {
         siop_sets: vec![shoal::water::SiopSource::Preset("almi_1".into()), shoal::water::SiopSource::File(path)],
         settings: Default::default(),
@@ -160,7 +160,7 @@ fn the_cli_resolves_a_preset_name_as_the_library_does() {
     let mut spec = InstrumentSpec::preset("cubesat").unwrap();
     spec.name = "my_cube".into();
     spec.detectors = 6;
-    spec.exposures = 4;
+    spec.lines = 4;
     lib.save_instrument("my_cube", &spec, false).unwrap();
     let out_dir = home.join("out");
     let out = shoal(&home)

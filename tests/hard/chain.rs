@@ -152,7 +152,7 @@ fn image_shape_extremes() {
     swath.retrievals = vec![almi()];
     let mut single = config(one_cell.clone());
     single.instrument.detectors = 1;
-    single.instrument.exposures = 1;
+    single.instrument.lines = 1;
     let cases = vec![
         ("1 × 1 scene".to_string(), config(one_cell)),
         ("1 detector × 1 line".to_string(), single),

@@ -44,7 +44,7 @@ pub fn uniform(chl: f64, nap: f64, cdom: f64) -> SceneSpec {
 pub fn instrument(name: &str, detectors: usize, lines: usize) -> InstrumentSpec {
     let mut i = InstrumentSpec::preset(name).unwrap();
     i.detectors = detectors;
-    i.exposures = lines;
+    i.lines = lines;
     i
 }
 

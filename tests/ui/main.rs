@@ -28,8 +28,11 @@ fn temp_library(name: &str) -> PathBuf {
 
 /// The default study (CubeSat vs SmallSat over Lake Hume) with A set to `a`, run at 1/`level`.
 fn harness(a: &str, level: usize, library: &std::path::Path) -> Harness<'static, ShoalApp> {
-    let state =
-        AppState { a: Slot::new(a, InstrumentSpec::preset(a).unwrap()), levels: vec![level], ..AppState::default() };
+    let state = AppState {
+        a: Slot::new(a, InstrumentSpec::preset(a).unwrap()),
+        decimations: vec![level],
+        ..AppState::default()
+    };
     let library = Library::at(library);
     Harness::builder().with_size(egui::vec2(1500.0, 960.0)).build_eframe(move |cc| {
         let mut app =
@@ -325,7 +328,7 @@ fn an_instrument_that_returns_no_pixel_is_never_a_pass() {
     let state = AppState {
         a: Slot::new("cubesat", broken.clone()),
         b: Slot::new("cubesat", broken),
-        levels: vec![16],
+        decimations: vec![16],
         ..AppState::default()
     };
     let library = Library::at(&dir);
