@@ -7,7 +7,8 @@
 //! than the new one and no longer wanted — and the consumer blocks in `take` until there is
 //! work or the mailbox is closed.
 
-use std::sync::{Condvar, Mutex, PoisonError};
+use std::sync::mpsc::{Receiver, sync_channel};
+use std::sync::{Arc, Condvar, Mutex, PoisonError};
 
 /// One waiting request at most; a newer one replaces it.
 #[derive(Debug)]
@@ -97,6 +98,66 @@ impl<T> Mailbox<T> {
     }
 }
 
+/// A named thread that answers requests taken from a [`Mailbox`]: the newest request wins,
+/// asking never blocks, and every answer goes back through a short queue the owner polls (the
+/// app, once per frame). `wake` runs after each answer (the app asks egui for a repaint).
+/// Dropping the worker closes its mailbox; the thread ends after the request in hand.
+#[derive(Debug)]
+pub struct Worker<Req, Out> {
+    inbox: Arc<Mailbox<Req>>,
+    answers: Receiver<Out>,
+}
+
+impl<Req: Send + 'static, Out: Send + 'static> Worker<Req, Out> {
+    /// Start thread `name` running `work` on each request.
+    pub fn spawn(
+        name: &str,
+        wake: impl Fn() + Send + 'static,
+        mut work: impl FnMut(Req) -> Out + Send + 'static,
+    ) -> std::io::Result<Self> {
+        let inbox = Arc::new(Mailbox::<Req>::new());
+        // Answers are taken every frame: a short queue is enough, and a full one only makes the
+        // worker wait for the next frame.
+        let (tx, answers) = sync_channel::<Out>(4);
+        let rx = inbox.clone();
+        std::thread::Builder::new().name(name.into()).spawn(move || {
+            while let Some(request) = rx.take() {
+                if tx.send(work(request)).is_err() {
+                    break;
+                }
+                wake();
+            }
+            rx.close();
+        })?;
+        Ok(Self { inbox, answers })
+    }
+
+    /// Ask, replacing a request not yet started. Never blocks.
+    pub fn request(&self, request: Req) -> Put<Req> {
+        self.inbox.put(request)
+    }
+
+    /// The oldest answer not yet taken.
+    pub fn poll(&self) -> Option<Out> {
+        self.answers.try_recv().ok()
+    }
+
+    /// The newest answer, dropping older ones not yet taken.
+    pub fn latest(&self) -> Option<Out> {
+        let mut last = None;
+        while let Some(a) = self.poll() {
+            last = Some(a);
+        }
+        last
+    }
+}
+
+impl<Req, Out> Drop for Worker<Req, Out> {
+    fn drop(&mut self) {
+        self.inbox.close();
+    }
+}
+
 /// A rayon pool of `threads` threads (0: one per available core) named `name-0`, `name-1`, …
 /// Every pool in Shoal is built here, so each job's threads are bounded and show in a profiler
 /// under the job's name.
@@ -110,7 +171,6 @@ pub fn pool(threads: usize, name: &'static str) -> std::io::Result<rayon::Thread
 
 #[cfg(test)]
 mod tests {
-    use std::sync::Arc;
     use std::time::Duration;
 
     use super::*;
@@ -151,6 +211,34 @@ mod tests {
         assert_eq!(consumer.join().unwrap(), vec![7]);
         assert_eq!(m.put(8), Put::Closed(8), "a closed mailbox hands the request back");
         assert!(m.is_closed());
+    }
+
+    #[test]
+    fn a_worker_answers_on_its_named_thread_and_stops_when_dropped() {
+        let woken = Arc::new(std::sync::atomic::AtomicUsize::new(0));
+        let w = {
+            let woken = woken.clone();
+            Worker::spawn(
+                "worker-test",
+                move || {
+                    woken.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+                },
+                |x: u32| (x * 2, std::thread::current().name().map(str::to_string)),
+            )
+            .unwrap()
+        };
+        assert_eq!(w.request(21), Put::Queued);
+        let answer = loop {
+            if let Some(a) = w.poll() {
+                break a;
+            }
+            std::thread::sleep(Duration::from_millis(1));
+        };
+        assert_eq!(answer, (42, Some("worker-test".into())));
+        assert!(woken.load(std::sync::atomic::Ordering::SeqCst) >= 1, "the owner was woken");
+        let inbox = w.inbox.clone();
+        drop(w);
+        assert!(inbox.is_closed(), "dropping the worker closes its mailbox");
     }
 
     #[test]

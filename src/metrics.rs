@@ -71,6 +71,29 @@ pub fn unit(variable: &str) -> &'static str {
     }
 }
 
+/// The name of a metrics variable, for people (`chl_mg_m3` → "chl-a"); substrate shares and
+/// unknown names are returned as they are.
+#[must_use]
+pub fn name(variable: &str) -> &str {
+    match variable {
+        "chl_mg_m3" => "chl-a",
+        "nap_g_m3" => "NAP",
+        "cdom_per_m" => "CDOM",
+        "depth_m" => "depth",
+        "depth_m_bottom_visible" => "depth where the bottom is visible",
+        v => v,
+    }
+}
+
+/// The name and unit of a metrics variable, for axis titles and table rows: "chl-a (mg m⁻³)".
+#[must_use]
+pub fn label(variable: &str) -> String {
+    match unit(variable) {
+        "" => name(variable).to_string(),
+        u => format!("{} ({u})", name(variable)),
+    }
+}
+
 /// Metrics of `retrieved` against `truth`; `None` entries of `retrieved` are failed retrievals,
 /// and `None` entries of `truth` are not candidates.
 #[must_use]
@@ -342,6 +365,7 @@ mod tests {
         let m = compare(&[Some(1.1), Some(1.8), None], &[Some(1.0), Some(2.0), Some(3.0)]);
         assert!((m.mean_abs_error - 0.15).abs() < 1e-12 && (m.mean_error + 0.05).abs() < 1e-12, "{m:?}");
         assert_eq!((unit("depth_m"), unit("depth_m_bottom_visible"), unit("chl_mg_m3")), ("m", "m", "mg m⁻³"));
+        assert_eq!((label("chl_mg_m3").as_str(), label("sand_fraction").as_str()), ("chl-a (mg m⁻³)", "sand_fraction"));
         // Nothing returned: finite numbers, zero returned.
         let m = compare(&[None, None], &[Some(1.0), Some(2.0)]);
         assert_eq!(m.n, 0);

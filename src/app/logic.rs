@@ -128,7 +128,7 @@ impl ShoalApp {
         }
         if let Some(r) = &self.raster {
             self.images.request(&self.state, &self.link, r);
-            if let Some(done) = r.poll() {
+            if let Some(done) = r.latest() {
                 self.images.receive(ctx, done);
             }
         }

@@ -42,12 +42,20 @@ pub struct Images {
     panels: Vec<(PanelImage, egui::TextureHandle)>,
     palette: Option<Palette>,
     difference_palette: Option<Palette>,
+    /// The histogram and scatter data that came with the images.
+    plot: Option<std::sync::Arc<super::plot_data::PlotData>>,
 }
 
 impl Images {
     /// The runs changed: the next frame asks for new images.
     pub fn invalidate(&mut self) {
         self.requested = None;
+    }
+
+    /// The histogram and scatter data of the results on display.
+    #[must_use]
+    pub fn plot(&self) -> Option<&super::plot_data::PlotData> {
+        self.plot.as_deref()
     }
 
     /// Are the newest images on display?
@@ -75,8 +83,8 @@ impl Images {
         if runs.iter().all(Option::is_none) {
             return;
         }
-        if raster.request(Job { key, runs, kind: state.product, band: state.band, layout: state.layout, max_side: 720 })
-        {
+        let job = Job { key, runs, kind: state.product, band: state.band, layout: state.layout, max_side: 720 };
+        if !matches!(raster.request(job), crate::jobs::Put::Closed(_)) {
             self.requested = Some(key);
         }
     }
@@ -97,6 +105,7 @@ impl Images {
             .collect();
         self.palette = Some(done.palette);
         self.difference_palette = done.difference_palette;
+        self.plot = Some(done.plot);
         self.shown = Some(done.key);
     }
 }

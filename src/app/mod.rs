@@ -10,6 +10,7 @@
 //! | persisted state, A/B configurations | [`model`] |
 //! | the engine thread's results | [`link`] |
 //! | product maps, colours, A − B | [`raster`] |
+//! | histogram and scatter data, off the UI thread | [`plot_data`] |
 //! | presets and instrument editor | `panels` |
 //! | maps with zoom, pan and hover | `maps` |
 //! | metrics table and plots | `plots` |
@@ -26,6 +27,7 @@ mod maps;
 pub mod model;
 mod panels;
 mod params;
+pub mod plot_data;
 mod plots;
 pub mod raster;
 mod session;
@@ -133,7 +135,7 @@ impl ShoalApp {
                     std::process::exit(1);
                 });
         let wake = ctx.clone();
-        let raster = raster::RasterThread::spawn(move || wake.request_repaint()).ok();
+        let raster = raster::spawn_raster_thread(move || wake.request_repaint()).ok();
         let export_path = crate::library::home_dir().join("exports").join("comparison").display().to_string();
         Self {
             state,

@@ -6,8 +6,9 @@ use egui::Color32;
 use egui_plot::{Bar, BarChart, HLine, Legend, Line, Plot, PlotPoints, Points};
 
 use super::ShoalApp;
+use super::plot_data::PlotData;
 use crate::engine::{RunOutput, StageStatus};
-use crate::metrics::{Metrics, bin_of, log_edges};
+use crate::metrics::Metrics;
 use crate::study::Check;
 
 const COLOURS: [Color32; 2] = [Color32::from_rgb(228, 26, 28), Color32::from_rgb(55, 126, 184)];
@@ -119,85 +120,56 @@ fn metrics_table(app: &ShoalApp, ui: &mut egui::Ui) {
     }
 }
 
-/// log10 of the returned (retrieved) and true values of the shown product.
-fn pairs(out: &RunOutput, variable: &str) -> Vec<(f64, f64)> {
-    let Some(ret) = out.retrievals.first() else { return Vec::new() };
-    let p = &ret.product;
-    let r = &out.radiance;
-    let (Some(truth), Some(got)) = (out.radiance.truth.map(variable), p.map(variable)) else { return Vec::new() };
-    // A strided sample of at most ~4000 pixels, visited directly: a frame never walks the whole
-    // truth array (2 M pixels at full resolution).
-    let cols = truth.ncols().max(1);
-    let step = (truth.len() / 4000).max(1);
-    (0..truth.len())
-        .step_by(step)
-        .map(|k| (k / cols, k % cols))
-        .filter(|&(i, j)| r.truth.land[[i, j]] == 0 && p.returned(i, j) && truth[[i, j]] > 0.0 && got[[i, j]] > 0.0)
-        .map(|(i, j)| (f64::from(truth[[i, j]]).log10(), f64::from(got[[i, j]]).log10()))
-        .collect()
-}
-
 fn histograms_and_scatter(app: &ShoalApp, ui: &mut egui::Ui, width: f32) {
-    let variable = app.state.product.variable().unwrap_or("chl_mg_m3");
-    let data: Vec<Vec<(f64, f64)>> =
-        app.link.shown.iter().map(|s| s.as_ref().map(|s| pairs(&s.output, variable)).unwrap_or_default()).collect();
-    let all: Vec<f64> = data.iter().flatten().flat_map(|p| [p.0, p.1]).collect();
-    let (lo, hi) = all.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(*v), b.max(*v)));
+    // Computed on the raster thread with the maps (app/plot_data.rs): a frame only draws.
+    let empty = PlotData::default();
+    let data = app.images.plot().unwrap_or(&empty);
+    let name = crate::metrics::name(&data.variable);
+    let unit = crate::metrics::unit(&data.variable);
+    let edges = &data.edges_log10;
     ui.vertical(|ui| {
-        ui.label(format!("{variable}: histograms (log10)"));
+        ui.label(format!("{name}: histograms"));
         Plot::new("hist")
             .width(width)
             .height(170.0)
             .legend(Legend::default().position(egui_plot::Corner::LeftTop))
-            .x_axis_label("log10 value")
+            .x_axis_label(format!("log10 {name} ({unit})"))
+            .y_axis_label("pixels")
             .show(ui, |p| {
-                if lo.is_finite() && hi > lo {
-                    let edges = log_edges(10f64.powf(lo), 10f64.powf(hi), 30);
-                    let centre = |b: usize| 0.5 * (edges[b].log10() + edges[b + 1].log10());
-                    let bw = (edges[1].log10() - edges[0].log10()) * 0.45;
-                    let count = |values: &mut dyn Iterator<Item = f64>| {
-                        let mut c = vec![0usize; 30];
-                        for v in values {
-                            if let Some(b) = bin_of(&edges, 10f64.powf(v)) {
-                                c[b] += 1;
-                            }
-                        }
-                        c
-                    };
-                    let truth = count(&mut data[0].iter().map(|p| p.0));
-                    let line: Vec<[f64; 2]> = truth.iter().enumerate().map(|(b, n)| [centre(b), *n as f64]).collect();
-                    p.line(Line::new("truth", PlotPoints::from(line)).color(Color32::GRAY).width(2.0));
-                    for (i, d) in data.iter().enumerate() {
-                        let c = count(&mut d.iter().map(|p| p.1));
-                        let offset = if i == 0 { -0.5 * bw } else { 0.5 * bw };
-                        let bars: Vec<Bar> = c
-                            .iter()
-                            .enumerate()
-                            .map(|(b, n)| Bar::new(centre(b) + offset, *n as f64).width(bw))
-                            .collect();
-                        p.bar_chart(BarChart::new(if i == 0 { "A" } else { "B" }, bars).color(COLOURS[i]));
-                    }
+                if edges.len() < 2 {
+                    return;
+                }
+                let centre = |b: usize| 0.5 * (edges[b] + edges[b + 1]);
+                let bw = (edges[1] - edges[0]) * 0.45;
+                let line: Vec<[f64; 2]> = data.truth.iter().enumerate().map(|(b, n)| [centre(b), *n as f64]).collect();
+                p.line(Line::new("truth", PlotPoints::from(line)).color(Color32::GRAY).width(2.0));
+                for (i, c) in data.counts.iter().enumerate() {
+                    let offset = if i == 0 { -0.5 * bw } else { 0.5 * bw };
+                    let bars: Vec<Bar> =
+                        c.iter().enumerate().map(|(b, n)| Bar::new(centre(b) + offset, *n as f64).width(bw)).collect();
+                    p.bar_chart(BarChart::new(if i == 0 { "A" } else { "B" }, bars).color(COLOURS[i]));
                 }
             });
     });
     ui.vertical(|ui| {
-        ui.label(format!("{variable}: retrieved vs true (log10)"));
+        ui.label(format!("{name}: retrieved vs true"));
         Plot::new("scatter")
             .width(width)
             .height(170.0)
             .data_aspect(1.0)
             .legend(Legend::default().position(egui_plot::Corner::LeftTop))
+            .x_axis_label(format!("log10 true ({unit})"))
+            .y_axis_label(format!("log10 retrieved ({unit})"))
             .show(ui, |p| {
-                for (i, d) in data.iter().enumerate() {
-                    let pts: Vec<[f64; 2]> = d.iter().map(|(t, g)| [*t, *g]).collect();
+                for (i, d) in data.scatter.iter().enumerate() {
                     p.points(
-                        Points::new(if i == 0 { "A" } else { "B" }, pts)
+                        Points::new(if i == 0 { "A" } else { "B" }, d.clone())
                             .radius(1.2)
                             .color(COLOURS[i].gamma_multiply(0.6)),
                     );
                 }
-                if lo.is_finite() && hi > lo {
-                    p.line(Line::new("1:1", PlotPoints::from(vec![[lo, lo], [hi, hi]])).color(Color32::DARK_GRAY));
+                if let (Some(lo), Some(hi)) = (edges.first(), edges.last()) {
+                    p.line(Line::new("1:1", PlotPoints::from(vec![[*lo, *lo], [*hi, *hi]])).color(Color32::DARK_GRAY));
                 }
             });
     });

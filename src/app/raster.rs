@@ -3,15 +3,15 @@
 //! the UI thread only uploads the finished images.
 
 use std::sync::Arc;
-use std::sync::mpsc::{Receiver, sync_channel};
 
 use ndarray::Array2;
 
 use super::model::ProductKind;
+use super::plot_data::{PlotData, plot_data};
 use crate::colormap::{Scale, categorical, diverging, viridis};
 use crate::engine::RunOutput;
 use crate::instrument::{Detector, DetectorMode, Viewing};
-use crate::jobs::{Mailbox, Put};
+use crate::jobs::Worker;
 
 /// A map's values and where they are valid.
 #[derive(Debug, Clone, PartialEq)]
@@ -319,6 +319,8 @@ pub struct Done {
     pub palette: Palette,
     /// The differences' palette, when the layout has one.
     pub difference_palette: Option<Palette>,
+    /// The histogram and scatter data of the product's variable.
+    pub plot: Arc<PlotData>,
 }
 
 /// One cached map: its run, product, band, truth flag and the map (`None`: the run has none).
@@ -405,57 +407,43 @@ pub fn panels(job: &Job, cache: &mut MapCache) -> Done {
     if let (Some(d), Some(p)) = (diff, difference_palette) {
         panels.push(PanelImage { title: "A − B".into(), image: colorize(&d, p, job.max_side), data: d });
     }
-    Done { key: job.key, panels, palette, difference_palette }
+    Done { key: job.key, panels, palette, difference_palette, plot: Arc::default() }
 }
 
-/// A thread that prepares map panels off the UI thread, always working on the newest request
-/// (a [`Mailbox`]: asking never blocks, and a request not yet started is replaced by a newer one).
-#[derive(Debug)]
-pub struct RasterThread {
-    jobs: Arc<Mailbox<Job>>,
-    done: Receiver<Done>,
-}
+/// A's and B's runs.
+type Runs = [Option<Arc<RunOutput>>; 2];
 
-impl RasterThread {
-    /// Start the thread; `wake` is called when an answer is ready (to request a repaint).
-    pub fn spawn(wake: impl Fn() + Send + 'static) -> std::io::Result<Self> {
-        // The UI takes every answer each frame: a short answer queue is enough.
-        let jobs = Arc::new(Mailbox::<Job>::new());
-        let (done_tx, done) = sync_channel::<Done>(2);
-        let job_rx = jobs.clone();
-        std::thread::Builder::new().name("shoal-raster".into()).spawn(move || {
-            let mut cache = MapCache::default();
-            while let Some(job) = job_rx.take() {
-                if done_tx.send(panels(&job, &mut cache)).is_err() {
-                    break;
-                }
-                wake();
+/// The thread that prepares map panels (and the plots' data) off the UI thread, always on the
+/// newest request (a [`Worker`]: asking never blocks, and a request not yet started is replaced
+/// by a newer one).
+pub type RasterThread = Worker<Job, Done>;
+
+/// Start the raster thread; `wake` is called when an answer is ready (to request a repaint).
+pub fn spawn_raster_thread(wake: impl Fn() + Send + 'static) -> std::io::Result<RasterThread> {
+    let mut cache = MapCache::default();
+    // The plot data depend on the runs and the variable only, not on the band or layout. The
+    // cache holds the runs themselves, so their identity cannot be reused by a newer run.
+    let mut last_plot: Option<(Runs, &'static str, Arc<PlotData>)> = None;
+    Worker::spawn("shoal-raster", wake, move |job: Job| {
+        let mut done = panels(&job, &mut cache);
+        let variable = job.kind.variable().unwrap_or("chl_mg_m3");
+        let same = |a: &Option<Arc<RunOutput>>, b: &Option<Arc<RunOutput>>| match (a, b) {
+            (Some(a), Some(b)) => Arc::ptr_eq(a, b),
+            (None, None) => true,
+            _ => false,
+        };
+        done.plot = match &last_plot {
+            Some((runs, v, plot)) if *v == variable && runs.iter().zip(&job.runs).all(|(a, b)| same(a, b)) => {
+                plot.clone()
             }
-            job_rx.close();
-        })?;
-        Ok(Self { jobs, done })
-    }
-
-    /// Ask for panels, replacing a request not yet started (returns false if the thread has
-    /// stopped). Never blocks.
-    pub fn request(&self, job: Job) -> bool {
-        !matches!(self.jobs.put(job), Put::Closed(_))
-    }
-
-    /// The newest answer, if any.
-    pub fn poll(&self) -> Option<Done> {
-        let mut last = None;
-        while let Ok(d) = self.done.try_recv() {
-            last = Some(d);
-        }
-        last
-    }
-}
-
-impl Drop for RasterThread {
-    fn drop(&mut self) {
-        self.jobs.close();
-    }
+            _ => {
+                let plot = Arc::new(plot_data(&job.runs, variable));
+                last_plot = Some((job.runs.clone(), variable, plot.clone()));
+                plot
+            }
+        };
+        done
+    })
 }
 
 #[cfg(test)]

@@ -369,3 +369,44 @@ fn a_shallow_scene_under_alm_shows_a_banner_whose_button_switches_to_sambuca() {
     assert!(h.query_by_label_contains(banner).is_none(), "the banner goes once SAMBUCA runs");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The histogram and scatter data (computed on the raster thread) count every pixel they claim
+/// to: the truth histogram every water pixel with a truth, A's every returned pixel, on bins
+/// that span all the values; the scatter is a sample no bigger than its cap.
+#[test]
+fn the_histograms_count_every_returned_pixel_and_the_scatter_is_a_capped_sample() {
+    use shoal::app::plot_data::{BINS, SCATTER_POINTS, plot_data};
+    let mut config = AppState::default().configs().remove(0);
+    config.fidelity.decimation = 8;
+    let out = std::sync::Arc::new(
+        shoal::engine::Engine::new().run(&config, &shoal::control::RunControl::new()).expect("runs"),
+    );
+    let data = plot_data(&[Some(out.clone()), None], "chl_mg_m3");
+    let truth = &out.radiance.truth;
+    let product = &out.retrievals[0].product;
+    let (mut with_truth, mut returned) = (0, 0);
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for ((r, c), t) in truth.chl_mg_m3.indexed_iter() {
+        if truth.land[[r, c]] != 0 || *t <= 0.0 {
+            continue;
+        }
+        with_truth += 1;
+        let t = f64::from(*t).log10();
+        (lo, hi) = (lo.min(t), hi.max(t));
+        let g = product.chl_mg_m3[[r, c]];
+        if product.returned(r, c) && g > 0.0 {
+            returned += 1;
+            let g = f64::from(g).log10();
+            (lo, hi) = (lo.min(g), hi.max(g));
+        }
+    }
+    assert!(returned > 1000, "a run that returns pixels ({returned})");
+    assert_eq!(data.truth.iter().sum::<usize>(), with_truth);
+    assert_eq!(data.counts[0].iter().sum::<usize>(), returned);
+    assert_eq!(data.counts[1].iter().sum::<usize>(), 0, "no B run");
+    assert_eq!(data.edges_log10.len(), BINS + 1);
+    // The last edge is lo + BINS × width: equal to hi up to rounding.
+    assert_eq!(data.edges_log10[0], lo);
+    assert!((data.edges_log10[BINS] - hi).abs() < 1e-12 * hi.abs().max(1.0));
+    assert!(!data.scatter[0].is_empty() && data.scatter[0].len() <= SCATTER_POINTS);
+}
