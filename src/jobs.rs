@@ -1,6 +1,11 @@
-//! Background work, in one place: the single-slot [`Mailbox`] where the newest request wins (the
-//! engine thread, the app's map colouring, its sweep/cost and export jobs all take work from
-//! one), and [`pool`], the one way Shoal builds a rayon pool (named threads, a bounded size).
+//! Background work, in one place:
+//! - [`Mailbox`], the single slot where the newest request wins (the engine thread takes its
+//!   runs from one);
+//! - [`Worker`], a named thread answering requests from a mailbox (the app's map colouring and
+//!   plot data, library listing and exports);
+//! - [`Task`], a one-off cancellable job streaming its results from its own pool (the app's
+//!   sweeps and cost measurements);
+//! - [`pool`], the one way Shoal builds a rayon pool (named threads, a bounded size).
 //!
 //! A mailbox is the right shape for interactive work: the producer (the UI thread) never blocks
 //! and never sleeps — `put` replaces whatever request is waiting, which is by construction older
@@ -9,6 +14,8 @@
 
 use std::sync::mpsc::{Receiver, sync_channel};
 use std::sync::{Arc, Condvar, Mutex, PoisonError};
+
+use crate::control::RunControl;
 
 /// One waiting request at most; a newer one replaces it.
 #[derive(Debug)]
@@ -155,6 +162,65 @@ impl<Req: Send + 'static, Out: Send + 'static> Worker<Req, Out> {
 impl<Req, Out> Drop for Worker<Req, Out> {
     fn drop(&mut self) {
         self.inbox.close();
+    }
+}
+
+/// What a [`Task`] sends: items as they are made, then how it ended.
+#[derive(Debug)]
+pub enum TaskNews<T> {
+    /// One result.
+    Item(T),
+    /// The task ended: `Ok` when it finished, else why not.
+    Done(Result<(), String>),
+}
+
+/// A one-off streaming job (a sweep, a cost measurement): its own named thread and its own rayon
+/// pool of all cores but one (at least one), so it neither queues behind the engine's runs nor
+/// takes every core from them. Results stream back as they are made; dropping the task cancels
+/// it (the work sees it through its [`RunControl`]).
+#[derive(Debug)]
+pub struct Task<T> {
+    news: Receiver<TaskNews<T>>,
+    control: Arc<RunControl>,
+}
+
+impl<T: Send + 'static> Task<T> {
+    /// Start `work` on thread `name`; it sends each result through its second argument. `wake`
+    /// runs after each message.
+    pub fn spawn(
+        name: &'static str,
+        wake: impl Fn() + Send + Sync + 'static,
+        work: impl FnOnce(&RunControl, &dyn Fn(T)) -> Result<(), String> + Send + 'static,
+    ) -> Result<Self, String> {
+        let (tx, news) = sync_channel::<TaskNews<T>>(64);
+        let control = Arc::new(RunControl::new());
+        let c = control.clone();
+        let cores = std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get);
+        let pool = pool(cores.saturating_sub(1).max(1), name).map_err(|e| e.to_string())?;
+        std::thread::Builder::new()
+            .name(name.into())
+            .spawn(move || {
+                let send = |item: T| {
+                    let _ = tx.send(TaskNews::Item(item));
+                    wake();
+                };
+                let result = pool.install(|| work(&c, &send));
+                let _ = tx.send(TaskNews::Done(result));
+                wake();
+            })
+            .map_err(|e| format!("cannot start {name}: {e}"))?;
+        Ok(Self { news, control })
+    }
+
+    /// The next message, if any.
+    pub fn poll(&self) -> Option<TaskNews<T>> {
+        self.news.try_recv().ok()
+    }
+}
+
+impl<T> Drop for Task<T> {
+    fn drop(&mut self) {
+        self.control.cancel();
     }
 }
 

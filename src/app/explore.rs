@@ -7,64 +7,15 @@
 //! Both run on a helper thread (not the engine thread, whose pool serves the maps) and stream
 //! their results; a new run or closing the window cancels the old one.
 
-use std::sync::Arc;
-use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
-
 use egui_plot::{HLine, Legend, Line, Plot, PlotPoints, Points};
 
 use super::model::AppState;
-use crate::control::RunControl;
 use crate::engine::{Engine, RunConfig};
+use crate::jobs::{Task, TaskNews};
 use crate::study::{Source, StudySpec};
 use crate::sweep::{
     CostRow, Parameter, Requirement, Row, SweepSpec, Table, Values, cost_of_accuracy, empty_table, run_job,
 };
-
-/// Messages from a helper thread.
-enum Msg<T> {
-    Item(T),
-    Done(Result<(), String>),
-}
-
-/// A helper thread's channel and its cancel switch. The work runs in a pool of its own (all cores
-/// but one, at least one), so a sweep or a cost measurement neither queues behind the engine's
-/// runs in a shared pool nor takes every core from the maps the engine is refining.
-struct Task<T> {
-    rx: Receiver<Msg<T>>,
-    control: Arc<RunControl>,
-}
-
-impl<T: Send + 'static> Task<T> {
-    fn spawn(
-        ctx: &egui::Context,
-        work: impl FnOnce(&RunControl, &dyn Fn(T)) -> Result<(), String> + Send + 'static,
-    ) -> Result<Self, String> {
-        let (tx, rx): (SyncSender<Msg<T>>, _) = sync_channel(64);
-        let control = Arc::new(RunControl::new());
-        let (c, wake) = (control.clone(), ctx.clone());
-        let cores = std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get);
-        let pool = crate::jobs::pool(cores.saturating_sub(1).max(1), "shoal-explore").map_err(|e| e.to_string())?;
-        std::thread::Builder::new()
-            .name("shoal-explore".into())
-            .spawn(move || {
-                let send = |item: T| {
-                    let _ = tx.send(Msg::Item(item));
-                    wake.request_repaint();
-                };
-                let result = pool.install(|| work(&c, &send));
-                let _ = tx.send(Msg::Done(result));
-                wake.request_repaint();
-            })
-            .map_err(|e| format!("cannot start a helper thread: {e}"))?;
-        Ok(Self { rx, control })
-    }
-}
-
-impl<T> Drop for Task<T> {
-    fn drop(&mut self) {
-        self.control.cancel();
-    }
-}
 
 /// Parameters the sweep window offers: (label, path below `instrument.`, unit, default range).
 const SWEEPABLE: [(&str, &str, &str, f64, f64); 8] = [
@@ -142,14 +93,14 @@ impl Explore {
     pub fn poll(&mut self) {
         if let Some(task) = &self.sweep_task {
             let mut finished = None;
-            while let Ok(msg) = task.rx.try_recv() {
+            while let Some(msg) = task.poll() {
                 match msg {
-                    Msg::Item(rows) => {
+                    TaskNews::Item(rows) => {
                         if let Some(t) = &mut self.table {
                             t.rows.extend(rows);
                         }
                     }
-                    Msg::Done(r) => finished = Some(r),
+                    TaskNews::Done(r) => finished = Some(r),
                 }
             }
             if let Some(r) = finished {
@@ -162,10 +113,10 @@ impl Explore {
         }
         if let Some(task) = &self.cost_task {
             let mut finished = None;
-            while let Ok(msg) = task.rx.try_recv() {
+            while let Some(msg) = task.poll() {
                 match msg {
-                    Msg::Item(row) => self.cost_rows.push(row),
-                    Msg::Done(r) => finished = Some(r),
+                    TaskNews::Item(row) => self.cost_rows.push(row),
+                    TaskNews::Done(r) => finished = Some(r),
                 }
             }
             if let Some(r) = finished {
@@ -221,14 +172,19 @@ impl Explore {
         self.table = Some(empty_table(&sweep, crate::sweep::Shard::ALL));
         self.sweep_total = sweep.jobs.len();
         self.sweep_status = format!("running {} runs at 1/{}", sweep.jobs.len(), self.decimation);
-        let task = Task::spawn(ctx, move |control, send| {
-            let mut engine = Engine::new();
-            for job in &sweep.jobs {
-                let (rows, _) = run_job(&mut engine, &sweep, job, control).map_err(|e| e.to_string())?;
-                send(rows);
-            }
-            Ok(())
-        });
+        let wake = ctx.clone();
+        let task = Task::spawn(
+            "shoal-explore",
+            move || wake.request_repaint(),
+            move |control, send| {
+                let mut engine = Engine::new();
+                for job in &sweep.jobs {
+                    let (rows, _) = run_job(&mut engine, &sweep, job, control).map_err(|e| e.to_string())?;
+                    send(rows);
+                }
+                Ok(())
+            },
+        );
         match task {
             Ok(t) => self.sweep_task = Some(t),
             Err(e) => self.sweep_status = e,
@@ -241,9 +197,14 @@ impl Explore {
         base.fidelity.decimation = self.cost_decimation;
         self.cost_rows.clear();
         self.cost_status = format!("measuring at 1/{} …", self.cost_decimation);
-        let task = Task::spawn(ctx, move |control, send| {
-            cost_of_accuracy(&base, control, |row| send(row.clone())).map(|_| ()).map_err(|e| e.to_string())
-        });
+        let wake = ctx.clone();
+        let task = Task::spawn(
+            "shoal-explore",
+            move || wake.request_repaint(),
+            move |control, send| {
+                cost_of_accuracy(&base, control, |row| send(row.clone())).map(|_| ()).map_err(|e| e.to_string())
+            },
+        );
         match task {
             Ok(t) => self.cost_task = Some(t),
             Err(e) => self.cost_status = e,

@@ -4,18 +4,20 @@
 //! atomically; a failed write says why in the app.
 //!
 //! Off the UI thread: the save dialog (rfd, through the desktop's file-chooser portal) and the
-//! writing run on a helper thread and report back through a channel the app polls each frame.
+//! writing run on the `shoal-export` [`Worker`], one export at a time, and report back through
+//! the answers the app polls each frame.
 //! Desktops without a portal get no dialog; the app then offers the typed path.
 
+use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 
 use super::ShoalApp;
 use super::model::AppState;
 use super::raster::{Palette, product_map};
 use crate::colormap::Scale;
 use crate::engine::RunOutput;
+use crate::jobs::{Put, Worker};
 use crate::study::{ComparisonPanel, comparison_figure, write_bytes, write_run};
 
 /// What an export needs: the results on display and the state that made them.
@@ -184,28 +186,103 @@ pub enum News {
     Failed(String),
 }
 
-/// The channel export threads report on.
+/// Where an export goes.
+enum Place {
+    /// Ask in a save dialog, starting at this path.
+    Dialog(PathBuf),
+    /// This path (typed by the user).
+    Path(PathBuf),
+}
+
+/// One export asked for.
+struct Order {
+    what: What,
+    snap: Snapshot,
+    place: Place,
+}
+
+/// Exports run one at a time on the `shoal-export` [`Worker`] (started at the first export):
+/// the dialog and the writing never block a frame. Unlike the maps, no export may be dropped for
+/// a newer one, so orders wait in a queue here and the worker gets the next when it answers.
+#[derive(Default)]
 pub struct Exports {
-    tx: SyncSender<News>,
-    rx: Receiver<News>,
-    /// Exports in flight.
+    worker: Option<Worker<Order, News>>,
+    queue: VecDeque<Order>,
+    busy: bool,
+    failures: Vec<String>,
+    /// Exports asked for and not yet answered.
     pub running: usize,
 }
 
-impl Default for Exports {
-    fn default() -> Self {
-        let (tx, rx) = sync_channel(8);
-        Self { tx, rx, running: 0 }
+impl Exports {
+    /// Ask for a place in a save dialog (a folder for data), then write `snap` there.
+    pub fn with_dialog(&mut self, what: What, snap: Snapshot, start: &Path) {
+        self.order(Order { what, snap, place: Place::Dialog(start.to_path_buf()) });
+    }
+
+    /// Write `snap` to `path` (the typed path).
+    pub fn write_to(&mut self, what: What, snap: Snapshot, path: PathBuf) {
+        self.order(Order { what, snap, place: Place::Path(path) });
+    }
+
+    fn order(&mut self, order: Order) {
+        self.queue.push_back(order);
+        self.running += 1;
+        self.next();
+    }
+
+    /// Hand the worker the next order when it is idle.
+    fn next(&mut self) {
+        if self.busy || self.queue.is_empty() {
+            return;
+        }
+        if self.worker.is_none() {
+            // The app repaints while `running` > 0, so the worker needs no waker.
+            match Worker::spawn("shoal-export", || {}, run) {
+                Ok(w) => self.worker = Some(w),
+                Err(e) => {
+                    self.fail_all(&format!("cannot start the export thread: {e}"));
+                    return;
+                }
+            }
+        }
+        let (Some(worker), Some(order)) = (&self.worker, self.queue.pop_front()) else { return };
+        match worker.request(order) {
+            Put::Queued => self.busy = true,
+            // Nothing else asks this worker, so nothing can be replaced; a closed one has stopped.
+            Put::Replaced(_) | Put::Closed(_) => {
+                self.worker = None;
+                self.fail_all("the export thread stopped");
+            }
+        }
+    }
+
+    fn fail_all(&mut self, why: &str) {
+        self.queue.clear();
+        self.busy = false;
+        self.failures.push(why.to_string());
+    }
+
+    /// The next news, if any.
+    pub fn poll(&mut self) -> Option<News> {
+        if let Some(why) = self.failures.pop() {
+            self.running = 0;
+            return Some(News::Failed(why));
+        }
+        let news = self.worker.as_ref()?.poll()?;
+        self.busy = false;
+        self.running = self.running.saturating_sub(1);
+        self.next();
+        Some(news)
     }
 }
 
-impl Exports {
-    /// Ask for a place in a save dialog (a folder for data), then write `snap` there. Both
-    /// happen on a helper thread.
-    pub fn with_dialog(&mut self, what: What, snap: Snapshot, start: &Path) {
-        let tx = self.tx.clone();
-        let start = start.to_path_buf();
-        let spawned = std::thread::Builder::new().name("shoal-export".into()).spawn(move || {
+/// The worker's job: ask where (when asked to), then write.
+fn run(order: Order) -> News {
+    let Order { what, snap, place } = order;
+    let path = match place {
+        Place::Path(p) => p,
+        Place::Dialog(start) => {
             let dir = start.parent().map(Path::to_path_buf).unwrap_or_default();
             let name = start.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
             let choice = match what {
@@ -220,42 +297,13 @@ impl Exports {
                     .set_directory(&dir)
                     .pick_folder(),
             };
-            let news = match choice {
-                None => News::NoChoice(what),
-                Some(path) => write(what, &snap, &path),
-            };
-            let _ = tx.send(news);
-        });
-        match spawned {
-            Ok(_) => self.running += 1,
-            Err(e) => {
-                self.running +=
-                    usize::from(self.tx.try_send(News::Failed(format!("cannot start the export: {e}"))).is_ok())
+            match choice {
+                Some(p) => p,
+                None => return News::NoChoice(what),
             }
         }
-    }
-
-    /// Write `snap` to `path` on a helper thread (the typed path).
-    pub fn write_to(&mut self, what: What, snap: Snapshot, path: PathBuf) {
-        let tx = self.tx.clone();
-        let spawned = std::thread::Builder::new().name("shoal-export".into()).spawn(move || {
-            let _ = tx.send(write(what, &snap, &path));
-        });
-        match spawned {
-            Ok(_) => self.running += 1,
-            Err(e) => {
-                self.running +=
-                    usize::from(self.tx.try_send(News::Failed(format!("cannot start the export: {e}"))).is_ok())
-            }
-        }
-    }
-
-    /// The next news, if any.
-    pub fn poll(&mut self) -> Option<News> {
-        let news = self.rx.try_recv().ok()?;
-        self.running = self.running.saturating_sub(1);
-        Some(news)
-    }
+    };
+    write(what, &snap, &path)
 }
 
 fn write(what: What, snap: &Snapshot, path: &Path) -> News {
