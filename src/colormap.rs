@@ -118,6 +118,39 @@ impl Scale {
         }
     }
 
+    /// Round tick values inside the scale, for colour bars and axes: 1-2-5 per decade on a log
+    /// scale (1-3 when it spans more than 1.5 decades, decades alone beyond 3), about five
+    /// 1-2-5 steps on a linear one. A scale of zero width gets its one value.
+    #[must_use]
+    pub fn nice_ticks(&self) -> Vec<f64> {
+        if !(self.lo.is_finite() && self.hi.is_finite()) {
+            return Vec::new();
+        }
+        let (lo, hi) = (self.lo.min(self.hi), self.hi.max(self.lo));
+        if hi <= lo {
+            return vec![lo];
+        }
+        let inside = |v: &f64| *v >= lo - 1e-9 * lo.abs() && *v <= hi + 1e-9 * hi.abs();
+        if self.log && lo > 0.0 {
+            let decades = (hi / lo).log10();
+            let mults: &[f64] = if decades > 3.0 {
+                &[1.0]
+            } else if decades > 1.5 {
+                &[1.0, 3.0]
+            } else {
+                &[1.0, 2.0, 5.0]
+            };
+            let (d0, d1) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+            (d0..=d1).flat_map(|d| mults.iter().map(move |m| m * 10f64.powi(d))).filter(inside).collect()
+        } else {
+            let raw = (hi - lo) / 5.0;
+            let mag = 10f64.powf(raw.log10().floor());
+            let step = [1.0, 2.0, 5.0, 10.0].iter().map(|m| m * mag).find(|s| *s >= raw).unwrap_or(raw);
+            let first = (lo / step).ceil() as i64;
+            (first..).map(|k| k as f64 * step).take_while(|v| inside(v)).collect()
+        }
+    }
+
     /// A scale covering the 1st–99th percentiles of the finite (and, for log, positive) values,
     /// logarithmic when they span more than a decade and are all positive.
     #[must_use]
@@ -152,5 +185,19 @@ mod tests {
         assert!((s.value(0.5) - 10.0).abs() < 1e-9);
         let r = Scale::robust((1..=1000).map(f64::from));
         assert!(r.log && (r.lo - 11.0).abs() < 1.0 && (r.hi - 990.0).abs() < 2.0);
+    }
+
+    #[test]
+    fn nice_ticks_are_round_and_inside() {
+        // The colour bar: 0.97 to 31 mg m⁻³ (1.5 decades) → 1, 3, 10, 30.
+        let chl = Scale { lo: 0.9689, hi: 31.37, log: true };
+        assert_eq!(chl.nice_ticks(), vec![1.0, 3.0, 10.0, 30.0]);
+        assert_eq!(Scale { lo: 2.0, hi: 9.0, log: true }.nice_ticks(), vec![2.0, 5.0]);
+        assert_eq!(Scale { lo: 0.01, hi: 100.0, log: true }.nice_ticks(), vec![0.01, 0.1, 1.0, 10.0, 100.0]);
+        assert_eq!(Scale { lo: 0.0, hi: 9.84, log: false }.nice_ticks(), vec![0.0, 2.0, 4.0, 6.0, 8.0]);
+        assert_eq!(Scale { lo: -1.0, hi: 1.0, log: false }.nice_ticks(), vec![-1.0, -0.5, 0.0, 0.5, 1.0]);
+        // Degenerate scales end, with their one value or none.
+        assert_eq!(Scale { lo: 5.0, hi: 5.0, log: false }.nice_ticks(), vec![5.0]);
+        assert!(Scale { lo: f64::NAN, hi: 1.0, log: false }.nice_ticks().is_empty());
     }
 }

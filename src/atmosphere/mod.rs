@@ -31,6 +31,7 @@ mod rayleigh;
 mod rt;
 mod solar;
 mod sos;
+mod sos_transfer;
 mod spec;
 mod wmo;
 

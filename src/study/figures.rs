@@ -92,31 +92,6 @@ fn raster(panel: &Panel, scale: &Scale, w: u32, h: u32, diverging: bool) -> Vec<
     rgb
 }
 
-/// Round tick values inside the scale: 1-2-5 per decade on a log scale (or decades alone when
-/// the scale spans many), five round steps on a linear one.
-fn nice_ticks(scale: &Scale) -> Vec<f64> {
-    let (lo, hi) = (scale.lo.min(scale.hi), scale.hi.max(scale.lo));
-    let inside = |v: &f64| *v >= lo * (1.0 - 1e-9) && *v <= hi * (1.0 + 1e-9);
-    if scale.log && lo > 0.0 {
-        let decades = (hi / lo).log10();
-        let mults: &[f64] = if decades > 3.0 {
-            &[1.0]
-        } else if decades > 1.5 {
-            &[1.0, 3.0]
-        } else {
-            &[1.0, 2.0, 5.0]
-        };
-        let (d0, d1) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
-        (d0..=d1).flat_map(|d| mults.iter().map(move |m| m * 10f64.powi(d))).filter(inside).collect()
-    } else {
-        let raw = (hi - lo) / 5.0;
-        let mag = 10f64.powf(raw.log10().floor());
-        let step = [1.0, 2.0, 5.0, 10.0].iter().map(|m| m * mag).find(|s| *s >= raw).unwrap_or(raw);
-        let first = (lo / step).ceil() as i64;
-        (first..).map(|k| k as f64 * step).take_while(|v| *v <= hi * (1.0 + 1e-9)).collect()
-    }
-}
-
 impl Draw for Maps {
     fn size(&self) -> (u32, u32) {
         (PANEL_W * self.panels.len() as u32 + BAR_W, TITLE_H + PANEL_H + CAPTION_H)
@@ -156,7 +131,7 @@ impl Draw for Maps {
             root.draw(&Rectangle::new([(bx, ya), (bx + 18, yb)], RGBColor(c[0], c[1], c[2]).filled())).map_err(err)?;
         }
         root.draw(&Rectangle::new([(bx, by0), (bx + 18, by1)], BLACK.stroke_width(1))).map_err(err)?;
-        for v in nice_ticks(&self.scale) {
+        for v in self.scale.nice_ticks() {
             let t = self.scale.position(v);
             let y = by1 - ((by1 - by0) as f64 * t).round() as i32;
             root.draw(&PathElement::new(vec![(bx + 18, y), (bx + 23, y)], BLACK)).map_err(err)?;
