@@ -285,8 +285,7 @@ pub fn sweep_window(app: &mut super::ShoalApp, ctx: &egui::Context) {
                 .y_axis_label("chl MAE %")
                 .show(ui, |p| {
                     for (k, s) in curves.series.iter().enumerate() {
-                        let c = crate::colormap::categorical(k);
-                        let colour = egui::Color32::from_rgb(c[0], c[1], c[2]);
+                        let colour = super::theme::category(k);
                         p.line(
                             Line::new(s.label.clone(), PlotPoints::from_iter(s.points.iter().map(|q| [q.x, q.mean])))
                                 .color(colour)
@@ -315,7 +314,7 @@ pub fn sweep_window(app: &mut super::ShoalApp, ctx: &egui::Context) {
                         }
                     }
                     if let Some(r) = &requirement {
-                        p.hline(HLine::new("requirement", r.mae_pct).color(egui::Color32::from_rgb(40, 150, 40)));
+                        p.hline(HLine::new("requirement", r.mae_pct).color(super::theme::PASS));
                     }
                 });
         }

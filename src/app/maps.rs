@@ -160,10 +160,9 @@ fn colour_bar(ui: &mut egui::Ui, palette: Palette, height: f32, label: &str, cla
         Palette::Classes => {
             Some(classes.iter().take(12).enumerate().map(|(k, n)| (categorical(k), n.replace('_', " "))).collect())
         }
-        Palette::Agreement => Some(vec![
-            (super::raster::AGREEMENT_COLOURS[0], "same".into()),
-            (super::raster::AGREEMENT_COLOURS[1], "different".into()),
-        ]),
+        Palette::Agreement => {
+            Some(vec![(super::theme::AGREEMENT[0], "same".into()), (super::theme::AGREEMENT[1], "different".into())])
+        }
         _ => None,
     };
     if let Some(named) = named {
@@ -231,7 +230,7 @@ fn retrieval_banner(app: &mut ShoalApp, ui: &mut egui::Ui) {
     if app.state.retrieval == RetrievalKind::Almi && app.state.scene.needs_bottom_model() {
         ui.horizontal_wrapped(|ui| {
             ui.colored_label(
-                Color32::from_rgb(200, 90, 0),
+                super::theme::NOTICE,
                 format!(
                     "`{}` has a visible bottom (ShallowBottom). aLMI assumes optically deep water: its \
                      concentrations are biased by the bottom, and it retrieves no depth or substrate.",

@@ -11,6 +11,7 @@
 //! | the engine thread's results | [`link`] |
 //! | product maps, colours, A − B | [`raster`] |
 //! | histogram and scatter data, off the UI thread | [`plot_data`] |
+//! | colours and what they mean | [`theme`] |
 //! | presets and instrument editor | `panels` |
 //! | maps with zoom, pan and hover | `maps` |
 //! | metrics table and plots | `plots` |
@@ -31,6 +32,7 @@ pub mod plot_data;
 mod plots;
 pub mod raster;
 mod session;
+pub mod theme;
 mod view;
 mod window;
 

@@ -190,7 +190,7 @@ fn editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
             if let Some((key, message)) = &app.ui.param_error
                 && *key == p.key
             {
-                ui.colored_label(egui::Color32::from_rgb(200, 40, 40), format!("refused: {message}"));
+                ui.colored_label(super::theme::FAIL, format!("refused: {message}"));
                 ui.end_row();
             }
             if v != before {
@@ -267,8 +267,8 @@ fn derived(app: &ShoalApp, ui: &mut egui::Ui) {
 fn graded(ui: &mut egui::Ui, text: String, level: u8, why: &str) {
     let colour = match level {
         0 => ui.visuals().text_color(),
-        1 => egui::Color32::from_rgb(200, 130, 0),
-        _ => egui::Color32::from_rgb(200, 40, 40),
+        1 => super::theme::WARN,
+        _ => super::theme::FAIL,
     };
     ui.colored_label(colour, text).on_hover_text(why);
 }
@@ -280,7 +280,7 @@ fn feasibility(app: &ShoalApp, ui: &mut egui::Ui) {
     // The warnings stay in sight; the figures behind them fold away.
     for (ab, figure) in Ab::BOTH.iter().zip(&figures) {
         for w in figure.iter().flat_map(|f| &f.warnings) {
-            ui.colored_label(egui::Color32::from_rgb(200, 40, 40), format!("{}: {}", ab.label(), w.message));
+            ui.colored_label(super::theme::FAIL, format!("{}: {}", ab.label(), w.message));
         }
     }
     egui::CollapsingHeader::new("Feasibility").default_open(false).show(ui, |ui| {

@@ -2,22 +2,19 @@
 //! and true values, the truth-vs-retrieved scatter, and the SNR per band against its requirement,
 //! with the per-stage timings of the runs on display.
 
-use egui::Color32;
 use egui_plot::{Bar, BarChart, HLine, Legend, Line, Plot, PlotPoints, Points};
 
-use super::ShoalApp;
 use super::plot_data::PlotData;
+use super::{ShoalApp, theme};
 use crate::engine::{RunOutput, StageStatus};
 use crate::metrics::Metrics;
 use crate::study::Check;
 
-const COLOURS: [Color32; 2] = [Color32::from_rgb(228, 26, 28), Color32::from_rgb(55, 126, 184)];
-
 fn pass(ok: bool) -> egui::RichText {
     if ok {
-        egui::RichText::new("pass").color(Color32::from_rgb(40, 150, 40))
+        egui::RichText::new("pass").color(theme::PASS)
     } else {
-        egui::RichText::new("FAIL").color(Color32::from_rgb(200, 40, 40)).strong()
+        egui::RichText::new("FAIL").color(theme::FAIL).strong()
     }
 }
 
@@ -142,12 +139,12 @@ fn histograms_and_scatter(app: &ShoalApp, ui: &mut egui::Ui, width: f32) {
                 let centre = |b: usize| 0.5 * (edges[b] + edges[b + 1]);
                 let bw = (edges[1] - edges[0]) * 0.45;
                 let line: Vec<[f64; 2]> = data.truth.iter().enumerate().map(|(b, n)| [centre(b), *n as f64]).collect();
-                p.line(Line::new("truth", PlotPoints::from(line)).color(Color32::GRAY).width(2.0));
+                p.line(Line::new("truth", PlotPoints::from(line)).color(theme::TRUTH).width(2.0));
                 for (i, c) in data.counts.iter().enumerate() {
                     let offset = if i == 0 { -0.5 * bw } else { 0.5 * bw };
                     let bars: Vec<Bar> =
                         c.iter().enumerate().map(|(b, n)| Bar::new(centre(b) + offset, *n as f64).width(bw)).collect();
-                    p.bar_chart(BarChart::new(if i == 0 { "A" } else { "B" }, bars).color(COLOURS[i]));
+                    p.bar_chart(BarChart::new(if i == 0 { "A" } else { "B" }, bars).color(theme::INSTRUMENT[i]));
                 }
             });
     });
@@ -165,11 +162,11 @@ fn histograms_and_scatter(app: &ShoalApp, ui: &mut egui::Ui, width: f32) {
                     p.points(
                         Points::new(if i == 0 { "A" } else { "B" }, d.clone())
                             .radius(1.2)
-                            .color(COLOURS[i].gamma_multiply(0.6)),
+                            .color(theme::INSTRUMENT[i].gamma_multiply(0.6)),
                     );
                 }
                 if let (Some(lo), Some(hi)) = (edges.first(), edges.last()) {
-                    p.line(Line::new("1:1", PlotPoints::from(vec![[*lo, *lo], [*hi, *hi]])).color(Color32::DARK_GRAY));
+                    p.line(Line::new("1:1", PlotPoints::from(vec![[*lo, *lo], [*hi, *hi]])).color(theme::REFERENCE));
                 }
             });
     });
@@ -201,11 +198,11 @@ fn snr_plot(app: &ShoalApp, ui: &mut egui::Ui, width: f32) {
                         .filter(|r| r.snr_measured.is_finite())
                         .map(|r| [r.centre_nm, r.snr_measured])
                         .collect();
-                    p.line(Line::new(name, PlotPoints::from(line)).color(COLOURS[i]).width(2.0));
-                    p.points(Points::new(format!("{name} measured"), dots).radius(2.5).color(COLOURS[i]));
+                    p.line(Line::new(name, PlotPoints::from(line)).color(theme::INSTRUMENT[i]).width(2.0));
+                    p.points(Points::new(format!("{name} measured"), dots).radius(2.5).color(theme::INSTRUMENT[i]));
                 }
                 if let Some(snr) = app.state.requirements.snr {
-                    p.hline(HLine::new("requirement", snr).color(Color32::from_rgb(40, 150, 40)));
+                    p.hline(HLine::new("requirement", snr).color(theme::PASS));
                 }
             });
     });
@@ -249,10 +246,7 @@ pub fn bottom(app: &mut ShoalApp, ui: &mut egui::Ui) {
                 metrics_table(app, ui);
                 for (i, e) in app.link.errors.iter().enumerate() {
                     if let Some(e) = e {
-                        ui.colored_label(
-                            Color32::from_rgb(200, 40, 40),
-                            format!("{}: {e}", if i == 0 { "A" } else { "B" }),
-                        );
+                        ui.colored_label(theme::FAIL, format!("{}: {e}", if i == 0 { "A" } else { "B" }));
                     }
                 }
             });

@@ -191,9 +191,6 @@ pub enum Palette {
     Agreement,
 }
 
-/// The colours of [`Palette::Agreement`]: same, different.
-pub const AGREEMENT_COLOURS: [[u8; 3]; 2] = [[170, 200, 170], [215, 48, 39]];
-
 /// An RGBA image ready to upload.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Image {
@@ -238,7 +235,7 @@ pub fn colorize(map: &MapData, palette: Palette, max_side: usize) -> Image {
                     Palette::Diverging(bound) => diverging((sum / n as f64) / bound.max(f64::MIN_POSITIVE)),
                     Palette::Classes => categorical(first.unwrap_or(0.0).max(0.0) as usize),
                     // Any disagreement in the block shows (a mean above 0).
-                    Palette::Agreement => AGREEMENT_COLOURS[usize::from(sum > 0.0)],
+                    Palette::Agreement => super::theme::AGREEMENT[usize::from(sum > 0.0)],
                 };
                 [c[0], c[1], c[2], 255]
             };

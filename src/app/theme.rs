@@ -1,0 +1,32 @@
+//! The app's colours, in one place: what each colour means is decided here, and panels, plots
+//! and maps name the meaning (`theme::FAIL`), not the RGB.
+//!
+//! Instrument colours are ColorBrewer Set1's red and blue (Harrower & Brewer 2003, The
+//! Cartographic Journal 40, 27–37), distinct for the common colour-vision deficiencies in
+//! lightness as well as hue.
+
+use egui::Color32;
+
+/// Instrument A, then B (plot lines, bars, points).
+pub const INSTRUMENT: [Color32; 2] = [Color32::from_rgb(228, 26, 28), Color32::from_rgb(55, 126, 184)];
+/// The truth in plots.
+pub const TRUTH: Color32 = Color32::GRAY;
+/// Reference lines (1:1).
+pub const REFERENCE: Color32 = Color32::DARK_GRAY;
+/// A requirement met, and the requirement's line in plots.
+pub const PASS: Color32 = Color32::from_rgb(40, 150, 40);
+/// A requirement failed, an error, a refused value.
+pub const FAIL: Color32 = Color32::from_rgb(200, 40, 40);
+/// Near a limit (feasibility amber).
+pub const WARN: Color32 = Color32::from_rgb(200, 130, 0);
+/// A banner that needs the user's attention (the scene does not suit the retrieval).
+pub const NOTICE: Color32 = Color32::from_rgb(200, 90, 0);
+/// Maps: pixels where A and B agree, then disagree (class products).
+pub const AGREEMENT: [[u8; 3]; 2] = [[170, 200, 170], [215, 48, 39]];
+
+/// A categorical colour (sweep series), from [`crate::colormap::categorical`].
+#[must_use]
+pub fn category(k: usize) -> Color32 {
+    let c = crate::colormap::categorical(k);
+    Color32::from_rgb(c[0], c[1], c[2])
+}
