@@ -214,7 +214,7 @@ impl Explore {
 
 fn labelled_drag(ui: &mut egui::Ui, label: &str, value: &mut f64, speed: f64) {
     let l = ui.label(label);
-    ui.add(egui::DragValue::new(value).speed(speed)).labelled_by(l.id);
+    ui.add(egui::DragValue::new(value).update_while_editing(false).speed(speed)).labelled_by(l.id);
 }
 
 /// The sweep window.
@@ -239,9 +239,9 @@ pub fn sweep_window(app: &mut super::ShoalApp, ctx: &egui::Context) {
             ui.label(SWEEPABLE[e.param].2);
         });
         ui.horizontal(|ui| {
-            ui.add(egui::Slider::new(&mut e.steps, 2..=20).text("Points"));
+            ui.add(egui::Slider::new(&mut e.steps, 2..=20).update_while_editing(false).text("Points"));
             ui.checkbox(&mut e.log, "Log spacing");
-            ui.add(egui::Slider::new(&mut e.seeds, 1..=10).text("Seeds"));
+            ui.add(egui::Slider::new(&mut e.seeds, 1..=10).update_while_editing(false).text("Seeds"));
         });
         ui.horizontal(|ui| {
             egui::ComboBox::from_label("Resolution").selected_text(format!("1/{}", e.decimation)).show_ui(ui, |ui| {

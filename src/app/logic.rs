@@ -41,8 +41,57 @@ pub enum UiCommand {
 }
 
 impl ShoalApp {
-    /// Apply one command.
+    /// Apply one command, asking first when it would replace unsaved edits.
     pub(super) fn apply(&mut self, command: UiCommand) {
+        if let Some(what) = self.edits_lost_by(&command) {
+            self.ui.confirm = Some(Confirm::Discard { command, what });
+            return;
+        }
+        self.apply_confirmed(command);
+    }
+
+    /// The unsaved edits `command` would replace, in words; `None` when it replaces none.
+    fn edits_lost_by(&self, command: &UiCommand) -> Option<String> {
+        let edited = |ab: Ab| {
+            let slot = self.state.slot(ab);
+            let prefix = format!("{} ", ab.label());
+            let changes: Vec<String> =
+                self.state.changes().iter().filter_map(|c| c.strip_prefix(&prefix).map(str::to_string)).collect();
+            slot.modified().then(|| format!("{} ({}: {})", ab.label(), slot.preset, changes.join("; ")))
+        };
+        let lost: Vec<String> = match command {
+            UiCommand::LoadInstrument { ab, .. } => edited(*ab).into_iter().collect(),
+            UiCommand::LoadStudy(_) => [Ab::A, Ab::B].into_iter().filter_map(edited).collect(),
+            _ => Vec::new(),
+        };
+        let target = match command {
+            UiCommand::LoadInstrument { entry, .. } | UiCommand::LoadStudy(entry) => entry.name.as_str(),
+            _ => "",
+        };
+        (!lost.is_empty()).then(|| format!("Loading `{target}` replaces unsaved edits of {}.", lost.join(" and ")))
+    }
+
+    /// Ctrl+Z undoes, Ctrl+Shift+Z and Ctrl+Y redo — unless a text field has the keyboard (it
+    /// keeps its own undo of the text being typed).
+    fn undo_shortcuts(&mut self, ctx: &egui::Context) {
+        use egui::{Key, KeyboardShortcut, Modifiers};
+        if ctx.memory(|m| m.focused().is_some()) {
+            return;
+        }
+        let (redo, undo) = ctx.input_mut(|i| {
+            let redo = i.consume_shortcut(&KeyboardShortcut::new(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z))
+                || i.consume_shortcut(&KeyboardShortcut::new(Modifiers::COMMAND, Key::Y));
+            (redo, i.consume_shortcut(&KeyboardShortcut::new(Modifiers::COMMAND, Key::Z)))
+        });
+        if redo {
+            self.ui.history.redo(&mut self.state);
+        } else if undo {
+            self.ui.history.undo(&mut self.state);
+        }
+    }
+
+    /// Apply one command without asking.
+    pub(super) fn apply_confirmed(&mut self, command: UiCommand) {
         match command {
             UiCommand::LoadInstrument { ab, entry } => match self.library.load_instrument(&entry) {
                 Ok(spec) => *self.state.slot_mut(ab) = Slot::new(&entry.name, spec),
@@ -112,6 +161,7 @@ impl ShoalApp {
     /// The per-frame logic before drawing: submit changed configurations, take results, maps
     /// and export news.
     pub(super) fn tick(&mut self, ctx: &egui::Context) {
+        self.undo_shortcuts(ctx);
         if self.applied_theme != Some(self.state.dark) {
             ctx.set_theme(if self.state.dark { egui::Theme::Dark } else { egui::Theme::Light });
             self.applied_theme = Some(self.state.dark);
@@ -167,7 +217,7 @@ impl ShoalApp {
         let result = match &confirm {
             Confirm::Instrument { name, spec, .. } => self.library.save_instrument(name, spec, overwrite),
             Confirm::Study { name, study } => self.library.save_study(name, study, overwrite),
-            Confirm::Export { .. } => return,
+            Confirm::Export { .. } | Confirm::Discard { .. } => return,
         };
         match result {
             Ok(path) => {

@@ -21,6 +21,7 @@
 pub mod bench;
 pub mod explore;
 mod export;
+mod history;
 pub mod link;
 mod listing;
 mod logic;
@@ -65,6 +66,8 @@ enum Confirm {
     Study { name: String, study: Box<crate::study::StudySpec> },
     /// A typed-path export over existing files.
     Export { what: export::What, path: PathBuf, existing: Vec<PathBuf> },
+    /// A load that would replace unsaved edits (`what`: whose, and which).
+    Discard { command: logic::UiCommand, what: String },
 }
 
 /// Transient UI state (not persisted).
@@ -78,6 +81,7 @@ struct UiState {
     exports: export::Exports,
     explore: explore::Explore,
     frame_times_ms: Vec<f32>,
+    history: history::History,
     zoom: maps::View,
     hover: Option<(usize, usize)>,
     /// A fault injected into A's runs (tests; `SHOAL_FAULT` at start).
@@ -258,6 +262,8 @@ impl ShoalApp {
             self.apply(command);
         }
         self.dialogs(&ctx);
+        // After everything that may change the design this frame: one undo step per settled change.
+        self.ui.history.observe(&self.state, ctx.input(|i| i.pointer.any_down()));
         // The UI thread's work for this frame (layout; not the GPU, not the wait for vsync).
         self.ui.frame_times_ms.push(start.elapsed().as_secs_f32() * 1e3);
         if self.ui.frame_times_ms.len() > 240 {
@@ -276,6 +282,23 @@ impl ShoalApp {
                 mark(&self.state.b),
                 self.state.scene_name
             ));
+            ui.separator();
+            let undo = self.ui.history.undo_text();
+            let clicked = ui
+                .add_enabled(undo.is_some(), egui::Button::new("Undo"))
+                .on_hover_text(undo.map_or_else(|| "Nothing to undo".into(), |t| format!("Undo: {t} (Ctrl+Z)")))
+                .clicked();
+            if clicked {
+                self.ui.history.undo(&mut self.state);
+            }
+            let redo = self.ui.history.redo_text();
+            let clicked = ui
+                .add_enabled(redo.is_some(), egui::Button::new("Redo"))
+                .on_hover_text(redo.map_or_else(|| "Nothing to redo".into(), |t| format!("Redo: {t} (Ctrl+Shift+Z)")))
+                .clicked();
+            if clicked {
+                self.ui.history.redo(&mut self.state);
+            }
             ui.separator();
             if ui
                 .button("Export figure…")
@@ -343,6 +366,7 @@ impl ShoalApp {
                 "These already exist: {}",
                 existing.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ")
             ),
+            Confirm::Discard { what, .. } => format!("{what} Undo (Ctrl+Z) brings them back."),
         };
         let r = egui::Modal::new(egui::Id::unique("shoal-confirm")).show(ctx, |ui| {
             ui.heading("Replace?");
@@ -355,6 +379,7 @@ impl ShoalApp {
                 Some(Confirm::Export { what, path, .. }) => {
                     self.ui.exports.write_to(what, export::Snapshot::of(self), path);
                 }
+                Some(Confirm::Discard { command, .. }) => self.apply_confirmed(command),
                 Some(save) => self.save(save, true),
                 None => {}
             }

@@ -69,10 +69,21 @@ fn band_editor(slot: &mut Slot, ui: &mut egui::Ui) {
         | InstrumentKind::IdealRadiometer { bands }
         | InstrumentKind::FilterImager { bands, .. } => bands,
         InstrumentKind::Spectrograph { start_nm, end_nm, sampling_nm, resolution_nm, .. } => {
-            ui.add(egui::Slider::new(start_nm, 350.0..=700.0).text("First band").suffix(" nm"));
-            ui.add(egui::Slider::new(end_nm, 500.0..=1000.0).text("Last band").suffix(" nm"));
-            ui.add(egui::Slider::new(sampling_nm, 1.0..=30.0).text("Sampling").suffix(" nm"));
-            ui.add(egui::Slider::new(resolution_nm, 1.0..=50.0).text("Resolution").suffix(" nm"));
+            ui.add(
+                egui::Slider::new(start_nm, 350.0..=700.0).update_while_editing(false).text("First band").suffix(" nm"),
+            );
+            ui.add(
+                egui::Slider::new(end_nm, 500.0..=1000.0).update_while_editing(false).text("Last band").suffix(" nm"),
+            );
+            ui.add(
+                egui::Slider::new(sampling_nm, 1.0..=30.0).update_while_editing(false).text("Sampling").suffix(" nm"),
+            );
+            ui.add(
+                egui::Slider::new(resolution_nm, 1.0..=50.0)
+                    .update_while_editing(false)
+                    .text("Resolution")
+                    .suffix(" nm"),
+            );
             return;
         }
     };
@@ -127,8 +138,20 @@ fn band_editor(slot: &mut Slot, ui: &mut egui::Ui) {
             ui.end_row();
             for (i, b) in list.iter_mut().enumerate() {
                 ui.label(format!("{}", i + 1));
-                ui.add(egui::DragValue::new(&mut b.centre_nm).range(380.0..=1000.0).speed(0.5).suffix(" c"));
-                ui.add(egui::DragValue::new(&mut b.fwhm_nm).range(1.0..=100.0).speed(0.2).suffix(" w"));
+                ui.add(
+                    egui::DragValue::new(&mut b.centre_nm)
+                        .update_while_editing(false)
+                        .range(380.0..=1000.0)
+                        .speed(0.5)
+                        .suffix(" c"),
+                );
+                ui.add(
+                    egui::DragValue::new(&mut b.fwhm_nm)
+                        .update_while_editing(false)
+                        .range(1.0..=100.0)
+                        .speed(0.2)
+                        .suffix(" w"),
+                );
                 if ui.small_button("remove").clicked() {
                     remove = Some(i);
                 }
@@ -161,6 +184,7 @@ fn editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
             // Never clamped: a preset outside the slider's span keeps its value, and a typed
             // value outside it is checked against the instrument's documented range below.
             let slider = egui::Slider::new(&mut v, p.range.0..=p.range.1)
+                .update_while_editing(false)
                 .text(p.label)
                 .suffix(p.unit)
                 .logarithmic(p.log)
@@ -395,9 +419,11 @@ fn settings(app: &mut ShoalApp, ui: &mut egui::Ui) {
         }
         ui.horizontal(|ui| {
             let l = ui.label("Scene seed");
-            ui.add(egui::DragValue::new(&mut s.scene_seed).range(0..=1_000_000).speed(1.0)).labelled_by(l.id);
+            ui.add(egui::DragValue::new(&mut s.scene_seed).update_while_editing(false).range(0..=1_000_000).speed(1.0))
+                .labelled_by(l.id);
             let l = ui.label("Noise seed");
-            ui.add(egui::DragValue::new(&mut s.noise_seed).range(0..=1_000_000).speed(1.0)).labelled_by(l.id);
+            ui.add(egui::DragValue::new(&mut s.noise_seed).update_while_editing(false).range(0..=1_000_000).speed(1.0))
+                .labelled_by(l.id);
         });
         let decimations = s.decimations();
         let (preview, finest) = (decimations[0], decimations.last().copied().unwrap_or(1));
@@ -471,7 +497,13 @@ fn optional_limit(ui: &mut egui::Ui, value: &mut Option<f64>, default: f64, rang
             *value = on.then_some(value.unwrap_or(default));
         }
         if let Some(v) = value {
-            ui.add(egui::DragValue::new(v).range(range.lo..=range.hi.min(1e4)).speed(0.5).max_decimals(1));
+            ui.add(
+                egui::DragValue::new(v)
+                    .update_while_editing(false)
+                    .range(range.lo..=range.hi.min(1e4))
+                    .speed(0.5)
+                    .max_decimals(1),
+            );
         }
     });
 }

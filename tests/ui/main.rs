@@ -410,3 +410,109 @@ fn the_histograms_count_every_returned_pixel_and_the_scatter_is_a_capped_sample(
     assert!((data.edges_log10[BINS] - hi).abs() < 1e-12 * hi.abs().max(1.0));
     assert!(!data.scatter[0].is_empty() && data.scatter[0].len() <= SCATTER_POINTS);
 }
+
+/// Typing into a parameter's number changes nothing until Enter: a half-typed `99999` is never
+/// run as 9, 99 and 999 mm. Enter applies it (here refused, out of range), and a valid number
+/// typed after it applies on Enter too.
+#[test]
+fn a_typed_value_is_applied_on_enter_not_per_keystroke() {
+    let lib = temp_library("typing");
+    let mut h = harness("cubesat", 16, &lib);
+    h.step();
+    let type_into_aperture = |h: &mut Harness<'static, ShoalApp>, text: &str| {
+        h.get_by_role_and_label(Role::SpinButton, "Aperture").click();
+        h.step();
+        h.step();
+        // The number is now a text field with its text selected: typing replaces it.
+        for c in text.chars() {
+            h.event(egui::Event::Text(c.to_string()));
+            h.step();
+            assert!(
+                (h.state().state.a.spec.aperture_mm - 60.0).abs() < 1e-9,
+                "after typing `{c}` of `{text}` the aperture is {} mm: applied per keystroke",
+                h.state().state.a.spec.aperture_mm
+            );
+        }
+    };
+    type_into_aperture(&mut h, "99999");
+    assert_eq!(h.state().refused_value(), None, "nothing is judged before Enter");
+    h.key_press(egui::Key::Enter);
+    h.step();
+    h.step();
+    assert!(h.state().refused_value().is_some_and(|m| m.contains("99999")), "{:?}", h.state().refused_value());
+    assert!((h.state().state.a.spec.aperture_mm - 60.0).abs() < 1e-9, "a refused value is not applied");
+
+    type_into_aperture(&mut h, "150");
+    h.key_press(egui::Key::Enter);
+    h.step();
+    h.step();
+    assert!((h.state().state.a.spec.aperture_mm - 150.0).abs() < 1e-9, "{}", h.state().state.a.spec.aperture_mm);
+    let _ = std::fs::remove_dir_all(&lib);
+}
+
+/// Ctrl+Z undoes an edit and Ctrl+Shift+Z redoes it; the Undo button does the same.
+#[test]
+fn undo_and_redo_walk_the_instrument_edits() {
+    let lib = temp_library("undo");
+    let mut h = harness("cubesat", 16, &lib);
+    h.step();
+    h.get_by_role_and_label(Role::Slider, "Aperture").set_value_accesskit(90.0);
+    h.step();
+    h.step();
+    h.get_by_role_and_label(Role::Slider, "Read noise").set_value_accesskit(40.0);
+    h.step();
+    h.step();
+    let aperture = |h: &Harness<'static, ShoalApp>| h.state().state.a.spec.aperture_mm;
+    let read_noise = |h: &Harness<'static, ShoalApp>| h.state().state.a.spec.read_noise_e;
+    assert_eq!((aperture(&h), read_noise(&h)), (90.0, 40.0));
+
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    h.step();
+    h.step();
+    assert_eq!(aperture(&h), 90.0, "the last edit goes first");
+    assert_ne!(read_noise(&h), 40.0);
+    h.get_by_label("Undo").click();
+    h.step();
+    h.step();
+    assert!((aperture(&h) - 60.0).abs() < 1e-9, "back to the preset's 60 mm");
+    assert!(!h.state().state.a.modified(), "the preset as loaded is no longer marked modified");
+
+    h.key_press_modifiers(egui::Modifiers::COMMAND | egui::Modifiers::SHIFT, egui::Key::Z);
+    h.step();
+    h.step();
+    assert_eq!(aperture(&h), 90.0, "redo brings the aperture back");
+    let _ = std::fs::remove_dir_all(&lib);
+}
+
+/// Choosing a preset over an edited instrument asks first; Cancel keeps the edits, Replace
+/// loads the preset.
+#[test]
+fn a_preset_does_not_replace_edits_without_asking() {
+    let lib = temp_library("discard");
+    let mut h = harness("cubesat", 16, &lib);
+    h.step();
+    h.get_by_role_and_label(Role::Slider, "Aperture").set_value_accesskit(90.0);
+    h.step();
+    h.step();
+    pick(&mut h, "Instrument A", "smallsat");
+    assert_eq!(h.state().state.a.spec.aperture_mm, 90.0, "nothing replaced before the answer");
+    assert!(
+        h.query_all_by_label_contains("replaces unsaved edits of A (cubesat: aperture_mm 60.0 → 90.0)")
+            .next()
+            .is_some(),
+        "the question names the edits"
+    );
+    h.get_by_label("Cancel").click();
+    h.step();
+    h.step();
+    assert_eq!(h.state().state.a.preset, "cubesat");
+    assert_eq!(h.state().state.a.spec.aperture_mm, 90.0, "Cancel keeps the edits");
+
+    pick(&mut h, "Instrument A", "smallsat");
+    h.get_by_label("Replace").click();
+    h.step();
+    h.step();
+    assert_eq!(h.state().state.a.preset, "smallsat");
+    assert!((h.state().state.a.spec.aperture_mm - 240.0).abs() < 1e-9);
+    let _ = std::fs::remove_dir_all(&lib);
+}
