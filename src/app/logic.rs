@@ -175,6 +175,11 @@ impl ShoalApp {
         self.listing.poll(&self.library, move || wake.request_repaint());
         if self.link.poll() {
             self.images.invalidate();
+            for (i, shown) in self.link.shown.iter().enumerate() {
+                if let Some(s) = shown {
+                    self.ui.run_seconds.insert((i, s.decimation), s.output.report.total_seconds);
+                }
+            }
         }
         if let Some(r) = &self.raster {
             self.images.request(&self.state, &self.link, r);

@@ -151,7 +151,7 @@ fn product_menu(app: &mut ShoalApp, ui: &mut egui::Ui) {
 fn colour_bar(ui: &mut egui::Ui, palette: Palette, height: f32, label: &str, classes: &[String]) {
     let (rect, _) = ui.allocate_exact_size(Vec2::new(86.0, height), Sense::hover());
     let painter = ui.painter_at(rect);
-    let bar = Rect::from_min_size(rect.min + Vec2::new(4.0, 16.0), Vec2::new(16.0, height - 28.0));
+    let bar = Rect::from_min_size(rect.min + Vec2::new(4.0, 16.0), Vec2::new(16.0, height - 40.0));
     let steps = 64;
     let text = ui.visuals().text_color();
     painter.text(rect.min, egui::Align2::LEFT_TOP, label, egui::FontId::proportional(11.0), text);
@@ -190,22 +190,77 @@ fn colour_bar(ui: &mut egui::Ui, palette: Palette, height: f32, label: &str, cla
         let y0 = bar.max.y - bar.height() * (k + 1) as f32 / steps as f32;
         painter.rect_filled(Rect::from_x_y_ranges(bar.x_range(), y0..=y1), 0.0, Color32::from_rgb(c[0], c[1], c[2]));
     }
-    for k in 0..=4 {
-        let t = f64::from(k) / 4.0;
-        let v = match palette {
-            Palette::Sequential(s) => s.value(t),
-            Palette::Diverging(b) => (2.0 * t - 1.0) * b,
-            Palette::Classes | Palette::Agreement => 0.0,
-        };
+    // Round ticks (1, 3, 10, 30 …) where they fall on the bar, not the bar's odd ends.
+    let ticks: Vec<(f64, f64)> = match palette {
+        Palette::Sequential(s) => s.nice_ticks().into_iter().map(|v| (v, s.position(v))).collect(),
+        Palette::Diverging(b) => crate::colormap::Scale { lo: -b, hi: b, log: false }
+            .nice_ticks()
+            .into_iter()
+            .map(|v| (v, 0.5 * (v / b + 1.0)))
+            .collect(),
+        Palette::Classes | Palette::Agreement => Vec::new(),
+    };
+    let [r, g, b, a] = super::theme::NOT_RETURNED;
+    let swatch = Rect::from_min_size(Pos2::new(bar.min.x, bar.max.y + 6.0), Vec2::splat(10.0));
+    painter.rect_filled(swatch, 0.0, Color32::from_rgba_unmultiplied(r, g, b, a));
+    painter.text(
+        swatch.right_center() + Vec2::new(4.0, 0.0),
+        egui::Align2::LEFT_CENTER,
+        "not returned",
+        egui::FontId::proportional(9.0),
+        text,
+    );
+    for (v, t) in ticks {
+        if !(-1e-9..=1.0 + 1e-9).contains(&t) {
+            continue;
+        }
         let y = bar.max.y - bar.height() * t as f32;
         painter.text(
             Pos2::new(bar.max.x + 4.0, y),
             egui::Align2::LEFT_CENTER,
-            format_value(v),
+            format_tick(v),
             egui::FontId::proportional(10.0),
             text,
         );
     }
+}
+
+/// A scale bar under a map `width_px` wide showing `ground_m` across: the longest round length
+/// (1-2-5 steps, 100 m to 500 km) that fits in 40 % of the width.
+fn scale_bar(ui: &mut egui::Ui, width_px: f32, ground_m: f64) {
+    let (rect, _) = ui.allocate_exact_size(Vec2::new(width_px, 16.0), Sense::hover());
+    if !(ground_m.is_finite() && ground_m > 0.0) {
+        return;
+    }
+    let m_per_px = ground_m / f64::from(width_px.max(1.0));
+    let lengths = [100.0, 200.0, 500.0, 1e3, 2e3, 5e3, 1e4, 2e4, 5e4, 1e5, 2e5, 5e5];
+    let Some(&length) = lengths.iter().rev().find(|&&l| l / m_per_px <= 0.4 * f64::from(width_px)) else { return };
+    let px = (length / m_per_px) as f32;
+    let colour = ui.visuals().text_color();
+    let painter = ui.painter_at(rect);
+    let y = rect.min.y + 4.0;
+    let (x0, x1) = (rect.min.x + 2.0, rect.min.x + 2.0 + px);
+    let stroke = egui::Stroke::new(1.5, colour);
+    painter.line_segment([Pos2::new(x0, y), Pos2::new(x1, y)], stroke);
+    for x in [x0, x1] {
+        painter.line_segment([Pos2::new(x, y - 3.0), Pos2::new(x, y + 3.0)], stroke);
+    }
+    let label = if length >= 1e3 { format!("{} km", length / 1e3) } else { format!("{length} m") };
+    painter.text(Pos2::new(x1 + 6.0, y), egui::Align2::LEFT_CENTER, label, egui::FontId::proportional(10.0), colour);
+}
+
+/// A round tick value as people write it: 30, 3, 0.3, 0.05 (no trailing zeros).
+fn format_tick(v: f64) -> String {
+    let a = v.abs();
+    if a == 0.0 {
+        return "0".into();
+    }
+    if !(1e-3..1e6).contains(&a) {
+        return format!("{v:.0e}");
+    }
+    let decimals = (3 - a.log10().floor() as i32).max(0) as usize;
+    let s = format!("{v:.decimals$}");
+    if s.contains('.') { s.trim_end_matches('0').trim_end_matches('.').to_string() } else { s }
 }
 
 fn format_value(v: f64) -> String {
@@ -284,6 +339,9 @@ pub fn central(app: &mut ShoalApp, ui: &mut egui::Ui) {
     let mut hovered: Option<Pos2> = None;
     let mut view = app.ui.zoom;
     let stale: Vec<bool> = (0..2).map(|i| app.link.stale(i)).collect();
+    // Swath of the instrument whose grid each panel is on (B's panel on B's, the rest on A's).
+    let swath_m: Vec<Option<f64>> =
+        (0..2).map(|i| app.link.shown[i].as_ref().map(|s| s.output.config.instrument.swath_m())).collect();
     ui.horizontal(|ui| {
         for (panel, tex) in &app.images.panels {
             ui.vertical(|ui| {
@@ -295,12 +353,16 @@ pub fn central(app: &mut ShoalApp, ui: &mut egui::Ui) {
                 ui.label(title);
                 let img = &panel.image;
                 let aspect = img.width as f32 / img.height.max(1) as f32;
-                let height = (width / aspect).min(avail.y - 40.0).max(40.0);
+                let height = (width / aspect).min(avail.y - 58.0).max(40.0);
                 let w = (height * aspect).min(width);
                 let (rect, resp) = ui.allocate_exact_size(Vec2::new(w, height), Sense::click_and_drag());
                 let painter = ui.painter_at(rect);
                 painter.rect_filled(rect, 0.0, ui.visuals().extreme_bg_color);
                 painter.image(tex.id(), rect, view.uv(), Color32::WHITE);
+                let swath = if panel.title == "B" { swath_m[1] } else { swath_m[0].or(swath_m[1]) };
+                if let Some(swath) = swath {
+                    scale_bar(ui, w, swath * f64::from(view.uv().width()));
+                }
                 if resp.dragged() {
                     view.centre -= resp.drag_delta() / rect.size() / view.zoom;
                 }
@@ -364,5 +426,14 @@ fn class_names(app: &ShoalApp) -> Vec<String> {
         ProductKind::Substrate => super::raster::substrate_classes(out),
         ProductKind::SiopSet => out.retrievals.first().map(|r| r.product.siop_set_names.clone()).unwrap_or_default(),
         _ => Vec::new(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn ticks_print_as_people_write_them() {
+        let t: Vec<String> = [100.0, 30.0, 3.0, 0.3, 0.05, -0.5, 0.0, 2e-5].map(super::format_tick).to_vec();
+        assert_eq!(t, ["100", "30", "3", "0.3", "0.05", "-0.5", "0", "2e-5"]);
     }
 }

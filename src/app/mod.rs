@@ -82,6 +82,13 @@ struct UiState {
     explore: explore::Explore,
     frame_times_ms: Vec<f32>,
     history: history::History,
+    /// The run in flight (generation, instrument, decimation) and when its progress was first
+    /// seen, for the time estimate.
+    progress_since: Option<((u64, usize, usize), Instant)>,
+    /// Seconds the last finished run took, per instrument and decimation (the estimate's base).
+    run_seconds: std::collections::HashMap<(usize, usize), f64>,
+    /// The metrics table's width as last drawn (the bottom panel lays its plots out by it).
+    metrics_width: Option<f32>,
     zoom: maps::View,
     hover: Option<(usize, usize)>,
     /// A fault injected into A's runs (tests; `SHOAL_FAULT` at start).
@@ -246,7 +253,7 @@ impl ShoalApp {
                 ui.small(m.as_str());
             }
         });
-        egui::Panel::left("left").resizable(true).default_size(340.0).show(ui, |ui| {
+        egui::Panel::left("left").resizable(true).default_size(380.0).show(ui, |ui| {
             egui::ScrollArea::vertical().show(ui, |ui| panels::left(self, ui));
         });
         egui::Panel::bottom("bottom").resizable(true).default_size(300.0).show(ui, |ui| plots::bottom(self, ui));
@@ -392,15 +399,38 @@ impl ShoalApp {
     fn status(&mut self, ui: &mut egui::Ui) {
         match self.link.progress {
             Some(p) if self.link.busy() => {
-                let fraction = if p.total > 0 { p.done as f32 / p.total as f32 } else { 0.0 };
                 let which = if p.index == 0 { "A" } else { "B" };
                 let level = if p.decimation == 1 {
                     "full resolution".to_string()
                 } else {
                     format!("preview 1/{}", p.decimation)
                 };
-                ui.add(
-                    egui::ProgressBar::new(fraction.min(1.0)).desired_width(140.0).text(format!("{which}: {level}")),
+                let key = (self.link.generation(), p.index, p.decimation);
+                let since = match self.ui.progress_since {
+                    Some((k, t)) if k == key => t,
+                    _ => {
+                        let now = Instant::now();
+                        self.ui.progress_since = Some((key, now));
+                        now
+                    }
+                };
+                let elapsed = since.elapsed().as_secs_f64();
+                // The stages add their rows as they start, so the row fraction alone runs ahead;
+                // the last run at this resolution, when there is one, gives the time it takes.
+                let (fraction, text) = match self.ui.run_seconds.get(&(p.index, p.decimation)) {
+                    Some(&last) if last > 0.5 => {
+                        let f = (elapsed / last).min(0.99);
+                        let left = (last - elapsed).max(0.0);
+                        (f, format!("{which}: {level} {:.0} %, ~{left:.0} s left", 100.0 * f))
+                    }
+                    _ => {
+                        let f = if p.total > 0 { p.done as f64 / p.total as f64 } else { 0.0 };
+                        (f.min(0.99), format!("{which}: {level} {:.0} %", 100.0 * f.min(0.99)))
+                    }
+                };
+                ui.add(egui::ProgressBar::new(fraction as f32).desired_width(220.0).text(text)).on_hover_text(
+                    "Estimated from the last run of this instrument at this resolution (its stages may now be \
+                     cached, so it can finish sooner); the first run shows the share of rows done.",
                 );
             }
             _ if self.link.busy() => {
@@ -411,9 +441,10 @@ impl ShoalApp {
             }
         }
         if let Some(ms) = self.median_frame_ms() {
-            ui.label(format!("UI {ms:.1} ms/frame")).on_hover_text(
-                "Median time the UI thread spends laying out a frame (the engine works on its own threads)",
-            );
+            ui.small("diagnostics").on_hover_text(format!(
+                "Diagnostics: the UI thread lays out a frame in {ms:.1} ms (median); the engine works \
+                 on its own threads."
+            ));
         }
     }
 

@@ -176,6 +176,10 @@ fn editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
     });
     let editing = app.state.editing;
     let mut changed: Vec<(&'static str, f64)> = Vec::new();
+    // Wider than egui's 100 px (on which a log slider jumped from 90 to 200 mm in a 20 px drag),
+    // fixed so the panel does not grow with its own content; the number beside each slider drags
+    // 10× finer with Shift held.
+    ui.spacing_mut().slider_width = 160.0;
     egui::Grid::new("params").num_columns(2).show(ui, |ui| {
         for p in &PARAMS {
             let slot = app.state.slot_mut(editing);
@@ -194,6 +198,7 @@ fn editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
             // built only while the pointer is on the slider.
             ui.add(slider).on_hover_ui(|ui| {
                 ui.label(p.tip);
+                ui.label("Type a value and press Enter; drag the number with Shift held for fine steps.");
                 if let Some(r) = crate::ranges::ALL.iter().find(|r| r.field("instrument.") == p.key) {
                     ui.label(format!("Allowed: {} (`{}`)", r.allowed(), p.key));
                 }

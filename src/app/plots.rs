@@ -2,7 +2,7 @@
 //! and true values, the truth-vs-retrieved scatter, and the SNR per band against its requirement,
 //! with the per-stage timings of the runs on display.
 
-use egui_plot::{Bar, BarChart, HLine, Legend, Line, Plot, PlotPoints, Points};
+use egui_plot::{Bar, BarChart, HLine, Line, Plot, PlotPoints, Points};
 
 use super::plot_data::PlotData;
 use super::{ShoalApp, theme};
@@ -59,7 +59,7 @@ fn metrics_table(app: &ShoalApp, ui: &mut egui::Ui) {
                 acc
             });
         for v in &variables {
-            ui.label(v.as_str());
+            ui.label(crate::metrics::label(v)).on_hover_text(format!("`{v}`"));
             for (run, checks) in runs.iter().zip(&checks) {
                 let m: Option<&Metrics> = run.and_then(|o| o.retrievals.first()).and_then(|r| r.metrics.get(v));
                 match m {
@@ -117,8 +117,19 @@ fn metrics_table(app: &ShoalApp, ui: &mut egui::Ui) {
     }
 }
 
-fn histograms_and_scatter(app: &ShoalApp, ui: &mut egui::Ui, width: f32) {
-    // Computed on the raster thread with the maps (app/plot_data.rs): a frame only draws.
+/// A plot's key, above the plot rather than over its data: a coloured swatch and name each.
+fn key(ui: &mut egui::Ui, items: &[(&str, egui::Color32)]) {
+    ui.horizontal(|ui| {
+        for (name, colour) in items {
+            ui.colored_label(*colour, "■");
+            ui.small(*name);
+        }
+    });
+}
+
+/// The histograms of the truth, A and B. Computed on the raster thread with the maps
+/// (app/plot_data.rs): a frame only draws.
+fn histogram(app: &ShoalApp, ui: &mut egui::Ui, width: f32) {
     let empty = PlotData::default();
     let data = app.images.plot().unwrap_or(&empty);
     let name = crate::metrics::name(&data.variable);
@@ -126,10 +137,10 @@ fn histograms_and_scatter(app: &ShoalApp, ui: &mut egui::Ui, width: f32) {
     let edges = &data.edges_log10;
     ui.vertical(|ui| {
         ui.label(format!("{name}: histograms"));
+        key(ui, &[("truth", theme::TRUTH), ("A", theme::INSTRUMENT[0]), ("B", theme::INSTRUMENT[1])]);
         Plot::new("hist")
             .width(width)
             .height(170.0)
-            .legend(Legend::default().position(egui_plot::Corner::LeftTop))
             .x_axis_label(format!("log10 {name} ({unit})"))
             .y_axis_label("pixels")
             .show(ui, |p| {
@@ -148,13 +159,22 @@ fn histograms_and_scatter(app: &ShoalApp, ui: &mut egui::Ui, width: f32) {
                 }
             });
     });
+}
+
+/// Retrieved against true values, log–log, with the 1:1 line.
+fn scatter(app: &ShoalApp, ui: &mut egui::Ui, width: f32) {
+    let empty = PlotData::default();
+    let data = app.images.plot().unwrap_or(&empty);
+    let name = crate::metrics::name(&data.variable);
+    let unit = crate::metrics::unit(&data.variable);
+    let edges = &data.edges_log10;
     ui.vertical(|ui| {
         ui.label(format!("{name}: retrieved vs true"));
+        key(ui, &[("A", theme::INSTRUMENT[0]), ("B", theme::INSTRUMENT[1]), ("1:1", theme::REFERENCE)]);
         Plot::new("scatter")
             .width(width)
             .height(170.0)
             .data_aspect(1.0)
-            .legend(Legend::default().position(egui_plot::Corner::LeftTop))
             .x_axis_label(format!("log10 true ({unit})"))
             .y_axis_label(format!("log10 retrieved ({unit})"))
             .show(ui, |p| {
@@ -175,36 +195,32 @@ fn histograms_and_scatter(app: &ShoalApp, ui: &mut egui::Ui, width: f32) {
 fn snr_plot(app: &ShoalApp, ui: &mut egui::Ui, width: f32) {
     ui.vertical(|ui| {
         ui.label("SNR per band (line: analytic, dots: measured)");
-        Plot::new("snr")
-            .width(width)
-            .height(170.0)
-            .legend(Legend::default().position(egui_plot::Corner::RightBottom))
-            .x_axis_label("nm")
-            .show(ui, |p| {
-                for (i, s) in app.link.shown.iter().enumerate() {
-                    let Some(s) = s else { continue };
-                    let name = if i == 0 { "A" } else { "B" };
-                    let line: Vec<[f64; 2]> = s
-                        .output
-                        .snr
-                        .iter()
-                        .filter(|r| r.snr_analytic.is_finite())
-                        .map(|r| [r.centre_nm, r.snr_analytic])
-                        .collect();
-                    let dots: Vec<[f64; 2]> = s
-                        .output
-                        .snr
-                        .iter()
-                        .filter(|r| r.snr_measured.is_finite())
-                        .map(|r| [r.centre_nm, r.snr_measured])
-                        .collect();
-                    p.line(Line::new(name, PlotPoints::from(line)).color(theme::INSTRUMENT[i]).width(2.0));
-                    p.points(Points::new(format!("{name} measured"), dots).radius(2.5).color(theme::INSTRUMENT[i]));
-                }
-                if let Some(snr) = app.state.requirements.snr {
-                    p.hline(HLine::new("requirement", snr).color(theme::PASS));
-                }
-            });
+        key(ui, &[("A", theme::INSTRUMENT[0]), ("B", theme::INSTRUMENT[1]), ("requirement", theme::PASS)]);
+        Plot::new("snr").width(width).height(170.0).x_axis_label("wavelength (nm)").y_axis_label("SNR").show(ui, |p| {
+            for (i, s) in app.link.shown.iter().enumerate() {
+                let Some(s) = s else { continue };
+                let name = if i == 0 { "A" } else { "B" };
+                let line: Vec<[f64; 2]> = s
+                    .output
+                    .snr
+                    .iter()
+                    .filter(|r| r.snr_analytic.is_finite())
+                    .map(|r| [r.centre_nm, r.snr_analytic])
+                    .collect();
+                let dots: Vec<[f64; 2]> = s
+                    .output
+                    .snr
+                    .iter()
+                    .filter(|r| r.snr_measured.is_finite())
+                    .map(|r| [r.centre_nm, r.snr_measured])
+                    .collect();
+                p.line(Line::new(name, PlotPoints::from(line)).color(theme::INSTRUMENT[i]).width(2.0));
+                p.points(Points::new(format!("{name} measured"), dots).radius(2.5).color(theme::INSTRUMENT[i]));
+            }
+            if let Some(snr) = app.state.requirements.snr {
+                p.hline(HLine::new("requirement", snr).color(theme::PASS));
+            }
+        });
     });
 }
 
@@ -237,11 +253,34 @@ fn timings(app: &ShoalApp, ui: &mut egui::Ui) {
     });
 }
 
-/// The bottom panel.
+/// Smallest width of a plot before the plots move to a row of their own, then wrap.
+const MIN_PLOT_WIDTH: f32 = 230.0;
+const GAP: f32 = 8.0;
+
+/// The bottom panel: the metrics table, then the histogram, scatter and SNR plots beside it
+/// when the window is wide enough for all three at [`MIN_PLOT_WIDTH`], else in rows below it
+/// (three, two or one to a row), so a plot never collapses to a sliver.
 pub fn bottom(app: &mut ShoalApp, ui: &mut egui::Ui) {
     egui::ScrollArea::vertical().show(ui, |ui| {
-        ui.horizontal_top(|ui| {
-            ui.vertical(|ui| {
+        let total = ui.available_width();
+        // The table's width as last drawn (it depends on the products shown).
+        let table = app.ui.metrics_width.unwrap_or(560.0);
+        let beside = total - table - GAP >= 3.0 * MIN_PLOT_WIDTH + 2.0 * GAP;
+        let plots = |app: &ShoalApp, ui: &mut egui::Ui, room: f32| {
+            let per_row = (((room + GAP) / (MIN_PLOT_WIDTH + GAP)).floor() as usize).clamp(1, 3);
+            let width = (room - GAP * (per_row - 1) as f32) / per_row as f32 - 4.0;
+            let draw: [&dyn Fn(&mut egui::Ui); 3] =
+                [&|ui| histogram(app, ui, width), &|ui| scatter(app, ui, width), &|ui| snr_plot(app, ui, width)];
+            for row in draw.chunks(per_row) {
+                ui.horizontal_top(|ui| {
+                    for d in row {
+                        d(ui);
+                    }
+                });
+            }
+        };
+        let metrics = |app: &mut ShoalApp, ui: &mut egui::Ui| {
+            let r = ui.vertical(|ui| {
                 ui.strong("Metrics (log-space MAE and bias, Seegers et al. 2018)");
                 metrics_table(app, ui);
                 for (i, e) in app.link.errors.iter().enumerate() {
@@ -250,10 +289,17 @@ pub fn bottom(app: &mut ShoalApp, ui: &mut egui::Ui) {
                     }
                 }
             });
-            let width = ((ui.available_width() - 24.0) / 3.0).max(160.0);
-            histograms_and_scatter(app, ui, width);
-            snr_plot(app, ui, width);
-        });
+            app.ui.metrics_width = Some(r.response.rect.width());
+        };
+        if beside {
+            ui.horizontal_top(|ui| {
+                metrics(app, ui);
+                plots(app, ui, total - table - GAP);
+            });
+        } else {
+            metrics(app, ui);
+            plots(app, ui, total);
+        }
         timings(app, ui);
     });
 }

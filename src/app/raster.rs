@@ -228,7 +228,7 @@ pub fn colorize(map: &MapData, palette: Palette, max_side: usize) -> Image {
             }
             let i = ((h - 1 - y) * w + x) * 4;
             let colour = if n == 0 {
-                [160, 160, 160, 90]
+                super::theme::NOT_RETURNED
             } else {
                 let c = match palette {
                     Palette::Sequential(_) => viridis(sum / n as f64),

@@ -24,6 +24,9 @@ pub const NOTICE: Color32 = Color32::from_rgb(200, 90, 0);
 /// Maps: pixels where A and B agree, then disagree (class products).
 pub const AGREEMENT: [[u8; 3]; 2] = [[170, 200, 170], [215, 48, 39]];
 
+/// Maps: land and pixels not returned (RGBA, translucent over the panel).
+pub const NOT_RETURNED: [u8; 4] = [160, 160, 160, 90];
+
 /// A categorical colour (sweep series), from [`crate::colormap::categorical`].
 #[must_use]
 pub fn category(k: usize) -> Color32 {
