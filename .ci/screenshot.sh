@@ -1,22 +1,26 @@
 #!/usr/bin/env bash
-# Take the README's screenshot: the real app in a real (virtual) X window, on the built-in
-# default study, saved once the full-resolution results are on screen; then the app quits.
+# Take the README's screenshots: the real app in a real (virtual) X window on the built-in
+# default study, at 1280x720 and 1920x1080, each saved once the full-resolution results are on
+# screen; then the app quits.
 #
-#   bash .ci/screenshot.sh [OUT.png]      (default: assets/screenshot.png)
+#   bash .ci/screenshot.sh [OUT_DIR]      (default: assets/)
 #
+# Writes OUT_DIR/screenshot_1280x720.png and OUT_DIR/screenshot_1920x1080.png.
 # Needs Xvfb and Mesa's software OpenGL (Debian/Ubuntu: apt install xvfb libgl1-mesa-dri).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-out=${1:-assets/screenshot.png}
+out=${1:-assets}
 if ! command -v xvfb-run >/dev/null; then
     echo "error: xvfb-run not found (apt install xvfb libgl1-mesa-dri)" >&2
     exit 2
 fi
 cargo build --release --locked
-# A throw-away preset library and session, so the screenshot does not depend on this user's.
-home=$(mktemp -d)
-trap 'rm -rf "$home"' EXIT
-SHOAL_HOME="$home" XDG_DATA_HOME="$home" LIBGL_ALWAYS_SOFTWARE=1 \
-    timeout 600 xvfb-run -a -s "-screen 0 1600x1000x24" \
-    ./target/release/shoal app --screenshot "$out"
-echo "wrote $out"
+for size in 1280x720 1920x1080; do
+    # A throw-away preset library and session, so the screenshot does not depend on this user's.
+    home=$(mktemp -d)
+    SHOAL_HOME="$home" XDG_DATA_HOME="$home" LIBGL_ALWAYS_SOFTWARE=1 \
+        timeout 900 xvfb-run -a -s "-screen 0 ${size}x24" \
+        ./target/release/shoal app --size "$size" --screenshot "$out/screenshot_$size.png"
+    rm -rf "$home"
+    echo "wrote $out/screenshot_$size.png"
+done

@@ -17,6 +17,7 @@ fn app(args: &AppArgs) -> ExitCode {
     let options = shoal::app::AppOptions {
         fresh: args.fresh || args.screenshot.is_some(),
         screenshot: args.screenshot.clone(),
+        size: args.size,
         ..shoal::app::AppOptions::default()
     };
     match shoal::app::run(options) {

@@ -56,6 +56,8 @@ pub struct AppOptions {
     pub engine_threads: usize,
     /// Start from the built-in default instead of the saved session.
     pub fresh: bool,
+    /// Window size, logical pixels (`None`: 1500 × 960, or the size saved with the session).
+    pub size: Option<[f32; 2]>,
 }
 
 /// A write that would replace a file of the user's, waiting for "Replace" or "Cancel".

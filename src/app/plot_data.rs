@@ -2,7 +2,7 @@
 //! beside the maps, once per (results, variable): a frame only draws them.
 //!
 //! Histograms count every water pixel (the truth) and every returned pixel (A, B) over one
-//! shared set of log10 bins; the scatter plots a strided sample of at most [`SCATTER_POINTS`]
+//! shared set of log10 bins spanning the central 99 % of the values (the rest in the end bins); the scatter plots a strided sample of at most [`SCATTER_POINTS`]
 //! pixels per instrument (enough to show the cloud; egui draws each point every frame).
 
 use std::sync::Arc;
@@ -51,16 +51,29 @@ fn values(out: &RunOutput, variable: &str, step: usize) -> Vec<(f64, Option<f64>
         .collect()
 }
 
+/// The histogram's log10 range: the 0.5th to 99.5th percentile of the truth and retrieved values
+/// (from a strided sample of at most 20 000), so that a few wild retrievals (1e-8 mg m⁻³) do not
+/// squeeze the distribution into two bins; values outside fall into the end bins. The full range
+/// when the percentiles coincide.
+fn bin_range(all: &[Vec<(f64, Option<f64>)>]) -> (f64, f64) {
+    let values = || all.iter().flatten().flat_map(|(t, g)| std::iter::once(*t).chain(*g)).map(f64::log10);
+    let n = values().count();
+    let mut sample: Vec<f64> = values().step_by(n / 20_000 + 1).collect();
+    if sample.is_empty() {
+        return (f64::NAN, f64::NAN);
+    }
+    sample.sort_by(f64::total_cmp);
+    let at = |q: f64| sample[((sample.len() - 1) as f64 * q).round() as usize];
+    let (lo, hi) = (at(0.005), at(0.995));
+    if hi > lo { (lo, hi) } else { values().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v))) }
+}
+
 /// The plot data of `variable` for A's and B's runs.
 #[must_use]
 pub fn plot_data(runs: &[Option<Arc<RunOutput>>; 2], variable: &str) -> PlotData {
     let all: Vec<Vec<(f64, Option<f64>)>> =
         runs.iter().map(|r| r.as_ref().map(|o| values(o, variable, 1)).unwrap_or_default()).collect();
-    let (lo, hi) = all
-        .iter()
-        .flatten()
-        .flat_map(|(t, g)| std::iter::once(*t).chain(*g))
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v.log10()), b.max(v.log10())));
+    let (lo, hi) = bin_range(&all);
     let mut out = PlotData { variable: variable.to_string(), ..PlotData::default() };
     for (k, r) in runs.iter().enumerate() {
         if let Some(o) = r {
@@ -76,7 +89,8 @@ pub fn plot_data(runs: &[Option<Arc<RunOutput>>; 2], variable: &str) -> PlotData
     }
     let width = (hi - lo) / BINS as f64;
     out.edges_log10 = (0..=BINS).map(|b| lo + width * b as f64).collect();
-    let bin = |v: f64| (((v.log10() - lo) / width) as usize).min(BINS - 1);
+    // Clamped: values beyond the range count in the end bins.
+    let bin = |v: f64| (((v.log10() - lo) / width).max(0.0) as usize).min(BINS - 1);
     let first_with_truth = all.iter().position(|v| !v.is_empty());
     out.truth = vec![0; BINS];
     if let Some(f) = first_with_truth {

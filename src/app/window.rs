@@ -35,12 +35,14 @@ pub fn run(options: AppOptions) -> Result<(), String> {
     let native = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default()
             .with_title("Shoal — instrument trade-offs over water")
-            .with_inner_size([1500.0, 960.0])
+            .with_inner_size(options.size.unwrap_or([1500.0, 960.0]))
             .with_min_inner_size([900.0, 600.0])
             .with_icon(icon()),
         // eframe's own file (window size and egui's memory) beside the session, so that with
         // SHOAL_HOME set nothing is written outside it.
         persistence_path: Some(crate::library::home_dir().join("window.ron")),
+        // A size asked for on the command line wins over the one saved with the session.
+        persist_window: options.size.is_none(),
         ..Default::default()
     };
     eframe::run_native("shoal", native, Box::new(move |cc| Ok(Box::new(ShoalApp::new(cc, options)))))

@@ -46,6 +46,21 @@ pub struct AppArgs {
     /// Save the window once the results are in, then quit (implies --fresh).
     #[arg(long, value_name = "FILE.png")]
     pub screenshot: Option<std::path::PathBuf>,
+    /// Window size in logical pixels, WIDTHxHEIGHT (default 1500x960; at least 900x600).
+    #[arg(long, value_name = "WxH", value_parser = parse_size)]
+    pub size: Option<[f32; 2]>,
+}
+
+/// `1280x720` → [1280, 720], within 900x600 to 7680x4320.
+fn parse_size(text: &str) -> Result<[f32; 2], String> {
+    let (w, h) =
+        text.split_once(['x', 'X']).ok_or_else(|| format!("`{text}`: expected WIDTHxHEIGHT, e.g. 1280x720"))?;
+    let num = |s: &str| s.trim().parse::<u32>().map_err(|e| format!("`{text}`: {e}"));
+    let (w, h) = (num(w)?, num(h)?);
+    if !(900..=7680).contains(&w) || !(600..=4320).contains(&h) {
+        return Err(format!("`{text}`: the window must be 900x600 to 7680x4320"));
+    }
+    Ok([w as f32, h as f32])
 }
 
 #[derive(Debug, Subcommand)]
