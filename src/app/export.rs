@@ -18,7 +18,7 @@ use super::raster::{Palette, product_map};
 use crate::colormap::Scale;
 use crate::engine::RunOutput;
 use crate::jobs::{Put, Worker};
-use crate::study::{ComparisonPanel, comparison_figure, write_bytes, write_run};
+use crate::study::{ComparisonPanel, ReviewSlide, SlideSeries, review_slide, write_bytes, write_run};
 
 /// What an export needs: the results on display and the state that made them.
 #[derive(Clone)]
@@ -69,7 +69,92 @@ pub fn write_figure(snap: &Snapshot, stem: &Path) -> Result<Vec<PathBuf>, String
         Palette::Sequential(s) => s,
         _ => Scale { lo: 0.0, hi: 8.0, log: false },
     };
-    let mut table = vec![vec![
+    let table = verdict_table(state, a, b);
+    let changes = state.changes();
+    let caption = vec![
+        format!(
+            "A: {}   B: {}   scene: {}   retrieval: {}   resolution 1/{}",
+            state.a.preset,
+            state.b.preset,
+            state.scene_name,
+            match state.retrieval {
+                super::model::RetrievalKind::Almi => "aLMI",
+                super::model::RetrievalKind::Sambuca => "SAMBUCA",
+            },
+            snap.decimation
+        ),
+        if changes.is_empty() { "Presets unchanged.".into() } else { format!("Changed: {}", changes.join("; ")) },
+        "Shoal: one colour scale for all panels; grey: land or not returned; metrics after Seegers et al. (2018)."
+            .into(),
+    ];
+    let title = format!("{} — {}", state.study_name, kind.label());
+    let variable = kind.variable().unwrap_or("chl_mg_m3");
+    let colour = |i: usize| super::theme::INSTRUMENT[i].to_array();
+    let named =
+        |i: usize, out: &RunOutput| format!("{}: {}", if i == 0 { "A" } else { "B" }, out.config.instrument.name);
+    let snr: Vec<SlideSeries> = [a, b]
+        .iter()
+        .enumerate()
+        .map(|(i, out)| SlideSeries {
+            name: named(i, out),
+            colour: {
+                let c = colour(i);
+                [c[0], c[1], c[2]]
+            },
+            points: out
+                .snr
+                .iter()
+                .filter(|r| r.snr_analytic.is_finite())
+                .map(|r| (r.centre_nm, r.snr_analytic))
+                .collect(),
+        })
+        .collect();
+    let plot = super::plot_data::plot_data(&snap.runs, variable);
+    let scatter: Vec<SlideSeries> = [a, b]
+        .iter()
+        .enumerate()
+        .map(|(i, out)| SlideSeries {
+            name: named(i, out),
+            colour: {
+                let c = colour(i);
+                [c[0], c[1], c[2]]
+            },
+            points: plot.scatter[i].iter().map(|p| (p[0], p[1])).collect(),
+        })
+        .collect();
+    let slide = ReviewSlide {
+        title,
+        caption,
+        label: kind.label().to_string(),
+        scale,
+        diverging: false,
+        panels,
+        snr,
+        snr_requirement: state.requirements.snr,
+        scatter,
+        scatter_label: format!("({})", crate::metrics::unit(variable)),
+        verdicts: table,
+        parameters: parameter_diff(a, b),
+    };
+    let fig = review_slide("comparison", &slide).map_err(|e| e.to_string())?;
+    let png = stem.with_extension("png");
+    let svg = stem.with_extension("svg");
+    write_bytes(&png, &fig.png).map_err(|e| e.to_string())?;
+    write_bytes(&svg, fig.svg.as_bytes()).map_err(|e| e.to_string())?;
+    let mut written = vec![png, svg];
+    for (name, out) in [("A", a), ("B", b)] {
+        let path = PathBuf::from(format!("{}_config_{name}.ron", stem.display()));
+        let text = out.config.to_ron().map_err(|e| e.to_string())?;
+        write_bytes(&path, text.as_bytes()).map_err(|e| e.to_string())?;
+        written.push(path);
+    }
+    Ok(written)
+}
+
+/// The verdict table of the slide: per instrument and product, MAE, bias, returned share and
+/// the judgement of `Requirements::check_run` (the app's and `shoal study`'s).
+fn verdict_table(state: &AppState, a: &RunOutput, b: &RunOutput) -> Vec<Vec<String>> {
+    let mut table: Vec<Vec<String>> = vec![vec![
         "instrument".into(),
         "product".into(),
         "MAE %".into(),
@@ -88,7 +173,12 @@ pub fn write_figure(snap: &Snapshot, stem: &Path) -> Result<Vec<PathBuf>, String
                     checks.iter().filter(|c| c.variable.as_deref() == Some(v.variable.as_str())).collect();
                 let req = match crate::study::verdict(mine.iter().copied()) {
                     Some(ok) => {
-                        let failed: Vec<&str> = mine.iter().filter(|c| !c.pass).map(|c| c.what.as_str()).collect();
+                        let name = crate::metrics::name(&v.variable);
+                        let failed: Vec<String> = mine
+                            .iter()
+                            .filter(|c| !c.pass)
+                            .map(|c| c.what.replace(v.variable.as_str(), name))
+                            .collect();
                         if ok { "pass".into() } else { format!("FAIL: {}", failed.join(", ")) }
                     }
                     None => String::new(),
@@ -100,7 +190,7 @@ pub fn write_figure(snap: &Snapshot, stem: &Path) -> Result<Vec<PathBuf>, String
                 };
                 table.push(vec![
                     format!("{name} ({})", out.config.instrument.name),
-                    format!("{} {}", ret.metrics.product, v.variable),
+                    format!("{} {}", ret.metrics.product, crate::metrics::label(&v.variable)),
                     mae,
                     bias,
                     format!("{:.1}", m.returned_pct),
@@ -109,31 +199,32 @@ pub fn write_figure(snap: &Snapshot, stem: &Path) -> Result<Vec<PathBuf>, String
             }
         }
     }
-    let changes = state.changes();
-    let caption = vec![
-        format!(
-            "A: {}   B: {}   scene: {}   retrieval: {:?}   resolution 1/{}",
-            state.a.preset, state.b.preset, state.scene_name, state.retrieval, snap.decimation
-        ),
-        if changes.is_empty() { "Presets unchanged.".into() } else { format!("Changed: {}", changes.join("; ")) },
-        "Shoal: one colour scale for all panels; grey: land or not returned; metrics after Seegers et al. (2018)."
-            .into(),
-    ];
-    let title = format!("{} — {}", state.study_name, kind.label());
-    let fig = comparison_figure("comparison", &title, kind.label(), scale, false, panels, table, caption)
-        .map_err(|e| e.to_string())?;
-    let png = stem.with_extension("png");
-    let svg = stem.with_extension("svg");
-    write_bytes(&png, &fig.png).map_err(|e| e.to_string())?;
-    write_bytes(&svg, fig.svg.as_bytes()).map_err(|e| e.to_string())?;
-    let mut written = vec![png, svg];
-    for (name, out) in [("A", a), ("B", b)] {
-        let path = PathBuf::from(format!("{}_config_{name}.ron", stem.display()));
-        let text = out.config.to_ron().map_err(|e| e.to_string())?;
-        write_bytes(&path, text.as_bytes()).map_err(|e| e.to_string())?;
-        written.push(path);
+    table
+}
+
+/// The instrument parameters in which the runs of A and B differ: (parameter, A, B), with the
+/// editor's names and units, plus the band count.
+fn parameter_diff(run_a: &RunOutput, run_b: &RunOutput) -> Vec<Vec<String>> {
+    let (a, b) = (&run_a.config.instrument, &run_b.config.instrument);
+    let mut rows = vec![vec!["parameter".to_string(), "A".to_string(), "B".to_string()]];
+    let show = |v: f64| {
+        let a = v.abs();
+        if a == 0.0 || (0.01..1e7).contains(&a) { format!("{}", (v * 1e4).round() / 1e4) } else { format!("{v:.3e}") }
+    };
+    for p in &super::params::PARAMS {
+        let (x, y) = ((p.get)(a) * p.scale, (p.get)(b) * p.scale);
+        if (x - y).abs() > 1e-12 * x.abs().max(y.abs()) {
+            rows.push(vec![p.label.to_string(), format!("{}{}", show(x), p.unit), format!("{}{}", show(y), p.unit)]);
+        }
     }
-    Ok(written)
+    let (ba, bb) = (run_a.response.bands.bands.len().to_string(), run_b.response.bands.bands.len().to_string());
+    if ba != bb {
+        rows.push(vec!["bands".into(), ba, bb]);
+    }
+    if rows.len() == 1 {
+        rows.push(vec!["(none: A and B are the same instrument)".into(), String::new(), String::new()]);
+    }
+    rows
 }
 
 /// Files an export to `path` would replace (empty: nothing of the user's is overwritten).

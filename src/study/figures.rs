@@ -46,10 +46,12 @@ pub(super) struct Maps {
     pub(super) scale: Scale,
     pub(super) panels: Vec<Panel>,
     pub(super) diverging: bool,
+    /// Width and height of each map's panel, px ([`PANEL`] in the study figures).
+    pub(super) panel: (u32, u32),
 }
 
-const PANEL_W: u32 = 300;
-const PANEL_H: u32 = 340;
+/// Panel size of the study figures' maps, px.
+pub(super) const PANEL: (u32, u32) = (300, 340);
 const BAR_W: u32 = 110;
 const TITLE_H: u32 = 34;
 const CAPTION_H: u32 = 26;
@@ -94,7 +96,7 @@ fn raster(panel: &Panel, scale: &Scale, w: u32, h: u32, diverging: bool) -> Vec<
 
 impl Draw for Maps {
     fn size(&self) -> (u32, u32) {
-        (PANEL_W * self.panels.len() as u32 + BAR_W, TITLE_H + PANEL_H + CAPTION_H)
+        (self.panel.0 * self.panels.len() as u32 + BAR_W, TITLE_H + self.panel.1 + CAPTION_H)
     }
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<Vec<Placed>, String> {
@@ -102,12 +104,12 @@ impl Draw for Maps {
         root.draw_text(&self.title, &(FONT, 17).into_font().color(&BLACK), (10, 8)).map_err(err)?;
         let mut placed = Vec::new();
         for (i, p) in self.panels.iter().enumerate() {
-            let x0 = (i as u32 * PANEL_W) as i32;
+            let x0 = (i as u32 * self.panel.0) as i32;
             let y0 = TITLE_H as i32;
             root.draw_text(&p.title, &(FONT, 13).into_font().color(&BLACK), (x0 + 10, y0 + 4)).map_err(err)?;
             // Fit the map in the panel, keeping its aspect ratio.
             let (rows, cols) = p.values.dim();
-            let (bw, bh) = (PANEL_W - 20, PANEL_H - 36);
+            let (bw, bh) = (self.panel.0 - 20, self.panel.1 - 36);
             let aspect = cols as f64 / rows.max(1) as f64;
             let (w, h) = if aspect >= f64::from(bw) / f64::from(bh) {
                 (bw, ((f64::from(bw) / aspect).round() as u32).max(1))
@@ -120,8 +122,8 @@ impl Draw for Maps {
             placed.push(Placed { x: mx, y: my, w, h, rgb: raster(p, &self.scale, w, h, self.diverging) });
         }
         // Colour bar.
-        let bx = (self.panels.len() as u32 * PANEL_W) as i32 + 12;
-        let (by0, by1) = (TITLE_H as i32 + 26, (TITLE_H + PANEL_H) as i32 - 12);
+        let bx = (self.panels.len() as u32 * self.panel.0) as i32 + 12;
+        let (by0, by1) = (TITLE_H as i32 + 26, (TITLE_H + self.panel.1) as i32 - 12);
         let steps = 120;
         for k in 0..steps {
             let t0 = k as f64 / steps as f64;
@@ -146,7 +148,7 @@ impl Draw for Maps {
         root.draw_text(
             &caption,
             &(FONT, 12).into_font().color(&RGBColor(60, 60, 60)),
-            (10, (TITLE_H + PANEL_H) as i32 + 6),
+            (10, (TITLE_H + self.panel.1) as i32 + 6),
         )
         .map_err(err)?;
         Ok(placed)
@@ -356,7 +358,14 @@ fn maps_figure(ctx: &Context<'_>) -> Option<Maps> {
             valid: Array2::from_shape_fn(map.dim(), |(r, c)| ret.product.returned(r, c) && map[[r, c]] > 0.0),
         });
     }
-    Some(Maps { title: ctx.title.clone(), label: ctx.var.label.into(), scale: ctx.scale, panels, diverging: false })
+    Some(Maps {
+        title: ctx.title.clone(),
+        label: ctx.var.label.into(),
+        scale: ctx.scale,
+        panels,
+        diverging: false,
+        panel: PANEL,
+    })
 }
 
 /// The class of a returned pixel for the histograms: chosen SIOP set, or dominant substrate.
@@ -478,6 +487,7 @@ mod tests {
             scale: Scale { lo: 1.0, hi: 240.0, log: true },
             panels: vec![Panel { title: "truth".into(), values, valid }],
             diverging: false,
+            panel: PANEL,
         };
         let f = render("t", &fig).unwrap();
         assert_eq!(&f.png[1..4], b"PNG");

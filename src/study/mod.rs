@@ -15,7 +15,6 @@
 //! ```
 
 mod budget;
-mod comparison;
 mod curves;
 mod figures;
 mod output;
@@ -23,15 +22,16 @@ mod render;
 pub mod reproduction;
 mod requirements;
 mod run;
+mod slide;
 
 pub use budget::{Budget, BudgetLine, Stage, budget_table, error_budget};
-pub use comparison::{ComparisonPanel, comparison_figure};
 pub use curves::{CurvePoint, CurveSeries, Curves, curve_figure, first_crossing};
 pub use figures::figure_set;
 pub use output::{Outputs, metrics_csv, write_bytes, write_run, write_study};
 pub use render::Figure;
 pub use requirements::{Check, ProductRequirement, Requirements, checks_csv, verdict};
 pub use run::{StudyResult, StudyRun, run_study};
+pub use slide::{ComparisonPanel, ReviewSlide, SLIDE, SlideSeries, review_slide};
 
 use std::path::{Path, PathBuf};
 

@@ -207,10 +207,17 @@ fn the_comparison_figure_exports_to_a_typed_path() {
     }
     h.step();
     h.step();
-    let png = std::fs::read(&files[0]).unwrap();
-    assert_eq!(&png[1..4], b"PNG");
+    let png = image::open(&files[0]).unwrap();
+    assert_eq!((png.width(), png.height()), (1920, 1080), "a review slide");
     let svg = std::fs::read_to_string(&files[1]).unwrap();
     assert!(svg.contains("cubesat") && svg.contains("smallsat"), "the caption names the presets");
+    for part in ["SNR per band", "Retrieved against true", "Verdicts", "A and B differ in", "Aperture", "aLMI"] {
+        assert!(svg.contains(part), "the slide has no `{part}`");
+    }
+    assert!(!svg.contains("Almi"), "the retrieval named as in the app");
+    if let Ok(dir) = std::env::var("SHOAL_KEEP_SLIDE") {
+        std::fs::copy(&files[0], std::path::Path::new(&dir).join("review_slide.png")).unwrap();
+    }
     // The configuration beside the figure is the one that ran, and loads back.
     let config = std::fs::read_to_string(&files[2]).unwrap();
     assert!(shoal::engine::RunConfig::from_ron(&config, "A").is_ok());

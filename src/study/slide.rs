@@ -1,0 +1,312 @@
+//! The review slide the app exports for a design review: one 1920 × 1080 page (PNG and SVG)
+//! carrying the comparison whole — truth, A and B maps on one colour scale with its bar, the SNR
+//! per band against the requirement, retrieved against true values, the verdict table, the
+//! parameters that differ between A and B, and a caption naming presets, scene and retrieval.
+//! Text sizes are chosen for a projector (table 16 px, title 30 px at 1920 px wide).
+
+use ndarray::Array2;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::StudyError;
+use super::figures::{Maps, Panel};
+use super::render::{Draw, FONT, Figure, Placed, err, render};
+use crate::colormap::Scale;
+
+/// A map of the slide.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ComparisonPanel {
+    /// Title above the map.
+    pub title: String,
+    /// Values.
+    pub values: Array2<f32>,
+    /// Where values are valid (elsewhere grey).
+    pub valid: Array2<bool>,
+}
+
+/// Slide size, px.
+pub const SLIDE: (u32, u32) = (1920, 1080);
+
+/// A named set of points of one colour (a line of the SNR plot, a cloud of the scatter).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SlideSeries {
+    /// Legend name ("A: cubesat").
+    pub name: String,
+    /// Colour, RGB.
+    pub colour: [u8; 3],
+    /// (x, y) points.
+    pub points: Vec<(f64, f64)>,
+}
+
+/// Everything on the slide.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ReviewSlide {
+    /// Title ("Lake Hume bloom — chl-a").
+    pub title: String,
+    /// Caption lines under everything.
+    pub caption: Vec<String>,
+    /// Colour-bar label ("chl-a (mg m⁻³)").
+    pub label: String,
+    /// The maps' shared scale.
+    pub scale: Scale,
+    /// Diverging palette (differences) rather than viridis.
+    pub diverging: bool,
+    /// Maps, left to right.
+    pub panels: Vec<ComparisonPanel>,
+    /// SNR per band, one series per instrument (x: band centre, nm).
+    pub snr: Vec<SlideSeries>,
+    /// The SNR requirement, if the study states one.
+    pub snr_requirement: Option<f64>,
+    /// Retrieved against true values, log10, one series per instrument.
+    pub scatter: Vec<SlideSeries>,
+    /// The scatter's axis title ("chl-a (mg m⁻³)").
+    pub scatter_label: String,
+    /// Verdict table, first row the header.
+    pub verdicts: Vec<Vec<String>>,
+    /// Parameters that differ between A and B, first row the header.
+    pub parameters: Vec<Vec<String>>,
+}
+
+const MARGIN: i32 = 24;
+const ROW_H: i32 = 24;
+const MAPS_TOP: i32 = 64;
+const MAPS_H: u32 = 620;
+const MAPS_W: u32 = 1230;
+const PLOTS_X: i32 = 1270;
+
+fn text_style(size: u32, colour: RGBColor) -> TextStyle<'static> {
+    (FONT, size).into_font().color(&colour)
+}
+
+/// A table at (x, y), first row bold-ruled; columns as wide as their longest cell.
+fn table<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    rows: &[Vec<String>],
+    (x, y): (i32, i32),
+    max_rows: usize,
+) -> Result<(), String> {
+    let columns = rows.first().map_or(0, Vec::len);
+    // DejaVu Sans at 16 px: about 9 px per character.
+    let widths: Vec<i32> = (0..columns)
+        .map(|c| rows.iter().map(|r| r.get(c).map_or(0, |s| s.chars().count())).max().unwrap_or(0) as i32 * 9 + 22)
+        .collect();
+    for (r, row) in rows.iter().take(max_rows).enumerate() {
+        let ty = y + ROW_H * r as i32;
+        let mut tx = x;
+        for (c, cell) in row.iter().enumerate() {
+            let colour = match cell.as_str() {
+                "pass" => RGBColor(30, 130, 30),
+                s if s.starts_with("FAIL") => RGBColor(190, 30, 30),
+                _ => RGBColor(25, 25, 25),
+            };
+            root.draw_text(cell, &text_style(16, colour), (tx, ty)).map_err(err)?;
+            tx += widths.get(c).copied().unwrap_or(90);
+        }
+        if r == 0 {
+            let ly = ty + ROW_H - 4;
+            root.draw(&PathElement::new(vec![(x, ly), (tx, ly)], BLACK)).map_err(err)?;
+        }
+    }
+    if rows.len() > max_rows {
+        let ty = y + ROW_H * max_rows as i32;
+        let more = format!("… {} more rows in the exported data", rows.len() - max_rows);
+        root.draw_text(&more, &text_style(14, RGBColor(90, 90, 90)), (x, ty)).map_err(err)?;
+    }
+    Ok(())
+}
+
+/// An x–y chart of `series` in `area` (lines for the SNR, dots for the scatter).
+fn chart<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    title: &str,
+    (x_label, y_label): (&str, &str),
+    series: &[SlideSeries],
+    lines: bool,
+    extra: Option<(f64, &str)>,
+) -> Result<(), String> {
+    let all = series.iter().flat_map(|s| s.points.iter());
+    let (mut x0, mut x1, mut y0, mut y1) = all
+        .fold((f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY), |(a, b, c, d), &(x, y)| {
+            (a.min(x), b.max(x), c.min(y), d.max(y))
+        });
+    if let Some((level, _)) = extra {
+        (y0, y1) = (y0.min(level), y1.max(level));
+    }
+    if !(x0.is_finite() && x1 > x0 && y0.is_finite() && y1 > y0) {
+        area.draw_text(&format!("{title}: no data"), &text_style(16, BLACK), (10, 10)).map_err(err)?;
+        return Ok(());
+    }
+    if lines {
+        // SNR from zero, so that a halved SNR looks halved.
+        y0 = y0.min(0.0);
+    } else {
+        // The scatter on one square range, so the 1:1 line is the diagonal.
+        (x0, x1) = (x0.min(y0), x1.max(y1));
+        (y0, y1) = (x0, x1);
+    }
+    let pad = |a: f64, b: f64| 0.04 * (b - a);
+    let (px, py) = (pad(x0, x1), pad(y0, y1));
+    let mut ctx = ChartBuilder::on(area)
+        .caption(title, text_style(18, BLACK))
+        .margin(8)
+        .x_label_area_size(44)
+        .y_label_area_size(64)
+        .build_cartesian_2d((x0 - px)..(x1 + px), (y0 - py)..(y1 + py))
+        .map_err(err)?;
+    let tick = |v: &f64| {
+        let s = format!("{v:.2}");
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    };
+    ctx.configure_mesh()
+        .x_label_formatter(&tick)
+        .y_label_formatter(&tick)
+        .x_desc(x_label)
+        .y_desc(y_label)
+        .label_style(text_style(14, BLACK))
+        .axis_desc_style(text_style(15, BLACK))
+        .light_line_style(RGBColor(235, 235, 235))
+        .draw()
+        .map_err(err)?;
+    for s in series {
+        let colour = RGBColor(s.colour[0], s.colour[1], s.colour[2]);
+        if lines {
+            ctx.draw_series(LineSeries::new(s.points.iter().copied(), colour.stroke_width(2)))
+                .map_err(err)?
+                .label(&s.name)
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], colour.stroke_width(2)));
+            ctx.draw_series(s.points.iter().map(|&p| Circle::new(p, 3, colour.filled()))).map_err(err)?;
+        } else {
+            ctx.draw_series(s.points.iter().map(|&p| Circle::new(p, 1, colour.mix(0.5).filled())))
+                .map_err(err)?
+                .label(&s.name)
+                .legend(move |(x, y)| Circle::new((x + 8, y), 4, colour.filled()));
+        }
+    }
+    if let Some((level, name)) = extra {
+        let green = RGBColor(30, 130, 30);
+        ctx.draw_series(LineSeries::new(vec![(x0 - px, level), (x1 + px, level)], green.stroke_width(2)))
+            .map_err(err)?
+            .label(name)
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], green.stroke_width(2)));
+    }
+    if !lines {
+        let grey = RGBColor(80, 80, 80);
+        ctx.draw_series(LineSeries::new(vec![(x0, x0), (x1, x1)], grey.stroke_width(1)))
+            .map_err(err)?
+            .label("1:1")
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], grey));
+    }
+    // The legend outside the data: in the upper left for the SNR (which falls to the NIR), lower
+    // right for the scatter (whose cloud follows the diagonal).
+    ctx.configure_series_labels()
+        .position(if lines { SeriesLabelPosition::UpperRight } else { SeriesLabelPosition::LowerRight })
+        .label_font(text_style(14, BLACK))
+        .background_style(WHITE.mix(0.85))
+        .border_style(RGBColor(200, 200, 200))
+        .draw()
+        .map_err(err)?;
+    Ok(())
+}
+
+impl Draw for ReviewSlide {
+    fn size(&self) -> (u32, u32) {
+        SLIDE
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<Vec<Placed>, String> {
+        root.fill(&WHITE).map_err(err)?;
+        root.draw_text(&self.title, &text_style(30, BLACK), (MARGIN, 16)).map_err(err)?;
+        // The maps, on the study figures' renderer at slide size.
+        let n = self.panels.len().max(1) as u32;
+        let maps = Maps {
+            title: String::new(),
+            label: self.label.clone(),
+            scale: self.scale,
+            panels: self
+                .panels
+                .iter()
+                .map(|p| Panel { title: p.title.clone(), values: p.values.clone(), valid: p.valid.clone() })
+                .collect(),
+            diverging: self.diverging,
+            panel: ((MAPS_W - 110) / n, MAPS_H - 60),
+        };
+        let (mw, mh) = maps.size();
+        let area = root.clone().shrink((MARGIN / 2, MAPS_TOP), (mw, mh));
+        let mut placed = maps.draw(&area)?;
+        for p in &mut placed {
+            p.x += MARGIN / 2;
+            p.y += MAPS_TOP;
+        }
+        // SNR and scatter down the right-hand side.
+        let snr_area = root.clone().shrink((PLOTS_X, MAPS_TOP), (1920 - PLOTS_X as u32 - 16, 310));
+        let requirement = self.snr_requirement.map(|v| (v, "requirement"));
+        chart(&snr_area, "SNR per band", ("band centre (nm)", "SNR"), &self.snr, true, requirement)?;
+        let scatter_area = root.clone().shrink((PLOTS_X, MAPS_TOP + 325), (1920 - PLOTS_X as u32 - 16, 300));
+        let x = format!("log10 true {}", self.scatter_label);
+        let y = format!("log10 retrieved {}", self.scatter_label);
+        chart(&scatter_area, "Retrieved against true", (&x, &y), &self.scatter, false, None)?;
+        // Tables along the bottom.
+        let table_y = MAPS_TOP + MAPS_H as i32 + 24;
+        root.draw_text("Verdicts", &text_style(20, BLACK), (MARGIN, table_y)).map_err(err)?;
+        table(root, &self.verdicts, (MARGIN, table_y + 30), 9)?;
+        root.draw_text("A and B differ in", &text_style(20, BLACK), (PLOTS_X, table_y)).map_err(err)?;
+        table(root, &self.parameters, (PLOTS_X, table_y + 30), 9)?;
+        let caption_y = 1080 - 24 * self.caption.len() as i32 - 10;
+        for (i, line) in self.caption.iter().enumerate() {
+            root.draw_text(line, &text_style(15, RGBColor(60, 60, 60)), (MARGIN, caption_y + 24 * i as i32))
+                .map_err(err)?;
+        }
+        Ok(placed)
+    }
+}
+
+/// Render `slide` as PNG and SVG (1920 × 1080).
+pub fn review_slide(name: &str, slide: &ReviewSlide) -> Result<Figure, StudyError> {
+    render(name, slide)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_slide_is_1920_by_1080_with_every_part_named() {
+        let values = Array2::from_shape_fn((60, 40), |(r, c)| 1.0 + (r + c) as f32 / 10.0);
+        let valid = Array2::from_elem((60, 40), true);
+        let panel = |t: &str| ComparisonPanel { title: t.into(), values: values.clone(), valid: valid.clone() };
+        let series = |name: &str, k: f64| SlideSeries {
+            name: name.into(),
+            colour: [200, 30, 30],
+            points: (0..8).map(|i| (400.0 + 60.0 * f64::from(i), k * (300.0 - 20.0 * f64::from(i)))).collect(),
+        };
+        let slide = ReviewSlide {
+            title: "Lake Hume bloom — chl-a".into(),
+            caption: vec!["A: cubesat   B: smallsat".into()],
+            label: "chl-a (mg m⁻³)".into(),
+            scale: Scale { lo: 1.0, hi: 8.0, log: true },
+            diverging: false,
+            panels: vec![panel("truth"), panel("A"), panel("B")],
+            snr: vec![series("A: cubesat", 0.3), series("B: smallsat", 1.0)],
+            snr_requirement: Some(100.0),
+            scatter: vec![SlideSeries {
+                name: "A".into(),
+                colour: [30, 30, 200],
+                points: vec![(0.0, 0.1), (1.0, 0.9)],
+            }],
+            scatter_label: "chl-a (mg m⁻³)".into(),
+            verdicts: vec![vec!["product".into(), "A".into()], vec!["chl-a".into(), "FAIL: MAE".into()]],
+            parameters: vec![
+                vec!["parameter".into(), "A".into(), "B".into()],
+                vec!["aperture".into(), "60 mm".into(), "240 mm".into()],
+            ],
+        };
+        let fig = review_slide("slide", &slide).unwrap();
+        let png = image::load_from_memory(&fig.png).unwrap();
+        assert_eq!((png.width(), png.height()), SLIDE);
+        for part in ["SNR per band", "Retrieved against true", "Verdicts", "A and B differ in", "requirement", "60 mm"]
+        {
+            assert!(fig.svg.contains(part), "the slide has no `{part}`");
+        }
+        assert_eq!(fig.svg.matches("<image").count(), 3, "three maps embedded");
+    }
+}
