@@ -134,7 +134,11 @@ pub fn write_figure(snap: &Snapshot, stem: &Path) -> Result<Vec<PathBuf>, String
         scatter,
         scatter_label: format!("({})", crate::metrics::unit(variable)),
         verdicts: table,
-        parameters: parameter_diff(a, b),
+        parameters: super::params::differences(
+            &a.config.instrument,
+            &b.config.instrument,
+            (a.response.bands.bands.len(), b.response.bands.bands.len()),
+        ),
     };
     let fig = review_slide("comparison", &slide).map_err(|e| e.to_string())?;
     let png = stem.with_extension("png");
@@ -200,31 +204,6 @@ fn verdict_table(state: &AppState, a: &RunOutput, b: &RunOutput) -> Vec<Vec<Stri
         }
     }
     table
-}
-
-/// The instrument parameters in which the runs of A and B differ: (parameter, A, B), with the
-/// editor's names and units, plus the band count.
-fn parameter_diff(run_a: &RunOutput, run_b: &RunOutput) -> Vec<Vec<String>> {
-    let (a, b) = (&run_a.config.instrument, &run_b.config.instrument);
-    let mut rows = vec![vec!["parameter".to_string(), "A".to_string(), "B".to_string()]];
-    let show = |v: f64| {
-        let a = v.abs();
-        if a == 0.0 || (0.01..1e7).contains(&a) { format!("{}", (v * 1e4).round() / 1e4) } else { format!("{v:.3e}") }
-    };
-    for p in &super::params::PARAMS {
-        let (x, y) = ((p.get)(a) * p.scale, (p.get)(b) * p.scale);
-        if (x - y).abs() > 1e-12 * x.abs().max(y.abs()) {
-            rows.push(vec![p.label.to_string(), format!("{}{}", show(x), p.unit), format!("{}{}", show(y), p.unit)]);
-        }
-    }
-    let (ba, bb) = (run_a.response.bands.bands.len().to_string(), run_b.response.bands.bands.len().to_string());
-    if ba != bb {
-        rows.push(vec!["bands".into(), ba, bb]);
-    }
-    if rows.len() == 1 {
-        rows.push(vec!["(none: A and B are the same instrument)".into(), String::new(), String::new()]);
-    }
-    rows
 }
 
 /// Files an export to `path` would replace (empty: nothing of the user's is overwritten).

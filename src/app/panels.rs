@@ -250,6 +250,19 @@ fn editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
     let slot = app.state.slot_mut(editing);
     egui::CollapsingHeader::new("Bands").default_open(false).show(ui, |ui| band_editor(slot, ui));
     derived(app, ui);
+    egui::CollapsingHeader::new("A vs B").default_open(false).show(ui, |ui| {
+        let bands = [Ab::A, Ab::B]
+            .map(|ab| app.link.shown[ab.index()].as_ref().map_or(0, |s| s.output.response.bands.bands.len()));
+        let rows = super::params::differences(&app.state.a.spec, &app.state.b.spec, (bands[0], bands[1]));
+        egui::Grid::new("a_vs_b").num_columns(3).striped(true).show(ui, |ui| {
+            for row in &rows {
+                for cell in row {
+                    ui.label(cell);
+                }
+                ui.end_row();
+            }
+        });
+    });
 }
 
 /// A derived figure: its name and how to compute it from an instrument.

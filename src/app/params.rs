@@ -171,3 +171,44 @@ pub const PARAMS: [Param; 13] = [
         set: |s, v| s.altitude_km = v,
     },
 ];
+
+/// The parameters in which instruments `a` and `b` differ, as rows (parameter, A, B) with a
+/// header row, in the editor's names and units; `bands` the band counts. One row saying so when
+/// they do not differ. Shown in the app ("A vs B") and on the review slide.
+#[must_use]
+pub fn differences(a: &InstrumentSpec, b: &InstrumentSpec, bands: (usize, usize)) -> Vec<Vec<String>> {
+    let mut rows = vec![vec!["parameter".to_string(), "A".to_string(), "B".to_string()]];
+    let show = |v: f64| {
+        let m = v.abs();
+        if m == 0.0 || (0.01..1e7).contains(&m) { format!("{}", (v * 1e4).round() / 1e4) } else { format!("{v:.3e}") }
+    };
+    for p in &PARAMS {
+        let (x, y) = ((p.get)(a) * p.scale, (p.get)(b) * p.scale);
+        if (x - y).abs() > 1e-12 * x.abs().max(y.abs()) {
+            rows.push(vec![p.label.to_string(), format!("{}{}", show(x), p.unit), format!("{}{}", show(y), p.unit)]);
+        }
+    }
+    if bands.0 != bands.1 {
+        rows.push(vec!["bands".into(), bands.0.to_string(), bands.1.to_string()]);
+    }
+    if rows.len() == 1 {
+        rows.push(vec!["(none: A and B are the same instrument)".into(), String::new(), String::new()]);
+    }
+    rows
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn differences_list_what_differs_in_the_editors_units() {
+        let a = InstrumentSpec::preset("cubesat").unwrap();
+        let b = InstrumentSpec::preset("smallsat").unwrap();
+        let rows = differences(&a, &b, (8, 8));
+        assert_eq!(rows[0], ["parameter", "A", "B"]);
+        assert!(rows.contains(&vec!["Aperture".into(), "60 mm".into(), "240 mm".into()]), "{rows:?}");
+        assert!(rows.iter().all(|r| r[0] != "Lines"), "equal parameters are not listed");
+        assert_eq!(differences(&a, &a, (8, 8))[1][0], "(none: A and B are the same instrument)");
+    }
+}
