@@ -212,6 +212,75 @@ impl Explore {
     }
 }
 
+/// The sweep's chl MAE curves (A solid, B dashed, seed range faint) against the swept parameter
+/// over its range, on a log axis for a log sweep.
+fn sweep_plot(
+    ui: &mut egui::Ui,
+    curves: &crate::study::Curves,
+    requirement: Option<&Requirement>,
+    x_label: &str,
+    log: bool,
+    range: (f64, f64),
+) {
+    let x_of = move |x: f64| if log { x.log10() } else { x };
+    let x_label = x_label.to_string();
+    let (from, to) = (x_of(range.0), x_of(range.1));
+    Plot::new("sweep-plot")
+        .legend(Legend::default().position(egui_plot::Corner::RightTop))
+        .x_axis_label(if log { format!("{x_label}, log scale") } else { x_label })
+        .y_axis_label("chl log-space MAE (%)")
+        // The axes from the sweep's range, not egui's −100…100 before the first point.
+        .include_x(from.min(to))
+        .include_x(from.max(to))
+        .include_y(0.0)
+        .x_axis_formatter(move |mark, _| significant(if log { 10f64.powf(mark.value) } else { mark.value }, 3))
+        .show(ui, |p| {
+            for (k, s) in curves.series.iter().enumerate() {
+                let colour = super::theme::INSTRUMENT.get(k).copied().unwrap_or_else(|| super::theme::category(k));
+                // B dashed over A: identical instruments stay visible as two curves.
+                let style = if k == 0 { egui_plot::LineStyle::Solid } else { egui_plot::LineStyle::dashed_loose() };
+                p.line(
+                    Line::new(s.label.clone(), PlotPoints::from_iter(s.points.iter().map(|q| [x_of(q.x), q.mean])))
+                        .color(colour)
+                        .style(style)
+                        .width(2.0),
+                );
+                p.line(
+                    Line::new(
+                        format!("{} lowest seed", s.label),
+                        PlotPoints::from_iter(s.points.iter().map(|q| [x_of(q.x), q.lo])),
+                    )
+                    .color(colour.gamma_multiply(0.4)),
+                );
+                p.line(
+                    Line::new(
+                        format!("{} highest seed", s.label),
+                        PlotPoints::from_iter(s.points.iter().map(|q| [x_of(q.x), q.hi])),
+                    )
+                    .color(colour.gamma_multiply(0.4)),
+                );
+                if let (Some(r), Some(x)) = (requirement, s.crossing) {
+                    p.points(
+                        Points::new(format!("{} meets", s.label), vec![[x_of(x), r.mae_pct]]).radius(6.0).color(colour),
+                    );
+                }
+            }
+            if let Some(r) = requirement {
+                p.hline(HLine::new("requirement", r.mae_pct).color(super::theme::PASS));
+            }
+        });
+}
+
+/// `v` to `digits` significant digits, without trailing zeros: 211.151 → "211", 0.0012345 → "0.00123".
+fn significant(v: f64, digits: i32) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let decimals = (digits - 1 - v.abs().log10().floor() as i32).max(0) as usize;
+    let s = format!("{v:.decimals$}");
+    if s.contains('.') { s.trim_end_matches('0').trim_end_matches('.').to_string() } else { s }
+}
+
 fn labelled_drag(ui: &mut egui::Ui, label: &str, value: &mut f64, speed: f64) {
     let l = ui.label(label);
     ui.add(egui::DragValue::new(value).update_while_editing(false).speed(speed)).labelled_by(l.id);
@@ -266,12 +335,24 @@ pub fn sweep_window(app: &mut super::ShoalApp, ctx: &egui::Context) {
         ui.label(format!("{} ({done}/{} runs)", e.sweep_status, e.sweep_total));
         let requirement = chl_requirement(&app.state);
         if let Some(table) = &e.table {
-            let curves = crate::sweep::figure::curves(table, "chl_mg_m3", requirement.as_ref(), false);
+            let mut curves = crate::sweep::figure::curves(table, "chl_mg_m3", requirement.as_ref(), false);
+            // A and B by their slots, not the study's de-duplicated names (`smallsat_2`).
+            if curves.series.len() == 2 {
+                for (s, (ab, slot)) in curves.series.iter_mut().zip([("A", &app.state.a), ("B", &app.state.b)]) {
+                    s.label = format!("{ab}: {}", slot.preset);
+                }
+            }
+            let (name, _, unit, _, _) = SWEEPABLE[e.param];
+            let x_label = if unit.is_empty() { name.to_string() } else { format!("{name} ({unit})") };
+            let log = e.log;
             for s in &curves.series {
                 match (&requirement, s.crossing) {
                     (Some(r), Some(x)) => ui.label(format!(
-                        "{}: meets chl MAE ≤ {:.0} % from {} = {x:.3}",
-                        s.label, r.mae_pct, curves.x_label
+                        "{}: meets chl MAE ≤ {:.0} % from {} = {} {unit}",
+                        s.label,
+                        r.mae_pct,
+                        name.to_lowercase(),
+                        significant(x, 3)
                     )),
                     (Some(r), None) => {
                         ui.label(format!("{}: does not meet chl MAE ≤ {:.0} % (so far)", s.label, r.mae_pct))
@@ -279,44 +360,7 @@ pub fn sweep_window(app: &mut super::ShoalApp, ctx: &egui::Context) {
                     (None, _) => ui.label(format!("{}: no chl MAE requirement set", s.label)),
                 };
             }
-            Plot::new("sweep-plot")
-                .legend(Legend::default())
-                .x_axis_label(curves.x_label.clone())
-                .y_axis_label("chl MAE %")
-                .show(ui, |p| {
-                    for (k, s) in curves.series.iter().enumerate() {
-                        let colour = super::theme::category(k);
-                        p.line(
-                            Line::new(s.label.clone(), PlotPoints::from_iter(s.points.iter().map(|q| [q.x, q.mean])))
-                                .color(colour)
-                                .width(2.0),
-                        );
-                        p.line(
-                            Line::new(
-                                format!("{} lowest seed", s.label),
-                                PlotPoints::from_iter(s.points.iter().map(|q| [q.x, q.lo])),
-                            )
-                            .color(colour.gamma_multiply(0.4)),
-                        );
-                        p.line(
-                            Line::new(
-                                format!("{} highest seed", s.label),
-                                PlotPoints::from_iter(s.points.iter().map(|q| [q.x, q.hi])),
-                            )
-                            .color(colour.gamma_multiply(0.4)),
-                        );
-                        if let (Some(r), Some(x)) = (&requirement, s.crossing) {
-                            p.points(
-                                Points::new(format!("{} meets", s.label), vec![[x, r.mae_pct]])
-                                    .radius(6.0)
-                                    .color(colour),
-                            );
-                        }
-                    }
-                    if let Some(r) = &requirement {
-                        p.hline(HLine::new("requirement", r.mae_pct).color(super::theme::PASS));
-                    }
-                });
+            sweep_plot(ui, &curves, requirement.as_ref(), &x_label, log, (e.from, e.to));
         }
     });
     if start {
@@ -385,4 +429,13 @@ pub fn cost_window(app: &mut super::ShoalApp, ctx: &egui::Context) {
 fn chl_requirement(state: &AppState) -> Option<Requirement> {
     let mae_pct = state.requirements.for_variable("chl_mg_m3")?.mae_pct?;
     Some(Requirement { variable: "chl_mg_m3".into(), mae_pct })
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn crossings_print_to_three_significant_digits() {
+        let t: Vec<String> = [211.151, 0.0012345, 1500.0, 2.5].map(|v| super::significant(v, 3)).to_vec();
+        assert_eq!(t, ["211", "0.00123", "1500", "2.5"]);
+    }
 }
