@@ -49,6 +49,8 @@ pub struct Explore {
     cost_decimation: usize,
     cost_task: Option<Task<CostRow>>,
     cost_rows: Vec<CostRow>,
+    /// Instrument A's configuration the cost rows were measured for (to mark them stale).
+    cost_config: Option<RunConfig>,
     cost_status: String,
 }
 
@@ -71,6 +73,7 @@ impl Default for Explore {
             cost_decimation: 4,
             cost_task: None,
             cost_rows: Vec::new(),
+            cost_config: None,
             cost_status: String::new(),
         }
     }
@@ -193,6 +196,7 @@ impl Explore {
 
     /// Start measuring the cost of accuracy for instrument A at 1/`cost_decimation`.
     pub fn start_cost(&mut self, ctx: &egui::Context, config: RunConfig) {
+        self.cost_config = Some(config.clone());
         let mut base = config;
         base.fidelity.decimation = self.cost_decimation;
         self.cost_rows.clear();
@@ -392,13 +396,21 @@ pub fn cost_window(app: &mut super::ShoalApp, ctx: &egui::Context) {
         });
         let e = &app.ui.explore;
         ui.label(format!("{} ({}/{} settings)", e.cost_status, e.cost_rows.len(), crate::sweep::settings(e.cost_decimation).len()));
+        if e.cost_config.as_ref().is_some_and(|c| Some(c) != app.state.configs().first()) {
+            ui.colored_label(super::theme::NOTICE, "Stale: A, the scene or the retrieval changed since these were measured. Press Measure to redo.");
+        }
         Plot::new("cost-plot").height(220.0).legend(Legend::default()).x_axis_label("time, s").y_axis_label("error, %").show(ui, |p| {
             let same: Vec<[f64; 2]> = e.cost_rows.iter().filter_map(|r| r.chl_pixel_pct.map(|v| [r.seconds, v])).collect();
             let other: Vec<[f64; 2]> = e.cost_rows.iter().filter(|r| r.chl_pixel_pct.is_none()).map(|r| [r.seconds, r.delta_mae_pct.abs()]).collect();
             p.points(Points::new("chl per pixel vs reference (median %)", same).radius(4.0));
             p.points(Points::new("previews: |ΔMAE| (points)", other).radius(4.0).shape(egui_plot::MarkerShape::Diamond));
+            // Each point named by its setting.
+            for r in &e.cost_rows {
+                let y = r.chl_pixel_pct.unwrap_or(r.delta_mae_pct.abs());
+                p.text(egui_plot::Text::new(r.label.clone(), egui_plot::PlotPoint::new(r.seconds, y), format!("  {}", r.label)).anchor(egui::Align2::LEFT_CENTER));
+            }
         });
-        egui::ScrollArea::vertical().show(ui, |ui| {
+        egui::ScrollArea::both().show(ui, |ui| {
             egui::Grid::new("cost-table").striped(true).num_columns(5).show(ui, |ui| {
                 for h in ["setting", "time s", "× ref", "ΔMAE", "chl per pixel %"] {
                     ui.strong(h);
