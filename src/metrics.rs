@@ -200,6 +200,34 @@ pub struct VariableMetrics {
     pub metrics: Metrics,
 }
 
+/// A confusion table of dominant substrates: `counts[t][r]` returned water pixels whose true
+/// dominant substrate is `classes[t]` and whose retrieved one is `classes[r]`. Classes by name,
+/// the truth's first, then any the retrieval knows and the scene does not.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Confusion {
+    /// Class names.
+    pub classes: Vec<String>,
+    /// Counts, (true class, retrieved class).
+    pub counts: Vec<Vec<usize>>,
+}
+
+impl Confusion {
+    /// Share of counted pixels on the diagonal, %.
+    #[must_use]
+    pub fn accuracy_pct(&self) -> Option<f64> {
+        let total: usize = self.counts.iter().flatten().sum();
+        let right: usize = (0..self.classes.len()).map(|i| self.counts[i][i]).sum();
+        (total > 0).then(|| 100.0 * right as f64 / total as f64)
+    }
+
+    /// Of the pixels truly of class `t`, the share retrieved as `t` (the producer's accuracy), %.
+    #[must_use]
+    pub fn recall_pct(&self, t: usize) -> Option<f64> {
+        let row: usize = self.counts.get(t)?.iter().sum();
+        (row > 0).then(|| 100.0 * self.counts[t][t] as f64 / row as f64)
+    }
+}
+
 /// Everything a study reports about one product.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ProductMetrics {
@@ -209,6 +237,8 @@ pub struct ProductMetrics {
     pub variables: Vec<VariableMetrics>,
     /// SAMBUCA: % of returned shallow pixels whose dominant substrate is the true dominant one.
     pub substrate_agreement_pct: Option<f64>,
+    /// SAMBUCA: true against retrieved dominant substrate over the returned water pixels.
+    pub substrate_confusion: Option<Confusion>,
     /// SAMBUCA: depth metrics over the pixels where each substrate truly dominates (where a
     /// substrate the retrieval does not know biases the depth, this shows it).
     pub depth_by_true_substrate: Vec<VariableMetrics>,
@@ -263,6 +293,7 @@ pub fn evaluate(product: &Product, truth: &Truth) -> ProductMetrics {
         },
     ];
     let mut substrate_agreement_pct = None;
+    let mut substrate_confusion = None;
     let mut depth_by_true_substrate = Vec::new();
     if let (Some(depth), Some(true_depth)) = (&product.depth_m, &truth.depth_m) {
         if let Some(tf) = &truth.substrate_fractions {
@@ -294,16 +325,28 @@ pub fn evaluate(product: &Product, truth: &Truth) -> ProductMetrics {
                     .map(|i| names[i].clone())
             };
             let returned: Vec<&(usize, usize)> = water.iter().filter(|&&(r, c)| product.returned(r, c)).collect();
-            if !returned.is_empty() {
-                let agree = returned
-                    .iter()
-                    .filter(|&&&(r, c)| {
-                        let got = dominant(f, &product.substrate_names, r, c);
-                        got.is_some() && got == dominant(tf, &truth.substrate_names, r, c)
-                    })
-                    .count();
-                substrate_agreement_pct = Some(100.0 * agree as f64 / returned.len() as f64);
+            let mut classes = truth.substrate_names.clone();
+            for n in &product.substrate_names {
+                if !classes.contains(n) {
+                    classes.push(n.clone());
+                }
             }
+            let mut counts = vec![vec![0usize; classes.len()]; classes.len()];
+            let index = |name: Option<String>| name.and_then(|n| classes.iter().position(|c| *c == n));
+            for &&(r, c) in &returned {
+                let t = index(dominant(tf, &truth.substrate_names, r, c));
+                let g = index(dominant(f, &product.substrate_names, r, c));
+                if let (Some(t), Some(g)) = (t, g) {
+                    counts[t][g] += 1;
+                }
+            }
+            let confusion = Confusion { classes, counts };
+            // Agreement over every returned pixel (a pixel without a dominant class disagrees).
+            if !returned.is_empty() {
+                let right: usize = (0..confusion.classes.len()).map(|i| confusion.counts[i][i]).sum();
+                substrate_agreement_pct = Some(100.0 * right as f64 / returned.len() as f64);
+            }
+            substrate_confusion = Some(confusion);
         }
     }
     let mut siop_set_counts = vec![0; product.siop_set_names.len()];
@@ -325,6 +368,7 @@ pub fn evaluate(product: &Product, truth: &Truth) -> ProductMetrics {
         product: product.name.clone(),
         variables,
         substrate_agreement_pct,
+        substrate_confusion,
         depth_by_true_substrate,
         siop_sets_used: siop_set_counts.iter().filter(|&&n| n > 0).count(),
         siop_set_counts,
@@ -336,6 +380,15 @@ pub fn evaluate(product: &Product, truth: &Truth) -> ProductMetrics {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_confusion_table_gives_accuracy_and_recall() {
+        let c = Confusion { classes: vec!["sand".into(), "coral".into()], counts: vec![vec![8, 2], vec![1, 9]] };
+        assert_eq!(c.accuracy_pct(), Some(85.0));
+        assert_eq!((c.recall_pct(0), c.recall_pct(1)), (Some(80.0), Some(90.0)));
+        let empty = Confusion { classes: vec!["sand".into()], counts: vec![vec![0]] };
+        assert_eq!((empty.accuracy_pct(), empty.recall_pct(0), empty.recall_pct(5)), (None, None, None));
+    }
 
     #[test]
     fn a_constant_factor_gives_mae_and_bias_of_that_factor() {

@@ -31,6 +31,46 @@ fn verdict_cell(ui: &mut egui::Ui, checks: &[&Check]) {
     }
 }
 
+/// The dominant-substrate confusion tables of A and B (rows: true class; cells: % of the row
+/// retrieved as each class), when the retrieval unmixes substrates.
+fn substrate_tables(app: &ShoalApp, ui: &mut egui::Ui) {
+    for (i, s) in app.link.shown.iter().enumerate() {
+        let Some(c) =
+            s.as_ref().and_then(|s| s.output.retrievals.first()).and_then(|r| r.metrics.substrate_confusion.as_ref())
+        else {
+            continue;
+        };
+        let ab = if i == 0 { "A" } else { "B" };
+        let accuracy = c.accuracy_pct().map_or_else(|| "–".into(), |a| format!("{a:.1} %"));
+        egui::CollapsingHeader::new(format!("{ab}: dominant substrate, {accuracy} of pixels correct"))
+            .id_salt(format!("confusion-{ab}"))
+            .default_open(false)
+            .show(ui, |ui| {
+                egui::Grid::new(format!("confusion-grid-{ab}")).striped(true).show(ui, |ui| {
+                    ui.strong("true \\ retrieved");
+                    for name in &c.classes {
+                        ui.strong(name.replace('_', " "));
+                    }
+                    ui.strong("correct");
+                    ui.end_row();
+                    for (t, row) in c.counts.iter().enumerate() {
+                        let n: usize = row.iter().sum();
+                        if n == 0 {
+                            continue;
+                        }
+                        ui.label(c.classes[t].replace('_', " "));
+                        for &k in row {
+                            ui.label(format!("{:.0} %", 100.0 * k as f64 / n as f64))
+                                .on_hover_text(format!("{k} of {n} pixels"));
+                        }
+                        ui.label(c.recall_pct(t).map_or_else(|| "–".into(), |r| format!("{r:.0} %")));
+                        ui.end_row();
+                    }
+                });
+            });
+    }
+}
+
 fn metrics_table(app: &ShoalApp, ui: &mut egui::Ui) {
     let runs: Vec<Option<&RunOutput>> = app.link.shown.iter().map(|s| s.as_ref().map(|s| s.output.as_ref())).collect();
     // One judgement for app, export and CLI: `Requirements::check_run`.
@@ -283,6 +323,7 @@ pub fn bottom(app: &mut ShoalApp, ui: &mut egui::Ui) {
             let r = ui.vertical(|ui| {
                 ui.strong("Metrics (log-space MAE and bias, Seegers et al. 2018)");
                 metrics_table(app, ui);
+                substrate_tables(app, ui);
                 for (i, e) in app.link.errors.iter().enumerate() {
                     if let Some(e) = e {
                         ui.colored_label(theme::FAIL, format!("{}: {e}", if i == 0 { "A" } else { "B" }));

@@ -227,6 +227,7 @@ pub fn write_study(result: &StudyResult, dir: &Path, figures: bool) -> Result<Ou
                 "siop_set_counts": ret.metrics.siop_set_counts,
                 "siop_sets_used": ret.metrics.siop_sets_used,
                 "substrate_agreement_pct": ret.metrics.substrate_agreement_pct,
+                "substrate_confusion": ret.metrics.substrate_confusion,
                 "depth_by_true_substrate": ret.metrics.depth_by_true_substrate,
                 "failed": ret.metrics.failed,
             }));

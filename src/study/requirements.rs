@@ -224,6 +224,7 @@ mod tests {
             product: "aLMI".into(),
             variables: vec![VariableMetrics { variable: variable.into(), metrics }],
             substrate_agreement_pct: None,
+            substrate_confusion: None,
             depth_by_true_substrate: Vec::new(),
             siop_set_counts: Vec::new(),
             siop_sets_used: 0,

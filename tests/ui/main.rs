@@ -374,6 +374,15 @@ fn a_shallow_scene_under_alm_shows_a_banner_whose_button_switches_to_sambuca() {
     assert_eq!(h.state().state.retrieval, shoal::app::model::RetrievalKind::Sambuca);
     assert_eq!(h.state().state.product, shoal::app::model::ProductKind::Depth, "the depth map is shown");
     assert!(h.query_by_label_contains(banner).is_none(), "the banner goes once SAMBUCA runs");
+    // SAMBUCA unmixes substrates: the substrate accuracy of its confusion table is on screen and
+    // equals the agreement the metrics report.
+    wait_for_engine(&mut h);
+    let metrics = &h.state().link.shown[0].as_ref().expect("A has a result").output.retrievals[0].metrics;
+    let confusion = metrics.substrate_confusion.as_ref().expect("a substrate confusion table");
+    let accuracy = confusion.accuracy_pct().expect("pixels counted");
+    assert!((accuracy - metrics.substrate_agreement_pct.unwrap()).abs() < 1e-9);
+    let title = format!("A: dominant substrate, {accuracy:.1} % of pixels correct");
+    assert!(h.query_by_label_contains(&title).is_some(), "`{title}` is not on screen");
     let _ = std::fs::remove_dir_all(&dir);
 }
 
