@@ -144,8 +144,32 @@ pub fn run(args: &StudyArgs) -> Result<(), CliError> {
     Ok(())
 }
 
-/// The metrics table on stderr: per instrument, product and variable; pixel accounting.
+/// The metrics table on stderr: per instrument, product and variable; pixel accounting; the
+/// spread over the noise seeds when there are several.
 fn print_metrics(result: &crate::study::StudyResult) {
+    print_runs(result);
+    let spread = crate::study::seed_spread(result);
+    if spread.iter().any(|s| s.seeds > 1) {
+        eprintln!(
+            "\nover the noise seeds: {:<12} {:<8} {:<24} {:>16} {:>17} {:>9}",
+            "instrument", "product", "variable", "MAE % (mean ± sd)", "MAE % (min–max)", "bias %"
+        );
+        for s in &spread {
+            eprintln!(
+                "                      {:<12} {:<8} {:<24} {:>16} {:>17} {:>+9.1}",
+                s.instrument,
+                s.product,
+                s.variable,
+                s.mae_text(),
+                format!("{:.1}–{:.1}", s.mae_pct_range.0, s.mae_pct_range.1),
+                s.bias_pct_mean
+            );
+        }
+    }
+}
+
+/// Per run: the metrics of each product and variable, and the pixel accounting.
+fn print_runs(result: &crate::study::StudyResult) {
     eprintln!(
         "{:<12} {:<8} {:<24} {:>9} {:>9} {:>10}  mean |error|, units",
         "instrument", "product", "variable", "MAE %", "bias %", "returned %"

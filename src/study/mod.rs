@@ -23,6 +23,7 @@ pub mod reproduction;
 mod requirements;
 mod run;
 mod slide;
+mod spread;
 
 pub use budget::{Budget, BudgetLine, Stage, budget_table, error_budget};
 pub use curves::{CurvePoint, CurveSeries, Curves, curve_figure, first_crossing};
@@ -32,6 +33,7 @@ pub use render::Figure;
 pub use requirements::{Check, ProductRequirement, Requirements, checks_csv, verdict};
 pub use run::{StudyResult, StudyRun, run_study};
 pub use slide::{ComparisonPanel, ReviewSlide, SLIDE, SlideSeries, review_slide};
+pub use spread::{SeedSpread, seed_spread, seed_spread_csv};
 
 use std::path::{Path, PathBuf};
 

@@ -201,6 +201,7 @@ pub fn metrics_csv(result: &StudyResult) -> String {
 pub fn write_study(result: &StudyResult, dir: &Path, figures: bool) -> Result<Outputs, StudyError> {
     let mut o = Outputs::default();
     text(dir, "metrics.csv", &metrics_csv(result), &mut o)?;
+    text(dir, "seed_spread.csv", &super::seed_spread_csv(&super::seed_spread(result)), &mut o)?;
     if let Some(r) = &result.study.spec.requirements {
         text(dir, "requirements.csv", &super::checks_csv(&r.check(result)), &mut o)?;
     }

@@ -87,3 +87,37 @@ fn the_study_command_runs_a_file_and_refuses_a_broken_one() {
     assert!(err.contains("instrumentz") && err.contains("tiny.ron"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Three noise seeds: the spread table holds each instrument's mean and scatter of the chl MAE,
+/// computed here from the runs by hand; `seed_spread.csv` carries it.
+#[test]
+fn the_seed_spread_is_the_mean_and_scatter_of_the_seeds() {
+    let mut spec = tiny_study();
+    spec.seeds = vec![1, 2, 3];
+    let mut resolved = spec.resolve(None).unwrap();
+    for (_, _, c) in &mut resolved.runs {
+        c.fidelity.decimation = 8;
+    }
+    let result = run_study(&resolved, &RunControl::new(), |_, _| Ok(())).unwrap();
+    assert_eq!(result.runs.len(), 6, "2 instruments × 3 seeds");
+    let spread = shoal::study::seed_spread(&result);
+    let row = spread.iter().find(|s| s.instrument == "cubesat" && s.variable == "chl_mg_m3").unwrap();
+    let maes: Vec<f64> = result
+        .runs
+        .iter()
+        .filter(|r| r.label == "cubesat")
+        .map(|r| r.retrievals[0].metrics.get("chl_mg_m3").unwrap().mae_pct())
+        .collect();
+    assert_eq!((row.seeds, maes.len()), (3, 3));
+    let mean = maes.iter().sum::<f64>() / 3.0;
+    let sd = (maes.iter().map(|m| (m - mean).powi(2)).sum::<f64>() / 2.0).sqrt();
+    assert!((row.mae_pct_mean - mean).abs() < 1e-12 && (row.mae_pct_std - sd).abs() < 1e-12);
+    assert!(sd > 0.0, "three noise draws give three different errors: {maes:?}");
+    assert!(row.mae_pct_range.0 <= mean && mean <= row.mae_pct_range.1);
+    let dir = std::env::temp_dir().join(format!("shoal-spread-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    write_study(&result, &dir, false).unwrap();
+    let csv = std::fs::read_to_string(dir.join("seed_spread.csv")).unwrap();
+    assert!(csv.lines().any(|l| l.starts_with("cubesat,aLMI,chl_mg_m3,3,")), "{csv}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -1,0 +1,111 @@
+//! The spread of the metrics over a study's noise seeds: one seed is one draw of the detector
+//! noise, so a design decision should rest on the mean and on how far the seeds scatter around
+//! it, not on one draw.
+
+use serde::Serialize;
+
+use super::StudyResult;
+
+/// One (instrument, product, variable) over the seeds.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SeedSpread {
+    /// Instrument label.
+    pub instrument: String,
+    /// Product (aLMI, SAMBUCA).
+    pub product: String,
+    /// Variable (`chl_mg_m3`).
+    pub variable: String,
+    /// Seeds with a value (a seed whose product returned no pixel has none).
+    pub seeds: usize,
+    /// Mean log-space MAE over the seeds, %.
+    pub mae_pct_mean: f64,
+    /// Sample standard deviation of the MAE over the seeds, % (0 for one seed).
+    pub mae_pct_std: f64,
+    /// Smallest and largest MAE over the seeds, %.
+    pub mae_pct_range: (f64, f64),
+    /// Mean log-space bias over the seeds, %.
+    pub bias_pct_mean: f64,
+}
+
+impl SeedSpread {
+    /// "37.0 ± 0.4 %" (the ± only when there are two seeds or more).
+    #[must_use]
+    pub fn mae_text(&self) -> String {
+        if self.seeds > 1 {
+            format!("{:.1} ± {:.1} %", self.mae_pct_mean, self.mae_pct_std)
+        } else {
+            format!("{:.1} %", self.mae_pct_mean)
+        }
+    }
+}
+
+/// The spread of every (instrument, product, variable) of `result` over its seeds, in the order
+/// they first appear.
+#[must_use]
+pub fn seed_spread(result: &StudyResult) -> Vec<SeedSpread> {
+    let mut keys: Vec<(String, String, String)> = Vec::new();
+    let mut values: Vec<Vec<(f64, f64)>> = Vec::new();
+    for run in &result.runs {
+        for ret in &run.retrievals {
+            for v in &ret.metrics.variables {
+                let key = (run.label.clone(), ret.metrics.product.clone(), v.variable.clone());
+                let i = keys.iter().position(|k| *k == key).unwrap_or_else(|| {
+                    keys.push(key);
+                    values.push(Vec::new());
+                    keys.len() - 1
+                });
+                if v.metrics.n > 0 && v.metrics.mae_pct().is_finite() {
+                    values[i].push((v.metrics.mae_pct(), v.metrics.bias_pct()));
+                }
+            }
+        }
+    }
+    keys.into_iter()
+        .zip(values)
+        .map(|((instrument, product, variable), v)| {
+            let n = v.len();
+            let mean =
+                |f: fn(&(f64, f64)) -> f64| if n == 0 { f64::NAN } else { v.iter().map(f).sum::<f64>() / n as f64 };
+            let mae_mean = mean(|p| p.0);
+            let std = if n > 1 {
+                (v.iter().map(|p| (p.0 - mae_mean).powi(2)).sum::<f64>() / (n - 1) as f64).sqrt()
+            } else {
+                0.0
+            };
+            let range = v.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| (a.min(p.0), b.max(p.0)));
+            SeedSpread {
+                instrument,
+                product,
+                variable,
+                seeds: n,
+                mae_pct_mean: mae_mean,
+                mae_pct_std: std,
+                mae_pct_range: if n == 0 { (f64::NAN, f64::NAN) } else { range },
+                bias_pct_mean: mean(|p| p.1),
+            }
+        })
+        .collect()
+}
+
+/// The spread as CSV: instrument, product, variable, seeds, MAE mean, std, min, max, bias mean.
+#[must_use]
+pub fn seed_spread_csv(rows: &[SeedSpread]) -> String {
+    let mut s = String::from(
+        "instrument,product,variable,seeds,mae_pct_mean,mae_pct_std,mae_pct_min,mae_pct_max,bias_pct_mean\n",
+    );
+    for r in rows {
+        s.push_str(&format!(
+            "{},{},{},{},{},{},{},{},{}\n",
+            r.instrument,
+            r.product,
+            r.variable,
+            r.seeds,
+            r.mae_pct_mean,
+            r.mae_pct_std,
+            r.mae_pct_range.0,
+            r.mae_pct_range.1,
+            r.bias_pct_mean
+        ));
+    }
+    s
+}
