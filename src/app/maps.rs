@@ -287,7 +287,7 @@ fn retrieval_banner(app: &mut ShoalApp, ui: &mut egui::Ui) {
             ui.colored_label(
                 super::theme::NOTICE,
                 format!(
-                    "`{}` has a visible bottom (ShallowBottom). aLMI assumes optically deep water: its \
+                    "`{}` has a visible bottom (its depth map is shallow). aLMI assumes optically deep water: its \
                      concentrations are biased by the bottom, and it retrieves no depth or substrate.",
                     app.state.scene_name
                 ),

@@ -30,7 +30,7 @@ pub mod model;
 mod panels;
 mod params;
 pub mod plot_data;
-mod plots;
+pub mod plots;
 pub mod raster;
 mod session;
 pub mod theme;
@@ -89,6 +89,8 @@ struct UiState {
     progress_since: Option<((u64, usize, usize), Instant)>,
     /// Seconds the last finished run took, per instrument and decimation (the estimate's base).
     run_seconds: std::collections::HashMap<(usize, usize), f64>,
+    /// Where the histogram, scatter and SNR plots were last drawn (for the layout test).
+    plot_rects: Vec<egui::Rect>,
     /// The metrics table's width as last drawn (the bottom panel lays its plots out by it).
     metrics_width: Option<f32>,
     zoom: maps::View,
@@ -227,6 +229,12 @@ impl ShoalApp {
     #[must_use]
     pub fn error(&self) -> Option<&str> {
         self.ui.error.as_deref()
+    }
+
+    /// Where the histogram, scatter and SNR plots were drawn in the last frame.
+    #[must_use]
+    pub fn plot_rects(&self) -> &[egui::Rect] {
+        &self.ui.plot_rects
     }
 
     /// Median time the UI thread spent drawing each of the last frames, ms.

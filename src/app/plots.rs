@@ -169,7 +169,7 @@ fn key(ui: &mut egui::Ui, items: &[(&str, egui::Color32)]) {
 
 /// The histograms of the truth, A and B. Computed on the raster thread with the maps
 /// (app/plot_data.rs): a frame only draws.
-fn histogram(app: &ShoalApp, ui: &mut egui::Ui, width: f32) {
+fn histogram(app: &ShoalApp, ui: &mut egui::Ui, width: f32) -> egui::Rect {
     let empty = PlotData::default();
     let data = app.images.plot().unwrap_or(&empty);
     let name = crate::metrics::name(&data.variable);
@@ -198,11 +198,13 @@ fn histogram(app: &ShoalApp, ui: &mut egui::Ui, width: f32) {
                     p.bar_chart(BarChart::new(if i == 0 { "A" } else { "B" }, bars).color(theme::INSTRUMENT[i]));
                 }
             });
-    });
+    })
+    .response
+    .rect
 }
 
 /// Retrieved against true values, log–log, with the 1:1 line.
-fn scatter(app: &ShoalApp, ui: &mut egui::Ui, width: f32) {
+fn scatter(app: &ShoalApp, ui: &mut egui::Ui, width: f32) -> egui::Rect {
     let empty = PlotData::default();
     let data = app.images.plot().unwrap_or(&empty);
     let name = crate::metrics::name(&data.variable);
@@ -229,10 +231,12 @@ fn scatter(app: &ShoalApp, ui: &mut egui::Ui, width: f32) {
                     p.line(Line::new("1:1", PlotPoints::from(vec![[*lo, *lo], [*hi, *hi]])).color(theme::REFERENCE));
                 }
             });
-    });
+    })
+    .response
+    .rect
 }
 
-fn snr_plot(app: &ShoalApp, ui: &mut egui::Ui, width: f32) {
+fn snr_plot(app: &ShoalApp, ui: &mut egui::Ui, width: f32) -> egui::Rect {
     ui.vertical(|ui| {
         ui.label("SNR per band (line: analytic, dots: measured)");
         key(ui, &[("A", theme::INSTRUMENT[0]), ("B", theme::INSTRUMENT[1]), ("requirement", theme::PASS)]);
@@ -261,7 +265,9 @@ fn snr_plot(app: &ShoalApp, ui: &mut egui::Ui, width: f32) {
                 p.hline(HLine::new("requirement", snr).color(theme::PASS));
             }
         });
-    });
+    })
+    .response
+    .rect
 }
 
 fn timings(app: &ShoalApp, ui: &mut egui::Ui) {
@@ -294,7 +300,7 @@ fn timings(app: &ShoalApp, ui: &mut egui::Ui) {
 }
 
 /// Smallest width of a plot before the plots move to a row of their own, then wrap.
-const MIN_PLOT_WIDTH: f32 = 230.0;
+pub const MIN_PLOT_WIDTH: f32 = 230.0;
 const GAP: f32 = 8.0;
 
 /// The bottom panel: the metrics table, then the histogram, scatter and SNR plots beside it
@@ -306,18 +312,20 @@ pub fn bottom(app: &mut ShoalApp, ui: &mut egui::Ui) {
         // The table's width as last drawn (it depends on the products shown).
         let table = app.ui.metrics_width.unwrap_or(560.0);
         let beside = total - table - GAP >= 3.0 * MIN_PLOT_WIDTH + 2.0 * GAP;
-        let plots = |app: &ShoalApp, ui: &mut egui::Ui, room: f32| {
+        let plots = |app: &ShoalApp, ui: &mut egui::Ui, room: f32| -> Vec<egui::Rect> {
             let per_row = (((room + GAP) / (MIN_PLOT_WIDTH + GAP)).floor() as usize).clamp(1, 3);
             let width = (room - GAP * (per_row - 1) as f32) / per_row as f32 - 4.0;
-            let draw: [&dyn Fn(&mut egui::Ui); 3] =
+            let draw: [&dyn Fn(&mut egui::Ui) -> egui::Rect; 3] =
                 [&|ui| histogram(app, ui, width), &|ui| scatter(app, ui, width), &|ui| snr_plot(app, ui, width)];
+            let mut rects = Vec::new();
             for row in draw.chunks(per_row) {
                 ui.horizontal_top(|ui| {
                     for d in row {
-                        d(ui);
+                        rects.push(d(ui));
                     }
                 });
             }
+            rects
         };
         let metrics = |app: &mut ShoalApp, ui: &mut egui::Ui| {
             let r = ui.vertical(|ui| {
@@ -332,15 +340,17 @@ pub fn bottom(app: &mut ShoalApp, ui: &mut egui::Ui) {
             });
             app.ui.metrics_width = Some(r.response.rect.width());
         };
-        if beside {
+        let rects = if beside {
             ui.horizontal_top(|ui| {
                 metrics(app, ui);
-                plots(app, ui, total - table - GAP);
-            });
+                plots(app, ui, total - table - GAP)
+            })
+            .inner
         } else {
             metrics(app, ui);
-            plots(app, ui, total);
-        }
+            plots(app, ui, total)
+        };
+        app.ui.plot_rects = rects;
         timings(app, ui);
     });
 }

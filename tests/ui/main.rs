@@ -540,3 +540,27 @@ fn a_preset_does_not_replace_edits_without_asking() {
     assert!((h.state().state.a.spec.aperture_mm - 240.0).abs() < 1e-9);
     let _ = std::fs::remove_dir_all(&lib);
 }
+
+/// At 1280 × 720 and at 1920 × 1080 every plot keeps at least its minimum width and lies inside
+/// the window (at 1280 × 720 the SNR plot used to collapse to a sliver past the right edge).
+#[test]
+fn the_plots_keep_their_minimum_width_from_1280x720_to_1920x1080() {
+    for (w, h_px) in [(1280.0, 720.0), (1920.0, 1080.0)] {
+        let dir = temp_library(&format!("layout{w}"));
+        let mut h = harness("cubesat", 16, &dir);
+        h.set_size(egui::vec2(w, h_px));
+        wait_for_engine(&mut h);
+        h.step();
+        let rects = h.state().plot_rects().to_vec();
+        assert_eq!(rects.len(), 3, "histogram, scatter and SNR plots drawn");
+        for r in &rects {
+            assert!(
+                r.width() >= shoal::app::plots::MIN_PLOT_WIDTH - 8.0,
+                "{w}×{h_px}: a plot is {:.0} px wide, below its minimum",
+                r.width()
+            );
+            assert!(r.right() <= w + 0.5, "{w}×{h_px}: a plot ends at {:.0}, past the window", r.right());
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}
