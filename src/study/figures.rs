@@ -164,7 +164,7 @@ struct Scatter {
 
 impl Draw for Scatter {
     fn size(&self) -> (u32, u32) {
-        (340 * self.panels.len() as u32, 380)
+        (480 * self.panels.len() as u32, 500)
     }
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<Vec<Placed>, String> {
@@ -174,10 +174,10 @@ impl Draw for Scatter {
         let (lo, hi) = (self.edges[0], self.edges[self.edges.len() - 1]);
         for (area, (title, counts)) in rest.split_evenly((1, self.panels.len())).iter().zip(&self.panels) {
             let mut chart = ChartBuilder::on(area)
-                .caption(title, (FONT, 12))
+                .caption(title, (FONT, 16))
                 .margin(8)
-                .x_label_area_size(34)
-                .y_label_area_size(48)
+                .x_label_area_size(44)
+                .y_label_area_size(64)
                 .build_cartesian_2d((lo..hi).log_scale(), (lo..hi).log_scale())
                 .map_err(err)?;
             chart
@@ -187,8 +187,8 @@ impl Draw for Scatter {
                 .y_desc("retrieved")
                 .x_label_formatter(&|v| tick_label(*v))
                 .y_label_formatter(&|v| tick_label(*v))
-                .label_style((FONT, 10))
-                .axis_desc_style((FONT, 11))
+                .label_style((FONT, 14))
+                .axis_desc_style((FONT, 15))
                 .draw()
                 .map_err(err)?;
             let max = counts.iter().flatten().copied().max().unwrap_or(1).max(1) as f64;
@@ -220,9 +220,16 @@ struct Histograms {
     panels: Vec<(String, Vec<Vec<usize>>, Vec<usize>)>,
 }
 
+/// The factor on the tallest bar that leaves room above it for a legend of `entries` lines, so
+/// the legend (top right, 19 px a line at 14 px text) covers no data in a ~390 px plot.
+fn legend_headroom(entries: usize) -> f64 {
+    let legend_px = 19.0 * entries as f64 + 24.0;
+    1.0 / (1.0 - (legend_px / 390.0).min(0.65))
+}
+
 impl Draw for Histograms {
     fn size(&self) -> (u32, u32) {
-        (380 * self.panels.len() as u32, 380)
+        (520 * self.panels.len() as u32, 500)
     }
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<Vec<Placed>, String> {
@@ -238,13 +245,13 @@ impl Draw for Histograms {
             .max()
             .unwrap_or(1)
             .max(1) as f64
-            * 1.08;
+            * legend_headroom(self.panels.iter().map(|(_, c, _)| c.len()).max().unwrap_or(0) + 1);
         for (area, (title, counts, truth)) in rest.split_evenly((1, self.panels.len())).iter().zip(&self.panels) {
             let mut chart = ChartBuilder::on(area)
-                .caption(title, (FONT, 12))
+                .caption(title, (FONT, 16))
                 .margin(8)
-                .x_label_area_size(34)
-                .y_label_area_size(52)
+                .x_label_area_size(44)
+                .y_label_area_size(70)
                 .build_cartesian_2d((lo..hi).log_scale(), 0.0..ymax)
                 .map_err(err)?;
             chart
@@ -254,8 +261,8 @@ impl Draw for Histograms {
                 .y_desc("pixels")
                 .x_label_formatter(&|v| tick_label(*v))
                 .y_label_formatter(&|v| format!("{v:.0}"))
-                .label_style((FONT, 10))
-                .axis_desc_style((FONT, 11))
+                .label_style((FONT, 14))
+                .axis_desc_style((FONT, 15))
                 .draw()
                 .map_err(err)?;
             let mut base = vec![0usize; nb];
@@ -293,7 +300,7 @@ impl Draw for Histograms {
                 .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 12, y)], BLACK.stroke_width(2)));
             chart
                 .configure_series_labels()
-                .label_font((FONT, 10))
+                .label_font((FONT, 14))
                 .background_style(WHITE.mix(0.85))
                 .border_style(BLACK)
                 .position(SeriesLabelPosition::UpperRight)
