@@ -89,39 +89,22 @@ pub fn write_figure(snap: &Snapshot, stem: &Path) -> Result<Vec<PathBuf>, String
     ];
     let title = format!("{} — {}", state.study_name, kind.label());
     let variable = kind.variable().unwrap_or("chl_mg_m3");
-    let colour = |i: usize| super::theme::INSTRUMENT[i].to_array();
-    let named =
-        |i: usize, out: &RunOutput| format!("{}: {}", if i == 0 { "A" } else { "B" }, out.config.instrument.name);
-    let snr: Vec<SlideSeries> = [a, b]
-        .iter()
-        .enumerate()
-        .map(|(i, out)| SlideSeries {
-            name: named(i, out),
-            colour: {
-                let c = colour(i);
-                [c[0], c[1], c[2]]
-            },
-            points: out
-                .snr
-                .iter()
-                .filter(|r| r.snr_analytic.is_finite())
-                .map(|r| (r.centre_nm, r.snr_analytic))
-                .collect(),
-        })
-        .collect();
+    // One series per instrument, in A's and B's colours.
+    let series = |i: usize, out: &RunOutput, points: Vec<(f64, f64)>| {
+        let [r, g, b, _] = super::theme::INSTRUMENT[i].to_array();
+        SlideSeries {
+            name: format!("{}: {}", if i == 0 { "A" } else { "B" }, out.config.instrument.name),
+            colour: [r, g, b],
+            points,
+        }
+    };
     let plot = super::plot_data::plot_data(&snap.runs, variable);
-    let scatter: Vec<SlideSeries> = [a, b]
-        .iter()
-        .enumerate()
-        .map(|(i, out)| SlideSeries {
-            name: named(i, out),
-            colour: {
-                let c = colour(i);
-                [c[0], c[1], c[2]]
-            },
-            points: plot.scatter[i].iter().map(|p| (p[0], p[1])).collect(),
-        })
-        .collect();
+    let (mut snr, mut scatter) = (Vec::new(), Vec::new());
+    for (i, out) in [a, b].into_iter().enumerate() {
+        let analytic = out.snr.iter().filter(|r| r.snr_analytic.is_finite()).map(|r| (r.centre_nm, r.snr_analytic));
+        snr.push(series(i, out, analytic.collect()));
+        scatter.push(series(i, out, plot.scatter[i].iter().map(|p| (p[0], p[1])).collect()));
+    }
     let slide = ReviewSlide {
         title,
         caption,
