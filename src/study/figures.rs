@@ -11,7 +11,7 @@ use ndarray::Array2;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::render::{Draw, FONT, Figure, Placed, err, render, tick_label};
+use super::render::{Draw, FONT, Figure, Panel, Placed, colour, err, raster, render, tick_label};
 use super::{StudyError, StudyResult, StudyRun};
 use crate::colormap::{Scale, categorical, viridis};
 use crate::metrics::{Metrics, bin_of, histogram_2d, log_edges};
@@ -31,14 +31,6 @@ const VARIABLES: [Variable; 4] = [
     Variable { key: "depth_m", label: "depth (m)" },
 ];
 
-/// A map panel: values with a validity mask.
-/// One map of a figure: values and where they are valid (elsewhere grey).
-pub(super) struct Panel {
-    pub(super) title: String,
-    pub(super) values: Array2<f32>,
-    pub(super) valid: Array2<bool>,
-}
-
 /// Maps side by side on one colour scale, with a colour bar labelled `label`.
 pub(super) struct Maps {
     pub(super) title: String,
@@ -55,44 +47,6 @@ pub(super) const PANEL: (u32, u32) = (300, 340);
 const BAR_W: u32 = 110;
 const TITLE_H: u32 = 34;
 const CAPTION_H: u32 = 26;
-
-/// The colour of scale position `t` (0–1) on the viridis or the diverging palette.
-fn colour(t: f64, diverging: bool) -> [u8; 3] {
-    if diverging { crate::colormap::diverging(2.0 * t - 1.0) } else { viridis(t) }
-}
-
-/// Rasterise `panel` into `w × h` pixels (block means in scale space; grey where invalid).
-fn raster(panel: &Panel, scale: &Scale, w: u32, h: u32, diverging: bool) -> Vec<u8> {
-    let (rows, cols) = panel.values.dim();
-    let mut rgb = vec![0u8; (w * h * 3) as usize];
-    for y in 0..h {
-        for x in 0..w {
-            // Row 0 (the first line) at the bottom: the image reads in the flight direction.
-            let yf = h - 1 - y;
-            let (r0, r1) = (
-                (yf as usize * rows) / h as usize,
-                (((yf + 1) as usize * rows) / h as usize).max(yf as usize * rows / h as usize + 1),
-            );
-            let (c0, c1) = (
-                (x as usize * cols) / w as usize,
-                (((x + 1) as usize * cols) / w as usize).max(x as usize * cols / w as usize + 1),
-            );
-            let (mut sum, mut n) = (0.0, 0usize);
-            for r in r0..r1.min(rows) {
-                for c in c0..c1.min(cols) {
-                    if panel.valid[[r, c]] {
-                        sum += scale.position(f64::from(panel.values[[r, c]]));
-                        n += 1;
-                    }
-                }
-            }
-            let colour = if n > 0 { colour(sum / n as f64, diverging) } else { [200, 200, 200] };
-            let i = ((y * w + x) * 3) as usize;
-            rgb[i..i + 3].copy_from_slice(&colour);
-        }
-    }
-    rgb
-}
 
 impl Draw for Maps {
     fn size(&self) -> (u32, u32) {

@@ -9,8 +9,8 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::StudyError;
-use super::figures::{Maps, Panel};
-use super::render::{Draw, FONT, Figure, Placed, err, render};
+use super::figures::Maps;
+use super::render::{Draw, FONT, Figure, Panel, Placed, err, render};
 use crate::colormap::Scale;
 
 /// A map of the slide.

@@ -1,0 +1,141 @@
+//! The left panel's read-only figures of A and B: derived figures (GSD, swath, f-number,
+//! étendue, line period, peak SNR), the feasibility checks, and the parameters in which A and B
+//! differ.
+
+use super::ShoalApp;
+use super::model::Ab;
+use crate::instrument::InstrumentSpec;
+
+/// A derived figure: its name and how to compute it from an instrument.
+type DerivedRow = (&'static str, fn(&InstrumentSpec) -> String);
+
+pub(super) fn derived(app: &ShoalApp, ui: &mut egui::Ui) {
+    egui::CollapsingHeader::new("Derived").default_open(true).show(ui, |ui| {
+        egui::Grid::new("derived").num_columns(3).striped(true).show(ui, |ui| {
+            ui.label("");
+            ui.label("A");
+            ui.label("B");
+            ui.end_row();
+            let rows: [DerivedRow; 5] = [
+                ("GSD", |s| format!("{:.1} m", s.gsd_m())),
+                ("Swath", |s| format!("{:.1} km", s.swath_m() / 1000.0)),
+                ("f-number", |s| format!("f/{:.2}", s.f_number())),
+                ("Étendue", |s| format!("{:.2e} m² sr", s.etendue_m2_sr())),
+                ("Line period", |s| {
+                    format!("{:.2} ms", 1e3 * s.gsd_m() / crate::instrument::ground_speed_m_s(s.altitude_km))
+                }),
+            ];
+            for (name, f) in rows {
+                ui.label(name);
+                ui.label(f(&app.state.a.spec));
+                ui.label(f(&app.state.b.spec));
+                ui.end_row();
+            }
+            ui.label("Peak SNR");
+            for i in 0..2 {
+                let snr = app.link.shown[i]
+                    .as_ref()
+                    .map(|s| s.output.snr.iter().map(|r| r.snr_analytic).fold(0.0, f64::max))
+                    .map_or_else(|| "–".to_string(), |v| format!("{v:.0}"));
+                ui.label(snr);
+            }
+            ui.end_row();
+        });
+        ui.small("Peak SNR: the best band at the scene's median radiance.");
+    });
+    feasibility(app, ui);
+}
+
+/// A value coloured by how far it is from sensible: red past a hard limit, amber near one.
+fn graded(ui: &mut egui::Ui, text: String, level: u8, why: &str) {
+    let colour = match level {
+        0 => ui.visuals().text_color(),
+        1 => super::theme::WARN,
+        _ => super::theme::FAIL,
+    };
+    ui.colored_label(colour, text).on_hover_text(why);
+}
+
+/// The engine's `Feasibility` stage for A and B over this scene (src/instrument/feasibility.rs).
+fn feasibility(app: &ShoalApp, ui: &mut egui::Ui) {
+    use crate::instrument::feasibility::{Q_DETECTOR_LIMITED, Q_OPTICS_LIMITED, SATURATION_HEADROOM};
+    let figures: Vec<_> = app.link.shown.iter().map(|s| s.as_ref().map(|s| s.output.feasibility.clone())).collect();
+    // The warnings stay in sight; the figures behind them fold away.
+    for (ab, figure) in Ab::BOTH.iter().zip(&figures) {
+        for w in figure.iter().flat_map(|f| &f.warnings) {
+            ui.colored_label(super::theme::FAIL, format!("{}: {}", ab.label(), w.message));
+        }
+    }
+    egui::CollapsingHeader::new("Feasibility").default_open(false).show(ui, |ui| {
+        egui::Grid::new("feasibility").num_columns(3).striped(true).show(ui, |ui| {
+            ui.label("");
+            ui.label("A");
+            ui.label("B");
+            ui.end_row();
+            type Row = (&'static str, fn(&crate::instrument::feasibility::Feasibility) -> (String, u8), &'static str);
+            let rows: [Row; 4] = [
+                (
+                    "Peak / full scale",
+                    |f| {
+                        let peak = f.bands.iter().map(|b| b.peak_fraction_of_full_scale).fold(0.0, f64::max);
+                        (format!("{:.0} %", 100.0 * peak), u8::from(peak >= SATURATION_HEADROOM) + u8::from(peak >= 1.0))
+                    },
+                    "Brightest water pixel's signal over full scale, worst band and detector: 100 % saturates",
+                ),
+                (
+                    "Smear",
+                    |f| (format!("{:.2} px", f.smear_px), 2 * u8::from(f.smear_px > 1.0)),
+                    "Exposure over line period: the ground moves this many pixels during one exposure",
+                ),
+                (
+                    "Optical Q",
+                    |f| {
+                        let (lo, hi) = f.bands.iter().fold((f64::INFINITY, 0.0f64), |(a, b), x| (a.min(x.q), b.max(x.q)));
+                        (format!("{lo:.2}–{hi:.2}"), u8::from(lo < Q_DETECTOR_LIMITED || hi > Q_OPTICS_LIMITED))
+                    },
+                    "Q = λN/p over the bands (Fiete 1999): below 0.5 the pixel limits resolution (aliasing); above 2 the optics blur over two pixels",
+                ),
+                (
+                    "ADC step / read noise",
+                    |f| {
+                        let r = f.quantisation_noise_e / f.read_noise_e.max(1e-9);
+                        (format!("{:.2}", r), u8::from(r > 0.5))
+                    },
+                    "Quantisation noise gain/√12 over the read noise: above 0.5 the ADC step adds to the noise floor",
+                ),
+            ];
+            for (name, f, why) in rows {
+                ui.label(name).on_hover_text(why);
+                for figure in &figures {
+                    match figure {
+                        Some(fig) => {
+                            let (text, level) = f(fig);
+                            graded(ui, text, level, why);
+                        }
+                        None => {
+                            ui.label("–");
+                        }
+                    }
+                }
+                ui.end_row();
+            }
+        });
+    });
+}
+
+/// The parameters in which A and B differ (the review slide shows the same table).
+pub(super) fn a_vs_b(app: &ShoalApp, ui: &mut egui::Ui) {
+    egui::CollapsingHeader::new("A vs B").default_open(false).show(ui, |ui| {
+        let bands = [Ab::A, Ab::B]
+            .map(|ab| app.link.shown[ab.index()].as_ref().map_or(0, |s| s.output.response.bands.bands.len()));
+        let rows = super::params::differences(&app.state.a.spec, &app.state.b.spec, (bands[0], bands[1]));
+        egui::Grid::new("a_vs_b").num_columns(3).striped(true).show(ui, |ui| {
+            for row in &rows {
+                for cell in row {
+                    ui.label(cell);
+                }
+                ui.end_row();
+            }
+        });
+    });
+}
