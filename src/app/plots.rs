@@ -157,6 +157,20 @@ fn metrics_table(app: &ShoalApp, ui: &mut egui::Ui) {
     }
 }
 
+/// The label of a log10 axis mark: the value itself at whole decades (0.1, 1, 10, 100), nothing
+/// between them (the plots hold log10 values; a reader wants the concentration).
+fn decade(log10: f64) -> String {
+    if (log10 - log10.round()).abs() > 1e-6 {
+        return String::new();
+    }
+    let e = log10.round() as i32;
+    match e {
+        -3..=-1 => format!("{:.*}", (-e) as usize, 10f64.powi(e)),
+        0..=5 => format!("{}", 10i64.pow(e as u32)),
+        _ => format!("1e{e}"),
+    }
+}
+
 /// A plot's key, above the plot rather than over its data: a coloured swatch and name each.
 fn key(ui: &mut egui::Ui, items: &[(&str, egui::Color32)]) {
     ui.horizontal(|ui| {
@@ -181,7 +195,8 @@ fn histogram(app: &ShoalApp, ui: &mut egui::Ui, width: f32) -> egui::Rect {
         Plot::new("hist")
             .width(width)
             .height(170.0)
-            .x_axis_label(format!("log10 {name} ({unit})"))
+            .x_axis_label(format!("{name} ({unit}), log scale"))
+            .x_axis_formatter(|mark, _| decade(mark.value))
             .y_axis_label("pixels")
             .show(ui, |p| {
                 if edges.len() < 2 {
@@ -217,8 +232,10 @@ fn scatter(app: &ShoalApp, ui: &mut egui::Ui, width: f32) -> egui::Rect {
             .width(width)
             .height(170.0)
             .data_aspect(1.0)
-            .x_axis_label(format!("log10 true ({unit})"))
-            .y_axis_label(format!("log10 retrieved ({unit})"))
+            .x_axis_label(format!("true ({unit}), log scale"))
+            .y_axis_label(format!("retrieved ({unit})"))
+            .x_axis_formatter(|mark, _| decade(mark.value))
+            .y_axis_formatter(|mark, _| decade(mark.value))
             .show(ui, |p| {
                 for (i, d) in data.scatter.iter().enumerate() {
                     p.points(
@@ -353,4 +370,13 @@ pub fn bottom(app: &mut ShoalApp, ui: &mut egui::Ui) {
         app.ui.plot_rects = rects;
         timings(app, ui);
     });
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn log_axes_print_decades_as_values() {
+        let t: Vec<String> = [-2.0, -1.0, 0.0, 1.0, 2.0, 0.5, 7.0].map(super::decade).to_vec();
+        assert_eq!(t, ["0.01", "0.1", "1", "10", "100", "", "1e7"]);
+    }
 }
