@@ -152,7 +152,7 @@ impl Engine {
         }
         let (rows, cols, nb) = radiance.radiance.dim();
         report.shape = (rows, cols, nb);
-        report.truth_shares = radiance.truth.shares.clone();
+        report.truth_shares = radiance.truth_shares.clone();
 
         Ok((radiance, radiance_key))
     }

@@ -144,6 +144,9 @@ pub struct RadianceCube {
     pub radiance: Array3<f32>,
     /// The scene's truth under each pixel.
     pub truth: Arc<Truth>,
+    /// Depth bins and substrate shares of the truth's water pixels, counted once per cube (runs
+    /// that reuse the cube from the cache reuse them).
+    pub truth_shares: super::shares::SceneShares,
     /// Water-model evaluations.
     pub water_evaluations: u64,
     /// Water-model evaluations that included the bottom term.
@@ -268,6 +271,7 @@ pub fn sample_radiance(
     Ok(RadianceCube {
         brightest_water_w_m2_sr_nm: super::plausibility::brightest_water(&radiance, &truth.land),
         radiance,
+        truth_shares: super::shares::SceneShares::of(&truth),
         truth: Arc::new(truth),
         water_evaluations: counters.iter().map(|c| c.0).sum(),
         bottom_evaluations: counters.iter().map(|c| c.1).sum(),
@@ -287,8 +291,7 @@ struct TruthBuffers {
 }
 
 impl TruthBuffers {
-    /// Shape the buffers into a [`Truth`] and count its shares (once per cube: runs that reuse
-    /// the cube from the cache reuse them).
+    /// Shape the buffers into a [`Truth`].
     fn into_truth(self, scene: &Scene, (rows, cols, nb): (usize, usize, usize)) -> Result<Truth, InstrumentError> {
         let bad = |e: ndarray::ShapeError| {
             InstrumentError::Invalid(FieldError { field: "truth".into(), message: e.to_string() })
@@ -296,7 +299,7 @@ impl TruthBuffers {
         let shallow = scene.depth.is_some();
         let maps = self.maps;
         let plane = |k: usize| Array2::from_shape_fn((rows, cols), |(r, c)| maps[(r * cols + c) * 4 + k]);
-        let mut truth = Truth {
+        let truth = Truth {
             rrs_above: Array3::from_shape_vec((rows, cols, nb), self.rrs).map_err(bad)?,
             chl_mg_m3: plane(0),
             nap_g_m3: plane(1),
@@ -309,9 +312,7 @@ impl TruthBuffers {
             },
             land: Array2::from_shape_vec((rows, cols), self.land).map_err(bad)?,
             substrate_names: scene.substrates.iter().map(|(n, _)| n.clone()).collect(),
-            shares: super::shares::SceneShares::default(),
         };
-        truth.shares = super::shares::SceneShares::of(&truth);
         Ok(truth)
     }
 }

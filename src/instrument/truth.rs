@@ -7,8 +7,6 @@
 
 use ndarray::{Array2, Array3};
 
-use super::shares::SceneShares;
-
 /// The scene's truth at each pixel centre, (row, column) maps on the instrument's grid.
 #[derive(Debug, Clone, Default)]
 pub struct Truth {
@@ -30,8 +28,6 @@ pub struct Truth {
     pub substrate_names: Vec<String>,
     /// 1 where the pixel centre is land.
     pub land: Array2<u8>,
-    /// Depth bins and substrate shares over the water pixels, counted once per truth.
-    pub shares: SceneShares,
 }
 
 impl Truth {
