@@ -170,6 +170,23 @@ impl Scale {
     }
 }
 
+/// A tick or axis value as people write it: `digits` significant digits without trailing zeros
+/// (211.151 → "211" at 3 digits; 0.30000000000000004 → "0.3"), and e-notation outside
+/// 0.001–10⁶ ("2e-5"). Colour bars, axes and crossings in the app and on the review slide.
+#[must_use]
+pub fn significant(v: f64, digits: i32) -> String {
+    let a = v.abs();
+    if a == 0.0 || !v.is_finite() {
+        return if a == 0.0 { "0".into() } else { format!("{v}") };
+    }
+    if !(1e-3..1e6).contains(&a) {
+        return format!("{v:.0e}");
+    }
+    let decimals = (digits - 1 - a.log10().floor() as i32).max(0) as usize;
+    let s = format!("{v:.decimals$}");
+    if s.contains('.') { s.trim_end_matches('0').trim_end_matches('.').to_string() } else { s }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -185,6 +202,14 @@ mod tests {
         assert!((s.value(0.5) - 10.0).abs() < 1e-9);
         let r = Scale::robust((1..=1000).map(f64::from));
         assert!(r.log && (r.lo - 11.0).abs() < 1.0 && (r.hi - 990.0).abs() < 2.0);
+    }
+
+    #[test]
+    fn values_print_as_people_write_them() {
+        let t: Vec<String> = [100.0, 30.0, 3.0, 0.3, 0.05, -0.5, 0.0, 2e-5].map(|v| significant(v, 4)).to_vec();
+        assert_eq!(t, ["100", "30", "3", "0.3", "0.05", "-0.5", "0", "2e-5"]);
+        let t: Vec<String> = [211.151, 0.0012345, 1500.0, 2.5].map(|v| significant(v, 3)).to_vec();
+        assert_eq!(t, ["211", "0.00123", "1500", "2.5"]);
     }
 
     #[test]

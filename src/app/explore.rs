@@ -237,7 +237,9 @@ fn sweep_plot(
         .include_x(from.min(to))
         .include_x(from.max(to))
         .include_y(0.0)
-        .x_axis_formatter(move |mark, _| significant(if log { 10f64.powf(mark.value) } else { mark.value }, 3))
+        .x_axis_formatter(move |mark, _| {
+            crate::colormap::significant(if log { 10f64.powf(mark.value) } else { mark.value }, 3)
+        })
         .show(ui, |p| {
             for (k, s) in curves.series.iter().enumerate() {
                 let colour = super::theme::INSTRUMENT.get(k).copied().unwrap_or_else(|| super::theme::category(k));
@@ -273,16 +275,6 @@ fn sweep_plot(
                 p.hline(HLine::new("requirement", r.mae_pct).color(super::theme::PASS));
             }
         });
-}
-
-/// `v` to `digits` significant digits, without trailing zeros: 211.151 → "211", 0.0012345 → "0.00123".
-fn significant(v: f64, digits: i32) -> String {
-    if v == 0.0 || !v.is_finite() {
-        return format!("{v}");
-    }
-    let decimals = (digits - 1 - v.abs().log10().floor() as i32).max(0) as usize;
-    let s = format!("{v:.decimals$}");
-    if s.contains('.') { s.trim_end_matches('0').trim_end_matches('.').to_string() } else { s }
 }
 
 fn labelled_drag(ui: &mut egui::Ui, label: &str, value: &mut f64, speed: f64) {
@@ -356,7 +348,7 @@ pub fn sweep_window(app: &mut super::ShoalApp, ctx: &egui::Context) {
                         s.label,
                         r.mae_pct,
                         name.to_lowercase(),
-                        significant(x, 3)
+                        crate::colormap::significant(x, 3)
                     )),
                     (Some(r), None) => {
                         ui.label(format!("{}: does not meet chl MAE ≤ {:.0} % (so far)", s.label, r.mae_pct))
@@ -441,13 +433,4 @@ pub fn cost_window(app: &mut super::ShoalApp, ctx: &egui::Context) {
 fn chl_requirement(state: &AppState) -> Option<Requirement> {
     let mae_pct = state.requirements.for_variable("chl_mg_m3")?.mae_pct?;
     Some(Requirement { variable: "chl_mg_m3".into(), mae_pct })
-}
-
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn crossings_print_to_three_significant_digits() {
-        let t: Vec<String> = [211.151, 0.0012345, 1500.0, 2.5].map(|v| super::significant(v, 3)).to_vec();
-        assert_eq!(t, ["211", "0.00123", "1500", "2.5"]);
-    }
 }

@@ -31,6 +31,16 @@ impl Design {
         }
     }
 
+    /// Is `state`'s design this one? (Compared in place: the history looks every frame, and
+    /// should not copy the scene to do it.)
+    fn matches(&self, state: &AppState) -> bool {
+        self.a == state.a
+            && self.b == state.b
+            && self.scene == state.scene
+            && self.scene_name == state.scene_name
+            && self.scene_seed == state.scene_seed
+    }
+
     fn restore(self, state: &mut AppState) {
         state.a = self.a;
         state.b = self.b;
@@ -81,9 +91,8 @@ impl History {
         if pointer_down {
             return;
         }
-        let now = Design::of(state);
-        if now != *settled {
-            let before = self.settled.replace(now);
+        if !settled.matches(state) {
+            let before = self.settled.replace(Design::of(state));
             self.undo.extend(before);
             if self.undo.len() > Self::DEPTH {
                 self.undo.remove(0);

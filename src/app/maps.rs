@@ -218,7 +218,7 @@ fn colour_bar(ui: &mut egui::Ui, palette: Palette, height: f32, label: &str, cla
         painter.text(
             Pos2::new(bar.max.x + 4.0, y),
             egui::Align2::LEFT_CENTER,
-            format_tick(v),
+            crate::colormap::significant(v, 4),
             egui::FontId::proportional(10.0),
             text,
         );
@@ -247,20 +247,6 @@ fn scale_bar(ui: &mut egui::Ui, width_px: f32, ground_m: f64) {
     }
     let label = if length >= 1e3 { format!("{} km", length / 1e3) } else { format!("{length} m") };
     painter.text(Pos2::new(x1 + 6.0, y), egui::Align2::LEFT_CENTER, label, egui::FontId::proportional(10.0), colour);
-}
-
-/// A round tick value as people write it: 30, 3, 0.3, 0.05 (no trailing zeros).
-fn format_tick(v: f64) -> String {
-    let a = v.abs();
-    if a == 0.0 {
-        return "0".into();
-    }
-    if !(1e-3..1e6).contains(&a) {
-        return format!("{v:.0e}");
-    }
-    let decimals = (3 - a.log10().floor() as i32).max(0) as usize;
-    let s = format!("{v:.decimals$}");
-    if s.contains('.') { s.trim_end_matches('0').trim_end_matches('.').to_string() } else { s }
 }
 
 fn format_value(v: f64) -> String {
@@ -426,14 +412,5 @@ fn class_names(app: &ShoalApp) -> Vec<String> {
         ProductKind::Substrate => super::raster::substrate_classes(out),
         ProductKind::SiopSet => out.retrievals.first().map(|r| r.product.siop_set_names.clone()).unwrap_or_default(),
         _ => Vec::new(),
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn ticks_print_as_people_write_them() {
-        let t: Vec<String> = [100.0, 30.0, 3.0, 0.3, 0.05, -0.5, 0.0, 2e-5].map(super::format_tick).to_vec();
-        assert_eq!(t, ["100", "30", "3", "0.3", "0.05", "-0.5", "0", "2e-5"]);
     }
 }

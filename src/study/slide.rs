@@ -153,10 +153,7 @@ fn chart<DB: DrawingBackend>(
         .y_label_area_size(64)
         .build_cartesian_2d((x0 - px)..(x1 + px), (y0 - py)..(y1 + py))
         .map_err(err)?;
-    let tick = |v: &f64| {
-        let s = format!("{v:.2}");
-        s.trim_end_matches('0').trim_end_matches('.').to_string()
-    };
+    let tick = |v: &f64| crate::colormap::significant(*v, 4);
     ctx.configure_mesh()
         .x_label_formatter(&tick)
         .y_label_formatter(&tick)
