@@ -201,7 +201,8 @@ impl ShoalApp {
             }
         }
         self.ui.explore.poll();
-        if self.link.busy() || self.ui.exports.running > 0 || self.ui.explore.busy() {
+        self.ui.seeds.poll();
+        if self.link.busy() || self.ui.exports.running > 0 || self.ui.explore.busy() || self.ui.seeds.busy() {
             ctx.request_repaint_after(Duration::from_millis(30));
         }
     }

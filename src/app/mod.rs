@@ -20,6 +20,7 @@
 //! | metrics table and plots | [`plots`] |
 //! | figure and data export | `export` |
 //! | sweep and cost-of-accuracy windows | `explore` |
+//! | seed spread of the metrics | `seeds` |
 
 pub mod bench;
 mod derived;
@@ -37,6 +38,7 @@ mod params;
 pub mod plot_data;
 pub mod plots;
 pub mod raster;
+mod seeds;
 mod session;
 pub mod theme;
 mod view;
@@ -87,6 +89,7 @@ struct UiState {
     typed_export: bool,
     exports: export::Exports,
     explore: explore::Explore,
+    seeds: seeds::SeedSpreadJob,
     frame_times_ms: Vec<f32>,
     history: history::History,
     /// The run in flight (generation, instrument, decimation) and when its progress was first
@@ -271,7 +274,10 @@ impl ShoalApp {
         egui::Panel::left("left").resizable(true).default_size(380.0).show(ui, |ui| {
             egui::ScrollArea::vertical().show(ui, |ui| panels::left(self, ui));
         });
-        egui::Panel::bottom("bottom").resizable(true).default_size(300.0).show(ui, |ui| plots::bottom(self, ui));
+        egui::Panel::bottom("bottom")
+            .resizable(true)
+            .default_size(plots::panel_height(ui.ctx()))
+            .show(ui, |ui| plots::bottom(self, ui));
         egui::CentralPanel::default().show(ui, |ui| maps::central(self, ui));
         if self.ui.explore.sweep_open {
             explore::sweep_window(self, &ctx);

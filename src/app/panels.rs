@@ -168,6 +168,21 @@ fn band_editor(slot: &mut Slot, ui: &mut egui::Ui) {
     }
 }
 
+/// Fine control on a slider rail: `value` moved by a tenth of `fraction` of the rail (the
+/// pointer's motion over the rail's width), in the slider's own scale (log or linear), kept in
+/// `range` (integer sliders have no fine mode: a tenth of a pixel's step rounds to nothing).
+fn fine_step(value: f64, fraction: f32, range: (f64, f64), log: bool) -> f64 {
+    let step = f64::from(fraction) / 10.0;
+    let (lo, hi) = range;
+    let moved = if log && lo > 0.0 && value > 0.0 {
+        (value.ln() + step * (hi.ln() - lo.ln())).exp()
+    } else {
+        value + step * (hi - lo)
+    };
+    // A value already outside the span (a typed one) is not pulled into it by a small drag.
+    moved.clamp(lo.min(value), hi.max(value))
+}
+
 fn editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
     ui.heading("Instrument");
     ui.horizontal(|ui| {
@@ -177,8 +192,8 @@ fn editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
     let editing = app.state.editing;
     let mut changed: Vec<(&'static str, f64)> = Vec::new();
     // Wider than egui's 100 px (on which a log slider jumped from 90 to 200 mm in a 20 px drag),
-    // fixed so the panel does not grow with its own content; the number beside each slider drags
-    // 10× finer with Shift held.
+    // fixed so the panel does not grow with its own content; Shift held makes a drag of the rail
+    // or of the number 10× finer.
     ui.spacing_mut().slider_width = 160.0;
     egui::Grid::new("params").num_columns(2).show(ui, |ui| {
         for p in &PARAMS {
@@ -196,9 +211,29 @@ fn editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
             let slider = if matches!(p.key, "detectors" | "lines" | "adc_bits") { slider.integer() } else { slider };
             // The hover text states the documented range (src/ranges.rs) a typed value must meet;
             // built only while the pointer is on the slider.
-            ui.add(slider).on_hover_ui(|ui| {
+            let integer = matches!(p.key, "detectors" | "lines" | "adc_bits");
+            let response = ui.add(slider);
+            // Shift held on the rail: the pointer's motion moves the value a tenth as far, from
+            // where it was (egui would jump to the pointer). A drag begun with Shift stays fine
+            // to its release, even if Shift is let go first (egui also sets the value on the
+            // release frame).
+            let fine_id = response.id.with("fine");
+            let interacting = !integer && response.interact_pointer_pos().is_some();
+            let fine = interacting
+                && (ui.input(|i| i.modifiers.shift) || ui.data(|d| d.get_temp::<bool>(fine_id)).unwrap_or(false));
+            ui.data_mut(|d| {
+                if fine {
+                    d.insert_temp(fine_id, true);
+                } else {
+                    d.remove::<bool>(fine_id);
+                }
+            });
+            if fine {
+                v = fine_step(before, response.drag_delta().x / ui.spacing().slider_width, p.range, p.log);
+            }
+            response.on_hover_ui(|ui| {
                 ui.label(p.tip);
-                ui.label("Type a value and press Enter; drag the number with Shift held for fine steps.");
+                ui.label("Type a value and press Enter; hold Shift while dragging the slider or the number for 10× finer steps.");
                 if let Some(r) = crate::ranges::ALL.iter().find(|r| r.field("instrument.") == p.key) {
                     ui.label(format!("Allowed: {} (`{}`)", r.allowed(), p.key));
                 }
@@ -405,4 +440,21 @@ pub fn left(app: &mut ShoalApp, ui: &mut egui::Ui) {
     editor(app, ui);
     ui.separator();
     settings(app, ui);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::fine_step;
+
+    #[test]
+    fn a_fine_drag_moves_a_tenth_of_the_rail_in_the_sliders_own_scale() {
+        // Linear 0–100: a whole rail's width moves 10.
+        assert!((fine_step(50.0, 1.0, (0.0, 100.0), false) - 60.0).abs() < 1e-9);
+        // Log 10–1000 (two decades): a whole rail's width is a fifth of a decade, ×10^0.2.
+        let v = fine_step(100.0, 1.0, (10.0, 1000.0), true);
+        assert!((v / 100.0 - 10f64.powf(0.2)).abs() < 1e-9, "{v}");
+        // Kept in the span, but a typed value outside it is not pulled in.
+        assert_eq!(fine_step(99.0, 1.0, (0.0, 100.0), false), 100.0);
+        assert!((fine_step(150.0, -0.125, (0.0, 100.0), false) - 148.75).abs() < 1e-9);
+    }
 }

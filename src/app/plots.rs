@@ -83,6 +83,7 @@ fn metrics_table(app: &ShoalApp, ui: &mut egui::Ui) {
             })
         })
         .collect();
+    let configs = app.state.configs();
     egui::Grid::new("metrics").num_columns(9).striped(true).show(ui, |ui| {
         for h in ["product", "A MAE", "A bias", "A returned", "A", "B MAE", "B bias", "B returned", "B"] {
             ui.strong(h);
@@ -100,7 +101,7 @@ fn metrics_table(app: &ShoalApp, ui: &mut egui::Ui) {
             });
         for v in &variables {
             ui.label(crate::metrics::label(v)).on_hover_text(format!("`{v}`"));
-            for (run, checks) in runs.iter().zip(&checks) {
+            for (index, (run, checks)) in runs.iter().zip(&checks).enumerate() {
                 let m: Option<&Metrics> = run.and_then(|o| o.retrievals.first()).and_then(|r| r.metrics.get(v));
                 match m {
                     Some(m) if m.n == 0 => {
@@ -120,11 +121,21 @@ fn metrics_table(app: &ShoalApp, ui: &mut egui::Ui) {
                             m.n
                         );
                         // Depth errors read in metres too (a log-space % alone hides whether 10 % is 0.2 m or 2 m).
-                        if unit == "m" {
-                            ui.label(format!("{:.1} % ({:.2} m)", m.mae_pct(), m.mean_abs_error)).on_hover_text(in_units);
+                        let mut text = if unit == "m" {
+                            format!("{:.1} % ({:.2} m)", m.mae_pct(), m.mean_abs_error)
                         } else {
-                            ui.label(format!("{:.1} %", m.mae_pct())).on_hover_text(in_units);
+                            format!("{:.1} %", m.mae_pct())
+                        };
+                        let mut hover = in_units;
+                        // The seed spread, when measured for these very designs.
+                        if let Some(s) = app.ui.seeds.get(&configs, index, v).filter(|s| s.seeds > 1) {
+                            text.push_str(&format!(" ±{:.1}", s.mae_pct_std));
+                            hover.push_str(&format!(
+                                "\n± is the standard deviation of the MAE over {} noise seeds at 1/{} (mean {:.1} %, range {:.1}–{:.1} %)",
+                                s.seeds, app.ui.seeds.decimation, s.mae_pct_mean, s.mae_pct_range.0, s.mae_pct_range.1
+                            ));
                         }
+                        ui.label(text).on_hover_text(hover);
                         ui.label(format!("{:+.1} %", m.bias_pct()));
                         ui.label(format!("{:.1} %", m.returned_pct));
                     }
@@ -155,6 +166,36 @@ fn metrics_table(app: &ShoalApp, ui: &mut egui::Ui) {
     if runs.iter().flatten().next().is_none() {
         ui.label("No results yet.");
     }
+}
+
+/// Start (or cancel) the seed-spread runs, and say what the ± in the table means.
+fn seed_controls(app: &mut ShoalApp, ui: &mut egui::Ui) {
+    let configs = app.state.configs();
+    ui.horizontal(|ui| {
+        let job = &mut app.ui.seeds;
+        if job.busy() {
+            let (done, total) = job.progress();
+            ui.spinner();
+            ui.label(format!("seed spread: {done} of {total} runs"));
+            if ui.button("Cancel").clicked() {
+                job.cancel();
+            }
+            return;
+        }
+        let start = ui
+            .button("Seed spread")
+            .on_hover_text("Rerun A and B over several detector-noise seeds; the table then shows ± the MAE's standard deviation over them");
+        ui.add(egui::DragValue::new(&mut job.seeds).range(2..=20).suffix(" seeds").update_while_editing(false));
+        ui.add(egui::DragValue::new(&mut job.decimation).range(1..=16).prefix("at 1/").update_while_editing(false));
+        if start.clicked() {
+            job.start(ui.ctx(), &configs);
+        } else if job.stale(&configs) {
+            ui.label(egui::RichText::new("stale: the designs changed").color(theme::WARN))
+                .on_hover_text("The spread was measured for other designs; it is not shown. Run it again.");
+        } else if !job.status.is_empty() {
+            ui.label(&job.status);
+        }
+    });
 }
 
 /// The label of a log10 axis mark: the value itself at whole decades (0.1, 1, 10, 100), nothing
@@ -194,7 +235,7 @@ fn histogram(app: &ShoalApp, ui: &mut egui::Ui, width: f32) -> egui::Rect {
         key(ui, &[("truth", theme::TRUTH), ("A", theme::INSTRUMENT[0]), ("B", theme::INSTRUMENT[1])]);
         Plot::new("hist")
             .width(width)
-            .height(170.0)
+            .height(plot_height(ui))
             .x_axis_label(format!("{name} ({unit}), log scale"))
             .x_axis_formatter(|mark, _| decade(mark.value))
             .y_axis_label("pixels")
@@ -218,6 +259,18 @@ fn histogram(app: &ShoalApp, ui: &mut egui::Ui, width: f32) -> egui::Rect {
     .rect
 }
 
+/// The plots' height: 170 px up to a 950 px tall window, growing with it to 360 px (at 4K the
+/// maps would otherwise take everything and leave the plots a strip).
+fn plot_height(ui: &egui::Ui) -> f32 {
+    (ui.ctx().content_rect().height() * 0.18).clamp(170.0, 360.0)
+}
+
+/// The bottom panel's first height: the plots, their titles and keys, and the timings line.
+#[must_use]
+pub fn panel_height(ctx: &egui::Context) -> f32 {
+    (ctx.content_rect().height() * 0.18).clamp(170.0, 360.0) + 130.0
+}
+
 /// Retrieved against true values, log–log, with the 1:1 line.
 fn scatter(app: &ShoalApp, ui: &mut egui::Ui, width: f32) -> egui::Rect {
     let empty = PlotData::default();
@@ -230,8 +283,13 @@ fn scatter(app: &ShoalApp, ui: &mut egui::Ui, width: f32) -> egui::Rect {
         key(ui, &[("A", theme::INSTRUMENT[0]), ("B", theme::INSTRUMENT[1]), ("1:1", theme::REFERENCE)]);
         Plot::new("scatter")
             .width(width)
-            .height(170.0)
-            .data_aspect(1.0)
+            .height(plot_height(ui))
+            // The same decades on both axes (not `data_aspect`, which on a wide plot stretched
+            // the x axis over 20 decades at 4K), so the 1:1 line is the box's diagonal.
+            .include_x(edges.first().copied().unwrap_or(-1.0))
+            .include_x(edges.last().copied().unwrap_or(1.0))
+            .include_y(edges.first().copied().unwrap_or(-1.0))
+            .include_y(edges.last().copied().unwrap_or(1.0))
             .x_axis_label(format!("true ({unit}), log scale"))
             .y_axis_label(format!("retrieved ({unit})"))
             .x_axis_formatter(|mark, _| decade(mark.value))
@@ -257,31 +315,34 @@ fn snr_plot(app: &ShoalApp, ui: &mut egui::Ui, width: f32) -> egui::Rect {
     ui.vertical(|ui| {
         ui.label("SNR per band (line: analytic, dots: measured)");
         key(ui, &[("A", theme::INSTRUMENT[0]), ("B", theme::INSTRUMENT[1]), ("requirement", theme::PASS)]);
-        Plot::new("snr").width(width).height(170.0).x_axis_label("wavelength (nm)").y_axis_label("SNR").show(ui, |p| {
-            for (i, s) in app.link.shown.iter().enumerate() {
-                let Some(s) = s else { continue };
-                let name = if i == 0 { "A" } else { "B" };
-                let line: Vec<[f64; 2]> = s
-                    .output
-                    .snr
-                    .iter()
-                    .filter(|r| r.snr_analytic.is_finite())
-                    .map(|r| [r.centre_nm, r.snr_analytic])
-                    .collect();
-                let dots: Vec<[f64; 2]> = s
-                    .output
-                    .snr
-                    .iter()
-                    .filter(|r| r.snr_measured.is_finite())
-                    .map(|r| [r.centre_nm, r.snr_measured])
-                    .collect();
-                p.line(Line::new(name, PlotPoints::from(line)).color(theme::INSTRUMENT[i]).width(2.0));
-                p.points(Points::new(format!("{name} measured"), dots).radius(2.5).color(theme::INSTRUMENT[i]));
-            }
-            if let Some(snr) = app.state.requirements.snr {
-                p.hline(HLine::new("requirement", snr).color(theme::PASS));
-            }
-        });
+        Plot::new("snr").width(width).height(plot_height(ui)).x_axis_label("wavelength (nm)").y_axis_label("SNR").show(
+            ui,
+            |p| {
+                for (i, s) in app.link.shown.iter().enumerate() {
+                    let Some(s) = s else { continue };
+                    let name = if i == 0 { "A" } else { "B" };
+                    let line: Vec<[f64; 2]> = s
+                        .output
+                        .snr
+                        .iter()
+                        .filter(|r| r.snr_analytic.is_finite())
+                        .map(|r| [r.centre_nm, r.snr_analytic])
+                        .collect();
+                    let dots: Vec<[f64; 2]> = s
+                        .output
+                        .snr
+                        .iter()
+                        .filter(|r| r.snr_measured.is_finite())
+                        .map(|r| [r.centre_nm, r.snr_measured])
+                        .collect();
+                    p.line(Line::new(name, PlotPoints::from(line)).color(theme::INSTRUMENT[i]).width(2.0));
+                    p.points(Points::new(format!("{name} measured"), dots).radius(2.5).color(theme::INSTRUMENT[i]));
+                }
+                if let Some(snr) = app.state.requirements.snr {
+                    p.hline(HLine::new("requirement", snr).color(theme::PASS));
+                }
+            },
+        );
     })
     .response
     .rect
@@ -347,6 +408,7 @@ pub fn bottom(app: &mut ShoalApp, ui: &mut egui::Ui) {
         let metrics = |app: &mut ShoalApp, ui: &mut egui::Ui| {
             let r = ui.vertical(|ui| {
                 ui.strong("Metrics (log-space MAE and bias, Seegers et al. 2018)");
+                seed_controls(app, ui);
                 metrics_table(app, ui);
                 substrate_tables(app, ui);
                 for (i, e) in app.link.errors.iter().enumerate() {

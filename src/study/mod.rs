@@ -33,7 +33,7 @@ pub use render::Figure;
 pub use requirements::{Check, ProductRequirement, Requirements, checks_csv, verdict};
 pub use run::{StudyResult, StudyRun, run_study};
 pub use slide::{ComparisonPanel, ReviewSlide, SLIDE, SlideSeries, review_slide};
-pub use spread::{SeedSpread, seed_spread, seed_spread_csv};
+pub use spread::{SeedSpread, seed_spread, seed_spread_csv, spread_of_runs};
 
 use std::path::{Path, PathBuf};
 

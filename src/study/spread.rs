@@ -4,7 +4,10 @@
 
 use serde::Serialize;
 
+use std::sync::Arc;
+
 use super::StudyResult;
+use crate::engine::RetrievalOutput;
 
 /// One (instrument, product, variable) over the seeds.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -43,12 +46,19 @@ impl SeedSpread {
 /// they first appear.
 #[must_use]
 pub fn seed_spread(result: &StudyResult) -> Vec<SeedSpread> {
+    spread_of_runs(result.runs.iter().map(|r| (r.label.as_str(), r.retrievals.as_slice())))
+}
+
+/// The spread over any set of runs, each given as (instrument label, its retrievals); runs of
+/// one label are that instrument's seeds (the app measures its own seeds this way).
+#[must_use]
+pub fn spread_of_runs<'a>(runs: impl IntoIterator<Item = (&'a str, &'a [Arc<RetrievalOutput>])>) -> Vec<SeedSpread> {
     let mut keys: Vec<(String, String, String)> = Vec::new();
     let mut values: Vec<Vec<(f64, f64)>> = Vec::new();
-    for run in &result.runs {
-        for ret in &run.retrievals {
+    for (label, retrievals) in runs {
+        for ret in retrievals {
             for v in &ret.metrics.variables {
-                let key = (run.label.clone(), ret.metrics.product.clone(), v.variable.clone());
+                let key = (label.to_string(), ret.metrics.product.clone(), v.variable.clone());
                 let i = keys.iter().position(|k| *k == key).unwrap_or_else(|| {
                     keys.push(key);
                     values.push(Vec::new());

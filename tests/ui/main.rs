@@ -544,8 +544,8 @@ fn a_preset_does_not_replace_edits_without_asking() {
 /// At 1280 × 720 and at 1920 × 1080 every plot keeps at least its minimum width and lies inside
 /// the window (at 1280 × 720 the SNR plot used to collapse to a sliver past the right edge).
 #[test]
-fn the_plots_keep_their_minimum_width_from_1280x720_to_1920x1080() {
-    for (w, h_px) in [(1280.0, 720.0), (1920.0, 1080.0)] {
+fn the_plots_keep_their_minimum_width_from_1280x720_to_4k() {
+    for (w, h_px) in [(1280.0, 720.0), (1920.0, 1080.0), (3840.0, 2160.0)] {
         let dir = temp_library(&format!("layout{w}"));
         let mut h = harness("cubesat", 16, &dir);
         h.set_size(egui::vec2(w, h_px));
@@ -563,4 +563,79 @@ fn the_plots_keep_their_minimum_width_from_1280x720_to_1920x1080() {
         }
         let _ = std::fs::remove_dir_all(&dir);
     }
+}
+
+/// The seed spread: A and B rerun over two noise seeds, the table shows ± beside the MAE, and an
+/// edit marks the spread stale and hides it (it belongs to the designs it was measured for).
+#[test]
+fn the_seed_spread_shows_beside_the_mae_and_goes_stale_after_an_edit() {
+    let dir = temp_library("seeds");
+    let mut h = harness("cubesat", 24, &dir);
+    wait_for_engine(&mut h);
+    assert_eq!(h.query_all_by_label_contains(" ±").count(), 0, "no spread before it is measured");
+    h.get_by_role_and_label(Role::SpinButton, "seeds").set_value_accesskit(2.0);
+    h.get_by_role_and_label(Role::SpinButton, "at 1/").set_value_accesskit(16.0);
+    h.step();
+    h.get_by_label("Seed spread").click();
+    h.step();
+    let start = Instant::now();
+    loop {
+        h.step();
+        if h.query_by_label_contains("2 seeds at 1/16").is_some() {
+            break;
+        }
+        assert!(start.elapsed() < Duration::from_secs(300), "the seed spread did not finish");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    h.step();
+    // chl, NAP and CDOM of A and B: six MAE cells carry a ±.
+    assert_eq!(h.query_all_by_label_contains(" ±").count(), 6, "a ± on every MAE cell");
+    h.state_mut().state.a.spec.aperture_mm *= 1.5;
+    h.step();
+    h.step();
+    assert_eq!(h.query_all_by_label_contains(" ±").count(), 0, "a stale spread is not shown");
+    assert!(h.query_by_label_contains("stale").is_some(), "the stale spread is named");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Shift held while dragging a slider's rail moves the value a tenth as far, from where it was:
+/// on the aperture's log slider (10–500 mm over 160 px) an 80 px drag is a factor
+/// 50^(0.1 × 80 / 160) = 1.216, where a plain drag would sweep half the range.
+#[test]
+fn shift_dragging_a_slider_rail_moves_the_value_a_tenth_as_far() {
+    let dir = temp_library("finedrag");
+    let mut h = harness("cubesat", 24, &dir);
+    h.step();
+    let before = h.state().state.a.spec.aperture_mm;
+    let rail = h.get_by_role_and_label(Role::Slider, "Aperture").rect();
+    let shift = egui::Modifiers::SHIFT;
+    let at = |dx: f32| egui::pos2(rail.center().x + dx, rail.center().y);
+    h.event(egui::Event::ModifiersChanged(shift));
+    h.event(egui::Event::PointerMoved(at(0.0)));
+    h.step();
+    h.event(egui::Event::PointerButton {
+        pos: at(0.0),
+        button: egui::PointerButton::Primary,
+        pressed: true,
+        modifiers: shift,
+    });
+    h.step();
+    for dx in [20.0, 40.0, 60.0, 80.0] {
+        h.event(egui::Event::PointerMoved(at(dx)));
+        h.step();
+    }
+    h.event(egui::Event::PointerButton {
+        pos: at(80.0),
+        button: egui::PointerButton::Primary,
+        pressed: false,
+        modifiers: shift,
+    });
+    h.event(egui::Event::ModifiersChanged(egui::Modifiers::NONE));
+    h.step();
+    h.step();
+    let after = h.state().state.a.spec.aperture_mm;
+    let expected = before * 50f64.powf(0.1 * 80.0 / 160.0);
+    // 1 %: the drag is in whole points, exact in f32; the rest is rounding of the displayed value.
+    assert!((after / expected - 1.0).abs() < 0.01, "aperture {before} → {after} mm, expected {expected:.2} mm");
+    let _ = std::fs::remove_dir_all(&dir);
 }
