@@ -148,52 +148,57 @@ pub fn invert(sets: &[AlmiSet], settings: &AlmiSettings, rrs_above: &[f64], vali
     }
     let mean_rrs = rrs[..m].iter().sum::<f64>() / m as f64;
     let mut best = AlmiPixel::FAILED;
+    // Per set: the rows of the system (r, y) and a + bb's pieces, computed once per pixel and set
+    // and used by both solves and the cost (they were rebuilt for each before).
+    let mut r = [[0.0; 3]; MAX_BANDS];
+    let mut y = [0.0; MAX_BANDS];
     for (s, set) in sets.iter().enumerate() {
         let o = &set.iops;
-        // Rows of the system and the forward model for one solution.
-        let row = |i: usize| -> ([f64; 3], f64) {
-            let (k, u) = (used[i], u[i]);
-            (
-                [o.a_ph[k] * u - o.bb_ph[k] * (1.0 - u), o.a_cdom[k] * u, o.a_nap[k] * u - o.bb_nap[k] * (1.0 - u)],
-                o.bb_w[k] * (1.0 - u) - o.a_w[k] * u,
-            )
-        };
+        for (i, &k) in used.iter().enumerate() {
+            let (u, v) = (u[i], 1.0 - u[i]);
+            r[i] = [o.a_ph[k] * u - o.bb_ph[k] * v, o.a_cdom[k] * u, o.a_nap[k] * u - o.bb_nap[k] * v];
+            y[i] = o.bb_w[k] * v - o.a_w[k] * u;
+        }
         let kappa = |i: usize, x: &[f64; 3]| -> (f64, f64) {
             let k = used[i];
             let a = o.a_w[k] + x[0] * o.a_ph[k] + x[1] * o.a_cdom[k] + x[2] * o.a_nap[k];
             let bb = o.bb_w[k] + x[0] * o.bb_ph[k] + x[2] * o.bb_nap[k];
             (a, bb)
         };
-        let solve = |w: &[f64]| -> Option<([f64; 3], f64, [f64; 3])> {
-            let (mut g, mut b, mut yy) = ([[0.0; 3]; 3], [0.0; 3], 0.0);
+        // The weighted normal equations (G symmetric: six sums, not nine).
+        let solve = |w2: Option<&[f64]>| -> Option<([f64; 3], f64, [f64; 3])> {
+            let (mut g00, mut g01, mut g02, mut g11, mut g12, mut g22) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+            let (mut b0, mut b1, mut b2, mut yy) = (0.0, 0.0, 0.0, 0.0);
             for i in 0..m {
-                let (r, y) = row(i);
-                let w2 = w[i] * w[i];
-                for p in 0..3 {
-                    b[p] += w2 * r[p] * y;
-                    for q in 0..3 {
-                        g[p][q] += w2 * r[p] * r[q];
-                    }
-                }
-                yy += w2 * y * y;
+                let w = w2.map_or(1.0, |w| w[i]);
+                let [r0, r1, r2] = r[i];
+                let (wr0, wr1, wr2, wy) = (w * r0, w * r1, w * r2, w * y[i]);
+                g00 += wr0 * r0;
+                g01 += wr0 * r1;
+                g02 += wr0 * r2;
+                g11 += wr1 * r1;
+                g12 += wr1 * r2;
+                g22 += wr2 * r2;
+                b0 += wr0 * y[i];
+                b1 += wr1 * y[i];
+                b2 += wr2 * y[i];
+                yy += wy * y[i];
             }
-            nnls3(&g, &b, yy)
+            nnls3(&[[g00, g01, g02], [g01, g11, g12], [g02, g12, g22]], &[b0, b1, b2], yy)
         };
-        let mut w = [1.0; MAX_BANDS];
-        let Some(mut sol) = solve(&w[..m]) else { continue };
+        let Some(mut sol) = solve(None) else { continue };
         if settings.noise_weighting {
             // Generalised least squares by one reweighting: the equation u·κ − bb errs by κ·σ_u,
             // with κ from the unweighted solution (κ varies slowly with the concentrations; a
             // second pass changes chl by < 0.1 % on the Lake Hume scene).
-            for _ in 0..1 {
-                for i in 0..m {
-                    let (a, bb) = kappa(i, &sol.0);
-                    w[i] = 1.0 / ((a + bb) * sigma_u[i]).max(1e-300);
-                }
-                match solve(&w[..m]) {
-                    Some(next) => sol = next,
-                    None => break,
-                }
+            let mut w2 = [1.0; MAX_BANDS];
+            for (i, w) in w2[..m].iter_mut().enumerate() {
+                let (a, bb) = kappa(i, &sol.0);
+                let w1 = 1.0 / ((a + bb) * sigma_u[i]).max(1e-300);
+                *w = w1 * w1;
+            }
+            if let Some(next) = solve(Some(&w2[..m])) {
+                sol = next;
             }
         }
         let (x, _, unconstrained) = sol;

@@ -177,7 +177,17 @@ pub fn nnls3(g: &[[f64; 3]; 3], b: &[f64; 3], yy: f64) -> Option<([f64; 3], f64,
         }
         r.max(0.0)
     };
-    let full = solve(7).unwrap_or([0.0; 3]);
+    let unscale = |x: [f64; 3]| -> [f64; 3] { std::array::from_fn(|j| if d[j] > 0.0 { x[j] / d[j] } else { 0.0 }) };
+    let full = solve(7);
+    // The unconstrained optimum is feasible: it is the constrained one (the problem is convex
+    // and its minimum lies in the feasible set; Lawson & Hanson 1974, ch. 23), so the other
+    // seven supports need not be tried. Most aLMI pixels end here.
+    if let Some(x) = full
+        && x.iter().all(|v| *v >= 0.0 && v.is_finite())
+    {
+        return Some((unscale(x), residual(&x), unscale(x)));
+    }
+    let full = full.unwrap_or([0.0; 3]);
     let mut best: Option<([f64; 3], f64)> = None;
     for mask in 0..8u8 {
         let Some(x) = solve(mask) else { continue };
@@ -190,7 +200,6 @@ pub fn nnls3(g: &[[f64; 3]; 3], b: &[f64; 3], yy: f64) -> Option<([f64; 3], f64,
         }
     }
     let (x, r) = best?;
-    let unscale = |x: [f64; 3]| -> [f64; 3] { std::array::from_fn(|j| if d[j] > 0.0 { x[j] / d[j] } else { 0.0 }) };
     Some((unscale(x), r, unscale(full)))
 }
 
