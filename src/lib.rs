@@ -61,6 +61,7 @@ pub mod scene;
 pub mod spectral;
 pub mod study;
 pub mod sweep;
+pub mod timing;
 pub mod toa;
 pub mod units;
 pub mod validation;

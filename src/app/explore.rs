@@ -47,7 +47,11 @@ pub struct Explore {
     sweep_total: usize,
     sweep_status: String,
     cost_decimation: usize,
-    cost_task: Option<Task<CostRow>>,
+    cost_task: Option<Task<(usize, CostRow)>>,
+    /// Rounds of the cost measurement (each setting timed once per round, interleaved).
+    cost_rounds: usize,
+    /// The chl error the cheapest acceptable setting may make, %.
+    cost_tolerance_pct: f64,
     cost_rows: Vec<CostRow>,
     /// Instrument A's configuration the cost rows were measured for (to mark them stale).
     cost_config: Option<RunConfig>,
@@ -72,6 +76,8 @@ impl Default for Explore {
             sweep_status: String::new(),
             cost_decimation: 4,
             cost_task: None,
+            cost_rounds: 3,
+            cost_tolerance_pct: 1.0,
             cost_rows: Vec::new(),
             cost_config: None,
             cost_status: String::new(),
@@ -118,13 +124,19 @@ impl Explore {
             let mut finished = None;
             while let Some(msg) = task.poll() {
                 match msg {
-                    TaskNews::Item(row) => self.cost_rows.push(row),
+                    TaskNews::Item((round, row)) => {
+                        self.cost_status = format!("round {} of {}: {}", round + 1, self.cost_rounds, row.label);
+                        match self.cost_rows.iter_mut().find(|r| r.label == row.label) {
+                            Some(r) => *r = row,
+                            None => self.cost_rows.push(row),
+                        }
+                    }
                     TaskNews::Done(r) => finished = Some(r),
                 }
             }
             if let Some(r) = finished {
                 self.cost_status = match r {
-                    Ok(()) => format!("done: {} settings", self.cost_rows.len()),
+                    Ok(()) => format!("done: {} settings × {} rounds", self.cost_rows.len(), self.cost_rounds),
                     Err(e) => e,
                 };
                 self.cost_task = None;
@@ -201,12 +213,15 @@ impl Explore {
         base.fidelity.decimation = self.cost_decimation;
         self.cost_rows.clear();
         self.cost_status = format!("measuring at 1/{} …", self.cost_decimation);
+        let rounds = self.cost_rounds;
         let wake = ctx.clone();
         let task = Task::spawn(
             "shoal-explore",
             move || wake.request_repaint(),
             move |control, send| {
-                cost_of_accuracy(&base, control, |row| send(row.clone())).map(|_| ()).map_err(|e| e.to_string())
+                cost_of_accuracy(&base, rounds, control, |round, row| send((round, row.clone())))
+                    .map(|_| ())
+                    .map_err(|e| e.to_string())
             },
         );
         match task {
@@ -374,7 +389,7 @@ pub fn cost_window(app: &mut super::ShoalApp, ctx: &egui::Context) {
     let mut open = app.ui.explore.cost_open;
     let mut start = false;
     egui::Window::new("Cost of accuracy").open(&mut open).default_size([640.0, 520.0]).show(ctx, |ui| {
-        ui.label("Time of the whole chain for instrument A against the error each fidelity setting makes (a fresh engine per setting).");
+        ui.label("Time of the whole chain for instrument A against the error each fidelity setting makes (a fresh engine per run; rounds interleave the settings with the reference).");
         ui.horizontal(|ui| {
             let e = &mut app.ui.explore;
             egui::ComboBox::from_label("Reference resolution").selected_text(format!("1/{}", e.cost_decimation)).show_ui(ui, |ui| {
@@ -382,6 +397,10 @@ pub fn cost_window(app: &mut super::ShoalApp, ctx: &egui::Context) {
                     ui.selectable_value(&mut e.cost_decimation, d, if d == 1 { "full".to_string() } else { format!("1/{d}") });
                 }
             });
+            ui.add(egui::DragValue::new(&mut e.cost_rounds).range(1..=10).suffix(" rounds").update_while_editing(false))
+                .on_hover_text("Each setting is timed once per round; with 3 or more, a setting whose times overlap the reference's says so");
+            ui.add(egui::DragValue::new(&mut e.cost_tolerance_pct).range(0.0..=100.0).speed(0.1).prefix("tolerance ").suffix(" %").update_while_editing(false))
+                .on_hover_text("The chl error (median per-pixel % from the reference; |ΔMAE| for a coarser grid) the cheapest acceptable setting may make");
             if ui.button("Measure").clicked() {
                 start = true;
             }
@@ -391,27 +410,39 @@ pub fn cost_window(app: &mut super::ShoalApp, ctx: &egui::Context) {
         if e.cost_config.as_ref().is_some_and(|c| Some(c) != app.state.configs().first()) {
             ui.colored_label(super::theme::NOTICE, "Stale: A, the scene or the retrieval changed since these were measured. Press Measure to redo.");
         }
-        Plot::new("cost-plot").height(220.0).legend(Legend::default()).x_axis_label("time, s").y_axis_label("error, %").show(ui, |p| {
-            let same: Vec<[f64; 2]> = e.cost_rows.iter().filter_map(|r| r.chl_pixel_pct.map(|v| [r.seconds, v])).collect();
-            let other: Vec<[f64; 2]> = e.cost_rows.iter().filter(|r| r.chl_pixel_pct.is_none()).map(|r| [r.seconds, r.delta_mae_pct.abs()]).collect();
+        let front: Vec<&str> = crate::sweep::pareto_front(&e.cost_rows).iter().map(|r| r.label.as_str()).collect();
+        let cheapest = if e.busy() { None } else { crate::sweep::cheapest_within(&e.cost_rows, e.cost_tolerance_pct) };
+        if let Some(c) = cheapest {
+            ui.label(egui::RichText::new(format!(
+                "Cheapest full-resolution setting within {} % chl per pixel: {} ({:.2} s, {})",
+                e.cost_tolerance_pct,
+                c.label,
+                c.seconds(),
+                c.comparison.text()
+            )).strong());
+        }
+        Plot::new("cost-plot").height(220.0).legend(Legend::default()).x_axis_label("time, s (median)").y_axis_label("error, %").show(ui, |p| {
+            let same: Vec<[f64; 2]> = e.cost_rows.iter().filter_map(|r| r.chl_pixel_pct.map(|v| [r.seconds(), v])).collect();
+            let other: Vec<[f64; 2]> = e.cost_rows.iter().filter(|r| r.chl_pixel_pct.is_none()).map(|r| [r.seconds(), r.delta_mae_pct.abs()]).collect();
             p.points(Points::new("chl per pixel vs reference (median %)", same).radius(4.0));
             p.points(Points::new("previews: |ΔMAE| (points)", other).radius(4.0).shape(egui_plot::MarkerShape::Diamond));
             // Each point named by its setting.
             for r in &e.cost_rows {
-                let y = r.chl_pixel_pct.unwrap_or(r.delta_mae_pct.abs());
-                p.text(egui_plot::Text::new(r.label.clone(), egui_plot::PlotPoint::new(r.seconds, y), format!("  {}", r.label)).anchor(egui::Align2::LEFT_CENTER));
+                p.text(egui_plot::Text::new(r.label.clone(), egui_plot::PlotPoint::new(r.seconds(), r.chl_error_pct().unwrap_or(r.delta_mae_pct.abs())), format!("  {}", r.label)).anchor(egui::Align2::LEFT_CENTER));
             }
         });
         egui::ScrollArea::both().show(ui, |ui| {
-            egui::Grid::new("cost-table").striped(true).num_columns(5).show(ui, |ui| {
-                for h in ["setting", "time s", "× ref", "ΔMAE", "chl per pixel %"] {
+            egui::Grid::new("cost-table").striped(true).num_columns(6).show(ui, |ui| {
+                for h in ["setting", "wall, median (range, n)", "CPU", "vs reference", "ΔMAE", "chl per pixel %"] {
                     ui.strong(h);
                 }
                 ui.end_row();
                 for r in &e.cost_rows {
-                    ui.label(r.label.as_str());
-                    ui.label(format!("{:.2}", r.seconds));
-                    ui.label(format!("{:.2}", r.ratio));
+                    let label = if front.contains(&r.label.as_str()) { format!("{} ◆", r.label) } else { r.label.clone() };
+                    ui.label(label).on_hover_text("◆: on the time–error Pareto front (no setting both faster and closer)");
+                    ui.label(r.time.wall_text());
+                    ui.label(r.time.cpu_text());
+                    ui.label(r.comparison.text());
                     ui.label(format!("{:+.2}", r.delta_mae_pct));
                     ui.label(r.chl_pixel_pct.map_or_else(|| "other grid".into(), |v| format!("{v:.3}")));
                     ui.end_row();

@@ -1,7 +1,7 @@
 //! `shoal bench`: what Shoal's physics costs in time and what it buys in accuracy, side by side
-//! with the reference codes' figures measured on this machine class (SAMBUCA Python forward
-//! model: 13–23 thousand evaluations/s at 451 bands on one core; OSOAA: 1–3.5 s per wavelength
-//! and geometry), and the whole chain against its targets ([`super::bench_chain`]).
+//! with the reference codes' figures, each printed with where and when it was measured
+//! ([`super::bench_reference`]; OSOAA: 1–3.5 s per wavelength and geometry), and the whole chain
+//! against its targets ([`super::bench_chain`]).
 
 use std::time::{Duration, Instant};
 
@@ -36,6 +36,17 @@ pub struct BenchArgs {
     /// full-fidelity run.
     #[arg(long)]
     pub accuracy: bool,
+    /// With `--accuracy`: also print the settings on the time–error Pareto front.
+    #[arg(long)]
+    pub pareto: bool,
+    /// With `--accuracy`: name the cheapest setting whose chl error from the full-fidelity run
+    /// stays within this many percent (median per-pixel difference; |ΔMAE| for a coarser grid).
+    #[arg(long, value_name = "PCT")]
+    pub tolerance_pct: Option<f64>,
+    /// With `--accuracy`: interleaved rounds (each setting timed once per round; at least 3 for
+    /// a range to compare).
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=50))]
+    pub rounds: u32,
     /// Skip the app rows (slider-to-preview latency and frame time; only with the `gui` feature).
     #[arg(long)]
     pub no_app: bool,
@@ -111,15 +122,18 @@ fn water_rows(out: &mut String, quick: bool) -> Result<(), CliError> {
     std::hint::black_box(sink);
     say!(out, "## Water model (Lee 1998/1999), 451 bands, one thread");
     say!(out);
-    say!(out, "| evaluation | evaluations/s | × SAMBUCA Python (13–23 k/s) |");
-    say!(out, "|---|---|---|");
+    let reference = super::bench_reference::SAMBUCA_FORWARD;
+    say!(out, "| evaluation | evaluations/s | {} | × reference |", reference.what);
+    say!(out, "|---|---|---|---|");
     for (label, r) in [
         ("shallow, Rrs only (per-pixel path)", fast_shallow),
         ("optically deep, Rrs only", fast_deep),
         ("shallow, every intermediate", full),
     ] {
-        say!(out, "| {label} | {:.0} | {:.0}–{:.0} |", r, r / 23_000.0, r / 13_000.0);
+        say!(out, "| {label} | {:.0} | {} | {} |", r, reference.text(), reference.ratio(r));
     }
+    say!(out);
+    say!(out, "{}", super::bench_reference::SIDE_BY_SIDE);
     say!(out);
     Ok(())
 }
@@ -252,7 +266,7 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
     say!(out);
     emit(&std::mem::take(&mut out), None)?;
     if args.accuracy {
-        super::bench_accuracy::accuracy_rows(&mut out, args.quick)?;
+        super::bench_accuracy::accuracy_rows(&mut out, args)?;
         return emit(&out, None);
     }
     water_rows(&mut out, args.quick)?;

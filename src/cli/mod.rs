@@ -13,6 +13,7 @@ mod atmosphere;
 mod bench;
 mod bench_accuracy;
 mod bench_chain;
+mod bench_reference;
 mod bench_retrieval;
 mod budget;
 mod grid;

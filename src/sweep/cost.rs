@@ -1,18 +1,21 @@
 //! The cost of accuracy: every fidelity setting trades time for error. [`cost_of_accuracy`] runs
-//! a configuration once per setting (a fresh engine each, so nothing comes from the cache) and
-//! compares the products with the full-fidelity run of the same configuration and seed:
+//! a configuration once per setting and round (a fresh engine each, so nothing comes from the
+//! cache), the rounds interleaved — reference, setting 1, setting 2, …, then again — so a slow
+//! spell of the machine falls on every setting alike ([`crate::timing`]). Each row reports the
+//! median wall and CPU time with their range, and against the reference either a ratio or, when
+//! the ranges overlap, "no measurable difference". Products are compared with the reference
+//! run of the same configuration and seed (first round):
 //!
 //! - **ΔMAE**: the chl-a log-space MAE against the truth, minus the reference's (points of %);
 //! - **chl per pixel**: median |retrieved / reference retrieved − 1| over pixels both return
 //!   (same grid only; a coarser grid has other pixels);
 //! - **Rrs(443) per pixel**: median |Rrs / reference Rrs − 1| over water pixels (same grid only).
 
-use std::time::Instant;
-
 use crate::control::RunControl;
 use crate::engine::{Engine, EngineError, RunConfig, RunOutput};
 use crate::parse::FieldError;
 use crate::study::StudyError;
+use crate::timing::{Comparison, Sample, Summary, measure};
 
 use super::apply;
 
@@ -21,10 +24,12 @@ use super::apply;
 pub struct CostRow {
     /// What the setting is.
     pub label: String,
-    /// Wall time of the whole chain, s.
-    pub seconds: f64,
-    /// Time over the reference's.
-    pub ratio: f64,
+    /// Its timed runs so far (one per round).
+    pub samples: Vec<Sample>,
+    /// Median and range of the samples.
+    pub time: Summary,
+    /// Against the reference's time (the reference row: no measurable difference with itself).
+    pub comparison: Comparison,
     /// chl-a MAE against the truth, %.
     pub chl_mae_pct: f64,
     /// `chl_mae_pct` minus the reference's, points of %.
@@ -33,6 +38,28 @@ pub struct CostRow {
     pub chl_pixel_pct: Option<f64>,
     /// Median per-pixel Rrs(443) difference from the reference, % (same grid only).
     pub rrs_pixel_pct: Option<f64>,
+}
+
+impl CostRow {
+    /// Median wall time, s.
+    #[must_use]
+    pub fn seconds(&self) -> f64 {
+        self.time.wall_s
+    }
+
+    /// The error the Pareto front and the tolerance use: the median per-pixel chl difference
+    /// from the reference, %, on the same grid. `None` for a preview: its pixels are a subset of
+    /// the reference's, so it is a different product (fewer pixels), not a cheaper equal one.
+    #[must_use]
+    pub fn chl_error_pct(&self) -> Option<f64> {
+        self.chl_pixel_pct.filter(|v| v.is_finite())
+    }
+
+    /// Is this row measurably faster than `other` (its slowest run beats `other`'s fastest)?
+    #[must_use]
+    pub fn measurably_faster_than(&self, other: &Self) -> bool {
+        self.time.wall_range_s.1 < other.time.wall_range_s.0
+    }
 }
 
 /// One fidelity setting: its label and the fields it sets.
@@ -133,54 +160,140 @@ fn per_pixel(out: &RunOutput, reference: &RunOutput) -> (Option<f64>, Option<f64
     (median(chl), median(rrs))
 }
 
-/// Measure every setting of [`settings`] on `base` (whose decimation is the reference's);
-/// `on_row` hears of each row as it is measured.
+/// Measure every setting of [`settings`] on `base` (whose decimation is the reference's), in
+/// `rounds` interleaved rounds (at least 1); `on_row` hears of each row each time it gains a
+/// sample, with the round it came from (0-based).
 pub fn cost_of_accuracy(
     base: &RunConfig,
+    rounds: usize,
     control: &RunControl,
-    mut on_row: impl FnMut(&CostRow),
+    mut on_row: impl FnMut(usize, &CostRow),
 ) -> Result<Vec<CostRow>, StudyError> {
-    let mut rows = Vec::new();
-    let mut reference: Option<(RunOutput, f64)> = None;
-    for setting in settings(base.fidelity.decimation) {
-        let config = apply(base, &setting.set)
-            .map_err(|m| StudyError::Invalid(FieldError { field: setting.label.clone(), message: m }))?;
-        let mut engine = Engine::new();
-        let start = Instant::now();
-        let run = engine.run(&config, control).map_err(|e| match e {
-            EngineError::Cancelled => StudyError::Cancelled,
-            other => StudyError::Run { instrument: config.instrument.name.clone(), message: other.to_string() },
-        })?;
-        let seconds = start.elapsed().as_secs_f64();
-        let mae = chl_mae(&run);
-        let row = match &reference {
-            None => CostRow {
-                label: setting.label,
-                seconds,
-                ratio: 1.0,
-                chl_mae_pct: mae,
-                delta_mae_pct: 0.0,
-                chl_pixel_pct: Some(0.0),
-                rrs_pixel_pct: Some(0.0),
-            },
-            Some((r, t)) => {
-                let (chl, rrs) = per_pixel(&run, r);
-                CostRow {
-                    label: setting.label,
-                    seconds,
-                    ratio: seconds / t,
+    let settings = settings(base.fidelity.decimation);
+    let configs = settings
+        .iter()
+        .map(|setting| {
+            apply(base, &setting.set)
+                .map_err(|m| StudyError::Invalid(FieldError { field: setting.label.clone(), message: m }))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut rows: Vec<CostRow> = Vec::with_capacity(settings.len());
+    let mut reference: Option<RunOutput> = None;
+    for round in 0..rounds.max(1) {
+        for (i, (setting, config)) in settings.iter().zip(&configs).enumerate() {
+            let mut engine = Engine::new();
+            let (run, sample) = measure(|| engine.run(config, control));
+            let run = run.map_err(|e| match e {
+                EngineError::Cancelled => StudyError::Cancelled,
+                other => StudyError::Run { instrument: config.instrument.name.clone(), message: other.to_string() },
+            })?;
+            if round == 0 {
+                let mae = chl_mae(&run);
+                let (delta, (chl, rrs)) = match &reference {
+                    None => (0.0, (Some(0.0), Some(0.0))),
+                    Some(r) => (mae - chl_mae(r), per_pixel(&run, r)),
+                };
+                rows.push(CostRow {
+                    label: setting.label.clone(),
+                    samples: Vec::new(),
+                    time: Summary::of(&[]),
+                    comparison: Comparison::NoMeasurableDifference,
                     chl_mae_pct: mae,
-                    delta_mae_pct: mae - chl_mae(r),
+                    delta_mae_pct: delta,
                     chl_pixel_pct: chl.map(|v| 100.0 * v),
                     rrs_pixel_pct: rrs.map(|v| 100.0 * v),
+                });
+                if reference.is_none() {
+                    reference = Some(run);
                 }
             }
-        };
-        on_row(&row);
-        rows.push(row);
-        if reference.is_none() {
-            reference = Some((run, seconds));
+            rows[i].samples.push(sample);
+            rows[i].time = Summary::of(&rows[i].samples);
+            let reference_time = rows[0].time;
+            rows[i].comparison = if i == 0 {
+                Comparison::NoMeasurableDifference
+            } else {
+                Comparison::of(&rows[i].time, &reference_time)
+            };
+            on_row(round, &rows[i]);
         }
     }
     Ok(rows)
+}
+
+/// The full-resolution rows on the time–error Pareto front, fastest first: a row is off the
+/// front when another is measurably faster ([`CostRow::measurably_faster_than`]) and no less
+/// accurate, or as fast within the noise and more accurate. Of rows that tie in both, the first
+/// (the reference comes first) stands for them.
+#[must_use]
+pub fn pareto_front(rows: &[CostRow]) -> Vec<&CostRow> {
+    let candidates: Vec<(usize, &CostRow, f64)> =
+        rows.iter().enumerate().filter_map(|(i, r)| r.chl_error_pct().map(|e| (i, r, e))).collect();
+    let mut front: Vec<&CostRow> = candidates
+        .iter()
+        .filter(|(i, r, e)| {
+            !candidates.iter().any(|(j, o, f)| {
+                let tied_time = !o.measurably_faster_than(r) && !r.measurably_faster_than(o);
+                (o.measurably_faster_than(r) && f <= e) || (tied_time && (f < e || (f == e && j < i)))
+            })
+        })
+        .map(|(_, r, _)| *r)
+        .collect();
+    front.sort_by(|a, b| a.seconds().total_cmp(&b.seconds()));
+    front
+}
+
+/// The fastest full-resolution row whose chl error from the reference is within
+/// `tolerance_pct` and that is measurably faster than the reference; the reference itself when
+/// none is.
+#[must_use]
+pub fn cheapest_within(rows: &[CostRow], tolerance_pct: f64) -> Option<&CostRow> {
+    let reference = rows.first()?;
+    rows.iter()
+        .skip(1)
+        .filter(|r| r.chl_error_pct().is_some_and(|e| e <= tolerance_pct) && r.measurably_faster_than(reference))
+        .min_by(|a, b| a.seconds().total_cmp(&b.seconds()))
+        .or(Some(reference))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::timing::Sample;
+
+    fn row(label: &str, times: &[f64], pixel: Option<f64>) -> CostRow {
+        let samples: Vec<Sample> = times.iter().map(|&w| Sample { wall_s: w, cpu_s: None }).collect();
+        CostRow {
+            label: label.into(),
+            time: Summary::of(&samples),
+            samples,
+            comparison: Comparison::NoMeasurableDifference,
+            chl_mae_pct: 30.0,
+            delta_mae_pct: 0.0,
+            chl_pixel_pct: pixel,
+            rrs_pixel_pct: pixel,
+        }
+    }
+
+    #[test]
+    fn the_front_ignores_differences_within_the_noise_and_previews() {
+        let rows = vec![
+            row("reference", &[1.6, 1.7, 1.8], Some(0.0)),
+            // As fast within the noise, no more accurate: tied with the reference, dropped.
+            row("same", &[1.55, 1.65, 1.75], Some(0.0)),
+            // Measurably faster, small error: on the front.
+            row("fast", &[1.0, 1.05, 1.1], Some(0.5)),
+            // As fast as `fast` within the noise but worse: off.
+            row("fast-worse", &[1.02, 1.06, 1.09], Some(0.9)),
+            // Fastest, larger error: on the front.
+            row("fastest", &[0.5, 0.52, 0.55], Some(3.0)),
+            // A preview: not a candidate.
+            row("preview", &[0.2, 0.21, 0.22], None),
+        ];
+        let front: Vec<&str> = pareto_front(&rows).iter().map(|r| r.label.as_str()).collect();
+        assert_eq!(front, ["fastest", "fast", "reference"]);
+        assert_eq!(cheapest_within(&rows, 1.0).unwrap().label, "fast");
+        assert_eq!(cheapest_within(&rows, 5.0).unwrap().label, "fastest");
+        assert_eq!(cheapest_within(&rows, 0.1).unwrap().label, "reference");
+    }
 }
