@@ -13,7 +13,8 @@ use rand::{RngExt, SeedableRng};
 
 use super::CliError;
 use crate::control::RunControl;
-use crate::retrieval::almi::{AlmiSet, AlmiSettings, invert as almi_invert};
+use crate::retrieval::almi::{AlmiSet, AlmiSettings};
+use crate::retrieval::almi_lanes::{PackedSets, invert_packed};
 use crate::retrieval::sambuca::{Observation, SambucaSettings, invert as sambuca_invert, objective_value};
 use crate::retrieval::sets::ALMI_SETS;
 use crate::retrieval::{BandModel, BandResponse, Parameters};
@@ -99,11 +100,12 @@ fn almi_rate(quick: bool) -> Result<(f64, f64, usize), CliError> {
         .collect();
     let valid = vec![true; bands.len()];
     let nedr = vec![1e-4; bands.len()];
+    let packed = PackedSets::new(&sets);
     let rate = |weighting: bool| {
         let settings = AlmiSettings { noise_weighting: weighting, ..AlmiSettings::default() };
         let mut sink = 0.0;
         let r = timed_rate(min_seconds(quick), pixels.len(), |i| {
-            sink += almi_invert(&sets, &settings, &pixels[i], &valid, &nedr).chl;
+            sink += invert_packed(&packed, &settings, &pixels[i], &valid, &nedr).chl;
         });
         std::hint::black_box(sink);
         r

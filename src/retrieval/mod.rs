@@ -12,6 +12,7 @@
 //! | images | [`run`] | a retrieval over a whole Rrs cube, the products and their flags |
 
 pub mod almi;
+pub mod almi_lanes;
 pub mod almi_reference;
 pub mod band_model;
 pub mod nnls;

@@ -8,7 +8,8 @@ use serde::{Deserialize, Serialize};
 
 use super::Mode;
 use super::RetrievalError;
-use super::almi::{AlmiFlags, AlmiSet, AlmiSettings, invert as almi_invert};
+use super::almi::{AlmiFlags, AlmiSet, AlmiSettings};
+use super::almi_lanes::{PackedSets, invert_packed};
 use super::almi_reference::invert_reference;
 use super::band_model::{BandModel, BandResponse};
 use super::sambuca::SambucaSettings;
@@ -269,6 +270,8 @@ pub(super) fn retrieve_almi(
             }));
         }
     }
+    // The sets side by side for the per-pixel loops (bit-identical to the scalar `almi::invert`).
+    let packed = PackedSets::new(&sets);
     let (rows, cols, nb) = inputs.rrs.dim();
     let results: Vec<Vec<AlmiRow>> = control.map_rows(rows, |at| {
         let r = at.index();
@@ -287,7 +290,7 @@ pub(super) fn retrieve_almi(
                     valid[k] = inputs.flags[[r, c, b]] & (RrsFlags::INVALID | RrsFlags::SATURATED) == 0;
                 }
                 let p = match settings.mode {
-                    Mode::Improved => almi_invert(&sets, settings, &obs, &valid, &nedr),
+                    Mode::Improved => invert_packed(&packed, settings, &obs, &valid, &nedr),
                     Mode::Reference => invert_reference(&sets, settings.g0, settings.g1, &obs, &valid),
                 };
                 if p.flags & AlmiFlags::FAILED != 0 || p.set.is_none() {

@@ -1,0 +1,375 @@
+//! aLMI with the SIOP sets in SIMD lanes: the same arithmetic as [`super::almi::invert`], laid
+//! out so the compiler vectorises it.
+//!
+//! The per-pixel work of aLMI is, for each SIOP set, two weighted normal-equation builds (ten
+//! sums over the bands), two 3-unknown NNLS solves and a forward-model cost. The sums and the
+//! cost are the same operations for every set with other coefficients: with the coefficients
+//! stored band by band with the sets side by side (`[band][set]`, [`PackedSets`]), the inner
+//! loops run over up to [`LANES`] sets at once. Only the NNLS solves stay per set.
+//!
+//! Every lane performs exactly the operations, in the same order, that the scalar
+//! [`super::almi::invert`] performs for that set, so the two give bit-identical pixels (tested
+//! below); the scalar one stays as the readable statement of the method.
+
+use super::almi::{AlmiFlags, AlmiPixel, AlmiSet, AlmiSettings, MAX_BANDS, u_from_rrs};
+use super::nnls::nnls3;
+use crate::water::rrs_below_from_above;
+
+/// Sets per chunk (one chunk of eight covers the built-in sets).
+pub const LANES: usize = 8;
+
+/// One chunk's coefficients at one band, a lane per set.
+#[derive(Debug, Clone, Copy, Default)]
+struct BandLanes {
+    a_w: [f64; LANES],
+    bb_w: [f64; LANES],
+    a_ph: [f64; LANES],
+    bb_ph: [f64; LANES],
+    a_cdom: [f64; LANES],
+    a_nap: [f64; LANES],
+    bb_nap: [f64; LANES],
+}
+
+/// The SIOP sets' band IOPs, band by band with the sets side by side, in chunks of [`LANES`].
+#[derive(Debug, Clone)]
+pub struct PackedSets {
+    /// `chunks[c][k]`: chunk `c` at band `k`.
+    chunks: Vec<Vec<BandLanes>>,
+    /// Sets in each chunk.
+    lanes: Vec<usize>,
+}
+
+impl PackedSets {
+    /// Pack `sets` (all with the same bands). Unused lanes of the last chunk hold zeros and are
+    /// never read back.
+    #[must_use]
+    pub fn new(sets: &[AlmiSet]) -> Self {
+        let n_bands = sets.first().map_or(0, |s| s.iops.a_w.len());
+        let mut chunks = Vec::new();
+        let mut lanes = Vec::new();
+        for chunk in sets.chunks(LANES) {
+            let mut bands = vec![BandLanes::default(); n_bands];
+            for (s, set) in chunk.iter().enumerate() {
+                let o = &set.iops;
+                for (k, b) in bands.iter_mut().enumerate() {
+                    b.a_w[s] = o.a_w[k];
+                    b.bb_w[s] = o.bb_w[k];
+                    b.a_ph[s] = o.a_ph[k];
+                    b.bb_ph[s] = o.bb_ph[k];
+                    b.a_cdom[s] = o.a_cdom[k];
+                    b.a_nap[s] = o.a_nap[k];
+                    b.bb_nap[s] = o.bb_nap[k];
+                }
+            }
+            chunks.push(bands);
+            lanes.push(chunk.len());
+        }
+        Self { chunks, lanes }
+    }
+}
+
+/// One set's NNLS answer: (x, residual², unconstrained x), or `None` (see [`nnls3`]).
+type Solution = Option<([f64; 3], f64, [f64; 3])>;
+
+/// The weighted normal equations of every lane: G (six sums, symmetric), b and yᵀy.
+#[derive(Clone, Copy)]
+struct Normal {
+    g: [[f64; LANES]; 6],
+    b: [[f64; LANES]; 3],
+    yy: [f64; LANES],
+}
+
+impl Normal {
+    fn solve(&self, s: usize) -> Solution {
+        let g = |j: usize| self.g[j][s];
+        nnls3(
+            &[[g(0), g(1), g(2)], [g(1), g(3), g(4)], [g(2), g(4), g(5)]],
+            &[self.b[0][s], self.b[1][s], self.b[2][s]],
+            self.yy[s],
+        )
+    }
+}
+
+/// The rows of one band in every lane: r (three columns) and y.
+#[derive(Clone, Copy, Default)]
+struct Rows {
+    r: [[f64; LANES]; 3],
+    y: [f64; LANES],
+}
+
+/// Accumulate the normal equations from `rows` with per-band, per-lane weights (`None`: 1).
+#[inline(always)]
+fn normal(rows: &[Rows], w2: Option<&[[f64; LANES]]>) -> Normal {
+    let mut n = Normal { g: [[0.0; LANES]; 6], b: [[0.0; LANES]; 3], yy: [0.0; LANES] };
+    for (i, row) in rows.iter().enumerate() {
+        for s in 0..LANES {
+            let w = w2.map_or(1.0, |w| w[i][s]);
+            let (r0, r1, r2, y) = (row.r[0][s], row.r[1][s], row.r[2][s], row.y[s]);
+            let (wr0, wr1, wr2, wy) = (w * r0, w * r1, w * r2, w * y);
+            n.g[0][s] += wr0 * r0;
+            n.g[1][s] += wr0 * r1;
+            n.g[2][s] += wr0 * r2;
+            n.g[3][s] += wr1 * r1;
+            n.g[4][s] += wr1 * r2;
+            n.g[5][s] += wr2 * r2;
+            n.b[0][s] += wr0 * y;
+            n.b[1][s] += wr1 * y;
+            n.b[2][s] += wr2 * y;
+            n.yy[s] += wy * y;
+        }
+    }
+    n
+}
+
+/// a and bb of every lane at band `c` for concentrations `x` (lane-wise).
+#[inline(always)]
+fn kappa(c: &BandLanes, x: &[[f64; LANES]; 3], s: usize) -> (f64, f64) {
+    let a = c.a_w[s] + x[0][s] * c.a_ph[s] + x[1][s] * c.a_cdom[s] + x[2][s] * c.a_nap[s];
+    let bb = c.bb_w[s] + x[0][s] * c.bb_ph[s] + x[2][s] * c.bb_nap[s];
+    (a, bb)
+}
+
+/// [`super::almi::invert`] over packed sets: the same inputs, the same pixel, bit for bit.
+/// On a CPU with AVX2 the lanes run four sets per instruction (two otherwise).
+#[must_use]
+pub fn invert_packed(
+    sets: &PackedSets,
+    settings: &AlmiSettings,
+    rrs_above: &[f64],
+    valid: &[bool],
+    nedr: &[f64],
+) -> AlmiPixel {
+    #[cfg(target_arch = "x86_64")]
+    if avx2::available() {
+        return avx2::invert(sets, settings, rrs_above, valid, nedr);
+    }
+    invert_lanes(sets, settings, rrs_above, valid, nedr)
+}
+
+/// The same code compiled for AVX2 (four doubles per instruction instead of two), chosen at
+/// run time so the binary still runs on any x86-64 CPU. The expression tree is unchanged (Rust
+/// never contracts a·b + c into an FMA), so both builds give identical pixels.
+#[cfg(target_arch = "x86_64")]
+mod avx2 {
+    use super::{AlmiPixel, AlmiSettings, PackedSets, invert_lanes};
+
+    pub fn available() -> bool {
+        std::is_x86_feature_detected!("avx2")
+    }
+
+    #[target_feature(enable = "avx2")]
+    fn invert_avx2(
+        sets: &PackedSets,
+        settings: &AlmiSettings,
+        rrs_above: &[f64],
+        valid: &[bool],
+        nedr: &[f64],
+    ) -> AlmiPixel {
+        invert_lanes(sets, settings, rrs_above, valid, nedr)
+    }
+
+    pub fn invert(
+        sets: &PackedSets,
+        settings: &AlmiSettings,
+        rrs_above: &[f64],
+        valid: &[bool],
+        nedr: &[f64],
+    ) -> AlmiPixel {
+        debug_assert!(available());
+        // SAFETY: callers check `available()`: the CPU executes AVX2 instructions.
+        #[allow(unsafe_code)]
+        unsafe {
+            invert_avx2(sets, settings, rrs_above, valid, nedr)
+        }
+    }
+}
+
+#[inline(always)]
+fn invert_lanes(
+    sets: &PackedSets,
+    settings: &AlmiSettings,
+    rrs_above: &[f64],
+    valid: &[bool],
+    nedr: &[f64],
+) -> AlmiPixel {
+    let (g0, g1) = (settings.g0, settings.g1);
+    let n = rrs_above.len().min(MAX_BANDS);
+    let mut used = [0usize; MAX_BANDS];
+    let mut m = 0;
+    for k in 0..n {
+        if valid[k] && rrs_above[k].is_finite() && rrs_above[k] > 0.0 {
+            used[m] = k;
+            m += 1;
+        }
+    }
+    if m < 3 {
+        return AlmiPixel::FAILED;
+    }
+    let used = &used[..m];
+    let mut rrs = [0.0; MAX_BANDS];
+    let mut u = [0.0; MAX_BANDS];
+    let mut sigma_u = [1.0; MAX_BANDS];
+    let mut sigma_rrs = [1.0; MAX_BANDS];
+    for (i, &k) in used.iter().enumerate() {
+        rrs[i] = rrs_below_from_above(rrs_above[k]);
+        if !(rrs[i].is_finite() && rrs[i] > 0.0) {
+            return AlmiPixel::FAILED;
+        }
+        u[i] = u_from_rrs(rrs[i], g0, g1);
+        if settings.noise_weighting {
+            let d = 0.52 + 1.7 * rrs_above[k];
+            sigma_rrs[i] = (nedr.get(k).copied().unwrap_or(0.0) * 0.52 / (d * d)).max(1e-12);
+            sigma_u[i] = sigma_rrs[i] / (g0 + 2.0 * g1 * u[i]);
+        }
+    }
+    let mean_rrs = rrs[..m].iter().sum::<f64>() / m as f64;
+    let mut best = AlmiPixel::FAILED;
+    let mut rows = [Rows::default(); MAX_BANDS];
+    let mut w2 = [[1.0; LANES]; MAX_BANDS];
+    for (chunk, (bands, &lanes)) in sets.chunks.iter().zip(&sets.lanes).enumerate() {
+        for (i, &k) in used.iter().enumerate() {
+            let c = &bands[k];
+            let (uu, v) = (u[i], 1.0 - u[i]);
+            let row = &mut rows[i];
+            for s in 0..LANES {
+                row.r[0][s] = c.a_ph[s] * uu - c.bb_ph[s] * v;
+                row.r[1][s] = c.a_cdom[s] * uu;
+                row.r[2][s] = c.a_nap[s] * uu - c.bb_nap[s] * v;
+                row.y[s] = c.bb_w[s] * v - c.a_w[s] * uu;
+            }
+        }
+        let first = normal(&rows[..m], None);
+        let mut sol: [Solution; LANES] = [None; LANES];
+        for (s, slot) in sol.iter_mut().enumerate().take(lanes) {
+            *slot = first.solve(s);
+        }
+        let x_of = |sol: &[Solution; LANES]| -> [[f64; LANES]; 3] {
+            let mut x = [[0.0; LANES]; 3];
+            for (s, p) in sol.iter().enumerate() {
+                if let Some((xs, _, _)) = p {
+                    for j in 0..3 {
+                        x[j][s] = xs[j];
+                    }
+                }
+            }
+            x
+        };
+        if settings.noise_weighting {
+            // One reweighting pass, as in the scalar code: weights from each lane's own solution.
+            let x = x_of(&sol);
+            for (i, &k) in used.iter().enumerate() {
+                let c = &bands[k];
+                for s in 0..LANES {
+                    let (a, bb) = kappa(c, &x, s);
+                    let w1 = 1.0 / ((a + bb) * sigma_u[i]).max(1e-300);
+                    w2[i][s] = w1 * w1;
+                }
+            }
+            let second = normal(&rows[..m], Some(&w2[..m]));
+            for (s, slot) in sol.iter_mut().enumerate().take(lanes) {
+                if slot.is_some()
+                    && let Some(next) = second.solve(s)
+                {
+                    *slot = Some(next);
+                }
+            }
+        }
+        // Cost in rrs space, every lane at once.
+        let x = x_of(&sol);
+        let mut sq = [0.0; LANES];
+        for (i, &k) in used.iter().enumerate() {
+            let c = &bands[k];
+            for s in 0..LANES {
+                let (a, bb) = kappa(c, &x, s);
+                let up = bb / (a + bb);
+                let d = (g0 + g1 * up) * up - rrs[i];
+                sq[s] += if settings.noise_weighting { (d / sigma_rrs[i]).powi(2) } else { d * d };
+            }
+        }
+        for (s, p) in sol.iter().enumerate().take(lanes) {
+            let Some((xs, _, unconstrained)) = p else { continue };
+            let cost =
+                if settings.noise_weighting { (sq[s] / m as f64).sqrt() } else { (sq[s] / m as f64).sqrt() / mean_rrs };
+            if cost.is_finite() && cost < best.cost {
+                let physical = unconstrained.iter().all(|v| *v >= 0.0);
+                let at_bound = xs.contains(&0.0);
+                best = AlmiPixel {
+                    chl: xs[0],
+                    cdom: xs[1],
+                    nap: xs[2],
+                    set: u8::try_from(chunk * LANES + s).ok(),
+                    cost,
+                    flags: if physical { AlmiFlags::PHYSICAL } else { 0 }
+                        | if at_bound { AlmiFlags::AT_BOUND } else { 0 },
+                };
+            }
+        }
+    }
+    best
+}
+
+#[cfg(test)]
+mod tests {
+    use rand::rngs::Xoshiro256PlusPlus;
+    use rand::{RngExt, SeedableRng};
+
+    use super::*;
+    use crate::retrieval::almi::invert;
+    use crate::retrieval::band_model::BandIops;
+
+    /// `n` sets of six bands with IOPs scattered around plausible values.
+    fn sets(n: usize, rng: &mut Xoshiro256PlusPlus) -> Vec<AlmiSet> {
+        let base = BandIops {
+            a_w: vec![0.007, 0.015, 0.062, 0.43, 0.80, 2.1],
+            bb_w: vec![0.0024, 0.0016, 0.0010, 0.0005, 0.0004, 0.0003],
+            a_ph: vec![0.060, 0.040, 0.015, 0.018, 0.004, 0.001],
+            a_cdom: vec![1.0, 0.45, 0.14, 0.028, 0.012, 0.004],
+            a_nap: vec![0.045, 0.030, 0.014, 0.005, 0.003, 0.002],
+            bb_ph: vec![0.0011, 0.0010, 0.0009, 0.0008, 0.0007, 0.0006],
+            bb_nap: vec![0.0095, 0.0087, 0.0079, 0.0066, 0.0062, 0.0058],
+        };
+        (0..n)
+            .map(|i| {
+                let mut f = || rng.random_range(0.5..2.0);
+                let mut o = base.clone();
+                for v in [&mut o.a_ph, &mut o.a_cdom, &mut o.a_nap, &mut o.bb_ph, &mut o.bb_nap] {
+                    let scale = f();
+                    v.iter_mut().for_each(|x| *x *= scale);
+                }
+                AlmiSet { name: format!("set {i}"), iops: o }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn packed_lanes_give_the_scalar_pixels_bit_for_bit() {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(3);
+        // 8 sets (one full chunk), 11 (a partial second chunk) and 3 (a partial first one).
+        for n_sets in [8, 11, 3] {
+            let sets = sets(n_sets, &mut rng);
+            let packed = PackedSets::new(&sets);
+            for weighting in [true, false] {
+                let settings = AlmiSettings { noise_weighting: weighting, ..AlmiSettings::default() };
+                for _ in 0..500 {
+                    let rrs: Vec<f64> = (0..6).map(|k| rng.random_range(0.0005..0.02) / (1.0 + k as f64)).collect();
+                    let mut valid = vec![true; 6];
+                    // Now and then a band left out, or a pixel with too few bands.
+                    if rng.random_range(0.0..1.0) < 0.2 {
+                        valid[rng.random_range(0..6)] = false;
+                    }
+                    let nedr: Vec<f64> = rrs.iter().map(|v| 0.02 * v).collect();
+                    let a = invert(&sets, &settings, &rrs, &valid, &nedr);
+                    let b = invert_packed(&packed, &settings, &rrs, &valid, &nedr);
+                    // The portable build too, where the CPU would have taken the AVX2 one.
+                    let c = invert_lanes(&packed, &settings, &rrs, &valid, &nedr);
+                    assert_eq!(format!("{b:?}"), format!("{c:?}"), "AVX2 and portable builds differ");
+                    assert_eq!(a.set, b.set, "{n_sets} sets: chosen set");
+                    assert_eq!(a.flags, b.flags);
+                    for (x, y) in [(a.chl, b.chl), (a.cdom, b.cdom), (a.nap, b.nap), (a.cost, b.cost)] {
+                        assert_eq!(x.to_bits(), y.to_bits(), "{n_sets} sets: {a:?} vs {b:?}");
+                    }
+                }
+            }
+        }
+    }
+}
