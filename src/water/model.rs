@@ -215,13 +215,25 @@ pub fn rrs_below_from_above(rrs_above: f64) -> f64 {
 #[derive(Debug, Clone)]
 pub struct WaterModel {
     siop: Siop,
+    /// Every column gives a > 0 and bb > 0: pure water's a_w and bb_w are positive and every
+    /// specific spectrum is non-negative, at every wavelength, so with the concentrations a
+    /// validated column has (finite, ≥ 0) nothing can cancel them. The per-call check of
+    /// [`Self::rrs_above_into`] is then skipped: it cost as much as the deep-water kernel.
+    positive_for_any_column: bool,
 }
 
 impl WaterModel {
     /// Bind a resolved SIOP set.
     #[must_use]
     pub fn new(siop: Siop) -> Self {
-        Self { siop }
+        let positive = |v: &[f64]| v.iter().all(|x| x.is_finite() && *x > 0.0);
+        let non_negative = |v: &[f64]| v.iter().all(|x| x.is_finite() && *x >= 0.0);
+        let positive_for_any_column = positive(&siop.a_w)
+            && positive(&siop.bb_w)
+            && [&siop.a_ph_star, &siop.a_cdom_star, &siop.a_nap_star, &siop.bb_ph_star, &siop.bb_nap_star]
+                .iter()
+                .all(|v| non_negative(v));
+        Self { siop, positive_for_any_column }
     }
 
     /// The SIOP set (and its grid).
@@ -334,7 +346,9 @@ impl WaterModel {
         };
         // Only a SIOP set with strongly negative specific spectra can make a or bb ≤ 0; check
         // before computing, as `evaluate` does (a cheap pass next to the kernel).
-        if let Some(i) = (0..n).find(|&i| !(k.absorption(i) > 0.0 && k.backscattering(i) > 0.0)) {
+        if !self.positive_for_any_column
+            && let Some(i) = (0..n).find(|&i| !(k.absorption(i) > 0.0 && k.backscattering(i) > 0.0))
+        {
             return Err(self.non_physical(i, k.absorption(i), k.backscattering(i)));
         }
         match column.bottom {
