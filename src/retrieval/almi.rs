@@ -110,43 +110,88 @@ pub fn u_from_rrs(rrs: f64, g0: f64, g1: f64) -> f64 {
     (-g0 + (g0 * g0 + 4.0 * g1 * rrs).sqrt()) / (2.0 * g1)
 }
 
+/// A pixel's per-band quantities, shared by [`invert`] and the lane version
+/// ([`super::almi_lanes`]): the bands in use, sub-surface rrs, u, and the noise σ of rrs and u.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Prepared {
+    /// Indices of the bands in use (the first `m`).
+    pub used: [usize; MAX_BANDS],
+    /// Bands in use.
+    pub m: usize,
+    /// Sub-surface rrs per band in use.
+    pub rrs: [f64; MAX_BANDS],
+    /// u per band in use.
+    pub u: [f64; MAX_BANDS],
+    /// σ of u per band in use (1 without noise weighting).
+    pub sigma_u: [f64; MAX_BANDS],
+    /// σ of rrs per band in use (1 without noise weighting).
+    pub sigma_rrs: [f64; MAX_BANDS],
+    /// Mean rrs over the bands in use.
+    pub mean_rrs: f64,
+}
+
+impl Default for Prepared {
+    fn default() -> Self {
+        Self {
+            used: [0; MAX_BANDS],
+            m: 0,
+            rrs: [0.0; MAX_BANDS],
+            u: [0.0; MAX_BANDS],
+            sigma_u: [1.0; MAX_BANDS],
+            sigma_rrs: [1.0; MAX_BANDS],
+            mean_rrs: 0.0,
+        }
+    }
+}
+
+impl Prepared {
+    /// Fill from one pixel; false if fewer than three bands are usable or an rrs is not positive.
+    #[inline(always)]
+    pub fn prepare(&mut self, settings: &AlmiSettings, rrs_above: &[f64], valid: &[bool], nedr: &[f64]) -> bool {
+        let (g0, g1) = (settings.g0, settings.g1);
+        let n = rrs_above.len().min(MAX_BANDS);
+        self.m = 0;
+        for k in 0..n {
+            if valid[k] && rrs_above[k].is_finite() && rrs_above[k] > 0.0 {
+                self.used[self.m] = k;
+                self.m += 1;
+            }
+        }
+        if self.m < 3 {
+            return false;
+        }
+        let m = self.m;
+        // σ of rrs and of u per band, from the Rrs noise (rrs = R/(0.52 + 1.7R): drrs/dR = 0.52/(0.52 + 1.7R)²).
+        for i in 0..m {
+            let k = self.used[i];
+            self.rrs[i] = rrs_below_from_above(rrs_above[k]);
+            if !(self.rrs[i].is_finite() && self.rrs[i] > 0.0) {
+                return false;
+            }
+            self.u[i] = u_from_rrs(self.rrs[i], g0, g1);
+            if settings.noise_weighting {
+                let d = 0.52 + 1.7 * rrs_above[k];
+                self.sigma_rrs[i] = (nedr.get(k).copied().unwrap_or(0.0) * 0.52 / (d * d)).max(1e-12);
+                self.sigma_u[i] = self.sigma_rrs[i] / (g0 + 2.0 * g1 * self.u[i]);
+            }
+        }
+        self.mean_rrs = self.rrs[..m].iter().sum::<f64>() / m as f64;
+        true
+    }
+}
+
 /// Invert one pixel: `rrs_above[k]` and `valid[k]` for the bands in use (same order as the
 /// sets' IOPs); `nedr[k]`, the noise-equivalent ΔRrs of each band, weights the equations when
 /// the settings ask for noise weighting.
 #[must_use]
 pub fn invert(sets: &[AlmiSet], settings: &AlmiSettings, rrs_above: &[f64], valid: &[bool], nedr: &[f64]) -> AlmiPixel {
     let (g0, g1) = (settings.g0, settings.g1);
-    let n = rrs_above.len().min(MAX_BANDS);
-    let mut used = [0usize; MAX_BANDS];
-    let mut m = 0;
-    for k in 0..n {
-        if valid[k] && rrs_above[k].is_finite() && rrs_above[k] > 0.0 {
-            used[m] = k;
-            m += 1;
-        }
-    }
-    if m < 3 {
+    let mut p = Prepared::default();
+    if !p.prepare(settings, rrs_above, valid, nedr) {
         return AlmiPixel::FAILED;
     }
+    let Prepared { ref used, m, ref rrs, ref u, ref sigma_u, ref sigma_rrs, mean_rrs } = p;
     let used = &used[..m];
-    let mut rrs = [0.0; MAX_BANDS];
-    let mut u = [0.0; MAX_BANDS];
-    // σ of rrs and of u per band, from the Rrs noise (rrs = R/(0.52 + 1.7R): drrs/dR = 0.52/(0.52 + 1.7R)²).
-    let mut sigma_u = [1.0; MAX_BANDS];
-    let mut sigma_rrs = [1.0; MAX_BANDS];
-    for (i, &k) in used.iter().enumerate() {
-        rrs[i] = rrs_below_from_above(rrs_above[k]);
-        if !(rrs[i].is_finite() && rrs[i] > 0.0) {
-            return AlmiPixel::FAILED;
-        }
-        u[i] = u_from_rrs(rrs[i], g0, g1);
-        if settings.noise_weighting {
-            let d = 0.52 + 1.7 * rrs_above[k];
-            sigma_rrs[i] = (nedr.get(k).copied().unwrap_or(0.0) * 0.52 / (d * d)).max(1e-12);
-            sigma_u[i] = sigma_rrs[i] / (g0 + 2.0 * g1 * u[i]);
-        }
-    }
-    let mean_rrs = rrs[..m].iter().sum::<f64>() / m as f64;
     let mut best = AlmiPixel::FAILED;
     // Per set: the rows of the system (r, y) and a + bb's pieces, computed once per pixel and set
     // and used by both solves and the cost (they were rebuilt for each before).

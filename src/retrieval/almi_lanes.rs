@@ -11,9 +11,8 @@
 //! [`super::almi::invert`] performs for that set, so the two give bit-identical pixels (tested
 //! below); the scalar one stays as the readable statement of the method.
 
-use super::almi::{AlmiFlags, AlmiPixel, AlmiSet, AlmiSettings, MAX_BANDS, u_from_rrs};
+use super::almi::{AlmiFlags, AlmiPixel, AlmiSet, AlmiSettings, MAX_BANDS, Prepared};
 use super::nnls::nnls3;
-use crate::water::rrs_below_from_above;
 
 /// Sets per chunk (one chunk of eight covers the built-in sets).
 pub const LANES: usize = 8;
@@ -193,36 +192,12 @@ fn invert_lanes(
     nedr: &[f64],
 ) -> AlmiPixel {
     let (g0, g1) = (settings.g0, settings.g1);
-    let n = rrs_above.len().min(MAX_BANDS);
-    let mut used = [0usize; MAX_BANDS];
-    let mut m = 0;
-    for k in 0..n {
-        if valid[k] && rrs_above[k].is_finite() && rrs_above[k] > 0.0 {
-            used[m] = k;
-            m += 1;
-        }
-    }
-    if m < 3 {
+    let mut p = Prepared::default();
+    if !p.prepare(settings, rrs_above, valid, nedr) {
         return AlmiPixel::FAILED;
     }
+    let Prepared { ref used, m, ref rrs, ref u, ref sigma_u, ref sigma_rrs, mean_rrs } = p;
     let used = &used[..m];
-    let mut rrs = [0.0; MAX_BANDS];
-    let mut u = [0.0; MAX_BANDS];
-    let mut sigma_u = [1.0; MAX_BANDS];
-    let mut sigma_rrs = [1.0; MAX_BANDS];
-    for (i, &k) in used.iter().enumerate() {
-        rrs[i] = rrs_below_from_above(rrs_above[k]);
-        if !(rrs[i].is_finite() && rrs[i] > 0.0) {
-            return AlmiPixel::FAILED;
-        }
-        u[i] = u_from_rrs(rrs[i], g0, g1);
-        if settings.noise_weighting {
-            let d = 0.52 + 1.7 * rrs_above[k];
-            sigma_rrs[i] = (nedr.get(k).copied().unwrap_or(0.0) * 0.52 / (d * d)).max(1e-12);
-            sigma_u[i] = sigma_rrs[i] / (g0 + 2.0 * g1 * u[i]);
-        }
-    }
-    let mean_rrs = rrs[..m].iter().sum::<f64>() / m as f64;
     let mut best = AlmiPixel::FAILED;
     let mut rows = [Rows::default(); MAX_BANDS];
     let mut w2 = [[1.0; LANES]; MAX_BANDS];
