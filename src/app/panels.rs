@@ -208,10 +208,10 @@ fn editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
                 .suffix(p.unit)
                 .logarithmic(p.log)
                 .clamping(egui::SliderClamping::Never);
-            let slider = if matches!(p.key, "detectors" | "lines" | "adc_bits") { slider.integer() } else { slider };
+            let integer = matches!(p.key, "detectors" | "lines" | "adc_bits");
+            let slider = if integer { slider.integer() } else { slider };
             // The hover text states the documented range (src/ranges.rs) a typed value must meet;
             // built only while the pointer is on the slider.
-            let integer = matches!(p.key, "detectors" | "lines" | "adc_bits");
             let response = ui.add(slider);
             // Shift held on the rail: the pointer's motion moves the value a tenth as far, from
             // where it was (egui would jump to the pointer). A drag begun with Shift stays fine

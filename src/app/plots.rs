@@ -71,7 +71,7 @@ fn substrate_tables(app: &ShoalApp, ui: &mut egui::Ui) {
     }
 }
 
-fn metrics_table(app: &ShoalApp, ui: &mut egui::Ui) {
+fn metrics_table(app: &ShoalApp, ui: &mut egui::Ui, configs: &[crate::engine::RunConfig]) {
     let runs: Vec<Option<&RunOutput>> = app.link.shown.iter().map(|s| s.as_ref().map(|s| s.output.as_ref())).collect();
     // One judgement for app, export and CLI: `Requirements::check_run`.
     let checks: Vec<Vec<Check>> = runs
@@ -83,7 +83,8 @@ fn metrics_table(app: &ShoalApp, ui: &mut egui::Ui) {
             })
         })
         .collect();
-    let configs = app.state.configs();
+    // The seed spread, when measured for these very designs.
+    let spread = app.ui.seeds.spread_for(configs).unwrap_or_default();
     egui::Grid::new("metrics").num_columns(9).striped(true).show(ui, |ui| {
         for h in ["product", "A MAE", "A bias", "A returned", "A", "B MAE", "B bias", "B returned", "B"] {
             ui.strong(h);
@@ -127,8 +128,10 @@ fn metrics_table(app: &ShoalApp, ui: &mut egui::Ui) {
                             format!("{:.1} %", m.mae_pct())
                         };
                         let mut hover = in_units;
-                        // The seed spread, when measured for these very designs.
-                        if let Some(s) = app.ui.seeds.get(&configs, index, v).filter(|s| s.seeds > 1) {
+                        let ab = if index == 0 { "A" } else { "B" };
+                        if let Some(s) =
+                            spread.iter().find(|s| s.instrument == ab && s.variable == *v).filter(|s| s.seeds > 1)
+                        {
                             text.push_str(&format!(" ±{:.1}", s.mae_pct_std));
                             hover.push_str(&format!(
                                 "\n± is the standard deviation of the MAE over {} noise seeds at 1/{} (mean {:.1} %, range {:.1}–{:.1} %)",
@@ -169,8 +172,7 @@ fn metrics_table(app: &ShoalApp, ui: &mut egui::Ui) {
 }
 
 /// Start (or cancel) the seed-spread runs, and say what the ± in the table means.
-fn seed_controls(app: &mut ShoalApp, ui: &mut egui::Ui) {
-    let configs = app.state.configs();
+fn seed_controls(app: &mut ShoalApp, ui: &mut egui::Ui, configs: &[crate::engine::RunConfig]) {
     ui.horizontal(|ui| {
         let job = &mut app.ui.seeds;
         if job.busy() {
@@ -188,8 +190,8 @@ fn seed_controls(app: &mut ShoalApp, ui: &mut egui::Ui) {
         ui.add(egui::DragValue::new(&mut job.seeds).range(2..=20).suffix(" seeds").update_while_editing(false));
         ui.add(egui::DragValue::new(&mut job.decimation).range(1..=16).prefix("at 1/").update_while_editing(false));
         if start.clicked() {
-            job.start(ui.ctx(), &configs);
-        } else if job.stale(&configs) {
+            job.start(ui.ctx(), configs);
+        } else if job.stale(configs) {
             ui.label(egui::RichText::new("stale: the designs changed").color(theme::WARN))
                 .on_hover_text("The spread was measured for other designs; it is not shown. Run it again.");
         } else if !job.status.is_empty() {
@@ -408,8 +410,10 @@ pub fn bottom(app: &mut ShoalApp, ui: &mut egui::Ui) {
         let metrics = |app: &mut ShoalApp, ui: &mut egui::Ui| {
             let r = ui.vertical(|ui| {
                 ui.strong("Metrics (log-space MAE and bias, Seegers et al. 2018)");
-                seed_controls(app, ui);
-                metrics_table(app, ui);
+                // A and B as the engine would run them, built once per frame for both.
+                let configs = app.state.configs();
+                seed_controls(app, ui, &configs);
+                metrics_table(app, ui, &configs);
                 substrate_tables(app, ui);
                 for (i, e) in app.link.errors.iter().enumerate() {
                     if let Some(e) = e {

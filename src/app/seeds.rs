@@ -149,14 +149,10 @@ impl SeedSpreadJob {
         self.measured.as_ref().is_some_and(|m| *m == unseeded(configs))
     }
 
-    /// The spread of instrument `index` (0 = A) and `variable`, if measured for `configs`.
+    /// The spread, if it was measured for `configs` (checked once per frame, not per cell).
     #[must_use]
-    pub fn get(&self, configs: &[RunConfig], index: usize, variable: &str) -> Option<&SeedSpread> {
-        let label = ["A", "B"].get(index)?;
-        if !self.fresh(configs) {
-            return None;
-        }
-        self.spread.iter().find(|s| s.instrument == *label && s.variable == variable)
+    pub fn spread_for(&self, configs: &[RunConfig]) -> Option<&[SeedSpread]> {
+        self.fresh(configs).then_some(self.spread.as_slice())
     }
 
     /// Is there a spread measured for other designs than `configs`?

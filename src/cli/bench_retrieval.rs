@@ -343,15 +343,11 @@ pub fn retrieval_rows(out: &mut String, quick: bool) -> Result<(), CliError> {
         samples.push(sample);
     }
     let time = Summary::of(&samples);
-    let runs = result.map_or(0, |r| r.runs.len());
-    let pixels: usize = resolved
-        .runs
-        .iter()
-        .map(|(_, _, c)| c.instrument.detectors * c.instrument.lines / c.fidelity.decimation.pow(2))
-        .sum();
+    let runs = result.as_ref().map_or(0, |r| r.runs.len());
+    let pixels: usize = result.iter().flat_map(|r| &r.runs).map(|r| r.report.shape.0 * r.report.shape.1).sum();
     let _ = writeln!(
         out,
-        "Full study `{}` ({runs} runs, ~{pixels} pixels{}), chain and aLMI, without writing files, on {} threads: wall {}, CPU {}.",
+        "Full study `{}` ({runs} runs, {pixels} pixels{}), chain and aLMI, without writing files, on {} threads: wall {}, CPU {}.",
         spec.name,
         if quick { ", decimation 4" } else { "" },
         rayon::current_num_threads(),
