@@ -75,6 +75,7 @@ pub const PRESETS: &[Asset] = embed_presets![
     "scenes/reservoir_chl_cdom.ron",
     "scenes/paper_heron_island.ron",
     "scenes/paper_lake_hume.ron",
+    "scenes/reef_survey_raster.ron",
     "instruments/nominal.ron",
     "instruments/cubesat.ron",
     "instruments/smallsat.ron",
@@ -85,6 +86,7 @@ pub const PRESETS: &[Asset] = embed_presets![
     "studies/heron_island_depth.ron",
     "studies/paper_heron_island.ron",
     "studies/paper_lake_hume.ron",
+    "studies/reef_survey_depth.ron",
     "sweeps/aperture_lake_hume.ron",
 ];
 
@@ -120,6 +122,19 @@ pub fn find(path: &str) -> Option<&'static Asset> {
 /// The paths of all embedded files, for error messages and `--list` output.
 pub fn paths() -> impl Iterator<Item = &'static str> {
     ALL.iter().map(|a| a.path)
+}
+
+/// GeoTIFF rasters of the built-in scenes (under `presets/scenes/`), made by the project:
+/// `tests/chain/rasters.rs` writes them and checks the shipped files are what it writes.
+const RASTERS: &[(&str, &[u8])] = &[
+    ("rasters/reef_survey_bathymetry.tif", include_bytes!("../presets/scenes/rasters/reef_survey_bathymetry.tif")),
+    ("rasters/reef_survey_habitat.tif", include_bytes!("../presets/scenes/rasters/reef_survey_habitat.tif")),
+];
+
+/// The embedded raster a built-in scene names by `path` (relative to `presets/scenes/`), if any.
+#[must_use]
+pub fn raster(path: &str) -> Option<&'static [u8]> {
+    RASTERS.iter().find(|(p, _)| *p == path).map(|(_, b)| *b)
 }
 
 /// DejaVu Sans (Bitstream Vera licence, assets/fonts), the one font of the figures and the

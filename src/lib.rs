@@ -50,6 +50,7 @@ pub mod colormap;
 pub mod control;
 pub mod correction;
 pub mod engine;
+pub mod geotiff;
 pub mod instrument;
 pub mod jobs;
 pub mod library;

@@ -11,6 +11,7 @@ use serde::{Deserialize, Serialize};
 
 use super::SceneError;
 use super::grf::gaussian_random_field;
+use super::raster::{GeoFrame, RasterCache, RasterSource, Resampling, resample};
 use crate::parse::FieldError;
 
 /// The statistical distribution of a random field's values.
@@ -120,6 +121,42 @@ pub enum MapSpec {
         /// Value of white.
         max: f64,
     },
+    /// A band of a GeoTIFF, resampled onto the scene's grid through both georeferences (see
+    /// [`super::raster`]): `Raster(path: "bathymetry.tif", band: 1, unit: "m")`.
+    Raster {
+        /// The GeoTIFF (relative to the scene file).
+        path: PathBuf,
+        /// Band, from 1.
+        #[serde(default = "super::raster::one_band")]
+        band: usize,
+        /// Map value = scale · file value + offset.
+        #[serde(default = "super::raster::unit_scale")]
+        scale: f64,
+        /// See `scale`.
+        #[serde(default)]
+        offset: f64,
+        /// The file value that marks a missing cell (default: the file's `GDAL_NODATA`).
+        #[serde(default)]
+        nodata: Option<f64>,
+        /// Unit of scale · value + offset: the scene field's ("m", "mg m-3", "g m-3", "m-1",
+        /// "1" for fractions and the land mask).
+        unit: String,
+        /// Resampling (default: bilinear; nearest for the land mask).
+        #[serde(default)]
+        resampling: Option<Resampling>,
+    },
+}
+
+/// What building a map needs besides its spec: where relative paths start, where the scene is
+/// on Earth, and the rasters already read.
+#[derive(Debug, Default)]
+pub struct MapContext<'a> {
+    /// Directory of the scene file.
+    pub base_dir: Option<&'a std::path::Path>,
+    /// The scene's place on Earth, if georeferenced.
+    pub frame: Option<&'a GeoFrame>,
+    /// Rasters read so far.
+    pub cache: RasterCache,
 }
 
 /// The raster extent maps are defined on.
@@ -171,13 +208,10 @@ fn finite(field: &str, v: f64) -> Result<(), SceneError> {
 }
 
 impl Map {
-    /// Build a map over `extent`; `field` names it in errors, `base_dir` resolves image paths.
-    pub fn build(
-        spec: &MapSpec,
-        extent: Extent,
-        field: &str,
-        base_dir: Option<&std::path::Path>,
-    ) -> Result<Self, SceneError> {
+    /// Build a map over `extent`; `field` names it in errors, `ctx` resolves files. A raster
+    /// map may hold NaN where its file has no data (see [`super::raster::fill_nodata`]).
+    pub fn build(spec: &MapSpec, extent: Extent, field: &str, ctx: &mut MapContext<'_>) -> Result<Self, SceneError> {
+        let base_dir = ctx.base_dir;
         let kind = match spec {
             MapSpec::Constant(v) => {
                 finite(field, *v)?;
@@ -273,6 +307,18 @@ impl Map {
                 }
                 Kind::Raster(Arc::new(values))
             }
+            MapSpec::Raster { path, band, scale, offset, nodata, unit, resampling } => {
+                let source = RasterSource {
+                    path: path.clone(),
+                    band: *band,
+                    scale: *scale,
+                    offset: *offset,
+                    nodata: *nodata,
+                    unit: unit.clone(),
+                    resampling: *resampling,
+                };
+                Kind::Raster(Arc::new(resample(&source, extent, ctx.frame, field, base_dir, &mut ctx.cache)?))
+            }
         };
         Ok(Self { kind, extent })
     }
@@ -304,6 +350,15 @@ impl Map {
                     + at(x0, y1) * (1.0 - fx) * fy
                     + at(x1, y1) * fx * fy
             }
+        }
+    }
+
+    /// The raster's cell values (row 0 south), if the map is a raster, for filling no-data
+    /// cells.
+    pub fn cells_mut(&mut self) -> Option<&mut [f32]> {
+        match &mut self.kind {
+            Kind::Raster(values) => Some(Arc::make_mut(values).as_mut_slice()),
+            _ => None,
         }
     }
 
@@ -418,7 +473,13 @@ mod tests {
 
     #[test]
     fn gradient_spans_the_scene() {
-        let m = Map::build(&MapSpec::Gradient { from: 1.0, to: 7.0, angle_deg: 0.0 }, extent(), "depth", None).unwrap();
+        let m = Map::build(
+            &MapSpec::Gradient { from: 1.0, to: 7.0, angle_deg: 0.0 },
+            extent(),
+            "depth",
+            &mut MapContext::default(),
+        )
+        .unwrap();
         assert!((m.value_at(-500.0, 0.0) - 1.0).abs() < 1e-12);
         assert!((m.value_at(500.0, 0.0) - 7.0).abs() < 1e-12);
         assert!((m.value_at(0.0, 200.0) - 4.0).abs() < 1e-12);
@@ -432,7 +493,7 @@ mod tests {
             seed: 1,
             clamp: Some((1.0, 100.0)),
         };
-        let m = Map::build(&spec, extent(), "chl", None).unwrap();
+        let m = Map::build(&spec, extent(), "chl", &mut MapContext::default()).unwrap();
         let (lo, hi) = m.range();
         assert!(lo >= 1.0 && hi <= 100.0 && lo < 3.0 && hi > 30.0, "{lo} {hi}");
     }
@@ -452,7 +513,7 @@ mod tests {
                 Shape::Ridge { from_m: (-400.0, -200.0), to_m: (400.0, -200.0), width_m: 20.0, amplitude: -3.0 },
             ],
         };
-        let m = Map::build(&spec, extent(), "depth", None).unwrap();
+        let m = Map::build(&spec, extent(), "depth", &mut MapContext::default()).unwrap();
         assert_eq!(m.value_at(0.0, 0.0), 2.0);
         assert_eq!(m.value_at(300.0, 150.0), 7.0);
         assert!((m.value_at(0.0, -200.0) - 4.0).abs() < 1e-9);
@@ -461,7 +522,7 @@ mod tests {
     #[test]
     fn missing_image_names_the_field_and_file() {
         let spec = MapSpec::Image { path: "no/such.png".into(), min: 0.0, max: 10.0 };
-        let e = Map::build(&spec, extent(), "maps.depth_m", None).unwrap_err().to_string();
+        let e = Map::build(&spec, extent(), "maps.depth_m", &mut MapContext::default()).unwrap_err().to_string();
         assert!(e.contains("maps.depth_m") && e.contains("no/such.png"), "{e}");
     }
 
@@ -473,7 +534,8 @@ mod tests {
         let img = image::GrayImage::from_fn(2, 2, |x, _| image::Luma([if x == 0 { 0 } else { 255 }]));
         img.save(dir.join("two.png")).unwrap();
         let spec = MapSpec::Image { path: "two.png".into(), min: 1.0, max: 9.0 };
-        let m = Map::build(&spec, extent(), "depth", Some(&dir)).unwrap();
+        let m = Map::build(&spec, extent(), "depth", &mut MapContext { base_dir: Some(&dir), ..MapContext::default() })
+            .unwrap();
         assert!((m.value_at(-490.0, 0.0) - 1.0).abs() < 1e-9);
         assert!((m.value_at(490.0, 0.0) - 9.0).abs() < 1e-9);
         std::fs::remove_dir_all(&dir).unwrap();

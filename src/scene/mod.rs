@@ -12,10 +12,12 @@
 
 mod grf;
 mod map;
+pub mod raster;
 mod spec;
 
 pub use grf::gaussian_random_field;
-pub use map::{Distribution, Extent, Map, MapSpec, Shape};
+pub use map::{Distribution, Extent, Map, MapContext, MapSpec, Shape};
+pub use raster::{GeoFrame, Georeference, Resampling};
 pub use spec::{Effect, LandSpec, Scene, SceneSpec, SubstrateLayer, SunSpec, day_of_year};
 
 use crate::atmosphere::AtmosphereError;

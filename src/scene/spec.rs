@@ -5,7 +5,8 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use super::SceneError;
-use super::map::{Extent, Map, MapSpec};
+use super::map::{Extent, Map, MapContext, MapSpec};
+use super::raster::{GeoFrame, Georeference, RasterCache, fill_nodata, resolve_frame};
 use crate::atmosphere::{AtmosphereSpec, Surface};
 use crate::parse::{FieldError, ParseError};
 use crate::spectral::SpectrumSource;
@@ -69,11 +70,18 @@ pub struct SceneSpec {
     /// What it represents and where its numbers come from.
     #[serde(default)]
     pub description: String,
+    /// Where the scene is on Earth (absent: a local frame). `Raster(path)` also sets the grid,
+    /// and then `width`, `height` and `cell_m` may be left out.
+    #[serde(default)]
+    pub georeference: Option<Georeference>,
     /// Cells along x (east), 1–20 000.
+    #[serde(default)]
     pub width: usize,
     /// Cells along y (north), 1–20 000.
+    #[serde(default)]
     pub height: usize,
     /// Ground size of a cell, m (0.1–10 000).
+    #[serde(default)]
     pub cell_m: f64,
     /// The sun.
     pub sun: SunSpec,
@@ -151,6 +159,38 @@ impl SceneSpec {
         self.effects.contains(&Effect::ShallowBottom)
     }
 
+    /// Take the grid of the scene's georeference raster: width, height and cell size must be
+    /// left out of the scene file or agree with the raster.
+    fn set_grid_from_raster(&mut self, grid: Extent) -> Result<(), SceneError> {
+        use crate::ranges as r;
+        let given = (self.width, self.height, self.cell_m);
+        if given != (0, 0, 0.0)
+            && (given.0 != grid.width || given.1 != grid.height || (given.2 - grid.cell_m).abs() > 1e-9 * grid.cell_m)
+        {
+            return Err(SceneError::Invalid(FieldError {
+                field: "width".into(),
+                message: format!(
+                    "the scene says {} × {} cells of {} m but its georeference raster is {} × {} of {} m; leave width, height and cell_m out",
+                    given.0, given.1, given.2, grid.width, grid.height, grid.cell_m
+                ),
+            }));
+        }
+        for (range, v) in [
+            (&r::SCENE_WIDTH, grid.width as f64),
+            (&r::SCENE_HEIGHT, grid.height as f64),
+            (&r::SCENE_CELL_M, grid.cell_m),
+        ] {
+            range.check(v).map_err(|message| {
+                SceneError::Invalid(FieldError {
+                    field: "georeference".into(),
+                    message: format!("the raster's grid: {message}"),
+                })
+            })?;
+        }
+        (self.width, self.height, self.cell_m) = (grid.width, grid.height, grid.cell_m);
+        Ok(())
+    }
+
     /// Check the numbers and that every effect has what it needs.
     pub fn validate(&self) -> Result<(), SceneError> {
         use crate::ranges as r;
@@ -160,9 +200,14 @@ impl SceneSpec {
                 .check(v)
                 .map_err(|message| SceneError::Invalid(FieldError { field: range.field("scene.").into(), message }))
         };
-        check(&r::SCENE_WIDTH, self.width as f64)?;
-        check(&r::SCENE_HEIGHT, self.height as f64)?;
-        check(&r::SCENE_CELL_M, self.cell_m)?;
+        // A raster georeference sets the grid; its numbers are checked when the scene builds.
+        let grid_from_raster = matches!(self.georeference, Some(Georeference::Raster(_)));
+        let unset = self.width == 0 && self.height == 0 && self.cell_m == 0.0;
+        if !(grid_from_raster && unset) {
+            check(&r::SCENE_WIDTH, self.width as f64)?;
+            check(&r::SCENE_HEIGHT, self.height as f64)?;
+            check(&r::SCENE_CELL_M, self.cell_m)?;
+        }
         check(&r::SCENE_SUN_ZENITH_DEG, self.sun.zenith_deg)?;
         if !self.sun.azimuth_deg.is_finite() {
             return bad("sun.azimuth_deg", format!("{} is not a finite angle", self.sun.azimuth_deg));
@@ -211,6 +256,8 @@ pub struct Scene {
     pub base_dir: Option<PathBuf>,
     /// Day of year.
     pub day_of_year: u32,
+    /// Where the scene is on Earth, if it is georeferenced.
+    pub frame: Option<GeoFrame>,
 }
 
 impl Scene {
@@ -224,17 +271,34 @@ impl Scene {
         spec.atmosphere
             .validate()
             .map_err(|e| SceneError::Invalid(FieldError { field: "atmosphere".into(), message: e.to_string() }))?;
+        let mut cache = RasterCache::default();
+        let frame = match &spec.georeference {
+            Some(g) => {
+                let (frame, grid) = resolve_frame(g, base_dir, &mut cache)?;
+                if let Some(grid) = grid {
+                    spec.set_grid_from_raster(grid)?;
+                }
+                Some(frame)
+            }
+            None => None,
+        };
         let extent = Extent { width: spec.width, height: spec.height, cell_m: spec.cell_m };
-        let map = |s: &MapSpec, field: &str| Map::build(s, extent, field, base_dir);
-        let chl = map(&spec.chl_mg_m3, "chl_mg_m3")?;
-        let nap = map(&spec.nap_g_m3, "nap_g_m3")?;
-        let cdom = map(&spec.cdom_per_m, "cdom_per_m")?;
+        let mut ctx = MapContext { base_dir, frame: frame.as_ref(), cache };
+        let mut map = |s: &MapSpec, field: &str| Map::build(s, extent, field, &mut ctx);
+        // The land mask first: a raster map may lack data only on land.
+        let mut land = match &spec.land {
+            Some(l) => Some(map(&l.mask, "land.mask")?),
+            None => None,
+        };
+        let mut chl = map(&spec.chl_mg_m3, "chl_mg_m3")?;
+        let mut nap = map(&spec.nap_g_m3, "nap_g_m3")?;
+        let mut cdom = map(&spec.cdom_per_m, "cdom_per_m")?;
         let bottom = spec.effects.contains(&Effect::ShallowBottom);
-        let depth = match (&spec.depth_m, bottom) {
+        let mut depth = match (&spec.depth_m, bottom) {
             (Some(d), true) => Some(map(d, "depth_m")?),
             _ => None,
         };
-        let substrates = if bottom {
+        let mut substrates = if bottom {
             spec.substrates
                 .iter()
                 .map(|l| Ok((l.name.clone(), map(&l.fraction, &format!("substrates.{}", l.name))?)))
@@ -242,10 +306,34 @@ impl Scene {
         } else {
             Vec::new()
         };
-        let land = match &spec.land {
-            Some(l) => Some(map(&l.mask, "land.mask")?),
-            None => None,
+        if let Some(cells) = land.as_mut().and_then(Map::cells_mut)
+            && let Some(i) = cells.iter().position(|v| v.is_nan())
+        {
+            return Err(SceneError::Invalid(FieldError {
+                field: "land.mask".into(),
+                message: format!(
+                    "{} cells have no data (the first at column {}, row {} from the south); the land mask must cover the scene",
+                    cells.iter().filter(|v| v.is_nan()).count(),
+                    i % extent.width,
+                    i / extent.width
+                ),
+            }));
+        }
+        let land_at = |col: usize, row: usize| {
+            let (hx, hy) = extent.half_size_m();
+            let (x, y) = (-hx + (col as f64 + 0.5) * extent.cell_m, -hy + (row as f64 + 0.5) * extent.cell_m);
+            land.as_ref().is_some_and(|m| m.value_at(x, y) > 0.5)
         };
+        let water_maps =
+            [(&mut chl, "chl_mg_m3".to_string()), (&mut nap, "nap_g_m3".into()), (&mut cdom, "cdom_per_m".into())]
+                .into_iter()
+                .chain(depth.as_mut().map(|d| (d, "depth_m".to_string())))
+                .chain(substrates.iter_mut().map(|(n, m)| (m, format!("substrates.{n}"))));
+        for (m, field) in water_maps {
+            if let Some(cells) = m.cells_mut() {
+                fill_nodata(cells, extent, &field, frame.as_ref(), &land_at)?;
+            }
+        }
         let scene = Self {
             spec,
             extent,
@@ -257,6 +345,7 @@ impl Scene {
             land,
             base_dir: base_dir.map(Path::to_path_buf),
             day_of_year: day,
+            frame,
         };
         scene.check_ranges()?;
         Ok(scene)

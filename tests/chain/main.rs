@@ -13,6 +13,7 @@ mod determinism;
 mod incremental;
 mod noise;
 mod plausibility;
+mod rasters;
 mod reproduction;
 mod retrieval;
 mod soak;

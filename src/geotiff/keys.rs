@@ -1,0 +1,215 @@
+//! The GeoKey directory (OGC GeoTIFF 1.1, §7.1): a list of (key, location, count, value) shorts
+//! in tag 34735, with text in 34737 and doubles in 34736; and GDAL's XML metadata (tag 42112).
+
+use super::Crs;
+
+/// GeoTIFF tag numbers.
+pub(super) const MODEL_PIXEL_SCALE: u16 = 33550;
+pub(super) const MODEL_TIEPOINT: u16 = 33922;
+pub(super) const MODEL_TRANSFORMATION: u16 = 34264;
+pub(super) const GEO_KEY_DIRECTORY: u16 = 34735;
+pub(super) const GEO_DOUBLE_PARAMS: u16 = 34736;
+pub(super) const GEO_ASCII_PARAMS: u16 = 34737;
+pub(super) const GDAL_METADATA: u16 = 42112;
+pub(super) const GDAL_NODATA: u16 = 42113;
+
+// GeoKey IDs and values (GeoTIFF 1.1, Annex B/C).
+const GT_MODEL_TYPE: u16 = 1024;
+const GT_RASTER_TYPE: u16 = 1025;
+const GT_CITATION: u16 = 1026;
+const GEOGRAPHIC_TYPE: u16 = 2048;
+const PROJECTED_CS_TYPE: u16 = 3072;
+const PROJ_LINEAR_UNITS: u16 = 3076;
+const PROJ_LINEAR_UNIT_SIZE: u16 = 3077;
+const MODEL_PROJECTED: u16 = 1;
+const MODEL_GEOGRAPHIC: u16 = 2;
+const USER_DEFINED: u16 = 32767;
+const RASTER_PIXEL_IS_AREA: u16 = 1;
+/// Raster type "PixelIsPoint": tie points refer to pixel centres.
+pub(super) const RASTER_PIXEL_IS_POINT: u16 = 2;
+const LINEAR_METRE: u16 = 9001;
+
+/// What the key directory says.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct Keys {
+    pub(super) crs: Crs,
+    /// Size of the linear unit, m.
+    pub(super) linear_unit_m: f64,
+    /// `GTRasterTypeGeoKey` (1 area, 2 point).
+    pub(super) raster_type: u16,
+}
+
+/// Parse the key directory (`dir`: tag 34735), its text (34737) and doubles (34736).
+pub(super) fn parse(dir: &[u16], ascii: &str, doubles: &[f64]) -> Result<Keys, String> {
+    if dir.len() < 4 || dir.len() < 4 + 4 * usize::from(dir[3]) {
+        return Err(format!("GeoKeyDirectory has {} shorts, fewer than its header says", dir.len()));
+    }
+    let mut keys = Keys { crs: Crs::None, linear_unit_m: 1.0, raster_type: RASTER_PIXEL_IS_AREA };
+    let (mut model, mut projected, mut geographic, mut citation) = (None, None, None, String::new());
+    for k in dir[4..4 + 4 * usize::from(dir[3])].chunks_exact(4) {
+        let (id, location, count, value) = (k[0], k[1], usize::from(k[2]), k[3]);
+        let short = (location == 0).then_some(value);
+        match id {
+            GT_MODEL_TYPE => model = short,
+            GT_RASTER_TYPE => keys.raster_type = short.unwrap_or(RASTER_PIXEL_IS_AREA),
+            PROJECTED_CS_TYPE => projected = short,
+            GEOGRAPHIC_TYPE => geographic = short,
+            PROJ_LINEAR_UNITS => {
+                keys.linear_unit_m = match short {
+                    Some(LINEAR_METRE) => 1.0,
+                    Some(9002) => 0.3048,          // international foot
+                    Some(9003) => 1200.0 / 3937.0, // US survey foot
+                    Some(9036) => 1000.0,          // kilometre
+                    _ => keys.linear_unit_m,
+                }
+            }
+            PROJ_LINEAR_UNIT_SIZE if location == GEO_DOUBLE_PARAMS => {
+                if let Some(v) = doubles.get(usize::from(value)) {
+                    keys.linear_unit_m = *v;
+                }
+            }
+            GT_CITATION if location == GEO_ASCII_PARAMS => {
+                let start = usize::from(value);
+                citation =
+                    ascii.get(start..(start + count).min(ascii.len())).unwrap_or("").trim_end_matches('|').into();
+            }
+            _ => {}
+        }
+    }
+    keys.crs = match (model, projected, geographic) {
+        (Some(MODEL_PROJECTED), Some(code), _) if code != USER_DEFINED => Crs::Projected { epsg: code },
+        (Some(MODEL_GEOGRAPHIC), _, Some(code)) if code != USER_DEFINED => Crs::Geographic { epsg: code },
+        (Some(MODEL_PROJECTED), _, _) | (Some(USER_DEFINED), _, _) => {
+            Crs::LocalMetres { name: if citation.is_empty() { "user-defined".into() } else { citation } }
+        }
+        _ => Crs::None,
+    };
+    Ok(keys)
+}
+
+/// The key directory and its text for `crs` (keys sorted by ID, as the standard asks).
+pub(super) fn build(crs: &Crs) -> (Vec<u16>, String) {
+    let mut ascii = String::new();
+    let mut keys: Vec<[u16; 4]> = vec![[GT_RASTER_TYPE, 0, 1, RASTER_PIXEL_IS_AREA]];
+    match crs {
+        Crs::Projected { epsg } => {
+            keys.push([GT_MODEL_TYPE, 0, 1, MODEL_PROJECTED]);
+            keys.push([PROJECTED_CS_TYPE, 0, 1, *epsg]);
+        }
+        Crs::Geographic { epsg } => {
+            keys.push([GT_MODEL_TYPE, 0, 1, MODEL_GEOGRAPHIC]);
+            keys.push([GEOGRAPHIC_TYPE, 0, 1, *epsg]);
+        }
+        Crs::LocalMetres { name } => {
+            // A user-defined projected CRS in metres with no datum: GDAL reads it as a local
+            // (engineering) CRS named by the citation.
+            ascii = format!("{}|", name.replace('|', "/"));
+            keys.push([GT_MODEL_TYPE, 0, 1, MODEL_PROJECTED]);
+            keys.push([GT_CITATION, GEO_ASCII_PARAMS, ascii.len() as u16, 0]);
+            keys.push([PROJECTED_CS_TYPE, 0, 1, USER_DEFINED]);
+            keys.push([PROJ_LINEAR_UNITS, 0, 1, LINEAR_METRE]);
+        }
+        Crs::None => {}
+    }
+    keys.sort_by_key(|k| k[0]);
+    let mut dir = vec![1, 1, 0, keys.len() as u16];
+    dir.extend(keys.iter().flatten());
+    (dir, ascii)
+}
+
+/// Escape text for XML.
+fn xml_escape(s: &str) -> String {
+    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
+}
+
+/// Undo [`xml_escape`] and decode character references (`&#x207B;`, `&#8315;`).
+fn xml_unescape(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    let mut rest = s;
+    while let Some(at) = rest.find('&') {
+        out += &rest[..at];
+        let tail = &rest[at..];
+        let end = tail.find(';').filter(|&e| e <= 10);
+        let decoded = end.and_then(|e| match &tail[1..e] {
+            "lt" => Some('<'),
+            "gt" => Some('>'),
+            "quot" => Some('"'),
+            "apos" => Some('\''),
+            "amp" => Some('&'),
+            r if r.starts_with("#x") || r.starts_with("#X") => {
+                u32::from_str_radix(&r[2..], 16).ok().and_then(char::from_u32)
+            }
+            r if r.starts_with('#') => r[1..].parse().ok().and_then(char::from_u32),
+            _ => None,
+        });
+        match (decoded, end) {
+            (Some(c), Some(e)) => {
+                out.push(c);
+                rest = &tail[e + 1..];
+            }
+            _ => {
+                out.push('&');
+                rest = &tail[1..];
+            }
+        }
+    }
+    out + rest
+}
+
+/// GDAL's metadata XML: band descriptions (`role="description"`), units (`role="unittype"`) and
+/// dataset items, as GDAL's GTiff driver writes them.
+pub(super) fn metadata_xml(descriptions: &[String], units: &[String], items: &[(String, String)]) -> String {
+    let mut s = String::from("<GDALMetadata>\n");
+    for (k, v) in items {
+        s += &format!("  <Item name=\"{}\">{}</Item>\n", xml_escape(k), xml_escape(v));
+    }
+    for (band, d) in descriptions.iter().enumerate().filter(|(_, d)| !d.is_empty()) {
+        s += &format!("  <Item name=\"DESCRIPTION\" sample=\"{band}\" role=\"description\">{}</Item>\n", xml_escape(d));
+    }
+    for (band, u) in units.iter().enumerate().filter(|(_, u)| !u.is_empty()) {
+        s += &format!("  <Item name=\"UNITTYPE\" sample=\"{band}\" role=\"unittype\">{}</Item>\n", xml_escape(u));
+    }
+    s + "</GDALMetadata>"
+}
+
+/// One `<Item …>value</Item>` of GDAL's metadata: (attributes, value).
+fn items(xml: &str) -> Vec<(Vec<(String, String)>, String)> {
+    let mut out = Vec::new();
+    let mut rest = xml;
+    while let Some(start) = rest.find("<Item") {
+        let after = &rest[start + 5..];
+        let (Some(close), Some(end)) = (after.find('>'), after.find("</Item>")) else { break };
+        if close > end {
+            break;
+        }
+        let attributes = after[..close]
+            .split('"')
+            .collect::<Vec<_>>()
+            .chunks(2)
+            .filter_map(|c| match c {
+                [name, value] => Some((name.trim().trim_end_matches('=').to_string(), xml_unescape(value))),
+                _ => None,
+            })
+            .collect();
+        out.push((attributes, xml_unescape(&after[close + 1..end])));
+        rest = &after[end + 7..];
+    }
+    out
+}
+
+/// Read GDAL's metadata XML back: (descriptions, units, dataset items) for `bands` bands.
+pub(super) fn parse_metadata(xml: &str, bands: usize) -> (Vec<String>, Vec<String>, Vec<(String, String)>) {
+    let (mut descriptions, mut units, mut dataset) =
+        (vec![String::new(); bands], vec![String::new(); bands], Vec::new());
+    for (attributes, value) in items(xml) {
+        let get = |k: &str| attributes.iter().find(|(n, _)| n == k).map(|(_, v)| v.as_str());
+        let sample = get("sample").and_then(|s| s.parse::<usize>().ok());
+        match (get("role"), sample) {
+            (Some("description"), Some(b)) if b < bands => descriptions[b] = value,
+            (Some("unittype"), Some(b)) if b < bands => units[b] = value,
+            (None, None) => dataset.push((get("name").unwrap_or("").to_string(), value)),
+            _ => {}
+        }
+    }
+    (descriptions, units, dataset)
+}
