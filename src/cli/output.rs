@@ -73,3 +73,22 @@ impl Csv {
         s
     }
 }
+
+/// `--format` of `shoal simulate` and `shoal study`: how cubes and maps are written.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum Format {
+    /// NumPy .npy arrays (one per product).
+    #[default]
+    Npy,
+    /// GeoTIFF (one file per product, bands with descriptions and units, georeferenced).
+    Geotiff,
+}
+
+impl From<Format> for crate::study::CubeFormat {
+    fn from(f: Format) -> Self {
+        match f {
+            Format::Npy => Self::Npy,
+            Format::Geotiff => Self::GeoTiff,
+        }
+    }
+}

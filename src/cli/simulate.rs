@@ -33,6 +33,9 @@ pub struct SimulateArgs {
     /// Output directory (created; files in it are replaced atomically).
     #[arg(long)]
     out: PathBuf,
+    /// Format of the cubes and maps: npy, or geotiff (georeferenced, for GIS tools).
+    #[arg(long, value_enum, default_value_t)]
+    format: super::output::Format,
     /// Simulate every n-th line and detector (a quick preview).
     #[arg(long)]
     decimation: Option<usize>,
@@ -177,7 +180,9 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     let config = config_from(args)?;
     let label = format!("{} over {}", config.instrument.name, config.scene.name);
     let out = run_with_progress(&config, args.threads, &label)?;
-    let written = crate::study::write_run(&out, &args.out).map_err(|e| CliError::Run(e.to_string()))?.files;
+    let written = crate::study::write_run_as(&out, &args.out, args.format.into())
+        .map_err(|e| CliError::Run(e.to_string()))?
+        .files;
     let (rows, cols, nb) = out.report.shape;
     eprintln!("{label}: {rows} lines × {cols} detectors × {nb} bands in {:.2} s", out.report.total_seconds);
     eprint!("{}", out.report.table());

@@ -11,7 +11,7 @@ use clap::Args;
 
 use super::CliError;
 use super::lookup::Lookup;
-use crate::study::{StudyError, StudySpec, run_study, write_run, write_study};
+use crate::study::{StudyError, StudySpec, run_study, write_run_as, write_study};
 
 /// Arguments of `shoal study`.
 #[derive(Debug, Args)]
@@ -27,6 +27,9 @@ pub struct StudyArgs {
     /// Worker threads (default: all cores).
     #[arg(long)]
     threads: Option<usize>,
+    /// Format of the per-instrument cubes and maps: npy, or geotiff (georeferenced).
+    #[arg(long, value_enum, default_value_t)]
+    format: super::output::Format,
     /// Do not write the per-instrument cubes (tables and figures only).
     #[arg(long)]
     no_cubes: bool,
@@ -100,7 +103,7 @@ pub fn run(args: &StudyArgs) -> Result<(), CliError> {
                 let (label, seed, _) = &resolved.runs[i];
                 if !args.no_cubes {
                     let sub = if spec.seeds.len() > 1 { format!("{label}_seed{seed}") } else { label.clone() };
-                    write_run(out, &args.out.join(sub))?;
+                    write_run_as(out, &args.out.join(sub), args.format.into())?;
                 }
                 bar.inc(1);
                 Ok(())

@@ -92,7 +92,9 @@ pub fn encode(raster: &Raster) -> Result<Vec<u8>, GeoTiffError> {
     }
     put(&mut dir, Tag::SampleFormat, &vec![SampleFormat::IEEEFP.to_u16(); n][..])?;
     if let Some(g) = raster.geotransform {
-        if g[2] == 0.0 && g[4] == 0.0 {
+        // North-up (rows going south): the usual scale + tie point; anything else (rotated, or
+        // rows going north as an ascending pushbroom image's do) as the full matrix.
+        if g[2] == 0.0 && g[4] == 0.0 && g[1] > 0.0 && g[5] < 0.0 {
             put(&mut dir, tag(keys::MODEL_PIXEL_SCALE), &[g[1], -g[5], 0.0][..])?;
             put(&mut dir, tag(keys::MODEL_TIEPOINT), &[0.0, 0.0, 0.0, g[0], g[3], 0.0][..])?;
         } else {

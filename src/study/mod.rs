@@ -17,6 +17,7 @@
 mod budget;
 mod curves;
 mod figures;
+mod geotiff_out;
 mod output;
 mod render;
 pub mod reproduction;
@@ -28,7 +29,8 @@ mod spread;
 pub use budget::{Budget, BudgetLine, Stage, budget_table, error_budget};
 pub use curves::{CurvePoint, CurveSeries, Curves, curve_figure, first_crossing};
 pub use figures::figure_set;
-pub use output::{Outputs, metrics_csv, write_bytes, write_run, write_study};
+pub use geotiff_out::{NODATA, swath_geotransform, write_run_geotiff};
+pub use output::{CubeFormat, Outputs, metrics_csv, write_bytes, write_run, write_run_as, write_study};
 pub use render::Figure;
 pub use requirements::{Check, ProductRequirement, Requirements, checks_csv, verdict};
 pub use run::{StudyResult, StudyRun, run_study};

@@ -133,6 +133,32 @@ pub fn write_run(out: &RunOutput, dir: &Path) -> Result<Outputs, StudyError> {
             npy(dir, &format!("{stem}_siop_set.npy"), s, &mut o)?;
         }
     }
+    let tables = write_tables(out, dir)?;
+    o.files.extend(tables.files);
+    Ok(o)
+}
+
+/// How a run's cubes and maps are written.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum CubeFormat {
+    /// NumPy `.npy`, one array per file (the default: what the science side reads).
+    #[default]
+    Npy,
+    /// GeoTIFF, one file per product with its bands, georeferenced ([`super::write_run_geotiff`]).
+    GeoTiff,
+}
+
+/// Write a run's products in `format` (tables, report and configuration in both).
+pub fn write_run_as(out: &RunOutput, dir: &Path, format: CubeFormat) -> Result<Outputs, StudyError> {
+    match format {
+        CubeFormat::Npy => write_run(out, dir),
+        CubeFormat::GeoTiff => super::write_run_geotiff(out, dir),
+    }
+}
+
+/// The run's band table, SNR table, report and resolved configuration.
+pub(super) fn write_tables(out: &RunOutput, dir: &Path) -> Result<Outputs, StudyError> {
+    let mut o = Outputs::default();
     let mut bands = String::from("band,centre_nm,fwhm_nm\n");
     for b in &out.response.bands.bands {
         let _ = writeln!(bands, "{},{},{}", b.name, number(b.centre_nm), number(b.fwhm_nm));

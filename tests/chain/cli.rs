@@ -109,3 +109,28 @@ fn sweep_shards_and_merge_on_the_command_line() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("shard `2/2`"));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn the_raster_study_runs_and_writes_geotiff_products() {
+    // The built-in raster-driven scene through `shoal study`, products as GeoTIFF.
+    let dir = std::env::temp_dir().join(format!("shoal-study-geotiff-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = shoal()
+        .args(["study", "reef_survey_depth", "--format", "geotiff", "--decimation", "4", "--no-figures", "--out"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    for f in ["level1_radiance.tif", "rrs.tif", "truth.tif", "sambuca.tif", "config.ron", "snr.csv"] {
+        assert!(dir.join("nominal").join(f).is_file(), "{f}");
+    }
+    assert!(!dir.join("nominal/rrs.npy").exists(), "geotiff replaces the .npy cubes");
+    let truth = shoal::geotiff::read(&dir.join("nominal/truth.tif")).unwrap();
+    assert_eq!(truth.crs, shoal::geotiff::Crs::Projected { epsg: 32756 });
+    let metrics = std::fs::read_to_string(dir.join("metrics.csv")).unwrap();
+    assert!(metrics.contains("nominal,1,SAMBUCA,depth_m,"), "{metrics}");
+    let bad = shoal().args(["study", "reef_survey_depth", "--format", "tiff", "--out"]).arg(&dir).output().unwrap();
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("geotiff"));
+    let _ = std::fs::remove_dir_all(&dir);
+}

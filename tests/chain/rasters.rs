@@ -414,3 +414,113 @@ fn the_reader_reads_what_gdal_writes() {
         assert!((a.value_at(x, y) - b.value_at(x, y)).abs() <= 0.5e-3 + 1e-7);
     }
 }
+
+/// `gdalinfo -json -stats` of `path`, parsed.
+fn gdalinfo(path: &Path) -> serde_json::Value {
+    let text = run_gdal("gdalinfo", ["-json".to_string(), "-stats".into(), path.display().to_string()]);
+    let _ = std::fs::remove_file(path.with_extension("tif.aux.xml"));
+    serde_json::from_str(&text).unwrap()
+}
+
+/// A band statistic of `gdalinfo -json -stats` at full precision (the top-level `mean` is
+/// rounded to three decimals).
+fn gdal_stat(band: &serde_json::Value, name: &str) -> f64 {
+    band["metadata"][""][format!("STATISTICS_{name}")].as_str().unwrap().parse().unwrap()
+}
+
+/// Mean, min and max of the finite values of `values` where `keep`.
+fn stats(values: impl Iterator<Item = (f64, bool)>) -> (f64, f64, f64) {
+    let (mut n, mut sum, mut lo, mut hi) = (0usize, 0.0, f64::INFINITY, f64::NEG_INFINITY);
+    for (v, keep) in values {
+        if keep && v.is_finite() {
+            (n, sum, lo, hi) = (n + 1, sum + v, lo.min(v), hi.max(v));
+        }
+    }
+    (sum / n as f64, lo, hi)
+}
+
+#[test]
+fn gdal_reads_the_products_we_write_with_their_crs_transform_nodata_and_values() {
+    use shoal::engine::RunConfig;
+    use shoal::retrieval::RetrievalSpec;
+    let scene = SceneSpec::preset("reef_survey_raster").unwrap();
+    let mut config = RunConfig::new(scene, shoal::instrument::InstrumentSpec::preset("nominal").unwrap());
+    config.retrievals = vec![RetrievalSpec::Sambuca { siop: None, substrates: None, settings: Default::default() }];
+    config.fidelity.decimation = 2;
+    let out = super::run(&config);
+    let dir = tempdir("products");
+    let written = shoal::study::write_run_geotiff(&out, &dir).unwrap();
+    assert!(written.files.iter().any(|f| f == "sambuca.tif"), "{:?}", written.files);
+    let truth = &out.radiance.truth;
+    let (g, residual_m) = shoal::study::swath_geotransform(&out.viewing, (ORIGIN.0 + 1200.0, ORIGIN.1 - 800.0));
+    assert!(residual_m < 0.01, "a nadir 2 km swath is affine to well under a centimetre: {residual_m} m");
+
+    let info = gdalinfo(&dir.join("truth.tif"));
+    let wkt = info["coordinateSystem"]["wkt"].as_str().unwrap();
+    assert!(wkt.contains(r#"ID["EPSG",32756]"#), "{wkt}");
+    let gt: Vec<f64> = info["geoTransform"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+    for k in 0..6 {
+        assert!((gt[k] - g[k]).abs() <= 1e-6 * g[k].abs().max(1.0), "geotransform {gt:?} vs {g:?}");
+    }
+    // The image's centre is the scene's centre (the track runs through it), to a pixel.
+    let (rows, cols) = (out.viewing.lines() as f64, out.viewing.columns() as f64);
+    let centre = (g[0] + g[1] * cols / 2.0 + g[2] * rows / 2.0, g[3] + g[4] * cols / 2.0 + g[5] * rows / 2.0);
+    assert!(
+        (centre.0 - 385_200.0).abs() < 2.0 * out.viewing.gsd_m
+            && (centre.1 - 7_405_200.0).abs() < 2.0 * out.viewing.gsd_m
+    );
+    let bands = info["bands"].as_array().unwrap();
+    // chl, NAP, CDOM, depth, three substrate fractions, land.
+    assert_eq!(bands.len(), 8);
+    assert_eq!(bands[3]["description"], "true depth");
+    assert_eq!(bands[3]["unit"], "m");
+    assert_eq!(bands[3]["noDataValue"], -9999.0);
+    let water = |(r, c): (usize, usize)| truth.land[[r, c]] == 0;
+    let depth = truth.depth_m.as_ref().unwrap();
+    let (mean, lo, hi) = stats(depth.indexed_iter().map(|(i, v)| (f64::from(*v), water(i))));
+    let s = &bands[3];
+    // GDAL sums in double the Float32 values we wrote, as we do here: agreement to rounding.
+    assert!((gdal_stat(s, "MEAN") - mean).abs() < 1e-9 * mean, "{s} vs {mean}");
+    assert!((gdal_stat(s, "MINIMUM") - lo).abs() < 1e-9 && (gdal_stat(s, "MAXIMUM") - hi).abs() < 1e-9);
+    let land_pixels = truth.land.iter().filter(|v| **v != 0).count();
+    assert!(land_pixels > 0, "the cay is in the image");
+    assert_eq!(bands[7]["description"], "land (1) or water (0)");
+    let land_mean = land_pixels as f64 / truth.land.len() as f64;
+    assert!((gdal_stat(&bands[7], "MEAN") - land_mean).abs() < 1e-9);
+
+    let info = gdalinfo(&dir.join("sambuca.tif"));
+    let bands = info["bands"].as_array().unwrap();
+    assert_eq!(bands[3]["description"], "retrieved depth");
+    let p = &out.retrievals[0].product;
+    let returned = |(r, c): (usize, usize)| p.returned(r, c);
+    let (mean, _, _) = stats(p.depth_m.as_ref().unwrap().indexed_iter().map(|(i, v)| (f64::from(*v), returned(i))));
+    assert!((gdal_stat(&bands[3], "MEAN") - mean).abs() < 1e-9 * mean);
+    // Not-returned pixels (land) are nodata, so GDAL's valid share is the returned share.
+    let returned_pct = 100.0
+        * p.flags.iter().filter(|f| **f & shoal::retrieval::ProductFlags::RETURNED != 0).count() as f64
+        / p.flags.len() as f64;
+    let valid_pct = gdal_stat(&bands[3], "VALID_PERCENT");
+    assert!((valid_pct - returned_pct).abs() < 0.01, "{valid_pct} vs {returned_pct}");
+
+    let info = gdalinfo(&dir.join("rrs.tif"));
+    assert_eq!(info["bands"].as_array().unwrap().len(), out.response.bands.bands.len());
+    assert_eq!(info["bands"][0]["unit"], "sr-1");
+}
+
+#[test]
+fn a_scene_without_a_georeference_is_written_in_a_local_metric_frame() {
+    let mut config = shoal::engine::RunConfig::new(
+        super::small_lake(),
+        shoal::instrument::InstrumentSpec::preset("nominal").unwrap(),
+    );
+    config.fidelity.decimation = 16;
+    let out = super::run(&config);
+    let dir = tempdir("local");
+    shoal::study::write_run_geotiff(&out, &dir).unwrap();
+    let info = gdalinfo(&dir.join("truth.tif"));
+    let wkt = info["coordinateSystem"]["wkt"].as_str().unwrap();
+    assert!(wkt.starts_with("ENGCRS[\"Shoal scene frame") && wkt.contains("metre"), "{wkt}");
+    let back = read(&dir.join("truth.tif")).unwrap();
+    assert!(matches!(back.crs, Crs::LocalMetres { .. }));
+    assert_eq!(back.bands[0].len(), out.viewing.lines() * out.viewing.columns());
+}
