@@ -10,7 +10,7 @@ use super::model::ProductKind;
 use super::plot_data::{PlotData, plot_data};
 use crate::colormap::{Scale, categorical, diverging, viridis};
 use crate::engine::RunOutput;
-use crate::instrument::{Detector, DetectorMode, Viewing};
+use crate::instrument::{Detector, DetectorMode};
 use crate::jobs::Worker;
 
 /// A map's values and where they are valid.
@@ -106,26 +106,6 @@ pub fn product_map(out: &RunOutput, kind: ProductKind, band: usize, truth: bool)
     }
 }
 
-/// Ground position (x, y) of each row and column's pixel, and the inverse: the nearest pixel of a
-/// viewing to a ground point, along and across track.
-fn nearest(v: &Viewing, x: f64, y: f64, heading_deg: f64) -> Option<(usize, usize)> {
-    let (rows, cols) = (v.lines(), v.columns());
-    if rows == 0 || cols == 0 {
-        return None;
-    }
-    let h = heading_deg.to_radians();
-    let (along, right) = ((h.sin(), h.cos()), (h.cos(), -h.sin()));
-    let proj = |p: (f64, f64), u: (f64, f64)| p.0 * u.0 + p.1 * u.1;
-    let a = |r: usize| proj(v.ground_m(0, r, cols / 2), along);
-    let c = |col: usize| proj(v.ground_m(0, rows / 2, col), right);
-    let (a0, a1, c0, c1) = (a(0), a(rows - 1), c(0), c(cols - 1));
-    let (pa, pc) = (proj((x, y), along), proj((x, y), right));
-    let fr = if rows > 1 { (pa - a0) / (a1 - a0) * (rows - 1) as f64 } else { 0.0 };
-    let fc = if cols > 1 { (pc - c0) / (c1 - c0) * (cols - 1) as f64 } else { 0.0 };
-    let (r, col) = (fr.round(), fc.round());
-    (r >= 0.0 && col >= 0.0 && r < rows as f64 && col < cols as f64).then_some((r as usize, col as usize))
-}
-
 /// A − B on A's pixels: B is sampled at the pixel nearest each of A's ground points.
 #[must_use]
 pub fn difference(a: &MapData, a_out: &RunOutput, b: &MapData, b_out: &RunOutput) -> MapData {
@@ -135,7 +115,7 @@ pub fn difference(a: &MapData, a_out: &RunOutput, b: &MapData, b_out: &RunOutput
     for r in 0..rows {
         for c in 0..cols {
             let (x, y) = a_out.viewing.ground_m(0, r, c);
-            if let Some((rb, cb)) = nearest(&b_out.viewing, x, y, b_out.config.instrument.heading_deg)
+            if let Some((rb, cb)) = b_out.viewing.nearest_pixel(x, y, b_out.config.instrument.heading_deg)
                 && rb < b.values.dim().0
                 && cb < b.values.dim().1
                 && a.valid[[r, c]]

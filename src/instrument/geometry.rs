@@ -237,6 +237,37 @@ impl Viewing {
         (x + l.dx_m, y + l.dy_m)
     }
 
+    /// The output pixel (row, column) nearest to scene point (x, y) m, projecting on the
+    /// along-track and across-track axes of a flight on `heading_deg`; `None` off the image.
+    #[must_use]
+    pub fn nearest_pixel(&self, x: f64, y: f64, heading_deg: f64) -> Option<(usize, usize)> {
+        let (rows, cols) = (self.lines(), self.columns());
+        if rows == 0 || cols == 0 {
+            return None;
+        }
+        let h = heading_deg.to_radians();
+        let (along, right) = ((h.sin(), h.cos()), (h.cos(), -h.sin()));
+        let proj = |p: (f64, f64), u: (f64, f64)| p.0 * u.0 + p.1 * u.1;
+        let a = |r: usize| proj(self.ground_m(0, r, cols / 2), along);
+        let c = |col: usize| proj(self.ground_m(0, rows / 2, col), right);
+        let (a0, a1, c0, c1) = (a(0), a(rows - 1), c(0), c(cols - 1));
+        let (pa, pc) = (proj((x, y), along), proj((x, y), right));
+        let fr = if rows > 1 { (pa - a0) / (a1 - a0) * (rows - 1) as f64 } else { 0.0 };
+        let fc = if cols > 1 { (pc - c0) / (c1 - c0) * (cols - 1) as f64 } else { 0.0 };
+        let (r, col) = (fr.round(), fc.round());
+        (r >= 0.0 && col >= 0.0 && r < rows as f64 && col < cols as f64).then_some((r as usize, col as usize))
+    }
+
+    /// The flight's heading, degrees clockwise from north, read from the ground track (0 for a
+    /// single line).
+    #[must_use]
+    pub fn track_heading_deg(&self) -> f64 {
+        match (self.track_m.first(), self.track_m.last()) {
+            (Some(a), Some(b)) if self.track_m.len() > 1 => (b.0 - a.0).atan2(b.1 - a.1).to_degrees(),
+            _ => 0.0,
+        }
+    }
+
     /// Along-track unit vector in the scene frame (east, north).
     #[must_use]
     pub fn along_track(heading_deg: f64) -> (f64, f64) {
@@ -251,6 +282,23 @@ mod tests {
 
     fn nominal() -> InstrumentSpec {
         InstrumentSpec::preset("nominal").unwrap()
+    }
+
+    #[test]
+    fn the_nearest_pixel_of_a_pixels_ground_point_is_itself_at_any_heading() {
+        for heading in [0.0, 37.0, 180.0, 290.0] {
+            let mut spec = nominal();
+            spec.heading_deg = heading;
+            let r = Response::new(&spec, 1.0).unwrap();
+            let v = Viewing::new(&spec, &r, 0.5, 0.0, 4, None).unwrap();
+            assert!((v.track_heading_deg().rem_euclid(360.0) - heading).abs() < 1e-6, "{heading}");
+            for (row, col) in [(0, 0), (3, 7), (v.lines() - 1, v.columns() - 1)] {
+                let (x, y) = v.ground_m(0, row, col);
+                assert_eq!(v.nearest_pixel(x, y, heading), Some((row, col)), "heading {heading}");
+            }
+            let far = v.ground_m(0, 0, 0);
+            assert_eq!(v.nearest_pixel(far.0 * 3.0 + 1e5, far.1 * 3.0 + 1e5, heading), None);
+        }
     }
 
     #[test]

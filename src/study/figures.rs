@@ -11,7 +11,7 @@ use ndarray::Array2;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::render::{Draw, FONT, Figure, Panel, Placed, colour, err, raster, render, tick_label};
+use super::render::{Draw, FONT, Figure, Panel, Placed, colour, err, raster, render, scale_bar_length, tick_label};
 use super::{StudyError, StudyResult, StudyRun};
 use crate::colormap::{Scale, categorical, viridis};
 use crate::metrics::{Metrics, bin_of, histogram_2d, log_edges};
@@ -63,7 +63,8 @@ impl Draw for Maps {
             root.draw_text(&p.title, &(FONT, 13).into_font().color(&BLACK), (x0 + 10, y0 + 4)).map_err(err)?;
             // Fit the map in the panel, keeping its aspect ratio.
             let (rows, cols) = p.values.dim();
-            let (bw, bh) = (self.panel.0 - 20, self.panel.1 - 36);
+            // Room under the map for the scale bar.
+            let (bw, bh) = (self.panel.0 - 20, self.panel.1 - 56);
             let aspect = cols as f64 / rows.max(1) as f64;
             let (w, h) = if aspect >= f64::from(bw) / f64::from(bh) {
                 (bw, ((f64::from(bw) / aspect).round() as u32).max(1))
@@ -74,6 +75,13 @@ impl Draw for Maps {
             root.draw(&Rectangle::new([(mx - 1, my - 1), (mx + w as i32, my + h as i32)], BLACK.stroke_width(1)))
                 .map_err(err)?;
             placed.push(Placed { x: mx, y: my, w, h, rgb: raster(p, &self.scale, w, h, self.diverging) });
+            // Scale bar under the map (the map raster is painted over whatever is drawn on it).
+            if let Some((len_m, label)) = scale_bar_length(0.3 * cols as f64 * p.spacing_m) {
+                let px = (len_m / (cols as f64 * p.spacing_m) * f64::from(w)).round() as i32;
+                let (bx, by) = (mx, my + h as i32 + 8);
+                root.draw(&Rectangle::new([(bx, by), (bx + px, by + 3)], BLACK.filled())).map_err(err)?;
+                root.draw_text(&label, &(FONT, 11).into_font().color(&BLACK), (bx + px + 6, by - 3)).map_err(err)?;
+            }
         }
         // Colour bar.
         let bx = (self.panels.len() as u32 * self.panel.0) as i32 + 12;
@@ -308,8 +316,12 @@ fn shared_scale(runs: &[&StudyRun], index: usize, var: Variable) -> Option<Scale
 fn maps_figure(ctx: &Context<'_>) -> Option<Maps> {
     let first = ctx.runs.first()?;
     let truth = first.truth.map(ctx.var.key)?;
-    let mut panels =
-        vec![Panel { title: "truth".into(), values: truth.clone(), valid: first.truth.land.mapv(|l| l == 0) }];
+    let mut panels = vec![Panel {
+        title: "truth".into(),
+        values: truth.clone(),
+        valid: first.truth.land.mapv(|l| l == 0),
+        spacing_m: spacing_m(first),
+    }];
     for run in ctx.runs {
         let Some(ret) = run.retrievals.get(ctx.index) else { continue };
         let Some(map) = ret.product.map(ctx.var.key) else { continue };
@@ -317,6 +329,7 @@ fn maps_figure(ctx: &Context<'_>) -> Option<Maps> {
             title: format!("{}: {}", run.label, metric_line(ret.metrics.get(ctx.var.key))),
             values: map.clone(),
             valid: Array2::from_shape_fn(map.dim(), |(r, c)| ret.product.returned(r, c) && map[[r, c]] > 0.0),
+            spacing_m: spacing_m(run),
         });
     }
     Some(Maps {
@@ -326,6 +339,53 @@ fn maps_figure(ctx: &Context<'_>) -> Option<Maps> {
         panels,
         diverging: false,
         panel: PANEL,
+    })
+}
+
+/// Ground distance between a run's neighbouring output pixels, m (nadir GSD × decimation).
+fn spacing_m(run: &StudyRun) -> f64 {
+    run.viewing.gsd_m * run.viewing.decimation as f64
+}
+
+/// A − B of two instruments' retrievals on A's pixels, B sampled at the pixel nearest each of A's
+/// ground points (the instruments' grids differ), on a diverging scale symmetric about zero.
+fn difference_figure(ctx: &Context<'_>) -> Option<Maps> {
+    let [a, b] = ctx.runs else { return None };
+    let (ra, rb) = (a.retrievals.get(ctx.index)?, b.retrievals.get(ctx.index)?);
+    let (ma, mb) = (ra.product.map(ctx.var.key)?, rb.product.map(ctx.var.key)?);
+    let heading = b.viewing.track_heading_deg();
+    let mut values = Array2::zeros(ma.dim());
+    let mut valid = Array2::from_elem(ma.dim(), false);
+    for ((r, c), va) in ma.indexed_iter() {
+        let (x, y) = a.viewing.ground_m(0, r, c);
+        if ra.product.returned(r, c)
+            && let Some((rb_, cb)) = b.viewing.nearest_pixel(x, y, heading)
+            && rb.product.returned(rb_, cb)
+        {
+            values[[r, c]] = va - mb[[rb_, cb]];
+            valid[[r, c]] = true;
+        }
+    }
+    let mut magnitudes: Vec<f64> =
+        values.iter().zip(&valid).filter(|(_, ok)| **ok).map(|(v, _)| f64::from(*v).abs()).collect();
+    if magnitudes.is_empty() {
+        return None;
+    }
+    let k = ((magnitudes.len() as f64 * 0.98) as usize).min(magnitudes.len() - 1);
+    let bound = *magnitudes.select_nth_unstable_by(k, f64::total_cmp).1;
+    let bound = if bound > 0.0 { bound } else { 1.0 };
+    Some(Maps {
+        title: format!("{}: A − B", ctx.title),
+        label: "A − B".into(),
+        scale: Scale { lo: -bound, hi: bound, log: false },
+        panels: vec![Panel {
+            title: format!("{} − {} (B at A's ground points)", a.label, b.label),
+            values,
+            valid,
+            spacing_m: spacing_m(a),
+        }],
+        diverging: true,
+        panel: (PANEL.0 + 90, PANEL.1),
     })
 }
 
@@ -413,6 +473,9 @@ pub fn figure_set(result: &StudyResult) -> Result<Vec<Figure>, StudyError> {
         .collect();
     let Some(first) = runs.first() else { return Ok(Vec::new()) };
     let mut figures = Vec::new();
+    if let Some(snr) = super::snr_figure::SnrFigure::of(result) {
+        figures.push(render("snr", &snr)?);
+    }
     for (index, ret0) in first.retrievals.iter().enumerate() {
         for var in VARIABLES {
             if first.truth.map(var.key).is_none() || ret0.product.map(var.key).is_none() {
@@ -424,6 +487,9 @@ pub fn figure_set(result: &StudyResult) -> Result<Vec<Figure>, StudyError> {
             let name = format!("{}_{}", ret0.spec.name(), var.key);
             if let Some(maps) = maps_figure(&ctx) {
                 figures.push(render(&format!("maps_{name}"), &maps)?);
+            }
+            if let Some(diff) = difference_figure(&ctx) {
+                figures.push(render(&format!("difference_{name}"), &diff)?);
             }
             if let Some((scatter, histograms)) = scatter_and_histograms(&ctx) {
                 figures.push(render(&format!("scatter_{name}"), &scatter)?);
@@ -446,7 +512,7 @@ mod tests {
             title: "test".into(),
             label: "chl-a (mg m⁻³)".into(),
             scale: Scale { lo: 1.0, hi: 240.0, log: true },
-            panels: vec![Panel { title: "truth".into(), values, valid }],
+            panels: vec![Panel { title: "truth".into(), values, valid, spacing_m: 20.0 }],
             diverging: false,
             panel: PANEL,
         };

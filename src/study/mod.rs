@@ -24,6 +24,7 @@ pub mod reproduction;
 mod requirements;
 mod run;
 mod slide;
+mod snr_figure;
 mod spread;
 
 pub use budget::{Budget, BudgetLine, Stage, budget_table, error_budget};

@@ -181,11 +181,32 @@ pub(super) struct Panel {
     pub(super) title: String,
     pub(super) values: Array2<f32>,
     pub(super) valid: Array2<bool>,
+    /// Ground distance between neighbouring pixels, m (0: no scale bar).
+    pub(super) spacing_m: f64,
+}
+
+/// The longest 1, 2 or 5 × 10ᵏ m that fits in `max_m` (a scale bar's length), with its label.
+pub(super) fn scale_bar_length(max_m: f64) -> Option<(f64, String)> {
+    if !(max_m.is_finite() && max_m > 0.0) {
+        return None;
+    }
+    let decade = 10f64.powf(max_m.log10().floor());
+    let len = [5.0, 2.0, 1.0].into_iter().map(|k| k * decade).find(|l| *l <= max_m)?;
+    let label = if len >= 1000.0 { format!("{} km", len / 1000.0) } else { format!("{len} m") };
+    Some((len, label))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn scale_bars_are_round_lengths() {
+        assert_eq!(scale_bar_length(3_700.0), Some((2_000.0, "2 km".into())));
+        assert_eq!(scale_bar_length(640.0), Some((500.0, "500 m".into())));
+        assert_eq!(scale_bar_length(1.0e4), Some((10_000.0, "10 km".into())));
+        assert_eq!(scale_bar_length(0.0), None);
+    }
 
     #[test]
     fn base64_matches_rfc4648_vectors() {

@@ -23,6 +23,10 @@ pub struct StudyRun {
     pub retrievals: Vec<Arc<RetrievalOutput>>,
     /// The truth maps.
     pub truth: Arc<Truth>,
+    /// Where each pixel looks (for A − B maps and scale bars).
+    pub viewing: Arc<crate::instrument::Viewing>,
+    /// The design's feasibility figures (f-number, smear, Q, peak signal).
+    pub feasibility: Arc<crate::instrument::feasibility::Feasibility>,
 }
 
 /// All runs of a study.
@@ -59,6 +63,8 @@ pub fn run_study(
             snr: out.snr.clone(),
             retrievals: out.retrievals.clone(),
             truth: Arc::clone(&out.radiance.truth),
+            viewing: Arc::clone(&out.viewing),
+            feasibility: Arc::clone(&out.feasibility),
         });
     }
     Ok(StudyResult { study: study.clone(), runs })

@@ -222,7 +222,12 @@ impl Draw for ReviewSlide {
             panels: self
                 .panels
                 .iter()
-                .map(|p| Panel { title: p.title.clone(), values: p.values.clone(), valid: p.valid.clone() })
+                .map(|p| Panel {
+                    title: p.title.clone(),
+                    values: p.values.clone(),
+                    valid: p.valid.clone(),
+                    spacing_m: 0.0,
+                })
                 .collect(),
             diverging: self.diverging,
             panel: ((MAPS_W - 110) / n, MAPS_H - 60),
