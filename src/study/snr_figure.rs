@@ -10,11 +10,14 @@ use super::StudyResult;
 use super::render::{Draw, FONT, Placed, err, tick_label};
 use crate::colormap::categorical;
 
+/// One instrument's points: its label and, per band, (centre nm, analytic SNR, measured SNR).
+type Series = (String, Vec<(f64, f64, f64)>);
+
 /// SNR against band centre, one series per instrument.
 pub(super) struct SnrFigure {
     pub(super) title: String,
-    /// Per instrument: label and (centre nm, analytic SNR, measured SNR) per band.
-    pub(super) series: Vec<(String, Vec<(f64, f64, f64)>)>,
+    /// Per instrument.
+    pub(super) series: Vec<Series>,
     /// The smallest SNR asked, if the study has one.
     pub(super) requirement: Option<f64>,
 }
@@ -22,7 +25,7 @@ pub(super) struct SnrFigure {
 impl SnrFigure {
     /// The figure of `result` (first seed of each instrument), if any run has SNR rows.
     pub(super) fn of(result: &StudyResult) -> Option<Self> {
-        let mut series: Vec<(String, Vec<(f64, f64, f64)>)> = Vec::new();
+        let mut series: Vec<Series> = Vec::new();
         for run in &result.runs {
             if series.iter().any(|(l, _)| *l == run.label) || run.snr.is_empty() {
                 continue;
