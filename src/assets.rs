@@ -116,7 +116,46 @@ pub fn preset(path: &str) -> Option<&'static Asset> {
 /// ```
 #[must_use]
 pub fn find(path: &str) -> Option<&'static Asset> {
-    ALL.iter().find(|a| a.path == path)
+    let found = ALL.iter().find(|a| a.path == path);
+    if let Some(a) = found
+        && let Ok(mut used) = USED.lock()
+        && !used.contains(&a.path)
+    {
+        used.push(a.path);
+    }
+    found
+}
+
+/// The data files [`find`] has handed out in this process, in first-use order: what a set of
+/// results was made from, for the review pack's provenance.
+static USED: std::sync::Mutex<Vec<&'static str>> = std::sync::Mutex::new(Vec::new());
+
+/// The embedded data files read so far in this process.
+#[must_use]
+pub fn used() -> Vec<&'static str> {
+    USED.lock().map(|u| u.clone()).unwrap_or_default()
+}
+
+/// `assets/PROVENANCE.md`, the index of the embedded data.
+pub const PROVENANCE_MD: &str = include_str!("../assets/PROVENANCE.md");
+
+/// The rows of the provenance index: (files, content, source, licence), markdown stripped of
+/// backticks.
+#[must_use]
+pub fn provenance() -> Vec<(String, String, String, String)> {
+    PROVENANCE_MD
+        .lines()
+        .filter(|l| l.starts_with("| `"))
+        .filter_map(|l| {
+            let cells: Vec<String> = l.trim_matches('|').split(" | ").map(|c| c.trim().replace('`', "")).collect();
+            match cells.as_slice() {
+                [files, content, source, licence] => {
+                    Some((files.clone(), content.clone(), source.clone(), licence.clone()))
+                }
+                _ => None,
+            }
+        })
+        .collect()
 }
 
 /// The paths of all embedded files, for error messages and `--list` output.

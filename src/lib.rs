@@ -57,6 +57,7 @@ pub mod library;
 pub mod metrics;
 pub mod parse;
 pub mod ranges;
+pub mod report;
 pub mod retrieval;
 pub mod scene;
 pub mod spectral;

@@ -7,6 +7,7 @@
 //! | `shoal atmosphere` | the atmosphere alone: CSV of E₀, L_path, T_up, T_down, S, Ed(0⁺) |
 //! | `shoal simulate` | scene × instrument → Level-0, Level-1, Rrs cubes, SNR, report, config |
 //! | `shoal study` | a study: instruments × seeds × retrievals → metrics.csv/json, figures, cubes |
+//! | `shoal report` | the review pack: one self-contained HTML page of a study (verdict, figures, provenance) |
 //! | `shoal bench` | performance and accuracy figures (water evaluations/s, LUT build time vs OSOAA) |
 
 mod atmosphere;
@@ -20,6 +21,7 @@ mod grid;
 mod interrupt;
 mod lookup;
 mod output;
+mod report;
 mod reproduce;
 pub mod simulate;
 mod study;
@@ -88,6 +90,9 @@ enum Command {
     /// Error budget of a study: how much of each product's error each stage contributes
     /// (noise, calibration, atmospheric correction, SIOP set choice).
     Budget(budget::BudgetArgs),
+    /// Write a study's review pack: a self-contained index.html (inline SVG figures, no network)
+    /// with its PNGs, from a results directory or by running the study.
+    Report(report::ReportArgs),
     /// Join the tables of `shoal sweep --shard` slices into the table one run writes.
     Merge(sweep::MergeArgs),
     /// Measure speed and accuracy: water evaluations per second, atmosphere LUT build times
@@ -188,6 +193,7 @@ pub fn main(app: impl FnOnce(&AppArgs) -> ExitCode) -> ExitCode {
         Command::Reproduce(args) => reproduce::run(&args),
         Command::Merge(args) => sweep::merge_run(&args),
         Command::Budget(args) => budget::run(&args),
+        Command::Report(args) => report::run(&args),
         Command::Bench(args) => bench::run(&args),
         Command::Ranges => output::emit(&crate::ranges::markdown_table(), None),
         Command::Dev(DevCommand::AerosolTable) => output::emit(&crate::atmosphere::component_table_csv(), None),

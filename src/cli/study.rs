@@ -114,7 +114,11 @@ pub fn run(args: &StudyArgs) -> Result<(), CliError> {
     });
     bar.finish_and_clear();
     let result = result?;
-    let outputs = pool.install(|| write_study(&result, &args.out, !args.no_figures))?;
+    let mut outputs = pool.install(|| write_study(&result, &args.out, !args.no_figures))?;
+    // What `shoal report DIR` builds the review pack from, without rerunning.
+    let review = crate::report::review_json(&crate::report::review_data(&result, &[], &[]))?;
+    crate::study::write_bytes(&args.out.join(crate::report::REVIEW_JSON), review.as_bytes())?;
+    outputs.files.push(crate::report::REVIEW_JSON.into());
     eprintln!("{}: {n} runs in {:.1} s", spec.name, start.elapsed().as_secs_f64());
     print_metrics(&result);
     if let Some(r) = &spec.requirements {

@@ -25,6 +25,8 @@ pub struct StudyRun {
     pub truth: Arc<Truth>,
     /// Where each pixel looks (for A − B maps and scale bars).
     pub viewing: Arc<crate::instrument::Viewing>,
+    /// Where the scene is on Earth, if georeferenced.
+    pub frame: Option<crate::scene::GeoFrame>,
     /// The design's feasibility figures (f-number, smear, Q, peak signal).
     pub feasibility: Arc<crate::instrument::feasibility::Feasibility>,
 }
@@ -65,6 +67,7 @@ pub fn run_study(
             truth: Arc::clone(&out.radiance.truth),
             viewing: Arc::clone(&out.viewing),
             feasibility: Arc::clone(&out.feasibility),
+            frame: out.scene.frame.clone(),
         });
     }
     Ok(StudyResult { study: study.clone(), runs })

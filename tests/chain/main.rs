@@ -14,6 +14,7 @@ mod incremental;
 mod noise;
 mod plausibility;
 mod rasters;
+mod report;
 mod reproduction;
 mod retrieval;
 mod soak;

@@ -1,0 +1,103 @@
+//! `shoal report`: the review pack of a study — a self-contained `index.html` with its PNGs —
+//! from a results directory `shoal study` wrote (no rerun), or by running a study.
+
+use std::path::{Path, PathBuf};
+
+use clap::Args;
+
+use super::CliError;
+use crate::report::{is_results_dir, load_results, review_data, write_pack};
+use crate::study::{error_budget, figure_set, run_study};
+
+/// Arguments of `shoal report`.
+#[derive(Debug, Args)]
+pub struct ReportArgs {
+    /// A results directory written by `shoal study`, or a study (RON file or built-in name) to
+    /// run first (default: cubesat_vs_smallsat).
+    target: Option<String>,
+    /// Output directory of the pack (index.html, figures/, review.json).
+    #[arg(long, default_value = "results/review")]
+    out: PathBuf,
+    /// When running a study: simulate every n-th line and detector.
+    #[arg(long)]
+    decimation: Option<usize>,
+    /// When running a study: add the error budget (each stage made perfect; 10 runs per
+    /// instrument and seed).
+    #[arg(long)]
+    budget: bool,
+    /// When running a study: add the cost-of-accuracy table of the first instrument, timed in
+    /// this many interleaved rounds (3 is the bench's default).
+    #[arg(long, value_name = "ROUNDS")]
+    cost: Option<usize>,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
+}
+
+/// `shoal report`.
+pub fn run(args: &ReportArgs) -> Result<(), CliError> {
+    let start = std::time::Instant::now();
+    let (data, figures) = match args.target.as_deref().map(Path::new).filter(|p| p.is_dir()) {
+        Some(dir) => {
+            if !is_results_dir(dir) {
+                return Err(CliError::Input(format!(
+                    "{}: not a results directory (no review.json); write one with `shoal study … --out {}`",
+                    dir.display(),
+                    dir.display()
+                )));
+            }
+            if args.budget || args.cost.is_some() || args.decimation.is_some() {
+                return Err(CliError::Input(
+                    "--budget, --cost and --decimation apply when a study is run, not to a results directory".into(),
+                ));
+            }
+            load_results(dir)?
+        }
+        None => run_for_report(args)?,
+    };
+    let index = write_pack(&data, &figures, &args.out)?;
+    eprintln!("review pack of {} in {:.1} s: {}", data.study, start.elapsed().as_secs_f64(), index.display());
+    Ok(())
+}
+
+fn run_for_report(args: &ReportArgs) -> Result<(crate::report::ReviewData, Vec<crate::study::Figure>), CliError> {
+    let (spec, dir) = super::study::load(args.target.as_deref())?;
+    let mut resolved = spec.resolve(dir.as_deref())?;
+    if let Some(d) = args.decimation {
+        if d == 0 || d > 64 {
+            return Err(CliError::Input(format!("--decimation {d} (allowed: 1 to 64)")));
+        }
+        for (_, _, c) in &mut resolved.runs {
+            c.fidelity.decimation = d;
+        }
+    }
+    if let Some(r) = args.cost
+        && !(1..=20).contains(&r)
+    {
+        return Err(CliError::Input(format!("--cost {r} (allowed: 1 to 20 rounds)")));
+    }
+    let pool =
+        crate::jobs::pool(args.threads.unwrap_or(0), "shoal-report").map_err(|e| CliError::Run(e.to_string()))?;
+    let control = super::interrupt::control();
+    eprintln!("{}: running {} runs …", spec.name, resolved.runs.len());
+    let result = pool.install(|| run_study(&resolved, &control, |_, _| Ok(())))?;
+    let mut budgets = Vec::new();
+    if args.budget {
+        let seeds: Vec<u64> = spec.seeds.clone();
+        let mut seen: Vec<&str> = Vec::new();
+        for (label, _, config) in &resolved.runs {
+            if !seen.contains(&label.as_str()) {
+                seen.push(label);
+                eprintln!("{label}: error budget, 10 configurations × {} seeds …", seeds.len());
+                budgets.extend(pool.install(|| error_budget(label, config, &seeds, &control))?);
+            }
+        }
+    }
+    let mut cost = Vec::new();
+    if let (Some(rounds), Some((_, _, base))) = (args.cost, resolved.runs.first()) {
+        eprintln!("cost of accuracy: {rounds} interleaved rounds …");
+        cost = pool.install(|| crate::sweep::cost_of_accuracy(base, rounds, &control, |_, _| {}))?;
+    }
+    let figures = pool.install(|| figure_set(&result))?;
+    Ok((review_data(&result, &budgets, &cost), figures))
+}

@@ -1,0 +1,476 @@
+//! The review pack's page: [`ReviewData`] and the study's figures as one HTML file. Figures are
+//! inline SVG (their map rasters are PNG data URIs inside), the style sheet is inline, there is
+//! no script and no reference outside the file: it opens from a USB stick, an e-mail or an
+//! air-gapped review room, and prints.
+
+use std::fmt::Write as _;
+
+use super::ReviewData;
+
+/// A figure for the page: its file stem and SVG text (and whether a PNG sits beside the page).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PageFigure {
+    /// File stem (`maps_alm_chl_mg_m3`).
+    pub name: String,
+    /// The SVG document.
+    pub svg: String,
+    /// Is `figures/<name>.png` written beside the page?
+    pub png: bool,
+}
+
+/// Escape text for HTML.
+#[must_use]
+pub fn escape(s: &str) -> String {
+    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
+}
+
+/// Base64 (RFC 4648) for data URIs.
+fn base64(bytes: &[u8]) -> String {
+    const T: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut s = String::with_capacity(bytes.len().div_ceil(3) * 4);
+    for c in bytes.chunks(3) {
+        let n =
+            (u32::from(c[0]) << 16) | (u32::from(*c.get(1).unwrap_or(&0)) << 8) | u32::from(*c.get(2).unwrap_or(&0));
+        for k in 0..4 {
+            if k <= c.len() {
+                s.push(T[(n >> (18 - 6 * k) & 63) as usize] as char);
+            } else {
+                s.push('=');
+            }
+        }
+    }
+    s
+}
+
+/// The SVG for inline use: no XML prolog, no namespace URI (HTML parses inline SVG without it),
+/// and scalable to the column width.
+fn inline_svg(svg: &str) -> String {
+    let start = svg.find("<svg").unwrap_or(0);
+    svg[start..].replacen(" xmlns=\"http://www.w3.org/2000/svg\"", "", 1).replacen("<svg ", "<svg role=\"img\" ", 1)
+}
+
+const STYLE: &str = "
+body { font: 15px/1.45 'DejaVu Sans', Verdana, sans-serif; color: #1b1b1b; margin: 0 auto; max-width: 1180px; padding: 24px 28px 60px; }
+h1 { font-size: 26px; margin: 0 0 4px; } h2 { font-size: 20px; margin: 34px 0 10px; border-bottom: 2px solid #2a5d8f; padding-bottom: 3px; }
+h3 { font-size: 16px; margin: 22px 0 6px; }
+.lead { font-size: 16px; color: #333; margin: 0 0 14px; }
+table { border-collapse: collapse; margin: 6px 0 14px; font-size: 13.5px; }
+th, td { border: 1px solid #c9ced6; padding: 3px 8px; text-align: left; vertical-align: top; }
+th { background: #eef2f7; } td.num { text-align: right; font-variant-numeric: tabular-nums; }
+tr.differs td { background: #fff6dc; }
+.pass { color: #0d6b2f; font-weight: bold; } .fail { color: #b3141b; font-weight: bold; }
+.meta td:first-child { font-weight: bold; background: #f5f7fa; }
+figure { margin: 14px 0 22px; } figure svg { max-width: 100%; height: auto; display: block; border: 1px solid #e1e4e8; }
+figcaption { font-size: 13px; color: #444; margin-top: 4px; }
+.row { display: flex; flex-wrap: wrap; gap: 12px; align-items: flex-start; } .row figure { margin: 8px 0; }
+pre { background: #f6f8fa; border: 1px solid #e1e4e8; padding: 8px; overflow-x: auto; font-size: 12px; max-height: 420px; }
+nav ol { columns: 2; font-size: 14px; } .note { color: #555; font-size: 13px; }
+.summary { display: flex; gap: 14px; flex-wrap: wrap; margin: 8px 0 6px; }
+.card { border: 1px solid #c9ced6; border-radius: 6px; padding: 8px 14px; min-width: 180px; }
+.card b { font-size: 18px; }
+@media print { h2 { break-before: auto; } figure, table { break-inside: avoid; } pre { max-height: none; } }
+";
+
+fn num(v: f64, decimals: usize) -> String {
+    if v.is_finite() { format!("{v:.decimals$}") } else { "–".into() }
+}
+
+/// The page.
+#[must_use]
+pub fn page(d: &ReviewData, figures: &[PageFigure]) -> String {
+    let mut h = String::with_capacity(1 << 20);
+    let _ = write!(
+        h,
+        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n<title>Shoal review pack — {}</title>\n<style>{STYLE}</style>\n</head>\n<body>\n",
+        escape(&d.study)
+    );
+    header(&mut h, d);
+    verdict(&mut h, d);
+    instruments(&mut h, d);
+    metrics(&mut h, d);
+    figures_section(&mut h, figures);
+    budget_and_cost(&mut h, d);
+    provenance(&mut h, d);
+    h += "<footer class=\"note\"><p>Made by Shoal, an end-to-end simulator of satellite optical instruments over water. This page needs no network and no script; every figure is inside it.</p></footer>\n</body>\n</html>\n";
+    h
+}
+
+fn header(h: &mut String, d: &ReviewData) {
+    let _ = write!(
+        h,
+        "<header>\n<p class=\"note\">Shoal review pack</p>\n<h1>{}</h1>\n<p class=\"lead\">{}</p>\n<table class=\"meta\">\n",
+        escape(&d.study),
+        escape(&d.study_description)
+    );
+    let names: Vec<&str> = d.instruments.iter().map(|i| i.label.as_str()).collect();
+    for (k, v) in [
+        ("Scene", format!("{} — {}", d.scene, d.scene_description)),
+        ("Place", d.scene_place.clone()),
+        ("Instruments", names.join(" vs ")),
+        ("Made", d.created_utc.clone()),
+        ("Shoal", format!("version {}, commit {}", d.version, d.commit)),
+        ("Machine", d.machine.line()),
+    ] {
+        let _ = writeln!(h, "<tr><td>{k}</td><td>{}</td></tr>", escape(&v));
+    }
+    h.push_str("</table>\n</header>\n<nav><ol>\n<li><a href=\"#verdict\">Verdict against the requirements</a></li>\n<li><a href=\"#instruments\">The instruments side by side</a></li>\n<li><a href=\"#metrics\">Product errors</a></li>\n<li><a href=\"#figures\">Figures</a></li>\n");
+    if !d.budget.is_empty() {
+        h.push_str("<li><a href=\"#budget\">Error budget</a></li>\n");
+    }
+    if !d.cost.is_empty() {
+        h.push_str("<li><a href=\"#cost\">Cost of accuracy</a></li>\n");
+    }
+    h.push_str("<li><a href=\"#provenance\">Provenance</a></li>\n</ol></nav>\n");
+}
+
+fn verdict(h: &mut String, d: &ReviewData) {
+    h.push_str("<section id=\"verdict\">\n<h2>Verdict against the requirements</h2>\n");
+    if d.checks.is_empty() {
+        h.push_str("<p>The study states no requirements, so nothing is judged. Add <code>requirements</code> to the study file to get a verdict with margins.</p>\n</section>\n");
+        return;
+    }
+    h.push_str("<div class=\"summary\">\n");
+    for inst in &d.instruments {
+        let mine: Vec<_> = d.checks.iter().filter(|c| c.instrument == inst.label).collect();
+        let passed = mine.iter().filter(|c| c.pass).count();
+        let all = passed == mine.len();
+        let _ = writeln!(
+            h,
+            "<div class=\"card\">{}<br><b class=\"{}\">{}</b> — {passed} of {} checks met</div>",
+            escape(&inst.label),
+            if all { "pass" } else { "fail" },
+            if all { "MEETS ALL" } else { "FAILS" },
+            mine.len()
+        );
+    }
+    h.push_str("</div>\n<p class=\"note\">Margin: how far inside the limit (negative: outside), in the value's unit. A product with no pixel returned has no value and fails.</p>\n");
+    // One row per requirement (and seed), the instruments side by side.
+    let labels: Vec<&str> = d.instruments.iter().map(|i| i.label.as_str()).collect();
+    let mut keys: Vec<(u64, &str, f64)> = Vec::new();
+    for c in &d.checks {
+        if !keys.iter().any(|k| k.0 == c.seed && k.1 == c.what) {
+            keys.push((c.seed, &c.what, c.limit));
+        }
+    }
+    let several_seeds = keys.iter().any(|k| k.0 != keys[0].0);
+    h.push_str("<table>\n<tr><th>requirement</th><th>limit</th>");
+    for l in &labels {
+        let _ = write!(h, "<th colspan=\"3\">{}: value, margin, verdict</th>", escape(l));
+    }
+    h.push_str("</tr>\n");
+    for (seed, what, limit) in keys {
+        let name = if several_seeds { format!("{what} (seed {seed})") } else { what.to_string() };
+        let _ = write!(h, "<tr><td>{}</td><td class=\"num\">{}</td>", escape(&name), num(limit, 1));
+        for l in &labels {
+            match d.checks.iter().find(|c| c.instrument == *l && c.seed == seed && c.what == what) {
+                Some(c) => {
+                    let _ = write!(
+                        h,
+                        "<td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"{}\">{}</td>",
+                        c.value.map_or_else(|| "none".into(), |v| num(v, 1)),
+                        c.margin.map_or_else(|| "no pixel".into(), |m| format!("{m:+.1}")),
+                        if c.pass { "pass" } else { "fail" },
+                        if c.pass { "pass" } else { "FAIL" }
+                    );
+                }
+                None => h.push_str("<td colspan=\"3\">–</td>"),
+            }
+        }
+        h.push_str("</tr>\n");
+    }
+    h.push_str("</table>\n</section>\n");
+}
+
+fn instruments(h: &mut String, d: &ReviewData) {
+    h.push_str("<section id=\"instruments\">\n<h2>The instruments side by side</h2>\n");
+    let head: String = d.instruments.iter().map(|i| format!("<th>{}</th>", escape(&i.label))).collect();
+    for i in &d.instruments {
+        if !i.description.is_empty() {
+            let _ = writeln!(h, "<p><b>{}</b>: {}</p>", escape(&i.label), escape(&i.description));
+        }
+    }
+    let _ = writeln!(h, "<h3>Derived figures</h3>\n<table>\n<tr><th></th>{head}</tr>");
+    for row in &d.derived {
+        let cells: String = row.values.iter().map(|v| format!("<td class=\"num\">{}</td>", escape(v))).collect();
+        let _ = writeln!(h, "<tr><td>{}</td>{cells}</tr>", escape(&row.name));
+    }
+    h.push_str("</table>\n");
+    let differing: Vec<_> = d.parameters.iter().filter(|p| p.differs()).collect();
+    let _ = writeln!(
+        h,
+        "<h3>Parameters that differ ({} of {})</h3>\n<table>\n<tr><th>parameter</th>{head}</tr>",
+        differing.len(),
+        d.parameters.len()
+    );
+    for p in &differing {
+        let cells: String = p.values.iter().map(|v| format!("<td>{}</td>", escape(v))).collect();
+        let _ = writeln!(h, "<tr class=\"differs\"><td>{}</td>{cells}</tr>", escape(&p.name));
+    }
+    h.push_str("</table>\n<details><summary>Every parameter</summary>\n<table>\n");
+    let _ = writeln!(h, "<tr><th>parameter</th>{head}</tr>");
+    for p in &d.parameters {
+        let cells: String = p.values.iter().map(|v| format!("<td>{}</td>", escape(v))).collect();
+        let class = if p.differs() { " class=\"differs\"" } else { "" };
+        let _ = writeln!(h, "<tr{class}><td>{}</td>{cells}</tr>", escape(&p.name));
+    }
+    h.push_str("</table>\n</details>\n<h3>Feasibility</h3>\n");
+    for i in &d.instruments {
+        if i.warnings.is_empty() {
+            let _ = writeln!(
+                h,
+                "<p><b>{}</b>: no plausibility guard crossed (peak signal below full scale, smear under a pixel, f-number at least 1).</p>",
+                escape(&i.label)
+            );
+        } else {
+            let _ = writeln!(h, "<p><b>{}</b>:</p><ul>", escape(&i.label));
+            for w in &i.warnings {
+                let _ = writeln!(h, "<li class=\"fail\">{}</li>", escape(w));
+            }
+            h.push_str("</ul>\n");
+        }
+        let _ = writeln!(
+            h,
+            "<details><summary>{}: per band (Q = λN/p; peak signal over full scale at the scene's brightest water)</summary>\n<table>\n<tr><th>band</th><th>centre nm</th><th>Q</th><th>peak / full scale</th></tr>",
+            escape(&i.label)
+        );
+        for (band, centre, q, peak) in &i.feasibility {
+            let class = if *peak >= 1.0 { " class=\"fail\"" } else { "" };
+            let _ = writeln!(
+                h,
+                "<tr><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\"{class}>{} %</td></tr>",
+                escape(band),
+                num(*centre, 1),
+                num(*q, 2),
+                num(100.0 * peak, 1)
+            );
+        }
+        h.push_str("</table>\n</details>\n");
+    }
+    h.push_str("</section>\n");
+}
+
+fn metrics(h: &mut String, d: &ReviewData) {
+    h.push_str("<section id=\"metrics\">\n<h2>Product errors</h2>\n<p class=\"note\">Log-space MAE and bias (Seegers et al. 2018) of each retrieved variable against the truth, over the water pixels; with several noise seeds, ± is the standard deviation of the MAE over them.</p>\n<table>\n<tr><th>instrument</th><th>retrieval</th><th>variable</th><th>MAE %</th><th>bias %</th><th>returned %</th><th>pixels</th><th>seeds</th></tr>\n");
+    for m in &d.metrics {
+        let spread = if m.seeds > 1 { format!(" ± {}", num(m.mae_pct_sd, 1)) } else { String::new() };
+        let _ = writeln!(
+            h,
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td class=\"num\">{}{spread}</td><td class=\"num\">{:+.1}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td></tr>",
+            escape(&m.instrument),
+            escape(&m.product),
+            escape(&m.variable),
+            num(m.mae_pct, 1),
+            m.bias_pct,
+            num(m.returned_pct, 1),
+            m.n,
+            m.seeds
+        );
+    }
+    h.push_str("</table>\n</section>\n");
+}
+
+/// "aLMI chl-a" for the key `alm_chl_mg_m3` of a figure's file stem.
+fn describe_key(key: &str) -> String {
+    let (retrieval, variable) = key.split_once('_').unwrap_or((key, ""));
+    let retrieval = match retrieval {
+        "alm" | "almi" => "aLMI",
+        "sambuca" => "SAMBUCA",
+        other => other,
+    };
+    let variable = match variable {
+        "chl_mg_m3" => "chlorophyll-a",
+        "nap_g_m3" => "NAP",
+        "cdom_per_m" => "CDOM absorption",
+        "depth_m" => "depth",
+        other => other,
+    };
+    format!("{retrieval} {variable}")
+}
+
+/// A figure's caption from its file stem.
+fn caption(name: &str) -> String {
+    let (kind, rest) = name.split_once('_').unwrap_or((name, ""));
+    let what = describe_key(rest);
+    match kind {
+        "snr" => "SNR per band at the scene's median water radiance: analytic (line) and measured in the noisy cube (open circles); the dashed line is the requirement.".into(),
+        "maps" => format!("Truth and each instrument's retrieval ({what}) on one colour scale; grey: land or not returned; scale bars give the ground distance."),
+        "difference" => format!("A − B ({what}): B sampled at the pixel nearest each of A's ground points; diverging scale symmetric about zero."),
+        "scatter" => format!("Retrieved against true ({what}), pixel density on log axes; the line is 1:1."),
+        "histogram" => format!("Distribution of retrieved values ({what}) by SIOP set or dominant substrate; the outline is the truth."),
+        _ => what,
+    }
+}
+
+fn figures_section(h: &mut String, figures: &[PageFigure]) {
+    h.push_str("<section id=\"figures\">\n<h2>Figures</h2>\n");
+    if figures.is_empty() {
+        h.push_str("<p>No figures were drawn for these results.</p>\n");
+    }
+    let mut shown = vec![false; figures.len()];
+    let put = |h: &mut String, f: &PageFigure| {
+        let link = if f.png { format!(" <a href=\"figures/{}.png\">PNG</a>", escape(&f.name)) } else { String::new() };
+        let _ = write!(
+            h,
+            "<figure id=\"fig-{}\">\n{}\n<figcaption>{}{link}</figcaption>\n</figure>\n",
+            escape(&f.name),
+            inline_svg(&f.svg),
+            escape(&caption(&f.name))
+        );
+    };
+    // SNR first, then per variable: maps beside their A − B, scatter and histograms.
+    for (i, f) in figures.iter().enumerate() {
+        if f.name == "snr" {
+            put(h, f);
+            shown[i] = true;
+        }
+    }
+    // Variables in the order of the chain's products, whatever order the figures came in.
+    let priority = |name: &str| {
+        ["chl_mg_m3", "nap_g_m3", "cdom_per_m", "depth_m"].iter().position(|v| name.ends_with(v)).unwrap_or(9)
+    };
+    let mut maps: Vec<usize> = (0..figures.len()).filter(|&i| figures[i].name.starts_with("maps_")).collect();
+    maps.sort_by_key(|&i| (priority(&figures[i].name), figures[i].name.clone()));
+    for i in maps {
+        let f = &figures[i];
+        let Some(key) = f.name.strip_prefix("maps_") else { continue };
+        let _ = writeln!(h, "<h3>{}</h3>\n<div class=\"row\">", escape(&describe_key(key)));
+        put(h, f);
+        shown[i] = true;
+        for kind in ["difference", "scatter", "histogram"] {
+            if let Some(j) = figures.iter().position(|g| g.name == format!("{kind}_{key}")) {
+                put(h, &figures[j]);
+                shown[j] = true;
+            }
+        }
+        h.push_str("</div>\n");
+    }
+    for (i, f) in figures.iter().enumerate() {
+        if !shown[i] {
+            put(h, f);
+        }
+    }
+    h.push_str("</section>\n");
+}
+
+fn budget_and_cost(h: &mut String, d: &ReviewData) {
+    if !d.budget.is_empty() {
+        h.push_str("<section id=\"budget\">\n<h2>Error budget</h2>\n<p class=\"note\">Each stage of the chain made perfect in turn (sequential share: the MAE it removes after those before it) and alone (the MAE with only this stage imperfect, above the floor). Points of %.</p>\n<table>\n<tr><th>instrument</th><th>variable</th><th>full MAE %</th><th>stage</th><th>sequential share</th><th>alone share</th><th>floor MAE %</th></tr>\n");
+        for (inst, var, full, stage, seq, alone, floor) in &d.budget {
+            let _ = writeln!(
+                h,
+                "<tr><td>{}</td><td>{}</td><td class=\"num\">{}</td><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td></tr>",
+                escape(inst),
+                escape(var),
+                num(*full, 1),
+                escape(stage),
+                num(*seq, 1),
+                num(*alone, 1),
+                num(*floor, 1)
+            );
+        }
+        h.push_str("</table>\n</section>\n");
+    }
+    if !d.cost.is_empty() {
+        h.push_str("<section id=\"cost\">\n<h2>Cost of accuracy</h2>\n<p class=\"note\">Each setting timed in interleaved rounds with the reference; a setting whose range of wall times overlaps the reference's shows \"no measurable difference\". Error: median per-pixel chl-a difference from the reference run.</p>\n<table>\n<tr><th>setting</th><th>rounds</th><th>wall s (median)</th><th>range</th><th>CPU s</th><th>vs reference</th><th>chl per pixel %</th></tr>\n");
+        for (setting, n, wall, range, cpu, vs, err) in &d.cost {
+            let _ = writeln!(
+                h,
+                "<tr><td>{}</td><td class=\"num\">{n}</td><td class=\"num\">{}</td><td class=\"num\">{}–{}</td><td class=\"num\">{}</td><td>{}</td><td class=\"num\">{}</td></tr>",
+                escape(setting),
+                num(*wall, 2),
+                num(range.0, 2),
+                num(range.1, 2),
+                cpu.map_or_else(|| "–".into(), |c| num(c, 2)),
+                escape(vs),
+                err.map_or_else(|| "other grid".into(), |e| num(e, 3))
+            );
+        }
+        h.push_str("</table>\n</section>\n");
+    }
+}
+
+fn provenance(h: &mut String, d: &ReviewData) {
+    h.push_str("<section id=\"provenance\">\n<h2>Provenance</h2>\n<h3>Data</h3>\n");
+    if d.data_sources.is_empty() {
+        h.push_str("<p>No embedded data file was recorded for these results.</p>\n");
+    } else {
+        h.push_str("<p class=\"note\">The embedded data files read to make these results, with their sources and licences (the full index and licence texts are in Shoal's <code>assets/PROVENANCE.md</code> and <code>assets/licenses/</code>).</p>\n<table>\n<tr><th>files</th><th>content</th><th>source</th><th>licence</th></tr>\n");
+        for (files, content, source, licence) in &d.data_sources {
+            let _ = writeln!(
+                h,
+                "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+                escape(files),
+                escape(content),
+                escape(source),
+                escape(licence)
+            );
+        }
+        h.push_str("</table>\n");
+    }
+    h.push_str("<h3>Configurations</h3>\n<p class=\"note\">The resolved run configuration of each instrument: <code>shoal simulate --config FILE</code> reruns it exactly.</p>\n");
+    let download = |name: &str, text: &str| {
+        format!(
+            "<a download=\"{}\" href=\"data:text/plain;charset=utf-8;base64,{}\">download {}</a>",
+            escape(name),
+            base64(text.as_bytes()),
+            escape(name)
+        )
+    };
+    for i in &d.instruments {
+        let file = format!("{}.ron", i.label);
+        let _ = writeln!(
+            h,
+            "<details><summary>{} — {}</summary>\n<pre>{}</pre>\n</details>",
+            escape(&i.label),
+            download(&file, &i.config_ron),
+            escape(&i.config_ron)
+        );
+    }
+    let _ = writeln!(
+        h,
+        "<details><summary>study — {}</summary>\n<pre>{}</pre>\n</details>",
+        download(&format!("{}.ron", d.study), &d.study_ron),
+        escape(&d.study_ron)
+    );
+    h.push_str("<h3>Stage timings</h3>\n<p class=\"note\">Seconds per stage of the first run of each instrument (\"cached\": reused from an earlier run whose inputs had not changed).</p>\n");
+    for i in &d.instruments {
+        let (rows, cols, bands, decimation) = i.shape;
+        let _ = writeln!(
+            h,
+            "<p><b>{}</b>: {rows} lines × {cols} detectors × {bands} bands ({}), {} s in all.</p>\n<table>\n<tr><th>stage</th><th></th><th>s</th></tr>",
+            escape(&i.label),
+            if decimation == 1 {
+                "full resolution".to_string()
+            } else {
+                format!("preview: every {decimation}th line and detector")
+            },
+            num(i.total_seconds, 2)
+        );
+        for (stage, status, s) in &i.stages {
+            let _ = writeln!(
+                h,
+                "<tr><td>{}</td><td>{}</td><td class=\"num\">{}</td></tr>",
+                escape(stage),
+                escape(status),
+                num(*s, 3)
+            );
+        }
+        h.push_str("</table>\n");
+    }
+    let _ = writeln!(h, "<h3>Machine</h3>\n<p>{}</p>\n</section>", escape(&d.machine.line()));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn text_is_escaped_and_svg_is_inlined_without_its_namespace_uri() {
+        assert_eq!(escape("a < b & \"c\""), "a &lt; b &amp; &quot;c&quot;");
+        let svg =
+            inline_svg("<?xml version=\"1.0\"?>\n<svg width=\"10\" xmlns=\"http://www.w3.org/2000/svg\"><rect/></svg>");
+        assert_eq!(svg, "<svg role=\"img\" width=\"10\"><rect/></svg>");
+        assert_eq!(base64(b"foobar"), "Zm9vYmFy");
+        assert_eq!(base64(b"fo"), "Zm8=");
+    }
+}

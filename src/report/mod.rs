@@ -1,0 +1,429 @@
+//! The review pack: one self-contained HTML page (inline SVG figures, no network, no JavaScript)
+//! that carries a study to a design review — what was compared, against which requirements,
+//! with what margins, the maps and plots, and where every number came from.
+//!
+//! [`ReviewData`] is everything the page states, as plain data: `shoal study` writes it beside
+//! its tables (`review.json`), so `shoal report RESULTS_DIR` rebuilds the page from a results
+//! directory without rerunning, and `shoal report STUDY` runs the study and builds it at once.
+//! [`html::page`] turns it and the study's figures into the page.
+
+pub mod html;
+mod machine;
+mod pack;
+
+use serde::{Deserialize, Serialize};
+
+pub use machine::Machine;
+pub use pack::{REVIEW_JSON, is_results_dir, load_results, review_json, write_pack};
+
+use crate::engine::RunConfig;
+use crate::study::{Budget, Check, StudyResult, StudyRun};
+use crate::sweep::CostRow;
+
+/// One row of the instruments' parameter table.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ParameterRow {
+    /// Dotted field name (`detector.read_noise_e`).
+    pub name: String,
+    /// Per instrument, the value as written in its RON.
+    pub values: Vec<String>,
+}
+
+impl ParameterRow {
+    /// Do the instruments differ here?
+    #[must_use]
+    pub fn differs(&self) -> bool {
+        self.values.windows(2).any(|w| w[0] != w[1])
+    }
+}
+
+/// A derived figure of one instrument (GSD, f-number, smear…).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Derived {
+    /// What it is.
+    pub name: String,
+    /// Per instrument, formatted with its unit.
+    pub values: Vec<String>,
+}
+
+/// One instrument as the review sees it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct InstrumentSummary {
+    /// Label in the study.
+    pub label: String,
+    /// Its description.
+    pub description: String,
+    /// The resolved run configuration (RON), as `config.ron` holds it.
+    pub config_ron: String,
+    /// The run's stages: (stage, "ran" or "cached", seconds).
+    pub stages: Vec<(String, String, f64)>,
+    /// Whole run, s.
+    pub total_seconds: f64,
+    /// Image: lines × detectors × bands, and the decimation.
+    pub shape: (usize, usize, usize, usize),
+    /// Plausibility warnings (saturation, smear, f-number).
+    pub warnings: Vec<String>,
+    /// Per band: (band, centre nm, Q = λN/p, peak signal / full scale).
+    pub feasibility: Vec<(String, f64, f64, f64)>,
+}
+
+/// One metrics row (over the noise seeds).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MetricRow {
+    /// Instrument.
+    pub instrument: String,
+    /// Retrieval.
+    pub product: String,
+    /// Variable.
+    pub variable: String,
+    /// Seeds.
+    pub seeds: usize,
+    /// Log-space MAE, %, mean over seeds.
+    pub mae_pct: f64,
+    /// Its standard deviation over seeds.
+    pub mae_pct_sd: f64,
+    /// Log-space bias, %, mean over seeds.
+    pub bias_pct: f64,
+    /// Share of candidate pixels returned, % (first seed).
+    pub returned_pct: f64,
+    /// Pixels compared (first seed).
+    pub n: usize,
+}
+
+/// One requirement check.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CheckRow {
+    /// Instrument.
+    pub instrument: String,
+    /// Seed.
+    pub seed: u64,
+    /// What.
+    pub what: String,
+    /// Value (none: nothing to judge, which fails).
+    pub value: Option<f64>,
+    /// Limit.
+    pub limit: f64,
+    /// Met?
+    pub pass: bool,
+    /// Margin inside the limit (negative: outside).
+    pub margin: Option<f64>,
+}
+
+impl From<&Check> for CheckRow {
+    fn from(c: &Check) -> Self {
+        Self {
+            instrument: c.instrument.clone(),
+            seed: c.seed,
+            what: c.what.clone(),
+            value: c.value,
+            limit: c.limit,
+            pass: c.pass,
+            margin: c.margin,
+        }
+    }
+}
+
+/// An error-budget line: (instrument, variable, full MAE %, stage, sequential share, alone
+/// share, floor MAE %), shares in points of %.
+pub type BudgetRow = (String, String, f64, String, f64, f64, f64);
+
+/// A cost-of-accuracy row: (setting, rounds, wall s median, wall range, CPU s median, vs
+/// reference, per-pixel chl difference from the reference %).
+pub type CostTableRow = (String, usize, f64, (f64, f64), Option<f64>, String, Option<f64>);
+
+/// A data file the results were made from: (path, content, source, licence).
+pub type DataSource = (String, String, String, String);
+
+/// Everything the review pack states.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ReviewData {
+    /// Study name.
+    pub study: String,
+    /// What it asks.
+    pub study_description: String,
+    /// Scene name.
+    pub scene: String,
+    /// Scene description.
+    pub scene_description: String,
+    /// Where the scene is (CRS), or "local frame".
+    pub scene_place: String,
+    /// When the results were made (UTC, ISO 8601).
+    pub created_utc: String,
+    /// Shoal's version.
+    pub version: String,
+    /// The git commit Shoal was built from.
+    pub commit: String,
+    /// The instruments in study order.
+    pub instruments: Vec<InstrumentSummary>,
+    /// Parameters side by side.
+    pub parameters: Vec<ParameterRow>,
+    /// Derived figures side by side.
+    pub derived: Vec<Derived>,
+    /// Requirement checks (empty: the study has none).
+    pub checks: Vec<CheckRow>,
+    /// Metrics with their spread over seeds.
+    pub metrics: Vec<MetricRow>,
+    /// The error budget, when run.
+    pub budget: Vec<BudgetRow>,
+    /// The cost-of-accuracy table, when run.
+    pub cost: Vec<CostTableRow>,
+    /// The data files read to make the results.
+    pub data_sources: Vec<DataSource>,
+    /// The machine.
+    pub machine: Machine,
+    /// The study file as resolved (RON).
+    pub study_ron: String,
+}
+
+/// The git commit this binary was built from (`src/build.rs`), or "unknown".
+#[must_use]
+pub fn commit() -> &'static str {
+    option_env!("SHOAL_GIT_COMMIT").unwrap_or("unknown")
+}
+
+/// Now, UTC, as `YYYY-MM-DDTHH:MM:SSZ` (civil-from-days: Hinnant, "chrono-Compatible Low-Level
+/// Date Algorithms").
+#[must_use]
+pub fn now_utc() -> String {
+    let secs = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_secs());
+    let (days, rem) = ((secs / 86_400) as i64, secs % 86_400);
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = doy - (153 * mp + 2) / 5 + 1;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 };
+    let y = yoe + era * 400 + i64::from(m <= 2);
+    format!("{y:04}-{m:02}-{d:02}T{:02}:{:02}:{:02}Z", rem / 3600, rem % 3600 / 60, rem % 60)
+}
+
+/// Flatten a JSON value into dotted (name, text) pairs; long arrays are summarised.
+fn flatten(prefix: &str, v: &serde_json::Value, out: &mut Vec<(String, String)>) {
+    use serde_json::Value;
+    match v {
+        Value::Object(map) => {
+            for (k, v) in map {
+                let name = if prefix.is_empty() { k.clone() } else { format!("{prefix}.{k}") };
+                flatten(&name, v, out);
+            }
+        }
+        Value::Array(items) if items.iter().any(|i| i.is_object() || i.is_array()) || items.len() > 6 => {
+            out.push((prefix.to_string(), format!("{} entries", items.len())));
+            if items.len() <= 40 {
+                for (i, item) in items.iter().enumerate() {
+                    flatten(&format!("{prefix}[{i}]"), item, out);
+                }
+            }
+        }
+        Value::String(s) => out.push((prefix.to_string(), s.clone())),
+        other => out.push((prefix.to_string(), other.to_string())),
+    }
+}
+
+/// The instruments' parameters side by side: every field of each spec, in the first one's order.
+fn parameter_rows(configs: &[&RunConfig]) -> Vec<ParameterRow> {
+    let flat: Vec<Vec<(String, String)>> = configs
+        .iter()
+        .map(|c| {
+            let mut out = Vec::new();
+            if let Ok(v) = serde_json::to_value(&c.instrument) {
+                flatten("", &v, &mut out);
+            }
+            out
+        })
+        .collect();
+    let mut names: Vec<String> = Vec::new();
+    for f in &flat {
+        for (n, _) in f {
+            if !names.contains(n) && n != "description" {
+                names.push(n.clone());
+            }
+        }
+    }
+    names
+        .into_iter()
+        .map(|name| ParameterRow {
+            values: flat
+                .iter()
+                .map(|f| f.iter().find(|(n, _)| *n == name).map_or_else(|| "–".into(), |(_, v)| v.clone()))
+                .collect(),
+            name,
+        })
+        .collect()
+}
+
+/// Figures derived from each design and its run.
+fn derived_rows(runs: &[&StudyRun], configs: &[&RunConfig]) -> Vec<Derived> {
+    let row = |name: &str, f: &dyn Fn(usize) -> String| Derived {
+        name: name.into(),
+        values: (0..runs.len()).map(f).collect(),
+    };
+    vec![
+        row("nadir GSD", &|k| format!("{:.1} m", configs[k].instrument.gsd_m())),
+        row("swath", &|k| format!("{:.1} km", configs[k].instrument.swath_m() / 1000.0)),
+        row("f-number", &|k| format!("f/{:.2}", runs[k].feasibility.f_number)),
+        row("along-track smear", &|k| format!("{:.2} px", runs[k].feasibility.smear_px)),
+        row("read noise", &|k| format!("{:.1} e⁻", runs[k].feasibility.read_noise_e)),
+        row("quantisation noise", &|k| format!("{:.1} e⁻", runs[k].feasibility.quantisation_noise_e)),
+        row("line period", &|k| format!("{:.2} ms", runs[k].report.line_period_s * 1e3)),
+        row("largest view zenith", &|k| format!("{:.1}°", runs[k].viewing.max_view_zenith_deg)),
+        row("worst peak signal / full scale", &|k| {
+            let worst = runs[k].feasibility.bands.iter().map(|b| b.peak_fraction_of_full_scale).fold(0.0, f64::max);
+            format!("{:.0} %", 100.0 * worst)
+        }),
+        row("lowest SNR at the reference radiance", &|k| {
+            runs[k]
+                .snr
+                .iter()
+                .min_by(|a, b| a.snr_analytic.total_cmp(&b.snr_analytic))
+                .map_or_else(|| "–".into(), |r| format!("{:.0} ({})", r.snr_analytic, r.band))
+        }),
+    ]
+}
+
+fn instrument_summary(run: &StudyRun, config: &RunConfig) -> InstrumentSummary {
+    InstrumentSummary {
+        label: run.label.clone(),
+        description: config.instrument.description.clone(),
+        config_ron: config.to_ron().unwrap_or_else(|e| format!("// cannot write the configuration: {e}")),
+        stages: run
+            .report
+            .stages
+            .iter()
+            .map(|s| {
+                let status = match s.status {
+                    crate::engine::StageStatus::Ran => "ran",
+                    crate::engine::StageStatus::Cached => "cached",
+                };
+                (format!("{:?}", s.stage), status.to_string(), s.seconds)
+            })
+            .collect(),
+        total_seconds: run.report.total_seconds,
+        shape: (run.report.shape.0, run.report.shape.1, run.report.shape.2, run.report.decimation),
+        warnings: run.report.warnings.iter().map(|w| w.message.clone()).collect(),
+        feasibility: run
+            .feasibility
+            .bands
+            .iter()
+            .map(|b| (b.band.clone(), b.centre_nm, b.q, b.peak_fraction_of_full_scale))
+            .collect(),
+    }
+}
+
+fn metric_rows(result: &StudyResult) -> Vec<MetricRow> {
+    crate::study::seed_spread(result)
+        .into_iter()
+        .map(|s| {
+            let first = result
+                .runs
+                .iter()
+                .filter(|r| r.label == s.instrument)
+                .flat_map(|r| r.retrievals.iter())
+                .find(|r| r.metrics.product == s.product)
+                .and_then(|r| r.metrics.get(&s.variable));
+            MetricRow {
+                returned_pct: first.map_or(0.0, |m| m.returned_pct),
+                n: first.map_or(0, |m| m.n),
+                instrument: s.instrument,
+                product: s.product,
+                variable: s.variable,
+                seeds: s.seeds,
+                mae_pct: s.mae_pct_mean,
+                mae_pct_sd: s.mae_pct_std,
+                bias_pct: s.bias_pct_mean,
+            }
+        })
+        .collect()
+}
+
+fn budget_rows(budget: &[Budget]) -> Vec<BudgetRow> {
+    budget
+        .iter()
+        .flat_map(|b| {
+            b.lines.iter().map(move |l| {
+                (
+                    b.instrument.clone(),
+                    b.variable.clone(),
+                    b.full_pct,
+                    l.stage.name().to_string(),
+                    l.sequential_pct,
+                    l.alone_pct,
+                    b.floor_pct,
+                )
+            })
+        })
+        .collect()
+}
+
+fn cost_rows(cost: &[CostRow]) -> Vec<CostTableRow> {
+    cost.iter()
+        .map(|r| {
+            (
+                r.label.clone(),
+                r.time.n,
+                r.time.wall_s,
+                r.time.wall_range_s,
+                r.time.cpu_s,
+                r.comparison.text(),
+                r.chl_error_pct(),
+            )
+        })
+        .collect()
+}
+
+/// The data files read so far in this process, with their provenance rows (a row names its
+/// files by path, later ones of a row by file name only).
+fn data_sources() -> Vec<DataSource> {
+    let used = crate::assets::used();
+    crate::assets::provenance()
+        .into_iter()
+        .filter(|(files, ..)| used.iter().any(|u| files.contains(u.rsplit('/').next().unwrap_or(u))))
+        .collect()
+}
+
+/// The review data of `result` (budget and cost rows when they were run).
+#[must_use]
+pub fn review_data(result: &StudyResult, budget: &[Budget], cost: &[CostRow]) -> ReviewData {
+    let study = &result.study;
+    // First seed of each instrument, in study order.
+    let mut firsts: Vec<usize> = Vec::new();
+    for (i, run) in result.runs.iter().enumerate() {
+        if !firsts.iter().any(|&j| result.runs[j].label == run.label) {
+            firsts.push(i);
+        }
+    }
+    let configs: Vec<&RunConfig> = firsts.iter().map(|&i| &study.runs[i].2).collect();
+    let runs: Vec<&StudyRun> = firsts.iter().map(|&i| &result.runs[i]).collect();
+    let scene = configs.first().map(|c| &c.scene);
+    ReviewData {
+        study: study.spec.name.clone(),
+        study_description: study.spec.description.clone(),
+        scene: scene.map(|s| s.name.clone()).unwrap_or_default(),
+        scene_description: scene.map(|s| s.description.clone()).unwrap_or_default(),
+        scene_place: result.runs.first().and_then(|r| r.frame.as_ref()).map_or_else(
+            || "a local frame (the scene has no georeference)".into(),
+            |f| format!("{}, scene centre at {:.1} E, {:.1} N", f.crs.describe(), f.centre.0, f.centre.1),
+        ),
+        created_utc: now_utc(),
+        version: env!("CARGO_PKG_VERSION").into(),
+        commit: commit().into(),
+        instruments: runs.iter().zip(&configs).map(|(r, c)| instrument_summary(r, c)).collect(),
+        parameters: parameter_rows(&configs),
+        derived: derived_rows(&runs, &configs),
+        checks: study
+            .spec
+            .requirements
+            .as_ref()
+            .map(|r| r.check(result).iter().map(CheckRow::from).collect())
+            .unwrap_or_default(),
+        metrics: metric_rows(result),
+        budget: budget_rows(budget),
+        cost: cost_rows(cost),
+        data_sources: data_sources(),
+        machine: Machine::this(),
+        study_ron: ron::ser::to_string_pretty(&study.spec, ron::ser::PrettyConfig::default().struct_names(true))
+            .unwrap_or_default(),
+    }
+}

@@ -1,0 +1,186 @@
+//! The review pack (`shoal report`) in a real browser: Debian's Chromium (which `.ci/run`
+//! installs) renders it headless; the page must not be blank, every image must load, and the
+//! HTML must reference nothing outside itself.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn shoal() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_shoal"))
+}
+
+fn tempdir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("shoal-report-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn ok(cmd: &mut Command) -> String {
+    let out = cmd.output().unwrap();
+    assert!(out.status.success(), "{cmd:?}: {}", String::from_utf8_lossy(&out.stderr));
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// Headless Chromium with the flags a closed network and a root user need (a fresh profile,
+/// no sandbox, no background connections).
+fn chromium(profile: &Path, args: &[String]) -> std::process::Output {
+    Command::new("chromium")
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--disable-quic",
+            "--no-first-run",
+            "--disable-background-networking",
+            "--disable-component-update",
+            "--disable-sync",
+            "--hide-scrollbars",
+        ])
+        .arg(format!("--user-data-dir={}", profile.display()))
+        .args(args)
+        .output()
+        .unwrap_or_else(|e| {
+            panic!("chromium does not run ({e}): install it (`apt-get install chromium`; .ci/run does)")
+        })
+}
+
+/// Every `src="…"`, `href="…"` and `url(…)` of `html` that is not inside the file: not a
+/// fragment, not a data URI, not a figure PNG written beside the page.
+fn external_references(html: &str) -> Vec<String> {
+    let mut found = Vec::new();
+    for key in ["src=\"", "href=\"", "url("] {
+        for (at, _) in html.match_indices(key) {
+            let value: String = html[at + key.len()..].chars().take_while(|c| !matches!(c, '"' | ')')).collect();
+            let local = value.starts_with('#') || value.starts_with("data:") || value.starts_with("figures/");
+            if !local || value.contains("..") {
+                found.push(value.chars().take(80).collect());
+            }
+        }
+    }
+    for marker in ["http://", "https://", "<script", "<link", "@import", "<iframe"] {
+        if html.contains(marker) {
+            found.push(marker.to_string());
+        }
+    }
+    found
+}
+
+/// Checks the page from inside the browser after load: every `<image>` of the inline SVGs and
+/// every `<img>` decoded to a non-empty bitmap, and every figure laid out with a size. Inserted
+/// into a copy of the page only: the pack itself has no script.
+const CHECKER: &str = r#"<script>
+window.addEventListener('load', async () => {
+  const hrefs = [...document.querySelectorAll('image, img')].map(e => e.getAttribute('href') || e.getAttribute('src'));
+  let loaded = 0;
+  await Promise.all(hrefs.map(h => new Promise(done => {
+    const im = new Image();
+    im.onload = () => { if (im.naturalWidth > 0 && im.naturalHeight > 0) loaded++; done(); };
+    im.onerror = () => done();
+    im.src = h;
+  })));
+  const svgs = [...document.querySelectorAll('figure svg')];
+  const sized = svgs.filter(s => { const r = s.getBoundingClientRect(); return r.width > 100 && r.height > 100; }).length;
+  document.body.setAttribute('data-check', `images ${loaded}/${hrefs.length} figures ${sized}/${svgs.length}`);
+});
+</script>"#;
+
+#[test]
+fn the_review_pack_renders_in_chromium_with_every_image_and_nothing_external() {
+    let dir = tempdir("pack");
+    let results = dir.join("results");
+    ok(shoal().args(["study", "cubesat_vs_smallsat", "--decimation", "8", "--no-cubes", "--out"]).arg(&results));
+    let pack = dir.join("pack");
+    ok(shoal().arg("report").arg(&results).arg("--out").arg(&pack));
+    let html = std::fs::read_to_string(pack.join("index.html")).unwrap();
+
+    // Self-contained: nothing outside the file but the PNG copies beside it.
+    assert_eq!(external_references(&html), Vec::<String>::new());
+    for f in std::fs::read_dir(results.join("figures")).unwrap() {
+        let name = f.unwrap().file_name().to_string_lossy().into_owned();
+        if let Some(stem) = name.strip_suffix(".svg") {
+            assert!(html.contains(&format!("id=\"fig-{stem}\"")), "{stem} is not on the page");
+            assert!(pack.join("figures").join(format!("{stem}.png")).is_file(), "{stem}.png");
+        }
+    }
+    // What a reviewer looks for: the verdict (the CubeSat misses the chl-a MAE requirement),
+    // both instruments, the commit, the configurations, the machine.
+    assert!(html.contains("cubesat: value, margin, verdict") && html.contains("smallsat: value, margin, verdict"));
+    assert!(html.contains("<b class=\"fail\">FAILS</b> — "), "a verdict card");
+    assert!(html.contains(&format!("commit {}", shoal::report::commit())));
+    assert!(html.contains("download=\"cubesat.ron\""));
+    assert!(html.contains("Parameters that differ") && html.contains("aperture_mm"));
+    assert!(html.contains("solar/solar_tsis1_hsrs_1nm.csv"), "the solar spectrum is a data source of every run");
+
+    // Rendered by a real browser: a screenshot that is not blank.
+    let profile = dir.join("profile");
+    let shot = dir.join("shot.png");
+    let out = chromium(
+        &profile,
+        &[
+            "--window-size=1280,2400".into(),
+            format!("--screenshot={}", shot.display()),
+            format!("file://{}", pack.join("index.html").display()),
+        ],
+    );
+    assert!(shot.is_file(), "no screenshot: {}", String::from_utf8_lossy(&out.stderr));
+    let img = image::open(&shot).unwrap().to_rgb8();
+    let n = (img.width() * img.height()) as f64;
+    let luminance: Vec<f64> =
+        img.pixels().map(|p| 0.2126 * f64::from(p[0]) + 0.7152 * f64::from(p[1]) + 0.0722 * f64::from(p[2])).collect();
+    let mean = luminance.iter().sum::<f64>() / n;
+    let sd = (luminance.iter().map(|l| (l - mean).powi(2)).sum::<f64>() / n).sqrt();
+    let inked = luminance.iter().filter(|l| **l < 200.0).count() as f64 / n;
+    let coloured = img.pixels().filter(|p| p[0].abs_diff(p[1]) > 40 || p[1].abs_diff(p[2]) > 40).count() as f64 / n;
+    assert!(sd > 20.0 && inked > 0.03, "the page looks blank: luminance sd {sd:.1}, inked {:.1} %", 100.0 * inked);
+    assert!(coloured > 0.002, "no colour on the first screen (the verdict's pass/fail): {:.2} %", 100.0 * coloured);
+
+    // Every image loaded, every figure laid out (checked from inside the page, on a copy).
+    let check = pack.join("check.html");
+    std::fs::write(&check, html.replace("</body>", &format!("{CHECKER}</body>"))).unwrap();
+    let out = chromium(
+        &profile,
+        &["--virtual-time-budget=15000".into(), "--dump-dom".into(), format!("file://{}", check.display())],
+    );
+    let dom = String::from_utf8_lossy(&out.stdout);
+    let result = dom.split("data-check=\"").nth(1).and_then(|s| s.split('"').next()).unwrap_or_else(|| {
+        panic!(
+            "the checker did not run: {}",
+            String::from_utf8_lossy(&out.stderr).chars().take(2000).collect::<String>()
+        )
+    });
+    let numbers: Vec<usize> = result.split(|c: char| !c.is_ascii_digit()).filter_map(|s| s.parse().ok()).collect();
+    let [loaded, images, sized, figures] = numbers[..] else { panic!("{result}") };
+    assert!(images > 0 && loaded == images, "images: {result}");
+    assert!(figures > 10 && sized == figures, "figures: {result}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_report_straight_from_a_study_carries_its_error_budget_and_bad_targets_are_refused() {
+    let dir = tempdir("budget");
+    let pack = dir.join("pack");
+    ok(shoal().args(["report", "reef_survey_depth", "--decimation", "8", "--budget", "--out"]).arg(&pack));
+    let html = std::fs::read_to_string(pack.join("index.html")).unwrap();
+    assert!(html.contains("id=\"budget\"") && html.contains("noise and quantisation"), "budget section");
+    assert!(html.contains("EPSG:32756"), "the raster scene's place");
+    assert!(html.contains("The study states no requirements"));
+    assert_eq!(external_references(&html), Vec::<String>::new());
+    // A results directory `shoal study` wrote makes a page without rerunning (no budget: the
+    // study did not run one).
+    let again = dir.join("again");
+    let from_dir = dir.join("results");
+    ok(shoal().args(["study", "reef_survey_depth", "--decimation", "8", "--no-cubes", "--out"]).arg(&from_dir));
+    ok(shoal().arg("report").arg(&from_dir).arg("--out").arg(&again));
+    let page = std::fs::read_to_string(again.join("index.html")).unwrap();
+    assert!(page.contains("id=\"fig-maps_sambuca_depth_m\"") && !page.contains("id=\"budget\""));
+
+    let empty = tempdir("empty");
+    let out = shoal().arg("report").arg(&empty).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no review.json"));
+    let out = shoal().args(["report", "no_such_study"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let _ = std::fs::remove_dir_all(&dir);
+    let _ = std::fs::remove_dir_all(&empty);
+}
