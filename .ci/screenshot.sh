@@ -24,3 +24,19 @@ for size in 1280x720 1920x1080; do
     rm -rf "$home"
     echo "wrote $out/screenshot_$size.png"
 done
+
+# The review pack of the default study (at 1/4 resolution), rendered by headless Chromium as the
+# test renders it: the top of the page, 1280 px wide.
+if command -v chromium >/dev/null; then
+    work=$(mktemp -d)
+    ./target/release/shoal study --decimation 4 --no-cubes --out "$work/study"
+    ./target/release/shoal report "$work/study" --out "$work/pack"
+    chromium --headless --no-sandbox --disable-gpu --disable-quic --no-first-run \
+        --disable-background-networking --disable-component-update --disable-sync \
+        --hide-scrollbars --user-data-dir="$work/profile" --window-size=1280,1700 \
+        --screenshot="$out/review_pack.png" "file://$work/pack/index.html" 2>/dev/null
+    rm -rf "$work"
+    echo "wrote $out/review_pack.png"
+else
+    echo "chromium not found: review_pack.png not retaken (apt install chromium)" >&2
+fi

@@ -20,6 +20,7 @@
 //! | [`assets`] | cited spectra embedded in the binary |
 //! | [`control`] | cancellation and progress shared by a run and its watcher |
 //! | [`jobs`] | background work: the newest-request-wins mailbox and the one rayon pool builder |
+//! | [`geotiff`] | GeoTIFF in and out: rasters with geotransform, CRS, nodata, band names and units |
 //! | [`spectral`] | wavelength grid, spectra, band sets, `band_from_fine` |
 //! | [`water`] | SIOP sets, IOPs, deep/shallow reflectance (Lee et al. 1998/1999, SAMBUCA) |
 //! | [`ranges`] | the documented range of every number a user sets: one table the validators use |
@@ -34,11 +35,12 @@
 //! | [`engine`] | the chain as cached stages; the worker thread the app talks to |
 //! | [`study`] | studies: runs per instrument and seed, metrics tables, figures (PNG/SVG), cubes; the paper reproduced |
 //! | [`sweep`] | sweeps: a study over one parameter or a grid of two, with seeds; shards and merge |
+//! | [`report`] | the review pack: a study's verdict, figures and provenance as one self-contained HTML page |
 //! | [`library`] | the preset library: built-ins and the user's own; atomic saves |
 //! | [`parse`] | RON parse errors described with line, column and field |
 //! | [`validation`] | comparisons with reference codes (OSOAA), shared by tests and `shoal bench` |
 //! | `app` | the desktop app (the `gui` feature; the only module that uses egui) |
-//! | [`cli`] | the headless command line (`shoal water`, `atmosphere`, `simulate`, `study`, `reproduce`, `sweep`, `merge`, `budget`, `bench`, `ranges`) |
+//! | [`cli`] | the headless command line (`shoal water`, `atmosphere`, `simulate`, `study`, `report`, `reproduce`, `sweep`, `merge`, `budget`, `bench`, `ranges`) |
 
 #[cfg(feature = "gui")]
 pub mod app;

@@ -18,7 +18,14 @@ impl ShoalApp {
                 self.export_to(export::What::Figure, path.clone());
             }
             if ui.button("Write data").on_hover_text("A folder NAME with one sub-folder per instrument").clicked() {
-                self.export_to(export::What::Data, path);
+                self.export_to(export::What::Data, path.clone());
+            }
+            if ui
+                .button("Write review pack")
+                .on_hover_text("A folder NAME with index.html (self-contained, opens in any browser) and its figures")
+                .clicked()
+            {
+                self.export_to(export::What::ReviewPack, path);
             }
         });
     }

@@ -189,6 +189,28 @@ fn verdict_table(state: &AppState, a: &RunOutput, b: &RunOutput) -> Vec<Vec<Stri
     table
 }
 
+/// Write the review pack of A and B into the folder `dir` (index.html, figures, review.json):
+/// the same page `shoal report` writes, with the app's requirements.
+pub fn write_review_pack(snap: &Snapshot, dir: &Path) -> Result<PathBuf, String> {
+    let (Some(a), Some(b)) = (&snap.runs[0], &snap.runs[1]) else { return Err("no results to export yet".into()) };
+    let state = &snap.state;
+    let runs = [
+        (format!("{} (A)", a.config.instrument.name), a.as_ref()),
+        (format!("{} (B)", b.config.instrument.name), b.as_ref()),
+    ];
+    let changes = state.changes();
+    let description = format!(
+        "A against B as set in the app{}{}",
+        if snap.decimation > 1 { format!(", preview at 1/{} resolution", snap.decimation) } else { String::new() },
+        if changes.is_empty() { String::new() } else { format!("; changed from the presets: {}", changes.join("; ")) }
+    );
+    let result =
+        crate::study::StudyResult::of_runs(&state.study_name, &description, &runs, Some(state.requirements.clone()))
+            .ok_or("no results to export yet")?;
+    let figures = crate::study::figure_set(&result).map_err(|e| e.to_string())?;
+    crate::report::write_pack(&crate::report::review_data(&result, &[], &[]), &figures, dir).map_err(|e| e.to_string())
+}
+
 /// Files an export to `path` would replace (empty: nothing of the user's is overwritten).
 #[must_use]
 pub fn existing(what: What, snap: &Snapshot, path: &Path) -> Vec<PathBuf> {
@@ -199,6 +221,7 @@ pub fn existing(what: What, snap: &Snapshot, path: &Path) -> Vec<PathBuf> {
             v.extend(["A", "B"].map(|n| PathBuf::from(format!("{}_config_{n}.ron", stem.display()))));
             v
         }
+        What::ReviewPack => vec![path.join("index.html")],
         What::Data => ["A", "B"]
             .iter()
             .zip(&snap.runs)
@@ -226,6 +249,20 @@ pub enum What {
     Figure,
     /// Cubes and metrics.
     Data,
+    /// The review pack (a folder with index.html).
+    ReviewPack,
+}
+
+impl What {
+    /// What it is, in messages.
+    #[must_use]
+    pub fn noun(self) -> &'static str {
+        match self {
+            Self::Figure => "figure",
+            Self::Data => "data",
+            Self::ReviewPack => "review pack",
+        }
+    }
 }
 
 /// News from an export thread.
@@ -349,6 +386,10 @@ fn run(order: Order) -> News {
                     .set_title("Export cubes and metrics to a folder")
                     .set_directory(&dir)
                     .pick_folder(),
+                What::ReviewPack => rfd::FileDialog::new()
+                    .set_title("Export the review pack to a folder (index.html and its figures)")
+                    .set_directory(&dir)
+                    .pick_folder(),
             };
             match choice {
                 Some(p) => p,
@@ -374,6 +415,10 @@ fn write(what: What, snap: &Snapshot, path: &Path) -> News {
         }
         What::Data => match write_data(snap, path) {
             Ok(n) => News::Written(format!("wrote {n} files under {}", path.display())),
+            Err(e) => News::Failed(format!("Export failed: {e}")),
+        },
+        What::ReviewPack => match write_review_pack(snap, path) {
+            Ok(index) => News::Written(format!("wrote the review pack: {}", index.display())),
             Err(e) => News::Failed(format!("Export failed: {e}")),
         },
     }

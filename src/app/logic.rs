@@ -192,7 +192,7 @@ impl ShoalApp {
                 super::export::News::Written(m) => self.ui.message = Some(m),
                 super::export::News::Failed(e) => self.ui.error = Some(e),
                 super::export::News::NoChoice(what) => {
-                    let what = if what == super::export::What::Figure { "figure" } else { "data" };
+                    let what = what.noun();
                     self.ui.message = Some(format!(
                         "No {what} exported: no file was chosen. If no dialog appeared, this desktop has no file-chooser portal; use Path to type one."
                     ));

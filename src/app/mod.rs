@@ -350,6 +350,19 @@ impl ShoalApp {
                     Path::new(self.ui.export_path.trim()),
                 );
             }
+            if ui
+                .button("Export review pack…")
+                .on_hover_text(
+                    "Choose a folder for the review pack: one self-contained index.html (verdict, figures, provenance) that opens in any browser",
+                )
+                .clicked()
+            {
+                self.ui.exports.with_dialog(
+                    export::What::ReviewPack,
+                    export::Snapshot::of(self),
+                    Path::new(self.ui.export_path.trim()),
+                );
+            }
             ui.separator();
             ui.toggle_value(&mut self.ui.explore.sweep_open, "Sweep")
                 .on_hover_text("A curve: one parameter of A and B over a range, with noise seeds");

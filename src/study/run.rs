@@ -58,9 +58,18 @@ pub fn run_study(
             other => StudyError::Run { instrument: label.clone(), message: other.to_string() },
         })?;
         on_run(i, &out)?;
-        runs.push(StudyRun {
-            label: label.clone(),
-            seed: *seed,
+        runs.push(StudyRun::of(label, *seed, &out));
+    }
+    Ok(StudyResult { study: study.clone(), runs })
+}
+
+impl StudyRun {
+    /// What a study keeps of a run (`label`: the instrument's name in the study).
+    #[must_use]
+    pub fn of(label: &str, seed: u64, out: &RunOutput) -> Self {
+        Self {
+            label: label.to_string(),
+            seed,
             report: out.report.clone(),
             snr: out.snr.clone(),
             retrievals: out.retrievals.clone(),
@@ -68,7 +77,41 @@ pub fn run_study(
             viewing: Arc::clone(&out.viewing),
             feasibility: Arc::clone(&out.feasibility),
             frame: out.scene.frame.clone(),
-        });
+        }
     }
-    Ok(StudyResult { study: study.clone(), runs })
+}
+
+impl StudyResult {
+    /// A study made of runs that already exist (the app's A and B): named `name`, over the first
+    /// run's scene and retrievals, judged against `requirements`. Each run is `(label, output)`;
+    /// `None` without runs.
+    #[must_use]
+    pub fn of_runs(
+        name: &str,
+        description: &str,
+        runs: &[(String, &RunOutput)],
+        requirements: Option<super::Requirements>,
+    ) -> Option<Self> {
+        use super::{Source, StudySpec};
+        let first = &runs.first()?.1.config;
+        let spec = StudySpec {
+            name: name.to_string(),
+            description: description.to_string(),
+            scene: Source::Inline(Box::new(first.scene.clone())),
+            instruments: runs.iter().map(|(_, o)| Source::Inline(Box::new(o.config.instrument.clone()))).collect(),
+            retrievals: first.retrievals.clone(),
+            seeds: vec![first.seed],
+            detector: None,
+            calibration: None,
+            correction: None,
+            fidelity: None,
+            requirements,
+        };
+        let resolved = ResolvedStudy {
+            spec,
+            runs: runs.iter().map(|(label, o)| (label.clone(), o.config.seed, o.config.clone())).collect(),
+        };
+        let runs = runs.iter().map(|(label, o)| StudyRun::of(label, o.config.seed, o)).collect();
+        Some(Self { study: resolved, runs })
+    }
 }

@@ -225,6 +225,38 @@ fn the_comparison_figure_exports_to_a_typed_path() {
 }
 
 #[test]
+fn the_review_pack_exports_from_the_app_to_a_typed_folder() {
+    let dir = temp_library("pack");
+    let mut h = harness("cubesat", 16, &dir);
+    wait_for_engine(&mut h);
+    h.get_by_label("Path").click();
+    h.step();
+    h.step();
+    let folder = dir.join("pack");
+    h.get_by_role_and_label(Role::TextInput, "Export to").set_text_value_accesskit(folder.to_str().unwrap());
+    h.step();
+    h.get_by_label("Write review pack").click();
+    let start = Instant::now();
+    let index = folder.join("index.html");
+    while !index.is_file() {
+        assert!(start.elapsed() < Duration::from_secs(120), "the review pack was not written");
+        assert_eq!(h.state().error(), None);
+        std::thread::sleep(Duration::from_millis(20));
+        h.step();
+    }
+    let html = std::fs::read_to_string(&index).unwrap();
+    // A and B as the app labels them, the app's requirements judged, figures inline.
+    for part in
+        ["cubesat (A)", "smallsat (B)", "Verdict against the requirements", "<svg role=\"img\"", "id=\"fig-snr\""]
+    {
+        assert!(html.contains(part), "the pack has no `{part}`");
+    }
+    assert!(!html.contains("http://") && !html.contains("<script"), "self-contained, no script");
+    assert!(folder.join("review.json").is_file());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn the_sweep_window_draws_a_curve_for_a_and_b() {
     let dir = temp_library("sweep");
     let mut h = harness("cubesat", 24, &dir);
