@@ -29,15 +29,50 @@ pub struct ReportArgs {
     /// this many interleaved rounds (3 is the bench's default).
     #[arg(long, value_name = "ROUNDS")]
     cost: Option<usize>,
+    /// A sweep's output directory (`shoal sweep --out DIR`) whose curves go into the pack;
+    /// repeat for several sweeps.
+    #[arg(long, value_name = "DIR")]
+    sweep: Vec<PathBuf>,
     /// Worker threads (default: all cores).
     #[arg(long)]
     threads: Option<usize>,
 }
 
+/// The curves (`sweep_*.svg`, and their PNGs) a sweep wrote into `dir`.
+fn sweep_figures(dir: &Path) -> Result<Vec<crate::study::Figure>, CliError> {
+    let entries = std::fs::read_dir(dir).map_err(|e| CliError::Input(format!("--sweep {}: {e}", dir.display())))?;
+    let mut svgs: Vec<PathBuf> = entries
+        .filter_map(Result::ok)
+        .map(|e| e.path())
+        .filter(|p| {
+            p.extension().is_some_and(|x| x == "svg")
+                && p.file_name().is_some_and(|n| n.to_string_lossy().starts_with("sweep_"))
+        })
+        .collect();
+    if svgs.is_empty() {
+        return Err(CliError::Input(format!(
+            "--sweep {}: no sweep curves (sweep_*.svg) there; run `shoal sweep … --out {}` without --no-figures",
+            dir.display(),
+            dir.display()
+        )));
+    }
+    svgs.sort();
+    let tag = dir.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+    svgs.into_iter()
+        .map(|p| {
+            let svg = std::fs::read_to_string(&p).map_err(|e| CliError::Run(format!("{}: {e}", p.display())))?;
+            let png = std::fs::read(p.with_extension("png")).unwrap_or_default();
+            let stem = p.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+            Ok(crate::study::Figure { name: format!("{stem}_{tag}"), png, svg })
+        })
+        .collect()
+}
+
 /// `shoal report`.
 pub fn run(args: &ReportArgs) -> Result<(), CliError> {
     let start = std::time::Instant::now();
-    let (data, figures) = match args.target.as_deref().map(Path::new).filter(|p| p.is_dir()) {
+    let sweeps = args.sweep.iter().map(|d| sweep_figures(d)).collect::<Result<Vec<_>, _>>()?;
+    let (data, mut figures) = match args.target.as_deref().map(Path::new).filter(|p| p.is_dir()) {
         Some(dir) => {
             if !is_results_dir(dir) {
                 return Err(CliError::Input(format!(
@@ -55,6 +90,7 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
         }
         None => run_for_report(args)?,
     };
+    figures.extend(sweeps.into_iter().flatten());
     let index = write_pack(&data, &figures, &args.out)?;
     eprintln!("review pack of {} in {:.1} s: {}", data.study, start.elapsed().as_secs_f64(), index.display());
     Ok(())

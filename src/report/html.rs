@@ -297,6 +297,7 @@ fn caption(name: &str) -> String {
         "difference" => format!("A − B ({what}): B sampled at the pixel nearest each of A's ground points; diverging scale symmetric about zero."),
         "scatter" => format!("Retrieved against true ({what}), pixel density on log axes; the line is 1:1."),
         "histogram" => format!("Distribution of retrieved values ({what}) by SIOP set or dominant substrate; the outline is the truth."),
+        "sweep" => "Trade-off curve from `shoal sweep`: the MAE against the swept parameter for each instrument, with the noise seeds' range and the requirement.".into(),
         _ => what,
     }
 }
@@ -344,8 +345,11 @@ fn figures_section(h: &mut String, figures: &[PageFigure]) {
         }
         h.push_str("</div>\n");
     }
-    for (i, f) in figures.iter().enumerate() {
-        if !shown[i] {
+    let rest: Vec<&PageFigure> = figures.iter().zip(&shown).filter(|(_, s)| !**s).map(|(f, _)| f).collect();
+    if !rest.is_empty() {
+        let sweeps = rest.iter().all(|f| f.name.starts_with("sweep_"));
+        h.push_str(if sweeps { "<h3>Trade-off curves</h3>\n" } else { "<h3>Other figures</h3>\n" });
+        for f in rest {
             put(h, f);
         }
     }

@@ -168,12 +168,29 @@ fn a_report_straight_from_a_study_carries_its_error_budget_and_bad_targets_are_r
     assert_eq!(external_references(&html), Vec::<String>::new());
     // A results directory `shoal study` wrote makes a page without rerunning (no budget: the
     // study did not run one).
+    // With a sweep's curves beside the study's figures.
     let again = dir.join("again");
     let from_dir = dir.join("results");
     ok(shoal().args(["study", "reef_survey_depth", "--decimation", "8", "--no-cubes", "--out"]).arg(&from_dir));
-    ok(shoal().arg("report").arg(&from_dir).arg("--out").arg(&again));
+    let sweep_file = dir.join("tiny_sweep.ron");
+    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/presets/sweeps/aperture_lake_hume.ron"))
+        .unwrap()
+        .replace("Range(from: 40, to: 300, steps: 8, log: true)", "List([50, 250])")
+        .replace("seeds: [1, 2, 3, 4, 5]", "seeds: [1]");
+    std::fs::write(&sweep_file, text).unwrap();
+    let sweep = dir.join("aperture");
+    ok(shoal().arg("sweep").arg(&sweep_file).args(["--decimation", "32", "--out"]).arg(&sweep));
+    ok(shoal().arg("report").arg(&from_dir).arg("--sweep").arg(&sweep).arg("--out").arg(&again));
     let page = std::fs::read_to_string(again.join("index.html")).unwrap();
     assert!(page.contains("id=\"fig-maps_sambuca_depth_m\"") && !page.contains("id=\"budget\""));
+    assert!(
+        page.contains("Trade-off curves") && page.contains("id=\"fig-sweep_chl_mg_m3_aperture\""),
+        "the sweep's curve"
+    );
+    let out =
+        shoal().arg("report").arg(&from_dir).arg("--sweep").arg(&from_dir).arg("--out").arg(&again).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no sweep curves"));
 
     let empty = tempdir("empty");
     let out = shoal().arg("report").arg(&empty).output().unwrap();
