@@ -29,6 +29,10 @@ const RASTER_PIXEL_IS_AREA: u16 = 1;
 pub(super) const RASTER_PIXEL_IS_POINT: u16 = 2;
 const LINEAR_METRE: u16 = 9001;
 
+/// The name of a user-defined CRS whose file gives no citation (two of them cannot be told
+/// apart, so a scene refuses to mix them).
+pub const USER_DEFINED_NAME: &str = "user-defined";
+
 /// What the key directory says.
 #[derive(Debug, Clone, PartialEq)]
 pub(super) struct Keys {
@@ -79,8 +83,10 @@ pub(super) fn parse(dir: &[u16], ascii: &str, doubles: &[f64]) -> Result<Keys, S
     keys.crs = match (model, projected, geographic) {
         (Some(MODEL_PROJECTED), Some(code), _) if code != USER_DEFINED => Crs::Projected { epsg: code },
         (Some(MODEL_GEOGRAPHIC), _, Some(code)) if code != USER_DEFINED => Crs::Geographic { epsg: code },
+        // A user-defined projection: a local frame, in metres only if its linear unit says so
+        // (`Crs::is_metric` checks `linear_unit_m`).
         (Some(MODEL_PROJECTED), _, _) | (Some(USER_DEFINED), _, _) => {
-            Crs::LocalMetres { name: if citation.is_empty() { "user-defined".into() } else { citation } }
+            Crs::LocalMetres { name: if citation.is_empty() { USER_DEFINED_NAME.into() } else { citation } }
         }
         _ => Crs::None,
     };
@@ -103,7 +109,7 @@ pub(super) fn build(crs: &Crs) -> (Vec<u16>, String) {
         Crs::LocalMetres { name } => {
             // A user-defined projected CRS in metres with no datum: GDAL reads it as a local
             // (engineering) CRS named by the citation.
-            ascii = format!("{}|", name.replace('|', "/"));
+            ascii = format!("{}|", super::write::ascii(&name.replace('|', "/")));
             keys.push([GT_MODEL_TYPE, 0, 1, MODEL_PROJECTED]);
             keys.push([GT_CITATION, GEO_ASCII_PARAMS, ascii.len() as u16, 0]);
             keys.push([PROJECTED_CS_TYPE, 0, 1, USER_DEFINED]);
@@ -156,18 +162,34 @@ fn xml_unescape(s: &str) -> String {
     out + rest
 }
 
-/// GDAL's metadata XML: band descriptions (`role="description"`), units (`role="unittype"`) and
-/// dataset items, as GDAL's GTiff driver writes them.
-pub(super) fn metadata_xml(descriptions: &[String], units: &[String], items: &[(String, String)]) -> String {
+/// Text for GDAL's XML: markup escaped, then anything beyond ASCII (an ASCII TIFF tag) as a
+/// character reference, which GDAL's XML parser and [`parse_metadata`] decode.
+fn xml_text(s: &str) -> String {
+    super::write::ascii(&xml_escape(s))
+}
+
+/// GDAL's metadata XML: band descriptions (`role="description"`), units (`role="unittype"`),
+/// scale and offset when not 1 and 0 (`role="scale"`, `role="offset"`) and dataset items, as
+/// GDAL's GTiff driver writes them.
+pub(super) fn metadata_xml(
+    descriptions: &[String],
+    units: &[String],
+    scales: &[(f64, f64)],
+    items: &[(String, String)],
+) -> String {
     let mut s = String::from("<GDALMetadata>\n");
     for (k, v) in items {
-        s += &format!("  <Item name=\"{}\">{}</Item>\n", xml_escape(k), xml_escape(v));
+        s += &format!("  <Item name=\"{}\">{}</Item>\n", xml_text(k), xml_text(v));
     }
     for (band, d) in descriptions.iter().enumerate().filter(|(_, d)| !d.is_empty()) {
-        s += &format!("  <Item name=\"DESCRIPTION\" sample=\"{band}\" role=\"description\">{}</Item>\n", xml_escape(d));
+        s += &format!("  <Item name=\"DESCRIPTION\" sample=\"{band}\" role=\"description\">{}</Item>\n", xml_text(d));
     }
     for (band, u) in units.iter().enumerate().filter(|(_, u)| !u.is_empty()) {
-        s += &format!("  <Item name=\"UNITTYPE\" sample=\"{band}\" role=\"unittype\">{}</Item>\n", xml_escape(u));
+        s += &format!("  <Item name=\"UNITTYPE\" sample=\"{band}\" role=\"unittype\">{}</Item>\n", xml_text(u));
+    }
+    for (band, (scale, offset)) in scales.iter().enumerate().filter(|(_, so)| **so != (1.0, 0.0)) {
+        s += &format!("  <Item name=\"SCALE\" sample=\"{band}\" role=\"scale\">{scale}</Item>\n");
+        s += &format!("  <Item name=\"OFFSET\" sample=\"{band}\" role=\"offset\">{offset}</Item>\n");
     }
     s + "</GDALMetadata>"
 }
@@ -197,19 +219,43 @@ fn items(xml: &str) -> Vec<(Vec<(String, String)>, String)> {
     out
 }
 
-/// Read GDAL's metadata XML back: (descriptions, units, dataset items) for `bands` bands.
-pub(super) fn parse_metadata(xml: &str, bands: usize) -> (Vec<String>, Vec<String>, Vec<(String, String)>) {
-    let (mut descriptions, mut units, mut dataset) =
-        (vec![String::new(); bands], vec![String::new(); bands], Vec::new());
+/// GDAL's metadata of a file with `bands` bands, read back.
+pub(super) struct Metadata {
+    pub(super) descriptions: Vec<String>,
+    pub(super) units: Vec<String>,
+    /// Per band: (scale, offset) of GDAL's unpacking, value = scale · stored + offset.
+    pub(super) scales: Vec<(f64, f64)>,
+    pub(super) items: Vec<(String, String)>,
+}
+
+/// Read GDAL's metadata XML back; a scale or offset that is not a number is an error (guessing
+/// would mis-scale every value).
+pub(super) fn parse_metadata(xml: &str, bands: usize) -> Result<Metadata, String> {
+    let mut m = Metadata {
+        descriptions: vec![String::new(); bands],
+        units: vec![String::new(); bands],
+        scales: vec![(1.0, 0.0); bands],
+        items: Vec::new(),
+    };
     for (attributes, value) in items(xml) {
         let get = |k: &str| attributes.iter().find(|(n, _)| n == k).map(|(_, v)| v.as_str());
         let sample = get("sample").and_then(|s| s.parse::<usize>().ok());
+        let number = |what: &str| {
+            value
+                .trim()
+                .parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| format!("GDAL band {what} `{value}` is not a number"))
+        };
         match (get("role"), sample) {
-            (Some("description"), Some(b)) if b < bands => descriptions[b] = value,
-            (Some("unittype"), Some(b)) if b < bands => units[b] = value,
-            (None, None) => dataset.push((get("name").unwrap_or("").to_string(), value)),
+            (Some("description"), Some(b)) if b < bands => m.descriptions[b] = value,
+            (Some("unittype"), Some(b)) if b < bands => m.units[b] = value,
+            (Some("scale"), Some(b)) if b < bands => m.scales[b].0 = number("scale")?,
+            (Some("offset"), Some(b)) if b < bands => m.scales[b].1 = number("offset")?,
+            (None, None) => m.items.push((get("name").unwrap_or("").to_string(), value)),
             _ => {}
         }
     }
-    (descriptions, units, dataset)
+    Ok(m)
 }

@@ -15,6 +15,7 @@ mod keys;
 mod read;
 mod write;
 
+pub use keys::USER_DEFINED_NAME;
 pub use read::{read, read_bytes};
 pub use write::{ascii as ascii_text, encode};
 
@@ -31,8 +32,8 @@ pub enum Crs {
         /// EPSG code, e.g. 4326.
         epsg: u16,
     },
-    /// A local engineering frame in metres (no place on Earth): Shoal's scene frame when the
-    /// scene has no georeference.
+    /// A local engineering frame (a user-defined projection; no place on Earth): Shoal's scene
+    /// frame when the scene has no georeference. Metres when the file's linear unit is.
     LocalMetres {
         /// What the frame is (written as the citation).
         name: String,
@@ -46,8 +47,7 @@ impl Crs {
     #[must_use]
     pub fn is_metric(&self, linear_unit_m: f64) -> bool {
         match self {
-            Self::Projected { .. } => (linear_unit_m - 1.0).abs() < 1e-12,
-            Self::LocalMetres { .. } => true,
+            Self::Projected { .. } | Self::LocalMetres { .. } => (linear_unit_m - 1.0).abs() < 1e-12,
             Self::Geographic { .. } | Self::None => false,
         }
     }
@@ -82,8 +82,11 @@ pub struct Raster {
     pub linear_unit_m: f64,
     /// Per band: a description (what the band holds).
     pub descriptions: Vec<String>,
-    /// Per band: the unit of its values.
+    /// Per band: the unit of its values (after `scales`).
     pub units: Vec<String>,
+    /// Per band: GDAL's (scale, offset) unpacking, value = scale · stored + offset; (1, 0) for
+    /// most files. `bands` hold the stored values; `nodata` is a stored value.
+    pub scales: Vec<(f64, f64)>,
     /// Dataset metadata items (name, value), written to and read from `GDAL_METADATA`.
     pub metadata: Vec<(String, String)>,
 }
@@ -103,14 +106,17 @@ impl Raster {
             linear_unit_m: 1.0,
             descriptions: vec![String::new(); n],
             units: vec![String::new(); n],
+            scales: vec![(1.0, 0.0); n],
             metadata: Vec::new(),
         }
     }
 
-    /// Is `v` missing (NaN, or equal to the nodata value)?
+    /// Is stored value `v` missing (NaN, or the nodata value)? The nodata text of a Float32 file
+    /// may not be exactly representable (`0.10000000000000001`): it matches at Float32
+    /// precision too.
     #[must_use]
     pub fn is_nodata(&self, v: f64) -> bool {
-        v.is_nan() || self.nodata.is_some_and(|n| v == n)
+        v.is_nan() || self.nodata.is_some_and(|n| v == n || (v as f32) == (n as f32))
     }
 
     /// The (X, Y) in CRS units of fractional pixel position (col, row) (corner convention:
@@ -201,6 +207,25 @@ mod tests {
         let (x, y) = back.world(2.5, 3.5).unwrap();
         let (col, row) = back.pixel(x, y).unwrap();
         assert!((col - 2.5).abs() < 1e-9 && (row - 3.5).abs() < 1e-9);
+    }
+
+    #[test]
+    fn non_ascii_text_and_band_scales_survive() {
+        let mut r = sample();
+        r.descriptions[0] = "chl-a über Seegras, µg L⁻¹ & <x>".into();
+        r.metadata = vec![("SCENE".into(), "Île d'Été".into())];
+        r.scales = vec![(0.01, -5.0), (1.0, 0.0), (2.0, 0.0)];
+        let back = read_bytes(&encode(&r).unwrap(), "text").unwrap();
+        // Superscripts and µ become ASCII unit text; everything else comes back as written.
+        assert_eq!(back.descriptions[0], "chl-a über Seegras, ug L-1 & <x>");
+        assert_eq!(back.item("SCENE"), Some("Île d'Été"));
+        assert_eq!(back.scales, r.scales);
+    }
+
+    #[test]
+    fn a_user_defined_crs_in_feet_is_not_metric() {
+        assert!(!Crs::LocalMetres { name: "site grid".into() }.is_metric(0.3048));
+        assert!(Crs::LocalMetres { name: "site grid".into() }.is_metric(1.0));
     }
 
     #[test]

@@ -69,6 +69,13 @@ fn decode(bytes: &[u8], origin: &str) -> Result<Raster, GeoTiffError> {
     // Chunk by chunk (strips or tiles, per plane when planar): the crate's whole-image read
     // asserts on some tiled multi-band layouts GDAL writes, and one chunk at a time keeps the
     // buffers small.
+    // A header can claim any size: refuse what would not fit in memory before allocating.
+    const MAX_SAMPLES: usize = 1 << 29;
+    if w.saturating_mul(h).saturating_mul(n) > MAX_SAMPLES {
+        return Err(GeoTiffError(format!(
+            "{origin}: {w} × {h} × {n} samples is more than Shoal reads at once ({MAX_SAMPLES}); crop or coarsen it first (gdal_translate -srcwin, gdalwarp -tr)"
+        )));
+    }
     let spp = if planar { 1 } else { n };
     let mut bands = vec![vec![f64::NAN; w * h]; n];
     let (cw, ch) = d.chunk_dimensions();
@@ -128,9 +135,14 @@ fn decode(bytes: &[u8], origin: &str) -> Result<Raster, GeoTiffError> {
             Some(s.parse::<f64>().map_err(|_| GeoTiffError(format!("{origin}: GDAL_NODATA `{s}` is not a number")))?)
         }
     };
-    let (descriptions, units, items) = match &metadata {
-        Some(xml) => keys::parse_metadata(xml, n),
-        None => (vec![String::new(); n], vec![String::new(); n], Vec::new()),
+    let meta = match &metadata {
+        Some(xml) => keys::parse_metadata(xml, n).map_err(|e| GeoTiffError(format!("{origin}: {e}")))?,
+        None => keys::Metadata {
+            descriptions: vec![String::new(); n],
+            units: vec![String::new(); n],
+            scales: vec![(1.0, 0.0); n],
+            items: Vec::new(),
+        },
     };
     Ok(Raster {
         width: w,
@@ -140,8 +152,9 @@ fn decode(bytes: &[u8], origin: &str) -> Result<Raster, GeoTiffError> {
         geotransform,
         crs: keys.crs,
         linear_unit_m: keys.linear_unit_m,
-        descriptions,
-        units,
-        metadata: items,
+        descriptions: meta.descriptions,
+        units: meta.units,
+        scales: meta.scales,
+        metadata: meta.items,
     })
 }

@@ -104,14 +104,10 @@ pub fn encode(raster: &Raster) -> Result<Vec<u8>, GeoTiffError> {
         let (key_dir, text) = keys::build(&raster.crs);
         put(&mut dir, tag(GEO_KEY_DIRECTORY), &key_dir[..])?;
         if !text.is_empty() {
-            put(&mut dir, tag(GEO_ASCII_PARAMS), ascii(&text).as_str())?;
+            put(&mut dir, tag(GEO_ASCII_PARAMS), text.as_str())?;
         }
     }
-    let xml = keys::metadata_xml(
-        &raster.descriptions.iter().map(|d| ascii(d)).collect::<Vec<_>>(),
-        &raster.units.iter().map(|u| ascii(u)).collect::<Vec<_>>(),
-        &raster.metadata.iter().map(|(k, v)| (ascii(k), ascii(v))).collect::<Vec<_>>(),
-    );
+    let xml = keys::metadata_xml(&raster.descriptions, &raster.units, &raster.scales, &raster.metadata);
     put(&mut dir, tag(GDAL_METADATA), xml.as_str())?;
     if let Some(v) = raster.nodata {
         put(&mut dir, tag(GDAL_NODATA), format!("{v}").as_str())?;

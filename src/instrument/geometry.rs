@@ -250,12 +250,40 @@ impl Viewing {
         let proj = |p: (f64, f64), u: (f64, f64)| p.0 * u.0 + p.1 * u.1;
         let a = |r: usize| proj(self.ground_m(0, r, cols / 2), along);
         let c = |col: usize| proj(self.ground_m(0, rows / 2, col), right);
-        let (a0, a1, c0, c1) = (a(0), a(rows - 1), c(0), c(cols - 1));
         let (pa, pc) = (proj((x, y), along), proj((x, y), right));
+        // Lines are evenly spaced along track; across track the spacing grows off nadir, so
+        // the column is found by bisection on the columns' (monotonic) positions.
+        let (a0, a1) = (a(0), a(rows - 1));
         let fr = if rows > 1 { (pa - a0) / (a1 - a0) * (rows - 1) as f64 } else { 0.0 };
-        let fc = if cols > 1 { (pc - c0) / (c1 - c0) * (cols - 1) as f64 } else { 0.0 };
-        let (r, col) = (fr.round(), fc.round());
-        (r >= 0.0 && col >= 0.0 && r < rows as f64 && col < cols as f64).then_some((r as usize, col as usize))
+        let r = fr.round();
+        let col = if cols == 1 {
+            0
+        } else {
+            let increasing = c(cols - 1) > c(0);
+            let before = |k: usize| if increasing { c(k) < pc } else { c(k) > pc };
+            // First column at or past pc, then the nearer of it and its neighbour.
+            let (mut lo, mut hi) = (0usize, cols);
+            while lo < hi {
+                let mid = (lo + hi) / 2;
+                if before(mid) { lo = mid + 1 } else { hi = mid }
+            }
+            match lo {
+                0 => 0,
+                k if k == cols => cols - 1,
+                k => {
+                    if (c(k) - pc).abs() < (c(k - 1) - pc).abs() {
+                        k
+                    } else {
+                        k - 1
+                    }
+                }
+            }
+        };
+        // Off the image: more than half a pixel beyond the outer columns or lines.
+        let half = |k0: usize, k1: usize| 0.5 * (c(k1) - c(k0)).abs();
+        let off_across = (col == 0 && (pc - c(0)).abs() > half(0, 1.min(cols - 1)).max(1e-9) && cols > 1)
+            || (col == cols - 1 && cols > 1 && (pc - c(cols - 1)).abs() > half(cols - 2, cols - 1));
+        (r >= 0.0 && r < rows as f64 && !off_across).then_some((r as usize, col))
     }
 
     /// The flight's heading, degrees clockwise from north, read from the ground track (0 for a
@@ -286,9 +314,13 @@ mod tests {
 
     #[test]
     fn the_nearest_pixel_of_a_pixels_ground_point_is_itself_at_any_heading() {
-        for heading in [0.0, 37.0, 180.0, 290.0] {
+        // The nominal instrument (±1° across track) and a wide one (±8°: 20 mm focal length),
+        // whose across-track spacing is far from even.
+        for (heading, focal_length_mm) in [(0.0, 165.0), (37.0, 165.0), (180.0, 20.0), (290.0, 20.0)] {
             let mut spec = nominal();
             spec.heading_deg = heading;
+            spec.focal_length_mm = focal_length_mm;
+            spec.aperture_mm = spec.aperture_mm.min(focal_length_mm);
             let r = Response::new(&spec, 1.0).unwrap();
             let v = Viewing::new(&spec, &r, 0.5, 0.0, 4, None).unwrap();
             assert!((v.track_heading_deg().rem_euclid(360.0) - heading).abs() < 1e-6, "{heading}");
@@ -298,6 +330,12 @@ mod tests {
             }
             let far = v.ground_m(0, 0, 0);
             assert_eq!(v.nearest_pixel(far.0 * 3.0 + 1e5, far.1 * 3.0 + 1e5, heading), None);
+            // Every column of the middle line, where the across-track spacing varies most.
+            let mid = v.lines() / 2;
+            for col in 0..v.columns() {
+                let (x, y) = v.ground_m(0, mid, col);
+                assert_eq!(v.nearest_pixel(x, y, heading), Some((mid, col)), "heading {heading}");
+            }
         }
     }
 

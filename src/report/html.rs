@@ -24,6 +24,20 @@ pub fn escape(s: &str) -> String {
     s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
 }
 
+/// A file name as a URL path segment: unreserved characters kept, the rest percent-encoded
+/// (RFC 3986), so a name with `#`, `?`, `%` or spaces still links to its file.
+fn url_path(name: &str) -> String {
+    name.bytes()
+        .map(|b| {
+            if b.is_ascii_alphanumeric() || b"-._~".contains(&b) {
+                (b as char).to_string()
+            } else {
+                format!("%{b:02X}")
+            }
+        })
+        .collect()
+}
+
 /// Base64 (RFC 4648) for data URIs.
 fn base64(bytes: &[u8]) -> String {
     const T: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
@@ -126,12 +140,24 @@ fn header(h: &mut String, d: &ReviewData) {
 fn verdict(h: &mut String, d: &ReviewData) {
     h.push_str("<section id=\"verdict\">\n<h2>Verdict against the requirements</h2>\n");
     if d.checks.is_empty() {
-        h.push_str("<p>The study states no requirements, so nothing is judged. Add <code>requirements</code> to the study file to get a verdict with margins.</p>\n</section>\n");
+        h.push_str(if d.has_requirements {
+            "<p>The study's requirements apply to nothing these runs produced (a variable no retrieval returns, no SNR floor), so nothing is judged.</p>\n</section>\n"
+        } else {
+            "<p>The study states no requirements, so nothing is judged. Add <code>requirements</code> to the study file to get a verdict with margins.</p>\n</section>\n"
+        });
         return;
     }
     h.push_str("<div class=\"summary\">\n");
     for inst in &d.instruments {
         let mine: Vec<_> = d.checks.iter().filter(|c| c.instrument == inst.label).collect();
+        if mine.is_empty() {
+            let _ = writeln!(
+                h,
+                "<div class=\"card\">{}<br><b>NOTHING JUDGED</b> — no check applies</div>",
+                escape(&inst.label)
+            );
+            continue;
+        }
         let passed = mine.iter().filter(|c| c.pass).count();
         let all = passed == mine.len();
         let _ = writeln!(
@@ -143,7 +169,15 @@ fn verdict(h: &mut String, d: &ReviewData) {
             mine.len()
         );
     }
-    h.push_str("</div>\n<p class=\"note\">Margin: how far inside the limit (negative: outside), in the value's unit. A product with no pixel returned has no value and fails.</p>\n");
+    let judged = if d.judged_retrieval.is_empty() {
+        String::new()
+    } else {
+        format!(" Product requirements judge the study's first retrieval, {}.", escape(&d.judged_retrieval))
+    };
+    let _ = writeln!(
+        h,
+        "</div>\n<p class=\"note\">Margin: how far inside the limit (negative: outside), in the value's unit. A product with no pixel returned has no value and fails.{judged}</p>"
+    );
     // One row per requirement (and seed), the instruments side by side.
     let labels: Vec<&str> = d.instruments.iter().map(|i| i.label.as_str()).collect();
     let mut keys: Vec<(u64, &str, f64)> = Vec::new();
@@ -292,7 +326,7 @@ fn caption(name: &str) -> String {
     let (kind, rest) = name.split_once('_').unwrap_or((name, ""));
     let what = describe_key(rest);
     match kind {
-        "snr" => "SNR per band at the scene's median water radiance: analytic (line) and measured in the noisy cube (open circles); the dashed line is the requirement.".into(),
+        "snr" => "SNR per band at the scene's median water radiance: analytic (line) and measured in the noisy cube (open circles); a dashed line, when drawn, is the study's SNR requirement.".into(),
         "maps" => format!("Truth and each instrument's retrieval ({what}) on one colour scale; grey: land or not returned; scale bars give the ground distance."),
         "difference" => format!("A − B ({what}): B sampled at the pixel nearest each of A's ground points; diverging scale symmetric about zero."),
         "scatter" => format!("Retrieved against true ({what}), pixel density on log axes; the line is 1:1."),
@@ -309,7 +343,11 @@ fn figures_section(h: &mut String, figures: &[PageFigure]) {
     }
     let mut shown = vec![false; figures.len()];
     let put = |h: &mut String, f: &PageFigure| {
-        let link = if f.png { format!(" <a href=\"figures/{}.png\">PNG</a>", escape(&f.name)) } else { String::new() };
+        let link = if f.png {
+            format!(" <a href=\"figures/{}.png\">PNG</a>", escape(&url_path(&f.name)))
+        } else {
+            String::new()
+        };
         let _ = write!(
             h,
             "<figure id=\"fig-{}\">\n{}\n<figcaption>{}{link}</figcaption>\n</figure>\n",
@@ -476,5 +514,6 @@ mod tests {
         assert_eq!(svg, "<svg role=\"img\" width=\"10\"><rect/></svg>");
         assert_eq!(base64(b"foobar"), "Zm9vYmFy");
         assert_eq!(base64(b"fo"), "Zm8=");
+        assert_eq!(url_path("sweep_chl #2?"), "sweep_chl%20%232%3F");
     }
 }

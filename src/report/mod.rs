@@ -159,8 +159,14 @@ pub struct ReviewData {
     pub parameters: Vec<ParameterRow>,
     /// Derived figures side by side.
     pub derived: Vec<Derived>,
-    /// Requirement checks (empty: the study has none).
+    /// Requirement checks (empty: the study has none, or none applies).
     pub checks: Vec<CheckRow>,
+    /// Does the study state requirements (even if none applies to what ran)?
+    #[serde(default)]
+    pub has_requirements: bool,
+    /// The retrieval the product requirements judge (the study's first).
+    #[serde(default)]
+    pub judged_retrieval: String,
     /// Metrics with their spread over seeds.
     pub metrics: Vec<MetricRow>,
     /// The error budget, when run.
@@ -210,7 +216,13 @@ fn flatten(prefix: &str, v: &serde_json::Value, out: &mut Vec<(String, String)>)
             }
         }
         Value::Array(items) if items.iter().any(|i| i.is_object() || i.is_array()) || items.len() > 6 => {
-            out.push((prefix.to_string(), format!("{} entries", items.len())));
+            // The digest makes two lists of the same length but other contents differ here too
+            // (their entries are listed only up to 40).
+            let digest = v
+                .to_string()
+                .bytes()
+                .fold(0xcbf2_9ce4_8422_2325u64, |h, b| (h ^ u64::from(b)).wrapping_mul(0x100_0000_01b3));
+            out.push((prefix.to_string(), format!("{} entries (digest {:08x})", items.len(), digest >> 32)));
             if items.len() <= 40 {
                 for (i, item) in items.iter().enumerate() {
                     flatten(&format!("{prefix}[{i}]"), item, out);
@@ -418,6 +430,11 @@ pub fn review_data(result: &StudyResult, budget: &[Budget], cost: &[CostRow]) ->
             .as_ref()
             .map(|r| r.check(result).iter().map(CheckRow::from).collect())
             .unwrap_or_default(),
+        has_requirements: study.spec.requirements.is_some(),
+        judged_retrieval: runs
+            .first()
+            .and_then(|r| r.retrievals.first())
+            .map_or_else(String::new, |r| r.metrics.product.clone()),
         metrics: metric_rows(result),
         budget: budget_rows(budget),
         cost: cost_rows(cost),

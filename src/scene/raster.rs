@@ -106,13 +106,16 @@ pub fn field_unit(field: &str) -> &'static str {
 /// Units compared the way people write them: `mg m⁻³`, `mg m-3`, `mg/m3`, `mg.m-3` agree.
 fn same_unit(a: &str, b: &str) -> bool {
     let norm = |s: &str| {
-        let s = crate::geotiff::ascii_text(s).to_lowercase().replace(['.', '*', '·'], " ");
-        let s = s.replace("/m3", " m-3").replace("/m", " m-1").replace("^", "");
+        let s = crate::geotiff::ascii_text(s).to_lowercase().replace(['.', '*', '·', '^'], " ");
+        let s = s.split_whitespace().collect::<Vec<_>>().join("");
+        // `1/m` and `/m` are per metre; `/m 3` (from `/m^3`) per cubic metre.
+        let s = s.strip_prefix("1/").map_or_else(|| s.clone(), |rest| format!("/{rest}"));
+        let s = s.replace("/m3", " m-3").replace("/m", " m-1").replace("m-", " m-");
         let s = s.split_whitespace().collect::<Vec<_>>().join(" ");
         match s.as_str() {
             "" | "fraction" | "-" | "unitless" | "dimensionless" => "1".to_string(),
-            "ug l-1" | "ug/l" => "mg m-3".into(),
-            "mg l-1" | "mg/l" => "g m-3".into(),
+            "ugl-1" | "ug/l" => "mg m-3".into(),
+            "mgl-1" | "mg/l" => "g m-3".into(),
             "metre" | "meter" | "metres" | "meters" => "m".into(),
             _ => s,
         }
@@ -246,15 +249,29 @@ pub fn resample(
         source.resampling.unwrap_or(if field == "land.mask" { Resampling::Nearest } else { Resampling::Bilinear })
             == Resampling::Nearest;
     let band = &r.bands[source.band - 1];
-    let missing = |v: f64| v.is_nan() || source.nodata.or(r.nodata).is_some_and(|n| v == n);
+    // Nodata is a stored value, compared at Float32 precision too (see `Raster::is_nodata`);
+    // GDAL's own band scale and offset unpack the stored value before the map's.
+    let nodata = source.nodata.or(r.nodata);
+    let missing = |v: f64| v.is_nan() || nodata.is_some_and(|n| v == n || (v as f32) == (n as f32));
+    let (file_scale, file_offset) = r.scales.get(source.band - 1).copied().unwrap_or((1.0, 0.0));
     let value = |col: usize, row: usize| {
         let v = band[row * r.width + col];
-        if missing(v) { None } else { Some(source.scale * v + source.offset) }
+        if missing(v) { None } else { Some(source.scale * (file_scale * v + file_offset) + source.offset) }
     };
     // Where each scene cell centre falls in the raster, as fractional (col, row) of cell centres.
     let (hx, hy) = extent.half_size_m();
     let locate: Locate = match (frame, r.geotransform) {
         (Some(f), Some(_)) => {
+            let anonymous =
+                |c: &Crs| matches!(c, Crs::LocalMetres { name } if name == crate::geotiff::USER_DEFINED_NAME);
+            if anonymous(&r.crs) || anonymous(&f.crs) {
+                return Err(invalid(
+                    field,
+                    format!(
+                        "{name} or the scene is in a user-defined CRS with no name, which cannot be matched to the other; give both an EPSG code (`gdal_edit.py -a_srs EPSG:…`)"
+                    ),
+                ));
+            }
             if r.crs != f.crs && r.crs != Crs::None {
                 return Err(invalid(
                     field,
@@ -362,4 +379,32 @@ pub fn fill_nodata(
         values[i] = median;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn units_agree_however_they_are_written() {
+        for (a, b) in [
+            ("mg m⁻³", "mg m-3"),
+            ("mg/m3", "mg m-3"),
+            ("mg m^-3", "mg m-3"),
+            ("µg/L", "mg m-3"),
+            ("ug L-1", "mg m-3"),
+            ("g/m^3", "g m-3"),
+            ("mg/L", "g m-3"),
+            ("1/m", "m-1"),
+            ("m^-1", "m-1"),
+            ("metres", "m"),
+            ("", "1"),
+            ("fraction", "1"),
+        ] {
+            assert!(same_unit(a, b), "`{a}` should be `{b}`");
+        }
+        for (a, b) in [("ft", "m"), ("cm", "m"), ("g m-3", "mg m-3"), ("m-1", "m"), ("%", "1")] {
+            assert!(!same_unit(a, b), "`{a}` is not `{b}`");
+        }
+    }
 }

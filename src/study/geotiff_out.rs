@@ -44,9 +44,13 @@ pub fn swath_geotransform(viewing: &Viewing, centre: (f64, f64)) -> ([f64; 6], f
         }
     }
     let var = |k: usize| (k * k - 1) as f64 / 12.0 * n; // Σ (i − ī)² over the grid
-    let (vc, vr) = (var(cols).max(f64::MIN_POSITIVE), var(rows).max(f64::MIN_POSITIVE));
-    let (a_x, a_y) = (sxc / vc, syc / vc);
-    let (b_x, b_y) = (sxr / vr, syr / vr);
+    // A single line or column has no spacing to fit along it: there the pixel is one GSD (times
+    // the decimation) across or along the track.
+    let spacing = viewing.gsd_m * viewing.decimation as f64;
+    let h = viewing.track_heading_deg().to_radians();
+    let (a_x, a_y) =
+        if cols > 1 { (sxc / var(cols), syc / var(cols)) } else { (spacing * h.cos(), -spacing * h.sin()) };
+    let (b_x, b_y) = if rows > 1 { (sxr / var(rows), syr / var(rows)) } else { (spacing * h.sin(), spacing * h.cos()) };
     let (x_mean, y_mean) = (sx / n, sy / n);
     // Pixel (c, r)'s centre is at corner coordinates (c + 0.5, r + 0.5).
     let x0 = x_mean - a_x * (c_mean + 0.5) - b_x * (r_mean + 0.5);

@@ -413,6 +413,31 @@ fn the_reader_reads_what_gdal_writes() {
         let (x, y) = scene_xy(col, row);
         assert!((a.value_at(x, y) - b.value_at(x, y)).abs() <= 0.5e-3 + 1e-7);
     }
+    // The same counts with GDAL's own band scale (`-a_scale`): the file unpacks itself, so the
+    // scene states no scale and gets fractions, not counts 1000 times too large.
+    let packed = dir.join("u16_packed.tif");
+    run_gdal(
+        "gdal_translate",
+        ["-q", "-a_scale", "0.001", "-a_offset", "0", u16_file.to_str().unwrap(), packed.to_str().unwrap()]
+            .map(String::from),
+    );
+    assert_eq!(read(&packed).unwrap().scales[1], (0.001, 0.0));
+    let scene = build_edited(
+        "u16-packed",
+        |t| {
+            t.replace(
+                r#"Raster(path: "rasters/reef_survey_habitat.tif", band: 2, unit: "1")"#,
+                &format!(r#"Raster(path: "{}", band: 2, unit: "1")"#, packed.display()),
+            )
+        },
+        |_| {},
+    )
+    .unwrap();
+    let a = sand(&scene);
+    for (col, row) in [(150, 100), (40, 30), (250, 170)] {
+        let (x, y) = scene_xy(col, row);
+        assert!((a.value_at(x, y) - b.value_at(x, y)).abs() <= 0.5e-3 + 1e-7, "{}", a.value_at(x, y));
+    }
 }
 
 /// `gdalinfo -json -stats` of `path`, parsed.
