@@ -6,6 +6,7 @@
 use std::fmt::Write as _;
 
 use super::ReviewData;
+use crate::study::base64;
 
 /// A figure for the page: its file stem and SVG text (and whether a PNG sits beside the page).
 #[derive(Debug, Clone, PartialEq)]
@@ -36,24 +37,6 @@ fn url_path(name: &str) -> String {
             }
         })
         .collect()
-}
-
-/// Base64 (RFC 4648) for data URIs.
-fn base64(bytes: &[u8]) -> String {
-    const T: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    let mut s = String::with_capacity(bytes.len().div_ceil(3) * 4);
-    for c in bytes.chunks(3) {
-        let n =
-            (u32::from(c[0]) << 16) | (u32::from(*c.get(1).unwrap_or(&0)) << 8) | u32::from(*c.get(2).unwrap_or(&0));
-        for k in 0..4 {
-            if k <= c.len() {
-                s.push(T[(n >> (18 - 6 * k) & 63) as usize] as char);
-            } else {
-                s.push('=');
-            }
-        }
-    }
-    s
 }
 
 /// The SVG for inline use: no XML prolog, no namespace URI (HTML parses inline SVG without it),
@@ -512,8 +495,6 @@ mod tests {
         let svg =
             inline_svg("<?xml version=\"1.0\"?>\n<svg width=\"10\" xmlns=\"http://www.w3.org/2000/svg\"><rect/></svg>");
         assert_eq!(svg, "<svg role=\"img\" width=\"10\"><rect/></svg>");
-        assert_eq!(base64(b"foobar"), "Zm9vYmFy");
-        assert_eq!(base64(b"fo"), "Zm8=");
         assert_eq!(url_path("sweep_chl #2?"), "sweep_chl%20%232%3F");
     }
 }

@@ -32,7 +32,7 @@ pub use curves::{CurvePoint, CurveSeries, Curves, curve_figure, first_crossing};
 pub use figures::figure_set;
 pub use geotiff_out::{NODATA, swath_geotransform, write_run_geotiff};
 pub use output::{CubeFormat, Outputs, metrics_csv, write_bytes, write_run, write_run_as, write_study};
-pub use render::Figure;
+pub use render::{Figure, base64};
 pub use requirements::{Check, ProductRequirement, Requirements, checks_csv, verdict};
 pub use run::{StudyResult, StudyRun, run_study};
 pub use slide::{ComparisonPanel, ReviewSlide, SLIDE, SlideSeries, review_slide};

@@ -55,7 +55,10 @@ pub(super) fn err<E: std::fmt::Debug>(e: E) -> String {
     format!("{e:?}")
 }
 
-fn base64(bytes: &[u8]) -> String {
+/// Base64 (RFC 4648, with padding) for data URIs: the SVG figures' rasters and the review
+/// pack's downloads.
+#[must_use]
+pub fn base64(bytes: &[u8]) -> String {
     const T: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     let mut s = String::with_capacity(bytes.len().div_ceil(3) * 4);
     for chunk in bytes.chunks(3) {
