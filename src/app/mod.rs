@@ -328,41 +328,26 @@ impl ShoalApp {
                 self.ui.history.redo(&mut self.state);
             }
             ui.separator();
-            if ui
-                .button("Export figure…")
-                .on_hover_text("Choose where to write the comparison figure (PNG and SVG) and the configurations")
-                .clicked()
-            {
-                self.ui.exports.with_dialog(
-                    export::What::Figure,
-                    export::Snapshot::of(self),
-                    Path::new(self.ui.export_path.trim()),
-                );
-            }
-            if ui
-                .button("Export data…")
-                .on_hover_text("Choose a folder for the cubes and metrics of A and B, as `shoal study` writes them")
-                .clicked()
-            {
-                self.ui.exports.with_dialog(
-                    export::What::Data,
-                    export::Snapshot::of(self),
-                    Path::new(self.ui.export_path.trim()),
-                );
-            }
-            if ui
-                .button("Export review pack…")
-                .on_hover_text(
-                    "Choose a folder for the review pack: one self-contained index.html (verdict, figures, provenance) that opens in any browser",
-                )
-                .clicked()
-            {
-                self.ui.exports.with_dialog(
+            // One menu for the three exports keeps the top bar within 1280 px.
+            let exports = [
+                (export::What::Figure, "Figure…", "Choose where to write the comparison figure (PNG and SVG) and the configurations"),
+                (export::What::Data, "Data…", "Choose a folder for the cubes and metrics of A and B, as `shoal study` writes them"),
+                (
                     export::What::ReviewPack,
-                    export::Snapshot::of(self),
-                    Path::new(self.ui.export_path.trim()),
-                );
-            }
+                    "Review pack…",
+                    "Choose a folder for the review pack: one self-contained index.html (verdict, figures, provenance) that opens in any browser",
+                ),
+            ];
+            ui.menu_button("Export", |ui| {
+                for (what, label, hover) in exports {
+                    if ui.button(label).on_hover_text(hover).clicked() {
+                        self.ui.exports.with_dialog(what, export::Snapshot::of(self), Path::new(self.ui.export_path.trim()));
+                        ui.close();
+                    }
+                }
+            })
+            .response
+            .on_hover_text("Write the comparison figure, the data or the review pack");
             ui.separator();
             ui.toggle_value(&mut self.ui.explore.sweep_open, "Sweep")
                 .on_hover_text("A curve: one parameter of A and B over a range, with noise seeds");

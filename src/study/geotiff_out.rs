@@ -130,10 +130,13 @@ pub fn write_run_geotiff(out: &RunOutput, dir: &Path) -> Result<Outputs, StudyEr
     let mut o = Outputs::default();
     let bands = &out.response.bands.bands;
     let truth = &out.radiance.truth;
+    // The georeference and metadata every file shares, computed once (the affine fit visits
+    // every pixel twice).
+    let shared = base(out);
     let all = |_: usize, _: usize| true;
     let water = |r: usize, c: usize| truth.land[[r, c]] == 0;
 
-    let mut l1 = base(out);
+    let mut l1 = shared.clone();
     for (b, band) in bands.iter().enumerate() {
         l1.bands.push(cube_plane(&out.level1.radiance, b, &all));
         l1.descriptions.push(format!("L1 radiance {} ({:.1} nm)", band.name, band.centre_nm));
@@ -144,7 +147,7 @@ pub fn write_run_geotiff(out: &RunOutput, dir: &Path) -> Result<Outputs, StudyEr
 
     let rrs = &out.correction.rrs;
     let valid = |b: usize| move |r: usize, c: usize| rrs.flags[[r, c, b]] & crate::correction::RrsFlags::INVALID == 0;
-    let mut rr = base(out);
+    let mut rr = shared.clone();
     for (b, band) in bands.iter().enumerate() {
         rr.bands.push(cube_plane(&rrs.rrs, b, &valid(b)));
         rr.descriptions.push(format!("Rrs {} ({:.1} nm)", band.name, band.centre_nm));
@@ -153,7 +156,7 @@ pub fn write_run_geotiff(out: &RunOutput, dir: &Path) -> Result<Outputs, StudyEr
     rr.nodata = Some(NODATA);
     file(dir, "rrs.tif", &rr, &mut o)?;
 
-    let mut t = base(out);
+    let mut t = shared.clone();
     let push = |r: &mut Raster, values: Vec<f64>, what: &str, unit: &str| {
         r.bands.push(values);
         r.descriptions.push(what.to_string());
@@ -177,7 +180,7 @@ pub fn write_run_geotiff(out: &RunOutput, dir: &Path) -> Result<Outputs, StudyEr
     for ret in &out.retrievals {
         let p = &ret.product;
         let returned = |r: usize, c: usize| p.flags[[r, c]] & ProductFlags::RETURNED != 0;
-        let mut m = base(out);
+        let mut m = shared.clone();
         m.metadata.push(("RETRIEVAL".into(), p.name.clone()));
         push(&mut m, plane(&p.chl_mg_m3, &returned), "retrieved chlorophyll-a", "mg m-3");
         push(&mut m, plane(&p.nap_g_m3, &returned), "retrieved NAP", "g m-3");

@@ -229,6 +229,15 @@ fn the_review_pack_exports_from_the_app_to_a_typed_folder() {
     let dir = temp_library("pack");
     let mut h = harness("cubesat", 16, &dir);
     wait_for_engine(&mut h);
+    // The top bar's Export menu offers the three exports.
+    h.get_by_label("Export").click();
+    h.step();
+    h.step();
+    for entry in ["Figure…", "Data…", "Review pack…"] {
+        assert!(h.query_by_label(entry).is_some(), "the Export menu has no `{entry}`");
+    }
+    h.key_press(egui::Key::Escape);
+    h.step();
     h.get_by_label("Path").click();
     h.step();
     h.step();
