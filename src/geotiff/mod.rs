@@ -52,12 +52,12 @@ impl Crs {
         }
     }
 
-    /// A short description ("EPSG:32756", "local frame (metres)").
+    /// A short description ("EPSG:32756", "local frame (NAME)").
     #[must_use]
     pub fn describe(&self) -> String {
         match self {
             Self::Projected { epsg } | Self::Geographic { epsg } => format!("EPSG:{epsg}"),
-            Self::LocalMetres { name } => format!("local frame in metres ({name})"),
+            Self::LocalMetres { name } => format!("local frame ({name})"),
             Self::None => "none".into(),
         }
     }

@@ -191,7 +191,11 @@ pub fn commit() -> &'static str {
 /// Date Algorithms").
 #[must_use]
 pub fn now_utc() -> String {
-    let secs = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_secs());
+    utc_text(std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_secs()))
+}
+
+/// `secs` after the Unix epoch as `YYYY-MM-DDTHH:MM:SSZ`.
+fn utc_text(secs: u64) -> String {
     let (days, rem) = ((secs / 86_400) as i64, secs % 86_400);
     let z = days + 719_468;
     let era = z.div_euclid(146_097);
@@ -442,5 +446,18 @@ pub fn review_data(result: &StudyResult, budget: &[Budget], cost: &[CostRow]) ->
         machine: Machine::this(),
         study_ron: ron::ser::to_string_pretty(&study.spec, ron::ser::PrettyConfig::default().struct_names(true))
             .unwrap_or_default(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn utc_text_matches_the_calendar() {
+        // Values from Python's datetime.utcfromtimestamp: the epoch, a leap day, this decade.
+        assert_eq!(utc_text(0), "1970-01-01T00:00:00Z");
+        assert_eq!(utc_text(951_782_400), "2000-02-29T00:00:00Z");
+        assert_eq!(utc_text(1_795_566_896), "2026-11-25T00:34:56Z");
     }
 }
