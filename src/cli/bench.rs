@@ -50,6 +50,24 @@ pub struct BenchArgs {
     /// Skip the app rows (slider-to-preview latency and frame time; only with the `gui` feature).
     #[arg(long)]
     pub no_app: bool,
+    /// Only these sections (comma-separated; default: all).
+    #[arg(long, value_enum, value_delimiter = ',')]
+    pub only: Vec<Section>,
+}
+
+/// A section of `shoal bench`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Section {
+    /// The water model's evaluations per second.
+    Water,
+    /// Atmosphere LUT builds and their errors against OSOAA.
+    Atmosphere,
+    /// The whole chain over Lake Hume, and the preview after each kind of change.
+    Chain,
+    /// Retrieval pixels per second, and the default study end to end.
+    Retrieval,
+    /// The app: slider to preview on screen (`gui` build only).
+    App,
 }
 
 fn machine() -> String {
@@ -269,17 +287,26 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
         super::bench_accuracy::accuracy_rows(&mut out, args)?;
         return emit(&out, None);
     }
-    water_rows(&mut out, args.quick)?;
-    emit(&std::mem::take(&mut out), None)?;
-    atmosphere_rows(&mut out, args.quick)?;
-    emit(&std::mem::take(&mut out), None)?;
-    super::bench_chain::chain_rows(&mut out, args.quick)?;
-    emit(&std::mem::take(&mut out), None)?;
-    super::bench_retrieval::retrieval_rows(&mut out, args.quick)?;
-    emit(&std::mem::take(&mut out), None)?;
+    let wanted = |s: Section| args.only.is_empty() || args.only.contains(&s);
+    if wanted(Section::Water) {
+        water_rows(&mut out, args.quick)?;
+        emit(&std::mem::take(&mut out), None)?;
+    }
+    if wanted(Section::Atmosphere) {
+        atmosphere_rows(&mut out, args.quick)?;
+        emit(&std::mem::take(&mut out), None)?;
+    }
+    if wanted(Section::Chain) {
+        super::bench_chain::chain_rows(&mut out, args.quick)?;
+        emit(&std::mem::take(&mut out), None)?;
+    }
+    if wanted(Section::Retrieval) {
+        super::bench_retrieval::retrieval_rows(&mut out, args.quick)?;
+        emit(&std::mem::take(&mut out), None)?;
+    }
     // The app rows need egui, which only the `gui` build has.
     #[cfg(feature = "gui")]
-    if !args.no_app {
+    if !args.no_app && wanted(Section::App) {
         out = crate::app::bench::rows(args.quick).map_err(CliError::Run)?;
     }
     emit(&out, None)

@@ -14,7 +14,7 @@ use rand::{RngExt, SeedableRng};
 use super::CliError;
 use crate::control::RunControl;
 use crate::retrieval::almi::{AlmiSet, AlmiSettings};
-use crate::retrieval::almi_lanes::{PackedSets, invert_packed};
+use crate::retrieval::almi_lanes::{PackedSets, Scratch, invert_packed};
 use crate::retrieval::sambuca::{Observation, SambucaSettings, invert as sambuca_invert, objective_value};
 use crate::retrieval::sets::ALMI_SETS;
 use crate::retrieval::{BandModel, BandResponse, Parameters};
@@ -104,8 +104,9 @@ fn almi_rate(quick: bool) -> Result<(f64, f64, usize), CliError> {
     let rate = |weighting: bool| {
         let settings = AlmiSettings { noise_weighting: weighting, ..AlmiSettings::default() };
         let mut sink = 0.0;
+        let mut scratch = Scratch::default();
         let r = timed_rate(min_seconds(quick), pixels.len(), |i| {
-            sink += invert_packed(&packed, &settings, &pixels[i], &valid, &nedr).chl;
+            sink += invert_packed(&mut scratch, &packed, &settings, &pixels[i], &valid, &nedr).chl;
         });
         std::hint::black_box(sink);
         r

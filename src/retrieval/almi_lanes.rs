@@ -12,7 +12,7 @@
 //! below); the scalar one stays as the readable statement of the method.
 
 use super::almi::{AlmiFlags, AlmiPixel, AlmiSet, AlmiSettings, MAX_BANDS, Prepared};
-use super::nnls::nnls3;
+use super::nnls::{MIN_DET, det3, nnls3};
 
 /// Sets per chunk (one chunk of eight covers the built-in sets).
 pub const LANES: usize = 8;
@@ -67,6 +67,20 @@ impl PackedSets {
     }
 }
 
+/// Per-thread work space of [`invert_packed`]: the rows and weights of every band (20 kB, so
+/// reused from pixel to pixel rather than zeroed for each).
+#[derive(Clone)]
+pub struct Scratch {
+    rows: Vec<Rows>,
+    w2: Vec<[f64; LANES]>,
+}
+
+impl Default for Scratch {
+    fn default() -> Self {
+        Self { rows: vec![Rows::default(); MAX_BANDS], w2: vec![[1.0; LANES]; MAX_BANDS] }
+    }
+}
+
 /// One set's NNLS answer: (x, residual², unconstrained x), or `None` (see [`nnls3`]).
 type Solution = Option<([f64; 3], f64, [f64; 3])>;
 
@@ -79,6 +93,69 @@ struct Normal {
 }
 
 impl Normal {
+    /// Every lane's NNLS. The common case — the unconstrained solution is feasible, so it is
+    /// the answer — runs lane-wise: [`nnls3`]'s column scaling, Cramer solve, residual and
+    /// unscaling, the same operations in the same order, so the same bits. A lane that leaves
+    /// that path (a zero or non-finite column, a singular system, a negative or non-finite
+    /// component) is solved by the scalar [`nnls3`], which then enumerates the supports.
+    #[inline(always)]
+    fn solve_all(&self, lanes: usize) -> [Solution; LANES] {
+        // Index of (i, j) among the six stored entries of the symmetric G.
+        const AT: [[usize; 3]; 3] = [[0, 1, 2], [1, 3, 4], [2, 4, 5]];
+        let mut d = [[0.0; LANES]; 3];
+        for (j, dj) in d.iter_mut().enumerate() {
+            for s in 0..LANES {
+                dj[s] = self.g[AT[j][j]][s].sqrt();
+            }
+        }
+        let mut x = [[0.0; LANES]; 3];
+        let mut r2 = [0.0; LANES];
+        let mut fast = [false; LANES];
+        for s in 0..LANES {
+            let ds = [d[0][s], d[1][s], d[2][s]];
+            let gs: [[f64; 3]; 3] = std::array::from_fn(|i| {
+                std::array::from_fn(|j| {
+                    if ds[i] > 0.0 && ds[j] > 0.0 { self.g[AT[i][j]][s] / (ds[i] * ds[j]) } else { 0.0 }
+                })
+            });
+            let bs: [f64; 3] = std::array::from_fn(|j| if ds[j] > 0.0 { self.b[j][s] / ds[j] } else { 0.0 });
+            let det = det3(&gs);
+            let mut xs = [0.0; 3];
+            for (j, xj) in xs.iter_mut().enumerate() {
+                let mut c = gs;
+                for (i, row) in c.iter_mut().enumerate() {
+                    row[j] = bs[i];
+                }
+                *xj = det3(&c) / det;
+            }
+            let mut r = self.yy[s];
+            for i in 0..3 {
+                r -= 2.0 * xs[i] * bs[i];
+                for j in 0..3 {
+                    r += xs[i] * gs[i][j] * xs[j];
+                }
+            }
+            r2[s] = r.max(0.0);
+            let finite = ds.iter().all(|v| v.is_finite() && *v > 0.0)
+                && (0..3).all(|j| self.b[j][s].is_finite())
+                && self.yy[s].is_finite();
+            fast[s] = finite && det.abs() > MIN_DET && xs.iter().all(|v| *v >= 0.0 && v.is_finite());
+            for j in 0..3 {
+                x[j][s] = xs[j] / ds[j];
+            }
+        }
+        std::array::from_fn(|s| {
+            if s >= lanes {
+                None
+            } else if fast[s] {
+                let xs = [x[0][s], x[1][s], x[2][s]];
+                Some((xs, r2[s], xs))
+            } else {
+                self.solve(s)
+            }
+        })
+    }
+
     fn solve(&self, s: usize) -> Solution {
         let g = |j: usize| self.g[j][s];
         nnls3(
@@ -132,6 +209,7 @@ fn kappa(c: &BandLanes, x: &[[f64; LANES]; 3], s: usize) -> (f64, f64) {
 /// On a CPU with AVX2 the lanes run four sets per instruction (two otherwise).
 #[must_use]
 pub fn invert_packed(
+    scratch: &mut Scratch,
     sets: &PackedSets,
     settings: &AlmiSettings,
     rrs_above: &[f64],
@@ -140,9 +218,9 @@ pub fn invert_packed(
 ) -> AlmiPixel {
     #[cfg(target_arch = "x86_64")]
     if avx2::available() {
-        return avx2::invert(sets, settings, rrs_above, valid, nedr);
+        return avx2::invert(scratch, sets, settings, rrs_above, valid, nedr);
     }
-    invert_lanes(sets, settings, rrs_above, valid, nedr)
+    invert_lanes(scratch, sets, settings, rrs_above, valid, nedr)
 }
 
 /// The same code compiled for AVX2 (four doubles per instruction instead of two), chosen at
@@ -150,7 +228,7 @@ pub fn invert_packed(
 /// never contracts a·b + c into an FMA), so both builds give identical pixels.
 #[cfg(target_arch = "x86_64")]
 mod avx2 {
-    use super::{AlmiPixel, AlmiSettings, PackedSets, invert_lanes};
+    use super::{AlmiPixel, AlmiSettings, PackedSets, Scratch, invert_lanes};
 
     pub fn available() -> bool {
         std::is_x86_feature_detected!("avx2")
@@ -158,16 +236,18 @@ mod avx2 {
 
     #[target_feature(enable = "avx2")]
     fn invert_avx2(
+        scratch: &mut Scratch,
         sets: &PackedSets,
         settings: &AlmiSettings,
         rrs_above: &[f64],
         valid: &[bool],
         nedr: &[f64],
     ) -> AlmiPixel {
-        invert_lanes(sets, settings, rrs_above, valid, nedr)
+        invert_lanes(scratch, sets, settings, rrs_above, valid, nedr)
     }
 
     pub fn invert(
+        scratch: &mut Scratch,
         sets: &PackedSets,
         settings: &AlmiSettings,
         rrs_above: &[f64],
@@ -178,13 +258,14 @@ mod avx2 {
         // SAFETY: callers check `available()`: the CPU executes AVX2 instructions.
         #[allow(unsafe_code)]
         unsafe {
-            invert_avx2(sets, settings, rrs_above, valid, nedr)
+            invert_avx2(scratch, sets, settings, rrs_above, valid, nedr)
         }
     }
 }
 
 #[inline(always)]
 fn invert_lanes(
+    scratch: &mut Scratch,
     sets: &PackedSets,
     settings: &AlmiSettings,
     rrs_above: &[f64],
@@ -199,8 +280,7 @@ fn invert_lanes(
     let Prepared { ref used, m, ref rrs, ref u, ref sigma_u, ref sigma_rrs, mean_rrs } = p;
     let used = &used[..m];
     let mut best = AlmiPixel::FAILED;
-    let mut rows = [Rows::default(); MAX_BANDS];
-    let mut w2 = [[1.0; LANES]; MAX_BANDS];
+    let Scratch { rows, w2 } = scratch;
     for (chunk, (bands, &lanes)) in sets.chunks.iter().zip(&sets.lanes).enumerate() {
         for (i, &k) in used.iter().enumerate() {
             let c = &bands[k];
@@ -214,10 +294,7 @@ fn invert_lanes(
             }
         }
         let first = normal(&rows[..m], None);
-        let mut sol: [Solution; LANES] = [None; LANES];
-        for (s, slot) in sol.iter_mut().enumerate().take(lanes) {
-            *slot = first.solve(s);
-        }
+        let mut sol = first.solve_all(lanes);
         let x_of = |sol: &[Solution; LANES]| -> [[f64; LANES]; 3] {
             let mut x = [[0.0; LANES]; 3];
             for (s, p) in sol.iter().enumerate() {
@@ -240,10 +317,10 @@ fn invert_lanes(
                     w2[i][s] = w1 * w1;
                 }
             }
-            let second = normal(&rows[..m], Some(&w2[..m]));
-            for (s, slot) in sol.iter_mut().enumerate().take(lanes) {
+            let second = normal(&rows[..m], Some(&w2[..m])).solve_all(lanes);
+            for (slot, next) in sol.iter_mut().zip(second).take(lanes) {
                 if slot.is_some()
-                    && let Some(next) = second.solve(s)
+                    && let Some(next) = next
                 {
                     *slot = Some(next);
                 }
@@ -323,6 +400,7 @@ mod tests {
         for n_sets in [8, 11, 3] {
             let sets = sets(n_sets, &mut rng);
             let packed = PackedSets::new(&sets);
+            let mut scratch = Scratch::default();
             for weighting in [true, false] {
                 let settings = AlmiSettings { noise_weighting: weighting, ..AlmiSettings::default() };
                 for _ in 0..500 {
@@ -334,9 +412,9 @@ mod tests {
                     }
                     let nedr: Vec<f64> = rrs.iter().map(|v| 0.02 * v).collect();
                     let a = invert(&sets, &settings, &rrs, &valid, &nedr);
-                    let b = invert_packed(&packed, &settings, &rrs, &valid, &nedr);
+                    let b = invert_packed(&mut scratch, &packed, &settings, &rrs, &valid, &nedr);
                     // The portable build too, where the CPU would have taken the AVX2 one.
-                    let c = invert_lanes(&packed, &settings, &rrs, &valid, &nedr);
+                    let c = invert_lanes(&mut scratch, &packed, &settings, &rrs, &valid, &nedr);
                     assert_eq!(format!("{b:?}"), format!("{c:?}"), "AVX2 and portable builds differ");
                     assert_eq!(a.set, b.set, "{n_sets} sets: chosen set");
                     assert_eq!(a.flags, b.flags);

@@ -109,6 +109,19 @@ fn least_squares(columns: &[Vec<f64>], y: &[f64], mask: u32) -> Option<Vec<f64>>
     Some(x)
 }
 
+/// The determinant of a 3 × 3 matrix by cofactors along the first row (shared with the lane
+/// version in `almi_lanes`, which must perform the same operations in the same order).
+#[inline(always)]
+#[must_use]
+pub(crate) fn det3(c: &[[f64; 3]; 3]) -> f64 {
+    c[0][0] * (c[1][1] * c[2][2] - c[1][2] * c[2][1]) - c[0][1] * (c[1][0] * c[2][2] - c[1][2] * c[2][0])
+        + c[0][2] * (c[1][0] * c[2][1] - c[1][1] * c[2][0])
+}
+
+/// The smallest |det| of the scaled Gram matrix [`nnls3`] solves with (below it the columns
+/// are taken as dependent).
+pub(crate) const MIN_DET: f64 = 1e-13;
+
 /// NNLS of at most 3 unknowns from the normal equations: G = AᵀA, b = Aᵀy, yy = yᵀy (the
 /// per-pixel path of aLMI: nothing allocated). Columns are scaled to unit norm; each support is
 /// solved by Cramer's rule on the scaled Gram matrix (well conditioned for 3 columns once scaled).
@@ -139,7 +152,7 @@ pub fn nnls3(g: &[[f64; 3]; 3], b: &[f64; 3], yy: f64) -> Option<([f64; 3], f64,
             2 => {
                 let (p, q) = (idx[0], idx[1]);
                 let det = gs[p][p] * gs[q][q] - gs[p][q] * gs[q][p];
-                if !(det.abs() > 1e-13) {
+                if !(det.abs() > MIN_DET) {
                     return None;
                 }
                 x[p] = (bs[p] * gs[q][q] - gs[p][q] * bs[q]) / det;
@@ -147,13 +160,8 @@ pub fn nnls3(g: &[[f64; 3]; 3], b: &[f64; 3], yy: f64) -> Option<([f64; 3], f64,
             }
             _ => {
                 let m = &gs;
-                let det3 = |c: &[[f64; 3]; 3]| {
-                    c[0][0] * (c[1][1] * c[2][2] - c[1][2] * c[2][1])
-                        - c[0][1] * (c[1][0] * c[2][2] - c[1][2] * c[2][0])
-                        + c[0][2] * (c[1][0] * c[2][1] - c[1][1] * c[2][0])
-                };
                 let det = det3(m);
-                if !(det.abs() > 1e-13) {
+                if !(det.abs() > MIN_DET) {
                     return None;
                 }
                 for j in 0..3 {

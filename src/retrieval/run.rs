@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 use super::Mode;
 use super::RetrievalError;
 use super::almi::{AlmiFlags, AlmiSet, AlmiSettings};
-use super::almi_lanes::{PackedSets, invert_packed};
+use super::almi_lanes::{PackedSets, Scratch, invert_packed};
 use super::almi_reference::invert_reference;
 use super::band_model::{BandModel, BandResponse};
 use super::sambuca::SambucaSettings;
@@ -278,6 +278,7 @@ pub(super) fn retrieve_almi(
         let mut obs = vec![0.0; used.len()];
         let mut valid = vec![false; used.len()];
         let nedr: Vec<f64> = used.iter().map(|&b| inputs.nedr[b]).collect();
+        let mut scratch = Scratch::default();
         let row = (0..cols)
             .map(|c| {
                 at.column(c);
@@ -290,7 +291,7 @@ pub(super) fn retrieve_almi(
                     valid[k] = inputs.flags[[r, c, b]] & (RrsFlags::INVALID | RrsFlags::SATURATED) == 0;
                 }
                 let p = match settings.mode {
-                    Mode::Improved => invert_packed(&packed, settings, &obs, &valid, &nedr),
+                    Mode::Improved => invert_packed(&mut scratch, &packed, settings, &obs, &valid, &nedr),
                     Mode::Reference => invert_reference(&sets, settings.g0, settings.g1, &obs, &valid),
                 };
                 if p.flags & AlmiFlags::FAILED != 0 || p.set.is_none() {
