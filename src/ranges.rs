@@ -266,6 +266,8 @@ ranges! {
     FIDELITY_SPECTRAL_STEP_NM = Range::closed("fidelity.spectral_step_nm", 0.1, 10.0, "nm", "spectral step of the simulation grids");
     /// Spatial-response quadrature.
     FIDELITY_SPATIAL_SAMPLES_PER_GSD = Range::count("fidelity.spatial_samples_per_gsd", 1.0, 8.0, "", "spatial-response points per GSD and axis");
+    /// Per-pixel spectra at band nodes.
+    FIDELITY_BAND_NODES = Range::count("fidelity.band_nodes", 0.0, 8.0, "", "water spectra per pixel at this many nodes per band (0: every grid wavelength)");
     /// Preview decimation.
     FIDELITY_DECIMATION = Range::count("fidelity.decimation", 1.0, 1000.0, "", "every n-th line and detector (1: full resolution)");
     /// LUT wavelength spacing.

@@ -21,6 +21,12 @@ pub struct Fidelity {
     /// Spatial-response quadrature points per GSD along each axis (1–8), when the scene asks for
     /// `SpatialResponse`.
     pub spatial_samples_per_gsd: usize,
+    /// Per-pixel water spectra at this many nodes per band (0–8; 0: at every grid wavelength).
+    /// The pixel's Rrs is evaluated only at each band's response quantiles and interpolated
+    /// linearly between them under the band; the atmosphere, the solar spectrum and the responses
+    /// stay on the full grid (see [`crate::instrument::BandAtmosphere`]). Land and scenes with
+    /// adjacency use the full grid.
+    pub band_nodes: usize,
     /// Preview decimation: every n-th line and detector (1 = full resolution).
     pub decimation: usize,
     /// Wavelength spacing of the atmosphere LUT nodes, nm (5–50); radiances are interpolated
@@ -39,6 +45,7 @@ impl Default for Fidelity {
         Self {
             spectral_step_nm: 1.0,
             spatial_samples_per_gsd: 2,
+            band_nodes: 0,
             decimation: 1,
             lut_wavelength_step_nm: 20.0,
             lut_view_step_deg: 5.0,
@@ -57,6 +64,7 @@ impl Fidelity {
         };
         check(&r::FIDELITY_SPECTRAL_STEP_NM, self.spectral_step_nm)?;
         check(&r::FIDELITY_SPATIAL_SAMPLES_PER_GSD, self.spatial_samples_per_gsd as f64)?;
+        check(&r::FIDELITY_BAND_NODES, self.band_nodes as f64)?;
         check(&r::FIDELITY_DECIMATION, self.decimation as f64)?;
         check(&r::FIDELITY_LUT_WAVELENGTH_STEP_NM, self.lut_wavelength_step_nm)?;
         check(&r::FIDELITY_LUT_VIEW_STEP_DEG, self.lut_view_step_deg)?;

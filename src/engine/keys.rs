@@ -95,6 +95,9 @@ pub(super) struct Inputs<'a> {
     /// (offsets and weights, from the aperture, altitude, exposure and GSD and
     /// `spatial_samples_per_gsd`) enters the radiance key by value.
     pub heading_deg: f64,
+    /// Nodes per band of the per-pixel water spectra (the optics stage: 0 = every grid
+    /// wavelength).
+    pub band_nodes: usize,
     /// The correction and calibration stages (decimation and seed, besides their own settings).
     pub decimation: usize,
     pub seed: u64,
@@ -133,6 +136,7 @@ impl<'a> Inputs<'a> {
             spectral_step_nm,
             // Enter the radiance key through the spatial kernel's offsets and weights.
             spatial_samples_per_gsd: _,
+            band_nodes,
             decimation,
             // Enter the LUT key through the axes they build (`lut_axes`).
             lut_wavelength_step_nm: _,
@@ -185,6 +189,7 @@ impl<'a> Inputs<'a> {
             },
             snr: SnrPatch { frames: snr_frames, detectors: snr_detectors, decimation, seed },
             heading_deg: *heading_deg,
+            band_nodes,
             decimation,
             seed,
         }

@@ -96,12 +96,25 @@ impl Engine {
         })?;
 
         // Optics: the scene on each group's grid.
-        let optics_key = KeyBuilder::new(Stage::Optics).after(scene_key).after(lut_key).after(response_key).finish();
+        let optics_key = KeyBuilder::new(Stage::Optics)
+            .after(scene_key)
+            .after(lut_key)
+            .after(response_key)
+            .with(&inputs.band_nodes)
+            .finish();
         let optics = self.stage(optics_key, report, control, || {
             response
                 .groups
                 .iter()
-                .map(|g| SceneOptics::new(&scene, &g.grid, lut.clone()))
+                .enumerate()
+                .map(|(gi, g)| {
+                    let optics = SceneOptics::new(&scene, &g.grid, lut.clone())?;
+                    if fid.band_nodes == 0 {
+                        Ok(optics)
+                    } else {
+                        optics.with_band_nodes(response.band_nodes(gi, fid.band_nodes))
+                    }
+                })
                 .collect::<Result<Vec<_>, _>>()
                 .map_err(failed_any(Stage::Optics))
         })?;

@@ -186,6 +186,40 @@ impl Response {
         }
     }
 
+    /// Grid indices of group `g` at which per-pixel spectra are evaluated with `per_band` nodes
+    /// per band: each band's response quantiles (k + ½)/n, k = 0…n−1, of the swath centre's
+    /// weights (one node is the band's median wavelength, two bracket it at the quartiles), and
+    /// the two ends of its response's support (so its tails are interpolated, not held flat),
+    /// merged over the group's bands, sorted, distinct.
+    #[must_use]
+    pub fn band_nodes(&self, g: usize, per_band: usize) -> Vec<usize> {
+        let centre = self.smile_class.len() / 2;
+        let mut nodes = Vec::new();
+        for k in 0..self.groups[g].bands.len() {
+            let (first, w) = self.weights(g, k, centre);
+            let total: f64 = w.iter().sum();
+            if w.is_empty() || total <= 0.0 {
+                continue;
+            }
+            nodes.extend([first, first + w.len() - 1]);
+            for q in 0..per_band {
+                let target = (q as f64 + 0.5) / per_band as f64 * total;
+                let mut cum = 0.0;
+                let i = w
+                    .iter()
+                    .position(|v| {
+                        cum += v;
+                        cum >= target
+                    })
+                    .unwrap_or(w.len() - 1);
+                nodes.push(first + i);
+            }
+        }
+        nodes.sort_unstable();
+        nodes.dedup();
+        nodes
+    }
+
     /// Wavelength ranges of the groups' grids (for reports).
     #[must_use]
     pub fn spans_nm(&self) -> Vec<Range<f64>> {

@@ -66,6 +66,50 @@ pub struct BandAtmosphere {
     pub spherical_albedo: Vec<f64>,
     /// Per group, per column: weights of the truth Rrs for each band of the group.
     pub truth_weights: Vec<Vec<BandWeights>>,
+    /// Per group (empty where the optics has no band nodes), per column, per band of the group:
+    /// the band's weights on the nodes' values (see [`NodeWeights`]).
+    pub node_weights: Vec<Vec<Vec<NodeWeights>>>,
+}
+
+/// A band's weights on per-pixel spectra known only at band nodes.
+///
+/// The pixel's f(λ) = Rrs/(1 − S·π·Rrs) and Rrs(λ) are taken as linear between neighbouring
+/// nodes (constant beyond the first and last), f(λ) ≈ Σₙ φₙ(λ)·fₙ with hat functions φₙ, so the
+/// band integrals of the module docs become sums over nodes with weights computed once per
+/// column on the full grid:
+///
+/// L_b = L_path,b + G_b + Σₙ Cₙ·fₙ,  Cₙ = Σ_λ w_b T_up Ed φₙ / Σ_λ w_b;  Rrs_b = Σₙ Dₙ·Rrsₙ,  Dₙ = Σ_λ w_b T_up Ed φₙ / Σ_λ w_b T_up Ed.
+///
+/// The atmosphere, the solar spectrum and the response keep their full-grid detail; only the
+/// water's smooth spectrum is interpolated (its error is measured in the cost table:
+/// `shoal bench --accuracy`).
+#[derive(Debug, Clone, Default)]
+pub struct NodeWeights {
+    /// First node the weights apply to.
+    pub first: usize,
+    /// Cₙ from node `first` on, W m⁻² sr⁻¹ nm⁻¹ per unit f (sr⁻¹).
+    pub radiance: Vec<f64>,
+    /// Dₙ from node `first` on (they sum to 1).
+    pub truth: Vec<f64>,
+}
+
+/// Per grid index of a group: the nodes either side and the weight of the upper one (linear in
+/// wavelength; constant beyond the end nodes).
+fn node_brackets(wavelengths_nm: &[f64], nodes: &[usize]) -> Vec<(usize, usize, f64)> {
+    let last = nodes.len() - 1;
+    (0..wavelengths_nm.len())
+        .map(|i| {
+            let n1 = nodes.partition_point(|&v| v <= i);
+            if n1 == 0 {
+                (0, 0, 0.0)
+            } else if n1 > last {
+                (last, last, 0.0)
+            } else {
+                let (a, b) = (wavelengths_nm[nodes[n1 - 1]], wavelengths_nm[nodes[n1]]);
+                (n1 - 1, n1, (wavelengths_nm[i] - a) / (b - a))
+            }
+        })
+        .collect()
 }
 
 impl BandAtmosphere {
@@ -82,6 +126,7 @@ impl BandAtmosphere {
             t_ed: vec![0.0; nc * nb],
             spherical_albedo: vec![0.0; nc * nb],
             truth_weights: Vec::new(),
+            node_weights: Vec::new(),
         };
         for (gi, group) in response.groups.iter().enumerate() {
             let paths: Vec<PathSpectrum> = viewing.looks[gi]
@@ -90,7 +135,11 @@ impl BandAtmosphere {
                 .collect::<Result<_, _>>()
                 .map_err(|e| InstrumentError::Scene(e.into()))?;
             let mut truth = Vec::with_capacity(nc);
+            let nodes = optics[gi].band_nodes();
+            let brackets = nodes.map(|n| node_brackets(group.grid.wavelengths_nm(), n));
+            let mut node_weights = Vec::new();
             for (c, path) in paths.iter().enumerate() {
+                let mut column_nodes = Vec::new();
                 let j = viewing.detector_index[c];
                 let mut per_band = Vec::with_capacity(group.bands.len());
                 for (k, &b) in group.bands.iter().enumerate() {
@@ -120,14 +169,27 @@ impl BandAtmosphere {
                     } else {
                         vec![1.0 / w.len() as f64; w.len()]
                     };
+                    if let Some(brackets) = &brackets {
+                        column_nodes.push(band_node_weights(&brackets[span.clone()], &te, total, &tw));
+                    }
                     per_band.push((first, tw));
                 }
                 truth.push(per_band);
+                if brackets.is_some() {
+                    node_weights.push(column_nodes);
+                }
             }
             out.paths.push(paths);
             out.truth_weights.push(truth);
+            out.node_weights.push(node_weights);
         }
         Ok(out)
+    }
+
+    /// Whether group `g` samples the water at band nodes.
+    #[must_use]
+    pub fn has_nodes(&self, g: usize) -> bool {
+        self.node_weights.get(g).is_some_and(|w| !w.is_empty())
     }
 
     /// Index of (column, band) in the per-column arrays.
@@ -135,6 +197,21 @@ impl BandAtmosphere {
     pub fn at(&self, column: usize, band: usize) -> usize {
         column * self.n_bands + band
     }
+}
+
+/// [`NodeWeights`] of one band: `brackets` of its grid points, `te` = w·T_up·Ed on them,
+/// `total` = Σw, `truth` the truth's weights on them (te/Σte).
+fn band_node_weights(brackets: &[(usize, usize, f64)], te: &[f64], total: f64, truth: &[f64]) -> NodeWeights {
+    let lo = brackets.iter().map(|b| b.0).min().unwrap_or(0);
+    let hi = brackets.iter().map(|b| b.1).max().unwrap_or(0);
+    let mut out = NodeWeights { first: lo, radiance: vec![0.0; hi + 1 - lo], truth: vec![0.0; hi + 1 - lo] };
+    for ((&(n0, n1, t), &v), &tw) in brackets.iter().zip(te).zip(truth) {
+        out.radiance[n0 - lo] += v * (1.0 - t) / total;
+        out.radiance[n1 - lo] += v * t / total;
+        out.truth[n0 - lo] += tw * (1.0 - t);
+        out.truth[n1 - lo] += tw * t;
+    }
+    out
 }
 
 /// What the sampling stage produces: the radiance each pixel sees and the truth under it.
@@ -205,6 +282,14 @@ pub fn sample_radiance(
             let mut scratch = Scratch::default();
             let mut spectra: Vec<(Vec<f64>, Vec<f64>)> =
                 optics.iter().map(|o| (vec![0.0; o.grid().len()], vec![0.0; o.grid().len()])).collect();
+            // Rrs and f = Rrs/(1 − S·π·Rrs) at the band nodes, per group that has them.
+            let mut at_nodes: Vec<(Vec<f64>, Vec<f64>)> = optics
+                .iter()
+                .map(|o| {
+                    let n = o.band_nodes().map_or(0, <[usize]>::len);
+                    (vec![0.0; n], vec![0.0; n])
+                })
+                .collect();
             for c in 0..cols {
                 let j = viewing.detector_index[c];
                 for rr in 0..n_rows {
@@ -220,6 +305,34 @@ pub fn sample_radiance(
                         let path = &atmosphere.paths[gi][c];
                         let (x0, y0) = viewing.ground_m(gi, r, c);
                         for (k, &(dx, dy)) in offsets.iter().enumerate() {
+                            let (node_rrs, node_f) = &mut at_nodes[gi];
+                            if atmosphere.has_nodes(gi)
+                                && optics[gi].water_at_nodes(
+                                    scene,
+                                    x0 + dx,
+                                    y0 + dy,
+                                    &look.geometry,
+                                    &mut scratch,
+                                    node_rrs,
+                                )?
+                            {
+                                let nodes = optics[gi].band_nodes().unwrap_or(&[]);
+                                for ((f, r), &i) in node_f.iter_mut().zip(node_rrs.iter()).zip(nodes) {
+                                    *f = r / (1.0 - path.spherical_albedo[i] * std::f64::consts::PI * r);
+                                }
+                                for (kb, &b) in group.bands.iter().enumerate() {
+                                    let nw = &atmosphere.node_weights[gi][c][kb];
+                                    let span = nw.first..nw.first + nw.radiance.len();
+                                    let water: f64 =
+                                        nw.radiance.iter().zip(&node_f[span.clone()]).map(|(a, v)| a * v).sum();
+                                    let t: f64 = nw.truth.iter().zip(&node_rrs[span]).map(|(a, v)| a * v).sum();
+                                    let i = atmosphere.at(c, b);
+                                    let weight = kernel.weights[b][k];
+                                    out[b] += (weight * (atmosphere.l_path[i] + atmosphere.glint[i] + water)) as f32;
+                                    truth[b] += (weight * t) as f32;
+                                }
+                                continue;
+                            }
                             let surface = optics[gi].radiance(
                                 scene,
                                 x0 + dx,

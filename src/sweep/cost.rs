@@ -66,16 +66,27 @@ impl CostRow {
 pub struct Setting {
     /// Label.
     pub label: String,
-    /// Fields set.
+    /// Numeric fields set, by path ([`apply`]).
     pub set: Vec<(&'static str, f64)>,
+    /// Any other change (switches, lists), made after `set`.
+    pub edit: Option<fn(&mut RunConfig)>,
 }
 
-/// The settings measured: the reference, previews at 2–24× the base decimation, spectral
-/// step, LUT nodes, radiative-transfer streams, orders and Fourier terms, the SNR patch, and one
-/// combination.
+/// aLMI's settings and sets in the first retrieval, if it is aLMI.
+fn almi(config: &mut RunConfig) -> Option<(&mut Vec<crate::water::SiopSource>, &mut crate::retrieval::AlmiSettings)> {
+    match config.retrievals.first_mut() {
+        Some(crate::retrieval::RetrievalSpec::Almi { siop_sets, settings }) => Some((siop_sets, settings)),
+        _ => None,
+    }
+}
+
+/// The settings measured: the reference, previews at 2–24× the base decimation, per-pixel
+/// spectra at band nodes, spectral step, LUT nodes, radiative-transfer streams, orders and
+/// Fourier terms, the SNR patch, aLMI's weighting and number of sets, and one combination.
 #[must_use]
 pub fn settings(base_decimation: usize) -> Vec<Setting> {
-    let s = |label: &str, set: Vec<(&'static str, f64)>| Setting { label: label.into(), set };
+    let s = |label: &str, set: Vec<(&'static str, f64)>| Setting { label: label.into(), set, edit: None };
+    let e = |label: &str, edit: fn(&mut RunConfig)| Setting { label: label.into(), set: Vec::new(), edit: Some(edit) };
     let mut out = vec![s("reference (defaults)", vec![])];
     for d in [2, 4, 8, 16, 24] {
         out.push(s(
@@ -84,6 +95,9 @@ pub fn settings(base_decimation: usize) -> Vec<Setting> {
         ));
     }
     out.extend([
+        s("band nodes 2 per band", vec![("fidelity.band_nodes", 2.0)]),
+        s("band nodes 3 per band", vec![("fidelity.band_nodes", 3.0)]),
+        s("band nodes 4 per band", vec![("fidelity.band_nodes", 4.0)]),
         s("spectral step 2 nm", vec![("fidelity.spectral_step_nm", 2.0)]),
         s("spectral step 5 nm", vec![("fidelity.spectral_step_nm", 5.0)]),
         s("LUT wavelength nodes 10 nm", vec![("fidelity.lut_wavelength_step_nm", 10.0)]),
@@ -94,6 +108,16 @@ pub fn settings(base_decimation: usize) -> Vec<Setting> {
         s("RT single scattering", vec![("scene.atmosphere.accuracy.max_orders", 1.0)]),
         s("RT 8 Fourier terms", vec![("scene.atmosphere.accuracy.fourier_terms", 8.0)]),
         s("SNR patch 16 frames", vec![("fidelity.snr_frames", 16.0)]),
+        e("aLMI unweighted (one solve per set)", |c| {
+            if let Some((_, settings)) = almi(c) {
+                settings.noise_weighting = false;
+            }
+        }),
+        e("aLMI 4 of 8 SIOP sets", |c| {
+            if let Some((sets, _)) = almi(c) {
+                sets.truncate(4);
+            }
+        }),
         s(
             "fast: 2 nm, LUT 40 nm, 8 streams",
             vec![
@@ -173,8 +197,12 @@ pub fn cost_of_accuracy(
     let configs = settings
         .iter()
         .map(|setting| {
-            apply(base, &setting.set)
-                .map_err(|m| StudyError::Invalid(FieldError { field: setting.label.clone(), message: m }))
+            let mut config = apply(base, &setting.set)
+                .map_err(|m| StudyError::Invalid(FieldError { field: setting.label.clone(), message: m }))?;
+            if let Some(edit) = setting.edit {
+                edit(&mut config);
+            }
+            Ok::<_, StudyError>(config)
         })
         .collect::<Result<Vec<_>, _>>()?;
     let mut rows: Vec<CostRow> = Vec::with_capacity(settings.len());

@@ -64,6 +64,18 @@ pub struct SceneOptics {
     nodes: Vec<(usize, usize, f64)>,
     adjacency: Option<Adjacency>,
     glint: bool,
+    /// The water model at band nodes only (`Fidelity::band_nodes`), if asked for.
+    nodes_water: Option<NodeWater>,
+}
+
+/// The water model at a subset of the grid (band nodes): the SIOPs and substrates picked at the
+/// nodes, so the model there gives bit for bit what the full grid gives at those wavelengths.
+#[derive(Debug, Clone)]
+struct NodeWater {
+    /// Grid indices of the nodes, increasing.
+    indices: Vec<usize>,
+    water: WaterModel,
+    substrates: Vec<Vec<f64>>,
 }
 
 /// Per-thread working memory of [`SceneOptics::radiance`].
@@ -142,7 +154,48 @@ impl SceneOptics {
             nodes,
             adjacency,
             glint: scene.wants(Effect::SunGlint),
+            nodes_water: None,
         })
+    }
+
+    /// Evaluate water spectra per pixel only at the grid indices `indices` (increasing; see
+    /// [`crate::instrument::Response::band_nodes`]) through [`Self::water_at_nodes`]. A scene
+    /// with adjacency keeps the full grid: its environment term needs whole spectra.
+    pub fn with_band_nodes(mut self, indices: Vec<usize>) -> Result<Self, SceneError> {
+        if self.adjacency.is_some() || indices.is_empty() {
+            return Ok(self);
+        }
+        let water = WaterModel::new(self.water.siop().subset(&indices)?);
+        let substrates = self.substrates.iter().map(|r| indices.iter().map(|&i| r[i]).collect()).collect();
+        self.nodes_water = Some(NodeWater { indices, water, substrates });
+        Ok(self)
+    }
+
+    /// The grid indices of the band nodes, when per-pixel spectra are evaluated there.
+    #[must_use]
+    pub fn band_nodes(&self) -> Option<&[usize]> {
+        self.nodes_water.as_ref().map(|n| n.indices.as_slice())
+    }
+
+    /// Rrs above the surface at the band nodes (`rrs`, one per node) at scene point (x, y):
+    /// `Ok(false)` on land or without band nodes (the caller then takes [`Self::radiance`]).
+    pub fn water_at_nodes(
+        &self,
+        scene: &Scene,
+        x_m: f64,
+        y_m: f64,
+        g: &Geometry,
+        scratch: &mut Scratch,
+        rrs: &mut [f64],
+    ) -> Result<bool, SceneError> {
+        let Some(nodes) = &self.nodes_water else { return Ok(false) };
+        if scene.is_land(x_m, y_m) {
+            return Ok(false);
+        }
+        let column = water_column(scene, x_m, y_m, &nodes.substrates, nodes.indices.len(), scratch);
+        let geometry = WaterGeometry { sun_zenith_rad: g.sun_zenith_rad, view_zenith_rad: g.view_zenith_rad };
+        nodes.water.rrs_above_into(&column, &geometry, rrs)?;
+        Ok(true)
     }
 
     /// The simulation grid.
@@ -238,33 +291,8 @@ impl SceneOptics {
             }
             Surface::Land
         } else {
-            let bottom = match &scene.depth {
-                Some(depth) => {
-                    let fractions: Vec<f64> =
-                        scene.substrates.iter().map(|(_, m)| m.value_at(x_m, y_m).max(0.0)).collect();
-                    let total: f64 = fractions.iter().sum();
-                    scratch.mix.clear();
-                    scratch.mix.resize(n, 0.0);
-                    for (f, r) in fractions.iter().zip(&self.substrates) {
-                        // Fractions are normalised to sum 1; where all vanish the first substrate covers.
-                        let w = if total > 0.0 { f / total } else { 1.0 / self.substrates.len() as f64 };
-                        for (m, v) in scratch.mix.iter_mut().zip(r) {
-                            *m += w * v;
-                        }
-                    }
-                    scratch.bottom_evaluations += 1;
-                    Bottom::Shallow { depth_m: depth.value_at(x_m, y_m), reflectance: &scratch.mix }
-                }
-                None => Bottom::OpticallyDeep,
-            };
-            let column = WaterColumn {
-                chl_mg_m3: scene.chl.value_at(x_m, y_m),
-                cdom_per_m: scene.cdom.value_at(x_m, y_m),
-                nap_g_m3: scene.nap.value_at(x_m, y_m),
-                bottom,
-            };
+            let column = water_column(scene, x_m, y_m, &self.substrates, n, scratch);
             let geometry = WaterGeometry { sun_zenith_rad: g.sun_zenith_rad, view_zenith_rad: g.view_zenith_rad };
-            scratch.water_evaluations += 1;
             self.water.rrs_above_into(&column, &geometry, rrs)?;
             for i in 0..n {
                 let lw = rrs[i] * path.ed[i] / (1.0 - path.spherical_albedo[i] * std::f64::consts::PI * rrs[i]);
@@ -282,5 +310,43 @@ impl SceneOptics {
             adj.add(x_m, y_m, g, path, land, &scratch.rho_target, l_toa);
         }
         Ok(surface)
+    }
+}
+
+/// The water column at scene point (x, y): the maps' concentrations and, in shallow scenes, the
+/// depth and the substrate mixture on the `n` wavelengths `substrates` are sampled on (mixed
+/// into `scratch`, whose evaluation counters it advances).
+fn water_column<'a>(
+    scene: &Scene,
+    x_m: f64,
+    y_m: f64,
+    substrates: &[Vec<f64>],
+    n: usize,
+    scratch: &'a mut Scratch,
+) -> WaterColumn<'a> {
+    scratch.water_evaluations += 1;
+    let bottom = match &scene.depth {
+        Some(depth) => {
+            let fractions: Vec<f64> = scene.substrates.iter().map(|(_, m)| m.value_at(x_m, y_m).max(0.0)).collect();
+            let total: f64 = fractions.iter().sum();
+            scratch.mix.clear();
+            scratch.mix.resize(n, 0.0);
+            for (f, r) in fractions.iter().zip(substrates) {
+                // Fractions are normalised to sum 1; where all vanish the first substrate covers.
+                let w = if total > 0.0 { f / total } else { 1.0 / substrates.len() as f64 };
+                for (m, v) in scratch.mix.iter_mut().zip(r) {
+                    *m += w * v;
+                }
+            }
+            scratch.bottom_evaluations += 1;
+            Bottom::Shallow { depth_m: depth.value_at(x_m, y_m), reflectance: &scratch.mix }
+        }
+        None => Bottom::OpticallyDeep,
+    };
+    WaterColumn {
+        chl_mg_m3: scene.chl.value_at(x_m, y_m),
+        cdom_per_m: scene.cdom.value_at(x_m, y_m),
+        nap_g_m3: scene.nap.value_at(x_m, y_m),
+        bottom,
     }
 }

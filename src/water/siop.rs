@@ -210,6 +210,34 @@ pub struct Siop {
     pub water_refractive_index: f64,
 }
 
+impl Siop {
+    /// The set at some of its grid's wavelengths (`indices`, strictly increasing): the same
+    /// values, picked, so a model on the subset gives bit for bit the full grid's values there.
+    pub fn subset(&self, indices: &[usize]) -> Result<Self, WaterError> {
+        let pick = |v: &[f64]| indices.iter().map(|&i| v[i]).collect::<Vec<f64>>();
+        if let Some(&i) = indices.iter().find(|&&i| i >= self.grid.len()) {
+            return Err(WaterError::OutOfRange {
+                field: "subset index".into(),
+                value: i as f64,
+                allowed: format!("0 to {}", self.grid.len().saturating_sub(1)),
+            });
+        }
+        let grid = WavelengthGrid::from_wavelengths(pick(self.grid.wavelengths_nm()))?;
+        Ok(Self {
+            name: self.name.clone(),
+            grid,
+            a_w: pick(&self.a_w),
+            bb_w: pick(&self.bb_w),
+            a_ph_star: pick(&self.a_ph_star),
+            bb_ph_star: pick(&self.bb_ph_star),
+            a_cdom_star: pick(&self.a_cdom_star),
+            a_nap_star: pick(&self.a_nap_star),
+            bb_nap_star: pick(&self.bb_nap_star),
+            water_refractive_index: self.water_refractive_index,
+        })
+    }
+}
+
 /// Where a SIOP set comes from, as scene and run files write it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub enum SiopSource {

@@ -119,7 +119,7 @@ fn after_a_change_of_any_one_field_a_warm_engine_returns_what_a_fresh_one_does()
         c
     };
     type Change = (&'static str, fn(&mut RunConfig));
-    let changes: [Change; 24] = [
+    let changes: [Change; 25] = [
         ("altitude_km", |c| c.instrument.altitude_km *= 1.1),
         ("heading_deg", |c| c.instrument.heading_deg += 20.0),
         ("aperture_mm", |c| c.instrument.aperture_mm *= 1.2),
@@ -142,6 +142,7 @@ fn after_a_change_of_any_one_field_a_warm_engine_returns_what_a_fresh_one_does()
         ("detector.quantise", |c| c.detector.quantise = !c.detector.quantise),
         ("seed", |c| c.seed += 1),
         ("fidelity.spectral_step_nm", |c| c.fidelity.spectral_step_nm = 2.0),
+        ("fidelity.band_nodes", |c| c.fidelity.band_nodes = if c.fidelity.band_nodes == 2 { 3 } else { 2 }),
         ("fidelity.decimation", |c| c.fidelity.decimation = 2),
         ("fidelity.snr_frames", |c| c.fidelity.snr_frames += 5),
     ];

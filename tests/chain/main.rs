@@ -4,6 +4,7 @@
 
 mod adjacency;
 mod bad_input;
+mod band_nodes;
 mod cli;
 mod closure;
 mod coherence;
