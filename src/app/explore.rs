@@ -10,7 +10,7 @@
 use egui_plot::{HLine, Legend, Line, Plot, PlotPoints, Points};
 
 use super::model::AppState;
-use crate::engine::{Engine, RunConfig};
+use crate::engine::{Engine, Fidelity, RunConfig};
 use crate::jobs::{Task, TaskNews};
 use crate::study::{Source, StudySpec};
 use crate::sweep::{
@@ -160,7 +160,7 @@ impl Explore {
             detector: None,
             calibration: None,
             correction: None,
-            fidelity: None,
+            fidelity: Some(state.fidelity.clone()),
             requirements: None,
         };
         let spec = SweepSpec {
@@ -208,8 +208,11 @@ impl Explore {
 
     /// Start measuring the cost of accuracy for instrument A at 1/`cost_decimation`.
     pub fn start_cost(&mut self, ctx: &egui::Context, config: RunConfig) {
-        self.cost_config = Some(config.clone());
-        let mut base = config;
+        // The reference is full fidelity, whatever the app runs with now: the table prices each
+        // setting against it, and a setting applied from it does not become the next table's
+        // reference.
+        let mut base = at_full_fidelity(config);
+        self.cost_config = Some(base.clone());
         base.fidelity.decimation = self.cost_decimation;
         self.cost_rows.clear();
         self.cost_status = format!("measuring at 1/{} …", self.cost_decimation);
@@ -388,8 +391,9 @@ pub fn sweep_window(app: &mut super::ShoalApp, ctx: &egui::Context) {
 pub fn cost_window(app: &mut super::ShoalApp, ctx: &egui::Context) {
     let mut open = app.ui.explore.cost_open;
     let mut start = false;
+    let mut apply = None;
     egui::Window::new("Cost of accuracy").open(&mut open).default_size([640.0, 520.0]).show(ctx, |ui| {
-        ui.label("Time of the whole chain for instrument A against the error each fidelity setting makes (a fresh engine per run; rounds interleave the settings with the reference).");
+        ui.label("Time of the whole chain for instrument A against the error each fidelity setting makes, each one change from full fidelity (a fresh engine per run; rounds interleave the settings with the reference).");
         ui.horizontal(|ui| {
             let e = &mut app.ui.explore;
             egui::ComboBox::from_label("Reference resolution").selected_text(format!("1/{}", e.cost_decimation)).show_ui(ui, |ui| {
@@ -407,20 +411,39 @@ pub fn cost_window(app: &mut super::ShoalApp, ctx: &egui::Context) {
         });
         let e = &app.ui.explore;
         ui.label(format!("{} ({}/{} settings)", e.cost_status, e.cost_rows.len(), crate::sweep::settings(e.cost_decimation).len()));
-        if e.cost_config.as_ref().is_some_and(|c| Some(c) != app.state.configs().first()) {
+        let now = app.state.configs().into_iter().next().map(at_full_fidelity);
+        if e.cost_config.is_some() && e.cost_config != now {
             ui.colored_label(super::theme::NOTICE, "Stale: A, the scene or the retrieval changed since these were measured. Press Measure to redo.");
         }
         let front: Vec<&str> = crate::sweep::pareto_front(&e.cost_rows).iter().map(|r| r.label.as_str()).collect();
         let cheapest = if e.busy() { None } else { crate::sweep::cheapest_within(&e.cost_rows, e.cost_tolerance_pct) };
         if let Some(c) = cheapest {
-            ui.label(egui::RichText::new(format!(
-                "Cheapest full-resolution setting within {} % chl per pixel: {} ({:.2} s, {})",
-                e.cost_tolerance_pct,
-                c.label,
-                c.seconds(),
-                c.comparison.text()
-            )).strong());
+            ui.horizontal(|ui| {
+                ui.label(egui::RichText::new(format!(
+                    "Cheapest full-resolution setting within {} % chl per pixel: {} ({:.2} s, {})",
+                    e.cost_tolerance_pct,
+                    c.label,
+                    c.seconds(),
+                    c.comparison.text()
+                )).strong());
+                let fidelity = e.cost_config.as_ref().and_then(|base| crate::sweep::fidelity_of(&c.label, base));
+                let button = ui.add_enabled(fidelity.is_some(), egui::Button::new("Apply to the app"));
+                let button = if fidelity.is_some() {
+                    button.on_hover_text("Run A and B (previews and full resolution) with this fidelity")
+                } else {
+                    button.on_disabled_hover_text("Not a fidelity setting alone (it changes the atmosphere's accuracy, the retrieval or the resolution): set it where it lives")
+                };
+                if button.clicked() {
+                    apply = fidelity;
+                }
+            });
         }
+        ui.horizontal(|ui| {
+            ui.label(format!("The app runs with: {}", fidelity_text(&app.state.fidelity)));
+            if app.state.fidelity != Fidelity::default() && ui.button("Back to the defaults").clicked() {
+                apply = Some(Fidelity::default());
+            }
+        });
         Plot::new("cost-plot").height(220.0).legend(Legend::default()).x_axis_label("time, s (median)").y_axis_label("error, %").show(ui, |p| {
             let same: Vec<[f64; 2]> = e.cost_rows.iter().filter_map(|r| r.chl_pixel_pct.map(|v| [r.seconds(), v])).collect();
             let other: Vec<[f64; 2]> = e.cost_rows.iter().filter(|r| r.chl_pixel_pct.is_none()).map(|r| [r.seconds(), r.delta_mae_pct.abs()]).collect();
@@ -450,6 +473,9 @@ pub fn cost_window(app: &mut super::ShoalApp, ctx: &egui::Context) {
             });
         });
     });
+    if let Some(fidelity) = apply {
+        app.state.fidelity = Fidelity { decimation: 1, ..fidelity };
+    }
     if start {
         let config = app.state.configs().swap_remove(0);
         app.ui.explore.start_cost(ctx, config);
@@ -458,6 +484,45 @@ pub fn cost_window(app: &mut super::ShoalApp, ctx: &egui::Context) {
         app.ui.explore.cost_task = None;
     }
     app.ui.explore.cost_open = open;
+}
+
+/// `config` at full fidelity (its decimation kept).
+fn at_full_fidelity(mut config: RunConfig) -> RunConfig {
+    config.fidelity = Fidelity { decimation: config.fidelity.decimation, ..Fidelity::full() };
+    config
+}
+
+/// The fields of `f` that differ from the defaults ("defaults" when none does).
+fn fidelity_text(f: &Fidelity) -> String {
+    let d = Fidelity::default();
+    let mut parts = Vec::new();
+    if f.band_nodes != d.band_nodes {
+        parts.push(if f.band_nodes == 0 {
+            "water spectra on the full grid".to_string()
+        } else {
+            format!("band nodes {} per band", f.band_nodes)
+        });
+    }
+    if f.spectral_step_nm != d.spectral_step_nm {
+        parts.push(format!("spectral step {} nm", f.spectral_step_nm));
+    }
+    if f.lut_wavelength_step_nm != d.lut_wavelength_step_nm {
+        parts.push(format!("LUT wavelength nodes {} nm", f.lut_wavelength_step_nm));
+    }
+    if f.lut_view_step_deg != d.lut_view_step_deg {
+        parts.push(format!("LUT view nodes {}°", f.lut_view_step_deg));
+    }
+    if f.spatial_samples_per_gsd != d.spatial_samples_per_gsd {
+        parts.push(format!("{} spatial samples per GSD", f.spatial_samples_per_gsd));
+    }
+    if f.snr_frames != d.snr_frames || f.snr_detectors != d.snr_detectors {
+        parts.push(format!("SNR patch {} frames × {} detectors", f.snr_frames, f.snr_detectors));
+    }
+    if parts.is_empty() {
+        format!("the default fidelity (band nodes {} per band)", d.band_nodes)
+    } else {
+        parts.join(", ")
+    }
 }
 
 /// The sweep's requirement: the chl MAE limit in use, when there is one.

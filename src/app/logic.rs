@@ -153,7 +153,7 @@ impl ShoalApp {
             detector: None,
             calibration: None,
             correction: None,
-            fidelity: None,
+            fidelity: (s.fidelity != crate::engine::Fidelity::default()).then(|| s.fidelity.clone()),
             requirements: Some(s.requirements.clone()),
         }
     }

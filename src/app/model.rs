@@ -5,7 +5,7 @@ use serde::{Deserialize, Serialize};
 
 pub use super::view::{Layout, ProductKind};
 
-use crate::engine::RunConfig;
+use crate::engine::{Fidelity, RunConfig};
 use crate::instrument::InstrumentSpec;
 use crate::retrieval::{AlmiSettings, RetrievalSpec, SambucaSettings};
 use crate::scene::{MapSpec, SceneSpec};
@@ -155,6 +155,9 @@ pub struct AppState {
     pub dark: bool,
     /// Study name for captions.
     pub study_name: String,
+    /// The fidelity of every run (its `decimation` is the preview level's, set per run): the
+    /// defaults, the study's, or a setting applied from the Cost window.
+    pub fidelity: Fidelity,
 }
 
 impl Default for AppState {
@@ -205,6 +208,7 @@ impl AppState {
             requirements: fallback_requirements(),
             dark: false,
             study_name: "cubesat_vs_smallsat".into(),
+            fidelity: Fidelity::default(),
         }
     }
 
@@ -244,6 +248,7 @@ impl AppState {
         if let Some(r) = &study.requirements {
             s.requirements = r.clone();
         }
+        s.fidelity = Fidelity { decimation: 1, ..first.2.fidelity.clone() };
         Ok(s)
     }
 
@@ -314,6 +319,7 @@ impl AppState {
             .iter()
             .map(|slot| {
                 let mut c = RunConfig::new(scene.clone(), slot.spec.clone());
+                c.fidelity = Fidelity { decimation: 1, ..self.fidelity.clone() };
                 c.seed = self.noise_seed;
                 c.retrievals = vec![self.retrieval_spec()];
                 c
@@ -402,6 +408,25 @@ mod tests {
         s.a.spec.aperture_mm = 80.0;
         assert!(s.a.modified());
         assert_eq!(s.changes(), vec!["A aperture_mm 60.0 → 80.0".to_string()]);
+    }
+
+    #[test]
+    fn the_app_fidelity_reaches_every_run_and_old_sessions_read_the_defaults() {
+        let mut s = AppState::default();
+        assert_eq!(s.fidelity, Fidelity::default());
+        s.fidelity.band_nodes = 4;
+        s.fidelity.decimation = 8;
+        for c in s.configs() {
+            assert_eq!(c.fidelity.band_nodes, 4);
+            assert_eq!(c.fidelity.decimation, 1, "the preview level sets decimation, not the state");
+        }
+        // A session saved before the field existed reads as the defaults.
+        let mut v: ron::Value = ron::from_str(&ron::to_string(&AppState::default()).unwrap()).unwrap();
+        if let ron::Value::Map(m) = &mut v {
+            m.remove(&ron::Value::String("fidelity".into()));
+        }
+        let old: AppState = v.into_rust().unwrap();
+        assert_eq!(old.fidelity, Fidelity::default());
     }
 
     #[test]

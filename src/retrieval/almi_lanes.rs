@@ -173,25 +173,50 @@ struct Rows {
     y: [f64; LANES],
 }
 
+/// Lanes per accumulation pass of [`normal`]: ten sums of four lanes fit the sixteen AVX2
+/// registers (all eight lanes at once would spill them to the stack at every band).
+const QUAD: usize = 4;
+const _: () = assert!(LANES % QUAD == 0);
+
 /// Accumulate the normal equations from `rows` with per-band, per-lane weights (`None`: 1).
+/// Each lane's sums run over the bands in order, whatever the pass, so the bits are the scalar
+/// code's.
 #[inline(always)]
 fn normal(rows: &[Rows], w2: Option<&[[f64; LANES]]>) -> Normal {
     let mut n = Normal { g: [[0.0; LANES]; 6], b: [[0.0; LANES]; 3], yy: [0.0; LANES] };
-    for (i, row) in rows.iter().enumerate() {
-        for s in 0..LANES {
-            let w = w2.map_or(1.0, |w| w[i][s]);
-            let (r0, r1, r2, y) = (row.r[0][s], row.r[1][s], row.r[2][s], row.y[s]);
-            let (wr0, wr1, wr2, wy) = (w * r0, w * r1, w * r2, w * y);
-            n.g[0][s] += wr0 * r0;
-            n.g[1][s] += wr0 * r1;
-            n.g[2][s] += wr0 * r2;
-            n.g[3][s] += wr1 * r1;
-            n.g[4][s] += wr1 * r2;
-            n.g[5][s] += wr2 * r2;
-            n.b[0][s] += wr0 * y;
-            n.b[1][s] += wr1 * y;
-            n.b[2][s] += wr2 * y;
-            n.yy[s] += wy * y;
+    for q in (0..LANES).step_by(QUAD) {
+        let mut g = [[0.0; QUAD]; 6];
+        let mut b = [[0.0; QUAD]; 3];
+        let mut yy = [0.0; QUAD];
+        for (i, row) in rows.iter().enumerate() {
+            for l in 0..QUAD {
+                let s = q + l;
+                let w = match w2 {
+                    Some(w) => w[i][s],
+                    None => 1.0,
+                };
+                let (r0, r1, r2, y) = (row.r[0][s], row.r[1][s], row.r[2][s], row.y[s]);
+                let (wr0, wr1, wr2, wy) = (w * r0, w * r1, w * r2, w * y);
+                g[0][l] += wr0 * r0;
+                g[1][l] += wr0 * r1;
+                g[2][l] += wr0 * r2;
+                g[3][l] += wr1 * r1;
+                g[4][l] += wr1 * r2;
+                g[5][l] += wr2 * r2;
+                b[0][l] += wr0 * y;
+                b[1][l] += wr1 * y;
+                b[2][l] += wr2 * y;
+                yy[l] += wy * y;
+            }
+        }
+        for l in 0..QUAD {
+            for j in 0..6 {
+                n.g[j][q + l] = g[j][l];
+            }
+            for j in 0..3 {
+                n.b[j][q + l] = b[j][l];
+            }
+            n.yy[q + l] = yy[l];
         }
     }
     n
@@ -329,13 +354,15 @@ fn invert_lanes(
         // Cost in rrs space, every lane at once.
         let x = x_of(&sol);
         let mut sq = [0.0; LANES];
+        let weighting = settings.noise_weighting;
         for (i, &k) in used.iter().enumerate() {
             let c = &bands[k];
+            let (target, sigma) = (rrs[i], sigma_rrs[i]);
             for s in 0..LANES {
                 let (a, bb) = kappa(c, &x, s);
                 let up = bb / (a + bb);
-                let d = (g0 + g1 * up) * up - rrs[i];
-                sq[s] += if settings.noise_weighting { (d / sigma_rrs[i]).powi(2) } else { d * d };
+                let d = (g0 + g1 * up) * up - target;
+                sq[s] += if weighting { (d / sigma).powi(2) } else { d * d };
             }
         }
         for (s, p) in sol.iter().enumerate().take(lanes) {

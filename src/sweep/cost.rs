@@ -80,14 +80,21 @@ fn almi(config: &mut RunConfig) -> Option<(&mut Vec<crate::water::SiopSource>, &
     }
 }
 
-/// The settings measured: the reference, previews at 2–24× the base decimation, per-pixel
+/// The settings measured, each one change from full fidelity ([`crate::engine::Fidelity::full`]):
+/// the reference, the shipped defaults, previews at 2–24× the base decimation, per-pixel
 /// spectra at band nodes, spectral step, LUT nodes, radiative-transfer streams, orders and
 /// Fourier terms, the SNR patch, aLMI's weighting and number of sets, and one combination.
 #[must_use]
 pub fn settings(base_decimation: usize) -> Vec<Setting> {
     let s = |label: &str, set: Vec<(&'static str, f64)>| Setting { label: label.into(), set, edit: None };
     let e = |label: &str, edit: fn(&mut RunConfig)| Setting { label: label.into(), set: Vec::new(), edit: Some(edit) };
-    let mut out = vec![s("reference (defaults)", vec![])];
+    let mut out = vec![
+        s("reference (full fidelity)", vec![]),
+        s(
+            "the defaults (band nodes 4 per band)",
+            vec![("fidelity.band_nodes", crate::engine::DEFAULT_BAND_NODES as f64)],
+        ),
+    ];
     for d in [2, 4, 8, 16, 24] {
         out.push(s(
             &format!("preview 1/{}", d * base_decimation),
@@ -128,6 +135,21 @@ pub fn settings(base_decimation: usize) -> Vec<Setting> {
         ),
     ]);
     out
+}
+
+/// The fidelity the row `label` of [`settings`] runs with, applied to `base`'s: `None` when the
+/// row is not a fidelity setting alone (it changes the atmosphere's accuracy, the retrieval, or
+/// the resolution), so it cannot become a run's fidelity.
+#[must_use]
+pub fn fidelity_of(label: &str, base: &RunConfig) -> Option<crate::engine::Fidelity> {
+    let setting = settings(base.fidelity.decimation).into_iter().find(|s| s.label == label)?;
+    let fidelity_only = setting.edit.is_none()
+        && !setting.set.is_empty()
+        && setting.set.iter().all(|(path, _)| path.starts_with("fidelity.") && *path != "fidelity.decimation");
+    if !fidelity_only {
+        return None;
+    }
+    apply(base, &setting.set).ok().map(|c| c.fidelity)
 }
 
 fn chl_mae(out: &RunOutput) -> f64 {
@@ -194,6 +216,10 @@ pub fn cost_of_accuracy(
     mut on_row: impl FnMut(usize, &CostRow),
 ) -> Result<Vec<CostRow>, StudyError> {
     let settings = settings(base.fidelity.decimation);
+    // Every row is one change from full fidelity (the reference), whatever `base` runs with.
+    let mut base = base.clone();
+    base.fidelity = crate::engine::Fidelity { decimation: base.fidelity.decimation, ..crate::engine::Fidelity::full() };
+    let base = &base;
     let configs = settings
         .iter()
         .map(|setting| {
@@ -301,6 +327,25 @@ mod tests {
             chl_pixel_pct: pixel,
             rrs_pixel_pct: pixel,
         }
+    }
+
+    #[test]
+    fn only_fidelity_rows_can_become_a_runs_fidelity() {
+        use crate::instrument::InstrumentSpec;
+        use crate::scene::SceneSpec;
+        let base = RunConfig::new(
+            SceneSpec::preset("lake_hume_bloom").unwrap_or_else(|e| panic!("{e}")),
+            InstrumentSpec::preset("cubesat").unwrap_or_else(|e| panic!("{e}")),
+        );
+        let f = fidelity_of("band nodes 4 per band", &base).map(|f| f.band_nodes);
+        assert_eq!(f, Some(4));
+        let f = fidelity_of("fast: 2 nm, LUT 40 nm, 8 streams", &base);
+        assert!(f.is_none(), "changes the atmosphere's accuracy too");
+        for label in ["reference (full fidelity)", "preview 1/4", "RT 8 streams", "aLMI unweighted (one solve per set)"]
+        {
+            assert!(fidelity_of(label, &base).is_none(), "{label}");
+        }
+        assert!(fidelity_of("no such row", &base).is_none());
     }
 
     #[test]
