@@ -279,86 +279,15 @@ pub fn sample_radiance(
             }
             let first_row = bi * block;
             let n_rows = land_block.len() / cols.max(1);
-            let mut scratch = Scratch::default();
-            let mut spectra: Vec<(Vec<f64>, Vec<f64>)> =
-                optics.iter().map(|o| (vec![0.0; o.grid().len()], vec![0.0; o.grid().len()])).collect();
-            // Rrs and f = Rrs/(1 − S·π·Rrs) at the band nodes, per group that has them.
-            let mut at_nodes: Vec<(Vec<f64>, Vec<f64>)> = optics
-                .iter()
-                .map(|o| {
-                    let n = o.band_nodes().map_or(0, <[usize]>::len);
-                    (vec![0.0; n], vec![0.0; n])
-                })
-                .collect();
+            let sampler = PixelSampler { scene, optics, viewing, response, atmosphere, kernel, offsets: &offsets };
+            let mut work = PixelWork::new(optics);
             for c in 0..cols {
-                let j = viewing.detector_index[c];
                 for rr in 0..n_rows {
                     let r = first_row + rr;
                     let mut at = control.row(r);
                     at.column(c);
                     let at = rr * pixel + c * nb;
-                    let out = &mut rad_block[at..at + nb];
-                    let truth = &mut rrs_block[at..at + nb];
-                    for (gi, group) in response.groups.iter().enumerate() {
-                        let (l_toa, rrs) = &mut spectra[gi];
-                        let look = &viewing.looks[gi][c];
-                        let path = &atmosphere.paths[gi][c];
-                        let (x0, y0) = viewing.ground_m(gi, r, c);
-                        for (k, &(dx, dy)) in offsets.iter().enumerate() {
-                            let (node_rrs, node_f) = &mut at_nodes[gi];
-                            if atmosphere.has_nodes(gi)
-                                && optics[gi].water_at_nodes(
-                                    scene,
-                                    x0 + dx,
-                                    y0 + dy,
-                                    &look.geometry,
-                                    &mut scratch,
-                                    node_rrs,
-                                )?
-                            {
-                                let nodes = optics[gi].band_nodes().unwrap_or(&[]);
-                                for ((f, r), &i) in node_f.iter_mut().zip(node_rrs.iter()).zip(nodes) {
-                                    *f = r / (1.0 - path.spherical_albedo[i] * std::f64::consts::PI * r);
-                                }
-                                for (kb, &b) in group.bands.iter().enumerate() {
-                                    let nw = &atmosphere.node_weights[gi][c][kb];
-                                    let span = nw.first..nw.first + nw.radiance.len();
-                                    let water: f64 =
-                                        nw.radiance.iter().zip(&node_f[span.clone()]).map(|(a, v)| a * v).sum();
-                                    let t: f64 = nw.truth.iter().zip(&node_rrs[span]).map(|(a, v)| a * v).sum();
-                                    let i = atmosphere.at(c, b);
-                                    let weight = kernel.weights[b][k];
-                                    out[b] += (weight * (atmosphere.l_path[i] + atmosphere.glint[i] + water)) as f32;
-                                    truth[b] += (weight * t) as f32;
-                                }
-                                continue;
-                            }
-                            let surface = optics[gi].radiance(
-                                scene,
-                                x0 + dx,
-                                y0 + dy,
-                                &look.geometry,
-                                path,
-                                &mut scratch,
-                                l_toa,
-                                rrs,
-                            )?;
-                            for (kb, &b) in group.bands.iter().enumerate() {
-                                let (first, w) = response.weights(gi, kb, j);
-                                let (num, den) = w
-                                    .iter()
-                                    .zip(&l_toa[first..first + w.len()])
-                                    .fold((0.0, 0.0), |(n, d), (wi, v)| (n + wi * v, d + wi));
-                                let weight = kernel.weights[b][k];
-                                out[b] += (weight * num / den) as f32;
-                                if surface == Surface::Water {
-                                    let (tf, tw) = &atmosphere.truth_weights[gi][c][kb];
-                                    let t: f64 = tw.iter().zip(&rrs[*tf..*tf + tw.len()]).map(|(a, v)| a * v).sum();
-                                    truth[b] += (weight * t) as f32;
-                                }
-                            }
-                        }
-                    }
+                    sampler.pixel(&mut work, r, c, &mut rad_block[at..at + nb], &mut rrs_block[at..at + nb])?;
                     let (x, y) = viewing.ground_m(0, r, c);
                     let at = rr * cols + c;
                     let fractions = if shallow {
@@ -373,7 +302,7 @@ pub fn sample_radiance(
                 }
             }
             control.tick(n_rows as u64);
-            Ok((scratch.water_evaluations, scratch.bottom_evaluations))
+            Ok((work.scratch.water_evaluations, work.scratch.bottom_evaluations))
         })
         .collect::<Result<Vec<_>, InstrumentError>>()?;
     apply_keystone(&mut radiance, cols, nb, &response.keystone_px, viewing.decimation);
@@ -389,6 +318,101 @@ pub fn sample_radiance(
         water_evaluations: counters.iter().map(|c| c.0).sum(),
         bottom_evaluations: counters.iter().map(|c| c.1).sum(),
     })
+}
+
+/// What every pixel of [`sample_radiance`] reads.
+struct PixelSampler<'a> {
+    scene: &'a Scene,
+    optics: &'a [SceneOptics],
+    viewing: &'a Viewing,
+    response: &'a Response,
+    atmosphere: &'a BandAtmosphere,
+    kernel: &'a SpatialKernel,
+    /// The kernel's offsets turned with the ground track, m (east, north).
+    offsets: &'a [(f64, f64)],
+}
+
+/// A worker's buffers for [`PixelSampler::pixel`].
+struct PixelWork {
+    scratch: Scratch,
+    /// Per group: TOA radiance and Rrs on the grid.
+    spectra: Vec<(Vec<f64>, Vec<f64>)>,
+    /// Per group: Rrs and f = Rrs/(1 − S·π·Rrs) at the band nodes (empty without them).
+    at_nodes: Vec<(Vec<f64>, Vec<f64>)>,
+}
+
+impl PixelWork {
+    fn new(optics: &[SceneOptics]) -> Self {
+        let pair = |n: usize| (vec![0.0; n], vec![0.0; n]);
+        Self {
+            scratch: Scratch::default(),
+            spectra: optics.iter().map(|o| pair(o.grid().len())).collect(),
+            at_nodes: optics.iter().map(|o| pair(o.band_nodes().map_or(0, <[usize]>::len))).collect(),
+        }
+    }
+}
+
+impl PixelSampler<'_> {
+    /// Add pixel (r, c)'s band radiance to `out` and its true band Rrs to `truth` (both zero on
+    /// entry), over every group and spatial quadrature point: at the band nodes where the
+    /// optics has them and the point is water, on the full grid otherwise.
+    fn pixel(
+        &self,
+        work: &mut PixelWork,
+        r: usize,
+        c: usize,
+        out: &mut [f32],
+        truth: &mut [f32],
+    ) -> Result<(), InstrumentError> {
+        let (atmosphere, kernel) = (self.atmosphere, self.kernel);
+        let j = self.viewing.detector_index[c];
+        for (gi, group) in self.response.groups.iter().enumerate() {
+            let optics = &self.optics[gi];
+            let look = &self.viewing.looks[gi][c];
+            let path = &atmosphere.paths[gi][c];
+            let (x0, y0) = self.viewing.ground_m(gi, r, c);
+            for (k, &(dx, dy)) in self.offsets.iter().enumerate() {
+                let (x, y) = (x0 + dx, y0 + dy);
+                let (node_rrs, node_f) = &mut work.at_nodes[gi];
+                if atmosphere.has_nodes(gi)
+                    && optics.water_at_nodes(self.scene, x, y, &look.geometry, &mut work.scratch, node_rrs)?
+                {
+                    let nodes = optics.band_nodes().unwrap_or(&[]);
+                    for ((f, rrs), &i) in node_f.iter_mut().zip(node_rrs.iter()).zip(nodes) {
+                        *f = rrs / (1.0 - path.spherical_albedo[i] * std::f64::consts::PI * rrs);
+                    }
+                    for (kb, &b) in group.bands.iter().enumerate() {
+                        let nw = &atmosphere.node_weights[gi][c][kb];
+                        let span = nw.first..nw.first + nw.radiance.len();
+                        let water: f64 = nw.radiance.iter().zip(&node_f[span.clone()]).map(|(a, v)| a * v).sum();
+                        let t: f64 = nw.truth.iter().zip(&node_rrs[span]).map(|(a, v)| a * v).sum();
+                        let i = atmosphere.at(c, b);
+                        let weight = kernel.weights[b][k];
+                        out[b] += (weight * (atmosphere.l_path[i] + atmosphere.glint[i] + water)) as f32;
+                        truth[b] += (weight * t) as f32;
+                    }
+                    continue;
+                }
+                let (l_toa, rrs) = &mut work.spectra[gi];
+                let surface = optics.radiance(self.scene, x, y, &look.geometry, path, &mut work.scratch, l_toa, rrs)?;
+                for (kb, &b) in group.bands.iter().enumerate() {
+                    let (first, w) = self.response.weights(gi, kb, j);
+                    let (num, den) = w
+                        .iter()
+                        .zip(&l_toa[first..first + w.len()])
+                        .fold((0.0, 0.0), |(n, d), (wi, v)| (n + wi * v, d + wi));
+                    let weight = kernel.weights[b][k];
+                    out[b] += (weight * num / den) as f32;
+                    if surface == Surface::Water {
+                        let (tf, tw) = &atmosphere.truth_weights[gi][c][kb];
+                        let t: f64 = tw.iter().zip(&rrs[*tf..*tf + tw.len()]).map(|(a, v)| a * v).sum();
+                        truth[b] += (weight * t) as f32;
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
 }
 
 /// The truth as the sampling loop writes it: flat row-major buffers.

@@ -176,7 +176,7 @@ struct Rows {
 /// Lanes per accumulation pass of [`normal`]: ten sums of four lanes fit the sixteen AVX2
 /// registers (all eight lanes at once would spill them to the stack at every band).
 const QUAD: usize = 4;
-const _: () = assert!(LANES % QUAD == 0);
+const _: () = assert!(LANES.is_multiple_of(QUAD));
 
 /// Accumulate the normal equations from `rows` with per-band, per-lane weights (`None`: 1).
 /// Each lane's sums run over the bands in order, whatever the pass, so the bits are the scalar

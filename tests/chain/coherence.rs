@@ -53,6 +53,10 @@ fn base(path: &str) -> RunConfig {
         )
         .unwrap();
     }
+    if path == "fidelity.band_nodes" {
+        // Band nodes act only without adjacency (whose environment term needs whole spectra).
+        scene.effects.retain(|e| *e != Effect::Adjacency);
+    }
     scene.atmosphere.surface = shoal::atmosphere::Surface::Wind { speed_m_s: 5.0 };
     for e in [Effect::SunGlint, Effect::SpatialResponse] {
         if !scene.effects.contains(&e) {
@@ -207,7 +211,8 @@ fn every_range_field_changes_the_output_or_is_documented_and_the_cache_follows()
         }
         let config = base(range.path);
         // One cached engine per base instrument, warmed on its base run.
-        let key = config.instrument.name.clone();
+        let adjacency = if config.scene.effects.contains(&Effect::Adjacency) { "" } else { " without adjacency" };
+        let key = format!("{}{adjacency}", config.instrument.name);
         if !engines.iter().any(|(k, _, _)| *k == key) {
             let mut e = Engine::new();
             let before = fingerprint(&e.run(&config, &RunControl::new()).unwrap());
