@@ -22,11 +22,14 @@ pub struct Fidelity {
     /// `SpatialResponse`.
     pub spatial_samples_per_gsd: usize,
     /// Per-pixel water spectra at this many nodes per band (0–8; 0: at every grid wavelength;
-    /// default [`DEFAULT_BAND_NODES`]).
+    /// default [`DEFAULT_BAND_NODES`]). A configuration file written before the field existed
+    /// has a fidelity without it and reads 0, so it reproduces its results; a file without any
+    /// fidelity gets the defaults.
     /// The pixel's Rrs is evaluated only at each band's response quantiles and interpolated
     /// linearly between them under the band; the atmosphere, the solar spectrum and the responses
     /// stay on the full grid (see [`crate::instrument::BandAtmosphere`]). Land and scenes with
     /// adjacency use the full grid.
+    #[serde(default)]
     pub band_nodes: usize,
     /// Preview decimation: every n-th line and detector (1 = full resolution).
     pub decimation: usize,
@@ -175,5 +178,21 @@ impl RunConfig {
     pub fn to_ron(&self) -> Result<String, InstrumentError> {
         ron::ser::to_string_pretty(self, ron::ser::PrettyConfig::default().struct_names(true))
             .map_err(|e| InstrumentError::Invalid(FieldError { field: "config".into(), message: e.to_string() }))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_fidelity_written_before_band_nodes_reads_the_full_grid() {
+        // A resolved configuration from before the field: its results reproduce (0 = full grid).
+        let old: Fidelity = ron::from_str("(spectral_step_nm: 1.0, decimation: 2)").unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(old.band_nodes, 0);
+        assert_eq!(old.decimation, 2);
+        // No fidelity at all: the defaults, band nodes included.
+        assert_eq!(Fidelity::default().band_nodes, DEFAULT_BAND_NODES);
+        assert_eq!(Fidelity::full(), Fidelity { band_nodes: 0, ..Fidelity::default() });
     }
 }

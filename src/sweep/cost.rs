@@ -80,7 +80,8 @@ fn almi(config: &mut RunConfig) -> Option<(&mut Vec<crate::water::SiopSource>, &
     }
 }
 
-/// The settings measured, each one change from full fidelity ([`crate::engine::Fidelity::full`]):
+/// The settings measured, each one change from the reference (the base's fidelity with per-pixel
+/// spectra on the full grid; [`crate::engine::Fidelity::full`] for the defaults):
 /// the reference, the shipped defaults, previews at 2–24× the base decimation, per-pixel
 /// spectra at band nodes, spectral step, LUT nodes, radiative-transfer streams, orders and
 /// Fourier terms, the SNR patch, aLMI's weighting and number of sets, and one combination.
@@ -104,7 +105,6 @@ pub fn settings(base_decimation: usize) -> Vec<Setting> {
     out.extend([
         s("band nodes 2 per band", vec![("fidelity.band_nodes", 2.0)]),
         s("band nodes 3 per band", vec![("fidelity.band_nodes", 3.0)]),
-        s("band nodes 4 per band", vec![("fidelity.band_nodes", 4.0)]),
         s("spectral step 2 nm", vec![("fidelity.spectral_step_nm", 2.0)]),
         s("spectral step 5 nm", vec![("fidelity.spectral_step_nm", 5.0)]),
         s("LUT wavelength nodes 10 nm", vec![("fidelity.lut_wavelength_step_nm", 10.0)]),
@@ -137,14 +137,15 @@ pub fn settings(base_decimation: usize) -> Vec<Setting> {
     out
 }
 
-/// The fidelity the row `label` of [`settings`] runs with, applied to `base`'s: `None` when the
-/// row is not a fidelity setting alone (it changes the atmosphere's accuracy, the retrieval, or
-/// the resolution), so it cannot become a run's fidelity.
+/// The fidelity the row `label` of [`settings`] runs with, applied to `base`'s (the reference
+/// row: `base`'s own): `None` when the row is not a fidelity setting alone (it changes the
+/// atmosphere's accuracy, the retrieval, or the resolution), so it cannot become a run's
+/// fidelity.
 #[must_use]
 pub fn fidelity_of(label: &str, base: &RunConfig) -> Option<crate::engine::Fidelity> {
     let setting = settings(base.fidelity.decimation).into_iter().find(|s| s.label == label)?;
+    // The reference (nothing set) is `base`'s own fidelity: applying it goes back to it.
     let fidelity_only = setting.edit.is_none()
-        && !setting.set.is_empty()
         && setting.set.iter().all(|(path, _)| path.starts_with("fidelity.") && *path != "fidelity.decimation");
     if !fidelity_only {
         return None;
@@ -216,9 +217,10 @@ pub fn cost_of_accuracy(
     mut on_row: impl FnMut(usize, &CostRow),
 ) -> Result<Vec<CostRow>, StudyError> {
     let settings = settings(base.fidelity.decimation);
-    // Every row is one change from full fidelity (the reference), whatever `base` runs with.
+    // Every row is one change from the reference: `base`'s fidelity with every approximation the
+    // table prices off (per-pixel spectra on the full grid), whatever band nodes `base` uses.
     let mut base = base.clone();
-    base.fidelity = crate::engine::Fidelity { decimation: base.fidelity.decimation, ..crate::engine::Fidelity::full() };
+    base.fidelity.band_nodes = 0;
     let base = &base;
     let configs = settings
         .iter()
@@ -337,12 +339,14 @@ mod tests {
             SceneSpec::preset("lake_hume_bloom").unwrap_or_else(|e| panic!("{e}")),
             InstrumentSpec::preset("cubesat").unwrap_or_else(|e| panic!("{e}")),
         );
-        let f = fidelity_of("band nodes 4 per band", &base).map(|f| f.band_nodes);
+        let f = fidelity_of("the defaults (band nodes 4 per band)", &base).map(|f| f.band_nodes);
         assert_eq!(f, Some(4));
+        let f = fidelity_of("band nodes 2 per band", &base).map(|f| (f.band_nodes, f.spectral_step_nm));
+        assert_eq!(f, Some((2, base.fidelity.spectral_step_nm)), "only the row's field changes");
+        assert_eq!(fidelity_of("reference (full fidelity)", &base), Some(base.fidelity.clone()), "back to it");
         let f = fidelity_of("fast: 2 nm, LUT 40 nm, 8 streams", &base);
         assert!(f.is_none(), "changes the atmosphere's accuracy too");
-        for label in ["reference (full fidelity)", "preview 1/4", "RT 8 streams", "aLMI unweighted (one solve per set)"]
-        {
+        for label in ["preview 1/4", "RT 8 streams", "aLMI unweighted (one solve per set)"] {
             assert!(fidelity_of(label, &base).is_none(), "{label}");
         }
         assert!(fidelity_of("no such row", &base).is_none());
