@@ -197,7 +197,9 @@ pub fn nnls3(g: &[[f64; 3]; 3], b: &[f64; 3], yy: f64) -> Option<([f64; 3], f64,
     }
     let full = full.unwrap_or([0.0; 3]);
     let mut best: Option<([f64; 3], f64)> = None;
-    for mask in 0..8u8 {
+    // The full support (mask 7) was just solved and is unsolvable or infeasible: it would be
+    // skipped below, so it is not solved again.
+    for mask in 0..7u8 {
         let Some(x) = solve(mask) else { continue };
         if x.iter().any(|v| *v < 0.0 || !v.is_finite()) {
             continue;
