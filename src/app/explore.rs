@@ -449,9 +449,10 @@ pub fn cost_window(app: &mut super::ShoalApp, ctx: &egui::Context) {
             let other: Vec<[f64; 2]> = e.cost_rows.iter().filter(|r| r.chl_pixel_pct.is_none()).map(|r| [r.seconds(), r.delta_mae_pct.abs()]).collect();
             p.points(Points::new("chl per pixel vs reference (median %)", same).radius(4.0));
             p.points(Points::new("previews: |ΔMAE| (points)", other).radius(4.0).shape(egui_plot::MarkerShape::Diamond));
-            // Each point named by its setting.
+            // Each point named by its setting, on the plot only: a named item would also take a
+            // legend line, and 22 of them covered the plot and the table at 1280 × 720.
             for r in &e.cost_rows {
-                p.text(egui_plot::Text::new(r.label.clone(), egui_plot::PlotPoint::new(r.seconds(), r.chl_error_pct().unwrap_or(r.delta_mae_pct.abs())), format!("  {}", r.label)).anchor(egui::Align2::LEFT_CENTER));
+                p.text(egui_plot::Text::new("", egui_plot::PlotPoint::new(r.seconds(), r.chl_error_pct().unwrap_or(r.delta_mae_pct.abs())), format!("  {}", r.label)).anchor(egui::Align2::LEFT_CENTER));
             }
         });
         egui::ScrollArea::both().show(ui, |ui| {
