@@ -41,13 +41,16 @@ pub enum Stage {
     Correction,
     /// SNR table.
     Snr,
+    /// A retrieval's model at the instrument's bands (its SIOP sets and substrates integrated
+    /// over the band responses): kept while only the Rrs changes.
+    RetrievalModel,
     /// A retrieval and its metrics.
     Retrieval,
 }
 
 impl Stage {
     /// Every stage, in chain order.
-    pub const ALL: [Self; 16] = [
+    pub const ALL: [Self; 17] = [
         Self::Scene,
         Self::Response,
         Self::Geometry,
@@ -63,6 +66,7 @@ impl Stage {
         Self::Level1,
         Self::Correction,
         Self::Snr,
+        Self::RetrievalModel,
         Self::Retrieval,
     ];
 
@@ -95,6 +99,7 @@ impl std::fmt::Display for Stage {
             Self::Level1 => "level-1",
             Self::Correction => "correction",
             Self::Snr => "snr",
+            Self::RetrievalModel => "retrieval model",
             Self::Retrieval => "retrieval",
         };
         f.write_str(name)

@@ -11,7 +11,7 @@ use crate::control::RunControl;
 use crate::instrument::{Detector, DetectorMode, RadianceCube};
 use crate::metrics::evaluate;
 use crate::retrieval::run::band_responses;
-use crate::retrieval::{RetrievalError, RetrievalInputs, retrieve};
+use crate::retrieval::{RetrievalError, RetrievalInputs, invert, prepare};
 use crate::water::WaterGeometry;
 
 /// Noise-equivalent ΔRrs per band at the typical radiance: the detector's noise (on, whatever
@@ -84,8 +84,14 @@ impl Engine {
                 scene_substrates: scene_substrates.clone(),
                 base_dir: config.scene_dir.as_deref(),
             };
+            // The model reads the bands, the scene's SIOP and substrates and the scene directory:
+            // the band key covers the first three (it follows the scene, the responses and the
+            // geometry), the directory is added.
+            let model_key =
+                KeyBuilder::new(Stage::RetrievalModel).after(side.band_key).with(spec).with(&config.scene_dir).finish();
+            let model = self.stage(model_key, report, control, || prepare(spec, &inputs).map_err(fail))?;
             let result = self.stage(key, report, control, || {
-                let product = retrieve(spec, &inputs, control).map_err(fail)?;
+                let product = invert(spec, &model, &inputs, control).map_err(fail)?;
                 let metrics = evaluate(&product, &radiance.truth);
                 Ok(RetrievalOutput {
                     spec: spec.clone(),

@@ -74,17 +74,58 @@ impl crate::control::Cancellable for RetrievalError {
     }
 }
 
-/// Run `spec` over the image.
+/// A retrieval's model at the instrument's bands: what [`invert`] needs besides the Rrs (each SIOP
+/// set and substrate read and integrated over the band responses). It depends on the spec, the
+/// bands and the scene's SIOP and substrates, not on the Rrs, so the engine keeps it while a
+/// change of noise, aperture or electronics re-runs the pixels (stage `RetrievalModel`).
+#[derive(Debug, Clone)]
+pub enum Model {
+    /// aLMI's sets.
+    Almi(run::AlmiModel),
+    /// SAMBUCA's set and substrates (boxed: the larger of the two by far).
+    Sambuca(Box<run_sambuca::SambucaModel>),
+}
+
+/// Prepare `spec`'s model at `inputs.bands` (reads `bands`, `scene_siop`, `scene_substrates`
+/// and `base_dir` only).
+pub fn prepare(spec: &RetrievalSpec, inputs: &RetrievalInputs<'_>) -> Result<Model, RetrievalError> {
+    spec.validate()?;
+    Ok(match spec {
+        RetrievalSpec::Almi { siop_sets, settings } => Model::Almi(run::almi_model(siop_sets, settings, inputs)?),
+        RetrievalSpec::Sambuca { siop, substrates, settings } => Model::Sambuca(Box::new(run_sambuca::sambuca_model(
+            siop.as_ref(),
+            substrates.as_deref(),
+            settings,
+            inputs,
+        )?)),
+    })
+}
+
+/// Run `spec` over the image with `model`, prepared by [`prepare`] from the same spec and bands.
+pub fn invert(
+    spec: &RetrievalSpec,
+    model: &Model,
+    inputs: &RetrievalInputs<'_>,
+    control: &crate::control::RunControl,
+) -> Result<Product, RetrievalError> {
+    match (spec, model) {
+        (RetrievalSpec::Almi { settings, .. }, Model::Almi(m)) => run::retrieve_almi(m, settings, inputs, control),
+        (RetrievalSpec::Sambuca { settings, .. }, Model::Sambuca(m)) => {
+            run_sambuca::retrieve_sambuca(m, settings, inputs, control)
+        }
+        _ => Err(RetrievalError::Invalid(FieldError {
+            field: "retrieval".into(),
+            message: format!("the model given was prepared for another retrieval than {}", spec.name()),
+        })),
+    }
+}
+
+/// Run `spec` over the image: [`prepare`], then [`invert`].
 pub fn retrieve(
     spec: &RetrievalSpec,
     inputs: &RetrievalInputs<'_>,
     control: &crate::control::RunControl,
 ) -> Result<Product, RetrievalError> {
-    spec.validate()?;
-    match spec {
-        RetrievalSpec::Almi { siop_sets, settings } => run::retrieve_almi(siop_sets, settings, inputs, control),
-        RetrievalSpec::Sambuca { siop, substrates, settings } => {
-            run_sambuca::retrieve_sambuca(siop.as_ref(), substrates.as_deref(), settings, inputs, control)
-        }
-    }
+    let model = prepare(spec, inputs)?;
+    invert(spec, &model, inputs, control)
 }

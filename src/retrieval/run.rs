@@ -219,12 +219,25 @@ fn default_almi_bands(bands: &[BandResponse]) -> Vec<usize> {
 /// One aLMI pixel as stored: (chl, cdom, nap, set, cost, flags).
 type AlmiRow = (f32, f32, f32, i16, f32, u8);
 
-pub(super) fn retrieve_almi(
+/// aLMI's model at the instrument's bands: the bands it uses and each SIOP set's band IOPs,
+/// packed side by side for the pixel loop. Reading and integrating eight sets is most of a small
+/// preview's retrieval time, and depends only on the spec and the bands.
+#[derive(Debug, Clone)]
+pub struct AlmiModel {
+    /// The instrument bands in use.
+    used: Vec<usize>,
+    /// The sets at those bands.
+    sets: Vec<AlmiSet>,
+    /// The sets packed in lanes.
+    packed: PackedSets,
+}
+
+/// Build [`AlmiModel`] of `sources` at `inputs.bands`.
+pub(super) fn almi_model(
     sources: &[SiopSource],
     settings: &AlmiSettings,
     inputs: &RetrievalInputs<'_>,
-    control: &RunControl,
-) -> Result<Product, RetrievalError> {
+) -> Result<AlmiModel, RetrievalError> {
     let used: Vec<usize> = match &settings.bands {
         None => default_almi_bands(&inputs.bands),
         Some(names) => names
@@ -272,6 +285,17 @@ pub(super) fn retrieve_almi(
     }
     // The sets side by side for the per-pixel loops (bit-identical to the scalar `almi::invert`).
     let packed = PackedSets::new(&sets);
+    Ok(AlmiModel { used, sets, packed })
+}
+
+/// aLMI over the image with `model` (from [`almi_model`] of the same settings and bands).
+pub(super) fn retrieve_almi(
+    model: &AlmiModel,
+    settings: &AlmiSettings,
+    inputs: &RetrievalInputs<'_>,
+    control: &RunControl,
+) -> Result<Product, RetrievalError> {
+    let AlmiModel { used, sets, packed } = model;
     let (rows, cols, nb) = inputs.rrs.dim();
     let results: Vec<Vec<AlmiRow>> = control.map_rows(rows, |at| {
         let r = at.index();
@@ -291,8 +315,8 @@ pub(super) fn retrieve_almi(
                     valid[k] = inputs.flags[[r, c, b]] & (RrsFlags::INVALID | RrsFlags::SATURATED) == 0;
                 }
                 let p = match settings.mode {
-                    Mode::Improved => invert_packed(&mut scratch, &packed, settings, &obs, &valid, &nedr),
-                    Mode::Reference => invert_reference(&sets, settings.g0, settings.g1, &obs, &valid),
+                    Mode::Improved => invert_packed(&mut scratch, packed, settings, &obs, &valid, &nedr),
+                    Mode::Reference => invert_reference(sets, settings.g0, settings.g1, &obs, &valid),
                 };
                 if p.flags & AlmiFlags::FAILED != 0 || p.set.is_none() {
                     return (0.0, 0.0, 0.0, -1, 0.0, ProductFlags::FAILED);

@@ -39,13 +39,32 @@ fn substrate_fractions(results: &[Vec<SambucaRow>], n_sub: usize) -> Array3<f32>
     fractions
 }
 
-pub(super) fn retrieve_sambuca(
+/// SAMBUCA's model at the instrument's bands: the SIOP set and the substrates integrated over the
+/// band responses (Gauss nodes for Shoal's fit, the package's band sums for the reference).
+/// Depends only on the spec, the scene's SIOP and substrates, and the bands.
+#[derive(Debug, Clone)]
+pub struct SambucaModel {
+    /// The SIOP set's name.
+    siop_name: String,
+    /// The substrates, in the product's order.
+    names: Vec<String>,
+    /// The model of the mode asked for.
+    kind: ModelKind,
+}
+
+#[derive(Debug, Clone)]
+enum ModelKind {
+    Improved(BandModel),
+    Reference { model: ReferenceModel, refractive_index: f64 },
+}
+
+/// Build [`SambucaModel`] at `inputs.bands`.
+pub(super) fn sambuca_model(
     siop: Option<&SiopSource>,
     substrates: Option<&[String]>,
     settings: &SambucaSettings,
     inputs: &RetrievalInputs<'_>,
-    control: &RunControl,
-) -> Result<Product, RetrievalError> {
+) -> Result<SambucaModel, RetrievalError> {
     let (spec, dir) = match siop {
         Some(src) => src.load(inputs.base_dir)?,
         None => inputs.scene_siop.clone(),
@@ -57,14 +76,45 @@ pub(super) fn retrieve_sambuca(
             message: "SAMBUCA needs at least one substrate".into(),
         }));
     }
-    let b = &settings.bounds;
     let library = SubstrateLibrary::embedded()?;
-    if settings.mode == Mode::Reference {
+    let kind = if settings.mode == Mode::Reference {
         let model = ReferenceModel::from_siop(&spec, dir.as_deref(), &library, &names, &inputs.bands)?;
-        let siop = (spec.name.as_str(), spec.water_refractive_index);
-        return retrieve_sambuca_reference(&model, siop, names, settings, inputs, control);
-    }
-    let model = BandModel::new(&spec, dir.as_deref(), &library, &names, &inputs.bands, settings.nodes_per_band)?;
+        ModelKind::Reference { model, refractive_index: spec.water_refractive_index }
+    } else {
+        ModelKind::Improved(BandModel::new(
+            &spec,
+            dir.as_deref(),
+            &library,
+            &names,
+            &inputs.bands,
+            settings.nodes_per_band,
+        )?)
+    };
+    Ok(SambucaModel { siop_name: spec.name, names, kind })
+}
+
+/// SAMBUCA over the image with `model` (from [`sambuca_model`] of the same settings and bands).
+pub(super) fn retrieve_sambuca(
+    model: &SambucaModel,
+    settings: &SambucaSettings,
+    inputs: &RetrievalInputs<'_>,
+    control: &RunControl,
+) -> Result<Product, RetrievalError> {
+    let b = &settings.bounds;
+    let SambucaModel { siop_name, names, kind } = model;
+    let model = match kind {
+        ModelKind::Reference { model, refractive_index } => {
+            return retrieve_sambuca_reference(
+                model,
+                (siop_name, *refractive_index),
+                names.clone(),
+                settings,
+                inputs,
+                control,
+            );
+        }
+        ModelKind::Improved(model) => model,
+    };
     let (rows, cols, nb) = inputs.rrs.dim();
     let inv_cos: Vec<(f64, f64)> =
         inputs.geometry.iter().map(|g| g.inverse_cosines_in_water(model.refractive_index)).collect();
@@ -84,7 +134,7 @@ pub(super) fn retrieve_sambuca(
                     valid[k] = inputs.flags[[r, c, k]] & (RrsFlags::INVALID | RrsFlags::SATURATED) == 0;
                 }
                 let o = Observation { rrs: &obs, valid: &valid, nedr: &inputs.nedr, inv_cos: inv_cos[c] };
-                let p = sambuca_invert(&model, settings, &o);
+                let p = sambuca_invert(model, settings, &o);
                 if !p.ok {
                     return failed;
                 }
@@ -119,7 +169,7 @@ pub(super) fn retrieve_sambuca(
             .collect();
         Ok::<_, RetrievalError>(row)
     })?;
-    Ok(sambuca_product(&results, names, &spec.name))
+    Ok(sambuca_product(&results, names.clone(), siop_name))
 }
 
 /// The SAMBUCA product from its per-pixel rows.

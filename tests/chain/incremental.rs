@@ -14,9 +14,10 @@ fn a_gain_change_reruns_only_digitisation_onward() {
     let mut engine = Engine::new();
     let mut config = RunConfig::new(small_lake(), small("nominal", 64, 48));
     let first = engine.run(&config, &RunControl::new()).unwrap();
-    // Every stage ran once, except the retrieval: none is configured.
+    // Every stage ran once, except the retrieval and its model: none is configured.
+    let retrieval = |s: Stage| matches!(s, Stage::Retrieval | Stage::RetrievalModel);
     assert!(
-        Stage::ALL.iter().all(|&s| engine.executions(s) == u64::from(s != Stage::Retrieval)),
+        Stage::ALL.iter().all(|&s| engine.executions(s) == u64::from(!retrieval(s))),
         "{:?}",
         counts(&engine)
     );
@@ -34,7 +35,7 @@ fn a_gain_change_reruns_only_digitisation_onward() {
             | Stage::Level1
             | Stage::Correction
             | Stage::Snr => 2,
-            Stage::Retrieval => 0,
+            Stage::RetrievalModel | Stage::Retrieval => 0,
             // Never the scene, the atmosphere or the photon counts.
             _ => 1,
         };
@@ -62,6 +63,29 @@ fn a_gain_change_reruns_only_digitisation_onward() {
     assert_eq!(engine.executions(Stage::Radiance), 1);
     assert_eq!(engine.executions(Stage::Electrons), 2);
     assert_eq!(engine.executions(Stage::Lut), 1);
+}
+
+#[test]
+fn an_aperture_change_reruns_the_retrieval_but_keeps_its_model() {
+    // The model (SIOP sets and substrates at the bands) reads the bands, not the Rrs: a change of
+    // the photon counts re-runs the pixels with the very same model; a change of the bands'
+    // view (the pixel pitch moves the central column's T_up·Ed) rebuilds it.
+    let mut engine = Engine::new();
+    let mut config = RunConfig::new(small_lake(), small("nominal", 32, 24));
+    config.retrievals = vec![ron::from_str("Almi()").unwrap()];
+    let first = engine.run(&config, &RunControl::new()).unwrap();
+    assert_eq!((engine.executions(Stage::RetrievalModel), engine.executions(Stage::Retrieval)), (1, 1));
+    config.instrument.aperture_mm *= 1.5;
+    let second = engine.run(&config, &RunControl::new()).unwrap();
+    assert_eq!(engine.executions(Stage::RetrievalModel), 1, "the model is kept");
+    assert_eq!(engine.executions(Stage::Retrieval), 2, "the pixels are not");
+    assert_ne!(first.retrievals[0].product.chl_mg_m3, second.retrievals[0].product.chl_mg_m3);
+    // What the kept model gives is what a fresh one gives, bit for bit (NaN included).
+    let fresh = Engine::new().run(&config, &RunControl::new()).unwrap();
+    assert_eq!(format!("{:?}", second.retrievals[0].product), format!("{:?}", fresh.retrievals[0].product));
+    config.instrument.pixel_pitch_um *= 1.1;
+    engine.run(&config, &RunControl::new()).unwrap();
+    assert_eq!(engine.executions(Stage::RetrievalModel), 2, "new bands, a new model");
 }
 
 #[test]
