@@ -151,23 +151,73 @@ impl Scale {
         }
     }
 
+    /// The mean of [`Scale::position`] over a set of values, from their mean `mean_value` and the
+    /// mean `mean_ln` of their `ln(max(v, f64::MIN_POSITIVE))`: the position is affine in `v` on
+    /// a linear scale and in `ln v` on a log scale, so the mean of positions is the position of
+    /// the mean (up to rounding). Lets a map keep block sums and be recoloured without revisiting
+    /// its pixels.
+    #[must_use]
+    pub fn position_of_mean(&self, mean_value: f64, mean_ln: f64) -> f64 {
+        if self.log {
+            let (a, b) = (self.lo.max(f64::MIN_POSITIVE).ln(), self.hi.max(f64::MIN_POSITIVE).ln());
+            if b > a { (mean_ln - a) / (b - a) } else { 0.5 }
+        } else if self.hi > self.lo {
+            (mean_value - self.lo) / (self.hi - self.lo)
+        } else {
+            0.5
+        }
+    }
+
     /// A scale covering the 1st–99th percentiles of the finite (and, for log, positive) values,
     /// logarithmic when they span more than a decade and are all positive.
     #[must_use]
     pub fn robust(values: impl IntoIterator<Item = f64>) -> Self {
         let mut v: Vec<f64> = values.into_iter().filter(|x| x.is_finite()).collect();
-        if v.is_empty() {
+        v.sort_unstable_by(f64::total_cmp);
+        Self::robust_sorted(&[&v])
+    }
+
+    /// [`Scale::robust`] of the union of several ascending slices of finite values (each map's
+    /// sorted sample, kept between redraws), without merging them.
+    #[must_use]
+    pub fn robust_sorted(sorted: &[&[f64]]) -> Self {
+        let n: usize = sorted.iter().map(|s| s.len()).sum();
+        if n == 0 {
             return Self { lo: 0.0, hi: 1.0, log: false };
         }
-        v.sort_by(f64::total_cmp);
-        let at = |q: f64| v[((v.len() - 1) as f64 * q).round() as usize];
+        let at = |q: f64| kth_smallest(sorted, ((n - 1) as f64 * q).round() as usize).unwrap_or(f64::NAN);
         let (lo, hi) = (at(0.01), at(0.99));
-        let positive = v[0] > 0.0;
+        let positive = at(0.0) > 0.0;
         let log = positive && hi > 10.0 * lo;
         let (lo, hi) =
             if hi > lo { (lo, hi) } else { (lo - 0.5 * lo.abs().max(1e-12), hi + 0.5 * hi.abs().max(1e-12)) };
         Self { lo, hi, log }
     }
+}
+
+/// The `k`-th smallest value (0-based) of the union of ascending slices of non-NaN values, without
+/// merging them: `None` when they hold `k` values or fewer. For each slice in turn, a binary
+/// search for the element whose rank in the union brackets `k` (ranks counted with
+/// `partition_point`, so ties are handled): O(m² log² n) for m slices.
+#[must_use]
+pub fn kth_smallest(sorted: &[&[f64]], k: usize) -> Option<f64> {
+    let below = |x: f64| sorted.iter().map(|s| s.partition_point(|v| *v < x)).sum::<usize>();
+    let up_to = |x: f64| sorted.iter().map(|s| s.partition_point(|v| *v <= x)).sum::<usize>();
+    for s in sorted {
+        let (mut lo, mut hi) = (0, s.len());
+        while lo < hi {
+            let mid = lo + (hi - lo) / 2;
+            let x = s[mid];
+            if up_to(x) <= k {
+                lo = mid + 1;
+            } else if below(x) > k {
+                hi = mid;
+            } else {
+                return Some(x);
+            }
+        }
+    }
+    None
 }
 
 /// A tick or axis value as people write it: `digits` significant digits without trailing zeros
@@ -190,6 +240,26 @@ pub fn significant(v: f64, digits: i32) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn kth_of_sorted_slices_is_the_kth_of_their_union() {
+        let a = [0.5, 1.0, 1.0, 4.0];
+        let b = [1.0, 2.0, 3.0];
+        let c: [f64; 0] = [];
+        let mut all: Vec<f64> = a.iter().chain(&b).copied().collect();
+        all.sort_by(f64::total_cmp);
+        for (k, want) in all.iter().enumerate() {
+            assert_eq!(kth_smallest(&[&a, &b, &c], k), Some(*want), "k = {k}");
+        }
+        assert_eq!(kth_smallest(&[&a, &b], all.len()), None);
+        // The same scale as from the values themselves.
+        let v: Vec<f64> = (0..997).map(|i| f64::from(i).mul_add(0.37, 1.0).sin().abs() * 50.0 + 0.01).collect();
+        let (x, y) = v.split_at(400);
+        let (mut x, mut y) = (x.to_vec(), y.to_vec());
+        x.sort_by(f64::total_cmp);
+        y.sort_by(f64::total_cmp);
+        assert_eq!(Scale::robust(v.iter().copied()), Scale::robust_sorted(&[&x, &y]));
+    }
 
     #[test]
     fn ends_and_middle() {

@@ -5,7 +5,8 @@
 //!   plot data, library listing and exports);
 //! - [`Task`], a one-off cancellable job streaming its results from its own pool (the app's
 //!   sweeps and cost measurements);
-//! - [`pool`], the one way Shoal builds a rayon pool (named threads, a bounded size).
+//! - [`pool`], the one way Shoal builds a rayon pool (named threads, a bounded size);
+//! - [`free_later`], dropping a large value on a thread of its own.
 //!
 //! A mailbox is the right shape for interactive work: the producer (the UI thread) never blocks
 //! and never sleeps — `put` replaces whatever request is waiting, which is by construction older
@@ -149,6 +150,16 @@ impl<Req: Send + 'static, Out: Send + 'static> Worker<Req, Out> {
         self.answers.try_recv().ok()
     }
 
+    /// The newest answer, waiting at most `timeout` for one when none is there yet: for an
+    /// owner that has just asked and would rather draw the answer in this frame than one refresh
+    /// later. The wait is bounded, so a slow answer costs the frame `timeout` at most.
+    pub fn latest_within(&self, timeout: std::time::Duration) -> Option<Out> {
+        match self.latest() {
+            Some(a) => Some(a),
+            None => self.answers.recv_timeout(timeout).ok().map(|a| self.latest().unwrap_or(a)),
+        }
+    }
+
     /// The newest answer, dropping older ones not yet taken.
     pub fn latest(&self) -> Option<Out> {
         let mut last = None;
@@ -233,6 +244,14 @@ pub fn pool(threads: usize, name: &'static str) -> std::io::Result<rayon::Thread
         .thread_name(move |i| format!("{name}-{i}"))
         .build()
         .map_err(|e| std::io::Error::other(format!("cannot start the {name} threads: {e}")))
+}
+
+/// Drop `value` on a short-lived thread of its own: for the last handle on a run at full
+/// resolution (its cubes are a gigabyte), whose freeing took 50 ms of a slider's preview when
+/// done on the thread that had replaced it. If no thread can be started, the closure (and the
+/// value with it) is dropped here instead.
+pub fn free_later<T: Send + 'static>(value: T) {
+    let _ = std::thread::Builder::new().name("shoal-free".into()).spawn(move || drop(value));
 }
 
 #[cfg(test)]

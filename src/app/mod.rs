@@ -23,6 +23,7 @@
 //! | seed spread of the metrics | `seeds` |
 
 pub mod bench;
+pub mod blocks;
 mod derived;
 mod dialogs;
 pub mod explore;

@@ -2,11 +2,15 @@
 //! beside the maps, once per (results, variable): a frame only draws them.
 //!
 //! Histograms count every water pixel (the truth) and every returned pixel (A, B) over one
-//! shared set of log10 bins spanning the central 99 % of the values (the rest in the end bins); the scatter plots a strided sample of at most [`SCATTER_POINTS`]
-//! pixels per instrument (enough to show the cloud; egui draws each point every frame).
+//! shared set of log10 bins spanning the central 99 % of the values (the rest in the end bins);
+//! the scatter plots a strided sample of at most [`SCATTER_POINTS`] pixels per instrument
+//! (enough to show the cloud; egui draws each point every frame). Each run's share
+//! ([`RunValues`]) is computed once and kept, so moving a slider of A does not revisit B's
+//! full-resolution pixels.
 
 use std::sync::Arc;
 
+use crate::colormap::kth_smallest;
 use crate::engine::RunOutput;
 
 /// Bins of the histograms.
@@ -51,58 +55,91 @@ fn values(out: &RunOutput, variable: &str, step: usize) -> Vec<(f64, Option<f64>
         .collect()
 }
 
+/// One run's share of the plots of a variable, computed once per run (a redraw after a change
+/// of A reuses B's): the log10 truth of every water pixel with a positive truth and the log10
+/// retrieval of every returned positive pixel, each sorted (so quantiles and bin counts of
+/// several runs come from binary searches), and the scatter sample.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct RunValues {
+    /// log10 truth, ascending.
+    pub truth_log10: Vec<f64>,
+    /// log10 retrieved, ascending.
+    pub retrieved_log10: Vec<f64>,
+    /// (log10 truth, log10 retrieved) of a strided sample of at most [`SCATTER_POINTS`] pixels.
+    pub scatter: Vec<[f64; 2]>,
+}
+
+impl RunValues {
+    /// The values of `variable` in `out`.
+    #[must_use]
+    pub fn of(out: &RunOutput, variable: &str) -> Self {
+        let all = values(out, variable, 1);
+        let mut truth_log10: Vec<f64> = all.iter().map(|(t, _)| t.log10()).collect();
+        let mut retrieved_log10: Vec<f64> = all.iter().filter_map(|(_, g)| g.map(f64::log10)).collect();
+        truth_log10.sort_unstable_by(f64::total_cmp);
+        retrieved_log10.sort_unstable_by(f64::total_cmp);
+        let n = out.radiance.truth.land.len();
+        let scatter = values(out, variable, n / SCATTER_POINTS + 1)
+            .into_iter()
+            .filter_map(|(t, g)| g.map(|g| [t.log10(), g.log10()]))
+            .collect();
+        Self { truth_log10, retrieved_log10, scatter }
+    }
+}
+
 /// The histogram's log10 range: the 0.5th to 99.5th percentile of the truth and retrieved values
-/// (from a strided sample of at most 20 000), so that a few wild retrievals (1e-8 mg m⁻³) do not
-/// squeeze the distribution into two bins; values outside fall into the end bins. The full range
-/// when the percentiles coincide.
-fn bin_range(all: &[Vec<(f64, Option<f64>)>]) -> (f64, f64) {
-    let values = || all.iter().flatten().flat_map(|(t, g)| std::iter::once(*t).chain(*g)).map(f64::log10);
-    let n = values().count();
-    let mut sample: Vec<f64> = values().step_by(n / 20_000 + 1).collect();
-    if sample.is_empty() {
+/// of all runs, so that a few wild retrievals (1e-8 mg m⁻³) do not squeeze the distribution into
+/// two bins; values outside fall into the end bins. The full range when the percentiles
+/// coincide.
+fn bin_range(sorted: &[&[f64]]) -> (f64, f64) {
+    let n: usize = sorted.iter().map(|s| s.len()).sum();
+    if n == 0 {
         return (f64::NAN, f64::NAN);
     }
-    sample.sort_by(f64::total_cmp);
-    let at = |q: f64| sample[((sample.len() - 1) as f64 * q).round() as usize];
+    let at = |q: f64| kth_smallest(sorted, ((n - 1) as f64 * q).round() as usize).unwrap_or(f64::NAN);
     let (lo, hi) = (at(0.005), at(0.995));
-    if hi > lo { (lo, hi) } else { values().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v))) }
+    if hi > lo { (lo, hi) } else { (at(0.0), at(1.0)) }
 }
 
 /// The plot data of `variable` for A's and B's runs.
 #[must_use]
 pub fn plot_data(runs: &[Option<Arc<RunOutput>>; 2], variable: &str) -> PlotData {
-    let all: Vec<Vec<(f64, Option<f64>)>> =
-        runs.iter().map(|r| r.as_ref().map(|o| values(o, variable, 1)).unwrap_or_default()).collect();
-    let (lo, hi) = bin_range(&all);
+    let values = runs.each_ref().map(|r| r.as_ref().map(|o| RunValues::of(o, variable)));
+    combine(variable, [values[0].as_ref(), values[1].as_ref()])
+}
+
+/// The plot data of `variable` from A's and B's [`RunValues`]: bins shared by both, counted by
+/// binary search in the sorted values (the bin of a value is monotone in it).
+#[must_use]
+pub fn combine(variable: &str, runs: [Option<&RunValues>; 2]) -> PlotData {
     let mut out = PlotData { variable: variable.to_string(), ..PlotData::default() };
     for (k, r) in runs.iter().enumerate() {
-        if let Some(o) = r {
-            let n = o.radiance.truth.land.len();
-            out.scatter[k] = values(o, variable, n / SCATTER_POINTS + 1)
-                .into_iter()
-                .filter_map(|(t, g)| g.map(|g| [t.log10(), g.log10()]))
-                .collect();
+        if let Some(r) = r {
+            out.scatter[k].clone_from(&r.scatter);
         }
     }
+    let sorted: Vec<&[f64]> =
+        runs.iter().flatten().flat_map(|r| [r.truth_log10.as_slice(), r.retrieved_log10.as_slice()]).collect();
+    let (lo, hi) = bin_range(&sorted);
     if !(lo.is_finite() && hi > lo) {
         return out;
     }
     let width = (hi - lo) / BINS as f64;
     out.edges_log10 = (0..=BINS).map(|b| lo + width * b as f64).collect();
     // Clamped: values beyond the range count in the end bins.
-    let bin = |v: f64| (((v.log10() - lo) / width).max(0.0) as usize).min(BINS - 1);
-    let first_with_truth = all.iter().position(|v| !v.is_empty());
-    out.truth = vec![0; BINS];
-    if let Some(f) = first_with_truth {
-        for (t, _) in &all[f] {
-            out.truth[bin(*t)] += 1;
-        }
+    let bin = |x: f64| (((x - lo) / width).max(0.0) as usize).min(BINS - 1);
+    let counts = |v: &[f64]| -> Vec<usize> {
+        let ends: Vec<usize> = (1..=BINS).map(|b| v.partition_point(|x| bin(*x) < b)).collect();
+        ends.iter().scan(0, |start, &end| Some(end - std::mem::replace(start, end))).collect()
+    };
+    // The truth of the first run that has one.
+    if let Some(r) = runs.iter().flatten().find(|r| !r.truth_log10.is_empty()) {
+        out.truth = counts(&r.truth_log10);
+    } else {
+        out.truth = vec![0; BINS];
     }
-    for (k, v) in all.iter().enumerate() {
-        out.counts[k] = vec![0; BINS];
-        for g in v.iter().filter_map(|(_, g)| *g) {
-            out.counts[k][bin(g)] += 1;
-        }
+    for (k, r) in runs.iter().enumerate() {
+        out.counts[k] = r.map_or_else(|| vec![0; BINS], |r| counts(&r.retrieved_log10));
     }
     out
 }

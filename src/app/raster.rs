@@ -6,9 +6,10 @@ use std::sync::Arc;
 
 use ndarray::Array2;
 
+use super::blocks::{Blocks, Prepared, palette_sample};
 use super::model::ProductKind;
-use super::plot_data::{PlotData, plot_data};
-use crate::colormap::{Scale, categorical, diverging, viridis};
+use super::plot_data::{PlotData, RunValues, combine};
+use crate::colormap::Scale;
 use crate::engine::RunOutput;
 use crate::instrument::{Detector, DetectorMode};
 use crate::jobs::Worker;
@@ -186,72 +187,37 @@ pub struct Image {
 /// the first row at the bottom (flight direction up). Invalid pixels are transparent grey.
 #[must_use]
 pub fn colorize(map: &MapData, palette: Palette, max_side: usize) -> Image {
-    let (rows, cols) = map.values.dim();
-    let step = rows.max(cols).div_ceil(max_side.max(1)).max(1);
-    let (h, w) = (rows.div_ceil(step).max(1), cols.div_ceil(step).max(1));
-    let mut rgba = vec![0u8; w * h * 4];
-    for y in 0..h {
-        for x in 0..w {
-            let (mut sum, mut n, mut first) = (0.0, 0usize, None);
-            for r in y * step..((y + 1) * step).min(rows) {
-                for c in x * step..((x + 1) * step).min(cols) {
-                    if map.valid[[r, c]] {
-                        let v = f64::from(map.values[[r, c]]);
-                        first.get_or_insert(v);
-                        sum += match palette {
-                            Palette::Sequential(s) => s.position(v),
-                            _ => v,
-                        };
-                        n += 1;
-                    }
-                }
-            }
-            let i = ((h - 1 - y) * w + x) * 4;
-            let colour = if n == 0 {
-                super::theme::NOT_RETURNED
-            } else {
-                let c = match palette {
-                    Palette::Sequential(_) => viridis(sum / n as f64),
-                    Palette::Diverging(bound) => diverging((sum / n as f64) / bound.max(f64::MIN_POSITIVE)),
-                    Palette::Classes => categorical(first.unwrap_or(0.0).max(0.0) as usize),
-                    // Any disagreement in the block shows (a mean above 0).
-                    Palette::Agreement => super::theme::AGREEMENT[usize::from(sum > 0.0)],
-                };
-                [c[0], c[1], c[2], 255]
-            };
-            rgba[i..i + 4].copy_from_slice(&colour);
-        }
-    }
-    Image { width: w, height: h, rgba }
+    Blocks::of(map, max_side).colorize(palette)
 }
 
 /// The palette shared by a set of maps: a robust scale over all valid values (log when they span
 /// a decade), ± the 99th percentile of |value| for differences, or classes.
 #[must_use]
 pub fn shared_palette(maps: &[&MapData], kind: ProductKind, difference: bool) -> Palette {
+    let samples: Vec<Vec<f64>> = maps.iter().map(|m| palette_sample(m)).collect();
+    let refs: Vec<&[f64]> = samples.iter().map(Vec::as_slice).collect();
+    palette_of_samples(&refs, kind, difference)
+}
+
+/// [`shared_palette`] from the maps' [`palette_sample`]s (kept with each map, so a redraw after
+/// a change of A does not revisit B's pixels).
+#[must_use]
+pub fn palette_of_samples(samples: &[&[f64]], kind: ProductKind, difference: bool) -> Palette {
     if kind.categorical() {
         return Palette::Classes;
     }
-    let mut values: Vec<f64> = Vec::new();
-    for m in maps {
-        let step = (m.values.len() / 50_000).max(1);
-        values.extend(
-            m.values.iter().zip(m.valid.iter()).step_by(step).filter(|(_, ok)| **ok).map(|(v, _)| f64::from(*v)),
-        );
-    }
     if difference {
-        let mut abs: Vec<f64> = values.iter().map(|v| v.abs()).filter(|v| v.is_finite()).collect();
-        abs.sort_by(f64::total_cmp);
+        let mut abs: Vec<f64> = samples.iter().flat_map(|s| s.iter()).map(|v| v.abs()).collect();
+        abs.sort_unstable_by(f64::total_cmp);
         let bound = abs.get(abs.len().saturating_sub(1) * 99 / 100).copied().unwrap_or(1.0);
         return Palette::Diverging(if bound > 0.0 { bound } else { 1.0 });
     }
-    let mut scale = Scale::robust(
-        values
-            .iter()
-            .copied()
-            .filter(|v| *v > 0.0 || !matches!(kind, ProductKind::Chl | ProductKind::Nap | ProductKind::Cdom)),
-    );
-    if matches!(kind, ProductKind::Chl | ProductKind::Nap | ProductKind::Cdom) && scale.lo > 0.0 {
+    let concentration = matches!(kind, ProductKind::Chl | ProductKind::Nap | ProductKind::Cdom);
+    // Concentrations are scaled over their positive values only.
+    let kept: Vec<&[f64]> =
+        samples.iter().map(|s| if concentration { &s[s.partition_point(|v| *v <= 0.0)..] } else { *s }).collect();
+    let mut scale = Scale::robust_sorted(&kept);
+    if concentration && scale.lo > 0.0 {
         scale.log = true;
     }
     Palette::Sequential(scale)
@@ -300,12 +266,13 @@ pub struct Done {
     pub plot: Arc<PlotData>,
 }
 
-/// One cached map: its run, product, band, truth flag and the map (`None`: the run has none).
-type CachedMap = (Arc<RunOutput>, ProductKind, usize, bool, Option<Arc<MapData>>);
+/// One cached map: its run, product, band, truth flag, display size and the prepared map (`None`:
+/// the run has none).
+type CachedMap = (Arc<RunOutput>, ProductKind, usize, bool, usize, Option<Arc<Prepared>>);
 
-/// Product maps already extracted, by run (kept alive here, so pointer equality is identity),
-/// product, band and truth, least recently used first: when only A changes, B's map is not
-/// rebuilt.
+/// Product maps already extracted and prepared for display, by run (kept alive here, so pointer
+/// equality is identity), product, band, truth and display size, least recently used first:
+/// when only A changes, B's map is neither rebuilt nor revisited.
 #[derive(Default)]
 pub struct MapCache {
     entries: Vec<CachedMap>,
@@ -316,21 +283,31 @@ impl MapCache {
     /// and all) alive.
     const CAPACITY: usize = 4;
 
-    fn get(&mut self, out: &Arc<RunOutput>, kind: ProductKind, band: usize, truth: bool) -> Option<Arc<MapData>> {
-        if let Some(i) =
-            self.entries.iter().position(|e| Arc::ptr_eq(&e.0, out) && e.1 == kind && e.2 == band && e.3 == truth)
+    fn get(
+        &mut self,
+        out: &Arc<RunOutput>,
+        kind: ProductKind,
+        band: usize,
+        truth: bool,
+        max_side: usize,
+    ) -> Option<Arc<Prepared>> {
+        if let Some(i) = self
+            .entries
+            .iter()
+            .position(|e| Arc::ptr_eq(&e.0, out) && e.1 == kind && e.2 == band && e.3 == truth && e.4 == max_side)
         {
             // Most recently used last: what is shown now stays, old runs leave first.
             let e = self.entries.remove(i);
-            let map = e.4.clone();
+            let map = e.5.clone();
             self.entries.push(e);
             return map;
         }
-        let map = product_map(out, kind, band, truth).map(Arc::new);
+        let map = product_map(out, kind, band, truth).map(|m| Arc::new(Prepared::new(Arc::new(m), max_side)));
         if self.entries.len() == Self::CAPACITY {
-            self.entries.remove(0);
+            // Possibly the last handle on a run at full resolution: freed off this thread.
+            crate::jobs::free_later(self.entries.remove(0));
         }
-        self.entries.push((out.clone(), kind, band, truth, map.clone()));
+        self.entries.push((out.clone(), kind, band, truth, max_side, map.clone()));
         map
     }
 }
@@ -339,9 +316,11 @@ impl MapCache {
 #[must_use]
 pub fn panels(job: &Job, cache: &mut MapCache) -> Done {
     use super::model::Layout;
-    let mut get = |i: usize, truth: bool| job.runs[i].as_ref().and_then(|o| cache.get(o, job.kind, job.band, truth));
+    let mut get = |i: usize, truth: bool| {
+        job.runs[i].as_ref().and_then(|o| cache.get(o, job.kind, job.band, truth, job.max_side))
+    };
     let (a, b) = (get(0, false), get(1, false));
-    let mut named: Vec<(String, Arc<MapData>)> = Vec::new();
+    let mut named: Vec<(String, Arc<Prepared>)> = Vec::new();
     let mut diff = None;
     match job.layout {
         Layout::TruthAB => {
@@ -364,31 +343,60 @@ pub fn panels(job: &Job, cache: &mut MapCache) -> Done {
             }
             if let (Some(a), Some(b), Some(ra), Some(rb)) = (&a, &b, &job.runs[0], &job.runs[1]) {
                 // Classes have no difference: A − B of a class map is where they agree.
-                diff = Some(Arc::new(if job.kind.categorical() {
-                    agreement(a, ra, b, rb)
+                let d = if job.kind.categorical() {
+                    agreement(&a.data, ra, &b.data, rb)
                 } else {
-                    difference(a, ra, b, rb)
-                }));
+                    difference(&a.data, ra, &b.data, rb)
+                };
+                diff = Some(Prepared::new(Arc::new(d), job.max_side));
             }
         }
     }
-    let refs: Vec<&MapData> = named.iter().map(|(_, m)| m.as_ref()).collect();
-    let palette = shared_palette(&refs, job.kind, false);
+    let samples: Vec<&[f64]> = named.iter().map(|(_, m)| m.sample.as_slice()).collect();
+    let palette = palette_of_samples(&samples, job.kind, false);
     let difference_palette = diff.as_ref().map(|d| {
-        if job.kind.categorical() { Palette::Agreement } else { shared_palette(&[d.as_ref()], job.kind, true) }
+        if job.kind.categorical() {
+            Palette::Agreement
+        } else {
+            palette_of_samples(&[d.sample.as_slice()], job.kind, true)
+        }
     });
     let mut panels: Vec<PanelImage> = named
         .into_iter()
-        .map(|(title, data)| PanelImage { image: colorize(&data, palette, job.max_side), title, data })
+        .map(|(title, m)| PanelImage { image: m.blocks.colorize(palette), title, data: m.data.clone() })
         .collect();
     if let (Some(d), Some(p)) = (diff, difference_palette) {
-        panels.push(PanelImage { title: "A − B".into(), image: colorize(&d, p, job.max_side), data: d });
+        panels.push(PanelImage { title: "A − B".into(), image: d.blocks.colorize(p), data: d.data });
     }
     Done { key: job.key, panels, palette, difference_palette, plot: Arc::default() }
 }
 
-/// A's and B's runs.
-type Runs = [Option<Arc<RunOutput>>; 2];
+/// Each run's share of the plots ([`RunValues`]), by run (kept alive here, so pointer equality
+/// is identity) and variable, least recently used first.
+#[derive(Default)]
+struct ValuesCache {
+    entries: Vec<(Arc<RunOutput>, &'static str, Arc<RunValues>)>,
+}
+
+impl ValuesCache {
+    /// A, B and two more (a variable switched back and forth).
+    const CAPACITY: usize = 4;
+
+    fn get(&mut self, out: &Arc<RunOutput>, variable: &'static str) -> Arc<RunValues> {
+        if let Some(i) = self.entries.iter().position(|e| Arc::ptr_eq(&e.0, out) && e.1 == variable) {
+            let e = self.entries.remove(i);
+            let values = e.2.clone();
+            self.entries.push(e);
+            return values;
+        }
+        let values = Arc::new(RunValues::of(out, variable));
+        if self.entries.len() == Self::CAPACITY {
+            crate::jobs::free_later(self.entries.remove(0));
+        }
+        self.entries.push((out.clone(), variable, values.clone()));
+        values
+    }
+}
 
 /// The thread that prepares map panels (and the plots' data) off the UI thread, always on the
 /// newest request (a [`Worker`]: asking never blocks, and a request not yet started is replaced
@@ -397,28 +405,13 @@ pub type RasterThread = Worker<Job, Done>;
 
 /// Start the raster thread; `wake` is called when an answer is ready (to request a repaint).
 pub fn spawn_raster_thread(wake: impl Fn() + Send + 'static) -> std::io::Result<RasterThread> {
-    let mut cache = MapCache::default();
-    // The plot data depend on the runs and the variable only, not on the band or layout. The
-    // cache holds the runs themselves, so their identity cannot be reused by a newer run.
-    let mut last_plot: Option<(Runs, &'static str, Arc<PlotData>)> = None;
+    let mut maps = MapCache::default();
+    let mut values = ValuesCache::default();
     Worker::spawn("shoal-raster", wake, move |job: Job| {
-        let mut done = panels(&job, &mut cache);
+        let mut done = panels(&job, &mut maps);
         let variable = job.kind.variable().unwrap_or("chl_mg_m3");
-        let same = |a: &Option<Arc<RunOutput>>, b: &Option<Arc<RunOutput>>| match (a, b) {
-            (Some(a), Some(b)) => Arc::ptr_eq(a, b),
-            (None, None) => true,
-            _ => false,
-        };
-        done.plot = match &last_plot {
-            Some((runs, v, plot)) if *v == variable && runs.iter().zip(&job.runs).all(|(a, b)| same(a, b)) => {
-                plot.clone()
-            }
-            _ => {
-                let plot = Arc::new(plot_data(&job.runs, variable));
-                last_plot = Some((job.runs.clone(), variable, plot.clone()));
-                plot
-            }
-        };
+        let runs = job.runs.each_ref().map(|r| r.as_ref().map(|o| values.get(o, variable)));
+        done.plot = Arc::new(combine(variable, [runs[0].as_deref(), runs[1].as_deref()]));
         done
     })
 }
@@ -426,6 +419,7 @@ pub fn spawn_raster_thread(wake: impl Fn() + Send + 'static) -> std::io::Result<
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::colormap::viridis;
 
     #[test]
     fn a_substrate_is_one_colour_whatever_order_a_product_lists_it_in() {
