@@ -16,11 +16,7 @@ fn a_gain_change_reruns_only_digitisation_onward() {
     let first = engine.run(&config, &RunControl::new()).unwrap();
     // Every stage ran once, except the retrieval and its model: none is configured.
     let retrieval = |s: Stage| matches!(s, Stage::Retrieval | Stage::RetrievalModel);
-    assert!(
-        Stage::ALL.iter().all(|&s| engine.executions(s) == u64::from(!retrieval(s))),
-        "{:?}",
-        counts(&engine)
-    );
+    assert!(Stage::ALL.iter().all(|&s| engine.executions(s) == u64::from(!retrieval(s))), "{:?}", counts(&engine));
 
     config.instrument.gain_e_per_dn = 2.0;
     let second = engine.run(&config, &RunControl::new()).unwrap();
