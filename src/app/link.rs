@@ -10,6 +10,13 @@ use std::time::{Duration, Instant};
 use crate::engine::worker::{EngineHandle, Event, Request, Wake};
 use crate::engine::{EngineError, RunConfig, RunOutput};
 
+/// The longest the engine waits, after a preview, for its maps to be on screen before it starts
+/// the finer levels (see `EngineHandle::set_preview_pause`). Turning a preview into images takes
+/// a few ms beside B at full resolution; run while the finer level took both cores, it took
+/// 5–16 ms and the maps came a frame later. A frame and a half: if the app draws no frames
+/// (minimised), refinement is late by this much at most.
+const PREVIEW_PAUSE: Duration = Duration::from_millis(25);
+
 /// A result on display.
 #[derive(Debug, Clone)]
 pub struct Shown {
@@ -58,8 +65,10 @@ pub struct EngineLink {
 impl EngineLink {
     /// Start the engine thread with `threads` rayon threads; it calls `wake` after each event.
     pub fn new(threads: usize, wake: Wake) -> std::io::Result<Self> {
+        let handle = EngineHandle::spawn_with_wake(threads, wake)?;
+        handle.set_preview_pause(PREVIEW_PAUSE);
         Ok(Self {
-            handle: EngineHandle::spawn_with_wake(threads, wake)?,
+            handle,
             generation: 0,
             submitted: Vec::new(),
             decimations: Vec::new(),
@@ -136,7 +145,10 @@ impl EngineLink {
                                 Some(s) => s.generation < generation || s.decimation >= decimation,
                             };
                             if replace {
-                                self.shown[index] = Some(Shown { generation, decimation, output });
+                                // The run replaced may hold the last handle on full-resolution
+                                // cubes: freed off the UI thread.
+                                let old = self.shown[index].replace(Shown { generation, decimation, output });
+                                crate::jobs::free_later(old);
                                 changed = true;
                                 if self.latency_pending
                                     && self
@@ -165,6 +177,14 @@ impl EngineLink {
             }
         }
         changed
+    }
+
+    /// The maps of what is shown are on screen: if that is the current generation's preview, the
+    /// engine (paused for it) goes on to the finer levels.
+    pub fn maps_on_screen(&self) {
+        if self.shown.iter().all(|s| s.as_ref().is_some_and(|s| s.generation == self.generation)) {
+            self.handle.preview_shown(self.generation);
+        }
     }
 
     /// Is the engine still working on the current generation?

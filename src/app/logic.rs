@@ -6,6 +6,9 @@
 use std::path::PathBuf;
 use std::time::Duration;
 
+/// The longest a frame waits for the images of a result it has just taken (see `tick`).
+const RASTER_WAIT: Duration = Duration::from_millis(6);
+
 use super::model::{Ab, AppState, ProductKind, RetrievalKind, Slot};
 use super::{Confirm, ShoalApp, model};
 use crate::library::{Entry, LibraryError};
@@ -182,9 +185,18 @@ impl ShoalApp {
             }
         }
         if let Some(r) = &self.raster {
-            self.images.request(&self.state, &self.link, r);
-            if let Some(done) = r.latest() {
+            // A new result's images are waited for briefly, so that they appear in the frame that
+            // took the result rather than one refresh (16.7 ms) later: recolouring A's preview
+            // beside B at full resolution takes a few ms from the kept block sums (`blocks`).
+            // The wait is capped, so a slower answer (B's first full-resolution maps) only
+            // costs this frame the cap and arrives with a later frame.
+            let asked = self.images.request(&self.state, &self.link, r);
+            let answer = if asked { r.latest_within(RASTER_WAIT) } else { r.latest() };
+            if let Some(done) = answer {
                 self.images.receive(ctx, done);
+            }
+            if self.images.ready() {
+                self.link.maps_on_screen();
             }
         }
         while let Some(news) = self.ui.exports.poll() {

@@ -64,8 +64,9 @@ impl Images {
         self.requested.is_some() && self.requested == self.shown
     }
 
-    /// Ask the raster thread for the images of the current state, if not already asked.
-    pub fn request(&mut self, state: &AppState, link: &EngineLink, raster: &RasterThread) {
+    /// Ask the raster thread for the images of the current state, if not already asked; true
+    /// when this call asked.
+    pub fn request(&mut self, state: &AppState, link: &EngineLink, raster: &RasterThread) -> bool {
         let mut h = DefaultHasher::new();
         state.product.hash(&mut h);
         state.band.hash(&mut h);
@@ -77,16 +78,18 @@ impl Images {
         }
         let key = h.finish();
         if self.requested == Some(key) {
-            return;
+            return false;
         }
         let runs = [link.shown[0].as_ref().map(|s| s.output.clone()), link.shown[1].as_ref().map(|s| s.output.clone())];
         if runs.iter().all(Option::is_none) {
-            return;
+            return false;
         }
         let job = Job { key, runs, kind: state.product, band: state.band, layout: state.layout, max_side: 720 };
-        if !matches!(raster.request(job), crate::jobs::Put::Closed(_)) {
-            self.requested = Some(key);
+        if matches!(raster.request(job), crate::jobs::Put::Closed(_)) {
+            return false;
         }
+        self.requested = Some(key);
+        true
     }
 
     /// Upload the raster thread's answer if it is the newest.

@@ -110,7 +110,21 @@ pub struct EngineHandle {
     events: Receiver<Event>,
     latest: Arc<AtomicU64>,
     counters: Arc<Counters>,
+    pause: Arc<PreviewPause>,
     thread: Option<JoinHandle<()>>,
+}
+
+/// The pause between a request's preview and its finer levels, for an owner that draws the
+/// preview: the engine waits until the owner says the preview is on screen
+/// ([`EngineHandle::preview_shown`]), a newer request arrives, or `limit` passes, whichever is
+/// first. Without it the finer run starts at once and takes every core while the owner is
+/// turning the preview into images, which then come a frame or two later. Off (zero) unless set.
+#[derive(Debug, Default)]
+struct PreviewPause {
+    /// The longest wait, µs (0: no pause).
+    limit_us: AtomicU64,
+    /// The newest generation whose preview the owner has on screen.
+    shown: AtomicU64,
 }
 
 impl EngineHandle {
@@ -129,13 +143,30 @@ impl EngineHandle {
         let worker_latest = latest.clone();
         let counters = Arc::new(Counters::default());
         let worker_counters = counters.clone();
+        let pause = Arc::new(PreviewPause::default());
+        let worker_pause = pause.clone();
         let pool = crate::jobs::pool(threads.max(1), "shoal-engine")?;
         let thread = std::thread::Builder::new().name("shoal-engine".into()).spawn(move || {
-            worker(&worker_requests, &event_tx, &worker_latest, &worker_counters, &pool, &wake);
+            let link = Link { events: &event_tx, latest: &worker_latest, counters: &worker_counters, wake: &wake };
+            worker(&worker_requests, &link, &worker_pause, &pool);
             // However the worker ended, later submissions are refused rather than left waiting.
             worker_requests.close();
         })?;
-        Ok(Self { requests, events: event_rx, latest, counters, thread: Some(thread) })
+        Ok(Self { requests, events: event_rx, latest, counters, pause, thread: Some(thread) })
+    }
+
+    /// Pause up to `limit` between a request's coarsest level and its finer ones, until
+    /// [`EngineHandle::preview_shown`] (zero: no pause, the default).
+    pub fn set_preview_pause(&self, limit: Duration) {
+        self.pause.limit_us.store(u64::try_from(limit.as_micros()).unwrap_or(u64::MAX), Ordering::SeqCst);
+    }
+
+    /// The preview of `generation` is on screen: a paused engine goes on to the finer levels.
+    pub fn preview_shown(&self, generation: u64) {
+        self.pause.shown.fetch_max(generation, Ordering::SeqCst);
+        if let Some(t) = &self.thread {
+            t.thread().unpark();
+        }
     }
 
     /// Submit a configuration snapshot; any run of an older generation is cancelled. Returns
@@ -245,14 +276,29 @@ impl Drop for EngineHandle {
     }
 }
 
-fn worker(
-    requests: &Mailbox<Request>,
-    events: &SyncSender<Event>,
-    latest: &Arc<AtomicU64>,
-    counters: &Counters,
-    pool: &rayon::ThreadPool,
-    wake: &Wake,
-) {
+/// The worker's ends of the handle.
+struct Link<'a> {
+    events: &'a SyncSender<Event>,
+    latest: &'a Arc<AtomicU64>,
+    counters: &'a Counters,
+    wake: &'a Wake,
+}
+
+/// Wait, after `generation`'s preview, until it is on screen, a newer generation arrives or the
+/// pause's limit passes.
+fn pause_after_preview(pause: &PreviewPause, latest: &AtomicU64, generation: u64) {
+    let limit = Duration::from_micros(pause.limit_us.load(Ordering::SeqCst));
+    let start = std::time::Instant::now();
+    while pause.shown.load(Ordering::SeqCst) < generation && latest.load(Ordering::SeqCst) == generation {
+        let Some(left) = limit.checked_sub(start.elapsed()).filter(|d| !d.is_zero()) else { return };
+        // Parked: `preview_shown` and `submit` (through the generation check after at most 2 ms)
+        // end the wait early.
+        std::thread::park_timeout(left.min(Duration::from_millis(2)));
+    }
+}
+
+fn worker(requests: &Mailbox<Request>, link: &Link<'_>, pause: &PreviewPause, pool: &rayon::ThreadPool) {
+    let Link { events, latest, counters, wake } = *link;
     let mut engine = Engine::new();
     // The mailbox holds only the newest request: an older one was replaced (and counted) there.
     while let Some(request) = requests.take() {
@@ -260,7 +306,10 @@ fn worker(
         // broken instrument does not hide the other's results).
         let mut failed = vec![false; request.configs.len()];
         let mut started = false;
-        'decimations: for &decimation in &request.decimations {
+        'decimations: for (level, &decimation) in request.decimations.iter().enumerate() {
+            if level == 1 && started {
+                pause_after_preview(pause, latest, request.generation);
+            }
             for (index, base) in request.configs.iter().enumerate() {
                 let Some(base) = base else { continue };
                 if failed[index] {

@@ -147,3 +147,44 @@ fn a_and_b_run_at_each_level_before_the_next() {
     }
     assert_eq!(order, vec![(4, 0), (4, 1), (1, 0), (1, 1)]);
 }
+
+/// The first event of `handle` that is a finished run, within `timeout`.
+fn next_finished(handle: &EngineHandle, timeout: Duration) -> Option<(u64, usize)> {
+    let deadline = Instant::now() + timeout;
+    while Instant::now() < deadline {
+        if let Some(Event::Finished { generation, decimation, .. }) = handle.wait(Duration::from_millis(100)) {
+            return Some((generation, decimation));
+        }
+    }
+    None
+}
+
+#[test]
+fn after_a_preview_the_engine_waits_until_it_is_on_screen() {
+    // With a pause far longer than the test's timeouts, the finer level can only come because
+    // the owner said the preview is shown, or because a newer request ended the wait.
+    let handle = EngineHandle::spawn(1).unwrap();
+    handle.set_preview_pause(Duration::from_secs(600));
+    let config = RunConfig::new(small_lake(), small("nominal", 32, 24));
+    let request = |generation, gain| {
+        let mut c = config.clone();
+        c.instrument.gain_e_per_dn = gain;
+        Request { generation, configs: vec![Some(c)], decimations: vec![4, 1] }
+    };
+    assert!(handle.submit(request(1, 3.0)));
+    assert_eq!(next_finished(&handle, Duration::from_secs(60)), Some((1, 4)));
+    let shown = Instant::now();
+    handle.preview_shown(1);
+    assert_eq!(next_finished(&handle, Duration::from_secs(60)), Some((1, 1)), "shown: refined");
+    let full = shown.elapsed();
+
+    assert!(handle.submit(request(2, 2.5)));
+    assert_eq!(next_finished(&handle, Duration::from_secs(60)), Some((2, 4)));
+    // Not shown: nothing comes in three times what the finer level took once it was shown.
+    assert_eq!(next_finished(&handle, 3 * full + Duration::from_millis(500)), None, "paused ({full:?})");
+    // A newer request ends the wait and runs at once.
+    assert!(handle.submit(request(3, 2.0)));
+    assert_eq!(next_finished(&handle, Duration::from_secs(60)), Some((3, 4)), "the newer preview");
+    handle.preview_shown(3);
+    assert_eq!(next_finished(&handle, Duration::from_secs(60)), Some((3, 1)));
+}
