@@ -25,10 +25,12 @@
 //! | `Level1` | Level-0, calibration | calibrated radiance |
 //! | `Correction` | Level-1, band atmosphere | Rrs, flags, per-scene approximation |
 //! | `Snr` | detector, typical radiance | analytic and measured SNR |
-//! | `Retrieval` | Rrs, band atmosphere, noise, retrieval settings | products and their metrics |
+//! | `RetrievalModel` | band atmosphere, retrieval settings, scene SIOP and substrates | SIOP sets and substrates at the bands |
+//! | `Retrieval` | Rrs, retrieval model, noise, retrieval settings | products and their metrics |
 //!
 //! Changing the gain re-runs `Detector`, `Feasibility`, `Level0`, `Calibration`, `Level1`,
-//! `Correction` and `Snr`, never the scene, the atmosphere or the photon counts. Effects a scene does not ask for
+//! `Correction`, `Snr` and a configured `Retrieval` (not its model), never the scene, the
+//! atmosphere or the photon counts. Effects a scene does not ask for
 //! are never computed and the report lists them as skipped. [`worker`] runs the engine on its own
 //! thread with its own rayon pool for the app.
 
