@@ -18,7 +18,9 @@ pub const BINS: usize = 30;
 /// Scatter points per instrument, at most.
 pub const SCATTER_POINTS: usize = 4000;
 
-/// What the histogram and scatter plots draw.
+/// What the histogram and scatter plots draw. The histograms are drawn as shares of each run's
+/// water pixels ([`PlotData::percent`]): A at a 1/24 preview beside B at full resolution has
+/// ~600 times fewer pixels, and as counts its bars would not show.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct PlotData {
     /// The variable (`chl_mg_m3`).
@@ -29,8 +31,21 @@ pub struct PlotData {
     pub truth: Vec<usize>,
     /// A's and B's counts per bin (returned pixels).
     pub counts: [Vec<usize>; 2],
+    /// A's and B's water pixels with a positive truth: what their counts are shares of (a
+    /// preview and a full-resolution run have very different numbers of pixels).
+    pub pixels: [usize; 2],
+    /// The water pixels of the run the truth histogram comes from.
+    pub truth_pixels: usize,
     /// A's and B's (log10 truth, log10 retrieved) samples.
     pub scatter: [Vec<[f64; 2]>; 2],
+}
+
+impl PlotData {
+    /// `count` as a percentage of `pixels` (0 when there are none).
+    #[must_use]
+    pub fn percent(count: usize, pixels: usize) -> f64 {
+        if pixels == 0 { 0.0 } else { 100.0 * count as f64 / pixels as f64 }
+    }
 }
 
 /// Water pixels with a positive truth and, for the retrieval, a returned positive value:
@@ -116,6 +131,7 @@ pub fn combine(variable: &str, runs: [Option<&RunValues>; 2]) -> PlotData {
     for (k, r) in runs.iter().enumerate() {
         if let Some(r) = r {
             out.scatter[k].clone_from(&r.scatter);
+            out.pixels[k] = r.truth_log10.len();
         }
     }
     let sorted: Vec<&[f64]> =
@@ -135,6 +151,7 @@ pub fn combine(variable: &str, runs: [Option<&RunValues>; 2]) -> PlotData {
     // The truth of the first run that has one.
     if let Some(r) = runs.iter().flatten().find(|r| !r.truth_log10.is_empty()) {
         out.truth = counts(&r.truth_log10);
+        out.truth_pixels = r.truth_log10.len();
     } else {
         out.truth = vec![0; BINS];
     }

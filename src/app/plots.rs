@@ -240,19 +240,29 @@ fn histogram(app: &ShoalApp, ui: &mut egui::Ui, width: f32) -> egui::Rect {
             .height(plot_height(ui))
             .x_axis_label(format!("{name} ({unit}), log scale"))
             .x_axis_formatter(|mark, _| decade(mark.value))
-            .y_axis_label("pixels")
+            .y_axis_label("% of water pixels")
             .show(ui, |p| {
                 if edges.len() < 2 {
                     return;
                 }
                 let centre = |b: usize| 0.5 * (edges[b] + edges[b + 1]);
                 let bw = (edges[1] - edges[0]) * 0.45;
-                let line: Vec<[f64; 2]> = data.truth.iter().enumerate().map(|(b, n)| [centre(b), *n as f64]).collect();
+                // Shares of each run's own water pixels: a preview beside a full-resolution run
+                // compares as a distribution (A's bars sum to its returned %).
+                let line: Vec<[f64; 2]> = data
+                    .truth
+                    .iter()
+                    .enumerate()
+                    .map(|(b, n)| [centre(b), PlotData::percent(*n, data.truth_pixels)])
+                    .collect();
                 p.line(Line::new("truth", PlotPoints::from(line)).color(theme::TRUTH).width(2.0));
                 for (i, c) in data.counts.iter().enumerate() {
                     let offset = if i == 0 { -0.5 * bw } else { 0.5 * bw };
-                    let bars: Vec<Bar> =
-                        c.iter().enumerate().map(|(b, n)| Bar::new(centre(b) + offset, *n as f64).width(bw)).collect();
+                    let bars: Vec<Bar> = c
+                        .iter()
+                        .enumerate()
+                        .map(|(b, n)| Bar::new(centre(b) + offset, PlotData::percent(*n, data.pixels[i])).width(bw))
+                        .collect();
                     p.bar_chart(BarChart::new(if i == 0 { "A" } else { "B" }, bars).color(theme::INSTRUMENT[i]));
                 }
             });

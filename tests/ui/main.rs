@@ -432,7 +432,7 @@ fn a_shallow_scene_under_alm_shows_a_banner_whose_button_switches_to_sambuca() {
 /// that span the central 99 % of the values; the scatter is a sample no bigger than its cap.
 #[test]
 fn the_histograms_count_every_returned_pixel_and_the_scatter_is_a_capped_sample() {
-    use shoal::app::plot_data::{BINS, SCATTER_POINTS, plot_data};
+    use shoal::app::plot_data::{BINS, PlotData, SCATTER_POINTS, plot_data};
     let mut config = AppState::default().configs().remove(0);
     config.fidelity.decimation = 8;
     let out = std::sync::Arc::new(
@@ -461,6 +461,11 @@ fn the_histograms_count_every_returned_pixel_and_the_scatter_is_a_capped_sample(
     assert_eq!(data.truth.iter().sum::<usize>(), with_truth);
     assert_eq!(data.counts[0].iter().sum::<usize>(), returned);
     assert_eq!(data.counts[1].iter().sum::<usize>(), 0, "no B run");
+    // Drawn as shares of each run's water pixels (a preview beside a full-resolution run): the
+    // truth's shares sum to 100 %, A's to its returned %.
+    assert_eq!((data.pixels, data.truth_pixels), ([with_truth, 0], with_truth));
+    let share: f64 = data.counts[0].iter().map(|n| PlotData::percent(*n, data.pixels[0])).sum();
+    assert!((share - 100.0 * returned as f64 / with_truth as f64).abs() < 1e-9, "{share}");
     assert_eq!(data.edges_log10.len(), BINS + 1);
     // The bins span the central 99 % of the values (outliers in the end bins): inside the full
     // range, and holding at least 98 % of the truth.
