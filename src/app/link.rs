@@ -147,8 +147,9 @@ impl EngineLink {
                             if replace {
                                 // The run replaced may hold the last handle on full-resolution
                                 // cubes: freed off the UI thread.
-                                let old = self.shown[index].replace(Shown { generation, decimation, output });
-                                crate::jobs::free_later(old);
+                                if let Some(old) = self.shown[index].replace(Shown { generation, decimation, output }) {
+                                    crate::jobs::free_later(old);
+                                }
                                 changed = true;
                                 if self.latency_pending
                                     && self
@@ -179,10 +180,14 @@ impl EngineLink {
         changed
     }
 
-    /// The maps of what is shown are on screen: if that is the current generation's preview, the
-    /// engine (paused for it) goes on to the finer levels.
+    /// The maps of what is shown are on screen: if that is the current generation's preview (an
+    /// instrument whose run failed counts as shown: its error is), the engine (paused for it)
+    /// goes on to the finer levels.
     pub fn maps_on_screen(&self) {
-        if self.shown.iter().all(|s| s.as_ref().is_some_and(|s| s.generation == self.generation)) {
+        let current = |i: usize| {
+            self.errors[i].is_some() || self.shown[i].as_ref().is_some_and(|s| s.generation == self.generation)
+        };
+        if current(0) && current(1) {
             self.handle.preview_shown(self.generation);
         }
     }

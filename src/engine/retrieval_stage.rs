@@ -59,10 +59,13 @@ impl Engine {
                 view_zenith_rad: l.geometry.view_zenith_rad,
             })
             .collect();
-        let fail = |e: RetrievalError| match e {
-            RetrievalError::Cancelled => EngineError::Cancelled,
-            other => EngineError::Failed { stage: Stage::Retrieval, message: other.to_string() },
+        let fail_in = |stage: Stage| {
+            move |e: RetrievalError| match e {
+                RetrievalError::Cancelled => EngineError::Cancelled,
+                other => EngineError::Failed { stage, message: other.to_string() },
+            }
         };
+        let fail = fail_in(Stage::Retrieval);
         let scene_siop = side.scene.spec.siop.load(side.scene.base_dir.as_deref()).map_err(|e| fail(e.into()))?;
         let scene_substrates: Vec<String> = side.scene.spec.substrates.iter().map(|s| s.name.clone()).collect();
         let mut out = Vec::with_capacity(config.retrievals.len());
@@ -89,7 +92,8 @@ impl Engine {
             // geometry), the directory is added.
             let model_key =
                 KeyBuilder::new(Stage::RetrievalModel).after(side.band_key).with(spec).with(&config.scene_dir).finish();
-            let model = self.stage(model_key, report, control, || prepare(spec, &inputs).map_err(fail))?;
+            let model = self
+                .stage(model_key, report, control, || prepare(spec, &inputs).map_err(fail_in(Stage::RetrievalModel)))?;
             let result = self.stage(key, report, control, || {
                 let product = invert(spec, &model, &inputs, control).map_err(fail)?;
                 let metrics = evaluate(&product, &radiance.truth);
