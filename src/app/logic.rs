@@ -6,12 +6,12 @@
 use std::path::PathBuf;
 use std::time::Duration;
 
-/// The longest a frame waits for the images of a result it has just taken (see `tick`).
-const RASTER_WAIT: Duration = Duration::from_millis(6);
-
 use super::model::{Ab, AppState, ProductKind, RetrievalKind, Slot};
 use super::{Confirm, ShoalApp, model};
 use crate::library::{Entry, LibraryError};
+
+/// The longest a frame waits for the images of a result it has just taken (see `tick`).
+const RASTER_WAIT: Duration = Duration::from_millis(6);
 
 /// Something a panel asked for, applied after the frame.
 #[derive(Debug, Clone)]

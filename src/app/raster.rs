@@ -266,24 +266,48 @@ pub struct Done {
     pub plot: Arc<PlotData>,
 }
 
-/// One cached map: its run, product, band, truth flag, display size and the prepared map (`None`:
-/// the run has none).
-type CachedMap = (Arc<RunOutput>, ProductKind, usize, bool, usize, Option<Arc<Prepared>>);
-
-/// Product maps already extracted and prepared for display, by run (kept alive here, so pointer
-/// equality is identity), product, band, truth and display size, least recently used first:
-/// when only A changes, B's map is neither rebuilt nor revisited.
-#[derive(Default)]
-pub struct MapCache {
-    entries: Vec<CachedMap>,
+/// Products derived from runs, by run (kept alive here, so pointer equality is identity) and a
+/// key, least recently used first: when only A changes, B's products are neither rebuilt nor
+/// revisited. Few entries, because each keeps its run (cubes and all) alive.
+pub struct ByRun<K, V> {
+    entries: Vec<(Arc<RunOutput>, K, V)>,
 }
 
-impl MapCache {
-    /// Maps kept: A, A's truth, B and one more. Few, because each entry keeps its run (cubes
-    /// and all) alive.
+impl<K, V> Default for ByRun<K, V> {
+    fn default() -> Self {
+        Self { entries: Vec::new() }
+    }
+}
+
+impl<K: PartialEq + Send + 'static, V: Clone + Send + 'static> ByRun<K, V> {
+    /// Entries kept: A, A's truth, B and one more.
     const CAPACITY: usize = 4;
 
-    fn get(
+    /// The product of `out` under `key`, made by `make` if not kept.
+    fn get(&mut self, out: &Arc<RunOutput>, key: K, make: impl FnOnce() -> V) -> V {
+        if let Some(i) = self.entries.iter().position(|e| Arc::ptr_eq(&e.0, out) && e.1 == key) {
+            // Most recently used last: what is shown now stays, old runs leave first.
+            let e = self.entries.remove(i);
+            let value = e.2.clone();
+            self.entries.push(e);
+            return value;
+        }
+        let value = make();
+        if self.entries.len() == Self::CAPACITY {
+            // Possibly the last handle on a run at full resolution: freed off this thread.
+            crate::jobs::free_later(self.entries.remove(0));
+        }
+        self.entries.push((out.clone(), key, value.clone()));
+        value
+    }
+}
+
+/// Maps prepared for display, by run and (product, band, truth, display size); `None`: the run
+/// has no such product.
+pub type MapCache = ByRun<(ProductKind, usize, bool, usize), Option<Arc<Prepared>>>;
+
+impl MapCache {
+    fn map(
         &mut self,
         out: &Arc<RunOutput>,
         kind: ProductKind,
@@ -291,24 +315,9 @@ impl MapCache {
         truth: bool,
         max_side: usize,
     ) -> Option<Arc<Prepared>> {
-        if let Some(i) = self
-            .entries
-            .iter()
-            .position(|e| Arc::ptr_eq(&e.0, out) && e.1 == kind && e.2 == band && e.3 == truth && e.4 == max_side)
-        {
-            // Most recently used last: what is shown now stays, old runs leave first.
-            let e = self.entries.remove(i);
-            let map = e.5.clone();
-            self.entries.push(e);
-            return map;
-        }
-        let map = product_map(out, kind, band, truth).map(|m| Arc::new(Prepared::new(Arc::new(m), max_side)));
-        if self.entries.len() == Self::CAPACITY {
-            // Possibly the last handle on a run at full resolution: freed off this thread.
-            crate::jobs::free_later(self.entries.remove(0));
-        }
-        self.entries.push((out.clone(), kind, band, truth, max_side, map.clone()));
-        map
+        self.get(out, (kind, band, truth, max_side), || {
+            product_map(out, kind, band, truth).map(|m| Arc::new(Prepared::new(Arc::new(m), max_side)))
+        })
     }
 }
 
@@ -317,7 +326,7 @@ impl MapCache {
 pub fn panels(job: &Job, cache: &mut MapCache) -> Done {
     use super::model::Layout;
     let mut get = |i: usize, truth: bool| {
-        job.runs[i].as_ref().and_then(|o| cache.get(o, job.kind, job.band, truth, job.max_side))
+        job.runs[i].as_ref().and_then(|o| cache.map(o, job.kind, job.band, truth, job.max_side))
     };
     let (a, b) = (get(0, false), get(1, false));
     let mut named: Vec<(String, Arc<Prepared>)> = Vec::new();
@@ -371,33 +380,6 @@ pub fn panels(job: &Job, cache: &mut MapCache) -> Done {
     Done { key: job.key, panels, palette, difference_palette, plot: Arc::default() }
 }
 
-/// Each run's share of the plots ([`RunValues`]), by run (kept alive here, so pointer equality
-/// is identity) and variable, least recently used first.
-#[derive(Default)]
-struct ValuesCache {
-    entries: Vec<(Arc<RunOutput>, &'static str, Arc<RunValues>)>,
-}
-
-impl ValuesCache {
-    /// A, B and two more (a variable switched back and forth).
-    const CAPACITY: usize = 4;
-
-    fn get(&mut self, out: &Arc<RunOutput>, variable: &'static str) -> Arc<RunValues> {
-        if let Some(i) = self.entries.iter().position(|e| Arc::ptr_eq(&e.0, out) && e.1 == variable) {
-            let e = self.entries.remove(i);
-            let values = e.2.clone();
-            self.entries.push(e);
-            return values;
-        }
-        let values = Arc::new(RunValues::of(out, variable));
-        if self.entries.len() == Self::CAPACITY {
-            crate::jobs::free_later(self.entries.remove(0));
-        }
-        self.entries.push((out.clone(), variable, values.clone()));
-        values
-    }
-}
-
 /// The thread that prepares map panels (and the plots' data) off the UI thread, always on the
 /// newest request (a [`Worker`]: asking never blocks, and a request not yet started is replaced
 /// by a newer one).
@@ -406,11 +388,15 @@ pub type RasterThread = Worker<Job, Done>;
 /// Start the raster thread; `wake` is called when an answer is ready (to request a repaint).
 pub fn spawn_raster_thread(wake: impl Fn() + Send + 'static) -> std::io::Result<RasterThread> {
     let mut maps = MapCache::default();
-    let mut values = ValuesCache::default();
+    // Each run's share of the plots, by variable.
+    let mut values = ByRun::<&'static str, Arc<RunValues>>::default();
     Worker::spawn("shoal-raster", wake, move |job: Job| {
         let mut done = panels(&job, &mut maps);
         let variable = job.kind.variable().unwrap_or("chl_mg_m3");
-        let runs = job.runs.each_ref().map(|r| r.as_ref().map(|o| values.get(o, variable)));
+        let runs = job
+            .runs
+            .each_ref()
+            .map(|r| r.as_ref().map(|o| values.get(o, variable, || Arc::new(RunValues::of(o, variable)))));
         done.plot = Arc::new(combine(variable, [runs[0].as_deref(), runs[1].as_deref()]));
         done
     })

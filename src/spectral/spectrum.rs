@@ -76,10 +76,7 @@ impl Spectrum {
         /// so each (file, column) is parsed once per process: parsing them was nearly all of the
         /// 1.6 ms each SIOP set took to resolve, eight sets per retrieval model.
         static PARSED: std::sync::Mutex<Vec<(&'static str, String, Spectrum)>> = std::sync::Mutex::new(Vec::new());
-        let asset = crate::assets::find(path).ok_or_else(|| SpectralError::UnknownAsset {
-            name: path.to_string(),
-            known: crate::assets::paths().collect::<Vec<_>>().join(", "),
-        })?;
+        let asset = Table::asset(path)?;
         let lock = || PARSED.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
         if let Some((_, _, s)) = lock().iter().find(|(p, c, _)| *p == asset.path && c == column) {
             return Ok(s.clone());

@@ -93,11 +93,17 @@ impl Table {
 
     /// Parse an embedded asset (path relative to `assets/`).
     pub fn from_asset(path: &str) -> Result<Self, SpectralError> {
-        let asset = crate::assets::find(path).ok_or_else(|| SpectralError::UnknownAsset {
+        let asset = Self::asset(path)?;
+        Self::parse(asset.text, asset.path)
+    }
+
+    /// The embedded asset `path` (its use recorded for the provenance list), or an error listing
+    /// the known ones.
+    pub(crate) fn asset(path: &str) -> Result<&'static crate::assets::Asset, SpectralError> {
+        crate::assets::find(path).ok_or_else(|| SpectralError::UnknownAsset {
             name: path.to_string(),
             known: crate::assets::paths().collect::<Vec<_>>().join(", "),
-        })?;
-        Self::parse(asset.text, asset.path)
+        })
     }
 
     /// Read a table from a file on disk.
