@@ -277,6 +277,13 @@ pub fn sample_radiance(
             if control.cancelled() {
                 return Err(InstrumentError::Cancelled);
             }
+            // Written before it is read: the zeroed allocation is still unmapped, so this first
+            // touch maps fresh pages. Read first (the `+=` of `pixel`), each page would map the
+            // kernel's shared zero page and then be copied on the first write, with a TLB flush
+            // sent to every core (an inter-processor interrupt, a VM exit here): 8 % of the
+            // default study's CPU time, measured with perf.
+            rad_block.fill(0.0);
+            rrs_block.fill(0.0);
             let first_row = bi * block;
             let n_rows = land_block.len() / cols.max(1);
             let sampler = PixelSampler { scene, optics, viewing, response, atmosphere, kernel, offsets: &offsets };
