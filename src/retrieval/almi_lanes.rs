@@ -119,6 +119,18 @@ fn det3_lanes(c: &[[&Lanes; 3]; 3]) -> Lanes {
     })
 }
 
+/// Component `j` of the solution of `rows`·x = `bs` by Cramer's rule (`det` = det(rows)), lane
+/// by lane as [`nnls3`] computes it. (A function, not a closure: the closure was left out of line.)
+#[inline(always)]
+fn cramer(rows: &[[&Lanes; 3]; 3], bs: &[Lanes; 3], det: &Lanes, j: usize) -> Lanes {
+    let mut c = *rows;
+    for (i, row) in c.iter_mut().enumerate() {
+        row[j] = &bs[i];
+    }
+    let num = det3_lanes(&c);
+    lanewise(|s| num[s] / det[s])
+}
+
 impl Normal {
     /// Every lane's NNLS, lane-wise: [`nnls3`]'s column scaling, Cramer solves, residuals and
     /// unscaling, the same operations in the same order, so the same bits. When the
@@ -161,15 +173,7 @@ impl Normal {
         // The full support by Cramer's rule.
         let rows = [[at(0, 0), at(0, 1), at(0, 2)], [at(1, 0), at(1, 1), at(1, 2)], [at(2, 0), at(2, 1), at(2, 2)]];
         let det = det3_lanes(&rows);
-        let cramer = |j: usize| {
-            let mut c = rows;
-            for (i, row) in c.iter_mut().enumerate() {
-                row[j] = &bs[i];
-            }
-            let num = det3_lanes(&c);
-            lanewise(|s| num[s] / det[s])
-        };
-        let full: [Lanes; 3] = [cramer(0), cramer(1), cramer(2)];
+        let full: [Lanes; 3] = [cramer(&rows, &bs, &det, 0), cramer(&rows, &bs, &det, 1), cramer(&rows, &bs, &det, 2)];
         let solvable: [bool; LANES] = lanewise(|s| det[s].abs() > MIN_DET);
         let fast: [bool; LANES] = lanewise(|s| regular[s] && solvable[s] && feasible(&full, s));
         let unscale =
