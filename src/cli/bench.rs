@@ -26,6 +26,16 @@ use crate::spectral::{BandSet, BandSetSpec, WavelengthGrid};
 use crate::validation::{Comparison, compare_paths, compare_water_runs};
 use crate::water::{Bottom, SiopSpec, SubstrateLibrary, SubstrateMix, WaterColumn, WaterGeometry, WaterModel};
 
+/// The configuration `shoal bench --accuracy` prices.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum AccuracyCase {
+    /// aLMI (eight SIOP sets) on the CubeSat over Lake Hume, full resolution.
+    Almi,
+    /// SAMBUCA (Acropora, sand, turf algae) on the nominal instrument over the Heron Island reef
+    /// with the spatial response switched on, at 1/2 resolution.
+    Sambuca,
+}
+
 /// Flags of `shoal bench`.
 #[derive(Debug, Args)]
 pub struct BenchArgs {
@@ -47,6 +57,12 @@ pub struct BenchArgs {
     /// a range to compare).
     #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=50))]
     pub rounds: u32,
+    /// With `--accuracy`: the case priced — aLMI on the CubeSat over Lake Hume, or SAMBUCA on
+    /// the nominal instrument over the Heron Island reef with its spatial response (at 1/2 of
+    /// full resolution: a full-resolution SAMBUCA run takes ~20 s, and the table runs ~20
+    /// settings × the rounds).
+    #[arg(long, value_enum, default_value_t = AccuracyCase::Almi)]
+    pub case: AccuracyCase,
     /// Skip the app rows (slider-to-preview latency and frame time; only with the `gui` feature).
     #[arg(long)]
     pub no_app: bool,

@@ -1,25 +1,27 @@
 //! `shoal bench --accuracy`: the cost-of-accuracy table (see `sweep::cost`) for the CubeSat over
-//! Lake Hume, each setting timed in interleaved rounds; with `--pareto`, the time–error Pareto
+//! Lake Hume with aLMI, or (`--case sambuca`) the Heron Island reef with SAMBUCA, each setting
+//! timed in interleaved rounds; with `--pareto`, the time–error Pareto
 //! front; with `--tolerance-pct`, the cheapest setting within that chl error.
 
 use std::fmt::Write as _;
 use std::io::IsTerminal as _;
 
 use super::CliError;
-use super::bench::BenchArgs;
+use super::bench::{AccuracyCase, BenchArgs};
 use crate::control::RunControl;
 use crate::engine::RunConfig;
 use crate::instrument::InstrumentSpec;
-use crate::scene::SceneSpec;
+use crate::scene::{Effect, SceneSpec};
 use crate::sweep::{CostRow, cheapest_within, cost_of_accuracy, pareto_front};
 
 fn pct(v: Option<f64>) -> String {
     v.map_or_else(|| "– (other grid)".to_string(), |v| format!("{v:.3}"))
 }
 
-fn row_line(r: &CostRow) -> String {
+fn row_line(r: &CostRow, depth: bool) -> String {
+    let depth = if depth { format!(" {} |", pct(r.depth_pixel_pct)) } else { String::new() };
     format!(
-        "| {} | {} | {} | {} | {:.1} | {:+.2} | {} | {} |\n",
+        "| {} | {} | {} | {} | {:.1} | {:+.2} | {} | {} |{depth}\n",
         r.label,
         r.time.wall_text(),
         r.time.cpu_text(),
@@ -31,6 +33,40 @@ fn row_line(r: &CostRow) -> String {
     )
 }
 
+/// The base configuration of `case` and its heading.
+fn case_base(case: AccuracyCase, quick: bool) -> Result<(RunConfig, String), CliError> {
+    match case {
+        AccuracyCase::Almi => {
+            let mut base = RunConfig::new(SceneSpec::preset("lake_hume_bloom")?, InstrumentSpec::preset("cubesat")?);
+            base.retrievals = vec![crate::retrieval::RetrievalSpec::Almi {
+                siop_sets: crate::retrieval::sets::default_almi_sets(),
+                settings: crate::retrieval::AlmiSettings::default(),
+            }];
+            base.fidelity.decimation = if quick { 4 } else { 1 };
+            let heading = format!("CubeSat over Lake Hume{}, aLMI", if quick { ", decimation 4" } else { "" });
+            Ok((base, heading))
+        }
+        AccuracyCase::Sambuca => {
+            let mut scene = SceneSpec::preset("heron_island_reef")?;
+            if !scene.effects.contains(&Effect::SpatialResponse) {
+                scene.effects.push(Effect::SpatialResponse);
+            }
+            let mut base = RunConfig::new(scene, InstrumentSpec::preset("nominal")?);
+            base.retrievals = vec![crate::retrieval::RetrievalSpec::Sambuca {
+                siop: None,
+                substrates: Some(vec!["acropora".into(), "sand".into(), "turf_algae".into()]),
+                settings: crate::retrieval::SambucaSettings::default(),
+            }];
+            base.fidelity.decimation = if quick { 8 } else { 2 };
+            let heading = format!(
+                "nominal instrument over the Heron Island reef with its spatial response, decimation {}, SAMBUCA (Acropora, sand, turf algae)",
+                base.fidelity.decimation
+            );
+            Ok((base, heading))
+        }
+    }
+}
+
 /// The cost-of-accuracy table (Markdown): each round's progress as it goes, then the table.
 pub fn accuracy_rows(out: &mut String, args: &BenchArgs) -> Result<(), CliError> {
     if let Some(t) = args.tolerance_pct
@@ -38,17 +74,11 @@ pub fn accuracy_rows(out: &mut String, args: &BenchArgs) -> Result<(), CliError>
     {
         return Err(CliError::Input(format!("--tolerance-pct: {t} (allowed: a percentage ≥ 0)")));
     }
-    let mut base = RunConfig::new(SceneSpec::preset("lake_hume_bloom")?, InstrumentSpec::preset("cubesat")?);
-    base.retrievals = vec![crate::retrieval::RetrievalSpec::Almi {
-        siop_sets: crate::retrieval::sets::default_almi_sets(),
-        settings: crate::retrieval::AlmiSettings::default(),
-    }];
-    base.fidelity.decimation = if args.quick { 4 } else { 1 };
+    let (base, heading) = case_base(args.case, args.quick)?;
     let rounds = args.rounds as usize;
     let _ = writeln!(
         out,
-        "\n## Cost of accuracy (CubeSat over Lake Hume{}, aLMI, seed 1; a fresh engine per run; {rounds} interleaved rounds)\n",
-        if args.quick { ", decimation 4" } else { "" }
+        "\n## Cost of accuracy ({heading}, seed 1; a fresh engine per run; {rounds} interleaved rounds)\n"
     );
     super::output::emit(&std::mem::take(out), None)?;
     let rows = cost_of_accuracy(&base, rounds, &RunControl::new(), |round, r| {
@@ -60,12 +90,15 @@ pub fn accuracy_rows(out: &mut String, args: &BenchArgs) -> Result<(), CliError>
     if std::io::stderr().is_terminal() {
         eprintln!();
     }
+    let depth = rows.iter().any(|r| r.depth_pixel_pct.is_some());
     let _ = writeln!(
         out,
-        "| setting | wall, median (range, n) | CPU, median | time vs reference | chl MAE % | ΔMAE vs reference (points) | chl per pixel vs reference, median % | Rrs(443) per pixel, median % |\n|---|---|---|---|---|---|---|---|"
+        "| setting | wall, median (range, n) | CPU, median | time vs reference | chl MAE % | ΔMAE vs reference (points) | chl per pixel vs reference, median % | Rrs(443) per pixel, median % |{}\n|---|---|---|---|---|---|---|---|{}",
+        if depth { " depth per pixel vs reference, median % |" } else { "" },
+        if depth { "---|" } else { "" }
     );
     for r in &rows {
-        out.push_str(&row_line(r));
+        out.push_str(&row_line(r, depth));
     }
     let _ = writeln!(
         out,

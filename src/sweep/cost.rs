@@ -38,6 +38,8 @@ pub struct CostRow {
     pub chl_pixel_pct: Option<f64>,
     /// Median per-pixel Rrs(443) difference from the reference, % (same grid only).
     pub rrs_pixel_pct: Option<f64>,
+    /// Median per-pixel depth difference from the reference, % (same grid, depth retrievals).
+    pub depth_pixel_pct: Option<f64>,
 }
 
 impl CostRow {
@@ -80,15 +82,30 @@ fn almi(config: &mut RunConfig) -> Option<(&mut Vec<crate::water::SiopSource>, &
     }
 }
 
-/// The settings measured, each one change from the reference (the base's fidelity with per-pixel
-/// spectra on the full grid; [`crate::engine::Fidelity::full`] for the defaults):
-/// the reference, the shipped defaults, previews at 2–24× the base decimation, per-pixel
-/// spectra at band nodes, spectral step, LUT nodes, radiative-transfer streams, orders and
-/// Fourier terms, the SNR patch, aLMI's weighting and number of sets, and one combination.
+/// The first retrieval's SAMBUCA settings, if it is SAMBUCA.
+fn sambuca(config: &mut RunConfig) -> Option<&mut crate::retrieval::SambucaSettings> {
+    match config.retrievals.first_mut() {
+        Some(crate::retrieval::RetrievalSpec::Sambuca { settings, .. }) => Some(settings),
+        _ => None,
+    }
+}
+
+/// The settings measured for `base`, each one change from the reference (the base's fidelity
+/// with per-pixel spectra on the full grid; [`crate::engine::Fidelity::full`] for the defaults):
+/// the reference, the shipped defaults, previews at 2–24× the base decimation, per-pixel spectra
+/// at band nodes (not with adjacency, which needs whole spectra), spectral step, LUT nodes,
+/// radiative-transfer streams, orders and Fourier terms, the SNR patch, and one combination; then
+/// the rows of the first retrieval — aLMI's weighting and number of SIOP sets, or SAMBUCA's
+/// Gauss nodes per band, iterations, starts and weighting — and, when the scene asks for the
+/// instrument's spatial response, its quadrature points per GSD. Rows that could change nothing
+/// for `base` are left out (a row identical to the reference would read as a free setting).
 #[must_use]
-pub fn settings(base_decimation: usize) -> Vec<Setting> {
+pub fn settings_for(base: &RunConfig) -> Vec<Setting> {
+    use crate::scene::Effect;
+    let base_decimation = base.fidelity.decimation;
     let s = |label: &str, set: Vec<(&'static str, f64)>| Setting { label: label.into(), set, edit: None };
     let e = |label: &str, edit: fn(&mut RunConfig)| Setting { label: label.into(), set: Vec::new(), edit: Some(edit) };
+    let effects = &base.scene.effects;
     let mut out = vec![
         s("reference (full fidelity)", vec![]),
         s(
@@ -102,9 +119,13 @@ pub fn settings(base_decimation: usize) -> Vec<Setting> {
             vec![("fidelity.decimation", (d * base_decimation) as f64)],
         ));
     }
+    if !effects.contains(&Effect::Adjacency) {
+        out.extend([
+            s("band nodes 2 per band", vec![("fidelity.band_nodes", 2.0)]),
+            s("band nodes 3 per band", vec![("fidelity.band_nodes", 3.0)]),
+        ]);
+    }
     out.extend([
-        s("band nodes 2 per band", vec![("fidelity.band_nodes", 2.0)]),
-        s("band nodes 3 per band", vec![("fidelity.band_nodes", 3.0)]),
         s("spectral step 2 nm", vec![("fidelity.spectral_step_nm", 2.0)]),
         s("spectral step 5 nm", vec![("fidelity.spectral_step_nm", 5.0)]),
         s("LUT wavelength nodes 10 nm", vec![("fidelity.lut_wavelength_step_nm", 10.0)]),
@@ -115,35 +136,62 @@ pub fn settings(base_decimation: usize) -> Vec<Setting> {
         s("RT single scattering", vec![("scene.atmosphere.accuracy.max_orders", 1.0)]),
         s("RT 8 Fourier terms", vec![("scene.atmosphere.accuracy.fourier_terms", 8.0)]),
         s("SNR patch 16 frames", vec![("fidelity.snr_frames", 16.0)]),
-        e("aLMI unweighted (one solve per set)", |c| {
-            if let Some((_, settings)) = almi(c) {
-                settings.noise_weighting = false;
-            }
-        }),
-        e("aLMI 4 of 8 SIOP sets", |c| {
-            if let Some((sets, _)) = almi(c) {
-                sets.truncate(4);
-            }
-        }),
-        s(
-            "fast: 2 nm, LUT 40 nm, 8 streams",
-            vec![
-                ("fidelity.spectral_step_nm", 2.0),
-                ("fidelity.lut_wavelength_step_nm", 40.0),
-                ("scene.atmosphere.accuracy.streams", 8.0),
-            ],
-        ),
     ]);
+    if effects.contains(&Effect::SpatialResponse) {
+        // The default is 2 points per GSD and axis.
+        out.extend([
+            s("spatial response 1 point per GSD", vec![("fidelity.spatial_samples_per_gsd", 1.0)]),
+            s("spatial response 3 points per GSD", vec![("fidelity.spatial_samples_per_gsd", 3.0)]),
+        ]);
+    }
+    match base.retrievals.first() {
+        Some(crate::retrieval::RetrievalSpec::Almi { .. }) => out.extend([
+            e("aLMI unweighted (one solve per set)", |c| {
+                if let Some((_, settings)) = almi(c) {
+                    settings.noise_weighting = false;
+                }
+            }),
+            e("aLMI 4 of 8 SIOP sets", |c| {
+                if let Some((sets, _)) = almi(c) {
+                    sets.truncate(4);
+                }
+            }),
+        ]),
+        // The defaults: 3 Gauss nodes per band, 100 iterations, adaptive starts, noise-weighted.
+        Some(crate::retrieval::RetrievalSpec::Sambuca { .. }) => out.extend([
+            e("SAMBUCA 1 Gauss node per band", |c| sambuca(c).into_iter().for_each(|s| s.nodes_per_band = 1)),
+            e("SAMBUCA 2 Gauss nodes per band", |c| sambuca(c).into_iter().for_each(|s| s.nodes_per_band = 2)),
+            e("SAMBUCA 5 Gauss nodes per band", |c| sambuca(c).into_iter().for_each(|s| s.nodes_per_band = 5)),
+            e("SAMBUCA 25 iterations per start", |c| sambuca(c).into_iter().for_each(|s| s.max_iterations = 25)),
+            e("SAMBUCA 50 iterations per start", |c| sambuca(c).into_iter().for_each(|s| s.max_iterations = 50)),
+            e("SAMBUCA shallow start only", |c| {
+                sambuca(c).into_iter().for_each(|s| s.starts = crate::retrieval::Starts::Shallow);
+            }),
+            e("SAMBUCA shallow and deep starts, every pixel", |c| {
+                sambuca(c).into_iter().for_each(|s| s.starts = crate::retrieval::Starts::ShallowAndDeep);
+            }),
+            e("SAMBUCA unweighted", |c| sambuca(c).into_iter().for_each(|s| s.noise_weighting = false)),
+        ]),
+        _ => {}
+    }
+    out.push(s(
+        "fast: 2 nm, LUT 40 nm, 8 streams",
+        vec![
+            ("fidelity.spectral_step_nm", 2.0),
+            ("fidelity.lut_wavelength_step_nm", 40.0),
+            ("scene.atmosphere.accuracy.streams", 8.0),
+        ],
+    ));
     out
 }
 
-/// The fidelity the row `label` of [`settings`] runs with, applied to `base`'s (the reference
+/// The fidelity the row `label` of [`settings_for`] runs with, applied to `base`'s (the reference
 /// row: `base`'s own): `None` when the row is not a fidelity setting alone (it changes the
 /// atmosphere's accuracy, the retrieval, or the resolution), so it cannot become a run's
 /// fidelity.
 #[must_use]
 pub fn fidelity_of(label: &str, base: &RunConfig) -> Option<crate::engine::Fidelity> {
-    let setting = settings(base.fidelity.decimation).into_iter().find(|s| s.label == label)?;
+    let setting = settings_for(base).into_iter().find(|s| s.label == label)?;
     // The reference (nothing set) is `base`'s own fidelity: applying it goes back to it.
     let fidelity_only = setting.edit.is_none()
         && setting.set.iter().all(|(path, _)| path.starts_with("fidelity.") && *path != "fidelity.decimation");
@@ -165,18 +213,31 @@ fn median(mut v: Vec<f64>) -> Option<f64> {
     Some(v[v.len() / 2])
 }
 
-/// Median relative difference of retrieved chl and of Rrs at the band nearest 443 nm, when the
+/// A row's per-pixel differences from the reference: median relative difference of retrieved
+/// chl, of Rrs at the band nearest 443 nm, and of retrieved depth (depth retrievals), when the
 /// grids match.
-fn per_pixel(out: &RunOutput, reference: &RunOutput) -> (Option<f64>, Option<f64>) {
-    let (Some(a), Some(b)) = (out.retrievals.first(), reference.retrievals.first()) else { return (None, None) };
+struct PerPixel {
+    chl: Option<f64>,
+    rrs: Option<f64>,
+    depth: Option<f64>,
+}
+
+impl PerPixel {
+    const NONE: Self = Self { chl: None, rrs: None, depth: None };
+}
+
+fn per_pixel(out: &RunOutput, reference: &RunOutput) -> PerPixel {
+    let (Some(a), Some(b)) = (out.retrievals.first(), reference.retrievals.first()) else { return PerPixel::NONE };
     if a.product.chl_mg_m3.dim() != b.product.chl_mg_m3.dim()
         || out.correction.rrs.rrs.dim() != reference.correction.rrs.rrs.dim()
     {
-        return (None, None);
+        return PerPixel::NONE;
     }
     let (rows, cols) = a.product.chl_mg_m3.dim();
     let mut chl = Vec::new();
     let mut rrs = Vec::new();
+    let mut depth = Vec::new();
+    let depths = a.product.depth_m.as_ref().zip(b.product.depth_m.as_ref());
     let band = out
         .response
         .bands
@@ -192,6 +253,12 @@ fn per_pixel(out: &RunOutput, reference: &RunOutput) -> (Option<f64>, Option<f64
                 if y > 0.0 {
                     chl.push((x / y - 1.0).abs());
                 }
+                if let Some((da, db)) = depths {
+                    let (x, y) = (f64::from(da[[r, c]]), f64::from(db[[r, c]]));
+                    if y > 0.0 && x.is_finite() {
+                        depth.push((x / y - 1.0).abs());
+                    }
+                }
             }
             if out.radiance.truth.land[[r, c]] == 0 {
                 let (x, y) = (
@@ -204,10 +271,10 @@ fn per_pixel(out: &RunOutput, reference: &RunOutput) -> (Option<f64>, Option<f64
             }
         }
     }
-    (median(chl), median(rrs))
+    PerPixel { chl: median(chl), rrs: median(rrs), depth: median(depth) }
 }
 
-/// Measure every setting of [`settings`] on `base` (whose decimation is the reference's), in
+/// Measure every setting of [`settings_for`] `base` on it (whose decimation is the reference's), in
 /// `rounds` interleaved rounds (at least 1); `on_row` hears of each row each time it gains a
 /// sample, with the round it came from (0-based).
 pub fn cost_of_accuracy(
@@ -216,7 +283,7 @@ pub fn cost_of_accuracy(
     control: &RunControl,
     mut on_row: impl FnMut(usize, &CostRow),
 ) -> Result<Vec<CostRow>, StudyError> {
-    let settings = settings(base.fidelity.decimation);
+    let settings = settings_for(base);
     // Every row is one change from the reference: `base`'s fidelity with every approximation the
     // table prices off (per-pixel spectra on the full grid), whatever band nodes `base` uses.
     let mut base = base.clone();
@@ -245,8 +312,11 @@ pub fn cost_of_accuracy(
             })?;
             if round == 0 {
                 let mae = chl_mae(&run);
-                let (delta, (chl, rrs)) = match &reference {
-                    None => (0.0, (Some(0.0), Some(0.0))),
+                let (delta, diff) = match &reference {
+                    None => {
+                        let has_depth = run.retrievals.first().is_some_and(|r| r.product.depth_m.is_some());
+                        (0.0, PerPixel { chl: Some(0.0), rrs: Some(0.0), depth: has_depth.then_some(0.0) })
+                    }
                     Some(r) => (mae - chl_mae(r), per_pixel(&run, r)),
                 };
                 rows.push(CostRow {
@@ -256,8 +326,9 @@ pub fn cost_of_accuracy(
                     comparison: Comparison::NoMeasurableDifference,
                     chl_mae_pct: mae,
                     delta_mae_pct: delta,
-                    chl_pixel_pct: chl.map(|v| 100.0 * v),
-                    rrs_pixel_pct: rrs.map(|v| 100.0 * v),
+                    chl_pixel_pct: diff.chl.map(|v| 100.0 * v),
+                    rrs_pixel_pct: diff.rrs.map(|v| 100.0 * v),
+                    depth_pixel_pct: diff.depth.map(|v| 100.0 * v),
                 });
                 if reference.is_none() {
                     reference = Some(run);
@@ -328,6 +399,58 @@ mod tests {
             delta_mae_pct: 0.0,
             chl_pixel_pct: pixel,
             rrs_pixel_pct: pixel,
+            depth_pixel_pct: None,
+        }
+    }
+
+    /// The rows of `base`, each applied: (label, configuration).
+    fn applied(base: &RunConfig) -> Vec<(String, RunConfig)> {
+        settings_for(base)
+            .into_iter()
+            .map(|setting| {
+                let mut c = apply(base, &setting.set).unwrap_or_else(|e| panic!("{}: {e}", setting.label));
+                if let Some(edit) = setting.edit {
+                    edit(&mut c);
+                }
+                (setting.label, c)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn each_case_gets_the_rows_of_its_retrieval_and_scene_and_every_row_changes_something() {
+        use crate::instrument::InstrumentSpec;
+        use crate::retrieval::{RetrievalSpec, SambucaSettings};
+        use crate::scene::{Effect, SceneSpec};
+        let preset = |s: &str| SceneSpec::preset(s).unwrap_or_else(|e| panic!("{e}"));
+        let instrument = |s: &str| InstrumentSpec::preset(s).unwrap_or_else(|e| panic!("{e}"));
+        let mut almi = RunConfig::new(preset("lake_hume_bloom"), instrument("cubesat"));
+        almi.retrievals = vec![RetrievalSpec::Almi {
+            siop_sets: crate::retrieval::sets::default_almi_sets(),
+            settings: crate::retrieval::AlmiSettings::default(),
+        }];
+        let mut reef = preset("heron_island_reef");
+        reef.effects.push(Effect::SpatialResponse);
+        let mut sambuca = RunConfig::new(reef, instrument("nominal"));
+        sambuca.retrievals = vec![RetrievalSpec::Sambuca {
+            siop: None,
+            substrates: Some(vec!["acropora".into(), "sand".into()]),
+            settings: SambucaSettings::default(),
+        }];
+        let labels = |base: &RunConfig| -> Vec<String> { applied(base).into_iter().map(|(l, _)| l).collect() };
+        let has = |labels: &[String], prefix: &str| labels.iter().any(|l| l.starts_with(prefix));
+        let (a, b) = (labels(&almi), labels(&sambuca));
+        assert!(has(&a, "aLMI ") && !has(&a, "SAMBUCA ") && has(&a, "band nodes 2") && !has(&a, "spatial"), "{a:?}");
+        // The reef has adjacency (whole spectra per pixel: band nodes do not apply) and asks for
+        // the spatial response.
+        assert!(has(&b, "SAMBUCA ") && !has(&b, "aLMI ") && !has(&b, "band nodes 2") && has(&b, "spatial"), "{b:?}");
+        for base in [&mut almi, &mut sambuca] {
+            // The table's reference: per-pixel spectra on the full grid (see `cost_of_accuracy`).
+            base.fidelity.band_nodes = 0;
+            let base = &*base;
+            for (label, config) in applied(base).into_iter().skip(1) {
+                assert_ne!(&config, base, "{label} changes nothing: it would read as a free setting");
+            }
         }
     }
 
