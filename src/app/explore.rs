@@ -456,8 +456,8 @@ pub fn cost_window(app: &mut super::ShoalApp, ctx: &egui::Context) {
             }
         });
         egui::ScrollArea::both().show(ui, |ui| {
-            egui::Grid::new("cost-table").striped(true).num_columns(6).show(ui, |ui| {
-                for h in ["setting", "wall, median (range, n)", "CPU", "vs reference", "ΔMAE", "chl per pixel %"] {
+            egui::Grid::new("cost-table").striped(true).num_columns(7).show(ui, |ui| {
+                for h in ["setting", "wall, median (range, n)", "CPU", "vs reference", "ΔMAE", "chl per pixel %", "p95 %"] {
                     ui.strong(h);
                 }
                 ui.end_row();
@@ -469,6 +469,7 @@ pub fn cost_window(app: &mut super::ShoalApp, ctx: &egui::Context) {
                     ui.label(r.comparison.text());
                     ui.label(format!("{:+.2}", r.delta_mae_pct));
                     ui.label(r.chl_pixel_pct.map_or_else(|| "other grid".into(), |v| format!("{v:.3}")));
+                    ui.label(r.chl_pixel_p95_pct.map_or_else(|| "–".into(), |v| format!("{v:.3}")));
                     ui.end_row();
                 }
             });

@@ -21,7 +21,7 @@ fn pct(v: Option<f64>) -> String {
 fn row_line(r: &CostRow, depth: bool) -> String {
     let depth = if depth { format!(" {} |", pct(r.depth_pixel_pct)) } else { String::new() };
     format!(
-        "| {} | {} | {} | {} | {:.1} | {:+.2} | {} | {} |{depth}\n",
+        "| {} | {} | {} | {} | {:.1} | {:+.2} | {} | {} | {} |{depth}\n",
         r.label,
         r.time.wall_text(),
         r.time.cpu_text(),
@@ -29,6 +29,7 @@ fn row_line(r: &CostRow, depth: bool) -> String {
         r.chl_mae_pct,
         r.delta_mae_pct,
         pct(r.chl_pixel_pct),
+        pct(r.chl_pixel_p95_pct),
         pct(r.rrs_pixel_pct)
     )
 }
@@ -93,7 +94,7 @@ pub fn accuracy_rows(out: &mut String, args: &BenchArgs) -> Result<(), CliError>
     let depth = rows.iter().any(|r| r.depth_pixel_pct.is_some());
     let _ = writeln!(
         out,
-        "| setting | wall, median (range, n) | CPU, median | time vs reference | chl MAE % | ΔMAE vs reference (points) | chl per pixel vs reference, median % | Rrs(443) per pixel, median % |{}\n|---|---|---|---|---|---|---|---|{}",
+        "| setting | wall, median (range, n) | CPU, median | time vs reference | chl MAE % | ΔMAE vs reference (points) | chl per pixel vs reference, median % | chl per pixel, 95th percentile % | Rrs(443) per pixel, median % |{}\n|---|---|---|---|---|---|---|---|---|{}",
         if depth { " depth per pixel vs reference, median % |" } else { "" },
         if depth { "---|" } else { "" }
     );

@@ -36,6 +36,10 @@ pub struct CostRow {
     pub delta_mae_pct: f64,
     /// Median per-pixel chl difference from the reference, % (same grid only).
     pub chl_pixel_pct: Option<f64>,
+    /// 95th percentile of the per-pixel chl difference, % (same grid only): a setting whose
+    /// error lives at edges (the spatial response) or in a few hard pixels shows here while its
+    /// median stays at zero.
+    pub chl_pixel_p95_pct: Option<f64>,
     /// Median per-pixel Rrs(443) difference from the reference, % (same grid only).
     pub rrs_pixel_pct: Option<f64>,
     /// Median per-pixel depth difference from the reference, % (same grid, depth retrievals).
@@ -205,12 +209,17 @@ fn chl_mae(out: &RunOutput) -> f64 {
     out.retrievals.first().and_then(|r| r.metrics.get("chl_mg_m3")).map_or(f64::NAN, crate::metrics::Metrics::mae_pct)
 }
 
-fn median(mut v: Vec<f64>) -> Option<f64> {
+/// The `q` quantile of `v` (nearest rank below), `None` if empty.
+fn quantile(v: &mut [f64], q: f64) -> Option<f64> {
     if v.is_empty() {
         return None;
     }
-    v.sort_by(f64::total_cmp);
-    Some(v[v.len() / 2])
+    let k = ((v.len() - 1) as f64 * q).floor() as usize;
+    Some(*v.select_nth_unstable_by(k, f64::total_cmp).1)
+}
+
+fn median(mut v: Vec<f64>) -> Option<f64> {
+    quantile(&mut v, 0.5)
 }
 
 /// A row's per-pixel differences from the reference: median relative difference of retrieved
@@ -218,12 +227,13 @@ fn median(mut v: Vec<f64>) -> Option<f64> {
 /// grids match.
 struct PerPixel {
     chl: Option<f64>,
+    chl_p95: Option<f64>,
     rrs: Option<f64>,
     depth: Option<f64>,
 }
 
 impl PerPixel {
-    const NONE: Self = Self { chl: None, rrs: None, depth: None };
+    const NONE: Self = Self { chl: None, chl_p95: None, rrs: None, depth: None };
 }
 
 fn per_pixel(out: &RunOutput, reference: &RunOutput) -> PerPixel {
@@ -271,7 +281,7 @@ fn per_pixel(out: &RunOutput, reference: &RunOutput) -> PerPixel {
             }
         }
     }
-    PerPixel { chl: median(chl), rrs: median(rrs), depth: median(depth) }
+    PerPixel { chl_p95: quantile(&mut chl, 0.95), chl: median(chl), rrs: median(rrs), depth: median(depth) }
 }
 
 /// Measure every setting of [`settings_for`] `base` on it (whose decimation is the reference's), in
@@ -315,7 +325,15 @@ pub fn cost_of_accuracy(
                 let (delta, diff) = match &reference {
                     None => {
                         let has_depth = run.retrievals.first().is_some_and(|r| r.product.depth_m.is_some());
-                        (0.0, PerPixel { chl: Some(0.0), rrs: Some(0.0), depth: has_depth.then_some(0.0) })
+                        (
+                            0.0,
+                            PerPixel {
+                                chl: Some(0.0),
+                                chl_p95: Some(0.0),
+                                rrs: Some(0.0),
+                                depth: has_depth.then_some(0.0),
+                            },
+                        )
                     }
                     Some(r) => (mae - chl_mae(r), per_pixel(&run, r)),
                 };
@@ -327,6 +345,7 @@ pub fn cost_of_accuracy(
                     chl_mae_pct: mae,
                     delta_mae_pct: delta,
                     chl_pixel_pct: diff.chl.map(|v| 100.0 * v),
+                    chl_pixel_p95_pct: diff.chl_p95.map(|v| 100.0 * v),
                     rrs_pixel_pct: diff.rrs.map(|v| 100.0 * v),
                     depth_pixel_pct: diff.depth.map(|v| 100.0 * v),
                 });
@@ -398,6 +417,7 @@ mod tests {
             chl_mae_pct: 30.0,
             delta_mae_pct: 0.0,
             chl_pixel_pct: pixel,
+            chl_pixel_p95_pct: pixel,
             rrs_pixel_pct: pixel,
             depth_pixel_pct: None,
         }
