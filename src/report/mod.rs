@@ -128,8 +128,8 @@ impl From<&Check> for CheckRow {
 pub type BudgetRow = (String, String, f64, String, f64, f64, f64);
 
 /// A cost-of-accuracy row: (setting, rounds, wall s median, wall range, CPU s median, vs
-/// reference, per-pixel chl difference from the reference %).
-pub type CostTableRow = (String, usize, f64, (f64, f64), Option<f64>, String, Option<f64>);
+/// reference, per-pixel chl difference from the reference %: median, 95th percentile).
+pub type CostTableRow = (String, usize, f64, (f64, f64), Option<f64>, String, Option<f64>, Option<f64>);
 
 /// A data file the results were made from: (path, content, source, licence).
 pub type DataSource = (String, String, String, String);
@@ -384,6 +384,7 @@ fn cost_rows(cost: &[CostRow]) -> Vec<CostTableRow> {
                 r.time.cpu_s,
                 r.comparison.text(),
                 r.chl_error_pct(),
+                r.chl_pixel_p95_pct.filter(|v| v.is_finite()),
             )
         })
         .collect()
