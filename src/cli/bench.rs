@@ -59,7 +59,7 @@ pub struct BenchArgs {
     pub rounds: u32,
     /// With `--accuracy`: the case priced — aLMI on the CubeSat over Lake Hume, or SAMBUCA on
     /// the nominal instrument over the Heron Island reef with its spatial response (at 1/2 of
-    /// full resolution: a full-resolution SAMBUCA run takes ~20 s, and the table runs ~20
+    /// full resolution: a full-resolution SAMBUCA run takes ~20 s, and the table runs 28
     /// settings × the rounds).
     #[arg(long, value_enum, default_value_t = AccuracyCase::Almi)]
     pub case: AccuracyCase,

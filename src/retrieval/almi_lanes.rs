@@ -181,25 +181,16 @@ impl Normal {
         let mut best = [[0.0; LANES]; 3];
         let mut best_r = residual(&full);
         if (0..lanes).any(|s| regular[s] && !fast[s]) {
-            // The other supports, in `nnls3`'s order (mask bit j: column j in the support).
+            // The other supports, in `nnls3`'s order (its masks 0 to 6: bit j, column j).
+            const SUPPORTS: [&[usize]; 7] = [&[], &[0], &[1], &[0, 1], &[2], &[0, 2], &[1, 2]];
             let mut found = [false; LANES];
-            for mask in 0..7usize {
-                let on = |j: usize| mask & (1 << j) != 0;
+            for support in SUPPORTS {
                 let mut x = [[0.0; LANES]; 3];
                 let mut ok = [true; LANES];
-                match mask.count_ones() {
-                    0 => {}
-                    1 => {
-                        let j = mask.trailing_zeros() as usize;
-                        x[j] = lanewise(|s| bs[j][s] / at(j, j)[s]);
-                    }
-                    _ => {
-                        let (p, q) = match mask {
-                            3 => (0, 1),
-                            5 => (0, 2),
-                            _ => (1, 2),
-                        };
-                        debug_assert!(on(p) && on(q));
+                match *support {
+                    [] => {}
+                    [j] => x[j] = lanewise(|s| bs[j][s] / at(j, j)[s]),
+                    [p, q, ..] => {
                         for s in 0..LANES {
                             let (gpp, gqq, gpq, gqp) = (at(p, p)[s], at(q, q)[s], at(p, q)[s], at(q, p)[s]);
                             let det = gpp * gqq - gpq * gqp;

@@ -209,12 +209,13 @@ fn chl_mae(out: &RunOutput) -> f64 {
     out.retrievals.first().and_then(|r| r.metrics.get("chl_mg_m3")).map_or(f64::NAN, crate::metrics::Metrics::mae_pct)
 }
 
-/// The `q` quantile of `v` (nearest rank below), `None` if empty.
+/// The `q` quantile of `v`: the element of rank ⌊q·n⌋ (for q = ½ the upper median, as the
+/// table's medians always were), `None` if empty.
 fn quantile(v: &mut [f64], q: f64) -> Option<f64> {
     if v.is_empty() {
         return None;
     }
-    let k = ((v.len() - 1) as f64 * q).floor() as usize;
+    let k = ((v.len() as f64 * q) as usize).min(v.len() - 1);
     Some(*v.select_nth_unstable_by(k, f64::total_cmp).1)
 }
 
