@@ -410,7 +410,11 @@ pub fn cost_window(app: &mut super::ShoalApp, ctx: &egui::Context) {
             }
         });
         let e = &app.ui.explore;
-        ui.label(format!("{} ({}/{} settings)", e.cost_status, e.cost_rows.len(), e.cost_config.as_ref().map_or(0, |c| crate::sweep::settings_for(c).len())));
+        // The rows depend on the run measured (its retrieval and scene): counted once one is.
+        match &e.cost_config {
+            Some(c) => ui.label(format!("{} ({}/{} settings)", e.cost_status, e.cost_rows.len(), crate::sweep::settings_for(c).len())),
+            None => ui.label(&e.cost_status),
+        };
         let now = app.state.configs().into_iter().next().map(at_full_fidelity);
         if e.cost_config.is_some() && e.cost_config != now {
             ui.colored_label(super::theme::NOTICE, "Stale: A, the scene or the retrieval changed since these were measured. Press Measure to redo.");
