@@ -107,6 +107,16 @@ fn lanewise<T: Copy + Default>(f: impl Fn(usize) -> T) -> [T; LANES] {
     out
 }
 
+const INF: f64 = f64::INFINITY;
+
+/// `x.is_finite()` as a floating-point comparison: `is_finite` compiles to integer tests of the
+/// bits, one lane at a time, where a comparison runs four lanes per instruction. (NaN compares
+/// false, so the two agree on every input.)
+#[inline(always)]
+fn finite(x: f64) -> bool {
+    x.abs() < INF
+}
+
 /// The lane-wise [`det3`]: the same expression per lane, so the same bits.
 #[inline(always)]
 fn det3_lanes(c: &[[&Lanes; 3]; 3]) -> Lanes {
@@ -153,8 +163,10 @@ impl Normal {
         let bs: [Lanes; 3] = [rhs(0), rhs(1), rhs(2)];
         let at = |i: usize, j: usize| &gs[AT[i][j]];
         // Lanes the lane-wise arithmetic holds for: every column present, the data finite.
+        // (`&` rather than `&&` and `all`, here and below: no short circuits, so no branches per
+        // lane, and the lanes are tested side by side.)
         let regular: [bool; LANES] = lanewise(|s| {
-            (0..3).all(|j| d[j][s].is_finite() && d[j][s] > 0.0 && self.b[j][s].is_finite()) && self.yy[s].is_finite()
+            (0..3).fold(finite(self.yy[s]), |ok, j| ok & (d[j][s] > 0.0) & (d[j][s] < INF) & finite(self.b[j][s]))
         });
         // The residual ‖A·x − y‖² of scaled x, as `nnls3` writes it (zeros included).
         let residual = |x: &[Lanes; 3]| -> Lanes {
@@ -169,7 +181,7 @@ impl Normal {
                 r.max(0.0)
             })
         };
-        let feasible = |x: &[Lanes; 3], s: usize| x.iter().all(|v| v[s] >= 0.0 && v[s].is_finite());
+        let feasible = |x: &[Lanes; 3], s: usize| x.iter().fold(true, |ok, v| ok & (v[s] >= 0.0) & (v[s] < INF));
         // The full support by Cramer's rule.
         let rows = [[at(0, 0), at(0, 1), at(0, 2)], [at(1, 0), at(1, 1), at(1, 2)], [at(2, 0), at(2, 1), at(2, 2)]];
         let det = det3_lanes(&rows);
@@ -202,12 +214,13 @@ impl Normal {
                 }
                 let r = residual(&x);
                 for s in 0..LANES {
-                    if ok[s] && feasible(&x, s) && (!found[s] || r[s] < best_r[s]) {
-                        found[s] = true;
-                        best_r[s] = r[s];
-                        for j in 0..3 {
-                            best[j][s] = x[j][s];
-                        }
+                    // Kept when feasible and the first found or strictly better: a select per
+                    // lane, not a branch.
+                    let take = ok[s] & feasible(&x, s) & (!found[s] | (r[s] < best_r[s]));
+                    found[s] |= take;
+                    best_r[s] = if take { r[s] } else { best_r[s] };
+                    for j in 0..3 {
+                        best[j][s] = if take { x[j][s] } else { best[j][s] };
                     }
                 }
             }
@@ -382,13 +395,17 @@ fn invert_lanes(
         for (i, &k) in used.iter().enumerate() {
             let c = &bands[k];
             let (uu, v) = (u[i], 1.0 - u[i]);
-            let row = &mut rows[i];
+            // Built in a local and stored whole: stores into the scratch (heap) might alias the
+            // coefficients (heap too) as far as the compiler knows, which kept it from computing
+            // the lanes side by side.
+            let mut row = Rows::default();
             for s in 0..LANES {
                 row.r[0][s] = c.a_ph[s] * uu - c.bb_ph[s] * v;
                 row.r[1][s] = c.a_cdom[s] * uu;
                 row.r[2][s] = c.a_nap[s] * uu - c.bb_nap[s] * v;
                 row.y[s] = c.bb_w[s] * v - c.a_w[s] * uu;
             }
+            rows[i] = row;
         }
         let first = normal(&rows[..m], None);
         let mut sol = first.solve_all(lanes);
@@ -408,11 +425,15 @@ fn invert_lanes(
             let x = x_of(&sol);
             for (i, &k) in used.iter().enumerate() {
                 let c = &bands[k];
-                for s in 0..LANES {
+                // A local, stored whole, as for the rows above (the divisions then run four lanes
+                // per instruction; they were scalar: 10 % of aLMI's time in perf).
+                let mut w = [0.0; LANES];
+                for (s, w) in w.iter_mut().enumerate() {
                     let (a, bb) = kappa(c, &x, s);
                     let w1 = 1.0 / ((a + bb) * sigma_u[i]).max(1e-300);
-                    w2[i][s] = w1 * w1;
+                    *w = w1 * w1;
                 }
+                w2[i] = w;
             }
             let second = normal(&rows[..m], Some(&w2[..m])).solve_all(lanes);
             for (slot, next) in sol.iter_mut().zip(second).take(lanes) {
