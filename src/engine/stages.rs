@@ -23,7 +23,6 @@ use crate::instrument::{
 };
 use crate::scene::{Effect, Scene};
 use crate::toa::SceneOptics;
-use ndarray::Array3;
 
 /// A stage's error as the engine reports it: cancellation stays cancellation, anything else
 /// names the stage.
@@ -329,7 +328,7 @@ impl Engine {
         let inputs = Inputs::of(config);
         let (detector, detector_key) = (&inst.detector, inst.detector_key);
         let nb = response.n_bands();
-        let typical = typical_radiance(&radiance.radiance, &radiance.truth.land);
+        let typical = radiance.typical_water_w_m2_sr_nm.clone();
         let snr_key = KeyBuilder::new(Stage::Snr).after(detector_key).with(&typical).with(&inputs.snr).finish();
         let snr = self.stage(snr_key, report, control, || {
             // A preview measures on fewer detectors (the estimate's spread grows as √decimation).
@@ -373,30 +372,4 @@ fn lut_axes(response: &Response, viewing: &Viewing, sun_zenith_deg: f64, fid: &s
     let max_vza = ((viewing.max_view_zenith_deg / fid.lut_view_step_deg).ceil().max(1.0) * fid.lut_view_step_deg)
         .min(crate::ranges::GEOMETRY_VIEW_ZENITH_DEG.hi);
     LutAxes::covering(nodes, (sun_zenith_deg, sun_zenith_deg), max_vza, (1.0, fid.lut_view_step_deg, 30.0))
-}
-
-/// Median band radiance over water pixels (at most ~20 000 of them, evenly strided: the median's
-/// sampling error, under 1 %, is far below what an SNR figure needs).
-fn typical_radiance(radiance: &Array3<f32>, land: &ndarray::Array2<u8>) -> Vec<f64> {
-    let (rows, cols, nb) = radiance.dim();
-    let (Some(rad), Some(land)) = (radiance.as_slice(), land.as_slice()) else { return vec![0.0; nb] };
-    let stride = (rows * cols / 20_000).max(1);
-    let mut per_band: Vec<Vec<f32>> = vec![Vec::new(); nb];
-    for (pixel, values) in rad.chunks(nb.max(1)).enumerate().step_by(stride) {
-        if land[pixel] == 0 {
-            for (list, v) in per_band.iter_mut().zip(values) {
-                list.push(*v);
-            }
-        }
-    }
-    per_band
-        .into_iter()
-        .map(|mut v| {
-            if v.is_empty() {
-                return 0.0;
-            }
-            let mid = v.len() / 2;
-            f64::from(*v.select_nth_unstable_by(mid, f32::total_cmp).1)
-        })
-        .collect()
 }

@@ -231,6 +231,10 @@ pub struct RadianceCube {
     /// Brightest band radiance over the water pixels (what the plausibility guard checks the
     /// detector's full scale against), W m⁻² sr⁻¹ nm⁻¹.
     pub brightest_water_w_m2_sr_nm: Vec<f64>,
+    /// Median band radiance over the water pixels (the SNR stage's typical radiance), W m⁻²
+    /// sr⁻¹ nm⁻¹: computed with the cube, so a run that reuses the cube does not recompute it
+    /// (it was 5 % of an electronics preview's time).
+    pub typical_water_w_m2_sr_nm: Vec<f64>,
 }
 
 /// Sample the scene through every pixel of `viewing`: `optics[g]` is the scene bound to group
@@ -319,6 +323,7 @@ pub fn sample_radiance(
     let truth = TruthBuffers { rrs: rrs_truth, maps, fractions, land }.into_truth(scene, (rows, cols, nb))?;
     Ok(RadianceCube {
         brightest_water_w_m2_sr_nm: super::plausibility::brightest_water(&radiance, &truth.land),
+        typical_water_w_m2_sr_nm: super::plausibility::typical_water(&radiance, &truth.land),
         radiance,
         truth_shares: super::shares::SceneShares::of(&truth),
         truth: Arc::new(truth),
