@@ -188,12 +188,14 @@ impl Calibration {
                 }
                 let mut light = vec![0.0; nb];
                 let mut saturated = 0;
+                // Every frame sees the same radiance: the exposures are set up once per band.
+                let lit: Vec<_> = (0..nb).map(|b| detector.exposure(j, b, diffuser_radiance[j * nb + b], t)).collect();
+                let dark: Vec<_> = (0..nb).map(|b| detector.exposure(j, b, 0.0, spec.dark_exposure_s)).collect();
                 for f in 0..spec.light_frames {
                     let mut rng = pixel_rng(seed, Stream::CalibrationLight, f, j);
                     let mut any = false;
-                    for b in 0..nb {
-                        let e = detector.expose(j, b, diffuser_radiance[j * nb + b], t, &mut rng);
-                        let r = detector.read_out(e, &mut rng);
+                    for (b, exposure) in lit.iter().enumerate() {
+                        let r = detector.read_out(exposure.draw(&mut rng), &mut rng);
                         any |= r.flags & Flags::SATURATED != 0;
                         light[b] += detector.level0_value(&r);
                     }
@@ -201,9 +203,8 @@ impl Calibration {
                 }
                 for f in 0..spec.dark_frames {
                     let mut rng = pixel_rng(seed, Stream::CalibrationDark, f, j);
-                    for b in 0..nb {
-                        let e = detector.expose(j, b, 0.0, spec.dark_exposure_s, &mut rng);
-                        offset[b] += detector.level0_value(&detector.read_out(e, &mut rng));
+                    for (b, exposure) in dark.iter().enumerate() {
+                        offset[b] += detector.level0_value(&detector.read_out(exposure.draw(&mut rng), &mut rng));
                     }
                 }
                 for b in 0..nb {

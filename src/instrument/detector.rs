@@ -106,6 +106,42 @@ fn shot<R: rand::Rng + ?Sized>(mean: f64, rng: &mut R) -> f64 {
     round_non_negative(mean + mean.sqrt() * z)
 }
 
+/// Shot noise set up for one mean (see [`shot`]).
+#[derive(Debug, Clone, Copy)]
+enum Shot {
+    /// No draw: noise off, or no signal.
+    Fixed(f64),
+    /// An exact Poisson draw (mean below 1000).
+    Poisson(Poisson<f64>),
+    /// The normal approximation.
+    Normal { mean: f64, sd: f64 },
+}
+
+/// One detector and band's exposure to a constant radiance, from [`Detector::exposure`].
+#[derive(Debug, Clone, Copy)]
+pub struct Exposure {
+    shot: Shot,
+    /// An ideal detector does not clip at the well.
+    ideal: bool,
+    well_e: f64,
+}
+
+impl Exposure {
+    /// Electrons of one frame: the same value as [`Detector::expose`] with the same generator.
+    #[inline]
+    pub fn draw<R: rand::Rng + ?Sized>(&self, rng: &mut R) -> f64 {
+        let e = match &self.shot {
+            Shot::Fixed(v) => *v,
+            Shot::Poisson(p) => p.sample(rng),
+            Shot::Normal { mean, sd } => {
+                let z: f64 = StandardNormal.sample(rng);
+                round_non_negative(mean + sd * z)
+            }
+        };
+        if self.ideal { e } else { e.min(self.well_e) }
+    }
+}
+
 /// Round half up to a whole number, negative values to 0. (`f64::round` is a libm call on the
 /// baseline x86-64 target; the truncating conversion is one instruction.)
 #[inline]
@@ -273,20 +309,83 @@ impl Detector {
         exposure_s: f64,
         rng: &mut R,
     ) -> f64 {
-        let mean = if exposure_s == self.exposure_s {
+        let mean = self.mean_e(j, b, radiance, exposure_s);
+        let e = if self.mode.noise { shot(mean, rng) } else { mean };
+        if self.ideal { e } else { e.min(self.well_e) }
+    }
+
+    /// Mean electrons of detector `j`, band `b` for `radiance` over `exposure_s`.
+    #[inline]
+    fn mean_e(&self, j: usize, b: usize, radiance: f64, exposure_s: f64) -> f64 {
+        if exposure_s == self.exposure_s {
             let i = j * self.n_bands + b;
             self.responsivity[i] * radiance.max(0.0) + self.dark_e[i]
         } else {
             self.responsivity(j, b) * radiance.max(0.0) * exposure_s / self.exposure_s
                 + self.dark_mean_e(j, b, exposure_s)
+        }
+    }
+
+    /// [`Self::expose`] prepared for repeated frames of one constant radiance (calibration
+    /// frames, the SNR patch): the mean and the shot-noise distribution are set up once, and
+    /// each [`Exposure::draw`] returns what `expose` would with the same generator.
+    #[must_use]
+    pub fn exposure(&self, j: usize, b: usize, radiance: f64, exposure_s: f64) -> Exposure {
+        let mean = self.mean_e(j, b, radiance, exposure_s);
+        let shot = if !self.mode.noise {
+            Shot::Fixed(mean)
+        } else if !(mean > 0.0) {
+            Shot::Fixed(0.0)
+        } else if mean < 1000.0 {
+            Poisson::new(mean).map_or(Shot::Fixed(mean), Shot::Poisson)
+        } else {
+            Shot::Normal { mean, sd: mean.sqrt() }
         };
-        let e = if self.mode.noise { shot(mean, rng) } else { mean };
-        if self.ideal { e } else { e.min(self.well_e) }
+        Exposure { shot, ideal: self.ideal, well_e: self.well_e }
     }
 
     /// Read out `electrons`: read noise, gain, bias and the ADC.
+    #[inline]
     pub fn read_out<R: rand::Rng + ?Sized>(&self, electrons: f64, rng: &mut R) -> Readout {
-        let noisy = if self.mode.noise { electrons + self.read_noise_e * normal(rng) } else { electrons };
+        let z = if self.mode.noise { normal(rng) } else { 0.0 };
+        self.read_out_with(electrons, z)
+    }
+
+    /// Read out one pixel's bands: `electrons[b]` to `dn[b]`, `flags[b]` and, when given,
+    /// `analog[b]`. The same values as [`Self::read_out`] band after band with the same `rng`:
+    /// the read-noise draws are taken first, in band order, then the arithmetic runs as a
+    /// separate loop the compiler can keep in registers (Level-0 spent most of its time in
+    /// per-value calls). `z` is a work buffer.
+    pub fn read_out_bands<R: rand::Rng + ?Sized>(
+        &self,
+        electrons: &[f32],
+        rng: &mut R,
+        z: &mut Vec<f64>,
+        dn: &mut [u16],
+        flags: &mut [u8],
+        mut analog: Option<&mut [f32]>,
+    ) {
+        z.clear();
+        if self.mode.noise {
+            z.extend(electrons.iter().map(|_| normal(rng)));
+        } else {
+            z.resize(electrons.len(), 0.0);
+        }
+        for (b, (&e, &z)) in electrons.iter().zip(z.iter()).enumerate() {
+            let r = self.read_out_with(f64::from(e), z);
+            dn[b] = r.dn;
+            flags[b] = r.flags;
+            if let Some(a) = analog.as_deref_mut() {
+                a[b] = r.analog_dn;
+            }
+        }
+    }
+
+    /// [`Self::read_out`] with its standard normal read-noise draw `z` given (ignored when noise
+    /// is off).
+    #[inline(always)]
+    fn read_out_with(&self, electrons: f64, z: f64) -> Readout {
+        let noisy = if self.mode.noise { electrons + self.read_noise_e * z } else { electrons };
         let analog = noisy * self.dn_per_e + self.bias_dn;
         let mut flags = 0;
         if !self.ideal && electrons >= self.well_e {
@@ -337,6 +436,30 @@ mod tests {
         assert_eq!(a, b);
         assert_ne!(a, c);
         assert_ne!(a, d);
+    }
+
+    #[test]
+    fn a_prepared_exposure_draws_what_expose_draws() {
+        use rand::RngExt;
+        let spec = InstrumentSpec::preset("nominal").unwrap();
+        let response = Response::new(&spec, 1.0).unwrap();
+        for noise in [true, false] {
+            let mode = DetectorMode { noise, ..DetectorMode::default() };
+            let d = Detector::new(&spec, &response, mode, 1);
+            let mut pick = pixel_rng(9, Stream::Exposure, 1, 1);
+            for _ in 0..200 {
+                let (j, b) = (pick.random_range(0..spec.detectors), pick.random_range(0..d.n_bands()));
+                // Radiances from dark (Poisson) to bright (normal approximation, clipped).
+                let radiance = 10f64.powf(pick.random_range(-4.0..3.0));
+                let t = if pick.random_range(0.0..1.0) < 0.5 { d.exposure_s() } else { 0.0 };
+                let prepared = d.exposure(j, b, radiance, t);
+                let (mut r1, mut r2) = (pixel_rng(3, Stream::Exposure, j, b), pixel_rng(3, Stream::Exposure, j, b));
+                for _ in 0..5 {
+                    let (a, e) = (d.expose(j, b, radiance, t, &mut r1), prepared.draw(&mut r2));
+                    assert_eq!(a.to_bits(), e.to_bits(), "noise {noise}: {a} vs {e}");
+                }
+            }
+        }
     }
 
     #[test]

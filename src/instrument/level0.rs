@@ -94,19 +94,20 @@ pub fn digitise_cube(
     control.fill_rows(outputs, rows, cols * nb, |at, (dn_row, flag_row, analog_row)| {
         let r = at.index();
         let line = viewing.line_index[r];
+        let mut z = Vec::with_capacity(nb);
         for c in 0..cols {
             at.column(c);
             let j = viewing.detector_index[c];
             let mut rng = pixel_rng(seed, Stream::Readout, line, j);
-            for b in 0..nb {
-                let i = c * nb + b;
-                let out = detector.read_out(f64::from(input[(r * cols + c) * nb + b]), &mut rng);
-                dn_row[i] = out.dn;
-                flag_row[i] = out.flags;
-                if keep_analog {
-                    analog_row[i] = out.analog_dn;
-                }
-            }
+            let span = c * nb..(c + 1) * nb;
+            detector.read_out_bands(
+                &input[(r * cols + c) * nb..(r * cols + c + 1) * nb],
+                &mut rng,
+                &mut z,
+                &mut dn_row[span.clone()],
+                &mut flag_row[span.clone()],
+                keep_analog.then(|| &mut analog_row[span]),
+            );
         }
         Ok::<_, InstrumentError>(())
     })?;

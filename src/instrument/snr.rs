@@ -63,20 +63,21 @@ pub fn measured_snr(detector: &Detector, radiance: &[f64], detectors: &[usize], 
             // Running sums per band: light Σx, Σx², dark Σx.
             let (mut s1, mut s2, mut d1) = (vec![0.0; nb], vec![0.0; nb], vec![0.0; nb]);
             let mut saturated = vec![false; nb];
+            // Every frame sees the same radiance: the exposures are set up once per band.
+            let lit: Vec<_> = (0..nb).map(|b| detector.exposure(j, b, radiance[b], t)).collect();
+            let dark: Vec<_> = (0..nb).map(|b| detector.exposure(j, b, 0.0, t)).collect();
             for f in 0..frames {
                 let mut rng = pixel_rng(seed, Stream::SnrPatch, 2 * f, j);
-                for b in 0..nb {
-                    let e = detector.expose(j, b, radiance[b], t, &mut rng);
-                    let out = detector.read_out(e, &mut rng);
+                for (b, exposure) in lit.iter().enumerate() {
+                    let out = detector.read_out(exposure.draw(&mut rng), &mut rng);
                     saturated[b] |= out.flags & Flags::SATURATED != 0;
                     let v = detector.level0_value(&out);
                     s1[b] += v;
                     s2[b] += v * v;
                 }
                 let mut rng = pixel_rng(seed, Stream::SnrPatch, 2 * f + 1, j);
-                for d in d1.iter_mut().enumerate() {
-                    let e = detector.expose(j, d.0, 0.0, t, &mut rng);
-                    *d.1 += detector.level0_value(&detector.read_out(e, &mut rng));
+                for (d, exposure) in d1.iter_mut().zip(&dark) {
+                    *d += detector.level0_value(&detector.read_out(exposure.draw(&mut rng), &mut rng));
                 }
             }
             let n = frames as f64;
