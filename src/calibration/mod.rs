@@ -258,13 +258,37 @@ pub fn calibrate(
 ) -> Result<Level1, CalibrationError> {
     let (rows, cols, nb) = level0.dn.dim();
     let mut out = vec![0.0f32; rows * cols * nb];
+    let not_standard = || {
+        CalibrationError::Invalid(FieldError { field: "Level-0 cube".into(), message: "not in standard layout".into() })
+    };
+    // The values calibration reads: the analogue ones when quantisation is off, else the DN.
+    let analog = level0.analog.as_ref().map(|a| a.as_slice().ok_or_else(not_standard)).transpose()?;
+    let dn = level0.dn.as_slice().ok_or_else(not_standard)?;
     control.fill_rows(out.as_mut_slice(), rows, cols * nb, |at, row| {
         let r = at.index();
         for c in 0..cols {
             at.column(c);
-            let j = viewing.detector_index[c];
-            for b in 0..nb {
-                row[c * nb + b] = calibration.radiance(j, b, level0.value(r, c, b)) as f32;
+            // [`Calibration::radiance`] over the column's bands, on slices (no index checks in
+            // the band loop, so neighbouring bands are computed together).
+            let j = viewing.detector_index[c] * nb;
+            let (offset, gain) = (&calibration.offset_dn[j..j + nb], &calibration.gain_dn_per_radiance[j..j + nb]);
+            let at_pixel = (r * cols + c) * nb..(r * cols + c + 1) * nb;
+            let out = &mut row[c * nb..(c + 1) * nb];
+            let radiance = |value: f64, b: usize| {
+                let g = gain[b];
+                (if g > 0.0 { (value - offset[b]) / g } else { 0.0 }) as f32
+            };
+            match analog {
+                Some(a) => {
+                    for (b, (o, &v)) in out.iter_mut().zip(&a[at_pixel]).enumerate() {
+                        *o = radiance(f64::from(v), b);
+                    }
+                }
+                None => {
+                    for (b, (o, &v)) in out.iter_mut().zip(&dn[at_pixel]).enumerate() {
+                        *o = radiance(f64::from(v), b);
+                    }
+                }
             }
         }
         Ok::<_, CalibrationError>(())

@@ -114,17 +114,16 @@ pub struct SceneApproximation {
     pub ed: Vec<f64>,
 }
 
+#[inline(always)]
 fn flag_for(level0_flags: u8, land: bool, value: f64) -> u8 {
-    let mut f = 0;
-    if level0_flags & Flags::SATURATED != 0 {
-        f |= RrsFlags::SATURATED;
-    }
-    if land || level0_flags & Flags::ZERO != 0 || !value.is_finite() {
-        f |= RrsFlags::INVALID;
-    } else if value < 0.0 {
-        f |= RrsFlags::NEGATIVE;
-    }
-    f
+    // Without branches (selects), and finiteness as a comparison: the flags of a column's bands
+    // are then computed side by side.
+    let saturated = level0_flags & Flags::SATURATED != 0;
+    let invalid = land | (level0_flags & Flags::ZERO != 0) | !(value.abs() < f64::INFINITY);
+    let negative = !invalid & (value < 0.0);
+    u8::from(saturated) * RrsFlags::SATURATED
+        | u8::from(invalid) * RrsFlags::INVALID
+        | u8::from(negative) * RrsFlags::NEGATIVE
 }
 
 /// The contiguous data of a standard-layout array.
@@ -167,19 +166,85 @@ pub fn correct_exact(
         for c in 0..cols {
             at.column(c);
             let is_land = land[r * cols + c] != 0;
-            for b in 0..nb {
-                let i = atmosphere.at(c, b);
-                let k = c * nb + b;
-                let y = (f64::from(l1[base + k]) - atmosphere.l_path[i] - atmosphere.glint[i]) / atmosphere.t_ed[i];
-                let value = y / (1.0 + atmosphere.spherical_albedo[i] * std::f64::consts::PI * y);
-                let f = flag_for(l0_flags[base + k], is_land, value);
-                flag_row[k] = f;
-                rrs_row[k] = if f & RrsFlags::INVALID != 0 { 0.0 } else { value as f32 };
+            // The column's slices, all of length nb, so the band loop runs without index
+            // checks and the compiler can compute neighbouring bands together.
+            let a = atmosphere.at(c, 0)..atmosphere.at(c, 0) + nb;
+            let (l_path, glint, t_ed, s_albedo) = (
+                &atmosphere.l_path[a.clone()],
+                &atmosphere.glint[a.clone()],
+                &atmosphere.t_ed[a.clone()],
+                &atmosphere.spherical_albedo[a],
+            );
+            let k = c * nb..(c + 1) * nb;
+            let (l1, l0_flags) = (&l1[base + k.start..base + k.end], &l0_flags[base + k.start..base + k.end]);
+            let (rrs_out, flag_out) = (&mut rrs_row[k.clone()], &mut flag_row[k]);
+            let column = ExactColumn { l1, l0_flags, is_land, l_path, glint, t_ed, s_albedo };
+            #[cfg(target_arch = "x86_64")]
+            if avx2::available() {
+                avx2::correct(&column, rrs_out, flag_out);
+                continue;
             }
+            column.correct(rrs_out, flag_out);
         }
         Ok::<_, CorrectionError>(())
     })?;
     assemble(rows, cols, nb, rrs, flags)
+}
+
+/// One column's inputs to [`correct_exact`], every slice one value per band.
+struct ExactColumn<'a> {
+    l1: &'a [f32],
+    l0_flags: &'a [u8],
+    is_land: bool,
+    l_path: &'a [f64],
+    glint: &'a [f64],
+    t_ed: &'a [f64],
+    s_albedo: &'a [f64],
+}
+
+impl ExactColumn<'_> {
+    /// The exact inversion band by band (see [`correct_exact`]).
+    #[inline(always)]
+    fn correct(&self, rrs_out: &mut [f32], flag_out: &mut [u8]) {
+        let nb = rrs_out.len();
+        let (l1, l0_flags) = (&self.l1[..nb], &self.l0_flags[..nb]);
+        let (l_path, glint, t_ed, s_albedo) =
+            (&self.l_path[..nb], &self.glint[..nb], &self.t_ed[..nb], &self.s_albedo[..nb]);
+        let flag_out = &mut flag_out[..nb];
+        for b in 0..nb {
+            let y = (f64::from(l1[b]) - l_path[b] - glint[b]) / t_ed[b];
+            let value = y / (1.0 + s_albedo[b] * std::f64::consts::PI * y);
+            let f = flag_for(l0_flags[b], self.is_land, value);
+            flag_out[b] = f;
+            rrs_out[b] = if f & RrsFlags::INVALID != 0 { 0.0 } else { value as f32 };
+        }
+    }
+}
+
+/// [`ExactColumn::correct`] compiled for AVX2 (four divisions per instruction), chosen at run
+/// time so the binary still runs on any x86-64 CPU. The same operations (Rust never contracts
+/// a·b + c into an FMA), so the same bits.
+#[cfg(target_arch = "x86_64")]
+mod avx2 {
+    use super::ExactColumn;
+
+    pub fn available() -> bool {
+        std::is_x86_feature_detected!("avx2")
+    }
+
+    #[target_feature(enable = "avx2")]
+    fn correct_avx2(column: &ExactColumn<'_>, rrs_out: &mut [f32], flag_out: &mut [u8]) {
+        column.correct(rrs_out, flag_out);
+    }
+
+    pub fn correct(column: &ExactColumn<'_>, rrs_out: &mut [f32], flag_out: &mut [u8]) {
+        debug_assert!(available());
+        // SAFETY: callers check `available()`: the CPU executes AVX2 instructions.
+        #[allow(unsafe_code)]
+        unsafe {
+            correct_avx2(column, rrs_out, flag_out);
+        }
+    }
 }
 
 impl SceneApproximation {
