@@ -121,9 +121,9 @@ fn flag_for(level0_flags: u8, land: bool, value: f64) -> u8 {
     let saturated = level0_flags & Flags::SATURATED != 0;
     let invalid = land | (level0_flags & Flags::ZERO != 0) | !(value.abs() < f64::INFINITY);
     let negative = !invalid & (value < 0.0);
-    u8::from(saturated) * RrsFlags::SATURATED
-        | u8::from(invalid) * RrsFlags::INVALID
-        | u8::from(negative) * RrsFlags::NEGATIVE
+    (u8::from(saturated) * RrsFlags::SATURATED)
+        | (u8::from(invalid) * RrsFlags::INVALID)
+        | (u8::from(negative) * RrsFlags::NEGATIVE)
 }
 
 /// The contiguous data of a standard-layout array.
