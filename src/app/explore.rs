@@ -392,7 +392,9 @@ pub fn cost_window(app: &mut super::ShoalApp, ctx: &egui::Context) {
     let mut open = app.ui.explore.cost_open;
     let mut start = false;
     let mut apply = None;
-    egui::Window::new("Cost of accuracy").open(&mut open).default_size([640.0, 520.0]).show(ctx, |ui| {
+    // 880 px wide: the table's seven columns fit (at 640 the p95 column sat past the right
+    // edge, behind a horizontal scroll, at 1280 × 720).
+    egui::Window::new("Cost of accuracy").open(&mut open).default_size([880.0, 520.0]).show(ctx, |ui| {
         ui.label("Time of the whole chain for instrument A against the error each fidelity setting makes, each one change from full fidelity (a fresh engine per run; rounds interleave the settings with the reference).");
         ui.horizontal(|ui| {
             let e = &mut app.ui.explore;
