@@ -235,9 +235,14 @@ impl Calibration {
     #[must_use]
     pub fn radiance(&self, j: usize, b: usize, value: f64) -> f64 {
         let i = j * self.n_bands + b;
-        let g = self.gain_dn_per_radiance[i];
-        if g > 0.0 { (value - self.offset_dn[i]) / g } else { 0.0 }
+        radiance_of(value, self.offset_dn[i], self.gain_dn_per_radiance[i])
     }
+}
+
+/// L1 = (DN − offset)/gain (Appendix A); 0 for a detector without a usable gain.
+#[inline(always)]
+fn radiance_of(value: f64, offset_dn: f64, gain: f64) -> f64 {
+    if gain > 0.0 { (value - offset_dn) / gain } else { 0.0 }
 }
 
 /// Level-1: calibrated band radiance at the entrance pupil.
@@ -274,10 +279,7 @@ pub fn calibrate(
             let (offset, gain) = (&calibration.offset_dn[j..j + nb], &calibration.gain_dn_per_radiance[j..j + nb]);
             let at_pixel = (r * cols + c) * nb..(r * cols + c + 1) * nb;
             let out = &mut row[c * nb..(c + 1) * nb];
-            let radiance = |value: f64, b: usize| {
-                let g = gain[b];
-                (if g > 0.0 { (value - offset[b]) / g } else { 0.0 }) as f32
-            };
+            let radiance = |value: f64, b: usize| radiance_of(value, offset[b], gain[b]) as f32;
             match analog {
                 Some(a) => {
                     for (b, (o, &v)) in out.iter_mut().zip(&a[at_pixel]).enumerate() {
