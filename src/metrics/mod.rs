@@ -17,8 +17,9 @@
 
 use serde::Serialize;
 
-use crate::instrument::Truth;
-use crate::retrieval::{Product, ProductFlags};
+mod evaluate;
+
+pub use evaluate::evaluate;
 
 /// The metrics of one product.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -98,46 +99,91 @@ pub fn label(variable: &str) -> String {
 /// and `None` entries of `truth` are not candidates.
 #[must_use]
 pub fn compare(retrieved: &[Option<f64>], truth: &[Option<f64>]) -> Metrics {
-    let mut n = 0usize;
-    let mut candidates = 0usize;
-    let (mut s_abs, mut s_dif, mut s_sq, mut s_lin_abs, mut s_lin) = (0.0, 0.0, 0.0, 0.0, 0.0);
-    let (mut sx, mut sy, mut sxx, mut syy, mut sxy) = (0.0, 0.0, 0.0, 0.0, 0.0);
+    let mut sums = Sums::default();
     for (m, o) in retrieved.iter().zip(truth) {
-        let Some(o) = o.filter(|o| o.is_finite() && *o > 0.0) else { continue };
-        candidates += 1;
-        let Some(m) = m.filter(|m| m.is_finite() && *m > 0.0) else { continue };
-        n += 1;
-        let (lm, lo) = (m.log10(), o.log10());
-        s_abs += (lm - lo).abs();
-        s_dif += lm - lo;
-        s_sq += (m - o) * (m - o);
-        s_lin_abs += (m - o).abs();
-        s_lin += m - o;
-        sx += lo;
-        sy += lm;
-        sxx += lo * lo;
-        syy += lm * lm;
-        sxy += lo * lm;
+        sums.add(*m, *o);
     }
-    let nf = n as f64;
-    let r2 = if n > 1 {
-        let cov = sxy - sx * sy / nf;
-        let (vx, vy) = (sxx - sx * sx / nf, syy - sy * sy / nf);
-        if vx > 0.0 && vy > 0.0 { (cov * cov / (vx * vy)).clamp(0.0, 1.0) } else { 0.0 }
-    } else {
-        0.0
-    };
-    Metrics {
-        n,
-        candidates,
-        excluded: candidates - n,
-        returned_pct: if candidates > 0 { 100.0 * nf / candidates as f64 } else { 0.0 },
-        mae: if n > 0 { 10f64.powf(s_abs / nf) } else { 1.0 },
-        bias: if n > 0 { 10f64.powf(s_dif / nf) } else { 1.0 },
-        rmse: if n > 0 { (s_sq / nf).sqrt() } else { 0.0 },
-        mean_abs_error: if n > 0 { s_lin_abs / nf } else { 0.0 },
-        mean_error: if n > 0 { s_lin / nf } else { 0.0 },
-        r2,
+    sums.metrics()
+}
+
+/// The running sums behind [`Metrics`]: [`compare`] adds pixels one by one, [`evaluate`] adds
+/// them in blocks of rows on several threads and merges the blocks in order.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Sums {
+    n: usize,
+    candidates: usize,
+    s_abs: f64,
+    s_dif: f64,
+    s_sq: f64,
+    s_lin_abs: f64,
+    s_lin: f64,
+    sx: f64,
+    sy: f64,
+    sxx: f64,
+    syy: f64,
+    sxy: f64,
+}
+
+impl Sums {
+    /// Add one pixel: retrieval `m` (`None`: failed) against truth `o` (`None`: no truth).
+    #[inline]
+    pub(crate) fn add(&mut self, m: Option<f64>, o: Option<f64>) {
+        let Some(o) = o.filter(|o| o.is_finite() && *o > 0.0) else { return };
+        self.candidates += 1;
+        let Some(m) = m.filter(|m| m.is_finite() && *m > 0.0) else { return };
+        self.n += 1;
+        let (lm, lo) = (m.log10(), o.log10());
+        self.s_abs += (lm - lo).abs();
+        self.s_dif += lm - lo;
+        self.s_sq += (m - o) * (m - o);
+        self.s_lin_abs += (m - o).abs();
+        self.s_lin += m - o;
+        self.sx += lo;
+        self.sy += lm;
+        self.sxx += lo * lo;
+        self.syy += lm * lm;
+        self.sxy += lo * lm;
+    }
+
+    /// Add another block's sums to these.
+    pub(crate) fn merge(&mut self, b: &Self) {
+        self.n += b.n;
+        self.candidates += b.candidates;
+        self.s_abs += b.s_abs;
+        self.s_dif += b.s_dif;
+        self.s_sq += b.s_sq;
+        self.s_lin_abs += b.s_lin_abs;
+        self.s_lin += b.s_lin;
+        self.sx += b.sx;
+        self.sy += b.sy;
+        self.sxx += b.sxx;
+        self.syy += b.syy;
+        self.sxy += b.sxy;
+    }
+
+    /// The metrics of the pixels added so far.
+    pub(crate) fn metrics(&self) -> Metrics {
+        let Self { n, candidates, s_abs, s_dif, s_sq, s_lin_abs, s_lin, sx, sy, sxx, syy, sxy } = *self;
+        let nf = n as f64;
+        let r2 = if n > 1 {
+            let cov = sxy - sx * sy / nf;
+            let (vx, vy) = (sxx - sx * sx / nf, syy - sy * sy / nf);
+            if vx > 0.0 && vy > 0.0 { (cov * cov / (vx * vy)).clamp(0.0, 1.0) } else { 0.0 }
+        } else {
+            0.0
+        };
+        Metrics {
+            n,
+            candidates,
+            excluded: candidates - n,
+            returned_pct: if candidates > 0 { 100.0 * nf / candidates as f64 } else { 0.0 },
+            mae: if n > 0 { 10f64.powf(s_abs / nf) } else { 1.0 },
+            bias: if n > 0 { 10f64.powf(s_dif / nf) } else { 1.0 },
+            rmse: if n > 0 { (s_sq / nf).sqrt() } else { 0.0 },
+            mean_abs_error: if n > 0 { s_lin_abs / nf } else { 0.0 },
+            mean_error: if n > 0 { s_lin / nf } else { 0.0 },
+            r2,
+        }
     }
 }
 
@@ -258,122 +304,6 @@ impl ProductMetrics {
     #[must_use]
     pub fn get(&self, variable: &str) -> Option<&Metrics> {
         self.variables.iter().find(|v| v.variable == variable).map(|v| &v.metrics)
-    }
-}
-
-/// Score `product` against the `truth` under the same pixels.
-#[must_use]
-pub fn evaluate(product: &Product, truth: &Truth) -> ProductMetrics {
-    let (rows, cols) = product.flags.dim();
-    let water: Vec<(usize, usize)> =
-        (0..rows).flat_map(|r| (0..cols).map(move |c| (r, c))).filter(|&(r, c)| truth.land[[r, c]] == 0).collect();
-    let got = |map: &ndarray::Array2<f32>, keep: &dyn Fn(usize, usize) -> bool| -> Vec<Option<f64>> {
-        water
-            .iter()
-            .filter(|&&(r, c)| keep(r, c))
-            .map(|&(r, c)| product.returned(r, c).then(|| f64::from(map[[r, c]])))
-            .collect()
-    };
-    let want = |map: &ndarray::Array2<f32>, keep: &dyn Fn(usize, usize) -> bool| -> Vec<Option<f64>> {
-        water.iter().filter(|&&(r, c)| keep(r, c)).map(|&(r, c)| Some(f64::from(map[[r, c]]))).collect()
-    };
-    let all = |_: usize, _: usize| true;
-    let mut variables = vec![
-        VariableMetrics {
-            variable: "chl_mg_m3".into(),
-            metrics: compare(&got(&product.chl_mg_m3, &all), &want(&truth.chl_mg_m3, &all)),
-        },
-        VariableMetrics {
-            variable: "nap_g_m3".into(),
-            metrics: compare(&got(&product.nap_g_m3, &all), &want(&truth.nap_g_m3, &all)),
-        },
-        VariableMetrics {
-            variable: "cdom_per_m".into(),
-            metrics: compare(&got(&product.cdom_per_m, &all), &want(&truth.cdom_per_m, &all)),
-        },
-    ];
-    let mut substrate_agreement_pct = None;
-    let mut substrate_confusion = None;
-    let mut depth_by_true_substrate = Vec::new();
-    if let (Some(depth), Some(true_depth)) = (&product.depth_m, &truth.depth_m) {
-        if let Some(tf) = &truth.substrate_fractions {
-            let n = tf.dim().2;
-            let dominant =
-                |r: usize, c: usize| (0..n).max_by(|&i, &j| tf[[r, c, i]].total_cmp(&tf[[r, c, j]])).unwrap_or(0);
-            for (s, name) in truth.substrate_names.iter().enumerate().take(n) {
-                let here = |r: usize, c: usize| dominant(r, c) == s;
-                depth_by_true_substrate.push(VariableMetrics {
-                    variable: format!("depth_m_over_{name}"),
-                    metrics: compare(&got(depth, &here), &want(true_depth, &here)),
-                });
-            }
-        }
-        variables.push(VariableMetrics {
-            variable: "depth_m".into(),
-            metrics: compare(&got(depth, &all), &want(true_depth, &all)),
-        });
-        let visible = |r: usize, c: usize| product.flags[[r, c]] & ProductFlags::BOTTOM_VISIBLE != 0;
-        variables.push(VariableMetrics {
-            variable: "depth_m_bottom_visible".into(),
-            metrics: compare(&got(depth, &visible), &want(true_depth, &visible)),
-        });
-        if let (Some(f), Some(tf)) = (&product.substrate_fractions, &truth.substrate_fractions) {
-            // Compared by name: the retrieval's library need not be the scene's.
-            let dominant = |a: &ndarray::Array3<f32>, names: &[String], r: usize, c: usize| -> Option<String> {
-                (0..names.len().min(a.dim().2))
-                    .max_by(|&i, &j| a[[r, c, i]].total_cmp(&a[[r, c, j]]))
-                    .map(|i| names[i].clone())
-            };
-            let returned: Vec<&(usize, usize)> = water.iter().filter(|&&(r, c)| product.returned(r, c)).collect();
-            let mut classes = truth.substrate_names.clone();
-            for n in &product.substrate_names {
-                if !classes.contains(n) {
-                    classes.push(n.clone());
-                }
-            }
-            let mut counts = vec![vec![0usize; classes.len()]; classes.len()];
-            let index = |name: Option<String>| name.and_then(|n| classes.iter().position(|c| *c == n));
-            for &&(r, c) in &returned {
-                let t = index(dominant(tf, &truth.substrate_names, r, c));
-                let g = index(dominant(f, &product.substrate_names, r, c));
-                if let (Some(t), Some(g)) = (t, g) {
-                    counts[t][g] += 1;
-                }
-            }
-            let confusion = Confusion { classes, counts };
-            // Agreement over every returned pixel (a pixel without a dominant class disagrees).
-            if !returned.is_empty() {
-                let right: usize = (0..confusion.classes.len()).map(|i| confusion.counts[i][i]).sum();
-                substrate_agreement_pct = Some(100.0 * right as f64 / returned.len() as f64);
-            }
-            substrate_confusion = Some(confusion);
-        }
-    }
-    let mut siop_set_counts = vec![0; product.siop_set_names.len()];
-    if product.siop_set.is_none() && siop_set_counts.len() == 1 {
-        // One set (SAMBUCA): every returned pixel used it.
-        siop_set_counts[0] = water.iter().filter(|&&(r, c)| product.returned(r, c)).count();
-    }
-    if let Some(sets) = &product.siop_set {
-        for &(r, c) in &water {
-            if let Ok(i) = usize::try_from(sets[[r, c]])
-                && product.returned(r, c)
-                && i < siop_set_counts.len()
-            {
-                siop_set_counts[i] += 1;
-            }
-        }
-    }
-    ProductMetrics {
-        product: product.name.clone(),
-        variables,
-        substrate_agreement_pct,
-        substrate_confusion,
-        depth_by_true_substrate,
-        siop_sets_used: siop_set_counts.iter().filter(|&&n| n > 0).count(),
-        siop_set_counts,
-        failed: water.iter().filter(|&&(r, c)| product.flags[[r, c]] & ProductFlags::FAILED != 0).count(),
-        stalled: water.iter().filter(|&&(r, c)| product.flags[[r, c]] & ProductFlags::STALLED != 0).count(),
     }
 }
 
