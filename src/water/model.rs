@@ -331,7 +331,6 @@ impl WaterModel {
                 allowed: format!("{n} (one per grid wavelength)"),
             });
         }
-        let (inv_cos_w, inv_cos_o) = geometry.inverse_cosines_in_water(s.water_refractive_index);
         let k = Kernel {
             a_w: &s.a_w[..n],
             bb_w: &s.bb_w[..n],
@@ -354,6 +353,10 @@ impl WaterModel {
         match column.bottom {
             Bottom::OpticallyDeep => k.deep(&mut out[..n]),
             Bottom::Shallow { depth_m, reflectance } => {
+                // Only the bottom's path needs the angles under water (two arcsines, two sines and
+                // two cosines: a third of a deep pixel's time at the band nodes, were they taken
+                // for every pixel).
+                let (inv_cos_w, inv_cos_o) = geometry.inverse_cosines_in_water(s.water_refractive_index);
                 k.shallow(depth_m, inv_cos_w, inv_cos_o, &reflectance[..n], &mut out[..n]);
             }
         }
