@@ -26,7 +26,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::control::RunControl;
-use crate::instrument::detector::{Detector, Stream, pixel_rng};
+use crate::instrument::detector::{Detector, Exposure, Stream, pixel_rng};
 use crate::instrument::{Flags, Level0, Response, Viewing};
 use crate::parse::FieldError;
 
@@ -186,31 +186,18 @@ impl Calibration {
                     }
                     return (j, offset, gain, 0);
                 }
-                let mut light = vec![0.0; nb];
-                let mut saturated = 0;
                 // Every frame sees the same radiance: the exposures are set up once per band.
                 let lit: Vec<_> = (0..nb).map(|b| detector.exposure(j, b, diffuser_radiance[j * nb + b], t)).collect();
                 let dark: Vec<_> = (0..nb).map(|b| detector.exposure(j, b, 0.0, spec.dark_exposure_s)).collect();
-                for f in 0..spec.light_frames {
-                    let mut rng = pixel_rng(seed, Stream::CalibrationLight, f, j);
-                    let mut any = false;
-                    for (b, exposure) in lit.iter().enumerate() {
-                        let r = detector.read_out(exposure.draw(&mut rng), &mut rng);
-                        any |= r.flags & Flags::SATURATED != 0;
-                        light[b] += detector.level0_value(&r);
-                    }
-                    saturated += usize::from(any);
-                }
-                for f in 0..spec.dark_frames {
-                    let mut rng = pixel_rng(seed, Stream::CalibrationDark, f, j);
-                    for (b, exposure) in dark.iter().enumerate() {
-                        offset[b] += detector.level0_value(&detector.read_out(exposure.draw(&mut rng), &mut rng));
-                    }
-                }
+                let frames = |exposures: &[Exposure], n: usize, streams: (Stream, Stream)| {
+                    frame_means(detector, j, exposures, n, (seed, streams.0, streams.1))
+                };
+                let (light, saturated) =
+                    frames(&lit, spec.light_frames, (Stream::CalibrationLightSum, Stream::CalibrationLight));
+                let (dark, _) = frames(&dark, spec.dark_frames, (Stream::CalibrationDarkSum, Stream::CalibrationDark));
                 for b in 0..nb {
-                    offset[b] /= spec.dark_frames as f64;
-                    let signal = light[b] / spec.light_frames as f64 - offset[b];
-                    gain[b] = signal / (diffuser_radiance[j * nb + b] * assumed) / drift;
+                    offset[b] = dark[b];
+                    gain[b] = (light[b] - dark[b]) / (diffuser_radiance[j * nb + b] * assumed) / drift;
                 }
                 (j, offset, gain, saturated)
             })
@@ -237,6 +224,40 @@ impl Calibration {
         let i = j * self.n_bands + b;
         radiance_of(value, self.offset_dn[i], self.gain_dn_per_radiance[i])
     }
+}
+
+/// The mean Level-0 value of `frames` frames of each band's exposure of detector `j`, and the
+/// frames in which a band saturated. Each band's mean is drawn at once where
+/// [`Detector::frames_mean`] shows that to be the same in distribution (no frame can clip, the
+/// ADC's rounding is dithered by the read noise); the other bands are read out frame by frame
+/// (for example dark frames whose bias sits within a few σ of zero, which clip). `streams`:
+/// (run seed, stream of the drawn means, stream of the frames).
+fn frame_means(
+    detector: &Detector,
+    j: usize,
+    exposures: &[Exposure],
+    frames: usize,
+    (seed, at_once, by_frame): (u64, Stream, Stream),
+) -> (Vec<f64>, usize) {
+    let mut rng = pixel_rng(seed, at_once, 0, j);
+    let drawn: Vec<Option<f64>> = exposures.iter().map(|e| detector.frames_mean(e, frames, &mut rng)).collect();
+    let left: Vec<usize> = (0..exposures.len()).filter(|&b| drawn[b].is_none()).collect();
+    let mut sums = vec![0.0; exposures.len()];
+    let mut saturated = 0;
+    if !left.is_empty() {
+        for f in 0..frames {
+            let mut rng = pixel_rng(seed, by_frame, f, j);
+            let mut any = false;
+            for &b in &left {
+                let r = detector.read_out(exposures[b].draw(&mut rng), &mut rng);
+                any |= r.flags & Flags::SATURATED != 0;
+                sums[b] += detector.level0_value(&r);
+            }
+            saturated += usize::from(any);
+        }
+    }
+    let means = drawn.iter().zip(&sums).map(|(d, s)| d.unwrap_or(s / frames as f64)).collect();
+    (means, saturated)
 }
 
 /// L1 = (DN − offset)/gain (Appendix A); 0 for a detector without a usable gain.

@@ -216,9 +216,7 @@ impl Engine {
             digitise_cube(&detector, &electrons, viewing, config.seed, control).map_err(failed(Stage::Level0))
         })?;
         drop(electrons);
-        let flags = level0.flags.as_slice().unwrap_or(&[]);
-        report.saturated = flags.iter().filter(|&&f| f & crate::instrument::Flags::SATURATED != 0).count();
-        report.zero_counts = flags.iter().filter(|&&f| f & crate::instrument::Flags::ZERO != 0).count();
+        (report.saturated, report.zero_counts) = (level0.saturated, level0.zero_counts);
 
         // Calibration and Level-1.
         let calibration_key = KeyBuilder::new(Stage::Calibration)

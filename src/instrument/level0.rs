@@ -22,6 +22,10 @@ pub struct Level0 {
     pub analog: Option<Array3<f32>>,
     /// [`super::Flags`] per pixel and band.
     pub flags: Array3<u8>,
+    /// Values flagged [`super::Flags::SATURATED`].
+    pub saturated: usize,
+    /// Values flagged [`super::Flags::ZERO`].
+    pub zero_counts: usize,
 }
 
 impl Level0 {
@@ -111,10 +115,28 @@ pub fn digitise_cube(
         }
         Ok::<_, InstrumentError>(())
     })?;
+    let (saturated, zero_counts) = count_flags(&flags);
     let shape = (rows, cols, nb);
     Ok(Level0 {
         dn: Array3::from_shape_vec(shape, dn).map_err(shape_error)?,
         analog: if keep_analog { Some(Array3::from_shape_vec(shape, analog).map_err(shape_error)?) } else { None },
         flags: Array3::from_shape_vec(shape, flags).map_err(shape_error)?,
+        saturated,
+        zero_counts,
     })
+}
+
+/// Values flagged saturated and zero, counted in one parallel pass (two filtered counts on one
+/// thread were 4 % of a preview after a gain change).
+fn count_flags(flags: &[u8]) -> (usize, usize) {
+    use super::Flags;
+    use rayon::prelude::*;
+    flags
+        .par_chunks(1 << 16)
+        .map(|chunk| {
+            chunk.iter().fold((0, 0), |(s, z), &f| {
+                (s + usize::from(f & Flags::SATURATED != 0), z + usize::from(f & Flags::ZERO != 0))
+            })
+        })
+        .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1))
 }
