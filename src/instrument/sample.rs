@@ -69,6 +69,9 @@ pub struct BandAtmosphere {
     /// Per group (empty where the optics has no band nodes), per column, per band of the group:
     /// the band's weights on the nodes' values (see [`NodeWeights`]).
     pub node_weights: Vec<Vec<Vec<NodeWeights>>>,
+    /// Per group (empty where the optics has no band nodes), per column: S·π at each band node,
+    /// side by side so the per-pixel f = Rrs/(1 − S·π·Rrs) runs over contiguous values.
+    pub node_s_pi: Vec<Vec<Vec<f64>>>,
 }
 
 /// A band's weights on per-pixel spectra known only at band nodes.
@@ -127,6 +130,7 @@ impl BandAtmosphere {
             spherical_albedo: vec![0.0; nc * nb],
             truth_weights: Vec::new(),
             node_weights: Vec::new(),
+            node_s_pi: Vec::new(),
         };
         for (gi, group) in response.groups.iter().enumerate() {
             let paths: Vec<PathSpectrum> = viewing.looks[gi]
@@ -179,9 +183,17 @@ impl BandAtmosphere {
                     node_weights.push(column_nodes);
                 }
             }
+            let node_s_pi = match nodes {
+                Some(nodes) => paths
+                    .iter()
+                    .map(|p| nodes.iter().map(|&i| p.spherical_albedo[i] * std::f64::consts::PI).collect())
+                    .collect(),
+                None => Vec::new(),
+            };
             out.paths.push(paths);
             out.truth_weights.push(truth);
             out.node_weights.push(node_weights);
+            out.node_s_pi.push(node_s_pi);
         }
         Ok(out)
     }
@@ -389,9 +401,8 @@ impl PixelSampler<'_> {
                 if atmosphere.has_nodes(gi)
                     && optics.water_at_nodes(self.scene, x, y, &look.geometry, &mut work.scratch, node_rrs)?
                 {
-                    let nodes = optics.band_nodes().unwrap_or(&[]);
-                    for ((f, rrs), &i) in node_f.iter_mut().zip(node_rrs.iter()).zip(nodes) {
-                        *f = rrs / (1.0 - path.spherical_albedo[i] * std::f64::consts::PI * rrs);
+                    for ((f, rrs), s_pi) in node_f.iter_mut().zip(node_rrs.iter()).zip(&atmosphere.node_s_pi[gi][c]) {
+                        *f = rrs / (1.0 - s_pi * rrs);
                     }
                     for (kb, &b) in group.bands.iter().enumerate() {
                         let nw = &atmosphere.node_weights[gi][c][kb];
