@@ -370,16 +370,21 @@ pub fn compare(a: &Reflectance, b: &Array3<f32>, b_flags: Option<&Array3<u8>>) -
     let acc = (0..pixels)
         .into_par_iter()
         .fold(empty, |mut acc, p| {
+            // One pixel's bands as slices (no per-value bounds checks), and whether it is a
+            // median sample decided once per pixel: the modulo per value was half the stage.
+            let span = p * nb..(p + 1) * nb;
+            let (a, a_flags, b) = (&ar[span.clone()], &af[span.clone()], &br[span.clone()]);
+            let b_flags = bf.map(|f| &f[span]);
+            let sampled = p % stride == 0;
             for band in 0..nb {
-                let i = p * nb + band;
-                let fb = bf.map_or(0, |f| f[i]);
-                let (x, y) = (f64::from(ar[i]), f64::from(br[i]));
-                if af[i] == 0 && fb == 0 && y > 0.0 && x.is_finite() {
+                let fb = b_flags.map_or(0, |f| f[band]);
+                let (x, y) = (f64::from(a[band]), f64::from(b[band]));
+                if a_flags[band] == 0 && fb == 0 && y > 0.0 && x.is_finite() {
                     let rel = (x - y) / y;
                     acc.n[band] += 1;
                     acc.sum[band] += rel;
                     acc.max[band] = acc.max[band].max(rel.abs());
-                    if p % stride == 0 {
+                    if sampled {
                         acc.sample[band].push(rel.abs());
                     }
                 }
