@@ -13,6 +13,7 @@
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
 use rand_distr::{Distribution, StandardNormal};
+use rayon::prelude::*;
 use rustfft::FftPlanner;
 use rustfft::num_complex::Complex32;
 
@@ -35,14 +36,26 @@ pub fn gaussian_random_field(width: usize, height: usize, cell_m: f64, correlati
         2.0 * std::f64::consts::PI * j / (len as f64 * cell_m)
     };
     let l2 = correlation_m * correlation_m;
-    for row in 0..height {
+    data.par_chunks_exact_mut(width.max(1)).enumerate().for_each(|(row, cells)| {
         let ky = freq(row, height);
-        for col in 0..width {
-            let kx = freq(col, width);
-            let amplitude = (-(kx * kx + ky * ky) * l2 / 4.0).exp() as f32; // √exp(−k²ℓ²/2)
-            data[row * width + col] *= amplitude;
+        if -(ky * ky) * l2 / 4.0 < -110.0 {
+            // Every amplitude of this row is below e^−110 (0 as an f32, below): most rows of a
+            // large field, whose exponentials were most of its synthesis time.
+            cells.iter_mut().for_each(|cell| *cell *= 0.0);
+            return;
         }
-    }
+        for (col, cell) in cells.iter_mut().enumerate() {
+            let kx = freq(col, width);
+            // √exp(−k²ℓ²/2). Below e^−110 the amplitude is 0 as an f32 (whose smallest value is
+            // 1.4·10⁻⁴⁵ ≈ e^−103.3). The exponent is clamped there before exp, which keeps libm
+            // off its slow underflow path (most of a large field's cells took it: the compiler
+            // evaluates exp on both sides of the select, so a branch alone did not avoid it).
+            let exponent = -(kx * kx + ky * ky) * l2 / 4.0;
+            let amplitude = exponent.max(-110.0).exp() as f32;
+            let amplitude = if exponent < -110.0 { 0.0 } else { amplitude };
+            *cell *= amplitude;
+        }
+    });
     fft_2d(&mut data, width, height);
     let mut field: Vec<f32> = data.iter().map(|c| c.re).collect();
     let mean = field.iter().map(|v| f64::from(*v)).sum::<f64>() / n as f64;
@@ -54,24 +67,43 @@ pub fn gaussian_random_field(width: usize, height: usize, cell_m: f64, correlati
     field
 }
 
-/// In-place 2-D inverse FFT (rows, then columns), unnormalised (the caller rescales).
+/// In-place 2-D inverse FFT (rows, then columns), unnormalised (the caller rescales). Rows are
+/// transformed in parallel; the columns too, as rows of the transpose (each transform is the
+/// same as one at a time, so the field does not depend on the thread count).
 fn fft_2d(data: &mut [Complex32], width: usize, height: usize) {
+    if width == 0 || height == 0 {
+        return;
+    }
     let mut planner = FftPlanner::<f32>::new();
-    let row_fft = planner.plan_fft_inverse(width);
-    for row in data.chunks_exact_mut(width) {
-        row_fft.process(row);
-    }
-    let col_fft = planner.plan_fft_inverse(height);
-    let mut column = vec![Complex32::new(0.0, 0.0); height];
-    for col in 0..width {
-        for (r, c) in column.iter_mut().enumerate() {
-            *c = data[r * width + col];
+    let rows = |data: &mut [Complex32], len: usize, fft: &std::sync::Arc<dyn rustfft::Fft<f32>>| {
+        data.par_chunks_exact_mut(len).for_each_init(
+            || vec![Complex32::new(0.0, 0.0); fft.get_inplace_scratch_len()],
+            |scratch, line| fft.process_with_scratch(line, scratch),
+        );
+    };
+    rows(data, width, &planner.plan_fft_inverse(width));
+    let mut transposed = vec![Complex32::new(0.0, 0.0); data.len()];
+    transpose_into(data, width, height, &mut transposed);
+    rows(&mut transposed, height, &planner.plan_fft_inverse(height));
+    transpose_into(&transposed, height, width, data);
+}
+
+/// Write the transpose of the row-major `width` × `height` array `data` into `out`, in
+/// cache-sized tiles.
+fn transpose_into(data: &[Complex32], width: usize, height: usize, out: &mut [Complex32]) {
+    const TILE: usize = 32;
+    // Each output row block (TILE input columns) is written by one task.
+    out.par_chunks_mut(TILE * height).enumerate().for_each(|(block, out_rows)| {
+        let c0 = block * TILE;
+        let c1 = (c0 + TILE).min(width);
+        for r0 in (0..height).step_by(TILE) {
+            for r in r0..(r0 + TILE).min(height) {
+                for c in c0..c1 {
+                    out_rows[(c - c0) * height + r] = data[r * width + c];
+                }
+            }
         }
-        col_fft.process(&mut column);
-        for (r, c) in column.iter().enumerate() {
-            data[r * width + col] = *c;
-        }
-    }
+    });
 }
 
 #[cfg(test)]

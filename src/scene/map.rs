@@ -7,6 +7,7 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::SceneError;
@@ -230,7 +231,7 @@ impl Map {
                     return Err(bad(format!("correlation_m = {correlation_m} must be above 0")));
                 }
                 let g = gaussian_random_field(extent.width, extent.height, extent.cell_m, *correlation_m, *seed);
-                let to_value: Box<dyn Fn(f32) -> f64> = match *distribution {
+                let to_value: Box<dyn Fn(f32) -> f64 + Send + Sync> = match *distribution {
                     Distribution::Normal { mean, std } => {
                         finite(field, mean)?;
                         if !(std.is_finite() && std >= 0.0) {
@@ -253,7 +254,7 @@ impl Map {
                     return Err(bad(format!("clamp ({lo}, {hi}) must be finite with min ≤ max")));
                 }
                 let values = g
-                    .iter()
+                    .par_iter()
                     .map(|x| {
                         let v = to_value(*x);
                         clamp.map_or(v, |(lo, hi)| v.clamp(lo, hi)) as f32
