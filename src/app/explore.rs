@@ -511,6 +511,16 @@ fn fidelity_text(f: &Fidelity) -> String {
             format!("band nodes {} per band", f.band_nodes)
         });
     }
+    if f.water_single_precision != d.water_single_precision {
+        parts.push(
+            if f.water_single_precision {
+                "water kernel in single precision"
+            } else {
+                "water kernel in double precision"
+            }
+            .to_string(),
+        );
+    }
     if f.spectral_step_nm != d.spectral_step_nm {
         parts.push(format!("spectral step {} nm", f.spectral_step_nm));
     }

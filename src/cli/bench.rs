@@ -24,7 +24,9 @@ use super::output::emit;
 use crate::atmosphere::{AerosolType, AtmosphereLut, AtmosphereSpec, LutAxes, RtAccuracy};
 use crate::spectral::{BandSet, BandSetSpec, WavelengthGrid};
 use crate::validation::{Comparison, compare_paths, compare_water_runs};
-use crate::water::{Bottom, SiopSpec, SubstrateLibrary, SubstrateMix, WaterColumn, WaterGeometry, WaterModel};
+use crate::water::{
+    Bottom, SingleWater, SiopSpec, SubstrateLibrary, SubstrateMix, WaterColumn, WaterGeometry, WaterModel,
+};
 
 /// The configuration `shoal bench --accuracy` prices.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -148,6 +150,17 @@ fn water_rows(out: &mut String, quick: bool) -> Result<(), CliError> {
         let _ = model.rrs_above_into(&column(n, Bottom::OpticallyDeep), &geo, &mut rrs);
         sink += rrs[100];
     });
+    // The single-precision kernel (the fidelity setting `water_single_precision`).
+    let single = SingleWater::new(&model);
+    let mut work = Vec::new();
+    let single_shallow = rate(reps, each, |n| {
+        let _ = single.rrs_above_into(&column(n, shallow(n)), &geo, &mut work, &mut rrs);
+        sink += rrs[100];
+    });
+    let single_deep = rate(reps, each, |n| {
+        let _ = single.rrs_above_into(&column(n, Bottom::OpticallyDeep), &geo, &mut work, &mut rrs);
+        sink += rrs[100];
+    });
     let full = rate(reps, each, |n| {
         if let Ok(r) = model.evaluate(&column(n, shallow(n)), &geo) {
             sink += r.rrs[100];
@@ -163,6 +176,8 @@ fn water_rows(out: &mut String, quick: bool) -> Result<(), CliError> {
         ("shallow, Rrs only (per-pixel path)", fast_shallow),
         ("optically deep, Rrs only", fast_deep),
         ("shallow, every intermediate", full),
+        ("shallow, Rrs only, single precision (setting `water_single_precision`)", single_shallow),
+        ("optically deep, Rrs only, single precision", single_deep),
     ] {
         say!(out, "| {label} | {:.0} | {} | {} |", r, reference.text(), reference.ratio(r));
     }

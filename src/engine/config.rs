@@ -31,6 +31,12 @@ pub struct Fidelity {
     /// adjacency use the full grid.
     #[serde(default)]
     pub band_nodes: usize,
+    /// Evaluate the per-pixel water spectra at the band nodes in single precision (`f32` lanes,
+    /// [`crate::water::SingleWater`]: Rrs within 2·10⁻⁶ of the double-precision kernel, about
+    /// three times as fast). Off by default; its time and error are the cost table's row. Only
+    /// with band nodes (the full-grid path stays in double precision).
+    #[serde(default)]
+    pub water_single_precision: bool,
     /// Preview decimation: every n-th line and detector (1 = full resolution).
     pub decimation: usize,
     /// Wavelength spacing of the atmosphere LUT nodes, nm (5–50); radiances are interpolated
@@ -50,6 +56,7 @@ impl Default for Fidelity {
             spectral_step_nm: 1.0,
             spatial_samples_per_gsd: 2,
             band_nodes: DEFAULT_BAND_NODES,
+            water_single_precision: false,
             decimation: 1,
             lut_wavelength_step_nm: 20.0,
             lut_view_step_deg: 5.0,

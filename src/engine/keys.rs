@@ -98,6 +98,8 @@ pub(super) struct Inputs<'a> {
     /// Nodes per band of the per-pixel water spectra (the optics stage: 0 = every grid
     /// wavelength).
     pub band_nodes: usize,
+    /// The per-pixel water kernel's precision (the optics stage).
+    pub water_single_precision: bool,
     /// The correction and calibration stages (decimation and seed, besides their own settings).
     pub decimation: usize,
     pub seed: u64,
@@ -137,6 +139,7 @@ impl<'a> Inputs<'a> {
             // Enter the radiance key through the spatial kernel's offsets and weights.
             spatial_samples_per_gsd: _,
             band_nodes,
+            water_single_precision,
             decimation,
             // Enter the LUT key through the axes they build (`lut_axes`).
             lut_wavelength_step_nm: _,
@@ -190,6 +193,7 @@ impl<'a> Inputs<'a> {
             snr: SnrPatch { frames: snr_frames, detectors: snr_detectors, decimation, seed },
             heading_deg: *heading_deg,
             band_nodes,
+            water_single_precision,
             decimation,
             seed,
         }

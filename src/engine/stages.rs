@@ -100,6 +100,7 @@ impl Engine {
             .after(lut_key)
             .after(response_key)
             .with(&inputs.band_nodes)
+            .with(&inputs.water_single_precision)
             .finish();
         let optics = self.stage(optics_key, report, control, || {
             response
@@ -111,7 +112,7 @@ impl Engine {
                     if fid.band_nodes == 0 {
                         Ok(optics)
                     } else {
-                        optics.with_band_nodes(response.band_nodes(gi, fid.band_nodes))
+                        optics.with_band_nodes(response.band_nodes(gi, fid.band_nodes), fid.water_single_precision)
                     }
                 })
                 .collect::<Result<Vec<_>, _>>()

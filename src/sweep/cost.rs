@@ -127,6 +127,11 @@ pub fn settings_for(base: &RunConfig) -> Vec<Setting> {
         out.extend([
             s("band nodes 2 per band", vec![("fidelity.band_nodes", 2.0)]),
             s("band nodes 3 per band", vec![("fidelity.band_nodes", 3.0)]),
+            // The single-precision kernel evaluates the spectra at the band nodes only.
+            e("the defaults, water kernel in single precision", |c| {
+                c.fidelity.band_nodes = crate::engine::DEFAULT_BAND_NODES;
+                c.fidelity.water_single_precision = true;
+            }),
         ]);
     }
     out.extend([

@@ -27,7 +27,7 @@ use crate::atmosphere::{AtmosphereError, AtmosphereLut, Geometry};
 use crate::parse::FieldError;
 use crate::scene::{Effect, Scene, SceneError};
 use crate::spectral::{Extrapolation, WavelengthGrid};
-use crate::water::{Bottom, SubstrateLibrary, SubstrateMix, WaterColumn, WaterGeometry, WaterModel};
+use crate::water::{Bottom, SingleWater, SubstrateLibrary, SubstrateMix, WaterColumn, WaterGeometry, WaterModel};
 
 pub use adjacency::Adjacency;
 
@@ -75,6 +75,8 @@ struct NodeWater {
     /// Grid indices of the nodes, increasing.
     indices: Vec<usize>,
     water: WaterModel,
+    /// The same model in single precision, when the fidelity asks for it.
+    single: Option<SingleWater>,
     substrates: Vec<Vec<f64>>,
 }
 
@@ -87,6 +89,8 @@ pub struct Scratch {
     pub bottom_evaluations: u64,
     /// Water evaluations in all.
     pub water_evaluations: u64,
+    /// The single-precision kernel's substrate reflectance.
+    single_bottom: Vec<f32>,
 }
 
 /// What [`SceneOptics::radiance`] found at a point.
@@ -161,13 +165,16 @@ impl SceneOptics {
     /// Evaluate water spectra per pixel only at the grid indices `indices` (increasing; see
     /// [`crate::instrument::Response::band_nodes`]) through [`Self::water_at_nodes`]. A scene
     /// with adjacency keeps the full grid: its environment term needs whole spectra.
-    pub fn with_band_nodes(mut self, indices: Vec<usize>) -> Result<Self, SceneError> {
+    /// With `single_precision`, the spectra at the nodes come from the single-precision kernel
+    /// (`Fidelity::water_single_precision`).
+    pub fn with_band_nodes(mut self, indices: Vec<usize>, single_precision: bool) -> Result<Self, SceneError> {
         if self.adjacency.is_some() || indices.is_empty() {
             return Ok(self);
         }
         let water = WaterModel::new(self.water.siop().subset(&indices)?);
+        let single = single_precision.then(|| SingleWater::new(&water));
         let substrates = self.substrates.iter().map(|r| indices.iter().map(|&i| r[i]).collect()).collect();
-        self.nodes_water = Some(NodeWater { indices, water, substrates });
+        self.nodes_water = Some(NodeWater { indices, water, single, substrates });
         Ok(self)
     }
 
@@ -192,9 +199,16 @@ impl SceneOptics {
         if scene.is_land(x_m, y_m) {
             return Ok(false);
         }
+        // The single-precision kernel's work buffer, out of `scratch` while the column borrows it.
+        let mut bottom = std::mem::take(&mut scratch.single_bottom);
         let column = water_column(scene, x_m, y_m, &nodes.substrates, nodes.indices.len(), scratch);
         let geometry = WaterGeometry { sun_zenith_rad: g.sun_zenith_rad, view_zenith_rad: g.view_zenith_rad };
-        nodes.water.rrs_above_into(&column, &geometry, rrs)?;
+        let result = match &nodes.single {
+            Some(single) => single.rrs_above_into(&column, &geometry, &mut bottom, rrs),
+            None => nodes.water.rrs_above_into(&column, &geometry, rrs),
+        };
+        scratch.single_bottom = bottom;
+        result?;
         Ok(true)
     }
 

@@ -31,6 +31,7 @@
 mod fastmath;
 pub mod limits;
 mod model;
+mod single;
 mod siop;
 mod substrate;
 
@@ -38,6 +39,7 @@ pub use fastmath::fast_exp;
 pub use model::{
     Bottom, WaterColumn, WaterGeometry, WaterModel, WaterReflectance, rrs_above_from_below, rrs_below_from_above,
 };
+pub use single::SingleWater;
 pub use siop::{Siop, SiopSource, SiopSpec};
 pub use substrate::{SubstrateEntry, SubstrateLibrary, SubstrateMix};
 

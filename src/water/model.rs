@@ -101,7 +101,10 @@ impl WaterColumn<'_> {
                     allowed: format!("{n_wavelengths} values, one per grid wavelength"),
                 });
             }
-            if let Some(r) = reflectance.iter().find(|r| !(r.is_finite() && (0.0..=1.0).contains(*r))) {
+            // A pass without an early exit (it vectorises; NaN and ±∞ fail both comparisons or
+            // the second), then the search for the message.
+            let in_range = reflectance.iter().fold(true, |ok, &r| ok & (0.0..=1.0).contains(&r));
+            if !in_range && let Some(r) = reflectance.iter().find(|r| !(r.is_finite() && (0.0..=1.0).contains(*r))) {
                 return Err(WaterError::OutOfRange {
                     field: "substrate reflectance".into(),
                     value: *r,
@@ -215,25 +218,29 @@ pub fn rrs_below_from_above(rrs_above: f64) -> f64 {
 #[derive(Debug, Clone)]
 pub struct WaterModel {
     siop: Siop,
-    /// Every column gives a > 0 and bb > 0: pure water's a_w and bb_w are positive and every
-    /// specific spectrum is non-negative, at every wavelength, so with the concentrations a
-    /// validated column has (finite, ≥ 0) nothing can cancel them. The per-call check of
-    /// [`Self::rrs_above_into`] is then skipped: it cost as much as the deep-water kernel.
-    positive_for_any_column: bool,
+    /// The wavelengths where a column could give a ≤ 0 or bb ≤ 0: those where pure water's
+    /// a_w or bb_w is not positive or a specific spectrum is negative (or any is not finite).
+    /// Everywhere else the concentrations a validated column has (finite, ≥ 0) cannot cancel
+    /// them, so the per-call check of [`Self::rrs_above_into`] looks only here: none for the
+    /// built-in sets, a few wavelengths for SAMBUCA's default set (a search over every
+    /// wavelength cost as much as the single-precision kernel).
+    may_be_non_positive: Vec<usize>,
 }
 
 impl WaterModel {
     /// Bind a resolved SIOP set.
     #[must_use]
     pub fn new(siop: Siop) -> Self {
-        let positive = |v: &[f64]| v.iter().all(|x| x.is_finite() && *x > 0.0);
-        let non_negative = |v: &[f64]| v.iter().all(|x| x.is_finite() && *x >= 0.0);
-        let positive_for_any_column = positive(&siop.a_w)
-            && positive(&siop.bb_w)
-            && [&siop.a_ph_star, &siop.a_cdom_star, &siop.a_nap_star, &siop.bb_ph_star, &siop.bb_nap_star]
-                .iter()
-                .all(|v| non_negative(v));
-        Self { siop, positive_for_any_column }
+        let positive = |v: f64| v.is_finite() && v > 0.0;
+        let non_negative = |v: f64| v.is_finite() && v >= 0.0;
+        let may_be_non_positive = (0..siop.grid.len())
+            .filter(|&i| {
+                let specific =
+                    [&siop.a_ph_star, &siop.a_cdom_star, &siop.a_nap_star, &siop.bb_ph_star, &siop.bb_nap_star];
+                !(positive(siop.a_w[i]) && positive(siop.bb_w[i]) && specific.iter().all(|v| non_negative(v[i])))
+            })
+            .collect();
+        Self { siop, may_be_non_positive }
     }
 
     /// The SIOP set (and its grid).
@@ -311,27 +318,38 @@ impl WaterModel {
         })
     }
 
-    /// Above-surface Rrs only, without allocating: the per-pixel path. Same formulas as
-    /// [`Self::evaluate`]; the exponential is [`super::fast_exp`] (≤ 4.5·10⁻¹⁶ relative) so the
-    /// loop vectorises. Inputs are validated as in `evaluate`, including a > 0 and bb > 0.
-    pub fn rrs_above_into(
+    /// The checks of [`Self::rrs_above_into`] (shared with the single-precision kernel,
+    /// [`super::SingleWater`]): the column, the geometry, the output length, and a > 0, bb > 0.
+    pub(super) fn check(
         &self,
         column: &WaterColumn<'_>,
         geometry: &WaterGeometry,
-        out: &mut [f64],
+        out_len: usize,
     ) -> Result<(), WaterError> {
-        let s = &self.siop;
-        let n = s.grid.len();
+        let n = self.siop.grid.len();
         column.validate(n)?;
         geometry.validate()?;
-        if out.len() != n {
+        if out_len != n {
             return Err(WaterError::OutOfRange {
                 field: "output length".into(),
-                value: out.len() as f64,
+                value: out_len as f64,
                 allowed: format!("{n} (one per grid wavelength)"),
             });
         }
-        let k = Kernel {
+        // Only a SIOP set with strongly negative specific spectra can make a or bb ≤ 0; check
+        // before computing, as `evaluate` does (a cheap pass next to the kernel).
+        let k = self.kernel(column);
+        if let Some(&i) =
+            self.may_be_non_positive.iter().find(|&&i| !(k.absorption(i) > 0.0 && k.backscattering(i) > 0.0))
+        {
+            return Err(self.non_physical(i, k.absorption(i), k.backscattering(i)));
+        }
+        Ok(())
+    }
+
+    fn kernel<'a>(&'a self, column: &WaterColumn<'_>) -> Kernel<'a> {
+        let (s, n) = (&self.siop, self.siop.grid.len());
+        Kernel {
             a_w: &s.a_w[..n],
             bb_w: &s.bb_w[..n],
             a_ph: &s.a_ph_star[..n],
@@ -342,14 +360,21 @@ impl WaterModel {
             chl: column.chl_mg_m3,
             cdom: column.cdom_per_m,
             nap: column.nap_g_m3,
-        };
-        // Only a SIOP set with strongly negative specific spectra can make a or bb ≤ 0; check
-        // before computing, as `evaluate` does (a cheap pass next to the kernel).
-        if !self.positive_for_any_column
-            && let Some(i) = (0..n).find(|&i| !(k.absorption(i) > 0.0 && k.backscattering(i) > 0.0))
-        {
-            return Err(self.non_physical(i, k.absorption(i), k.backscattering(i)));
         }
+    }
+
+    /// Above-surface Rrs only, without allocating: the per-pixel path. Same formulas as
+    /// [`Self::evaluate`]; the exponential is [`super::fast_exp`] (≤ 4.5·10⁻¹⁶ relative) so the
+    /// loop vectorises. Inputs are validated as in `evaluate`, including a > 0 and bb > 0.
+    pub fn rrs_above_into(
+        &self,
+        column: &WaterColumn<'_>,
+        geometry: &WaterGeometry,
+        out: &mut [f64],
+    ) -> Result<(), WaterError> {
+        self.check(column, geometry, out.len())?;
+        let (s, n) = (&self.siop, out.len());
+        let k = self.kernel(column);
         match column.bottom {
             Bottom::OpticallyDeep => k.deep(&mut out[..n]),
             Bottom::Shallow { depth_m, reflectance } => {
