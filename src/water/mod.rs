@@ -29,6 +29,7 @@
 //!   data. Remote Sens. Environ. 113, 755–770 (SAMBUCA).
 
 mod fastmath;
+mod kernel;
 pub mod limits;
 mod model;
 mod single;

@@ -1,7 +1,7 @@
 //! The semi-analytical shallow-water reflectance model of Lee et al. (1998, 1999) as coded in
 //! SAMBUCA (`sambuca_core.forward_model`), with every intermediate returned.
 
-use super::fastmath::fast_exp;
+use super::kernel::{self, Spectra};
 use super::{Siop, WaterError, limits};
 use crate::units::PI;
 
@@ -402,18 +402,7 @@ impl WaterModel {
 }
 
 /// The SIOP spectra and concentrations of one evaluation, laid out for a vectorised loop.
-struct Kernel<'a> {
-    a_w: &'a [f64],
-    bb_w: &'a [f64],
-    a_ph: &'a [f64],
-    a_cdom: &'a [f64],
-    a_nap: &'a [f64],
-    bb_ph: &'a [f64],
-    bb_nap: &'a [f64],
-    chl: f64,
-    cdom: f64,
-    nap: f64,
-}
+type Kernel<'a> = Spectra<'a, f64>;
 
 impl Kernel<'_> {
     fn absorption(&self, i: usize) -> f64 {
@@ -484,49 +473,14 @@ mod avx2 {
     }
 }
 
-/// Optically deep Rrs: every slice is re-sliced to one length here so that the loop carries no
-/// bounds checks and vectorises.
+/// Optically deep Rrs ([`kernel::deep`] on `f64`).
 #[inline(always)]
 fn deep_kernel(k: &Kernel<'_>, out: &mut [f64]) {
-    let n = out.len();
-    let (a_w, bb_w, a_ph, a_cdom, a_nap, bb_ph, bb_nap) =
-        (&k.a_w[..n], &k.bb_w[..n], &k.a_ph[..n], &k.a_cdom[..n], &k.a_nap[..n], &k.bb_ph[..n], &k.bb_nap[..n]);
-    let (chl, cdom, nap) = (k.chl, k.cdom, k.nap);
-    for i in 0..n {
-        let a = a_w[i] + chl * a_ph[i] + cdom * a_cdom[i] + nap * a_nap[i];
-        let bb = bb_w[i] + chl * bb_ph[i] + nap * bb_nap[i];
-        let u = bb / (a + bb);
-        out[i] = rrs_above_from_below((0.084 + 0.17 * u) * u);
-    }
+    kernel::deep(k, out);
 }
 
-/// Shallow-water Rrs (Lee et al. 1999 eq. 5 with the SAMBUCA attenuation factors).
+/// Shallow-water Rrs ([`kernel::shallow`] on `f64`).
 #[inline(always)]
 fn shallow_kernel(k: &Kernel<'_>, depth_m: f64, inv_cos_w: f64, inv_cos_o: f64, rb: &[f64], out: &mut [f64]) {
-    let n = out.len();
-    let (a_w, bb_w, a_ph, a_cdom, a_nap, bb_ph, bb_nap, rb) = (
-        &k.a_w[..n],
-        &k.bb_w[..n],
-        &k.a_ph[..n],
-        &k.a_cdom[..n],
-        &k.a_nap[..n],
-        &k.bb_ph[..n],
-        &k.bb_nap[..n],
-        &rb[..n],
-    );
-    let (chl, cdom, nap) = (k.chl, k.cdom, k.nap);
-    let inv_pi = 1.0 / PI;
-    for i in 0..n {
-        let a = a_w[i] + chl * a_ph[i] + cdom * a_cdom[i] + nap * a_nap[i];
-        let bb = bb_w[i] + chl * bb_ph[i] + nap * bb_nap[i];
-        let kappa = a + bb;
-        let u = bb / kappa;
-        let kh = kappa * depth_m;
-        let du_c = 1.03 * (1.0 + 2.4 * u).sqrt();
-        let du_b = 1.04 * (1.0 + 5.4 * u).sqrt();
-        let rrs_dp = (0.084 + 0.17 * u) * u;
-        let column = rrs_dp * (1.0 - fast_exp(-(inv_cos_w + du_c * inv_cos_o) * kh));
-        let bottom = rb[i] * inv_pi * fast_exp(-(inv_cos_w + du_b * inv_cos_o) * kh);
-        out[i] = rrs_above_from_below(column + bottom);
-    }
+    kernel::shallow(k, depth_m, inv_cos_w, inv_cos_o, rb, out);
 }

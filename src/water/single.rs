@@ -10,9 +10,8 @@
 //! the cost table's row (`shoal bench --accuracy`). The checks are the double-precision
 //! model's, so bad input gets the same messages.
 
-use std::f32::consts::PI;
-
 use super::WaterError;
+use super::kernel::Spectra;
 use super::model::{Bottom, WaterColumn, WaterGeometry, WaterModel};
 
 /// A water model's spectra in `f32`, with the model itself for its checks.
@@ -93,7 +92,7 @@ impl SingleWater {
 /// r⁷ (truncation ≤ 8·10⁻⁹ relative), 2^k from the exponent bits; within 3·10⁻⁷ relative (about
 /// 2.5 f32 ulps: the roundings of the steps). Clamped to the f32 range.
 #[inline(always)]
-fn exp_f32(x: f32) -> f32 {
+pub(super) fn exp_f32(x: f32) -> f32 {
     // 1.5·2²³: adding it rounds to an integer held in the low mantissa bits.
     const SHIFT: f32 = 12_582_912.0;
     const LN2_HI: f32 = 0.693_145_75;
@@ -108,39 +107,25 @@ fn exp_f32(x: f32) -> f32 {
     p * f32::from_bits(t.to_bits().wrapping_add(127) << 23)
 }
 
-/// The kernel: deep when `rb` is `None`. The same expressions as the double-precision kernel.
+/// The kernel on `f32` lanes: deep when `rb` is `None` ([`super::kernel`], the equations the
+/// double-precision kernel runs).
 #[inline(always)]
 fn kernel(w: &SingleWater, c: &Column, rb: Option<&[f32]>, out: &mut [f64]) {
-    let n = out.len();
-    let (a_w, bb_w, a_ph, a_cdom, a_nap, bb_ph, bb_nap) =
-        (&w.a_w[..n], &w.bb_w[..n], &w.a_ph[..n], &w.a_cdom[..n], &w.a_nap[..n], &w.bb_ph[..n], &w.bb_nap[..n]);
-    let Column { chl, cdom, nap, depth_m, inv_cos_w, inv_cos_o } = *c;
-    let above = |rrs: f32| f64::from(0.52 * rrs / (1.0 - 1.7 * rrs));
+    let spectra = Spectra {
+        a_w: &w.a_w,
+        bb_w: &w.bb_w,
+        a_ph: &w.a_ph,
+        a_cdom: &w.a_cdom,
+        a_nap: &w.a_nap,
+        bb_ph: &w.bb_ph,
+        bb_nap: &w.bb_nap,
+        chl: c.chl,
+        cdom: c.cdom,
+        nap: c.nap,
+    };
     match rb {
-        None => {
-            for i in 0..n {
-                let a = a_w[i] + chl * a_ph[i] + cdom * a_cdom[i] + nap * a_nap[i];
-                let bb = bb_w[i] + chl * bb_ph[i] + nap * bb_nap[i];
-                let u = bb / (a + bb);
-                out[i] = above((0.084 + 0.17 * u) * u);
-            }
-        }
-        Some(rb) => {
-            let rb = &rb[..n];
-            for i in 0..n {
-                let a = a_w[i] + chl * a_ph[i] + cdom * a_cdom[i] + nap * a_nap[i];
-                let bb = bb_w[i] + chl * bb_ph[i] + nap * bb_nap[i];
-                let kappa = a + bb;
-                let u = bb / kappa;
-                let kh = kappa * depth_m;
-                let du_c = 1.03 * (1.0 + 2.4 * u).sqrt();
-                let du_b = 1.04 * (1.0 + 5.4 * u).sqrt();
-                let rrs_dp = (0.084 + 0.17 * u) * u;
-                let column = rrs_dp * (1.0 - exp_f32(-(inv_cos_w + du_c * inv_cos_o) * kh));
-                let bottom = rb[i] * (1.0 / PI) * exp_f32(-(inv_cos_w + du_b * inv_cos_o) * kh);
-                out[i] = above(column + bottom);
-            }
-        }
+        None => super::kernel::deep(&spectra, out),
+        Some(rb) => super::kernel::shallow(&spectra, c.depth_m, c.inv_cos_w, c.inv_cos_o, rb, out),
     }
 }
 
