@@ -201,13 +201,16 @@ pub fn settings_for(base: &RunConfig) -> Vec<Setting> {
 #[must_use]
 pub fn fidelity_of(label: &str, base: &RunConfig) -> Option<crate::engine::Fidelity> {
     let setting = settings_for(base).into_iter().find(|s| s.label == label)?;
-    // The reference (nothing set) is `base`'s own fidelity: applying it goes back to it.
-    let fidelity_only = setting.edit.is_none()
-        && setting.set.iter().all(|(path, _)| path.starts_with("fidelity.") && *path != "fidelity.decimation");
-    if !fidelity_only {
-        return None;
+    // The row's configuration; the reference (nothing set) is `base` itself, so applying it
+    // goes back to `base`'s fidelity.
+    let mut config = apply(base, &setting.set).ok()?;
+    if let Some(edit) = setting.edit {
+        edit(&mut config);
     }
-    apply(base, &setting.set).ok().map(|c| c.fidelity)
+    // A fidelity setting alone: nothing but the fidelity differs, and not its resolution.
+    let fidelity = config.fidelity.clone();
+    config.fidelity = base.fidelity.clone();
+    (config == *base && fidelity.decimation == base.fidelity.decimation).then_some(fidelity)
 }
 
 fn chl_mae(out: &RunOutput) -> f64 {
@@ -499,6 +502,9 @@ mod tests {
             assert!(fidelity_of(label, &base).is_none(), "{label}");
         }
         assert!(fidelity_of("no such row", &base).is_none());
+        // A row set by an edit of the fidelity alone is one too.
+        let f = fidelity_of("the defaults, water kernel in single precision", &base);
+        assert_eq!(f.map(|f| (f.band_nodes, f.water_single_precision)), Some((4, true)));
     }
 
     #[test]
