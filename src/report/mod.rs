@@ -453,38 +453,21 @@ pub fn review_data(result: &StudyResult, budget: &[Budget], cost: &[CostRow]) ->
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::timing::{Comparison, Sample, Summary};
-
-    /// A cost row timed at `walls` seconds (CPU twice the wall), with per-pixel chl errors.
-    fn cost_row(label: &str, walls: &[f64], comparison: Comparison, pixel: Option<f64>, p95: Option<f64>) -> CostRow {
-        let samples: Vec<Sample> = walls.iter().map(|&w| Sample { wall_s: w, cpu_s: Some(2.0 * w) }).collect();
-        CostRow {
-            label: label.into(),
-            time: Summary::of(&samples),
-            samples,
-            comparison,
-            chl_mae_pct: 37.0,
-            delta_mae_pct: 0.07,
-            chl_pixel_pct: pixel,
-            chl_pixel_p95_pct: p95,
-            rrs_pixel_pct: pixel,
-            depth_pixel_pct: None,
-        }
-    }
+    use crate::timing::Comparison;
 
     #[test]
     fn the_review_pack_states_each_cost_row_with_its_range_and_95th_percentile() {
         let rows = [
-            cost_row(
+            CostRow::timed(
                 "reference (full fidelity)",
                 &[4.47, 4.32, 4.49],
                 Comparison::NoMeasurableDifference,
                 Some(0.0),
                 Some(0.0),
             ),
-            cost_row("the defaults", &[3.63, 3.57, 3.53], Comparison::Ratio(0.7987), Some(0.003), Some(1.713)),
-            cost_row("preview 1/4", &[0.49, 0.45, 0.51], Comparison::Ratio(0.11), None, None),
-            cost_row(
+            CostRow::timed("the defaults", &[3.63, 3.57, 3.53], Comparison::Ratio(0.7987), Some(0.003), Some(1.713)),
+            CostRow::timed("preview 1/4", &[0.49, 0.45, 0.51], Comparison::Ratio(0.11), None, None),
+            CostRow::timed(
                 "a setting whose percentile failed",
                 &[4.4, 4.3, 4.5],
                 Comparison::NoMeasurableDifference,

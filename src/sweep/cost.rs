@@ -47,6 +47,33 @@ pub struct CostRow {
 }
 
 impl CostRow {
+    /// A row timed at `walls` seconds (CPU twice the wall), chl MAE 37 % (+0.07 points), with the
+    /// per-pixel chl error `pixel` (also the Rrs error) and its 95th percentile `p95`: for the
+    /// tests of the tables that print rows.
+    #[cfg(test)]
+    #[must_use]
+    pub(crate) fn timed(
+        label: &str,
+        walls: &[f64],
+        comparison: Comparison,
+        pixel: Option<f64>,
+        p95: Option<f64>,
+    ) -> Self {
+        let samples: Vec<Sample> = walls.iter().map(|&w| Sample { wall_s: w, cpu_s: Some(2.0 * w) }).collect();
+        Self {
+            label: label.into(),
+            time: Summary::of(&samples),
+            samples,
+            comparison,
+            chl_mae_pct: 37.0,
+            delta_mae_pct: 0.07,
+            chl_pixel_pct: pixel,
+            chl_pixel_p95_pct: p95,
+            rrs_pixel_pct: pixel,
+            depth_pixel_pct: None,
+        }
+    }
+
     /// Median wall time, s.
     #[must_use]
     pub fn seconds(&self) -> f64 {

@@ -1,0 +1,116 @@
+use super::*;
+
+#[test]
+fn generators_are_per_pixel() {
+    use rand::Rng;
+    let a = pixel_rng(7, Stream::Exposure, 3, 4).next_u64();
+    let b = pixel_rng(7, Stream::Exposure, 3, 4).next_u64();
+    let c = pixel_rng(7, Stream::Exposure, 4, 3).next_u64();
+    let d = pixel_rng(7, Stream::Readout, 3, 4).next_u64();
+    assert_eq!(a, b);
+    assert_ne!(a, c);
+    assert_ne!(a, d);
+}
+
+/// Mean and variance of `values`.
+fn moments(values: &[f64]) -> (f64, f64) {
+    let n = values.len() as f64;
+    let mean = values.iter().sum::<f64>() / n;
+    (mean, values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0))
+}
+
+#[test]
+fn the_frames_mean_drawn_at_once_is_the_frame_by_frame_mean_in_distribution() {
+    let mut spec = InstrumentSpec::preset("nominal").unwrap();
+    // A bias 20 σ above zero, so that dim frames do not clip either.
+    spec.bias_dn = 100.0;
+    let response = Response::new(&spec, 1.0).unwrap();
+    let d = Detector::new(&spec, &response, DetectorMode::default(), 1);
+    let (frames, trials) = (100, 2000);
+    // Dark-like (Poisson, tens of e⁻), mid (Poisson, hundreds) and bright (the normal
+    // approximation, 20 000 e⁻): read noise 15 e⁻ = 5 DN, so the rounding is dithered.
+    for target_e in [20.0, 400.0, 20_000.0] {
+        let exposure = d.exposure(0, 0, target_e / d.responsivity(0, 0), d.exposure_s());
+        let by_frame: Vec<f64> = (0..trials)
+            .map(|t| {
+                let mut rng = pixel_rng(t, Stream::CalibrationLight, 0, 0);
+                let sum: f64 =
+                    (0..frames).map(|_| d.level0_value(&d.read_out(exposure.draw(&mut rng), &mut rng))).sum();
+                sum / frames as f64
+            })
+            .collect();
+        let at_once: Vec<f64> = (0..trials)
+            .map(|t| d.frames_mean(&exposure, frames, &mut pixel_rng(t, Stream::CalibrationLightSum, 0, 0)).unwrap())
+            .collect();
+        let ((m1, v1), (m2, v2)) = (moments(&by_frame), moments(&at_once));
+        // Means within 4 standard errors of their difference; variances within 15 % (the
+        // ratio of two 2000-sample variances has a standard error of 4.5 %: 3.3 σ).
+        let se = (v1 / trials as f64 + v2 / trials as f64).sqrt();
+        assert!((m1 - m2).abs() < 4.0 * se, "{target_e} e: means {m1} vs {m2} (se {se})");
+        assert!((v2 / v1 - 1.0).abs() < 0.15, "{target_e} e: variances {v1} vs {v2}");
+    }
+}
+
+#[test]
+fn the_frames_mean_is_refused_where_frames_clip_or_rounding_is_not_dithered() {
+    let mut spec = InstrumentSpec::preset("nominal").unwrap();
+    let response = Response::new(&spec, 1.0).unwrap();
+    let d = Detector::new(&spec, &response, DetectorMode::default(), 1);
+    let mut rng = pixel_rng(1, Stream::CalibrationLightSum, 0, 0);
+    let near_well = d.exposure(0, 0, 0.999 * d.well_e() / d.responsivity(0, 0), d.exposure_s());
+    assert_eq!(d.frames_mean(&near_well, 100, &mut rng), None);
+    let mid = d.exposure(0, 0, 400.0 / d.responsivity(0, 0), d.exposure_s());
+    assert!(d.frames_mean(&mid, 100, &mut rng).is_some());
+    assert_eq!(d.frames_mean(&mid, 0, &mut rng), None);
+    // The nominal bias (10.4 DN) is 2 σ of read noise (5 DN) above zero: dark frames clip.
+    let dark = d.exposure(0, 0, 0.0, 0.0);
+    assert_eq!(d.frames_mean(&dark, 100, &mut rng), None);
+    // 1 e⁻ of read noise at 3 e⁻/DN: a third of a DN, the rounding shows in the mean.
+    spec.read_noise_e = 1.0;
+    let quiet = Detector::new(&spec, &response, DetectorMode::default(), 1);
+    let mid = quiet.exposure(0, 0, 400.0 / quiet.responsivity(0, 0), quiet.exposure_s());
+    assert_eq!(quiet.frames_mean(&mid, 100, &mut rng), None);
+    // Without noise every frame is the same value, and so is the mean.
+    let ideal = Detector::new(&spec, &response, DetectorMode { noise: false, ..DetectorMode::default() }, 1);
+    let mid = ideal.exposure(0, 0, 400.0 / ideal.responsivity(0, 0), ideal.exposure_s());
+    let one = ideal.level0_value(&ideal.read_out(mid.draw(&mut rng), &mut rng));
+    assert_eq!(ideal.frames_mean(&mid, 100, &mut rng), Some(one));
+}
+
+#[test]
+fn a_prepared_exposure_draws_what_expose_draws() {
+    use rand::RngExt;
+    let spec = InstrumentSpec::preset("nominal").unwrap();
+    let response = Response::new(&spec, 1.0).unwrap();
+    for noise in [true, false] {
+        let mode = DetectorMode { noise, ..DetectorMode::default() };
+        let d = Detector::new(&spec, &response, mode, 1);
+        let mut pick = pixel_rng(9, Stream::Exposure, 1, 1);
+        for _ in 0..200 {
+            let (j, b) = (pick.random_range(0..spec.detectors), pick.random_range(0..d.n_bands()));
+            // Radiances from dark (Poisson) to bright (normal approximation, clipped).
+            let radiance = 10f64.powf(pick.random_range(-4.0..3.0));
+            let t = if pick.random_range(0.0..1.0) < 0.5 { d.exposure_s() } else { 0.0 };
+            let prepared = d.exposure(j, b, radiance, t);
+            let (mut r1, mut r2) = (pixel_rng(3, Stream::Exposure, j, b), pixel_rng(3, Stream::Exposure, j, b));
+            for _ in 0..5 {
+                let (a, e) = (d.expose(j, b, radiance, t, &mut r1), prepared.draw(&mut r2));
+                assert_eq!(a.to_bits(), e.to_bits(), "noise {noise}: {a} vs {e}");
+            }
+        }
+    }
+}
+
+#[test]
+fn shot_noise_mean_and_variance() {
+    let mut rng = pixel_rng(1, Stream::Exposure, 0, 0);
+    for mean in [3.0, 500.0, 20_000.0] {
+        let n = 40_000;
+        let xs: Vec<f64> = (0..n).map(|_| shot(mean, &mut rng)).collect();
+        let m = xs.iter().sum::<f64>() / n as f64;
+        let v = xs.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1) as f64;
+        // Standard errors: mean √(μ/n), variance μ·√(2/n) (normal), 5σ allowed.
+        assert!((m - mean).abs() < 5.0 * (mean / n as f64).sqrt(), "{mean}: {m}");
+        assert!((v - mean).abs() < 5.0 * mean * (2.0 / n as f64).sqrt() + 0.1, "{mean}: {v}");
+    }
+}
