@@ -141,6 +141,90 @@ fn cramer(rows: &[[&Lanes; 3]; 3], bs: &[Lanes; 3], det: &Lanes, j: usize) -> La
     lanewise(|s| num[s] / det[s])
 }
 
+/// Whether lane `s` of `x` is feasible: every component finite and non-negative.
+#[inline(always)]
+fn feasible(x: &[Lanes; 3], s: usize) -> bool {
+    x.iter().fold(true, |ok, v| ok & (v[s] >= 0.0) & (v[s] < INF))
+}
+
+/// Index of (i, j) among the six stored entries of a symmetric 3 × 3 matrix.
+const AT: [[usize; 3]; 3] = [[0, 1, 2], [1, 3, 4], [2, 4, 5]];
+
+/// The column-scaled normal equations of every lane, as [`nnls3`] scales them.
+struct Scaled {
+    /// The scaled Gram matrix's six entries (symmetric bit for bit: d_i·d_j = d_j·d_i exactly).
+    gs: [Lanes; 6],
+    bs: [Lanes; 3],
+    yy: Lanes,
+}
+
+impl Scaled {
+    #[inline(always)]
+    fn at(&self, i: usize, j: usize) -> &Lanes {
+        &self.gs[AT[i][j]]
+    }
+
+    /// The residual ‖A·x − y‖² of scaled x with its non-zeros in `support`, as `nnls3` writes
+    /// it but without the terms of the zeros outside the support. In a lane that can win (x
+    /// finite, G finite) each such term is ±0, and adding ±0 leaves r as it was (at most the
+    /// sign of a zero r changes, and r only enters comparisons), so the kept terms, added in
+    /// `nnls3`'s order, give its residual. With every term, the seven residuals of the
+    /// enumeration were half of aLMI's time (perf).
+    #[inline(always)]
+    fn residual(&self, x: &[Lanes; 3], support: &[usize]) -> Lanes {
+        lanewise(|s| {
+            let mut r = self.yy[s];
+            for &i in support {
+                r -= 2.0 * x[i][s] * self.bs[i][s];
+                for &j in support {
+                    r += x[i][s] * self.at(i, j)[s] * x[j][s];
+                }
+            }
+            r.max(0.0)
+        })
+    }
+}
+
+/// The enumeration's best feasible solution so far, per lane.
+struct Best {
+    found: [bool; LANES],
+    x: [Lanes; 3],
+    r: Lanes,
+}
+
+impl Best {
+    /// Solve on `support` (at most two columns) as [`nnls3`] does, and keep the solution in each
+    /// lane where it is feasible and the first found or strictly better: a select per lane, not
+    /// a branch.
+    #[inline(always)]
+    fn consider(&mut self, sc: &Scaled, support: &[usize]) {
+        let mut x = [[0.0; LANES]; 3];
+        let mut ok = [true; LANES];
+        match *support {
+            [] => {}
+            [j] => x[j] = lanewise(|s| sc.bs[j][s] / sc.at(j, j)[s]),
+            [p, q, ..] => {
+                for s in 0..LANES {
+                    let (gpp, gqq, gpq, gqp) = (sc.at(p, p)[s], sc.at(q, q)[s], sc.at(p, q)[s], sc.at(q, p)[s]);
+                    let det = gpp * gqq - gpq * gqp;
+                    ok[s] = det.abs() > MIN_DET;
+                    x[p][s] = (sc.bs[p][s] * gqq - gpq * sc.bs[q][s]) / det;
+                    x[q][s] = (gpp * sc.bs[q][s] - gqp * sc.bs[p][s]) / det;
+                }
+            }
+        }
+        let r = sc.residual(&x, support);
+        for s in 0..LANES {
+            let take = ok[s] & feasible(&x, s) & (!self.found[s] | (r[s] < self.r[s]));
+            self.found[s] |= take;
+            self.r[s] = if take { r[s] } else { self.r[s] };
+            for j in 0..3 {
+                self.x[j][s] = if take { x[j][s] } else { self.x[j][s] };
+            }
+        }
+    }
+}
+
 impl Normal {
     /// Every lane's NNLS, lane-wise: [`nnls3`]'s column scaling, Cramer solves, residuals and
     /// unscaling, the same operations in the same order, so the same bits. When the
@@ -152,79 +236,45 @@ impl Normal {
     /// support).
     #[inline(always)]
     fn solve_all(&self, lanes: usize) -> [Solution; LANES] {
-        // Index of (i, j) among the six stored entries of the symmetric G (the scaled Gram
-        // matrix is symmetric bit for bit too: d_i·d_j = d_j·d_i exactly).
-        const AT: [[usize; 3]; 3] = [[0, 1, 2], [1, 3, 4], [2, 4, 5]];
         let col = |j: usize| lanewise(|s| self.g[AT[j][j]][s].sqrt());
         let d: [Lanes; 3] = [col(0), col(1), col(2)];
-        let scaled = |i: usize, j: usize| lanewise(|s| self.g[AT[i][j]][s] / (d[i][s] * d[j][s]));
-        let gs: [Lanes; 6] = [scaled(0, 0), scaled(0, 1), scaled(0, 2), scaled(1, 1), scaled(1, 2), scaled(2, 2)];
+        let scale = |i: usize, j: usize| lanewise(|s| self.g[AT[i][j]][s] / (d[i][s] * d[j][s]));
+        let gs: [Lanes; 6] = [scale(0, 0), scale(0, 1), scale(0, 2), scale(1, 1), scale(1, 2), scale(2, 2)];
         let rhs = |j: usize| lanewise(|s| self.b[j][s] / d[j][s]);
-        let bs: [Lanes; 3] = [rhs(0), rhs(1), rhs(2)];
-        let at = |i: usize, j: usize| &gs[AT[i][j]];
+        let scaled = Scaled { gs, bs: [rhs(0), rhs(1), rhs(2)], yy: self.yy };
+        let at = |i: usize, j: usize| scaled.at(i, j);
         // Lanes the lane-wise arithmetic holds for: every column present, the data finite.
         // (`&` rather than `&&` and `all`, here and below: no short circuits, so no branches per
         // lane, and the lanes are tested side by side.)
         let regular: [bool; LANES] = lanewise(|s| {
             (0..3).fold(finite(self.yy[s]), |ok, j| ok & (d[j][s] > 0.0) & (d[j][s] < INF) & finite(self.b[j][s]))
         });
-        // The residual ‖A·x − y‖² of scaled x, as `nnls3` writes it (zeros included).
-        let residual = |x: &[Lanes; 3]| -> Lanes {
-            lanewise(|s| {
-                let mut r = self.yy[s];
-                for i in 0..3 {
-                    r -= 2.0 * x[i][s] * bs[i][s];
-                    for j in 0..3 {
-                        r += x[i][s] * at(i, j)[s] * x[j][s];
-                    }
-                }
-                r.max(0.0)
-            })
-        };
-        let feasible = |x: &[Lanes; 3], s: usize| x.iter().fold(true, |ok, v| ok & (v[s] >= 0.0) & (v[s] < INF));
         // The full support by Cramer's rule.
         let rows = [[at(0, 0), at(0, 1), at(0, 2)], [at(1, 0), at(1, 1), at(1, 2)], [at(2, 0), at(2, 1), at(2, 2)]];
         let det = det3_lanes(&rows);
-        let full: [Lanes; 3] = [cramer(&rows, &bs, &det, 0), cramer(&rows, &bs, &det, 1), cramer(&rows, &bs, &det, 2)];
+        let full: [Lanes; 3] = [
+            cramer(&rows, &scaled.bs, &det, 0),
+            cramer(&rows, &scaled.bs, &det, 1),
+            cramer(&rows, &scaled.bs, &det, 2),
+        ];
         let solvable: [bool; LANES] = lanewise(|s| det[s].abs() > MIN_DET);
         let fast: [bool; LANES] = lanewise(|s| regular[s] && solvable[s] && feasible(&full, s));
         let unscale =
             |x: &[Lanes; 3], s: usize| -> [f64; 3] { [x[0][s] / d[0][s], x[1][s] / d[1][s], x[2][s] / d[2][s]] };
-        let mut best = [[0.0; LANES]; 3];
-        let mut best_r = residual(&full);
+        let mut best = Best { found: [false; LANES], x: [[0.0; LANES]; 3], r: scaled.residual(&full, &[0, 1, 2]) };
         if (0..lanes).any(|s| regular[s] && !fast[s]) {
-            // The other supports, in `nnls3`'s order (its masks 0 to 6: bit j, column j).
-            const SUPPORTS: [&[usize]; 7] = [&[], &[0], &[1], &[0, 1], &[2], &[0, 2], &[1, 2]];
-            let mut found = [false; LANES];
-            for support in SUPPORTS {
-                let mut x = [[0.0; LANES]; 3];
-                let mut ok = [true; LANES];
-                match *support {
-                    [] => {}
-                    [j] => x[j] = lanewise(|s| bs[j][s] / at(j, j)[s]),
-                    [p, q, ..] => {
-                        for s in 0..LANES {
-                            let (gpp, gqq, gpq, gqp) = (at(p, p)[s], at(q, q)[s], at(p, q)[s], at(q, p)[s]);
-                            let det = gpp * gqq - gpq * gqp;
-                            ok[s] = det.abs() > MIN_DET;
-                            x[p][s] = (bs[p][s] * gqq - gpq * bs[q][s]) / det;
-                            x[q][s] = (gpp * bs[q][s] - gqp * bs[p][s]) / det;
-                        }
-                    }
-                }
-                let r = residual(&x);
-                for s in 0..LANES {
-                    // Kept when feasible and the first found or strictly better: a select per
-                    // lane, not a branch.
-                    let take = ok[s] & feasible(&x, s) & (!found[s] | (r[s] < best_r[s]));
-                    found[s] |= take;
-                    best_r[s] = if take { r[s] } else { best_r[s] };
-                    for j in 0..3 {
-                        best[j][s] = if take { x[j][s] } else { best[j][s] };
-                    }
-                }
-            }
+            // The other supports, in `nnls3`'s order (its masks 0 to 6: bit j, column j), each
+            // spelled out so that its indices are constants once inlined (a loop over the
+            // supports left them as loads, and ran slower).
+            best.consider(&scaled, &[]);
+            best.consider(&scaled, &[0]);
+            best.consider(&scaled, &[1]);
+            best.consider(&scaled, &[0, 1]);
+            best.consider(&scaled, &[2]);
+            best.consider(&scaled, &[0, 2]);
+            best.consider(&scaled, &[1, 2]);
         }
+        let Best { x: best, r: best_r, .. } = best;
         let mut out: [Solution; LANES] = [None; LANES];
         for (s, slot) in out.iter_mut().enumerate().take(lanes) {
             *slot = if fast[s] {
