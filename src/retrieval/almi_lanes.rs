@@ -12,7 +12,7 @@
 //! below); the scalar one stays as the readable statement of the method.
 
 use super::almi::{AlmiFlags, AlmiPixel, AlmiSet, AlmiSettings, MAX_BANDS, Prepared};
-use super::nnls::{MIN_DET, det3, nnls3};
+use super::nnls::{MIN_DET, column_scale, det3, nnls3};
 
 /// Sets per chunk (one chunk of eight covers the built-in sets).
 pub const LANES: usize = 8;
@@ -109,6 +109,18 @@ fn lanewise<T: Copy + Default>(f: impl Fn(usize) -> T) -> [T; LANES] {
 
 const INF: f64 = f64::INFINITY;
 
+/// The lane mask of `b`: all bits set when true.
+#[inline(always)]
+fn mask(b: bool) -> u64 {
+    u64::from(b).wrapping_neg()
+}
+
+/// `a` where `mask` is set, else `b`, by bit operations (no branch).
+#[inline(always)]
+fn select(mask: u64, a: f64, b: f64) -> f64 {
+    f64::from_bits((a.to_bits() & mask) | (b.to_bits() & !mask))
+}
+
 /// `x.is_finite()` as a floating-point comparison: `is_finite` compiles to integer tests of the
 /// bits, one lane at a time, where a comparison runs four lanes per instruction. (NaN compares
 /// false, so the two agree on every input.)
@@ -129,16 +141,17 @@ fn det3_lanes(c: &[[&Lanes; 3]; 3]) -> Lanes {
     })
 }
 
-/// Component `j` of the solution of `rows`·x = `bs` by Cramer's rule (`det` = det(rows)), lane
-/// by lane as [`nnls3`] computes it. (A function, not a closure: the closure was left out of line.)
+/// Component `j` of the solution of `rows`·x = `bs` by Cramer's rule (`inv_det` = 1/det(rows)),
+/// lane by lane as [`nnls3`] computes it. (A function, not a closure: the closure was left out
+/// of line.)
 #[inline(always)]
-fn cramer(rows: &[[&Lanes; 3]; 3], bs: &[Lanes; 3], det: &Lanes, j: usize) -> Lanes {
+fn cramer(rows: &[[&Lanes; 3]; 3], bs: &[Lanes; 3], inv_det: &Lanes, j: usize) -> Lanes {
     let mut c = *rows;
     for (i, row) in c.iter_mut().enumerate() {
         row[j] = &bs[i];
     }
     let num = det3_lanes(&c);
-    lanewise(|s| num[s] / det[s])
+    lanewise(|s| num[s] * inv_det[s])
 }
 
 /// Whether lane `s` of `x` is feasible: every component finite and non-negative.
@@ -172,54 +185,66 @@ impl Scaled {
     /// enumeration were half of aLMI's time (perf).
     #[inline(always)]
     fn residual(&self, x: &[Lanes; 3], support: &[usize]) -> Lanes {
-        lanewise(|s| {
-            let mut r = self.yy[s];
-            for &i in support {
-                r -= 2.0 * x[i][s] * self.bs[i][s];
-                for &j in support {
-                    r += x[i][s] * self.at(i, j)[s] * x[j][s];
-                }
+        lanewise(|s| self.residual_lane(&[x[0][s], x[1][s], x[2][s]], support, s))
+    }
+
+    /// [`Self::residual`] of lane `s`.
+    #[inline(always)]
+    fn residual_lane(&self, x: &[f64; 3], support: &[usize], s: usize) -> f64 {
+        let mut r = self.yy[s];
+        for &i in support {
+            r -= 2.0 * x[i] * self.bs[i][s];
+            for &j in support {
+                r += x[i] * self.at(i, j)[s] * x[j];
             }
-            r.max(0.0)
-        })
+        }
+        r.max(0.0)
     }
 }
 
-/// The enumeration's best feasible solution so far, per lane.
+/// The enumeration's best feasible solution so far, per lane. It starts from the empty support
+/// (x = 0, the residual yᵀy), the first support `nnls3` tries and always feasible, so a later
+/// support is kept exactly when it is feasible and strictly better, as in `nnls3`.
 struct Best {
-    found: [bool; LANES],
     x: [Lanes; 3],
     r: Lanes,
 }
 
 impl Best {
-    /// Solve on `support` (at most two columns) as [`nnls3`] does, and keep the solution in each
-    /// lane where it is feasible and the first found or strictly better: a select per lane, not
-    /// a branch.
+    #[inline(always)]
+    fn empty(sc: &Scaled) -> Self {
+        Self { x: [[0.0; LANES]; 3], r: sc.residual(&[[0.0; LANES]; 3], &[]) }
+    }
+
+    /// Solve on `support` (one or two columns) as [`nnls3`] does, and keep the solution in each
+    /// lane where it is feasible and strictly better. One loop over the lanes does it all, so
+    /// the masks stay in vector registers (stored as `bool` arrays between loops, they were
+    /// packed to bytes and back, and the enumeration took a third of aLMI's time).
     #[inline(always)]
     fn consider(&mut self, sc: &Scaled, support: &[usize]) {
-        let mut x = [[0.0; LANES]; 3];
-        let mut ok = [true; LANES];
-        match *support {
-            [] => {}
-            [j] => x[j] = lanewise(|s| sc.bs[j][s] / sc.at(j, j)[s]),
-            [p, q, ..] => {
-                for s in 0..LANES {
+        for s in 0..LANES {
+            let mut x = [0.0; 3];
+            let ok = match *support {
+                [j] => {
+                    x[j] = sc.bs[j][s] / sc.at(j, j)[s];
+                    true
+                }
+                [p, q, ..] => {
                     let (gpp, gqq, gpq, gqp) = (sc.at(p, p)[s], sc.at(q, q)[s], sc.at(p, q)[s], sc.at(q, p)[s]);
                     let det = gpp * gqq - gpq * gqp;
-                    ok[s] = det.abs() > MIN_DET;
-                    x[p][s] = (sc.bs[p][s] * gqq - gpq * sc.bs[q][s]) / det;
-                    x[q][s] = (gpp * sc.bs[q][s] - gqp * sc.bs[p][s]) / det;
+                    let inv = 1.0 / det;
+                    x[p] = (sc.bs[p][s] * gqq - gpq * sc.bs[q][s]) * inv;
+                    x[q] = (gpp * sc.bs[q][s] - gqp * sc.bs[p][s]) * inv;
+                    det.abs() > MIN_DET * (gpp * gqq)
                 }
-            }
-        }
-        let r = sc.residual(&x, support);
-        for s in 0..LANES {
-            let take = ok[s] & feasible(&x, s) & (!self.found[s] | (r[s] < self.r[s]));
-            self.found[s] |= take;
-            self.r[s] = if take { r[s] } else { self.r[s] };
-            for j in 0..3 {
-                self.x[j][s] = if take { x[j][s] } else { self.x[j][s] };
+                [] => true,
+            };
+            let r = sc.residual_lane(&x, support, s);
+            let feasible = x.iter().fold(true, |ok, v| ok & (*v >= 0.0) & (*v < INF));
+            let take = ok & feasible & (r < self.r[s]);
+            self.r[s] = if take { r } else { self.r[s] };
+            for (j, v) in x.iter().enumerate() {
+                self.x[j][s] = if take { *v } else { self.x[j][s] };
             }
         }
     }
@@ -236,37 +261,41 @@ impl Normal {
     /// support).
     #[inline(always)]
     fn solve_all(&self, lanes: usize) -> [Solution; LANES] {
-        let col = |j: usize| lanewise(|s| self.g[AT[j][j]][s].sqrt());
-        let d: [Lanes; 3] = [col(0), col(1), col(2)];
-        let scale = |i: usize, j: usize| lanewise(|s| self.g[AT[i][j]][s] / (d[i][s] * d[j][s]));
+        let norm2 = |j: usize| &self.g[AT[j][j]];
+        let col = |j: usize| lanewise(|s| column_scale(norm2(j)[s]));
+        let sc: [Lanes; 3] = [col(0), col(1), col(2)];
+        let scale = |i: usize, j: usize| lanewise(|s| self.g[AT[i][j]][s] * sc[i][s] * sc[j][s]);
         let gs: [Lanes; 6] = [scale(0, 0), scale(0, 1), scale(0, 2), scale(1, 1), scale(1, 2), scale(2, 2)];
-        let rhs = |j: usize| lanewise(|s| self.b[j][s] / d[j][s]);
+        let rhs = |j: usize| lanewise(|s| self.b[j][s] * sc[j][s]);
         let scaled = Scaled { gs, bs: [rhs(0), rhs(1), rhs(2)], yy: self.yy };
         let at = |i: usize, j: usize| scaled.at(i, j);
         // Lanes the lane-wise arithmetic holds for: every column present, the data finite.
         // (`&` rather than `&&` and `all`, here and below: no short circuits, so no branches per
         // lane, and the lanes are tested side by side.)
         let regular: [bool; LANES] = lanewise(|s| {
-            (0..3).fold(finite(self.yy[s]), |ok, j| ok & (d[j][s] > 0.0) & (d[j][s] < INF) & finite(self.b[j][s]))
+            (0..3)
+                .fold(finite(self.yy[s]), |ok, j| ok & (norm2(j)[s] > 0.0) & (norm2(j)[s] < INF) & finite(self.b[j][s]))
         });
         // The full support by Cramer's rule.
         let rows = [[at(0, 0), at(0, 1), at(0, 2)], [at(1, 0), at(1, 1), at(1, 2)], [at(2, 0), at(2, 1), at(2, 2)]];
         let det = det3_lanes(&rows);
+        let inv_det = lanewise(|s| 1.0 / det[s]);
         let full: [Lanes; 3] = [
-            cramer(&rows, &scaled.bs, &det, 0),
-            cramer(&rows, &scaled.bs, &det, 1),
-            cramer(&rows, &scaled.bs, &det, 2),
+            cramer(&rows, &scaled.bs, &inv_det, 0),
+            cramer(&rows, &scaled.bs, &inv_det, 1),
+            cramer(&rows, &scaled.bs, &inv_det, 2),
         ];
-        let solvable: [bool; LANES] = lanewise(|s| det[s].abs() > MIN_DET);
+        let solvable: [bool; LANES] = lanewise(|s| det[s].abs() > MIN_DET * (at(0, 0)[s] * at(1, 1)[s] * at(2, 2)[s]));
         let fast: [bool; LANES] = lanewise(|s| regular[s] && solvable[s] && feasible(&full, s));
         let unscale =
-            |x: &[Lanes; 3], s: usize| -> [f64; 3] { [x[0][s] / d[0][s], x[1][s] / d[1][s], x[2][s] / d[2][s]] };
-        let mut best = Best { found: [false; LANES], x: [[0.0; LANES]; 3], r: scaled.residual(&full, &[0, 1, 2]) };
+            |x: &[Lanes; 3], s: usize| -> [f64; 3] { [x[0][s] * sc[0][s], x[1][s] * sc[1][s], x[2][s] * sc[2][s]] };
+        let full_r = scaled.residual(&full, &[0, 1, 2]);
+        let mut best = Best::empty(&scaled);
         if (0..lanes).any(|s| regular[s] && !fast[s]) {
-            // The other supports, in `nnls3`'s order (its masks 0 to 6: bit j, column j), each
-            // spelled out so that its indices are constants once inlined (a loop over the
-            // supports left them as loads, and ran slower).
-            best.consider(&scaled, &[]);
+            // The other supports, in `nnls3`'s order (its masks 0 to 6: bit j, column j; the
+            // empty one is where `best` starts), each spelled out so that its indices are
+            // constants once inlined (a loop over the supports left them as loads, and ran
+            // slower).
             best.consider(&scaled, &[0]);
             best.consider(&scaled, &[1]);
             best.consider(&scaled, &[0, 1]);
@@ -274,16 +303,22 @@ impl Normal {
             best.consider(&scaled, &[0, 2]);
             best.consider(&scaled, &[1, 2]);
         }
-        let Best { x: best, r: best_r, .. } = best;
+        let Best { x: best, r: best_r } = best;
         let mut out: [Solution; LANES] = [None; LANES];
         for (s, slot) in out.iter_mut().enumerate().take(lanes) {
-            *slot = if fast[s] {
-                let x = unscale(&full, s);
-                Some((x, best_r[s], x))
-            } else if regular[s] {
+            // Which of the full and the enumerated solution a lane takes is data, unpredictable
+            // lane to lane: chosen by bit masks rather than a branch (the branch, mispredicted,
+            // cost 12 % of aLMI's time). Irregular lanes are rare and take the branch.
+            *slot = if regular[s] {
+                let (full, best) = (unscale(&full, s), unscale(&best, s));
+                let fast = mask(fast[s]);
                 // `nnls3` returns the unconstrained x only when it was solvable (zeros otherwise).
-                let unconstrained = if solvable[s] { unscale(&full, s) } else { [0.0; 3] };
-                Some((unscale(&best, s), best_r[s], unconstrained))
+                let solvable = mask(solvable[s]);
+                Some((
+                    std::array::from_fn(|j| select(fast, full[j], best[j])),
+                    select(fast, full_r[s], best_r[s]),
+                    std::array::from_fn(|j| select(solvable, full[j], 0.0)),
+                ))
             } else {
                 self.solve(s)
             };
@@ -437,7 +472,7 @@ fn invert_lanes(
     if !p.prepare(settings, rrs_above, valid, nedr) {
         return AlmiPixel::FAILED;
     }
-    let Prepared { ref used, m, ref rrs, ref u, ref sigma_u, ref sigma_rrs, mean_rrs } = p;
+    let Prepared { ref used, m, ref rrs, ref u, ref sigma_u, ref inv_sigma_rrs, mean_rrs } = p;
     let used = &used[..m];
     let mut best = AlmiPixel::FAILED;
     let Scratch { rows, w2 } = scratch;
@@ -500,12 +535,12 @@ fn invert_lanes(
         let weighting = settings.noise_weighting;
         for (i, &k) in used.iter().enumerate() {
             let c = &bands[k];
-            let (target, sigma) = (rrs[i], sigma_rrs[i]);
+            let (target, inv_sigma) = (rrs[i], inv_sigma_rrs[i]);
             for s in 0..LANES {
                 let (a, bb) = kappa(c, &x, s);
                 let up = bb / (a + bb);
                 let d = (g0 + g1 * up) * up - target;
-                sq[s] += if weighting { (d / sigma).powi(2) } else { d * d };
+                sq[s] += if weighting { (d * inv_sigma).powi(2) } else { d * d };
             }
         }
         for (s, p) in sol.iter().enumerate().take(lanes) {

@@ -118,29 +118,51 @@ pub(crate) fn det3(c: &[[f64; 3]; 3]) -> f64 {
         + c[0][2] * (c[1][0] * c[2][1] - c[1][1] * c[2][0])
 }
 
-/// The smallest |det| of the scaled Gram matrix [`nnls3`] solves with (below it the columns
+/// The smallest |det| of the scaled Gram matrix [`nnls3`] solves with, relative to the product
+/// of its diagonal (so the determinant of the columns' correlation matrix: below it the columns
 /// are taken as dependent).
 pub(crate) const MIN_DET: f64 = 1e-13;
 
+/// The column scale of [`nnls3`] for a column whose Gram diagonal (squared norm) is `g_jj`: the
+/// power of two 2⁻ᵏ with 2ᵏ ≤ √g_jj < 2ᵏ⁺¹, read off the exponent of `g_jj`. Scaled, the column's
+/// squared norm lies in [1, 4), and since the scale is a power of two, scaling and unscaling
+/// round nothing (a scale of 1/√g_jj cost a square root and divisions, and rounded). Integer
+/// operations on the bits, so they vectorise in the lane version (`almi_lanes`).
+#[inline(always)]
+#[must_use]
+pub(crate) fn column_scale(g_jj: f64) -> f64 {
+    // Biased exponent e of g_jj: g_jj = m·2^(e − 1023), m ∈ [1, 2) (zero and subnormals: e = 0).
+    // k = ⌊(e − 1023)/2⌋ = ((e + 1) >> 1) − 512, and 2⁻ᵏ has biased exponent 1023 − k.
+    let e = (g_jj.to_bits() >> 52) & 0x7ff;
+    f64::from_bits((1535 - ((e + 1) >> 1)) << 52)
+}
+
 /// NNLS of at most 3 unknowns from the normal equations: G = AᵀA, b = Aᵀy, yy = yᵀy (the
-/// per-pixel path of aLMI: nothing allocated). Columns are scaled to unit norm; each support is
-/// solved by Cramer's rule on the scaled Gram matrix (well conditioned for 3 columns once scaled).
+/// per-pixel path of aLMI: nothing allocated). Columns are scaled by powers of two to squared
+/// norms in [1, 4) ([`column_scale`]); each support is solved by Cramer's rule on the scaled
+/// Gram matrix (well conditioned for 3 columns once scaled), with one division per support.
 /// Returns (x, ‖A·x − y‖², unconstrained x), or `None` if nothing is solvable.
 #[must_use]
 pub fn nnls3(g: &[[f64; 3]; 3], b: &[f64; 3], yy: f64) -> Option<([f64; 3], f64, [f64; 3])> {
-    let d: [f64; 3] = std::array::from_fn(|j| g[j][j].sqrt());
-    if d.iter().any(|v| !v.is_finite()) || b.iter().any(|v| !v.is_finite()) || !yy.is_finite() {
+    // A negative, infinite or NaN squared norm, or non-finite data: no answer.
+    if (0..3).any(|j| !(g[j][j] >= 0.0 && g[j][j] < f64::INFINITY))
+        || b.iter().any(|v| !v.is_finite())
+        || !yy.is_finite()
+    {
         return None;
     }
+    // A column of zeros is left out of every support.
+    let present: [bool; 3] = std::array::from_fn(|j| g[j][j] > 0.0);
+    let sc: [f64; 3] = std::array::from_fn(|j| column_scale(g[j][j]));
     let gs: [[f64; 3]; 3] = std::array::from_fn(|i| {
-        std::array::from_fn(|j| if d[i] > 0.0 && d[j] > 0.0 { g[i][j] / (d[i] * d[j]) } else { 0.0 })
+        std::array::from_fn(|j| if present[i] && present[j] { g[i][j] * sc[i] * sc[j] } else { 0.0 })
     });
-    let bs: [f64; 3] = std::array::from_fn(|j| if d[j] > 0.0 { b[j] / d[j] } else { 0.0 });
+    let bs: [f64; 3] = std::array::from_fn(|j| if present[j] { b[j] * sc[j] } else { 0.0 });
     let solve = |mask: u8| -> Option<[f64; 3]> {
         let mut idx = [0usize; 3];
         let mut len = 0;
         for j in 0..3 {
-            if mask & (1 << j) != 0 && d[j] > 0.0 {
+            if mask & (1 << j) != 0 && present[j] {
                 idx[len] = j;
                 len += 1;
             }
@@ -152,24 +174,26 @@ pub fn nnls3(g: &[[f64; 3]; 3], b: &[f64; 3], yy: f64) -> Option<([f64; 3], f64,
             2 => {
                 let (p, q) = (idx[0], idx[1]);
                 let det = gs[p][p] * gs[q][q] - gs[p][q] * gs[q][p];
-                if !(det.abs() > MIN_DET) {
+                if !(det.abs() > MIN_DET * (gs[p][p] * gs[q][q])) {
                     return None;
                 }
-                x[p] = (bs[p] * gs[q][q] - gs[p][q] * bs[q]) / det;
-                x[q] = (gs[p][p] * bs[q] - gs[q][p] * bs[p]) / det;
+                let inv = 1.0 / det;
+                x[p] = (bs[p] * gs[q][q] - gs[p][q] * bs[q]) * inv;
+                x[q] = (gs[p][p] * bs[q] - gs[q][p] * bs[p]) * inv;
             }
             _ => {
                 let m = &gs;
                 let det = det3(m);
-                if !(det.abs() > MIN_DET) {
+                if !(det.abs() > MIN_DET * (gs[0][0] * gs[1][1] * gs[2][2])) {
                     return None;
                 }
+                let inv = 1.0 / det;
                 for j in 0..3 {
                     let mut c = *m;
                     for i in 0..3 {
                         c[i][j] = bs[i];
                     }
-                    x[j] = det3(&c) / det;
+                    x[j] = det3(&c) * inv;
                 }
             }
         }
@@ -185,7 +209,7 @@ pub fn nnls3(g: &[[f64; 3]; 3], b: &[f64; 3], yy: f64) -> Option<([f64; 3], f64,
         }
         r.max(0.0)
     };
-    let unscale = |x: [f64; 3]| -> [f64; 3] { std::array::from_fn(|j| if d[j] > 0.0 { x[j] / d[j] } else { 0.0 }) };
+    let unscale = |x: [f64; 3]| -> [f64; 3] { std::array::from_fn(|j| if present[j] { x[j] * sc[j] } else { 0.0 }) };
     let full = solve(7);
     // The unconstrained optimum is feasible: it is the constrained one (the problem is convex
     // and its minimum lies in the feasible set; Lawson & Hanson 1974, ch. 23), so the other
@@ -239,6 +263,55 @@ mod tests {
         assert_eq!(s.x[1], 0.0);
         assert!((s.x[0] - 2.0).abs() < 1e-12);
         assert!(nnls(&cols, &[f64::NAN, 1.0, 1.0]).is_none());
+    }
+
+    #[test]
+    fn column_scale_is_the_power_of_two_below_the_norm() {
+        // Squared norms from subnormal to 1e300, including exact powers of two.
+        let mut g = 5e-324;
+        while g < 1e300 {
+            for v in [g, g * 1.5, g * 3.999] {
+                let s = column_scale(v);
+                // A power of two: scaling by it is exact (the mantissa bits are zero).
+                assert_eq!(s.to_bits() & ((1u64 << 52) - 1), 0, "{v:e}: scale {s:e}");
+                if v >= f64::MIN_POSITIVE {
+                    let scaled = v * s * s;
+                    assert!((1.0..4.0).contains(&scaled), "{v:e}: scaled squared norm {scaled}");
+                    // 2⁻ᵏ ≤ ... : √v·s in [1, 2).
+                    assert!((1.0..2.0).contains(&(v.sqrt() * s)), "{v:e}");
+                } else {
+                    assert!(v * s * s < 4.0, "{v:e}");
+                }
+            }
+            g *= 7.3;
+        }
+        assert_eq!(column_scale(1.0), 1.0);
+        assert_eq!(column_scale(4.0), 0.5);
+        assert_eq!(column_scale(0.25), 2.0);
+    }
+
+    #[test]
+    fn nnls3_is_unchanged_by_a_power_of_two_column_scale() {
+        // Scaling a column by 2^k scales its coefficient by 2^−k exactly: the scaled problems
+        // are the same bits once nnls3 has scaled them.
+        let g = [[2.0, 0.3, 0.1], [0.3, 1.0, -0.2], [0.1, -0.2, 0.7]];
+        let b = [1.0, -0.5, 0.4];
+        let (x, r, u) = nnls3(&g, &b, 3.0).unwrap();
+        let k = 2f64.powi(20);
+        let g2 = [
+            [g[0][0], g[0][1] * k, g[0][2]],
+            [g[1][0] * k, g[1][1] * k * k, g[1][2] * k],
+            [g[2][0], g[2][1] * k, g[2][2]],
+        ];
+        let b2 = [b[0], b[1] * k, b[2]];
+        let (x2, r2, u2) = nnls3(&g2, &b2, 3.0).unwrap();
+        assert_eq!(x[0].to_bits(), x2[0].to_bits());
+        assert_eq!(x[1].to_bits(), (x2[1] * k).to_bits());
+        assert_eq!(x[2].to_bits(), x2[2].to_bits());
+        assert_eq!(r.to_bits(), r2.to_bits());
+        assert_eq!(u[1].to_bits(), (u2[1] * k).to_bits());
+        // The second coefficient wants to be negative: it sits on the bound.
+        assert!(u[1] < 0.0 && x[1] == 0.0, "{x:?} {u:?}");
     }
 
     #[test]
