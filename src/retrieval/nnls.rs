@@ -292,8 +292,8 @@ mod tests {
 
     #[test]
     fn nnls3_is_unchanged_by_a_power_of_two_column_scale() {
-        // Scaling a column by 2^k scales its coefficient by 2^−k exactly: the scaled problems
-        // are the same bits once nnls3 has scaled them.
+        // Scaling a column by a power of two scales its coefficient by the inverse, exactly:
+        // nnls3's column scales absorb it, so the two problems it solves are the same bits.
         let g = [[2.0, 0.3, 0.1], [0.3, 1.0, -0.2], [0.1, -0.2, 0.7]];
         let b = [1.0, -0.5, 0.4];
         let (x, r, u) = nnls3(&g, &b, 3.0).unwrap();
