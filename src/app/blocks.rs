@@ -6,7 +6,7 @@
 //! therefore the shared scale, so B's map must be recoloured — but B's pixels need not be
 //! revisited: a block's colour is the palette at the block's mean position, and the position is
 //! affine in `v` (linear scales, differences) or in `ln v` (log scales)
-//! ([`Scale::position_of_mean`]), so the sums of `v` and `ln v` per block are enough. B at full
+//! ([`crate::colormap::Scale::position_of_mean`]), so the sums of `v` and `ln v` per block are enough. B at full
 //! resolution (1.5 M pixels) is then recoloured from ~0.35 M block sums without a logarithm.
 
 use std::sync::Arc;

@@ -32,8 +32,9 @@ pub struct Fidelity {
     #[serde(default)]
     pub band_nodes: usize,
     /// Evaluate the per-pixel water spectra at the band nodes in single precision (`f32` lanes,
-    /// [`crate::water::SingleWater`]: Rrs within 2·10⁻⁶ of the double-precision kernel, about
-    /// three times as fast). Off by default; its time and error are the cost table's row. Only
+    /// [`crate::water::SingleWater`]: Rrs within 2·10⁻⁶ of the double-precision kernel, 2.4× its
+    /// evaluations per second in shallow water). Off by default; its time and error are the
+    /// cost table's row. Only
     /// with band nodes (the full-grid path stays in double precision).
     #[serde(default)]
     pub water_single_precision: bool,

@@ -1,5 +1,5 @@
 //! The engine on its own thread, for the app: requests in through a single-slot
-//! [`Mailbox`](crate::jobs::Mailbox) (the newest wins; submitting never blocks), events out
+//! [`crate::jobs::Mailbox`] (the newest wins; submitting never blocks), events out
 //! through a bounded channel, with generation numbers so that stale work is abandoned and stale
 //! results dropped.
 //!

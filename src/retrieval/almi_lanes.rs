@@ -81,8 +81,9 @@ impl Default for Scratch {
     }
 }
 
-/// One set's NNLS answer: (x, residual², unconstrained x), or `None` (see [`nnls3`]).
-type Solution = Option<([f64; 3], f64, [f64; 3])>;
+/// One set's NNLS answer: (x, unconstrained x), or `None` (see [`nnls3`]; its residual is not
+/// needed here, so the lanes do not carry it).
+type Solution = Option<([f64; 3], [f64; 3])>;
 
 /// The weighted normal equations of every lane: G (six sums, symmetric), b and yᵀy.
 #[derive(Clone, Copy)]
@@ -154,10 +155,10 @@ fn cramer(rows: &[[&Lanes; 3]; 3], bs: &[Lanes; 3], inv_det: &Lanes, j: usize) -
     lanewise(|s| num[s] * inv_det[s])
 }
 
-/// Whether lane `s` of `x` is feasible: every component finite and non-negative.
+/// Whether `x` is feasible: every component finite and non-negative.
 #[inline(always)]
-fn feasible(x: &[Lanes; 3], s: usize) -> bool {
-    x.iter().fold(true, |ok, v| ok & (v[s] >= 0.0) & (v[s] < INF))
+fn feasible(x: &[f64; 3]) -> bool {
+    x.iter().fold(true, |ok, v| ok & (*v >= 0.0) & (*v < INF))
 }
 
 /// Index of (i, j) among the six stored entries of a symmetric 3 × 3 matrix.
@@ -238,11 +239,10 @@ impl Best {
                     x[q] = (gpp * sc.bs[q][s] - gqp * sc.bs[p][s]) * inv;
                     det.abs() > MIN_DET * (gpp * gqq)
                 }
-                [] => true,
+                _ => unreachable!("the enumeration considers supports of one or two columns"),
             };
             let r = sc.residual_lane(&x, support, s);
-            let feasible = x.iter().fold(true, |ok, v| ok & (*v >= 0.0) & (*v < INF));
-            let take = ok & feasible & (r < self.r[s]);
+            let take = ok & feasible(&x) & (r < self.r[s]);
             self.r[s] = if take { r } else { self.r[s] };
             for (j, v) in x.iter().enumerate() {
                 self.x[j][s] = if take { *v } else { self.x[j][s] };
@@ -287,10 +287,10 @@ impl Normal {
             cramer(&rows, &scaled.bs, &inv_det, 2),
         ];
         let solvable: [bool; LANES] = lanewise(|s| det[s].abs() > MIN_DET * (at(0, 0)[s] * at(1, 1)[s] * at(2, 2)[s]));
-        let fast: [bool; LANES] = lanewise(|s| regular[s] && solvable[s] && feasible(&full, s));
+        let fast: [bool; LANES] =
+            lanewise(|s| regular[s] && solvable[s] && feasible(&[full[0][s], full[1][s], full[2][s]]));
         let unscale =
             |x: &[Lanes; 3], s: usize| -> [f64; 3] { [x[0][s] * sc[0][s], x[1][s] * sc[1][s], x[2][s] * sc[2][s]] };
-        let full_r = scaled.residual(&full, &[0, 1, 2]);
         let mut best = Best::empty(&scaled);
         if (0..lanes).any(|s| regular[s] && !fast[s]) {
             // The other supports, in `nnls3`'s order (its masks 0 to 6: bit j, column j; the
@@ -304,12 +304,13 @@ impl Normal {
             best.consider(&scaled, &[0, 2]);
             best.consider(&scaled, &[1, 2]);
         }
-        let Best { x: best, r: best_r } = best;
+        let best = best.x;
         let mut out: [Solution; LANES] = [None; LANES];
         for (s, slot) in out.iter_mut().enumerate().take(lanes) {
             // Which of the full and the enumerated solution a lane takes is data, unpredictable
-            // lane to lane: chosen by bit masks rather than a branch (the branch, mispredicted,
-            // cost 12 % of aLMI's time). Irregular lanes are rare and take the branch.
+            // lane to lane: chosen by bit masks rather than a branch (perf put 12 % of aLMI's
+            // time on this loop; the selects gained 2–4 %). Irregular lanes are rare and take
+            // the branch.
             *slot = if regular[s] {
                 let (full, best) = (unscale(&full, s), unscale(&best, s));
                 let fast = mask(fast[s]);
@@ -317,7 +318,6 @@ impl Normal {
                 let solvable = mask(solvable[s]);
                 Some((
                     std::array::from_fn(|j| select(fast, full[j], best[j])),
-                    select(fast, full_r[s], best_r[s]),
                     std::array::from_fn(|j| select(solvable, full[j], 0.0)),
                 ))
             } else {
@@ -334,6 +334,7 @@ impl Normal {
             &[self.b[0][s], self.b[1][s], self.b[2][s]],
             self.yy[s],
         )
+        .map(|(x, _, unconstrained)| (x, unconstrained))
     }
 }
 
@@ -498,7 +499,7 @@ fn invert_lanes(
         let x_of = |sol: &[Solution; LANES]| -> [[f64; LANES]; 3] {
             let mut x = [[0.0; LANES]; 3];
             for (s, p) in sol.iter().enumerate() {
-                if let Some((xs, _, _)) = p {
+                if let Some((xs, _)) = p {
                     for j in 0..3 {
                         x[j][s] = xs[j];
                     }
@@ -545,7 +546,7 @@ fn invert_lanes(
             }
         }
         for (s, p) in sol.iter().enumerate().take(lanes) {
-            let Some((xs, _, unconstrained)) = p else { continue };
+            let Some((xs, unconstrained)) = p else { continue };
             let cost =
                 if settings.noise_weighting { (sq[s] / m as f64).sqrt() } else { (sq[s] / m as f64).sqrt() / mean_rrs };
             if cost.is_finite() && cost < best.cost {

@@ -139,7 +139,7 @@ pub(crate) fn column_scale(g_jj: f64) -> f64 {
 
 /// NNLS of at most 3 unknowns from the normal equations: G = AᵀA, b = Aᵀy, yy = yᵀy (the
 /// per-pixel path of aLMI: nothing allocated). Columns are scaled by powers of two to squared
-/// norms in [1, 4) ([`column_scale`]); each support is solved by Cramer's rule on the scaled
+/// norms in [1, 4) (`column_scale`); each support is solved by Cramer's rule on the scaled
 /// Gram matrix (well conditioned for 3 columns once scaled), with one division per support.
 /// Returns (x, ‖A·x − y‖², unconstrained x), or `None` if nothing is solvable.
 #[must_use]
@@ -277,7 +277,7 @@ mod tests {
                 if v >= f64::MIN_POSITIVE {
                     let scaled = v * s * s;
                     assert!((1.0..4.0).contains(&scaled), "{v:e}: scaled squared norm {scaled}");
-                    // 2⁻ᵏ ≤ ... : √v·s in [1, 2).
+                    // 2ᵏ ≤ √v < 2ᵏ⁺¹, with s = 2⁻ᵏ.
                     assert!((1.0..2.0).contains(&(v.sqrt() * s)), "{v:e}");
                 } else {
                     assert!(v * s * s < 4.0, "{v:e}");

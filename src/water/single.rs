@@ -3,7 +3,9 @@
 //!
 //! A fidelity setting (`Fidelity::water_single_precision`, off by default): a vector register
 //! holds twice as many `f32` as `f64` values, and the CPU divides and takes square roots of them
-//! faster, so the kernel runs about three times as fast (AVX2) and five times with AVX-512.
+//! faster. Measured per call with 451 wavelengths on one core (`shoal bench --only water`, AMD
+//! EPYC Zen 4, AVX-512 build): 647 k/s against 275 k/s shallow (2.4×), 3.7 M/s against 2.2 M/s
+//! optically deep (1.7×); the checks and conversions around the kernel stay in `f64`.
 //! Rrs differs from the double-precision kernel by a few parts in 10⁷ (tested below: within
 //! 2·10⁻⁶ relative over shallow and deep columns, concentrations from zero to extreme, and sun
 //! and view angles to 80°), far below any instrument's noise; its effect on the products is
