@@ -20,6 +20,7 @@
 //! | [`assets`] | cited spectra embedded in the binary |
 //! | [`control`] | cancellation and progress shared by a run and its watcher |
 //! | [`jobs`] | background work: the newest-request-wins mailbox and the one rayon pool builder |
+//! | [`simd`] | hot loops compiled per instruction-set level (AVX-512, AVX2 + FMA), chosen at run time |
 //! | [`geotiff`] | GeoTIFF in and out: rasters with geotransform, CRS, nodata, band names and units |
 //! | [`spectral`] | wavelength grid, spectra, band sets, `band_from_fine` |
 //! | [`water`] | SIOP sets, IOPs, deep/shallow reflectance (Lee et al. 1998/1999, SAMBUCA) |
@@ -62,6 +63,7 @@ pub mod ranges;
 pub mod report;
 pub mod retrieval;
 pub mod scene;
+pub mod simd;
 pub mod spectral;
 pub mod study;
 pub mod sweep;

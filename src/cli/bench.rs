@@ -25,7 +25,8 @@ use crate::atmosphere::{AerosolType, AtmosphereLut, AtmosphereSpec, LutAxes, RtA
 use crate::spectral::{BandSet, BandSetSpec, WavelengthGrid};
 use crate::validation::{Comparison, compare_paths, compare_water_runs};
 use crate::water::{
-    Bottom, SingleWater, SiopSpec, SubstrateLibrary, SubstrateMix, WaterColumn, WaterGeometry, WaterModel,
+    Bottom, SingleScratch, SingleWater, SiopSpec, SubstrateLibrary, SubstrateMix, WaterColumn, WaterGeometry,
+    WaterModel,
 };
 
 /// The configuration `shoal bench --accuracy` prices.
@@ -152,7 +153,7 @@ fn water_rows(out: &mut String, quick: bool) -> Result<(), CliError> {
     });
     // The single-precision kernel (the fidelity setting `water_single_precision`).
     let single = SingleWater::new(&model);
-    let mut work = Vec::new();
+    let mut work = SingleScratch::default();
     let single_shallow = rate(reps, each, |n| {
         let _ = single.rrs_above_into(&column(n, shallow(n)), &geo, &mut work, &mut rrs);
         sink += rrs[100];

@@ -179,12 +179,7 @@ pub fn correct_exact(
             let (l1, l0_flags) = (&l1[base + k.start..base + k.end], &l0_flags[base + k.start..base + k.end]);
             let (rrs_out, flag_out) = (&mut rrs_row[k.clone()], &mut flag_row[k]);
             let column = ExactColumn { l1, l0_flags, is_land, l_path, glint, t_ed, s_albedo };
-            #[cfg(target_arch = "x86_64")]
-            if avx2::available() {
-                avx2::correct(&column, rrs_out, flag_out);
-                continue;
-            }
-            column.correct(rrs_out, flag_out);
+            crate::simd::avx2(Correct { column: &column, rrs_out, flag_out });
         }
         Ok::<_, CorrectionError>(())
     })?;
@@ -221,29 +216,20 @@ impl ExactColumn<'_> {
     }
 }
 
-/// [`ExactColumn::correct`] compiled for AVX2 (four divisions per instruction), chosen at run
-/// time so the binary still runs on any x86-64 CPU. The same operations (Rust never contracts
-/// a·b + c into an FMA), so the same bits.
-#[cfg(target_arch = "x86_64")]
-mod avx2 {
-    use super::ExactColumn;
+/// [`ExactColumn::correct`] as a [`crate::simd::Kernel`]: with AVX2, four divisions per
+/// instruction (the same operations at every level, so the same bits).
+struct Correct<'a, 'c> {
+    column: &'a ExactColumn<'c>,
+    rrs_out: &'a mut [f32],
+    flag_out: &'a mut [u8],
+}
 
-    pub fn available() -> bool {
-        std::is_x86_feature_detected!("avx2")
-    }
+impl crate::simd::Kernel for Correct<'_, '_> {
+    type Output = ();
 
-    #[target_feature(enable = "avx2")]
-    fn correct_avx2(column: &ExactColumn<'_>, rrs_out: &mut [f32], flag_out: &mut [u8]) {
-        column.correct(rrs_out, flag_out);
-    }
-
-    pub fn correct(column: &ExactColumn<'_>, rrs_out: &mut [f32], flag_out: &mut [u8]) {
-        debug_assert!(available());
-        // SAFETY: callers check `available()`: the CPU executes AVX2 instructions.
-        #[allow(unsafe_code)]
-        unsafe {
-            correct_avx2(column, rrs_out, flag_out);
-        }
+    #[inline(always)]
+    fn run(self) {
+        self.column.correct(self.rrs_out, self.flag_out);
     }
 }
 

@@ -403,7 +403,8 @@ fn kappa(c: &BandLanes, x: &[[f64; LANES]; 3], s: usize) -> (f64, f64) {
 }
 
 /// [`super::almi::invert`] over packed sets: the same inputs, the same pixel, bit for bit.
-/// On a CPU with AVX2 the lanes run four sets per instruction (two otherwise).
+/// On a CPU with AVX2 the lanes run four sets per instruction (two otherwise); not AVX-512,
+/// which measured 0–3 % slower on AMD Zen 4 (see [`crate::simd`]).
 #[must_use]
 pub fn invert_packed(
     scratch: &mut Scratch,
@@ -413,50 +414,25 @@ pub fn invert_packed(
     valid: &[bool],
     nedr: &[f64],
 ) -> AlmiPixel {
-    #[cfg(target_arch = "x86_64")]
-    if avx2::available() {
-        return avx2::invert(scratch, sets, settings, rrs_above, valid, nedr);
-    }
-    invert_lanes(scratch, sets, settings, rrs_above, valid, nedr)
+    crate::simd::avx2(Invert { scratch, sets, settings, rrs_above, valid, nedr })
 }
 
-/// The same code compiled for AVX2 (four doubles per instruction instead of two), chosen at
-/// run time so the binary still runs on any x86-64 CPU. The expression tree is unchanged (Rust
-/// never contracts a·b + c into an FMA), so both builds give identical pixels.
-#[cfg(target_arch = "x86_64")]
-mod avx2 {
-    use super::{AlmiPixel, AlmiSettings, PackedSets, Scratch, invert_lanes};
+/// [`invert_lanes`]'s arguments, to run it through [`crate::simd::avx2`].
+struct Invert<'a> {
+    scratch: &'a mut Scratch,
+    sets: &'a PackedSets,
+    settings: &'a AlmiSettings,
+    rrs_above: &'a [f64],
+    valid: &'a [bool],
+    nedr: &'a [f64],
+}
 
-    pub fn available() -> bool {
-        std::is_x86_feature_detected!("avx2")
-    }
+impl crate::simd::Kernel for Invert<'_> {
+    type Output = AlmiPixel;
 
-    #[target_feature(enable = "avx2")]
-    fn invert_avx2(
-        scratch: &mut Scratch,
-        sets: &PackedSets,
-        settings: &AlmiSettings,
-        rrs_above: &[f64],
-        valid: &[bool],
-        nedr: &[f64],
-    ) -> AlmiPixel {
-        invert_lanes(scratch, sets, settings, rrs_above, valid, nedr)
-    }
-
-    pub fn invert(
-        scratch: &mut Scratch,
-        sets: &PackedSets,
-        settings: &AlmiSettings,
-        rrs_above: &[f64],
-        valid: &[bool],
-        nedr: &[f64],
-    ) -> AlmiPixel {
-        debug_assert!(available());
-        // SAFETY: callers check `available()`: the CPU executes AVX2 instructions.
-        #[allow(unsafe_code)]
-        unsafe {
-            invert_avx2(scratch, sets, settings, rrs_above, valid, nedr)
-        }
+    #[inline(always)]
+    fn run(self) -> AlmiPixel {
+        invert_lanes(self.scratch, self.sets, self.settings, self.rrs_above, self.valid, self.nedr)
     }
 }
 

@@ -27,7 +27,9 @@ use crate::atmosphere::{AtmosphereError, AtmosphereLut, Geometry};
 use crate::parse::FieldError;
 use crate::scene::{Effect, Scene, SceneError};
 use crate::spectral::{Extrapolation, WavelengthGrid};
-use crate::water::{Bottom, SingleWater, SubstrateLibrary, SubstrateMix, WaterColumn, WaterGeometry, WaterModel};
+use crate::water::{
+    Bottom, SingleScratch, SingleWater, SubstrateLibrary, SubstrateMix, WaterColumn, WaterGeometry, WaterModel,
+};
 
 pub use adjacency::Adjacency;
 
@@ -90,7 +92,7 @@ pub struct Scratch {
     /// Water evaluations in all.
     pub water_evaluations: u64,
     /// The single-precision kernel's substrate reflectance.
-    single_bottom: Vec<f32>,
+    single: SingleScratch,
 }
 
 /// What [`SceneOptics::radiance`] found at a point.
@@ -200,14 +202,14 @@ impl SceneOptics {
             return Ok(false);
         }
         // The single-precision kernel's work buffer, out of `scratch` while the column borrows it.
-        let mut bottom = std::mem::take(&mut scratch.single_bottom);
+        let mut bottom = std::mem::take(&mut scratch.single);
         let column = water_column(scene, x_m, y_m, &nodes.substrates, nodes.indices.len(), scratch);
         let geometry = WaterGeometry { sun_zenith_rad: g.sun_zenith_rad, view_zenith_rad: g.view_zenith_rad };
         let result = match &nodes.single {
             Some(single) => single.rrs_above_into(&column, &geometry, &mut bottom, rrs),
             None => nodes.water.rrs_above_into(&column, &geometry, rrs),
         };
-        scratch.single_bottom = bottom;
+        scratch.single = bottom;
         result?;
         Ok(true)
     }

@@ -40,7 +40,7 @@ pub use fastmath::fast_exp;
 pub use model::{
     Bottom, WaterColumn, WaterGeometry, WaterModel, WaterReflectance, rrs_above_from_below, rrs_below_from_above,
 };
-pub use single::SingleWater;
+pub use single::{SingleScratch, SingleWater};
 pub use siop::{Siop, SiopSource, SiopSpec};
 pub use substrate::{SubstrateEntry, SubstrateLibrary, SubstrateMix};
 

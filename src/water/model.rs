@@ -74,8 +74,27 @@ impl WaterGeometry {
 
 impl WaterColumn<'_> {
     /// Check concentrations and depth against [`limits`] and that the substrate spectrum has
-    /// one value per grid wavelength.
+    /// one value per grid wavelength, each in [0, 1].
     pub fn validate(&self, n_wavelengths: usize) -> Result<(), WaterError> {
+        self.validate_scalars(n_wavelengths)?;
+        if let Bottom::Shallow { reflectance, .. } = self.bottom {
+            // A pass without an early exit (it vectorises; NaN and ±∞ fail both comparisons or
+            // the second), then the search for the message.
+            let in_range = reflectance.iter().fold(true, |ok, &r| ok & (0.0..=1.0).contains(&r));
+            if !in_range && let Some(r) = reflectance.iter().find(|r| !(r.is_finite() && (0.0..=1.0).contains(*r))) {
+                return Err(WaterError::OutOfRange {
+                    field: "substrate reflectance".into(),
+                    value: *r,
+                    allowed: "0 to 1".into(),
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// [`Self::validate`] but for the reflectance's values (the per-pixel kernels check those
+    /// in their loop).
+    fn validate_scalars(&self, n_wavelengths: usize) -> Result<(), WaterError> {
         let check = |field: &str, v: f64, max: f64, unit: &str| {
             if v.is_finite() && (0.0..=max).contains(&v) {
                 Ok(())
@@ -99,16 +118,6 @@ impl WaterColumn<'_> {
                     field: "substrate reflectance length".into(),
                     value: reflectance.len() as f64,
                     allowed: format!("{n_wavelengths} values, one per grid wavelength"),
-                });
-            }
-            // A pass without an early exit (it vectorises; NaN and ±∞ fail both comparisons or
-            // the second), then the search for the message.
-            let in_range = reflectance.iter().fold(true, |ok, &r| ok & (0.0..=1.0).contains(&r));
-            if !in_range && let Some(r) = reflectance.iter().find(|r| !(r.is_finite() && (0.0..=1.0).contains(*r))) {
-                return Err(WaterError::OutOfRange {
-                    field: "substrate reflectance".into(),
-                    value: *r,
-                    allowed: "0 to 1".into(),
                 });
             }
         }
@@ -218,29 +227,13 @@ pub fn rrs_below_from_above(rrs_above: f64) -> f64 {
 #[derive(Debug, Clone)]
 pub struct WaterModel {
     siop: Siop,
-    /// The wavelengths where a column could give a ≤ 0 or bb ≤ 0: those where pure water's
-    /// a_w or bb_w is not positive or a specific spectrum is negative (or any is not finite).
-    /// Everywhere else the concentrations a validated column has (finite, ≥ 0) cannot cancel
-    /// them, so the per-call check of [`Self::rrs_above_into`] looks only here: none for the
-    /// built-in sets, a few wavelengths for SAMBUCA's default set (a search over every
-    /// wavelength cost as much as the single-precision kernel).
-    may_be_non_positive: Vec<usize>,
 }
 
 impl WaterModel {
     /// Bind a resolved SIOP set.
     #[must_use]
     pub fn new(siop: Siop) -> Self {
-        let positive = |v: f64| v.is_finite() && v > 0.0;
-        let non_negative = |v: f64| v.is_finite() && v >= 0.0;
-        let may_be_non_positive = (0..siop.grid.len())
-            .filter(|&i| {
-                let specific =
-                    [&siop.a_ph_star, &siop.a_cdom_star, &siop.a_nap_star, &siop.bb_ph_star, &siop.bb_nap_star];
-                !(positive(siop.a_w[i]) && positive(siop.bb_w[i]) && specific.iter().all(|v| non_negative(v[i])))
-            })
-            .collect();
-        Self { siop, may_be_non_positive }
+        Self { siop }
     }
 
     /// The SIOP set (and its grid).
@@ -318,8 +311,10 @@ impl WaterModel {
         })
     }
 
-    /// The checks of [`Self::rrs_above_into`] (shared with the single-precision kernel,
-    /// [`super::SingleWater`]): the column, the geometry, the output length, and a > 0, bb > 0.
+    /// The checks of [`Self::rrs_above_into`] made before its kernel runs (shared with the
+    /// single-precision kernel, [`super::SingleWater`]): the column's concentrations, depth and
+    /// reflectance length, the geometry, the output length. The kernels check the rest in their
+    /// loop (a > 0, bb > 0, 0 ≤ ρ_b ≤ 1); [`Self::diagnose`] names what failed.
     pub(super) fn check(
         &self,
         column: &WaterColumn<'_>,
@@ -327,7 +322,7 @@ impl WaterModel {
         out_len: usize,
     ) -> Result<(), WaterError> {
         let n = self.siop.grid.len();
-        column.validate(n)?;
+        column.validate_scalars(n)?;
         geometry.validate()?;
         if out_len != n {
             return Err(WaterError::OutOfRange {
@@ -336,20 +331,26 @@ impl WaterModel {
                 allowed: format!("{n} (one per grid wavelength)"),
             });
         }
-        // Only a SIOP set with strongly negative specific spectra can make a or bb ≤ 0; check
-        // before computing, as `evaluate` does (a cheap pass next to the kernel).
-        let k = self.kernel(column);
-        if let Some(&i) =
-            self.may_be_non_positive.iter().find(|&&i| !(k.absorption(i) > 0.0 && k.backscattering(i) > 0.0))
-        {
-            return Err(self.non_physical(i, k.absorption(i), k.backscattering(i)));
-        }
         Ok(())
     }
 
-    fn kernel<'a>(&'a self, column: &WaterColumn<'_>) -> Kernel<'a> {
+    /// What made a kernel's in-loop check fail for `column`: a substrate reflectance outside
+    /// [0, 1], or the first wavelength where a or bb is not positive (computed as the
+    /// double-precision kernel computes them). `None` if neither holds in double precision.
+    pub(super) fn diagnose(&self, column: &WaterColumn<'_>) -> Option<WaterError> {
+        if let Err(e) = column.validate(self.siop.grid.len()) {
+            return Some(e);
+        }
+        let k = self.spectra(column);
+        (0..self.siop.grid.len()).find_map(|i| {
+            let (a, bb) = (kernel::absorption(&k, i), kernel::backscattering(&k, i));
+            (!(a > 0.0 && bb > 0.0)).then(|| self.non_physical(i, a, bb))
+        })
+    }
+
+    fn spectra<'a>(&'a self, column: &WaterColumn<'_>) -> Spectra<'a, f64> {
         let (s, n) = (&self.siop, self.siop.grid.len());
-        Kernel {
+        Spectra {
             a_w: &s.a_w[..n],
             bb_w: &s.bb_w[..n],
             a_ph: &s.a_ph_star[..n],
@@ -364,8 +365,11 @@ impl WaterModel {
     }
 
     /// Above-surface Rrs only, without allocating: the per-pixel path. Same formulas as
-    /// [`Self::evaluate`]; the exponential is [`super::fast_exp`] (≤ 4.5·10⁻¹⁶ relative) so the
-    /// loop vectorises. Inputs are validated as in `evaluate`, including a > 0 and bb > 0.
+    /// [`Self::evaluate`], with fused multiply-adds and [`super::fast_exp`]'s fused build
+    /// (≤ 4.5·10⁻¹⁶ relative), on the widest vector instructions the CPU has
+    /// ([`crate::simd::widest`]); it agrees with `evaluate` to a few parts in 10¹⁵. Inputs are
+    /// validated as in `evaluate`, including a > 0 and bb > 0 (on an error `out` holds no
+    /// answer).
     pub fn rrs_above_into(
         &self,
         column: &WaterColumn<'_>,
@@ -373,19 +377,34 @@ impl WaterModel {
         out: &mut [f64],
     ) -> Result<(), WaterError> {
         self.check(column, geometry, out.len())?;
-        let (s, n) = (&self.siop, out.len());
-        let k = self.kernel(column);
-        match column.bottom {
-            Bottom::OpticallyDeep => k.deep(&mut out[..n]),
+        let spectra = self.spectra(column);
+        let floor = match column.bottom {
+            Bottom::OpticallyDeep => kernel::Floor::Deep,
             Bottom::Shallow { depth_m, reflectance } => {
                 // Only the bottom's path needs the angles under water (two arcsines, two sines and
                 // two cosines: a third of a deep pixel's time at the band nodes, were they taken
                 // for every pixel).
-                let (inv_cos_w, inv_cos_o) = geometry.inverse_cosines_in_water(s.water_refractive_index);
-                k.shallow(depth_m, inv_cos_w, inv_cos_o, &reflectance[..n], &mut out[..n]);
+                let (inv_cos_w, inv_cos_o) = geometry.inverse_cosines_in_water(self.siop.water_refractive_index);
+                kernel::Floor::Shallow { depth_m, inv_cos_w, inv_cos_o, rb: reflectance }
             }
+        };
+        if crate::simd::widest(kernel::Evaluation { spectra: &spectra, floor, out }) {
+            Ok(())
+        } else {
+            Err(self.diagnose(column).unwrap_or_else(|| self.non_physical_somewhere()))
         }
-        Ok(())
+    }
+
+    /// The message when the kernel's check failed and [`Self::diagnose`] found nothing (which
+    /// the double-precision kernel, computing a and bb as `diagnose` does, cannot reach).
+    pub(super) fn non_physical_somewhere(&self) -> WaterError {
+        WaterError::Siop {
+            set: self.siop.name.clone(),
+            field: "total absorption/backscattering".into(),
+            message: "a or bb is not positive at some wavelength for these concentrations \
+                      (in single precision; a specific spectrum is too negative there)"
+                .into(),
+        }
     }
 
     fn non_physical(&self, i: usize, a: f64, bb: f64) -> WaterError {
@@ -399,88 +418,4 @@ impl WaterModel {
             ),
         }
     }
-}
-
-/// The SIOP spectra and concentrations of one evaluation, laid out for a vectorised loop.
-type Kernel<'a> = Spectra<'a, f64>;
-
-impl Kernel<'_> {
-    fn absorption(&self, i: usize) -> f64 {
-        self.a_w[i] + self.chl * self.a_ph[i] + self.cdom * self.a_cdom[i] + self.nap * self.a_nap[i]
-    }
-
-    fn backscattering(&self, i: usize) -> f64 {
-        self.bb_w[i] + self.chl * self.bb_ph[i] + self.nap * self.bb_nap[i]
-    }
-
-    fn deep(&self, out: &mut [f64]) {
-        #[cfg(target_arch = "x86_64")]
-        if avx2::available() {
-            avx2::deep(self, out);
-            return;
-        }
-        deep_kernel(self, out);
-    }
-
-    fn shallow(&self, depth_m: f64, inv_cos_w: f64, inv_cos_o: f64, rb: &[f64], out: &mut [f64]) {
-        #[cfg(target_arch = "x86_64")]
-        if avx2::available() {
-            avx2::shallow(self, depth_m, inv_cos_w, inv_cos_o, rb, out);
-            return;
-        }
-        shallow_kernel(self, depth_m, inv_cos_w, inv_cos_o, rb, out);
-    }
-}
-
-/// The same kernels compiled for AVX2 + FMA (four doubles per instruction instead of two),
-/// chosen at run time so that the binary still runs on any x86-64 CPU. The arithmetic is the
-/// same expression tree (Rust never contracts a·b + c into an FMA), so both builds give
-/// identical results.
-#[cfg(target_arch = "x86_64")]
-mod avx2 {
-    use super::{Kernel, deep_kernel, shallow_kernel};
-
-    pub fn available() -> bool {
-        std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma")
-    }
-
-    #[target_feature(enable = "avx2,fma")]
-    fn deep_avx2(k: &Kernel<'_>, out: &mut [f64]) {
-        deep_kernel(k, out);
-    }
-
-    #[target_feature(enable = "avx2,fma")]
-    fn shallow_avx2(k: &Kernel<'_>, depth_m: f64, inv_cos_w: f64, inv_cos_o: f64, rb: &[f64], out: &mut [f64]) {
-        shallow_kernel(k, depth_m, inv_cos_w, inv_cos_o, rb, out);
-    }
-
-    pub fn deep(k: &Kernel<'_>, out: &mut [f64]) {
-        debug_assert!(available());
-        // SAFETY: callers check `available()`: the CPU executes AVX2 and FMA instructions.
-        #[allow(unsafe_code)]
-        unsafe {
-            deep_avx2(k, out);
-        }
-    }
-
-    pub fn shallow(k: &Kernel<'_>, depth_m: f64, inv_cos_w: f64, inv_cos_o: f64, rb: &[f64], out: &mut [f64]) {
-        debug_assert!(available());
-        // SAFETY: callers check `available()`: the CPU executes AVX2 and FMA instructions.
-        #[allow(unsafe_code)]
-        unsafe {
-            shallow_avx2(k, depth_m, inv_cos_w, inv_cos_o, rb, out);
-        }
-    }
-}
-
-/// Optically deep Rrs ([`kernel::deep`] on `f64`).
-#[inline(always)]
-fn deep_kernel(k: &Kernel<'_>, out: &mut [f64]) {
-    kernel::deep(k, out);
-}
-
-/// Shallow-water Rrs ([`kernel::shallow`] on `f64`).
-#[inline(always)]
-fn shallow_kernel(k: &Kernel<'_>, depth_m: f64, inv_cos_w: f64, inv_cos_o: f64, rb: &[f64], out: &mut [f64]) {
-    kernel::shallow(k, depth_m, inv_cos_w, inv_cos_o, rb, out);
 }

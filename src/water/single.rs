@@ -4,8 +4,8 @@
 //! A fidelity setting (`Fidelity::water_single_precision`, off by default): a vector register
 //! holds twice as many `f32` as `f64` values, and the CPU divides and takes square roots of them
 //! faster. Measured per call with 451 wavelengths on one core (`shoal bench --only water`, AMD
-//! EPYC Zen 4, AVX-512 build): 647 k/s against 275 k/s shallow (2.4×), 3.7 M/s against 2.2 M/s
-//! optically deep (1.7×); the checks and conversions around the kernel stay in `f64`.
+//! EPYC Zen 4, AVX-512 build): 1.27 M/s against 559 k/s shallow (2.3×), 5.2 M/s against
+//! 2.9 M/s optically deep (1.8×); the checks before the kernel stay in `f64`.
 //! Rrs differs from the double-precision kernel by a few parts in 10⁷ (tested below: within
 //! 2·10⁻⁶ relative over shallow and deep columns, concentrations from zero to extreme, and sun
 //! and view angles to 80°), far below any instrument's noise; its effect on the products is
@@ -13,7 +13,7 @@
 //! model's, so bad input gets the same messages.
 
 use super::WaterError;
-use super::kernel::Spectra;
+use super::kernel::{Evaluation, Floor, Spectra};
 use super::model::{Bottom, WaterColumn, WaterGeometry, WaterModel};
 
 /// A water model's spectra in `f32`, with the model itself for its checks.
@@ -29,15 +29,12 @@ pub struct SingleWater {
     bb_nap: Vec<f32>,
 }
 
-/// The concentrations and geometry of one evaluation.
-#[derive(Debug, Clone, Copy)]
-struct Column {
-    chl: f32,
-    cdom: f32,
-    nap: f32,
-    depth_m: f32,
-    inv_cos_w: f32,
-    inv_cos_o: f32,
+/// Work buffers of [`SingleWater::rrs_above_into`], kept by the caller between calls (one per
+/// thread): the substrate reflectance and Rrs in `f32`.
+#[derive(Debug, Clone, Default)]
+pub struct SingleScratch {
+    bottom: Vec<f32>,
+    rrs: Vec<f32>,
 }
 
 impl SingleWater {
@@ -59,40 +56,99 @@ impl SingleWater {
     }
 
     /// Above-surface Rrs into `out` (one per grid wavelength), as [`WaterModel::rrs_above_into`]
-    /// but in single precision; `bottom` is a work buffer for the substrate reflectance.
+    /// but in single precision.
+    ///
+    /// The kernel writes `f32` into `scratch`, and the passes before and after it narrow the
+    /// substrate reflectance and widen Rrs, all on the widest vector instructions the CPU has
+    /// ([`crate::simd::widest`]): with only `f32` in the kernel's loop the compiler fills whole
+    /// registers (16 lanes with AVX-512; an `f64` in the loop held it to 8).
     pub fn rrs_above_into(
         &self,
         column: &WaterColumn<'_>,
         geometry: &WaterGeometry,
-        bottom: &mut Vec<f32>,
+        scratch: &mut SingleScratch,
         out: &mut [f64],
     ) -> Result<(), WaterError> {
         self.model.check(column, geometry, out.len())?;
-        let mut c = Column {
+        let n = out.len();
+        let SingleScratch { bottom, rrs } = scratch;
+        rrs.resize(n, 0.0);
+        let mut pass = Pass {
+            water: self,
             chl: column.chl_mg_m3 as f32,
             cdom: column.cdom_per_m as f32,
             nap: column.nap_g_m3 as f32,
-            depth_m: 0.0,
-            inv_cos_w: 0.0,
-            inv_cos_o: 0.0,
+            shallow: None,
+            rrs,
+            out,
         };
-        match column.bottom {
-            Bottom::OpticallyDeep => dispatch(self, &c, None, out),
-            Bottom::Shallow { depth_m, reflectance } => {
-                let (w, o) = geometry.inverse_cosines_in_water(self.model.siop().water_refractive_index);
-                (c.depth_m, c.inv_cos_w, c.inv_cos_o) = (depth_m as f32, w as f32, o as f32);
-                bottom.clear();
-                bottom.extend(reflectance.iter().map(|&r| r as f32));
-                dispatch(self, &c, Some(bottom), out);
-            }
+        if let Bottom::Shallow { depth_m, reflectance } = column.bottom {
+            let (w, o) = geometry.inverse_cosines_in_water(self.model.siop().water_refractive_index);
+            bottom.resize(n, 0.0);
+            pass.shallow = Some((depth_m as f32, w as f32, o as f32, reflectance, bottom));
         }
-        Ok(())
+        if crate::simd::widest(pass) {
+            Ok(())
+        } else {
+            Err(self.model.diagnose(column).unwrap_or_else(|| self.model.non_physical_somewhere()))
+        }
+    }
+}
+
+/// One single-precision evaluation as a [`crate::simd::Kernel`]: narrow ρ_b, run the kernel,
+/// widen Rrs. Its output is the kernel's check.
+struct Pass<'a> {
+    water: &'a SingleWater,
+    chl: f32,
+    cdom: f32,
+    nap: f32,
+    /// Depth, 1/cos θ_w, 1/cos θ_o, ρ_b, and the buffer ρ_b is narrowed into.
+    #[allow(clippy::type_complexity)]
+    shallow: Option<(f32, f32, f32, &'a [f64], &'a mut [f32])>,
+    rrs: &'a mut [f32],
+    out: &'a mut [f64],
+}
+
+impl crate::simd::Kernel for Pass<'_> {
+    type Output = bool;
+
+    #[inline(always)]
+    fn run(self) -> bool {
+        let w = self.water;
+        let spectra = Spectra {
+            a_w: &w.a_w,
+            bb_w: &w.bb_w,
+            a_ph: &w.a_ph,
+            a_cdom: &w.a_cdom,
+            a_nap: &w.a_nap,
+            bb_ph: &w.bb_ph,
+            bb_nap: &w.bb_nap,
+            chl: self.chl,
+            cdom: self.cdom,
+            nap: self.nap,
+        };
+        let floor = match self.shallow {
+            None => Floor::Deep,
+            Some((depth_m, inv_cos_w, inv_cos_o, reflectance, bottom)) => {
+                for (b, &r) in bottom.iter_mut().zip(reflectance) {
+                    *b = r as f32;
+                }
+                Floor::Shallow { depth_m, inv_cos_w, inv_cos_o, rb: bottom }
+            }
+        };
+        let ok = Evaluation { spectra: &spectra, floor, out: &mut *self.rrs }.run();
+        for (o, &r) in self.out.iter_mut().zip(self.rrs.iter()) {
+            *o = f64::from(r);
+        }
+        ok
     }
 }
 
 /// exp(x) in single precision: x = k·ln 2 + r with |r| ≤ ln 2/2, e^r by its Taylor series to
 /// r⁷ (truncation ≤ 8·10⁻⁹ relative), 2^k from the exponent bits; within 3·10⁻⁷ relative (about
-/// 2.5 f32 ulps: the roundings of the steps). Clamped to the f32 range.
+/// 2.5 f32 ulps: the roundings of the steps). Clamped to the f32 range. The steps are fused
+/// multiply-adds (one instruction each in the kernel's AVX2 and AVX-512 builds; see
+/// [`super::kernel::Lane::mad`] for the portable build).
 #[inline(always)]
 pub(super) fn exp_f32(x: f32) -> f32 {
     // 1.5·2²³: adding it rounds to an integer held in the low mantissa bits.
@@ -100,92 +156,13 @@ pub(super) fn exp_f32(x: f32) -> f32 {
     const LN2_HI: f32 = 0.693_145_75;
     const LN2_LO: f32 = 1.428_606_8e-6;
     let x = x.clamp(-87.0, 88.0);
-    let t = x * std::f32::consts::LOG2_E + SHIFT;
+    let t = x.mul_add(std::f32::consts::LOG2_E, SHIFT);
     let k = t - SHIFT;
-    let r = (x - k * LN2_HI) - k * LN2_LO;
+    let r = k.mul_add(-LN2_LO, k.mul_add(-LN2_HI, x));
     let r2 = r * r;
-    let high = (1.0 / 24.0 + r * (1.0 / 120.0)) + r2 * (1.0 / 720.0 + r * (1.0 / 5040.0));
-    let p = (1.0 + r) + r2 * ((0.5 + r * (1.0 / 6.0)) + r2 * high);
+    let high = r.mul_add(1.0 / 120.0, 1.0 / 24.0) + r2 * r.mul_add(1.0 / 5040.0, 1.0 / 720.0);
+    let p = r2.mul_add(r.mul_add(1.0 / 6.0, 0.5) + r2 * high, 1.0 + r);
     p * f32::from_bits(t.to_bits().wrapping_add(127) << 23)
-}
-
-/// The kernel on `f32` lanes: deep when `rb` is `None` ([`super::kernel`], the equations the
-/// double-precision kernel runs).
-#[inline(always)]
-fn kernel(w: &SingleWater, c: &Column, rb: Option<&[f32]>, out: &mut [f64]) {
-    let spectra = Spectra {
-        a_w: &w.a_w,
-        bb_w: &w.bb_w,
-        a_ph: &w.a_ph,
-        a_cdom: &w.a_cdom,
-        a_nap: &w.a_nap,
-        bb_ph: &w.bb_ph,
-        bb_nap: &w.bb_nap,
-        chl: c.chl,
-        cdom: c.cdom,
-        nap: c.nap,
-    };
-    match rb {
-        None => super::kernel::deep(&spectra, out),
-        Some(rb) => super::kernel::shallow(&spectra, c.depth_m, c.inv_cos_w, c.inv_cos_o, rb, out),
-    }
-}
-
-/// The widest build the CPU runs (chosen at run time, like the double-precision kernel).
-fn dispatch(w: &SingleWater, c: &Column, rb: Option<&[f32]>, out: &mut [f64]) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        if simd::avx512_available() {
-            simd::avx512(w, c, rb, out);
-            return;
-        }
-        if simd::avx2_available() {
-            simd::avx2(w, c, rb, out);
-            return;
-        }
-    }
-    kernel(w, c, rb, out);
-}
-
-#[cfg(target_arch = "x86_64")]
-mod simd {
-    use super::{Column, SingleWater, kernel};
-
-    pub fn avx512_available() -> bool {
-        std::arch::is_x86_feature_detected!("avx512f") && avx2_available()
-    }
-
-    pub fn avx2_available() -> bool {
-        std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
-    }
-
-    #[target_feature(enable = "avx512f,avx2,fma")]
-    fn avx512_kernel(w: &SingleWater, c: &Column, rb: Option<&[f32]>, out: &mut [f64]) {
-        kernel(w, c, rb, out);
-    }
-
-    #[target_feature(enable = "avx2,fma")]
-    fn avx2_kernel(w: &SingleWater, c: &Column, rb: Option<&[f32]>, out: &mut [f64]) {
-        kernel(w, c, rb, out);
-    }
-
-    pub fn avx512(w: &SingleWater, c: &Column, rb: Option<&[f32]>, out: &mut [f64]) {
-        debug_assert!(avx512_available());
-        // SAFETY: callers check `avx512_available()`: the CPU executes AVX-512F, AVX2 and FMA.
-        #[allow(unsafe_code)]
-        unsafe {
-            avx512_kernel(w, c, rb, out);
-        }
-    }
-
-    pub fn avx2(w: &SingleWater, c: &Column, rb: Option<&[f32]>, out: &mut [f64]) {
-        debug_assert!(avx2_available());
-        // SAFETY: callers check `avx2_available()`: the CPU executes AVX2 and FMA instructions.
-        #[allow(unsafe_code)]
-        unsafe {
-            avx2_kernel(w, c, rb, out);
-        }
-    }
 }
 
 #[cfg(test)]
@@ -212,8 +189,8 @@ mod tests {
             .unwrap()
             .mix_on_grid(&SubstrateMix::parse("ncc_sand:0.5,brown_acropora:0.5").unwrap(), &grid)
             .unwrap();
-        let (mut want, mut got, mut work) = (vec![0.0; grid.len()], vec![0.0; grid.len()], Vec::new());
-        let mut worst = 0.0f64;
+        let (mut want, mut got, mut work) = (vec![0.0; grid.len()], vec![0.0; grid.len()], SingleScratch::default());
+        let (mut worst, mut worst_fused) = (0.0f64, 0.0f64);
         for (chl, cdom, nap) in [(0.0, 0.0, 0.0), (0.1, 0.01, 0.1), (5.0, 0.5, 5.0), (100.0, 5.0, 200.0)] {
             for depth in [None, Some(0.1), Some(2.0), Some(15.0), Some(60.0)] {
                 for (sun, view) in [(0.0, 0.0), (30.0, 10.0), (80.0, 60.0)] {
@@ -226,10 +203,67 @@ mod tests {
                     for (a, b) in want.iter().zip(&got) {
                         worst = worst.max(((b - a) / a).abs());
                     }
+                    let full = model.evaluate(&column, &g).unwrap().rrs_above;
+                    for (a, b) in want.iter().zip(&full) {
+                        worst_fused = worst_fused.max(((b - a) / a).abs());
+                    }
                 }
             }
         }
         assert!(worst < 2e-6, "largest relative difference {worst:e}");
+        // The per-pixel double-precision path fuses its multiply-adds and uses `fast_exp`;
+        // `evaluate` does neither. About twenty roundings apart: measured 1.6·10⁻¹⁵ over these
+        // columns, allowed 4·10⁻¹⁵.
+        assert!(worst_fused < 4e-15, "per-pixel path against evaluate: {worst_fused:e}");
+    }
+
+    /// The per-pixel kernels check a > 0, bb > 0 and 0 ≤ ρ_b ≤ 1 inside their loop; a failure
+    /// must still give `evaluate`'s message, in both precisions, for deep and shallow columns.
+    #[test]
+    fn in_loop_checks_give_the_messages_of_evaluate() {
+        let grid = WavelengthGrid::uniform(400.0, 700.0, 10.0).unwrap();
+        let mut siop = SiopSpec::sambuca_default().resolve(&grid, None).unwrap();
+        let g = WaterGeometry::from_degrees(30.0, 20.0);
+        let n = grid.len();
+        let mut out = vec![0.0; n];
+        let mut scratch = SingleScratch::default();
+        let run = |model: &WaterModel, column: &WaterColumn<'_>, out: &mut [f64], scratch: &mut SingleScratch| {
+            let want = model.evaluate(column, &g).unwrap_err().to_string();
+            let fast = model.rrs_above_into(column, &g, out).unwrap_err().to_string();
+            let single = SingleWater::new(model).rrs_above_into(column, &g, scratch, out).unwrap_err().to_string();
+            assert_eq!(fast, want);
+            assert_eq!(single, want);
+            want
+        };
+        // A substrate reflectance above 1, then not a number, at one wavelength.
+        let model = WaterModel::new(siop.clone());
+        for bad in [1.5, f64::NAN, -0.1] {
+            let mut rb = vec![0.2; n];
+            rb[n / 2] = bad;
+            let column = WaterColumn {
+                chl_mg_m3: 1.0,
+                cdom_per_m: 0.1,
+                nap_g_m3: 1.0,
+                bottom: Bottom::Shallow { depth_m: 3.0, reflectance: &rb },
+            };
+            let e = run(&model, &column, &mut out, &mut scratch);
+            assert!(e.contains("substrate reflectance") && e.contains("0 to 1"), "{e}");
+        }
+        // A specific absorption negative enough at 550 nm that a < 0 for chl = 10.
+        siop.a_ph_star[15] = -1.0;
+        let model = WaterModel::new(siop);
+        let rb = vec![0.2; n];
+        for bottom in [Bottom::OpticallyDeep, Bottom::Shallow { depth_m: 3.0, reflectance: &rb }] {
+            let column = WaterColumn { chl_mg_m3: 10.0, cdom_per_m: 0.1, nap_g_m3: 1.0, bottom };
+            let e = run(&model, &column, &mut out, &mut scratch);
+            assert!(e.contains("not positive") && e.contains("550 nm"), "{e}");
+            // With chl = 0 the same set is valid, and both kernels answer.
+            let fine = WaterColumn { chl_mg_m3: 0.0, ..column };
+            model.rrs_above_into(&fine, &g, &mut out).unwrap();
+            assert!(out.iter().all(|v| v.is_finite() && *v > 0.0));
+            SingleWater::new(&model).rrs_above_into(&fine, &g, &mut scratch, &mut out).unwrap();
+            assert!(out.iter().all(|v| v.is_finite() && *v > 0.0));
+        }
     }
 
     #[test]
@@ -241,8 +275,8 @@ mod tests {
         let g = WaterGeometry::from_degrees(30.0, 0.0);
         let mut out = vec![0.0; grid.len()];
         let want = model.rrs_above_into(&column, &g, &mut out).unwrap_err().to_string();
-        let got = single.rrs_above_into(&column, &g, &mut Vec::new(), &mut out).unwrap_err().to_string();
+        let got = single.rrs_above_into(&column, &g, &mut SingleScratch::default(), &mut out).unwrap_err().to_string();
         assert_eq!(got, want);
-        assert!(single.rrs_above_into(&column, &g, &mut Vec::new(), &mut [0.0; 3]).is_err());
+        assert!(single.rrs_above_into(&column, &g, &mut SingleScratch::default(), &mut [0.0; 3]).is_err());
     }
 }
