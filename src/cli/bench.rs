@@ -100,7 +100,11 @@ fn machine() -> String {
         })
         .unwrap_or_else(|| "unknown CPU".into());
     let threads = std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get);
-    format!("{cpu}, {threads} logical cores, rayon pool {} threads", rayon::current_num_threads())
+    format!(
+        "{cpu}, {threads} logical cores, rayon pool {} threads, vector kernels at {}",
+        rayon::current_num_threads(),
+        crate::simd::widest_level()
+    )
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
