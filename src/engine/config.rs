@@ -33,9 +33,10 @@ pub struct Fidelity {
     pub band_nodes: usize,
     /// Evaluate the per-pixel water spectra at the band nodes in single precision (`f32` lanes,
     /// [`crate::water::SingleWater`]: Rrs within 2·10⁻⁶ of the double-precision kernel, 2.3× its
-    /// evaluations per second in shallow water at 451 wavelengths). Off by default; its time and
-    /// error are the cost table's row. Only with band nodes (the full-grid path stays in double
-    /// precision).
+    /// evaluations per second in shallow water at 451 wavelengths). On by default
+    /// ([`DEFAULT_WATER_SINGLE_PRECISION`]); a configuration file whose fidelity has no such
+    /// field reads `false`, so it reproduces its results. Only with band nodes (the full-grid
+    /// path, the cost table's reference, stays in double precision).
     #[serde(default)]
     pub water_single_precision: bool,
     /// Preview decimation: every n-th line and detector (1 = full resolution).
@@ -57,7 +58,7 @@ impl Default for Fidelity {
             spectral_step_nm: 1.0,
             spatial_samples_per_gsd: 2,
             band_nodes: DEFAULT_BAND_NODES,
-            water_single_precision: false,
+            water_single_precision: DEFAULT_WATER_SINGLE_PRECISION,
             decimation: 1,
             lut_wavelength_step_nm: 20.0,
             lut_view_step_deg: 5.0,
@@ -74,12 +75,22 @@ impl Default for Fidelity {
 /// +0.08 points; 2 and 3 nodes per band were no faster and erred 1.7 % and 0.7 %.
 pub const DEFAULT_BAND_NODES: usize = 4;
 
+/// The default of [`Fidelity::water_single_precision`], chosen from the cost table (`shoal bench
+/// --accuracy --pareto --tolerance-pct 1`, 2026-11-25, CubeSat over Lake Hume, full resolution,
+/// 3 interleaved rounds): with band nodes, the single-precision kernel was the cheapest
+/// full-resolution setting within 1 % chl error and on the Pareto front — 3.02 s (3.00–3.05)
+/// against 3.37 s (3.13–4.22) in double precision, the same chl error per pixel against the
+/// reference (0.003 % median, 1.713 % 95th percentile). The default study, back to back,
+/// three runs each: radiance stage 1.21–1.23 s against 1.33–1.34 s; its metrics move by about
+/// one part in 10⁷.
+pub const DEFAULT_WATER_SINGLE_PRECISION: bool = true;
+
 impl Fidelity {
-    /// Every approximation off: the defaults, with per-pixel spectra on the full grid. The
-    /// reference of the cost table (each setting's error is measured against it).
+    /// Every approximation off: the defaults, with per-pixel spectra on the full grid in double
+    /// precision. The reference of the cost table (each setting's error is measured against it).
     #[must_use]
     pub fn full() -> Self {
-        Self { band_nodes: 0, ..Self::default() }
+        Self { band_nodes: 0, water_single_precision: false, ..Self::default() }
     }
 
     /// Check every number against [`crate::ranges`]; the message names field, value and range.
@@ -198,9 +209,11 @@ mod tests {
         // A resolved configuration from before the field: its results reproduce (0 = full grid).
         let old: Fidelity = ron::from_str("(spectral_step_nm: 1.0, decimation: 2)").unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(old.band_nodes, 0);
+        assert!(!old.water_single_precision, "written before the kernel's precision was a default");
         assert_eq!(old.decimation, 2);
-        // No fidelity at all: the defaults, band nodes included.
+        // No fidelity at all: the defaults, band nodes and the kernel's precision included.
         assert_eq!(Fidelity::default().band_nodes, DEFAULT_BAND_NODES);
-        assert_eq!(Fidelity::full(), Fidelity { band_nodes: 0, ..Fidelity::default() });
+        assert_eq!(Fidelity::default().water_single_precision, DEFAULT_WATER_SINGLE_PRECISION);
+        assert_eq!(Fidelity::full(), Fidelity { band_nodes: 0, water_single_precision: false, ..Fidelity::default() });
     }
 }

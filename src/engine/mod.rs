@@ -46,7 +46,7 @@ mod stages;
 pub mod worker;
 
 pub use cache::Stage;
-pub use config::{DEFAULT_BAND_NODES, Fidelity, RunConfig};
+pub use config::{DEFAULT_BAND_NODES, DEFAULT_WATER_SINGLE_PRECISION, Fidelity, RunConfig};
 pub use fault::{Fault, FaultKind};
 pub use products::{CorrectionProduct, RetrievalOutput, RunOutput};
 pub use report::{RunReport, StageReport, StageStatus};

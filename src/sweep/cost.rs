@@ -139,10 +139,10 @@ pub fn settings_for(base: &RunConfig) -> Vec<Setting> {
     let effects = &base.scene.effects;
     let mut out = vec![
         s("reference (full fidelity)", vec![]),
-        s(
-            "the defaults (band nodes 4 per band)",
-            vec![("fidelity.band_nodes", crate::engine::DEFAULT_BAND_NODES as f64)],
-        ),
+        e("the defaults (band nodes 4, single precision)", |c| {
+            c.fidelity.band_nodes = crate::engine::DEFAULT_BAND_NODES;
+            c.fidelity.water_single_precision = crate::engine::DEFAULT_WATER_SINGLE_PRECISION;
+        }),
     ];
     for d in [2, 4, 8, 16, 24] {
         out.push(s(
@@ -154,10 +154,10 @@ pub fn settings_for(base: &RunConfig) -> Vec<Setting> {
         out.extend([
             s("band nodes 2 per band", vec![("fidelity.band_nodes", 2.0)]),
             s("band nodes 3 per band", vec![("fidelity.band_nodes", 3.0)]),
-            // The single-precision kernel evaluates the spectra at the band nodes only.
-            e("the defaults, water kernel in single precision", |c| {
-                c.fidelity.band_nodes = crate::engine::DEFAULT_BAND_NODES;
-                c.fidelity.water_single_precision = true;
+            // The defaults but for the kernel's precision (the defaults before 2026-11-25).
+            e("band nodes 4, double precision", |c| {
+                c.fidelity.band_nodes = 4;
+                c.fidelity.water_single_precision = false;
             }),
         ]);
     }
@@ -331,9 +331,11 @@ pub fn cost_of_accuracy(
 ) -> Result<Vec<CostRow>, StudyError> {
     let settings = settings_for(base);
     // Every row is one change from the reference: `base`'s fidelity with every approximation the
-    // table prices off (per-pixel spectra on the full grid), whatever band nodes `base` uses.
+    // table prices off (per-pixel spectra on the full grid, in double precision), whatever band
+    // nodes `base` uses.
     let mut base = base.clone();
     base.fidelity.band_nodes = 0;
+    base.fidelity.water_single_precision = false;
     let base = &base;
     let configs = settings
         .iter()
@@ -503,6 +505,7 @@ mod tests {
         for base in [&mut almi, &mut sambuca] {
             // The table's reference: per-pixel spectra on the full grid (see `cost_of_accuracy`).
             base.fidelity.band_nodes = 0;
+            base.fidelity.water_single_precision = false;
             let base = &*base;
             for (label, config) in applied(base).into_iter().skip(1) {
                 assert_ne!(&config, base, "{label} changes nothing: it would read as a free setting");
@@ -518,8 +521,8 @@ mod tests {
             SceneSpec::preset("lake_hume_bloom").unwrap_or_else(|e| panic!("{e}")),
             InstrumentSpec::preset("cubesat").unwrap_or_else(|e| panic!("{e}")),
         );
-        let f = fidelity_of("the defaults (band nodes 4 per band)", &base).map(|f| f.band_nodes);
-        assert_eq!(f, Some(4));
+        let f = fidelity_of("band nodes 4, double precision", &base);
+        assert_eq!(f.map(|f| (f.band_nodes, f.water_single_precision)), Some((4, false)));
         let f = fidelity_of("band nodes 2 per band", &base).map(|f| (f.band_nodes, f.spectral_step_nm));
         assert_eq!(f, Some((2, base.fidelity.spectral_step_nm)), "only the row's field changes");
         assert_eq!(fidelity_of("reference (full fidelity)", &base), Some(base.fidelity.clone()), "back to it");
@@ -530,7 +533,7 @@ mod tests {
         }
         assert!(fidelity_of("no such row", &base).is_none());
         // A row set by an edit of the fidelity alone is one too.
-        let f = fidelity_of("the defaults, water kernel in single precision", &base);
+        let f = fidelity_of("the defaults (band nodes 4, single precision)", &base);
         assert_eq!(f.map(|f| (f.band_nodes, f.water_single_precision)), Some((4, true)));
     }
 
