@@ -37,6 +37,7 @@
 mod cache;
 mod config;
 mod fault;
+mod files;
 mod keys;
 mod products;
 mod report;

@@ -70,11 +70,14 @@ impl Engine {
         let scene_substrates: Vec<String> = side.scene.spec.substrates.iter().map(|s| s.name.clone()).collect();
         let mut out = Vec::with_capacity(config.retrievals.len());
         for spec in &config.retrievals {
+            // A SIOP or substrate file the retrieval names, edited on disk, is a new retrieval.
+            let files = super::files::fingerprint(spec, config.scene_dir.as_deref());
             let key = KeyBuilder::new(Stage::Retrieval)
                 .after(correction_key)
                 .after(side.band_key)
                 .with(&nedr)
                 .with(spec)
+                .with(&files)
                 .finish();
             let inputs = RetrievalInputs {
                 rrs: &correction.rrs.rrs,
@@ -89,9 +92,13 @@ impl Engine {
             };
             // The model reads the bands, the scene's SIOP and substrates and the scene directory:
             // the band key covers the first three (it follows the scene, the responses and the
-            // geometry), the directory is added.
-            let model_key =
-                KeyBuilder::new(Stage::RetrievalModel).after(side.band_key).with(spec).with(&config.scene_dir).finish();
+            // geometry), the directory and the files the retrieval names are added.
+            let model_key = KeyBuilder::new(Stage::RetrievalModel)
+                .after(side.band_key)
+                .with(spec)
+                .with(&config.scene_dir)
+                .with(&files)
+                .finish();
             let model = self
                 .stage(model_key, report, control, || prepare(spec, &inputs).map_err(fail_in(Stage::RetrievalModel)))?;
             let result = self.stage(key, report, control, || {

@@ -5,6 +5,7 @@
 use std::sync::Arc;
 
 use super::cache::{Key, KeyBuilder, Stage};
+use super::files;
 use super::keys::Inputs;
 use super::products::{CorrectionProduct, InstrumentSide, SceneSide};
 use super::report::{RunReport, SkippedEffect};
@@ -47,8 +48,16 @@ impl Engine {
         let instrument = &config.instrument;
         let fid = &config.fidelity;
         let inputs = Inputs::of(config);
+        // The files the configuration names, by path, length and modification time
+        // ([`super::files`]): a file edited on disk changes the key of the stage that reads it
+        // (and so every key after it), as an edit of the configuration would.
+        let scene_dir = config.scene_dir.as_deref();
         // Scene.
-        let scene_key = KeyBuilder::new(Stage::Scene).with(&config.scene).with(&config.scene_dir).finish();
+        let scene_key = KeyBuilder::new(Stage::Scene)
+            .with(&config.scene)
+            .with(&config.scene_dir)
+            .with(&files::fingerprint(&config.scene, scene_dir))
+            .finish();
         let scene = self.stage(scene_key, report, control, || {
             Scene::build(&config.scene, config.scene_dir.as_deref()).map_err(failed_any(Stage::Scene))
         })?;
@@ -59,7 +68,10 @@ impl Engine {
         }
 
         // Spectral response.
-        let response_key = KeyBuilder::new(Stage::Response).with(&inputs.response).finish();
+        let response_key = KeyBuilder::new(Stage::Response)
+            .with(&inputs.response)
+            .with(&files::fingerprint(&config.instrument, scene_dir))
+            .finish();
         let response = self.stage(response_key, report, control, || {
             Response::new(instrument, fid.spectral_step_nm).map_err(failed(Stage::Response))
         })?;

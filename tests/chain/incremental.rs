@@ -102,6 +102,40 @@ fn a_sun_change_rebuilds_the_atmosphere_but_a_band_free_change_does_not() {
 }
 
 #[test]
+fn a_siop_file_edited_on_disk_reruns_the_scene_and_matches_a_fresh_engine() {
+    // The configuration names the file, not its contents: without the files' fingerprint in the
+    // keys, an engine kept warm (the app's) would serve the old set's products.
+    let dir = std::env::temp_dir().join(format!("shoal-siop-edit-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let csv = dir.join("a_ph.csv");
+    let original =
+        std::fs::read_to_string(format!("{}/presets/examples/my_siop.csv", env!("CARGO_MANIFEST_DIR"))).unwrap();
+    std::fs::write(&csv, &original).unwrap();
+    let mut config = RunConfig::new(small_lake(), small("nominal", 32, 24));
+    config.scene.siop = shoal::water::SiopSource::Csv(csv.clone());
+    let mut engine = Engine::new();
+    let first = engine.run(&config, &RunControl::new()).unwrap();
+    // Twice the chl-specific absorption, written under the same name.
+    let doubled: String = original
+        .lines()
+        .map(|l| match l.split_once(',') {
+            Some((w, v)) if w.parse::<f64>().is_ok() => format!("{w},{}\n", 2.0 * v.trim().parse::<f64>().unwrap()),
+            _ => format!("{l}\n"),
+        })
+        .collect();
+    std::fs::write(&csv, doubled).unwrap();
+    let second = engine.run(&config, &RunControl::new()).unwrap();
+    assert_eq!(engine.executions(Stage::Scene), 2, "the edit re-ran the scene");
+    assert_ne!(first.radiance.radiance, second.radiance.radiance, "the edit changed the radiance");
+    let fresh = Engine::new().run(&config, &RunControl::new()).unwrap();
+    assert_eq!(fingerprint(&second), fingerprint(&fresh), "the warm engine returns what a fresh one does");
+    // Unchanged, it comes from the cache.
+    engine.run(&config, &RunControl::new()).unwrap();
+    assert_eq!(engine.executions(Stage::Scene), 2);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
 fn a_cancelled_run_stops_and_leaves_the_engine_usable() {
     let mut engine = Engine::new();
     let config = RunConfig::new(small_lake(), small("nominal", 64, 64));
