@@ -228,7 +228,7 @@ impl crate::simd::Kernel for Correct<'_, '_> {
     type Output = ();
 
     #[inline(always)]
-    fn run(self) {
+    fn run<L: crate::simd::Level>(self) {
         self.column.correct(self.rrs_out, self.flag_out);
     }
 }

@@ -7,12 +7,14 @@
 //! engine lives for the whole session.
 //!
 //! [`fingerprint`] finds the files without a list of the fields that hold paths (a list a new
-//! field could miss): every string in the configuration, serialised, that names an existing file
-//! — as given, or relative to the scene's directory — counts, and so does every quoted string
-//! inside such a file when it is RON (a SIOP file names its CSV columns relative to itself). Each
-//! file enters the fingerprint with its path, length and modification time; contents are not
-//! read (a raster may be large, and the key is built for every slider move). A string that
-//! happens to name a file no stage reads only makes the keys more cautious.
+//! field could miss): every quoted string in the configuration's RON text (the text the keys
+//! hash) that names an existing file — as given, or relative to the scene's directory — counts,
+//! and so does every quoted string inside such a file when it is small text (a SIOP file names
+//! its CSV columns relative to itself, whatever its extension). A file up to [`HASHED_BYTES`]
+//! enters the fingerprint with its contents; a larger one (a raster) with its length,
+//! modification and status-change times and inode, so that an edit keeping length and
+//! modification time (`cp -p`, `rsync -a`) still counts. A string that happens to name a file
+//! no stage reads only makes the keys more cautious.
 
 use std::collections::BTreeSet;
 use std::hash::{DefaultHasher, Hash, Hasher};
@@ -20,24 +22,26 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-/// How deep references are followed: the configuration's files, and the files a RON file among
-/// them names (a SIOP file's CSV columns).
+/// How deep references are followed: the configuration's files, and the files one of them
+/// names (a SIOP file's CSV columns).
 const DEPTH: usize = 2;
 
-/// A hash of the path, length and modification time of every file `part` (a part of a run's
-/// configuration) refers to, as given or under `base_dir` (see the module docs); 0 when it
-/// refers to none.
+/// Files up to this size are hashed whole (and searched for the files they name): the SIOP,
+/// substrate and spectrum files, a few kilobytes each. Keys are built on every slider move.
+pub const HASHED_BYTES: u64 = 1 << 20;
+
+/// A hash of every file `part` (a part of a run's configuration) refers to, as given or under
+/// `base_dir` (see the module docs); 0 when it refers to none.
 #[must_use]
 pub fn fingerprint(part: &impl Serialize, base_dir: Option<&Path>) -> u64 {
-    let mut strings = Vec::new();
-    if let Ok(value) = serde_json::to_value(part) {
-        collect_strings(&value, &mut strings);
-    }
-    let mut files = BTreeSet::new();
+    // The same text the keys hash; if `part` cannot be written as RON the key building fails
+    // the same way, so nothing is lost by finding no file here.
+    let Ok(text) = ron::to_string(part) else { return 0 };
     let mut bases: Vec<PathBuf> = base_dir.iter().map(|d| d.to_path_buf()).collect();
     bases.push(PathBuf::new());
-    for s in &strings {
-        add_file(s, &bases, &mut files, DEPTH);
+    let mut files = BTreeSet::new();
+    for quoted in quoted_strings(&text) {
+        add_file(quoted, &bases, &mut files, DEPTH);
     }
     if files.is_empty() {
         return 0;
@@ -45,21 +49,49 @@ pub fn fingerprint(part: &impl Serialize, base_dir: Option<&Path>) -> u64 {
     let mut h = DefaultHasher::new();
     for path in &files {
         path.hash(&mut h);
-        if let Ok(meta) = std::fs::metadata(path) {
-            meta.len().hash(&mut h);
-            meta.modified().ok().hash(&mut h);
-        }
+        state_of(path).hash(&mut h);
     }
     h.finish()
 }
 
-fn collect_strings(value: &serde_json::Value, out: &mut Vec<String>) {
-    match value {
-        serde_json::Value::String(s) => out.push(s.clone()),
-        serde_json::Value::Array(items) => items.iter().for_each(|v| collect_strings(v, out)),
-        serde_json::Value::Object(map) => map.values().for_each(|v| collect_strings(v, out)),
-        _ => {}
+/// The pieces of `text` between double quotes (every other piece: paths hold no escaped
+/// quotes, and a wrong piece names no file and adds nothing).
+fn quoted_strings(text: &str) -> impl Iterator<Item = &str> {
+    text.split('"').skip(1).step_by(2)
+}
+
+/// What identifies a file's version: its contents when small, else its metadata.
+#[derive(Hash)]
+enum State {
+    Contents(Vec<u8>),
+    /// Length, modification time, and (on Unix) status-change time and inode.
+    Metadata {
+        len: u64,
+        modified: Option<std::time::SystemTime>,
+        identity: (i64, i64, u64),
+    },
+    Unreadable,
+}
+
+fn state_of(path: &Path) -> State {
+    let Ok(meta) = std::fs::metadata(path) else { return State::Unreadable };
+    if meta.len() <= HASHED_BYTES
+        && let Ok(bytes) = std::fs::read(path)
+    {
+        return State::Contents(bytes);
     }
+    State::Metadata { len: meta.len(), modified: meta.modified().ok(), identity: identity(&meta) }
+}
+
+#[cfg(unix)]
+fn identity(meta: &std::fs::Metadata) -> (i64, i64, u64) {
+    use std::os::unix::fs::MetadataExt;
+    (meta.ctime(), meta.ctime_nsec(), meta.ino())
+}
+
+#[cfg(not(unix))]
+fn identity(_: &std::fs::Metadata) -> (i64, i64, u64) {
+    (0, 0, 0)
 }
 
 /// Add `name` (as given, or under one of `bases`) if it is a file, and what it names in turn.
@@ -74,13 +106,10 @@ fn add_file(name: &str, bases: &[PathBuf], files: &mut BTreeSet<PathBuf>, depth:
         if !path.is_file() || !files.insert(path.clone()) {
             continue;
         }
-        if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("ron"))
-            && let Ok(text) = std::fs::read_to_string(&path)
-        {
+        let small = std::fs::metadata(&path).is_ok_and(|m| m.len() <= HASHED_BYTES);
+        if small && let Ok(text) = std::fs::read_to_string(&path) {
             let base = vec![path.parent().map(Path::to_path_buf).unwrap_or_default()];
-            // The quoted strings: every other piece between double quotes (paths in these
-            // files have no escaped quotes; a wrong piece names no file and adds nothing).
-            for quoted in text.split('"').skip(1).step_by(2) {
+            for quoted in quoted_strings(&text) {
                 add_file(quoted, &base, files, depth - 1);
             }
         }
@@ -112,10 +141,18 @@ mod tests {
         std::fs::write(&csv, "wavelength_nm,a_ph_star\n400,0.031\n700,0.01\n").unwrap();
         let edited = fingerprint(&scene, Some(&dir));
         assert_ne!(edited, with_file, "an edit of the nested CSV");
-        // The same bytes with a later modification time count as an edit too.
-        let later = std::time::SystemTime::now() + std::time::Duration::from_secs(5);
-        std::fs::File::options().write(true).open(&csv).unwrap().set_modified(later).unwrap();
-        assert_ne!(fingerprint(&scene, Some(&dir)), edited, "a touch");
+        // A same-length edit with the old modification time restored (as `cp -p` would leave
+        // it): small files are hashed whole.
+        let modified = std::fs::metadata(&csv).unwrap().modified().unwrap();
+        std::fs::write(&csv, "wavelength_nm,a_ph_star\n400,0.032\n700,0.01\n").unwrap();
+        std::fs::File::options().write(true).open(&csv).unwrap().set_modified(modified).unwrap();
+        assert_ne!(fingerprint(&scene, Some(&dir)), edited, "same length, same time, new contents");
+        // A SIOP file under another extension still has its CSVs followed.
+        std::fs::rename(dir.join("siop.ron"), dir.join("siop.txt")).unwrap();
+        scene.siop = SiopSource::File("siop.txt".into());
+        let renamed = fingerprint(&scene, Some(&dir));
+        std::fs::write(&csv, "wavelength_nm,a_ph_star\n400,0.033\n700,0.01\n").unwrap();
+        assert_ne!(fingerprint(&scene, Some(&dir)), renamed, "the CSV a .txt SIOP file names");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -48,8 +48,8 @@ impl Engine {
         let instrument = &config.instrument;
         let fid = &config.fidelity;
         let inputs = Inputs::of(config);
-        // The files the configuration names, by path, length and modification time
-        // ([`super::files`]): a file edited on disk changes the key of the stage that reads it
+        // The files the configuration names, by contents (or, for large ones, length, times and
+        // inode; [`super::files`]): a file edited on disk changes the key of the stage that reads it
         // (and so every key after it), as an edit of the configuration would.
         let scene_dir = config.scene_dir.as_deref();
         // Scene.

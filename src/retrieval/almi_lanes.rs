@@ -431,7 +431,7 @@ impl crate::simd::Kernel for Invert<'_> {
     type Output = AlmiPixel;
 
     #[inline(always)]
-    fn run(self) -> AlmiPixel {
+    fn run<L: crate::simd::Level>(self) -> AlmiPixel {
         invert_lanes(self.scratch, self.sets, self.settings, self.rrs_above, self.valid, self.nedr)
     }
 }

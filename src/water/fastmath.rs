@@ -1,8 +1,8 @@
 //! A branch-free `exp` that the compiler can vectorise, for the water model's inner loop.
 //!
-//! Two builds of one formula: [`fast_exp`] with separate multiplies and adds (what a caller
-//! compiled for baseline x86-64 can run fast), and `fast_exp_fused` with fused multiply-adds
-//! (one instruction each and one rounding, for the water kernels, which run with FMA: see
+//! One formula at each instruction-set level: [`fast_exp`] with separate multiplies and adds
+//! (what a caller compiled for baseline x86-64 can run fast), and in the water kernels with
+//! fused multiply-adds where the level has FMA (one instruction each and one rounding; see
 //! [`crate::simd`]).
 //!
 //! `f64::exp` is a libm call, which stops loops from vectorising. This version reduces
@@ -21,6 +21,8 @@
 //! - Estrin, G. (1960) Organization of computer systems: the fixed plus variable structure
 //!   computer. Proc. Western Joint IRE-AIEE-ACM Computer Conference, 33–40.
 
+use crate::simd::{Baseline, Level, mad};
+
 const LOG2_E: f64 = std::f64::consts::LOG2_E;
 // Cody–Waite split of ln 2 (fdlibm's e_exp.c values): LN2_HI has trailing zero bits so that
 // k·LN2_HI is exact for |k| < 2¹¹.
@@ -38,30 +40,25 @@ const SHIFT: f64 = 6_755_399_441_055_744.0;
 #[inline(always)]
 #[must_use]
 pub fn fast_exp(x: f64) -> f64 {
-    exp::<false>(x)
+    exp::<Baseline>(x)
 }
 
 /// [`fast_exp`] with fused multiply-adds (for code compiled with FMA; without it each is a libm
 /// call). Same accuracy bound (tested below).
-#[inline(always)]
-#[must_use]
-pub(crate) fn fast_exp_fused(x: f64) -> f64 {
-    exp::<true>(x)
+#[cfg(test)]
+fn fast_exp_fused(x: f64) -> f64 {
+    exp::<crate::simd::Avx2>(x)
 }
 
-/// a·b + c, fused or not.
+/// e^x with a·b + c as level `L` computes it ([`crate::simd::mad`]).
 #[inline(always)]
-fn mad<const FUSED: bool>(a: f64, b: f64, c: f64) -> f64 {
-    if FUSED { a.mul_add(b, c) } else { a * b + c }
-}
-
-#[inline(always)]
-fn exp<const FUSED: bool>(x: f64) -> f64 {
+pub(super) fn exp<L: Level>(x: f64) -> f64 {
+    let mad = mad::<L, f64>;
     let x = x.clamp(-708.0, 709.0);
-    let t = mad::<FUSED>(x, LOG2_E, SHIFT);
+    let t = mad(x, LOG2_E, SHIFT);
     let k = t - SHIFT;
     // (x − k·LN2_HI) − k·LN2_LO
-    let r = mad::<FUSED>(k, -LN2_LO, mad::<FUSED>(k, -LN2_HI, x));
+    let r = mad(k, -LN2_LO, mad(k, -LN2_HI, x));
     // Taylor coefficients 1/k!, evaluated by Estrin's scheme: pairs, then powers r², r⁴, r⁸.
     // Horner's rule would chain 13 dependent multiply-adds (latency-bound in the water loop);
     // Estrin's tree is four levels deep.
@@ -69,18 +66,18 @@ fn exp<const FUSED: bool>(x: f64) -> f64 {
     let r4 = r2 * r2;
     let r8 = r4 * r4;
     let q0 = 1.0 + r;
-    let q1 = mad::<FUSED>(r, 1.0 / 6.0, 0.5);
-    let q2 = mad::<FUSED>(r, 1.0 / 120.0, 1.0 / 24.0);
-    let q3 = mad::<FUSED>(r, 1.0 / 5_040.0, 1.0 / 720.0);
-    let q4 = mad::<FUSED>(r, 1.0 / 362_880.0, 1.0 / 40_320.0);
-    let q5 = mad::<FUSED>(r, 1.0 / 39_916_800.0, 1.0 / 3_628_800.0);
-    let q6 = mad::<FUSED>(r, 1.0 / 6_227_020_800.0, 1.0 / 479_001_600.0);
-    let s0 = mad::<FUSED>(q1, r2, q0);
-    let s1 = mad::<FUSED>(q3, r2, q2);
-    let s2 = mad::<FUSED>(q5, r2, q4);
-    let t0 = mad::<FUSED>(s1, r4, s0);
-    let t1 = mad::<FUSED>(q6, r4, s2);
-    let p = mad::<FUSED>(t1, r8, t0);
+    let q1 = mad(r, 1.0 / 6.0, 0.5);
+    let q2 = mad(r, 1.0 / 120.0, 1.0 / 24.0);
+    let q3 = mad(r, 1.0 / 5_040.0, 1.0 / 720.0);
+    let q4 = mad(r, 1.0 / 362_880.0, 1.0 / 40_320.0);
+    let q5 = mad(r, 1.0 / 39_916_800.0, 1.0 / 3_628_800.0);
+    let q6 = mad(r, 1.0 / 6_227_020_800.0, 1.0 / 479_001_600.0);
+    let s0 = mad(q1, r2, q0);
+    let s1 = mad(q3, r2, q2);
+    let s2 = mad(q5, r2, q4);
+    let t0 = mad(s1, r4, s0);
+    let t1 = mad(q6, r4, s2);
+    let p = mad(t1, r8, t0);
     // Low mantissa bits of t hold 2⁵¹ + k; adding the bias and shifting leaves (k+1023)<<52.
     let two_k = f64::from_bits(t.to_bits().wrapping_add(1023) << 52);
     p * two_k

@@ -4,20 +4,23 @@
 //! [`super::WaterModel::rrs_above_into`] runs them on `f64`, the single-precision setting
 //! ([`super::SingleWater`]) on `f32`, both through [`crate::simd::widest`]. Every slice is
 //! re-sliced to one length so that the loops carry no bounds checks and vectorise; the
-//! exponential is branch-free for the same reason (`fast_exp_fused`, or its `f32` counterpart),
-//! and every a·b + c is one fused multiply-add (one rounding instead of two, and a shorter chain
-//! of dependent instructions: the loop is bound by that chain's latency, not by arithmetic).
+//! exponential is branch-free for the same reason (`fast_exp`, or its `f32` counterpart), and
+//! where the level has FMA every a·b + c is one fused multiply-add (one rounding instead of two,
+//! and a shorter chain of dependent instructions: the loop is bound by that chain's latency, not
+//! by arithmetic; [`crate::simd::mad`]).
 //!
 //! The loops also check, without a branch, that every a and bb is positive (and for the bottom
-//! that 0 ≤ ρ_b ≤ 1): a pass of its own over the wavelengths cost a fifth of the
-//! single-precision kernel's time. When a check fails the caller builds the message (the
+//! that 0 ≤ ρ_b ≤ 1): the checks' passes of their own took 11 % of a single-precision call
+//! (perf), against the kernel's 81 %. When a check fails the caller builds the message (the
 //! output is then not used).
 
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
+use crate::simd::{Level, MulAdd, mad};
+
 /// A lane type the kernels run on.
 pub(super) trait Lane:
-    Copy
+    MulAdd
     + PartialOrd
     + Add<Output = Self>
     + Sub<Output = Self>
@@ -28,11 +31,8 @@ pub(super) trait Lane:
     /// A constant of the equations (exact for `f64`, rounded to nearest for `f32`).
     fn c(x: f64) -> Self;
     fn sqrt(self) -> Self;
-    /// self·b + c, fused (one rounding; one instruction where the kernel runs with FMA, libm's
-    /// exact `fma` on the portable build).
-    fn mad(self, b: Self, c: Self) -> Self;
-    /// A vectorisable e^x.
-    fn exp(self) -> Self;
+    /// A vectorisable e^x, its steps fused multiply-adds where `L` has FMA.
+    fn exp<L: Level>(self) -> Self;
 }
 
 impl Lane for f64 {
@@ -45,12 +45,8 @@ impl Lane for f64 {
         f64::sqrt(self)
     }
     #[inline(always)]
-    fn mad(self, b: Self, c: Self) -> Self {
-        self.mul_add(b, c)
-    }
-    #[inline(always)]
-    fn exp(self) -> Self {
-        super::fastmath::fast_exp_fused(self)
+    fn exp<L: Level>(self) -> Self {
+        super::fastmath::exp::<L>(self)
     }
 }
 
@@ -64,12 +60,8 @@ impl Lane for f32 {
         f32::sqrt(self)
     }
     #[inline(always)]
-    fn mad(self, b: Self, c: Self) -> Self {
-        self.mul_add(b, c)
-    }
-    #[inline(always)]
-    fn exp(self) -> Self {
-        super::single::exp_f32(self)
+    fn exp<L: Level>(self) -> Self {
+        super::single::exp_f32::<L>(self)
     }
 }
 
@@ -85,6 +77,24 @@ pub(super) struct Spectra<'a, T> {
     pub chl: T,
     pub cdom: T,
     pub nap: T,
+}
+
+impl<'a, T: Copy> Spectra<'a, T> {
+    /// The first `n` wavelengths: every slice re-sliced to one length, so that the loop over them
+    /// carries no bounds checks and vectorises (panics if a spectrum is shorter).
+    #[inline(always)]
+    fn first(&self, n: usize) -> Self {
+        Spectra {
+            a_w: &self.a_w[..n],
+            bb_w: &self.bb_w[..n],
+            a_ph: &self.a_ph[..n],
+            a_cdom: &self.a_cdom[..n],
+            a_nap: &self.a_nap[..n],
+            bb_ph: &self.bb_ph[..n],
+            bb_nap: &self.bb_nap[..n],
+            ..*self
+        }
+    }
 }
 
 /// The bottom of one evaluation: optically deep, or at `depth_m` with reflectance `rb` (one per
@@ -108,11 +118,11 @@ impl<T: Lane> crate::simd::Kernel for Evaluation<'_, '_, T> {
     type Output = bool;
 
     #[inline(always)]
-    fn run(self) -> bool {
+    fn run<L: Level>(self) -> bool {
         match self.floor {
-            Floor::Deep => deep(self.spectra, self.out),
+            Floor::Deep => deep::<T, L>(self.spectra, self.out),
             Floor::Shallow { depth_m, inv_cos_w, inv_cos_o, rb } => {
-                shallow(self.spectra, depth_m, inv_cos_w, inv_cos_o, rb, self.out)
+                shallow::<T, L>(self.spectra, depth_m, inv_cos_w, inv_cos_o, rb, self.out)
             }
         }
     }
@@ -121,20 +131,20 @@ impl<T: Lane> crate::simd::Kernel for Evaluation<'_, '_, T> {
 /// Total absorption a = a_w + chl·a*_ph + cdom·a*_CDOM + nap·a*_NAP (m⁻¹; Lee et al. 1999 eq. 2,
 /// SAMBUCA's form).
 #[inline(always)]
-pub(super) fn absorption<T: Lane>(k: &Spectra<'_, T>, i: usize) -> T {
-    k.nap.mad(k.a_nap[i], k.cdom.mad(k.a_cdom[i], k.chl.mad(k.a_ph[i], k.a_w[i])))
+pub(super) fn absorption<T: Lane, L: Level>(k: &Spectra<'_, T>, i: usize) -> T {
+    mad::<L, T>(k.nap, k.a_nap[i], mad::<L, T>(k.cdom, k.a_cdom[i], mad::<L, T>(k.chl, k.a_ph[i], k.a_w[i])))
 }
 
 /// Total backscattering bb = bb_w + chl·bb*_ph + nap·bb*_NAP (m⁻¹).
 #[inline(always)]
-pub(super) fn backscattering<T: Lane>(k: &Spectra<'_, T>, i: usize) -> T {
-    k.nap.mad(k.bb_nap[i], k.chl.mad(k.bb_ph[i], k.bb_w[i]))
+pub(super) fn backscattering<T: Lane, L: Level>(k: &Spectra<'_, T>, i: usize) -> T {
+    mad::<L, T>(k.nap, k.bb_nap[i], mad::<L, T>(k.chl, k.bb_ph[i], k.bb_w[i]))
 }
 
 /// Rrs(0⁺) from rrs(0⁻) (Lee et al. 2002), as [`super::rrs_above_from_below`].
 #[inline(always)]
-fn above<T: Lane>(rrs: T) -> T {
-    T::c(0.52) * rrs / T::c(-1.7).mad(rrs, T::c(1.0))
+fn above<T: Lane, L: Level>(rrs: T) -> T {
+    T::c(0.52) * rrs / mad::<L, T>(T::c(-1.7), rrs, T::c(1.0))
 }
 
 /// Both positive (false for NaN).
@@ -145,24 +155,16 @@ fn positive<T: Lane>(a: T, bb: T) -> bool {
 
 /// Optically deep Rrs into `out` (one per wavelength); whether every a and bb was positive.
 #[inline(always)]
-fn deep<T: Lane>(k: &Spectra<'_, T>, out: &mut [T]) -> bool {
+fn deep<T: Lane, L: Level>(k: &Spectra<'_, T>, out: &mut [T]) -> bool {
     let n = out.len();
-    let k = Spectra {
-        a_w: &k.a_w[..n],
-        bb_w: &k.bb_w[..n],
-        a_ph: &k.a_ph[..n],
-        a_cdom: &k.a_cdom[..n],
-        a_nap: &k.a_nap[..n],
-        bb_ph: &k.bb_ph[..n],
-        bb_nap: &k.bb_nap[..n],
-        ..*k
-    };
+    let k = k.first(n);
+    let mad = mad::<L, T>;
     let mut ok = true;
     for i in 0..n {
-        let (a, bb) = (absorption(&k, i), backscattering(&k, i));
+        let (a, bb) = (absorption::<T, L>(&k, i), backscattering::<T, L>(&k, i));
         ok &= positive(a, bb);
         let u = bb / (a + bb);
-        out[i] = above(T::c(0.17).mad(u, T::c(0.084)) * u);
+        out[i] = above::<T, L>(mad(T::c(0.17), u, T::c(0.084)) * u);
     }
     ok
 }
@@ -170,34 +172,33 @@ fn deep<T: Lane>(k: &Spectra<'_, T>, out: &mut [T]) -> bool {
 /// Shallow-water Rrs into `out` (Lee et al. 1999 eq. 5 with the SAMBUCA attenuation factors);
 /// whether every a and bb was positive and every ρ_b in [0, 1].
 #[inline(always)]
-fn shallow<T: Lane>(k: &Spectra<'_, T>, depth_m: T, inv_cos_w: T, inv_cos_o: T, rb: &[T], out: &mut [T]) -> bool {
+fn shallow<T: Lane, L: Level>(
+    k: &Spectra<'_, T>,
+    depth_m: T,
+    inv_cos_w: T,
+    inv_cos_o: T,
+    rb: &[T],
+    out: &mut [T],
+) -> bool {
     let n = out.len();
-    let k = Spectra {
-        a_w: &k.a_w[..n],
-        bb_w: &k.bb_w[..n],
-        a_ph: &k.a_ph[..n],
-        a_cdom: &k.a_cdom[..n],
-        a_nap: &k.a_nap[..n],
-        bb_ph: &k.bb_ph[..n],
-        bb_nap: &k.bb_nap[..n],
-        ..*k
-    };
+    let k = k.first(n);
     let rb = &rb[..n];
     let inv_pi = T::c(1.0 / std::f64::consts::PI);
+    let mad = mad::<L, T>;
     let mut ok = true;
     for i in 0..n {
-        let (a, bb) = (absorption(&k, i), backscattering(&k, i));
+        let (a, bb) = (absorption::<T, L>(&k, i), backscattering::<T, L>(&k, i));
         ok &= positive(a, bb) & (rb[i] >= T::c(0.0)) & (rb[i] <= T::c(1.0));
         let kappa = a + bb;
         let u = bb / kappa;
         let kh = kappa * depth_m;
-        let du_c = T::c(1.03) * T::c(2.4).mad(u, T::c(1.0)).sqrt();
-        let du_b = T::c(1.04) * T::c(5.4).mad(u, T::c(1.0)).sqrt();
-        let rrs_dp = T::c(0.17).mad(u, T::c(0.084)) * u;
+        let du_c = T::c(1.03) * mad(T::c(2.4), u, T::c(1.0)).sqrt();
+        let du_b = T::c(1.04) * mad(T::c(5.4), u, T::c(1.0)).sqrt();
+        let rrs_dp = mad(T::c(0.17), u, T::c(0.084)) * u;
         // rrs_dp·(1 − e_c) + ρ_b/π·e_b
-        let e_c = (-du_c.mad(inv_cos_o, inv_cos_w) * kh).exp();
-        let e_b = (-du_b.mad(inv_cos_o, inv_cos_w) * kh).exp();
-        out[i] = above((rb[i] * inv_pi).mad(e_b, (-rrs_dp).mad(e_c, rrs_dp)));
+        let e_c = (-mad(du_c, inv_cos_o, inv_cos_w) * kh).exp::<L>();
+        let e_b = (-mad(du_b, inv_cos_o, inv_cos_w) * kh).exp::<L>();
+        out[i] = above::<T, L>(mad(rb[i] * inv_pi, e_b, mad(-rrs_dp, e_c, rrs_dp)));
     }
     ok
 }
@@ -205,14 +206,15 @@ fn shallow<T: Lane>(k: &Spectra<'_, T>, depth_m: T, inv_cos_w: T, inv_cos_o: T, 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::simd::Kernel;
+    use crate::simd::{Baseline, Kernel};
 
-    /// Every a·b + c is fused at every level (libm's exact `fma` on the portable build), and
-    /// division and square root are exactly rounded, so the portable build and the widest one
-    /// this CPU runs give the same bits, in both precisions.
+    /// The baseline build multiplies and adds apart, the vector builds fuse: the two agree to
+    /// the roundings that fusing saves — measured 5.4·10⁻¹⁶ (f64) and 2.8·10⁻⁷ (f32) relative
+    /// over these spectra, allowed 4·10⁻¹⁵ and 2·10⁻⁶ (the bounds of the f64 path against
+    /// `evaluate` and of f32 against f64).
     #[test]
-    fn the_portable_and_the_widest_builds_agree_bit_for_bit() {
-        fn check<T: Lane + std::fmt::Debug>(narrow: impl Fn(f64) -> T) {
+    fn the_baseline_and_the_widest_builds_agree_to_their_roundings() {
+        fn check<T: Lane>(narrow: impl Fn(f64) -> T, widen: impl Fn(T) -> f64, tolerance: f64) {
             let n = 451;
             let spectrum = |scale: f64, phase: f64| -> Vec<T> {
                 (0..n).map(|i| narrow(scale * (1.1 + (i as f64 * 0.037 + phase).sin()))).collect()
@@ -247,13 +249,18 @@ mod tests {
                         Floor::Deep
                     }
                 };
-                let (mut portable, mut widest) = (vec![zero; n], vec![zero; n]);
-                assert!(Evaluation { spectra: &k, floor: floor(), out: &mut portable }.run());
+                let (mut baseline, mut widest) = (vec![zero; n], vec![zero; n]);
+                assert!(Evaluation { spectra: &k, floor: floor(), out: &mut baseline }.run::<Baseline>());
                 assert!(crate::simd::widest(Evaluation { spectra: &k, floor: floor(), out: &mut widest }));
-                assert_eq!(format!("{portable:?}"), format!("{widest:?}"), "shallow {shallow}");
+                let worst = baseline
+                    .iter()
+                    .zip(&widest)
+                    .map(|(&a, &b)| ((widen(b) - widen(a)) / widen(a)).abs())
+                    .fold(0.0, f64::max);
+                assert!(worst < tolerance, "shallow {shallow}: {worst:e}");
             }
         }
-        check(|x| x);
-        check(|x| x as f32);
+        check(|x| x, |x| x, 4e-15);
+        check(|x| x as f32, f64::from, 2e-6);
     }
 }

@@ -3,6 +3,7 @@
 
 use super::kernel::{self, Spectra};
 use super::{Siop, WaterError, limits};
+use crate::simd::Baseline;
 use crate::units::PI;
 
 /// Constituent concentrations and the bottom, for one water column.
@@ -335,16 +336,26 @@ impl WaterModel {
     }
 
     /// What made a kernel's in-loop check fail for `column`: a substrate reflectance outside
-    /// [0, 1], or the first wavelength where a or bb is not positive (computed as the
-    /// double-precision kernel computes them). `None` if neither holds in double precision.
+    /// [0, 1], or the first wavelength where a or bb is not positive (computed as `evaluate`
+    /// computes them: double precision, unfused). `None` if neither holds.
     pub(super) fn diagnose(&self, column: &WaterColumn<'_>) -> Option<WaterError> {
         if let Err(e) = column.validate(self.siop.grid.len()) {
             return Some(e);
         }
         let k = self.spectra(column);
         (0..self.siop.grid.len()).find_map(|i| {
-            let (a, bb) = (kernel::absorption(&k, i), kernel::backscattering(&k, i));
+            let (a, bb) = (kernel::absorption::<f64, Baseline>(&k, i), kernel::backscattering::<f64, Baseline>(&k, i));
             (!(a > 0.0 && bb > 0.0)).then(|| self.non_physical(i, a, bb))
+        })
+    }
+
+    /// Whether a > 0 and bb > 0 at every wavelength of the grid, computed as `evaluate`
+    /// computes them (the single-precision kernel's check where rounding could flip a sign).
+    pub(super) fn all_positive(&self, column: &WaterColumn<'_>) -> bool {
+        let k = self.spectra(column);
+        (0..self.siop.grid.len()).fold(true, |ok, i| {
+            let (a, bb) = (kernel::absorption::<f64, Baseline>(&k, i), kernel::backscattering::<f64, Baseline>(&k, i));
+            ok & (a > 0.0) & (bb > 0.0)
         })
     }
 
@@ -395,14 +406,16 @@ impl WaterModel {
         }
     }
 
-    /// The message when the kernel's check failed and [`Self::diagnose`] found nothing (which
-    /// the double-precision kernel, computing a and bb as `diagnose` does, cannot reach).
+    /// The message when the kernel's check failed and [`Self::diagnose`] found nothing: a or bb
+    /// within a rounding of zero, positive as `evaluate` computes it and not as the kernel does
+    /// (in single precision, or with fused multiply-adds).
     pub(super) fn non_physical_somewhere(&self) -> WaterError {
         WaterError::Siop {
             set: self.siop.name.clone(),
             field: "total absorption/backscattering".into(),
-            message: "a or bb is not positive at some wavelength for these concentrations \
-                      (in single precision; a specific spectrum is too negative there)"
+            message: "a or bb is within a rounding of zero at some wavelength for these \
+                      concentrations, not positive as the per-pixel kernel rounds it (a specific \
+                      spectrum is too negative there)"
                 .into(),
         }
     }

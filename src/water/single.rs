@@ -1,11 +1,13 @@
 //! The per-pixel water kernel in single precision: the formulas of
 //! [`WaterModel::rrs_above_into`] (Lee et al. 1998, 1999, as coded in SAMBUCA) on `f32` lanes.
 //!
-//! A fidelity setting (`Fidelity::water_single_precision`, off by default): a vector register
+//! A fidelity setting (`Fidelity::water_single_precision`, on by default with band nodes): a vector register
 //! holds twice as many `f32` as `f64` values, and the CPU divides and takes square roots of them
 //! faster. Measured per call with 451 wavelengths on one core (`shoal bench --only water`, AMD
-//! EPYC Zen 4, AVX-512 build): 1.27 M/s against 559 k/s shallow (2.3×), 5.2 M/s against
-//! 2.9 M/s optically deep (1.8×); the checks before the kernel stay in `f64`.
+//! EPYC Zen 4, AVX-512 build, SAMBUCA's default set): 1.10 M/s against 559 k/s shallow (2.0×),
+//! 4.1 M/s against 2.9 M/s optically deep (1.4×), its checks included. The checks are decided in `f64` where `f32` could decide them
+//! differently: the substrate reflectance's range (tested before rounding), and the sign of a
+//! and bb at the wavelengths where the SIOP set can make them ≤ 0.
 //! Rrs differs from the double-precision kernel by a few parts in 10⁷ (tested below: within
 //! 2·10⁻⁶ relative over shallow and deep columns, concentrations from zero to extreme, and sun
 //! and view angles to 80°), far below any instrument's noise; its effect on the products is
@@ -15,11 +17,15 @@
 use super::WaterError;
 use super::kernel::{Evaluation, Floor, Spectra};
 use super::model::{Bottom, WaterColumn, WaterGeometry, WaterModel};
+use crate::simd::{Level, mad};
 
 /// A water model's spectra in `f32`, with the model itself for its checks.
 #[derive(Debug, Clone)]
 pub struct SingleWater {
     model: WaterModel,
+    /// The set at the wavelengths where the sign of a or bb is checked in `f64` (see
+    /// [`Self::new`]).
+    sign_in_double: Option<WaterModel>,
     a_w: Vec<f32>,
     bb_w: Vec<f32>,
     a_ph: Vec<f32>,
@@ -43,8 +49,21 @@ impl SingleWater {
     pub fn new(model: &WaterModel) -> Self {
         let s = model.siop();
         let f = |v: &[f64]| v.iter().map(|&x| x as f32).collect();
+        // Where the set could give a ≤ 0 or bb ≤ 0 for some valid column: a pure-water value not
+        // positive, or a specific spectrum negative (none in the built-in sets; some
+        // wavelengths of SAMBUCA's default). There the sign is decided in `f64`, as `evaluate`
+        // decides it: near zero, `f32` rounding could flip it either way. The set at those
+        // wavelengths is a model of its own, so the check is one short loop without gathers.
+        let positive = |v: f64| v.is_finite() && v > 0.0;
+        let non_negative = |v: f64| v.is_finite() && v >= 0.0;
+        let specific = [&s.a_ph_star, &s.a_cdom_star, &s.a_nap_star, &s.bb_ph_star, &s.bb_nap_star];
+        let risky: Vec<usize> = (0..s.grid.len())
+            .filter(|&i| !(positive(s.a_w[i]) && positive(s.bb_w[i]) && specific.iter().all(|v| non_negative(v[i]))))
+            .collect();
+        let sign_in_double = if risky.is_empty() { None } else { s.subset(&risky).ok().map(WaterModel::new) };
         Self {
             model: model.clone(),
+            sign_in_double,
             a_w: f(&s.a_w),
             bb_w: f(&s.bb_w),
             a_ph: f(&s.a_ph_star),
@@ -87,7 +106,8 @@ impl SingleWater {
             bottom.resize(n, 0.0);
             pass.shallow = Some((depth_m as f32, w as f32, o as f32, reflectance, bottom));
         }
-        if crate::simd::widest(pass) {
+        let signs_agree = self.sign_in_double.as_ref().is_none_or(|m| m.all_positive(column));
+        if crate::simd::widest(pass) && signs_agree {
             Ok(())
         } else {
             Err(self.model.diagnose(column).unwrap_or_else(|| self.model.non_physical_somewhere()))
@@ -113,7 +133,7 @@ impl crate::simd::Kernel for Pass<'_> {
     type Output = bool;
 
     #[inline(always)]
-    fn run(self) -> bool {
+    fn run<L: Level>(self) -> bool {
         let w = self.water;
         let spectra = Spectra {
             a_w: &w.a_w,
@@ -127,16 +147,20 @@ impl crate::simd::Kernel for Pass<'_> {
             cdom: self.cdom,
             nap: self.nap,
         };
+        let mut in_range = true;
         let floor = match self.shallow {
             None => Floor::Deep,
             Some((depth_m, inv_cos_w, inv_cos_o, reflectance, bottom)) => {
+                // The range is checked on the `f64` value: 1 + 10⁻⁹ rounds to 1 in `f32`, and
+                // −10⁻³⁰⁰ to −0.
                 for (b, &r) in bottom.iter_mut().zip(reflectance) {
+                    in_range &= (0.0..=1.0).contains(&r);
                     *b = r as f32;
                 }
                 Floor::Shallow { depth_m, inv_cos_w, inv_cos_o, rb: bottom }
             }
         };
-        let ok = Evaluation { spectra: &spectra, floor, out: &mut *self.rrs }.run();
+        let ok = Evaluation { spectra: &spectra, floor, out: &mut *self.rrs }.run::<L>() & in_range;
         for (o, &r) in self.out.iter_mut().zip(self.rrs.iter()) {
             *o = f64::from(r);
         }
@@ -147,21 +171,21 @@ impl crate::simd::Kernel for Pass<'_> {
 /// exp(x) in single precision: x = k·ln 2 + r with |r| ≤ ln 2/2, e^r by its Taylor series to
 /// r⁷ (truncation ≤ 8·10⁻⁹ relative), 2^k from the exponent bits; within 3·10⁻⁷ relative (about
 /// 2.5 f32 ulps: the roundings of the steps). Clamped to the f32 range. The steps are fused
-/// multiply-adds (one instruction each in the kernel's AVX2 and AVX-512 builds; see
-/// [`super::kernel::Lane::mad`] for the portable build).
+/// multiply-adds where level `L` has FMA ([`crate::simd::mad`]).
 #[inline(always)]
-pub(super) fn exp_f32(x: f32) -> f32 {
+pub(super) fn exp_f32<L: Level>(x: f32) -> f32 {
+    let mad = mad::<L, f32>;
     // 1.5·2²³: adding it rounds to an integer held in the low mantissa bits.
     const SHIFT: f32 = 12_582_912.0;
     const LN2_HI: f32 = 0.693_145_75;
     const LN2_LO: f32 = 1.428_606_8e-6;
     let x = x.clamp(-87.0, 88.0);
-    let t = x.mul_add(std::f32::consts::LOG2_E, SHIFT);
+    let t = mad(x, std::f32::consts::LOG2_E, SHIFT);
     let k = t - SHIFT;
-    let r = k.mul_add(-LN2_LO, k.mul_add(-LN2_HI, x));
+    let r = mad(k, -LN2_LO, mad(k, -LN2_HI, x));
     let r2 = r * r;
-    let high = r.mul_add(1.0 / 120.0, 1.0 / 24.0) + r2 * r.mul_add(1.0 / 5040.0, 1.0 / 720.0);
-    let p = r2.mul_add(r.mul_add(1.0 / 6.0, 0.5) + r2 * high, 1.0 + r);
+    let high = mad(r, 1.0 / 120.0, 1.0 / 24.0) + r2 * mad(r, 1.0 / 5040.0, 1.0 / 720.0);
+    let p = mad(r2, mad(r, 1.0 / 6.0, 0.5) + r2 * high, 1.0 + r);
     p * f32::from_bits(t.to_bits().wrapping_add(127) << 23)
 }
 
@@ -175,8 +199,11 @@ mod tests {
     fn exp_f32_is_within_three_parts_in_ten_million() {
         for i in -8700..=8800 {
             let x = i as f32 * 0.01;
-            let (got, want) = (f64::from(exp_f32(x)), f64::from(x).exp());
-            assert!(((got - want) / want).abs() < 3e-7, "exp({x}) = {got}, not {want}");
+            let want = f64::from(x).exp();
+            for got in [exp_f32::<crate::simd::Baseline>(x), exp_f32::<crate::simd::Avx2>(x)] {
+                let got = f64::from(got);
+                assert!(((got - want) / want).abs() < 3e-7, "exp({x}) = {got}, not {want}");
+            }
         }
     }
 
@@ -237,7 +264,8 @@ mod tests {
         };
         // A substrate reflectance above 1, then not a number, at one wavelength.
         let model = WaterModel::new(siop.clone());
-        for bad in [1.5, f64::NAN, -0.1] {
+        // 1 + 10⁻⁹ and −10⁻³⁰⁰ round into [0, 1] in f32: the range is checked before.
+        for bad in [1.5, f64::NAN, -0.1, 1.0 + 1e-9, -1e-300] {
             let mut rb = vec![0.2; n];
             rb[n / 2] = bad;
             let column = WaterColumn {
