@@ -16,7 +16,7 @@
 //! modification time (`cp -p`, `rsync -a`) still counts. A string that happens to name a file
 //! no stage reads only makes the keys more cautious.
 
-use std::collections::BTreeSet;
+use std::collections::BTreeMap;
 use std::hash::{DefaultHasher, Hash, Hasher};
 use std::path::{Path, PathBuf};
 
@@ -39,7 +39,7 @@ pub fn fingerprint(part: &impl Serialize, base_dir: Option<&Path>) -> u64 {
     let Ok(text) = ron::to_string(part) else { return 0 };
     let mut bases: Vec<PathBuf> = base_dir.iter().map(|d| d.to_path_buf()).collect();
     bases.push(PathBuf::new());
-    let mut files = BTreeSet::new();
+    let mut files = BTreeMap::new();
     for quoted in quoted_strings(&text) {
         add_file(quoted, &bases, &mut files, DEPTH);
     }
@@ -47,10 +47,7 @@ pub fn fingerprint(part: &impl Serialize, base_dir: Option<&Path>) -> u64 {
         return 0;
     }
     let mut h = DefaultHasher::new();
-    for path in &files {
-        path.hash(&mut h);
-        state_of(path).hash(&mut h);
-    }
+    files.hash(&mut h);
     h.finish()
 }
 
@@ -94,8 +91,9 @@ fn identity(_: &std::fs::Metadata) -> (i64, i64, u64) {
     (0, 0, 0)
 }
 
-/// Add `name` (as given, or under one of `bases`) if it is a file, and what it names in turn.
-fn add_file(name: &str, bases: &[PathBuf], files: &mut BTreeSet<PathBuf>, depth: usize) {
+/// Add `name` (as given, or under one of `bases`) if it is a file, with its state, and what it
+/// names in turn (each file is read once).
+fn add_file(name: &str, bases: &[PathBuf], files: &mut BTreeMap<PathBuf, State>, depth: usize) {
     if depth == 0 || name.is_empty() || name.len() > 4096 || name.contains('\n') {
         return;
     }
@@ -103,15 +101,18 @@ fn add_file(name: &str, bases: &[PathBuf], files: &mut BTreeSet<PathBuf>, depth:
     let candidates: Vec<PathBuf> =
         if given.is_absolute() { vec![given.to_path_buf()] } else { bases.iter().map(|b| b.join(given)).collect() };
     for path in candidates {
-        if !path.is_file() || !files.insert(path.clone()) {
+        if !path.is_file() || files.contains_key(&path) {
             continue;
         }
-        let small = std::fs::metadata(&path).is_ok_and(|m| m.len() <= HASHED_BYTES);
-        if small && let Ok(text) = std::fs::read_to_string(&path) {
-            let base = vec![path.parent().map(Path::to_path_buf).unwrap_or_default()];
-            for quoted in quoted_strings(&text) {
-                add_file(quoted, &base, files, depth - 1);
-            }
+        let state = state_of(&path);
+        let base = vec![path.parent().map(Path::to_path_buf).unwrap_or_default()];
+        let text = match &state {
+            State::Contents(bytes) => std::str::from_utf8(bytes).ok().map(str::to_owned),
+            _ => None,
+        };
+        files.insert(path, state);
+        for quoted in text.iter().flat_map(|t| quoted_strings(t)) {
+            add_file(quoted, &base, files, depth - 1);
         }
     }
 }

@@ -91,7 +91,7 @@ pub struct Scratch {
     pub bottom_evaluations: u64,
     /// Water evaluations in all.
     pub water_evaluations: u64,
-    /// The single-precision kernel's substrate reflectance.
+    /// The single-precision kernel's work buffers.
     single: SingleScratch,
 }
 
@@ -202,14 +202,14 @@ impl SceneOptics {
             return Ok(false);
         }
         // The single-precision kernel's work buffer, out of `scratch` while the column borrows it.
-        let mut bottom = std::mem::take(&mut scratch.single);
+        let mut single_scratch = std::mem::take(&mut scratch.single);
         let column = water_column(scene, x_m, y_m, &nodes.substrates, nodes.indices.len(), scratch);
         let geometry = WaterGeometry { sun_zenith_rad: g.sun_zenith_rad, view_zenith_rad: g.view_zenith_rad };
         let result = match &nodes.single {
-            Some(single) => single.rrs_above_into(&column, &geometry, &mut bottom, rrs),
+            Some(single) => single.rrs_above_into(&column, &geometry, &mut single_scratch, rrs),
             None => nodes.water.rrs_above_into(&column, &geometry, rrs),
         };
-        scratch.single = bottom;
+        scratch.single = single_scratch;
         result?;
         Ok(true)
     }

@@ -104,7 +104,13 @@ impl SingleWater {
         if let Bottom::Shallow { depth_m, reflectance } = column.bottom {
             let (w, o) = geometry.inverse_cosines_in_water(self.model.siop().water_refractive_index);
             bottom.resize(n, 0.0);
-            pass.shallow = Some((depth_m as f32, w as f32, o as f32, reflectance, bottom));
+            pass.shallow = Some(ShallowBottom {
+                depth_m: depth_m as f32,
+                inv_cos_w: w as f32,
+                inv_cos_o: o as f32,
+                reflectance,
+                narrowed: bottom,
+            });
         }
         let signs_agree = self.sign_in_double.as_ref().is_none_or(|m| m.all_positive(column));
         if crate::simd::widest(pass) && signs_agree {
@@ -122,11 +128,19 @@ struct Pass<'a> {
     chl: f32,
     cdom: f32,
     nap: f32,
-    /// Depth, 1/cos θ_w, 1/cos θ_o, ρ_b, and the buffer ρ_b is narrowed into.
-    #[allow(clippy::type_complexity)]
-    shallow: Option<(f32, f32, f32, &'a [f64], &'a mut [f32])>,
+    shallow: Option<ShallowBottom<'a>>,
     rrs: &'a mut [f32],
     out: &'a mut [f64],
+}
+
+/// A shallow column's bottom for [`Pass`]: depth and under-water paths, ρ_b, and the buffer ρ_b
+/// is narrowed into.
+struct ShallowBottom<'a> {
+    depth_m: f32,
+    inv_cos_w: f32,
+    inv_cos_o: f32,
+    reflectance: &'a [f64],
+    narrowed: &'a mut [f32],
 }
 
 impl crate::simd::Kernel for Pass<'_> {
@@ -150,7 +164,7 @@ impl crate::simd::Kernel for Pass<'_> {
         let mut in_range = true;
         let floor = match self.shallow {
             None => Floor::Deep,
-            Some((depth_m, inv_cos_w, inv_cos_o, reflectance, bottom)) => {
+            Some(ShallowBottom { depth_m, inv_cos_w, inv_cos_o, reflectance, narrowed: bottom }) => {
                 // The range is checked on the `f64` value: 1 + 10⁻⁹ rounds to 1 in `f32`, and
                 // −10⁻³⁰⁰ to −0.
                 for (b, &r) in bottom.iter_mut().zip(reflectance) {
