@@ -415,57 +415,11 @@ impl Detector {
         Some(value)
     }
 
-    /// Read out one pixel's bands: `electrons[b]` to `dn[b]`, `flags[b]` and, when given,
-    /// `analog[b]`. The same values as [`Self::read_out`] band after band with the same `rng`:
-    /// the read-noise draws are taken first, in band order, then the arithmetic runs as a
-    /// separate loop the compiler can keep in registers (Level-0 spent most of its time in
-    /// per-value calls). `z` is a work buffer.
-    pub fn read_out_bands<R: rand::Rng + ?Sized>(
-        &self,
-        electrons: &[f32],
-        rng: &mut R,
-        z: &mut Vec<f64>,
-        dn: &mut [u16],
-        flags: &mut [u8],
-        mut analog: Option<&mut [f32]>,
-    ) {
-        z.clear();
-        if self.mode.noise {
-            z.extend(electrons.iter().map(|_| normal(rng)));
-        } else {
-            z.resize(electrons.len(), 0.0);
-        }
-        for (b, (&e, &z)) in electrons.iter().zip(z.iter()).enumerate() {
-            let r = self.read_out_with(f64::from(e), z);
-            dn[b] = r.dn;
-            flags[b] = r.flags;
-            if let Some(a) = analog.as_deref_mut() {
-                a[b] = r.analog_dn;
-            }
-        }
-    }
-
     /// [`Self::read_out`] with its standard normal read-noise draw `z` given (ignored when noise
-    /// is off).
+    /// is off). The arithmetic is [`readout::value`], shared with Level-0's vector lanes.
     #[inline(always)]
     fn read_out_with(&self, electrons: f64, z: f64) -> Readout {
-        let noisy = if self.mode.noise { electrons + self.read_noise_e * z } else { electrons };
-        let analog = noisy * self.dn_per_e + self.bias_dn;
-        let mut flags = 0;
-        if !self.ideal && electrons >= self.well_e {
-            flags |= Flags::SATURATED;
-        }
-        let dn = round_non_negative(analog).min(self.dn_max);
-        if self.mode.quantise {
-            if dn >= self.dn_max {
-                flags |= Flags::SATURATED;
-            }
-            if dn <= 0.0 {
-                flags |= Flags::ZERO;
-            }
-        }
-        let analog = if self.mode.quantise || self.ideal { analog } else { analog.min(self.dn_max) };
-        Readout { dn: dn as u16, analog_dn: analog as f32, flags }
+        readout::value(readout::Adc::of(self), electrons, z)
     }
 
     /// The value Level-1 calibrates: the DN, or the analogue value when quantisation is off.
@@ -486,5 +440,6 @@ impl Detector {
     }
 }
 
+mod readout;
 #[cfg(test)]
 mod tests;

@@ -7,7 +7,7 @@
 use ndarray::Array3;
 
 use super::InstrumentError;
-use super::detector::{Detector, Stream, pixel_rng};
+use super::detector::{Detector, Stream, normal, pixel_rng};
 use super::geometry::Viewing;
 use crate::control::RunControl;
 use crate::parse::FieldError;
@@ -90,6 +90,7 @@ pub fn digitise_cube(
         InstrumentError::Invalid(FieldError { field: "cube".into(), message: "not contiguous".into() })
     })?;
     let keep_analog = !detector.mode().quantise;
+    let noise = detector.mode().noise;
     let n = rows * cols * nb;
     let mut dn = vec![0u16; n];
     let mut flags = vec![0u8; n];
@@ -98,21 +99,18 @@ pub fn digitise_cube(
     control.fill_rows(outputs, rows, cols * nb, |at, (dn_row, flag_row, analog_row)| {
         let r = at.index();
         let line = viewing.line_index[r];
-        let mut z = Vec::with_capacity(nb);
-        for c in 0..cols {
-            at.column(c);
-            let j = viewing.detector_index[c];
-            let mut rng = pixel_rng(seed, Stream::Readout, line, j);
-            let span = c * nb..(c + 1) * nb;
-            detector.read_out_bands(
-                &input[(r * cols + c) * nb..(r * cols + c + 1) * nb],
-                &mut rng,
-                &mut z,
-                &mut dn_row[span.clone()],
-                &mut flag_row[span.clone()],
-                keep_analog.then(|| &mut analog_row[span]),
-            );
+        // The row's read-noise draws first, pixel by pixel from each pixel's generator, then
+        // the arithmetic over the whole row in vector lanes.
+        let mut z = vec![0.0; cols * nb];
+        if noise {
+            for (c, z) in z.chunks_exact_mut(nb).enumerate() {
+                at.column(c);
+                let mut rng = pixel_rng(seed, Stream::Readout, line, viewing.detector_index[c]);
+                z.iter_mut().for_each(|z| *z = normal(&mut rng));
+            }
         }
+        let electrons = &input[r * cols * nb..(r + 1) * cols * nb];
+        detector.read_out_run(electrons, &z, dn_row, flag_row, keep_analog.then_some(analog_row));
         Ok::<_, InstrumentError>(())
     })?;
     let (saturated, zero_counts) = count_flags(&flags);

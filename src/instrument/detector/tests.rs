@@ -114,3 +114,101 @@ fn shot_noise_mean_and_variance() {
         assert!((v - mean).abs() < 5.0 * mean * (2.0 / n as f64).sqrt() + 0.1, "{mean}: {v}");
     }
 }
+
+/// The readout as first written, one branch at a time: round half up after the sum, then clip
+/// to the ADC's range.
+fn readout_as_written(d: &Detector, electrons: f64, z: f64) -> Readout {
+    let noisy = if d.mode.noise { electrons + d.read_noise_e * z } else { electrons };
+    let analog = noisy * d.dn_per_e + d.bias_dn;
+    let mut flags = 0;
+    if !d.ideal && electrons >= d.well_e {
+        flags |= Flags::SATURATED;
+    }
+    let dn = (if analog > 0.0 { (analog + 0.5) as i64 as f64 } else { 0.0 }).min(d.dn_max);
+    if d.mode.quantise {
+        if dn >= d.dn_max {
+            flags |= Flags::SATURATED;
+        }
+        if dn <= 0.0 {
+            flags |= Flags::ZERO;
+        }
+    }
+    let analog = if d.mode.quantise || d.ideal { analog } else { analog.min(d.dn_max) };
+    Readout { dn: dn as u16, analog_dn: analog as f32, flags }
+}
+
+/// The readout's branch-free arithmetic, at one value ([`Detector::read_out`]) and in Level-0's
+/// vector lanes ([`Detector::read_out_run`]), gives exactly the readout as first written: in
+/// every mode, at the ties of the rounding, at both ends of the ADC and the well, and for NaN
+/// and ∞ (which a corrupt cube could hold).
+#[test]
+fn the_vectorised_readout_is_the_one_value_readout() {
+    let mut spec = InstrumentSpec::preset("nominal").unwrap();
+    spec.adc_bits = 12;
+    spec.bias_dn = 3.0;
+    let response = Response::new(&spec, 1.0).unwrap();
+    let modes = [
+        DetectorMode::default(),
+        DetectorMode { noise: false, quantise: true },
+        DetectorMode { noise: true, quantise: false },
+        DetectorMode::IDEAL,
+    ];
+    let mut ideal_spec = spec.clone();
+    let crate::instrument::spec::InstrumentKind::Multispectral { bands } = &spec.kind else {
+        panic!("the nominal instrument is a multispectral imager")
+    };
+    ideal_spec.kind = crate::instrument::spec::InstrumentKind::IdealRadiometer { bands: bands.clone() };
+    let detectors = modes.iter().map(|&m| Detector::new(&spec, &response, m, 1)).chain(std::iter::once(Detector::new(
+        &ideal_spec,
+        &response,
+        DetectorMode::default(),
+        1,
+    )));
+    for d in detectors {
+        let k = d.gain_e_per_dn;
+        // Electrons that land on ties and on either side of them, at zero, at the top of the
+        // ADC and of the well, beyond both, and values no readout should see but must survive.
+        let mut electrons: Vec<f32> = vec![0.0, -0.0, -5.0, 1e-30, f32::MAX, f32::INFINITY, f32::NAN, -f32::INFINITY];
+        for dn in [0.0, 1.0, 2.0, 7.5, 100.0, d.dn_max - 1.0, d.dn_max, d.dn_max + 3.0] {
+            for half in [-0.5, 0.5, 0.0] {
+                let e = ((dn + half - d.bias_dn) * k) as f32;
+                electrons.extend([e, f32::from_bits(e.to_bits() + 1), f32::from_bits(e.to_bits().saturating_sub(1))]);
+            }
+        }
+        let well = d.well_e as f32;
+        electrons.extend([well, f32::from_bits(well.to_bits() - 1), 2.0 * well]);
+        let mut rng = pixel_rng(3, Stream::Readout, 0, 0);
+        for draws in 0..3 {
+            let z: Vec<f64> = electrons
+                .iter()
+                .enumerate()
+                .map(|(i, _)| match (draws, d.mode.noise) {
+                    (_, false) | (0, _) => 0.0,
+                    (1, _) => normal(&mut rng),
+                    // Draws that carry the value exactly onto a tie of the rounding.
+                    _ => (i % 3) as f64 * 0.5 * k / d.read_noise_e,
+                })
+                .collect();
+            let n = electrons.len();
+            let (mut dn, mut flags, mut analog) = (vec![0u16; n], vec![0u8; n], vec![0.0f32; n]);
+            d.read_out_run(&electrons, &z, &mut dn, &mut flags, Some(&mut analog));
+            let mut dn_only = vec![0u16; n];
+            d.read_out_run(&electrons, &z, &mut dn_only, &mut flags.clone(), None);
+            for i in 0..n {
+                let one = readout_as_written(&d, f64::from(electrons[i]), z[i]);
+                let scalar = d.read_out_with(f64::from(electrons[i]), z[i]);
+                let what = format!("mode {:?}, ideal {}, {} e, z {}", d.mode, d.ideal, electrons[i], z[i]);
+                assert_eq!((dn[i], flags[i]), (one.dn, one.flags), "{what}");
+                assert_eq!(dn_only[i], one.dn, "{what}");
+                assert_eq!((scalar.dn, scalar.flags), (one.dn, one.flags), "{what}");
+                assert!(scalar.analog_dn.to_bits() == one.analog_dn.to_bits() || one.analog_dn.is_nan(), "{what}");
+                assert!(
+                    analog[i].to_bits() == one.analog_dn.to_bits() || (analog[i].is_nan() && one.analog_dn.is_nan()),
+                    "{what}: {} vs {}",
+                    analog[i],
+                    one.analog_dn
+                );
+            }
+        }
+    }
+}
