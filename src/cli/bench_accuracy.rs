@@ -126,7 +126,7 @@ pub fn accuracy_rows(out: &mut String, args: &BenchArgs) -> Result<(), CliError>
             Some(r) => {
                 let _ = writeln!(
                     out,
-                    "\nCheapest full-resolution setting within {t} % chl error per pixel: **{}** ({:.2} s, {} the reference's time, chl error {:.3} %). Previews are not candidates: they return a subset of the pixels.",
+                    "\nCheapest full-resolution setting within {t} % chl error per pixel: **{}** ({:.2} s, {} the reference's time, chl error {:.3} %). Of settings the timings cannot tell apart, the most accurate is named; previews are not candidates: they return a subset of the pixels.",
                     r.label,
                     r.seconds(),
                     r.comparison.text(),
