@@ -245,16 +245,13 @@ fn frame_means(
     let mut sums = vec![0.0; exposures.len()];
     let mut saturated = 0;
     if !left.is_empty() {
-        for f in 0..frames {
-            let mut rng = pixel_rng(seed, by_frame, f, j);
-            let mut any = false;
-            for &b in &left {
-                let r = detector.read_out(exposures[b].draw(&mut rng), &mut rng);
-                any |= r.flags & Flags::SATURATED != 0;
-                sums[b] += detector.level0_value(&r);
-            }
-            saturated += usize::from(any);
-        }
+        let mut frame_saturated = vec![false; frames];
+        let rng_of = |f| pixel_rng(seed, by_frame, f, j);
+        detector.read_out_frames(exposures, &left, frames, rng_of, |f, b, r| {
+            frame_saturated[f] |= r.flags & Flags::SATURATED != 0;
+            sums[b] += detector.level0_value(&r);
+        });
+        saturated = frame_saturated.iter().filter(|&&s| s).count();
     }
     let means = drawn.iter().zip(&sums).map(|(d, s)| d.unwrap_or(s / frames as f64)).collect();
     (means, saturated)

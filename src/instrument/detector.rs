@@ -351,7 +351,7 @@ impl Detector {
     }
 
     /// Read out `electrons`: read noise, gain, bias and the ADC.
-    #[inline]
+    #[inline(always)]
     pub fn read_out<R: rand::Rng + ?Sized>(&self, electrons: f64, rng: &mut R) -> Readout {
         let z = if self.mode.noise { normal(rng) } else { 0.0 };
         self.read_out_with(electrons, z)

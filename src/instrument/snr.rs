@@ -66,20 +66,19 @@ pub fn measured_snr(detector: &Detector, radiance: &[f64], detectors: &[usize], 
             // Every frame sees the same radiance: the exposures are set up once per band.
             let lit: Vec<_> = (0..nb).map(|b| detector.exposure(j, b, radiance[b], t)).collect();
             let dark: Vec<_> = (0..nb).map(|b| detector.exposure(j, b, 0.0, t)).collect();
-            for f in 0..frames {
-                let mut rng = pixel_rng(seed, Stream::SnrPatch, 2 * f, j);
-                for (b, exposure) in lit.iter().enumerate() {
-                    let out = detector.read_out(exposure.draw(&mut rng), &mut rng);
-                    saturated[b] |= out.flags & Flags::SATURATED != 0;
-                    let v = detector.level0_value(&out);
-                    s1[b] += v;
-                    s2[b] += v * v;
-                }
-                let mut rng = pixel_rng(seed, Stream::SnrPatch, 2 * f + 1, j);
-                for (d, exposure) in d1.iter_mut().zip(&dark) {
-                    *d += detector.level0_value(&detector.read_out(exposure.draw(&mut rng), &mut rng));
-                }
-            }
+            // Frame f's light frame draws from generator 2f, its dark frame from 2f + 1.
+            let bands: Vec<usize> = (0..nb).collect();
+            let light_rng = |f: usize| pixel_rng(seed, Stream::SnrPatch, 2 * f, j);
+            detector.read_out_frames(&lit, &bands, frames, light_rng, |_, b, out| {
+                saturated[b] |= out.flags & Flags::SATURATED != 0;
+                let v = detector.level0_value(&out);
+                s1[b] += v;
+                s2[b] += v * v;
+            });
+            let dark_rng = |f: usize| pixel_rng(seed, Stream::SnrPatch, 2 * f + 1, j);
+            detector.read_out_frames(&dark, &bands, frames, dark_rng, |_, b, out| {
+                d1[b] += detector.level0_value(&out);
+            });
             let n = frames as f64;
             (0..nb)
                 .map(|b| {

@@ -9,13 +9,16 @@
 //! after a gain change). Level-0 now takes a row's draws first and runs the arithmetic over the
 //! row in a [`Kernel`].
 
-use super::{Detector, Flags, Readout};
+use rand::rngs::Xoshiro256PlusPlus;
+
+use super::{Detector, Exposure, Flags, Readout, normal};
 use crate::simd::{self, Kernel, Level};
 
-/// One run of values to read out (see [`Detector::read_out_run`]).
-struct Run<'a> {
+/// One run of values to read out (see [`Detector::read_out_run`]); electrons in `f32` (the
+/// cube) or `f64` (frames drawn by [`Detector::read_out_frames`]).
+struct Run<'a, E> {
     detector: &'a Detector,
-    electrons: &'a [f32],
+    electrons: &'a [E],
     z: &'a [f64],
     dn: &'a mut [u16],
     flags: &'a mut [u8],
@@ -104,7 +107,7 @@ impl Adc {
     }
 }
 
-impl Kernel for Run<'_> {
+impl<E: Copy + Into<f64>> Kernel for Run<'_, E> {
     type Output = ();
 
     #[inline(always)]
@@ -115,13 +118,13 @@ impl Kernel for Run<'_> {
         match analog {
             None => {
                 for ((&e, &z), (dn, flags)) in inputs.zip(dn.iter_mut().zip(flags.iter_mut())) {
-                    let r = value(adc, f64::from(e), z);
+                    let r = value(adc, e.into(), z);
                     (*dn, *flags) = (r.dn, r.flags);
                 }
             }
             Some(analog) => {
                 for (((&e, &z), (dn, flags)), analog) in inputs.zip(dn.iter_mut().zip(flags.iter_mut())).zip(analog) {
-                    let r = value(adc, f64::from(e), z);
+                    let r = value(adc, e.into(), z);
                     (*dn, *flags, *analog) = (r.dn, r.flags, r.analog_dn);
                 }
             }
@@ -137,9 +140,9 @@ impl Detector {
     ///
     /// # Panics
     /// If the slices' lengths differ.
-    pub fn read_out_run(
+    pub fn read_out_run<E: Copy + Into<f64>>(
         &self,
-        electrons: &[f32],
+        electrons: &[E],
         z: &[f64],
         dn: &mut [u16],
         flags: &mut [u8],
@@ -151,5 +154,35 @@ impl Detector {
             "readout run: slices of different lengths"
         );
         simd::widest(Run { detector: self, electrons, z, dn, flags, analog });
+    }
+
+    /// `frames` frames of `exposures[b]` for each band `b` in `bands`, read out: frame `f`'s
+    /// generator `rng_of(f)` draws each band's electrons then its read noise, in the order of
+    /// `bands`, exactly as [`Exposure::draw`] then [`Self::read_out`] would; the readouts are
+    /// then computed in vector lanes ([`Self::read_out_run`]) and handed to
+    /// `each(frame, band, readout)` in frame order. For the frame loops of the calibration and
+    /// the SNR patch (a preview after a gain change read out 0.3 M and 0.7 M such values).
+    pub fn read_out_frames(
+        &self,
+        exposures: &[Exposure],
+        bands: &[usize],
+        frames: usize,
+        rng_of: impl Fn(usize) -> Xoshiro256PlusPlus,
+        mut each: impl FnMut(usize, usize, Readout),
+    ) {
+        let n = frames * bands.len();
+        let (mut electrons, mut z) = (Vec::with_capacity(n), Vec::with_capacity(n));
+        for f in 0..frames {
+            let mut rng = rng_of(f);
+            for &b in bands {
+                electrons.push(exposures[b].draw(&mut rng));
+                z.push(if self.mode.noise { normal(&mut rng) } else { 0.0 });
+            }
+        }
+        let (mut dn, mut flags, mut analog) = (vec![0u16; n], vec![0u8; n], vec![0.0f32; n]);
+        self.read_out_run(&electrons, &z, &mut dn, &mut flags, Some(&mut analog));
+        for (i, ((&dn, &flags), &analog_dn)) in dn.iter().zip(&flags).zip(&analog).enumerate() {
+            each(i / bands.len(), bands[i % bands.len()], Readout { dn, analog_dn, flags });
+        }
     }
 }

@@ -212,3 +212,34 @@ fn the_vectorised_readout_is_the_one_value_readout() {
         }
     }
 }
+
+/// The frame loops' batched readout draws and reads out exactly what drawing and reading out
+/// one value at a time does, band order and generators included.
+#[test]
+fn frames_read_out_at_once_are_the_frames_read_out_one_by_one() {
+    let spec = InstrumentSpec::preset("nominal").unwrap();
+    let response = Response::new(&spec, 1.0).unwrap();
+    for mode in [DetectorMode::default(), DetectorMode { noise: false, quantise: true }] {
+        let d = Detector::new(&spec, &response, mode, 1);
+        let t = d.exposure_s();
+        // No light (a fixed value), Poisson (tens of e⁻) and the normal approximation (20 000 e⁻).
+        let exposures: Vec<Exposure> = [0.0, 30.0, 20_000.0, 500.0]
+            .iter()
+            .enumerate()
+            .map(|(b, &e)| d.exposure(0, b, e / d.responsivity(0, b), t))
+            .collect();
+        let bands = [2, 0, 3];
+        let rng_of = |f: usize| pixel_rng(9, Stream::CalibrationDark, f, 4);
+        let mut batched = Vec::new();
+        d.read_out_frames(&exposures, &bands, 5, rng_of, |f, b, r| batched.push((f, b, r.dn, r.flags, r.analog_dn)));
+        let mut one_by_one = Vec::new();
+        for f in 0..5 {
+            let mut rng = rng_of(f);
+            for &b in &bands {
+                let r = d.read_out(exposures[b].draw(&mut rng), &mut rng);
+                one_by_one.push((f, b, r.dn, r.flags, r.analog_dn));
+            }
+        }
+        assert_eq!(batched, one_by_one, "mode {mode:?}");
+    }
+}
