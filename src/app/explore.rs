@@ -431,7 +431,8 @@ pub fn cost_window(app: &mut super::ShoalApp, ctx: &egui::Context) {
                     c.label,
                     c.seconds(),
                     c.comparison.text()
-                )).strong());
+                )).strong())
+                .on_hover_text("Measurably faster than the reference; of the settings no other is measurably faster than, the one with the smallest chl error");
                 let fidelity = e.cost_config.as_ref().and_then(|base| crate::sweep::fidelity_of(&c.label, base));
                 let button = ui.add_enabled(fidelity.is_some(), egui::Button::new("Apply to the app"));
                 let button = if fidelity.is_some() {

@@ -101,12 +101,14 @@ pub fn digitise_cube(
         let line = viewing.line_index[r];
         // The row's read-noise draws first, pixel by pixel from each pixel's generator, then
         // the arithmetic over the whole row in vector lanes.
+        // Every column is visited (with the noise off too), so that a fault armed at a pixel
+        // fires there.
         let mut z = vec![0.0; cols * nb];
-        if noise {
-            for (c, z) in z.chunks_exact_mut(nb).enumerate() {
-                at.column(c);
+        for c in 0..cols {
+            at.column(c);
+            if noise {
                 let mut rng = pixel_rng(seed, Stream::Readout, line, viewing.detector_index[c]);
-                z.iter_mut().for_each(|z| *z = normal(&mut rng));
+                z[c * nb..(c + 1) * nb].iter_mut().for_each(|z| *z = normal(&mut rng));
             }
         }
         let electrons = &input[r * cols * nb..(r + 1) * cols * nb];

@@ -431,28 +431,23 @@ pub fn pareto_front(rows: &[CostRow]) -> Vec<&CostRow> {
 /// `tolerance_pct` and that is measurably faster than the reference; the reference itself when
 /// none is.
 ///
-/// "Cheapest" is decided only as far as the timings can tell: of the candidates, the one with
-/// the lowest median time and every candidate not measurably slower than it
-/// ([`CostRow::measurably_faster_than`]) tie, and of those the one with the smallest chl error
-/// is taken (the first listed of equal errors). A median alone once named "band nodes 3"
-/// (3.08 s, 0.68 % chl) over the defaults (3.12 s, 0.003 %), whose ranges overlapped.
+/// "Cheapest" is decided only as far as the timings can tell: the candidates that no other
+/// candidate is measurably faster than ([`CostRow::measurably_faster_than`]) tie, and of those
+/// the one with the smallest chl error is taken (the first listed of equal errors). The tie is
+/// never empty: the candidate with the fastest single run is in it. A median alone once named
+/// "band nodes 3" (3.08 s, 0.68 % chl) over the defaults (3.12 s, 0.003 %), whose ranges
+/// overlapped.
 #[must_use]
 pub fn cheapest_within(rows: &[CostRow], tolerance_pct: f64) -> Option<&CostRow> {
     let reference = rows.first()?;
     let candidates: Vec<(&CostRow, f64)> = rows
         .iter()
         .skip(1)
+        .filter(|r| !r.samples.is_empty() && r.measurably_faster_than(reference))
         .filter_map(|r| r.chl_error_pct().filter(|&e| e <= tolerance_pct).map(|e| (r, e)))
-        .filter(|(r, _)| r.measurably_faster_than(reference))
         .collect();
-    let Some(&(fastest, _)) = candidates.iter().min_by(|a, b| a.0.seconds().total_cmp(&b.0.seconds())) else {
-        return Some(reference);
-    };
-    candidates
-        .iter()
-        .filter(|(r, _)| !fastest.measurably_faster_than(r))
-        .min_by(|a, b| a.1.total_cmp(&b.1))
-        .map(|(r, _)| *r)
+    let unbeaten = candidates.iter().filter(|(r, _)| !candidates.iter().any(|(o, _)| o.measurably_faster_than(r)));
+    unbeaten.min_by(|a, b| a.1.total_cmp(&b.1)).map(|(r, _)| *r).or(Some(reference))
 }
 
 #[cfg(test)]
@@ -589,6 +584,15 @@ mod tests {
         assert_eq!(cheapest_within(&rows, 1.0).unwrap().label, "defaults");
         // Within 0.002 % only the slower row qualifies; it beats the reference measurably.
         assert_eq!(cheapest_within(&rows, 0.002).unwrap().label, "slower");
+        // The review's case: the fastest row's slow run overlaps both others, but one of them
+        // is measurably faster than the other, which is then out of the tie.
+        let spread = vec![
+            row("reference", &[10.0, 10.5, 11.0], Some(0.0)),
+            row("erratic", &[5.0, 5.1, 9.0], Some(0.9)),
+            row("steady", &[6.0, 6.1, 6.2], Some(0.5)),
+            row("exact but slower", &[8.8, 8.9, 9.0], Some(0.0)),
+        ];
+        assert_eq!(cheapest_within(&spread, 1.0).unwrap().label, "steady");
         // A row as fast as the fastest within the noise but beyond the tolerance is no candidate.
         assert_eq!(cheapest_within(&rows[..2], 1.0).unwrap().label, "band nodes 3");
         assert_eq!(cheapest_within(&rows[..2], 0.5).unwrap().label, "reference");

@@ -50,6 +50,18 @@ fn a_panic_in_any_pixel_stage_names_the_stage_and_pixel_and_the_engine_recovers(
     }
 }
 
+/// With the noise off Level-0 draws nothing, and still visits every pixel: a fault armed at
+/// one fires there (the row-at-once readout once visited columns only to draw their noise).
+#[test]
+fn a_panic_in_level_0_without_noise_names_its_pixel() {
+    let mut c = config();
+    c.detector = shoal::instrument::DetectorMode { noise: false, quantise: true };
+    c.fault = Some(Fault { stage: Stage::Level0, row: 9, column: 4, kind: FaultKind::Panic });
+    let Err(e) = Engine::new().run(&c, &RunControl::new()) else { panic!("the fault did not fire") };
+    let EngineError::Internal { stage, site, .. } = e else { panic!("{e}") };
+    assert_eq!((stage, site), (Stage::Level0, Some(PixelSite { row: 9, column: Some(4) })));
+}
+
 #[test]
 fn a_panic_in_a_stage_without_pixels_names_the_stage() {
     let mut c = config();

@@ -31,9 +31,11 @@ struct Run<'a, E> {
 /// off): read noise, gain, bias and the ADC (Janesick 2007, ch. 2–3; see [`super`]).
 ///
 /// - analogue value a = (e + σ_read·z)/gain + bias, DN;
-/// - DN = round(a) = ⌊a + ½⌋, clipped to 0 … `dn_max` (= 2^bits − 1, an integer ≤ 2¹⁶ − 1);
+/// - DN = round(a) = ⌊a + ½⌋ (the floor of the sum a + ½ as rounded in `f64`), clipped to
+///   0 … `dn_max` (= 2^bits − 1, an integer ≤ 2¹⁶ − 1);
 /// - flags: saturated where the well filled (electrons ≥ well, not for an ideal radiometer) or
-///   the ADC reached its top; zero where it read 0 (both only with quantisation on).
+///   the ADC reached its top (the ADC's part only with quantisation on); zero where it read 0
+///   (only with quantisation on).
 ///
 /// Written for vector lanes: a is clamped to [0, dn_max] before it is rounded, which gives the
 /// same DN as rounding then clipping (rounding is monotone and leaves the integer `dn_max` in
@@ -162,7 +164,9 @@ impl Detector {
     /// `bands`, exactly as [`Exposure::draw`] then [`Self::read_out`] would; the readouts are
     /// then computed in vector lanes ([`Self::read_out_run`]) and handed to
     /// `each(frame, band, readout)` in frame order. For the frame loops of the calibration and
-    /// the SNR patch (a preview after a gain change read out 0.3 M and 0.7 M such values).
+    /// the SNR patch (a preview after a gain change reads out 0.73 M dark-frame values and
+    /// 0.3 M SNR-patch values). Frames are taken in blocks of at most `FRAME_BLOCK_VALUES`
+    /// (16 384) values, so the memory held does not grow with the frames or the bands.
     pub fn read_out_frames(
         &self,
         exposures: &[Exposure],
@@ -171,19 +175,33 @@ impl Detector {
         rng_of: impl Fn(usize) -> Xoshiro256PlusPlus,
         mut each: impl FnMut(usize, usize, Readout),
     ) {
-        let n = frames * bands.len();
-        let (mut electrons, mut z) = (Vec::with_capacity(n), Vec::with_capacity(n));
-        for f in 0..frames {
-            let mut rng = rng_of(f);
-            for &b in bands {
-                electrons.push(exposures[b].draw(&mut rng));
-                z.push(if self.mode.noise { normal(&mut rng) } else { 0.0 });
-            }
+        if bands.is_empty() {
+            return;
         }
+        let per_block = (FRAME_BLOCK_VALUES / bands.len()).max(1);
+        let n = per_block.min(frames) * bands.len();
+        let (mut electrons, mut z) = (Vec::with_capacity(n), Vec::with_capacity(n));
         let (mut dn, mut flags, mut analog) = (vec![0u16; n], vec![0u8; n], vec![0.0f32; n]);
-        self.read_out_run(&electrons, &z, &mut dn, &mut flags, Some(&mut analog));
-        for (i, ((&dn, &flags), &analog_dn)) in dn.iter().zip(&flags).zip(&analog).enumerate() {
-            each(i / bands.len(), bands[i % bands.len()], Readout { dn, analog_dn, flags });
+        for first in (0..frames).step_by(per_block) {
+            let block = first..(first + per_block).min(frames);
+            electrons.clear();
+            z.clear();
+            for f in block.clone() {
+                let mut rng = rng_of(f);
+                for &b in bands {
+                    electrons.push(exposures[b].draw(&mut rng));
+                    z.push(if self.mode.noise { normal(&mut rng) } else { 0.0 });
+                }
+            }
+            let m = electrons.len();
+            self.read_out_run(&electrons, &z, &mut dn[..m], &mut flags[..m], Some(&mut analog[..m]));
+            for (i, ((&dn, &flags), &analog_dn)) in dn.iter().zip(&flags).zip(&analog).take(m).enumerate() {
+                each(block.start + i / bands.len(), bands[i % bands.len()], Readout { dn, analog_dn, flags });
+            }
         }
     }
 }
+
+/// Values [`Detector::read_out_frames`] holds at once (about 23 bytes each): 16 384 covers the
+/// calibration's 100 frames × 19 bands and the SNR patch's 128 × 19 in one block.
+const FRAME_BLOCK_VALUES: usize = 1 << 14;
