@@ -6,6 +6,10 @@ use std::process::ExitCode;
 use shoal::cli::AppArgs;
 
 fn main() -> ExitCode {
+    if let Err(e) = shoal::simd::check_env() {
+        eprintln!("error: {e}");
+        return ExitCode::from(2);
+    }
     if std::env::args().len() <= 1 {
         return app(&AppArgs::default());
     }

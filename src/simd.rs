@@ -92,32 +92,87 @@ impl MulAdd for f32 {
     }
 }
 
-/// The instruction-set level this CPU runs `widest` at: "AVX-512", "AVX2+FMA" or "portable"
-/// (for `shoal bench` to print).
-#[must_use]
-pub fn widest_level() -> &'static str {
-    #[cfg(target_arch = "x86_64")]
-    {
-        if x86::avx512_available() {
-            return "AVX-512";
-        }
-        if x86::avx2_available() {
-            return "AVX2+FMA";
+/// The environment variable that caps the level every kernel runs at: `baseline`, `avx2` or
+/// `avx512` (unset: no cap). With it, one machine measures what a CPU without AVX-512 or
+/// without AVX2 would (`SHOAL_SIMD=baseline shoal bench`), and the levels' results can be
+/// compared. Any other value is refused by the binary at start ([`check_env`]).
+pub const CAP_ENV: &str = "SHOAL_SIMD";
+
+/// A cap on the level, from [`CAP_ENV`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Cap {
+    /// The baseline only.
+    Baseline,
+    /// AVX2 + FMA at most.
+    Avx2,
+    /// No cap.
+    Avx512,
+}
+
+impl Cap {
+    /// The cap a value of [`CAP_ENV`] asks for (`None`: unset).
+    ///
+    /// # Errors
+    /// A value other than `baseline`, `avx2` and `avx512`, with the variable and the values
+    /// allowed named.
+    pub fn parse(value: Option<&str>) -> Result<Self, String> {
+        match value.map(str::trim) {
+            None | Some("avx512") => Ok(Self::Avx512),
+            Some("avx2") => Ok(Self::Avx2),
+            Some("baseline") => Ok(Self::Baseline),
+            Some(other) => {
+                Err(format!("{CAP_ENV}={other:?}: allowed values are baseline, avx2 and avx512 (or leave it unset)"))
+            }
         }
     }
-    "portable"
+}
+
+/// The cap in force: read from [`CAP_ENV`] once; a value [`Cap::parse`] refuses caps nothing
+/// (the binary refuses to start with one, see [`check_env`]).
+fn cap() -> Cap {
+    static CAP: std::sync::OnceLock<Cap> = std::sync::OnceLock::new();
+    *CAP.get_or_init(|| Cap::parse(std::env::var(CAP_ENV).ok().as_deref()).unwrap_or(Cap::Avx512))
+}
+
+/// Check [`CAP_ENV`].
+///
+/// # Errors
+/// Its value is not one of those allowed (the message names them).
+pub fn check_env() -> Result<(), String> {
+    Cap::parse(std::env::var(CAP_ENV).ok().as_deref()).map(|_| ())
+}
+
+/// The instruction-set level this CPU runs `widest` at: "AVX-512", "AVX2+FMA" or "portable"
+/// (for `shoal bench` to print), with "(capped by SHOAL_SIMD)" when [`CAP_ENV`] lowered it.
+#[must_use]
+pub fn widest_level() -> String {
+    #[cfg(target_arch = "x86_64")]
+    {
+        let capped = |level: &str, cap_lowered: bool| {
+            if cap_lowered { format!("{level} (capped by {CAP_ENV})") } else { level.to_string() }
+        };
+        if x86::avx512_available() && cap() >= Cap::Avx512 {
+            return "AVX-512".into();
+        }
+        if x86::avx2_available() && cap() >= Cap::Avx2 {
+            return capped("AVX2+FMA", x86::avx512_available());
+        }
+        return capped("portable", x86::avx2_available());
+    }
+    #[allow(unreachable_code)]
+    "portable".into()
 }
 
 /// Run `kernel` at the widest level the CPU has: AVX-512 (F and VL) with AVX2 and FMA, or AVX2
-/// with FMA, or the baseline.
+/// with FMA, or the baseline (at most the level [`CAP_ENV`] allows).
 #[inline]
 pub fn widest<K: Kernel>(kernel: K) -> K::Output {
     #[cfg(target_arch = "x86_64")]
     {
-        if x86::avx512_available() {
+        if x86::avx512_available() && cap() >= Cap::Avx512 {
             return x86::avx512(kernel);
         }
-        if x86::avx2_available() {
+        if x86::avx2_available() && cap() >= Cap::Avx2 {
             return x86::avx2(kernel);
         }
     }
@@ -125,11 +180,11 @@ pub fn widest<K: Kernel>(kernel: K) -> K::Output {
 }
 
 /// Run `kernel` with AVX2 and FMA where the CPU has them (even if it has AVX-512), else at the
-/// baseline.
+/// baseline (at most the level [`CAP_ENV`] allows).
 #[inline]
 pub fn avx2<K: Kernel>(kernel: K) -> K::Output {
     #[cfg(target_arch = "x86_64")]
-    if x86::avx2_available() {
+    if x86::avx2_available() && cap() >= Cap::Avx2 {
         return x86::avx2(kernel);
     }
     kernel.run::<Baseline>()
@@ -200,11 +255,19 @@ mod tests {
         let fused = Dot(&a, &b).run::<Avx2>();
         assert_eq!(base.to_bits(), a.iter().zip(&b).fold(0.0, |s, (a, b)| a * b + s).to_bits());
         assert_eq!(fused.to_bits(), a.iter().zip(&b).fold(0.0, |s, (a, b)| a.mul_add(*b, s)).to_bits());
-        let want = match widest_level() {
-            "portable" => base,
-            _ => fused,
-        };
+        let want = if widest_level().starts_with("portable") { base } else { fused };
         assert_eq!(widest(Dot(&a, &b)).to_bits(), want.to_bits());
         assert_eq!(avx2(Dot(&a, &b)).to_bits(), want.to_bits());
+    }
+
+    #[test]
+    fn the_cap_takes_the_three_levels_and_refuses_anything_else_by_name() {
+        assert_eq!(Cap::parse(None), Ok(Cap::Avx512));
+        assert_eq!(Cap::parse(Some("avx512")), Ok(Cap::Avx512));
+        assert_eq!(Cap::parse(Some(" avx2 ")), Ok(Cap::Avx2));
+        assert_eq!(Cap::parse(Some("baseline")), Ok(Cap::Baseline));
+        let e = Cap::parse(Some("sse9")).unwrap_err();
+        assert!(e.contains("SHOAL_SIMD") && e.contains("baseline, avx2 and avx512"), "{e}");
+        assert!(Cap::Baseline < Cap::Avx2 && Cap::Avx2 < Cap::Avx512);
     }
 }

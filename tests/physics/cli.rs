@@ -159,6 +159,25 @@ fn bad_input_exits_2_with_one_line_naming_the_field() {
     }
 }
 
+/// `SHOAL_SIMD` caps the vector level: the three levels are accepted, and a value it does not
+/// know stops the binary at start with the variable and the values allowed named. (That the
+/// levels agree to their roundings is tested on the kernels: `simd`, `water::kernel`.)
+#[test]
+fn the_simd_cap_is_checked_at_start() {
+    let bin = env!("CARGO_BIN_EXE_shoal");
+    let run = |cap: &str| Command::new(bin).args(["water", "--depth", "3"]).env("SHOAL_SIMD", cap).output().unwrap();
+    let bad = run("sse9");
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(bad.stdout.is_empty());
+    let err = String::from_utf8_lossy(&bad.stderr);
+    assert!(err.contains("SHOAL_SIMD") && err.contains("baseline, avx2 and avx512"), "{err}");
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    for cap in ["baseline", "avx2", "avx512"] {
+        let ok = run(cap);
+        assert!(ok.status.success(), "{cap}: {}", String::from_utf8_lossy(&ok.stderr));
+    }
+}
+
 #[test]
 fn malformed_ron_names_the_line_and_the_field() {
     let dir = std::env::temp_dir().join(format!("shoal-cli-{}", std::process::id()));
