@@ -406,7 +406,7 @@ pub fn cost_window(app: &mut super::ShoalApp, ctx: &egui::Context) {
             ui.add(egui::DragValue::new(&mut e.cost_rounds).range(1..=10).suffix(" rounds").update_while_editing(false))
                 .on_hover_text("Each setting is timed once per round; with 3 or more, a setting whose times overlap the reference's says so");
             ui.add(egui::DragValue::new(&mut e.cost_tolerance_pct).range(0.0..=100.0).speed(0.1).prefix("tolerance ").suffix(" %").update_while_editing(false))
-                .on_hover_text("The chl error (median per-pixel % from the reference; |ΔMAE| for a coarser grid) the cheapest acceptable setting may make");
+                .on_hover_text("The chl error (median per-pixel % difference from the reference, on the same grid) the cheapest acceptable setting may make; previews, on a coarser grid, are not candidates");
             if ui.button("Measure").clicked() {
                 start = true;
             }
