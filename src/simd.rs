@@ -98,26 +98,26 @@ impl MulAdd for f32 {
 /// compared. Any other value is refused by the binary at start ([`check_env`]).
 pub const CAP_ENV: &str = "SHOAL_SIMD";
 
-/// A cap on the level, from [`CAP_ENV`].
+/// An instruction-set tier, ordered: what a CPU has, and what [`CAP_ENV`] allows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
-pub enum Cap {
-    /// The baseline only.
+pub enum Tier {
+    /// The baseline (SSE2 on x86-64).
     Baseline,
-    /// AVX2 + FMA at most.
+    /// AVX2 with FMA.
     Avx2,
-    /// No cap.
+    /// AVX-512 (F and VL) with AVX2 and FMA.
     Avx512,
 }
 
-impl Cap {
-    /// The cap a value of [`CAP_ENV`] asks for (`None`: unset).
+impl Tier {
+    /// The cap a value of [`CAP_ENV`] asks for (`None` or empty, unset: no cap).
     ///
     /// # Errors
     /// A value other than `baseline`, `avx2` and `avx512`, with the variable and the values
     /// allowed named.
-    pub fn parse(value: Option<&str>) -> Result<Self, String> {
+    pub fn parse_cap(value: Option<&str>) -> Result<Self, String> {
         match value.map(str::trim) {
-            None | Some("avx512") => Ok(Self::Avx512),
+            None | Some("" | "avx512") => Ok(Self::Avx512),
             Some("avx2") => Ok(Self::Avx2),
             Some("baseline") => Ok(Self::Baseline),
             Some(other) => {
@@ -125,13 +125,30 @@ impl Cap {
             }
         }
     }
+
+    /// The highest tier this CPU has.
+    fn of_cpu() -> Self {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if x86::avx512_available() {
+                return Self::Avx512;
+            }
+            if x86::avx2_available() {
+                return Self::Avx2;
+            }
+        }
+        Self::Baseline
+    }
 }
 
-/// The cap in force: read from [`CAP_ENV`] once; a value [`Cap::parse`] refuses caps nothing
-/// (the binary refuses to start with one, see [`check_env`]).
-fn cap() -> Cap {
-    static CAP: std::sync::OnceLock<Cap> = std::sync::OnceLock::new();
-    *CAP.get_or_init(|| Cap::parse(std::env::var(CAP_ENV).ok().as_deref()).unwrap_or(Cap::Avx512))
+/// The tier the kernels run at: the CPU's, at most the cap read from [`CAP_ENV`] (once; a value
+/// the binary refuses at start, see [`check_env`], caps nothing).
+fn tier() -> Tier {
+    static TIER: std::sync::OnceLock<Tier> = std::sync::OnceLock::new();
+    *TIER.get_or_init(|| {
+        let cap = Tier::parse_cap(std::env::var(CAP_ENV).ok().as_deref()).unwrap_or(Tier::Avx512);
+        Tier::of_cpu().min(cap)
+    })
 }
 
 /// Check [`CAP_ENV`].
@@ -139,55 +156,43 @@ fn cap() -> Cap {
 /// # Errors
 /// Its value is not one of those allowed (the message names them).
 pub fn check_env() -> Result<(), String> {
-    Cap::parse(std::env::var(CAP_ENV).ok().as_deref()).map(|_| ())
+    Tier::parse_cap(std::env::var(CAP_ENV).ok().as_deref()).map(|_| ())
 }
 
 /// The instruction-set level this CPU runs `widest` at: "AVX-512", "AVX2+FMA" or "portable"
 /// (for `shoal bench` to print), with "(capped by SHOAL_SIMD)" when [`CAP_ENV`] lowered it.
 #[must_use]
 pub fn widest_level() -> String {
-    #[cfg(target_arch = "x86_64")]
-    {
-        let capped = |level: &str, cap_lowered: bool| {
-            if cap_lowered { format!("{level} (capped by {CAP_ENV})") } else { level.to_string() }
-        };
-        if x86::avx512_available() && cap() >= Cap::Avx512 {
-            return "AVX-512".into();
-        }
-        if x86::avx2_available() && cap() >= Cap::Avx2 {
-            return capped("AVX2+FMA", x86::avx512_available());
-        }
-        return capped("portable", x86::avx2_available());
-    }
-    #[allow(unreachable_code)]
-    "portable".into()
+    let name = match tier() {
+        Tier::Avx512 => "AVX-512",
+        Tier::Avx2 => "AVX2+FMA",
+        Tier::Baseline => "portable",
+    };
+    if tier() < Tier::of_cpu() { format!("{name} (capped by {CAP_ENV})") } else { name.into() }
 }
 
 /// Run `kernel` at the widest level the CPU has: AVX-512 (F and VL) with AVX2 and FMA, or AVX2
 /// with FMA, or the baseline (at most the level [`CAP_ENV`] allows).
 #[inline]
 pub fn widest<K: Kernel>(kernel: K) -> K::Output {
-    #[cfg(target_arch = "x86_64")]
-    {
-        if x86::avx512_available() && cap() >= Cap::Avx512 {
-            return x86::avx512(kernel);
-        }
-        if x86::avx2_available() && cap() >= Cap::Avx2 {
-            return x86::avx2(kernel);
-        }
+    match tier() {
+        #[cfg(target_arch = "x86_64")]
+        Tier::Avx512 => x86::avx512(kernel),
+        #[cfg(target_arch = "x86_64")]
+        Tier::Avx2 => x86::avx2(kernel),
+        _ => kernel.run::<Baseline>(),
     }
-    kernel.run::<Baseline>()
 }
 
 /// Run `kernel` with AVX2 and FMA where the CPU has them (even if it has AVX-512), else at the
 /// baseline (at most the level [`CAP_ENV`] allows).
 #[inline]
 pub fn avx2<K: Kernel>(kernel: K) -> K::Output {
-    #[cfg(target_arch = "x86_64")]
-    if x86::avx2_available() && cap() >= Cap::Avx2 {
-        return x86::avx2(kernel);
+    match tier() {
+        #[cfg(target_arch = "x86_64")]
+        Tier::Avx512 | Tier::Avx2 => x86::avx2(kernel),
+        _ => kernel.run::<Baseline>(),
     }
-    kernel.run::<Baseline>()
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -262,12 +267,13 @@ mod tests {
 
     #[test]
     fn the_cap_takes_the_three_levels_and_refuses_anything_else_by_name() {
-        assert_eq!(Cap::parse(None), Ok(Cap::Avx512));
-        assert_eq!(Cap::parse(Some("avx512")), Ok(Cap::Avx512));
-        assert_eq!(Cap::parse(Some(" avx2 ")), Ok(Cap::Avx2));
-        assert_eq!(Cap::parse(Some("baseline")), Ok(Cap::Baseline));
-        let e = Cap::parse(Some("sse9")).unwrap_err();
+        assert_eq!(Tier::parse_cap(None), Ok(Tier::Avx512));
+        assert_eq!(Tier::parse_cap(Some("")), Ok(Tier::Avx512));
+        assert_eq!(Tier::parse_cap(Some("avx512")), Ok(Tier::Avx512));
+        assert_eq!(Tier::parse_cap(Some(" avx2 ")), Ok(Tier::Avx2));
+        assert_eq!(Tier::parse_cap(Some("baseline")), Ok(Tier::Baseline));
+        let e = Tier::parse_cap(Some("sse9")).unwrap_err();
         assert!(e.contains("SHOAL_SIMD") && e.contains("baseline, avx2 and avx512"), "{e}");
-        assert!(Cap::Baseline < Cap::Avx2 && Cap::Avx2 < Cap::Avx512);
+        assert!(Tier::Baseline < Tier::Avx2 && Tier::Avx2 < Tier::Avx512);
     }
 }

@@ -100,9 +100,8 @@ pub fn digitise_cube(
         let r = at.index();
         let line = viewing.line_index[r];
         // The row's read-noise draws first, pixel by pixel from each pixel's generator, then
-        // the arithmetic over the whole row in vector lanes.
-        // Every column is visited (with the noise off too), so that a fault armed at a pixel
-        // fires there.
+        // the arithmetic over the whole row in vector lanes. Every column is visited, with the
+        // noise off too, so that a fault armed at a pixel fires there.
         let mut z = vec![0.0; cols * nb];
         for c in 0..cols {
             at.column(c);

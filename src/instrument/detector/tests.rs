@@ -152,8 +152,7 @@ fn the_vectorised_readout_is_the_one_value_readout() {
 }
 
 fn readout_matches_as_written(spec: &InstrumentSpec) {
-    let spec = spec.clone();
-    let response = Response::new(&spec, 1.0).unwrap();
+    let response = Response::new(spec, 1.0).unwrap();
     let modes = [
         DetectorMode::default(),
         DetectorMode { noise: false, quantise: true },
@@ -165,7 +164,7 @@ fn readout_matches_as_written(spec: &InstrumentSpec) {
         panic!("the nominal instrument is a multispectral imager")
     };
     ideal_spec.kind = crate::instrument::spec::InstrumentKind::IdealRadiometer { bands: bands.clone() };
-    let detectors = modes.iter().map(|&m| Detector::new(&spec, &response, m, 1)).chain(std::iter::once(Detector::new(
+    let detectors = modes.iter().map(|&m| Detector::new(spec, &response, m, 1)).chain(std::iter::once(Detector::new(
         &ideal_spec,
         &response,
         DetectorMode::default(),
