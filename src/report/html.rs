@@ -39,12 +39,10 @@ fn url_path(name: &str) -> String {
         .collect()
 }
 
-/// The SVG for inline use: no XML prolog, no namespace URI (HTML parses inline SVG without it),
-/// and scalable to the column width.
-fn inline_svg(svg: &str) -> String {
-    let start = svg.find("<svg").unwrap_or(0);
-    svg[start..].replacen(" xmlns=\"http://www.w3.org/2000/svg\"", "", 1).replacen("<svg ", "<svg role=\"img\" ", 1)
-}
+/// The page's Content Security Policy: no script, no connection, no resource from outside the
+/// file (images only as `data:` URIs, the one inline style sheet). A second wall behind
+/// [`super::svg::clean`]: a figure that slipped through could still run nothing and fetch nothing.
+const CSP: &str = "default-src 'none'; img-src data:; style-src 'unsafe-inline'; form-action 'none'; base-uri 'none'";
 
 const STYLE: &str = "
 body { font: 15px/1.45 'DejaVu Sans', Verdana, sans-serif; color: #1b1b1b; margin: 0 auto; max-width: 1180px; padding: 24px 28px 60px; }
@@ -78,7 +76,7 @@ pub fn page(d: &ReviewData, figures: &[PageFigure]) -> String {
     let mut h = String::with_capacity(1 << 20);
     let _ = write!(
         h,
-        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n<title>Shoal review pack — {}</title>\n<style>{STYLE}</style>\n</head>\n<body>\n",
+        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<meta http-equiv=\"Content-Security-Policy\" content=\"{CSP}\">\n<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n<title>Shoal review pack — {}</title>\n<style>{STYLE}</style>\n</head>\n<body>\n",
         escape(&d.study)
     );
     header(&mut h, d);
@@ -326,6 +324,20 @@ fn figures_section(h: &mut String, figures: &[PageFigure]) {
     }
     let mut shown = vec![false; figures.len()];
     let put = |h: &mut String, f: &PageFigure| {
+        let svg = match super::svg::clean(&f.svg) {
+            // Read aloud as one image with its caption.
+            Ok(svg) => svg.replacen("<svg", "<svg role=\"img\"", 1),
+            Err(refused) => {
+                let _ = writeln!(
+                    h,
+                    "<p class=\"fail\" id=\"fig-{}\">Figure {} left out: {}.</p>",
+                    escape(&f.name),
+                    escape(&f.name),
+                    escape(&refused.to_string())
+                );
+                return;
+            }
+        };
         let link = if f.png {
             format!(" <a href=\"figures/{}.png\">PNG</a>", escape(&url_path(&f.name)))
         } else {
@@ -335,7 +347,7 @@ fn figures_section(h: &mut String, figures: &[PageFigure]) {
             h,
             "<figure id=\"fig-{}\">\n{}\n<figcaption>{}{link}</figcaption>\n</figure>\n",
             escape(&f.name),
-            inline_svg(&f.svg),
+            svg,
             escape(&caption(&f.name))
         );
     };
@@ -491,11 +503,8 @@ mod tests {
     use super::*;
 
     #[test]
-    fn text_is_escaped_and_svg_is_inlined_without_its_namespace_uri() {
+    fn text_is_escaped_and_file_names_are_url_encoded() {
         assert_eq!(escape("a < b & \"c\""), "a &lt; b &amp; &quot;c&quot;");
-        let svg =
-            inline_svg("<?xml version=\"1.0\"?>\n<svg width=\"10\" xmlns=\"http://www.w3.org/2000/svg\"><rect/></svg>");
-        assert_eq!(svg, "<svg role=\"img\" width=\"10\"><rect/></svg>");
         assert_eq!(url_path("sweep_chl #2?"), "sweep_chl%20%232%3F");
     }
 }

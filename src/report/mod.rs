@@ -10,6 +10,7 @@
 pub mod html;
 mod machine;
 mod pack;
+pub mod svg;
 
 use serde::{Deserialize, Serialize};
 
@@ -179,6 +180,10 @@ pub struct ReviewData {
     pub machine: Machine,
     /// The study file as resolved (RON).
     pub study_ron: String,
+    /// The figures drawn with these results (file stems under `figures/`): the only ones a pack
+    /// built from the results folder takes.
+    #[serde(default)]
+    pub figures: Vec<String>,
 }
 
 /// The git commit this binary was built from (`src/build.rs`), or "unknown".
@@ -447,6 +452,7 @@ pub fn review_data(result: &StudyResult, budget: &[Budget], cost: &[CostRow]) ->
         machine: Machine::this(),
         study_ron: ron::ser::to_string_pretty(&study.spec, ron::ser::PrettyConfig::default().struct_names(true))
             .unwrap_or_default(),
+        figures: Vec::new(),
     }
 }
 
@@ -517,6 +523,7 @@ mod tests {
             data_sources: Vec::new(),
             machine: machine::Machine::this(),
             study_ron: String::new(),
+            figures: Vec::new(),
         };
         let html = html::page(&data, &[]);
         let row = |label: &str| {

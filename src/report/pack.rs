@@ -21,19 +21,21 @@ pub fn review_json(data: &ReviewData) -> Result<String, StudyError> {
 }
 
 /// Write the pack into `out`: `index.html` (self-contained), `figures/NAME.png` and
-/// `review.json`. Returns the page's path.
+/// `review.json` (listing the figures). Returns the page's path.
 pub fn write_pack(data: &ReviewData, figures: &[Figure], out: &Path) -> Result<PathBuf, StudyError> {
     let mut shown = Vec::with_capacity(figures.len());
     for f in figures {
         let png = !f.png.is_empty();
         if png {
-            write_bytes(&out.join("figures").join(format!("{}.png", f.name)), &f.png)?;
+            write_bytes(&crate::parse::join_name(&out.join("figures"), "figure", &format!("{}.png", f.name))?, &f.png)?;
         }
         shown.push(PageFigure { name: f.name.clone(), svg: f.svg.clone(), png });
     }
-    write_bytes(&out.join(REVIEW_JSON), review_json(data)?.as_bytes())?;
+    let mut data = data.clone();
+    data.figures = figures.iter().map(|f| f.name.clone()).collect();
+    write_bytes(&out.join(REVIEW_JSON), review_json(&data)?.as_bytes())?;
     let index = out.join("index.html");
-    write_bytes(&index, page(data, &shown).as_bytes())?;
+    write_bytes(&index, page(&data, &shown).as_bytes())?;
     Ok(index)
 }
 
@@ -43,30 +45,30 @@ pub fn is_results_dir(dir: &Path) -> bool {
     dir.join(REVIEW_JSON).is_file()
 }
 
-/// The review data and figures of a results directory written by `shoal study` (figures in
-/// name order; a figure's PNG is read when it is there).
+/// The review data and figures of a results directory written by `shoal study`: the figures
+/// its `review.json` lists, each read from `figures/NAME.svg` (and its PNG when there), in that
+/// order. The directory is never listed, so a file planted there is not read; what is read is
+/// untrusted and passes [`super::svg::clean`] before it reaches a page. A `review.json` that does
+/// not parse, or lists a figure that is missing or not a plain name, is refused naming it.
 pub fn load_results(dir: &Path) -> Result<(ReviewData, Vec<Figure>), StudyError> {
     let path = dir.join(REVIEW_JSON);
-    let text = std::fs::read_to_string(&path).map_err(|e| io(format!("cannot read {}: {e}", path.display())))?;
-    let data: ReviewData = serde_json::from_str(&text).map_err(|e| {
-        io(format!("{}: {e} (written by another version of Shoal? rerun `shoal study`)", path.display()))
-    })?;
-    let mut figures = Vec::new();
-    let fig_dir = dir.join("figures");
-    if let Ok(entries) = std::fs::read_dir(&fig_dir) {
-        let mut svgs: Vec<PathBuf> = entries
-            .filter_map(Result::ok)
-            .map(|e| e.path())
-            .filter(|p| p.extension().is_some_and(|x| x == "svg"))
-            .collect();
-        svgs.sort();
-        for svg_path in svgs {
-            let name = svg_path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-            let svg = std::fs::read_to_string(&svg_path)
-                .map_err(|e| io(format!("cannot read {}: {e}", svg_path.display())))?;
-            let png = std::fs::read(svg_path.with_extension("png")).unwrap_or_default();
-            figures.push(Figure { name, png, svg });
-        }
+    let bad =
+        |message: String| StudyError::Invalid(crate::parse::FieldError { field: path.display().to_string(), message });
+    let text = std::fs::read_to_string(&path).map_err(|e| bad(format!("cannot be read: {e}")))?;
+    let data: ReviewData = serde_json::from_str(&text)
+        .map_err(|e| bad(format!("{e} (written by another version of Shoal, or changed? rerun `shoal study`)")))?;
+    let mut figures = Vec::with_capacity(data.figures.len());
+    for name in &data.figures {
+        let svg_path = crate::parse::join_name(&dir.join("figures"), "review.json figures", &format!("{name}.svg"))
+            .map_err(|e| bad(e.to_string()))?;
+        let svg = std::fs::read_to_string(&svg_path).map_err(|e| {
+            bad(format!(
+                "lists the figure `{name}`, but {} cannot be read ({e}): an incomplete folder? rerun `shoal study`",
+                svg_path.display()
+            ))
+        })?;
+        let png = std::fs::read(svg_path.with_extension("png")).unwrap_or_default();
+        figures.push(Figure { name: name.clone(), png, svg });
     }
     Ok((data, figures))
 }

@@ -137,7 +137,11 @@ fn the_review_pack_renders_in_chromium_with_every_image_and_nothing_external() {
 
     // Every image loaded, every figure laid out (checked from inside the page, on a copy).
     let check = pack.join("check.html");
-    std::fs::write(&check, html.replace("</body>", &format!("{CHECKER}</body>"))).unwrap();
+    // The copy drops the page's Content-Security-Policy, which (rightly) blocks the checker too.
+    let csp_start = html.find("<meta http-equiv=\"Content-Security-Policy\"").expect("the page states its CSP");
+    let csp_end = csp_start + html[csp_start..].find('>').unwrap() + 1;
+    let unlocked = format!("{}{}", &html[..csp_start], &html[csp_end..]);
+    std::fs::write(&check, unlocked.replace("</body>", &format!("{CHECKER}</body>"))).unwrap();
     let out = chromium(
         &profile,
         &["--virtual-time-budget=15000".into(), "--dump-dom".into(), format!("file://{}", check.display())],
