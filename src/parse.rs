@@ -128,6 +128,52 @@ pub fn preset_names<T: Preset>() -> Vec<String> {
     names
 }
 
+/// Longest name that becomes a file or folder name.
+pub const MAX_NAME_CHARS: usize = 64;
+
+/// Check that `name` (of `field`) can become one file or folder name and nothing more: 1 to
+/// [`MAX_NAME_CHARS`] letters, digits, spaces and `_ - . + ( ) ,`, not starting with a dot or a
+/// space and not ending with one. Names come from presets and studies other people made: one
+/// that held `/`, `..` or a control character would write outside the output folder.
+///
+/// ```
+/// use shoal::parse::check_name;
+/// assert!(check_name("instrument.name", "SmallSat (2x)").is_ok());
+/// let e = check_name("instrument.name", "../../X").unwrap_err();
+/// assert_eq!(e.field, "instrument.name");
+/// ```
+pub fn check_name(field: &str, name: &str) -> Result<(), FieldError> {
+    let allowed = |c: char| c.is_alphanumeric() || " _-.+(),".contains(c);
+    let count = name.chars().count();
+    let problem = if count == 0 {
+        Some("is empty".to_string())
+    } else if count > MAX_NAME_CHARS {
+        Some(format!("has {count} characters"))
+    } else if let Some(c) = name.chars().find(|c| !allowed(*c)) {
+        Some(format!("holds {:?}", c))
+    } else if name.starts_with(['.', ' ']) || name.ends_with(['.', ' ']) {
+        Some("starts or ends with a dot or a space".to_string())
+    } else {
+        None
+    };
+    match problem {
+        None => Ok(()),
+        Some(p) => Err(FieldError {
+            field: field.into(),
+            message: format!(
+                "`{}` {p} (a name becomes a file name: 1 to {MAX_NAME_CHARS} letters, digits, spaces and _ - . + ( ) ,, not starting or ending with a dot or a space)",
+                name.escape_debug()
+            ),
+        }),
+    }
+}
+
+/// `dir` joined with `name`, once [`check_name`] has accepted it.
+pub fn join_name(dir: &std::path::Path, field: &str, name: &str) -> Result<std::path::PathBuf, FieldError> {
+    check_name(field, name)?;
+    Ok(dir.join(name))
+}
+
 #[cfg(test)]
 mod tests {
     #![allow(clippy::unwrap_used)]
@@ -145,6 +191,23 @@ mod tests {
         let e = ron::from_str::<S>(text).unwrap_err();
         let m = describe(text, &e);
         assert!(m.starts_with("line 3, column 17, field `aperture_mm`: "), "{m}");
+    }
+
+    #[test]
+    fn a_name_is_one_file_name_or_refused() {
+        for good in ["cubesat", "SmallSat (2x)", "Sentinel-2A MSI", "a.b", "été_1", "x+y,z"] {
+            assert!(check_name("n", good).is_ok(), "{good}");
+        }
+        for bad in
+            ["", "..", ".", "../../X", "a/b", "a\\b", ".hidden", "trailing ", "nul\0", "tab\t", "x:y", &"a".repeat(65)]
+        {
+            let e = check_name("instrument.name", bad).unwrap_err();
+            assert_eq!(e.field, "instrument.name");
+            assert!(e.message.contains("a name becomes a file name"), "{bad}: {e}");
+        }
+        let dir = std::path::Path::new("/out");
+        assert_eq!(join_name(dir, "n", "cubesat").unwrap(), dir.join("cubesat"));
+        assert!(join_name(dir, "n", "../x").is_err());
     }
 
     #[test]

@@ -150,6 +150,7 @@ impl InstrumentSpec {
             })
         };
         let count = |n: usize| n as f64;
+        crate::parse::check_name("instrument.name", &self.name).map_err(InstrumentError::Invalid)?;
         check(&r::INSTRUMENT_ALTITUDE_KM, self.altitude_km)?;
         check(&r::INSTRUMENT_HEADING_DEG, self.heading_deg)?;
         check(&r::INSTRUMENT_APERTURE_MM, self.aperture_mm)?;
@@ -164,6 +165,18 @@ impl InstrumentSpec {
         check(&r::INSTRUMENT_GAIN_E_PER_DN, self.gain_e_per_dn)?;
         check(&r::INSTRUMENT_BIAS_DN, self.bias_dn)?;
         check(&r::INSTRUMENT_ADC_BITS, f64::from(self.adc_bits))?;
+        // The offset must leave counts for a signal: at or above the largest count the full
+        // scale is 0 e⁻ and every pixel saturates.
+        let max_dn = f64::from(u32::MAX >> (32 - self.adc_bits));
+        if self.bias_dn >= max_dn {
+            return Err(InstrumentError::Invalid(FieldError {
+                field: r::INSTRUMENT_BIAS_DN.field("instrument.").into(),
+                message: format!(
+                    "{} is at or above the largest count of a {}-bit ADC ({max_dn}): no signal could be read (allowed: 0 to below {max_dn} DN)",
+                    self.bias_dn, self.adc_bits
+                ),
+            }));
+        }
         check(&r::INSTRUMENT_OPTICAL_TRANSMISSION, self.optical_transmission)?;
         check(&r::INSTRUMENT_DARK_CURRENT_E_S, self.dark_current_e_s)?;
         check(&r::INSTRUMENT_PRNU, self.prnu)?;

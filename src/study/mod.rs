@@ -18,6 +18,7 @@ mod budget;
 mod curves;
 mod figures;
 mod geotiff_out;
+mod outdir;
 mod output;
 mod render;
 pub mod reproduction;
@@ -31,6 +32,7 @@ pub use budget::{Budget, BudgetLine, Stage, budget_table, error_budget};
 pub use curves::{CurvePoint, CurveSeries, Curves, curve_figure, first_crossing};
 pub use figures::figure_set;
 pub use geotiff_out::{NODATA, swath_geotransform, write_run_geotiff};
+pub use outdir::{MARKER, OutputDir};
 pub use output::{CubeFormat, Outputs, metrics_csv, write_bytes, write_run, write_run_as, write_study};
 pub use render::{Figure, base64};
 pub use requirements::{Check, ProductRequirement, Requirements, checks_csv, verdict};
@@ -210,6 +212,7 @@ impl StudySpec {
                 message: format!("{} seeds (allowed: 1 to 1000)", self.seeds.len()),
             }));
         }
+        crate::parse::check_name("name", &self.name)?;
         if let Some(r) = &self.requirements {
             r.validate()?;
         }
