@@ -208,12 +208,16 @@ pub fn write_review_pack(snap: &Snapshot, dir: &Path) -> Result<PathBuf, String>
         crate::study::StudyResult::of_runs(&state.study_name, &description, &runs, Some(state.requirements.clone()))
             .ok_or("no results to export yet")?;
     let figures = crate::study::figure_set(&result).map_err(|e| e.to_string())?;
-    crate::report::write_pack(&crate::report::review_data(&result, &[], &[]), &figures, dir).map_err(|e| e.to_string())
+    let out = crate::study::OutputDir::create(dir, "Shoal app: review pack").map_err(|e| e.to_string())?;
+    crate::report::write_pack(&crate::report::review_data(&result, &[], &[]), &figures, out.path())
+        .map_err(|e| e.to_string())?;
+    out.commit().map_err(|e| e.to_string())?;
+    Ok(dir.join("index.html"))
 }
 
 /// Files an export to `path` would replace (empty: nothing of the user's is overwritten).
 #[must_use]
-pub fn existing(what: What, snap: &Snapshot, path: &Path) -> Vec<PathBuf> {
+pub fn existing(what: What, path: &Path) -> Vec<PathBuf> {
     let candidates: Vec<PathBuf> = match what {
         What::Figure => {
             let stem = path.with_extension("");
@@ -221,24 +225,27 @@ pub fn existing(what: What, snap: &Snapshot, path: &Path) -> Vec<PathBuf> {
             v.extend(["A", "B"].map(|n| PathBuf::from(format!("{}_config_{n}.ron", stem.display()))));
             v
         }
-        What::ReviewPack => vec![path.join("index.html")],
-        What::Data => ["A", "B"]
-            .iter()
-            .zip(&snap.runs)
-            .filter_map(|(name, run)| run.as_ref().map(|o| path.join(format!("{name}_{}", o.config.instrument.name))))
-            .collect(),
+        // A folder is replaced whole ([`crate::study::OutputDir`]): anything in it counts.
+        What::ReviewPack | What::Data => {
+            let full = std::fs::read_dir(path).is_ok_and(|mut entries| entries.next().is_some());
+            if full { vec![path.to_path_buf()] } else { Vec::new() }
+        }
     };
     candidates.into_iter().filter(|p| p.exists()).collect()
 }
 
-/// Write both runs' cubes and metrics under `dir`.
+/// Write both runs' cubes and metrics into the folder `dir` (written whole: a new or empty
+/// folder, or one Shoal wrote, which is replaced).
 pub fn write_data(snap: &Snapshot, dir: &Path) -> Result<usize, String> {
+    let out = crate::study::OutputDir::create(dir, "Shoal app: data export").map_err(|e| e.to_string())?;
     let mut n = 0;
     for (name, run) in ["A", "B"].iter().zip(&snap.runs) {
-        let Some(out) = run else { return Err("no results to export yet".into()) };
-        let sub = dir.join(format!("{name}_{}", out.config.instrument.name));
-        n += write_run(out, &sub).map_err(|e| e.to_string())?.files.len();
+        let Some(run) = run else { return Err("no results to export yet".into()) };
+        let sub = format!("{name}_{}", run.config.instrument.name);
+        let sub = crate::parse::join_name(out.path(), "instrument.name", &sub).map_err(|e| e.to_string())?;
+        n += write_run(run, &sub).map_err(|e| e.to_string())?.files.len();
     }
+    out.commit().map_err(|e| e.to_string())?;
     Ok(n)
 }
 

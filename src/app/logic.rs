@@ -222,7 +222,7 @@ impl ShoalApp {
     /// Export to a typed path, asking first if that would replace existing files.
     pub(super) fn export_to(&mut self, what: super::export::What, path: PathBuf) {
         let snap = super::export::Snapshot::of(self);
-        let existing = super::export::existing(what, &snap, &path);
+        let existing = super::export::existing(what, &path);
         if existing.is_empty() {
             self.ui.exports.write_to(what, snap, path);
         } else {

@@ -33,8 +33,8 @@ pub fn run(args: &BudgetArgs) -> Result<(), CliError> {
     }
     let (spec, dir) = super::study::load(args.study.as_deref())?;
     let resolved = spec.resolve(dir.as_deref())?;
-    let pool =
-        crate::jobs::pool(args.threads.unwrap_or(0), "shoal-budget").map_err(|e| CliError::Run(e.to_string()))?;
+    let out = crate::study::OutputDir::create(&args.out, "shoal budget")?;
+    let pool = super::pool(args.threads.unwrap_or(0), "shoal-budget")?;
     let seeds: Vec<u64> = (1..=args.seeds).collect();
     let control = super::interrupt::control();
     let start = std::time::Instant::now();
@@ -58,6 +58,6 @@ pub fn run(args: &BudgetArgs) -> Result<(), CliError> {
     let table = budget_table(&budgets);
     println!("{table}");
     eprintln!("{}: error budget in {:.1} s", spec.name, start.elapsed().as_secs_f64());
-    write_bytes(&args.out.join("budget.md"), table.as_bytes())?;
-    Ok(())
+    write_bytes(&out.path().join("budget.md"), table.as_bytes())?;
+    Ok(out.commit()?)
 }

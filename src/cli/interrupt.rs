@@ -1,7 +1,9 @@
 //! Ctrl-C (and SIGTERM) during a command: the first signal cancels the run cleanly — the engine
 //! stops at its next row check, a file being written is finished or removed (writes are temp +
-//! rename, see `study::write_bytes`), nothing half-written or `.partial` stays — and the command
-//! exits with code 130. A second signal exits at once.
+//! rename, see `study::write_bytes`; a results folder is staged beside `--out` and removed, see
+//! `study::OutputDir`), nothing half-written or `.partial` stays — and the command exits with code
+//! 130. A second signal exits at once; the staging folder it leaves is removed by the next run
+//! into the same `--out`.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, OnceLock};

@@ -29,6 +29,10 @@ impl<T> Lookup<T> {
                 std::fs::read_to_string(arg).map_err(|e| CliError::Input(format!("{} {arg}: {e}", self.flag)))?;
             return Ok(((self.from_ron)(&text, arg)?, Path::new(arg).parent().map(Path::to_path_buf)));
         }
+        if arg.contains(std::path::MAIN_SEPARATOR) || arg.contains('/') {
+            // A path that is not there (a built-in or library name never holds a separator).
+            return Err(CliError::Input(format!("{} {arg}: no such file or folder", self.flag)));
+        }
         let library = Library::user();
         match library.find(self.kind, arg) {
             Some(entry) => {

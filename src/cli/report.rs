@@ -72,7 +72,19 @@ fn sweep_figures(dir: &Path) -> Result<Vec<crate::study::Figure>, CliError> {
 pub fn run(args: &ReportArgs) -> Result<(), CliError> {
     let start = std::time::Instant::now();
     let sweeps = args.sweep.iter().map(|d| sweep_figures(d)).collect::<Result<Vec<_>, _>>()?;
-    let (data, mut figures) = match args.target.as_deref().map(Path::new).filter(|p| p.is_dir()) {
+    let results_dir = args.target.as_deref().map(Path::new).filter(|p| p.is_dir());
+    if let Some(dir) = results_dir
+        && let (Ok(d), Ok(o)) = (dir.canonicalize(), args.out.canonicalize())
+        && (o.starts_with(&d) || d.starts_with(&o))
+    {
+        return Err(CliError::Input(format!(
+            "--out {}: the pack goes to a folder of its own, not into or around the results it reads ({})",
+            args.out.display(),
+            dir.display()
+        )));
+    }
+    let out = crate::study::OutputDir::create(&args.out, "shoal report")?;
+    let (data, mut figures) = match results_dir {
         Some(dir) => {
             if !is_results_dir(dir) {
                 return Err(CliError::Input(format!(
@@ -91,7 +103,9 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
         None => run_for_report(args)?,
     };
     figures.extend(sweeps.into_iter().flatten());
-    let index = write_pack(&data, &figures, &args.out)?;
+    write_pack(&data, &figures, out.path())?;
+    out.commit()?;
+    let index = args.out.join("index.html");
     eprintln!("review pack of {} in {:.1} s: {}", data.study, start.elapsed().as_secs_f64(), index.display());
     Ok(())
 }
@@ -112,8 +126,7 @@ fn run_for_report(args: &ReportArgs) -> Result<(crate::report::ReviewData, Vec<c
     {
         return Err(CliError::Input(format!("--cost {r} (allowed: 1 to 20 rounds)")));
     }
-    let pool =
-        crate::jobs::pool(args.threads.unwrap_or(0), "shoal-report").map_err(|e| CliError::Run(e.to_string()))?;
+    let pool = super::pool(args.threads.unwrap_or(0), "shoal-report")?;
     let control = super::interrupt::control();
     eprintln!("{}: running {} runs …", spec.name, resolved.runs.len());
     let result = pool.install(|| run_study(&resolved, &control, |_, _| Ok(())))?;

@@ -47,8 +47,8 @@ pub fn run(args: &ReproduceArgs) -> Result<(), CliError> {
             .check(d as f64)
             .map_err(|m| CliError::Input(format!("--decimation: {m}")))?;
     }
-    let pool =
-        crate::jobs::pool(args.threads.unwrap_or(0), "shoal-reproduce").map_err(|e| CliError::Run(e.to_string()))?;
+    let out = crate::study::OutputDir::create(&args.out, "shoal reproduce")?;
+    let pool = super::pool(args.threads.unwrap_or(0), "shoal-reproduce")?;
     let start = Instant::now();
     let (lake, heron) = pool.install(|| -> Result<_, CliError> {
         Ok((run_one(LAKE_HUME, args.decimation)?, run_one(HERON_ISLAND, args.decimation)?))
@@ -66,12 +66,12 @@ pub fn run(args: &ReproduceArgs) -> Result<(), CliError> {
         rayon::current_num_threads().max(pool.current_num_threads())
     );
     let md = reproduction::markdown(&rows, &header);
-    std::fs::create_dir_all(&args.out).map_err(|e| CliError::Run(format!("{}: {e}", args.out.display())))?;
-    write_bytes(&args.out.join("reproduction.csv"), reproduction::csv(&rows).as_bytes())?;
-    write_bytes(&args.out.join("reproduction.md"), md.as_bytes())?;
+    write_bytes(&out.path().join("reproduction.csv"), reproduction::csv(&rows).as_bytes())?;
+    write_bytes(&out.path().join("reproduction.md"), md.as_bytes())?;
     let figure = pool.install(|| reproduction::figure5(&lake, &heron, &numbers))?;
-    write_bytes(&args.out.join("figure5.png"), &figure.png)?;
-    write_bytes(&args.out.join("figure5.svg"), figure.svg.as_bytes())?;
+    write_bytes(&out.path().join("figure5.png"), &figure.png)?;
+    write_bytes(&out.path().join("figure5.svg"), figure.svg.as_bytes())?;
+    out.commit()?;
     print!("{md}");
     eprintln!("wrote {}", args.out.display());
     Ok(())

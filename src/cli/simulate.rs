@@ -30,7 +30,7 @@ pub struct SimulateArgs {
     /// A full run configuration (RON, as written to config.ron); flags override it.
     #[arg(long)]
     config: Option<PathBuf>,
-    /// Output directory (created; files in it are replaced atomically).
+    /// Output directory (written whole: a new folder, or one Shoal wrote, which is replaced).
     #[arg(long)]
     out: PathBuf,
     /// Format of the cubes and maps: npy, or geotiff (georeferenced, for GIS tools).
@@ -142,7 +142,7 @@ pub fn config_from(args: &SimulateArgs) -> Result<RunConfig, CliError> {
 
 /// Run `config` on `threads` threads with a progress bar on standard error.
 pub fn run_with_progress(config: &RunConfig, threads: Option<usize>, label: &str) -> Result<RunOutput, CliError> {
-    let pool = crate::jobs::pool(threads.unwrap_or(0), "shoal-simulate").map_err(|e| CliError::Run(e.to_string()))?;
+    let pool = super::pool(threads.unwrap_or(0), "shoal-simulate")?;
     let control = Arc::new(super::interrupt::control());
     let bar = indicatif::ProgressBar::new(1);
     bar.set_style(
@@ -178,11 +178,13 @@ pub fn run_with_progress(config: &RunConfig, threads: Option<usize>, label: &str
 /// `shoal simulate`.
 pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     let config = config_from(args)?;
+    let dir = crate::study::OutputDir::create(&args.out, "shoal simulate")?;
     let label = format!("{} over {}", config.instrument.name, config.scene.name);
     let out = run_with_progress(&config, args.threads, &label)?;
-    let written = crate::study::write_run_as(&out, &args.out, args.format.into())
+    let written = crate::study::write_run_as(&out, dir.path(), args.format.into())
         .map_err(|e| CliError::Run(e.to_string()))?
         .files;
+    dir.commit()?;
     let (rows, cols, nb) = out.report.shape;
     eprintln!("{label}: {rows} lines × {cols} detectors × {nb} bands in {:.2} s", out.report.total_seconds);
     eprint!("{}", out.report.table());

@@ -75,7 +75,9 @@ pub fn run(args: &StudyArgs) -> Result<(), CliError> {
         }
         c.fault = fault;
     }
-    let pool = crate::jobs::pool(args.threads.unwrap_or(0), "shoal-study").map_err(|e| CliError::Run(e.to_string()))?;
+    // The output folder is checked (and a staging folder beside it opened) before any run.
+    let out_dir = crate::study::OutputDir::create(&args.out, "shoal study")?;
+    let pool = super::pool(args.threads.unwrap_or(0), "shoal-study")?;
     let n = resolved.runs.len();
     let bar = indicatif::ProgressBar::new(n as u64);
     bar.set_style(
@@ -99,11 +101,12 @@ pub fn run(args: &StudyArgs) -> Result<(), CliError> {
             }
         });
         let result = pool.install(|| {
-            run_study(&resolved, &control, |i, out| {
+            run_study(&resolved, &control, |i, run_out| {
                 let (label, seed, _) = &resolved.runs[i];
                 if !args.no_cubes {
                     let sub = if spec.seeds.len() > 1 { format!("{label}_seed{seed}") } else { label.clone() };
-                    write_run_as(out, &args.out.join(sub), args.format.into())?;
+                    let dir = crate::parse::join_name(out_dir.path(), "instrument.name", &sub)?;
+                    write_run_as(run_out, &dir, args.format.into())?;
                 }
                 bar.inc(1);
                 Ok(())
@@ -114,11 +117,15 @@ pub fn run(args: &StudyArgs) -> Result<(), CliError> {
     });
     bar.finish_and_clear();
     let result = result?;
-    let mut outputs = pool.install(|| write_study(&result, &args.out, !args.no_figures))?;
-    // What `shoal report DIR` builds the review pack from, without rerunning.
-    let review = crate::report::review_json(&crate::report::review_data(&result, &[], &[]))?;
-    crate::study::write_bytes(&args.out.join(crate::report::REVIEW_JSON), review.as_bytes())?;
+    let mut outputs = pool.install(|| write_study(&result, out_dir.path(), !args.no_figures))?;
+    // What `shoal report DIR` builds the review pack from, without rerunning: the data and the
+    // names of the figures drawn (the pack takes only those).
+    let mut review = crate::report::review_data(&result, &[], &[]);
+    review.figures = outputs.figure_names();
+    let review = crate::report::review_json(&review)?;
+    crate::study::write_bytes(&out_dir.path().join(crate::report::REVIEW_JSON), review.as_bytes())?;
     outputs.files.push(crate::report::REVIEW_JSON.into());
+    out_dir.commit()?;
     eprintln!("{}: {n} runs in {:.1} s", spec.name, start.elapsed().as_secs_f64());
     print_metrics(&result);
     if let Some(r) = &spec.requirements {

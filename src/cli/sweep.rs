@@ -101,7 +101,8 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
             c.fidelity.decimation = d;
         }
     }
-    let pool = crate::jobs::pool(args.threads.unwrap_or(0), "shoal-sweep").map_err(|e| CliError::Run(e.to_string()))?;
+    let out = crate::study::OutputDir::create(&args.out, "shoal sweep")?;
+    let pool = super::pool(args.threads.unwrap_or(0), "shoal-sweep")?;
     let mine = sweep.jobs.iter().filter(|j| shard.owns(j.index)).count();
     let bar = indicatif::ProgressBar::new(mine as u64);
     bar.set_style(
@@ -118,9 +119,9 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
     for (j, s) in &result.seconds {
         timings.push_str(&format!("{j},{s:.3}\n"));
     }
-    write_bytes(&args.out.join("timings.csv"), timings.as_bytes())?;
+    write_bytes(&out.path().join("timings.csv"), timings.as_bytes())?;
     write_bytes(
-        &args.out.join("sweep.ron"),
+        &out.path().join("sweep.ron"),
         ron::ser::to_string_pretty(&spec, ron::ser::PrettyConfig::default()).unwrap_or_default().as_bytes(),
     )?;
     eprintln!(
@@ -132,14 +133,16 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
     );
     if shard.count > 1 {
         // A slice: the table only; curves come from `shoal merge`.
-        write_bytes(&args.out.join("table.csv"), result.table.to_csv().as_bytes())?;
-        return Ok(());
+        write_bytes(&out.path().join("table.csv"), result.table.to_csv().as_bytes())?;
+    } else {
+        write_outputs(&result.table, Some(&spec), out.path(), !args.no_figures)?;
     }
-    write_outputs(&result.table, Some(&spec), &args.out, !args.no_figures)
+    Ok(out.commit()?)
 }
 
 /// `shoal merge`.
 pub fn merge_run(args: &MergeArgs) -> Result<(), CliError> {
+    let out = crate::study::OutputDir::create(&args.out, "shoal merge")?;
     let mut parts = Vec::new();
     let mut spec = None;
     for dir in &args.shards {
@@ -156,9 +159,10 @@ pub fn merge_run(args: &MergeArgs) -> Result<(), CliError> {
     eprintln!("{}: merged {} tables, {} runs, {} rows", table.name, parts.len(), table.jobs, table.rows.len());
     if let Some(s) = &spec {
         write_bytes(
-            &args.out.join("sweep.ron"),
+            &out.path().join("sweep.ron"),
             ron::ser::to_string_pretty(s, ron::ser::PrettyConfig::default()).unwrap_or_default().as_bytes(),
         )?;
     }
-    write_outputs(&table, spec.as_ref(), &args.out, !args.no_figures)
+    write_outputs(&table, spec.as_ref(), out.path(), !args.no_figures)?;
+    Ok(out.commit()?)
 }

@@ -19,6 +19,18 @@ pub struct Outputs {
     pub files: Vec<String>,
 }
 
+impl Outputs {
+    /// The figures written (the stems of `figures/*.svg`), in the order they were drawn.
+    #[must_use]
+    pub fn figure_names(&self) -> Vec<String> {
+        self.files
+            .iter()
+            .filter_map(|f| f.strip_prefix("figures/").and_then(|f| f.strip_suffix(".svg")))
+            .map(str::to_string)
+            .collect()
+    }
+}
+
 /// Write `bytes` to `path` atomically: a temporary file beside it, flushed to disk, then renamed
 /// over `path`. A failure (full disk, read-only directory) removes the temporary file and names
 /// the file and the reason; `path` then still holds what it held before.
