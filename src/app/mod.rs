@@ -136,6 +136,8 @@ pub struct ShoalApp {
     saved_state: Option<AppState>,
     /// The session write in progress (on its own thread: the UI thread never touches the disk).
     session_writer: Option<std::thread::JoinHandle<Result<(), String>>>,
+    /// This window's hold on the session (`None`: it does not save the session).
+    _session_lock: Option<session::SessionLock>,
 }
 
 /// Storage key of the session.
@@ -178,19 +180,36 @@ impl ShoalApp {
             session_path: None,
             saved_state: None,
             session_writer: None,
+            _session_lock: None,
         }
     }
 
-    /// The app as eframe creates it: the saved session, or the default study.
+    /// The app as eframe creates it: the saved session, or the default study. A fresh start
+    /// (`--fresh`, `--screenshot`) reads and writes no session; a second window while another
+    /// holds the session starts from it but does not save it (and says so).
     #[must_use]
     pub fn new(cc: &eframe::CreationContext<'_>, options: AppOptions) -> Self {
         let path = session::session_path(&crate::library::home_dir());
-        let (state, problem) = match (options.fresh, session::load_session(&path)) {
+        let lock = if options.fresh { Err(String::new()) } else { session::SessionLock::acquire(&path) };
+        // A fresh start does not read the session either (an unreadable one stays where it is).
+        let saved = if options.fresh { None } else { Some(session::load_session(&path)) };
+        let (state, problem) = match (options.fresh, saved.unwrap_or(session::SavedSession::None)) {
             (true, _) => (None, None),
-            (false, session::SavedSession::Restored(s)) => (Some(*s), None),
+            (false, session::SavedSession::Restored(s, reset)) => (
+                Some(*s),
+                (!reset.is_empty()).then(|| {
+                    format!("Parts of the saved session were out of range and were reset: {}.", reset.join("; "))
+                }),
+            ),
             // A session saved by an earlier Shoal in eframe's own storage (outside SHOAL_HOME).
             (false, session::SavedSession::None) => {
-                (cc.storage.and_then(|s| eframe::get_value::<AppState>(s, STATE_KEY)), None)
+                let mut old = cc.storage.and_then(|s| eframe::get_value::<AppState>(s, STATE_KEY));
+                let reset = old.as_mut().map(session::repair).unwrap_or_default();
+                (
+                    old,
+                    (!reset.is_empty())
+                        .then(|| format!("Parts of the saved session were reset: {}.", reset.join("; "))),
+                )
             }
             (false, session::SavedSession::Unreadable { message, kept_at }) => (
                 None,
@@ -202,8 +221,18 @@ impl ShoalApp {
             ),
         };
         let mut app = Self::with_state(state.unwrap_or_default(), &cc.egui_ctx, options);
-        app.session_path = Some(path);
         app.ui.error = problem;
+        match lock {
+            Ok(lock) => {
+                app.session_path = Some(path);
+                app._session_lock = Some(lock);
+            }
+            Err(why) if !why.is_empty() => {
+                let before = app.ui.error.take().map(|e| format!("{e} ")).unwrap_or_default();
+                app.ui.error = Some(format!("{before}{why}: this window will not save its session."));
+            }
+            Err(_) => {}
+        }
         match crate::engine::Fault::from_env() {
             Ok(fault) => app.ui.fault = fault,
             Err(e) => app.ui.error = Some(e),

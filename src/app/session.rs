@@ -1,12 +1,15 @@
-//! The app's session on disk: where it is, reading it (a file that does not parse is moved
-//! aside, never overwritten), writing it atomically.
+//! The app's session on disk: where it is, reading it (a file that cannot be read is moved aside
+//! under a name of its own, never overwritten), checking what was read field by field, writing it
+//! atomically, and the lock that keeps a second window from overwriting the first one's session.
 
-use super::model::AppState;
+use std::path::{Path, PathBuf};
+
+use super::model::{AppState, Slot, fallback_requirements};
 
 /// Where the session is kept: `session.ron` in the user's Shoal directory (`SHOAL_HOME` when it
 /// is set; see [`crate::library::home_dir`]), beside the preset library and the exports.
 #[must_use]
-pub fn session_path(home: &std::path::Path) -> std::path::PathBuf {
+pub fn session_path(home: &Path) -> PathBuf {
     home.join("session.ron")
 }
 
@@ -15,28 +18,45 @@ pub fn session_path(home: &std::path::Path) -> std::path::PathBuf {
 pub enum SavedSession {
     /// No session file: the first start.
     None,
-    /// The session as saved.
-    Restored(Box<AppState>),
-    /// A file that does not parse (an older or damaged session). It has been moved aside to
-    /// the path given, so the next save cannot overwrite what the user made; the message says
-    /// what was wrong.
+    /// The session as saved, with what had to be reset in it (empty: nothing).
+    Restored(Box<AppState>, Vec<String>),
+    /// A file that cannot be read (not UTF-8, not RON, an older or damaged session). It has been
+    /// moved aside to the path given, so the next save cannot overwrite what the user made; the
+    /// message says what was wrong.
     Unreadable {
         /// Why it could not be read.
         message: String,
         /// Where the file now is.
-        kept_at: std::path::PathBuf,
+        kept_at: PathBuf,
     },
 }
 
-/// Read the session at `path`; a file that does not parse is renamed to `*.unreadable`.
+/// A free name for an unreadable session: `session.ron.unreadable`, then `….unreadable.2`, …,
+/// so an earlier one kept aside is never overwritten.
+fn aside_name(path: &Path) -> PathBuf {
+    let first = path.with_extension("ron.unreadable");
+    (1..10_000)
+        .map(|i| if i == 1 { first.clone() } else { path.with_extension(format!("ron.unreadable.{i}")) })
+        .find(|p| !p.exists())
+        .unwrap_or(first)
+}
+
+/// Read the session at `path`. A file that cannot be read as a session is renamed to a free
+/// `*.unreadable*` name; one that reads is checked field by field ([`repair`]).
 #[must_use]
-pub fn load_session(path: &std::path::Path) -> SavedSession {
-    let Ok(text) = std::fs::read_to_string(path) else { return SavedSession::None };
-    match ron::from_str::<AppState>(&text) {
-        Ok(state) => SavedSession::Restored(Box::new(state)),
-        Err(e) => {
-            let kept_at = path.with_extension("ron.unreadable");
-            let message = crate::parse::describe(&text, &e);
+pub fn load_session(path: &Path) -> SavedSession {
+    let Ok(bytes) = std::fs::read(path) else { return SavedSession::None };
+    let parsed = match String::from_utf8(bytes) {
+        Ok(text) => ron::from_str::<AppState>(&text).map_err(|e| crate::parse::describe(&text, &e)),
+        Err(e) => Err(format!("byte {} is not UTF-8 text", e.utf8_error().valid_up_to())),
+    };
+    match parsed {
+        Ok(mut state) => {
+            let reset = repair(&mut state);
+            SavedSession::Restored(Box::new(state), reset)
+        }
+        Err(message) => {
+            let kept_at = aside_name(path);
             let moved = std::fs::rename(path, &kept_at);
             SavedSession::Unreadable {
                 message: match moved {
@@ -49,21 +69,116 @@ pub fn load_session(path: &std::path::Path) -> SavedSession {
     }
 }
 
+/// Check a restored session field by field, as the app's editors would have: each part that
+/// is out of range (a hand-edited or damaged file: a NaN aperture, a negative step) is reset to
+/// its default and named in the list returned, so the rest of the session is kept.
+pub fn repair(state: &mut AppState) -> Vec<String> {
+    let defaults = AppState::default();
+    let mut reset = Vec::new();
+    for (name, slot, default) in [("A", &mut state.a, &defaults.a), ("B", &mut state.b, &defaults.b)] {
+        if let Err(e) = slot.spec.validate() {
+            let back = [&slot.original, &default.spec].into_iter().find(|s| s.validate().is_ok()).cloned();
+            let back = back.unwrap_or_else(|| default.spec.clone());
+            reset.push(format!("instrument {name} ({e}): back to {}", back.name));
+            *slot = Slot { preset: slot.preset.clone(), original: back.clone(), spec: back };
+        } else if slot.original.validate().is_err() {
+            slot.original = slot.spec.clone();
+        }
+    }
+    if let Err(e) = state.scene.validate() {
+        reset.push(format!("scene ({e}): back to {}", defaults.scene_name));
+        (state.scene, state.scene_name) = (defaults.scene.clone(), defaults.scene_name.clone());
+    }
+    if let Err(e) = state.fidelity.validate() {
+        reset.push(format!("fidelity ({e}): back to the defaults"));
+        state.fidelity = defaults.fidelity.clone();
+    }
+    if let Err(e) = state.requirements.validate() {
+        reset.push(format!("requirements ({e}): back to the defaults"));
+        state.requirements = fallback_requirements();
+    }
+    if let Err(e) = state.retrieval_spec().validate() {
+        reset.push(format!("retrieval settings ({e}): back to the defaults"));
+        (state.almi, state.sambuca) = (defaults.almi.clone(), defaults.sambuca.clone());
+    }
+    reset
+}
+
 /// Write the session to `path` atomically (a temporary file, synced, then a rename).
-pub fn save_session(path: &std::path::Path, state: &AppState) -> Result<(), String> {
+pub fn save_session(path: &Path, state: &AppState) -> Result<(), String> {
     let text = ron::ser::to_string_pretty(state, ron::ser::PrettyConfig::default())
         .map_err(|e| format!("cannot encode the session: {e}"))?;
     crate::study::write_bytes(path, text.as_bytes()).map_err(|e| e.to_string())
+}
+
+/// The session's lock: a file beside the session naming the process that owns it. The window
+/// that holds it saves the session; a second window started meanwhile does not (it is told so),
+/// so whichever closes last cannot overwrite the other's work. A lock left by a process that no
+/// longer runs is taken over.
+#[derive(Debug)]
+pub struct SessionLock {
+    path: PathBuf,
+}
+
+/// Is process `pid` running? (Linux: its /proc entry. Elsewhere, a lock is always taken as
+/// held: the second window then saves nothing, which loses no one's work.)
+fn running(pid: u32) -> bool {
+    !Path::new("/proc/self").exists() || Path::new(&format!("/proc/{pid}")).exists()
+}
+
+impl SessionLock {
+    /// Take the lock beside `session`, or say which running process holds it.
+    pub fn acquire(session: &Path) -> Result<Self, String> {
+        let path = session.with_extension("lock");
+        if let Some(parent) = path.parent() {
+            let _ = std::fs::create_dir_all(parent);
+        }
+        for _ in 0..2 {
+            match std::fs::OpenOptions::new().write(true).create_new(true).open(&path) {
+                Ok(mut f) => {
+                    use std::io::Write as _;
+                    let _ = write!(f, "{}", std::process::id());
+                    return Ok(Self { path });
+                }
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
+                    let holder = std::fs::read_to_string(&path).ok().and_then(|t| t.trim().parse::<u32>().ok());
+                    match holder {
+                        Some(pid) if running(pid) && pid != std::process::id() => {
+                            return Err(format!("another Shoal window (process {pid}) has the session open"));
+                        }
+                        // Left by a process that is gone (or unreadable): take it over.
+                        _ => {
+                            let _ = std::fs::remove_file(&path);
+                        }
+                    }
+                }
+                Err(e) => return Err(format!("cannot create {}: {e}", path.display())),
+            }
+        }
+        Err(format!("cannot take {}", path.display()))
+    }
+}
+
+impl Drop for SessionLock {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.path);
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
+    fn home(tag: &str) -> PathBuf {
+        let home = std::env::temp_dir().join(format!("shoal-session-{tag}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&home);
+        std::fs::create_dir_all(&home).unwrap_or_else(|e| panic!("{e}"));
+        home
+    }
+
     #[test]
     fn the_session_round_trips_and_a_broken_one_is_kept_aside() {
-        let home = std::env::temp_dir().join(format!("shoal-session-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&home);
+        let home = home("trip");
         let path = session_path(&home);
         assert!(path.starts_with(&home));
         assert!(matches!(load_session(&path), SavedSession::None));
@@ -71,7 +186,7 @@ mod tests {
         s.a.spec.aperture_mm = 77.0;
         save_session(&path, &s).unwrap();
         match load_session(&path) {
-            SavedSession::Restored(back) => assert_eq!(*back, s),
+            SavedSession::Restored(back, reset) => assert_eq!((*back, reset), (s, Vec::new())),
             other => panic!("{other:?}"),
         }
         std::fs::write(&path, "AppState(a: 3").unwrap();
@@ -82,6 +197,59 @@ mod tests {
             }
             other => panic!("{other:?}"),
         }
+        let _ = std::fs::remove_dir_all(&home);
+    }
+
+    #[test]
+    fn a_non_utf8_session_is_kept_and_a_second_unreadable_one_does_not_overwrite_the_first() {
+        let home = home("utf8");
+        let path = session_path(&home);
+        let mut text = ron::to_string(&AppState::default()).unwrap().into_bytes();
+        text.insert(10, 0xFF);
+        std::fs::write(&path, &text).unwrap();
+        let SavedSession::Unreadable { message, kept_at: first } = load_session(&path) else { panic!("read") };
+        assert!(message.contains("not UTF-8"), "{message}");
+        assert_eq!(std::fs::read(&first).unwrap(), text, "kept byte for byte");
+        std::fs::write(&path, "AppState(").unwrap();
+        let SavedSession::Unreadable { kept_at: second, .. } = load_session(&path) else { panic!("read") };
+        assert_ne!(first, second);
+        assert_eq!(std::fs::read(&first).unwrap(), text, "the first one kept aside is untouched");
+        assert_eq!(std::fs::read_to_string(&second).unwrap(), "AppState(");
+        let _ = std::fs::remove_dir_all(&home);
+    }
+
+    #[test]
+    fn a_nan_in_the_session_is_reset_with_its_field_named_and_the_rest_kept() {
+        let mut s = AppState::default();
+        s.a.spec.aperture_mm = f64::NAN;
+        s.b.spec.read_noise_e = 12.0;
+        s.fidelity.spectral_step_nm = -1.0;
+        s.noise_seed = 9;
+        let reset = repair(&mut s);
+        assert_eq!(reset.len(), 2, "{reset:?}");
+        assert!(reset[0].starts_with("instrument A (") && reset[0].contains("aperture_mm"), "{reset:?}");
+        assert!(reset[1].starts_with("fidelity (") && reset[1].contains("spectral_step_nm"), "{reset:?}");
+        assert_eq!(s.a.spec, AppState::default().a.spec);
+        assert_eq!((s.b.spec.read_noise_e, s.noise_seed), (12.0, 9), "valid fields are kept");
+        assert!(repair(&mut s).is_empty(), "a repaired session is valid");
+    }
+
+    #[test]
+    fn one_window_holds_the_lock_and_a_stale_lock_is_taken_over() {
+        let home = home("lock");
+        let path = session_path(&home);
+        let lock = SessionLock::acquire(&path).unwrap();
+        // The same process asking again (a second window in this process) takes it over; a lock
+        // naming another running process is refused. PID 1 always runs.
+        std::fs::write(path.with_extension("lock"), "1").unwrap();
+        let e = SessionLock::acquire(&path).unwrap_err();
+        assert!(e.contains("process 1"), "{e}");
+        // PID 0 is never a user process: a stale lock.
+        std::fs::write(path.with_extension("lock"), "0").unwrap();
+        let again = SessionLock::acquire(&path).unwrap();
+        drop(lock);
+        drop(again);
+        assert!(!path.with_extension("lock").exists());
         let _ = std::fs::remove_dir_all(&home);
     }
 }
