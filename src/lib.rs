@@ -47,6 +47,7 @@
 pub mod app;
 pub mod assets;
 pub mod atmosphere;
+pub mod budget;
 pub mod calibration;
 pub mod cli;
 pub mod colormap;

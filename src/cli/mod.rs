@@ -161,6 +161,20 @@ macro_rules! input_error {
 }
 input_error!(crate::water::WaterError, crate::atmosphere::AtmosphereError, crate::spectral::SpectralError);
 
+/// Most worker threads a command starts (`--threads`): beyond a few per core threads only
+/// contend, and a typo of 100 000 would stall the machine starting them.
+pub const MAX_THREADS: usize = 256;
+
+/// A command's rayon pool, its `--threads` checked first (0: one per core).
+fn pool(threads: usize, name: &'static str) -> Result<rayon::ThreadPool, CliError> {
+    if threads > MAX_THREADS {
+        return Err(CliError::Input(format!(
+            "--threads {threads} is out of range (allowed: 0, one per core, to {MAX_THREADS})"
+        )));
+    }
+    crate::jobs::pool(threads, name).map_err(|e| CliError::Run(e.to_string()))
+}
+
 /// `shoal dev almi-sets DIR`.
 fn almi_sets(dir: &std::path::Path) -> Result<(), CliError> {
     use crate::retrieval::sets::{ALMI_SETS, almi_clusters, set_ron};

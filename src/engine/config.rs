@@ -168,8 +168,10 @@ impl RunConfig {
 
     /// Check every setting that needs no built stage against [`crate::ranges`] — instrument,
     /// fidelity, calibration, correction, the scene's numbers and atmosphere, the retrievals'
-    /// settings — so a bad value is refused before any stage runs, named with the stage that
-    /// owns it. (The maps' values are checked when the scene stage builds them.)
+    /// settings — and what the run will ask of the machine against its budget
+    /// ([`super::resources`]), so a bad value or a run that would not fit is refused before any
+    /// stage runs, named with the stage that owns it. (The maps' values are checked when the
+    /// scene stage builds them.)
     pub fn validate(&self) -> Result<(), super::EngineError> {
         use super::{EngineError, Stage};
         fn at<E: std::fmt::Display>(stage: Stage) -> impl Fn(E) -> EngineError {
@@ -186,6 +188,14 @@ impl RunConfig {
         for r in &self.retrievals {
             r.validate().map_err(|e| at(Stage::Retrieval)(format!("{}: {e}", r.name())))?;
         }
+        // What the run will ask of the machine, against its budget (`engine::resources`).
+        let budget = crate::budget::Budget::from_env().map_err(at(Stage::Scene))?;
+        let demand = super::resources::run_demand(self);
+        budget.check(&demand).map_err(at(if demand.atmosphere_s > budget.atmosphere_s {
+            Stage::Lut
+        } else {
+            Stage::Geometry
+        }))?;
         Ok(())
     }
 

@@ -41,6 +41,7 @@ mod files;
 mod keys;
 mod products;
 mod report;
+pub mod resources;
 mod retrieval_stage;
 mod run;
 mod stages;

@@ -16,7 +16,7 @@ mod read;
 mod write;
 
 pub use keys::USER_DEFINED_NAME;
-pub use read::{read, read_bytes};
+pub use read::{MAX_SAMPLES, read, read_bytes, read_bytes_limited, read_limited};
 pub use write::{ascii as ascii_text, encode};
 
 /// A coordinate reference system, as far as Shoal needs to know it.

@@ -11,10 +11,19 @@ use tiff::tags::{PlanarConfiguration, Tag};
 use super::keys::{self, GDAL_METADATA, GDAL_NODATA, GEO_ASCII_PARAMS, GEO_DOUBLE_PARAMS, GEO_KEY_DIRECTORY};
 use super::{Crs, GeoTiffError, Raster};
 
-/// Read the GeoTIFF at `path`.
+/// Most samples (all bands) the reader holds at once, whatever the budget.
+pub const MAX_SAMPLES: usize = 1 << 29;
+
+/// Read the GeoTIFF at `path` (at most [`MAX_SAMPLES`] samples).
 pub fn read(path: &Path) -> Result<Raster, GeoTiffError> {
+    read_limited(path, MAX_SAMPLES)
+}
+
+/// Read the GeoTIFF at `path` if it holds at most `max_samples` samples (all bands), checked
+/// from its header before anything is decoded: a small compressed file can claim gigabytes.
+pub fn read_limited(path: &Path, max_samples: usize) -> Result<Raster, GeoTiffError> {
     let bytes = std::fs::read(path).map_err(|e| GeoTiffError(format!("cannot read {}: {e}", path.display())))?;
-    read_bytes(&bytes, &path.display().to_string())
+    read_bytes_limited(&bytes, &path.display().to_string(), max_samples)
 }
 
 fn samples(result: DecodingResult) -> Vec<f64> {
@@ -33,15 +42,20 @@ fn samples(result: DecodingResult) -> Vec<f64> {
     }
 }
 
-/// Read GeoTIFF `bytes`; `origin` names the file in errors.
+/// Read GeoTIFF `bytes`; `origin` names the file in errors (at most [`MAX_SAMPLES`] samples).
 pub fn read_bytes(bytes: &[u8], origin: &str) -> Result<Raster, GeoTiffError> {
+    read_bytes_limited(bytes, origin, MAX_SAMPLES)
+}
+
+/// [`read_bytes`] for a file of at most `max_samples` samples.
+pub fn read_bytes_limited(bytes: &[u8], origin: &str, max_samples: usize) -> Result<Raster, GeoTiffError> {
     // The decoder asserts on some malformed inputs; a bad file must be an error, not a crash.
-    std::panic::catch_unwind(|| decode(bytes, origin)).unwrap_or_else(|_| {
+    std::panic::catch_unwind(|| decode(bytes, origin, max_samples.min(MAX_SAMPLES))).unwrap_or_else(|_| {
         Err(GeoTiffError(format!("{origin}: the TIFF decoder failed on this file (malformed or unsupported layout)")))
     })
 }
 
-fn decode(bytes: &[u8], origin: &str) -> Result<Raster, GeoTiffError> {
+fn decode(bytes: &[u8], origin: &str, max_samples: usize) -> Result<Raster, GeoTiffError> {
     let fail = |e: tiff::TiffError| GeoTiffError::from_tiff(origin, &e);
     let mut d = Decoder::new(Cursor::new(bytes)).map_err(fail)?;
     let (w, h) = d.dimensions().map_err(fail)?;
@@ -70,10 +84,10 @@ fn decode(bytes: &[u8], origin: &str) -> Result<Raster, GeoTiffError> {
     // asserts on some tiled multi-band layouts GDAL writes, and one chunk at a time keeps the
     // buffers small.
     // A header can claim any size: refuse what would not fit in memory before allocating.
-    const MAX_SAMPLES: usize = 1 << 29;
-    if w.saturating_mul(h).saturating_mul(n) > MAX_SAMPLES {
+    if w.saturating_mul(h).saturating_mul(n) > max_samples {
         return Err(GeoTiffError(format!(
-            "{origin}: {w} × {h} × {n} samples is more than Shoal reads at once ({MAX_SAMPLES}); crop or coarsen it first (gdal_translate -srcwin, gdalwarp -tr)"
+            "{origin}: {w} × {h} × {n} samples ({:.1} GB as read) is more than this run may hold ({max_samples} samples; see SHOAL_MEMORY_BUDGET); crop it to the scene or coarsen it first (gdal_translate -srcwin, gdalwarp -tr)",
+            (w as f64) * (h as f64) * (n as f64) * 8.0 / 1e9
         )));
     }
     let spp = if planar { 1 } else { n };

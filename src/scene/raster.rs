@@ -141,9 +141,13 @@ impl RasterCache {
             return Ok(Arc::clone(r));
         }
         let embedded = base_dir.is_none().then(|| crate::assets::raster(&path.to_string_lossy())).flatten();
+        // A quarter of the run's memory budget for one file's samples.
+        let limit = crate::budget::Budget::from_env().map_err(|m| invalid(field, m))?.raster_limit_samples();
         let raster = match embedded {
-            Some(bytes) if !full.exists() => crate::geotiff::read_bytes(bytes, &path.display().to_string()),
-            _ => crate::geotiff::read(&full),
+            Some(bytes) if !full.exists() => {
+                crate::geotiff::read_bytes_limited(bytes, &path.display().to_string(), limit)
+            }
+            _ => crate::geotiff::read_limited(&full, limit),
         }
         .map_err(|e| invalid(field, format!("GeoTIFF: {e}")))?;
         let raster = Arc::new(raster);
@@ -178,7 +182,13 @@ pub fn resolve_frame(
                     format!(
                         "{name} is in {} ({}): the scene grid needs a projected CRS in metres; reproject it, e.g. `gdalwarp -t_srs EPSG:32756 -tr 10 10 in.tif out.tif`",
                         r.crs.describe(),
-                        if matches!(r.crs, Crs::Geographic { .. }) { "degrees" } else { "no metric unit" }
+                        if matches!(r.crs, Crs::Geographic { .. }) {
+                            "degrees"
+                        } else if r.linear_unit_m.is_nan() {
+                            "its linear unit is not stated in the file: add ProjLinearUnitsGeoKey, e.g. with `gdal_edit.py -a_srs EPSG:…`"
+                        } else {
+                            "no metric unit"
+                        }
                     ),
                 ));
             }
@@ -204,6 +214,72 @@ pub fn resolve_frame(
 
 /// Scene (x, y), m → fractional (column, row) of the raster's cell centres.
 type Locate = Box<dyn Fn(f64, f64) -> Option<(f64, f64)>>;
+
+/// Where each scene cell centre falls in raster `r`, as fractional (col, row) of cell centres:
+/// through both geotransforms, or stretched over the scene when the raster has none.
+fn locator(
+    r: &Arc<Raster>,
+    extent: Extent,
+    frame: Option<&GeoFrame>,
+    field: &str,
+    path: &Path,
+) -> Result<Locate, SceneError> {
+    let name = path.display();
+    let (hx, hy) = extent.half_size_m();
+    Ok(match (frame, r.geotransform) {
+        (Some(f), Some(_)) => {
+            let anonymous =
+                |c: &Crs| matches!(c, Crs::LocalMetres { name } if name == crate::geotiff::USER_DEFINED_NAME);
+            if anonymous(&r.crs) || anonymous(&f.crs) {
+                return Err(invalid(
+                    field,
+                    format!(
+                        "{name} or the scene is in a user-defined CRS with no name, which cannot be matched to the other; give both an EPSG code (`gdal_edit.py -a_srs EPSG:…`)"
+                    ),
+                ));
+            }
+            if r.crs != f.crs && r.crs != Crs::None {
+                return Err(invalid(
+                    field,
+                    format!(
+                        "{name} is in {}, the scene in {}; reproject it with `gdalwarp -t_srs {}`",
+                        r.crs.describe(),
+                        f.crs.describe(),
+                        f.crs.describe()
+                    ),
+                ));
+            }
+            let unit = r.linear_unit_m;
+            if !(unit.is_finite() && unit > 0.0) {
+                return Err(invalid(
+                    field,
+                    format!(
+                        "{name} ({}) does not state its linear unit: add ProjLinearUnitsGeoKey, e.g. with `gdal_edit.py -a_srs {}`",
+                        r.crs.describe(),
+                        r.crs.describe()
+                    ),
+                ));
+            }
+            let (cx, cy) = f.centre;
+            let r = Arc::clone(r);
+            Box::new(move |x, y| r.pixel(cx + x / unit, cy + y / unit).map(|(c, row)| (c - 0.5, row - 0.5)))
+        }
+        (None, Some(_)) => {
+            return Err(invalid(
+                field,
+                format!(
+                    "{name} is georeferenced ({}) but the scene is not: give the scene `georeference: Some(Raster(\"{name}\"))` (or `Epsg(code: …, centre: (…, …))`) so the map lands where it belongs",
+                    r.crs.describe()
+                ),
+            ));
+        }
+        // No geotransform: stretched over the scene, top row north (as `Image` maps are).
+        (_, None) => {
+            let (w, h) = (r.width as f64, r.height as f64);
+            Box::new(move |x, y| Some(((x + hx) / (2.0 * hx) * w - 0.5, (hy - y) / (2.0 * hy) * h - 0.5)))
+        }
+    })
+}
 
 /// The values of `source` on the scene grid `extent` (row 0 = south, as maps store them), NaN
 /// where the raster has no data.
@@ -258,51 +334,8 @@ pub fn resample(
         let v = band[row * r.width + col];
         if missing(v) { None } else { Some(source.scale * (file_scale * v + file_offset) + source.offset) }
     };
-    // Where each scene cell centre falls in the raster, as fractional (col, row) of cell centres.
+    let locate = locator(&r, extent, frame, field, &source.path)?;
     let (hx, hy) = extent.half_size_m();
-    let locate: Locate = match (frame, r.geotransform) {
-        (Some(f), Some(_)) => {
-            let anonymous =
-                |c: &Crs| matches!(c, Crs::LocalMetres { name } if name == crate::geotiff::USER_DEFINED_NAME);
-            if anonymous(&r.crs) || anonymous(&f.crs) {
-                return Err(invalid(
-                    field,
-                    format!(
-                        "{name} or the scene is in a user-defined CRS with no name, which cannot be matched to the other; give both an EPSG code (`gdal_edit.py -a_srs EPSG:…`)"
-                    ),
-                ));
-            }
-            if r.crs != f.crs && r.crs != Crs::None {
-                return Err(invalid(
-                    field,
-                    format!(
-                        "{name} is in {}, the scene in {}; reproject it with `gdalwarp -t_srs {}`",
-                        r.crs.describe(),
-                        f.crs.describe(),
-                        f.crs.describe()
-                    ),
-                ));
-            }
-            let unit = r.linear_unit_m;
-            let (cx, cy) = f.centre;
-            let r = Arc::clone(&r);
-            Box::new(move |x, y| r.pixel(cx + x / unit, cy + y / unit).map(|(c, row)| (c - 0.5, row - 0.5)))
-        }
-        (None, Some(_)) => {
-            return Err(invalid(
-                field,
-                format!(
-                    "{name} is georeferenced ({}) but the scene is not: give the scene `georeference: Some(Raster(\"{name}\"))` (or `Epsg(code: …, centre: (…, …))`) so the map lands where it belongs",
-                    r.crs.describe()
-                ),
-            ));
-        }
-        // No geotransform: stretched over the scene, top row north (as `Image` maps are).
-        (_, None) => {
-            let (w, h) = (r.width as f64, r.height as f64);
-            Box::new(move |x, y| Some(((x + hx) / (2.0 * hx) * w - 0.5, (hy - y) / (2.0 * hy) * h - 0.5)))
-        }
-    };
     let (w, h) = (r.width as isize, r.height as isize);
     let mut out = Vec::with_capacity(extent.width * extent.height);
     for row in 0..extent.height {

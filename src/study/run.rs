@@ -47,6 +47,12 @@ pub fn run_study(
     control: &RunControl,
     mut on_run: impl FnMut(usize, &RunOutput) -> Result<(), StudyError>,
 ) -> Result<StudyResult, StudyError> {
+    // The runs together against the machine's budget, before any runs (each run checks itself
+    // alone when the engine validates it).
+    let budget = crate::budget::Budget::from_env()
+        .map_err(|m| StudyError::Invalid(crate::parse::FieldError { field: "budget".into(), message: m }))?;
+    let configs: Vec<&crate::engine::RunConfig> = study.runs.iter().map(|r| &r.2).collect();
+    budget.check(&crate::engine::resources::study_demand(&configs))?;
     let mut engine = Engine::new();
     let mut runs = Vec::with_capacity(study.runs.len());
     for (i, (label, seed, config)) in study.runs.iter().enumerate() {

@@ -1,0 +1,261 @@
+//! What a run will ask of the machine, known before it starts: the bytes of its cubes, maps and
+//! rasters and the work of its radiative transfer, against a budget. A run that would not fit is
+//! refused at validation with one line naming the fields that drive it and what would fit —
+//! instead of an allocation failure (an abort) minutes in, or a run that never ends.
+//!
+//! The estimate is an upper bound built from the products' element types (a pixel-band of the
+//! chain holds radiance, the truth's Rrs, Level-0 counts and flags, Level-1, Rrs and their flags)
+//! and the scene's stored maps; `shoal bench` and the tests hold it against measured peaks.
+//!
+//! The budget it is held to is [`crate::budget::Budget`].
+
+use crate::budget::{Demand, Lever, Part};
+use crate::instrument::InstrumentKind;
+use crate::scene::{Georeference, MapSpec, SceneSpec};
+use crate::spectral::BandSetSpec;
+
+use super::RunConfig;
+
+/// Bytes a run holds per pixel and band: radiance, truth Rrs, Level-1 and Rrs (f32 each), the
+/// Level-0 counts (u16), three flag planes (u8), and the analogue signal when kept (f32) — 24 —
+/// plus the stages' working copies while they run (measured: the default study peaks at 30 per
+/// pixel-band; see the tests).
+const BYTES_PER_PIXEL_BAND: f64 = 36.0;
+/// Bytes a run holds per pixel beyond its bands: the truth's maps, the retrievals' products and
+/// flags, the view geometry of each column.
+const BYTES_PER_PIXEL: f64 = 160.0;
+/// Bytes per scene cell of a stored map (f32), and the peak while a random field is synthesised
+/// (complex f32 spectrum, its transpose, the field).
+const BYTES_PER_CELL_MAP: f64 = 4.0;
+const BYTES_PER_CELL_RANDOM_FIELD: f64 = 20.0;
+/// Seconds of radiative transfer per unit of work (layers × streams² × Fourier terms × orders,
+/// orders counted up to [`ORDERS_COUNTED`]), fitted to LUT build times of the Lake Hume scene on
+/// the 2-core machine of `shoal bench` (0.04 s at the defaults, 0.49 s with layers of 0.0005,
+/// 5.0 s at 48 streams, 96 terms and layers of 0.002) and rounded up, so the plan overestimates
+/// those by 1.3–3.5×.
+const SECONDS_PER_RT_WORK: f64 = 1e-9;
+/// Orders the successive-orders solver runs at most in practice: it stops when an order adds less
+/// than `order_tolerance`, within a few tens of orders for any atmosphere Shoal accepts.
+const ORDERS_COUNTED: f64 = 100.0;
+/// A fixed part of every LUT build, s.
+const RT_OVERHEAD_S: f64 = 0.05;
+/// Bytes per level and pair of quadrature streams the solver holds while it solves a Fourier
+/// term: the level's mixed scattering kernel, one 3 × 3 Stokes block of f64 per stream pair
+/// (`atmosphere::sos::solve`); the fields per level and stream are smaller by a factor of streams.
+const RT_BYTES_PER_LEVEL_STREAM_PAIR: f64 = 72.0;
+/// Runs whose full products the engine's cache can hold at once (`Stage::capacity` of the image
+/// stages); a study keeps only the truth and products of the others.
+const CACHED_RUNS: usize = 4;
+/// Bytes a study keeps per pixel-band of a run no longer cached: the truth's Rrs (f32).
+const KEPT_BYTES_PER_PIXEL_BAND: f64 = 4.0;
+
+/// Bands an instrument will have (without reading its band files).
+fn band_count(kind: &InstrumentKind) -> usize {
+    let set = |b: &BandSetSpec| match b {
+        BandSetSpec::Olci { bands, .. } => bands.as_ref().map_or(19, Vec::len),
+        BandSetSpec::Msi { bands, .. } => bands.as_ref().map_or(9, Vec::len),
+        BandSetSpec::Gaussian(g) => g.len(),
+    };
+    match kind {
+        InstrumentKind::Multispectral { bands } | InstrumentKind::IdealRadiometer { bands } => set(bands),
+        InstrumentKind::FilterImager { bands, .. } => set(bands),
+        InstrumentKind::Spectrograph { start_nm, end_nm, sampling_nm, .. } => {
+            let n = ((end_nm - start_nm) / sampling_nm).floor();
+            if n.is_finite() && n >= 0.0 { n as usize + 1 } else { 1 }
+        }
+    }
+}
+
+/// The scene's stored maps and their peak while built.
+fn scene_parts(scene: &SceneSpec, parts: &mut Vec<Part>) {
+    let cells = (scene.width as f64) * (scene.height as f64);
+    let mut maps: Vec<&MapSpec> = vec![&scene.chl_mg_m3, &scene.nap_g_m3, &scene.cdom_per_m];
+    maps.extend(scene.depth_m.as_ref());
+    maps.extend(scene.substrates.iter().map(|s| &s.fraction));
+    maps.extend(scene.land.as_ref().map(|l| &l.mask));
+    let stored = maps
+        .iter()
+        .filter(|m| matches!(m, MapSpec::RandomField { .. } | MapSpec::Image { .. } | MapSpec::Raster { .. }))
+        .count();
+    let random = maps.iter().any(|m| matches!(m, MapSpec::RandomField { .. }));
+    let transient = if random { BYTES_PER_CELL_RANDOM_FIELD } else { 0.0 };
+    if stored > 0 {
+        parts.push(Part {
+            what: format!("scene maps ({stored} stored, {} × {} cells)", scene.width, scene.height),
+            bytes: cells * (stored as f64 * BYTES_PER_CELL_MAP + transient),
+            fields: "scene.width, scene.height (or the georeference raster's grid)",
+            lever: Lever::SceneGrid { width: scene.width, height: scene.height },
+        });
+    }
+    if matches!(scene.georeference, Some(Georeference::Raster(_)))
+        || maps.iter().any(|m| matches!(m, MapSpec::Raster { .. }))
+    {
+        // A raster is read whole (as f64) once; its size is known when its header is read, and
+        // the reader refuses one larger than the budget's share then ([`raster_limit_samples`]).
+        parts.push(Part {
+            what: "the scene's rasters (checked when read)".into(),
+            bytes: 0.0,
+            fields: "the raster files",
+            lever: Lever::SceneGrid { width: scene.width, height: scene.height },
+        });
+    }
+}
+
+/// Optical depth of the column as the solver layers it, an upper bound: Rayleigh at the
+/// shortest wavelength (~1.2 at 325 nm, sea level) plus the aerosol's (its τ at 550 nm, up to ×3
+/// in the UV).
+fn column_depth(config: &RunConfig) -> f64 {
+    1.3 + 3.0 * config.scene.atmosphere.aot550
+}
+
+/// Planned seconds of the atmosphere's radiative transfer: each successive order of scattering
+/// visits every layer, stream pair and Fourier term, once per LUT wavelength node; the fit
+/// ([`SECONDS_PER_RT_WORK`]) absorbs the nodes.
+#[must_use]
+pub fn atmosphere_seconds(config: &RunConfig) -> f64 {
+    let acc = &config.scene.atmosphere.accuracy;
+    let layers = (column_depth(config) / acc.max_layer_depth).ceil().max(acc.min_layers as f64);
+    let streams = acc.streams as f64;
+    let orders = (acc.max_orders as f64).min(ORDERS_COUNTED);
+    RT_OVERHEAD_S + layers * streams * streams * acc.fourier_terms as f64 * orders * SECONDS_PER_RT_WORK
+}
+
+/// The solver's memory: per level, the scattering kernel of every pair of quadrature streams
+/// (2·streams per hemisphere pair), on each worker thread solving a Fourier term.
+fn atmosphere_part(config: &RunConfig) -> Part {
+    let acc = &config.scene.atmosphere.accuracy;
+    let layers = (column_depth(config) / acc.max_layer_depth).ceil().max(acc.min_layers as f64);
+    let quadrature = 2.0 * acc.streams as f64;
+    let threads = rayon::current_num_threads() as f64;
+    Part {
+        what: format!("radiative transfer ({layers:.0} layers, {} streams)", acc.streams),
+        bytes: (layers + 1.0) * quadrature * quadrature * RT_BYTES_PER_LEVEL_STREAM_PAIR * threads,
+        fields: "scene.atmosphere.accuracy.max_layer_depth, streams",
+        lever: Lever::Layers,
+    }
+}
+
+/// What `config` will ask for, alone.
+#[must_use]
+pub fn run_demand(config: &RunConfig) -> Demand {
+    let mut parts = Vec::new();
+    scene_parts(&config.scene, &mut parts);
+    parts.push(atmosphere_part(config));
+    parts.push(cube_part(config, BYTES_PER_PIXEL_BAND));
+    Demand { parts, atmosphere_s: atmosphere_seconds(config) }
+}
+
+/// The pixels a run simulates: its lines and detectors at its decimation, cropped to those that
+/// can look at the scene (the geometry stage drops the others): at most the scene's diagonal
+/// over the ground sampling distance (altitude · pitch / focal length) along each axis.
+fn image_size(config: &RunConfig) -> (usize, usize) {
+    let i = &config.instrument;
+    let d = config.fidelity.decimation.max(1);
+    let s = &config.scene;
+    let gsd_m = i.altitude_km * 1e3 * i.pixel_pitch_um * 1e-6 / (i.focal_length_mm * 1e-3);
+    let diagonal_m = (s.width as f64 * s.cell_m).hypot(s.height as f64 * s.cell_m);
+    let across = if gsd_m > 0.0 && diagonal_m > 0.0 { (diagonal_m / gsd_m).ceil() as usize + 2 } else { usize::MAX };
+    (i.lines.min(across).div_ceil(d), i.detectors.min(across).div_ceil(d))
+}
+
+fn cube_part(config: &RunConfig, bytes_per_pixel_band: f64) -> Part {
+    let i = &config.instrument;
+    let (rows, cols) = image_size(config);
+    let bands = band_count(&i.kind);
+    let pixels = rows as f64 * cols as f64;
+    Part {
+        what: format!("cubes of {} ({rows} × {cols} pixels × {bands} bands)", i.name),
+        bytes: pixels * (bands as f64 * bytes_per_pixel_band + BYTES_PER_PIXEL),
+        fields: "instrument.lines, instrument.detectors, the bands, fidelity.decimation",
+        lever: Lever::Image { rows, columns: cols, decimation: config.fidelity.decimation.max(1) },
+    }
+}
+
+/// What a study's runs ask for together: a study keeps the truth and products of every run
+/// until its tables and figures are written, and the engine's cache the full cubes of the last
+/// few ([`CACHED_RUNS`]); scenes and atmospheres are built one at a time.
+#[must_use]
+pub fn study_demand(configs: &[&RunConfig]) -> Demand {
+    let mut demand = Demand::default();
+    for c in configs {
+        let one = run_demand(c);
+        demand.atmosphere_s = demand.atmosphere_s.max(one.atmosphere_s);
+        let shared: Vec<Part> = one.parts.into_iter().filter(|p| !p.what.starts_with("cubes")).collect();
+        if shared.iter().map(|p| p.bytes).sum::<f64>() > demand.bytes() {
+            demand.parts = shared;
+        }
+    }
+    // The largest runs' full cubes (the cache may hold any of them), the others' kept truth.
+    let mut by_size: Vec<&RunConfig> = configs.to_vec();
+    by_size
+        .sort_by(|a, b| cube_part(b, BYTES_PER_PIXEL_BAND).bytes.total_cmp(&cube_part(a, BYTES_PER_PIXEL_BAND).bytes));
+    for (i, c) in by_size.iter().enumerate() {
+        if i < CACHED_RUNS {
+            demand.parts.push(cube_part(c, BYTES_PER_PIXEL_BAND));
+        } else {
+            let kept = cube_part(c, KEPT_BYTES_PER_PIXEL_BAND);
+            demand.parts.push(Part { what: kept.what.replacen("cubes", "the truth kept", 1), ..kept });
+        }
+    }
+    demand
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::budget::{Budget, DEFAULT_ATMOSPHERE_S};
+
+    fn default_runs() -> Vec<RunConfig> {
+        let study = crate::study::StudySpec::default_study().unwrap_or_else(|e| panic!("{e}"));
+        study.resolve(None).unwrap_or_else(|e| panic!("{e}")).runs.into_iter().map(|r| r.2).collect()
+    }
+
+    #[test]
+    fn the_default_study_fits_and_its_estimate_bounds_the_measured_peak() {
+        let runs = default_runs();
+        let demand = study_demand(&runs.iter().collect::<Vec<_>>());
+        // Measured with /usr/bin/time on `shoal study` at full resolution: 2.33 GB peak. The
+        // estimate is an upper bound within a factor 1.6 (it plans for the working copies).
+        let gb = demand.bytes() / 1024.0_f64.powi(3);
+        assert!((2.33..2.33 * 1.6).contains(&gb), "{gb} GB: {demand:?}");
+        assert!(demand.atmosphere_s < 60.0, "{}", demand.atmosphere_s);
+        let budget = Budget { memory_bytes: 14e9, atmosphere_s: DEFAULT_ATMOSPHERE_S };
+        assert!(budget.check(&demand).is_ok());
+    }
+
+    #[test]
+    fn the_largest_instrument_is_refused_naming_its_fields_and_what_would_fit() {
+        // The largest instrument over the largest scene (the instrument is cropped to the scene).
+        let mut c = default_runs().remove(0);
+        (c.instrument.lines, c.instrument.detectors) = (100_000, 20_000);
+        (c.scene.width, c.scene.height) = (20_000, 20_000);
+        let budget = Budget { memory_bytes: 14e9, atmosphere_s: DEFAULT_ATMOSPHERE_S };
+        let e = budget.check(&run_demand(&c)).unwrap_err();
+        assert!(e.field.contains("instrument.lines") && e.message.contains("fidelity.decimation"), "{e}");
+        c.fidelity.decimation = 64;
+        assert!(budget.check(&run_demand(&c)).is_ok(), "a preview of it fits");
+    }
+
+    #[test]
+    fn thin_layers_are_refused_for_their_memory_and_many_terms_for_their_time() {
+        let mut c = default_runs().remove(0);
+        let budget = Budget { memory_bytes: 14e9, atmosphere_s: DEFAULT_ATMOSPHERE_S };
+        // The thinnest layers and the most streams: each level holds (2 · 48)² Stokes blocks.
+        let acc = &mut c.scene.atmosphere.accuracy;
+        (acc.max_layer_depth, acc.streams) = (1e-4, 48);
+        c.scene.atmosphere.aot550 = 5.0;
+        let e = budget.check(&run_demand(&c)).unwrap_err();
+        assert!(e.field.contains("max_layer_depth") && e.message.contains("raise max_layer_depth"), "{e}");
+        // Memory that fits, work that does not fit a budget of 10 s (SHOAL_TIME_BUDGET_S=10):
+        // every Fourier term and order at 24 streams, planned at ~45 s. (Within the default
+        // 900 s, memory binds first: the work per byte of kernel is bounded by terms × orders.)
+        let acc = &mut c.scene.atmosphere.accuracy;
+        (acc.max_layer_depth, acc.streams, acc.fourier_terms, acc.max_orders) = (0.002, 24, 96, 500);
+        let short = Budget { atmosphere_s: 10.0, ..budget };
+        assert!(budget.check(&run_demand(&c)).is_ok());
+        let e = short.check(&run_demand(&c)).unwrap_err();
+        assert_eq!(e.field, "scene.atmosphere.accuracy", "{e}");
+        // The defaults plan well under a second.
+        assert!(atmosphere_seconds(&default_runs()[0]) < 0.5);
+    }
+}
