@@ -171,7 +171,7 @@ ranges! {
     /// Conversion gain.
     INSTRUMENT_GAIN_E_PER_DN = Range::closed("instrument.gain_e_per_dn", 0.01, 1e4, "e-/DN", "conversion gain");
     /// ADC offset.
-    INSTRUMENT_BIAS_DN = Range::closed("instrument.bias_dn", 0.0, 65_535.0, "DN", "ADC offset");
+    INSTRUMENT_BIAS_DN = Range::closed("instrument.bias_dn", 0.0, 65_535.0, "DN", "ADC offset (below the ADC's largest count, 2^adc_bits − 1)").below_hi();
     /// ADC resolution.
     INSTRUMENT_ADC_BITS = Range::count("instrument.adc_bits", 1.0, 16.0, "bits", "ADC resolution");
     /// Optics transmission.
@@ -214,8 +214,15 @@ ranges! {
     SCENE_CDOM_PER_M = Range::closed("scene.cdom_per_m", 0.0, limits::MAX_CDOM_PER_M, "m-1", "CDOM absorption at the reference wavelength (every value)");
     /// Depth map values.
     SCENE_DEPTH_M = Range::above("scene.depth_m", 0.0, limits::MAX_DEPTH_M, "m", "water depth (every value of the map)");
+    /// Land reflectance.
+    SCENE_LAND_REFLECTANCE = Range::closed("scene.land.reflectance", 0.0, 1.0, "", "land surface reflectance (Lambertian; every value of the spectrum)");
     /// Substrate fraction map values.
     SCENE_SUBSTRATE_FRACTION = Range::closed("scene.substrates[i].fraction", 0.0, 1.0, "", "areal fraction of a substrate (every value)");
+
+    // Spectra written as formulas (SpectrumSource::PowerLaw and Exponential, wherever one is
+    // given: SIOP sets, land reflectance, QE).
+    /// Reference wavelength of an analytic spectrum.
+    SPECTRUM_REFERENCE_NM = Range::closed("spectrum.reference_nm", 100.0, 3000.0, "nm", "reference wavelength of a PowerLaw or Exponential spectrum");
 
     // Atmosphere (AtmosphereSpec::validate, RtAccuracy::validate).
     /// Aerosol optical thickness.
@@ -255,7 +262,7 @@ ranges! {
     /// Fourier terms.
     ACCURACY_FOURIER_TERMS = Range::count("scene.atmosphere.accuracy.fourier_terms", 1.0, 96.0, "", "azimuthal Fourier terms");
     /// Layer optical depth.
-    ACCURACY_MAX_LAYER_DEPTH = Range::above("scene.atmosphere.accuracy.max_layer_depth", 0.0, 1.0, "", "largest optical depth of one layer");
+    ACCURACY_MAX_LAYER_DEPTH = Range::closed("scene.atmosphere.accuracy.max_layer_depth", 0.0001, 1.0, "", "largest optical depth of one layer (thinner layers only multiply the work)");
     /// Fewest layers.
     ACCURACY_MIN_LAYERS = Range::count("scene.atmosphere.accuracy.min_layers", 1.0, 500.0, "", "fewest layers");
     /// Order tolerance.

@@ -49,6 +49,7 @@ pub(super) fn parse(dir: &[u16], ascii: &str, doubles: &[f64]) -> Result<Keys, S
         return Err(format!("GeoKeyDirectory has {} shorts, fewer than its header says", dir.len()));
     }
     let mut keys = Keys { crs: Crs::None, linear_unit_m: 1.0, raster_type: RASTER_PIXEL_IS_AREA };
+    let mut unit_stated = false;
     let (mut model, mut projected, mut geographic, mut citation) = (None, None, None, String::new());
     for k in dir[4..4 + 4 * usize::from(dir[3])].chunks_exact(4) {
         let (id, location, count, value) = (k[0], k[1], usize::from(k[2]), k[3]);
@@ -59,6 +60,7 @@ pub(super) fn parse(dir: &[u16], ascii: &str, doubles: &[f64]) -> Result<Keys, S
             PROJECTED_CS_TYPE => projected = short,
             GEOGRAPHIC_TYPE => geographic = short,
             PROJ_LINEAR_UNITS => {
+                unit_stated = true;
                 keys.linear_unit_m = match short {
                     Some(LINEAR_METRE) => 1.0,
                     Some(9002) => 0.3048,          // international foot
@@ -69,6 +71,7 @@ pub(super) fn parse(dir: &[u16], ascii: &str, doubles: &[f64]) -> Result<Keys, S
             }
             PROJ_LINEAR_UNIT_SIZE if location == GEO_DOUBLE_PARAMS => {
                 if let Some(v) = doubles.get(usize::from(value)) {
+                    unit_stated = true;
                     keys.linear_unit_m = *v;
                 }
             }
@@ -90,7 +93,21 @@ pub(super) fn parse(dir: &[u16], ascii: &str, doubles: &[f64]) -> Result<Keys, S
         }
         _ => Crs::None,
     };
+    // A projected EPSG code implies its unit, which only an EPSG database knows: without the
+    // unit key, only the UTM families (metres by definition) are taken as metres. Any other is
+    // left unknown (NaN), so a CRS in US feet is never read as metres.
+    if let Crs::Projected { epsg } = keys.crs
+        && !unit_stated
+        && !utm_metres(epsg)
+    {
+        keys.linear_unit_m = f64::NAN;
+    }
     Ok(keys)
+}
+
+/// Is `epsg` a UTM zone in metres (WGS 84 north/south, NAD83, ETRS89, GDA94/GDA2020 MGA)?
+fn utm_metres(epsg: u16) -> bool {
+    matches!(epsg, 32601..=32660 | 32701..=32760 | 26901..=26923 | 25828..=25838 | 28348..=28358 | 7846..=7859)
 }
 
 /// The key directory and its text for `crs` (keys sorted by ID, as the standard asks).

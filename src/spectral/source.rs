@@ -113,11 +113,16 @@ impl SpectrumSource {
             }
             Self::PowerLaw { coefficient, reference_nm, exponent } => {
                 check_finite("PowerLaw", &[*coefficient, *reference_nm, *exponent])?;
-                Ok(wl.iter().map(|l| coefficient * (reference_nm / l).powf(*exponent)).collect())
+                check_reference("PowerLaw", *reference_nm)?;
+                finite_values("PowerLaw", wl.iter().map(|l| coefficient * (reference_nm / l).powf(*exponent)).collect())
             }
             Self::Exponential { coefficient, reference_nm, slope_per_nm } => {
                 check_finite("Exponential", &[*coefficient, *reference_nm, *slope_per_nm])?;
-                Ok(wl.iter().map(|l| coefficient * (-slope_per_nm * (l - reference_nm)).exp()).collect())
+                check_reference("Exponential", *reference_nm)?;
+                finite_values(
+                    "Exponential",
+                    wl.iter().map(|l| coefficient * (-slope_per_nm * (l - reference_nm)).exp()).collect(),
+                )
             }
             Self::Constant(c) => {
                 check_finite("Constant", &[*c])?;
@@ -129,6 +134,26 @@ impl SpectrumSource {
 
 fn pick(own: Extrapolation, default: Extrapolation) -> Extrapolation {
     if own == Extrapolation::Error { default } else { own }
+}
+
+/// A reference wavelength must be one ([`crate::ranges::SPECTRUM_REFERENCE_NM`]): −1e308 nm
+/// would turn the spectrum into zeros or infinities without a word.
+fn check_reference(what: &str, reference_nm: f64) -> Result<(), SpectralError> {
+    crate::ranges::SPECTRUM_REFERENCE_NM
+        .check(reference_nm)
+        .map_err(|m| SpectralError::BadSpectrum { name: what.into(), message: format!("reference_nm: {m}") })
+}
+
+/// The values of an analytic spectrum, refused when one overflowed (a slope too steep for the
+/// grid's span).
+fn finite_values(what: &str, values: Vec<f64>) -> Result<Vec<f64>, SpectralError> {
+    match values.iter().find(|v| !v.is_finite()) {
+        None => Ok(values),
+        Some(v) => Err(SpectralError::BadSpectrum {
+            name: what.into(),
+            message: format!("a value is {v} on the simulation grid: the coefficient, slope or exponent is too large"),
+        }),
+    }
 }
 
 fn check_finite(what: &str, values: &[f64]) -> Result<(), SpectralError> {

@@ -117,13 +117,18 @@ impl SceneOptics {
             .map(|(name, _)| library.mix_on_grid(&SubstrateMix { parts: vec![(name.clone(), 1.0)] }, grid))
             .collect::<Result<Vec<_>, _>>()?;
         let land = match &scene.spec.land {
-            Some(l) => Some(
-                l.reflectance
-                    .sample(grid, Extrapolation::Clamp, scene.base_dir.as_deref())?
-                    .into_iter()
-                    .map(|r| r.clamp(0.0, 1.0))
-                    .collect(),
-            ),
+            Some(l) => {
+                let r = l.reflectance.sample(grid, Extrapolation::Clamp, scene.base_dir.as_deref())?;
+                // A reflectance outside 0–1 is refused with its wavelength, not clamped.
+                let range = &crate::ranges::SCENE_LAND_REFLECTANCE;
+                if let Some((w, v)) = grid.wavelengths_nm().iter().zip(&r).find(|(_, v)| !range.contains(**v)) {
+                    return Err(SceneError::Invalid(crate::parse::FieldError {
+                        field: range.field("scene.").into(),
+                        message: format!("{v} at {w} nm is out of range (allowed: {})", range.allowed()),
+                    }));
+                }
+                Some(r)
+            }
             None => None,
         };
         let atmosphere = lut.atmosphere();

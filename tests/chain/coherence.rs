@@ -18,6 +18,7 @@ use shoal::instrument::InstrumentSpec;
 use shoal::ranges::{self, Range};
 use shoal::retrieval::RetrievalSpec;
 use shoal::scene::{Effect, MapSpec, SceneSpec};
+use shoal::spectral::SpectrumSource;
 
 use crate::common::{both_retrievals, instrument_for, sweep_path};
 
@@ -172,6 +173,17 @@ fn set(config: &RunConfig, path: &str, value: f64) -> RunConfig {
         "scene.cdom_per_m" => c.scene.cdom_per_m = m,
         "scene.depth_m" => c.scene.depth_m = Some(m),
         "scene.substrates[i].fraction" => c.scene.substrates[0].fraction = m,
+        // A spectrum's values: the land's reflectance, constant over wavelength.
+        "scene.land.reflectance" => {
+            if let Some(land) = &mut c.scene.land {
+                land.reflectance = SpectrumSource::Constant(value);
+            }
+        }
+        // A formula spectrum's reference wavelength: the detector's QE as a power law about it.
+        "spectrum.reference_nm" => {
+            c.instrument.quantum_efficiency =
+                SpectrumSource::PowerLaw { coefficient: 0.7, reference_nm: value, exponent: 0.2 };
+        }
         _ => {
             c = shoal::sweep::apply(config, &[(&sweep_path(path), value)]).unwrap();
         }
@@ -181,6 +193,9 @@ fn set(config: &RunConfig, path: &str, value: f64) -> RunConfig {
 
 /// The value of a numeric field in `config` (maps: the value their constant would take).
 fn current(config: &RunConfig, path: &str) -> f64 {
+    if path == "spectrum.reference_nm" {
+        return 550.0;
+    }
     let tree = serde_json::to_value(config).unwrap();
     let mut node = &tree;
     for key in sweep_path(path).split('.') {

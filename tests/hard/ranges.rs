@@ -60,6 +60,28 @@ fn refusal(range: &Range, value: f64) -> Option<String> {
         let geometry = shoal::atmosphere::Geometry::from_degrees(sun, view, azimuth);
         return atmosphere.validate().err().or_else(|| geometry.validate().err()).map(|e| e.to_string());
     }
+    if range.path == "spectrum.reference_nm" {
+        // Wherever a formula spectrum is given (SIOP, QE, land): checked when it is sampled.
+        let grid = shoal::spectral::WavelengthGrid::from_wavelengths(vec![400.0, 500.0]).unwrap();
+        let s =
+            shoal::spectral::SpectrumSource::Exponential { coefficient: 1.0, reference_nm: value, slope_per_nm: 0.01 };
+        return s.sample(&grid, shoal::spectral::Extrapolation::Error, None).err().map(|e| e.to_string());
+    }
+    if range.path == "scene.land.reflectance" {
+        // A spectrum's values: checked on the simulation grid, when the scene's optics are built.
+        let mut c = base("scene.chl_mg_m3");
+        c.scene.land = Some(shoal::scene::LandSpec {
+            mask: MapSpec::Constant(0.0),
+            reflectance: shoal::spectral::SpectrumSource::Constant(value),
+        });
+        c.fidelity.decimation = 1000;
+        c.retrievals.clear();
+        return match shoal::engine::Engine::new().run(&c, &shoal::control::RunControl::new()) {
+            Ok(_) => None,
+            Err(EngineError::Failed { message, .. }) => Some(message),
+            Err(other) => panic!("{}: not a refusal: {other}", range.path),
+        };
+    }
     let map_field = ["scene.chl_mg_m3", "scene.nap_g_m3", "scene.cdom_per_m", "scene.depth_m"].contains(&range.path)
         || range.path.starts_with("scene.substrates");
     if map_field {
@@ -69,7 +91,16 @@ fn refusal(range: &Range, value: f64) -> Option<String> {
         map(&mut spec, value);
         return Scene::build(&spec, None).err().map(|e| e.to_string());
     }
-    let config = shoal::sweep::apply(&base(range.path), &[(&sweep_path(range.path), value)]).unwrap();
+    let mut config = shoal::sweep::apply(&base(range.path), &[(&sweep_path(range.path), value)]).unwrap();
+    if range.path == "instrument.bias_dn" {
+        // The offset's range is that of the widest ADC; a narrower one refuses less (tested in
+        // the instrument's own tests).
+        config.instrument.adc_bits = 16;
+    }
+    if range.path == "instrument.adc_bits" && value < 8.0 {
+        // A few-bit ADC needs an offset below its largest count (the cross-field rule).
+        config.instrument.bias_dn = 0.0;
+    }
     match config.validate() {
         Ok(()) => None,
         Err(EngineError::Failed { message, .. }) => Some(message),
