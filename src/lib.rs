@@ -19,6 +19,7 @@
 //! | [`units`] | constants, unit conversions, angle helpers |
 //! | [`assets`] | cited spectra embedded in the binary |
 //! | [`control`] | cancellation and progress shared by a run and its watcher |
+//! | [`budget`] | what a run may use of the machine (memory, the atmosphere's time), checked before it starts |
 //! | [`jobs`] | background work: the newest-request-wins mailbox and the one rayon pool builder |
 //! | [`simd`] | hot loops compiled per instruction-set level (AVX-512, AVX2 + FMA), chosen at run time |
 //! | [`geotiff`] | GeoTIFF in and out: rasters with geotransform, CRS, nodata, band names and units |

@@ -66,6 +66,8 @@ pub struct AppOptions {
     pub fresh: bool,
     /// Window size, logical pixels (`None`: 1500 × 960, or the size saved with the session).
     pub size: Option<[f32; 2]>,
+    /// The user's Shoal folder, where the session is kept (`None`: [`crate::library::home_dir`]).
+    pub home: Option<PathBuf>,
 }
 
 /// A write that would replace a file of the user's, waiting for "Replace" or "Cancel".
@@ -189,7 +191,8 @@ impl ShoalApp {
     /// holds the session starts from it but does not save it (and says so).
     #[must_use]
     pub fn new(cc: &eframe::CreationContext<'_>, options: AppOptions) -> Self {
-        let path = session::session_path(&crate::library::home_dir());
+        let home = options.home.clone().unwrap_or_else(crate::library::home_dir);
+        let path = session::session_path(&home);
         let lock = if options.fresh { Err(String::new()) } else { session::SessionLock::acquire(&path) };
         // A fresh start does not read the session either (an unreadable one stays where it is).
         let saved = if options.fresh { None } else { Some(session::load_session(&path)) };

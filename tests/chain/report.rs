@@ -205,3 +205,54 @@ fn a_report_straight_from_a_study_carries_its_error_budget_and_bad_targets_are_r
     let _ = std::fs::remove_dir_all(&dir);
     let _ = std::fs::remove_dir_all(&empty);
 }
+
+/// A figure planted in a results folder with a script, an event handler and an image from a
+/// server on this machine: in Chromium no script runs and no request reaches the server — both
+/// for the pack as written (the figure is left out) and for a copy with the planted SVG pasted
+/// into the page raw, which only the page's Content-Security-Policy then stops.
+#[test]
+fn a_planted_figure_runs_no_script_and_calls_nowhere_in_chromium() {
+    use std::io::Read as _;
+    let dir = tempdir("planted");
+    let results = dir.join("results");
+    ok(shoal().args(["study", "cubesat_vs_smallsat", "--decimation", "16", "--no-cubes", "--out"]).arg(&results));
+    // A server that records whether anything connects.
+    let server = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+    server.set_nonblocking(true).unwrap();
+    let port = server.local_addr().unwrap().port();
+    let planted = format!(
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"50\" height=\"50\" onload=\"document.body.setAttribute('data-pwned','onload')\">\
+         <script>document.body.setAttribute('data-pwned','script')</script>\
+         <image href=\"http://127.0.0.1:{port}/leak.png\" width=\"10\" height=\"10\"/>\
+         <rect width=\"10\" height=\"10\" style=\"fill:url(http://127.0.0.1:{port}/css)\"/></svg>"
+    );
+    std::fs::write(results.join("figures/snr.svg"), &planted).unwrap();
+    let pack = dir.join("pack");
+    ok(shoal().arg("report").arg(&results).arg("--out").arg(&pack));
+    let page = std::fs::read_to_string(pack.join("index.html")).unwrap();
+    assert!(page.contains("Figure snr left out: not a figure Shoal draws"), "the reviewer is told");
+    // The second wall: the same page with the hostile SVG pasted in raw.
+    let raw = pack.join("raw.html");
+    std::fs::write(&raw, page.replacen("<section id=\"figures\">", &format!("<section id=\"figures\">{planted}"), 1))
+        .unwrap();
+    let profile = dir.join("profile");
+    for file in [pack.join("index.html"), raw] {
+        let out = chromium(
+            &profile,
+            &["--virtual-time-budget=5000".into(), "--dump-dom".into(), format!("file://{}", file.display())],
+        );
+        let dom = String::from_utf8_lossy(&out.stdout);
+        assert!(dom.contains("Shoal review pack"), "{}: not rendered", file.display());
+        // The attribute the planted script sets (its source text quotes it with ' only).
+        assert!(!dom.contains("data-pwned=\""), "{}: a planted script ran", file.display());
+    }
+    let mut request = Vec::new();
+    match server.accept() {
+        Ok((mut s, _)) => {
+            let _ = s.read_to_end(&mut request);
+            panic!("the page called out: {}", String::from_utf8_lossy(&request));
+        }
+        Err(e) => assert_eq!(e.kind(), std::io::ErrorKind::WouldBlock, "{e}"),
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

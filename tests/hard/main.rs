@@ -7,6 +7,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 mod atmosphere;
+mod attacks;
 mod chain;
 #[path = "../common/mod.rs"]
 mod common;

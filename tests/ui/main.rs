@@ -18,6 +18,8 @@ use shoal::app::{AppOptions, ShoalApp};
 use shoal::instrument::InstrumentSpec;
 use shoal::library::Library;
 
+mod session;
+
 /// A fresh, empty user library in the system temporary directory.
 fn temp_library(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("shoal-ui-{}-{name}", std::process::id()));
