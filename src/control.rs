@@ -79,6 +79,41 @@ impl std::fmt::Display for PixelSite {
 
 const UNARMED: usize = usize::MAX;
 
+/// Where a run is: the stage computing now and how far its rows have gone.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StageProgress {
+    /// The stage (`retrieval`, `radiance`, …).
+    pub name: &'static str,
+    /// Stages computed so far in this run, this one included (cached ones are not counted).
+    pub ordinal: u32,
+    /// Rows of this stage done.
+    pub done: u64,
+    /// Rows of this stage in all (0 until its per-pixel loop starts, or if it has none).
+    pub total: u64,
+    /// Seconds since the stage started.
+    pub seconds: f64,
+}
+
+impl StageProgress {
+    /// Seconds left in this stage at its pace so far, once the pace is known (at least 5 % of
+    /// its rows and half a second done); `None` before.
+    #[must_use]
+    pub fn seconds_left(&self) -> Option<f64> {
+        let f = if self.total > 0 { self.done as f64 / self.total as f64 } else { return None };
+        (f >= 0.05 && self.seconds >= 0.5 && f < 1.0).then(|| self.seconds * (1.0 - f) / f)
+    }
+}
+
+/// The stage a run is in (see [`RunControl::begin_stage`]).
+#[derive(Debug, Clone, Copy)]
+struct StageMark {
+    name: &'static str,
+    ordinal: u32,
+    start: std::time::Instant,
+    done: u64,
+    total: u64,
+}
+
 /// Cancellation flag and progress counters of one run.
 #[derive(Debug)]
 pub struct RunControl {
@@ -93,6 +128,8 @@ pub struct RunControl {
     armed: (AtomicUsize, AtomicUsize),
     /// Where the first panicking row guard was.
     site: Mutex<Option<PixelSite>>,
+    /// The stage computing now.
+    stage: Mutex<Option<StageMark>>,
 }
 
 impl Default for RunControl {
@@ -105,6 +142,7 @@ impl Default for RunControl {
             after_cancel: AtomicU64::default(),
             armed: (AtomicUsize::new(UNARMED), AtomicUsize::new(UNARMED)),
             site: Mutex::new(None),
+            stage: Mutex::new(None),
         }
     }
 }
@@ -201,6 +239,29 @@ impl RunControl {
     #[must_use]
     pub fn progress(&self) -> (u64, u64) {
         (self.done.load(Ordering::Relaxed), self.total.load(Ordering::Relaxed))
+    }
+
+    /// A stage called `name` starts computing (the engine calls this for each stage it does not
+    /// serve from its cache); [`Self::stage_progress`] then counts its rows alone.
+    pub fn begin_stage(&self, name: &'static str) {
+        let (done, total) = self.progress();
+        let mut stage = self.stage.lock().unwrap_or_else(PoisonError::into_inner);
+        let ordinal = stage.map_or(1, |s| s.ordinal + 1);
+        *stage = Some(StageMark { name, ordinal, start: std::time::Instant::now(), done, total });
+    }
+
+    /// The stage computing now and its rows, if a stage has begun.
+    #[must_use]
+    pub fn stage_progress(&self) -> Option<StageProgress> {
+        let mark = (*self.stage.lock().unwrap_or_else(PoisonError::into_inner))?;
+        let (done, total) = self.progress();
+        Some(StageProgress {
+            name: mark.name,
+            ordinal: mark.ordinal,
+            done: done.saturating_sub(mark.done),
+            total: total.saturating_sub(mark.total),
+            seconds: mark.start.elapsed().as_secs_f64(),
+        })
     }
 
     /// Fill `outputs` (see [`RowSplit`]) row by row: `f(guard, row)` writes row `guard.index()`

@@ -81,9 +81,11 @@ impl Stage {
     }
 }
 
-impl std::fmt::Display for Stage {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let name = match self {
+impl Stage {
+    /// The stage's name in messages and progress ("atmosphere LUT", "retrieval").
+    #[must_use]
+    pub const fn name(self) -> &'static str {
+        match self {
             Self::Scene => "scene",
             Self::Response => "response",
             Self::Geometry => "geometry",
@@ -101,8 +103,13 @@ impl std::fmt::Display for Stage {
             Self::Snr => "snr",
             Self::RetrievalModel => "retrieval model",
             Self::Retrieval => "retrieval",
-        };
-        f.write_str(name)
+        }
+    }
+}
+
+impl std::fmt::Display for Stage {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
     }
 }
 

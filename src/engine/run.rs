@@ -70,6 +70,7 @@ impl Engine {
             return Ok(product);
         }
         let start = Instant::now();
+        control.begin_stage(stage.name());
         let fault = self.fault.filter(|f| f.stage == stage);
         if let Some(f) = fault {
             match f.kind {

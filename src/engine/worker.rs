@@ -47,6 +47,8 @@ pub enum Event {
         done: u64,
         /// Units in all (grows as stages start).
         total: u64,
+        /// The stage computing now and its own rows.
+        stage: Option<crate::control::StageProgress>,
     },
     /// A run finished (or failed).
     Finished {
@@ -181,6 +183,14 @@ impl EngineHandle {
             }
             Put::Closed(_) => false,
         }
+    }
+
+    /// Stop the run in flight and the rest of its request (the results already sent stay the
+    /// caller's): the worker takes `generation` (newer than any submitted) as the newest, so
+    /// the request in flight is stale; the caller's next [`Self::submit`] must carry
+    /// `generation` or a newer one.
+    pub fn cancel(&self, generation: u64) {
+        self.latest.fetch_max(generation, Ordering::SeqCst);
     }
 
     /// The newest generation submitted.
@@ -333,8 +343,9 @@ fn worker(requests: &Mailbox<Request>, link: &Link<'_>, pause: &PreviewPause, po
                     let reporter = s.spawn(move || {
                         while !done_flag.load(Ordering::Acquire) {
                             let (d, t) = watcher.progress();
+                            let stage = watcher.stage_progress();
                             if events
-                                .try_send(Event::Progress { generation, index, decimation, done: d, total: t })
+                                .try_send(Event::Progress { generation, index, decimation, done: d, total: t, stage })
                                 .is_ok()
                             {
                                 wake();
