@@ -323,6 +323,8 @@ ranges! {
     REQUIREMENT_BIAS_PCT = Range::closed("requirements.products[i].bias_pct", 0.0, 1e4, "%", "largest log-space bias, either sign");
     /// Smallest returned share.
     REQUIREMENT_RETURNED_PCT = Range::closed("requirements.products[i].returned_pct", 0.0, 100.0, "%", "smallest share of water pixels retrieved");
+    /// Smallest share of pixels whose dominant substrate is right.
+    REQUIREMENT_SUBSTRATE_PCT = Range::closed("requirements.substrate_pct", 0.0, 100.0, "%", "smallest share of returned water pixels whose dominant substrate is the truth's");
     /// Smallest SNR.
     REQUIREMENT_SNR = Range::above("requirements.snr", 0.0, 1e6, "", "smallest SNR of every band at the typical radiance").below_hi();
 }

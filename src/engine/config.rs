@@ -139,6 +139,11 @@ pub struct RunConfig {
     /// Fidelity settings.
     #[serde(default)]
     pub fidelity: Fidelity,
+    /// The radiance the SNR is stated at, W m⁻² sr⁻¹ µm⁻¹, as a spectrum sampled at each band
+    /// centre (a mission's or IOCCG's "typical radiance": `Constant(40.0)`, or
+    /// `Table(wavelength_nm: […], values: […])`); `None`: the scene's median water radiance.
+    #[serde(default)]
+    pub snr_reference: Option<crate::spectral::SpectrumSource>,
     /// Seed of every random draw of the instrument (noise, fixed patterns, calibration frames,
     /// the approximation's sample points). The scene's maps have their own seeds.
     #[serde(default)]
@@ -161,6 +166,7 @@ impl RunConfig {
             correction: CorrectionSpec::default(),
             retrievals: Vec::new(),
             fidelity: Fidelity::default(),
+            snr_reference: None,
             seed: 1,
             fault: None,
         }

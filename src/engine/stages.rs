@@ -340,26 +340,66 @@ impl Engine {
         let (detector, detector_key) = (&inst.detector, inst.detector_key);
         let nb = response.n_bands();
         let typical = radiance.typical_water_w_m2_sr_nm.clone();
-        let snr_key = KeyBuilder::new(Stage::Snr).after(detector_key).with(&typical).with(&inputs.snr).finish();
+        // The SNR at the user's reference radiance when one is set (the retrievals keep
+        // weighting by the scene's own typical radiance).
+        let at = match &config.snr_reference {
+            Some(reference) => {
+                reference_radiance(reference, &response.bands.centres_nm(), config.scene_dir.as_deref())?
+            }
+            None => typical.clone(),
+        };
+        let snr_key = KeyBuilder::new(Stage::Snr).after(detector_key).with(&at).with(&inputs.snr).finish();
         let snr = self.stage(snr_key, report, control, || {
             // A preview measures on fewer detectors (the estimate's spread grows as √decimation).
             let n = instrument.detectors;
             let m = (fid.snr_detectors / fid.decimation).clamp(1, n);
             let picks: Vec<usize> = (0..m).map(|i| (2 * i + 1) * n / (2 * m)).collect();
             let centres = response.bands.centres_nm();
-            let measured = measured_snr(detector, &typical, &picks, fid.snr_frames, config.seed);
+            let measured = measured_snr(detector, &at, &picks, fid.snr_frames, config.seed);
+            let full = crate::instrument::plausibility::full_scale_e(detector);
             Ok((0..nb)
                 .map(|b| SnrRow {
                     band: response.bands.bands[b].name.clone(),
                     centre_nm: centres[b],
-                    radiance: typical[b],
-                    snr_analytic: analytic_snr(detector, n / 2, b, typical[b]),
+                    radiance: at[b],
+                    snr_analytic: analytic_snr(detector, n / 2, b, at[b]),
                     snr_measured: measured[b],
+                    full_scale_fraction: crate::instrument::plausibility::peak_signal_e(detector, b, at[b])
+                        / full.max(f64::MIN_POSITIVE),
                 })
                 .collect::<Vec<_>>())
         })?;
         Ok((snr, typical))
     }
+}
+
+/// The reference radiance at each band centre, W m⁻² sr⁻¹ nm⁻¹ (the spectrum is stated per µm, as
+/// missions state it); every value must be positive and finite.
+fn reference_radiance(
+    reference: &crate::spectral::SpectrumSource,
+    centres_nm: &[f64],
+    dir: Option<&std::path::Path>,
+) -> Result<Vec<f64>, EngineError> {
+    let fail =
+        |message: String| EngineError::Failed { stage: Stage::Snr, message: format!("snr_reference: {message}") };
+    let mut sorted = centres_nm.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    sorted.dedup();
+    let grid = crate::spectral::WavelengthGrid::from_wavelengths(sorted.clone()).map_err(|e| fail(e.to_string()))?;
+    let values =
+        reference.sample(&grid, crate::spectral::Extrapolation::Clamp, dir).map_err(|e| fail(e.to_string()))?;
+    centres_nm
+        .iter()
+        .map(|c| {
+            let i = sorted.iter().position(|s| s == c).unwrap_or(0);
+            let v = values[i];
+            if v.is_finite() && v > 0.0 && v <= 1e4 {
+                Ok(v / 1000.0)
+            } else {
+                Err(fail(format!("{v} W m⁻² sr⁻¹ µm⁻¹ at {c:.0} nm (allowed: above 0, at most 10000)")))
+            }
+        })
+        .collect()
 }
 
 /// LUT axes: wavelength nodes on a fixed lattice covering the grids (so a change of bands rarely

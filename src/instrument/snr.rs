@@ -30,6 +30,19 @@ pub struct SnrRow {
     pub snr_analytic: f64,
     /// SNR measured on a simulated uniform patch.
     pub snr_measured: f64,
+    /// The reference radiance's signal (photo and dark electrons, at the brightest detector)
+    /// over the full scale (the well or the ADC's top count, the smaller;
+    /// [`super::plausibility::full_scale_e`]): at 1 or more the band saturates at its own
+    /// reference radiance and its SNR is no figure of merit (the verdict fails it).
+    pub full_scale_fraction: f64,
+}
+
+impl SnrRow {
+    /// Does the band saturate at its reference radiance?
+    #[must_use]
+    pub fn saturated(&self) -> bool {
+        self.full_scale_fraction >= 1.0
+    }
 }
 
 /// Analytic SNR of detector `j`, band `b` at band radiance `radiance` (infinite without noise).

@@ -18,6 +18,7 @@ mod budget;
 mod curves;
 mod figures;
 mod geotiff_out;
+mod maps_figure;
 mod outdir;
 mod output;
 mod render;
@@ -27,6 +28,7 @@ mod run;
 mod slide;
 mod snr_figure;
 mod spread;
+mod substrate_figure;
 
 pub use budget::{Budget, BudgetLine, Stage, budget_table, error_budget};
 pub use curves::{CurvePoint, CurveSeries, Curves, curve_figure, first_crossing};
@@ -129,6 +131,9 @@ pub struct StudySpec {
     /// What the products and bands must achieve (checked and reported with margins).
     #[serde(default)]
     pub requirements: Option<Requirements>,
+    /// The radiance every run's SNR is stated at (see [`RunConfig::snr_reference`]).
+    #[serde(default)]
+    pub snr_reference: Option<crate::spectral::SpectrumSource>,
 }
 
 fn default_seeds() -> Vec<u64> {
@@ -253,6 +258,9 @@ impl StudySpec {
                 }
                 if let Some(f) = &self.fidelity {
                     config.fidelity = f.clone();
+                }
+                if let Some(r) = &self.snr_reference {
+                    config.snr_reference = Some(r.clone());
                 }
                 runs.push((label.clone(), seed, config));
             }

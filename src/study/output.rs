@@ -86,16 +86,17 @@ fn number(v: f64) -> String {
 /// The SNR table of a run as CSV.
 #[must_use]
 pub fn snr_csv(out: &RunOutput) -> String {
-    let mut s = String::from("band,centre_nm,radiance_w_m2_sr_nm,snr_analytic,snr_measured\n");
+    let mut s = String::from("band,centre_nm,radiance_w_m2_sr_nm,snr_analytic,snr_measured,signal_over_full_scale\n");
     for r in out.snr.iter() {
         let _ = writeln!(
             s,
-            "{},{},{},{},{}",
+            "{},{},{},{},{},{}",
             r.band,
             number(r.centre_nm),
             number(r.radiance),
             number(r.snr_analytic),
-            number(r.snr_measured)
+            number(r.snr_measured),
+            number(r.full_scale_fraction)
         );
     }
     s

@@ -9,6 +9,7 @@
 //! requirements: Some((
 //!     products: [(variable: "chl_mg_m3", mae_pct: Some(20), bias_pct: Some(10), returned_pct: Some(95))],
 //!     snr: Some(100),
+//!     substrate_pct: Some(70),
 //! )),
 //! ```
 
@@ -48,6 +49,10 @@ pub struct Requirements {
     /// Smallest analytic SNR in every band at the scene's reference (median water) radiance.
     #[serde(default)]
     pub snr: Option<f64>,
+    /// Smallest share of returned water pixels whose dominant substrate is the truth's, % (for a
+    /// retrieval that unmixes substrates; checked as the variable `substrate`).
+    #[serde(default)]
+    pub substrate_pct: Option<f64>,
 }
 
 /// One check.
@@ -78,13 +83,18 @@ impl Check {
         self.value.map_or_else(|| "–".into(), |v| format!("{v:.decimals$}"))
     }
 
-    /// One line a reviewer can read: "chl_mg_m3 MAE % 12.3 ≤ 20: pass (margin 7.7)".
+    /// One line a reviewer can read: "chl-a MAE % 12.3 vs limit 20: pass (margin +7.7)" (the
+    /// variable by its name for people, [`crate::metrics::name`]).
     #[must_use]
     pub fn describe(&self) -> String {
         let verdict = if self.pass { "pass" } else { "FAIL" };
+        let what = match &self.variable {
+            Some(v) => self.what.replacen(v.as_str(), crate::metrics::name(v), 1),
+            None => self.what.clone(),
+        };
         match (self.value, self.margin) {
-            (Some(v), Some(m)) => format!("{} {v:.1} vs limit {}: {verdict} (margin {m:+.1})", self.what, self.limit),
-            _ => format!("{} (limit {}): {verdict}, no pixel returned", self.what, self.limit),
+            (Some(v), Some(m)) => format!("{what} {v:.1} vs limit {}: {verdict} (margin {m:+.1})", self.limit),
+            _ => format!("{what} (limit {}): {verdict}, no pixel returned", self.limit),
         }
     }
 }
@@ -122,6 +132,11 @@ impl Requirements {
             && let Err(message) = crate::ranges::REQUIREMENT_SNR.check(s)
         {
             return bad("requirements.snr".into(), message);
+        }
+        if let Some(s) = self.substrate_pct
+            && let Err(message) = crate::ranges::REQUIREMENT_SUBSTRATE_PCT.check(s)
+        {
+            return bad("requirements.substrate_pct".into(), message);
         }
         Ok(())
     }
@@ -185,9 +200,27 @@ impl Requirements {
                 push(Some(&p.variable), format!("{} returned %", p.variable), Some(m.returned_pct), l, false);
             }
         }
+        if let (Some(l), Some(a)) = (self.substrate_pct, metrics.and_then(|m| m.substrate_agreement_pct)) {
+            push(Some("substrate"), "substrate right %".into(), Some(a), l, false);
+        }
         if let Some(l) = self.snr {
             for row in snr {
-                push(None, format!("SNR {} ({:.0} nm)", row.band, row.centre_nm), Some(row.snr_analytic), l, false);
+                // A band that saturates at its reference radiance measures nothing there: its
+                // analytic SNR (which knows no well) is not its figure of merit; it fails at 0.
+                let (what, value) = if row.saturated() {
+                    (
+                        format!(
+                            "SNR {} ({:.0} nm), saturated ({:.0} % of full scale)",
+                            row.band,
+                            row.centre_nm,
+                            100.0 * row.full_scale_fraction
+                        ),
+                        0.0,
+                    )
+                } else {
+                    (format!("SNR {} ({:.0} nm)", row.band, row.centre_nm), row.snr_analytic)
+                };
+                push(None, what, Some(value), l, false);
             }
         }
         out
@@ -242,6 +275,7 @@ mod tests {
                 returned_pct,
             }],
             snr: None,
+            substrate_pct: None,
         }
     }
 

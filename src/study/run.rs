@@ -112,6 +112,7 @@ impl StudyResult {
             correction: None,
             fidelity: None,
             requirements,
+            snr_reference: first.snr_reference.clone(),
         };
         let resolved = ResolvedStudy {
             spec,

@@ -36,7 +36,7 @@ fn simulate_writes_cubes_tables_report_and_config() {
     assert_eq!(npy_shape(&dir.join("truth_depth_m.npy")), shape[..2].to_vec());
     assert_eq!(npy_shape(&dir.join("truth_substrate_fractions.npy")), vec![shape[0], shape[1], 4]);
     let snr = std::fs::read_to_string(dir.join("snr.csv")).unwrap();
-    assert!(snr.starts_with("band,centre_nm,radiance_w_m2_sr_nm,snr_analytic,snr_measured\n"));
+    assert!(snr.starts_with("band,centre_nm,radiance_w_m2_sr_nm,snr_analytic,snr_measured,signal_over_full_scale\n"));
     assert_eq!(snr.lines().count(), 20);
     let report = std::fs::read_to_string(dir.join("report.json")).unwrap();
     assert!(report.contains("\"stages\"") && report.contains("SunGlint"));

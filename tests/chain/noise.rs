@@ -223,3 +223,31 @@ fn cubesat_and_smallsat_snr_follow_the_instrument_equation_of_table1() {
         assert!(predicted > 3.0, "{}: {predicted}", c.band);
     }
 }
+
+/// The SNR stated at a reference radiance (as missions and IOCCG state it): every band's row
+/// refers to that radiance (given per µm, kept per nm) and its analytic SNR is the instrument
+/// equation's there; the full-scale share grows in proportion; a radiance that is not one is
+/// refused naming the field.
+#[test]
+fn the_snr_is_stated_at_the_reference_radiance_the_user_sets() {
+    let t1 = Table1::CUBESAT;
+    let srf = olci_srf_lambda_integrals();
+    let mut c = RunConfig::new(small_lake(), small("cubesat", 64, 32));
+    c.snr_reference = Some(shoal::spectral::SpectrumSource::Constant(40.0));
+    let out = run(&c);
+    for row in out.snr.iter() {
+        assert!((row.radiance - 0.040).abs() < 1e-12, "{}: {} W m⁻² sr⁻¹ nm⁻¹", row.band, row.radiance);
+        let integral = srf.iter().find(|(n, _)| *n == row.band).unwrap().1;
+        let want = t1.snr(row.radiance, integral);
+        assert!((row.snr_analytic / want - 1.0).abs() < 1e-8, "{}: {} vs {want}", row.band, row.snr_analytic);
+    }
+    // Twice the radiance: twice the signal against full scale.
+    c.snr_reference = Some(shoal::spectral::SpectrumSource::Constant(80.0));
+    let twice = run(&c);
+    for (a, b) in out.snr.iter().zip(twice.snr.iter()) {
+        assert!((b.full_scale_fraction / a.full_scale_fraction - 2.0).abs() < 1e-9, "{}", a.band);
+    }
+    c.snr_reference = Some(shoal::spectral::SpectrumSource::Constant(-1.0));
+    let e = shoal::engine::Engine::new().run(&c, &shoal::control::RunControl::new()).unwrap_err().to_string();
+    assert!(e.contains("snr_reference") && e.contains("-1"), "{e}");
+}

@@ -43,6 +43,7 @@ fn refusal(range: &Range, value: f64) -> Option<String> {
             "mae_pct" => r.products[0].mae_pct = Some(value),
             "bias_pct" => r.products[0].bias_pct = Some(value),
             "returned_pct" => r.products[0].returned_pct = Some(value),
+            "substrate_pct" => r.substrate_pct = Some(value),
             _ => r.snr = Some(value),
         }
         return r.validate().err().map(|e| e.to_string());
