@@ -6,7 +6,6 @@
 use std::fmt::Write as _;
 
 use super::ReviewData;
-use crate::study::base64;
 
 /// A figure for the page: its file stem and SVG text (and whether a PNG sits beside the page).
 #[derive(Debug, Clone, PartialEq)]
@@ -66,7 +65,7 @@ nav ol { columns: 2; font-size: 14px; } .note { color: #555; font-size: 13px; }
 @media print { h2 { break-before: auto; } figure, table { break-inside: avoid; } pre { max-height: none; } }
 ";
 
-fn num(v: f64, decimals: usize) -> String {
+pub(super) fn num(v: f64, decimals: usize) -> String {
     if v.is_finite() { format!("{v:.decimals$}") } else { "–".into() }
 }
 
@@ -84,8 +83,9 @@ pub fn page(d: &ReviewData, figures: &[PageFigure]) -> String {
     instruments(&mut h, d);
     metrics(&mut h, d);
     figures_section(&mut h, figures);
-    budget_and_cost(&mut h, d);
-    provenance(&mut h, d);
+    super::substrate::section(&mut h, d);
+    super::sections::budget_and_cost(&mut h, d);
+    super::sections::provenance(&mut h, d);
     h += "<footer class=\"note\"><p>Made by Shoal, an end-to-end simulator of satellite optical instruments over water. This page needs no network and no script; every figure is inside it.</p></footer>\n</body>\n</html>\n";
     h
 }
@@ -108,7 +108,21 @@ fn header(h: &mut String, d: &ReviewData) {
     ] {
         let _ = writeln!(h, "<tr><td>{k}</td><td>{}</td></tr>", escape(&v));
     }
-    h.push_str("</table>\n</header>\n<nav><ol>\n<li><a href=\"#verdict\">Verdict against the requirements</a></li>\n<li><a href=\"#instruments\">The instruments side by side</a></li>\n<li><a href=\"#metrics\">Product errors</a></li>\n<li><a href=\"#figures\">Figures</a></li>\n");
+    h.push_str("</table>\n");
+    // Results at reduced resolution say so before anything else is read.
+    let reduced: Vec<String> =
+        d.instruments.iter().filter(|i| i.shape.3 > 1).map(|i| format!("{} at 1/{}", i.label, i.shape.3)).collect();
+    if !reduced.is_empty() {
+        let _ = writeln!(
+            h,
+            "<p class=\"fail\">Reduced resolution: {} (every n-th line and detector). Errors and verdicts are estimates from fewer pixels; run at full resolution for the review.</p>",
+            escape(&reduced.join(", "))
+        );
+    }
+    h.push_str("</header>\n<nav><ol>\n<li><a href=\"#verdict\">Verdict against the requirements</a></li>\n<li><a href=\"#instruments\">The instruments side by side</a></li>\n<li><a href=\"#metrics\">Product errors</a></li>\n<li><a href=\"#figures\">Figures</a></li>\n");
+    if !d.substrates.is_empty() {
+        h.push_str("<li><a href=\"#substrate\">Bottom type</a></li>\n");
+    }
     if !d.budget.is_empty() {
         h.push_str("<li><a href=\"#budget\">Error budget</a></li>\n");
     }
@@ -297,6 +311,7 @@ fn describe_key(key: &str) -> String {
         "nap_g_m3" => "NAP",
         "cdom_per_m" => "CDOM absorption",
         "depth_m" => "depth",
+        "substrate" => "bottom type (dominant substrate)",
         other => other,
     };
     format!("{retrieval} {variable}")
@@ -309,6 +324,7 @@ fn caption(name: &str) -> String {
     match kind {
         "snr" => "SNR per band at the scene's median water radiance: analytic (line) and measured in the noisy cube (open circles); a dashed line, when drawn, is the study's SNR requirement.".into(),
         "maps" => format!("Truth and each instrument's retrieval ({what}) on one colour scale; grey: land or not returned; scale bars give the ground distance."),
+        "agreement" => format!("Where each instrument's {what} is the truth's (green) or not (red), with the share right."),
         "difference" => format!("A − B ({what}): B sampled at the pixel nearest each of A's ground points; diverging scale symmetric about zero."),
         "scatter" => format!("Retrieved against true ({what}), pixel density on log axes; the line is 1:1."),
         "histogram" => format!("Distribution of retrieved values ({what}) by SIOP set or dominant substrate; the outline is the truth."),
@@ -360,7 +376,10 @@ fn figures_section(h: &mut String, figures: &[PageFigure]) {
     }
     // Variables in the order of the chain's products, whatever order the figures came in.
     let priority = |name: &str| {
-        ["chl_mg_m3", "nap_g_m3", "cdom_per_m", "depth_m"].iter().position(|v| name.ends_with(v)).unwrap_or(9)
+        ["chl_mg_m3", "nap_g_m3", "cdom_per_m", "depth_m", "substrate"]
+            .iter()
+            .position(|v| name.ends_with(v))
+            .unwrap_or(9)
     };
     let mut maps: Vec<usize> = (0..figures.len()).filter(|&i| figures[i].name.starts_with("maps_")).collect();
     maps.sort_by_key(|&i| (priority(&figures[i].name), figures[i].name.clone()));
@@ -370,7 +389,7 @@ fn figures_section(h: &mut String, figures: &[PageFigure]) {
         let _ = writeln!(h, "<h3>{}</h3>\n<div class=\"row\">", escape(&describe_key(key)));
         put(h, f);
         shown[i] = true;
-        for kind in ["difference", "scatter", "histogram"] {
+        for kind in ["difference", "agreement", "scatter", "histogram"] {
             if let Some(j) = figures.iter().position(|g| g.name == format!("{kind}_{key}")) {
                 put(h, &figures[j]);
                 shown[j] = true;
@@ -389,115 +408,6 @@ fn figures_section(h: &mut String, figures: &[PageFigure]) {
     h.push_str("</section>\n");
 }
 
-fn budget_and_cost(h: &mut String, d: &ReviewData) {
-    if !d.budget.is_empty() {
-        h.push_str("<section id=\"budget\">\n<h2>Error budget</h2>\n<p class=\"note\">Each stage of the chain made perfect in turn (sequential share: the MAE it removes after those before it) and alone (the MAE with only this stage imperfect, above the floor). Points of %.</p>\n<table>\n<tr><th>instrument</th><th>variable</th><th>full MAE %</th><th>stage</th><th>sequential share</th><th>alone share</th><th>floor MAE %</th></tr>\n");
-        for (inst, var, full, stage, seq, alone, floor) in &d.budget {
-            let _ = writeln!(
-                h,
-                "<tr><td>{}</td><td>{}</td><td class=\"num\">{}</td><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td></tr>",
-                escape(inst),
-                escape(var),
-                num(*full, 1),
-                escape(stage),
-                num(*seq, 1),
-                num(*alone, 1),
-                num(*floor, 1)
-            );
-        }
-        h.push_str("</table>\n</section>\n");
-    }
-    if !d.cost.is_empty() {
-        h.push_str("<section id=\"cost\">\n<h2>Cost of accuracy</h2>\n<p class=\"note\">Each setting timed in interleaved rounds with the reference; a setting whose range of wall times overlaps the reference's shows \"no measurable difference\". Error: per-pixel chl-a difference from the reference run, median and 95th percentile (an error that lives at edges or in a few hard pixels shows in the second while the first stays at zero).</p>\n<table>\n<tr><th>setting</th><th>rounds</th><th>wall s (median)</th><th>range</th><th>CPU s</th><th>vs reference</th><th>chl per pixel %</th><th>p95 %</th></tr>\n");
-        for (setting, n, wall, range, cpu, vs, err, p95) in &d.cost {
-            let _ = writeln!(
-                h,
-                "<tr><td>{}</td><td class=\"num\">{n}</td><td class=\"num\">{}</td><td class=\"num\">{}–{}</td><td class=\"num\">{}</td><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td></tr>",
-                escape(setting),
-                num(*wall, 2),
-                num(range.0, 2),
-                num(range.1, 2),
-                cpu.map_or_else(|| "–".into(), |c| num(c, 2)),
-                escape(vs),
-                err.map_or_else(|| "other grid".into(), |e| num(e, 3)),
-                p95.map_or_else(|| "–".into(), |e| num(e, 3))
-            );
-        }
-        h.push_str("</table>\n</section>\n");
-    }
-}
-
-fn provenance(h: &mut String, d: &ReviewData) {
-    h.push_str("<section id=\"provenance\">\n<h2>Provenance</h2>\n<h3>Data</h3>\n");
-    if d.data_sources.is_empty() {
-        h.push_str("<p>No embedded data file was recorded for these results.</p>\n");
-    } else {
-        h.push_str("<p class=\"note\">The embedded data files read to make these results, with their sources and licences (the full index and licence texts are in Shoal's <code>assets/PROVENANCE.md</code> and <code>assets/licenses/</code>).</p>\n<table>\n<tr><th>files</th><th>content</th><th>source</th><th>licence</th></tr>\n");
-        for (files, content, source, licence) in &d.data_sources {
-            let _ = writeln!(
-                h,
-                "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
-                escape(files),
-                escape(content),
-                escape(source),
-                escape(licence)
-            );
-        }
-        h.push_str("</table>\n");
-    }
-    h.push_str("<h3>Configurations</h3>\n<p class=\"note\">The resolved run configuration of each instrument: <code>shoal simulate --config FILE</code> reruns it exactly.</p>\n");
-    let download = |name: &str, text: &str| {
-        format!(
-            "<a download=\"{}\" href=\"data:text/plain;charset=utf-8;base64,{}\">download {}</a>",
-            escape(name),
-            base64(text.as_bytes()),
-            escape(name)
-        )
-    };
-    for i in &d.instruments {
-        let file = format!("{}.ron", i.label);
-        let _ = writeln!(
-            h,
-            "<details><summary>{} — {}</summary>\n<pre>{}</pre>\n</details>",
-            escape(&i.label),
-            download(&file, &i.config_ron),
-            escape(&i.config_ron)
-        );
-    }
-    let _ = writeln!(
-        h,
-        "<details><summary>study — {}</summary>\n<pre>{}</pre>\n</details>",
-        download(&format!("{}.ron", d.study), &d.study_ron),
-        escape(&d.study_ron)
-    );
-    h.push_str("<h3>Stage timings</h3>\n<p class=\"note\">Seconds per stage of the first run of each instrument (\"cached\": reused from an earlier run whose inputs had not changed).</p>\n");
-    for i in &d.instruments {
-        let (rows, cols, bands, decimation) = i.shape;
-        let _ = writeln!(
-            h,
-            "<p><b>{}</b>: {rows} lines × {cols} detectors × {bands} bands ({}), {} s in all.</p>\n<table>\n<tr><th>stage</th><th></th><th>s</th></tr>",
-            escape(&i.label),
-            if decimation == 1 {
-                "full resolution".to_string()
-            } else {
-                format!("preview: every {decimation}th line and detector")
-            },
-            num(i.total_seconds, 2)
-        );
-        for (stage, status, s) in &i.stages {
-            let _ = writeln!(
-                h,
-                "<tr><td>{}</td><td>{}</td><td class=\"num\">{}</td></tr>",
-                escape(stage),
-                escape(status),
-                num(*s, 3)
-            );
-        }
-        h.push_str("</table>\n");
-    }
-    let _ = writeln!(h, "<h3>Machine</h3>\n<p>{}</p>\n</section>", escape(&d.machine.line()));
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -505,6 +415,7 @@ mod tests {
     #[test]
     fn text_is_escaped_and_file_names_are_url_encoded() {
         assert_eq!(escape("a < b & \"c\""), "a &lt; b &amp; &quot;c&quot;");
+
         assert_eq!(url_path("sweep_chl #2?"), "sweep_chl%20%232%3F");
     }
 }

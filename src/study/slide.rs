@@ -250,10 +250,13 @@ impl Draw for ReviewSlide {
         // Tables along the bottom.
         let table_y = MAPS_TOP + MAPS_H as i32 + 24;
         root.draw_text("Verdicts", &text_style(20, BLACK), (MARGIN, table_y)).map_err(err)?;
-        table(root, &self.verdicts, (MARGIN, table_y + 30), 9)?;
-        root.draw_text("A and B differ in", &text_style(20, BLACK), (PLOTS_X, table_y)).map_err(err)?;
-        table(root, &self.parameters, (PLOTS_X, table_y + 30), 9)?;
         let caption_y = 1080 - 24 * self.caption.len() as i32 - 10;
+        // As many rows as fit above the caption (the products of either retrieval and the SNR
+        // row fit at three caption lines).
+        let rows = usize::try_from((caption_y - table_y - 30) / ROW_H).unwrap_or(1).max(2);
+        table(root, &self.verdicts, (MARGIN, table_y + 30), rows)?;
+        root.draw_text("A and B differ in", &text_style(20, BLACK), (PLOTS_X, table_y)).map_err(err)?;
+        table(root, &self.parameters, (PLOTS_X, table_y + 30), rows)?;
         for (i, line) in self.caption.iter().enumerate() {
             root.draw_text(line, &text_style(15, RGBColor(60, 60, 60)), (MARGIN, caption_y + 24 * i as i32))
                 .map_err(err)?;

@@ -1,0 +1,80 @@
+//! Tests of the review data: the cost rows as the page prints them, the UTC text.
+
+use super::*;
+use crate::timing::Comparison;
+
+#[test]
+fn the_review_pack_states_each_cost_row_with_its_range_and_95th_percentile() {
+    let rows = [
+        CostRow::timed(
+            "reference (full fidelity)",
+            &[4.47, 4.32, 4.49],
+            Comparison::NoMeasurableDifference,
+            Some(0.0),
+            Some(0.0),
+        ),
+        CostRow::timed("the defaults", &[3.63, 3.57, 3.53], Comparison::Ratio(0.7987), Some(0.003), Some(1.713)),
+        CostRow::timed("preview 1/4", &[0.49, 0.45, 0.51], Comparison::Ratio(0.11), None, None),
+        CostRow::timed(
+            "a setting whose percentile failed",
+            &[4.4, 4.3, 4.5],
+            Comparison::NoMeasurableDifference,
+            Some(0.1),
+            Some(f64::NAN),
+        ),
+    ];
+    let table = cost_rows(&rows);
+    // Median of three, the range, the CPU median, the comparison's text, both errors.
+    assert_eq!(
+        table[1],
+        ("the defaults".to_string(), 3, 3.57, (3.53, 3.63), Some(7.14), "0.80×".to_string(), Some(0.003), Some(1.713))
+    );
+    assert_eq!((table[2].6, table[2].7), (None, None), "a preview has other pixels: no per-pixel error");
+    assert_eq!((table[3].6, table[3].7), (Some(0.1), None), "a non-finite percentile is left out, not printed as NaN");
+    let data = ReviewData {
+        study: "s".into(),
+        study_description: String::new(),
+        scene: String::new(),
+        scene_description: String::new(),
+        scene_place: String::new(),
+        created_utc: String::new(),
+        version: String::new(),
+        commit: String::new(),
+        instruments: Vec::new(),
+        parameters: Vec::new(),
+        derived: Vec::new(),
+        checks: Vec::new(),
+        has_requirements: false,
+        judged_retrieval: String::new(),
+        metrics: Vec::new(),
+        budget: Vec::new(),
+        cost: table,
+        data_sources: Vec::new(),
+        machine: machine::Machine::this(),
+        study_ron: String::new(),
+        figures: Vec::new(),
+        substrates: Vec::new(),
+    };
+    let html = html::page(&data, &[]);
+    let row = |label: &str| {
+        let at = html.find(&format!("<tr><td>{label}</td>")).unwrap_or_else(|| panic!("no row {label}"));
+        html[at..at + html[at..].find("</tr>").unwrap()].to_string()
+    };
+    assert_eq!(
+        row("the defaults"),
+        "<tr><td>the defaults</td><td class=\"num\">3</td><td class=\"num\">3.57</td><td class=\"num\">3.53–3.63</td>\
+         <td class=\"num\">7.14</td><td>0.80×</td><td class=\"num\">0.003</td><td class=\"num\">1.713</td>"
+    );
+    assert!(row("reference (full fidelity)").contains("<td>no measurable difference</td>"));
+    assert!(row("preview 1/4").ends_with("<td class=\"num\">other grid</td><td class=\"num\">–</td>"));
+    assert!(row("a setting whose percentile failed").ends_with("<td class=\"num\">0.100</td><td class=\"num\">–</td>"));
+    assert!(!html.contains("NaN"));
+}
+
+#[test]
+fn utc_text_matches_the_calendar() {
+    // Values from Python's datetime.utcfromtimestamp: the epoch, a leap day, this decade.
+    assert_eq!(utc_text(0), "1970-01-01T00:00:00Z");
+    assert_eq!(utc_text(951_782_400), "2000-02-29T00:00:00Z");
+    assert_eq!(utc_text(1_795_566_896), "2026-11-25T00:34:56Z");
+}
