@@ -2,6 +2,7 @@
 //! table, figures, cubes and resolved configuration. With no study named, the built-in
 //! CubeSat vs SmallSat study over Lake Hume runs, so a new user sees a result at once.
 
+use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -127,14 +128,17 @@ pub fn run(args: &StudyArgs) -> Result<(), CliError> {
     outputs.files.push(crate::report::REVIEW_JSON.into());
     out_dir.commit()?;
     eprintln!("{}: {n} runs in {:.1} s", spec.name, start.elapsed().as_secs_f64());
-    print_metrics(&result);
+    let mut table = String::new();
+    print_metrics(&mut table, &result);
     if let Some(r) = &spec.requirements {
-        eprintln!(
+        let _ = writeln!(
+            table,
             "{:<12} {:<28} {:>10} {:>10} {:>6} {:>10}",
             "instrument", "requirement", "value", "limit", "", "margin"
         );
         for c in r.check(&result) {
-            eprintln!(
+            let _ = writeln!(
+                table,
                 "{:<12} {:<28} {:>10} {:>10.1} {:>6} {:>10}",
                 c.instrument,
                 c.what,
@@ -145,6 +149,7 @@ pub fn run(args: &StudyArgs) -> Result<(), CliError> {
             );
         }
     }
+    super::output::emit(&table, None)?;
     let mut warned: Vec<&str> = Vec::new();
     for run in &result.runs {
         if !warned.contains(&run.label.as_str()) {
@@ -158,18 +163,21 @@ pub fn run(args: &StudyArgs) -> Result<(), CliError> {
     Ok(())
 }
 
-/// The metrics table on stderr: per instrument, product and variable; pixel accounting; the
-/// spread over the noise seeds when there are several.
-fn print_metrics(result: &crate::study::StudyResult) {
-    print_runs(result);
+/// The metrics table (for standard output; progress and warnings go to standard error): per
+/// instrument, product and variable; pixel accounting; the spread over the noise seeds when there
+/// are several.
+fn print_metrics(out: &mut String, result: &crate::study::StudyResult) {
+    print_runs(out, result);
     let spread = crate::study::seed_spread(result);
     if spread.iter().any(|s| s.seeds > 1) {
-        eprintln!(
+        let _ = writeln!(
+            out,
             "\nover the noise seeds: {:<12} {:<8} {:<24} {:>16} {:>17} {:>9}",
             "instrument", "product", "variable", "MAE % (mean ± sd)", "MAE % (min–max)", "bias %"
         );
         for s in &spread {
-            eprintln!(
+            let _ = writeln!(
+                out,
                 "                      {:<12} {:<8} {:<24} {:>16} {:>17} {:>+9.1}",
                 s.instrument,
                 s.product,
@@ -183,15 +191,17 @@ fn print_metrics(result: &crate::study::StudyResult) {
 }
 
 /// Per run: the metrics of each product and variable, and the pixel accounting.
-fn print_runs(result: &crate::study::StudyResult) {
-    eprintln!(
+fn print_runs(out: &mut String, result: &crate::study::StudyResult) {
+    let _ = writeln!(
+        out,
         "{:<12} {:<8} {:<24} {:>9} {:>9} {:>10}  mean |error|, units",
         "instrument", "product", "variable", "MAE %", "bias %", "returned %"
     );
     for run in &result.runs {
         for ret in &run.retrievals {
             for v in ret.metrics.variables.iter().chain(&ret.metrics.depth_by_true_substrate) {
-                eprintln!(
+                let _ = writeln!(
+                    out,
                     "{:<12} {:<8} {:<24} {:>9.1} {:>+9.1} {:>10.2}  {:.3} {}",
                     run.label,
                     ret.metrics.product,
@@ -204,19 +214,22 @@ fn print_runs(result: &crate::study::StudyResult) {
                 );
             }
             if let Some(a) = ret.metrics.substrate_agreement_pct {
-                eprintln!(
+                let _ = writeln!(
+                    out,
                     "{:<12} {:<8} dominant substrate right in {a:.1} % of pixels",
                     run.label, ret.metrics.product
                 );
             }
             if ret.metrics.failed > 0 || ret.metrics.stalled > 0 {
-                eprintln!(
+                let _ = writeln!(
+                    out,
                     "{:<12} {:<8} water pixels not returned: {}; stalled at the start depth: {}",
                     run.label, ret.metrics.product, ret.metrics.failed, ret.metrics.stalled
                 );
             }
             if !ret.metrics.siop_set_counts.is_empty() {
-                eprintln!(
+                let _ = writeln!(
+                    out,
                     "{:<12} {:<8} SIOP sets used: {} of {}",
                     run.label,
                     ret.metrics.product,

@@ -18,6 +18,22 @@ pub fn apply(base: &RunConfig, settings: &[(&str, f64)]) -> Result<RunConfig, St
     Ok(config)
 }
 
+/// The number at `path` of `config` (`None`: no such field, or not a number there — a field of
+/// another instrument kind, a map).
+#[must_use]
+pub fn value(config: &RunConfig, path: &str) -> Option<f64> {
+    let tree = serde_json::to_value(config).ok()?;
+    let mut node = &tree;
+    for key in path.split('.') {
+        node = match node {
+            Value::Object(map) => map.get(key)?,
+            Value::Array(items) => items.get(key.parse::<usize>().ok()?)?,
+            _ => return None,
+        };
+    }
+    node.as_f64()
+}
+
 fn set(tree: &mut Value, path: &str, value: f64) -> Result<(), String> {
     let mut node = tree;
     for key in path.split('.') {

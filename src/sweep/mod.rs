@@ -25,7 +25,7 @@ pub mod figure;
 mod run;
 mod table;
 
-pub use apply::apply;
+pub use apply::{apply, value};
 pub use cost::{CostRow, Setting, cheapest_within, cost_of_accuracy, fidelity_of, pareto_front, settings_for};
 pub use figure::sweep_figure;
 pub use run::{Job, SweepResult, empty_table, run_job, run_sweep};

@@ -70,6 +70,8 @@ pub fn run_job(
         other => StudyError::Run { instrument: format!("{label} at {settings:?}"), message: other.to_string() },
     })?;
     let secs = start.elapsed().as_secs_f64();
+    let (r, c, b) = out.level0.dn.dim();
+    let saturated_pct = 100.0 * out.report.saturated as f64 / (r * c * b).max(1) as f64;
     let mut rows = Vec::new();
     for ret in &out.retrievals {
         for v in &ret.metrics.variables {
@@ -85,6 +87,7 @@ pub fn run_job(
                 bias_pct: v.metrics.bias_pct(),
                 returned_pct: v.metrics.returned_pct,
                 n: v.metrics.n,
+                saturated_pct,
             });
         }
     }

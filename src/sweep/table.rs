@@ -32,6 +32,9 @@ pub struct Row {
     pub returned_pct: f64,
     /// Pixels compared.
     pub n: usize,
+    /// Level-0 pixel-bands saturated (the well or the ADC full), % — where a curve jumps because
+    /// the design saturates, the table says so. Tables written before the column read 0.
+    pub saturated_pct: f64,
 }
 
 /// A sweep table: identity, the runs it holds, and its rows.
@@ -64,15 +67,23 @@ impl Table {
             s.push_str(p);
             s.push(',');
         }
-        s.push_str("instrument,seed,product,variable,mae_pct,bias_pct,returned_pct,n\n");
+        s.push_str("instrument,seed,product,variable,mae_pct,bias_pct,returned_pct,n,saturated_pct\n");
         for r in &self.rows {
             s.push_str(&format!("{},{},", r.job, r.point));
             for v in &r.values {
                 s.push_str(&format!("{v},"));
             }
             s.push_str(&format!(
-                "{},{},{},{},{},{},{},{}\n",
-                r.instrument, r.seed, r.product, r.variable, r.mae_pct, r.bias_pct, r.returned_pct, r.n
+                "{},{},{},{},{},{},{},{},{}\n",
+                r.instrument,
+                r.seed,
+                r.product,
+                r.variable,
+                r.mae_pct,
+                r.bias_pct,
+                r.returned_pct,
+                r.n,
+                r.saturated_pct
             ));
         }
         s
@@ -105,10 +116,12 @@ impl Table {
             }
             if columns.is_empty() {
                 columns = line.split(',').map(str::to_string).collect();
-                if columns.len() < 10 || columns[0] != "job" {
+                // Tables written before the `saturated_pct` column end at `n`.
+                let trailing = if columns.last().map(String::as_str) == Some("saturated_pct") { 9 } else { 8 };
+                if columns.len() < trailing + 2 || columns[0] != "job" {
                     return Err(bad(i + 1, "expected the column header".into()));
                 }
-                table.parameters = columns[2..columns.len() - 8].to_vec();
+                table.parameters = columns[2..columns.len() - trailing].to_vec();
                 continue;
             }
             let cells: Vec<&str> = line.split(',').collect();
@@ -138,6 +151,7 @@ impl Table {
                 bias_pct: num(7 + np)?,
                 returned_pct: num(8 + np)?,
                 n: int(9 + np)? as usize,
+                saturated_pct: if cells.len() > 10 + np { num(10 + np)? } else { 0.0 },
             });
         }
         Ok(table)

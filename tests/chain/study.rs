@@ -71,6 +71,9 @@ fn the_study_command_runs_a_file_and_refuses_a_broken_one() {
         .output()
         .unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    // The table is the command's output: on stdout, for a pipe; progress stays on stderr.
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(table.contains("MAE %") && table.contains("cubesat") && table.contains("chl_mg_m3"), "{table}");
     assert!(dir.join("out/cubesat/level0_dn.npy").exists());
     assert!(dir.join("out/smallsat/alm_chl_mg_m3.npy").exists());
     assert!(dir.join("out/figures/maps_alm_chl_mg_m3.png").exists());
