@@ -60,6 +60,27 @@ pub struct Entry {
     pub builtin: bool,
     /// The user's file, if not built in.
     pub path: Option<PathBuf>,
+    /// Its `description` field (empty when it has none or cannot be read).
+    pub description: String,
+}
+
+/// The `description: "…"` of a preset's RON text (empty without one), read without parsing
+/// the whole preset (a listing shows it beside the name).
+#[must_use]
+pub fn description_of(text: &str) -> String {
+    let Some(at) = text.find("description:") else { return String::new() };
+    let rest = text[at + "description:".len()..].trim_start();
+    let Some(body) = rest.strip_prefix('"') else { return String::new() };
+    let mut out = String::new();
+    let mut chars = body.chars();
+    while let Some(c) = chars.next() {
+        match c {
+            '"' => return out,
+            '\\' => out.extend(chars.next()),
+            c => out.push(c),
+        }
+    }
+    String::new()
 }
 
 /// Errors of the library: the message names the file and what went wrong.
@@ -106,6 +127,20 @@ pub fn home_dir() -> PathBuf {
     std::env::var_os("HOME").map_or_else(|| PathBuf::from(".shoal"), |h| PathBuf::from(h).join(".config").join("shoal"))
 }
 
+/// Where the app's exports go by default, a folder the user sees: `SHOAL_HOME/exports` when
+/// `SHOAL_HOME` is set, else `~/Documents/Shoal` (or `~/Shoal` without a Documents folder).
+#[must_use]
+pub fn export_dir() -> PathBuf {
+    if let Some(h) = std::env::var_os("SHOAL_HOME") {
+        return PathBuf::from(h).join("exports");
+    }
+    match std::env::var_os("HOME").map(PathBuf::from) {
+        Some(home) if home.join("Documents").is_dir() => home.join("Documents").join("Shoal"),
+        Some(home) => home.join("Shoal"),
+        None => home_dir().join("exports"),
+    }
+}
+
 fn valid_name(name: &str) -> bool {
     !name.is_empty() && name.len() <= 64 && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
 }
@@ -129,7 +164,13 @@ impl Library {
     #[must_use]
     pub fn list(&self, kind: Kind) -> Vec<Entry> {
         let builtin = builtin_names(kind);
-        let mut out: Vec<Entry> = builtin.into_iter().map(|name| Entry { name, builtin: true, path: None }).collect();
+        let mut out: Vec<Entry> = builtin
+            .into_iter()
+            .map(|name| {
+                let text = crate::assets::preset(&format!("{}/{name}.ron", kind.folder())).map(|a| a.text);
+                Entry { description: text.map(description_of).unwrap_or_default(), name, builtin: true, path: None }
+            })
+            .collect();
         let mut user: Vec<Entry> = std::fs::read_dir(self.dir.join(kind.folder()))
             .into_iter()
             .flatten()
@@ -142,6 +183,13 @@ impl Library {
                             name: s.to_string(),
                             builtin: false,
                             path: Some(path.clone()),
+                            // A user's file larger than a preset can be is not read for this.
+                            description: std::fs::metadata(&path)
+                                .ok()
+                                .filter(|m| m.len() < 1 << 20)
+                                .and_then(|_| std::fs::read_to_string(&path).ok())
+                                .map(|t| description_of(&t))
+                                .unwrap_or_default(),
                         })
                     })
                     .flatten()
@@ -237,6 +285,16 @@ mod tests {
             std::env::temp_dir().join(format!("shoal-lib-{}-{:?}", std::process::id(), std::thread::current().id()));
         let _ = std::fs::remove_dir_all(&d);
         d
+    }
+
+    #[test]
+    fn a_description_is_read_from_the_text_without_parsing_it() {
+        assert_eq!(
+            description_of("X(name: \"a\", description: \"Lake \\\"Hume\\\" bloom\", b: 1)"),
+            "Lake \"Hume\" bloom"
+        );
+        assert_eq!(description_of("X(name: \"a\")"), "");
+        assert_eq!(description_of("X(description: \"cut"), "", "an unterminated string is no description");
     }
 
     #[test]

@@ -33,8 +33,10 @@ pub(super) fn derived(app: &ShoalApp, ui: &mut egui::Ui) {
             }
             ui.label("Peak SNR");
             for i in 0..2 {
-                let snr = app.link.shown[i]
-                    .as_ref()
+                // Only the configuration set: a failed or pending run shows no figure.
+                let snr = app
+                    .link
+                    .current(i)
                     .map(|s| s.output.snr.iter().map(|r| r.snr_analytic).fold(0.0, f64::max))
                     .map_or_else(|| "–".to_string(), |v| format!("{v:.0}"));
                 ui.label(snr);
@@ -59,7 +61,7 @@ fn graded(ui: &mut egui::Ui, text: String, level: u8, why: &str) {
 /// The engine's `Feasibility` stage for A and B over this scene (src/instrument/feasibility.rs).
 fn feasibility(app: &ShoalApp, ui: &mut egui::Ui) {
     use crate::instrument::feasibility::{Q_DETECTOR_LIMITED, Q_OPTICS_LIMITED, SATURATION_HEADROOM};
-    let figures: Vec<_> = app.link.shown.iter().map(|s| s.as_ref().map(|s| s.output.feasibility.clone())).collect();
+    let figures: Vec<_> = (0..2).map(|i| app.link.current(i).map(|s| s.output.feasibility.clone())).collect();
     // The warnings stay in sight; the figures behind them fold away.
     for (ab, figure) in Ab::BOTH.iter().zip(&figures) {
         for w in figure.iter().flat_map(|f| &f.warnings) {
@@ -126,8 +128,8 @@ fn feasibility(app: &ShoalApp, ui: &mut egui::Ui) {
 /// The parameters in which A and B differ (the review slide shows the same table).
 pub(super) fn a_vs_b(app: &ShoalApp, ui: &mut egui::Ui) {
     egui::CollapsingHeader::new("A vs B").default_open(false).show(ui, |ui| {
-        let bands = [Ab::A, Ab::B]
-            .map(|ab| app.link.shown[ab.index()].as_ref().map_or(0, |s| s.output.response.bands.bands.len()));
+        let bands =
+            [Ab::A, Ab::B].map(|ab| app.link.current(ab.index()).map_or(0, |s| s.output.response.bands.bands.len()));
         let rows = super::params::differences(&app.state.a.spec, &app.state.b.spec, (bands[0], bands[1]));
         egui::Grid::new("a_vs_b").num_columns(3).striped(true).show(ui, |ui| {
             for row in &rows {

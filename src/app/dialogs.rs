@@ -3,14 +3,13 @@
 //! error dialog.
 
 use std::path::PathBuf;
-use std::time::Instant;
 
 use super::{Confirm, ShoalApp, export};
 
 impl ShoalApp {
     /// The typed-path export row (shown on request, or when a dialog could not be used).
     pub(super) fn typed_export(&mut self, ui: &mut egui::Ui) {
-        ui.horizontal(|ui| {
+        ui.horizontal_centered(|ui| {
             let l = ui.label("Export to");
             ui.add(egui::TextEdit::singleline(&mut self.ui.export_path).desired_width(420.0)).labelled_by(l.id);
             let path = PathBuf::from(self.ui.export_path.trim());
@@ -63,49 +62,53 @@ impl ShoalApp {
         }
     }
 
+    /// The run's state, in a box of fixed width (nothing beside it moves as the text changes):
+    /// the stage running and how far its rows have gone, with the time left in it once its pace
+    /// is known; Cancel; after a cancel, Refine; a failed instrument in red; "up to date" only
+    /// when both instruments show the configuration set, at the finest level asked for.
     pub(super) fn status(&mut self, ui: &mut egui::Ui) {
-        match self.link.progress {
-            Some(p) if self.link.busy() => {
-                let which = if p.index == 0 { "A" } else { "B" };
-                let level = if p.decimation == 1 {
-                    "full resolution".to_string()
-                } else {
-                    format!("preview 1/{}", p.decimation)
-                };
-                let key = (self.link.generation(), p.index, p.decimation);
-                let since = match self.ui.progress_since {
-                    Some((k, t)) if k == key => t,
-                    _ => {
-                        let now = Instant::now();
-                        self.ui.progress_since = Some((key, now));
-                        now
+        let size = egui::vec2(STATUS_WIDTH, ui.spacing().interact_size.y);
+        let failed: Vec<&str> = (0..2)
+            .filter(|&i| matches!(self.link.standing(i), super::link::Standing::Failed(_)))
+            .map(|i| if i == 0 { "A" } else { "B" })
+            .collect();
+        let mut cancel = false;
+        let mut refine = false;
+        ui.allocate_ui_with_layout(size, egui::Layout::left_to_right(egui::Align::Center), |ui| {
+            ui.set_min_size(size);
+            if self.link.busy() {
+                cancel =
+                    ui.button("Cancel run").on_hover_text("Stop here: what is on screen stays, as a preview").clicked();
+                match self.link.progress {
+                    Some(p) => {
+                        let (fraction, text, hover) = progress_text(&p);
+                        let bar = egui::ProgressBar::new(fraction).desired_width(ui.available_width() - 4.0).text(text);
+                        ui.add(bar).on_hover_text(hover);
                     }
-                };
-                let elapsed = since.elapsed().as_secs_f64();
-                // The stages add their rows as they start, so the row fraction alone runs ahead;
-                // the last run at this resolution, when there is one, gives the time it takes.
-                let (fraction, text) = match self.ui.run_seconds.get(&(p.index, p.decimation)) {
-                    Some(&last) if last > 0.5 => {
-                        let f = (elapsed / last).min(0.99);
-                        let left = (last - elapsed).max(0.0);
-                        (f, format!("{which}: {level} {:.0} %, ~{left:.0} s left", 100.0 * f))
+                    None => {
+                        ui.spinner();
+                        ui.label("starting");
                     }
-                    _ => {
-                        let f = if p.total > 0 { p.done as f64 / p.total as f64 } else { 0.0 };
-                        (f.min(0.99), format!("{which}: {level} {:.0} %", 100.0 * f.min(0.99)))
-                    }
-                };
-                ui.add(egui::ProgressBar::new(fraction as f32).desired_width(220.0).text(text)).on_hover_text(
-                    "Estimated from the last run of this instrument at this resolution (its stages may now be \
-                     cached, so it can finish sooner); the first run shows the share of rows done.",
-                );
-            }
-            _ if self.link.busy() => {
-                ui.add(egui::ProgressBar::new(0.0).desired_width(140.0).text("starting"));
-            }
-            _ => {
+                }
+            } else if !failed.is_empty() {
+                ui.colored_label(super::theme::FAIL, format!("{} failed: see the maps", failed.join(" and ")))
+                    .on_hover_text(
+                        "The run of the configuration set failed; its reason is shown where its maps would be.",
+                    );
+            } else if self.link.cancelled() {
+                refine = ui.button("Refine").on_hover_text("Run on to full resolution").clicked();
+                ui.colored_label(super::theme::WARN, "stopped: previews");
+            } else if self.state.preview_only {
+                ui.label("preview only (settings)");
+            } else {
                 ui.label("up to date");
             }
+        });
+        if cancel {
+            self.link.cancel();
+        }
+        if refine {
+            self.link.refine();
         }
         if let Some(ms) = self.median_frame_ms() {
             ui.small("diagnostics").on_hover_text(format!(
@@ -127,5 +130,55 @@ impl ShoalApp {
                 self.ui.error = None;
             }
         }
+    }
+}
+
+/// Width of the status box in the top bar, logical pixels.
+const STATUS_WIDTH: f32 = 330.0;
+
+/// The progress bar's fraction, text and hover for the run in flight: the stage and its own rows
+/// (a stage without a per-pixel loop shows no fraction), the time left in it only once its pace
+/// is known. Never a figure for the whole run: the stages' costs differ by orders of magnitude
+/// (a SAMBUCA row costs a thousand Level-0 rows), so no row count can say how much is left.
+fn progress_text(p: &super::link::Progress) -> (f32, String, String) {
+    let which = if p.index == 0 { "A" } else { "B" };
+    let level = if p.decimation == 1 { "full res.".to_string() } else { format!("1/{}", p.decimation) };
+    match p.stage {
+        Some(stage) if stage.total > 0 => {
+            let f = (stage.done as f64 / stage.total as f64).min(1.0);
+            let left = stage.seconds_left().map_or_else(String::new, |s| format!(", ~{}", duration(s)));
+            (
+                f as f32,
+                format!("{which} {level}: {} {:.0} %{left}", stage.name, 100.0 * f),
+                format!(
+                    "{which} at {level}: stage {} (the {}th computed), {} of {} rows after {}{}",
+                    stage.name,
+                    stage.ordinal,
+                    stage.done,
+                    stage.total,
+                    duration(stage.seconds),
+                    if left.is_empty() {
+                        "; the time left shows once 5 % of the rows are done".to_string()
+                    } else {
+                        format!("; at this pace{left} left in this stage")
+                    }
+                ),
+            )
+        }
+        Some(stage) => (
+            0.0,
+            format!("{which} {level}: {}", stage.name),
+            format!("{which} at {level}: stage {} for {}", stage.name, duration(stage.seconds)),
+        ),
+        None => (0.0, format!("{which} {level}: starting"), String::new()),
+    }
+}
+
+/// `12 s`, `3 min 5 s`.
+fn duration(seconds: f64) -> String {
+    if seconds < 60.0 {
+        format!("{seconds:.0} s")
+    } else {
+        format!("{} min {:.0} s", (seconds / 60.0).floor(), seconds % 60.0)
     }
 }

@@ -7,7 +7,7 @@
 //! Both run on a helper thread (not the engine thread, whose pool serves the maps) and stream
 //! their results; a new run or closing the window cancels the old one.
 
-use egui_plot::{HLine, Legend, Line, Plot, PlotPoints, Points};
+use egui_plot::{Legend, Plot, Points};
 
 use super::model::AppState;
 use crate::engine::{Engine, Fidelity, RunConfig};
@@ -17,25 +17,22 @@ use crate::sweep::{
     CostRow, Parameter, Requirement, Row, SweepSpec, Table, Values, cost_of_accuracy, empty_table, run_job,
 };
 
-/// Parameters the sweep window offers: (label, path below `instrument.`, unit, default range).
-const SWEEPABLE: [(&str, &str, &str, f64, f64); 8] = [
-    ("Aperture", "aperture_mm", "mm", 40.0, 300.0),
-    ("Exposure", "exposure_s", "s", 0.0005, 0.005),
-    ("Read noise", "read_noise_e", "e⁻", 1.0, 80.0),
-    ("Well depth", "well_depth_e", "e⁻", 10_000.0, 400_000.0),
-    ("Gain", "gain_e_per_dn", "e⁻/DN", 0.5, 20.0),
-    ("Optical transmission", "optical_transmission", "", 0.3, 1.0),
-    ("Focal length", "focal_length_mm", "mm", 80.0, 400.0),
-    ("Altitude", "altitude_km", "km", 400.0, 800.0),
-];
-
 /// The windows' state (not persisted: results belong to the session).
 pub struct Explore {
     /// Is the sweep window open?
     pub sweep_open: bool,
     /// Is the cost window open?
     pub cost_open: bool,
-    param: usize,
+    /// The swept field's path in the run configuration (`instrument.aperture_mm`).
+    param: String,
+    /// A second parameter and its span (a curve per value), if any.
+    second: Option<(String, f64, f64)>,
+    /// The product whose MAE the curves show.
+    variable: String,
+    /// The MAE on a log axis.
+    log_y: bool,
+    /// The requirement on `variable` in use.
+    requirement: Option<Requirement>,
     from: f64,
     to: f64,
     steps: usize,
@@ -63,9 +60,13 @@ impl Default for Explore {
         Self {
             sweep_open: false,
             cost_open: false,
-            param: 0,
-            from: SWEEPABLE[0].3,
-            to: SWEEPABLE[0].4,
+            param: "instrument.aperture_mm".into(),
+            second: None,
+            variable: "chl_mg_m3".into(),
+            log_y: true,
+            requirement: None,
+            from: 40.0,
+            to: 300.0,
             steps: 6,
             log: true,
             seeds: 3,
@@ -144,9 +145,29 @@ impl Explore {
         }
     }
 
-    /// Start the sweep of the chosen parameter over A and B as they are now.
+    /// Start the sweep of the chosen parameter (and the second, when set) over A and B as they
+    /// are now.
     pub fn start_sweep(&mut self, ctx: &egui::Context, state: &AppState) {
-        let (_, key, _, _, _) = SWEEPABLE[self.param];
+        let whole = |path: &str| crate::ranges::ALL.iter().any(|r| r.path == path && r.whole);
+        // Whole-number fields take whole values (a list), the rest a range.
+        let values = |path: &str, from: f64, to: f64, steps: usize, log: bool| {
+            if whole(path) {
+                let mut v: Vec<f64> =
+                    (0..steps).map(|i| (from + (to - from) * i as f64 / (steps.max(2) - 1) as f64).round()).collect();
+                v.dedup();
+                Values::List(v)
+            } else {
+                Values::Range { from, to, steps, log: log && from > 0.0 }
+            }
+        };
+        let mut parameters = vec![Parameter {
+            path: self.param.clone(),
+            values: values(&self.param, self.from, self.to, self.steps, self.log),
+        }];
+        if let Some((path, a, b)) = &self.second {
+            parameters.push(Parameter { path: path.clone(), values: values(path, *a, *b, 3, false) });
+        }
+        let key = self.param.rsplit('.').next().unwrap_or("parameter").to_string();
         let study = StudySpec {
             name: "app".into(),
             description: String::new(),
@@ -162,17 +183,15 @@ impl Explore {
             correction: None,
             fidelity: Some(state.fidelity.clone()),
             requirements: None,
+            snr_reference: state.snr_reference.clone(),
         };
         let spec = SweepSpec {
             name: format!("app_{key}"),
             description: String::new(),
             study: Source::Inline(Box::new(study)),
-            parameters: vec![Parameter {
-                path: format!("instrument.{key}"),
-                values: Values::Range { from: self.from, to: self.to, steps: self.steps, log: self.log },
-            }],
+            parameters,
             seeds: (1..=self.seeds).collect(),
-            requirement: chl_requirement(state),
+            requirement: sweep::requirement(state, &self.variable),
         };
         let mut sweep = match spec.resolve(None) {
             Ok(s) => s,
@@ -232,159 +251,6 @@ impl Explore {
             Err(e) => self.cost_status = e,
         }
     }
-}
-
-/// The sweep's chl MAE curves (A solid, B dashed, seed range faint) against the swept parameter
-/// over its range, on a log axis for a log sweep.
-fn sweep_plot(
-    ui: &mut egui::Ui,
-    curves: &crate::study::Curves,
-    requirement: Option<&Requirement>,
-    x_label: &str,
-    log: bool,
-    range: (f64, f64),
-) {
-    let x_of = move |x: f64| if log { x.log10() } else { x };
-    let x_label = x_label.to_string();
-    let (from, to) = (x_of(range.0), x_of(range.1));
-    Plot::new("sweep-plot")
-        .legend(Legend::default().position(egui_plot::Corner::RightTop))
-        .x_axis_label(if log { format!("{x_label}, log scale") } else { x_label })
-        .y_axis_label("chl log-space MAE (%)")
-        // The axes from the sweep's range, not egui's −100…100 before the first point.
-        .include_x(from.min(to))
-        .include_x(from.max(to))
-        .include_y(0.0)
-        .x_axis_formatter(move |mark, _| {
-            crate::colormap::significant(if log { 10f64.powf(mark.value) } else { mark.value }, 3)
-        })
-        .show(ui, |p| {
-            for (k, s) in curves.series.iter().enumerate() {
-                let colour = super::theme::INSTRUMENT.get(k).copied().unwrap_or_else(|| super::theme::category(k));
-                // B dashed over A: identical instruments stay visible as two curves.
-                let style = if k == 0 { egui_plot::LineStyle::Solid } else { egui_plot::LineStyle::dashed_loose() };
-                p.line(
-                    Line::new(s.label.clone(), PlotPoints::from_iter(s.points.iter().map(|q| [x_of(q.x), q.mean])))
-                        .color(colour)
-                        .style(style)
-                        .width(2.0),
-                );
-                p.line(
-                    Line::new(
-                        format!("{} lowest seed", s.label),
-                        PlotPoints::from_iter(s.points.iter().map(|q| [x_of(q.x), q.lo])),
-                    )
-                    .color(colour.gamma_multiply(0.4)),
-                );
-                p.line(
-                    Line::new(
-                        format!("{} highest seed", s.label),
-                        PlotPoints::from_iter(s.points.iter().map(|q| [x_of(q.x), q.hi])),
-                    )
-                    .color(colour.gamma_multiply(0.4)),
-                );
-                if let (Some(r), Some(x)) = (requirement, s.crossing) {
-                    p.points(
-                        Points::new(format!("{} meets", s.label), vec![[x_of(x), r.mae_pct]]).radius(6.0).color(colour),
-                    );
-                }
-            }
-            if let Some(r) = requirement {
-                p.hline(HLine::new("requirement", r.mae_pct).color(super::theme::PASS));
-            }
-        });
-}
-
-fn labelled_drag(ui: &mut egui::Ui, label: &str, value: &mut f64, speed: f64) {
-    let l = ui.label(label);
-    ui.add(egui::DragValue::new(value).update_while_editing(false).speed(speed)).labelled_by(l.id);
-}
-
-/// The sweep window.
-pub fn sweep_window(app: &mut super::ShoalApp, ctx: &egui::Context) {
-    let mut open = app.ui.explore.sweep_open;
-    let mut start = false;
-    egui::Window::new("Sweep").open(&mut open).default_size([620.0, 460.0]).show(ctx, |ui| {
-        let e = &mut app.ui.explore;
-        ui.horizontal(|ui| {
-            let before = e.param;
-            egui::ComboBox::from_label("Parameter").selected_text(SWEEPABLE[e.param].0).show_ui(ui, |ui| {
-                for (i, p) in SWEEPABLE.iter().enumerate() {
-                    ui.selectable_value(&mut e.param, i, p.0);
-                }
-            });
-            if e.param != before {
-                (e.from, e.to) = (SWEEPABLE[e.param].3, SWEEPABLE[e.param].4);
-            }
-            let (from_speed, to_speed) = (0.01 * e.from.abs().max(1e-3), 0.01 * e.to.abs().max(1e-3));
-            labelled_drag(ui, "From", &mut e.from, from_speed);
-            labelled_drag(ui, "To", &mut e.to, to_speed);
-            ui.label(SWEEPABLE[e.param].2);
-        });
-        ui.horizontal(|ui| {
-            ui.add(egui::Slider::new(&mut e.steps, 2..=20).update_while_editing(false).text("Points"));
-            ui.checkbox(&mut e.log, "Log spacing");
-            ui.add(egui::Slider::new(&mut e.seeds, 1..=10).update_while_editing(false).text("Seeds"));
-        });
-        ui.horizontal(|ui| {
-            egui::ComboBox::from_label("Resolution").selected_text(format!("1/{}", e.decimation)).show_ui(ui, |ui| {
-                for d in [2, 4, 8, 16, 24] {
-                    ui.selectable_value(&mut e.decimation, d, format!("1/{d}"));
-                }
-            });
-            let runs = 2 * e.steps * e.seeds as usize;
-            if ui.button("Run sweep").on_hover_text(format!("{runs} runs of A and B")).clicked() {
-                start = true;
-            }
-        });
-        if e.sweep_task.is_some() && ui.button("Stop").clicked() {
-            e.sweep_task = None;
-            e.sweep_status = "stopped".into();
-        }
-        let done = e.table.as_ref().map_or(0, |t| {
-            let mut jobs: Vec<usize> = t.rows.iter().map(|r| r.job).collect();
-            jobs.dedup();
-            jobs.len()
-        });
-        ui.label(format!("{} ({done}/{} runs)", e.sweep_status, e.sweep_total));
-        let requirement = chl_requirement(&app.state);
-        if let Some(table) = &e.table {
-            let mut curves = crate::sweep::figure::curves(table, "chl_mg_m3", requirement.as_ref(), false);
-            // A and B by their slots, not the study's de-duplicated names (`smallsat_2`).
-            if curves.series.len() == 2 {
-                for (s, (ab, slot)) in curves.series.iter_mut().zip([("A", &app.state.a), ("B", &app.state.b)]) {
-                    s.label = format!("{ab}: {}", slot.preset);
-                }
-            }
-            let (name, _, unit, _, _) = SWEEPABLE[e.param];
-            let x_label = if unit.is_empty() { name.to_string() } else { format!("{name} ({unit})") };
-            let log = e.log;
-            for s in &curves.series {
-                match (&requirement, s.crossing) {
-                    (Some(r), Some(x)) => ui.label(format!(
-                        "{}: meets chl MAE ≤ {:.0} % from {} = {} {unit}",
-                        s.label,
-                        r.mae_pct,
-                        name.to_lowercase(),
-                        crate::colormap::significant(x, 3)
-                    )),
-                    (Some(r), None) => {
-                        ui.label(format!("{}: does not meet chl MAE ≤ {:.0} % (so far)", s.label, r.mae_pct))
-                    }
-                    (None, _) => ui.label(format!("{}: no chl MAE requirement set", s.label)),
-                };
-            }
-            sweep_plot(ui, &curves, requirement.as_ref(), &x_label, log, (e.from, e.to));
-        }
-    });
-    if start {
-        let state = app.state.clone();
-        app.ui.explore.start_sweep(ctx, &state);
-    }
-    if !open {
-        app.ui.explore.sweep_task = None;
-    }
-    app.ui.explore.sweep_open = open;
 }
 
 /// The cost-of-accuracy window.
@@ -544,11 +410,8 @@ fn fidelity_text(f: &Fidelity) -> String {
     }
 }
 
-/// The sweep's requirement: the chl MAE limit in use, when there is one.
-fn chl_requirement(state: &AppState) -> Option<Requirement> {
-    let mae_pct = state.requirements.for_variable("chl_mg_m3")?.mae_pct?;
-    Some(Requirement { variable: "chl_mg_m3".into(), mae_pct })
-}
+mod sweep;
+pub use sweep::sweep_window;
 
 #[cfg(test)]
 mod tests;

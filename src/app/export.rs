@@ -14,11 +14,10 @@ use std::sync::Arc;
 
 use super::ShoalApp;
 use super::model::AppState;
-use super::raster::{Palette, product_map};
-use crate::colormap::Scale;
+pub use super::slide::write_figure;
 use crate::engine::RunOutput;
 use crate::jobs::{Put, Worker};
-use crate::study::{ComparisonPanel, ReviewSlide, SlideSeries, review_slide, write_bytes, write_run};
+use crate::study::{write_bytes, write_run};
 
 /// What an export needs: the results on display and the state that made them.
 #[derive(Clone)]
@@ -29,170 +28,48 @@ pub struct Snapshot {
     pub runs: [Option<Arc<RunOutput>>; 2],
     /// A's decimation.
     pub decimation: usize,
+    /// Per instrument, why it has no result to export (failed, still running), if it has none.
+    pub missing: [Option<String>; 2],
 }
 
 impl Snapshot {
-    /// The snapshot of `app` now.
+    /// The snapshot of `app` now: only results of the configuration set (a failed run's or an
+    /// earlier configuration's results are never exported as the current design's).
     #[must_use]
     pub fn of(app: &ShoalApp) -> Self {
+        use super::link::Standing;
+        let missing = [0, 1].map(|i| {
+            let ab = if i == 0 { "A" } else { "B" };
+            match app.link.standing(i) {
+                Standing::Current(_) => None,
+                Standing::Failed(e) => Some(format!("{ab}'s run of the configuration set failed ({e})")),
+                Standing::Earlier(_) | Standing::Waiting => {
+                    Some(format!("{ab} is still running for the configuration set"))
+                }
+            }
+        });
         Self {
             state: app.state.clone(),
-            runs: [0, 1].map(|i| app.link.shown[i].as_ref().map(|s| s.output.clone())),
-            decimation: app.link.shown[0].as_ref().map_or(1, |s| s.decimation),
+            runs: [0, 1].map(|i| app.link.current(i).map(|s| s.output.clone())),
+            decimation: app.link.current(0).map_or(1, |s| s.decimation),
+            missing,
+        }
+    }
+
+    /// A's and B's results, or why there are none to export.
+    pub fn both(&self) -> Result<(&Arc<RunOutput>, &Arc<RunOutput>), String> {
+        match (&self.runs[0], &self.runs[1]) {
+            (Some(a), Some(b)) => Ok((a, b)),
+            _ => Err(self.missing.iter().flatten().cloned().collect::<Vec<_>>().join("; ")
+                + ": nothing exported (the results on screen do not all belong to the configuration set)"),
         }
     }
 }
 
-/// Write the comparison figure and the configurations next to `stem`.
-pub fn write_figure(snap: &Snapshot, stem: &Path) -> Result<Vec<PathBuf>, String> {
-    let state = &snap.state;
-    let (Some(a), Some(b)) = (&snap.runs[0], &snap.runs[1]) else { return Err("no results to export yet".into()) };
-    let kind = state.product;
-    let mut panels = Vec::new();
-    for (title, out, truth) in [("truth", a, true), ("A", a, false), ("B", b, false)] {
-        if let Some(m) = product_map(out, kind, state.band, truth) {
-            let label = if truth {
-                title.to_string()
-            } else {
-                format!("{title}: {}", if title == "A" { &state.a.preset } else { &state.b.preset })
-            };
-            panels.push(ComparisonPanel { title: label, values: m.values, valid: m.valid });
-        }
-    }
-    if panels.is_empty() {
-        return Err(format!("the runs have no {} to show", kind.label()));
-    }
-    let refs: Vec<super::raster::MapData> =
-        panels.iter().map(|p| super::raster::MapData { values: p.values.clone(), valid: p.valid.clone() }).collect();
-    let refs: Vec<&super::raster::MapData> = refs.iter().collect();
-    let scale = match super::raster::shared_palette(&refs, kind, false) {
-        Palette::Sequential(s) => s,
-        _ => Scale { lo: 0.0, hi: 8.0, log: false },
-    };
-    let table = verdict_table(state, a, b);
-    let changes = state.changes();
-    let caption = vec![
-        format!(
-            "A: {}   B: {}   scene: {}   retrieval: {}   resolution 1/{}",
-            state.a.preset,
-            state.b.preset,
-            state.scene_name,
-            match state.retrieval {
-                super::model::RetrievalKind::Almi => "aLMI",
-                super::model::RetrievalKind::Sambuca => "SAMBUCA",
-            },
-            snap.decimation
-        ),
-        if changes.is_empty() { "Presets unchanged.".into() } else { format!("Changed: {}", changes.join("; ")) },
-        "Shoal: one colour scale for all panels; grey: land or not returned; metrics after Seegers et al. (2018)."
-            .into(),
-    ];
-    let title = format!("{} — {}", state.study_name, kind.label());
-    let variable = kind.variable().unwrap_or("chl_mg_m3");
-    // One series per instrument, in A's and B's colours.
-    let series = |i: usize, out: &RunOutput, points: Vec<(f64, f64)>| {
-        let [r, g, b, _] = super::theme::INSTRUMENT[i].to_array();
-        SlideSeries {
-            name: format!("{}: {}", if i == 0 { "A" } else { "B" }, out.config.instrument.name),
-            colour: [r, g, b],
-            points,
-        }
-    };
-    let plot = super::plot_data::plot_data(&snap.runs, variable);
-    let (mut snr, mut scatter) = (Vec::new(), Vec::new());
-    for (i, out) in [a, b].into_iter().enumerate() {
-        let analytic = out.snr.iter().filter(|r| r.snr_analytic.is_finite()).map(|r| (r.centre_nm, r.snr_analytic));
-        snr.push(series(i, out, analytic.collect()));
-        scatter.push(series(i, out, plot.scatter[i].iter().map(|p| (p[0], p[1])).collect()));
-    }
-    let slide = ReviewSlide {
-        title,
-        caption,
-        label: kind.label().to_string(),
-        scale,
-        diverging: false,
-        panels,
-        snr,
-        snr_requirement: state.requirements.snr,
-        scatter,
-        scatter_label: format!("({})", crate::metrics::unit(variable)),
-        verdicts: table,
-        parameters: super::params::differences(
-            &a.config.instrument,
-            &b.config.instrument,
-            (a.response.bands.bands.len(), b.response.bands.bands.len()),
-        ),
-    };
-    let fig = review_slide("comparison", &slide).map_err(|e| e.to_string())?;
-    let png = stem.with_extension("png");
-    let svg = stem.with_extension("svg");
-    write_bytes(&png, &fig.png).map_err(|e| e.to_string())?;
-    write_bytes(&svg, fig.svg.as_bytes()).map_err(|e| e.to_string())?;
-    let mut written = vec![png, svg];
-    for (name, out) in [("A", a), ("B", b)] {
-        let path = PathBuf::from(format!("{}_config_{name}.ron", stem.display()));
-        let text = out.config.to_ron().map_err(|e| e.to_string())?;
-        write_bytes(&path, text.as_bytes()).map_err(|e| e.to_string())?;
-        written.push(path);
-    }
-    Ok(written)
-}
-
-/// The verdict table of the slide: per instrument and product, MAE, bias, returned share and
-/// the judgement of `Requirements::check_run` (the app's and `shoal study`'s).
-fn verdict_table(state: &AppState, a: &RunOutput, b: &RunOutput) -> Vec<Vec<String>> {
-    let mut table: Vec<Vec<String>> = vec![vec![
-        "instrument".into(),
-        "product".into(),
-        "MAE %".into(),
-        "bias %".into(),
-        "returned %".into(),
-        "requirement".into(),
-    ]];
-    for (name, out) in [("A", a), ("B", b)] {
-        for ret in &out.retrievals {
-            // The app's and `shoal study`'s judgement: `Requirements::check_run`.
-            let checks =
-                state.requirements.check_run(&out.config.instrument.name, out.config.seed, Some(&ret.metrics), &[]);
-            for v in &ret.metrics.variables {
-                let m = &v.metrics;
-                let mine: Vec<&crate::study::Check> =
-                    checks.iter().filter(|c| c.variable.as_deref() == Some(v.variable.as_str())).collect();
-                let req = match crate::study::verdict(mine.iter().copied()) {
-                    Some(ok) => {
-                        let name = crate::metrics::name(&v.variable);
-                        let failed: Vec<String> = mine
-                            .iter()
-                            .filter(|c| !c.pass)
-                            .map(|c| c.what.replace(v.variable.as_str(), name))
-                            .collect();
-                        if ok { "pass".into() } else { format!("FAIL: {}", failed.join(", ")) }
-                    }
-                    None => String::new(),
-                };
-                let (mae, bias) = if m.n == 0 {
-                    ("–".into(), "–".into())
-                } else {
-                    (format!("{:.1}", m.mae_pct()), format!("{:+.1}", m.bias_pct()))
-                };
-                table.push(vec![
-                    format!("{name} ({})", out.config.instrument.name),
-                    format!("{} {}", ret.metrics.product, crate::metrics::label(&v.variable)),
-                    mae,
-                    bias,
-                    format!("{:.1}", m.returned_pct),
-                    req,
-                ]);
-            }
-        }
-    }
-    table
-}
-
-/// Write the review pack of A and B into the folder `dir` (index.html, figures, review.json):
-/// the same page `shoal report` writes, with the app's requirements.
-pub fn write_review_pack(snap: &Snapshot, dir: &Path) -> Result<PathBuf, String> {
-    let (Some(a), Some(b)) = (&snap.runs[0], &snap.runs[1]) else { return Err("no results to export yet".into()) };
+/// A and B as a study, as set in the app: named after what is compared now (a loaded study's
+/// name would outlive a change of scene), with the app's requirements.
+fn study_of(snap: &Snapshot) -> Result<crate::study::StudyResult, String> {
+    let (a, b) = snap.both()?;
     let state = &snap.state;
     let runs = [
         (format!("{} (A)", a.config.instrument.name), a.as_ref()),
@@ -200,13 +77,20 @@ pub fn write_review_pack(snap: &Snapshot, dir: &Path) -> Result<PathBuf, String>
     ];
     let changes = state.changes();
     let description = format!(
-        "A against B as set in the app{}{}",
-        if snap.decimation > 1 { format!(", preview at 1/{} resolution", snap.decimation) } else { String::new() },
-        if changes.is_empty() { String::new() } else { format!("; changed from the presets: {}", changes.join("; ")) }
+        "A against B as set in the app, {} retrieval{}{}",
+        state.retrieval_spec().name(),
+        if snap.decimation > 1 { format!(", at 1/{} resolution (a preview)", snap.decimation) } else { String::new() },
+        if changes.is_empty() { String::new() } else { format!("; instrument edits: {}", changes.join("; ")) }
     );
-    let result =
-        crate::study::StudyResult::of_runs(&state.study_name, &description, &runs, Some(state.requirements.clone()))
-            .ok_or("no results to export yet")?;
+    let name = format!("{} vs {} over {}", state.a.preset, state.b.preset, state.scene_name);
+    crate::study::StudyResult::of_runs(&name, &description, &runs, Some(state.requirements.clone()))
+        .ok_or_else(|| "no results to export yet".to_string())
+}
+
+/// Write the review pack of A and B into the folder `dir` (index.html, figures, review.json):
+/// the same page `shoal report` writes, with the app's requirements.
+pub fn write_review_pack(snap: &Snapshot, dir: &Path) -> Result<PathBuf, String> {
+    let result = study_of(snap)?;
     let figures = crate::study::figure_set(&result).map_err(|e| e.to_string())?;
     let out = crate::study::OutputDir::create(dir, "Shoal app: review pack").map_err(|e| e.to_string())?;
     crate::report::write_pack(&crate::report::review_data(&result, &[], &[]), &figures, out.path())
@@ -234,19 +118,26 @@ pub fn existing(what: What, path: &Path) -> Vec<PathBuf> {
     candidates.into_iter().filter(|p| p.exists()).collect()
 }
 
-/// Write both runs' cubes and metrics into the folder `dir` (written whole: a new or empty
-/// folder, or one Shoal wrote, which is replaced).
+/// Write A's and B's data into the folder `dir` as `shoal study` writes a study: the metrics
+/// tables (CSV and JSON), the requirement checks, the seed spread, the figures, `review.json`
+/// (so `shoal report DIR` makes the pack) and per instrument its cubes, SNR table, report and
+/// configuration. Written whole: a new or empty folder, or one Shoal wrote, which is replaced.
 pub fn write_data(snap: &Snapshot, dir: &Path) -> Result<usize, String> {
+    let result = study_of(snap)?;
     let out = crate::study::OutputDir::create(dir, "Shoal app: data export").map_err(|e| e.to_string())?;
-    let mut n = 0;
+    let mut outputs = crate::study::write_study(&result, out.path(), true).map_err(|e| e.to_string())?;
     for (name, run) in ["A", "B"].iter().zip(&snap.runs) {
-        let Some(run) = run else { return Err("no results to export yet".into()) };
+        let Some(run) = run else { continue };
         let sub = format!("{name}_{}", run.config.instrument.name);
         let sub = crate::parse::join_name(out.path(), "instrument.name", &sub).map_err(|e| e.to_string())?;
-        n += write_run(run, &sub).map_err(|e| e.to_string())?.files.len();
+        outputs.files.extend(write_run(run, &sub).map_err(|e| e.to_string())?.files);
     }
+    let mut review = crate::report::review_data(&result, &[], &[]);
+    review.figures = outputs.figure_names();
+    let json = crate::report::review_json(&review).map_err(|e| e.to_string())?;
+    write_bytes(&out.path().join(crate::report::REVIEW_JSON), json.as_bytes()).map_err(|e| e.to_string())?;
     out.commit().map_err(|e| e.to_string())?;
-    Ok(n)
+    Ok(outputs.files.len() + 1)
 }
 
 /// Which export.

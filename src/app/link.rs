@@ -29,7 +29,7 @@ pub struct Shown {
 }
 
 /// Progress of the run in flight.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Progress {
     /// Instrument (0 = A, 1 = B).
     pub index: usize,
@@ -39,6 +39,33 @@ pub struct Progress {
     pub done: u64,
     /// Rows in all.
     pub total: u64,
+    /// The stage computing now and its own rows.
+    pub stage: Option<crate::control::StageProgress>,
+}
+
+/// What one instrument has to show for the configuration now set: panels draw a result only as
+/// `Current`; `Earlier` greyed and marked; `Failed` as its reason, never the numbers of before.
+#[derive(Debug, Clone, Copy)]
+pub enum Standing<'a> {
+    /// No result yet.
+    Waiting,
+    /// The current configuration's result (a preview while its decimation is not the finest).
+    Current(&'a Shown),
+    /// An earlier configuration's result, kept until the new one's first preview arrives.
+    Earlier(&'a Shown),
+    /// The current configuration's run failed: why.
+    Failed(&'a str),
+}
+
+impl<'a> Standing<'a> {
+    /// The result, if it belongs to the configuration now set.
+    #[must_use]
+    pub fn current(self) -> Option<&'a Shown> {
+        match self {
+            Self::Current(s) => Some(s),
+            _ => None,
+        }
+    }
 }
 
 /// The engine link.
@@ -60,6 +87,9 @@ pub struct EngineLink {
     /// Seconds from the last submission to its first results of A and B arriving.
     pub last_latency_s: Option<f64>,
     latency_pending: bool,
+    /// The user stopped the current generation's runs (the results shown stay, as far as they
+    /// went); cleared by the next submission.
+    cancelled: bool,
 }
 
 impl EngineLink {
@@ -79,7 +109,55 @@ impl EngineLink {
             finished: [false, false],
             last_latency_s: None,
             latency_pending: false,
+            cancelled: false,
         })
+    }
+
+    /// What instrument `index` has to show for the configuration now set (see [`Standing`]).
+    #[must_use]
+    pub fn standing(&self, index: usize) -> Standing<'_> {
+        if let Some(e) = self.errors.get(index).and_then(Option::as_deref) {
+            return Standing::Failed(e);
+        }
+        match self.shown.get(index).and_then(Option::as_ref) {
+            None => Standing::Waiting,
+            Some(s) if s.generation == self.generation => Standing::Current(s),
+            Some(s) => Standing::Earlier(s),
+        }
+    }
+
+    /// The current configuration's result of instrument `index`, if it has one.
+    #[must_use]
+    pub fn current(&self, index: usize) -> Option<&Shown> {
+        self.standing(index).current()
+    }
+
+    /// The finest decimation of the current request (1: full resolution).
+    #[must_use]
+    pub fn finest(&self) -> usize {
+        self.decimations.last().copied().unwrap_or(1)
+    }
+
+    /// Stop the current configuration's runs where they are; what was shown stays, as a
+    /// preview. Nothing runs again until the configuration changes or [`Self::refine`].
+    pub fn cancel(&mut self) {
+        if self.busy() {
+            self.cancelled = true;
+            self.progress = None;
+            // The worker takes the next generation as the newest: the request in flight is stale.
+            self.handle.cancel(self.generation + 1);
+        }
+    }
+
+    /// Did the user stop the current configuration's runs?
+    #[must_use]
+    pub fn cancelled(&self) -> bool {
+        self.cancelled
+    }
+
+    /// Run the current configuration again to its finest level (after a cancel).
+    pub fn refine(&mut self) {
+        self.submitted.clear();
     }
 
     /// The newest generation submitted.
@@ -109,6 +187,7 @@ impl EngineLink {
             })
             .collect();
         self.generation += 1;
+        self.cancelled = false;
         self.submitted.clone_from(&configs);
         self.decimations.clone_from(&decimations);
         self.errors = [None, None];
@@ -130,8 +209,8 @@ impl EngineLink {
         let mut changed = false;
         while let Some(event) = self.handle.poll() {
             match event {
-                Event::Progress { index, decimation, done, total, .. } => {
-                    self.progress = Some(Progress { index, decimation, done, total });
+                Event::Progress { index, decimation, done, total, stage, .. } => {
+                    self.progress = Some(Progress { index, decimation, done, total, stage });
                 }
                 Event::Finished { generation, index, decimation, result } => {
                     let finest = self.decimations.last().copied().unwrap_or(1);
@@ -195,7 +274,7 @@ impl EngineLink {
     /// Is the engine still working on the current generation?
     #[must_use]
     pub fn busy(&self) -> bool {
-        !self.finished.iter().all(|f| *f)
+        !self.cancelled && !self.finished.iter().all(|f| *f)
     }
 
     /// Is instrument `index`'s shown result from an older generation than the newest?

@@ -154,10 +154,12 @@ impl ShoalApp {
             retrievals: vec![s.retrieval_spec()],
             seeds: vec![s.noise_seed],
             detector: None,
-            calibration: None,
+            calibration: (s.calibration != crate::calibration::CalibrationSpec::default())
+                .then(|| s.calibration.clone()),
             correction: None,
             fidelity: (s.fidelity != crate::engine::Fidelity::default()).then(|| s.fidelity.clone()),
             requirements: Some(s.requirements.clone()),
+            snr_reference: s.snr_reference.clone(),
         }
     }
 
@@ -178,11 +180,6 @@ impl ShoalApp {
         self.listing.poll(&self.library, move || wake.request_repaint());
         if self.link.poll() {
             self.images.invalidate();
-            for (i, shown) in self.link.shown.iter().enumerate() {
-                if let Some(s) = shown {
-                    self.ui.run_seconds.insert((i, s.decimation), s.output.report.total_seconds);
-                }
-            }
         }
         if let Some(r) = &self.raster {
             // A new result's images are waited for briefly, so that they appear in the frame that

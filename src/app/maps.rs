@@ -6,7 +6,7 @@ use std::hash::{DefaultHasher, Hash, Hasher};
 use egui::{Color32, Pos2, Rect, Sense, Vec2};
 
 use super::ShoalApp;
-use super::link::EngineLink;
+use super::link::{EngineLink, Standing};
 use super::model::{AppState, Layout, ProductKind};
 use super::raster::{Done, Job, Palette, PanelImage, RasterThread};
 use crate::colormap::{categorical, diverging, viridis};
@@ -58,6 +58,12 @@ impl Images {
         self.plot.as_deref()
     }
 
+    /// Panels on display.
+    #[must_use]
+    pub fn panel_count(&self) -> usize {
+        self.panels.len()
+    }
+
     /// Are the newest images on display?
     #[must_use]
     pub fn ready(&self) -> bool {
@@ -72,16 +78,24 @@ impl Images {
         state.band.hash(&mut h);
         state.layout.hash(&mut h);
         // The results themselves, not their generation: a result carried over to a new
-        // generation (the instrument did not change) keeps its images.
-        for s in &link.shown {
-            s.as_ref().map(|s| std::sync::Arc::as_ptr(&s.output)).hash(&mut h);
+        // generation (the instrument did not change) keeps its images. A run that failed shows
+        // no map (never the previous configuration's).
+        let runs = [0, 1].map(|i| match link.standing(i) {
+            Standing::Current(s) | Standing::Earlier(s) => Some(s.output.clone()),
+            Standing::Failed(_) | Standing::Waiting => None,
+        });
+        for r in &runs {
+            r.as_ref().map(std::sync::Arc::as_ptr).hash(&mut h);
         }
         let key = h.finish();
         if self.requested == Some(key) {
             return false;
         }
-        let runs = [link.shown[0].as_ref().map(|s| s.output.clone()), link.shown[1].as_ref().map(|s| s.output.clone())];
         if runs.iter().all(Option::is_none) {
+            // Nothing to show (both failed): no map of an earlier configuration stays up.
+            self.panels.clear();
+            self.plot = None;
+            (self.requested, self.shown) = (Some(key), Some(key));
             return false;
         }
         let job = Job { key, runs, kind: state.product, band: state.band, layout: state.layout, max_side: 720 };
@@ -122,8 +136,8 @@ fn product_menu(app: &mut ShoalApp, ui: &mut egui::Ui) {
             }
         });
         if state.product.per_band() {
-            let names: Vec<String> = app.link.shown[0]
-                .as_ref()
+            let names: Vec<String> = (0..2)
+                .find_map(|i| app.link.current(i))
                 .map(|s| {
                     s.output
                         .response
@@ -252,7 +266,7 @@ fn scale_bar(ui: &mut egui::Ui, width_px: f32, ground_m: f64) {
     painter.text(Pos2::new(x1 + 6.0, y), egui::Align2::LEFT_CENTER, label, egui::FontId::proportional(10.0), colour);
 }
 
-fn format_value(v: f64) -> String {
+pub(super) fn format_value(v: f64) -> String {
     let a = v.abs();
     if a == 0.0 {
         "0".into()
@@ -267,58 +281,70 @@ fn format_value(v: f64) -> String {
     }
 }
 
-/// The scene ↔ retrieval banner: a scene whose bottom shows needs a retrieval that models one.
-fn retrieval_banner(app: &mut ShoalApp, ui: &mut egui::Ui) {
-    use super::logic::UiCommand;
-    use super::model::RetrievalKind;
-    if app.state.retrieval == RetrievalKind::Almi && app.state.scene.needs_bottom_model() {
-        ui.horizontal_wrapped(|ui| {
-            ui.colored_label(
-                super::theme::NOTICE,
-                format!(
-                    "`{}` has a visible bottom (its depth map is shallow). aLMI assumes optically deep water: its \
-                     concentrations are biased by the bottom, and it retrieves no depth or substrate.",
-                    app.state.scene_name
-                ),
-            );
-            if ui.button("Use SAMBUCA").on_hover_text("Retrieve depth, substrate and water together").clicked() {
-                app.ui.commands.push(UiCommand::UseRetrieval(RetrievalKind::Sambuca));
-            }
-        });
-    }
+/// Per instrument, for its panels: (shows the previous configuration, the preview's decimation
+/// if a preview), which run the truth panel comes from, each run's swath, and why a run
+/// returned no pixel.
+struct PanelStates {
+    marks: Vec<(bool, Option<usize>)>,
+    truth_from: usize,
+    swath_m: Vec<Option<f64>>,
+    empty: Vec<Option<String>>,
 }
 
-/// What the shown product is when the retrieval does not make it.
-fn product_note(app: &ShoalApp) -> Option<String> {
-    use super::model::RetrievalKind;
-    let retrieval = match app.state.retrieval {
-        RetrievalKind::Almi => "aLMI",
-        RetrievalKind::Sambuca => "SAMBUCA",
-    };
-    let missing = matches!(
-        (app.state.retrieval, app.state.product),
-        (RetrievalKind::Almi, ProductKind::Depth | ProductKind::Substrate)
-            | (RetrievalKind::Sambuca, ProductKind::SiopSet)
-    );
-    missing.then(|| {
-        let product = app.state.product.label().split(" (").next().unwrap_or_default();
-        format!("{retrieval} does not retrieve the {product}: A and B have no map of it.")
-    })
+fn panel_states(app: &ShoalApp) -> PanelStates {
+    // Per instrument: is what is shown the previous configuration's (greyed, marked), or the
+    // current one's preview?
+    let finest = app.link.finest();
+    let marks: Vec<(bool, Option<usize>)> = (0..2)
+        .map(|i| match app.link.standing(i) {
+            Standing::Earlier(_) => (true, None),
+            Standing::Current(s) if s.decimation != finest => (false, Some(s.decimation)),
+            _ => (false, None),
+        })
+        .collect();
+    // The truth comes from A's run (B's when A has none).
+    let truth_from = usize::from(!matches!(app.link.standing(0), Standing::Current(_) | Standing::Earlier(_)));
+    // Swath of the instrument whose grid each panel is on (B's panel on B's, the rest on A's).
+    let swath_m: Vec<Option<f64>> = (0..2)
+        .map(|i| match app.link.standing(i) {
+            Standing::Current(s) | Standing::Earlier(s) => Some(s.output.config.instrument.swath_m()),
+            _ => None,
+        })
+        .collect();
+    let empty: Vec<Option<String>> = (0..2)
+        .map(|i| match app.link.standing(i) {
+            Standing::Current(s) => super::metrics_table::no_pixel_reason(&s.output),
+            _ => None,
+        })
+        .collect();
+    PanelStates { marks, truth_from, swath_m, empty }
 }
 
 /// The central panel.
 pub fn central(app: &mut ShoalApp, ui: &mut egui::Ui) {
+    use super::banners::{failure_box, product_note, retrieval_banner};
     retrieval_banner(app, ui);
     product_menu(app, ui);
     if let Some(note) = product_note(app) {
         ui.label(note);
     }
+    let failures: Vec<(usize, String)> = (0..2)
+        .filter_map(|i| match app.link.standing(i) {
+            Standing::Failed(e) => Some((i, e.to_string())),
+            _ => None,
+        })
+        .collect();
+    for (i, e) in &failures {
+        failure_box(app, ui, *i, e);
+    }
     if app.images.panels.is_empty() {
-        ui.add_space(40.0);
-        ui.vertical_centered(|ui| {
-            ui.spinner();
-            ui.label("Running the chain: the first preview appears within seconds.");
-        });
+        if failures.is_empty() && (app.link.busy() || !app.images.ready()) && product_note(app).is_none() {
+            ui.add_space(40.0);
+            ui.vertical_centered(|ui| {
+                ui.spinner();
+                ui.label("Running the chain: the first preview appears within seconds.");
+            });
+        }
         return;
     }
     let n = app.images.panels.len();
@@ -327,17 +353,21 @@ pub fn central(app: &mut ShoalApp, ui: &mut egui::Ui) {
     let width = ((avail.x - bar_w - 8.0 * n as f32) / n as f32).max(60.0);
     let mut hovered: Option<Pos2> = None;
     let mut view = app.ui.zoom;
-    let stale: Vec<bool> = (0..2).map(|i| app.link.stale(i)).collect();
-    // Swath of the instrument whose grid each panel is on (B's panel on B's, the rest on A's).
-    let swath_m: Vec<Option<f64>> =
-        (0..2).map(|i| app.link.shown[i].as_ref().map(|s| s.output.config.instrument.swath_m())).collect();
+    let PanelStates { marks, truth_from, swath_m, empty } = panel_states(app);
     ui.horizontal(|ui| {
         for (panel, tex) in &app.images.panels {
             ui.vertical(|ui| {
-                let title = match panel.title.as_str() {
-                    "A" if stale[0] => "A (updating)".to_string(),
-                    "B" if stale[1] => "B (updating)".to_string(),
-                    t => t.to_string(),
+                let index = match panel.title.as_str() {
+                    "A" => Some(0),
+                    "B" => Some(1),
+                    "truth" => Some(truth_from),
+                    _ => None,
+                };
+                let (earlier, preview) = index.map_or((marks[0].0 || marks[1].0, None), |i| marks[i]);
+                let title = match (earlier, preview) {
+                    (true, _) => format!("{} (previous configuration, updating)", panel.title),
+                    (false, Some(d)) => format!("{} (preview 1/{d})", panel.title),
+                    _ => panel.title.clone(),
                 };
                 ui.label(title);
                 let img = &panel.image;
@@ -347,7 +377,19 @@ pub fn central(app: &mut ShoalApp, ui: &mut egui::Ui) {
                 let (rect, resp) = ui.allocate_exact_size(Vec2::new(w, height), Sense::click_and_drag());
                 let painter = ui.painter_at(rect);
                 painter.rect_filled(rect, 0.0, ui.visuals().extreme_bg_color);
-                painter.image(tex.id(), rect, view.uv(), Color32::WHITE);
+                // The previous configuration's map, greyed until the new one arrives.
+                let tint = if earlier { Color32::from_gray(110) } else { Color32::WHITE };
+                painter.image(tex.id(), rect, view.uv(), tint);
+                if let Some(why) = index.and_then(|i| empty[i].as_ref()).filter(|_| panel.title != "truth") {
+                    painter.text(
+                        rect.center(),
+                        egui::Align2::CENTER_CENTER,
+                        "no pixel returned",
+                        egui::FontId::proportional(14.0),
+                        super::theme::FAIL,
+                    );
+                    resp.clone().on_hover_text(why);
+                }
                 let swath = if panel.title == "B" { swath_m[1] } else { swath_m[0].or(swath_m[1]) };
                 if let Some(swath) = swath {
                     scale_bar(ui, w, swath * f64::from(view.uv().width()));
@@ -378,12 +420,20 @@ pub fn central(app: &mut ShoalApp, ui: &mut egui::Ui) {
                 colour_bar(ui, p, 220.0, &label, &classes);
             }
             if let Some(p) = app.images.difference_palette {
-                colour_bar(ui, p, 160.0, "A − B", &classes);
+                // The difference in the product's own unit ("A − B (mg m⁻³)").
+                let unit = app.state.product.label().split_once(" (").map_or(String::new(), |(_, u)| format!(" ({u}"));
+                colour_bar(ui, p, 160.0, &format!("A − B{unit}"), &classes);
             }
         });
     });
     app.ui.zoom = view;
-    // Value under the cursor, in every panel (rows are drawn bottom-up).
+    hover_readout(app, ui, hovered);
+}
+
+/// The value under the cursor in every panel (rows are drawn bottom-up): class maps by class
+/// name, A − B of classes as agree or differ.
+fn hover_readout(app: &mut ShoalApp, ui: &mut egui::Ui, hovered: Option<Pos2>) {
+    let classes = class_names(app);
     if let Some(uv) = hovered {
         let mut parts = Vec::new();
         let mut cell = None;
@@ -392,10 +442,18 @@ pub fn central(app: &mut ShoalApp, ui: &mut egui::Ui) {
             let c = ((uv.x * cols as f32) as usize).min(cols.saturating_sub(1));
             let r = (((1.0 - uv.y) * rows as f32) as usize).min(rows.saturating_sub(1));
             cell.get_or_insert((r, c));
-            let text = if panel.data.valid[[r, c]] {
-                format_value(f64::from(panel.data.values[[r, c]]))
-            } else {
+            let value = panel.data.values[[r, c]];
+            let text = if !panel.data.valid[[r, c]] {
                 "–".into()
+            } else if app.state.product.categorical() && panel.title != "A − B" {
+                // A class map holds the class index: show its name.
+                classes
+                    .get(value.max(0.0) as usize)
+                    .map_or_else(|| format_value(f64::from(value)), |n| n.replace('_', " "))
+            } else if panel.title == "A − B" && app.state.product.categorical() {
+                if value > 0.5 { "differ".into() } else { "agree".into() }
+            } else {
+                format_value(f64::from(value))
             };
             parts.push(format!("{}: {text}", panel.title));
         }
@@ -410,7 +468,7 @@ pub fn central(app: &mut ShoalApp, ui: &mut egui::Ui) {
 
 /// The names of the shown product's classes, in colour order (substrates or SIOP sets).
 fn class_names(app: &ShoalApp) -> Vec<String> {
-    let Some(out) = app.link.shown.iter().flatten().next().map(|s| &s.output) else { return Vec::new() };
+    let Some(out) = (0..2).find_map(|i| app.link.current(i)).map(|s| &s.output) else { return Vec::new() };
     match app.state.product {
         ProductKind::Substrate => super::raster::substrate_classes(out),
         ProductKind::SiopSet => out.retrievals.first().map(|r| r.product.siop_set_names.clone()).unwrap_or_default(),

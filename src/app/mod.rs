@@ -22,10 +22,13 @@
 //! | sweep and cost-of-accuracy windows | `explore` |
 //! | seed spread of the metrics | `seeds` |
 
+mod banners;
 pub mod bench;
 pub mod blocks;
+mod conditions;
 mod derived;
 mod dialogs;
+mod editors;
 pub mod explore;
 mod export;
 mod history;
@@ -33,6 +36,7 @@ pub mod link;
 mod listing;
 mod logic;
 mod maps;
+mod metrics_table;
 pub mod model;
 mod panels;
 mod params;
@@ -41,6 +45,8 @@ pub mod plots;
 pub mod raster;
 mod seeds;
 mod session;
+mod slide;
+mod snr_table;
 pub mod theme;
 mod view;
 mod window;
@@ -95,11 +101,6 @@ struct UiState {
     seeds: seeds::SeedSpreadJob,
     frame_times_ms: Vec<f32>,
     history: history::History,
-    /// The run in flight (generation, instrument, decimation) and when its progress was first
-    /// seen, for the time estimate.
-    progress_since: Option<((u64, usize, usize), Instant)>,
-    /// Seconds the last finished run took, per instrument and decimation (the estimate's base).
-    run_seconds: std::collections::HashMap<(usize, usize), f64>,
     /// Where the histogram, scatter and SNR plots were last drawn (for the layout test).
     plot_rects: Vec<egui::Rect>,
     /// The metrics table's width as last drawn (the bottom panel lays its plots out by it).
@@ -112,6 +113,8 @@ struct UiState {
     confirm: Option<Confirm>,
     /// An instrument value refused by its range: (parameter key, message), shown inline.
     param_error: Option<(&'static str, String)>,
+    /// A scene, atmosphere or calibration value refused by its range.
+    conditions_error: Option<String>,
     /// What the panels asked for this frame, applied after it is drawn (`logic.rs`).
     commands: Vec<logic::UiCommand>,
 }
@@ -166,7 +169,7 @@ impl ShoalApp {
                 });
         let wake = ctx.clone();
         let raster = raster::spawn_raster_thread(move || wake.request_repaint()).ok();
-        let export_path = crate::library::home_dir().join("exports").join("comparison").display().to_string();
+        let export_path = crate::library::export_dir().join("comparison").display().to_string();
         Self {
             state,
             link,
@@ -272,6 +275,12 @@ impl ShoalApp {
         self.ui.error.as_deref()
     }
 
+    /// Map panels on screen (truth, A, B, A − B).
+    #[must_use]
+    pub fn map_panels(&self) -> usize {
+        self.images.panel_count()
+    }
+
     /// Where the histogram, scatter and SNR plots were drawn in the last frame.
     #[must_use]
     pub fn plot_rects(&self) -> &[egui::Rect] {
@@ -297,12 +306,20 @@ impl ShoalApp {
         self.tick(&ctx);
         egui::Panel::top("top").show(ui, |ui| {
             self.top_bar(ui);
-            if self.ui.typed_export {
-                self.typed_export(ui);
-            }
-            if let Some(m) = &self.ui.message {
-                ui.small(m.as_str());
-            }
+            // A second row always there, so a message or the typed-path row never moves the
+            // window's content down: the typed path when asked for, else the last message.
+            ui.allocate_ui_with_layout(
+                egui::vec2(ui.available_width(), ui.spacing().interact_size.y),
+                egui::Layout::left_to_right(egui::Align::Center),
+                |ui| {
+                    ui.set_min_height(ui.spacing().interact_size.y);
+                    if self.ui.typed_export {
+                        self.typed_export(ui);
+                    } else if let Some(m) = &self.ui.message {
+                        ui.add(egui::Label::new(egui::RichText::new(m.as_str()).small()).truncate());
+                    }
+                },
+            );
         });
         egui::Panel::left("left").resizable(true).default_size(380.0).show(ui, |ui| {
             egui::ScrollArea::vertical().show(ui, |ui| panels::left(self, ui));
@@ -333,16 +350,10 @@ impl ShoalApp {
     }
 
     fn top_bar(&mut self, ui: &mut egui::Ui) {
+        // Fixed-width controls first and the names (whose "(modified)" comes and goes) last, so
+        // no button moves under the pointer as the text changes.
         ui.horizontal(|ui| {
             ui.heading("Shoal");
-            let mark =
-                |s: &model::Slot| if s.modified() { format!("{} (modified)", s.preset) } else { s.preset.clone() };
-            ui.label(format!(
-                "A: {}   B: {}   scene: {}",
-                mark(&self.state.a),
-                mark(&self.state.b),
-                self.state.scene_name
-            ));
             ui.separator();
             let undo = self.ui.history.undo_text();
             let clicked = ui
@@ -397,6 +408,12 @@ impl ShoalApp {
             ui.selectable_value(&mut self.state.dark, true, "Dark");
             ui.separator();
             self.status(ui);
+            ui.separator();
+            let mark =
+                |s: &model::Slot| if s.modified() { format!("{} (modified)", s.preset) } else { s.preset.clone() };
+            let names =
+                format!("A: {}   B: {}   scene: {}", mark(&self.state.a), mark(&self.state.b), self.state.scene_name);
+            ui.add(egui::Label::new(names.as_str()).truncate()).on_hover_text(names);
         });
     }
 

@@ -37,7 +37,8 @@ impl Slot {
 }
 
 /// The limits the app judges by when the study states none: the default study's (chl MAE ≤ 20 %,
-/// |bias| ≤ 10 %, ≥ 95 % returned; NAP and CDOM looser) plus depth MAE ≤ 10 %, SNR ≥ 100.
+/// |bias| ≤ 10 %, ≥ 95 % returned; NAP and CDOM looser) plus depth MAE ≤ 10 %, SNR ≥ 100 and
+/// the dominant substrate right in ≥ 70 % of pixels.
 #[must_use]
 pub fn fallback_requirements() -> Requirements {
     let p = |variable: &str, mae: f64, bias: Option<f64>, returned: Option<f64>| ProductRequirement {
@@ -54,6 +55,7 @@ pub fn fallback_requirements() -> Requirements {
             p("depth_m", 10.0, None, None),
         ],
         snr: Some(100.0),
+        substrate_pct: Some(70.0),
     }
 }
 
@@ -158,6 +160,13 @@ pub struct AppState {
     /// The fidelity of every run (its `decimation` is the preview level's, set per run): the
     /// defaults, the study's, or a setting applied from the Cost window.
     pub fidelity: Fidelity,
+    /// Stop at the previews: the final (finest) level is not run until this is off (for a long
+    /// retrieval at full resolution, or a slow machine).
+    pub preview_only: bool,
+    /// The calibration of both instruments (its systematic errors are worst-case controls).
+    pub calibration: crate::calibration::CalibrationSpec,
+    /// The radiance the SNR is stated at (`None`: the scene's median water radiance).
+    pub snr_reference: Option<crate::spectral::SpectrumSource>,
 }
 
 impl Default for AppState {
@@ -184,6 +193,7 @@ fn fallback_study() -> StudySpec {
         correction: None,
         fidelity: None,
         requirements: None,
+        snr_reference: None,
     })
 }
 
@@ -209,6 +219,9 @@ impl AppState {
             dark: false,
             study_name: "cubesat_vs_smallsat".into(),
             fidelity: Fidelity::default(),
+            preview_only: false,
+            calibration: crate::calibration::CalibrationSpec::default(),
+            snr_reference: None,
         }
     }
 
@@ -249,6 +262,8 @@ impl AppState {
             s.requirements = r.clone();
         }
         s.fidelity = Fidelity { decimation: 1, ..first.2.fidelity.clone() };
+        s.calibration = first.2.calibration.clone();
+        s.snr_reference = first.2.snr_reference.clone();
         Ok(s)
     }
 
@@ -322,18 +337,31 @@ impl AppState {
                 c.fidelity = Fidelity { decimation: 1, ..self.fidelity.clone() };
                 c.seed = self.noise_seed;
                 c.retrievals = vec![self.retrieval_spec()];
+                c.calibration = self.calibration.clone();
+                c.snr_reference.clone_from(&self.snr_reference);
                 c
             })
             .collect()
     }
 
-    /// Preview decimations, coarsest first, validated (1–64, decreasing, ending at the final one).
+    /// The levels set, coarsest first, validated (1–64, decreasing, ending at the final one).
     #[must_use]
-    pub fn decimations(&self) -> Vec<usize> {
+    pub fn levels(&self) -> Vec<usize> {
         let mut l: Vec<usize> = self.decimations.iter().copied().filter(|d| (1..=64).contains(d)).collect();
         l.sort_unstable_by(|a, b| b.cmp(a));
         l.dedup();
         if l.is_empty() { vec![24, 4, 1] } else { l }
+    }
+
+    /// The levels the engine runs: [`Self::levels`], without the final one when
+    /// [`Self::preview_only`] (unless it is the only one).
+    #[must_use]
+    pub fn decimations(&self) -> Vec<usize> {
+        let mut l = self.levels();
+        if self.preview_only && l.len() > 1 {
+            l.pop();
+        }
+        l
     }
 
     /// The parameters edited away from each slot's preset, for captions ("A aperture_mm 60 → 80").

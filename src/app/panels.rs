@@ -4,23 +4,28 @@
 
 use super::ShoalApp;
 use super::logic::UiCommand;
-use super::model::{Ab, RetrievalKind, Slot};
+use super::model::{Ab, RetrievalKind};
 use super::params::PARAMS;
-use crate::instrument::InstrumentKind;
 use crate::library::{Entry, Kind};
 use crate::retrieval::{Mode, Objective, Starts};
-use crate::spectral::{BandSetSpec, GaussianBand, Platform};
 
+/// A preset picker: each entry with its description on hover, the chosen one's on the box.
 fn library_combo(ui: &mut egui::Ui, label: &str, current: &str, entries: &[Entry]) -> Option<Entry> {
     let mut picked = None;
-    egui::ComboBox::from_label(label).selected_text(current).show_ui(ui, |ui| {
+    let chosen = entries.iter().find(|e| e.name == current).map(|e| e.description.as_str()).unwrap_or_default();
+    let r = egui::ComboBox::from_label(label).selected_text(current).show_ui(ui, |ui| {
         for e in entries {
             let text = if e.builtin { e.name.clone() } else { format!("{} (mine)", e.name) };
-            if ui.selectable_label(e.name == current, text).clicked() {
+            let item = ui.selectable_label(e.name == current, text);
+            let item = if e.description.is_empty() { item } else { item.on_hover_text(&e.description) };
+            if item.clicked() {
                 picked = Some(e.clone());
             }
         }
     });
+    if !chosen.is_empty() {
+        r.response.on_hover_text(chosen);
+    }
     picked
 }
 
@@ -36,6 +41,10 @@ fn presets(app: &mut ShoalApp, ui: &mut egui::Ui) {
     let scenes = app.listing.get(Kind::Scene).to_vec();
     if let Some(entry) = library_combo(ui, "Scene", &app.state.scene_name.clone(), &scenes) {
         app.ui.commands.push(UiCommand::LoadScene(entry));
+    }
+    // What the scene is, in its own words (the state's copy: it is the scene that runs).
+    if !app.state.scene.description.is_empty() {
+        ui.add(egui::Label::new(egui::RichText::new(&app.state.scene.description).small().weak()).wrap());
     }
     let studies = app.listing.get(Kind::Study).to_vec();
     if let Some(entry) = library_combo(ui, "Study", &app.state.study_name.clone(), &studies) {
@@ -63,109 +72,12 @@ fn save_presets(app: &mut ShoalApp, ui: &mut egui::Ui) {
     });
 }
 
-fn band_editor(slot: &mut Slot, ui: &mut egui::Ui) {
-    let bands = match &mut slot.spec.kind {
-        InstrumentKind::Multispectral { bands }
-        | InstrumentKind::IdealRadiometer { bands }
-        | InstrumentKind::FilterImager { bands, .. } => bands,
-        InstrumentKind::Spectrograph { start_nm, end_nm, sampling_nm, resolution_nm, .. } => {
-            ui.add(
-                egui::Slider::new(start_nm, 350.0..=700.0).update_while_editing(false).text("First band").suffix(" nm"),
-            );
-            ui.add(
-                egui::Slider::new(end_nm, 500.0..=1000.0).update_while_editing(false).text("Last band").suffix(" nm"),
-            );
-            ui.add(
-                egui::Slider::new(sampling_nm, 1.0..=30.0).update_while_editing(false).text("Sampling").suffix(" nm"),
-            );
-            ui.add(
-                egui::Slider::new(resolution_nm, 1.0..=50.0)
-                    .update_while_editing(false)
-                    .text("Resolution")
-                    .suffix(" nm"),
-            );
-            return;
-        }
-    };
-    let name = match bands {
-        BandSetSpec::Olci { platform: Platform::A, .. } => "OLCI S3A",
-        BandSetSpec::Olci { .. } => "OLCI S3B",
-        BandSetSpec::Msi { platform: Platform::A, .. } => "MSI S2A",
-        BandSetSpec::Msi { .. } => "MSI S2B",
-        BandSetSpec::Gaussian(_) => "Custom (Gaussian)",
-    };
-    let mut choice: Option<BandSetSpec> = None;
-    egui::ComboBox::from_label("Band set").selected_text(name).show_ui(ui, |ui| {
-        if ui.selectable_label(name == "OLCI S3A", "OLCI S3A").clicked() {
-            choice = Some(BandSetSpec::Olci { platform: Platform::A, bands: None });
-        }
-        if ui.selectable_label(name == "OLCI S3B", "OLCI S3B").clicked() {
-            choice = Some(BandSetSpec::Olci { platform: Platform::B, bands: None });
-        }
-        if ui.selectable_label(name == "MSI S2A", "MSI S2A").clicked() {
-            choice = Some(BandSetSpec::Msi { platform: Platform::A, bands: None });
-        }
-        if ui.selectable_label(name == "MSI S2B", "MSI S2B").clicked() {
-            choice = Some(BandSetSpec::Msi { platform: Platform::B, bands: None });
-        }
-        if ui.selectable_label(name.starts_with("Custom"), "Custom (Gaussian)").clicked() {
-            // Start from the current bands' centres and widths.
-            let list = crate::spectral::BandSet::from_spec(bands)
-                .map(|set| {
-                    set.bands
-                        .iter()
-                        .map(|b| GaussianBand {
-                            name: Some(b.name.clone()),
-                            centre_nm: b.centre_nm,
-                            fwhm_nm: b.fwhm_nm,
-                        })
-                        .collect()
-                })
-                .unwrap_or_default();
-            choice = Some(BandSetSpec::Gaussian(list));
-        }
-    });
-    if let Some(c) = choice {
-        *bands = c;
-    }
-    if let BandSetSpec::Gaussian(list) = bands {
-        let mut remove = None;
-        egui::Grid::new("bands").num_columns(4).striped(true).show(ui, |ui| {
-            ui.label("band");
-            ui.label("centre nm");
-            ui.label("FWHM nm");
-            ui.label("");
-            ui.end_row();
-            for (i, b) in list.iter_mut().enumerate() {
-                ui.label(format!("{}", i + 1));
-                ui.add(
-                    egui::DragValue::new(&mut b.centre_nm)
-                        .update_while_editing(false)
-                        .range(380.0..=1000.0)
-                        .speed(0.5)
-                        .suffix(" c"),
-                );
-                ui.add(
-                    egui::DragValue::new(&mut b.fwhm_nm)
-                        .update_while_editing(false)
-                        .range(1.0..=100.0)
-                        .speed(0.2)
-                        .suffix(" w"),
-                );
-                if ui.small_button("remove").clicked() {
-                    remove = Some(i);
-                }
-                ui.end_row();
-            }
-        });
-        if let Some(i) = remove {
-            list.remove(i);
-        }
-        if ui.button("Add band").clicked() {
-            let c = list.last().map_or(560.0, |b| (b.centre_nm + 20.0).min(990.0));
-            list.push(GaussianBand { name: None, centre_nm: c, fwhm_nm: 10.0 });
-        }
-    }
+/// A number typed into a slider's field: the number alone or followed by the slider's unit
+/// (`60`, `60 mm`, `6e1`); anything else is `None`.
+fn parse_typed(text: &str, unit: &str) -> Option<f64> {
+    let t = text.trim();
+    let t = t.strip_suffix(unit.trim()).unwrap_or(t).trim();
+    t.parse::<f64>().ok().filter(|v| v.is_finite())
 }
 
 /// Fine control on a slider rail: `value` moved by a tenth of `fraction` of the rail (the
@@ -202,17 +114,33 @@ fn editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
             let before = v;
             // Never clamped: a preset outside the slider's span keeps its value, and a typed
             // value outside it is checked against the instrument's documented range below.
+            // A typed text that is not a number is refused aloud (egui would ignore it).
+            let not_a_number: std::cell::Cell<Option<String>> = std::cell::Cell::new(None);
             let slider = egui::Slider::new(&mut v, p.range.0..=p.range.1)
                 .update_while_editing(false)
                 .text(p.label)
                 .suffix(p.unit)
                 .logarithmic(p.log)
-                .clamping(egui::SliderClamping::Never);
+                .clamping(egui::SliderClamping::Never)
+                .custom_parser(|text| {
+                    let parsed = parse_typed(text, p.unit);
+                    if parsed.is_none() {
+                        not_a_number.set(Some(text.to_string()));
+                    }
+                    parsed
+                });
             let integer = matches!(p.key, "detectors" | "lines" | "adc_bits");
             let slider = if integer { slider.integer() } else { slider };
             // The hover text states the documented range (src/ranges.rs) a typed value must meet;
             // built only while the pointer is on the slider.
             let response = ui.add(slider);
+            if let Some(text) = not_a_number.take() {
+                let allowed = crate::ranges::ALL
+                    .iter()
+                    .find(|r| r.field("instrument.") == p.key)
+                    .map_or_else(String::new, |r| format!(" (allowed: {})", r.allowed()));
+                app.ui.param_error = Some((p.key, format!("{}: `{text}` is not a number{allowed}", p.key)));
+            }
             // Shift held on the rail: the pointer's motion moves the value a tenth as far, from
             // where it was (egui would jump to the pointer). A drag begun with Shift stays fine
             // to its release, even if Shift is let go first (egui also sets the value on the
@@ -251,12 +179,6 @@ fn editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
                 }
             }
             ui.end_row();
-            if let Some((key, message)) = &app.ui.param_error
-                && *key == p.key
-            {
-                ui.colored_label(super::theme::FAIL, format!("refused: {message}"));
-                ui.end_row();
-            }
             if v != before {
                 let slot = app.state.slot_mut(editing);
                 let mut candidate = slot.spec.clone();
@@ -273,6 +195,15 @@ fn editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
             }
         }
     });
+    // A refused value, under the sliders and wrapped to the panel (inside the grid it widened
+    // the panel for good).
+    if let Some((key, message)) = &app.ui.param_error {
+        let label = PARAMS.iter().find(|p| p.key == *key).map_or(*key, |p| p.label);
+        ui.add(
+            egui::Label::new(egui::RichText::new(format!("{label} refused: {message}")).color(super::theme::FAIL))
+                .wrap(),
+        );
+    }
     // Linked parameters follow to the other instrument.
     for (key, value) in changed {
         if app.state.linked.iter().any(|k| k == key)
@@ -283,7 +214,7 @@ fn editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
         }
     }
     let slot = app.state.slot_mut(editing);
-    egui::CollapsingHeader::new("Bands").default_open(false).show(ui, |ui| band_editor(slot, ui));
+    egui::CollapsingHeader::new("Bands").default_open(false).show(ui, |ui| super::editors::band_editor(slot, ui));
     super::derived::derived(app, ui);
     super::derived::a_vs_b(app, ui);
 }
@@ -349,7 +280,7 @@ fn settings(app: &mut ShoalApp, ui: &mut egui::Ui) {
             ui.add(egui::DragValue::new(&mut s.noise_seed).update_while_editing(false).range(0..=1_000_000).speed(1.0))
                 .labelled_by(l.id);
         });
-        let decimations = s.decimations();
+        let decimations = s.levels();
         let (preview, finest) = (decimations[0], decimations.last().copied().unwrap_or(1));
         let (mut pre, mut fin) = (preview, finest);
         ui.horizontal(|ui| {
@@ -370,66 +301,13 @@ fn settings(app: &mut ShoalApp, ui: &mut egui::Ui) {
             // Preview first, then 1/4 while the final level is finer, then the final level.
             s.decimations = [pre, 4, fin].into_iter().filter(|&d| d <= pre).collect();
         }
+        ui.checkbox(&mut s.preview_only, "Preview only").on_hover_text(
+            "Run the previews and stop: the final level runs when this is off (for a long retrieval at full resolution)",
+        );
     });
-    egui::CollapsingHeader::new("Requirements").default_open(false).show(ui, |ui| requirements_editor(app, ui));
-}
-
-/// Per product: largest MAE and |bias| (log-space, %) and smallest share returned; the SNR floor.
-/// An unticked limit is not checked. The verdicts use these, as `shoal study` does.
-fn requirements_editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
-    let r = &mut app.state.requirements;
-    egui::Grid::new("requirements").num_columns(4).show(ui, |ui| {
-        for h in ["", "MAE ≤ %", "|bias| ≤ %", "returned ≥ %"] {
-            ui.strong(h);
-        }
-        ui.end_row();
-        for (variable, label) in
-            [("chl_mg_m3", "chl-a"), ("nap_g_m3", "NAP"), ("cdom_per_m", "CDOM"), ("depth_m", "depth")]
-        {
-            // Edit a copy; the study's list changes only when a limit does (a product with no
-            // limit left is dropped from it).
-            let before = r.for_variable(variable).cloned();
-            let mut p = before.clone().unwrap_or(crate::study::ProductRequirement {
-                variable: variable.into(),
-                mae_pct: None,
-                bias_pct: None,
-                returned_pct: None,
-            });
-            ui.label(label);
-            optional_limit(ui, &mut p.mae_pct, 20.0, &crate::ranges::REQUIREMENT_MAE_PCT);
-            optional_limit(ui, &mut p.bias_pct, 10.0, &crate::ranges::REQUIREMENT_BIAS_PCT);
-            optional_limit(ui, &mut p.returned_pct, 95.0, &crate::ranges::REQUIREMENT_RETURNED_PCT);
-            ui.end_row();
-            if before.as_ref() != Some(&p) {
-                r.products.retain(|q| q.variable != variable);
-                if p.mae_pct.is_some() || p.bias_pct.is_some() || p.returned_pct.is_some() {
-                    r.products.push(p);
-                }
-            }
-        }
-        ui.label("SNR ≥");
-        optional_limit(ui, &mut r.snr, 100.0, &crate::ranges::REQUIREMENT_SNR);
-        ui.end_row();
-    });
-}
-
-/// A ticked limit with its value, clamped to the range's bounds; unticked: not checked.
-fn optional_limit(ui: &mut egui::Ui, value: &mut Option<f64>, default: f64, range: &crate::ranges::Range) {
-    ui.horizontal(|ui| {
-        let mut on = value.is_some();
-        if ui.checkbox(&mut on, "").on_hover_text(range.meaning).changed() {
-            *value = on.then_some(value.unwrap_or(default));
-        }
-        if let Some(v) = value {
-            ui.add(
-                egui::DragValue::new(v)
-                    .update_while_editing(false)
-                    .range(range.lo..=range.hi.min(1e4))
-                    .speed(0.5)
-                    .max_decimals(1),
-            );
-        }
-    });
+    egui::CollapsingHeader::new("Requirements")
+        .default_open(false)
+        .show(ui, |ui| super::editors::requirements_editor(app, ui));
 }
 
 /// The left panel.
@@ -440,11 +318,22 @@ pub fn left(app: &mut ShoalApp, ui: &mut egui::Ui) {
     editor(app, ui);
     ui.separator();
     settings(app, ui);
+    super::conditions::conditions(app, ui);
 }
 
 #[cfg(test)]
 mod tests {
     use super::fine_step;
+
+    #[test]
+    fn a_typed_number_reads_with_or_without_its_unit_and_letters_do_not() {
+        assert_eq!(super::parse_typed(" 60 ", " mm"), Some(60.0));
+        assert_eq!(super::parse_typed("60 mm", " mm"), Some(60.0));
+        assert_eq!(super::parse_typed("6e1", " mm"), Some(60.0));
+        assert_eq!(super::parse_typed("sixty", " mm"), None);
+        assert_eq!(super::parse_typed("60x", " mm"), None);
+        assert_eq!(super::parse_typed("inf", " mm"), None);
+    }
 
     #[test]
     fn a_fine_drag_moves_a_tenth_of_the_rail_in_the_sliders_own_scale() {

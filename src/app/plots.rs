@@ -4,213 +4,46 @@
 
 use egui_plot::{Bar, BarChart, HLine, Line, Plot, PlotPoints, Points};
 
+use super::metrics_table::{metrics_table, seed_controls, substrate_tables};
 use super::plot_data::PlotData;
 use super::{ShoalApp, theme};
-use crate::engine::{RunOutput, StageStatus};
-use crate::metrics::Metrics;
-use crate::study::Check;
+use crate::engine::StageStatus;
 
-fn pass(ok: bool) -> egui::RichText {
-    if ok {
-        egui::RichText::new("pass").color(theme::PASS)
-    } else {
-        egui::RichText::new("FAIL").color(theme::FAIL).strong()
+/// Grid marks of a log10 axis at 1, 2, …, 9 × each decade in view (a decade's first mark
+/// drawn strongest), so a range narrower than a decade (depths of 1–7 m) still has marks.
+pub(super) fn log_grid(input: egui_plot::GridInput) -> Vec<egui_plot::GridMark> {
+    let (lo, hi) = input.bounds;
+    if !(lo.is_finite() && hi.is_finite() && hi > lo) || hi - lo > 40.0 {
+        return Vec::new();
     }
-}
-
-/// The verdict cell of a set of checks, the checks listed on hover.
-fn verdict_cell(ui: &mut egui::Ui, checks: &[&Check]) {
-    match crate::study::verdict(checks.iter().copied()) {
-        Some(ok) => {
-            let text = checks.iter().map(|c| c.describe()).collect::<Vec<_>>().join("\n");
-            ui.label(pass(ok)).on_hover_text(text);
-        }
-        None => {
-            ui.label("").on_hover_text("no requirement on this product (Requirements, left panel)");
-        }
-    }
-}
-
-/// The dominant-substrate confusion tables of A and B (rows: true class; cells: % of the row
-/// retrieved as each class), when the retrieval unmixes substrates.
-fn substrate_tables(app: &ShoalApp, ui: &mut egui::Ui) {
-    for (i, s) in app.link.shown.iter().enumerate() {
-        let Some(c) =
-            s.as_ref().and_then(|s| s.output.retrievals.first()).and_then(|r| r.metrics.substrate_confusion.as_ref())
-        else {
-            continue;
-        };
-        let ab = if i == 0 { "A" } else { "B" };
-        let accuracy = c.accuracy_pct().map_or_else(|| "–".into(), |a| format!("{a:.1} %"));
-        egui::CollapsingHeader::new(format!("{ab}: dominant substrate, {accuracy} of pixels correct"))
-            .id_salt(format!("confusion-{ab}"))
-            .default_open(false)
-            .show(ui, |ui| {
-                egui::Grid::new(format!("confusion-grid-{ab}")).striped(true).show(ui, |ui| {
-                    ui.strong("true \\ retrieved");
-                    for name in &c.classes {
-                        ui.strong(name.replace('_', " "));
-                    }
-                    ui.strong("correct");
-                    ui.end_row();
-                    for (t, row) in c.counts.iter().enumerate() {
-                        let n: usize = row.iter().sum();
-                        if n == 0 {
-                            continue;
-                        }
-                        ui.label(c.classes[t].replace('_', " "));
-                        for &k in row {
-                            ui.label(format!("{:.0} %", 100.0 * k as f64 / n as f64))
-                                .on_hover_text(format!("{k} of {n} pixels"));
-                        }
-                        ui.label(c.recall_pct(t).map_or_else(|| "–".into(), |r| format!("{r:.0} %")));
-                        ui.end_row();
-                    }
-                });
-            });
-    }
-}
-
-fn metrics_table(app: &ShoalApp, ui: &mut egui::Ui, configs: &[crate::engine::RunConfig]) {
-    let runs: Vec<Option<&RunOutput>> = app.link.shown.iter().map(|s| s.as_ref().map(|s| s.output.as_ref())).collect();
-    // One judgement for app, export and CLI: `Requirements::check_run`.
-    let checks: Vec<Vec<Check>> = runs
-        .iter()
-        .map(|run| {
-            run.map_or_else(Vec::new, |o| {
-                let metrics = o.retrievals.first().map(|r| &r.metrics);
-                app.state.requirements.check_run(&o.config.instrument.name, o.config.seed, metrics, &o.snr)
-            })
-        })
-        .collect();
-    // The seed spread, when measured for these very designs.
-    let spread = app.ui.seeds.spread_for(configs).unwrap_or_default();
-    egui::Grid::new("metrics").num_columns(9).striped(true).show(ui, |ui| {
-        for h in ["product", "A MAE", "A bias", "A returned", "A", "B MAE", "B bias", "B returned", "B"] {
-            ui.strong(h);
-        }
-        ui.end_row();
-        let variables: Vec<String> = runs
-            .iter()
-            .flatten()
-            .flat_map(|o| o.retrievals.iter().flat_map(|r| r.metrics.variables.iter().map(|v| v.variable.clone())))
-            .fold(Vec::new(), |mut acc, v| {
-                if !acc.contains(&v) {
-                    acc.push(v);
-                }
-                acc
-            });
-        for v in &variables {
-            ui.label(crate::metrics::label(v)).on_hover_text(format!("`{v}`"));
-            for (index, (run, checks)) in runs.iter().zip(&checks).enumerate() {
-                let m: Option<&Metrics> = run.and_then(|o| o.retrievals.first()).and_then(|r| r.metrics.get(v));
-                match m {
-                    Some(m) if m.n == 0 => {
-                        // Nothing returned: no MAE or bias to show (never "0.0 %").
-                        ui.label("–").on_hover_text("no pixel returned");
-                        ui.label("–").on_hover_text("no pixel returned");
-                        ui.label(format!("{:.1} %", m.returned_pct));
-                    }
-                    Some(m) => {
-                        let unit = crate::metrics::unit(v);
-                        let in_units = format!(
-                            "log-space MAE {:.1} %; mean |error| {:.3} {unit}, mean error {:+.3} {unit}, RMSE {:.3} {unit} ({} pixels)",
-                            m.mae_pct(),
-                            m.mean_abs_error,
-                            m.mean_error,
-                            m.rmse,
-                            m.n
-                        );
-                        // Depth errors read in metres too (a log-space % alone hides whether 10 % is 0.2 m or 2 m).
-                        let mut text = if unit == "m" {
-                            format!("{:.1} % ({:.2} m)", m.mae_pct(), m.mean_abs_error)
-                        } else {
-                            format!("{:.1} %", m.mae_pct())
-                        };
-                        let mut hover = in_units;
-                        let ab = if index == 0 { "A" } else { "B" };
-                        if let Some(s) =
-                            spread.iter().find(|s| s.instrument == ab && s.variable == *v).filter(|s| s.seeds > 1)
-                        {
-                            text.push_str(&format!(" ±{:.1}", s.mae_pct_std));
-                            hover.push_str(&format!(
-                                "\n± is the standard deviation of the MAE over {} noise seeds at 1/{} (mean {:.1} %, range {:.1}–{:.1} %)",
-                                s.seeds, app.ui.seeds.decimation, s.mae_pct_mean, s.mae_pct_range.0, s.mae_pct_range.1
-                            ));
-                        }
-                        ui.label(text).on_hover_text(hover);
-                        ui.label(format!("{:+.1} %", m.bias_pct()));
-                        ui.label(format!("{:.1} %", m.returned_pct));
-                    }
-                    None => {
-                        for _ in 0..3 {
-                            ui.label("–");
-                        }
-                    }
-                }
-                let mine: Vec<&Check> = checks.iter().filter(|c| c.variable.as_deref() == Some(v.as_str())).collect();
-                verdict_cell(ui, &mine);
+    let mut marks = Vec::new();
+    for e in (lo.floor() as i32)..=(hi.ceil() as i32) {
+        for k in 1..=9 {
+            let value = f64::from(e) + f64::from(k).log10();
+            if (lo..=hi).contains(&value) {
+                marks.push(egui_plot::GridMark { value, step_size: if k == 1 { 1.0 } else { 0.1 } });
             }
-            ui.end_row();
         }
-        if app.state.requirements.snr.is_some() && runs.iter().any(Option::is_some) {
-            ui.label("SNR, every band");
-            for (run, checks) in runs.iter().zip(&checks) {
-                let lowest = run.and_then(|o| o.snr.iter().map(|r| r.snr_analytic).reduce(f64::min));
-                ui.label(lowest.map_or_else(|| "–".into(), |s| format!("lowest {s:.0}")));
-                ui.label("");
-                ui.label("");
-                let mine: Vec<&Check> = checks.iter().filter(|c| c.variable.is_none()).collect();
-                verdict_cell(ui, &mine);
-            }
-            ui.end_row();
-        }
-    });
-    if runs.iter().flatten().next().is_none() {
-        ui.label("No results yet.");
     }
+    marks
 }
 
-/// Start (or cancel) the seed-spread runs, and say what the ± in the table means.
-fn seed_controls(app: &mut ShoalApp, ui: &mut egui::Ui, configs: &[crate::engine::RunConfig]) {
-    ui.horizontal(|ui| {
-        let job = &mut app.ui.seeds;
-        if job.busy() {
-            let (done, total) = job.progress();
-            ui.spinner();
-            ui.label(format!("seed spread: {done} of {total} runs"));
-            if ui.button("Cancel").clicked() {
-                job.cancel();
-            }
-            return;
-        }
-        let start = ui
-            .button("Seed spread")
-            .on_hover_text("Rerun A and B over several detector-noise seeds; the table then shows ± the MAE's standard deviation over them");
-        ui.add(egui::DragValue::new(&mut job.seeds).range(2..=20).suffix(" seeds").update_while_editing(false));
-        ui.add(egui::DragValue::new(&mut job.decimation).range(1..=16).prefix("at 1/").update_while_editing(false));
-        if start.clicked() {
-            job.start(ui.ctx(), configs);
-        } else if job.stale(configs) {
-            ui.label(egui::RichText::new("stale: the designs changed").color(theme::WARN))
-                .on_hover_text("The spread was measured for other designs; it is not shown. Run it again.");
-        } else if !job.status.is_empty() {
-            ui.label(&job.status);
-        }
-    });
-}
-
-/// The label of a log10 axis mark: the value itself at whole decades (0.1, 1, 10, 100), nothing
-/// between them (the plots hold log10 values; a reader wants the concentration).
-fn decade(log10: f64) -> String {
-    if (log10 - log10.round()).abs() > 1e-6 {
+/// The label of a [`log_grid`] mark: the value at 1, 2 and 5 × a decade (every mark when less
+/// than a decade is in view), nothing at the others.
+pub(super) fn log_label(mark: egui_plot::GridMark, range: &std::ops::RangeInclusive<f64>) -> String {
+    let span = range.end() - range.start();
+    let value = 10f64.powf(mark.value);
+    let mantissa = value / 10f64.powf(mark.value.floor());
+    let k = mantissa.round();
+    if (mantissa - k).abs() > 1e-6 || !(span < 1.2 || [1.0, 2.0, 5.0].contains(&k)) || (span > 4.0 && k != 1.0) {
         return String::new();
     }
-    let e = log10.round() as i32;
-    match e {
-        -3..=-1 => format!("{:.*}", (-e) as usize, 10f64.powi(e)),
-        0..=5 => format!("{}", 10i64.pow(e as u32)),
-        _ => format!("1e{e}"),
+    let e = mark.value.floor() as i32;
+    if (-3..=5).contains(&e) {
+        let decimals = usize::try_from(-e).unwrap_or(0);
+        format!("{value:.decimals$}")
+    } else {
+        format!("{k}e{e}")
     }
 }
 
@@ -239,8 +72,13 @@ fn histogram(app: &ShoalApp, ui: &mut egui::Ui, width: f32) -> egui::Rect {
             .width(width)
             .height(plot_height(ui))
             .x_axis_label(format!("{name} ({unit}), log scale"))
-            .x_axis_formatter(|mark, _| decade(mark.value))
+            .x_grid_spacer(log_grid)
+            .x_axis_formatter(log_label)
             .y_axis_label("% of water pixels")
+            // The wheel scrolls the panel; these plots are read, not explored.
+            .allow_scroll(false)
+            .allow_zoom(false)
+            .allow_drag(false)
             .show(ui, |p| {
                 if edges.len() < 2 {
                     return;
@@ -304,8 +142,21 @@ fn scatter(app: &ShoalApp, ui: &mut egui::Ui, width: f32) -> egui::Rect {
             .include_y(edges.last().copied().unwrap_or(1.0))
             .x_axis_label(format!("true ({unit}), log scale"))
             .y_axis_label(format!("retrieved ({unit})"))
-            .x_axis_formatter(|mark, _| decade(mark.value))
-            .y_axis_formatter(|mark, _| decade(mark.value))
+            .x_grid_spacer(log_grid)
+            .y_grid_spacer(log_grid)
+            .x_axis_formatter(log_label)
+            .y_axis_formatter(log_label)
+            .allow_scroll(false)
+            .allow_zoom(false)
+            .allow_drag(false)
+            .label_formatter(move |h| {
+                let egui_plot::HoverPosition::NearDataPoint { plot_name, position, .. } = h else { return None };
+                Some(format!(
+                    "{plot_name}: true {}, retrieved {} {unit}",
+                    super::maps::format_value(10f64.powf(position.x)),
+                    super::maps::format_value(10f64.powf(position.y))
+                ))
+            })
             .show(ui, |p| {
                 for (i, d) in data.scatter.iter().enumerate() {
                     p.points(
@@ -327,11 +178,22 @@ fn snr_plot(app: &ShoalApp, ui: &mut egui::Ui, width: f32) -> egui::Rect {
     ui.vertical(|ui| {
         ui.label("SNR per band (line: analytic, dots: measured)");
         key(ui, &[("A", theme::INSTRUMENT[0]), ("B", theme::INSTRUMENT[1]), ("requirement", theme::PASS)]);
-        Plot::new("snr").width(width).height(plot_height(ui)).x_axis_label("wavelength (nm)").y_axis_label("SNR").show(
-            ui,
-            |p| {
-                for (i, s) in app.link.shown.iter().enumerate() {
-                    let Some(s) = s else { continue };
+        Plot::new("snr")
+            .width(width)
+            .height(plot_height(ui))
+            .x_axis_label("wavelength (nm)")
+            .y_axis_label("SNR")
+            .x_axis_formatter(|mark, _| format!("{:.0}", mark.value))
+            .allow_scroll(false)
+            .allow_zoom(false)
+            .allow_drag(false)
+            .label_formatter(|h| {
+                let egui_plot::HoverPosition::NearDataPoint { plot_name, position, .. } = h else { return None };
+                Some(format!("{plot_name}: {:.0} nm, SNR {:.0}", position.x, position.y))
+            })
+            .show(ui, |p| {
+                for i in 0..2 {
+                    let Some(s) = app.link.current(i) else { continue };
                     let name = if i == 0 { "A" } else { "B" };
                     let line: Vec<[f64; 2]> = s
                         .output
@@ -353,8 +215,7 @@ fn snr_plot(app: &ShoalApp, ui: &mut egui::Ui, width: f32) -> egui::Rect {
                 if let Some(snr) = app.state.requirements.snr {
                     p.hline(HLine::new("requirement", snr).color(theme::PASS));
                 }
-            },
-        );
+            });
     })
     .response
     .rect
@@ -362,8 +223,8 @@ fn snr_plot(app: &ShoalApp, ui: &mut egui::Ui, width: f32) -> egui::Rect {
 
 fn timings(app: &ShoalApp, ui: &mut egui::Ui) {
     egui::CollapsingHeader::new("Stage timings").default_open(false).show(ui, |ui| {
-        for (i, s) in app.link.shown.iter().enumerate() {
-            let Some(s) = s else { continue };
+        for i in 0..2 {
+            let Some(s) = app.link.current(i) else { continue };
             let r = &s.output.report;
             let ran: Vec<String> = r
                 .stages
@@ -444,15 +305,33 @@ pub fn bottom(app: &mut ShoalApp, ui: &mut egui::Ui) {
             plots(app, ui, total)
         };
         app.ui.plot_rects = rects;
+        super::snr_table::snr_section(app, ui);
         timings(app, ui);
     });
 }
 
 #[cfg(test)]
 mod tests {
+    use egui_plot::{GridInput, GridMark};
+
+    fn labels(lo: f64, hi: f64) -> Vec<String> {
+        super::log_grid(GridInput { bounds: (lo, hi), base_step_size: 0.01 })
+            .into_iter()
+            .map(|m| super::log_label(m, &(lo..=hi)))
+            .filter(|l| !l.is_empty())
+            .collect()
+    }
+
     #[test]
-    fn log_axes_print_decades_as_values() {
-        let t: Vec<String> = [-2.0, -1.0, 0.0, 1.0, 2.0, 0.5, 7.0].map(super::decade).to_vec();
-        assert_eq!(t, ["0.01", "0.1", "1", "10", "100", "", "1e7"]);
+    fn log_axes_label_values_and_keep_marks_inside_a_decade() {
+        // Depths of 1–7 m: less than a decade in view, every integer labelled.
+        assert_eq!(labels(0.0, 0.85), ["1", "2", "3", "4", "5", "6", "7"]);
+        // Three decades: 1, 2 and 5 of each.
+        assert_eq!(labels(-1.0, 2.0), ["0.1", "0.2", "0.5", "1", "2", "5", "10", "20", "50", "100"]);
+        // Wide: decades only, in exponent form far from 1.
+        assert_eq!(labels(4.0, 9.0), ["10000", "100000", "1e6", "1e7", "1e8", "1e9"]);
+        let m = GridMark { value: 0.5, step_size: 0.1 };
+        assert_eq!(super::log_label(m, &(0.0..=3.0)), "", "a mark between 1-2-5 values is not labelled");
+        assert!(super::log_grid(GridInput { bounds: (f64::NAN, 1.0), base_step_size: 0.1 }).is_empty());
     }
 }

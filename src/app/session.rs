@@ -5,6 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use super::model::{AppState, Slot, fallback_requirements};
+use crate::spectral::SpectrumSource;
 
 /// Where the session is kept: `session.ron` in the user's Shoal directory (`SHOAL_HOME` when it
 /// is set; see [`crate::library::home_dir`]), beside the preset library and the exports.
@@ -92,6 +93,23 @@ pub fn repair(state: &mut AppState) -> Vec<String> {
     if let Err(e) = state.fidelity.validate() {
         reset.push(format!("fidelity ({e}): back to the defaults"));
         state.fidelity = defaults.fidelity.clone();
+    }
+    if let Some(SpectrumSource::Constant(v) | SpectrumSource::PowerLaw { coefficient: v, .. }) = &state.snr_reference
+        && !(v.is_finite() && *v > 0.0)
+    {
+        reset.push(format!("SNR reference radiance ({v}): back to the scene's median water radiance"));
+        state.snr_reference = None;
+    }
+    if let Some(SpectrumSource::Table { wavelength_nm, values, .. }) = &state.snr_reference
+        && (wavelength_nm.len() != values.len()
+            || values.iter().chain(wavelength_nm).any(|v| !(v.is_finite() && *v > 0.0)))
+    {
+        reset.push("SNR reference spectrum: back to the scene's median water radiance".into());
+        state.snr_reference = None;
+    }
+    if let Err(e) = state.calibration.validate() {
+        reset.push(format!("calibration ({e}): back to the defaults"));
+        state.calibration = defaults.calibration.clone();
     }
     if let Err(e) = state.requirements.validate() {
         reset.push(format!("requirements ({e}): back to the defaults"));

@@ -18,6 +18,7 @@ use shoal::app::{AppOptions, ShoalApp};
 use shoal::instrument::InstrumentSpec;
 use shoal::library::Library;
 
+mod review;
 mod session;
 
 /// A fresh, empty user library in the system temporary directory.
@@ -292,7 +293,7 @@ fn the_sweep_window_draws_a_curve_for_a_and_b() {
     assert_eq!(h.state().explore().sweep_rows(), 12);
     assert!(h.query_by_label_contains("done: 4 runs").is_some());
     // Each instrument's line says whether it meets the chl requirement.
-    assert!(h.query_all_by_label_contains("chl MAE ≤").count() >= 2);
+    assert!(h.query_all_by_label_contains("chl-a MAE ≤").count() >= 2);
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -340,7 +341,7 @@ fn an_out_of_range_slider_value_is_refused_inline() {
     h.step();
     let expected = "aperture_mm: 5000 is out of range (allowed: above 0, at most 2000 mm)";
     assert_eq!(h.state().refused_value(), Some(expected));
-    assert!(h.query_all_by_label(&format!("refused: {expected}")).next().is_some(), "not on screen");
+    assert!(h.query_all_by_label(&format!("Aperture refused: {expected}")).next().is_some(), "not on screen");
     assert!((h.state().state.a.spec.aperture_mm - 60.0).abs() < 1e-9, "the instrument keeps 60 mm");
     h.get_by_role_and_label(Role::Slider, "Aperture").set_value_accesskit(100.0);
     h.step();
@@ -621,8 +622,8 @@ fn the_seed_spread_shows_beside_the_mae_and_goes_stale_after_an_edit() {
     let mut h = harness("cubesat", 24, &dir);
     wait_for_engine(&mut h);
     assert_eq!(h.query_all_by_label_contains(" ±").count(), 0, "no spread before it is measured");
-    h.get_by_role_and_label(Role::SpinButton, "seeds").set_value_accesskit(2.0);
-    h.get_by_role_and_label(Role::SpinButton, "at 1/").set_value_accesskit(16.0);
+    h.get_by_role_and_label(Role::SpinButton, "noise seeds").set_value_accesskit(2.0);
+    h.get_by_role_and_label(Role::SpinButton, "1/").set_value_accesskit(16.0);
     h.step();
     h.get_by_label("Seed spread").click();
     h.step();

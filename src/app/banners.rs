@@ -1,0 +1,73 @@
+//! What the central panel says before its maps: a scene the retrieval does not suit (and the
+//! switch to the one that does), a product the retrieval does not make, and a run of the
+//! configuration set that failed (its reason in full where its maps would be, and the way out).
+
+use super::ShoalApp;
+use super::model::ProductKind;
+
+/// The scene ↔ retrieval banner: a scene whose bottom shows needs a retrieval that models one.
+pub(super) fn retrieval_banner(app: &mut ShoalApp, ui: &mut egui::Ui) {
+    use super::logic::UiCommand;
+    use super::model::RetrievalKind;
+    if app.state.retrieval == RetrievalKind::Almi && app.state.scene.needs_bottom_model() {
+        ui.horizontal_wrapped(|ui| {
+            ui.colored_label(
+                super::theme::NOTICE,
+                format!(
+                    "`{}` has a visible bottom (its depth map is shallow). aLMI assumes optically deep water: its \
+                     concentrations are biased by the bottom, and it retrieves no depth or substrate.",
+                    app.state.scene_name
+                ),
+            );
+            if ui.button("Use SAMBUCA").on_hover_text("Retrieve depth, substrate and water together").clicked() {
+                app.ui.commands.push(UiCommand::UseRetrieval(RetrievalKind::Sambuca));
+            }
+        });
+    }
+}
+
+/// What the shown product is when the retrieval does not make it.
+pub(super) fn product_note(app: &ShoalApp) -> Option<String> {
+    use super::model::RetrievalKind;
+    let retrieval = match app.state.retrieval {
+        RetrievalKind::Almi => "aLMI",
+        RetrievalKind::Sambuca => "SAMBUCA",
+    };
+    let missing = matches!(
+        (app.state.retrieval, app.state.product),
+        (RetrievalKind::Almi, ProductKind::Depth | ProductKind::Substrate)
+            | (RetrievalKind::Sambuca, ProductKind::SiopSet)
+    );
+    missing.then(|| {
+        let product = app.state.product.label().split(" (").next().unwrap_or_default();
+        format!("{retrieval} does not retrieve the {product}: A and B have no map of it.")
+    })
+}
+
+/// Where instrument `index`'s maps would be when its run of the configuration set failed: the
+/// reason in full, and the way out when Shoal knows one.
+pub(super) fn failure_box(app: &mut ShoalApp, ui: &mut egui::Ui, index: usize, message: &str) {
+    use super::logic::UiCommand;
+    use super::model::RetrievalKind;
+    let ab = if index == 0 { "A" } else { "B" };
+    egui::Frame::group(ui.style()).stroke(egui::Stroke::new(1.5, super::theme::FAIL)).show(ui, |ui| {
+        ui.set_width(ui.available_width());
+        ui.colored_label(
+            super::theme::FAIL,
+            format!("{ab}: the run of the configuration set failed — nothing of {ab} is shown."),
+        );
+        ui.add(egui::Label::new(message).wrap());
+        let deep = !app.state.scene.needs_bottom_model();
+        if app.state.retrieval == RetrievalKind::Sambuca && deep {
+            ui.horizontal_wrapped(|ui| {
+                ui.label(format!(
+                    "`{}` is optically deep: SAMBUCA fits a bottom it does not have.",
+                    app.state.scene_name
+                ));
+                if ui.button("Use aLMI").on_hover_text("Retrieve chl-a, NAP and CDOM for deep water").clicked() {
+                    app.ui.commands.push(UiCommand::UseRetrieval(RetrievalKind::Almi));
+                }
+            });
+        }
+    });
+}

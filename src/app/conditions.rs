@@ -1,0 +1,123 @@
+//! The left panel's scene and atmosphere controls, for worst-case checks of a design: the
+//! aerosol model and its optical thickness, the sun zenith, a wind-roughened surface and its
+//! glint, adjacency (when the scene has land), and the calibration's systematic errors. Each
+//! value is checked against its documented range ([`crate::ranges`]) before it is taken; a
+//! refused value keeps the last valid one and says why.
+
+use super::ShoalApp;
+use crate::atmosphere::{AerosolType, Surface};
+use crate::ranges::Range;
+use crate::scene::Effect;
+
+/// A slider over `range` (clamped to `span` for dragging, the range checked when typed);
+/// returns the refusal, if the value was refused.
+fn checked(
+    ui: &mut egui::Ui,
+    value: &mut f64,
+    span: (f64, f64),
+    range: &Range,
+    label: &str,
+    suffix: &str,
+) -> Option<String> {
+    let mut v = *value;
+    ui.add(
+        egui::Slider::new(&mut v, span.0..=span.1)
+            .update_while_editing(false)
+            .clamping(egui::SliderClamping::Never)
+            .text(label)
+            .suffix(suffix),
+    )
+    .on_hover_text(format!("{} (allowed: {})", range.meaning, range.allowed()));
+    if v == *value {
+        return None;
+    }
+    match range.check(v) {
+        Ok(()) => {
+            *value = v;
+            None
+        }
+        Err(m) => Some(format!("{}: {m}", range.path)),
+    }
+}
+
+/// The scene and atmosphere controls.
+pub(super) fn conditions(app: &mut ShoalApp, ui: &mut egui::Ui) {
+    use crate::ranges as r;
+    egui::CollapsingHeader::new("Scene and atmosphere").default_open(false).show(ui, |ui| {
+        let s = &mut app.state;
+        let mut refused = None;
+        let atm = &mut s.scene.atmosphere;
+        let names = [
+            (AerosolType::None, "none"),
+            (AerosolType::Maritime, "maritime"),
+            (AerosolType::Continental, "continental"),
+            (AerosolType::Urban, "urban"),
+        ];
+        let current = names.iter().find(|(a, _)| *a == atm.aerosol).map_or("?", |(_, n)| *n);
+        egui::ComboBox::from_label("Aerosol (WMO)").selected_text(current).show_ui(ui, |ui| {
+            for (a, n) in names {
+                ui.selectable_value(&mut atm.aerosol, a, n);
+            }
+        });
+        refused = refused.or(checked(ui, &mut atm.aot550, (0.0, 1.0), &r::ATMOSPHERE_AOT550, "AOT(550)", ""));
+        refused = refused.or(checked(
+            ui,
+            &mut s.scene.sun.zenith_deg,
+            (0.0, 85.0),
+            &r::SCENE_SUN_ZENITH_DEG,
+            "Sun zenith",
+            "°",
+        ));
+        // Glint needs a wind-roughened surface: the two move together.
+        let mut glint = s.scene.effects.contains(&Effect::SunGlint);
+        if ui.checkbox(&mut glint, "Sun glint (Cox–Munk, wind-roughened sea)").changed() {
+            if glint {
+                if matches!(s.scene.atmosphere.surface, Surface::Flat) {
+                    s.scene.atmosphere.surface = Surface::Wind { speed_m_s: 5.0 };
+                }
+                s.scene.effects.push(Effect::SunGlint);
+            } else {
+                s.scene.effects.retain(|e| *e != Effect::SunGlint);
+            }
+        }
+        if let Surface::Wind { speed_m_s } = &mut s.scene.atmosphere.surface {
+            refused =
+                refused.or(checked(ui, speed_m_s, (0.0, 15.0), &r::ATMOSPHERE_WIND_SPEED_M_S, "Wind speed", " m/s"));
+        }
+        if s.scene.land.is_some() {
+            let mut adjacency = s.scene.effects.contains(&Effect::Adjacency);
+            if ui.checkbox(&mut adjacency, "Adjacency (light from the land scattered into water pixels)").changed() {
+                if adjacency {
+                    s.scene.effects.push(Effect::Adjacency);
+                } else {
+                    s.scene.effects.retain(|e| *e != Effect::Adjacency);
+                }
+            }
+        }
+        ui.label("Calibration errors (systematic)");
+        let c = &mut s.calibration;
+        refused = refused.or(checked(
+            ui,
+            &mut c.diffuser_bias_pct,
+            (-10.0, 10.0),
+            &r::CALIBRATION_DIFFUSER_BIAS_PCT,
+            "Diffuser error",
+            " %",
+        ));
+        refused = refused.or(checked(
+            ui,
+            &mut c.gain_drift_pct,
+            (-10.0, 10.0),
+            &r::CALIBRATION_GAIN_DRIFT_PCT,
+            "Gain drift",
+            " %",
+        ));
+        if refused.is_some() {
+            app.ui.conditions_error = refused;
+        }
+        if let Some(m) = &app.ui.conditions_error {
+            ui.add(egui::Label::new(egui::RichText::new(format!("refused: {m}")).color(super::theme::FAIL)).wrap());
+        }
+        ui.small("These change the scene and the calibration of A and B alike.");
+    });
+}

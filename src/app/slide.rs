@@ -1,0 +1,202 @@
+//! The comparison figure an engineer takes to a design review: the maps on one scale, the SNR
+//! per band against the requirement, retrieved against true values, the verdicts and the
+//! parameters A and B differ in, as a 1920 × 1080 slide (PNG and SVG), with the resolved
+//! configurations beside it.
+
+use std::path::{Path, PathBuf};
+
+use super::export::Snapshot;
+use super::model::AppState;
+use super::raster::{Palette, product_map};
+use crate::colormap::Scale;
+use crate::engine::RunOutput;
+use crate::study::{ComparisonPanel, ReviewSlide, SlideSeries, review_slide, write_bytes};
+
+/// Write the comparison figure and the configurations next to `stem`.
+pub fn write_figure(snap: &Snapshot, stem: &Path) -> Result<Vec<PathBuf>, String> {
+    let state = &snap.state;
+    let (a, b) = snap.both()?;
+    let kind = state.product;
+    let mut panels = Vec::new();
+    for (title, out, truth) in [("truth", a, true), ("A", a, false), ("B", b, false)] {
+        if let Some(m) = product_map(out, kind, state.band, truth) {
+            let label = if truth {
+                title.to_string()
+            } else {
+                format!("{title}: {}", if title == "A" { &state.a.preset } else { &state.b.preset })
+            };
+            panels.push(ComparisonPanel { title: label, values: m.values, valid: m.valid });
+        }
+    }
+    if panels.is_empty() {
+        return Err(format!("the runs have no {} to show", kind.label()));
+    }
+    let refs: Vec<super::raster::MapData> =
+        panels.iter().map(|p| super::raster::MapData { values: p.values.clone(), valid: p.valid.clone() }).collect();
+    let refs: Vec<&super::raster::MapData> = refs.iter().collect();
+    let scale = match super::raster::shared_palette(&refs, kind, false) {
+        Palette::Sequential(s) => s,
+        _ => Scale { lo: 0.0, hi: 8.0, log: false },
+    };
+    let table = verdict_table(state, a, b);
+    let changes = state.changes();
+    let caption = vec![
+        format!(
+            "A: {}   B: {}   scene: {}   retrieval: {}   resolution 1/{}",
+            state.a.preset,
+            state.b.preset,
+            state.scene_name,
+            match state.retrieval {
+                super::model::RetrievalKind::Almi => "aLMI",
+                super::model::RetrievalKind::Sambuca => "SAMBUCA",
+            },
+            snap.decimation
+        ),
+        if changes.is_empty() {
+            "Instruments as in their presets.".into()
+        } else {
+            format!("Instrument edits: {}", changes.join("; "))
+        },
+        "Shoal: one colour scale for all panels; grey: land or not returned; metrics after Seegers et al. (2018)."
+            .into(),
+    ];
+    // What is compared, as set now (a study's name would outlive a change of scene).
+    let title = format!("{} vs {} over {} — {}", state.a.preset, state.b.preset, state.scene_name, kind.label());
+    let variable = kind.variable().unwrap_or("chl_mg_m3");
+    // One series per instrument, in A's and B's colours.
+    let series = |i: usize, out: &RunOutput, points: Vec<(f64, f64)>| {
+        let [r, g, b, _] = super::theme::INSTRUMENT[i].to_array();
+        SlideSeries {
+            name: format!("{}: {}", if i == 0 { "A" } else { "B" }, out.config.instrument.name),
+            colour: [r, g, b],
+            points,
+        }
+    };
+    let plot = super::plot_data::plot_data(&snap.runs, variable);
+    let (mut snr, mut scatter) = (Vec::new(), Vec::new());
+    for (i, out) in [a, b].into_iter().enumerate() {
+        let analytic = out.snr.iter().filter(|r| r.snr_analytic.is_finite()).map(|r| (r.centre_nm, r.snr_analytic));
+        snr.push(series(i, out, analytic.collect()));
+        scatter.push(series(i, out, plot.scatter[i].iter().map(|p| (p[0], p[1])).collect()));
+    }
+    let slide = ReviewSlide {
+        title,
+        caption,
+        label: kind.label().to_string(),
+        scale,
+        diverging: false,
+        panels,
+        snr,
+        snr_requirement: state.requirements.snr,
+        scatter,
+        scatter_label: format!("({})", crate::metrics::unit(variable)),
+        verdicts: table,
+        parameters: super::params::differences(
+            &a.config.instrument,
+            &b.config.instrument,
+            (a.response.bands.bands.len(), b.response.bands.bands.len()),
+        ),
+    };
+    let fig = review_slide("comparison", &slide).map_err(|e| e.to_string())?;
+    let png = stem.with_extension("png");
+    let svg = stem.with_extension("svg");
+    write_bytes(&png, &fig.png).map_err(|e| e.to_string())?;
+    write_bytes(&svg, fig.svg.as_bytes()).map_err(|e| e.to_string())?;
+    let mut written = vec![png, svg];
+    for (name, out) in [("A", a), ("B", b)] {
+        let path = PathBuf::from(format!("{}_config_{name}.ron", stem.display()));
+        let text = out.config.to_ron().map_err(|e| e.to_string())?;
+        write_bytes(&path, text.as_bytes()).map_err(|e| e.to_string())?;
+        written.push(path);
+    }
+    Ok(written)
+}
+
+/// The verdict table of the slide: one row per product with A and B side by side (MAE, bias,
+/// returned share and the judgement of `Requirements::check_run`, the app's and `shoal
+/// study`'s), then the SNR floor's row.
+fn verdict_table(state: &AppState, a: &RunOutput, b: &RunOutput) -> Vec<Vec<String>> {
+    let mut header = vec!["product".to_string()];
+    for ab in ["A", "B"] {
+        header.extend([format!("{ab} MAE %"), format!("{ab} bias %"), format!("{ab} returned %"), ab.to_string()]);
+    }
+    let runs = [a, b];
+    let checks: Vec<Vec<crate::study::Check>> = runs
+        .iter()
+        .map(|out| {
+            let metrics = out.retrievals.first().map(|r| &r.metrics);
+            state.requirements.check_run(&out.config.instrument.name, out.config.seed, metrics, &out.snr)
+        })
+        .collect();
+    let judged = |checks: &[crate::study::Check], variable: Option<&str>| {
+        let mine: Vec<&crate::study::Check> = checks.iter().filter(|c| c.variable.as_deref() == variable).collect();
+        match crate::study::verdict(mine.iter().copied()) {
+            Some(true) => "pass".to_string(),
+            Some(false) => {
+                let name = variable.map_or("SNR", crate::metrics::name);
+                let failed: Vec<String> = mine
+                    .iter()
+                    .filter(|c| !c.pass)
+                    .map(|c| {
+                        let what = variable.map_or_else(|| c.what.clone(), |v| c.what.replace(v, name));
+                        what.replacen(&format!("{name} "), "", 1)
+                    })
+                    .take(2)
+                    .collect();
+                format!("FAIL: {}", failed.join(", "))
+            }
+            None => String::new(),
+        }
+    };
+    let mut table = vec![header];
+    let variables: Vec<String> = runs
+        .iter()
+        .flat_map(|o| o.retrievals.iter().take(1).flat_map(|r| r.metrics.variables.iter().map(|v| v.variable.clone())))
+        .fold(Vec::new(), |mut acc, v| {
+            if !acc.contains(&v) {
+                acc.push(v);
+            }
+            acc
+        });
+    for v in &variables {
+        let mut row = vec![crate::metrics::label(v).to_string()];
+        for (out, checks) in runs.iter().zip(&checks) {
+            let m = out.retrievals.first().and_then(|r| r.metrics.get(v));
+            match m {
+                Some(m) if m.n > 0 => row.extend([
+                    format!("{:.1}", m.mae_pct()),
+                    format!("{:+.1}", m.bias_pct()),
+                    format!("{:.1}", m.returned_pct),
+                ]),
+                Some(m) => row.extend(["–".into(), "–".into(), format!("{:.1}", m.returned_pct)]),
+                None => row.extend(["–".into(), "–".into(), "–".into()]),
+            }
+            row.push(judged(checks, Some(v)));
+        }
+        table.push(row);
+    }
+    let agreement = |o: &RunOutput| o.retrievals.first().and_then(|r| r.metrics.substrate_agreement_pct);
+    if runs.iter().any(|o| agreement(o).is_some()) {
+        let mut row = vec!["bottom type".to_string()];
+        for (out, checks) in runs.iter().zip(&checks) {
+            let right = agreement(out).map_or_else(|| "–".into(), |a| format!("{a:.1} % right"));
+            row.extend([right, String::new(), String::new(), judged(checks, Some("substrate"))]);
+        }
+        table.push(row);
+    }
+    if state.requirements.snr.is_some() {
+        let mut row = vec!["SNR, every band".to_string()];
+        for (out, checks) in runs.iter().zip(&checks) {
+            let saturated = out.snr.iter().filter(|r| r.saturated()).count();
+            let lowest = out.snr.iter().map(|r| r.snr_analytic).reduce(f64::min);
+            let value = if saturated > 0 {
+                format!("{saturated} saturated")
+            } else {
+                lowest.map_or_else(|| "–".into(), |l| format!("lowest {l:.0}"))
+            };
+            row.extend([value, String::new(), String::new(), judged(checks, None)]);
+        }
+        table.push(row);
+    }
+    table
+}
