@@ -183,6 +183,8 @@ fn snr_plot(app: &ShoalApp, ui: &mut egui::Ui, width: f32) -> egui::Rect {
             .height(plot_height(ui))
             .x_axis_label("wavelength (nm)")
             .y_axis_label("SNR")
+            // Ticks every 100 nm (egui's own spacing left this axis without labels).
+            .x_grid_spacer(egui_plot::uniform_grid_spacer(|_| [50.0, 100.0, 500.0]))
             .x_axis_formatter(|mark, _| format!("{:.0}", mark.value))
             .allow_scroll(false)
             .allow_zoom(false)
@@ -264,6 +266,15 @@ pub fn bottom(app: &mut ShoalApp, ui: &mut egui::Ui) {
         let table = app.ui.metrics_width.unwrap_or(560.0);
         let beside = total - table - GAP >= 3.0 * MIN_PLOT_WIDTH + 2.0 * GAP;
         let plots = |app: &ShoalApp, ui: &mut egui::Ui, room: f32| -> Vec<egui::Rect> {
+            // No axes without data: a failed or pending configuration has nothing to plot.
+            if (0..2).all(|i| !matches!(app.link.standing(i), super::link::Standing::Current(_) | super::link::Standing::Earlier(_))) {
+                // The plots' room kept, so the panel does not shrink to the note and jump back.
+                ui.allocate_ui(egui::vec2(room, plot_height(ui) + 40.0), |ui| {
+                    ui.set_min_size(egui::vec2(room.min(MIN_PLOT_WIDTH), plot_height(ui) + 40.0));
+                    ui.label("No results of the configuration set to plot.");
+                });
+                return Vec::new();
+            }
             let per_row = (((room + GAP) / (MIN_PLOT_WIDTH + GAP)).floor() as usize).clamp(1, 3);
             let width = (room - GAP * (per_row - 1) as f32) / per_row as f32 - 4.0;
             let draw: [&dyn Fn(&mut egui::Ui) -> egui::Rect; 3] =
