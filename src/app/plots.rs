@@ -267,7 +267,9 @@ pub fn bottom(app: &mut ShoalApp, ui: &mut egui::Ui) {
         let beside = total - table - GAP >= 3.0 * MIN_PLOT_WIDTH + 2.0 * GAP;
         let plots = |app: &ShoalApp, ui: &mut egui::Ui, room: f32| -> Vec<egui::Rect> {
             // No axes without data: a failed or pending configuration has nothing to plot.
-            if (0..2).all(|i| !matches!(app.link.standing(i), super::link::Standing::Current(_) | super::link::Standing::Earlier(_))) {
+            if (0..2).all(|i| {
+                !matches!(app.link.standing(i), super::link::Standing::Current(_) | super::link::Standing::Earlier(_))
+            }) {
                 // The plots' room kept, so the panel does not shrink to the note and jump back.
                 ui.allocate_ui(egui::vec2(room, plot_height(ui) + 40.0), |ui| {
                     ui.set_min_size(egui::vec2(room.min(MIN_PLOT_WIDTH), plot_height(ui) + 40.0));

@@ -118,7 +118,8 @@ pub fn write_figure(snap: &Snapshot, stem: &Path) -> Result<Vec<PathBuf>, String
 fn verdict_table(state: &AppState, a: &RunOutput, b: &RunOutput) -> Vec<Vec<String>> {
     let mut header = vec!["product".to_string()];
     for ab in ["A", "B"] {
-        header.extend([format!("{ab} MAE %"), format!("{ab} bias %"), format!("{ab} returned %"), ab.to_string()]);
+        // Short headings (every value is a %): the table must leave room for the parameters'.
+        header.extend([format!("{ab} MAE"), format!("{ab} bias"), format!("{ab} ret."), ab.to_string()]);
     }
     let runs = [a, b];
     let checks: Vec<Vec<crate::study::Check>> = runs
@@ -132,6 +133,10 @@ fn verdict_table(state: &AppState, a: &RunOutput, b: &RunOutput) -> Vec<Vec<Stri
         let mine: Vec<&crate::study::Check> = checks.iter().filter(|c| c.variable.as_deref() == variable).collect();
         match crate::study::verdict(mine.iter().copied()) {
             Some(true) => "pass".to_string(),
+            Some(false) if variable.is_none() => {
+                // The SNR floor: how many bands miss it (the SNR chart beside shows which).
+                format!("FAIL: {} of {} bands", mine.iter().filter(|c| !c.pass).count(), mine.len())
+            }
             Some(false) => {
                 let name = variable.map_or("SNR", crate::metrics::name);
                 let failed: Vec<String> = mine
@@ -139,7 +144,7 @@ fn verdict_table(state: &AppState, a: &RunOutput, b: &RunOutput) -> Vec<Vec<Stri
                     .filter(|c| !c.pass)
                     .map(|c| {
                         let what = variable.map_or_else(|| c.what.clone(), |v| c.what.replace(v, name));
-                        what.replacen(&format!("{name} "), "", 1)
+                        what.replacen(&format!("{name} "), "", 1).trim_end_matches(" %").to_string()
                     })
                     .take(2)
                     .collect();

@@ -81,7 +81,7 @@ pub fn name(variable: &str) -> &str {
         "nap_g_m3" => "NAP",
         "cdom_per_m" => "CDOM",
         "depth_m" => "depth",
-        "depth_m_bottom_visible" => "depth where the bottom is visible",
+        "depth_m_bottom_visible" => "depth, bottom visible",
         v => v,
     }
 }

@@ -323,6 +323,7 @@ fn caption(name: &str) -> String {
     let what = describe_key(rest);
     match kind {
         "snr" => "SNR per band at the scene's median water radiance: analytic (line) and measured in the noisy cube (open circles); a dashed line, when drawn, is the study's SNR requirement.".into(),
+        "maps" if rest.ends_with("substrate") => "The dominant substrate of the truth and of each instrument's retrieval, one colour per substrate; grey: land or not returned; scale bars give the ground distance.".into(),
         "maps" => format!("Truth and each instrument's retrieval ({what}) on one colour scale; grey: land or not returned; scale bars give the ground distance."),
         "agreement" => format!("Where each instrument's {what} is the truth's (green) or not (red), with the share right."),
         "difference" => format!("A − B ({what}): B sampled at the pixel nearest each of A's ground points; diverging scale symmetric about zero."),

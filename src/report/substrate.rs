@@ -94,10 +94,12 @@ pub(super) fn section(h: &mut String, d: &ReviewData) {
         if !s.depth.is_empty() {
             h.push_str("<table>\n<tr><th>depth over</th><th>MAE %</th><th>mean |error| (m)</th><th>pixels</th></tr>\n");
             for (what, mae, abs, n) in &s.depth {
+                // `depth_m_over_turf_algae` → "turf algae".
+                let over = what.strip_prefix("depth_m_over_").unwrap_or(what).replace('_', " ");
                 let _ = writeln!(
                     h,
                     "<tr><td>{}</td><td class=\"num\">{mae:.1}</td><td class=\"num\">{abs:.2}</td><td class=\"num\">{n}</td></tr>",
-                    escape(what)
+                    escape(&over)
                 );
             }
             h.push_str("</table>\n");

@@ -138,7 +138,9 @@ fn paint(map: &Array2<Option<usize>>, palette: &[[u8; 3]], w: u32, h: u32) -> Ve
 
 impl Draw for ClassMaps {
     fn size(&self) -> (u32, u32) {
-        (PANEL.0 * self.panels.len().max(1) as u32 + LEGEND_W, TITLE_H + PANEL.1 + CAPTION_H)
+        // Wide enough for the title (DejaVu Sans at 17 px: about 10 px a character).
+        let title = 20 + 10 * self.title.chars().count() as u32;
+        ((PANEL.0 * self.panels.len().max(1) as u32 + LEGEND_W).max(title), TITLE_H + PANEL.1 + CAPTION_H)
     }
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<Vec<Placed>, String> {

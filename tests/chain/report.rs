@@ -167,6 +167,19 @@ fn a_report_straight_from_a_study_carries_its_error_budget_and_bad_targets_are_r
     ok(shoal().args(["report", "reef_survey_depth", "--decimation", "8", "--budget", "--out"]).arg(&pack));
     let html = std::fs::read_to_string(pack.join("index.html")).unwrap();
     assert!(html.contains("id=\"budget\"") && html.contains("noise and quantisation"), "budget section");
+    // Bottom type: the dominant substrate's maps, where it is right, the confusion table and
+    // the depth error per true substrate.
+    for part in [
+        "id=\"substrate\"",
+        "dominant substrate right in",
+        "id=\"fig-maps_sambuca_substrate\"",
+        "id=\"fig-agreement_sambuca_substrate\"",
+        "true \\ retrieved",
+        "depth over",
+    ] {
+        assert!(html.contains(part), "the pack has no `{part}`");
+    }
+    assert!(html.contains("Reduced resolution:"), "a pack at 1/8 says so at the top");
     assert!(html.contains("EPSG:32756"), "the raster scene's place");
     assert!(html.contains("The study states no requirements"));
     assert_eq!(external_references(&html), Vec::<String>::new());

@@ -189,3 +189,42 @@ fn the_wheel_over_a_plot_scrolls_the_panel_and_does_not_zoom_it() {
     assert_eq!(after[0].size(), before[0].size(), "the plot changed size");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The slide over the reef under SAMBUCA: titled by what is compared (not the study it came
+/// from), every product's row and the bottom type and SNR rows present with nothing cut, the
+/// caption true to the instruments (`SHOAL_KEEP_SLIDE=DIR` keeps the PNG).
+#[test]
+fn the_slide_over_the_reef_names_what_is_compared_and_cuts_no_row() {
+    let dir = temp_library("reefslide");
+    let mut h = harness("cubesat", 16, &dir);
+    pick(&mut h, "Scene", "heron_island_reef");
+    h.get_by_label("Use SAMBUCA").click();
+    wait_for_engine(&mut h);
+    h.get_by_label("Path").click();
+    h.step();
+    h.step();
+    let stem = dir.join("review").join("reef");
+    h.get_by_role_and_label(Role::TextInput, "Export to").set_text_value_accesskit(stem.to_str().unwrap());
+    h.step();
+    h.get_by_label("Write figure").click();
+    let svg_path = dir.join("review").join("reef.svg");
+    let start = Instant::now();
+    while !svg_path.is_file() {
+        assert!(start.elapsed() < Duration::from_secs(120), "the figure was not written");
+        assert_eq!(h.state().error(), None);
+        std::thread::sleep(Duration::from_millis(20));
+        h.step();
+    }
+    let svg = std::fs::read_to_string(&svg_path).unwrap();
+    assert!(svg.contains("cubesat vs smallsat over heron_island_reef"), "the title names the comparison");
+    assert!(!svg.contains("cubesat_vs_smallsat"), "the study's name over another scene");
+    for row in ["depth (m)", "bottom type", "SNR, every band", "SAMBUCA"] {
+        assert!(svg.contains(row), "the slide has no `{row}`");
+    }
+    assert!(!svg.contains("more rows"), "rows were cut");
+    assert!(svg.contains("Instruments as in their presets."), "the caption says what it knows");
+    if let Ok(keep) = std::env::var("SHOAL_KEEP_SLIDE") {
+        std::fs::copy(dir.join("review").join("reef.png"), std::path::Path::new(&keep).join("reef_slide.png")).unwrap();
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
