@@ -1,8 +1,9 @@
 //! Timing that can be believed on a noisy machine: every measurement records wall time and the
 //! process's CPU time; settings are compared by repeats interleaved with their reference
-//! (R A B … R A B …, so a slow spell of the machine hits every setting alike), and a setting
-//! whose range of wall times overlaps the reference's is reported as "no measurable difference"
-//! rather than as a ratio of two noisy numbers.
+//! (R A B … R A B …, so a slow spell of the machine hits every setting alike) and paired by
+//! round ([`Paired`]): a difference is claimed only when the interval of the per-round ratios
+//! excludes 1, and is reported as "no measurable difference" otherwise rather than as a ratio of
+//! two noisy numbers.
 //!
 //! CPU time is the whole process's (user + system, all threads) from `/proc/self/stat`, in the
 //! kernel's clock ticks (10 ms on Linux); `None` where that file does not exist. Rows it is used
@@ -109,46 +110,131 @@ impl Summary {
     }
 }
 
-/// A setting's time against its reference's.
+/// A series of runs against another, paired by round: the median of the per-round ratios and a
+/// distribution-free interval for it.
+///
+/// Each round gives one ratio (a setting's time over its reference's, taken next to it in time),
+/// so a slow spell of the machine, or a drift across rounds, moves both terms of a pair and
+/// cancels; what is left is the setting's own effect and the run-to-run noise. The interval is
+/// the sign test's confidence interval for the median (Conover 1999, *Practical Nonparametric
+/// Statistics*, §3.2): with the n ratios sorted, [x₍ₖ₎, x₍ₙ₊₁₋ₖ₎] covers the true median with
+/// probability 1 − 2·P(B ≤ k − 1), B ~ Binomial(n, ½), whatever the noise's distribution; k is
+/// the largest rank that keeps the coverage at [`LEVEL`] or above. It needs no normality, and a
+/// single slow run (an outlier) moves at most one order statistic.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Paired {
+    /// Median ratio.
+    pub ratio: f64,
+    /// Interval, low end.
+    pub lo: f64,
+    /// Interval, high end.
+    pub hi: f64,
+    /// Rounds paired.
+    pub n: usize,
+    /// The interval's coverage, %.
+    pub level_pct: f64,
+}
+
+/// The coverage an interval must reach before a difference is claimed: 90 %.
+pub const LEVEL: f64 = 0.90;
+
+/// Rounds a claim needs: with fewer, no sign-test interval reaches [`LEVEL`] (4 rounds give
+/// 87.5 % at best).
+pub const MIN_ROUNDS: usize = 5;
+
+/// P(B ≤ j) for B ~ Binomial(n, ½).
+fn binomial_cdf_half(n: usize, j: usize) -> f64 {
+    let mut c = 1.0f64;
+    let mut sum = 0.0;
+    for i in 0..=j.min(n) {
+        if i > 0 {
+            c = c * (n - i + 1) as f64 / i as f64;
+        }
+        sum += c;
+    }
+    sum / 2f64.powi(i32::try_from(n).unwrap_or(i32::MAX))
+}
+
+impl Paired {
+    /// The paired comparison of `ratios` (one per round, each > 0); `None` without any.
+    #[must_use]
+    pub fn of(ratios: &[f64]) -> Option<Self> {
+        let mut logs: Vec<f64> = ratios.iter().filter(|r| r.is_finite() && **r > 0.0).map(|r| r.ln()).collect();
+        let n = logs.len();
+        if n == 0 {
+            return None;
+        }
+        logs.sort_by(f64::total_cmp);
+        let median = if n % 2 == 1 { logs[n / 2] } else { 0.5 * (logs[n / 2 - 1] + logs[n / 2]) };
+        // The largest k whose interval still covers with probability LEVEL (k = 1 at least: the
+        // whole range, whose coverage 1 − 2^(1−n) is reported when it falls short).
+        let coverage = |k: usize| 1.0 - 2.0 * binomial_cdf_half(n, k - 1);
+        let k = (1..=n.div_ceil(2)).take_while(|&k| coverage(k) >= LEVEL).last().unwrap_or(1);
+        Some(Self {
+            ratio: median.exp(),
+            lo: logs[k - 1].exp(),
+            hi: logs[n - k].exp(),
+            n,
+            level_pct: 100.0 * coverage(k),
+        })
+    }
+
+    /// A known ratio (tests and rows measured once).
+    #[must_use]
+    pub const fn exact(ratio: f64) -> Self {
+        Self { ratio, lo: ratio, hi: ratio, n: 0, level_pct: 100.0 }
+    }
+
+    /// Does the interval exclude 1 at the coverage a claim needs?
+    #[must_use]
+    pub fn differs(&self) -> bool {
+        self.level_pct >= 100.0 * LEVEL && (self.hi < 1.0 || self.lo > 1.0)
+    }
+}
+
+/// A setting's time against its reference's, paired by round ([`Paired`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Comparison {
-    /// The two ranges of wall times overlap: the repeats cannot tell them apart.
-    NoMeasurableDifference,
-    /// Ratio of the medians (setting / reference), the ranges apart.
-    Ratio(f64),
+    /// The interval holds 1, or too few rounds were run to claim anything: the runs cannot
+    /// tell the two apart (the ratio and interval, when measured, are kept for the reader).
+    NoMeasurableDifference(Option<Paired>),
+    /// The setting's median ratio, its interval excluding 1.
+    Ratio(Paired),
 }
 
 impl Comparison {
-    /// Compare `setting` with `reference` by their wall-time ranges.
+    /// The comparison of per-round ratios (setting over reference).
     #[must_use]
-    pub fn of(setting: &Summary, reference: &Summary) -> Self {
-        let (a, b) = (setting.wall_range_s, reference.wall_range_s);
-        if setting.n < 2 || reference.n < 2 {
-            // One sample has no range: a ratio, which the reader is told rests on one run.
-            return Self::Ratio(setting.wall_s / reference.wall_s);
-        }
-        if a.0 <= b.1 && b.0 <= a.1 {
-            Self::NoMeasurableDifference
-        } else {
-            Self::Ratio(setting.wall_s / reference.wall_s)
+    pub fn of_ratios(ratios: &[f64]) -> Self {
+        match Paired::of(ratios) {
+            Some(p) if p.differs() => Self::Ratio(p),
+            other => Self::NoMeasurableDifference(other),
         }
     }
 
-    /// "0.42×" or "no measurable difference".
+    /// "0.85× (0.83–0.87)", or "no measurable difference (0.97–1.04×)", or with too few rounds
+    /// "no measurable difference (3 rounds; 5 needed)".
     #[must_use]
     pub fn text(&self) -> String {
         match self {
-            Self::NoMeasurableDifference => "no measurable difference".into(),
-            Self::Ratio(r) => format!("{r:.2}×"),
+            Self::Ratio(p) if p.n == 0 => format!("{:.2}×", p.ratio),
+            Self::Ratio(p) => format!("{:.2}× ({:.2}–{:.2})", p.ratio, p.lo, p.hi),
+            Self::NoMeasurableDifference(Some(p)) if p.n > 0 && p.n < MIN_ROUNDS => {
+                format!("no measurable difference ({} rounds; {MIN_ROUNDS} needed)", p.n)
+            }
+            Self::NoMeasurableDifference(Some(p)) if p.n > 0 => {
+                format!("no measurable difference ({:.2}–{:.2}×)", p.lo, p.hi)
+            }
+            Self::NoMeasurableDifference(_) => "no measurable difference".into(),
         }
     }
 
-    /// The ratio, if the ranges are apart.
+    /// The ratio, if the setting measurably differs.
     #[must_use]
     pub fn ratio(&self) -> Option<f64> {
         match self {
-            Self::NoMeasurableDifference => None,
-            Self::Ratio(r) => Some(*r),
+            Self::NoMeasurableDifference(_) => None,
+            Self::Ratio(p) => Some(p.ratio),
         }
     }
 }
@@ -162,17 +248,28 @@ mod tests {
     }
 
     #[test]
-    fn medians_ranges_and_overlap() {
+    fn medians_and_ranges() {
         let r = s(&[1.0, 1.2, 1.1]);
         assert_eq!(r.wall_s, 1.1);
         assert_eq!(r.wall_range_s, (1.0, 1.2));
         assert_eq!(r.cpu_s, Some(2.2));
         assert!((r.spread_pct() - 100.0 * 0.1 / 1.1).abs() < 1e-12);
-        // Overlapping ranges: no ratio is claimed.
-        assert_eq!(Comparison::of(&s(&[1.15, 1.3, 1.25]), &r), Comparison::NoMeasurableDifference);
-        // Apart: the ratio of the medians.
-        assert_eq!(Comparison::of(&s(&[0.5, 0.55, 0.6]), &r), Comparison::Ratio(0.55 / 1.1));
         assert_eq!(s(&[1.0, 3.0]).wall_s, 2.0);
+    }
+
+    #[test]
+    fn the_sign_test_interval_has_its_binomial_coverage() {
+        // n = 5: the whole range, 1 − 2/32 = 93.75 %; n = 7: the second from each end,
+        // 1 − 2·8/128 = 87.5 % < 90 %, so again the range (98.4 %); n = 9: the second, 96.1 %.
+        let p = Paired::of(&[0.9, 0.8, 1.0, 0.85, 0.95]).unwrap();
+        assert!((p.ratio - 0.9).abs() < 1e-12 && (p.lo - 0.8).abs() < 1e-12 && (p.hi - 1.0).abs() < 1e-12);
+        assert!((p.level_pct - 93.75).abs() < 1e-9);
+        let p = Paired::of(&[1.0; 9]).unwrap();
+        assert!((p.level_pct - 100.0 * (1.0 - 2.0 * 10.0 / 512.0)).abs() < 1e-9, "{p:?}");
+        let three = Paired::of(&[0.5, 0.5, 0.5]).unwrap();
+        assert!(!three.differs(), "3 rounds reach 75 %: no claim");
+        assert!(Comparison::of_ratios(&[0.5; 3]).text().contains("3 rounds; 5 needed"));
+        assert_eq!(binomial_cdf_half(4, 4), 1.0);
     }
 
     #[test]

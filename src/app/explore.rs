@@ -7,14 +7,12 @@
 //! Both run on a helper thread (not the engine thread, whose pool serves the maps) and stream
 //! their results; a new run or closing the window cancels the old one.
 
-use egui_plot::{Legend, Plot, Points};
-
 use super::model::AppState;
 use crate::engine::{Engine, Fidelity, RunConfig};
 use crate::jobs::{Task, TaskNews};
 use crate::study::{Source, StudySpec};
 use crate::sweep::{
-    CostRow, Parameter, Requirement, Row, SweepSpec, Table, Values, cost_of_accuracy, empty_table, run_job,
+    CostRow, ErrorOf, Parameter, Requirement, Row, SweepSpec, Table, Values, cost_of_accuracy, empty_table, run_job,
 };
 
 /// The windows' state (not persisted: results belong to the session).
@@ -47,7 +45,9 @@ pub struct Explore {
     cost_task: Option<Task<(usize, CostRow)>>,
     /// Rounds of the cost measurement (each setting timed once per round, interleaved).
     cost_rounds: usize,
-    /// The chl error the cheapest acceptable setting may make, %.
+    /// The product whose error the plot, the front and the tolerance read.
+    cost_error_of: ErrorOf,
+    /// The error the cheapest acceptable setting may make, %.
     cost_tolerance_pct: f64,
     cost_rows: Vec<CostRow>,
     /// Instrument A's configuration the cost rows were measured for (to mark them stale).
@@ -77,7 +77,8 @@ impl Default for Explore {
             sweep_status: String::new(),
             cost_decimation: 4,
             cost_task: None,
-            cost_rounds: 3,
+            cost_rounds: 5,
+            cost_error_of: ErrorOf::Chl,
             cost_tolerance_pct: 1.0,
             cost_rows: Vec::new(),
             cost_config: None,
@@ -253,114 +254,6 @@ impl Explore {
     }
 }
 
-/// The cost-of-accuracy window.
-pub fn cost_window(app: &mut super::ShoalApp, ctx: &egui::Context) {
-    let mut open = app.ui.explore.cost_open;
-    let mut start = false;
-    let mut apply = None;
-    // 880 px wide: the table's seven columns fit (at 640 the p95 column sat past the right
-    // edge, behind a horizontal scroll, at 1280 × 720).
-    egui::Window::new("Cost of accuracy").open(&mut open).default_size([880.0, 520.0]).show(ctx, |ui| {
-        ui.label("Time of the whole chain for instrument A against the error each fidelity setting makes, each one change from full fidelity (a fresh engine per run; rounds interleave the settings with the reference).");
-        ui.horizontal(|ui| {
-            let e = &mut app.ui.explore;
-            egui::ComboBox::from_label("Reference resolution").selected_text(format!("1/{}", e.cost_decimation)).show_ui(ui, |ui| {
-                for d in [1, 2, 4, 8] {
-                    ui.selectable_value(&mut e.cost_decimation, d, if d == 1 { "full".to_string() } else { format!("1/{d}") });
-                }
-            });
-            ui.add(egui::DragValue::new(&mut e.cost_rounds).range(1..=10).suffix(" rounds").update_while_editing(false))
-                .on_hover_text("Each setting is timed once per round; with 3 or more, a setting whose times overlap the reference's says so");
-            ui.add(egui::DragValue::new(&mut e.cost_tolerance_pct).range(0.0..=100.0).speed(0.1).prefix("tolerance ").suffix(" %").update_while_editing(false))
-                .on_hover_text("The chl error (median per-pixel % difference from the reference, on the same grid) the cheapest acceptable setting may make; previews, on a coarser grid, are not candidates");
-            if ui.button("Measure").clicked() {
-                start = true;
-            }
-        });
-        let e = &app.ui.explore;
-        // The rows depend on the run measured (its retrieval and scene): counted once one is.
-        match &e.cost_config {
-            Some(c) => ui.label(format!("{} ({}/{} settings)", e.cost_status, e.cost_rows.len(), crate::sweep::settings_for(c).len())),
-            None => ui.label(&e.cost_status),
-        };
-        let now = app.state.configs().into_iter().next().map(at_full_fidelity);
-        if e.cost_config.is_some() && e.cost_config != now {
-            ui.colored_label(super::theme::NOTICE, "Stale: A, the scene or the retrieval changed since these were measured. Press Measure to redo.");
-        }
-        let front: Vec<&str> = crate::sweep::pareto_front(&e.cost_rows).iter().map(|r| r.label.as_str()).collect();
-        let cheapest = if e.busy() { None } else { crate::sweep::cheapest_within(&e.cost_rows, e.cost_tolerance_pct) };
-        if let Some(c) = cheapest {
-            ui.horizontal(|ui| {
-                ui.label(egui::RichText::new(format!(
-                    "Cheapest full-resolution setting within {} % chl per pixel: {} ({:.2} s, {})",
-                    e.cost_tolerance_pct,
-                    c.label,
-                    c.seconds(),
-                    c.comparison.text()
-                )).strong())
-                .on_hover_text("Measurably faster than the reference; of the settings no other is measurably faster than, the one with the smallest chl error");
-                let fidelity = e.cost_config.as_ref().and_then(|base| crate::sweep::fidelity_of(&c.label, base));
-                let button = ui.add_enabled(fidelity.is_some(), egui::Button::new("Apply to the app"));
-                let button = if fidelity.is_some() {
-                    button.on_hover_text("Run A and B (previews and full resolution) with this fidelity: the row's change from full fidelity (a study's own fidelity settings are replaced)")
-                } else {
-                    button.on_disabled_hover_text("Not a fidelity setting alone (it changes the atmosphere's accuracy, the retrieval or the resolution): set it where it lives")
-                };
-                if button.clicked() {
-                    apply = fidelity;
-                }
-            });
-        }
-        ui.horizontal(|ui| {
-            ui.label(format!("The app runs with: {}", fidelity_text(&app.state.fidelity)));
-            if app.state.fidelity != Fidelity::default() && ui.button("Back to the defaults").clicked() {
-                apply = Some(Fidelity::default());
-            }
-        });
-        Plot::new("cost-plot").height(220.0).legend(Legend::default()).x_axis_label("time, s (median)").y_axis_label("error, %").show(ui, |p| {
-            let same: Vec<[f64; 2]> = e.cost_rows.iter().filter_map(|r| r.chl_pixel_pct.map(|v| [r.seconds(), v])).collect();
-            let other: Vec<[f64; 2]> = e.cost_rows.iter().filter(|r| r.chl_pixel_pct.is_none()).map(|r| [r.seconds(), r.delta_mae_pct.abs()]).collect();
-            p.points(Points::new("chl per pixel vs reference (median %)", same).radius(4.0));
-            p.points(Points::new("previews: |ΔMAE| (points)", other).radius(4.0).shape(egui_plot::MarkerShape::Diamond));
-            // Each point named by its setting, on the plot only: a named item would also take a
-            // legend line, and 22 of them covered the plot and the table at 1280 × 720.
-            for r in &e.cost_rows {
-                p.text(egui_plot::Text::new("", egui_plot::PlotPoint::new(r.seconds(), r.chl_error_pct().unwrap_or(r.delta_mae_pct.abs())), format!("  {}", r.label)).anchor(egui::Align2::LEFT_CENTER));
-            }
-        });
-        egui::ScrollArea::both().show(ui, |ui| {
-            egui::Grid::new("cost-table").striped(true).num_columns(7).show(ui, |ui| {
-                for h in ["setting", "wall, median (range, n)", "CPU", "vs reference", "ΔMAE", "chl per pixel %", "p95 %"] {
-                    ui.strong(h);
-                }
-                ui.end_row();
-                for r in &e.cost_rows {
-                    let label = if front.contains(&r.label.as_str()) { format!("{} ◆", r.label) } else { r.label.clone() };
-                    ui.label(label).on_hover_text("◆: on the time–error Pareto front (no setting both faster and closer)");
-                    ui.label(r.time.wall_text());
-                    ui.label(r.time.cpu_text());
-                    ui.label(r.comparison.text());
-                    ui.label(format!("{:+.2}", r.delta_mae_pct));
-                    ui.label(r.chl_pixel_pct.map_or_else(|| "other grid".into(), |v| format!("{v:.3}")));
-                    ui.label(r.chl_pixel_p95_pct.map_or_else(|| "–".into(), |v| format!("{v:.3}")));
-                    ui.end_row();
-                }
-            });
-        });
-    });
-    if let Some(fidelity) = apply {
-        app.state.fidelity = Fidelity { decimation: 1, ..fidelity };
-    }
-    if start {
-        let config = app.state.configs().swap_remove(0);
-        app.ui.explore.start_cost(ctx, config);
-    }
-    if !open {
-        app.ui.explore.cost_task = None;
-    }
-    app.ui.explore.cost_open = open;
-}
-
 /// `config` at full fidelity (its decimation kept).
 fn at_full_fidelity(mut config: RunConfig) -> RunConfig {
     config.fidelity = Fidelity { decimation: config.fidelity.decimation, ..Fidelity::full() };
@@ -410,6 +303,8 @@ fn fidelity_text(f: &Fidelity) -> String {
     }
 }
 
+mod cost;
+pub use cost::cost_window;
 mod sweep;
 pub use sweep::sweep_window;
 

@@ -56,9 +56,14 @@ pub struct BenchArgs {
     /// stays within this many percent (median per-pixel difference; |ΔMAE| for a coarser grid).
     #[arg(long, value_name = "PCT")]
     pub tolerance_pct: Option<f64>,
-    /// With `--accuracy`: interleaved rounds (each setting timed once per round; at least 3 for
-    /// a range to compare).
-    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=50))]
+    /// With `--accuracy`: the product whose per-pixel error from the full-fidelity run the
+    /// Pareto front and `--tolerance-pct` read (bottom: % of pixels whose bottom type changes).
+    #[arg(long, default_value = "chl", value_parser = ["chl", "nap", "cdom", "depth", "bottom"])]
+    pub error_of: String,
+    /// With `--accuracy`: interleaved rounds (each setting timed once per round, paired with
+    /// the reference's runs either side): at least 5 for any claim at 90 % coverage, 8 or more
+    /// to tolerate one slow run.
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=50))]
     pub rounds: u32,
     /// With `--accuracy`: the case priced — aLMI on the CubeSat over Lake Hume, or SAMBUCA on
     /// the nominal instrument over the Heron Island reef with its spatial response (at 1/2 of

@@ -12,25 +12,36 @@ use crate::control::RunControl;
 use crate::engine::RunConfig;
 use crate::instrument::InstrumentSpec;
 use crate::scene::{Effect, SceneSpec};
-use crate::sweep::{CostRow, cheapest_within, cost_of_accuracy, pareto_front};
+use crate::sweep::{CostRow, ErrorOf, cheapest_within, cost_of_accuracy, pareto_front};
 
 fn pct(v: Option<f64>) -> String {
     v.map_or_else(|| "– (other grid)".to_string(), |v| format!("{v:.3}"))
 }
 
-fn row_line(r: &CostRow, depth: bool) -> String {
-    let depth = if depth { format!(" {} |", pct(r.depth_pixel_pct)) } else { String::new() };
+/// A row of the table; the reference's verdicts are "–".
+fn row_line(r: &CostRow, reference: bool, depth: bool, bottom: bool) -> String {
+    let mut extra = String::new();
+    if depth {
+        let _ = write!(extra, " {} |", pct(r.errors.depth_pct));
+    }
+    if bottom {
+        let _ = write!(extra, " {} |", pct(r.errors.bottom_changed_pct));
+    }
+    let verdict = |c: Option<crate::timing::Comparison>| {
+        if reference { "–".to_string() } else { c.map_or_else(|| "–".into(), |c| c.text()) }
+    };
     format!(
-        "| {} | {} | {} | {} | {:.1} | {:+.2} | {} | {} | {} |{depth}\n",
+        "| {} | {} | {} | {} | {} | {:.1} | {:+.2} | {} | {} | {} |{extra}\n",
         r.label,
         r.time.wall_text(),
+        verdict(Some(r.comparison)),
         r.time.cpu_text(),
-        r.comparison.text(),
+        verdict(r.cpu_comparison),
         r.chl_mae_pct,
         r.delta_mae_pct,
-        pct(r.chl_pixel_pct),
-        pct(r.chl_pixel_p95_pct),
-        pct(r.rrs_pixel_pct)
+        pct(r.errors.chl_pct),
+        pct(r.errors.chl_p95_pct),
+        pct(r.errors.rrs_pct)
     )
 }
 
@@ -75,6 +86,9 @@ pub fn accuracy_rows(out: &mut String, args: &BenchArgs) -> Result<(), CliError>
     {
         return Err(CliError::Input(format!("--tolerance-pct: {t} (allowed: a percentage ≥ 0)")));
     }
+    let of = ErrorOf::parse(&args.error_of).ok_or_else(|| {
+        CliError::Input(format!("--error-of {} (allowed: chl, nap, cdom, depth, bottom)", args.error_of))
+    })?;
     let (base, heading) = case_base(args.case, args.quick)?;
     let rounds = args.rounds as usize;
     let _ = writeln!(
@@ -91,46 +105,61 @@ pub fn accuracy_rows(out: &mut String, args: &BenchArgs) -> Result<(), CliError>
     if std::io::stderr().is_terminal() {
         eprintln!();
     }
-    let depth = rows.iter().any(|r| r.depth_pixel_pct.is_some());
+    let depth = rows.iter().any(|r| r.errors.depth_pct.is_some());
+    let bottom = rows.iter().any(|r| r.errors.bottom_changed_pct.is_some());
     let _ = writeln!(
         out,
-        "| setting | wall, median (range, n) | CPU, median | time vs reference | chl MAE % | ΔMAE vs reference (points) | chl per pixel vs reference, median % | chl per pixel, 95th percentile % | Rrs(443) per pixel, median % |{}\n|---|---|---|---|---|---|---|---|---|{}",
+        "| setting | wall, median (range, n) | wall vs reference, paired | CPU, median | CPU vs reference, paired | chl MAE % | ΔMAE vs reference (points) | chl per pixel vs reference, median % | chl per pixel, 95th percentile % | Rrs(443) per pixel, median % |{}{}\n|---|---|---|---|---|---|---|---|---|---|{}",
         if depth { " depth per pixel vs reference, median % |" } else { "" },
-        if depth { "---|" } else { "" }
+        if bottom { " bottom type changed, % of pixels |" } else { "" },
+        "---|".repeat(usize::from(depth) + usize::from(bottom))
     );
-    for r in &rows {
-        out.push_str(&row_line(r, depth));
+    for (i, r) in rows.iter().enumerate() {
+        out.push_str(&row_line(r, i == 0, depth, bottom));
     }
-    let _ = writeln!(
-        out,
-        "\nRounds run reference, setting 1, setting 2, … and again, so a slow spell of the machine falls on every setting; a row whose range of wall times overlaps the reference's says \"no measurable difference\". CPU is the process's user + system time (all threads). Each row changes one setting from the defaults (the last, three). Per-pixel columns compare the same pixels with the same noise, so they isolate the setting's own error; a preview's ΔMAE mixes that with fewer pixels in the sample."
-    );
+    let _ = writeln!(out, "\n{}", crate::sweep::COST_METHOD);
     if args.pareto {
         let _ = writeln!(
             out,
-            "\n### Pareto front (full-resolution settings: median wall time against the median per-pixel chl difference from the reference; a row must be measurably faster to beat another)\n"
+            "\n### Pareto front (full-resolution settings: time relative to the reference against {}; a row must be measurably faster, paired by round, to beat another)\n",
+            of.measure()
         );
-        let _ = writeln!(out, "| setting | wall, median | chl error % |\n|---|---|---|");
-        for r in pareto_front(&rows) {
+        let _ = writeln!(
+            out,
+            "| setting | wall, median | wall vs reference, paired | {} error % |\n|---|---|---|---|",
+            of.label()
+        );
+        for r in pareto_front(&rows, of) {
             let _ = writeln!(
                 out,
-                "| {} | {} | {:.3} |",
+                "| {} | {} | {} | {:.3} |",
                 r.label,
                 r.time.wall_text(),
-                r.chl_error_pct().unwrap_or(f64::NAN)
+                r.comparison.text(),
+                r.error_pct(of).unwrap_or(f64::NAN)
             );
         }
     }
     if let Some(t) = args.tolerance_pct {
-        match cheapest_within(&rows, t) {
+        match cheapest_within(&rows, of, t) {
+            Some(r) if std::ptr::eq(r, &rows[0]) => {
+                let _ = writeln!(
+                    out,
+                    "\nCheapest full-resolution setting within {t} % {} error: **the reference** ({:.2} s): no setting within it is measurably faster, paired by round.",
+                    of.label(),
+                    r.seconds()
+                );
+            }
             Some(r) => {
                 let _ = writeln!(
                     out,
-                    "\nCheapest full-resolution setting within {t} % chl error per pixel: **{}** ({:.2} s, {} the reference's time, chl error {:.3} %). Of settings the timings cannot tell apart, the most accurate is named; previews are not candidates: they return a subset of the pixels.",
+                    "\nCheapest full-resolution setting within {t} % {} error ({}): **{}** ({:.2} s, {} the reference's time, error {:.3} %). Of settings the timings cannot tell apart, the most accurate is named; previews are not candidates: they return a subset of the pixels.",
+                    of.label(),
+                    of.measure(),
                     r.label,
                     r.seconds(),
                     r.comparison.text(),
-                    r.chl_error_pct().unwrap_or(f64::NAN)
+                    r.error_pct(of).unwrap_or(f64::NAN)
                 );
             }
             None => {

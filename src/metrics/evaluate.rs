@@ -66,7 +66,8 @@ struct Classes {
 
 /// The substrate with the largest fraction at (r, c) among the first `n` (the last of equals,
 /// as `Iterator::max_by` picks).
-fn dominant(fractions: &ndarray::Array3<f32>, n: usize, r: usize, c: usize) -> Option<usize> {
+#[must_use]
+pub fn dominant(fractions: &ndarray::Array3<f32>, n: usize, r: usize, c: usize) -> Option<usize> {
     (0..n.min(fractions.dim().2)).max_by(|&i, &j| fractions[[r, c, i]].total_cmp(&fractions[[r, c, j]]))
 }
 

@@ -19,7 +19,7 @@ use serde::Serialize;
 
 mod evaluate;
 
-pub use evaluate::evaluate;
+pub use evaluate::{dominant, evaluate};
 
 /// The metrics of one product.
 #[derive(Debug, Clone, PartialEq, Serialize)]

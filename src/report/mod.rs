@@ -385,16 +385,22 @@ fn budget_rows(budget: &[Budget]) -> Vec<BudgetRow> {
 
 fn cost_rows(cost: &[CostRow]) -> Vec<CostTableRow> {
     cost.iter()
-        .map(|r| {
+        .enumerate()
+        .map(|(i, r)| {
+            let vs = match (i, r.cpu_comparison) {
+                (0, _) => "–".to_string(),
+                (_, Some(cpu)) => format!("{}; CPU {}", r.comparison.text(), cpu.text()),
+                (_, None) => r.comparison.text(),
+            };
             (
                 r.label.clone(),
                 r.time.n,
                 r.time.wall_s,
                 r.time.wall_range_s,
                 r.time.cpu_s,
-                r.comparison.text(),
-                r.chl_error_pct(),
-                r.chl_pixel_p95_pct.filter(|v| v.is_finite()),
+                vs,
+                r.error_pct(crate::sweep::ErrorOf::Chl),
+                r.errors.chl_p95_pct.filter(|v| v.is_finite()),
             )
         })
         .collect()

@@ -47,7 +47,9 @@ pub(super) fn budget_and_cost(h: &mut String, d: &ReviewData) {
         h.push_str("</table>\n</section>\n");
     }
     if !d.cost.is_empty() {
-        h.push_str("<section id=\"cost\">\n<h2>Cost of accuracy</h2>\n<p class=\"note\">Each setting timed in interleaved rounds with the reference; a setting whose range of wall times overlaps the reference's shows \"no measurable difference\". Error: per-pixel chl-a difference from the reference run, median and 95th percentile (an error that lives at edges or in a few hard pixels shows in the second while the first stays at zero).</p>\n<table>\n<tr><th>setting</th><th>rounds</th><th>wall s (median)</th><th>range</th><th>CPU s</th><th>vs reference</th><th>chl per pixel %</th><th>p95 %</th></tr>\n");
+        h.push_str("<section id=\"cost\">\n<h2>Cost of accuracy</h2>\n<p class=\"note\">");
+        h.push_str(&escape(crate::sweep::COST_METHOD));
+        h.push_str(" Error: per-pixel chl-a difference from the reference run, median and 95th percentile (an error that lives at edges or in a few hard pixels shows in the second while the first stays at zero).</p>\n<table>\n<tr><th>setting</th><th>runs</th><th>wall s (median)</th><th>range</th><th>CPU s</th><th>vs reference, paired by round (wall; CPU)</th><th>chl per pixel %</th><th>p95 %</th></tr>\n");
         for (setting, n, wall, range, cpu, vs, err, p95) in &d.cost {
             let _ = writeln!(
                 h,

@@ -1,7 +1,7 @@
 //! Tests of the review data: the cost rows as the page prints them, the UTC text.
 
 use super::*;
-use crate::timing::Comparison;
+use crate::timing::{Comparison, Paired};
 
 #[test]
 fn the_review_pack_states_each_cost_row_with_its_range_and_95th_percentile() {
@@ -9,16 +9,22 @@ fn the_review_pack_states_each_cost_row_with_its_range_and_95th_percentile() {
         CostRow::timed(
             "reference (full fidelity)",
             &[4.47, 4.32, 4.49],
-            Comparison::NoMeasurableDifference,
+            Comparison::NoMeasurableDifference(None),
             Some(0.0),
             Some(0.0),
         ),
-        CostRow::timed("the defaults", &[3.63, 3.57, 3.53], Comparison::Ratio(0.7987), Some(0.003), Some(1.713)),
-        CostRow::timed("preview 1/4", &[0.49, 0.45, 0.51], Comparison::Ratio(0.11), None, None),
+        CostRow::timed(
+            "the defaults",
+            &[3.63, 3.57, 3.53],
+            Comparison::Ratio(Paired::exact(0.7987)),
+            Some(0.003),
+            Some(1.713),
+        ),
+        CostRow::timed("preview 1/4", &[0.49, 0.45, 0.51], Comparison::Ratio(Paired::exact(0.11)), None, None),
         CostRow::timed(
             "a setting whose percentile failed",
             &[4.4, 4.3, 4.5],
-            Comparison::NoMeasurableDifference,
+            Comparison::NoMeasurableDifference(None),
             Some(0.1),
             Some(f64::NAN),
         ),
@@ -65,7 +71,8 @@ fn the_review_pack_states_each_cost_row_with_its_range_and_95th_percentile() {
         "<tr><td>the defaults</td><td class=\"num\">3</td><td class=\"num\">3.57</td><td class=\"num\">3.53–3.63</td>\
          <td class=\"num\">7.14</td><td>0.80×</td><td class=\"num\">0.003</td><td class=\"num\">1.713</td>"
     );
-    assert!(row("reference (full fidelity)").contains("<td>no measurable difference</td>"));
+    assert!(row("reference (full fidelity)").contains("<td>–</td>"), "the reference has no verdict against itself");
+    assert!(row("a setting whose percentile failed").contains("<td>no measurable difference</td>"));
     assert!(row("preview 1/4").ends_with("<td class=\"num\">other grid</td><td class=\"num\">–</td>"));
     assert!(row("a setting whose percentile failed").ends_with("<td class=\"num\">0.100</td><td class=\"num\">–</td>"));
     assert!(!html.contains("NaN"));

@@ -26,7 +26,10 @@ mod run;
 mod table;
 
 pub use apply::{apply, value};
-pub use cost::{CostRow, Setting, cheapest_within, cost_of_accuracy, fidelity_of, pareto_front, settings_for};
+pub use cost::{
+    COST_METHOD, CostRow, ErrorOf, PerPixel, Setting, cheapest_within, cost_of_accuracy, fidelity_of, pareto_front,
+    settings_for,
+};
 pub use figure::sweep_figure;
 pub use run::{Job, SweepResult, empty_table, run_job, run_sweep};
 pub use table::{Row, Table, merge};
