@@ -130,12 +130,13 @@ pub fn accuracy_rows(out: &mut String, args: &BenchArgs) -> Result<(), CliError>
             of.label()
         );
         for r in pareto_front(&rows, of) {
+            let verdict = if std::ptr::eq(r, &rows[0]) { "–".to_string() } else { r.comparison.text() };
             let _ = writeln!(
                 out,
                 "| {} | {} | {} | {:.3} |",
                 r.label,
                 r.time.wall_text(),
-                r.comparison.text(),
+                verdict,
                 r.error_pct(of).unwrap_or(f64::NAN)
             );
         }
