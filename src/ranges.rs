@@ -15,9 +15,10 @@ use crate::water::limits;
 
 /// Shortest wavelength Shoal simulates, nm.
 pub const MIN_SIMULATED_NM: f64 = 325.0;
-/// Longest wavelength Shoal simulates, nm: the end of the gas-absorption table
-/// (`assets/atmosphere/atmosphere_gas_absorption_wasi6.csv`, 300–1000 nm).
-pub const MAX_SIMULATED_NM: f64 = 1000.0;
+/// Longest wavelength Shoal simulates, nm: the end of the solar spectrum, the SWIR gas table
+/// and the aerosol table (`assets/solar/solar_tsis1_hsrs_1nm.csv`,
+/// `assets/atmosphere/gas_transmittance_6sv.csv`, `assets/atmosphere/wmo_aerosol_mie.csv`).
+pub const MAX_SIMULATED_NM: f64 = 2500.0;
 
 /// The allowed values of one numeric field.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -182,14 +183,44 @@ ranges! {
     INSTRUMENT_PRNU = Range::closed("instrument.prnu", 0.0, 0.5, "", "photo-response non-uniformity, relative rms");
     /// Dark-signal non-uniformity.
     INSTRUMENT_DSNU_E = Range::closed("instrument.dsnu_e", 0.0, 1e6, "e-", "dark-signal non-uniformity, rms");
+    /// Dark current: temperature it is specified at.
+    DARK_REFERENCE_C = Range::closed("instrument.dark_temperature.reference_c", -273.0, 150.0, "°C", "temperature at which the dark current is specified");
+    /// Dark current: operating temperature.
+    DARK_OPERATING_C = Range::closed("instrument.dark_temperature.operating_c", -273.0, 150.0, "°C", "detector operating temperature");
+    /// Dark current: doubling temperature step.
+    DARK_DOUBLING_DELTA_C = Range::closed("instrument.dark_temperature.law.Doubling.delta_c", 0.5, 50.0, "°C", "temperature rise that doubles the dark current");
+    /// Dark current: activation energy.
+    DARK_ACTIVATION_EV = Range::closed("instrument.dark_temperature.law.Arrhenius.activation_ev", 0.05, 2.0, "eV", "activation energy of the dark current (Arrhenius law)");
+    /// A further focal plane: pixel pitch.
+    PLANE_PIXEL_PITCH_UM = Range::above("instrument.focal_planes[].pixel_pitch_um", 0.0, 100.0, "µm", "the plane's pixel pitch (a whole multiple or fraction of the first plane's)");
+    /// A further focal plane: detectors.
+    PLANE_DETECTORS = Range::count("instrument.focal_planes[].detectors", 1.0, 40_000.0, "", "the plane's detectors across track (its swath must cover the first plane's)");
+    /// A further focal plane: read noise.
+    PLANE_READ_NOISE_E = Range::closed("instrument.focal_planes[].read_noise_e", 0.0, 1e5, "e-", "the plane's read noise, rms");
+    /// A further focal plane: full well.
+    PLANE_WELL_DEPTH_E = Range::above("instrument.focal_planes[].well_depth_e", 0.0, 1e9, "e-", "the plane's full-well capacity");
+    /// A further focal plane: conversion gain.
+    PLANE_GAIN_E_PER_DN = Range::closed("instrument.focal_planes[].gain_e_per_dn", 0.01, 1e4, "e-/DN", "the plane's conversion gain");
+    /// A further focal plane: ADC offset.
+    PLANE_BIAS_DN = Range::closed("instrument.focal_planes[].bias_dn", 0.0, 65_535.0, "DN", "the plane's ADC offset (below 2^adc_bits − 1)").below_hi();
+    /// A further focal plane: ADC resolution.
+    PLANE_ADC_BITS = Range::count("instrument.focal_planes[].adc_bits", 1.0, 16.0, "bits", "the plane's ADC resolution");
+    /// A further focal plane: dark current.
+    PLANE_DARK_CURRENT_E_S = Range::closed("instrument.focal_planes[].dark_current_e_s", 0.0, 1e9, "e-/s", "the plane's dark current per pixel (at dark_temperature.reference_c when given)");
+    /// A further focal plane: PRNU.
+    PLANE_PRNU = Range::closed("instrument.focal_planes[].prnu", 0.0, 0.5, "", "the plane's photo-response non-uniformity, relative rms");
+    /// A further focal plane: integration time.
+    PLANE_EXPOSURE_S = Range::above("instrument.focal_planes[].exposure_s", 0.0, 10.0, "s", "the plane's integration time (default: the instrument's times the pitch ratio)");
+    /// A further focal plane: DSNU.
+    PLANE_DSNU_E = Range::closed("instrument.focal_planes[].dsnu_e", 0.0, 1e6, "e-", "the plane's dark-signal non-uniformity, rms");
     /// Spectrograph: first band centre.
-    SPECTROGRAPH_START_NM = Range::closed("instrument.kind.Spectrograph.start_nm", 350.0, 1000.0, "nm", "first band centre");
+    SPECTROGRAPH_START_NM = Range::closed("instrument.kind.Spectrograph.start_nm", 350.0, 2500.0, "nm", "first band centre");
     /// Spectrograph: last band centre.
-    SPECTROGRAPH_END_NM = Range::closed("instrument.kind.Spectrograph.end_nm", 350.0, 1000.0, "nm", "last band centre (not below start_nm; end_nm + 2.5·resolution_nm + abs(smile_nm) ≤ 1000 nm)");
+    SPECTROGRAPH_END_NM = Range::closed("instrument.kind.Spectrograph.end_nm", 350.0, 2500.0, "nm", "last band centre (not below start_nm; end_nm + 2.5·resolution_nm + abs(smile_nm) ≤ 2500 nm)");
     /// Spectrograph: sampling.
     SPECTROGRAPH_SAMPLING_NM = Range::above("instrument.kind.Spectrograph.sampling_nm", 0.0, 100.0, "nm", "spectral sampling per detector row (at most 2000 samples)");
     /// Spectrograph: resolution.
-    SPECTROGRAPH_RESOLUTION_NM = Range::above("instrument.kind.Spectrograph.resolution_nm", 0.0, 100.0, "nm", "spectral resolution, FWHM (every band's response, centre ± 2.5 FWHM, within 325–1000 nm)");
+    SPECTROGRAPH_RESOLUTION_NM = Range::above("instrument.kind.Spectrograph.resolution_nm", 0.0, 100.0, "nm", "spectral resolution, FWHM (every band's response, centre ± 2.5 FWHM, within 325–2500 nm)");
     /// Spectrograph: smile.
     SPECTROGRAPH_SMILE_NM = Range::closed("instrument.kind.Spectrograph.smile_nm", -20.0, 20.0, "nm", "band-centre shift at the swath edges");
     /// Spectrograph: keystone.

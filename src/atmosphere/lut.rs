@@ -65,7 +65,12 @@ impl LutAxes {
             }
             Ok(())
         };
-        check("wavelengths_nm", &self.wavelengths_nm, 325.0, 1025.0)?;
+        check(
+            "wavelengths_nm",
+            &self.wavelengths_nm,
+            crate::ranges::MIN_SIMULATED_NM,
+            crate::ranges::MAX_SIMULATED_NM,
+        )?;
         let (sun, view) = (&crate::ranges::GEOMETRY_SUN_ZENITH_DEG, &crate::ranges::GEOMETRY_VIEW_ZENITH_DEG);
         check("sun_zenith_deg", &self.sun_zenith_deg, sun.lo, sun.hi)?;
         check("view_zenith_deg", &self.view_zenith_deg, view.lo, view.hi)?;

@@ -20,6 +20,7 @@ mod aerosol;
 mod complex;
 mod fresnel;
 mod gas;
+mod gas_swir;
 mod glint;
 mod kernels;
 mod lut;

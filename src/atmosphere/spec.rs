@@ -10,7 +10,7 @@ use serde::{Deserialize, Serialize};
 use super::aerosol::mixture_optics;
 use super::check;
 use super::fresnel::SEA_REFRACTIVE_INDEX;
-use super::gas::{GasAmounts, transmittance as gas_transmittance};
+use super::gas::{GasAmounts, transmittance as gas_transmittance, two_way_transmittance};
 use super::glint::glint_radiance_norm;
 use super::rayleigh::{AIR_DEPOLARIZATION, RayleighColumn, RayleighDepth, STANDARD_PRESSURE_HPA};
 use super::rt::{RtAccuracy, WavelengthColumn, solve_sun, solve_transmittance};
@@ -190,8 +190,9 @@ pub struct AtmosphereTerms {
     pub t_down: f64,
     /// Direct downward transmittance e^{−τ/μ₀}·T_gas (the diffuse part is `t_down − t_down_direct`).
     pub t_down_direct: f64,
-    /// Total upward transmittance of the water-leaving radiance (gases included; see
-    /// `rt::solve_transmittance`).
+    /// Total upward transmittance of the water-leaving radiance (see `rt::solve_transmittance`);
+    /// its gas factor is the upward leg given the sun's, T(m₀ + m_v)/T(m₀), so that
+    /// `ed_0plus_w_m2_nm · t_up` carries the two-way gas transmittance.
     pub t_up: f64,
     /// Direct upward transmittance e^{−τ/μ_v}·T_gas.
     pub t_up_direct: f64,
@@ -199,7 +200,7 @@ pub struct AtmosphereTerms {
     pub spherical_albedo: f64,
     /// Downwelling irradiance just above the surface (black water), W m⁻² nm⁻¹.
     pub ed_0plus_w_m2_nm: f64,
-    /// Gas transmittance sun→surface→sensor.
+    /// Gas transmittance sun→surface→sensor, T(m₀ + m_v).
     pub t_gas: f64,
     /// Sun-glint radiance at TOA (0 for a flat surface), W m⁻² sr⁻¹ nm⁻¹.
     pub l_glint_w_m2_sr_nm: f64,
@@ -257,9 +258,10 @@ impl Atmosphere {
         Ok(self.e0.value_at(wavelength_nm, Extrapolation::Error)? * solar::sun_distance_factor(self.spec.day_of_year))
     }
 
-    /// The optical column at `wavelength_nm` (325–1025 nm, the aerosol table's range).
+    /// The optical column at `wavelength_nm` (325–2500 nm, the aerosol table's range).
     pub fn column(&self, wavelength_nm: f64) -> Result<WavelengthColumn, AtmosphereError> {
-        range("wavelength_nm", wavelength_nm, 325.0, 1025.0, " nm")?;
+        use crate::ranges::{MAX_SIMULATED_NM, MIN_SIMULATED_NM};
+        range("wavelength_nm", wavelength_nm, MIN_SIMULATED_NM, MAX_SIMULATED_NM, " nm")?;
         let s = &self.spec;
         let site =
             RayleighColumn { pressure_hpa: s.pressure_hpa, latitude_deg: s.latitude_deg, ..RayleighColumn::default() };
@@ -286,6 +288,24 @@ impl Atmosphere {
         } else {
             Ok(1.0)
         }
+    }
+
+    /// Sun–surface–sensor gas transmittance T(m₀ + m_v) (1 when gases are off; see
+    /// [`super::gas::two_way_transmittance`]).
+    pub fn gas_two_way(&self, wavelength_nm: f64, mu0: f64, muv: f64) -> Result<f64, AtmosphereError> {
+        if self.spec.gases {
+            two_way_transmittance(wavelength_nm, mu0, muv, &self.spec.gas_amounts, self.spec.pressure_hpa)
+        } else {
+            Ok(1.0)
+        }
+    }
+
+    /// The upward leg's gas factor given the sun's: T(m₀ + m_v)/T(m₀), so that Ed(0⁺) (which
+    /// carries T(m₀)) times the upward transmittance carries the two-way T(m₀ + m_v).
+    pub fn gas_up_after_down(&self, wavelength_nm: f64, mu0: f64, muv: f64) -> Result<f64, AtmosphereError> {
+        let down = self.gas(wavelength_nm, mu0)?;
+        let both = self.gas_two_way(wavelength_nm, mu0, muv)?;
+        Ok(if down > 0.0 { (both / down).min(1.0) } else { 0.0 })
     }
 
     /// All terms at one wavelength and geometry, by a direct RT solve (what `shoal atmosphere`
@@ -335,8 +355,9 @@ impl Atmosphere {
     /// Combine normalised RT results with E₀ and gases into physical terms.
     pub fn assemble(&self, n: &Normalised) -> Result<AtmosphereTerms, AtmosphereError> {
         let e0 = self.e0(n.wavelength_nm)?;
-        let (tg0, tgv) = (self.gas(n.wavelength_nm, n.mu0)?, self.gas(n.wavelength_nm, n.muv)?);
-        let t_gas = tg0 * tgv;
+        let tg0 = self.gas(n.wavelength_nm, n.mu0)?;
+        let t_gas = self.gas_two_way(n.wavelength_nm, n.mu0, n.muv)?;
+        let tgv = self.gas_up_after_down(n.wavelength_nm, n.mu0, n.muv)?;
         let l_path = n.radiance * e0 * t_gas;
         Ok(AtmosphereTerms {
             wavelength_nm: n.wavelength_nm,

@@ -80,8 +80,9 @@ impl Component {
         }
     }
 
-    /// Refractive index n + i·k at `wavelength_um`: OSOAA's table, linearly interpolated in λ,
-    /// then rounded to 3 decimals (real) and 5 decimals (imaginary) as OSOAA does.
+    /// Refractive index n + i·k at `wavelength_um`: OSOAA's table (WMO 1983 values, 0.2–2.5 µm
+    /// here), linearly interpolated in λ, then rounded to 3 decimals (real) and 5 decimals
+    /// (imaginary) as OSOAA does.
     #[must_use]
     pub fn refractive_index(self, wavelength_um: f64) -> Complex {
         let table: &[(f64, f64, f64)] = match self {
@@ -98,6 +99,12 @@ impl Component {
                 (0.694, 1.53, 0.008),
                 (0.86, 1.52, 0.008),
                 (1.06, 1.52, 0.008),
+                (1.3, 1.46, 0.008),
+                (1.536, 1.4, 0.008),
+                (1.8, 1.33, 0.008),
+                (2.0, 1.26, 0.008),
+                (2.25, 1.22, 0.009),
+                (2.5, 1.18, 0.009),
             ],
             Self::WaterSoluble => &[
                 (0.20, 1.53, 0.07),
@@ -112,6 +119,12 @@ impl Component {
                 (0.694, 1.53, 0.007),
                 (0.86, 1.52, 0.012),
                 (1.06, 1.52, 0.017),
+                (1.3, 1.51, 0.02),
+                (1.536, 1.51, 0.023),
+                (1.8, 1.46, 0.017),
+                (2.0, 1.42, 0.008),
+                (2.25, 1.42, 0.01),
+                (2.5, 1.42, 0.012),
             ],
             Self::Oceanic => &[
                 (0.20, 1.429, 0.000_03),
@@ -126,6 +139,12 @@ impl Component {
                 (0.694, 1.376, 0.0),
                 (0.86, 1.372, 0.0),
                 (1.06, 1.367, 0.000_06),
+                (1.3, 1.365, 0.000_14),
+                (1.536, 1.359, 0.000_24),
+                (1.8, 1.351, 0.000_31),
+                (2.0, 1.347, 0.001_07),
+                (2.25, 1.334, 0.000_85),
+                (2.5, 1.309, 0.002_39),
             ],
             Self::Soot => &[
                 (0.20, 1.50, 0.35),
@@ -140,6 +159,12 @@ impl Component {
                 (0.694, 1.75, 0.43),
                 (0.86, 1.75, 0.43),
                 (1.06, 1.75, 0.44),
+                (1.3, 1.76, 0.45),
+                (1.536, 1.77, 0.46),
+                (1.8, 1.79, 0.48),
+                (2.0, 1.8, 0.49),
+                (2.25, 1.81, 0.5),
+                (2.5, 1.82, 0.51),
             ],
         };
         let w = wavelength_um.clamp(table[0].0, table[table.len() - 1].0);

@@ -356,7 +356,7 @@ impl Engine {
             let picks: Vec<usize> = (0..m).map(|i| (2 * i + 1) * n / (2 * m)).collect();
             let centres = response.bands.centres_nm();
             let measured = measured_snr(detector, &at, &picks, fid.snr_frames, config.seed);
-            let full = crate::instrument::plausibility::full_scale_e(detector);
+            let full = |b: usize| crate::instrument::plausibility::full_scale_e(detector, b);
             Ok((0..nb)
                 .map(|b| SnrRow {
                     band: response.bands.bands[b].name.clone(),
@@ -365,7 +365,7 @@ impl Engine {
                     snr_analytic: analytic_snr(detector, n / 2, b, at[b]),
                     snr_measured: measured[b],
                     full_scale_fraction: crate::instrument::plausibility::peak_signal_e(detector, b, at[b])
-                        / full.max(f64::MIN_POSITIVE),
+                        / full(b).max(f64::MIN_POSITIVE),
                 })
                 .collect::<Vec<_>>())
         })?;
@@ -403,22 +403,36 @@ fn reference_radiance(
 }
 
 /// LUT axes: wavelength nodes on a fixed lattice covering the grids (so a change of bands rarely
-/// rebuilds the table), one sun node, view nodes up to the swath edge.
+/// rebuilds the table), one sun node, view nodes up to the swath edge. Only the lattice nodes
+/// that bracket a stretch of simulated wavelengths are kept: a SWIR band adds the nodes around
+/// it, not the 1000 nm between it and the visible (interpolation between two nodes uses only
+/// those two, so leaving out the nodes of a gap changes nothing where wavelengths are simulated).
 fn lut_axes(response: &Response, viewing: &Viewing, sun_zenith_deg: f64, fid: &super::Fidelity) -> LutAxes {
-    let (lo, hi) = response.groups.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), g| {
-        let (l, h) = g.grid.range_nm();
-        (a.min(l), b.max(h))
-    });
+    use crate::ranges::{MAX_SIMULATED_NM, MIN_SIMULATED_NM};
     let step = fid.lut_wavelength_step_nm;
-    let first = ((lo / step).floor() * step).max(325.0);
-    let last = ((hi / step).ceil() * step).min(1025.0);
-    let mut nodes = vec![first];
-    let mut w = (first / step).floor() * step + step;
-    while w < last {
-        nodes.push(w);
-        w += step;
+    let mut nodes: Vec<f64> = Vec::new();
+    for g in &response.groups {
+        let w = g.grid.wavelengths_nm();
+        let mut start = 0;
+        for i in 1..=w.len() {
+            // A stretch ends where the next wavelength is more than a lattice step away.
+            if i < w.len() && w[i] - w[i - 1] <= step {
+                continue;
+            }
+            let (lo, hi) = (w[start], w[i - 1]);
+            let first = ((lo / step).floor() * step).max(MIN_SIMULATED_NM);
+            let last = ((hi / step).ceil() * step).min(MAX_SIMULATED_NM);
+            nodes.push(first);
+            let mut x = (first / step).floor() * step + step;
+            while x < last {
+                nodes.push(x);
+                x += step;
+            }
+            nodes.push(last);
+            start = i;
+        }
     }
-    nodes.push(last);
+    nodes.sort_by(f64::total_cmp);
     nodes.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
     let max_vza = ((viewing.max_view_zenith_deg / fid.lut_view_step_deg).ceil().max(1.0) * fid.lut_view_step_deg)
         .min(crate::ranges::GEOMETRY_VIEW_ZENITH_DEG.hi);

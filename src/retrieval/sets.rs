@@ -174,7 +174,7 @@ pub fn set_ron(index: usize, cluster: &ClusterSiop, total_stations: usize) -> St
          SiopSpec(\n    name: \"almi_{n}\",\n    description: \"aLMI set {n}/8: a*_NAP(440) {a:.4} m2/g, S_NAP {sn:.5}, bb*_NAP(555) {b:.5} m2/g, n {nb:.3}, S_CDOM {sc:.5}\",\n    \
          water_absorption: Asset(file: \"water/water_absorption_wasi6.csv\", column: \"a_w_per_m\"),\n    \
          water_backscatter: Asset(file: \"water/water_scattering_pure.csv\", column: \"bb_w_S0\"),\n    \
-         phytoplankton_absorption: Asset(file: \"phytoplankton/aph_specific_wasi6_classes.csv\", column: \"cyanobacteria\"),\n    \
+         phytoplankton_absorption: Asset(file: \"phytoplankton/aph_specific_wasi6_classes.csv\", column: \"cyanobacteria\", outside: Zero),\n    \
          phytoplankton_backscatter: Asset(file: \"phytoplankton/bbph_norm_wasi6.csv\", column: \"bb_phy_norm\", scale: 0.001, outside: Clamp),\n    \
          cdom_absorption: Exponential(coefficient: 1.0, reference_nm: 440.0, slope_per_nm: {sc:.6}),\n    \
          nap_absorption: Exponential(coefficient: {a:.6}, reference_nm: 440.0, slope_per_nm: {sn:.6}),\n    \

@@ -53,6 +53,9 @@ pub enum BandSetSpec {
     },
     /// Custom bands with Gaussian SRFs.
     Gaussian(Vec<GaussianBand>),
+    /// Several sets one after the other (an OLCI set and Gaussian SWIR bands); band names must
+    /// stay distinct.
+    Combined(Vec<BandSetSpec>),
 }
 
 impl BandSetSpec {
@@ -188,6 +191,14 @@ impl BandSet {
                     .collect::<Result<Vec<_>, _>>()?;
                 Ok(Self { name: label.into(), bands })
             }
+            BandSetSpec::Combined(parts) => {
+                if parts.is_empty() {
+                    return Err(SpectralError::Bands("a combined band set needs at least one part".into()));
+                }
+                let sets = parts.iter().map(Self::build).collect::<Result<Vec<_>, _>>()?;
+                let name = sets.iter().map(|s| s.name.as_str()).collect::<Vec<_>>().join(" + ");
+                Ok(Self { name, bands: sets.into_iter().flat_map(|s| s.bands).collect() })
+            }
             BandSetSpec::Gaussian(list) => {
                 if list.is_empty() {
                     return Err(SpectralError::Bands("a Gaussian band set needs at least one band".into()));
@@ -245,19 +256,32 @@ impl Band {
 
     /// A Gaussian band: SRF = exp(−4 ln2 (λ−c)²/FWHM²), sampled to ±2.5 FWHM.
     pub fn gaussian(spec: &GaussianBand) -> Result<Self, SpectralError> {
+        /// Where Shoal has spectral data (the solar spectrum, 300–2500 nm).
+        const DATA_NM: (f64, f64) = (300.0, 2500.0);
         let (c, w) = (spec.centre_nm, spec.fwhm_nm);
-        if !(c.is_finite() && (300.0..=2500.0).contains(&c)) {
+        if !(c.is_finite() && (DATA_NM.0..=DATA_NM.1).contains(&c)) {
             return Err(SpectralError::Bands(format!("centre_nm = {c} is out of range (300 to 2500 nm)")));
         }
-        if !(w.is_finite() && (0.1..=200.0).contains(&w)) {
-            return Err(SpectralError::Bands(format!("fwhm_nm = {w} is out of range (0.1 to 200 nm)")));
+        if !(w.is_finite() && (0.1..=300.0).contains(&w)) {
+            return Err(SpectralError::Bands(format!("fwhm_nm = {w} is out of range (0.1 to 300 nm)")));
         }
         let name = spec.name.clone().unwrap_or_else(|| format!("B{c:.0}"));
+        let response = |x: f64| (-4.0 * std::f64::consts::LN_2 * ((x - c) / w).powi(2)).exp();
+        // Centre ± 2.5 FWHM, cut where the data end if the response there is below 1 % of the
+        // peak (a 2200 nm band of 187 nm FWHM loses a tail of 0.2 %): what lies beyond would
+        // have nothing to multiply.
+        let (lo, hi) = ((c - 2.5 * w).max(DATA_NM.0), (c + 2.5 * w).min(DATA_NM.1));
+        if response(lo) > 0.01 || response(hi) > 0.01 {
+            return Err(SpectralError::Bands(format!(
+                "band centred at {c} nm with FWHM {w} nm reaches beyond 300–2500 nm with more than 1 % of its peak \
+                 (allowed: the response below 1 % of the peak where the data end)"
+            )));
+        }
         let n = 201;
         let (wl, v): (Vec<f64>, Vec<f64>) = (0..n)
             .map(|i| {
-                let x = c - 2.5 * w + 5.0 * w * i as f64 / (n - 1) as f64;
-                (x, (-4.0 * std::f64::consts::LN_2 * ((x - c) / w).powi(2)).exp())
+                let x = lo + (hi - lo) * i as f64 / (n - 1) as f64;
+                (x, response(x))
             })
             .unzip();
         Ok(Self { name: name.clone(), centre_nm: c, fwhm_nm: w, srf: Spectrum::new(name, wl, v)? })

@@ -261,7 +261,10 @@ impl SceneOptics {
         for (i, &wl) in self.grid.wavelengths_nm().iter().enumerate() {
             let (j0, j1, t) = self.nodes[i];
             let (a, b) = (&norm[j0], &norm[j1]);
-            let (tg0, tgv) = (atmosphere.gas(wl, mu0)?, atmosphere.gas(wl, muv)?);
+            // Ed carries the sun's leg; the upward factor the rest of the two-way transmittance
+            // (band-model gases are not a product of legs: see `gas::two_way_transmittance`).
+            let tg0 = atmosphere.gas(wl, mu0)?;
+            let tgv = atmosphere.gas_up_after_down(wl, mu0, muv)?;
             let e0 = self.e0[i];
             p.l_path[i] = loglin(a.radiance, b.radiance, t) * e0 * tg0 * tgv;
             p.ed[i] = loglin(a.ed, b.ed, t) * e0 * tg0;
