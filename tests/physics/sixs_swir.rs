@@ -1,0 +1,209 @@
+//! The atmosphere from 865 to 2250 nm against 6SV 1.1, on the reference rows in
+//! `tests/data/sixs/swir_reference.csv` (provenance in `tests/data/PROVENANCE.md`): three cases
+//! (maritime and continental aerosol, water vapour 0.5–4 cm, a target at 1 km), ten wavelengths
+//! and three Sentinel-2A bands. Shoal runs its own optics — Bodhaine Rayleigh depth, WMO Mie
+//! aerosol, scalar successive orders — over a black surface (water refractive index 1: no Fresnel
+//! reflection, as 6SV's black Lambertian ground), with gases.
+//!
+//! What is compared and why the tolerances are what they are:
+//! - **gas transmittance** (two-way): Shoal's SWIR gas table is 6SV's own band model tabulated
+//!   against path amount (`assets/atmosphere/gas_transmittance_6sv.csv`), so this checks the
+//!   table and its interpolation in amount, air mass and pressure, not an independent model.
+//! - **optical depths**: independent (Shoal's Bodhaine formula and Mie code against 6SV's).
+//! - **path reflectance** without gases: independent radiative transfer (scalar here, vector in
+//!   6SV; 6SV's aerosol phase functions come from its own Mie tables of the same WMO components).
+
+use shoal::atmosphere::{AerosolType, Atmosphere, AtmosphereSpec, GasAmounts, Geometry};
+use shoal::spectral::Table;
+
+use crate::data;
+
+/// One reference row and Shoal's value of each quantity.
+struct Compared {
+    label: String,
+    quantity: &'static str,
+    shoal: f64,
+    sixs: f64,
+}
+
+impl Compared {
+    fn error_pct(&self) -> f64 {
+        100.0 * (self.shoal / self.sixs - 1.0)
+    }
+}
+
+fn atmosphere(t: &Table, i: usize) -> Atmosphere {
+    let num = |c: &str| t.column_f64(c).unwrap()[i];
+    let aerosol = AerosolType::parse(t.column_str("aerosol").unwrap()[i]).unwrap();
+    AtmosphereSpec {
+        aerosol,
+        aot550: num("aot550"),
+        pressure_hpa: num("pressure_hpa"),
+        gases: true,
+        gas_amounts: GasAmounts { ozone_atm_cm: num("ozone_atm_cm"), water_vapour_cm: num("water_vapour_cm") },
+        // A black surface, as 6SV's black Lambertian ground: no Fresnel-reflected sky light.
+        water_refractive_index: 1.0,
+        day_of_year: 172,
+        ..AtmosphereSpec::default()
+    }
+    .build()
+    .unwrap()
+}
+
+/// (transmittance, τ_R, τ_a, ρ_path without gases) at `wavelength_nm`.
+fn at(atm: &Atmosphere, g: &Geometry, wavelength_nm: f64) -> [f64; 4] {
+    let t = atm.terms(wavelength_nm, g).unwrap();
+    [t.t_gas, t.tau_rayleigh, t.tau_aerosol, t.rho_path / t.t_gas]
+}
+
+/// Band averages over the Sentinel-2A SRF weighted by SRF × E₀ (6SV's band integration): the
+/// gas transmittance at every nanometre, the RT terms every 5 nm (they vary smoothly).
+fn band(atm: &Atmosphere, g: &Geometry, name: &str) -> [f64; 4] {
+    let srf = Table::from_asset("srf/srf_s2a_msi.csv").unwrap();
+    let w = srf.column_f64("wavelength_nm").unwrap();
+    let r = srf.column_f64(name).unwrap();
+    let (mut gas, mut gas_w) = (0.0, 0.0);
+    let mut rt = [0.0; 3];
+    let mut rt_w = 0.0;
+    for (&wl, &s) in w.iter().zip(&r) {
+        if s <= 1e-3 {
+            continue;
+        }
+        let weight = s * atm.e0(wl).unwrap();
+        let (mu0, muv) = (g.sun_zenith_rad.cos(), g.view_zenith_rad.cos());
+        gas += weight * atm.gas_two_way(wl, mu0, muv).unwrap();
+        gas_w += weight;
+        if (wl as i64) % 5 == 0 {
+            let v = at(atm, g, wl);
+            for k in 0..3 {
+                rt[k] += weight * v[k + 1];
+            }
+            rt_w += weight;
+        }
+    }
+    [gas / gas_w, rt[0] / rt_w, rt[1] / rt_w, rt[2] / rt_w]
+}
+
+fn compare() -> Vec<Compared> {
+    let t = Table::from_file(&data("sixs/swir_reference.csv")).unwrap();
+    let mut out = Vec::new();
+    for i in 0..t.len() {
+        let num = |c: &str| t.column_f64(c).unwrap()[i];
+        let atm = atmosphere(&t, i);
+        let g = Geometry::from_degrees(num("sun_zenith_deg"), num("view_zenith_deg"), num("relative_azimuth_deg"));
+        let name = t.column_str("band").unwrap()[i];
+        let shoal = match name.strip_suffix("nm") {
+            Some(wl) => at(&atm, &g, wl.parse().unwrap()),
+            None => band(&atm, &g, name.trim_start_matches("S2A_")),
+        };
+        let label = format!("{} {name}", t.column_str("case").unwrap()[i]);
+        let sixs = [num("t_gas_two_way"), num("tau_rayleigh"), num("tau_aerosol"), num("rho_path")];
+        for (k, quantity) in ["t_gas", "tau_rayleigh", "tau_aerosol", "rho_path"].into_iter().enumerate() {
+            out.push(Compared { label: label.clone(), quantity, shoal: shoal[k], sixs: sixs[k] });
+        }
+    }
+    out
+}
+
+#[test]
+fn swir_atmosphere_matches_6sv() {
+    let rows = compare();
+    for r in &rows {
+        eprintln!("| {} | {} | {:.5} | {:.5} | {:+.2} % |", r.label, r.quantity, r.shoal, r.sixs, r.error_pct());
+    }
+    let worst = |quantity: &str, keep: &dyn Fn(&Compared) -> bool| {
+        rows.iter()
+            .filter(|r| r.quantity == quantity && keep(r))
+            .map(|r| (r.error_pct().abs(), format!("{}: shoal {:.5} 6SV {:.5}", r.label, r.shoal, r.sixs)))
+            .fold((0.0, String::new()), |a, b| if b.0 > a.0 { b } else { a })
+    };
+    let sea_level = |r: &Compared| !r.label.starts_with('C');
+    let swir_nm =
+        |r: &Compared| r.label.split(' ').nth(1).and_then(|w| w.strip_suffix("nm")).and_then(|w| w.parse::<f64>().ok());
+    let swir =
+        |r: &Compared| swir_nm(r).is_some_and(|w| w > 1000.0) || r.label.contains("B11") || r.label.contains("B12");
+    // Gas, sea level, 1000–2500 nm (T ≥ 0.01: below, a relative error of a vanishing signal
+    // says nothing): the table is 6SV's band model, so only the interpolation in slant water
+    // column and air mass differs. Measured 0.17 %.
+    let (e, at) = worst("t_gas", &|r| sea_level(r) && swir(r) && r.sixs >= 0.01);
+    assert!(e < 0.3, "SWIR gas transmittance at sea level: {e:.2} % at {at}");
+    // Below 1000 nm (865 nm, B8A) Shoal's gases are WASI's Gregg & Carder model, independent of
+    // 6SV: measured 0.74 % (B8A, 4 cm of water vapour, air mass 3.2).
+    let (e, at) = worst("t_gas", &|r| sea_level(r) && !swir(r));
+    assert!(e < 1.0, "VNIR gas transmittance: {e:.2} % at {at}");
+    // At 1 km (899 hPa) the mixed gases' column shrinks with pressure in Shoal as in 6SV, but
+    // water vapour's lines also narrow at low pressure, which the table does not model: window
+    // bands measured within 1.43 % (2200 nm); the saturated 1375 nm band (T = 0.23) is 37 % low
+    // and is left out.
+    let (e, at) = worst("t_gas", &|r| !sea_level(r) && r.sixs > 0.5);
+    assert!(e < 2.0, "gas transmittance at 1 km, windows: {e:.2} % at {at}");
+    // Rayleigh depth: Bodhaine et al. (1999) against 6SV's own formula, measured 1.85 % where
+    // τ_R < 0.001 (2250 nm).
+    let (e, at) = worst("tau_rayleigh", &|_| true);
+    assert!(e < 2.5, "Rayleigh depth: {e:.2} % at {at}");
+    // Aerosol depth, maritime: Shoal's Mie of the WMO components (OSOAA's tables) against 6SV's
+    // maritime model; measured 6.0 % (1610 nm).
+    let maritime = |r: &Compared| !r.label.starts_with('B');
+    let (e, at) = worst("tau_aerosol", &|r| maritime(r));
+    assert!(e < 7.0, "maritime aerosol depth: {e:.2} % at {at}");
+    // Continental to 1650 nm: measured 9.3 %. Beyond 2 µm Shoal's is 30–32 % lower: the WMO
+    // dust-like real index falls to 1.22 at 2.25 µm in OSOAA's table (Data_WMO_cor), and
+    // dust-like particles carry the continental extinction there; 6SV's continental model keeps
+    // 22 % of its 550 nm extinction at 2250 nm where Shoal's keeps 15 % (see the next test).
+    let (e, at) =
+        worst("tau_aerosol", &|r| !maritime(r) && swir_nm(r).is_none_or(|w| w < 2000.0) && !r.label.contains("B12"));
+    assert!(e < 10.0, "continental aerosol depth to 1650 nm: {e:.2} % at {at}");
+    let (e, at) = worst("tau_aerosol", &|r| !maritime(r));
+    assert!(e < 33.0, "continental aerosol depth beyond 2 µm moved from the documented 32 %: {e:.2} % at {at}");
+    // Path reflectance without gases, to 1240 nm: independent radiative transfer, measured
+    // 4.0 % (scalar SOS against vector 6SV, and the aerosol models' differences above).
+    let (e, at) = worst("rho_path", &|r| swir_nm(r).is_some_and(|w| w <= 1240.0) || r.label.contains("B8A"));
+    assert!(e < 5.0, "path reflectance to 1240 nm: {e:.2} % at {at}");
+    // From 1375 nm the maritime aerosol makes the difference: Shoal's scatters more (single-
+    // scattering albedo 0.98 against 6SV's 0.97 at 1650 nm and 0.89 at 2250 nm, next test), so
+    // its path reflectance is up to 14 % higher at 1.6 µm and up to 48 % higher at 2.1–2.25 µm
+    // (a path reflectance of 0.002–0.003). Held at the measured values so that a change shows.
+    let (e, at) =
+        worst("rho_path", &|r| swir_nm(r).is_some_and(|w| (1300.0..2000.0).contains(&w)) || r.label.contains("B11"));
+    assert!(e < 14.0, "path reflectance 1375–1650 nm: {e:.2} % at {at}");
+    let (e, at) = worst("rho_path", &|_| true);
+    assert!(e < 49.0, "path reflectance 2.1–2.25 µm: {e:.2} % at {at}");
+}
+
+/// Shoal's WMO mixtures (OSOAA's component tables through Shoal's Mie code) against 6SV's own
+/// models (`assets/atmosphere/aerosol_6sv_models.csv`): the cause of the SWIR path-reflectance
+/// differences, printed for the record and held so that a change shows.
+#[test]
+fn aerosol_models_in_the_swir_against_6sv_models() {
+    let t = Table::from_asset("atmosphere/aerosol_6sv_models.csv").unwrap();
+    let (model, wl) = (t.column_str("model").unwrap(), t.column_f64("wavelength_nm").unwrap());
+    let (ext, ssa, g) = (t.column_f64("nor_ext").unwrap(), t.column_f64("ssa").unwrap(), t.column_f64("g").unwrap());
+    for i in 0..t.len() {
+        let Ok(kind) = AerosolType::parse(model[i]) else { continue };
+        if !(860.0..=2250.0).contains(&wl[i]) || kind == AerosolType::Urban {
+            continue;
+        }
+        let o = shoal::atmosphere::mixture_optics(kind, wl[i]).unwrap().unwrap();
+        // Measured: maritime extinction ratio within 6.1 % and single-scattering albedo within
+        // 11.1 % (0.984 against 0.886 at 2250 nm); continental within 34 % and 13.7 % (1950 nm).
+        let (e_ext, e_ssa) = ((o.extinction_ratio / ext[i] - 1.0).abs(), (o.ssa / ssa[i] - 1.0).abs());
+        let (max_ext, max_ssa) = if kind == AerosolType::Maritime { (0.065, 0.115) } else { (0.35, 0.14) };
+        assert!(
+            e_ext < max_ext && e_ssa < max_ssa,
+            "{} at {} nm: extinction {e_ext:.3}, SSA {e_ssa:.3}",
+            model[i],
+            wl[i]
+        );
+        eprintln!(
+            "| {} | {} | {:.4} | {:.4} | {:.4} | {:.4} | {:.3} | {:.3} |",
+            model[i],
+            wl[i],
+            o.extinction_ratio,
+            ext[i],
+            o.ssa,
+            ssa[i],
+            o.phase.asymmetry(),
+            g[i]
+        );
+    }
+}
