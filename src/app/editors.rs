@@ -14,10 +14,16 @@ pub(super) fn band_editor(slot: &mut Slot, ui: &mut egui::Ui) {
         | InstrumentKind::FilterImager { bands, .. } => bands,
         InstrumentKind::Spectrograph { start_nm, end_nm, sampling_nm, resolution_nm, .. } => {
             ui.add(
-                egui::Slider::new(start_nm, 350.0..=700.0).update_while_editing(false).text("First band").suffix(" nm"),
+                egui::Slider::new(start_nm, 350.0..=2400.0)
+                    .update_while_editing(false)
+                    .text("First band")
+                    .suffix(" nm"),
             );
             ui.add(
-                egui::Slider::new(end_nm, 500.0..=1000.0).update_while_editing(false).text("Last band").suffix(" nm"),
+                egui::Slider::new(end_nm, 400.0..=crate::ranges::MAX_SIMULATED_NM)
+                    .update_while_editing(false)
+                    .text("Last band")
+                    .suffix(" nm"),
             );
             ui.add(
                 egui::Slider::new(sampling_nm, 1.0..=30.0).update_while_editing(false).text("Sampling").suffix(" nm"),
@@ -37,6 +43,7 @@ pub(super) fn band_editor(slot: &mut Slot, ui: &mut egui::Ui) {
         BandSetSpec::Msi { platform: Platform::A, .. } => "MSI S2A",
         BandSetSpec::Msi { .. } => "MSI S2B",
         BandSetSpec::Gaussian(_) => "Custom (Gaussian)",
+        BandSetSpec::Combined(_) => "Combined",
     };
     let mut choice: Option<BandSetSpec> = None;
     egui::ComboBox::from_label("Band set").selected_text(name).show_ui(ui, |ui| {
@@ -85,14 +92,14 @@ pub(super) fn band_editor(slot: &mut Slot, ui: &mut egui::Ui) {
                 ui.add(
                     egui::DragValue::new(&mut b.centre_nm)
                         .update_while_editing(false)
-                        .range(380.0..=1000.0)
+                        .range(crate::ranges::MIN_SIMULATED_NM..=crate::ranges::MAX_SIMULATED_NM)
                         .speed(0.5)
                         .fixed_decimals(1),
                 );
                 ui.add(
                     egui::DragValue::new(&mut b.fwhm_nm)
                         .update_while_editing(false)
-                        .range(1.0..=100.0)
+                        .range(1.0..=300.0)
                         .speed(0.2)
                         .fixed_decimals(1),
                 );
@@ -106,7 +113,7 @@ pub(super) fn band_editor(slot: &mut Slot, ui: &mut egui::Ui) {
             list.remove(i);
         }
         if ui.button("Add band").clicked() {
-            let c = list.last().map_or(560.0, |b| (b.centre_nm + 20.0).min(990.0));
+            let c = list.last().map_or(560.0, |b| (b.centre_nm + 20.0).min(crate::ranges::MAX_SIMULATED_NM - 10.0));
             list.push(GaussianBand { name: None, centre_nm: c, fwhm_nm: 10.0 });
         }
     }

@@ -40,6 +40,7 @@ mod metrics_table;
 pub mod model;
 mod panels;
 mod params;
+mod planes;
 pub mod plot_data;
 pub mod plots;
 pub mod raster;
@@ -115,6 +116,8 @@ struct UiState {
     param_error: Option<(&'static str, String)>,
     /// A scene, atmosphere or calibration value refused by its range.
     conditions_error: Option<String>,
+    /// A focal-plane edit refused by the instrument's validation.
+    plane_error: Option<String>,
     /// What the panels asked for this frame, applied after it is drawn (`logic.rs`).
     commands: Vec<logic::UiCommand>,
 }

@@ -13,7 +13,10 @@ use crate::retrieval::{Mode, Objective, Starts};
 fn library_combo(ui: &mut egui::Ui, label: &str, current: &str, entries: &[Entry]) -> Option<Entry> {
     let mut picked = None;
     let chosen = entries.iter().find(|e| e.name == current).map(|e| e.description.as_str()).unwrap_or_default();
-    let r = egui::ComboBox::from_label(label).selected_text(current).show_ui(ui, |ui| {
+    // Tall enough for the whole library at 1280 × 720 (the default height hid user presets
+    // below ten built-in instruments).
+    let height = 0.6 * ui.ctx().content_rect().height();
+    let r = egui::ComboBox::from_label(label).selected_text(current).height(height).show_ui(ui, |ui| {
         for e in entries {
             let text = if e.builtin { e.name.clone() } else { format!("{} (mine)", e.name) };
             let item = ui.selectable_label(e.name == current, text);
@@ -215,6 +218,16 @@ fn editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
     }
     let slot = app.state.slot_mut(editing);
     egui::CollapsingHeader::new("Bands").default_open(false).show(ui, |ui| super::editors::band_editor(slot, ui));
+    let slot = app.state.slot_mut(editing);
+    let title = if slot.spec.focal_planes.is_empty() {
+        "Focal planes".to_string()
+    } else {
+        format!("Focal planes ({})", slot.spec.focal_planes.len() + 1)
+    };
+    egui::CollapsingHeader::new(title)
+        .id_salt("focal-planes")
+        .default_open(false)
+        .show(ui, |ui| super::planes::plane_editor(slot, ui, &mut app.ui.plane_error));
     super::derived::derived(app, ui);
     super::derived::a_vs_b(app, ui);
 }

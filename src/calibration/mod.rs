@@ -161,12 +161,17 @@ impl Calibration {
         let nd = e0_band.len() / nb.max(1);
         // Diffuser radiance at normal incidence, then the incidence that fills 60 % of the range.
         let normal: Vec<f64> = e0_band.iter().map(|e| spec.diffuser_reflectance * e / std::f64::consts::PI).collect();
-        let range_e =
-            detector.well_e().min((detector.dn_max() - detector.bias_dn()).max(1.0) * detector.gain_e_per_dn());
-        let peak = (0..nd * nb).map(|i| detector.responsivity(i / nb, i % nb) * normal[i]).fold(0.0, f64::max);
+        // Each band's range in electrons (its focal plane's well or ADC top, the smaller), and
+        // the incidence at which the band closest to its top fills 60 % of it.
+        let range_e = |b: usize| {
+            detector.well_e(b).min((detector.dn_max(b) - detector.bias_dn(b)).max(1.0) * detector.gain_e_per_dn(b))
+        };
+        let fill = (0..nd * nb)
+            .map(|i| detector.responsivity(i / nb, i % nb) * normal[i] / range_e(i % nb))
+            .fold(0.0, f64::max);
         let cos_inc = match spec.sun_incidence_deg {
             Some(a) => a.to_radians().cos(),
-            None if peak > 0.0 => (0.6 * range_e / peak).min(1.0),
+            None if fill > 0.0 => (0.6 / fill).min(1.0),
             None => 1.0,
         };
         let diffuser_radiance: Vec<f64> = normal.iter().map(|l| l * cos_inc).collect();
@@ -181,8 +186,8 @@ impl Calibration {
                 let mut gain = vec![0.0; nb];
                 if spec.perfect {
                     for b in 0..nb {
-                        offset[b] = detector.bias_dn() + detector.dark_mean_e(j, b, t) / detector.gain_e_per_dn();
-                        gain[b] = detector.responsivity(j, b) / detector.gain_e_per_dn() / drift;
+                        offset[b] = detector.bias_dn(b) + detector.dark_mean_e(j, b, t) / detector.gain_e_per_dn(b);
+                        gain[b] = detector.responsivity(j, b) / detector.gain_e_per_dn(b) / drift;
                     }
                     return (j, offset, gain, 0);
                 }
@@ -240,7 +245,8 @@ fn frame_means(
     (seed, at_once, by_frame): (u64, Stream, Stream),
 ) -> (Vec<f64>, usize) {
     let mut rng = pixel_rng(seed, at_once, 0, j);
-    let drawn: Vec<Option<f64>> = exposures.iter().map(|e| detector.frames_mean(e, frames, &mut rng)).collect();
+    let drawn: Vec<Option<f64>> =
+        exposures.iter().enumerate().map(|(b, e)| detector.frames_mean(b, e, frames, &mut rng)).collect();
     let left: Vec<usize> = (0..exposures.len()).filter(|&b| drawn[b].is_none()).collect();
     let mut sums = vec![0.0; exposures.len()];
     let mut saturated = 0;

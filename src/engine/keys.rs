@@ -14,7 +14,7 @@ use serde::Serialize;
 
 use super::RunConfig;
 use super::config::Fidelity;
-use crate::instrument::{DetectorMode, InstrumentKind, InstrumentSpec};
+use crate::instrument::{BandSelection, DarkTemperature, DetectorMode, FocalPlane, InstrumentKind, InstrumentSpec};
 use crate::spectral::SpectrumSource;
 
 /// What the spectral response is computed from.
@@ -28,6 +28,79 @@ pub(super) struct ResponseInputs<'a> {
     pub pixel_pitch_um: f64,
     pub focal_length_mm: f64,
     pub spectral_step_nm: f64,
+    /// Which bands each further focal plane holds, and its QE.
+    pub planes: Vec<PlaneResponse<'a>>,
+}
+
+/// A further focal plane's part of the spectral response.
+#[derive(Serialize)]
+pub(super) struct PlaneResponse<'a> {
+    pub bands: &'a BandSelection,
+    pub quantum_efficiency: &'a SpectrumSource,
+}
+
+/// A further focal plane's part of the photon and electron counts.
+#[derive(Serialize)]
+pub(super) struct PlanePhoton {
+    pub pixel_pitch_um: f64,
+    pub detectors: usize,
+    pub dark_current_e_s: f64,
+    pub dark_temperature: Option<DarkTemperature>,
+    pub prnu: f64,
+    pub dsnu_e: f64,
+    pub well_depth_e: f64,
+    pub exposure_s: Option<f64>,
+}
+
+/// A further focal plane's readout electronics.
+#[derive(Serialize)]
+pub(super) struct PlaneElectronics {
+    pub read_noise_e: f64,
+    pub gain_e_per_dn: f64,
+    pub bias_dn: f64,
+    pub adc_bits: u32,
+}
+
+/// A further focal plane taken apart, every field named (see the module's note).
+fn plane_parts(p: &FocalPlane) -> (PlaneResponse<'_>, PlanePhoton, PlaneElectronics) {
+    let FocalPlane {
+        // Labels: no product depends on them.
+        name: _,
+        material: _,
+        bands,
+        pixel_pitch_um,
+        detectors,
+        quantum_efficiency,
+        dark_current_e_s,
+        dark_temperature,
+        read_noise_e,
+        well_depth_e,
+        gain_e_per_dn,
+        bias_dn,
+        adc_bits,
+        prnu,
+        dsnu_e,
+        exposure_s,
+    } = p;
+    (
+        PlaneResponse { bands, quantum_efficiency },
+        PlanePhoton {
+            pixel_pitch_um: *pixel_pitch_um,
+            detectors: *detectors,
+            dark_current_e_s: *dark_current_e_s,
+            dark_temperature: *dark_temperature,
+            prnu: *prnu,
+            dsnu_e: *dsnu_e,
+            well_depth_e: *well_depth_e,
+            exposure_s: *exposure_s,
+        },
+        PlaneElectronics {
+            read_noise_e: *read_noise_e,
+            gain_e_per_dn: *gain_e_per_dn,
+            bias_dn: *bias_dn,
+            adc_bits: *adc_bits,
+        },
+    )
 }
 
 /// The geometry an instrument flies (a change re-runs `Geometry` onward).
@@ -59,6 +132,8 @@ pub(super) struct PhotonSide<'a> {
     pub prnu: f64,
     pub dsnu_e: f64,
     pub well_depth_e: f64,
+    pub dark_temperature: Option<DarkTemperature>,
+    pub planes: Vec<PlanePhoton>,
     pub noise: bool,
     pub seed: u64,
 }
@@ -70,6 +145,7 @@ pub(super) struct Electronics {
     pub gain_e_per_dn: f64,
     pub bias_dn: f64,
     pub adc_bits: u32,
+    pub planes: Vec<PlaneElectronics>,
     pub quantise: bool,
 }
 
@@ -132,7 +208,18 @@ impl<'a> Inputs<'a> {
             dark_current_e_s,
             prnu,
             dsnu_e,
+            dark_temperature,
+            // A label: the first plane's numbers are the fields above.
+            material: _,
+            focal_planes,
         } = &config.instrument;
+        let (mut plane_response, mut plane_photon, mut plane_electronics) = (Vec::new(), Vec::new(), Vec::new());
+        for p in focal_planes {
+            let (r, ph, e) = plane_parts(p);
+            plane_response.push(r);
+            plane_photon.push(ph);
+            plane_electronics.push(e);
+        }
         let DetectorMode { noise, quantise } = config.detector;
         let Fidelity {
             spectral_step_nm,
@@ -156,6 +243,7 @@ impl<'a> Inputs<'a> {
                 pixel_pitch_um: *pixel_pitch_um,
                 focal_length_mm: *focal_length_mm,
                 spectral_step_nm,
+                planes: plane_response,
             },
             orbit: Orbit {
                 altitude_km: *altitude_km,
@@ -180,6 +268,8 @@ impl<'a> Inputs<'a> {
                 prnu: *prnu,
                 dsnu_e: *dsnu_e,
                 well_depth_e: *well_depth_e,
+                dark_temperature: *dark_temperature,
+                planes: plane_photon,
                 noise,
                 seed,
             },
@@ -188,6 +278,7 @@ impl<'a> Inputs<'a> {
                 gain_e_per_dn: *gain_e_per_dn,
                 bias_dn: *bias_dn,
                 adc_bits: *adc_bits,
+                planes: plane_electronics,
                 quantise,
             },
             snr: SnrPatch { frames: snr_frames, detectors: snr_detectors, decimation, seed },

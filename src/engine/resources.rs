@@ -51,11 +51,14 @@ const KEPT_BYTES_PER_PIXEL_BAND: f64 = 4.0;
 
 /// Bands an instrument will have (without reading its band files).
 fn band_count(kind: &InstrumentKind) -> usize {
-    let set = |b: &BandSetSpec| match b {
-        BandSetSpec::Olci { bands, .. } => bands.as_ref().map_or(19, Vec::len),
-        BandSetSpec::Msi { bands, .. } => bands.as_ref().map_or(9, Vec::len),
-        BandSetSpec::Gaussian(g) => g.len(),
-    };
+    fn set(b: &BandSetSpec) -> usize {
+        match b {
+            BandSetSpec::Olci { bands, .. } => bands.as_ref().map_or(19, Vec::len),
+            BandSetSpec::Msi { bands, .. } => bands.as_ref().map_or(9, Vec::len),
+            BandSetSpec::Gaussian(g) => g.len(),
+            BandSetSpec::Combined(parts) => parts.iter().map(set).sum(),
+        }
+    }
     match kind {
         InstrumentKind::Multispectral { bands } | InstrumentKind::IdealRadiometer { bands } => set(bands),
         InstrumentKind::FilterImager { bands, .. } => set(bands),

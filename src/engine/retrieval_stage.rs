@@ -25,7 +25,7 @@ fn nedr(config: &RunConfig, side: &SceneSide, typical: &[f64]) -> Vec<f64> {
         .map(|b| {
             let k = detector.responsivity(j, b);
             let signal = k * typical[b];
-            let noise = detector.variance_e2(signal, detector.dark_mean_e(j, b, detector.exposure_s())).sqrt();
+            let noise = detector.variance_e2(b, signal, detector.dark_mean_e(j, b, detector.exposure_s())).sqrt();
             let t_ed = side.band_atmosphere.t_ed[side.band_atmosphere.at(column, b)];
             let v = noise / k / t_ed;
             if v.is_finite() && v > 0.0 { v } else { 1e-6 }

@@ -124,11 +124,14 @@ enum Shot {
 /// One detector and band's exposure to a constant radiance, from [`Detector::exposure`].
 #[derive(Debug, Clone, Copy)]
 pub struct Exposure {
+    /// The draw of the electrons of all `binned` pixels together.
     shot: Shot,
+    /// Pixels averaged into the value (m² for a finer focal plane, 1 otherwise).
+    binned: f64,
     /// An ideal detector does not clip at the well.
     ideal: bool,
     well_e: f64,
-    /// Mean electrons of a frame.
+    /// Mean electrons of a frame (per pixel).
     mean_e: f64,
 }
 
@@ -144,6 +147,7 @@ impl Exposure {
                 round_non_negative(mean + sd * z)
             }
         };
+        let e = if self.binned > 1.0 { e / self.binned } else { e };
         if self.ideal { e } else { e.min(self.well_e) }
     }
 }
@@ -161,8 +165,8 @@ pub fn normal<R: rand::Rng + ?Sized>(rng: &mut R) -> f64 {
     StandardNormal.sample(rng)
 }
 
-/// The detector of one instrument: per-(detector, band) responsivity and dark signal, and the
-/// readout electronics.
+/// The detector of one instrument: per-(detector, band) responsivity and dark signal, and each
+/// focal plane's readout electronics ([`plane::PlaneElectronics`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Detector {
     n_bands: usize,
@@ -171,15 +175,11 @@ pub struct Detector {
     responsivity: Vec<f64>,
     /// Mean dark electrons at the nominal exposure (dark current and DSNU), per detector × band.
     dark_e: Vec<f64>,
-    /// Dark current, e⁻/s (for exposures other than the nominal one).
-    dark_current_e_s: f64,
+    /// Each band's focal plane (an index into `planes`).
+    plane_of_band: Vec<usize>,
+    /// The focal planes: the instrument's first, then its `focal_planes`.
+    planes: Vec<PlaneElectronics>,
     exposure_s: f64,
-    well_e: f64,
-    read_noise_e: f64,
-    gain_e_per_dn: f64,
-    dn_per_e: f64,
-    bias_dn: f64,
-    dn_max: f64,
     ideal: bool,
     mode: DetectorMode,
 }
@@ -197,45 +197,47 @@ pub struct Readout {
 
 impl Detector {
     /// The detector of `spec` with `response`, fixed patterns drawn from `seed`.
+    ///
+    /// The first focal plane's PRNU and DSNU come from each detector's generator in band order
+    /// (as they did before focal planes existed, so a one-plane instrument's patterns are
+    /// unchanged); a further plane's from a generator of its own per (plane, band, native
+    /// detector), so the grid pixels of one coarse pixel share its pattern.
     #[must_use]
     pub fn new(spec: &InstrumentSpec, response: &Response, mode: DetectorMode, seed: u64) -> Self {
         let ideal = spec.is_ideal();
         let mode = if ideal { DetectorMode::IDEAL } else { mode };
         let nb = response.n_bands();
         let nd = spec.detectors;
-        let geometric = spec.exposure_s * spec.optical_transmission * spec.etendue_m2_sr();
+        let planes = PlaneElectronics::of(spec);
+        let plane_of_band: Vec<usize> =
+            (0..nb).map(|b| response.plane_of_band.get(b).copied().unwrap_or(0).min(planes.len() - 1)).collect();
         let mut responsivity = vec![0.0; nd * nb];
         let mut dark_e = vec![0.0; nd * nb];
         for j in 0..nd {
             let mut rng = pixel_rng(seed, Stream::FixedPattern, 0, j);
             for (gi, g) in response.groups.iter().enumerate() {
                 for (k, &b) in g.bands.iter().enumerate() {
+                    let p = plane_of_band[b];
+                    let plane = &planes[p];
                     let photons: f64 = response.weights(gi, k, j).1.iter().sum();
-                    let (z1, z2) = (normal(&mut rng), normal(&mut rng));
-                    let prnu = if ideal { 1.0 } else { (1.0 + spec.prnu * z1).max(0.0) };
+                    let (z1, z2) = if p == 0 {
+                        (normal(&mut rng), normal(&mut rng))
+                    } else {
+                        let mut own = pixel_rng(seed, Stream::FixedPattern, (p << 16) | b, j / plane.block());
+                        (normal(&mut own), normal(&mut own))
+                    };
+                    let prnu = if ideal { 1.0 } else { (1.0 + plane.prnu * z1).max(0.0) };
+                    // The plane's own integration time (a ratio of the instrument's, at which every
+                    // stage calls the detector).
+                    let t = spec.exposure_s * plane.exposure_ratio;
+                    let geometric = t * spec.optical_transmission * plane.etendue_m2_sr;
                     responsivity[j * nb + b] = geometric * photons * prnu;
-                    let dsnu = if ideal { 0.0 } else { spec.dsnu_e * z2 };
-                    dark_e[j * nb + b] = (spec.dark_current_e_s * spec.exposure_s + dsnu).max(0.0);
+                    let dsnu = if ideal { 0.0 } else { plane.dsnu_e * z2 };
+                    dark_e[j * nb + b] = (plane.dark_current_e_s * t + dsnu).max(0.0);
                 }
             }
         }
-        Self {
-            n_bands: nb,
-            responsivity,
-            dark_e,
-            dark_current_e_s: spec.dark_current_e_s,
-            exposure_s: spec.exposure_s,
-            // In f32 precision: the electrons cube is stored as f32 (level0.rs), and a pixel
-            // clipped at the well must still compare ≥ the well when read out and be flagged.
-            well_e: f64::from(spec.well_depth_e as f32),
-            read_noise_e: spec.read_noise_e,
-            gain_e_per_dn: spec.gain_e_per_dn,
-            dn_per_e: 1.0 / spec.gain_e_per_dn,
-            bias_dn: spec.bias_dn,
-            dn_max: spec.dn_max(),
-            ideal,
-            mode,
-        }
+        Self { n_bands: nb, responsivity, dark_e, plane_of_band, planes, exposure_s: spec.exposure_s, ideal, mode }
     }
 
     /// Noise and quantisation switches in effect (the ideal radiometer has neither).
@@ -262,11 +264,32 @@ impl Detector {
         self.responsivity[j * self.n_bands + b]
     }
 
+    /// Band `b`'s focal plane.
+    #[must_use]
+    pub fn plane(&self, b: usize) -> &PlaneElectronics {
+        &self.planes[self.plane_of_band[b]]
+    }
+
+    /// Band `b`'s focal-plane index (0: the instrument's first).
+    #[must_use]
+    pub fn plane_index(&self, b: usize) -> usize {
+        self.plane_of_band[b]
+    }
+
+    /// The focal planes.
+    #[must_use]
+    pub fn planes(&self) -> &[PlaneElectronics] {
+        &self.planes
+    }
+
     /// Mean dark electrons of detector `j`, band `b` for an exposure of `exposure_s`.
     #[must_use]
     pub fn dark_mean_e(&self, j: usize, b: usize, exposure_s: f64) -> f64 {
-        let fixed = self.dark_e[j * self.n_bands + b] - self.dark_current_e_s * self.exposure_s;
-        (self.dark_current_e_s * exposure_s + fixed * exposure_s / self.exposure_s).max(0.0)
+        // `exposure_s` is on the instrument's clock; the plane integrates its share of it.
+        let plane = self.plane(b);
+        let own = exposure_s * plane.exposure_ratio;
+        let fixed = self.dark_e[j * self.n_bands + b] - plane.dark_current_e_s * self.exposure_s * plane.exposure_ratio;
+        (plane.dark_current_e_s * own + fixed * exposure_s / self.exposure_s).max(0.0)
     }
 
     /// Nominal exposure time, s.
@@ -275,34 +298,34 @@ impl Detector {
         self.exposure_s
     }
 
-    /// Full-well capacity, e⁻.
+    /// Full-well capacity of band `b`'s pixels, e⁻.
     #[must_use]
-    pub fn well_e(&self) -> f64 {
-        self.well_e
+    pub fn well_e(&self, b: usize) -> f64 {
+        self.plane(b).well_e
     }
 
-    /// Conversion gain, e⁻/DN.
+    /// Conversion gain of band `b`'s readout, e⁻/DN.
     #[must_use]
-    pub fn gain_e_per_dn(&self) -> f64 {
-        self.gain_e_per_dn
+    pub fn gain_e_per_dn(&self, b: usize) -> f64 {
+        self.plane(b).gain_e_per_dn
     }
 
-    /// Read noise, e⁻ rms.
+    /// Read noise of band `b`'s value, e⁻ rms (÷ m for m × m binned pixels).
     #[must_use]
-    pub fn read_noise_e(&self) -> f64 {
-        self.read_noise_e
+    pub fn read_noise_e(&self, b: usize) -> f64 {
+        self.plane(b).read_noise_e
     }
 
-    /// Bias, DN.
+    /// Bias of band `b`'s readout, DN.
     #[must_use]
-    pub fn bias_dn(&self) -> f64 {
-        self.bias_dn
+    pub fn bias_dn(&self, b: usize) -> f64 {
+        self.plane(b).bias_dn
     }
 
-    /// Largest DN.
+    /// Largest DN of band `b`'s ADC.
     #[must_use]
-    pub fn dn_max(&self) -> f64 {
-        self.dn_max
+    pub fn dn_max(&self, b: usize) -> f64 {
+        self.plane(b).dn_max
     }
 
     /// Electrons collected by detector `j`, band `b` from band radiance `radiance` during
@@ -316,8 +339,15 @@ impl Detector {
         rng: &mut R,
     ) -> f64 {
         let mean = self.mean_e(j, b, radiance, exposure_s);
-        let e = if self.mode.noise { shot(mean, rng) } else { mean };
-        if self.ideal { e } else { e.min(self.well_e) }
+        let plane = self.plane(b);
+        let q = plane.binned();
+        // m × m binned pixels: the shot noise of their summed electrons, averaged.
+        let e = match (self.mode.noise, q > 1.0) {
+            (false, _) => mean,
+            (true, false) => shot(mean, rng),
+            (true, true) => shot(mean * q, rng) / q,
+        };
+        if self.ideal { e } else { e.min(plane.well_e) }
     }
 
     /// Mean electrons of detector `j`, band `b` for `radiance` over `exposure_s`.
@@ -338,23 +368,26 @@ impl Detector {
     #[must_use]
     pub fn exposure(&self, j: usize, b: usize, radiance: f64, exposure_s: f64) -> Exposure {
         let mean = self.mean_e(j, b, radiance, exposure_s);
+        let plane = self.plane(b);
+        let q = plane.binned();
+        let summed = mean * q;
         let shot = if !self.mode.noise {
-            Shot::Fixed(mean)
+            Shot::Fixed(summed)
         } else if !(mean > 0.0) {
             Shot::Fixed(0.0)
-        } else if mean < 1000.0 {
-            Poisson::new(mean).map_or(Shot::Fixed(mean), Shot::Poisson)
+        } else if summed < 1000.0 {
+            Poisson::new(summed).map_or(Shot::Fixed(summed), Shot::Poisson)
         } else {
-            Shot::Normal { mean, sd: mean.sqrt() }
+            Shot::Normal { mean: summed, sd: summed.sqrt() }
         };
-        Exposure { shot, ideal: self.ideal, well_e: self.well_e, mean_e: mean }
+        Exposure { shot, binned: q, ideal: self.ideal, well_e: plane.well_e, mean_e: mean }
     }
 
-    /// Read out `electrons`: read noise, gain, bias and the ADC.
+    /// Read out band `b`'s `electrons`: read noise, gain, bias and the ADC.
     #[inline(always)]
-    pub fn read_out<R: rand::Rng + ?Sized>(&self, electrons: f64, rng: &mut R) -> Readout {
+    pub fn read_out<R: rand::Rng + ?Sized>(&self, b: usize, electrons: f64, rng: &mut R) -> Readout {
         let z = if self.mode.noise { normal(rng) } else { 0.0 };
-        self.read_out_with(electrons, z)
+        self.read_out_with(b, electrons, z)
     }
 
     /// The mean Level-0 value of `frames` frames of `exposure`, drawn at once: the sum of the
@@ -377,7 +410,13 @@ impl Detector {
     ///
     /// The calibration averages 100 light and 100 dark frames per detector and band: frame by
     /// frame that was the slowest part of a preview after a gain change.
-    pub fn frames_mean<R: rand::Rng + ?Sized>(&self, exposure: &Exposure, frames: usize, rng: &mut R) -> Option<f64> {
+    pub fn frames_mean<R: rand::Rng + ?Sized>(
+        &self,
+        b: usize,
+        exposure: &Exposure,
+        frames: usize,
+        rng: &mut R,
+    ) -> Option<f64> {
         /// A frame clips with probability below 10⁻⁹ beyond this many σ.
         const MARGIN_SIGMA: f64 = 6.0;
         if frames == 0 {
@@ -385,30 +424,34 @@ impl Detector {
         }
         if !self.mode.noise {
             // Every frame is the same value.
-            return Some(self.level0_value(&self.read_out_with(exposure.draw(rng), 0.0)));
+            return Some(self.level0_value(&self.read_out_with(b, exposure.draw(rng), 0.0)));
         }
+        let plane = self.plane(b);
+        let q = exposure.binned;
         let mu = exposure.mean_e.max(0.0);
-        let sd_dn = (mu + self.read_noise_e * self.read_noise_e).sqrt() * self.dn_per_e;
-        let mean_dn = mu * self.dn_per_e + self.bias_dn;
-        if !self.ideal && mu + MARGIN_SIGMA * mu.sqrt() >= self.well_e {
+        let sd_dn = (mu / q + plane.read_noise_e * plane.read_noise_e).sqrt() * plane.dn_per_e;
+        let mean_dn = mu * plane.dn_per_e + plane.bias_dn;
+        if !self.ideal && mu + MARGIN_SIGMA * (mu / q).sqrt() >= plane.well_e {
             return None;
         }
         if self.mode.quantise {
-            let clear = mean_dn - MARGIN_SIGMA * sd_dn > 0.0 && mean_dn + MARGIN_SIGMA * sd_dn < self.dn_max - 0.5;
-            if self.read_noise_e * self.dn_per_e < 1.0 || !clear {
+            let clear = mean_dn - MARGIN_SIGMA * sd_dn > 0.0 && mean_dn + MARGIN_SIGMA * sd_dn < plane.dn_max - 0.5;
+            if plane.read_noise_e * plane.dn_per_e < 1.0 || !clear {
                 return None;
             }
-        } else if !self.ideal && mean_dn + MARGIN_SIGMA * sd_dn >= self.dn_max {
+        } else if !self.ideal && mean_dn + MARGIN_SIGMA * sd_dn >= plane.dn_max {
             return None;
         }
         let n = frames as f64;
-        let electrons = match &exposure.shot {
+        // The frames' summed electrons (of all binned pixels), then per pixel.
+        let summed = match &exposure.shot {
             Shot::Fixed(v) => n * v,
-            Shot::Poisson(_) => Poisson::new(n * mu).map_or(n * mu, |p| p.sample(rng)),
+            Shot::Poisson(_) => Poisson::new(n * q * mu).map_or(n * q * mu, |p| p.sample(rng)),
             Shot::Normal { mean, sd } => n * mean + sd * n.sqrt() * normal(rng),
         };
-        let read_e = self.read_noise_e * n.sqrt() * normal(rng);
-        let mut value = (electrons + read_e) / n * self.dn_per_e + self.bias_dn;
+        let electrons = summed / q;
+        let read_e = plane.read_noise_e * n.sqrt() * normal(rng);
+        let mut value = (electrons + read_e) / n * plane.dn_per_e + plane.bias_dn;
         if self.mode.quantise {
             value += (1.0 / (12.0 * n)).sqrt() * normal(rng);
         }
@@ -418,8 +461,8 @@ impl Detector {
     /// [`Self::read_out`] with its standard normal read-noise draw `z` given (ignored when noise
     /// is off). The arithmetic is [`readout::value`], shared with Level-0's vector lanes.
     #[inline(always)]
-    fn read_out_with(&self, electrons: f64, z: f64) -> Readout {
-        readout::value(readout::Adc::of(self), electrons, z)
+    fn read_out_with(&self, b: usize, electrons: f64, z: f64) -> Readout {
+        readout::value(readout::Adc::of(self, b), electrons, z)
     }
 
     /// The value Level-1 calibrates: the DN, or the analogue value when quantisation is off.
@@ -428,18 +471,24 @@ impl Detector {
         if self.mode.quantise { f64::from(r.dn) } else { f64::from(r.analog_dn) }
     }
 
-    /// Noise variance in electrons² of a pixel with `signal_e` photo-electrons and `dark_e`
-    /// dark electrons: shot + read + quantisation (Janesick 2007, eq. 2.14 and §4.4).
+    /// Noise variance in electrons² of band `b`'s value with `signal_e` photo-electrons and
+    /// `dark_e` dark electrons per pixel: shot + read + quantisation (Janesick 2007, eq. 2.14 and
+    /// §4.4); for m × m binned pixels the shot noise of their mean, the read noise σ/m, and one
+    /// rounding of the mean.
     #[must_use]
-    pub fn variance_e2(&self, signal_e: f64, dark_e: f64) -> f64 {
+    pub fn variance_e2(&self, b: usize, signal_e: f64, dark_e: f64) -> f64 {
         if !self.mode.noise {
             return 0.0;
         }
-        let quant = if self.mode.quantise { self.gain_e_per_dn * self.gain_e_per_dn / 12.0 } else { 0.0 };
-        signal_e + dark_e + self.read_noise_e * self.read_noise_e + quant
+        let plane = self.plane(b);
+        let quant = if self.mode.quantise { plane.gain_e_per_dn * plane.gain_e_per_dn / 12.0 } else { 0.0 };
+        (signal_e + dark_e) / plane.binned() + plane.read_noise_e * plane.read_noise_e + quant
     }
 }
 
+mod plane;
 mod readout;
+
+pub use plane::PlaneElectronics;
 #[cfg(test)]
 mod tests;

@@ -84,7 +84,6 @@ impl Feasibility {
         line_period_s: f64,
     ) -> Self {
         let f_number = spec.focal_length_mm / spec.aperture_mm;
-        let full = full_scale_e(detector);
         let bands = names
             .iter()
             .zip(centres_nm)
@@ -97,7 +96,10 @@ impl Feasibility {
                     centre_nm,
                     airy_diameter_um: 2.44 * lambda_um * f_number,
                     q: lambda_um * f_number / spec.pixel_pitch_um,
-                    peak_fraction_of_full_scale: if full > 0.0 { peak_e / full } else { f64::INFINITY },
+                    peak_fraction_of_full_scale: {
+                        let full = full_scale_e(detector, b);
+                        if full > 0.0 { peak_e / full } else { f64::INFINITY }
+                    },
                 }
             })
             .collect();

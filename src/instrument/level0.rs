@@ -39,6 +39,86 @@ impl Level0 {
     }
 }
 
+/// The generator of a coarse focal plane's pixel: plane `plane`, native line `line` and detector
+/// `detector` (the grid's divided by the plane's block), kept apart from the first plane's by
+/// the plane in the seed. Every grid pixel of the block draws the same values.
+fn plane_rng(seed: u64, stream: Stream, plane: usize, line: usize, detector: usize) -> rand::rngs::Xoshiro256PlusPlus {
+    pixel_rng(super::detector::mix64(seed ^ (plane as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)), stream, line, detector)
+}
+
+/// Draw one value per band of the pixel at grid `line`, `detector` into `out` with `draw`: the
+/// bands of planes that sample the grid pixel by pixel from the pixel's own generator in band
+/// order (a one-plane instrument's draws are what they were before focal planes existed), each
+/// coarse plane's bands from its block's generator ([`plane_rng`]).
+fn draw_bands(
+    detector: &Detector,
+    seed: u64,
+    stream: Stream,
+    line: usize,
+    j: usize,
+    out: &mut [f64],
+    mut draw: impl FnMut(usize, &mut rand::rngs::Xoshiro256PlusPlus) -> f64,
+) {
+    let mut rng = pixel_rng(seed, stream, line, j);
+    for (b, o) in out.iter_mut().enumerate() {
+        if detector.plane(b).block() == 1 {
+            *o = draw(b, &mut rng);
+        }
+    }
+    for (p, plane) in detector.planes().iter().enumerate().filter(|(_, q)| q.block() > 1) {
+        let k = plane.block();
+        let mut rng = plane_rng(seed, stream, p, line / k, j / k);
+        for (b, o) in out.iter_mut().enumerate() {
+            if detector.plane_index(b) == p {
+                *o = draw(b, &mut rng);
+            }
+        }
+    }
+}
+
+/// `radiance` with each coarse plane's bands replaced by their mean over the plane's pixel (the
+/// k × k block of grid pixels, as far as the grid is simulated); `None` without coarse planes.
+fn block_means(detector: &Detector, radiance: &[f32], viewing: &Viewing, cols: usize, nb: usize) -> Option<Vec<f32>> {
+    let coarse: Vec<usize> = (0..nb).filter(|&b| detector.plane(b).block() > 1).collect();
+    if coarse.is_empty() {
+        return None;
+    }
+    let rows = radiance.len() / (cols * nb).max(1);
+    let mut out = radiance.to_vec();
+    let dense = |index: &[usize], k: usize| -> (Vec<usize>, usize) {
+        let mut ids = Vec::with_capacity(index.len());
+        let (mut last, mut n) = (usize::MAX, 0);
+        for &v in index {
+            if v / k != last {
+                last = v / k;
+                n += 1;
+            }
+            ids.push(n - 1);
+        }
+        (ids, n)
+    };
+    for &b in &coarse {
+        let k = detector.plane(b).block();
+        let (row_id, n_r) = dense(&viewing.line_index[..rows], k);
+        let (col_id, n_c) = dense(&viewing.detector_index[..cols], k);
+        let (mut sum, mut count) = (vec![0.0f64; n_r * n_c], vec![0u32; n_r * n_c]);
+        for r in 0..rows {
+            for c in 0..cols {
+                let i = row_id[r] * n_c + col_id[c];
+                sum[i] += f64::from(radiance[(r * cols + c) * nb + b]);
+                count[i] += 1;
+            }
+        }
+        for r in 0..rows {
+            for c in 0..cols {
+                let i = row_id[r] * n_c + col_id[c];
+                out[(r * cols + c) * nb + b] = (sum[i] / f64::from(count[i].max(1))) as f32;
+            }
+        }
+    }
+    Some(out)
+}
+
 fn shape_error(e: ndarray::ShapeError) -> InstrumentError {
     InstrumentError::Invalid(FieldError { field: "cube".into(), message: e.to_string() })
 }
@@ -58,17 +138,23 @@ pub fn expose_cube(
     let input = input.as_slice().ok_or_else(|| {
         InstrumentError::Invalid(FieldError { field: "cube".into(), message: "not contiguous".into() })
     })?;
+    // A coarse focal plane's pixel sees the mean radiance of its block.
+    let averaged = block_means(detector, input, viewing, cols, nb);
+    let input = averaged.as_deref().unwrap_or(input);
     let mut out = vec![0.0f32; rows * cols * nb];
     control.fill_rows(out.as_mut_slice(), rows, cols * nb, |at, row| {
         let r = at.index();
         let line = viewing.line_index[r];
+        let mut e = vec![0.0f64; nb];
         for c in 0..cols {
             at.column(c);
             let j = viewing.detector_index[c];
-            let mut rng = pixel_rng(seed, Stream::Exposure, line, j);
-            for b in 0..nb {
-                let l = f64::from(input[(r * cols + c) * nb + b]);
-                row[c * nb + b] = detector.expose(j, b, l, t, &mut rng) as f32;
+            let pixel = &input[(r * cols + c) * nb..(r * cols + c + 1) * nb];
+            draw_bands(detector, seed, Stream::Exposure, line, j, &mut e, |b, rng| {
+                detector.expose(j, b, f64::from(pixel[b]), t, rng)
+            });
+            for (o, v) in row[c * nb..(c + 1) * nb].iter_mut().zip(&e) {
+                *o = *v as f32;
             }
         }
         Ok::<_, InstrumentError>(())
@@ -91,6 +177,7 @@ pub fn digitise_cube(
     })?;
     let keep_analog = !detector.mode().quantise;
     let noise = detector.mode().noise;
+    let bands: Vec<usize> = (0..nb).collect();
     let n = rows * cols * nb;
     let mut dn = vec![0u16; n];
     let mut flags = vec![0u8; n];
@@ -106,12 +193,14 @@ pub fn digitise_cube(
         for c in 0..cols {
             at.column(c);
             if noise {
-                let mut rng = pixel_rng(seed, Stream::Readout, line, viewing.detector_index[c]);
-                z[c * nb..(c + 1) * nb].iter_mut().for_each(|z| *z = normal(&mut rng));
+                let j = viewing.detector_index[c];
+                draw_bands(detector, seed, Stream::Readout, line, j, &mut z[c * nb..(c + 1) * nb], |_, rng| {
+                    normal(rng)
+                });
             }
         }
         let electrons = &input[r * cols * nb..(r + 1) * cols * nb];
-        detector.read_out_run(electrons, &z, dn_row, flag_row, keep_analog.then_some(analog_row));
+        detector.read_out_run(&bands, electrons, &z, dn_row, flag_row, keep_analog.then_some(analog_row));
         Ok::<_, InstrumentError>(())
     })?;
     let (saturated, zero_counts) = count_flags(&flags);

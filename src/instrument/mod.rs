@@ -4,6 +4,7 @@
 //! | part | module | what it models |
 //! |---|---|---|
 //! | the file | [`spec`] | every Table 1 parameter of Matthews et al. (2023) and the model kind |
+//! | focal planes | [`focal`] | detectors beyond the first (SWIR InGaAs, MCT), pitch, dark-current temperature laws |
 //! | spectral response | [`response`] | SRF × QE × photon weighting per band, smile, keystone |
 //! | viewing geometry | [`geometry`] | pushbroom ground points, view zenith and azimuth, spherical Earth |
 //! | spatial response | [`spatial`] | diffraction, detector footprint, along-track smear (when asked) |
@@ -29,6 +30,7 @@
 
 pub mod detector;
 pub mod feasibility;
+pub mod focal;
 pub mod geometry;
 pub mod level0;
 pub mod plausibility;
@@ -41,6 +43,7 @@ pub mod spec;
 pub mod truth;
 
 pub use detector::{Detector, DetectorMode, Flags};
+pub use focal::{BandSelection, DarkLaw, DarkTemperature, DetectorMaterial, FocalPlane, Sampling};
 pub use geometry::{Look, Viewing};
 pub use level0::{Level0, digitise_cube, expose_cube};
 pub use response::{GeometryGroup, Response};

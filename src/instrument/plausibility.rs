@@ -46,11 +46,11 @@ pub const MIN_F_NUMBER: f64 = 1.0;
 /// Largest along-track smear accepted without a warning, pixels.
 pub const MAX_SMEAR_PX: f64 = 1.0;
 
-/// Full scale of detector `detector` in electrons: the well, or the ADC's top code if that clips
-/// first: min(well, (DN_max − bias)·gain).
+/// Full scale of band `b` in electrons: its focal plane's well, or its ADC's top code if that
+/// clips first: min(well, (DN_max − bias)·gain).
 #[must_use]
-pub fn full_scale_e(detector: &Detector) -> f64 {
-    detector.well_e().min((detector.dn_max() - detector.bias_dn()).max(0.0) * detector.gain_e_per_dn())
+pub fn full_scale_e(detector: &Detector, b: usize) -> f64 {
+    detector.well_e(b).min((detector.dn_max(b) - detector.bias_dn(b)).max(0.0) * detector.gain_e_per_dn(b))
 }
 
 /// The guards for `spec` flown over a scene whose brightest water radiance per band is
@@ -111,10 +111,11 @@ pub fn peak_signal_e(detector: &Detector, b: usize, radiance_w_m2_sr_nm: f64) ->
 
 /// The worst band's peak signal against full scale, over every detector (PRNU included).
 fn saturation(detector: &Detector, bands: &[String], brightest: &[f64]) -> Option<Warning> {
-    let full = full_scale_e(detector);
-    let peaks: Vec<f64> =
-        (0..brightest.len().min(detector.n_bands())).map(|b| peak_signal_e(detector, b, brightest[b])).collect();
-    let over: Vec<usize> = (0..peaks.len()).filter(|&b| peaks[b] >= full).collect();
+    // Each band's peak as a share of its own full scale (focal planes differ).
+    let peaks: Vec<f64> = (0..brightest.len().min(detector.n_bands()))
+        .map(|b| peak_signal_e(detector, b, brightest[b]) / full_scale_e(detector, b).max(f64::MIN_POSITIVE))
+        .collect();
+    let over: Vec<usize> = (0..peaks.len()).filter(|&b| peaks[b] >= 1.0).collect();
     let worst = (0..peaks.len()).max_by(|&a, &b| peaks[a].total_cmp(&peaks[b]))?;
     if over.is_empty() {
         return None;
@@ -124,7 +125,7 @@ fn saturation(detector: &Detector, bands: &[String], brightest: &[f64]) -> Optio
     let more = if over.len() > 6 { format!(" and {} more", over.len() - 6) } else { String::new() };
     Some(Warning {
         guard: Guard::Saturation,
-        value: peaks[worst] / full,
+        value: peaks[worst],
         limit: 1.0,
         message: format!(
             "saturates at the scene's brightest water radiance in {} of {} bands ({}{more}): {} needs \
@@ -133,9 +134,9 @@ fn saturation(detector: &Detector, bands: &[String], brightest: &[f64]) -> Optio
             peaks.len(),
             listed.join(", "),
             name(worst),
-            peaks[worst],
-            full,
-            100.0 * peaks[worst] / full
+            peak_signal_e(detector, worst, brightest[worst]),
+            full_scale_e(detector, worst),
+            100.0 * peaks[worst]
         ),
     })
 }

@@ -41,6 +41,29 @@ pub struct Response {
     pub smile_class: Vec<usize>,
     /// Across-track keystone shift of each band, detector pixels.
     pub keystone_px: Vec<f64>,
+    /// Each band's focal plane: 0 for the instrument's first, i + 1 for `focal_planes[i]`.
+    pub plane_of_band: Vec<usize>,
+}
+
+/// Each band's focal plane (0: the first; i + 1: `spec.focal_planes[i]`, the first that claims
+/// it). A further plane that claims no band is an error: its numbers would change nothing.
+fn planes_of(spec: &InstrumentSpec, bands: &BandSet) -> Result<Vec<usize>, InstrumentError> {
+    let plane_of: Vec<usize> = bands
+        .bands
+        .iter()
+        .map(|b| spec.focal_planes.iter().position(|p| p.bands.holds(&b.name, b.centre_nm)).map_or(0, |i| i + 1))
+        .collect();
+    if let Some(i) = (0..spec.focal_planes.len()).find(|i| !plane_of.contains(&(i + 1))) {
+        let names: Vec<String> = bands.bands.iter().map(|b| format!("{} ({:.0} nm)", b.name, b.centre_nm)).collect();
+        return Err(InstrumentError::Invalid(FieldError {
+            field: format!("instrument.focal_planes[{i}].bands"),
+            message: format!(
+                "selects none of the instrument's bands (allowed: names or centres among {}; an earlier plane takes a band first)",
+                names.join(", ")
+            ),
+        }));
+    }
+    Ok(plane_of)
 }
 
 /// Number of smile classes a swath is split into (smile varies slowly across track).
@@ -68,7 +91,10 @@ impl Response {
                 BandSet { name: "spectrograph".into(), bands: list }
             }
         };
-        let qe_source = &spec.quantum_efficiency;
+        let plane_of_band = planes_of(spec, &bands)?;
+        let qe_sources: Vec<&crate::spectral::SpectrumSource> = std::iter::once(&spec.quantum_efficiency)
+            .chain(spec.focal_planes.iter().map(|p| &p.quantum_efficiency))
+            .collect();
         let (smile_nm, keystone) = match &spec.kind {
             InstrumentKind::Spectrograph { smile_nm, keystone_px, .. } => (*smile_nm, *keystone_px),
             _ => (0.0, 0.0),
@@ -103,12 +129,21 @@ impl Response {
                 let margin = smile_nm.abs() + step_nm;
                 let supports: Vec<(f64, f64)> = members.iter().map(|&b| bands.bands[b].srf.range_nm()).collect();
                 let grid = support_grid(&supports, margin, step_nm)?;
-                let qe = qe_source.sample(&grid, Extrapolation::Clamp, None)?;
-                if let Some(q) = qe.iter().find(|q| !(q.is_finite() && (0.0..=1.0).contains(*q))) {
-                    return Err(InstrumentError::Invalid(FieldError {
-                        field: "quantum_efficiency".into(),
-                        message: format!("value {q} is outside 0 to 1"),
-                    }));
+                let mut qe_of_plane = Vec::with_capacity(qe_sources.len());
+                for (p, source) in qe_sources.iter().enumerate() {
+                    let qe = source.sample(&grid, Extrapolation::Clamp, None)?;
+                    if let Some(q) = qe.iter().find(|q| !(q.is_finite() && (0.0..=1.0).contains(*q))) {
+                        let field = if p == 0 {
+                            "quantum_efficiency".to_string()
+                        } else {
+                            format!("instrument.focal_planes[{}].quantum_efficiency", p - 1)
+                        };
+                        return Err(InstrumentError::Invalid(FieldError {
+                            field,
+                            message: format!("value {q} is outside 0 to 1"),
+                        }));
+                    }
+                    qe_of_plane.push(qe);
                 }
                 let weights = (0..n_classes)
                     .map(|c| {
@@ -124,6 +159,7 @@ impl Response {
                             .map(|k| {
                                 let (first, row) = avg.row(k);
                                 let area = avg.srf_area_nm(k);
+                                let qe = &qe_of_plane[plane_of_band[members[k]]];
                                 let w = row
                                     .iter()
                                     .enumerate()
@@ -143,7 +179,7 @@ impl Response {
         let nb = bands.len();
         let keystone_px =
             (0..nb).map(|b| if nb > 1 { keystone * (b as f64 / (nb - 1) as f64 - 0.5) } else { 0.0 }).collect();
-        Ok(Self { bands, groups, smile_class, keystone_px })
+        Ok(Self { bands, groups, smile_class, keystone_px, plane_of_band })
     }
 
     /// Number of bands.
@@ -235,9 +271,10 @@ pub use crate::ranges::{MAX_SIMULATED_NM, MIN_SIMULATED_NM};
 fn support_grid(supports: &[(f64, f64)], margin_nm: f64, step_nm: f64) -> Result<WavelengthGrid, InstrumentError> {
     let mut nodes: Vec<i64> = Vec::new();
     for &(lo, hi) in supports {
-        let (a, b) = (((lo - margin_nm) / step_nm).floor() as i64, ((hi + margin_nm) / step_nm).ceil() as i64);
+        let (mut a, mut b) = (((lo - margin_nm) / step_nm).floor() as i64, ((hi + margin_nm) / step_nm).ceil() as i64);
         let (from, to) = ((a as f64) * step_nm, (b as f64) * step_nm);
-        if from < MIN_SIMULATED_NM || to > MAX_SIMULATED_NM {
+        // The margin may be cut where the data end; the response itself may not.
+        if lo < MIN_SIMULATED_NM || hi > MAX_SIMULATED_NM {
             return Err(InstrumentError::Invalid(FieldError {
                 field: "bands".into(),
                 message: format!(
@@ -246,6 +283,8 @@ fn support_grid(supports: &[(f64, f64)], margin_nm: f64, step_nm: f64) -> Result
                 ),
             }));
         }
+        a = a.max((MIN_SIMULATED_NM / step_nm).ceil() as i64);
+        b = b.min((MAX_SIMULATED_NM / step_nm).floor() as i64);
         nodes.extend(a..=b);
     }
     nodes.sort_unstable();

@@ -2,7 +2,9 @@
 //! measured on simulated Level-0 frames of a uniform patch, side by side.
 //!
 //! Analytic (Janesick 2007, eq. 2.14 with the quantisation term of §4.4):
-//! SNR = S / √(S + D + σ_read² + gain²/12), S = K·L photo-electrons, D dark electrons.
+//! SNR = S / √(S + D + σ_read² + gain²/12), S = K·L photo-electrons, D dark electrons, each
+//! band with its focal plane's numbers (for m × m binned pixels the variance is
+//! (S + D + σ_read²)/m² + gain²/12: see [`super::focal`]).
 //! Measured: `frames` exposures of a uniform radiance and as many dark exposures through the
 //! full detector model (shot, dark, read noise, full well, ADC); per detector, the temporal
 //! mean of light minus dark DN over the temporal standard deviation of the light DN; the
@@ -50,7 +52,7 @@ impl SnrRow {
 pub fn analytic_snr(detector: &Detector, j: usize, b: usize, radiance: f64) -> f64 {
     let signal = detector.responsivity(j, b) * radiance;
     let dark = detector.dark_mean_e(j, b, nominal_exposure(detector));
-    let var = detector.variance_e2(signal, dark);
+    let var = detector.variance_e2(b, signal, dark);
     if var > 0.0 { signal / var.sqrt() } else { f64::INFINITY }
 }
 

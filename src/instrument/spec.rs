@@ -4,6 +4,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::InstrumentError;
+use super::focal::{DarkTemperature, DetectorMaterial, FocalPlane, Sampling};
 use crate::parse::{FieldError, ParseError};
 use crate::spectral::{BandSetSpec, SpectrumSource};
 
@@ -113,6 +114,21 @@ pub struct InstrumentSpec {
     /// Dark-signal non-uniformity, electrons rms across detectors (fixed pattern).
     #[serde(default)]
     pub dsnu_e: f64,
+    /// The first focal plane's dark-current temperature law, when `dark_current_e_s` is given
+    /// at another temperature than the detector runs at.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dark_temperature: Option<DarkTemperature>,
+    /// The first focal plane's detector material (the fields above are its numbers).
+    #[serde(default, skip_serializing_if = "is_silicon")]
+    pub material: DetectorMaterial,
+    /// Focal planes beyond the first ([`super::focal`]); a band sits on the first unless one of
+    /// these claims it.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub focal_planes: Vec<FocalPlane>,
+}
+
+fn is_silicon(m: &DetectorMaterial) -> bool {
+    *m == DetectorMaterial::Silicon
 }
 
 /// Orbital ground speed for a circular orbit at `altitude_km`: v = √(GM/(R+h))·R/(R+h).
@@ -181,6 +197,10 @@ impl InstrumentSpec {
         check(&r::INSTRUMENT_DARK_CURRENT_E_S, self.dark_current_e_s)?;
         check(&r::INSTRUMENT_PRNU, self.prnu)?;
         check(&r::INSTRUMENT_DSNU_E, self.dsnu_e)?;
+        if let Some(t) = &self.dark_temperature {
+            t.validate("instrument.dark_temperature")?;
+        }
+        self.validate_planes()?;
         if let InstrumentKind::Spectrograph { start_nm, end_nm, sampling_nm, resolution_nm, smile_nm, keystone_px } =
             &self.kind
         {
@@ -193,7 +213,10 @@ impl InstrumentSpec {
             if end_nm < start_nm {
                 return Err(InstrumentError::Invalid(FieldError {
                     field: r::SPECTROGRAPH_END_NM.field("instrument.").into(),
-                    message: format!("{end_nm} is below start_nm = {start_nm} (allowed: start_nm to 1000 nm)"),
+                    message: format!(
+                        "{end_nm} is below start_nm = {start_nm} (allowed: start_nm to {} nm)",
+                        crate::ranges::MAX_SIMULATED_NM
+                    ),
                 }));
             }
             // Each band's Gaussian response is tabulated over centre ± 2.5 FWHM (Band::gaussian),
@@ -205,7 +228,7 @@ impl InstrumentSpec {
                     message: format!(
                         "{end_nm} with resolution_nm = {resolution_nm} and smile_nm = {smile_nm} puts the last band's \
                          response at {:.1} nm (allowed: end_nm + 2.5·resolution_nm + |smile_nm| ≤ {} nm, the end \
-                         of Shoal's gas-absorption data)",
+                         of Shoal's atmospheric data)",
                         end_nm + reach,
                         crate::ranges::MAX_SIMULATED_NM
                     ),
@@ -236,6 +259,74 @@ impl InstrumentSpec {
             check(&r::FILTER_ROWS_PER_BAND, count(*rows_per_band))?;
         }
         Ok(())
+    }
+
+    /// Check the focal planes beyond the first: each number in its range, a pitch that tiles the
+    /// first plane's grid, enough detectors for its swath.
+    fn validate_planes(&self) -> Result<(), InstrumentError> {
+        use crate::ranges as r;
+        for (i, p) in self.focal_planes.iter().enumerate() {
+            let at = format!("instrument.focal_planes[{i}]");
+            let fail = |field: &str, message: String| {
+                InstrumentError::Invalid(FieldError { field: format!("{at}.{field}"), message })
+            };
+            let check = |range: &r::Range, v: f64| range.check(v).map_err(|m| fail(range.name(), m));
+            crate::parse::check_name(&format!("{at}.name"), &p.name).map_err(InstrumentError::Invalid)?;
+            check(&r::PLANE_PIXEL_PITCH_UM, p.pixel_pitch_um)?;
+            check(&r::PLANE_DETECTORS, p.detectors as f64)?;
+            check(&r::PLANE_READ_NOISE_E, p.read_noise_e)?;
+            check(&r::PLANE_WELL_DEPTH_E, p.well_depth_e)?;
+            check(&r::PLANE_GAIN_E_PER_DN, p.gain_e_per_dn)?;
+            check(&r::PLANE_BIAS_DN, p.bias_dn)?;
+            check(&r::PLANE_ADC_BITS, f64::from(p.adc_bits))?;
+            check(&r::PLANE_DARK_CURRENT_E_S, p.dark_current_e_s)?;
+            check(&r::PLANE_PRNU, p.prnu)?;
+            check(&r::PLANE_DSNU_E, p.dsnu_e)?;
+            if let Some(t) = p.exposure_s {
+                check(&r::PLANE_EXPOSURE_S, t)?;
+            }
+            if p.bias_dn >= p.dn_max() {
+                return Err(fail(
+                    "bias_dn",
+                    format!(
+                        "{} is at or above the largest count of a {}-bit ADC ({}): no signal could be read (allowed: 0 to below {} DN)",
+                        p.bias_dn,
+                        p.adc_bits,
+                        p.dn_max(),
+                        p.dn_max()
+                    ),
+                ));
+            }
+            if let Some(t) = &p.dark_temperature {
+                t.validate(&format!("{at}.dark_temperature"))?;
+            }
+            let sampling =
+                Sampling::of(p.pixel_pitch_um, self.pixel_pitch_um).map_err(|m| fail("pixel_pitch_um", m))?;
+            // Its swath must cover the first plane's (a band missing at the edges has no value
+            // to retrieve from).
+            let swath = p.detectors as f64 * p.pixel_pitch_um;
+            let first = self.detectors as f64 * self.pixel_pitch_um;
+            if swath < first * (1.0 - 1e-9) {
+                let needed = (first / p.pixel_pitch_um).ceil();
+                return Err(fail(
+                    "detectors",
+                    format!(
+                        "{} detectors of {} µm span less than the first plane's {} × {} µm (allowed: at least {needed}, so that its swath covers the image's; sampling {sampling:?})",
+                        p.detectors, p.pixel_pitch_um, self.detectors, self.pixel_pitch_um
+                    ),
+                ));
+            }
+            if self.focal_planes[..i].iter().any(|q| q.name == p.name) {
+                return Err(fail("name", format!("`{}` names two focal planes (allowed: one name per plane)", p.name)));
+            }
+        }
+        Ok(())
+    }
+
+    /// Dark current of the first focal plane at its operating temperature, e⁻ s⁻¹.
+    #[must_use]
+    pub fn dark_current_at_operating_e_s(&self) -> f64 {
+        self.dark_current_e_s * self.dark_temperature.map_or(1.0, |t| t.factor())
     }
 
     /// Ground sampling distance at nadir, m: GSD = altitude · pitch / focal length.

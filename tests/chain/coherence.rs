@@ -28,6 +28,10 @@ const NO_EFFECT: &[(&str, &str)] = &[
     ("atmosphere_run.", "`shoal atmosphere`'s own inputs (its day and geometry): not part of a run"),
     ("instrument.name", "a label for reports and file names"),
     ("instrument.description", "a label"),
+    (
+        "instrument.focal_planes[].detectors",
+        "a further plane's detectors need only cover the first plane's swath (checked); the image is the first plane's grid",
+    ),
 ];
 
 fn documented(what: &str) -> Option<&'static str> {
@@ -43,6 +47,11 @@ fn base(path: &str) -> RunConfig {
     instrument.dark_current_e_s = 200.0;
     instrument.prnu = 0.01;
     instrument.dsnu_e = 5.0;
+    crate::common::with_dark_laws(&mut instrument);
+    for p in &mut instrument.focal_planes {
+        p.prnu = 0.01;
+        p.dsnu_e = 5.0;
+    }
     // Heron Island's reef cut to 2.4 × 1.6 km around the swath, with its cay moved 700 m west of
     // it (the adjacency FFT then runs on 240 × 160 cells instead of 1100 × 600).
     let mut scene = SceneSpec::preset("heron_island_reef").unwrap();
@@ -157,6 +166,8 @@ fn chosen_value(path: &str) -> Option<f64> {
         // Fourier terms: the azimuthal series is complete before the default's 24 terms; two
         // terms cut it.
         "scene.atmosphere.accuracy.fourier_terms" => 2.0,
+        // A further plane's pitch must tile the grid: three times the first's.
+        "instrument.focal_planes[].pixel_pitch_um" => 46.5,
         // SAMBUCA's fits converge in fewer than 100 iterations; 3 stops them early.
         "retrievals[i].Sambuca.settings.max_iterations" => 3.0,
         _ => return None,

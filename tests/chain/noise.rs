@@ -26,12 +26,12 @@ fn count_noise_matches_the_analytic_value_at_three_radiances() {
             .map(|f| {
                 let mut rng = pixel_rng(3, Stream::Exposure, f, j);
                 let e = det.expose(j, b, radiance, spec.exposure_s, &mut rng);
-                det.level0_value(&det.read_out(e, &mut rng))
+                det.level0_value(&det.read_out(0, e, &mut rng))
             })
             .collect();
         let mean = dn.iter().sum::<f64>() / n as f64;
         let std = (dn.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1) as f64).sqrt();
-        let analytic_dn = det.variance_e2(electrons, 0.0).sqrt() / spec.gain_e_per_dn;
+        let analytic_dn = det.variance_e2(0, electrons, 0.0).sqrt() / spec.gain_e_per_dn;
         // The standard deviation of a sample std over 20 000 draws is 0.5 %: 2 % is 4σ.
         let rel = (std - analytic_dn).abs() / analytic_dn;
         assert!(rel < 0.02, "{electrons} e-: std {std:.3} DN vs analytic {analytic_dn:.3} DN ({:.2} %)", 100.0 * rel);
@@ -52,7 +52,7 @@ fn saturation_at_the_well_and_at_the_adc_limit() {
     let mut rng = pixel_rng(1, Stream::Exposure, 0, j);
     let e = det.expose(j, b, radiance, spec.exposure_s, &mut rng);
     assert_eq!(e, spec.well_depth_e, "the well clips");
-    let r = det.read_out(e, &mut rng);
+    let r = det.read_out(0, e, &mut rng);
     assert!(r.flags & Flags::SATURATED != 0);
     assert!(f64::from(r.dn) < spec.dn_max(), "80 000 e- at 3 e-/DN fit a 16-bit ADC");
     // A gain of 1 e-/DN puts the ADC limit (65 535 e-) below the well: the ADC clips first.
@@ -60,13 +60,13 @@ fn saturation_at_the_well_and_at_the_adc_limit() {
     let det = detector(&spec);
     let e = det.expose(j, b, 0.95 * spec.well_depth_e / det.responsivity(j, b), spec.exposure_s, &mut rng);
     assert!(e < spec.well_depth_e);
-    let r = det.read_out(e, &mut rng);
+    let r = det.read_out(0, e, &mut rng);
     assert_eq!(r.dn, 65_535);
     assert!(r.flags & Flags::SATURATED != 0);
     // 8 bits: 255 is the ceiling.
     spec.adc_bits = 8;
     let det = detector(&spec);
-    let r = det.read_out(10_000.0, &mut rng);
+    let r = det.read_out(0, 10_000.0, &mut rng);
     assert_eq!(r.dn, 255);
     assert!(r.flags & Flags::SATURATED != 0);
     // Through the chain, whose electrons cube is stored in f32: a well of 12 345.6 e- (not an
@@ -85,7 +85,7 @@ fn saturation_at_the_well_and_at_the_adc_limit() {
     let det = detector(&spec);
     let quiet =
         Detector::new(&spec, &Response::new(&spec, 1.0).unwrap(), DetectorMode { noise: false, quantise: true }, 7);
-    let r = quiet.read_out(0.0, &mut rng);
+    let r = quiet.read_out(0, 0.0, &mut rng);
     assert_eq!((r.dn, r.flags), (0, Flags::ZERO));
     // With read noise σ = 15 e- at 1 e-/DN, DN = round(15·z) clipped at 0 is 0 exactly when
     // 15·z < 0.5: probability Φ(0.5/15) = 0.513 30. Over 2 000 pixels the count of zeros has
@@ -96,7 +96,7 @@ fn saturation_at_the_well_and_at_the_adc_limit() {
     let p_zero = 0.513_30;
     let mut zeros = 0;
     for i in 0..n {
-        let r = det.read_out(0.0, &mut pixel_rng(2, Stream::Readout, i, 0));
+        let r = det.read_out(0, 0.0, &mut pixel_rng(2, Stream::Readout, i, 0));
         assert_eq!(r.flags & Flags::ZERO != 0, r.dn == 0, "pixel {i}: DN {} flags {}", r.dn, r.flags);
         zeros += usize::from(r.dn == 0);
     }

@@ -14,6 +14,8 @@ pub fn instrument_for(path: &str) -> &'static str {
         "hyperspectral"
     } else if path.contains("FilterImager") {
         "filter_imager"
+    } else if path.contains("focal_planes") || path.contains("dark_temperature") {
+        "smallsat_swir"
     } else {
         "cubesat"
     }
@@ -31,5 +33,30 @@ pub fn both_retrievals() -> Vec<RetrievalSpec> {
 #[must_use]
 pub fn sweep_path(path: &str) -> String {
     let index = if path.contains("Sambuca") { ".1" } else { ".0" };
-    path.replace("[i]", index)
+    // The ranges table names a further focal plane `focal_planes[]`; the SWIR SmallSat has one.
+    // The dark-current laws: the first plane's doubles ([`with_dark_laws`]), the SWIR plane's is
+    // Arrhenius.
+    let path = path.replace("[i]", index).replace("focal_planes[]", "focal_planes.0");
+    match path.strip_prefix("instrument.dark_temperature.law.Arrhenius") {
+        Some(rest) => format!("instrument.focal_planes.0.dark_temperature.law.Arrhenius{rest}"),
+        None => path,
+    }
+}
+
+/// Give an instrument with further focal planes every optional field the ranges table names:
+/// the first plane a dark current specified at 20 °C with silicon's doubling law, run at 0 °C
+/// (the SWIR SmallSat's SWIR plane has the Arrhenius law), and each further plane its own
+/// integration time (by default it follows the first's).
+pub fn with_dark_laws(instrument: &mut shoal::instrument::InstrumentSpec) {
+    if !instrument.focal_planes.is_empty() {
+        instrument.dark_temperature = Some(shoal::instrument::DarkTemperature {
+            reference_c: 20.0,
+            operating_c: 0.0,
+            law: shoal::instrument::DarkLaw::Doubling { delta_c: 6.3 },
+        });
+        let t = instrument.exposure_s;
+        for p in &mut instrument.focal_planes {
+            p.exposure_s = Some(2.0 * t);
+        }
+    }
 }

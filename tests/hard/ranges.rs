@@ -16,7 +16,8 @@ use crate::common::{both_retrievals, instrument_for, sweep_path};
 /// A configuration in which every path of the table exists: both retrievals, a sun incidence,
 /// a wind-roughened surface; a spectrograph or filter imager for their `kind` fields.
 fn base(path: &str) -> RunConfig {
-    let instrument = InstrumentSpec::preset(instrument_for(path)).unwrap();
+    let mut instrument = InstrumentSpec::preset(instrument_for(path)).unwrap();
+    crate::common::with_dark_laws(&mut instrument);
     let mut c = RunConfig::new(SceneSpec::preset("lake_hume_bloom").unwrap(), instrument);
     c.retrievals = both_retrievals();
     c.calibration.sun_incidence_deg = Some(30.0);
@@ -102,6 +103,9 @@ fn refusal(range: &Range, value: f64) -> Option<String> {
         // A few-bit ADC needs an offset below its largest count (the cross-field rule).
         config.instrument.bias_dn = 0.0;
     }
+    if range.path == "instrument.focal_planes[].adc_bits" && value < 8.0 {
+        config.instrument.focal_planes[0].bias_dn = 0.0;
+    }
     match config.validate() {
         Ok(()) => None,
         Err(EngineError::Failed { message, .. }) => Some(message),
@@ -142,16 +146,25 @@ fn the_allowed_ends_pass() {
         };
         let mut ends = vec![inside(range.lo, range.lo_open, 1.0), inside(range.hi, range.hi_open, -1.0)];
         if range.path == "instrument.kind.Spectrograph.start_nm" {
-            ends.pop(); // start_nm = 1000 would put it above end_nm; the end is checked there.
+            ends.pop(); // start_nm = 2500 would put it above end_nm; the end is checked there.
         }
         if range.path == "instrument.kind.Spectrograph.end_nm" {
-            // end_nm = 350 would be below start_nm, and end_nm = 1000 puts the last band's
-            // response past 1000 nm (end_nm + 2.5·resolution ≤ 1000): each refused with its own
+            // end_nm = 350 would be below start_nm, and end_nm = 2500 puts the last band's
+            // response past 2500 nm (end_nm + 2.5·resolution ≤ 2500): each refused with its own
             // message, tested below.
             ends.clear();
         }
         if range.path == "instrument.kind.Spectrograph.resolution_nm" {
-            ends.pop(); // 100 nm puts the 900 nm band's response past 1000 nm (its own message).
+            ends.pop(); // 100 nm puts the first band's response below 325 nm (its own message).
+        }
+        if range.path == "instrument.focal_planes[].pixel_pitch_um" {
+            // A further plane's pitch must also tile the first plane's grid (a whole multiple up
+            // to 16× or fraction down to 1/8 of 15.5 µm): neither end does (its own message,
+            // tested in the instrument's tests).
+            ends.clear();
+        }
+        if range.path == "instrument.focal_planes[].detectors" {
+            ends.remove(0); // One detector cannot cover the first plane's swath (its own message).
         }
         if range.path == "instrument.kind.Spectrograph.sampling_nm" {
             ends.remove(0); // A tiny step would give more than 2000 samples (its own message).
@@ -184,6 +197,8 @@ fn a_spectrograph_reaching_past_the_data_is_refused_by_name() {
     let base = base("instrument.kind.Spectrograph.end_nm");
     let with_end = |end: f64| {
         let mut c = base.clone();
+        // 417 bands to 2500 nm: a preview, so that the memory budget does not refuse it first.
+        c.fidelity.decimation = 8;
         if let shoal::instrument::InstrumentKind::Spectrograph { end_nm, .. } = &mut c.instrument.kind {
             *end_nm = end;
         }
@@ -192,9 +207,9 @@ fn a_spectrograph_reaching_past_the_data_is_refused_by_name() {
     let shoal::instrument::InstrumentKind::Spectrograph { resolution_nm, smile_nm, .. } = base.instrument.kind else {
         panic!("not a spectrograph")
     };
-    // The last band's response reaches end + 2.5·FWHM + |smile|: allowed up to exactly 1000 nm.
-    let last = 1000.0 - 2.5 * resolution_nm - smile_nm.abs();
-    assert!(with_end(last).validate().is_ok());
+    // The last band's response reaches end + 2.5·FWHM + |smile|: allowed up to exactly 2500 nm.
+    let last = 2500.0 - 2.5 * resolution_nm - smile_nm.abs();
+    assert!(with_end(last).validate().is_ok(), "{:?}", with_end(last).validate());
     let e = with_end(last + 0.5).validate().unwrap_err().to_string();
-    assert!(e.contains("kind.Spectrograph.end_nm") && e.contains("≤ 1000 nm"), "{e}");
+    assert!(e.contains("kind.Spectrograph.end_nm") && e.contains("≤ 2500 nm"), "{e}");
 }

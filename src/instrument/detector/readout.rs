@@ -19,7 +19,8 @@ use crate::simd::{self, Kernel, Level};
 /// One run of values to read out (see [`Detector::read_out_run`]); electrons in `f32` (the
 /// cube) or `f64` (frames drawn by [`Detector::read_out_frames`]).
 struct Run<'a, E> {
-    detector: &'a Detector,
+    /// The converter of each lane, cycling: value i is read by `lanes[i % lanes.len()]`.
+    lanes: &'a [Adc],
     electrons: &'a [E],
     z: &'a [f64],
     dn: &'a mut [u16],
@@ -81,7 +82,7 @@ fn floor_small(y: f64) -> (u16, f64) {
 /// What [`value`] reads of a [`Detector`], copied out of it: in locals, the loop need not read
 /// them again after each byte it stores (a `u8` store may alias any byte of the detector, and
 /// with the fields read through the reference the loop stayed scalar).
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, PartialEq)]
 pub(super) struct Adc {
     noise: bool,
     quantise: bool,
@@ -95,17 +96,19 @@ pub(super) struct Adc {
 }
 
 impl Adc {
+    /// Band `b`'s converter (its focal plane's).
     #[inline(always)]
-    pub(super) fn of(d: &Detector) -> Self {
+    pub(super) fn of(d: &Detector, b: usize) -> Self {
+        let p = d.plane(b);
         Self {
             noise: d.mode.noise,
             quantise: d.mode.quantise,
             ideal: d.ideal,
-            read_noise_e: d.read_noise_e,
-            dn_per_e: d.dn_per_e,
-            bias_dn: d.bias_dn,
-            dn_max: d.dn_max,
-            well_e: d.well_e,
+            read_noise_e: p.read_noise_e,
+            dn_per_e: p.dn_per_e,
+            bias_dn: p.bias_dn,
+            dn_max: p.dn_max,
+            well_e: p.well_e,
         }
     }
 }
@@ -115,8 +118,20 @@ impl<E: Copy + Into<f64>> Kernel for Run<'_, E> {
 
     #[inline(always)]
     fn run<L: Level>(self) {
-        let Run { detector, electrons, z, dn, flags, analog } = self;
-        let adc = Adc::of(detector);
+        let Run { lanes, electrons, z, dn, flags, mut analog } = self;
+        if lanes.len() > 1 {
+            // Several focal planes: each value's converter by its lane (scalar; one-plane
+            // instruments keep the vector loop below).
+            for i in 0..electrons.len() {
+                let r = value(lanes[i % lanes.len()], electrons[i].into(), z[i]);
+                (dn[i], flags[i]) = (r.dn, r.flags);
+                if let Some(a) = analog.as_deref_mut().and_then(|a| a.get_mut(i)) {
+                    *a = r.analog_dn;
+                }
+            }
+            return;
+        }
+        let adc = lanes[0];
         let inputs = electrons.iter().zip(z);
         match analog {
             None => {
@@ -137,14 +152,16 @@ impl<E: Copy + Into<f64>> Kernel for Run<'_, E> {
 
 impl Detector {
     /// Read out a run of values whose standard normal read-noise draws are given:
-    /// `electrons[i]` and `z[i]` to `dn[i]`, `flags[i]` and, when given, `analog[i]`. The values
-    /// [`Self::read_out`] gives with the same draws (tested), computed in vector lanes. With the
+    /// `electrons[i]` and `z[i]` to `dn[i]`, `flags[i]` and, when given, `analog[i]`, value i
+    /// being of band `bands[i % bands.len()]`. The values [`Self::read_out`] gives with the same
+    /// draws (tested), computed in vector lanes when every band shares one focal plane. With the
     /// noise off the draws are not read.
     ///
     /// # Panics
-    /// If the slices' lengths differ.
+    /// If the slices' lengths differ or `bands` is empty.
     pub fn read_out_run<E: Copy + Into<f64>>(
         &self,
+        bands: &[usize],
         electrons: &[E],
         z: &[f64],
         dn: &mut [u16],
@@ -156,7 +173,9 @@ impl Detector {
             z.len() == n && dn.len() == n && flags.len() == n && analog.as_ref().is_none_or(|a| a.len() == n),
             "readout run: slices of different lengths"
         );
-        simd::widest(Run { detector: self, electrons, z, dn, flags, analog });
+        let lanes: Vec<Adc> = bands.iter().map(|&b| Adc::of(self, b)).collect();
+        let lanes: &[Adc] = if lanes.iter().all(|a| *a == lanes[0]) { &lanes[..1] } else { &lanes };
+        simd::widest(Run { lanes, electrons, z, dn, flags, analog });
     }
 
     /// `frames` frames of `exposures[b]` for each band `b` in `bands`, read out: frame `f`'s
@@ -194,7 +213,7 @@ impl Detector {
                 }
             }
             let m = electrons.len();
-            self.read_out_run(&electrons, &z, &mut dn[..m], &mut flags[..m], Some(&mut analog[..m]));
+            self.read_out_run(bands, &electrons, &z, &mut dn[..m], &mut flags[..m], Some(&mut analog[..m]));
             for (i, ((&dn, &flags), &analog_dn)) in dn.iter().zip(&flags).zip(&analog).take(m).enumerate() {
                 each(block.start + i / bands.len(), bands[i % bands.len()], Readout { dn, analog_dn, flags });
             }

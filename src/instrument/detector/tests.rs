@@ -35,12 +35,12 @@ fn the_frames_mean_drawn_at_once_is_the_frame_by_frame_mean_in_distribution() {
             .map(|t| {
                 let mut rng = pixel_rng(t, Stream::CalibrationLight, 0, 0);
                 let sum: f64 =
-                    (0..frames).map(|_| d.level0_value(&d.read_out(exposure.draw(&mut rng), &mut rng))).sum();
+                    (0..frames).map(|_| d.level0_value(&d.read_out(0, exposure.draw(&mut rng), &mut rng))).sum();
                 sum / frames as f64
             })
             .collect();
         let at_once: Vec<f64> = (0..trials)
-            .map(|t| d.frames_mean(&exposure, frames, &mut pixel_rng(t, Stream::CalibrationLightSum, 0, 0)).unwrap())
+            .map(|t| d.frames_mean(0, &exposure, frames, &mut pixel_rng(t, Stream::CalibrationLightSum, 0, 0)).unwrap())
             .collect();
         let ((m1, v1), (m2, v2)) = (moments(&by_frame), moments(&at_once));
         // Means within 4 standard errors of their difference; variances within 15 % (the
@@ -57,24 +57,24 @@ fn the_frames_mean_is_refused_where_frames_clip_or_rounding_is_not_dithered() {
     let response = Response::new(&spec, 1.0).unwrap();
     let d = Detector::new(&spec, &response, DetectorMode::default(), 1);
     let mut rng = pixel_rng(1, Stream::CalibrationLightSum, 0, 0);
-    let near_well = d.exposure(0, 0, 0.999 * d.well_e() / d.responsivity(0, 0), d.exposure_s());
-    assert_eq!(d.frames_mean(&near_well, 100, &mut rng), None);
+    let near_well = d.exposure(0, 0, 0.999 * d.well_e(0) / d.responsivity(0, 0), d.exposure_s());
+    assert_eq!(d.frames_mean(0, &near_well, 100, &mut rng), None);
     let mid = d.exposure(0, 0, 400.0 / d.responsivity(0, 0), d.exposure_s());
-    assert!(d.frames_mean(&mid, 100, &mut rng).is_some());
-    assert_eq!(d.frames_mean(&mid, 0, &mut rng), None);
+    assert!(d.frames_mean(0, &mid, 100, &mut rng).is_some());
+    assert_eq!(d.frames_mean(0, &mid, 0, &mut rng), None);
     // The nominal bias (10.4 DN) is 2 σ of read noise (5 DN) above zero: dark frames clip.
     let dark = d.exposure(0, 0, 0.0, 0.0);
-    assert_eq!(d.frames_mean(&dark, 100, &mut rng), None);
+    assert_eq!(d.frames_mean(0, &dark, 100, &mut rng), None);
     // 1 e⁻ of read noise at 3 e⁻/DN: a third of a DN, the rounding shows in the mean.
     spec.read_noise_e = 1.0;
     let quiet = Detector::new(&spec, &response, DetectorMode::default(), 1);
     let mid = quiet.exposure(0, 0, 400.0 / quiet.responsivity(0, 0), quiet.exposure_s());
-    assert_eq!(quiet.frames_mean(&mid, 100, &mut rng), None);
+    assert_eq!(quiet.frames_mean(0, &mid, 100, &mut rng), None);
     // Without noise every frame is the same value, and so is the mean.
     let ideal = Detector::new(&spec, &response, DetectorMode { noise: false, ..DetectorMode::default() }, 1);
     let mid = ideal.exposure(0, 0, 400.0 / ideal.responsivity(0, 0), ideal.exposure_s());
-    let one = ideal.level0_value(&ideal.read_out(mid.draw(&mut rng), &mut rng));
-    assert_eq!(ideal.frames_mean(&mid, 100, &mut rng), Some(one));
+    let one = ideal.level0_value(&ideal.read_out(0, mid.draw(&mut rng), &mut rng));
+    assert_eq!(ideal.frames_mean(0, &mid, 100, &mut rng), Some(one));
 }
 
 #[test]
@@ -118,22 +118,23 @@ fn shot_noise_mean_and_variance() {
 /// The readout as first written, one branch at a time: round half up after the sum, then clip
 /// to the ADC's range.
 fn readout_as_written(d: &Detector, electrons: f64, z: f64) -> Readout {
-    let noisy = if d.mode.noise { electrons + d.read_noise_e * z } else { electrons };
-    let analog = noisy * d.dn_per_e + d.bias_dn;
+    let p = d.plane(0);
+    let noisy = if d.mode.noise { electrons + p.read_noise_e * z } else { electrons };
+    let analog = noisy * p.dn_per_e + p.bias_dn;
     let mut flags = 0;
-    if !d.ideal && electrons >= d.well_e {
+    if !d.ideal && electrons >= p.well_e {
         flags |= Flags::SATURATED;
     }
-    let dn = (if analog > 0.0 { (analog + 0.5) as i64 as f64 } else { 0.0 }).min(d.dn_max);
+    let dn = (if analog > 0.0 { (analog + 0.5) as i64 as f64 } else { 0.0 }).min(p.dn_max);
     if d.mode.quantise {
-        if dn >= d.dn_max {
+        if dn >= p.dn_max {
             flags |= Flags::SATURATED;
         }
         if dn <= 0.0 {
             flags |= Flags::ZERO;
         }
     }
-    let analog = if d.mode.quantise || d.ideal { analog } else { analog.min(d.dn_max) };
+    let analog = if d.mode.quantise || d.ideal { analog } else { analog.min(p.dn_max) };
     Readout { dn: dn as u16, analog_dn: analog as f32, flags }
 }
 
@@ -171,17 +172,17 @@ fn readout_matches_as_written(spec: &InstrumentSpec) {
         1,
     )));
     for d in detectors {
-        let k = d.gain_e_per_dn;
+        let k = d.gain_e_per_dn(0);
         // Electrons that land on ties and on either side of them, at zero, at the top of the
         // ADC and of the well, beyond both, and values no readout should see but must survive.
         let mut electrons: Vec<f32> = vec![0.0, -0.0, -5.0, 1e-30, f32::MAX, f32::INFINITY, f32::NAN, -f32::INFINITY];
-        for dn in [0.0, 1.0, 2.0, 7.5, 100.0, d.dn_max - 1.0, d.dn_max, d.dn_max + 3.0] {
+        for dn in [0.0, 1.0, 2.0, 7.5, 100.0, d.dn_max(0) - 1.0, d.dn_max(0), d.dn_max(0) + 3.0] {
             for half in [-0.5, 0.5, 0.0] {
-                let e = ((dn + half - d.bias_dn) * k) as f32;
+                let e = ((dn + half - d.bias_dn(0)) * k) as f32;
                 electrons.extend([e, f32::from_bits(e.to_bits() + 1), f32::from_bits(e.to_bits().saturating_sub(1))]);
             }
         }
-        let well = d.well_e as f32;
+        let well = d.well_e(0) as f32;
         electrons.extend([well, f32::from_bits(well.to_bits() - 1), 2.0 * well]);
         let mut rng = pixel_rng(3, Stream::Readout, 0, 0);
         for draws in 0..3 {
@@ -192,17 +193,17 @@ fn readout_matches_as_written(spec: &InstrumentSpec) {
                     (_, false) | (0, _) => 0.0,
                     (1, _) => normal(&mut rng),
                     // Draws that carry the value exactly onto a tie of the rounding.
-                    _ => (i % 3) as f64 * 0.5 * k / d.read_noise_e,
+                    _ => (i % 3) as f64 * 0.5 * k / d.read_noise_e(0),
                 })
                 .collect();
             let n = electrons.len();
             let (mut dn, mut flags, mut analog) = (vec![0u16; n], vec![0u8; n], vec![0.0f32; n]);
-            d.read_out_run(&electrons, &z, &mut dn, &mut flags, Some(&mut analog));
+            d.read_out_run(&[0], &electrons, &z, &mut dn, &mut flags, Some(&mut analog));
             let mut dn_only = vec![0u16; n];
-            d.read_out_run(&electrons, &z, &mut dn_only, &mut flags.clone(), None);
+            d.read_out_run(&[0], &electrons, &z, &mut dn_only, &mut flags.clone(), None);
             for i in 0..n {
                 let one = readout_as_written(&d, f64::from(electrons[i]), z[i]);
-                let scalar = d.read_out_with(f64::from(electrons[i]), z[i]);
+                let scalar = d.read_out_with(0, f64::from(electrons[i]), z[i]);
                 let what = format!("mode {:?}, ideal {}, {} e, z {}", d.mode, d.ideal, electrons[i], z[i]);
                 assert_eq!((dn[i], flags[i]), (one.dn, one.flags), "{what}");
                 assert_eq!(dn_only[i], one.dn, "{what}");
@@ -243,7 +244,7 @@ fn frames_read_out_at_once_are_the_frames_read_out_one_by_one() {
         for f in 0..5 {
             let mut rng = rng_of(f);
             for &b in &bands {
-                let r = d.read_out(exposures[b].draw(&mut rng), &mut rng);
+                let r = d.read_out(b, exposures[b].draw(&mut rng), &mut rng);
                 one_by_one.push((f, b, r.dn, r.flags, r.analog_dn));
             }
         }
