@@ -49,6 +49,7 @@ pub const ALL: &[Asset] = embed![
     "atmosphere/atmosphere_gas_absorption_wasi6.csv",
     "atmosphere/rayleigh_optical_depth_bodhaine1999.csv",
     "atmosphere/wmo_aerosol_mie.csv",
+    "atmosphere/gas_transmittance_6sv.csv",
 ];
 
 macro_rules! embed_presets {
@@ -81,6 +82,10 @@ pub const PRESETS: &[Asset] = embed_presets![
     "instruments/smallsat.ron",
     "instruments/hyperspectral.ron",
     "instruments/filter_imager.ron",
+    "instruments/sentinel2a_msi.ron",
+    "instruments/landsat8_oli.ron",
+    "instruments/smallsat_swir.ron",
+    "instruments/sentinel3a_olci.ron",
     "studies/cubesat_vs_smallsat.ron",
     "studies/lake_hume_nominal.ron",
     "studies/heron_island_depth.ron",

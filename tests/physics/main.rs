@@ -8,9 +8,11 @@ mod aerosol;
 mod almi_reference;
 mod atmosphere_limits;
 mod cli;
+mod missions;
 mod osoaa;
 mod sambuca;
 mod sambuca_reference;
+mod sixs_swir;
 mod water_limits;
 
 /// Path of a file under `tests/data/`.
