@@ -352,6 +352,7 @@ pub fn central(app: &mut ShoalApp, ui: &mut egui::Ui) {
     let bar_w = 96.0;
     let width = ((avail.x - bar_w - 8.0 * n as f32) / n as f32).max(60.0);
     let mut hovered: Option<Pos2> = None;
+    let mut clicked = None;
     let mut view = app.ui.zoom;
     let PanelStates { marks, truth_from, swath_m, empty } = panel_states(app);
     ui.horizontal(|ui| {
@@ -397,6 +398,17 @@ pub fn central(app: &mut ShoalApp, ui: &mut egui::Ui) {
                 if resp.dragged() {
                     view.centre -= resp.drag_delta() / rect.size() / view.zoom;
                 }
+                // A click opens the scene's spectrum at that point (A's pixel for the truth and
+                // difference panels when A has a result).
+                if let Some(p) = resp.clicked().then(|| resp.interact_pointer_pos()).flatten() {
+                    let uv = view.uv();
+                    let f = (p - rect.min) / rect.size();
+                    let run = index.filter(|_| panel.title != "truth").unwrap_or(truth_from);
+                    clicked = Some(super::spectrum::Pick {
+                        run,
+                        uv: (uv.min.x + f.x * uv.width(), uv.min.y + f.y * uv.height()),
+                    });
+                }
                 if resp.hovered() {
                     let scroll = ui.input_mut(|i| {
                         let s = i.smooth_scroll_delta;
@@ -427,6 +439,9 @@ pub fn central(app: &mut ShoalApp, ui: &mut egui::Ui) {
         });
     });
     app.ui.zoom = view;
+    if let Some(pick) = clicked {
+        app.ui.spectrum.pick(pick);
+    }
     hover_readout(app, ui, hovered);
 }
 
@@ -462,7 +477,7 @@ fn hover_readout(app: &mut ShoalApp, ui: &mut egui::Ui, hovered: Option<Pos2>) {
             ui.label(format!("row {r}, column {c}   {}", parts.join("   ")));
         }
     } else {
-        ui.label("Drag to pan, scroll to zoom; the maps move together.");
+        ui.label("Drag to pan, scroll to zoom (the maps move together); click for the spectrum there.");
     }
 }
 

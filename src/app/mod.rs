@@ -17,6 +17,7 @@
 //! | status, typed export, Replace? and error dialogs | `dialogs` |
 //! | undo and redo | `history` |
 //! | maps with zoom, pan and hover | `maps` |
+//! | the spectrum at a clicked point, 350–2500 nm | [`spectrum`] |
 //! | metrics table and plots | [`plots`] |
 //! | figure and data export | `export` |
 //! | sweep and cost-of-accuracy windows | `explore` |
@@ -43,11 +44,13 @@ mod params;
 mod planes;
 pub mod plot_data;
 pub mod plots;
+mod probe;
 pub mod raster;
 mod seeds;
 mod session;
 mod slide;
 mod snr_table;
+pub mod spectrum;
 pub mod theme;
 mod view;
 mod window;
@@ -118,6 +121,8 @@ struct UiState {
     conditions_error: Option<String>,
     /// A focal-plane edit refused by the instrument's validation.
     plane_error: Option<String>,
+    /// The spectrum at the point last clicked on a map.
+    spectrum: spectrum::SpectrumWindow,
     /// What the panels asked for this frame, applied after it is drawn (`logic.rs`).
     commands: Vec<logic::UiCommand>,
 }
@@ -249,58 +254,6 @@ impl ShoalApp {
         app
     }
 
-    /// Inject `fault` into A's runs (tests of the failure path); `None` removes it.
-    pub fn inject_fault(&mut self, fault: Option<crate::engine::Fault>) {
-        self.ui.fault = fault;
-    }
-
-    /// Use `library` for presets (tests).
-    pub fn set_library(&mut self, library: Library) {
-        self.listing.reread(&library);
-        self.library = library;
-    }
-
-    /// The sweep and cost windows' state.
-    #[must_use]
-    pub fn explore(&self) -> &explore::Explore {
-        &self.ui.explore
-    }
-
-    /// The inline message of a refused instrument value, if one is shown.
-    #[must_use]
-    pub fn refused_value(&self) -> Option<&str> {
-        self.ui.param_error.as_ref().map(|(_, m)| m.as_str())
-    }
-
-    /// The last error shown to the user, if any.
-    #[must_use]
-    pub fn error(&self) -> Option<&str> {
-        self.ui.error.as_deref()
-    }
-
-    /// Map panels on screen (truth, A, B, A − B).
-    #[must_use]
-    pub fn map_panels(&self) -> usize {
-        self.images.panel_count()
-    }
-
-    /// Where the histogram, scatter and SNR plots were drawn in the last frame.
-    #[must_use]
-    pub fn plot_rects(&self) -> &[egui::Rect] {
-        &self.ui.plot_rects
-    }
-
-    /// Median time the UI thread spent drawing each of the last frames, ms.
-    #[must_use]
-    pub fn median_frame_ms(&self) -> Option<f32> {
-        let mut v = self.ui.frame_times_ms.clone();
-        if v.is_empty() {
-            return None;
-        }
-        v.sort_by(f32::total_cmp);
-        Some(v[v.len() / 2])
-    }
-
     /// Per frame, before drawing: submit changed configurations, take results and images.
     /// Draw one frame into `ui` (everything but the eframe plumbing).
     pub fn draw(&mut self, ui: &mut egui::Ui) {
@@ -337,6 +290,9 @@ impl ShoalApp {
         }
         if self.ui.explore.cost_open {
             explore::cost_window(self, &ctx);
+        }
+        if self.ui.spectrum.open {
+            spectrum::spectrum_window(self, &ctx);
         }
         // Commands after the panels that asked for them, before the dialogs that may report them.
         for command in std::mem::take(&mut self.ui.commands) {

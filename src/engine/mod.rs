@@ -44,6 +44,7 @@ mod report;
 pub mod resources;
 mod retrieval_stage;
 mod run;
+pub mod spectrum;
 mod stages;
 pub mod worker;
 

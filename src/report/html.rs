@@ -323,6 +323,7 @@ fn caption(name: &str) -> String {
     let what = describe_key(rest);
     match kind {
         "snr" => "SNR per band at the scene's median water radiance: analytic (line) and measured in the noisy cube (open circles); a dashed line, when drawn, is the study's SNR requirement.".into(),
+        "spectrum" => "The scene at a typical water pixel (median true chl-a), 350–2500 nm: TOA radiance (black), path radiance (grey) and true Rrs, the forward model every nm; each instrument's bands shaded at their FWHM, its Level-1 radiance and corrected Rrs there as dots.".into(),
         "maps" if rest.ends_with("substrate") => "The dominant substrate of the truth and of each instrument's retrieval, one colour per substrate; grey: land or not returned; scale bars give the ground distance.".into(),
         "maps" => format!("Truth and each instrument's retrieval ({what}) on one colour scale; grey: land or not returned; scale bars give the ground distance."),
         "agreement" => format!("Where each instrument's {what} is the truth's (green) or not (red), with the share right."),
@@ -370,7 +371,7 @@ fn figures_section(h: &mut String, figures: &[PageFigure]) {
     };
     // SNR first, then per variable: maps beside their A − B, scatter and histograms.
     for (i, f) in figures.iter().enumerate() {
-        if f.name == "snr" {
+        if f.name == "snr" || f.name == "spectrum" {
             put(h, f);
             shown[i] = true;
         }

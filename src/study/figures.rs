@@ -391,6 +391,18 @@ pub fn figure_set(result: &StudyResult) -> Result<Vec<Figure>, StudyError> {
     if let Some(snr) = super::snr_figure::SnrFigure::of(result) {
         figures.push(render("snr", &snr)?);
     }
+    if let Some(data) = result.spectrum.as_deref() {
+        let s = &data.point;
+        let title = format!(
+            "{} — the scene at a typical water pixel ({:.0}, {:.0}) m, view zenith {:.1}°{}",
+            result.study.spec.name,
+            s.ground_m.0,
+            s.ground_m.1,
+            s.view_zenith_deg,
+            if s.gases { "" } else { "; gases left out by the scene" }
+        );
+        figures.push(render("spectrum", &super::spectrum_figure::SpectrumFigure { title, data })?);
+    }
     for (index, ret0) in first.retrievals.iter().enumerate() {
         for var in VARIABLES {
             if first.truth.map(var.key).is_none() || ret0.product.map(var.key).is_none() {

@@ -27,6 +27,7 @@ mod requirements;
 mod run;
 mod slide;
 mod snr_figure;
+pub mod spectrum_figure;
 mod spread;
 mod substrate_figure;
 

@@ -38,6 +38,9 @@ pub struct StudyResult {
     pub study: ResolvedStudy,
     /// The runs, in instrument then seed order.
     pub runs: Vec<StudyRun>,
+    /// The scene's spectrum at a typical water pixel of the first run, with what each
+    /// instrument (first seed) measured there (`None` without water).
+    pub spectrum: Option<Arc<super::spectrum_figure::StudySpectrum>>,
 }
 
 /// Run every configuration of `study`; `on_run` sees each full run output (to write its cubes)
@@ -54,7 +57,8 @@ pub fn run_study(
     let configs: Vec<&crate::engine::RunConfig> = study.runs.iter().map(|r| &r.2).collect();
     budget.check(&crate::engine::resources::study_demand(&configs))?;
     let mut engine = Engine::new();
-    let mut runs = Vec::with_capacity(study.runs.len());
+    let mut runs: Vec<StudyRun> = Vec::with_capacity(study.runs.len());
+    let mut spectrum: Option<super::spectrum_figure::StudySpectrum> = None;
     for (i, (label, seed, config)) in study.runs.iter().enumerate() {
         let out = engine.run(config, control).map_err(|e| match e {
             EngineError::Cancelled => StudyError::Cancelled,
@@ -64,9 +68,19 @@ pub fn run_study(
             other => StudyError::Run { instrument: label.clone(), message: other.to_string() },
         })?;
         on_run(i, &out)?;
+        // The spectrum at the first run's typical water pixel; each instrument's first seed adds
+        // what it measured there (the outputs are not kept: the cubes would fill the memory).
+        let first_seed = !runs.iter().any(|r| r.label == *label);
+        if i == 0 {
+            spectrum = super::spectrum_figure::StudySpectrum::of(&out, &[])
+                .map_err(|message| StudyError::Run { instrument: label.clone(), message })?;
+        }
+        if let Some(s) = spectrum.as_mut().filter(|_| first_seed) {
+            s.instruments.push(crate::engine::spectrum::instrument_at(&out, label, s.point.ground_m));
+        }
         runs.push(StudyRun::of(label, *seed, &out));
     }
-    Ok(StudyResult { study: study.clone(), runs })
+    Ok(StudyResult { study: study.clone(), runs, spectrum: spectrum.map(Arc::new) })
 }
 
 impl StudyRun {
@@ -118,7 +132,9 @@ impl StudyResult {
             spec,
             runs: runs.iter().map(|(label, o)| (label.clone(), o.config.seed, o.config.clone())).collect(),
         };
+        // A spectrum that cannot be computed leaves the figure out, not the export.
+        let spectrum = super::spectrum_figure::StudySpectrum::of(runs[0].1, runs).ok().flatten().map(Arc::new);
         let runs = runs.iter().map(|(label, o)| StudyRun::of(label, o.config.seed, o)).collect();
-        Some(Self { study: resolved, runs })
+        Some(Self { study: resolved, runs, spectrum })
     }
 }

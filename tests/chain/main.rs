@@ -20,6 +20,7 @@ mod reproduction;
 mod retrieval;
 mod soak;
 mod spatial;
+mod spectrum;
 mod study;
 mod sweep;
 mod user_data;

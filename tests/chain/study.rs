@@ -46,6 +46,16 @@ fn a_study_writes_tables_and_figures() {
         assert!(svg.starts_with("<svg") && svg.contains("chl-a"));
     }
     assert!(outputs.files.iter().any(|f| f == "study.ron"));
+    // The spectrum at a typical water pixel, with both instruments' bands and measurements.
+    let spectrum = result.spectrum.as_deref().expect("a lake has water");
+    assert!(spectrum.point.water);
+    let labels: Vec<&str> = spectrum.instruments.iter().map(|i| i.label.as_str()).collect();
+    assert_eq!(labels, ["cubesat", "smallsat"]);
+    assert!(
+        spectrum.instruments.iter().all(|i| i.pixel.is_some() && i.bands.iter().any(|b| b.level1_w_m2_sr_um.is_some()))
+    );
+    let svg = std::fs::read_to_string(dir.join("figures").join("spectrum.svg")).unwrap();
+    assert!(svg.contains("wavelength (nm)") && svg.contains("2400") && svg.contains("cubesat Level-1"));
     // The SmallSat's chl is better than the CubeSat's, as Table 1 predicts.
     let mae = |label: &str| {
         let run = result.runs.iter().find(|r| r.label == label).unwrap();

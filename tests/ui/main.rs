@@ -20,6 +20,7 @@ use shoal::library::Library;
 
 mod review;
 mod session;
+mod spectrum;
 
 /// A fresh, empty user library in the system temporary directory.
 fn temp_library(name: &str) -> PathBuf {

@@ -1,0 +1,58 @@
+//! A click on a map opens the scene's spectrum at that point, with both instruments' bands; a
+//! change of A asks again of the new run (the window never shows a run no longer on screen).
+
+use std::time::{Duration, Instant};
+
+use egui_kittest::kittest::Queryable;
+
+use super::{harness, temp_library, wait_for_engine};
+
+/// Step until a node labelled with `text` (in part) shows, at most a minute.
+fn wait_for_text(h: &mut egui_kittest::Harness<'static, shoal::app::ShoalApp>, text: &str) {
+    let start = Instant::now();
+    while h.query_by_label_contains(text).is_none() {
+        assert!(start.elapsed() < Duration::from_secs(60), "`{text}` never showed");
+        h.step();
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+#[test]
+fn a_click_on_a_map_shows_the_spectrum_there() {
+    let dir = temp_library("spectrum");
+    let mut h = harness("cubesat", 8, &dir);
+    wait_for_engine(&mut h);
+    assert!(h.query_by_label("Spectrum at a point").is_none(), "closed until a map is clicked");
+    // The truth panel's title sits right above its map (the topmost "truth" on screen; the
+    // plots' keys below say it too).
+    let title = h
+        .query_all_by_label("truth")
+        .map(|n| n.rect())
+        .min_by(|a, b| a.top().total_cmp(&b.top()))
+        .expect("a truth panel");
+    let at = egui::pos2(title.left() + 60.0, title.bottom() + 60.0);
+    h.event(egui::Event::PointerMoved(at));
+    h.step();
+    for pressed in [true, false] {
+        h.event(egui::Event::PointerButton {
+            pos: at,
+            button: egui::PointerButton::Primary,
+            pressed,
+            modifiers: egui::Modifiers::NONE,
+        });
+        h.step();
+    }
+    wait_for_text(&mut h, "Water at (");
+    assert!(h.query_by_label("Spectrum at a point").is_some());
+    assert!(h.query_by_label_contains("of A; sun zenith 60.0°").is_some());
+    assert!(h.query_by_label_contains("A: bands (FWHM) and what it measured").is_some());
+    assert!(h.query_by_label_contains("B: bands (FWHM) and what it measured").is_some());
+    // A new A: the spectrum is computed again for its run, and the old one is not shown meanwhile.
+    h.state_mut().state.a.spec.aperture_mm *= 1.5;
+    h.step();
+    h.step();
+    assert!(h.query_by_label_contains("Water at (").is_none(), "the previous run's spectrum stays up");
+    wait_for_engine(&mut h);
+    wait_for_text(&mut h, "Water at (");
+    let _ = std::fs::remove_dir_all(&dir);
+}
