@@ -291,7 +291,7 @@ impl Atmosphere {
     }
 
     /// Sun–surface–sensor gas transmittance T(m₀ + m_v) (1 when gases are off; see
-    /// [`super::gas::two_way_transmittance`]).
+    /// `gas::two_way_transmittance`).
     pub fn gas_two_way(&self, wavelength_nm: f64, mu0: f64, muv: f64) -> Result<f64, AtmosphereError> {
         if self.spec.gases {
             two_way_transmittance(wavelength_nm, mu0, muv, &self.spec.gas_amounts, self.spec.pressure_hpa)

@@ -113,7 +113,7 @@ fn column_depth(config: &RunConfig) -> f64 {
 
 /// Planned seconds of the atmosphere's radiative transfer: each successive order of scattering
 /// visits every layer, stream pair and Fourier term, once per LUT wavelength node; the fit
-/// ([`SECONDS_PER_RT_WORK`]) absorbs the nodes.
+/// (`SECONDS_PER_RT_WORK`) absorbs the nodes.
 #[must_use]
 pub fn atmosphere_seconds(config: &RunConfig) -> f64 {
     let acc = &config.scene.atmosphere.accuracy;
@@ -176,7 +176,7 @@ fn cube_part(config: &RunConfig, bytes_per_pixel_band: f64) -> Part {
 
 /// What a study's runs ask for together: a study keeps the truth and products of every run
 /// until its tables and figures are written, and the engine's cache the full cubes of the last
-/// few ([`CACHED_RUNS`]); scenes and atmospheres are built one at a time.
+/// few (`CACHED_RUNS`); scenes and atmospheres are built one at a time.
 #[must_use]
 pub fn study_demand(configs: &[&RunConfig]) -> Demand {
     let mut demand = Demand::default();

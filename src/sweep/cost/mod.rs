@@ -182,7 +182,7 @@ fn chl_mae(out: &RunOutput) -> f64 {
 
 /// Measure every setting of [`settings_for`] `base` on it (whose decimation is the reference's), in
 /// `rounds` interleaved rounds (at least 1) and one closing reference run, and pair each row's
-/// runs with the reference's ([`rows`]); `on_row` hears of each row each time its figures change,
+/// runs with the reference's (`rows`); `on_row` hears of each row each time its figures change,
 /// with the round (0-based) in progress.
 pub fn cost_of_accuracy(
     base: &RunConfig,
