@@ -23,8 +23,9 @@ pub struct SimulateArgs {
     /// paper_heron_island) or a scene RON file.
     #[arg(long, default_value = "lake_hume_bloom")]
     scene: String,
-    /// Instrument: a built-in name (nominal, cubesat, smallsat, hyperspectral, filter_imager) or
-    /// an instrument RON file.
+    /// Instrument: a preset name (yours in the library first, then the built-ins nominal,
+    /// cubesat, smallsat, hyperspectral, filter_imager, sentinel2a_msi, landsat8_oli,
+    /// sentinel3a_olci, smallsat_swir) or an instrument RON file.
     #[arg(long, default_value = "nominal")]
     instrument: String,
     /// A full run configuration (RON, as written to config.ron); flags override it.

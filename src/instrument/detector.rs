@@ -99,6 +99,7 @@ pub fn pixel_rng(seed: u64, stream: Stream, line: usize, detector: usize) -> Xos
 }
 
 /// Shot noise: a Poisson draw of mean `mean` electrons (normal approximation above 1000).
+#[inline(always)]
 fn shot<R: rand::Rng + ?Sized>(mean: f64, rng: &mut R) -> f64 {
     if !(mean > 0.0) {
         return 0.0;

@@ -46,6 +46,12 @@ fn plane_rng(seed: u64, stream: Stream, plane: usize, line: usize, detector: usi
     pixel_rng(super::detector::mix64(seed ^ (plane as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)), stream, line, detector)
 }
 
+/// Does every band sample the grid pixel by pixel (one focal plane, or no coarse one)? Then a
+/// pixel's draws come from its own generator in band order, with no lookup per band.
+fn on_grid(detector: &Detector) -> bool {
+    detector.planes().iter().all(|p| p.block() == 1)
+}
+
 /// Draw one value per band of the pixel at grid `line`, `detector` into `out` with `draw`: the
 /// bands of planes that sample the grid pixel by pixel from the pixel's own generator in band
 /// order (a one-plane instrument's draws are what they were before focal planes existed), each
@@ -141,6 +147,7 @@ pub fn expose_cube(
     // A coarse focal plane's pixel sees the mean radiance of its block.
     let averaged = block_means(detector, input, viewing, cols, nb);
     let input = averaged.as_deref().unwrap_or(input);
+    let every_band_on_grid = on_grid(detector);
     let mut out = vec![0.0f32; rows * cols * nb];
     control.fill_rows(out.as_mut_slice(), rows, cols * nb, |at, row| {
         let r = at.index();
@@ -150,6 +157,15 @@ pub fn expose_cube(
             at.column(c);
             let j = viewing.detector_index[c];
             let pixel = &input[(r * cols + c) * nb..(r * cols + c + 1) * nb];
+            if every_band_on_grid {
+                // The pixel's own generator, band after band, straight into the row (the loop
+                // the one-plane instruments of the default study spend their Level-0 time in).
+                let mut rng = pixel_rng(seed, Stream::Exposure, line, j);
+                for (b, o) in row[c * nb..(c + 1) * nb].iter_mut().enumerate() {
+                    *o = detector.expose(j, b, f64::from(pixel[b]), t, &mut rng) as f32;
+                }
+                continue;
+            }
             draw_bands(detector, seed, Stream::Exposure, line, j, &mut e, |b, rng| {
                 detector.expose(j, b, f64::from(pixel[b]), t, rng)
             });
@@ -178,6 +194,7 @@ pub fn digitise_cube(
     let keep_analog = !detector.mode().quantise;
     let noise = detector.mode().noise;
     let bands: Vec<usize> = (0..nb).collect();
+    let every_band_on_grid = on_grid(detector);
     let n = rows * cols * nb;
     let mut dn = vec![0u16; n];
     let mut flags = vec![0u8; n];
@@ -192,7 +209,10 @@ pub fn digitise_cube(
         let mut z = vec![0.0; cols * nb];
         for c in 0..cols {
             at.column(c);
-            if noise {
+            if noise && every_band_on_grid {
+                let mut rng = pixel_rng(seed, Stream::Readout, line, viewing.detector_index[c]);
+                z[c * nb..(c + 1) * nb].iter_mut().for_each(|z| *z = normal(&mut rng));
+            } else if noise {
                 let j = viewing.detector_index[c];
                 draw_bands(detector, seed, Stream::Readout, line, j, &mut z[c * nb..(c + 1) * nb], |_, rng| {
                     normal(rng)

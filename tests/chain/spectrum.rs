@@ -36,7 +36,7 @@ fn the_point_spectrum_integrates_to_the_runs_band_radiance() {
     assert!(s.water, "the centre of the lake is water");
     assert!(s.l_toa_w_m2_sr_um.iter().chain(&s.rrs_per_sr).all(|v| v.is_finite() && *v >= 0.0));
     // The band radiance of the run at this pixel is the response-weighted mean of the spectrum
-    // (Response docs). The run's LUT has nodes every 25 nm, the spectrum's every 50 nm, both
+    // (Response docs). The run's LUT has nodes every 20 nm, the spectrum's every 50 nm, both
     // interpolated log–log: where the terms follow a power law that is exact; the aerosol's
     // departure from one and the run's band nodes (the water model at 4 nodes per band) bound
     // the difference, measured at most 0.1 % over these bands; 0.5 % leaves room without hiding
