@@ -88,6 +88,7 @@ pub const PRESETS: &[Asset] = embed_presets![
     "instruments/sentinel3a_olci.ron",
     "studies/cubesat_vs_smallsat.ron",
     "studies/msi_vs_smallsat.ron",
+    "studies/cubesat_vs_smallsat_image.ron",
     "studies/lake_hume_nominal.ron",
     "studies/heron_island_depth.ron",
     "studies/paper_heron_island.ron",

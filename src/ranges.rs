@@ -336,6 +336,10 @@ ranges! {
     // Atmospheric correction (CorrectionSpec::validate).
     /// Approximation sample points.
     CORRECTION_APPROX_POINTS = Range::count("correction.approx_points", 1.0, 10_000.0, "", "water pixels of the per-scene approximation (paper: 20)");
+    /// Image-based correction: the aerosol pair's band centres.
+    CORRECTION_PAIR_NM = Range::closed("correction.image.pair_nm", 600.0, 2500.0, "nm", "centres of the short and long band of the aerosol pair, short first (the instrument's nearest bands, within 30 nm)");
+    /// Image-based correction: AOT nodes of the family's tables.
+    CORRECTION_AOT_NODE = Range::above("correction.image.aot_nodes", 0.0, 5.0, "", "AOT(550) nodes of the aerosol family's tables, increasing (0 is always added)");
 
     // Retrievals (RetrievalSpec::validate).
     /// aLMI rrs(u) linear coefficient.

@@ -21,6 +21,10 @@
 //! - Matthews, M. W. et al. (2023) Sensors 23, 7824, Appendix A (equations A1–A3).
 //! - Vermote, E. F. et al. (1997) 6S: an overview. IEEE TGRS 35, 675–686.
 
+pub mod image;
+
+pub use image::{AerosolFamily, AerosolRetrieval, FamilyLuts, ImageCorrection, correct_image};
+
 use ndarray::{Array2, Array3};
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
@@ -67,18 +71,21 @@ impl RrsFlags {
 }
 
 /// Correction settings.
-#[derive(Debug, Clone, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct CorrectionSpec {
     /// Random water pixels for the paper's per-scene approximation (Appendix A: 20).
     pub approx_points: usize,
     /// Deliver the per-scene approximation as the Rrs product instead of the exact correction.
     pub use_approximation: bool,
+    /// Deliver the image-based correction ([`image`]): the aerosol from the instrument's own
+    /// long bands, the scene's true atmosphere unknown to it. `None`: the exact correction.
+    pub image: Option<ImageCorrection>,
 }
 
 impl Default for CorrectionSpec {
     fn default() -> Self {
-        Self { approx_points: 20, use_approximation: false }
+        Self { approx_points: 20, use_approximation: false, image: None }
     }
 }
 
@@ -88,7 +95,17 @@ impl CorrectionSpec {
         let range = &crate::ranges::CORRECTION_APPROX_POINTS;
         range
             .check(self.approx_points as f64)
-            .map_err(|message| CorrectionError::Invalid(FieldError { field: range.path.into(), message }))
+            .map_err(|message| CorrectionError::Invalid(FieldError { field: range.path.into(), message }))?;
+        if let Some(image) = &self.image {
+            if self.use_approximation {
+                return Err(CorrectionError::Invalid(FieldError {
+                    field: "correction.image".into(),
+                    message: "choose one: the image-based correction or use_approximation".into(),
+                }));
+            }
+            image.validate()?;
+        }
+        Ok(())
     }
 }
 
@@ -115,7 +132,7 @@ pub struct SceneApproximation {
 }
 
 #[inline(always)]
-fn flag_for(level0_flags: u8, land: bool, value: f64) -> u8 {
+pub(crate) fn flag_for(level0_flags: u8, land: bool, value: f64) -> u8 {
     // Without branches (selects), and finiteness as a comparison: the flags of a column's bands
     // are then computed side by side.
     let saturated = level0_flags & Flags::SATURATED != 0;
@@ -127,13 +144,13 @@ fn flag_for(level0_flags: u8, land: bool, value: f64) -> u8 {
 }
 
 /// The contiguous data of a standard-layout array.
-fn slice<T, D: ndarray::Dimension>(a: &ndarray::Array<T, D>) -> Result<&[T], CorrectionError> {
+pub(crate) fn slice<T, D: ndarray::Dimension>(a: &ndarray::Array<T, D>) -> Result<&[T], CorrectionError> {
     a.as_slice().ok_or_else(|| {
         CorrectionError::Invalid(FieldError { field: "cube".into(), message: "not in standard layout".into() })
     })
 }
 
-fn assemble(
+pub(crate) fn assemble(
     rows: usize,
     cols: usize,
     nb: usize,

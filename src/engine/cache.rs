@@ -37,6 +37,10 @@ pub enum Stage {
     Calibration,
     /// Level-1 radiance.
     Level1,
+    /// The image-based correction's aerosol family: one LUT per model and AOT node.
+    AerosolLuts,
+    /// The image-based correction's aerosol family tabulated over the run's geometry.
+    AerosolFamily,
     /// Rrs.
     Correction,
     /// SNR table.
@@ -50,7 +54,7 @@ pub enum Stage {
 
 impl Stage {
     /// Every stage, in chain order.
-    pub const ALL: [Self; 17] = [
+    pub const ALL: [Self; 19] = [
         Self::Scene,
         Self::Response,
         Self::Geometry,
@@ -64,6 +68,8 @@ impl Stage {
         Self::Level0,
         Self::Calibration,
         Self::Level1,
+        Self::AerosolLuts,
+        Self::AerosolFamily,
         Self::Correction,
         Self::Snr,
         Self::RetrievalModel,
@@ -99,6 +105,8 @@ impl Stage {
             Self::Level0 => "level-0",
             Self::Calibration => "calibration",
             Self::Level1 => "level-1",
+            Self::AerosolLuts => "aerosol LUTs",
+            Self::AerosolFamily => "aerosol family",
             Self::Correction => "correction",
             Self::Snr => "snr",
             Self::RetrievalModel => "retrieval model",

@@ -29,6 +29,11 @@ pub struct CorrectionProduct {
     pub approximation_vs_exact: Vec<crate::correction::BandDifference>,
     /// Per band: delivered Rrs against the truth.
     pub rrs_vs_truth: Vec<crate::correction::BandDifference>,
+    /// What the image-based correction found (AOT and Ångström per pixel), when it ran.
+    pub aerosol: Option<crate::correction::AerosolRetrieval>,
+    /// The image-based correction's aerosol family and the pair of bands (short, long) it
+    /// read, when it ran.
+    pub family: Option<(Arc<crate::correction::AerosolFamily>, (usize, usize))>,
 }
 
 /// Everything a run produced (shared with the cache: cheap to clone).
@@ -85,6 +90,8 @@ pub(super) struct SceneSide {
     pub(super) response: Arc<Response>,
     pub(super) response_key: Key,
     pub(super) viewing: Arc<Viewing>,
+    /// The viewing geometry's key (after the response and the scene).
+    pub(super) geometry_key: Key,
     pub(super) optics: Arc<Vec<SceneOptics>>,
     pub(super) band_atmosphere: Arc<BandAtmosphere>,
     pub(super) band_key: Key,

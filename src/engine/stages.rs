@@ -15,7 +15,7 @@ use crate::atmosphere::{AtmosphereLut, LutAxes};
 use crate::calibration::{Calibration, band_e0, calibrate};
 use crate::control::Cancellable;
 use crate::control::RunControl;
-use crate::correction::{SceneApproximation, compare, correct_exact};
+use crate::correction::{AerosolFamily, FamilyLuts, SceneApproximation, compare, correct_exact, correct_image};
 use crate::instrument::feasibility::Feasibility;
 use crate::instrument::sample::BandAtmosphere;
 use crate::instrument::{
@@ -136,7 +136,7 @@ impl Engine {
             BandAtmosphere::new(&optics, &viewing, &response).map_err(failed(Stage::BandAtmosphere))
         })?;
 
-        Ok(SceneSide { scene, response, response_key, viewing, optics, band_atmosphere, band_key })
+        Ok(SceneSide { scene, response, response_key, viewing, geometry_key, optics, band_atmosphere, band_key })
     }
 
     /// The pupil radiance and the truth (the spatial response only when the scene asks for it).
@@ -280,6 +280,37 @@ impl Engine {
             .with(&inputs.seed)
             .with(&inputs.decimation)
             .finish();
+        // The image-based correction's family: its atmospheres once per scene atmosphere and LUT
+        // axes (two instruments with the same axes share them), its band terms once per
+        // instrument geometry. Neither depends on the scene's true aerosol.
+        let family = match &config.correction.image {
+            Some(image) => {
+                let axes = lut_axes(&side.response, &side.viewing, config.scene.sun.zenith_deg, fid);
+                let mut atmosphere = config.scene.atmosphere.clone();
+                atmosphere.day_of_year = side.scene.day_of_year;
+                (atmosphere.aerosol, atmosphere.aot550) = (crate::atmosphere::AerosolType::None, 0.0);
+                let luts_key = KeyBuilder::new(Stage::AerosolLuts).with(&atmosphere).with(&axes).with(image).finish();
+                let luts = self.stage(luts_key, report, control, || {
+                    FamilyLuts::build(image, &atmosphere, &axes, control).map_err(failed(Stage::AerosolLuts))
+                })?;
+                let key = KeyBuilder::new(Stage::AerosolFamily)
+                    .after(luts_key)
+                    .after(side.geometry_key)
+                    .with(&side.scene.spec.effects)
+                    .finish();
+                let fam = self.stage(key, report, control, || {
+                    AerosolFamily::tabulate(&luts, &side.scene, &side.response, &side.viewing, control)
+                        .map_err(failed(Stage::AerosolFamily))
+                })?;
+                let pair = image.pair(&side.response.bands.centres_nm()).map_err(failed(Stage::Correction))?;
+                Some((fam, pair, key))
+            }
+            None => None,
+        };
+        let correction_key = match &family {
+            Some((_, _, key)) => KeyBuilder::new(Stage::Correction).after(correction_key).after(*key).finish(),
+            None => correction_key,
+        };
         let correction = self.stage(correction_key, report, control, || {
             let fail = failed(Stage::Correction);
             let approximation = SceneApproximation::new(
@@ -294,7 +325,16 @@ impl Engine {
             // A preview computes only the product it shows; the diagnostics (the approximation
             // against the exact correction, and both against the truth) come with full resolution.
             let diagnostics = fid.decimation == 1;
-            let exact = if diagnostics || !config.correction.use_approximation {
+            let image = match &family {
+                Some((fam, pair, _)) => {
+                    Some(correct_image(level1, fam, *pair, &radiance.truth.land, control).map_err(&fail)?)
+                }
+                None => None,
+            };
+            // The image-based product is compared with the truth; the exact and approximate
+            // corrections are not run beside it (`shoal budget` prices the difference).
+            let diagnostics = diagnostics && image.is_none();
+            let exact = if diagnostics || (!config.correction.use_approximation && image.is_none()) {
                 Some(correct_exact(level1, band_atmosphere, &radiance.truth.land, control).map_err(&fail)?)
             } else {
                 None
@@ -308,16 +348,19 @@ impl Engine {
                 (Some(a), Some(e), true) => compare(a, &e.rrs, Some(&e.flags)),
                 _ => Vec::new(),
             };
-            let rrs = match (exact, approx) {
-                (_, Some(a)) if config.correction.use_approximation => a,
-                (Some(e), _) => e,
-                (None, Some(a)) => a,
-                (None, None) => {
+            let (image, aerosol) = image.map_or((None, None), |(r, a)| (Some(r), Some(a)));
+            let rrs = match (image, exact, approx) {
+                (Some(i), _, _) => i,
+                (None, _, Some(a)) if config.correction.use_approximation => a,
+                (None, Some(e), _) => e,
+                (None, None, Some(a)) => a,
+                (None, None, None) => {
                     return Err(EngineError::Failed { stage: Stage::Correction, message: "no correction ran".into() });
                 }
             };
             let rrs_vs_truth = if diagnostics { compare(&rrs, &radiance.truth.rrs_above, None) } else { Vec::new() };
-            Ok(CorrectionProduct { rrs, approximation, approximation_vs_exact, rrs_vs_truth })
+            let family = family.as_ref().map(|(f, pair, _)| (f.clone(), *pair));
+            Ok(CorrectionProduct { rrs, approximation, approximation_vs_exact, rrs_vs_truth, aerosol, family })
         })?;
         report.approximation = Some(correction.approximation.clone());
         report.approximation_vs_exact = correction.approximation_vs_exact.clone();

@@ -11,6 +11,7 @@ mod coherence;
 #[path = "../common/mod.rs"]
 mod common;
 mod determinism;
+mod image_correction;
 mod incremental;
 mod noise;
 mod plausibility;
