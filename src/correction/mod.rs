@@ -21,9 +21,11 @@
 //! - Matthews, M. W. et al. (2023) Sensors 23, 7824, Appendix A (equations A1–A3).
 //! - Vermote, E. F. et al. (1997) 6S: an overview. IEEE TGRS 35, 675–686.
 
+pub mod family;
 pub mod image;
 
-pub use image::{AerosolFamily, AerosolRetrieval, FamilyLuts, ImageCorrection, correct_image};
+pub use family::{AerosolFamily, FamilyLuts};
+pub use image::{AerosolRetrieval, ImageCorrection, correct_image};
 
 use ndarray::{Array2, Array3};
 use rand::SeedableRng;

@@ -34,6 +34,21 @@ pub struct SkippedEffect {
     pub reason: String,
 }
 
+/// The image-based correction's aerosol against the scene's true aerosol.
+#[derive(Debug, Clone, PartialEq, Serialize, Default)]
+pub struct AerosolSummary {
+    /// Retrieved AOT(550) over the water pixels: median, 5th and 95th percentiles.
+    pub aot550: (f64, f64, f64),
+    /// The scene's AOT(550).
+    pub aot550_true: f64,
+    /// Retrieved Ångström exponent (443–865 nm), median over the water pixels.
+    pub angstrom: f64,
+    /// The scene's aerosol model's Ångström exponent (443–865 nm).
+    pub angstrom_true: f64,
+    /// Share of retrieved pixels whose measured ε lay outside the family's range, %.
+    pub outside_family_pct: f64,
+}
+
 /// The report of one run.
 #[derive(Debug, Clone, PartialEq, Serialize, Default)]
 pub struct RunReport {
@@ -73,6 +88,8 @@ pub struct RunReport {
     pub approximation_vs_exact: Vec<BandDifference>,
     /// Per band: the delivered Rrs against the true band Rrs.
     pub rrs_vs_truth: Vec<BandDifference>,
+    /// What the image-based correction retrieved of the aerosol, against the scene's.
+    pub aerosol: Option<AerosolSummary>,
     /// Line period and exposure, s.
     pub line_period_s: f64,
     /// The truth's depth and substrate shares over the water pixels seen.
@@ -112,5 +129,33 @@ impl RunReport {
         }
         out.push_str(&format!("{:<19} {:<9} {:>8.3}\n", "total", "", self.total_seconds));
         out
+    }
+}
+
+/// The retrieved aerosol's percentiles against the scene's (its model's Ångström exponent from
+/// its own optics; NaN where the scene has no aerosol).
+pub(super) fn aerosol_summary(
+    a: &crate::correction::AerosolRetrieval,
+    truth: &crate::atmosphere::AtmosphereSpec,
+) -> AerosolSummary {
+    let mut aot: Vec<f64> = a.aot550.iter().filter(|v| v.is_finite()).map(|&v| f64::from(v)).collect();
+    let mut alpha: Vec<f64> = a.angstrom.iter().filter(|v| v.is_finite()).map(|&v| f64::from(v)).collect();
+    aot.sort_by(f64::total_cmp);
+    alpha.sort_by(f64::total_cmp);
+    let q = |v: &[f64], p: f64| if v.is_empty() { f64::NAN } else { v[((v.len() - 1) as f64 * p).round() as usize] };
+    let angstrom_true = crate::atmosphere::AtmosphereSpec { aot550: 1.0, ..truth.clone() }
+        .build()
+        .ok()
+        .and_then(|atm| {
+            let tau = |nm: f64| atm.column(nm).ok().and_then(|c| c.aerosol.map(|x| x.0));
+            Some(-(tau(865.0)? / tau(443.0)?).ln() / (865.0f64 / 443.0).ln())
+        })
+        .unwrap_or(f64::NAN);
+    AerosolSummary {
+        aot550: (q(&aot, 0.5), q(&aot, 0.05), q(&aot, 0.95)),
+        aot550_true: truth.aot550,
+        angstrom: q(&alpha, 0.5),
+        angstrom_true,
+        outside_family_pct: if aot.is_empty() { 0.0 } else { 100.0 * a.outside_family as f64 / aot.len() as f64 },
     }
 }

@@ -333,6 +333,7 @@ impl Engine {
             };
             // The image-based product is compared with the truth; the exact and approximate
             // corrections are not run beside it (`shoal budget` prices the difference).
+            let against_truth = diagnostics;
             let diagnostics = diagnostics && image.is_none();
             let exact = if diagnostics || (!config.correction.use_approximation && image.is_none()) {
                 Some(correct_exact(level1, band_atmosphere, &radiance.truth.land, control).map_err(&fail)?)
@@ -358,13 +359,15 @@ impl Engine {
                     return Err(EngineError::Failed { stage: Stage::Correction, message: "no correction ran".into() });
                 }
             };
-            let rrs_vs_truth = if diagnostics { compare(&rrs, &radiance.truth.rrs_above, None) } else { Vec::new() };
+            let rrs_vs_truth = if against_truth { compare(&rrs, &radiance.truth.rrs_above, None) } else { Vec::new() };
             let family = family.as_ref().map(|(f, pair, _)| (f.clone(), *pair));
             Ok(CorrectionProduct { rrs, approximation, approximation_vs_exact, rrs_vs_truth, aerosol, family })
         })?;
         report.approximation = Some(correction.approximation.clone());
         report.approximation_vs_exact = correction.approximation_vs_exact.clone();
         report.rrs_vs_truth = correction.rrs_vs_truth.clone();
+        report.aerosol =
+            correction.aerosol.as_ref().map(|a| super::report::aerosol_summary(a, &config.scene.atmosphere));
         Ok((correction, correction_key))
     }
 

@@ -2,7 +2,8 @@
 //!
 //! Each stage that makes error has a "perfect" switch: instrument noise and quantisation off,
 //! calibration perfect (gains and offsets exact), atmospheric correction exact (the per-pixel
-//! inversion of the same radiative transfer instead of the per-scene approximation), and the
+//! inversion of the same radiative transfer instead of the per-scene approximation or the
+//! image-based correction's aerosol from the design's own bands), and the
 //! retrieval given the scene's own SIOP set (no set-selection error). Two budgets:
 //!
 //! - **sequential**: make the stages perfect one after another in chain order; each stage's share
@@ -58,7 +59,11 @@ impl Stage {
                 config.detector.quantise = false;
             }
             Self::Calibration => config.calibration.perfect = true,
-            Self::Correction => config.correction.use_approximation = false,
+            Self::Correction => {
+                // The perfect correction: the exact inversion with the forward model's atmosphere.
+                config.correction.use_approximation = false;
+                config.correction.image = None;
+            }
             Self::SiopChoice => {
                 let truth = config.scene.siop.clone();
                 for r in &mut config.retrievals {

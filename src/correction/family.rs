@@ -1,0 +1,220 @@
+//! The image-based correction's aerosol family ([`super::image`]): one atmosphere per model and
+//! AOT node from Shoal's own radiative transfer, and their band-effective terms over a run's
+//! geometry (the photon-weighted means the forward model uses, Vermote et al. 1997).
+
+use rayon::prelude::*;
+
+use super::CorrectionError;
+use super::image::{ImageCorrection, invalid};
+use crate::atmosphere::{AerosolType, AtmosphereLut, AtmosphereSpec, LutAxes};
+use crate::control::RunControl;
+use crate::instrument::{Response, Viewing};
+use crate::scene::Scene;
+use crate::toa::SceneOptics;
+
+/// The family's tables: per model, per AOT node, per column and band.
+#[derive(Debug, Clone)]
+pub struct AerosolFamily {
+    /// The models.
+    pub models: Vec<AerosolType>,
+    /// AOT(550) nodes, the first 0.
+    pub aot550: Vec<f64>,
+    /// Each model's Ångström exponent between 443 and 865 nm.
+    pub angstrom: Vec<f64>,
+    /// Bands.
+    pub n_bands: usize,
+    /// `terms[m][k]`: the band terms of model m at node k.
+    pub terms: Vec<Vec<BandTerms>>,
+}
+
+/// Band-effective atmosphere of every column: index column·bands + band.
+#[derive(Debug, Clone, Default)]
+pub struct BandTerms {
+    /// Path radiance, W m⁻² sr⁻¹ nm⁻¹.
+    pub l_path: Vec<f64>,
+    /// (T_up·Ed), W m⁻² nm⁻¹.
+    pub t_ed: Vec<f64>,
+    /// Spherical albedo.
+    pub spherical_albedo: Vec<f64>,
+}
+
+/// The band terms of every column for one atmosphere (the photon-weighted means of
+/// `BandAtmosphere`, without what only the forward model needs). Where every detector has the
+/// same response (no smile), the terms are computed at [`TERM_COLUMNS`] columns spread over the
+/// swath and interpolated linearly between them: they follow the view zenith, which changes
+/// smoothly across track.
+fn band_terms(optics: &[SceneOptics], viewing: &Viewing, response: &Response) -> Result<BandTerms, CorrectionError> {
+    let nb = response.n_bands();
+    let nc = viewing.columns();
+    let one_response = response.smile_class.iter().all(|&c| c == response.smile_class.first().copied().unwrap_or(0));
+    let sampled: Vec<usize> = if one_response && nc > TERM_COLUMNS {
+        let mut v: Vec<usize> = (0..TERM_COLUMNS).map(|i| i * (nc - 1) / (TERM_COLUMNS - 1)).collect();
+        v.dedup();
+        v
+    } else {
+        (0..nc).collect()
+    };
+    let mut at_sampled = BandTerms {
+        l_path: vec![0.0; sampled.len() * nb],
+        t_ed: vec![0.0; sampled.len() * nb],
+        spherical_albedo: vec![0.0; sampled.len() * nb],
+    };
+    for (gi, group) in response.groups.iter().enumerate() {
+        let columns: Vec<Vec<(usize, f64, f64, f64)>> = sampled
+            .par_iter()
+            .enumerate()
+            .map(|(si, &c)| {
+                let look = &viewing.looks[gi][c];
+                let path =
+                    optics[gi].path_spectrum(&look.geometry).map_err(|e| invalid("correction.image", e.to_string()))?;
+                let j = viewing.detector_index[c];
+                Ok(group
+                    .bands
+                    .iter()
+                    .enumerate()
+                    .map(|(k, &b)| {
+                        let (first, w) = response.weights(gi, k, j);
+                        let span = first..first + w.len();
+                        let total: f64 = w.iter().sum();
+                        let l = w.iter().zip(&path.l_path[span.clone()]).map(|(a, x)| a * x).sum::<f64>() / total;
+                        let te: Vec<f64> = w
+                            .iter()
+                            .zip(&path.t_up[span.clone()])
+                            .zip(&path.ed[span.clone()])
+                            .map(|((a, t), e)| a * t * e)
+                            .collect();
+                        let te_sum: f64 = te.iter().sum();
+                        let s = if te_sum > 0.0 {
+                            te.iter().zip(&path.spherical_albedo[span]).map(|(a, s)| a * s).sum::<f64>() / te_sum
+                        } else {
+                            0.0
+                        };
+                        (si * nb + b, l, te_sum / total, s)
+                    })
+                    .collect())
+            })
+            .collect::<Result<_, CorrectionError>>()?;
+        for (i, l, te, s) in columns.into_iter().flatten() {
+            (at_sampled.l_path[i], at_sampled.t_ed[i], at_sampled.spherical_albedo[i]) = (l, te, s);
+        }
+    }
+    if sampled.len() == nc {
+        return Ok(at_sampled);
+    }
+    let mut out =
+        BandTerms { l_path: vec![0.0; nc * nb], t_ed: vec![0.0; nc * nb], spherical_albedo: vec![0.0; nc * nb] };
+    for c in 0..nc {
+        let s1 = sampled.partition_point(|&x| x < c).clamp(1, sampled.len() - 1);
+        let (a, z) = (sampled[s1 - 1], sampled[s1]);
+        let t = if z > a { (c - a) as f64 / (z - a) as f64 } else { 0.0 };
+        for b in 0..nb {
+            let (i0, i1, o) = ((s1 - 1) * nb + b, s1 * nb + b, c * nb + b);
+            out.l_path[o] = at_sampled.l_path[i0] + t * (at_sampled.l_path[i1] - at_sampled.l_path[i0]);
+            out.t_ed[o] = at_sampled.t_ed[i0] + t * (at_sampled.t_ed[i1] - at_sampled.t_ed[i0]);
+            out.spherical_albedo[o] = at_sampled.spherical_albedo[i0]
+                + t * (at_sampled.spherical_albedo[i1] - at_sampled.spherical_albedo[i0]);
+        }
+    }
+    Ok(out)
+}
+
+/// Columns at which [`band_terms`] computes the family's terms when it may interpolate.
+pub const TERM_COLUMNS: usize = 33;
+
+/// The family's atmospheres: one LUT per model and AOT node (the τ = 0 Rayleigh atmosphere
+/// shared), over a run's LUT axes. Independent of the instrument's bands beyond the axes, so
+/// two instruments over the same scene share it.
+#[derive(Debug, Clone)]
+pub struct FamilyLuts {
+    /// The models.
+    pub models: Vec<AerosolType>,
+    /// AOT(550) nodes, the first 0.
+    pub aot550: Vec<f64>,
+    /// Each model's Ångström exponent between 443 and 865 nm.
+    pub angstrom: Vec<f64>,
+    /// `luts[m][k]`.
+    pub luts: Vec<Vec<std::sync::Arc<AtmosphereLut>>>,
+}
+
+impl FamilyLuts {
+    /// Build the family's LUTs: `atmosphere` is the scene's (its aerosol and AOT replaced by
+    /// each member's), `axes` the run's LUT axes.
+    pub fn build(
+        settings: &ImageCorrection,
+        atmosphere: &AtmosphereSpec,
+        axes: &LutAxes,
+        control: &RunControl,
+    ) -> Result<Self, CorrectionError> {
+        settings.validate()?;
+        let fail = |e: String| invalid("correction.image", e);
+        let lut_of = |aerosol: AerosolType, aot: f64| -> Result<std::sync::Arc<AtmosphereLut>, CorrectionError> {
+            if control.cancelled() {
+                return Err(CorrectionError::Cancelled);
+            }
+            let spec = AtmosphereSpec { aerosol, aot550: aot, ..atmosphere.clone() };
+            let built = spec.build().map_err(|e| fail(e.to_string()))?;
+            Ok(std::sync::Arc::new(AtmosphereLut::build(&built, axes.clone()).map_err(|e| fail(e.to_string()))?))
+        };
+        let mut aot550 = vec![0.0];
+        aot550.extend_from_slice(&settings.aot_nodes);
+        // τ = 0 is the same Rayleigh atmosphere for every model: built once.
+        let rayleigh = lut_of(AerosolType::None, 0.0)?;
+        let mut luts = Vec::with_capacity(settings.models.len());
+        let mut angstrom = Vec::with_capacity(settings.models.len());
+        for &m in &settings.models {
+            let mut row = vec![rayleigh.clone()];
+            for &t in &settings.aot_nodes {
+                row.push(lut_of(m, t)?);
+            }
+            luts.push(row);
+            let built = AtmosphereSpec { aerosol: m, aot550: 1.0, ..atmosphere.clone() }
+                .build()
+                .map_err(|e| fail(e.to_string()))?;
+            let tau = |nm: f64| -> Result<f64, CorrectionError> {
+                Ok(built.column(nm).map_err(|e| fail(e.to_string()))?.aerosol.map_or(0.0, |a| a.0))
+            };
+            angstrom.push(-(tau(865.0)? / tau(443.0)?).ln() / (865.0f64 / 443.0).ln());
+        }
+        Ok(Self { models: settings.models.clone(), aot550, angstrom, luts })
+    }
+}
+
+impl AerosolFamily {
+    /// The family's band terms over an instrument's geometry and bands.
+    pub fn tabulate(
+        luts: &FamilyLuts,
+        scene: &Scene,
+        response: &Response,
+        viewing: &Viewing,
+        control: &RunControl,
+    ) -> Result<Self, CorrectionError> {
+        let terms_of = |lut: &std::sync::Arc<AtmosphereLut>| -> Result<BandTerms, CorrectionError> {
+            if control.cancelled() {
+                return Err(CorrectionError::Cancelled);
+            }
+            let optics = response
+                .groups
+                .iter()
+                .map(|g| SceneOptics::new(scene, &g.grid, lut.clone()))
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(|e| invalid("correction.image", e.to_string()))?;
+            band_terms(&optics, viewing, response)
+        };
+        let rayleigh = terms_of(&luts.luts[0][0])?;
+        let mut terms = Vec::with_capacity(luts.models.len());
+        for row in &luts.luts {
+            let mut out = vec![rayleigh.clone()];
+            for lut in &row[1..] {
+                out.push(terms_of(lut)?);
+            }
+            terms.push(out);
+        }
+        Ok(Self {
+            models: luts.models.clone(),
+            aot550: luts.aot550.clone(),
+            angstrom: luts.angstrom.clone(),
+            n_bands: response.n_bands(),
+            terms,
+        })
+    }
+}
