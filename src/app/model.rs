@@ -167,6 +167,9 @@ pub struct AppState {
     pub calibration: crate::calibration::CalibrationSpec,
     /// The radiance the SNR is stated at (`None`: the scene's median water radiance).
     pub snr_reference: Option<crate::spectral::SpectrumSource>,
+    /// The atmospheric correction of both instruments: exact, the paper's per-scene
+    /// approximation, or image-based from a band pair.
+    pub correction: crate::correction::CorrectionSpec,
 }
 
 impl Default for AppState {
@@ -222,6 +225,7 @@ impl AppState {
             preview_only: false,
             calibration: crate::calibration::CalibrationSpec::default(),
             snr_reference: None,
+            correction: crate::correction::CorrectionSpec::default(),
         }
     }
 
@@ -264,6 +268,7 @@ impl AppState {
         s.fidelity = Fidelity { decimation: 1, ..first.2.fidelity.clone() };
         s.calibration = first.2.calibration.clone();
         s.snr_reference = first.2.snr_reference.clone();
+        s.correction = first.2.correction.clone();
         Ok(s)
     }
 
@@ -339,6 +344,7 @@ impl AppState {
                 c.retrievals = vec![self.retrieval_spec()];
                 c.calibration = self.calibration.clone();
                 c.snr_reference.clone_from(&self.snr_reference);
+                c.correction = self.correction.clone();
                 c
             })
             .collect()

@@ -123,7 +123,8 @@ impl StudyResult {
             seeds: vec![first.seed],
             detector: None,
             calibration: None,
-            correction: None,
+            correction: (first.correction != crate::correction::CorrectionSpec::default())
+                .then(|| first.correction.clone()),
             fidelity: None,
             requirements,
             snr_reference: first.snr_reference.clone(),

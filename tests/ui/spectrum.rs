@@ -1,5 +1,6 @@
 //! A click on a map opens the scene's spectrum at that point, with both instruments' bands; a
 //! change of A asks again of the new run (the window never shows a run no longer on screen).
+//! The atmospheric correction chosen in the app reaches both runs.
 
 use std::time::{Duration, Instant};
 
@@ -54,5 +55,24 @@ fn a_click_on_a_map_shows_the_spectrum_there() {
     assert!(h.query_by_label_contains("Water at (").is_none(), "the previous run's spectrum stays up");
     wait_for_engine(&mut h);
     wait_for_text(&mut h, "Water at (");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn the_image_based_correction_set_in_the_app_reaches_both_runs() {
+    let dir = temp_library("imagecorr");
+    let mut h = harness("cubesat", 8, &dir);
+    wait_for_engine(&mut h);
+    assert!(h.state().link.shown[0].as_ref().unwrap().output.correction.aerosol.is_none(), "exact by default");
+    // What the scene panel's "Atmospheric correction" choice sets.
+    h.state_mut().state.correction.image = Some(shoal::correction::ImageCorrection::default());
+    h.step();
+    wait_for_engine(&mut h);
+    for i in 0..2 {
+        let out = &h.state().link.shown[i].as_ref().unwrap().output;
+        let aerosol = out.correction.aerosol.as_ref().expect("the image-based correction ran");
+        assert!(aerosol.aot550.iter().any(|v| v.is_finite() && *v > 0.0));
+        assert_eq!(out.config.correction.image.as_ref().unwrap().pair_nm, [779.0, 865.0]);
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }
