@@ -96,6 +96,7 @@ pub const PRESETS: &[Asset] = embed_presets![
     "studies/paper_lake_hume.ron",
     "studies/reef_survey_depth.ron",
     "sweeps/aperture_lake_hume.ron",
+    "sweeps/nir_snr_sweep.ron",
 ];
 
 /// Names of the built-in presets in `folder` (`"instruments"`, `"scenes"`, …), in embedding order.

@@ -120,7 +120,16 @@ pub fn atmosphere_seconds(config: &RunConfig) -> f64 {
     let layers = (column_depth(config) / acc.max_layer_depth).ceil().max(acc.min_layers as f64);
     let streams = acc.streams as f64;
     let orders = (acc.max_orders as f64).min(ORDERS_COUNTED);
-    RT_OVERHEAD_S + layers * streams * streams * acc.fourier_terms as f64 * orders * SECONDS_PER_RT_WORK
+    let one = RT_OVERHEAD_S + layers * streams * streams * acc.fourier_terms as f64 * orders * SECONDS_PER_RT_WORK;
+    // The image-based correction solves one more atmosphere per model and AOT node, and the
+    // shared Rayleigh one; their columns are no deeper than the family's largest AOT.
+    let family = config.correction.image.as_ref().map_or(0.0, |i| {
+        let deepest = i.aot_nodes.iter().copied().fold(0.0, f64::max);
+        let layers = ((1.3 + 3.0 * deepest) / acc.max_layer_depth).ceil().max(acc.min_layers as f64);
+        let each = RT_OVERHEAD_S + layers * streams * streams * acc.fourier_terms as f64 * orders * SECONDS_PER_RT_WORK;
+        (i.models.len() * i.aot_nodes.len() + 1) as f64 * each
+    });
+    one + family
 }
 
 /// The solver's memory: per level, the scattering kernel of every pair of quadrature streams

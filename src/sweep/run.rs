@@ -73,6 +73,23 @@ pub fn run_job(
     let (r, c, b) = out.level0.dn.dim();
     let saturated_pct = 100.0 * out.report.saturated as f64 / (r * c * b).max(1) as f64;
     let mut rows = Vec::new();
+    // With an image-based correction, its own error: Rrs at 400–560 nm against the truth.
+    if let Some(m) = out.correction.family.as_ref().and_then(|_| rrs_error(&out, 400.0, 560.0)) {
+        rows.push(Row {
+            job: job.index,
+            point: job.point,
+            values: job.values.clone(),
+            instrument: label.clone(),
+            seed: job.seed,
+            product: "correction".into(),
+            variable: "rrs_400_560".into(),
+            mae_pct: m.mae_pct(),
+            bias_pct: m.bias_pct(),
+            returned_pct: m.returned_pct,
+            n: m.n,
+            saturated_pct,
+        });
+    }
     for ret in &out.retrievals {
         for v in &ret.metrics.variables {
             rows.push(Row {
@@ -124,4 +141,35 @@ pub fn run_sweep(
         on_job(job.index, secs);
     }
     Ok(SweepResult { table, seconds })
+}
+
+/// Log-space error (Seegers et al. 2018, as ACIX-Aqua reports Rrs: Pahlevan et al. 2021) of the
+/// corrected Rrs against the true band Rrs, over every water pixel and band centred in
+/// `lo_nm`–`hi_nm`; a non-positive or flagged value counts as not returned.
+fn rrs_error(out: &crate::engine::RunOutput, lo_nm: f64, hi_nm: f64) -> Option<crate::metrics::Metrics> {
+    let bands: Vec<usize> = out
+        .response
+        .bands
+        .bands
+        .iter()
+        .enumerate()
+        .filter(|(_, b)| (lo_nm..=hi_nm).contains(&b.centre_nm))
+        .map(|(i, _)| i)
+        .collect();
+    let (rows, cols, _) = out.correction.rrs.rrs.dim();
+    let truth = &out.radiance.truth;
+    let (mut retrieved, mut expected) = (Vec::new(), Vec::new());
+    for r in 0..rows {
+        for c in 0..cols {
+            if !truth.is_water(r, c) {
+                continue;
+            }
+            for &b in &bands {
+                let ok = out.correction.rrs.flags[[r, c, b]] & crate::correction::RrsFlags::INVALID == 0;
+                retrieved.push(ok.then(|| f64::from(out.correction.rrs.rrs[[r, c, b]])));
+                expected.push(Some(f64::from(truth.rrs_above[[r, c, b]])));
+            }
+        }
+    }
+    (!bands.is_empty()).then(|| crate::metrics::compare(&retrieved, &expected))
 }
