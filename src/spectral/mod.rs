@@ -16,13 +16,15 @@
 //! - ESA (2016) Sentinel-3 OLCI spectral response functions, `S3A_OL_SRF_20160713_mean_rsr`.
 //! - ESA (2024) Sentinel-2 Spectral Response Functions, COPE-GSEG-EOPG-TN-15-0007 v4.0.
 
+mod averager;
 mod bands;
 mod grid;
 mod source;
 mod spectrum;
 mod table;
 
-pub use bands::{Band, BandAverager, BandSet, BandSetSpec, GaussianBand, Platform};
+pub use averager::BandAverager;
+pub use bands::{Band, BandSet, BandSetSpec, GaussianBand, Platform};
 pub use grid::WavelengthGrid;
 pub use source::SpectrumSource;
 pub use spectrum::{Extrapolation, Spectrum};

@@ -14,8 +14,10 @@ fn a_gain_change_reruns_only_digitisation_onward() {
     let mut engine = Engine::new();
     let mut config = RunConfig::new(small_lake(), small("nominal", 64, 48));
     let first = engine.run(&config, &RunControl::new()).unwrap();
-    // Every stage ran once, except the retrieval and its model: none is configured.
-    let retrieval = |s: Stage| matches!(s, Stage::Retrieval | Stage::RetrievalModel);
+    // Every stage ran once, except the retrieval and its model (none is configured) and the
+    // image-based correction's family (the correction is exact).
+    let retrieval =
+        |s: Stage| matches!(s, Stage::Retrieval | Stage::RetrievalModel | Stage::AerosolLuts | Stage::AerosolFamily);
     assert!(Stage::ALL.iter().all(|&s| engine.executions(s) == u64::from(!retrieval(s))), "{:?}", counts(&engine));
 
     config.instrument.gain_e_per_dn = 2.0;
@@ -31,7 +33,7 @@ fn a_gain_change_reruns_only_digitisation_onward() {
             | Stage::Level1
             | Stage::Correction
             | Stage::Snr => 2,
-            Stage::RetrievalModel | Stage::Retrieval => 0,
+            Stage::RetrievalModel | Stage::Retrieval | Stage::AerosolLuts | Stage::AerosolFamily => 0,
             // Never the scene, the atmosphere or the photon counts.
             _ => 1,
         };
@@ -212,4 +214,23 @@ fn after_a_change_of_any_one_field_a_warm_engine_returns_what_a_fresh_one_does()
         // And back: the base products again, from the cache.
         assert!(fingerprint(&warm.run(&base, &RunControl::new()).unwrap()) == before, "{field}: back to the base");
     }
+}
+
+#[test]
+fn the_image_based_correction_keeps_its_family_across_gain_and_true_aerosol_changes() {
+    let mut engine = Engine::new();
+    let mut config = RunConfig::new(small_lake(), small("cubesat", 48, 32));
+    config.correction.image = Some(shoal::correction::ImageCorrection::default());
+    engine.run(&config, &RunControl::new()).unwrap();
+    // A gain change reruns the correction, not its family.
+    config.instrument.gain_e_per_dn = 2.0;
+    engine.run(&config, &RunControl::new()).unwrap();
+    assert_eq!(engine.executions(Stage::Correction), 2);
+    assert_eq!((engine.executions(Stage::AerosolLuts), engine.executions(Stage::AerosolFamily)), (1, 1));
+    // The scene's true AOT rebuilds the scene's LUT, not the family's atmospheres (the
+    // processor does not know the truth).
+    config.scene.atmosphere.aot550 = 0.2;
+    engine.run(&config, &RunControl::new()).unwrap();
+    assert_eq!(engine.executions(Stage::Lut), 2);
+    assert_eq!(engine.executions(Stage::AerosolLuts), 1);
 }

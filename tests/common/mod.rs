@@ -37,6 +37,12 @@ pub fn sweep_path(path: &str) -> String {
     // The dark-current laws: the first plane's doubles ([`with_dark_laws`]), the SWIR plane's is
     // Arrhenius.
     let path = path.replace("[i]", index).replace("focal_planes[]", "focal_planes.0");
+    // The image-based correction's lists: the pair's long band, the AOT node 0.2.
+    let path = match path.as_str() {
+        "correction.image.pair_nm" => "correction.image.pair_nm.1".to_string(),
+        "correction.image.aot_nodes" => "correction.image.aot_nodes.2".to_string(),
+        _ => path,
+    };
     match path.strip_prefix("instrument.dark_temperature.law.Arrhenius") {
         Some(rest) => format!("instrument.focal_planes.0.dark_temperature.law.Arrhenius{rest}"),
         None => path,
