@@ -93,6 +93,23 @@ fn refusal(range: &Range, value: f64) -> Option<String> {
         map(&mut spec, value);
         return Scene::build(&spec, None).err().map(|e| e.to_string());
     }
+    if range.path.starts_with("correction.image") {
+        // The image-based correction's lists: the pair's ends with the other end where it
+        // leaves the pair ordered (600 … 2500 nm), an AOT node as the table's only node.
+        let mut image = shoal::correction::ImageCorrection::default();
+        if range.path == "correction.image.pair_nm" {
+            image.pair_nm = if value < 1500.0 { [value, 2500.0] } else { [600.0, value] };
+        } else {
+            image.aot_nodes = vec![value];
+        }
+        let mut config = base("scene.chl_mg_m3");
+        config.correction.image = Some(image);
+        return match config.validate() {
+            Ok(()) => None,
+            Err(EngineError::Failed { message, .. }) => Some(message),
+            Err(other) => panic!("{}: not a refusal: {other}", range.path),
+        };
+    }
     let mut config = shoal::sweep::apply(&base(range.path), &[(&sweep_path(range.path), value)]).unwrap();
     if range.path == "instrument.bias_dn" {
         // The offset's range is that of the widest ADC; a narrower one refuses less (tested in
