@@ -146,6 +146,16 @@ pub fn settings_for(base: &RunConfig) -> Vec<Setting> {
         ]),
         _ => {}
     }
+    // The image-based correction (the aerosol from the design's 779/865 nm bands) priced beside
+    // the exact one, where the design has the pair.
+    let centres = crate::instrument::Response::new(&base.instrument, base.fidelity.spectral_step_nm)
+        .map(|r| r.bands.centres_nm())
+        .unwrap_or_default();
+    if base.correction.image.is_none() && crate::correction::ImageCorrection::default().pair(&centres).is_ok() {
+        out.push(e("image-based correction (779/865 nm)", |c| {
+            c.correction.image = Some(crate::correction::ImageCorrection::default());
+        }));
+    }
     out.push(s(
         "fast: 2 nm, LUT 40 nm, 8 streams",
         vec![
