@@ -360,6 +360,8 @@ ranges! {
     REQUIREMENT_RETURNED_PCT = Range::closed("requirements.products[i].returned_pct", 0.0, 100.0, "%", "smallest share of water pixels retrieved");
     /// Smallest share of pixels whose dominant substrate is right.
     REQUIREMENT_SUBSTRATE_PCT = Range::closed("requirements.substrate_pct", 0.0, 100.0, "%", "smallest share of returned water pixels whose dominant substrate is the truth's");
+    /// Largest allowed corrected-Rrs error per band.
+    REQUIREMENT_RRS_MAE_PCT = Range::closed("requirements.rrs.mae_pct", 0.0, 1e4, "%", "largest log-space MAE of the corrected Rrs in every band centred from `from_nm` to `to_nm` (default 400–560 nm)");
     /// Smallest SNR.
     REQUIREMENT_SNR = Range::above("requirements.snr", 0.0, 1e6, "", "smallest SNR of every band at the typical radiance").below_hi();
 }

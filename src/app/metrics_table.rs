@@ -159,7 +159,13 @@ pub(super) fn metrics_table(app: &ShoalApp, ui: &mut egui::Ui, configs: &[crate:
         .map(|c| {
             c.run().map_or_else(Vec::new, |o| {
                 let metrics = o.retrievals.first().map(|r| &r.metrics);
-                app.state.requirements.check_run(&o.config.instrument.name, o.config.seed, metrics, &o.snr)
+                app.state.requirements.check_run(
+                    &o.config.instrument.name,
+                    o.config.seed,
+                    metrics,
+                    &o.snr,
+                    &o.correction.rrs_metrics,
+                )
             })
         })
         .collect();

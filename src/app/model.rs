@@ -56,6 +56,7 @@ pub fn fallback_requirements() -> Requirements {
         ],
         snr: Some(100.0),
         substrate_pct: Some(70.0),
+        rrs: None,
     }
 }
 

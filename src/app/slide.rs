@@ -126,7 +126,13 @@ fn verdict_table(state: &AppState, a: &RunOutput, b: &RunOutput) -> Vec<Vec<Stri
         .iter()
         .map(|out| {
             let metrics = out.retrievals.first().map(|r| &r.metrics);
-            state.requirements.check_run(&out.config.instrument.name, out.config.seed, metrics, &out.snr)
+            state.requirements.check_run(
+                &out.config.instrument.name,
+                out.config.seed,
+                metrics,
+                &out.snr,
+                &out.correction.rrs_metrics,
+            )
         })
         .collect();
     let judged = |checks: &[crate::study::Check], variable: Option<&str>| {

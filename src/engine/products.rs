@@ -29,6 +29,8 @@ pub struct CorrectionProduct {
     pub approximation_vs_exact: Vec<crate::correction::BandDifference>,
     /// Per band: delivered Rrs against the truth.
     pub rrs_vs_truth: Vec<crate::correction::BandDifference>,
+    /// Per band: the delivered Rrs against the truth, log-space metrics.
+    pub rrs_metrics: Vec<crate::correction::BandRrsMetrics>,
     /// What the image-based correction found (AOT and Ångström per pixel), when it ran.
     pub aerosol: Option<crate::correction::AerosolRetrieval>,
     /// The image-based correction's aerosol family and the pair of bands (short, long) it

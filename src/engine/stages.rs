@@ -361,7 +361,23 @@ impl Engine {
             };
             let rrs_vs_truth = if against_truth { compare(&rrs, &radiance.truth.rrs_above, None) } else { Vec::new() };
             let family = family.as_ref().map(|(f, pair, _)| (f.clone(), *pair));
-            Ok(CorrectionProduct { rrs, approximation, approximation_vs_exact, rrs_vs_truth, aerosol, family })
+            let names: Vec<String> = side.response.bands.bands.iter().map(|b| b.name.clone()).collect();
+            let rrs_metrics = crate::correction::band_rrs_metrics(
+                &rrs,
+                &radiance.truth.rrs_above,
+                &radiance.truth.land,
+                &names,
+                &side.response.bands.centres_nm(),
+            );
+            Ok(CorrectionProduct {
+                rrs,
+                approximation,
+                approximation_vs_exact,
+                rrs_vs_truth,
+                rrs_metrics,
+                aerosol,
+                family,
+            })
         })?;
         report.approximation = Some(correction.approximation.clone());
         report.approximation_vs_exact = correction.approximation_vs_exact.clone();

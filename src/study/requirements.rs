@@ -53,6 +53,32 @@ pub struct Requirements {
     /// retrieval that unmixes substrates; checked as the variable `substrate`).
     #[serde(default)]
     pub substrate_pct: Option<f64>,
+    /// Largest log-space MAE of the corrected Rrs against the truth in every band of a range
+    /// (as ACIX-Aqua states atmospheric-correction performance: Pahlevan et al. 2021).
+    #[serde(default)]
+    pub rrs: Option<RrsRequirement>,
+}
+
+/// The corrected Rrs's error per band, in the bands centred from `from_nm` to `to_nm`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RrsRequirement {
+    /// Largest log-space MAE, %.
+    pub mae_pct: f64,
+    /// First band centre judged, nm.
+    #[serde(default = "default_rrs_from_nm")]
+    pub from_nm: f64,
+    /// Last band centre judged, nm.
+    #[serde(default = "default_rrs_to_nm")]
+    pub to_nm: f64,
+}
+
+fn default_rrs_from_nm() -> f64 {
+    400.0
+}
+
+fn default_rrs_to_nm() -> f64 {
+    560.0
 }
 
 /// One check.
@@ -138,6 +164,17 @@ impl Requirements {
         {
             return bad("requirements.substrate_pct".into(), message);
         }
+        if let Some(r) = &self.rrs {
+            if let Err(message) = crate::ranges::REQUIREMENT_RRS_MAE_PCT.check(r.mae_pct) {
+                return bad("requirements.rrs.mae_pct".into(), message);
+            }
+            if !(350.0..=2500.0).contains(&r.from_nm) || !(r.from_nm..=2500.0).contains(&r.to_nm) {
+                return bad(
+                    "requirements.rrs.from_nm, to_nm".into(),
+                    format!("{} to {} nm (allowed: 350 ≤ from_nm ≤ to_nm ≤ 2500)", r.from_nm, r.to_nm),
+                );
+            }
+        }
         Ok(())
     }
 
@@ -156,7 +193,7 @@ impl Requirements {
             .iter()
             .flat_map(|run| {
                 let metrics = run.retrievals.first().map(|r| &r.metrics);
-                self.check_run(&run.label, run.seed, metrics, &run.snr)
+                self.check_run(&run.label, run.seed, metrics, &run.snr, &run.rrs_metrics)
             })
             .collect()
     }
@@ -165,7 +202,14 @@ impl Requirements {
     /// does not make is skipped: it has no candidate pixels to judge), and the SNR floor against
     /// every band of `snr`.
     #[must_use]
-    pub fn check_run(&self, label: &str, seed: u64, metrics: Option<&ProductMetrics>, snr: &[SnrRow]) -> Vec<Check> {
+    pub fn check_run(
+        &self,
+        label: &str,
+        seed: u64,
+        metrics: Option<&ProductMetrics>,
+        snr: &[SnrRow],
+        rrs: &[crate::correction::BandRrsMetrics],
+    ) -> Vec<Check> {
         let mut out = Vec::new();
         let mut push = |variable: Option<&str>, what: String, value: Option<f64>, limit: f64, upper: bool| {
             let margin = value.map(|v| if upper { limit - v } else { v - limit });
@@ -202,6 +246,13 @@ impl Requirements {
         }
         if let (Some(l), Some(a)) = (self.substrate_pct, metrics.and_then(|m| m.substrate_agreement_pct)) {
             push(Some("substrate"), "substrate right %".into(), Some(a), l, false);
+        }
+        if let Some(req) = &self.rrs {
+            for band in rrs.iter().filter(|b| (req.from_nm..=req.to_nm).contains(&b.centre_nm)) {
+                let m = &band.metrics;
+                let what = format!("Rrs {} ({:.0} nm) MAE %", band.band, band.centre_nm);
+                push(None, what, (m.n > 0).then(|| m.mae_pct()), req.mae_pct, true);
+            }
         }
         if let Some(l) = self.snr {
             for row in snr {
@@ -276,6 +327,7 @@ mod tests {
             }],
             snr: None,
             substrate_pct: None,
+            rrs: None,
         }
     }
 
@@ -284,7 +336,7 @@ mod tests {
         // The metrics of an empty product read MAE 0 %, bias 0 %: the false pass this guards.
         let empty = product("chl_mg_m3", compare(&[None, None, None], &[Some(1.0), Some(2.0), Some(3.0)]));
         assert_eq!(empty.get("chl_mg_m3").unwrap().mae_pct(), 0.0);
-        let checks = chl_limits(None).check_run("A", 1, Some(&empty), &[]);
+        let checks = chl_limits(None).check_run("A", 1, Some(&empty), &[], &[]);
         assert_eq!(checks.len(), 2);
         for c in &checks {
             assert!(!c.pass && c.value.is_none() && c.margin.is_none(), "{c:?}");
@@ -300,13 +352,13 @@ mod tests {
         // Retrieved 1.05× the truth on 3 of 4 pixels: MAE = bias = 5 %, 75 % returned.
         let m = compare(&[Some(1.05), Some(2.1), Some(3.15), None], &[Some(1.0), Some(2.0), Some(3.0), Some(4.0)]);
         let p = product("chl_mg_m3", m);
-        let checks = chl_limits(Some(70.0)).check_run("A", 1, Some(&p), &[]);
+        let checks = chl_limits(Some(70.0)).check_run("A", 1, Some(&p), &[], &[]);
         let values: Vec<(bool, f64)> = checks.iter().map(|c| (c.pass, c.margin.unwrap())).collect();
         assert!((values[0].1 - 15.0).abs() < 1e-9 && values[0].0, "MAE 5 % under 20 %: {values:?}");
         assert!((values[1].1 - 5.0).abs() < 1e-9 && values[1].0, "|bias| 5 % under 10 %: {values:?}");
         assert!((values[2].1 - 5.0).abs() < 1e-9 && values[2].0, "75 % returned over 70 %: {values:?}");
         assert_eq!(verdict(&checks), Some(true));
-        let checks = chl_limits(Some(80.0)).check_run("A", 1, Some(&p), &[]);
+        let checks = chl_limits(Some(80.0)).check_run("A", 1, Some(&p), &[], &[]);
         assert_eq!(verdict(&checks), Some(false), "75 % returned under an 80 % floor fails");
         assert_eq!(verdict(&[]), None, "nothing checked: no verdict");
     }

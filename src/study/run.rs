@@ -29,6 +29,8 @@ pub struct StudyRun {
     pub frame: Option<crate::scene::GeoFrame>,
     /// The design's feasibility figures (f-number, smear, Q, peak signal).
     pub feasibility: Arc<crate::instrument::feasibility::Feasibility>,
+    /// Per band: the corrected Rrs against the truth (log-space).
+    pub rrs_metrics: Vec<crate::correction::BandRrsMetrics>,
 }
 
 /// All runs of a study.
@@ -97,6 +99,7 @@ impl StudyRun {
             viewing: Arc::clone(&out.viewing),
             feasibility: Arc::clone(&out.feasibility),
             frame: out.scene.frame.clone(),
+            rrs_metrics: out.correction.rrs_metrics.clone(),
         }
     }
 }

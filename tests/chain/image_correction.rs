@@ -144,3 +144,22 @@ fn a_gain_error_at_865_nm_reaches_443_nm_as_the_extrapolation_predicts() {
     assert!(measured < 0.0, "an over-read 865 nm band over-corrects the blue");
     assert!((measured / predicted - 1.0).abs() < 0.10, "measured {measured:e}, predicted {predicted:e}");
 }
+
+#[test]
+fn an_rrs_requirement_judges_each_band_of_its_range() {
+    let out = run(&clear_water(AerosolType::Continental, 0.15));
+    let req: shoal::study::Requirements = ron::from_str("(rrs: Some((mae_pct: 5)))").unwrap();
+    req.validate().unwrap();
+    let checks = req.check_run("A", 1, None, &out.snr, &out.correction.rrs_metrics);
+    // Every band centred from 400 to 560 nm: OLCI Oa01–Oa05 (Oa06's SRF centroid is at
+    // 560.45 nm), each within 5 % here: the closure's Rrs errors are below 1.5 % at these bands.
+    assert_eq!(checks.len(), 5, "{checks:?}");
+    assert!(checks.iter().all(|c| c.pass && c.what.starts_with("Rrs Oa0")), "{checks:?}");
+    let strict: shoal::study::Requirements =
+        ron::from_str("(rrs: Some((mae_pct: 0.01, from_nm: 600, to_nm: 700)))").unwrap();
+    let checks = strict.check_run("A", 1, None, &out.snr, &out.correction.rrs_metrics);
+    assert!(!checks.is_empty() && checks.iter().all(|c| !c.pass));
+    let bad: shoal::study::Requirements = ron::from_str("(rrs: Some((mae_pct: 5, from_nm: 700, to_nm: 600)))").unwrap();
+    let e = bad.validate().unwrap_err().to_string();
+    assert!(e.contains("requirements.rrs") && e.contains("700"), "{e}");
+}

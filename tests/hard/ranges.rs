@@ -40,6 +40,10 @@ fn refusal(range: &Range, value: f64) -> Option<String> {
     };
     if range.path.starts_with("requirements.") {
         let mut r: Requirements = ron::from_str("(products: [(variable: \"chl_mg_m3\")])").unwrap();
+        if range.path == "requirements.rrs.mae_pct" {
+            r.rrs = Some(shoal::study::RrsRequirement { mae_pct: value, from_nm: 400.0, to_nm: 560.0 });
+            return r.validate().err().map(|e| e.to_string());
+        }
         match range.name() {
             "mae_pct" => r.products[0].mae_pct = Some(value),
             "bias_pct" => r.products[0].bias_pct = Some(value),

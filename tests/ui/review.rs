@@ -111,7 +111,7 @@ fn a_saturating_design_fails_its_snr_verdict() {
     assert!(a.snr.iter().all(shoal::instrument::SnrRow::saturated), "2000 mm saturates every band");
     assert!(h.query_all_by_label_contains("19 saturated").next().is_some(), "the SNR row says so");
     // A's SNR verdict fails; B (the SmallSat, unchanged) keeps its own.
-    let snr_checks = h.state().state.requirements.check_run("a", 1, None, &a.snr);
+    let snr_checks = h.state().state.requirements.check_run("a", 1, None, &a.snr, &[]);
     assert!(snr_checks.iter().all(|c| !c.pass && c.what.contains("saturated")), "{snr_checks:?}");
     let _ = std::fs::remove_dir_all(&dir);
 }
