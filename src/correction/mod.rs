@@ -436,9 +436,10 @@ pub struct BandRrsMetrics {
     pub metrics: crate::metrics::Metrics,
 }
 
-/// Per band, `rrs` against `truth` over the water pixels of `land` (at most [`MEDIAN_SAMPLES`]
-/// evenly strided pixels per band: the log-space MAE of 200 000 pixels is within a fraction of
-/// a per cent of all of them), one band per task.
+/// Per band, `rrs` against `truth` over the water pixels of `land`: at most [`RRS_SAMPLES`]
+/// evenly strided pixels per band (the log-space MAE is a mean: over 20 000 pixels its standard
+/// error is under 1 % of itself, 0.1 points at an MAE of 10 %; all of Lake Hume's 1.5 M
+/// pixels took 0.23 s per run), one band per task.
 #[must_use]
 pub fn band_rrs_metrics(
     rrs: &Reflectance,
@@ -450,7 +451,7 @@ pub fn band_rrs_metrics(
     let (rows, cols, nb) = rrs.rrs.dim();
     let water: Vec<(usize, usize)> =
         (0..rows).flat_map(|r| (0..cols).map(move |c| (r, c))).filter(|&(r, c)| land[[r, c]] == 0).collect();
-    let stride = (water.len() / MEDIAN_SAMPLES).max(1);
+    let stride = (water.len() / RRS_SAMPLES).max(1);
     (0..nb)
         .into_par_iter()
         .map(|b| {
@@ -468,3 +469,6 @@ pub fn band_rrs_metrics(
         })
         .collect()
 }
+
+/// Water pixels per band [`band_rrs_metrics`] judges, at most.
+pub const RRS_SAMPLES: usize = 20_000;
