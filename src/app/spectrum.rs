@@ -133,6 +133,14 @@ pub fn spectrum_window(app: &mut ShoalApp, ctx: &egui::Context) {
         }
         let current = w.shown.as_ref().filter(|a| a.from == from && a.pick == pick);
         match current.map(|a| &a.result) {
+            // The clicked instrument has no result of the configuration set (its run failed or
+            // is on its way): nothing is computed from an earlier one.
+            None if from[pick.run].is_none() => {
+                let who = ["A", "B"][pick.run];
+                ui.label(format!(
+                    "{who} has no result of the configuration set (failed or updating): the spectrum follows its run."
+                ));
+            }
             None => {
                 ui.horizontal(|ui| {
                     ui.spinner();

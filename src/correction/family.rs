@@ -1,6 +1,7 @@
 //! The image-based correction's aerosol family ([`super::image`]): one atmosphere per model and
 //! AOT node from Shoal's own radiative transfer, and their band-effective terms over a run's
-//! geometry (the photon-weighted means the forward model uses, Vermote et al. 1997).
+//! geometry (the photon-weighted means the forward model uses, `band_atmosphere::band_means`;
+//! Vermote et al. 1997).
 
 use rayon::prelude::*;
 
@@ -74,22 +75,8 @@ fn band_terms(optics: &[SceneOptics], viewing: &Viewing, response: &Response) ->
                     .enumerate()
                     .map(|(k, &b)| {
                         let (first, w) = response.weights(gi, k, j);
-                        let span = first..first + w.len();
-                        let total: f64 = w.iter().sum();
-                        let l = w.iter().zip(&path.l_path[span.clone()]).map(|(a, x)| a * x).sum::<f64>() / total;
-                        let te: Vec<f64> = w
-                            .iter()
-                            .zip(&path.t_up[span.clone()])
-                            .zip(&path.ed[span.clone()])
-                            .map(|((a, t), e)| a * t * e)
-                            .collect();
-                        let te_sum: f64 = te.iter().sum();
-                        let s = if te_sum > 0.0 {
-                            te.iter().zip(&path.spherical_albedo[span]).map(|(a, s)| a * s).sum::<f64>() / te_sum
-                        } else {
-                            0.0
-                        };
-                        (si * nb + b, l, te_sum / total, s)
+                        let m = crate::instrument::band_atmosphere::band_means(&path, first, w);
+                        (si * nb + b, m.l_path, m.t_ed, m.spherical_albedo)
                     })
                     .collect())
             })

@@ -36,6 +36,7 @@
 
 mod cache;
 mod config;
+mod correction_stage;
 mod fault;
 mod files;
 mod keys;

@@ -7,7 +7,7 @@ use std::sync::Arc;
 use super::cache::{Key, KeyBuilder, Stage};
 use super::files;
 use super::keys::Inputs;
-use super::products::{CorrectionProduct, InstrumentSide, SceneSide};
+use super::products::{InstrumentSide, SceneSide};
 use super::report::{RunReport, SkippedEffect};
 use super::run::Engine;
 use super::{EngineError, RunConfig};
@@ -15,7 +15,6 @@ use crate::atmosphere::{AtmosphereLut, LutAxes};
 use crate::calibration::{Calibration, band_e0, calibrate};
 use crate::control::Cancellable;
 use crate::control::RunControl;
-use crate::correction::{AerosolFamily, FamilyLuts, SceneApproximation, compare, correct_exact, correct_image};
 use crate::instrument::feasibility::Feasibility;
 use crate::instrument::sample::BandAtmosphere;
 use crate::instrument::{
@@ -27,7 +26,7 @@ use crate::toa::SceneOptics;
 
 /// A stage's error as the engine reports it: cancellation stays cancellation, anything else
 /// names the stage.
-fn failed<E: Cancellable + std::fmt::Display>(stage: Stage) -> impl Fn(E) -> EngineError {
+pub(super) fn failed<E: Cancellable + std::fmt::Display>(stage: Stage) -> impl Fn(E) -> EngineError {
     move |e| {
         if e.is_cancelled() { EngineError::Cancelled } else { EngineError::Failed { stage, message: e.to_string() } }
     }
@@ -255,138 +254,6 @@ impl Engine {
         Ok(InstrumentSide { detector, detector_key, feasibility, level0, calibration, level1, level1_key })
     }
 
-    /// Atmospheric correction: the delivered Rrs and the diagnostics.
-    #[allow(clippy::too_many_arguments)]
-    pub(super) fn correction_stage(
-        &mut self,
-        config: &RunConfig,
-        side: &SceneSide,
-        radiance: &RadianceCube,
-        radiance_key: Key,
-        inst: &InstrumentSide,
-        control: &RunControl,
-        report: &mut RunReport,
-    ) -> Result<(Arc<CorrectionProduct>, Key), EngineError> {
-        let fid = &config.fidelity;
-        let inputs = Inputs::of(config);
-        let (band_atmosphere, band_key, level1, level1_key) =
-            (&side.band_atmosphere, side.band_key, &inst.level1, inst.level1_key);
-        // Atmospheric correction.
-        let correction_key = KeyBuilder::new(Stage::Correction)
-            .after(level1_key)
-            .after(band_key)
-            .after(radiance_key)
-            .with(&config.correction)
-            .with(&inputs.seed)
-            .with(&inputs.decimation)
-            .finish();
-        // The image-based correction's family: its atmospheres once per scene atmosphere and LUT
-        // axes (two instruments with the same axes share them), its band terms once per
-        // instrument geometry. Neither depends on the scene's true aerosol.
-        let family = match &config.correction.image {
-            Some(image) => {
-                let axes = lut_axes(&side.response, &side.viewing, config.scene.sun.zenith_deg, fid);
-                let mut atmosphere = config.scene.atmosphere.clone();
-                atmosphere.day_of_year = side.scene.day_of_year;
-                (atmosphere.aerosol, atmosphere.aot550) = (crate::atmosphere::AerosolType::None, 0.0);
-                let luts_key = KeyBuilder::new(Stage::AerosolLuts).with(&atmosphere).with(&axes).with(image).finish();
-                let luts = self.stage(luts_key, report, control, || {
-                    FamilyLuts::build(image, &atmosphere, &axes, control).map_err(failed(Stage::AerosolLuts))
-                })?;
-                let key = KeyBuilder::new(Stage::AerosolFamily)
-                    .after(luts_key)
-                    .after(side.geometry_key)
-                    .with(&side.scene.spec.effects)
-                    .finish();
-                let fam = self.stage(key, report, control, || {
-                    AerosolFamily::tabulate(&luts, &side.scene, &side.response, &side.viewing, control)
-                        .map_err(failed(Stage::AerosolFamily))
-                })?;
-                let pair = image.pair(&side.response.bands.centres_nm()).map_err(failed(Stage::Correction))?;
-                Some((fam, pair, key))
-            }
-            None => None,
-        };
-        let correction_key = match &family {
-            Some((_, _, key)) => KeyBuilder::new(Stage::Correction).after(correction_key).after(*key).finish(),
-            None => correction_key,
-        };
-        let correction = self.stage(correction_key, report, control, || {
-            let fail = failed(Stage::Correction);
-            let approximation = SceneApproximation::new(
-                &radiance.radiance,
-                &radiance.truth.rrs_above,
-                band_atmosphere,
-                &radiance.truth.land,
-                config.correction.approx_points,
-                config.seed,
-            )
-            .map_err(&fail)?;
-            // A preview computes only the product it shows; the diagnostics (the approximation
-            // against the exact correction, and both against the truth) come with full resolution.
-            let diagnostics = fid.decimation == 1;
-            let image = match &family {
-                Some((fam, pair, _)) => {
-                    Some(correct_image(level1, fam, *pair, &radiance.truth.land, control).map_err(&fail)?)
-                }
-                None => None,
-            };
-            // The image-based product is compared with the truth; the exact and approximate
-            // corrections are not run beside it (`shoal budget` prices the difference).
-            let against_truth = diagnostics;
-            let diagnostics = diagnostics && image.is_none();
-            let exact = if diagnostics || (!config.correction.use_approximation && image.is_none()) {
-                Some(correct_exact(level1, band_atmosphere, &radiance.truth.land, control).map_err(&fail)?)
-            } else {
-                None
-            };
-            let approx = if diagnostics || config.correction.use_approximation {
-                Some(approximation.correct(level1, &radiance.truth.land, control).map_err(&fail)?)
-            } else {
-                None
-            };
-            let approximation_vs_exact = match (&approx, &exact, diagnostics) {
-                (Some(a), Some(e), true) => compare(a, &e.rrs, Some(&e.flags)),
-                _ => Vec::new(),
-            };
-            let (image, aerosol) = image.map_or((None, None), |(r, a)| (Some(r), Some(a)));
-            let rrs = match (image, exact, approx) {
-                (Some(i), _, _) => i,
-                (None, _, Some(a)) if config.correction.use_approximation => a,
-                (None, Some(e), _) => e,
-                (None, None, Some(a)) => a,
-                (None, None, None) => {
-                    return Err(EngineError::Failed { stage: Stage::Correction, message: "no correction ran".into() });
-                }
-            };
-            let rrs_vs_truth = if against_truth { compare(&rrs, &radiance.truth.rrs_above, None) } else { Vec::new() };
-            let family = family.as_ref().map(|(f, pair, _)| (f.clone(), *pair));
-            let names: Vec<String> = side.response.bands.bands.iter().map(|b| b.name.clone()).collect();
-            let rrs_metrics = crate::correction::band_rrs_metrics(
-                &rrs,
-                &radiance.truth.rrs_above,
-                &radiance.truth.land,
-                &names,
-                &side.response.bands.centres_nm(),
-            );
-            Ok(CorrectionProduct {
-                rrs,
-                approximation,
-                approximation_vs_exact,
-                rrs_vs_truth,
-                rrs_metrics,
-                aerosol,
-                family,
-            })
-        })?;
-        report.approximation = Some(correction.approximation.clone());
-        report.approximation_vs_exact = correction.approximation_vs_exact.clone();
-        report.rrs_vs_truth = correction.rrs_vs_truth.clone();
-        report.aerosol =
-            correction.aerosol.as_ref().map(|a| super::report::aerosol_summary(a, &config.scene.atmosphere));
-        Ok((correction, correction_key))
-    }
-
     /// SNR at the scene's typical (median water) radiance.
     pub(super) fn snr_stage(
         &mut self,
@@ -469,7 +336,7 @@ fn reference_radiance(
 /// that bracket a stretch of simulated wavelengths are kept: a SWIR band adds the nodes around
 /// it, not the 1000 nm between it and the visible (interpolation between two nodes uses only
 /// those two, so leaving out the nodes of a gap changes nothing where wavelengths are simulated).
-fn lut_axes(response: &Response, viewing: &Viewing, sun_zenith_deg: f64, fid: &super::Fidelity) -> LutAxes {
+pub(super) fn lut_axes(response: &Response, viewing: &Viewing, sun_zenith_deg: f64, fid: &super::Fidelity) -> LutAxes {
     use crate::ranges::{MAX_SIMULATED_NM, MIN_SIMULATED_NM};
     let step = fid.lut_wavelength_step_nm;
     let mut nodes: Vec<f64> = Vec::new();

@@ -28,6 +28,7 @@
 //! - Schowengerdt, R. A. (2007) Remote Sensing: Models and Methods for Image Processing, 3rd ed.,
 //!   Academic Press, ch. 3 (pushbroom geometry, system PSF = optics ⊗ detector ⊗ motion).
 
+pub mod band_atmosphere;
 pub mod detector;
 pub mod feasibility;
 pub mod focal;

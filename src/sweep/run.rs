@@ -72,40 +72,31 @@ pub fn run_job(
     let secs = start.elapsed().as_secs_f64();
     let (r, c, b) = out.level0.dn.dim();
     let saturated_pct = 100.0 * out.report.saturated as f64 / (r * c * b).max(1) as f64;
+    let row = |product: &str, variable: &str, mae_pct: f64, bias_pct: f64, returned_pct: f64, n: usize| Row {
+        job: job.index,
+        point: job.point,
+        values: job.values.clone(),
+        instrument: label.clone(),
+        seed: job.seed,
+        product: product.into(),
+        variable: variable.into(),
+        mae_pct,
+        bias_pct,
+        returned_pct,
+        n,
+        saturated_pct,
+    };
     let mut rows = Vec::new();
     // With an image-based correction, its own error: Rrs at 400–560 nm against the truth.
-    if let Some(m) = out.correction.family.as_ref().and_then(|_| rrs_error(&out, 400.0, 560.0)) {
-        rows.push(Row {
-            job: job.index,
-            point: job.point,
-            values: job.values.clone(),
-            instrument: label.clone(),
-            seed: job.seed,
-            product: "correction".into(),
-            variable: "rrs_400_560".into(),
-            mae_pct: m.mae_pct(),
-            bias_pct: m.bias_pct(),
-            returned_pct: m.returned_pct,
-            n: m.n,
-            saturated_pct,
-        });
+    if let Some(p) =
+        out.correction.family.as_ref().and_then(|_| pooled_rrs_error(&out.correction.rrs_metrics, 400.0, 560.0))
+    {
+        rows.push(row("correction", "rrs_400_560", p.0, p.1, p.2, p.3));
     }
     for ret in &out.retrievals {
         for v in &ret.metrics.variables {
-            rows.push(Row {
-                job: job.index,
-                point: job.point,
-                values: job.values.clone(),
-                instrument: label.clone(),
-                seed: job.seed,
-                product: ret.metrics.product.clone(),
-                variable: v.variable.clone(),
-                mae_pct: v.metrics.mae_pct(),
-                bias_pct: v.metrics.bias_pct(),
-                returned_pct: v.metrics.returned_pct,
-                n: v.metrics.n,
-                saturated_pct,
-            });
+            let m = &v.metrics;
+            rows.push(row(&ret.metrics.product, &v.variable, m.mae_pct(), m.bias_pct(), m.returned_pct, m.n));
         }
     }
     Ok((rows, secs))
@@ -143,33 +134,27 @@ pub fn run_sweep(
     Ok(SweepResult { table, seconds })
 }
 
-/// Log-space error (Seegers et al. 2018, as ACIX-Aqua reports Rrs: Pahlevan et al. 2021) of the
-/// corrected Rrs against the true band Rrs, over every water pixel and band centred in
-/// `lo_nm`–`hi_nm`; a non-positive or flagged value counts as not returned.
-fn rrs_error(out: &crate::engine::RunOutput, lo_nm: f64, hi_nm: f64) -> Option<crate::metrics::Metrics> {
-    let bands: Vec<usize> = out
-        .response
-        .bands
-        .bands
-        .iter()
-        .enumerate()
-        .filter(|(_, b)| (lo_nm..=hi_nm).contains(&b.centre_nm))
-        .map(|(i, _)| i)
-        .collect();
-    let (rows, cols, _) = out.correction.rrs.rrs.dim();
-    let truth = &out.radiance.truth;
-    let (mut retrieved, mut expected) = (Vec::new(), Vec::new());
-    for r in 0..rows {
-        for c in 0..cols {
-            if !truth.is_water(r, c) {
-                continue;
-            }
-            for &b in &bands {
-                let ok = out.correction.rrs.flags[[r, c, b]] & crate::correction::RrsFlags::INVALID == 0;
-                retrieved.push(ok.then(|| f64::from(out.correction.rrs.rrs[[r, c, b]])));
-                expected.push(Some(f64::from(truth.rrs_above[[r, c, b]])));
-            }
-        }
+/// The corrected Rrs's log-space error (Seegers et al. 2018, as ACIX-Aqua reports Rrs:
+/// Pahlevan et al. 2021) over every band centred in `lo_nm`–`hi_nm`, pooled from the run's
+/// per-band metrics: the pooled mean of |log10 ratio| is the per-band means weighted by their
+/// pixels, so MAE = 10^(Σ n_b·log10 MAE_b / Σ n_b), and the bias alike. (MAE %, bias %,
+/// returned %, pixels); `None` without such a band or pixel.
+fn pooled_rrs_error(
+    bands: &[crate::correction::BandRrsMetrics],
+    lo_nm: f64,
+    hi_nm: f64,
+) -> Option<(f64, f64, f64, usize)> {
+    let judged: Vec<&crate::metrics::Metrics> =
+        bands.iter().filter(|b| (lo_nm..=hi_nm).contains(&b.centre_nm)).map(|b| &b.metrics).collect();
+    let n: usize = judged.iter().map(|m| m.n).sum();
+    let candidates: usize = judged.iter().map(|m| m.candidates).sum();
+    if n == 0 {
+        return None;
     }
-    (!bands.is_empty()).then(|| crate::metrics::compare(&retrieved, &expected))
+    let mean_log = |f: fn(&crate::metrics::Metrics) -> f64| {
+        judged.iter().map(|m| m.n as f64 * f(m).log10()).sum::<f64>() / n as f64
+    };
+    let mae = 10f64.powf(mean_log(|m| m.mae));
+    let bias = 10f64.powf(mean_log(|m| m.bias));
+    Some((100.0 * (mae - 1.0), 100.0 * (bias - 1.0), 100.0 * n as f64 / candidates.max(1) as f64, n))
 }

@@ -1,0 +1,150 @@
+//! The correction stage: Level-1 to Rrs by the exact inversion, the paper's per-scene
+//! approximation or the image-based correction (with its aerosol family, `correction::family`),
+//! and the Rrs against the truth.
+
+use std::sync::Arc;
+
+use super::cache::{Key, KeyBuilder, Stage};
+use super::keys::Inputs;
+use super::products::{CorrectionProduct, InstrumentSide, SceneSide};
+use super::report::RunReport;
+use super::run::Engine;
+use super::stages::{failed, lut_axes};
+use super::{EngineError, RunConfig};
+use crate::control::RunControl;
+use crate::correction::{AerosolFamily, FamilyLuts, SceneApproximation, compare, correct_exact, correct_image};
+use crate::instrument::RadianceCube;
+
+impl Engine {
+    /// Atmospheric correction: the delivered Rrs and the diagnostics.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn correction_stage(
+        &mut self,
+        config: &RunConfig,
+        side: &SceneSide,
+        radiance: &RadianceCube,
+        radiance_key: Key,
+        inst: &InstrumentSide,
+        control: &RunControl,
+        report: &mut RunReport,
+    ) -> Result<(Arc<CorrectionProduct>, Key), EngineError> {
+        let fid = &config.fidelity;
+        let inputs = Inputs::of(config);
+        let (band_atmosphere, band_key, level1, level1_key) =
+            (&side.band_atmosphere, side.band_key, &inst.level1, inst.level1_key);
+        // Atmospheric correction.
+        let correction_key = KeyBuilder::new(Stage::Correction)
+            .after(level1_key)
+            .after(band_key)
+            .after(radiance_key)
+            .with(&config.correction)
+            .with(&inputs.seed)
+            .with(&inputs.decimation)
+            .finish();
+        // The image-based correction's family: its atmospheres once per scene atmosphere and LUT
+        // axes (two instruments with the same axes share them), its band terms once per
+        // instrument geometry. Neither depends on the scene's true aerosol.
+        let family = match &config.correction.image {
+            Some(image) => {
+                let axes = lut_axes(&side.response, &side.viewing, config.scene.sun.zenith_deg, fid);
+                let mut atmosphere = config.scene.atmosphere.clone();
+                atmosphere.day_of_year = side.scene.day_of_year;
+                (atmosphere.aerosol, atmosphere.aot550) = (crate::atmosphere::AerosolType::None, 0.0);
+                let luts_key = KeyBuilder::new(Stage::AerosolLuts).with(&atmosphere).with(&axes).with(image).finish();
+                let luts = self.stage(luts_key, report, control, || {
+                    FamilyLuts::build(image, &atmosphere, &axes, control).map_err(failed(Stage::AerosolLuts))
+                })?;
+                let key = KeyBuilder::new(Stage::AerosolFamily)
+                    .after(luts_key)
+                    .after(side.geometry_key)
+                    .with(&side.scene.spec.effects)
+                    .finish();
+                let fam = self.stage(key, report, control, || {
+                    AerosolFamily::tabulate(&luts, &side.scene, &side.response, &side.viewing, control)
+                        .map_err(failed(Stage::AerosolFamily))
+                })?;
+                let pair = image.pair(&side.response.bands.centres_nm()).map_err(failed(Stage::Correction))?;
+                Some((fam, pair, key))
+            }
+            None => None,
+        };
+        let correction_key = match &family {
+            Some((_, _, key)) => KeyBuilder::new(Stage::Correction).after(correction_key).after(*key).finish(),
+            None => correction_key,
+        };
+        let correction = self.stage(correction_key, report, control, || {
+            let fail = failed(Stage::Correction);
+            let approximation = SceneApproximation::new(
+                &radiance.radiance,
+                &radiance.truth.rrs_above,
+                band_atmosphere,
+                &radiance.truth.land,
+                config.correction.approx_points,
+                config.seed,
+            )
+            .map_err(&fail)?;
+            // A preview computes only the product it shows; the diagnostics (the approximation
+            // against the exact correction, and both against the truth) come with full resolution.
+            let diagnostics = fid.decimation == 1;
+            let image = match &family {
+                Some((fam, pair, _)) => {
+                    Some(correct_image(level1, fam, *pair, &radiance.truth.land, control).map_err(&fail)?)
+                }
+                None => None,
+            };
+            // The image-based product is compared with the truth; the exact and approximate
+            // corrections are not run beside it (`shoal budget` prices the difference).
+            let against_truth = diagnostics;
+            let diagnostics = diagnostics && image.is_none();
+            let exact = if diagnostics || (!config.correction.use_approximation && image.is_none()) {
+                Some(correct_exact(level1, band_atmosphere, &radiance.truth.land, control).map_err(&fail)?)
+            } else {
+                None
+            };
+            let approx = if diagnostics || config.correction.use_approximation {
+                Some(approximation.correct(level1, &radiance.truth.land, control).map_err(&fail)?)
+            } else {
+                None
+            };
+            let approximation_vs_exact = match (&approx, &exact, diagnostics) {
+                (Some(a), Some(e), true) => compare(a, &e.rrs, Some(&e.flags)),
+                _ => Vec::new(),
+            };
+            let (image, aerosol) = image.map_or((None, None), |(r, a)| (Some(r), Some(a)));
+            let rrs = match (image, exact, approx) {
+                (Some(i), _, _) => i,
+                (None, _, Some(a)) if config.correction.use_approximation => a,
+                (None, Some(e), _) => e,
+                (None, None, Some(a)) => a,
+                (None, None, None) => {
+                    return Err(EngineError::Failed { stage: Stage::Correction, message: "no correction ran".into() });
+                }
+            };
+            let rrs_vs_truth = if against_truth { compare(&rrs, &radiance.truth.rrs_above, None) } else { Vec::new() };
+            let family = family.as_ref().map(|(f, pair, _)| (f.clone(), *pair));
+            let names: Vec<String> = side.response.bands.bands.iter().map(|b| b.name.clone()).collect();
+            let rrs_metrics = crate::correction::band_rrs_metrics(
+                &rrs,
+                &radiance.truth.rrs_above,
+                &radiance.truth.land,
+                &names,
+                &side.response.bands.centres_nm(),
+            );
+            Ok(CorrectionProduct {
+                rrs,
+                approximation,
+                approximation_vs_exact,
+                rrs_vs_truth,
+                rrs_metrics,
+                aerosol,
+                family,
+            })
+        })?;
+        report.approximation = Some(correction.approximation.clone());
+        report.approximation_vs_exact = correction.approximation_vs_exact.clone();
+        report.rrs_vs_truth = correction.rrs_vs_truth.clone();
+        report.aerosol =
+            correction.aerosol.as_ref().map(|a| super::report::aerosol_summary(a, &config.scene.atmosphere));
+        Ok((correction, correction_key))
+    }
+}

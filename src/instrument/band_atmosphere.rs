@@ -1,0 +1,229 @@
+//! The band-effective atmosphere of each output column: path radiance, glint, Ed, T·Ed and
+//! spherical albedo through each band's photon weights (the formulas are in the module docs of
+//! [`super::sample`]), and the weights the truth and the band nodes use.
+
+use rayon::prelude::*;
+
+use super::InstrumentError;
+use super::geometry::Viewing;
+use super::response::Response;
+use crate::toa::{PathSpectrum, SceneOptics};
+
+/// Per band of a group: first grid index and weights on the grid from there.
+pub type BandWeights = Vec<(usize, Vec<f64>)>;
+
+/// The atmosphere seen by each output column through each band's response.
+#[derive(Debug, Clone)]
+pub struct BandAtmosphere {
+    /// Bands.
+    pub n_bands: usize,
+    /// Per group, per output column: the atmosphere on the group's grid.
+    pub paths: Vec<Vec<PathSpectrum>>,
+    /// Per column × band: band-effective path radiance, W m⁻² sr⁻¹ nm⁻¹.
+    pub l_path: Vec<f64>,
+    /// Per column × band: band-effective glint radiance.
+    pub glint: Vec<f64>,
+    /// Per column × band: band-effective Ed(0⁺), W m⁻² nm⁻¹.
+    pub ed: Vec<f64>,
+    /// Per column × band: (T_up·Ed)_b.
+    pub t_ed: Vec<f64>,
+    /// Per column × band: band-effective spherical albedo.
+    pub spherical_albedo: Vec<f64>,
+    /// Per group, per column: weights of the truth Rrs for each band of the group.
+    pub truth_weights: Vec<Vec<BandWeights>>,
+    /// Per group (empty where the optics has no band nodes), per column, per band of the group:
+    /// the band's weights on the nodes' values (see [`NodeWeights`]).
+    pub node_weights: Vec<Vec<Vec<NodeWeights>>>,
+    /// Per group (empty where the optics has no band nodes), per column: S·π at each band node,
+    /// side by side so the per-pixel f = Rrs/(1 − S·π·Rrs) runs over contiguous values.
+    pub node_s_pi: Vec<Vec<Vec<f64>>>,
+}
+
+/// A band's weights on per-pixel spectra known only at band nodes.
+///
+/// The pixel's f(λ) = Rrs/(1 − S·π·Rrs) and Rrs(λ) are taken as linear between neighbouring
+/// nodes (constant beyond the first and last), f(λ) ≈ Σₙ φₙ(λ)·fₙ with hat functions φₙ, so the
+/// band integrals of the module docs become sums over nodes with weights computed once per
+/// column on the full grid:
+///
+/// L_b = L_path,b + G_b + Σₙ Cₙ·fₙ,  Cₙ = Σ_λ w_b T_up Ed φₙ / Σ_λ w_b;  Rrs_b = Σₙ Dₙ·Rrsₙ,  Dₙ = Σ_λ w_b T_up Ed φₙ / Σ_λ w_b T_up Ed.
+///
+/// The atmosphere, the solar spectrum and the response keep their full-grid detail; only the
+/// water's smooth spectrum is interpolated (its error is measured in the cost table:
+/// `shoal bench --accuracy`).
+#[derive(Debug, Clone, Default)]
+pub struct NodeWeights {
+    /// First node the weights apply to.
+    pub first: usize,
+    /// Cₙ from node `first` on, W m⁻² sr⁻¹ nm⁻¹ per unit f (sr⁻¹).
+    pub radiance: Vec<f64>,
+    /// Dₙ from node `first` on (they sum to 1).
+    pub truth: Vec<f64>,
+}
+
+/// Per grid index of a group: the nodes either side and the weight of the upper one (linear in
+/// wavelength; constant beyond the end nodes).
+fn node_brackets(wavelengths_nm: &[f64], nodes: &[usize]) -> Vec<(usize, usize, f64)> {
+    let last = nodes.len() - 1;
+    (0..wavelengths_nm.len())
+        .map(|i| {
+            let n1 = nodes.partition_point(|&v| v <= i);
+            if n1 == 0 {
+                (0, 0, 0.0)
+            } else if n1 > last {
+                (last, last, 0.0)
+            } else {
+                let (a, b) = (wavelengths_nm[nodes[n1 - 1]], wavelengths_nm[nodes[n1]]);
+                (n1 - 1, n1, (wavelengths_nm[i] - a) / (b - a))
+            }
+        })
+        .collect()
+}
+
+impl BandAtmosphere {
+    /// Build the band-effective atmosphere of every output column.
+    pub fn new(optics: &[SceneOptics], viewing: &Viewing, response: &Response) -> Result<Self, InstrumentError> {
+        let nb = response.n_bands();
+        let nc = viewing.columns();
+        let mut out = Self {
+            n_bands: nb,
+            paths: Vec::new(),
+            l_path: vec![0.0; nc * nb],
+            glint: vec![0.0; nc * nb],
+            ed: vec![0.0; nc * nb],
+            t_ed: vec![0.0; nc * nb],
+            spherical_albedo: vec![0.0; nc * nb],
+            truth_weights: Vec::new(),
+            node_weights: Vec::new(),
+            node_s_pi: Vec::new(),
+        };
+        for (gi, group) in response.groups.iter().enumerate() {
+            let paths: Vec<PathSpectrum> = viewing.looks[gi]
+                .par_iter()
+                .map(|look| optics[gi].path_spectrum(&look.geometry))
+                .collect::<Result<_, _>>()
+                .map_err(|e| InstrumentError::Scene(e.into()))?;
+            let mut truth = Vec::with_capacity(nc);
+            let nodes = optics[gi].band_nodes();
+            let brackets = nodes.map(|n| node_brackets(group.grid.wavelengths_nm(), n));
+            let mut node_weights = Vec::new();
+            for (c, path) in paths.iter().enumerate() {
+                let mut column_nodes = Vec::new();
+                let j = viewing.detector_index[c];
+                let mut per_band = Vec::with_capacity(group.bands.len());
+                for (k, &b) in group.bands.iter().enumerate() {
+                    let (first, w) = response.weights(gi, k, j);
+                    let span = first..first + w.len();
+                    let m = band_means(path, first, w);
+                    let (te, te_sum, total) = (&m.te, m.te_sum, m.total);
+                    let i = c * nb + b;
+                    out.l_path[i] = m.l_path;
+                    out.glint[i] = m.glint;
+                    out.ed[i] = m.ed;
+                    out.t_ed[i] = m.t_ed;
+                    out.spherical_albedo[i] = m.spherical_albedo;
+                    let tw = if te_sum > 0.0 {
+                        te.iter().map(|v| v / te_sum).collect()
+                    } else {
+                        vec![1.0 / w.len() as f64; w.len()]
+                    };
+                    if let Some(brackets) = &brackets {
+                        column_nodes.push(band_node_weights(&brackets[span.clone()], te, total, &tw));
+                    }
+                    per_band.push((first, tw));
+                }
+                truth.push(per_band);
+                if brackets.is_some() {
+                    node_weights.push(column_nodes);
+                }
+            }
+            let node_s_pi = match nodes {
+                Some(nodes) => paths
+                    .iter()
+                    .map(|p| nodes.iter().map(|&i| p.spherical_albedo[i] * std::f64::consts::PI).collect())
+                    .collect(),
+                None => Vec::new(),
+            };
+            out.paths.push(paths);
+            out.truth_weights.push(truth);
+            out.node_weights.push(node_weights);
+            out.node_s_pi.push(node_s_pi);
+        }
+        Ok(out)
+    }
+
+    /// Whether group `g` samples the water at band nodes.
+    #[must_use]
+    pub fn has_nodes(&self, g: usize) -> bool {
+        self.node_weights.get(g).is_some_and(|w| !w.is_empty())
+    }
+
+    /// Index of (column, band) in the per-column arrays.
+    #[must_use]
+    pub fn at(&self, column: usize, band: usize) -> usize {
+        column * self.n_bands + band
+    }
+}
+
+/// [`NodeWeights`] of one band: `brackets` of its grid points, `te` = w·T_up·Ed on them,
+/// `total` = Σw, `truth` the truth's weights on them (te/Σte).
+fn band_node_weights(brackets: &[(usize, usize, f64)], te: &[f64], total: f64, truth: &[f64]) -> NodeWeights {
+    let lo = brackets.iter().map(|b| b.0).min().unwrap_or(0);
+    let hi = brackets.iter().map(|b| b.1).max().unwrap_or(0);
+    let mut out = NodeWeights { first: lo, radiance: vec![0.0; hi + 1 - lo], truth: vec![0.0; hi + 1 - lo] };
+    for ((&(n0, n1, t), &v), &tw) in brackets.iter().zip(te).zip(truth) {
+        out.radiance[n0 - lo] += v * (1.0 - t) / total;
+        out.radiance[n1 - lo] += v * t / total;
+        out.truth[n0 - lo] += tw * (1.0 - t);
+        out.truth[n1 - lo] += tw * t;
+    }
+    out
+}
+
+/// One band's photon-weighted means over a column's atmosphere (module docs of [`super::sample`]):
+/// `w` the band's weights on the grid from index `first`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BandMeans {
+    /// Σw, photons J⁻¹.
+    pub total: f64,
+    /// L_path,b = Σ w L_path / Σw.
+    pub l_path: f64,
+    /// G_b = Σ w L_glint / Σw.
+    pub glint: f64,
+    /// Ed,b = Σ w Ed / Σw.
+    pub ed: f64,
+    /// (T·Ed)_b = Σ w T_up Ed / Σw.
+    pub t_ed: f64,
+    /// S_b = Σ w T_up Ed S / Σ w T_up Ed (0 where T·Ed vanishes).
+    pub spherical_albedo: f64,
+    /// w·T_up·Ed on the band's grid points.
+    pub te: Vec<f64>,
+    /// Σ w·T_up·Ed.
+    pub te_sum: f64,
+}
+
+/// [`BandMeans`] of the band with weights `w` from grid index `first`, through `path`.
+#[must_use]
+pub fn band_means(path: &PathSpectrum, first: usize, w: &[f64]) -> BandMeans {
+    let span = first..first + w.len();
+    let total: f64 = w.iter().sum();
+    let dot = |v: &[f64]| w.iter().zip(&v[span.clone()]).map(|(a, x)| a * x).sum::<f64>() / total;
+    let te: Vec<f64> =
+        w.iter().zip(&path.t_up[span.clone()]).zip(&path.ed[span.clone()]).map(|((a, t), e)| a * t * e).collect();
+    let te_sum: f64 = te.iter().sum();
+    let spherical_albedo = if te_sum > 0.0 {
+        te.iter().zip(&path.spherical_albedo[span.clone()]).map(|(a, s)| a * s).sum::<f64>() / te_sum
+    } else {
+        0.0
+    };
+    BandMeans {
+        total,
+        l_path: dot(&path.l_path),
+        glint: dot(&path.glint),
+        ed: dot(&path.ed),
+        t_ed: te_sum / total,
+        spherical_albedo,
+        te,
+        te_sum,
+    }
+}
