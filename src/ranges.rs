@@ -340,6 +340,14 @@ ranges! {
     CORRECTION_PAIR_NM = Range::closed("correction.image.pair_nm", 600.0, 2500.0, "nm", "centres of the short and long band of the aerosol pair, short first (the instrument's nearest bands, within 30 nm)");
     /// Image-based correction: AOT nodes of the family's tables.
     CORRECTION_AOT_NODE = Range::above("correction.image.aot_nodes", 0.0, 5.0, "", "AOT(550) nodes of the aerosol family's tables, increasing (0 is always added)");
+    /// Dark-spectrum fitting: tile side.
+    CORRECTION_DARK_TILE_PX = Range::count("correction.image.dark.tile_px", 0.0, 100_000.0, "pixels", "tile side of dark-spectrum fitting (0: the whole scene)");
+    /// Dark-spectrum fitting: darkest pixels.
+    CORRECTION_DARK_PIXELS = Range::count("correction.image.dark.pixels", 2.0, 100_000.0, "", "darkest pixels per band in the intercept fit (ACOLITE: 200)");
+    /// Dark-spectrum fitting: gas transmittance threshold.
+    CORRECTION_DARK_MIN_GAS = Range::closed("correction.image.dark.min_gas_transmittance", 0.0, 1.0, "", "bands with a lower two-way gas transmittance are not fitted (ACOLITE: 0.85)");
+    /// Dark-spectrum fitting: band range.
+    CORRECTION_DARK_WAVE_RANGE_NM = Range::closed("correction.image.dark.wave_range_nm", 350.0, 2500.0, "nm", "bands fitted, shortest first (ACOLITE: 400-2500)");
 
     // Retrievals (RetrievalSpec::validate).
     /// aLMI rrs(u) linear coefficient.

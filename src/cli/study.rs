@@ -241,7 +241,7 @@ fn print_runs(out: &mut String, result: &crate::study::StudyResult) {
         if let Some(a) = &run.report.aerosol {
             let _ = writeln!(
                 out,
-                "{:<12} aerosol  AOT(550) {:.3} (5–95 %: {:.3}–{:.3}; true {:.3}), Ångström {:.2} (true {:.2}); outside the family: {:.1} %",
+                "{:<12} aerosol  AOT(550) {:.3} (5–95 %: {:.3}–{:.3}; true {:.3}), Ångström {:.2} (true {:.2}); outside the family: {:.1} %; {}{}",
                 run.label,
                 a.aot550.0,
                 a.aot550.1,
@@ -249,7 +249,9 @@ fn print_runs(out: &mut String, result: &crate::study::StudyResult) {
                 a.aot550_true,
                 a.angstrom,
                 a.angstrom_true,
-                a.outside_family_pct
+                a.outside_family_pct,
+                a.fit,
+                if a.passes_mean > 1.0 { format!(", {:.1} passes", a.passes_mean) } else { String::new() }
             );
         }
     }

@@ -26,6 +26,9 @@ pub struct AerosolFamily {
     pub n_bands: usize,
     /// `terms[m][k]`: the band terms of model m at node k.
     pub terms: Vec<Vec<BandTerms>>,
+    /// Two-way gas transmittance of every column and band: (T·Ed) of the Rayleigh atmosphere
+    /// with its gases over the same without them (1 where the scene has no gases).
+    pub gas_two_way: Vec<f64>,
 }
 
 /// Band-effective atmosphere of every column: index column·bands + band.
@@ -121,6 +124,9 @@ pub struct FamilyLuts {
     pub angstrom: Vec<f64>,
     /// `luts[m][k]`.
     pub luts: Vec<Vec<std::sync::Arc<AtmosphereLut>>>,
+    /// The Rayleigh atmosphere without gases, where the scene has them (for the bands'
+    /// gas transmittance).
+    pub gas_free: Option<std::sync::Arc<AtmosphereLut>>,
 }
 
 impl FamilyLuts {
@@ -134,13 +140,15 @@ impl FamilyLuts {
     ) -> Result<Self, CorrectionError> {
         settings.validate()?;
         let fail = |e: String| invalid("correction.image", e);
-        let lut_of = |aerosol: AerosolType, aot: f64| -> Result<std::sync::Arc<AtmosphereLut>, CorrectionError> {
+        let lut_with = |spec: AtmosphereSpec| -> Result<std::sync::Arc<AtmosphereLut>, CorrectionError> {
             if control.cancelled() {
                 return Err(CorrectionError::Cancelled);
             }
-            let spec = AtmosphereSpec { aerosol, aot550: aot, ..atmosphere.clone() };
             let built = spec.build().map_err(|e| fail(e.to_string()))?;
             Ok(std::sync::Arc::new(AtmosphereLut::build(&built, axes.clone()).map_err(|e| fail(e.to_string()))?))
+        };
+        let lut_of = |aerosol: AerosolType, aot: f64| -> Result<std::sync::Arc<AtmosphereLut>, CorrectionError> {
+            lut_with(AtmosphereSpec { aerosol, aot550: aot, ..atmosphere.clone() })
         };
         let mut aot550 = vec![0.0];
         aot550.extend_from_slice(&settings.aot_nodes);
@@ -162,7 +170,17 @@ impl FamilyLuts {
             };
             angstrom.push(-(tau(865.0)? / tau(443.0)?).ln() / (865.0f64 / 443.0).ln());
         }
-        Ok(Self { models: settings.models.clone(), aot550, angstrom, luts })
+        let gas_free = if atmosphere.gases {
+            Some(lut_with(AtmosphereSpec {
+                aerosol: AerosolType::None,
+                aot550: 0.0,
+                gases: false,
+                ..atmosphere.clone()
+            })?)
+        } else {
+            None
+        };
+        Ok(Self { models: settings.models.clone(), aot550, angstrom, luts, gas_free })
     }
 }
 
@@ -196,7 +214,15 @@ impl AerosolFamily {
             }
             terms.push(out);
         }
+        let gas_two_way = match &luts.gas_free {
+            Some(lut) => {
+                let free = terms_of(lut)?;
+                rayleigh.t_ed.iter().zip(&free.t_ed).map(|(a, b)| if *b > 0.0 { a / b } else { 1.0 }).collect()
+            }
+            None => vec![1.0; rayleigh.t_ed.len()],
+        };
         Ok(Self {
+            gas_two_way,
             models: luts.models.clone(),
             aot550: luts.aot550.clone(),
             angstrom: luts.angstrom.clone(),

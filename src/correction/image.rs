@@ -42,14 +42,56 @@ use crate::calibration::Level1;
 use crate::control::RunControl;
 use crate::parse::FieldError;
 
+/// How the correction finds the aerosol.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum AerosolFit {
+    /// Two-band model selection per pixel (Gordon & Wang 1994), with the NIR water-leaving
+    /// iteration of Bailey et al. (2010) when `nir_iteration` is on.
+    #[default]
+    BandPair,
+    /// Dark-spectrum fitting, one atmosphere per tile (Vanhellemont & Ruddick 2018; [`super::dark`]).
+    DarkSpectrum,
+}
+
+/// Settings of dark-spectrum fitting ([`super::dark`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct DarkSpectrumSettings {
+    /// Tile side, pixels; 0: one atmosphere for the whole scene (ACOLITE's `fixed`, as
+    /// published).
+    pub tile_px: usize,
+    /// Darkest pixels per band whose linear fit against rank gives the dark value at rank 0
+    /// (ACOLITE's `intercept` option; 200 in its MSI, OLI and OLCI settings).
+    pub pixels: usize,
+    /// Bands whose two-way gas transmittance is below this are not fitted (ACOLITE's
+    /// `min_tgas_aot`, 0.85).
+    pub min_gas_transmittance: f64,
+    /// Bands fitted, nm (ACOLITE's `dsf_wave_range`).
+    pub wave_range_nm: [f64; 2],
+}
+
+impl Default for DarkSpectrumSettings {
+    fn default() -> Self {
+        Self { tile_px: 0, pixels: 200, min_gas_transmittance: 0.85, wave_range_nm: [400.0, 2500.0] }
+    }
+}
+
 /// Settings of the image-based correction.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct ImageCorrection {
+    /// How the aerosol is found.
+    pub fit: AerosolFit,
     /// Centres of the short and long band of the aerosol pair, nm: the instrument's bands
     /// nearest them are used (l2gen's 748/869 for MODIS, 779/865 for OLCI; 1240/2130 or
-    /// 1610/2200 as a SWIR pair).
+    /// 1610/2200 as a SWIR pair). Band-pair fit only.
     pub pair_nm: [f64; 2],
+    /// The NIR water-leaving reflectance at the pair's bands estimated from the red band and
+    /// taken away before the aerosol fit, iterated (Bailey et al. 2010, as l2gen does it;
+    /// [`super::nir_water`]). Band-pair fit only; needs bands near 443, 555 and 670 nm.
+    pub nir_iteration: bool,
+    /// Dark-spectrum fitting's settings.
+    pub dark: DarkSpectrumSettings,
     /// The aerosol models of the family.
     pub models: Vec<AerosolType>,
     /// AOT(550) nodes of the family's tables (0 is always added).
@@ -59,9 +101,42 @@ pub struct ImageCorrection {
 impl Default for ImageCorrection {
     fn default() -> Self {
         Self {
+            fit: AerosolFit::BandPair,
             pair_nm: [779.0, 865.0],
+            nir_iteration: true,
+            dark: DarkSpectrumSettings::default(),
             models: vec![AerosolType::Maritime, AerosolType::Continental, AerosolType::Urban],
             aot_nodes: vec![0.05, 0.1, 0.2, 0.4, 0.8],
+        }
+    }
+}
+
+impl ImageCorrection {
+    /// Dark-spectrum fitting with ACOLITE's two models (its MOD1 and MOD2 are continental and
+    /// maritime). Urban and continental differ too little in the NIR for two adjacent bands to
+    /// tell them apart: with all three, a noise-free continental scene fits urban at 885/900 nm
+    /// with a smaller RMSD than continental (whose two lowest bands hold the water's residual).
+    #[must_use]
+    pub fn dark_spectrum() -> Self {
+        Self {
+            fit: AerosolFit::DarkSpectrum,
+            models: vec![AerosolType::Maritime, AerosolType::Continental],
+            ..Self::default()
+        }
+    }
+
+    /// A short name for tables and menus.
+    #[must_use]
+    pub fn label(&self) -> String {
+        match self.fit {
+            AerosolFit::BandPair => format!(
+                "{:.0}/{:.0} nm pair{}",
+                self.pair_nm[0],
+                self.pair_nm[1],
+                if self.nir_iteration { ", NIR iteration" } else { "" }
+            ),
+            AerosolFit::DarkSpectrum if self.dark.tile_px == 0 => "dark spectrum, scene".into(),
+            AerosolFit::DarkSpectrum => format!("dark spectrum, {} px tiles", self.dark.tile_px),
         }
     }
 }
@@ -92,6 +167,20 @@ impl ImageCorrection {
         }
         if self.aot_nodes.is_empty() || self.aot_nodes.windows(2).any(|w| w[1] <= w[0]) {
             return Err(invalid(a.path, format!("{:?}: one or more nodes, increasing", self.aot_nodes)));
+        }
+        let d = &self.dark;
+        let tile = &crate::ranges::CORRECTION_DARK_TILE_PX;
+        tile.check(d.tile_px as f64).map_err(|m| invalid(tile.path, m))?;
+        let px = &crate::ranges::CORRECTION_DARK_PIXELS;
+        px.check(d.pixels as f64).map_err(|m| invalid(px.path, m))?;
+        let gas = &crate::ranges::CORRECTION_DARK_MIN_GAS;
+        gas.check(d.min_gas_transmittance).map_err(|m| invalid(gas.path, m))?;
+        let w = &crate::ranges::CORRECTION_DARK_WAVE_RANGE_NM;
+        for v in d.wave_range_nm {
+            w.check(v).map_err(|m| invalid(w.path, m))?;
+        }
+        if d.wave_range_nm[0] >= d.wave_range_nm[1] {
+            return Err(invalid(w.path, format!("{:?}: the shortest first", d.wave_range_nm)));
         }
         Ok(())
     }
@@ -125,22 +214,8 @@ impl ImageCorrection {
     }
 }
 
-/// Relative margin beyond the family's ε range before a pixel counts as outside it.
-const EDGE: f64 = 0.005;
-
 /// How far a pair's centre may be from the band it picks, nm.
 pub const PAIR_TOLERANCE_NM: f64 = 30.0;
-
-/// What the correction found in each pixel.
-#[derive(Debug, Clone)]
-pub struct AerosolRetrieval {
-    /// AOT(550), NaN where not retrieved (land, invalid pair bands).
-    pub aot550: Array2<f32>,
-    /// Ångström exponent 443–865 nm of the mixture, NaN where not retrieved.
-    pub angstrom: Array2<f32>,
-    /// Pixels whose measured ε lay outside the family's range (the nearest model used).
-    pub outside_family: usize,
-}
 
 /// Where the measured long-band aerosol signal lies in a model's table: up to three nodes and
 /// their weights, so that any tabulated quantity at the model's τ is Σ wᵢ·vᵢ. `a_long[k]` is the
@@ -149,7 +224,7 @@ pub struct AerosolRetrieval {
 /// (path radiance is close to, but not, linear in τ: a linear interpolation between AOT nodes
 /// 0.1 and 0.2 left 3 % at 400 nm and 10 % at 665 nm in Rrs); beyond the last node the last
 /// segment is extended; a signal at or below zero is τ = 0.
-fn locate(a_long: &[f64], measured: f64) -> [(usize, f64); 3] {
+pub(super) fn locate(a_long: &[f64], measured: f64) -> [(usize, f64); 3] {
     let n = a_long.len();
     if measured <= 0.0 || n < 2 {
         return [(0, 1.0), (0, 0.0), (0, 0.0)];
@@ -186,122 +261,212 @@ fn locate(a_long: &[f64], measured: f64) -> [(usize, f64); 3] {
 }
 
 /// Σ wᵢ·vᵢ of `value(k)` over the located nodes.
-fn weighted(nodes: &[(usize, f64); 3], value: impl Fn(usize) -> f64) -> f64 {
+pub(super) fn weighted(nodes: &[(usize, f64); 3], value: impl Fn(usize) -> f64) -> f64 {
     nodes.iter().map(|&(k, w)| if w == 0.0 { 0.0 } else { w * value(k) }).sum()
+}
+
+/// What the correction found in each pixel.
+#[derive(Debug, Clone)]
+pub struct AerosolRetrieval {
+    /// AOT(550), NaN where not retrieved (land, invalid pair bands).
+    pub aot550: Array2<f32>,
+    /// Ångström exponent 443–865 nm of the mixture, NaN where not retrieved.
+    pub angstrom: Array2<f32>,
+    /// Pixels whose measured ε lay outside the family's range (the nearest model used).
+    pub outside_family: usize,
+    /// Mean passes of the NIR water-leaving iteration over the retrieved pixels (1 without it).
+    pub passes_mean: f64,
+    /// Dark-spectrum fitting's tiles (empty for the band-pair fit).
+    pub tiles: Vec<super::dark::TileFit>,
+}
+
+/// One pixel of Level-1 as a fit sees it.
+pub(super) struct Pixel<'a> {
+    /// Row.
+    pub row: usize,
+    /// Column (the index of the family's terms is column·bands + band).
+    pub col: usize,
+    /// Bands.
+    pub nb: usize,
+    /// Calibrated radiance per band.
+    pub l1: &'a [f32],
+    /// Level-0 flags per band.
+    pub flags: &'a [u8],
+    /// The pixel is land (its Rrs is not retrieved).
+    pub land: bool,
+}
+
+impl Pixel<'_> {
+    /// Index of band `b` in the family's terms.
+    pub fn at(&self, b: usize) -> usize {
+        self.col * self.nb + b
+    }
+}
+
+/// A pixel's atmosphere: up to six weighted table entries (two models, three AOT nodes each),
+/// its AOT(550) and Ångström exponent.
+#[derive(Default)]
+pub(super) struct Mixture<'f> {
+    /// (band terms, weight).
+    pub entries: Vec<(&'f BandTerms, f64)>,
+    /// AOT(550).
+    pub aot550: f64,
+    /// Ångström exponent 443–865 nm.
+    pub angstrom: f64,
+    /// The measured ε lay outside the family's range.
+    pub outside: bool,
+    /// Passes of the NIR iteration.
+    pub passes: usize,
+}
+
+impl Mixture<'_> {
+    /// (L_path, T·Ed, S) at index `i` (column·bands + band).
+    #[inline]
+    pub fn terms(&self, i: usize) -> (f64, f64, f64) {
+        let (mut lp, mut te, mut s) = (0.0, 0.0, 0.0);
+        for &(t, w) in &self.entries {
+            lp += w * t.l_path[i];
+            te += w * t.t_ed[i];
+            s += w * t.spherical_albedo[i];
+        }
+        (lp, te, s)
+    }
+
+    /// Rrs from radiance `l1` at index `i`: y = (L1 − L_path)/(T·Ed), Rrs = y/(1 + S·π·y).
+    #[inline]
+    pub fn rrs(&self, i: usize, l1: f64) -> f64 {
+        let (lp, te, s) = self.terms(i);
+        let y = (l1 - lp) / te;
+        y / (1.0 + s * std::f64::consts::PI * y)
+    }
+
+    /// The water's part of the TOA radiance at index `i` for above-surface `rrs`: the inverse
+    /// of [`Self::rrs`], (T·Ed)·Rrs/(1 − S·π·Rrs).
+    #[inline]
+    pub fn water_radiance(&self, i: usize, rrs: f64) -> f64 {
+        let (_, te, s) = self.terms(i);
+        te * rrs / (1.0 - s * std::f64::consts::PI * rrs)
+    }
 }
 
 /// Correct `level1` with the family: see the module docs.
 pub fn correct_image(
     level1: &Level1,
     family: &AerosolFamily,
-    pair: (usize, usize),
+    settings: &ImageCorrection,
+    bands: &crate::spectral::BandSet,
     land: &Array2<u8>,
     control: &RunControl,
 ) -> Result<(Reflectance, AerosolRetrieval), CorrectionError> {
-    let (rows, cols, nb) = level1.radiance.dim();
-    if nb != family.n_bands || family.terms.is_empty() {
+    let nb = level1.radiance.dim().2;
+    if nb != family.n_bands || family.terms.is_empty() || bands.len() != nb {
         return Err(invalid("correction.image", format!("the family has {} bands, Level-1 {nb}", family.n_bands)));
     }
+    match settings.fit {
+        AerosolFit::BandPair => {
+            let fit = super::pair::PairFit::new(family, settings, bands)?;
+            apply(level1, land, control, |p, mix, scratch| fit.fit(p, mix, scratch))
+        }
+        AerosolFit::DarkSpectrum => {
+            let tiles = super::dark::fit_tiles(level1, family, &settings.dark, bands, control)?;
+            let (rows, cols) = (level1.radiance.dim().0, level1.radiance.dim().1);
+            let index = super::dark::tile_index(&tiles, rows, cols);
+            let mixtures: Vec<Mixture<'_>> = tiles.iter().map(|t| t.mixture(family)).collect();
+            let (rrs, mut retrieval) = apply(level1, land, control, |p, mix, _: &mut ()| {
+                let m = &mixtures[index[p.row * cols + p.col]];
+                mix.entries.extend_from_slice(&m.entries);
+                (mix.aot550, mix.angstrom, mix.passes) = (m.aot550, m.angstrom, 1);
+                true
+            })?;
+            retrieval.tiles = tiles;
+            Ok((rrs, retrieval))
+        }
+    }
+}
+
+/// Every pixel through `fit` (which fills the pixel's [`Mixture`] and says whether the pixel is
+/// usable), then every band inverted with that mixture; rows in parallel, each with its own
+/// scratch `S` (so the result does not depend on the threads).
+fn apply<'f, S: Default>(
+    level1: &Level1,
+    land: &Array2<u8>,
+    control: &RunControl,
+    fit: impl Fn(&Pixel<'_>, &mut Mixture<'f>, &mut S) -> bool + Sync,
+) -> Result<(Reflectance, AerosolRetrieval), CorrectionError> {
+    let (rows, cols, nb) = level1.radiance.dim();
     let (l1, l0_flags, land_s) = (slice(&level1.radiance)?, slice(&level1.flags)?, slice(land)?);
-    let (s_band, l_band) = pair;
-    let nm = family.models.len();
     let stride = cols * nb;
     let per_row = control.map_rows(rows, |at| {
         let r = at.index();
         let base = r * stride;
         let (mut rrs_row, mut flag_row) = (vec![0.0f32; stride], vec![0u8; stride]);
         let (mut aot_row, mut alpha_row) = (vec![f32::NAN; cols], vec![f32::NAN; cols]);
-        let mut outside = 0usize;
-        let mut located = vec![[(0usize, 1.0f64), (0, 0.0), (0, 0.0)]; nm];
-        let mut eps = vec![0.0; nm];
-        let mut a_long = vec![0.0; family.aot550.len()];
-        let mut order: Vec<usize> = Vec::with_capacity(nm);
-        let mut entries: Vec<(&BandTerms, f64)> = Vec::with_capacity(6);
+        let (mut outside, mut passes) = (0usize, 0usize);
+        let mut scratch = S::default();
+        let mut mix = Mixture::default();
+        let (mut lp, mut te, mut sa) = (vec![0.0f64; nb], vec![0.0f64; nb], vec![0.0f64; nb]);
         for c in 0..cols {
             at.column(c);
-            let px = &l1[base + c * nb..base + (c + 1) * nb];
-            let fl = &l0_flags[base + c * nb..base + (c + 1) * nb];
-            let is_land = land_s[r * cols + c] != 0;
-            let i = |b: usize| c * nb + b;
-            let rayleigh = &family.terms[0][0];
-            let a_l = f64::from(px[l_band]) - rayleigh.l_path[i(l_band)];
-            let a_s = f64::from(px[s_band]) - rayleigh.l_path[i(s_band)];
-            let usable = !is_land && fl[l_band] == 0 && fl[s_band] == 0;
-            // Each model's τ and ε for this pixel.
-            for m in 0..nm {
-                for (k, t) in family.terms[m].iter().enumerate() {
-                    a_long[k] = t.l_path[i(l_band)] - rayleigh.l_path[i(l_band)];
-                }
-                located[m] = locate(&a_long, a_l);
-                let short =
-                    weighted(&located[m], |k| family.terms[m][k].l_path[i(s_band)] - rayleigh.l_path[i(s_band)]);
-                eps[m] = if a_l > 0.0 { short / a_l } else { 0.0 };
-            }
-            let measured = if a_l > 0.0 { a_s / a_l } else { 0.0 };
-            // The bracketing pair (by ε), or the nearest model outside the family's range.
-            order.clear();
-            order.extend(0..nm);
-            order.sort_by(|&a, &b| eps[a].total_cmp(&eps[b]));
-            let (m1, m2, w, out) = match order.windows(2).find(|p| eps[p[0]] <= measured && measured <= eps[p[1]]) {
-                Some(p) => {
-                    let d = eps[p[1]] - eps[p[0]];
-                    (p[0], p[1], if d > 0.0 { (measured - eps[p[0]]) / d } else { 0.0 }, false)
-                }
-                None if nm == 1 || measured < eps[order[0]] => (order[0], order[0], 0.0, nm > 1),
-                None => (order[nm - 1], order[nm - 1], 0.0, true),
+            let span = c * nb..(c + 1) * nb;
+            let p = Pixel {
+                row: r,
+                col: c,
+                nb,
+                l1: &l1[base + span.start..base + span.end],
+                flags: &l0_flags[base + span.start..base + span.end],
+                land: land_s[r * cols + c] != 0,
             };
-            // Counted as outside only beyond half a per cent of the family's range: a member's
-            // own pixels sit on its edge and the water's NIR signal moves them across it.
-            let (lo, hi) = (eps[order[0]], eps[order[nm - 1]]);
-            if out && usable && a_l > 0.0 && (measured < lo * (1.0 - EDGE) || measured > hi * (1.0 + EDGE)) {
-                outside += 1;
-            }
-            // The pixel's atmosphere as at most six weighted table entries (two models, three
-            // nodes each), then every band from them.
-            entries.clear();
-            for (m, share) in [(m1, 1.0 - w), (m2, w)] {
-                for &(k, weight) in &located[m] {
-                    if share * weight != 0.0 {
-                        entries.push((&family.terms[m][k], share * weight));
-                    }
+            mix.entries.clear();
+            (mix.outside, mix.passes) = (false, 1);
+            let usable = fit(&p, &mut mix, &mut scratch) && !p.land;
+            // The mixture's terms for all bands at once (contiguous per column).
+            lp.fill(0.0);
+            te.fill(0.0);
+            sa.fill(0.0);
+            for &(t, w) in &mix.entries {
+                let (tl, tt, ts) = (&t.l_path[span.clone()], &t.t_ed[span.clone()], &t.spherical_albedo[span.clone()]);
+                for b in 0..nb {
+                    lp[b] += w * tl[b];
+                    te[b] += w * tt[b];
+                    sa[b] += w * ts[b];
                 }
             }
             for b in 0..nb {
-                let (mut lp, mut te, mut s) = (0.0, 0.0, 0.0);
-                for &(t, weight) in &entries {
-                    lp += weight * t.l_path[i(b)];
-                    te += weight * t.t_ed[i(b)];
-                    s += weight * t.spherical_albedo[i(b)];
-                }
-                let y = (f64::from(px[b]) - lp) / te;
-                let value = y / (1.0 + s * std::f64::consts::PI * y);
-                let f = flag_for(fl[b], is_land || !usable, value);
-                flag_row[c * nb + b] = f;
-                rrs_row[c * nb + b] = if f & RrsFlags::INVALID != 0 { 0.0 } else { value as f32 };
+                let y = (f64::from(p.l1[b]) - lp[b]) / te[b];
+                let value = y / (1.0 + sa[b] * std::f64::consts::PI * y);
+                let f = flag_for(p.flags[b], !usable, value);
+                flag_row[span.start + b] = f;
+                rrs_row[span.start + b] = if f & RrsFlags::INVALID != 0 { 0.0 } else { value as f32 };
             }
             if usable {
-                let tau = |m: usize| weighted(&located[m], |k| family.aot550[k]).max(0.0);
-                aot_row[c] = ((1.0 - w) * tau(m1) + w * tau(m2)) as f32;
-                alpha_row[c] = ((1.0 - w) * family.angstrom[m1] + w * family.angstrom[m2]) as f32;
+                aot_row[c] = mix.aot550 as f32;
+                alpha_row[c] = mix.angstrom as f32;
+                outside += usize::from(mix.outside);
+                passes += mix.passes;
             }
         }
-        Ok::<_, CorrectionError>((rrs_row, flag_row, aot_row, alpha_row, outside))
+        Ok::<_, CorrectionError>((rrs_row, flag_row, aot_row, alpha_row, outside, passes))
     })?;
     let (mut rrs, mut flags) = (Vec::with_capacity(rows * stride), Vec::with_capacity(rows * stride));
-    let (mut aot, mut alpha, mut outside) = (Vec::with_capacity(rows * cols), Vec::with_capacity(rows * cols), 0);
-    for (a, b, c, d, e) in per_row {
+    let (mut aot, mut alpha) = (Vec::with_capacity(rows * cols), Vec::with_capacity(rows * cols));
+    let (mut outside, mut passes) = (0, 0);
+    for (a, b, c, d, e, f) in per_row {
         rrs.extend_from_slice(&a);
         flags.extend_from_slice(&b);
         aot.extend_from_slice(&c);
         alpha.extend_from_slice(&d);
         outside += e;
+        passes += f;
     }
+    let retrieved = aot.iter().filter(|v| v.is_finite()).count();
     let shape = (rows, cols);
     let bad = |e: ndarray::ShapeError| invalid("cube", e.to_string());
     let retrieval = AerosolRetrieval {
         aot550: Array2::from_shape_vec(shape, aot).map_err(bad)?,
         angstrom: Array2::from_shape_vec(shape, alpha).map_err(bad)?,
         outside_family: outside,
+        passes_mean: if retrieved == 0 { 0.0 } else { passes as f64 / retrieved as f64 },
+        tiles: Vec::new(),
     };
     Ok((assemble(rows, cols, nb, rrs, flags)?, retrieval))
 }

@@ -21,11 +21,15 @@
 //! - Matthews, M. W. et al. (2023) Sensors 23, 7824, Appendix A (equations A1–A3).
 //! - Vermote, E. F. et al. (1997) 6S: an overview. IEEE TGRS 35, 675–686.
 
+pub mod dark;
 pub mod family;
 pub mod image;
+pub mod nir_water;
+mod pair;
 
+pub use dark::TileFit;
 pub use family::{AerosolFamily, FamilyLuts};
-pub use image::{AerosolRetrieval, ImageCorrection, correct_image};
+pub use image::{AerosolFit, AerosolRetrieval, DarkSpectrumSettings, ImageCorrection, correct_image};
 
 use ndarray::{Array2, Array3};
 use rand::SeedableRng;

@@ -50,7 +50,12 @@ impl Engine {
                 let mut atmosphere = config.scene.atmosphere.clone();
                 atmosphere.day_of_year = side.scene.day_of_year;
                 (atmosphere.aerosol, atmosphere.aot550) = (crate::atmosphere::AerosolType::None, 0.0);
-                let luts_key = KeyBuilder::new(Stage::AerosolLuts).with(&atmosphere).with(&axes).with(image).finish();
+                let luts_key = KeyBuilder::new(Stage::AerosolLuts)
+                    .with(&atmosphere)
+                    .with(&axes)
+                    .with(&image.models)
+                    .with(&image.aot_nodes)
+                    .finish();
                 let luts = self.stage(luts_key, report, control, || {
                     FamilyLuts::build(image, &atmosphere, &axes, control).map_err(failed(Stage::AerosolLuts))
                 })?;
@@ -63,8 +68,7 @@ impl Engine {
                     AerosolFamily::tabulate(&luts, &side.scene, &side.response, &side.viewing, control)
                         .map_err(failed(Stage::AerosolFamily))
                 })?;
-                let pair = image.pair(&side.response.bands.centres_nm()).map_err(failed(Stage::Correction))?;
-                Some((fam, pair, key))
+                Some((fam, image, key))
             }
             None => None,
         };
@@ -87,9 +91,10 @@ impl Engine {
             // against the exact correction, and both against the truth) come with full resolution.
             let diagnostics = fid.decimation == 1;
             let image = match &family {
-                Some((fam, pair, _)) => {
-                    Some(correct_image(level1, fam, *pair, &radiance.truth.land, control).map_err(&fail)?)
-                }
+                Some((fam, settings, _)) => Some(
+                    correct_image(level1, fam, settings, &side.response.bands, &radiance.truth.land, control)
+                        .map_err(&fail)?,
+                ),
                 None => None,
             };
             // The image-based product is compared with the truth; the exact and approximate
@@ -121,7 +126,7 @@ impl Engine {
                 }
             };
             let rrs_vs_truth = if against_truth { compare(&rrs, &radiance.truth.rrs_above, None) } else { Vec::new() };
-            let family = family.as_ref().map(|(f, pair, _)| (f.clone(), *pair));
+            let family = family.as_ref().map(|(f, _, _)| f.clone());
             let names: Vec<String> = side.response.bands.bands.iter().map(|b| b.name.clone()).collect();
             let rrs_metrics = crate::correction::band_rrs_metrics(
                 &rrs,
@@ -143,8 +148,10 @@ impl Engine {
         report.approximation = Some(correction.approximation.clone());
         report.approximation_vs_exact = correction.approximation_vs_exact.clone();
         report.rrs_vs_truth = correction.rrs_vs_truth.clone();
-        report.aerosol =
-            correction.aerosol.as_ref().map(|a| super::report::aerosol_summary(a, &config.scene.atmosphere));
+        report.aerosol = match (&correction.aerosol, &config.correction.image) {
+            (Some(a), Some(settings)) => Some(super::report::aerosol_summary(a, settings, &config.scene.atmosphere)),
+            _ => None,
+        };
         Ok((correction, correction_key))
     }
 }

@@ -33,9 +33,8 @@ pub struct CorrectionProduct {
     pub rrs_metrics: Vec<crate::correction::BandRrsMetrics>,
     /// What the image-based correction found (AOT and Ångström per pixel), when it ran.
     pub aerosol: Option<crate::correction::AerosolRetrieval>,
-    /// The image-based correction's aerosol family and the pair of bands (short, long) it
-    /// read, when it ran.
-    pub family: Option<(Arc<crate::correction::AerosolFamily>, (usize, usize))>,
+    /// The image-based correction's aerosol family, when it ran.
+    pub family: Option<Arc<crate::correction::AerosolFamily>>,
 }
 
 /// Everything a run produced (shared with the cache: cheap to clone).

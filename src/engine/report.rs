@@ -47,6 +47,11 @@ pub struct AerosolSummary {
     pub angstrom_true: f64,
     /// Share of retrieved pixels whose measured ε lay outside the family's range, %.
     pub outside_family_pct: f64,
+    /// Mean passes of the NIR water-leaving iteration (1 without it).
+    pub passes_mean: f64,
+    /// What the correction did, in words (its fit; for dark-spectrum fitting the models the
+    /// tiles chose).
+    pub fit: String,
 }
 
 /// The report of one run.
@@ -136,6 +141,7 @@ impl RunReport {
 /// its own optics; NaN where the scene has no aerosol).
 pub(super) fn aerosol_summary(
     a: &crate::correction::AerosolRetrieval,
+    settings: &crate::correction::ImageCorrection,
     truth: &crate::atmosphere::AtmosphereSpec,
 ) -> AerosolSummary {
     let mut aot: Vec<f64> = a.aot550.iter().filter(|v| v.is_finite()).map(|&v| f64::from(v)).collect();
@@ -157,5 +163,28 @@ pub(super) fn aerosol_summary(
         angstrom: q(&alpha, 0.5),
         angstrom_true,
         outside_family_pct: if aot.is_empty() { 0.0 } else { 100.0 * a.outside_family as f64 / aot.len() as f64 },
+        passes_mean: a.passes_mean,
+        fit: fit_words(a, settings),
     }
+}
+
+/// The correction's fit in words: its label, and for dark-spectrum fitting the models chosen
+/// (share of tiles) and the bands that set the AOT.
+fn fit_words(a: &crate::correction::AerosolRetrieval, settings: &crate::correction::ImageCorrection) -> String {
+    if a.tiles.is_empty() {
+        return settings.label();
+    }
+    let mut models: Vec<(crate::atmosphere::AerosolType, usize)> = Vec::new();
+    for t in &a.tiles {
+        match models.iter_mut().find(|m| m.0 == t.model) {
+            Some(m) => m.1 += 1,
+            None => models.push((t.model, 1)),
+        }
+    }
+    let n = a.tiles.len();
+    let chosen: Vec<String> = models
+        .iter()
+        .map(|(m, k)| format!("{} {:.0} %", format!("{m:?}").to_lowercase(), 100.0 * *k as f64 / n as f64))
+        .collect();
+    format!("{}; {} tile{}: {}", settings.label(), n, if n == 1 { "" } else { "s" }, chosen.join(", "))
 }

@@ -98,13 +98,22 @@ fn refusal(range: &Range, value: f64) -> Option<String> {
         return Scene::build(&spec, None).err().map(|e| e.to_string());
     }
     if range.path.starts_with("correction.image") {
-        // The image-based correction's lists: the pair's ends with the other end where it
-        // leaves the pair ordered (600 … 2500 nm), an AOT node as the table's only node.
+        // The image-based correction's lists: the pair's and the dark-spectrum band range's
+        // ends with the other end where it leaves them ordered, an AOT node as the table's
+        // only node; counts as whole numbers.
         let mut image = shoal::correction::ImageCorrection::default();
-        if range.path == "correction.image.pair_nm" {
-            image.pair_nm = if value < 1500.0 { [value, 2500.0] } else { [600.0, value] };
-        } else {
-            image.aot_nodes = vec![value];
+        let dark = &mut image.dark;
+        match range.path {
+            "correction.image.pair_nm" => {
+                image.pair_nm = if value < 1500.0 { [value, 2500.0] } else { [600.0, value] };
+            }
+            "correction.image.dark.tile_px" => dark.tile_px = value as usize,
+            "correction.image.dark.pixels" => dark.pixels = value as usize,
+            "correction.image.dark.min_gas_transmittance" => dark.min_gas_transmittance = value,
+            "correction.image.dark.wave_range_nm" => {
+                dark.wave_range_nm = if value < 1500.0 { [value, 2500.0] } else { [350.0, value] };
+            }
+            _ => image.aot_nodes = vec![value],
         }
         let mut config = base("scene.chl_mg_m3");
         config.correction.image = Some(image);
@@ -149,7 +158,11 @@ fn every_range_refuses_just_outside_and_names_field_value_and_range() {
     // Every entry has a value on each side, except whole-number ranges from 0 (nothing below).
     let one_sided = ranges::ALL.iter().filter(|r| r.just_outside().len() == 1).count();
     let zero_based: Vec<&str> = ranges::ALL.iter().filter(|r| r.just_outside().len() == 1).map(|r| r.path).collect();
-    assert_eq!(zero_based, ["fidelity.band_nodes"], "only these have nothing below their range");
+    assert_eq!(
+        zero_based,
+        ["fidelity.band_nodes", "correction.image.dark.tile_px"],
+        "only these have nothing below their range"
+    );
     assert_eq!(refused, 2 * ranges::ALL.len() - one_sided, "every entry refused on both sides");
 }
 

@@ -1,0 +1,130 @@
+//! The band-pair fit of the image-based correction, pixel by pixel (Gordon & Wang 1994; the
+//! steps are in [`super::image`]'s module docs), with the NIR water-leaving iteration of
+//! Bailey et al. (2010) around it ([`super::nir_water`]).
+
+use super::CorrectionError;
+use super::family::AerosolFamily;
+use super::image::{ImageCorrection, Mixture, Pixel, locate, weighted};
+use super::nir_water::{self, NirWater};
+use crate::spectral::BandSet;
+
+/// Relative margin beyond the family's ε range before a pixel counts as outside it.
+const EDGE: f64 = 0.005;
+
+/// The fit's fixed inputs.
+pub(super) struct PairFit<'f> {
+    family: &'f AerosolFamily,
+    /// Short and long band of the pair.
+    pair: (usize, usize),
+    /// The NIR water model, when the iteration is on.
+    nir: Option<NirWater>,
+}
+
+/// Per-row working space.
+#[derive(Default)]
+pub(super) struct Scratch {
+    located: Vec<[(usize, f64); 3]>,
+    eps: Vec<f64>,
+    a_long: Vec<f64>,
+    order: Vec<usize>,
+    /// The water's radiance at the pair's bands where the previous pixel of the row converged.
+    warm: Option<[f64; 2]>,
+}
+
+impl<'f> PairFit<'f> {
+    /// The fit for an instrument's bands.
+    pub fn new(
+        family: &'f AerosolFamily,
+        settings: &ImageCorrection,
+        bands: &BandSet,
+    ) -> Result<Self, CorrectionError> {
+        let pair = settings.pair(&bands.centres_nm())?;
+        let nir = if settings.nir_iteration { Some(NirWater::new(bands)?) } else { None };
+        Ok(Self { family, pair, nir })
+    }
+
+    /// Fill `mix` with the pixel's atmosphere; false where the pair's bands are flagged.
+    pub fn fit(&self, p: &Pixel<'_>, mix: &mut Mixture<'f>, scratch: &mut Scratch) -> bool {
+        let (s, l) = self.pair;
+        let usable = !p.land && p.flags[l] == 0 && p.flags[s] == 0;
+        // The water's part of the TOA radiance at the pair's bands, from the previous pass; the
+        // first pass starts where the row's previous water pixel ended (l2gen starts every pixel
+        // black: the fixed point is the same, reached in fewer passes).
+        let mut water = if usable && self.nir.is_some() { scratch.warm.unwrap_or([0.0; 2]) } else { [0.0; 2] };
+        let mut previous_red = f64::INFINITY;
+        for pass in 1..=nir_water::MAX_PASSES + 1 {
+            self.select(p, water, mix, scratch);
+            mix.passes = pass;
+            let Some(nir) = self.nir.as_ref().filter(|_| usable) else { break };
+            let rrs = |b: usize| mix.rrs(p.at(b), f64::from(p.l1[b]));
+            let red = rrs(nir.red);
+            if red < 0.0
+                || (red - previous_red).abs() < nir_water::CONVERGED * red.abs()
+                || pass > nir_water::MAX_PASSES
+            {
+                scratch.warm = Some(water);
+                break;
+            }
+            previous_red = red;
+            let ramp = nir.chl_oc4(rrs).map_or(0.0, NirWater::ramp);
+            let estimate = nir.estimate(rrs, [s, l]).unwrap_or([0.0; 2]);
+            for (j, b) in [s, l].into_iter().enumerate() {
+                let new = mix.water_radiance(p.at(b), ramp * estimate[j]);
+                water[j] = (1.0 - nir_water::DAMPING) * new + nir_water::DAMPING * water[j];
+            }
+        }
+        usable
+    }
+
+    /// Two-band model selection with the water's radiance `water` taken from the pair's bands.
+    fn select(&self, p: &Pixel<'_>, water: [f64; 2], mix: &mut Mixture<'f>, scratch: &mut Scratch) {
+        let family = self.family;
+        let (s_band, l_band) = self.pair;
+        let nm = family.models.len();
+        let Scratch { located, eps, a_long, order, .. } = scratch;
+        located.resize(nm, [(0, 1.0), (0, 0.0), (0, 0.0)]);
+        eps.resize(nm, 0.0);
+        a_long.resize(family.aot550.len(), 0.0);
+        let rayleigh = &family.terms[0][0];
+        let (il, is) = (p.at(l_band), p.at(s_band));
+        let a_l = f64::from(p.l1[l_band]) - rayleigh.l_path[il] - water[1];
+        let a_s = f64::from(p.l1[s_band]) - rayleigh.l_path[is] - water[0];
+        // Each model's τ and ε for this pixel.
+        for m in 0..nm {
+            for (k, t) in family.terms[m].iter().enumerate() {
+                a_long[k] = t.l_path[il] - rayleigh.l_path[il];
+            }
+            located[m] = locate(a_long, a_l);
+            let short = weighted(&located[m], |k| family.terms[m][k].l_path[is] - rayleigh.l_path[is]);
+            eps[m] = if a_l > 0.0 { short / a_l } else { 0.0 };
+        }
+        let measured = if a_l > 0.0 { a_s / a_l } else { 0.0 };
+        // The bracketing pair (by ε), or the nearest model outside the family's range.
+        order.clear();
+        order.extend(0..nm);
+        order.sort_by(|&a, &b| eps[a].total_cmp(&eps[b]));
+        let (m1, m2, w, out) = match order.windows(2).find(|q| eps[q[0]] <= measured && measured <= eps[q[1]]) {
+            Some(q) => {
+                let d = eps[q[1]] - eps[q[0]];
+                (q[0], q[1], if d > 0.0 { (measured - eps[q[0]]) / d } else { 0.0 }, false)
+            }
+            None if nm == 1 || measured < eps[order[0]] => (order[0], order[0], 0.0, nm > 1),
+            None => (order[nm - 1], order[nm - 1], 0.0, true),
+        };
+        // Counted as outside only beyond half a per cent of the family's range: a member's own
+        // pixels sit on its edge and the water's NIR signal moves them across it.
+        let (lo, hi) = (eps[order[0]], eps[order[nm - 1]]);
+        mix.outside = out && a_l > 0.0 && (measured < lo * (1.0 - EDGE) || measured > hi * (1.0 + EDGE));
+        mix.entries.clear();
+        for (m, share) in [(m1, 1.0 - w), (m2, w)] {
+            for &(k, weight) in &located[m] {
+                if share * weight != 0.0 {
+                    mix.entries.push((&family.terms[m][k], share * weight));
+                }
+            }
+        }
+        let tau = |m: usize| weighted(&located[m], |k| family.aot550[k]).max(0.0);
+        mix.aot550 = (1.0 - w) * tau(m1) + w * tau(m2);
+        mix.angstrom = (1.0 - w) * family.angstrom[m1] + w * family.angstrom[m2];
+    }
+}
