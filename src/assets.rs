@@ -89,6 +89,7 @@ pub const PRESETS: &[Asset] = embed_presets![
     "studies/cubesat_vs_smallsat.ron",
     "studies/msi_vs_smallsat.ron",
     "studies/cubesat_vs_smallsat_image.ron",
+    "studies/cubesat_vs_smallsat_dsf.ron",
     "studies/lake_hume_swir_image.ron",
     "studies/lake_hume_nominal.ron",
     "studies/heron_island_depth.ron",

@@ -125,38 +125,48 @@ pub(super) fn conditions(app: &mut ShoalApp, ui: &mut egui::Ui) {
 
 /// The atmospheric correction both instruments' Level-1 goes through: exact (the forward
 /// model's own atmosphere, the "perfect correction"), the paper's per-scene approximation, or
-/// image-based from a band pair (the aerosol from the design's own bands; `correction::image`).
+/// image-based (the aerosol from the design's own bands; `correction::image`): a band pair with
+/// the NIR water iteration, a SWIR pair, or dark-spectrum fitting.
 fn correction_choice(ui: &mut egui::Ui, spec: &mut crate::correction::CorrectionSpec) {
-    use crate::correction::ImageCorrection;
-    let choices: [(&str, &str, Option<[f64; 2]>, bool); 4] = [
+    use crate::correction::{AerosolFit, ImageCorrection};
+    let pair = |p: [f64; 2]| Some(ImageCorrection { pair_nm: p, ..ImageCorrection::default() });
+    let choices: [(&str, &str, Option<ImageCorrection>, bool); 5] = [
         ("exact", "The forward model's own atmosphere, per pixel: the perfect correction", None, false),
         ("per-scene (paper)", "Matthews et al. 2023, Appendix A: one set of terms from 20 water pixels", None, true),
         (
             "image: 779/865 nm",
-            "Aerosol from the design's 779 and 865 nm bands (Gordon & Wang 1994; l2gen's OLCI pair)",
-            Some([779.0, 865.0]),
+            "Aerosol from the design's 779 and 865 nm bands (Gordon & Wang 1994; l2gen's OLCI pair), \
+             the water's NIR signal estimated from the red band (Bailey et al. 2010)",
+            pair([779.0, 865.0]),
             false,
         ),
         (
             "image: 1610/2200 nm",
             "Aerosol from a SWIR pair, black even over turbid water (Wang & Shi 2007)",
-            Some([1610.0, 2200.0]),
+            pair([1610.0, 2200.0]),
+            false,
+        ),
+        (
+            "image: dark spectrum",
+            "One atmosphere for the scene from its darkest pixels in every band (ACOLITE; \
+             Vanhellemont & Ruddick 2018)",
+            Some(ImageCorrection::dark_spectrum()),
             false,
         ),
     ];
     let current = choices
         .iter()
-        .position(|(_, _, pair, approx)| match (&spec.image, pair) {
-            (Some(i), Some(p)) => i.pair_nm == *p,
+        .position(|(_, _, image, approx)| match (&spec.image, image) {
+            (Some(i), Some(c)) => i.fit == c.fit && (c.fit == AerosolFit::DarkSpectrum || i.pair_nm == c.pair_nm),
             (None, None) => spec.use_approximation == *approx,
             _ => false,
         })
-        .map_or("image: custom pair", |i| choices[i].0);
+        .map_or("image: custom", |i| choices[i].0);
     egui::ComboBox::from_label("Atmospheric correction").selected_text(current).show_ui(ui, |ui| {
-        for (name, hover, pair, approx) in choices {
+        for (name, hover, image, approx) in choices {
             if ui.selectable_label(current == name, name).on_hover_text(hover).clicked() {
                 spec.use_approximation = approx;
-                spec.image = pair.map(|p| ImageCorrection { pair_nm: p, ..ImageCorrection::default() });
+                spec.image = image;
             }
         }
     });

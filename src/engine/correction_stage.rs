@@ -41,39 +41,9 @@ impl Engine {
             .with(&inputs.seed)
             .with(&inputs.decimation)
             .finish();
-        // The image-based correction's family: its atmospheres once per scene atmosphere and LUT
-        // axes (two instruments with the same axes share them), its band terms once per
-        // instrument geometry. Neither depends on the scene's true aerosol.
-        let family = match &config.correction.image {
-            Some(image) => {
-                let axes = lut_axes(&side.response, &side.viewing, config.scene.sun.zenith_deg, fid);
-                let mut atmosphere = config.scene.atmosphere.clone();
-                atmosphere.day_of_year = side.scene.day_of_year;
-                (atmosphere.aerosol, atmosphere.aot550) = (crate::atmosphere::AerosolType::None, 0.0);
-                let luts_key = KeyBuilder::new(Stage::AerosolLuts)
-                    .with(&atmosphere)
-                    .with(&axes)
-                    .with(&image.models)
-                    .with(&image.aot_nodes)
-                    .finish();
-                let luts = self.stage(luts_key, report, control, || {
-                    FamilyLuts::build(image, &atmosphere, &axes, control).map_err(failed(Stage::AerosolLuts))
-                })?;
-                let key = KeyBuilder::new(Stage::AerosolFamily)
-                    .after(luts_key)
-                    .after(side.geometry_key)
-                    .with(&side.scene.spec.effects)
-                    .finish();
-                let fam = self.stage(key, report, control, || {
-                    AerosolFamily::tabulate(&luts, &side.scene, &side.response, &side.viewing, control)
-                        .map_err(failed(Stage::AerosolFamily))
-                })?;
-                Some((fam, image, key))
-            }
-            None => None,
-        };
+        let family = self.aerosol_family(config, side, control, report)?;
         let correction_key = match &family {
-            Some((_, _, key)) => KeyBuilder::new(Stage::Correction).after(correction_key).after(*key).finish(),
+            Some((_, key)) => KeyBuilder::new(Stage::Correction).after(correction_key).after(*key).finish(),
             None => correction_key,
         };
         let correction = self.stage(correction_key, report, control, || {
@@ -90,12 +60,12 @@ impl Engine {
             // A preview computes only the product it shows; the diagnostics (the approximation
             // against the exact correction, and both against the truth) come with full resolution.
             let diagnostics = fid.decimation == 1;
-            let image = match &family {
-                Some((fam, settings, _)) => Some(
+            let image = match (&family, &config.correction.image) {
+                (Some((fam, _)), Some(settings)) => Some(
                     correct_image(level1, fam, settings, &side.response.bands, &radiance.truth.land, control)
                         .map_err(&fail)?,
                 ),
-                None => None,
+                _ => None,
             };
             // The image-based product is compared with the truth; the exact and approximate
             // corrections are not run beside it (`shoal budget` prices the difference).
@@ -126,7 +96,7 @@ impl Engine {
                 }
             };
             let rrs_vs_truth = if against_truth { compare(&rrs, &radiance.truth.rrs_above, None) } else { Vec::new() };
-            let family = family.as_ref().map(|(f, _, _)| f.clone());
+            let family = family.as_ref().map(|(f, _)| f.clone());
             let names: Vec<String> = side.response.bands.bands.iter().map(|b| b.name.clone()).collect();
             let rrs_metrics = crate::correction::band_rrs_metrics(
                 &rrs,
@@ -149,9 +119,52 @@ impl Engine {
         report.approximation_vs_exact = correction.approximation_vs_exact.clone();
         report.rrs_vs_truth = correction.rrs_vs_truth.clone();
         report.aerosol = match (&correction.aerosol, &config.correction.image) {
-            (Some(a), Some(settings)) => Some(super::report::aerosol_summary(a, settings, &config.scene.atmosphere)),
+            (Some(a), Some(settings)) => Some(super::report::aerosol_summary(
+                a,
+                settings,
+                &config.scene.atmosphere,
+                &side.response.bands.centres_nm(),
+            )),
             _ => None,
         };
         Ok((correction, correction_key))
+    }
+
+    /// The image-based correction's family and its key, when the run asks for the
+    /// image-based correction: its atmospheres once per scene atmosphere and LUT axes (two
+    /// instruments with the same axes share them), its band terms once per instrument geometry.
+    /// Neither depends on the scene's true aerosol.
+    fn aerosol_family(
+        &mut self,
+        config: &RunConfig,
+        side: &SceneSide,
+        control: &RunControl,
+        report: &mut RunReport,
+    ) -> Result<Option<(Arc<AerosolFamily>, Key)>, EngineError> {
+        let Some(image) = &config.correction.image else { return Ok(None) };
+        let fid = &config.fidelity;
+        let axes = lut_axes(&side.response, &side.viewing, config.scene.sun.zenith_deg, fid);
+        let mut atmosphere = config.scene.atmosphere.clone();
+        atmosphere.day_of_year = side.scene.day_of_year;
+        (atmosphere.aerosol, atmosphere.aot550) = (crate::atmosphere::AerosolType::None, 0.0);
+        let luts_key = KeyBuilder::new(Stage::AerosolLuts)
+            .with(&atmosphere)
+            .with(&axes)
+            .with(&image.models)
+            .with(&image.aot_nodes)
+            .finish();
+        let luts = self.stage(luts_key, report, control, || {
+            FamilyLuts::build(image, &atmosphere, &axes, control).map_err(failed(Stage::AerosolLuts))
+        })?;
+        let key = KeyBuilder::new(Stage::AerosolFamily)
+            .after(luts_key)
+            .after(side.geometry_key)
+            .with(&side.scene.spec.effects)
+            .finish();
+        let fam = self.stage(key, report, control, || {
+            AerosolFamily::tabulate(&luts, &side.scene, &side.response, &side.viewing, control)
+                .map_err(failed(Stage::AerosolFamily))
+        })?;
+        Ok(Some((fam, key)))
     }
 }

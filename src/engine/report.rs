@@ -143,6 +143,7 @@ pub(super) fn aerosol_summary(
     a: &crate::correction::AerosolRetrieval,
     settings: &crate::correction::ImageCorrection,
     truth: &crate::atmosphere::AtmosphereSpec,
+    centres_nm: &[f64],
 ) -> AerosolSummary {
     let mut aot: Vec<f64> = a.aot550.iter().filter(|v| v.is_finite()).map(|&v| f64::from(v)).collect();
     let mut alpha: Vec<f64> = a.angstrom.iter().filter(|v| v.is_finite()).map(|&v| f64::from(v)).collect();
@@ -164,13 +165,17 @@ pub(super) fn aerosol_summary(
         angstrom_true,
         outside_family_pct: if aot.is_empty() { 0.0 } else { 100.0 * a.outside_family as f64 / aot.len() as f64 },
         passes_mean: a.passes_mean,
-        fit: fit_words(a, settings),
+        fit: fit_words(a, settings, centres_nm),
     }
 }
 
 /// The correction's fit in words: its label, and for dark-spectrum fitting the models chosen
-/// (share of tiles) and the bands that set the AOT.
-fn fit_words(a: &crate::correction::AerosolRetrieval, settings: &crate::correction::ImageCorrection) -> String {
+/// (share of tiles) and, for one tile, the bands that set the AOT.
+fn fit_words(
+    a: &crate::correction::AerosolRetrieval,
+    settings: &crate::correction::ImageCorrection,
+    centres_nm: &[f64],
+) -> String {
     if a.tiles.is_empty() {
         return settings.label();
     }
@@ -186,5 +191,12 @@ fn fit_words(a: &crate::correction::AerosolRetrieval, settings: &crate::correcti
         .iter()
         .map(|(m, k)| format!("{} {:.0} %", format!("{m:?}").to_lowercase(), 100.0 * *k as f64 / n as f64))
         .collect();
-    format!("{}; {} tile{}: {}", settings.label(), n, if n == 1 { "" } else { "s" }, chosen.join(", "))
+    let bands = match a.tiles.as_slice() {
+        [one] => {
+            let nm = |b: usize| centres_nm.get(b).map_or(f64::NAN, |c| *c);
+            format!(", AOT from {:.0} and {:.0} nm", nm(one.bands[0]), nm(one.bands[1]))
+        }
+        _ => String::new(),
+    };
+    format!("{}; {} tile{}: {}{bands}", settings.label(), n, if n == 1 { "" } else { "s" }, chosen.join(", "))
 }

@@ -391,6 +391,9 @@ pub fn figure_set(result: &StudyResult) -> Result<Vec<Figure>, StudyError> {
     if let Some(snr) = super::snr_figure::SnrFigure::of(result) {
         figures.push(render("snr", &snr)?);
     }
+    if let Some(rrs) = super::rrs_figure::RrsFigure::of(result) {
+        figures.push(render("rrs_error", &rrs)?);
+    }
     if let Some(data) = result.spectrum.as_deref() {
         let s = &data.point;
         let title = format!(

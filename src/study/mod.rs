@@ -24,6 +24,7 @@ mod output;
 mod render;
 pub mod reproduction;
 mod requirements;
+mod rrs_figure;
 mod run;
 mod slide;
 mod snr_figure;

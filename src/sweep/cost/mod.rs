@@ -146,14 +146,19 @@ pub fn settings_for(base: &RunConfig) -> Vec<Setting> {
         ]),
         _ => {}
     }
-    // The image-based correction (the aerosol from the design's 779/865 nm bands) priced beside
-    // the exact one, where the design has the pair.
+    // The image-based corrections priced beside the exact one: the 779/865 nm pair where the
+    // design has it, and dark-spectrum fitting.
     let centres = crate::instrument::Response::new(&base.instrument, base.fidelity.spectral_step_nm)
         .map(|r| r.bands.centres_nm())
         .unwrap_or_default();
-    if base.correction.image.is_none() && crate::correction::ImageCorrection::default().pair(&centres).is_ok() {
-        out.push(e("image-based correction (779/865 nm)", |c| {
-            c.correction.image = Some(crate::correction::ImageCorrection::default());
+    if base.correction.image.is_none() {
+        if crate::correction::ImageCorrection::default().pair(&centres).is_ok() {
+            out.push(e("image-based correction (779/865 nm, NIR iteration)", |c| {
+                c.correction.image = Some(crate::correction::ImageCorrection::default());
+            }));
+        }
+        out.push(e("image-based correction (dark spectrum, scene)", |c| {
+            c.correction.image = Some(crate::correction::ImageCorrection::dark_spectrum());
         }));
     }
     out.push(s(
