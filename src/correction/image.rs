@@ -1,5 +1,8 @@
-//! The image-based correction: the aerosol from the instrument's own long bands, as a real
-//! processor finds it, knowing nothing of the scene's true atmosphere.
+//! The image-based correction: the aerosol from the instrument's own Level-1, as a real
+//! processor finds it, knowing nothing of the scene's true atmosphere. Two fits share the
+//! family ([`super::family`]) and the per-pixel inversion (`apply`): the band pair below
+//! (`pair.rs`, with the NIR water iteration of [`super::nir_water`]) and dark-spectrum fitting
+//! ([`super::dark`]).
 //!
 //! **Two-band model selection** (Gordon & Wang 1994; Ahmad et al. 2010, as NASA's l2gen runs
 //! it; Wang & Shi 2007 with a SWIR pair). A family of aerosol models, each tabulated at a few
@@ -8,7 +11,8 @@
 //! and spherical albedo S of every column, through each band's response — the same radiative
 //! transfer as the forward model, so the family is exact where the scene's aerosol is a member.
 //! Per pixel, with A(λ) = L1(λ) − L_path(λ; τ = 0) the aerosol's part of the signal and the
-//! water taken as black at the pair's bands (their Rrs left in A is the black-pixel error):
+//! water taken as black at the pair's bands (their Rrs left in A is the black-pixel error,
+//! which the NIR iteration estimates and takes away):
 //!
 //! 1. for each model, τ_m such that A_m(λ_l; τ_m) = A(λ_l) at the long band (quadratic in the
 //!    signal over the three nearest nodes; beyond the last node, the last segment extended;

@@ -79,7 +79,10 @@ fn base(path: &str) -> RunConfig {
     // Coarse LUT nodes keep each run short; they are inputs like any other.
     c.fidelity.lut_wavelength_step_nm = 40.0;
     c.fidelity.lut_view_step_deg = 10.0;
-    if path.starts_with("correction.image") {
+    if path.starts_with("correction.image.dark") {
+        // Dark-spectrum fitting's settings act only when it is the fit.
+        c.correction.image = Some(shoal::correction::ImageCorrection::dark_spectrum());
+    } else if path.starts_with("correction.image") {
         // The image-based correction's settings act only when it is on.
         c.correction.image = Some(shoal::correction::ImageCorrection::default());
     }
@@ -177,6 +180,14 @@ fn chosen_value(path: &str) -> Option<f64> {
         "correction.image.pair_nm" => 900.0,
         // An AOT node (its `aot_nodes.2`, 0.2) moved within its neighbours 0.1 and 0.4.
         "correction.image.aot_nodes" => 0.15,
+        // Dark-spectrum fitting over the 16 × 12 image: 8-pixel tiles (2 × 2 where the default
+        // is one scene-wide tile); 20 darkest pixels where the default's 200 take them all; a
+        // gas threshold of 0.99 and a band range starting at 770 nm, each leaving out bands the
+        // default fits (its two lowest-AOT bands are below 800 nm here).
+        "correction.image.dark.tile_px" => 8.0,
+        "correction.image.dark.pixels" => 20.0,
+        "correction.image.dark.min_gas_transmittance" => 0.99,
+        "correction.image.dark.wave_range_nm" => 770.0,
         // SAMBUCA's fits converge in fewer than 100 iterations; 3 stops them early.
         "retrievals[i].Sambuca.settings.max_iterations" => 3.0,
         _ => return None,
@@ -247,7 +258,8 @@ fn every_range_field_changes_the_output_or_is_documented_and_the_cache_follows()
         let config = base(range.path);
         // One cached engine per base instrument, warmed on its base run.
         let adjacency = if config.scene.effects.contains(&Effect::Adjacency) { "" } else { " without adjacency" };
-        let image = if config.correction.image.is_some() { " image-corrected" } else { "" };
+        let image =
+            config.correction.image.as_ref().map_or(String::new(), |i| format!(" image-corrected, {}", i.label()));
         let key = format!("{}{adjacency}{image}", config.instrument.name);
         if !engines.iter().any(|(k, _, _)| *k == key) {
             let mut e = Engine::new();

@@ -37,9 +37,11 @@ pub fn sweep_path(path: &str) -> String {
     // The dark-current laws: the first plane's doubles ([`with_dark_laws`]), the SWIR plane's is
     // Arrhenius.
     let path = path.replace("[i]", index).replace("focal_planes[]", "focal_planes.0");
-    // The image-based correction's lists: the pair's long band, the AOT node 0.2.
+    // The image-based correction's lists: the pair's long band, the AOT node 0.2, the start of
+    // dark-spectrum fitting's band range.
     let path = match path.as_str() {
         "correction.image.pair_nm" => "correction.image.pair_nm.1".to_string(),
+        "correction.image.dark.wave_range_nm" => "correction.image.dark.wave_range_nm.0".to_string(),
         "correction.image.aot_nodes" => "correction.image.aot_nodes.2".to_string(),
         _ => path,
     };
