@@ -266,6 +266,14 @@ ranges! {
     ATMOSPHERE_WATER_VAPOUR_CM = Range::closed("scene.atmosphere.gas_amounts.water_vapour_cm", 0.0, 10.0, "cm", "precipitable water");
     /// Wind speed of a rough surface.
     ATMOSPHERE_WIND_SPEED_M_S = Range::closed("scene.atmosphere.surface.Wind.speed_m_s", 0.0, 30.0, "m/s", "wind speed (Cox–Munk surface)");
+    /// A user's WMO mixture: dust-like fraction.
+    ATMOSPHERE_MIXTURE_DUST_LIKE = Range::closed("scene.atmosphere.aerosol.Mixture.dust_like", 0.0, 1.0, "", "volume fraction of the dust-like component (the four are normalised by their sum, which must be above 0)");
+    /// A user's WMO mixture: water-soluble fraction.
+    ATMOSPHERE_MIXTURE_WATER_SOLUBLE = Range::closed("scene.atmosphere.aerosol.Mixture.water_soluble", 0.0, 1.0, "", "volume fraction of the water-soluble component");
+    /// A user's WMO mixture: oceanic fraction.
+    ATMOSPHERE_MIXTURE_OCEANIC = Range::closed("scene.atmosphere.aerosol.Mixture.oceanic", 0.0, 1.0, "", "volume fraction of the oceanic component");
+    /// A user's WMO mixture: soot fraction.
+    ATMOSPHERE_MIXTURE_SOOT = Range::closed("scene.atmosphere.aerosol.Mixture.soot", 0.0, 1.0, "", "volume fraction of the soot component");
     /// Latitude.
     ATMOSPHERE_LATITUDE_DEG = Range::closed("scene.atmosphere.latitude_deg", -90.0, 90.0, "degrees", "latitude (gravity in the Rayleigh depth)");
     /// Molecular scale height.

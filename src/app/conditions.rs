@@ -53,7 +53,9 @@ pub(super) fn conditions(app: &mut ShoalApp, ui: &mut egui::Ui) {
             (AerosolType::Continental, "continental"),
             (AerosolType::Urban, "urban"),
         ];
-        let current = names.iter().find(|(a, _)| *a == atm.aerosol).map_or("?", |(_, n)| *n);
+        // A user's mixture (set in a scene file) shows its fractions; the menu offers the models.
+        let current =
+            names.iter().find(|(a, _)| *a == atm.aerosol).map_or_else(|| atm.aerosol.name(), |(_, n)| (*n).into());
         egui::ComboBox::from_label("Aerosol (WMO)").selected_text(current).show_ui(ui, |ui| {
             for (a, n) in names {
                 ui.selectable_value(&mut atm.aerosol, a, n);

@@ -58,7 +58,7 @@ pub use rt::{
 pub use solar::{e0_on_grid, sun_distance_factor, tsis1};
 pub use sos::Streams;
 pub use spec::{Atmosphere, AtmosphereSpec, AtmosphereTerms, Geometry, Normalised, Surface};
-pub use wmo::{AerosolType, Component};
+pub use wmo::{AerosolType, Component, WmoFractions};
 
 use crate::spectral::SpectralError;
 

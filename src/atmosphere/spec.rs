@@ -122,6 +122,25 @@ impl AtmosphereSpec {
         if let Surface::Wind { speed_m_s } = self.surface {
             check(&r::ATMOSPHERE_WIND_SPEED_M_S, speed_m_s)?;
         }
+        if let super::wmo::AerosolType::Mixture(f) = self.aerosol {
+            let fields = [
+                &r::ATMOSPHERE_MIXTURE_DUST_LIKE,
+                &r::ATMOSPHERE_MIXTURE_WATER_SOLUBLE,
+                &r::ATMOSPHERE_MIXTURE_OCEANIC,
+                &r::ATMOSPHERE_MIXTURE_SOOT,
+            ];
+            for (range, (_, _, v)) in fields.into_iter().zip(f.named()) {
+                check(range, v)?;
+            }
+            let total: f64 = f.named().iter().map(|n| n.2).sum();
+            if total <= 0.0 {
+                return Err(AtmosphereError::OutOfRange {
+                    field: "aerosol.Mixture".into(),
+                    value: total,
+                    allowed: "fractions summing to more than 0".into(),
+                });
+            }
+        }
         check(&r::ATMOSPHERE_LATITUDE_DEG, self.latitude_deg)?;
         check(&r::ATMOSPHERE_RAYLEIGH_SCALE_HEIGHT_KM, self.rayleigh_scale_height_km)?;
         check(&r::ATMOSPHERE_AEROSOL_SCALE_HEIGHT_KM, self.aerosol_scale_height_km)?;

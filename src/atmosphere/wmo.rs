@@ -178,7 +178,7 @@ impl Component {
 }
 
 /// The aerosol mixtures Shoal offers (WMO models as in OSOAA and 6S).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum AerosolType {
     /// No aerosol (Rayleigh atmosphere).
     None,
@@ -188,21 +188,84 @@ pub enum AerosolType {
     Continental,
     /// WMO urban: 0.17 dust-like + 0.61 water-soluble + 0.22 soot by volume.
     Urban,
+    /// A user's mixture of the four WMO components by volume (OSOAA's user-defined WMO model,
+    /// `-AER.WMO.Model 4`; 6S's "user defined" basic components): an aerosol outside the
+    /// correction's family.
+    Mixture(WmoFractions),
+}
+
+/// Volume fractions of the WMO components; they are normalised by their sum.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct WmoFractions {
+    /// Dust-like.
+    pub dust_like: f64,
+    /// Water-soluble.
+    pub water_soluble: f64,
+    /// Oceanic.
+    pub oceanic: f64,
+    /// Soot.
+    pub soot: f64,
+}
+
+impl Default for WmoFractions {
+    /// WMO continental's fractions.
+    fn default() -> Self {
+        Self { dust_like: 0.70, water_soluble: 0.29, oceanic: 0.0, soot: 0.01 }
+    }
+}
+
+impl WmoFractions {
+    /// The fractions with their field names, in the order of [`Component`]s.
+    #[must_use]
+    pub fn named(&self) -> [(&'static str, Component, f64); 4] {
+        [
+            ("dust_like", Component::DustLike, self.dust_like),
+            ("water_soluble", Component::WaterSoluble, self.water_soluble),
+            ("oceanic", Component::Oceanic, self.oceanic),
+            ("soot", Component::Soot, self.soot),
+        ]
+    }
 }
 
 impl AerosolType {
-    /// Parse `none|maritime|continental|urban`.
+    /// Parse `none|maritime|continental|urban|mixture:DL,WS,OC,SO` (volume fractions of
+    /// dust-like, water-soluble, oceanic and soot).
     pub fn parse(text: &str) -> Result<Self, String> {
-        match text.trim().to_ascii_lowercase().as_str() {
+        let text = text.trim().to_ascii_lowercase();
+        if let Some(list) = text.strip_prefix("mixture:") {
+            let v: Vec<f64> =
+                list.split(',').map(|x| x.trim().parse::<f64>()).collect::<Result<_, _>>().map_err(|e| {
+                    format!("mixture:{list}: {e} (four volume fractions: dust-like, water-soluble, oceanic, soot)")
+                })?;
+            let [dust_like, water_soluble, oceanic, soot] = v[..] else {
+                return Err(format!("mixture:{list}: four volume fractions (dust-like, water-soluble, oceanic, soot)"));
+            };
+            return Ok(Self::Mixture(WmoFractions { dust_like, water_soluble, oceanic, soot }));
+        }
+        match text.as_str() {
             "none" => Ok(Self::None),
             "maritime" => Ok(Self::Maritime),
             "continental" => Ok(Self::Continental),
             "urban" => Ok(Self::Urban),
-            other => Err(format!("unknown aerosol model `{other}` (allowed: none, maritime, continental, urban)")),
+            other => Err(format!(
+                "unknown aerosol model `{other}` (allowed: none, maritime, continental, urban, mixture:DL,WS,OC,SO)"
+            )),
         }
     }
 
-    /// Volume fractions of the components (OSOAA_AEROSOLS.F).
+    /// A short name (`continental`, `mixture 0.50/0.30/0.20/0.00`).
+    #[must_use]
+    pub fn name(&self) -> String {
+        match self {
+            Self::Mixture(f) => {
+                format!("mixture {:.2}/{:.2}/{:.2}/{:.2}", f.dust_like, f.water_soluble, f.oceanic, f.soot)
+            }
+            other => format!("{other:?}").to_lowercase(),
+        }
+    }
+
+    /// Volume fractions of the components (OSOAA_AEROSOLS.F), summing to 1.
     #[must_use]
     pub fn volume_fractions(self) -> Vec<(Component, f64)> {
         match self {
@@ -212,6 +275,11 @@ impl AerosolType {
                 vec![(Component::DustLike, 0.70), (Component::WaterSoluble, 0.29), (Component::Soot, 0.01)]
             }
             Self::Urban => vec![(Component::DustLike, 0.17), (Component::WaterSoluble, 0.61), (Component::Soot, 0.22)],
+            Self::Mixture(f) => {
+                let named = f.named();
+                let total: f64 = named.iter().map(|n| n.2).sum();
+                named.iter().filter(|n| n.2 > 0.0).map(|n| (n.1, n.2 / total)).collect()
+            }
         }
     }
 

@@ -68,6 +68,10 @@ fn base(path: &str) -> RunConfig {
         scene.effects.retain(|e| *e != Effect::Adjacency);
     }
     scene.atmosphere.surface = shoal::atmosphere::Surface::Wind { speed_m_s: 5.0 };
+    if path.starts_with("scene.atmosphere.aerosol.Mixture") {
+        // A user's mixture (continental's fractions; the oceanic one 0 until changed).
+        scene.atmosphere.aerosol = shoal::atmosphere::AerosolType::Mixture(Default::default());
+    }
     for e in [Effect::SunGlint, Effect::SpatialResponse] {
         if !scene.effects.contains(&e) {
             scene.effects.push(e);
@@ -260,7 +264,8 @@ fn every_range_field_changes_the_output_or_is_documented_and_the_cache_follows()
         let adjacency = if config.scene.effects.contains(&Effect::Adjacency) { "" } else { " without adjacency" };
         let image =
             config.correction.image.as_ref().map_or(String::new(), |i| format!(" image-corrected, {}", i.label()));
-        let key = format!("{}{adjacency}{image}", config.instrument.name);
+        let aerosol = config.scene.atmosphere.aerosol.name();
+        let key = format!("{}{adjacency}{image}, {aerosol}", config.instrument.name);
         if !engines.iter().any(|(k, _, _)| *k == key) {
             let mut e = Engine::new();
             let before = fingerprint(&e.run(&config, &RunControl::new()).unwrap());

@@ -14,7 +14,8 @@ use shoal::study::Requirements;
 use crate::common::{both_retrievals, instrument_for, sweep_path};
 
 /// A configuration in which every path of the table exists: both retrievals, a sun incidence,
-/// a wind-roughened surface; a spectrograph or filter imager for their `kind` fields.
+/// a wind-roughened surface; a user's aerosol mixture for its fields; a spectrograph or filter
+/// imager for their `kind` fields.
 fn base(path: &str) -> RunConfig {
     let mut instrument = InstrumentSpec::preset(instrument_for(path)).unwrap();
     crate::common::with_dark_laws(&mut instrument);
@@ -22,6 +23,9 @@ fn base(path: &str) -> RunConfig {
     c.retrievals = both_retrievals();
     c.calibration.sun_incidence_deg = Some(30.0);
     c.scene.atmosphere.surface = shoal::atmosphere::Surface::Wind { speed_m_s: 5.0 };
+    if path.starts_with("scene.atmosphere.aerosol.Mixture") {
+        c.scene.atmosphere.aerosol = shoal::atmosphere::AerosolType::Mixture(Default::default());
+    }
     c.validate().unwrap();
     c
 }

@@ -72,3 +72,33 @@ fn bulk_properties_agree_with_6sv() {
     assert!(mixture_optics(AerosolType::None, 550.0).unwrap().is_none());
     assert!(matches!(PhaseFunction::Rayleigh { depolarization: 0.0 }.asymmetry(), g if g.abs() < 1e-12));
 }
+
+/// A user's WMO mixture with continental's fractions is continental (limit test), whatever
+/// scale its fractions are given at; bad fractions are refused naming the field.
+#[test]
+fn a_users_mixture_with_continentals_fractions_is_continental() {
+    use shoal::atmosphere::{AtmosphereSpec, WmoFractions};
+    let doubled = WmoFractions { dust_like: 1.4, water_soluble: 0.58, oceanic: 0.0, soot: 0.02 };
+    for kind in [AerosolType::Mixture(WmoFractions::default()), AerosolType::Mixture(doubled)] {
+        for nm in [443.0, 865.0, 1610.0] {
+            let (a, b) = (
+                mixture_optics(kind, nm).unwrap().unwrap(),
+                mixture_optics(AerosolType::Continental, nm).unwrap().unwrap(),
+            );
+            // The same components and number fractions up to rounding of the normalisation.
+            assert!((a.extinction_ratio / b.extinction_ratio - 1.0).abs() < 1e-12, "{kind:?} {nm}");
+            assert!((a.ssa - b.ssa).abs() < 1e-12, "{kind:?} {nm}");
+        }
+    }
+    assert_eq!(AerosolType::parse("mixture:0.7,0.29,0,0.01").unwrap(), AerosolType::Mixture(WmoFractions::default()));
+    assert!(AerosolType::parse("mixture:0.7,0.29").unwrap_err().contains("four volume fractions"));
+    let mut spec = AtmosphereSpec {
+        aerosol: AerosolType::Mixture(WmoFractions { soot: -0.1, ..WmoFractions::default() }),
+        ..AtmosphereSpec::default()
+    };
+    let e = spec.validate().unwrap_err().to_string();
+    assert!(e.contains("aerosol.Mixture.soot"), "{e}");
+    spec.aerosol = AerosolType::Mixture(WmoFractions { dust_like: 0.0, water_soluble: 0.0, oceanic: 0.0, soot: 0.0 });
+    let e = spec.validate().unwrap_err().to_string();
+    assert!(e.contains("aerosol.Mixture") && e.contains("more than 0"), "{e}");
+}
