@@ -17,6 +17,7 @@ mod bench_chain;
 mod bench_reference;
 mod bench_retrieval;
 mod budget;
+mod correct;
 mod grid;
 mod interrupt;
 mod lookup;
@@ -87,6 +88,9 @@ enum Command {
     /// Run a sweep: a study repeated over one parameter (or a grid of two) with several noise
     /// seeds per point; writes the table and the curves with the requirement's crossing.
     Sweep(sweep::SweepArgs),
+    /// The image-based atmospheric correction on TOA radiance spectra from a CSV (geometry and
+    /// band radiances per row): Rrs per band, AOT and Ångström exponent per row.
+    Correct(correct::CorrectArgs),
     /// Error budget of a study: how much of each product's error each stage contributes
     /// (noise, calibration, atmospheric correction, SIOP set choice).
     Budget(budget::BudgetArgs),
@@ -207,6 +211,7 @@ pub fn main(app: impl FnOnce(&AppArgs) -> ExitCode) -> ExitCode {
         Command::Reproduce(args) => reproduce::run(&args),
         Command::Merge(args) => sweep::merge_run(&args),
         Command::Budget(args) => budget::run(&args),
+        Command::Correct(args) => correct::run(&args),
         Command::Report(args) => report::run(&args),
         Command::Bench(args) => bench::run(&args),
         Command::Ranges => output::emit(&crate::ranges::markdown_table(), None),

@@ -78,7 +78,7 @@ impl From<SceneError> for CliError {
 /// A RON file, or a preset name as the app's library resolves it (the user's own preset in
 /// `SHOAL_HOME/presets` first, then the built-in): the parsed spec and the file's directory.
 /// `--scene`: a file, the user's library, or a built-in.
-const SCENES: Lookup<SceneSpec> = Lookup {
+pub(super) const SCENES: Lookup<SceneSpec> = Lookup {
     kind: Kind::Scene,
     flag: "--scene",
     from_ron: |text, origin| Ok(SceneSpec::from_ron(text, origin)?),
@@ -87,7 +87,7 @@ const SCENES: Lookup<SceneSpec> = Lookup {
 };
 
 /// `--instrument`: a file, the user's library, or a built-in.
-const INSTRUMENTS: Lookup<InstrumentSpec> = Lookup {
+pub(super) const INSTRUMENTS: Lookup<InstrumentSpec> = Lookup {
     kind: Kind::Instrument,
     flag: "--instrument",
     from_ron: |text, origin| Ok(InstrumentSpec::from_ron(text, origin)?),

@@ -44,14 +44,20 @@ pub struct BandTerms {
 
 /// The band terms of every column for one atmosphere (the photon-weighted means of
 /// `BandAtmosphere`, without what only the forward model needs). Where every detector has the
-/// same response (no smile), the terms are computed at [`TERM_COLUMNS`] columns spread over the
-/// swath and interpolated linearly between them: they follow the view zenith, which changes
-/// smoothly across track.
-fn band_terms(optics: &[SceneOptics], viewing: &Viewing, response: &Response) -> Result<BandTerms, CorrectionError> {
+/// same response (no smile) and the columns are a swath (`across_track`), the terms are computed
+/// at [`TERM_COLUMNS`] columns spread over it and interpolated linearly between them: they follow
+/// the view zenith, which changes smoothly across track. Otherwise (a user's spectra, one per
+/// column, `shoal correct`) every column is computed.
+fn band_terms(
+    optics: &[SceneOptics],
+    viewing: &Viewing,
+    response: &Response,
+    across_track: bool,
+) -> Result<BandTerms, CorrectionError> {
     let nb = response.n_bands();
     let nc = viewing.columns();
     let one_response = response.smile_class.iter().all(|&c| c == response.smile_class.first().copied().unwrap_or(0));
-    let sampled: Vec<usize> = if one_response && nc > TERM_COLUMNS {
+    let sampled: Vec<usize> = if across_track && one_response && nc > TERM_COLUMNS {
         let mut v: Vec<usize> = (0..TERM_COLUMNS).map(|i| i * (nc - 1) / (TERM_COLUMNS - 1)).collect();
         v.dedup();
         v
@@ -185,12 +191,14 @@ impl FamilyLuts {
 }
 
 impl AerosolFamily {
-    /// The family's band terms over an instrument's geometry and bands.
+    /// The family's band terms over an instrument's geometry and bands; `across_track`: the
+    /// viewing's columns are a swath (see `band_terms`).
     pub fn tabulate(
         luts: &FamilyLuts,
         scene: &Scene,
         response: &Response,
         viewing: &Viewing,
+        across_track: bool,
         control: &RunControl,
     ) -> Result<Self, CorrectionError> {
         let terms_of = |lut: &std::sync::Arc<AtmosphereLut>| -> Result<BandTerms, CorrectionError> {
@@ -203,7 +211,7 @@ impl AerosolFamily {
                 .map(|g| SceneOptics::new(scene, &g.grid, lut.clone()))
                 .collect::<Result<Vec<_>, _>>()
                 .map_err(|e| invalid("correction.image", e.to_string()))?;
-            band_terms(&optics, viewing, response)
+            band_terms(&optics, viewing, response, across_track)
         };
         let rayleigh = terms_of(&luts.luts[0][0])?;
         let mut terms = Vec::with_capacity(luts.models.len());

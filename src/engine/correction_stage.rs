@@ -162,7 +162,7 @@ impl Engine {
             .with(&side.scene.spec.effects)
             .finish();
         let fam = self.stage(key, report, control, || {
-            AerosolFamily::tabulate(&luts, &side.scene, &side.response, &side.viewing, control)
+            AerosolFamily::tabulate(&luts, &side.scene, &side.response, &side.viewing, true, control)
                 .map_err(failed(Stage::AerosolFamily))
         })?;
         Ok(Some((fam, key)))

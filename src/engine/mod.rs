@@ -55,6 +55,7 @@ pub use fault::{Fault, FaultKind};
 pub use products::{CorrectionProduct, RetrievalOutput, RunOutput};
 pub use report::{RunReport, StageReport, StageStatus};
 pub use run::Engine;
+pub use stages::lut_axes_covering;
 
 /// An engine failure: the stage and what went wrong (the message names the field).
 #[derive(Debug, thiserror::Error, Clone, PartialEq)]

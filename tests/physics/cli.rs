@@ -210,3 +210,22 @@ fn out_file_is_written_whole() {
     assert!(std::fs::read_dir(&dir).unwrap().count() == 1, "no temporary file left behind");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn correct_refuses_a_spectrum_without_its_bands_or_with_a_bad_geometry() {
+    let dir = std::env::temp_dir().join(format!("shoal-correct-bad-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let toa = dir.join("toa.csv");
+    std::fs::write(&toa, "sun_zenith_deg,view_zenith_deg,relative_azimuth_deg,Oa01\n30,10,90,50\n").unwrap();
+    let out = dir.join("res");
+    let (code, _, err) =
+        shoal(&["correct", "--toa", toa.to_str().unwrap(), "--instrument", "cubesat", "--out", out.to_str().unwrap()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--toa") && err.contains("Oa02"), "{err}");
+    std::fs::write(&toa, "sun_zenith_deg,view_zenith_deg,relative_azimuth_deg\n95,10,90\n").unwrap();
+    let (code, _, err) =
+        shoal(&["correct", "--toa", toa.to_str().unwrap(), "--instrument", "cubesat", "--out", out.to_str().unwrap()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(!out.exists(), "nothing written on a refusal");
+    std::fs::remove_dir_all(&dir).ok();
+}
