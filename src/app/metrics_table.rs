@@ -256,10 +256,64 @@ pub(super) fn metrics_table(app: &ShoalApp, ui: &mut egui::Ui, configs: &[crate:
             }
             ui.end_row();
         }
+        correction_rows(ui, &columns);
     });
     if columns.iter().all(|c| c.run().is_none()) {
         ui.label("No results yet.");
     }
+}
+
+/// With an image-based correction: the aerosol it found against the scene's, and the corrected
+/// Rrs's log-space error at 400–560 nm (pooled over the bands there, as ACIX-Aqua reports it).
+fn correction_rows(ui: &mut egui::Ui, columns: &[Column<'_>]) {
+    let aerosol = |c: &Column<'_>| c.run().and_then(|o| o.report.aerosol.clone());
+    if !columns.iter().any(|c| aerosol(c).is_some()) {
+        return;
+    }
+    ui.label("aerosol found").on_hover_text(
+        "AOT(550) the image-based correction found from the design's own bands (median over the water \
+         pixels), against the scene's true AOT",
+    );
+    for column in columns {
+        match aerosol(column) {
+            Some(a) => {
+                ui.label(column.text(format!("AOT {:.3} (true {:.3})", a.aot550.0, a.aot550_true))).on_hover_text(
+                    format!(
+                        "5–95 %: {:.3}–{:.3}; Ångström {:.2} (true {:.2}); outside the family: {:.1} %; {}",
+                        a.aot550.1, a.aot550.2, a.angstrom, a.angstrom_true, a.outside_family_pct, a.fit
+                    ),
+                );
+            }
+            None => {
+                ui.label("–").on_hover_text("the exact correction: the scene's own atmosphere");
+            }
+        }
+        for _ in 0..3 {
+            ui.label("");
+        }
+    }
+    ui.end_row();
+    ui.label("Rrs 400–560 nm")
+        .on_hover_text("the corrected Rrs against the truth, log-space, every band centred in 400–560 nm");
+    for column in columns {
+        let pooled =
+            column.run().and_then(|o| crate::correction::pooled_rrs_error(&o.correction.rrs_metrics, 400.0, 560.0));
+        match pooled {
+            Some((mae, bias, returned, n)) => {
+                ui.label(column.text(format!("{mae:.1} %")))
+                    .on_hover_text(format!("log-space MAE over {n} band values ({returned:.1} % positive)"));
+                ui.label(column.text(format!("{bias:+.1} %")));
+                ui.label(column.text(format!("{returned:.1} %")));
+            }
+            None => {
+                for _ in 0..3 {
+                    ui.label("–");
+                }
+            }
+        }
+        ui.label("");
+    }
+    ui.end_row();
 }
 
 /// The MAE (with its seed spread when measured), bias and returned cells of variable `v` of

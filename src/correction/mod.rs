@@ -26,10 +26,12 @@ pub mod family;
 pub mod image;
 pub mod nir_water;
 mod pair;
+mod rrs_metrics;
 
 pub use dark::TileFit;
 pub use family::{AerosolFamily, FamilyLuts};
 pub use image::{AerosolFit, AerosolRetrieval, DarkSpectrumSettings, ImageCorrection, correct_image};
+pub use rrs_metrics::{BandRrsMetrics, RRS_SAMPLES, band_rrs_metrics, pooled_rrs_error};
 
 use ndarray::{Array2, Array3};
 use rand::SeedableRng;
@@ -427,52 +429,3 @@ pub fn compare(a: &Reflectance, b: &Array3<f32>, b_flags: Option<&Array3<u8>>) -
 
 /// Pixels per band the median of [`compare`] is taken from, at most.
 const MEDIAN_SAMPLES: usize = 200_000;
-
-/// One band's corrected Rrs against the truth: log-space metrics (Seegers et al. 2018, as
-/// ACIX-Aqua reports Rrs: Pahlevan et al. 2021) over the water pixels.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct BandRrsMetrics {
-    /// Band name.
-    pub band: String,
-    /// Band centre, nm.
-    pub centre_nm: f64,
-    /// The metrics; a flagged or non-positive Rrs is a pixel not returned.
-    pub metrics: crate::metrics::Metrics,
-}
-
-/// Per band, `rrs` against `truth` over the water pixels of `land`: at most [`RRS_SAMPLES`]
-/// evenly strided pixels per band (the log-space MAE is a mean: over 20 000 pixels its standard
-/// error is under 1 % of itself, 0.1 points at an MAE of 10 %; all of Lake Hume's 1.5 M
-/// pixels took 0.23 s per run), one band per task.
-#[must_use]
-pub fn band_rrs_metrics(
-    rrs: &Reflectance,
-    truth: &Array3<f32>,
-    land: &Array2<u8>,
-    names: &[String],
-    centres_nm: &[f64],
-) -> Vec<BandRrsMetrics> {
-    let (rows, cols, nb) = rrs.rrs.dim();
-    let water: Vec<(usize, usize)> =
-        (0..rows).flat_map(|r| (0..cols).map(move |c| (r, c))).filter(|&(r, c)| land[[r, c]] == 0).collect();
-    let stride = (water.len() / RRS_SAMPLES).max(1);
-    (0..nb)
-        .into_par_iter()
-        .map(|b| {
-            let (mut got, mut want) = (Vec::new(), Vec::new());
-            for &(r, c) in water.iter().step_by(stride) {
-                let ok = rrs.flags[[r, c, b]] & RrsFlags::INVALID == 0;
-                got.push(ok.then(|| f64::from(rrs.rrs[[r, c, b]])));
-                want.push(Some(f64::from(truth[[r, c, b]])));
-            }
-            BandRrsMetrics {
-                band: names.get(b).cloned().unwrap_or_default(),
-                centre_nm: centres_nm.get(b).copied().unwrap_or(f64::NAN),
-                metrics: crate::metrics::compare(&got, &want),
-            }
-        })
-        .collect()
-}
-
-/// Water pixels per band [`band_rrs_metrics`] judges, at most.
-pub const RRS_SAMPLES: usize = 20_000;

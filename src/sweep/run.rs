@@ -88,8 +88,11 @@ pub fn run_job(
     };
     let mut rows = Vec::new();
     // With an image-based correction, its own error: Rrs at 400–560 nm against the truth.
-    if let Some(p) =
-        out.correction.family.as_ref().and_then(|_| pooled_rrs_error(&out.correction.rrs_metrics, 400.0, 560.0))
+    if let Some(p) = out
+        .correction
+        .family
+        .as_ref()
+        .and_then(|_| crate::correction::pooled_rrs_error(&out.correction.rrs_metrics, 400.0, 560.0))
     {
         rows.push(row("correction", "rrs_400_560", p.0, p.1, p.2, p.3));
     }
@@ -132,29 +135,4 @@ pub fn run_sweep(
         on_job(job.index, secs);
     }
     Ok(SweepResult { table, seconds })
-}
-
-/// The corrected Rrs's log-space error (Seegers et al. 2018, as ACIX-Aqua reports Rrs:
-/// Pahlevan et al. 2021) over every band centred in `lo_nm`–`hi_nm`, pooled from the run's
-/// per-band metrics: the pooled mean of |log10 ratio| is the per-band means weighted by their
-/// pixels, so MAE = 10^(Σ n_b·log10 MAE_b / Σ n_b), and the bias alike. (MAE %, bias %,
-/// returned %, pixels); `None` without such a band or pixel.
-fn pooled_rrs_error(
-    bands: &[crate::correction::BandRrsMetrics],
-    lo_nm: f64,
-    hi_nm: f64,
-) -> Option<(f64, f64, f64, usize)> {
-    let judged: Vec<&crate::metrics::Metrics> =
-        bands.iter().filter(|b| (lo_nm..=hi_nm).contains(&b.centre_nm)).map(|b| &b.metrics).collect();
-    let n: usize = judged.iter().map(|m| m.n).sum();
-    let candidates: usize = judged.iter().map(|m| m.candidates).sum();
-    if n == 0 {
-        return None;
-    }
-    let mean_log = |f: fn(&crate::metrics::Metrics) -> f64| {
-        judged.iter().map(|m| m.n as f64 * f(m).log10()).sum::<f64>() / n as f64
-    };
-    let mae = 10f64.powf(mean_log(|m| m.mae));
-    let bias = 10f64.powf(mean_log(|m| m.bias));
-    Some((100.0 * (mae - 1.0), 100.0 * (bias - 1.0), 100.0 * n as f64 / candidates.max(1) as f64, n))
 }

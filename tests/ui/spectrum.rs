@@ -74,5 +74,10 @@ fn the_image_based_correction_set_in_the_app_reaches_both_runs() {
         assert!(aerosol.aot550.iter().any(|v| v.is_finite() && *v > 0.0));
         assert_eq!(out.config.correction.image.as_ref().unwrap().pair_nm, [779.0, 865.0]);
     }
+    // The metrics table tells what the correction found and what it left in Rrs.
+    h.step();
+    assert!(h.query_by_label_contains("aerosol found").is_some(), "the aerosol row is shown");
+    assert_eq!(h.query_all_by_label_contains("(true 0.100)").count(), 2, "the AOT found for A and B");
+    assert!(h.query_by_label_contains("Rrs 400–560 nm").is_some(), "the Rrs row is shown");
     let _ = std::fs::remove_dir_all(&dir);
 }
