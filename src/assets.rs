@@ -72,6 +72,7 @@ pub const PRESETS: &[Asset] = embed_presets![
     "siop/almi_8.ron",
     "scenes/lake_hume_bloom.ron",
     "scenes/lake_hume_dust.ron",
+    "scenes/clear_water.ron",
     "scenes/heron_island_reef.ron",
     "scenes/aquaculture_turbidity.ron",
     "scenes/reservoir_chl_cdom.ron",
@@ -100,6 +101,7 @@ pub const PRESETS: &[Asset] = embed_presets![
     "studies/reef_survey_depth.ron",
     "sweeps/aperture_lake_hume.ron",
     "sweeps/nir_snr_sweep.ron",
+    "sweeps/nir_snr_sweep_clear.ron",
 ];
 
 /// Names of the built-in presets in `folder` (`"instruments"`, `"scenes"`, …), in embedding order.
