@@ -336,12 +336,28 @@ impl Mixture<'_> {
         (lp, te, s)
     }
 
-    /// Rrs from radiance `l1` at index `i`: y = (L1 − L_path)/(T·Ed), Rrs = y/(1 + S·π·y).
+    /// The terms of every band of a column at once (`span`: its indices), into `lp`, `te` and
+    /// `sa` (contiguous per column, so the loop vectorises).
+    #[inline]
+    pub fn column_terms(&self, span: std::ops::Range<usize>, lp: &mut [f64], te: &mut [f64], sa: &mut [f64]) {
+        lp.fill(0.0);
+        te.fill(0.0);
+        sa.fill(0.0);
+        for &(t, w) in &self.entries {
+            let (tl, tt, ts) = (&t.l_path[span.clone()], &t.t_ed[span.clone()], &t.spherical_albedo[span.clone()]);
+            for b in 0..lp.len() {
+                lp[b] += w * tl[b];
+                te[b] += w * tt[b];
+                sa[b] += w * ts[b];
+            }
+        }
+    }
+
+    /// Rrs from radiance `l1` at index `i`.
     #[inline]
     pub fn rrs(&self, i: usize, l1: f64) -> f64 {
         let (lp, te, s) = self.terms(i);
-        let y = (l1 - lp) / te;
-        y / (1.0 + s * std::f64::consts::PI * y)
+        invert(l1, lp, te, s)
     }
 
     /// The water's part of the TOA radiance at index `i` for above-surface `rrs`: the inverse
@@ -351,6 +367,13 @@ impl Mixture<'_> {
         let (_, te, s) = self.terms(i);
         te * rrs / (1.0 - s * std::f64::consts::PI * rrs)
     }
+}
+
+/// The exact inversion with a band's terms: y = (L1 − L_path)/(T·Ed), Rrs = y/(1 + S·π·y).
+#[inline]
+fn invert(l1: f64, l_path: f64, t_ed: f64, spherical_albedo: f64) -> f64 {
+    let y = (l1 - l_path) / t_ed;
+    y / (1.0 + spherical_albedo * std::f64::consts::PI * y)
 }
 
 /// Correct `level1` with the family: see the module docs.
@@ -423,21 +446,9 @@ fn apply<'f, S: Default>(
             mix.entries.clear();
             (mix.outside, mix.passes) = (false, 1);
             let usable = fit(&p, &mut mix, &mut scratch) && !p.land;
-            // The mixture's terms for all bands at once (contiguous per column).
-            lp.fill(0.0);
-            te.fill(0.0);
-            sa.fill(0.0);
-            for &(t, w) in &mix.entries {
-                let (tl, tt, ts) = (&t.l_path[span.clone()], &t.t_ed[span.clone()], &t.spherical_albedo[span.clone()]);
-                for b in 0..nb {
-                    lp[b] += w * tl[b];
-                    te[b] += w * tt[b];
-                    sa[b] += w * ts[b];
-                }
-            }
+            mix.column_terms(span.clone(), &mut lp, &mut te, &mut sa);
             for b in 0..nb {
-                let y = (f64::from(p.l1[b]) - lp[b]) / te[b];
-                let value = y / (1.0 + sa[b] * std::f64::consts::PI * y);
+                let value = invert(f64::from(p.l1[b]), lp[b], te[b], sa[b]);
                 let f = flag_for(p.flags[b], !usable, value);
                 flag_row[span.start + b] = f;
                 rrs_row[span.start + b] = if f & RrsFlags::INVALID != 0 { 0.0 } else { value as f32 };

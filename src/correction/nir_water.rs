@@ -130,15 +130,15 @@ impl NirWater {
     }
 
     /// The above-surface Rrs, sr⁻¹, of the bands `nir` from the above-surface Rrs of the
-    /// previous pass (`rrs(b)`), or None where the model gives no NIR signal (Rrs(670) ≤ 0,
-    /// bb_p ≤ 0, no chlorophyll).
-    pub fn estimate(&self, rrs: impl Fn(usize) -> f64, nir: [usize; 2]) -> Option<[f64; 2]> {
+    /// previous pass (`rrs(b)`) and its OC4 chlorophyll `chl_mg_m3`, or None where the model
+    /// gives no NIR signal (Rrs(670) ≤ 0, bb_p ≤ 0).
+    pub fn estimate(&self, rrs: impl Fn(usize) -> f64, chl_mg_m3: f64, nir: [usize; 2]) -> Option<[f64; 2]> {
         let below = |r: f64| r / (0.52 + 1.7 * r);
         let red = rrs(self.red);
         if red <= 0.0 {
             return None;
         }
-        let chl = self.chl_oc4(&rrs)?.clamp(0.2, 30.0);
+        let chl = chl_mg_m3.clamp(0.2, 30.0);
         let a_red = self.a_w[self.red] + (0.9389 * chl.ln() - 3.7589).exp().clamp(0.0, 0.5);
         let u_red = u_from_rrs(below(red))?;
         let bbp_red = u_red * a_red / (1.0 - u_red) - self.bb_w[self.red];

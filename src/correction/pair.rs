@@ -66,8 +66,10 @@ impl<'f> PairFit<'f> {
                 break;
             }
             previous_red = red;
-            let ramp = nir.chl_oc4(rrs).map_or(0.0, NirWater::ramp);
-            let estimate = nir.estimate(rrs, [s, l]).unwrap_or([0.0; 2]);
+            // No chlorophyll (a ratio not positive) or below the ramp: the water stays black.
+            let chl = nir.chl_oc4(rrs).unwrap_or(0.0);
+            let ramp = NirWater::ramp(chl);
+            let estimate = if ramp > 0.0 { nir.estimate(rrs, chl, [s, l]).unwrap_or([0.0; 2]) } else { [0.0; 2] };
             for (j, b) in [s, l].into_iter().enumerate() {
                 let new = mix.water_radiance(p.at(b), ramp * estimate[j]);
                 water[j] = (1.0 - nir_water::DAMPING) * new + nir_water::DAMPING * water[j];

@@ -199,6 +199,47 @@ pub(super) fn scale_bar_length(max_m: f64) -> Option<(f64, String)> {
     Some((len, label))
 }
 
+/// A per-band chart: band centre (nm, with 15 nm of margin) against a logarithmic `y_desc` (a
+/// factor 1.6 of margin) spanning the finite positive `ys`; the SNR and Rrs-error figures'
+/// frame. An error, `nothing`, when there is no x or no such y.
+pub(super) fn band_log_chart<'a, DB: DrawingBackend>(
+    root: &'a DrawingArea<DB, Shift>,
+    title: &str,
+    y_desc: &str,
+    xs: impl Iterator<Item = f64>,
+    ys: impl Iterator<Item = f64>,
+    nothing: &str,
+) -> Result<ChartContext<'a, DB, Cartesian2d<plotters::coord::types::RangedCoordf64, LogCoord<f64>>>, String> {
+    let (x_lo, x_hi) = xs.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| (lo.min(x), hi.max(x)));
+    let (y_lo, y_hi) = ys
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), y| (lo.min(y), hi.max(y)));
+    if !(x_lo.is_finite() && y_lo.is_finite()) {
+        return Err(nothing.into());
+    }
+    let (x_lo, x_hi) = (x_lo - 15.0, x_hi + 15.0);
+    let (y_lo, y_hi) = (y_lo / 1.6, y_hi * 1.6);
+    let mut chart = ChartBuilder::on(root)
+        .caption(title, (FONT, 16))
+        .margin(12)
+        .x_label_area_size(44)
+        .y_label_area_size(64)
+        .build_cartesian_2d(x_lo..x_hi, (y_lo..y_hi).log_scale())
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc("band centre (nm)")
+        .y_desc(y_desc)
+        .x_label_formatter(&|v| format!("{v:.0}"))
+        .y_label_formatter(&|v| tick_label(*v))
+        .label_style((FONT, 14))
+        .axis_desc_style((FONT, 15))
+        .draw()
+        .map_err(err)?;
+    Ok(chart)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -8,7 +8,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::StudyResult;
-use super::render::{Draw, FONT, Placed, err, tick_label};
+use super::render::{Draw, FONT, Placed, band_log_chart, err};
 use crate::colormap::categorical;
 
 /// One instrument's points: its label and, per band, (centre nm, MAE %, |bias| %).
@@ -64,40 +64,16 @@ impl Draw for RrsFigure {
         root.fill(&WHITE).map_err(err)?;
         // Errors below 0.1 % are drawn at 0.1 % (a log axis has no zero).
         let floor = |v: f64| if v.is_finite() { v.max(0.1) } else { f64::NAN };
-        let (mut x_lo, mut x_hi, mut y_lo, mut y_hi) =
-            (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
-        for &(x, mae, bias) in self.series.iter().flat_map(|(_, p)| p.iter()) {
-            (x_lo, x_hi) = (x_lo.min(x), x_hi.max(x));
-            for v in [floor(mae), floor(bias)].into_iter().filter(|v| v.is_finite()) {
-                (y_lo, y_hi) = (y_lo.min(v), y_hi.max(v));
-            }
-        }
-        if let Some((r, _, _)) = self.requirement {
-            (y_lo, y_hi) = (y_lo.min(r), y_hi.max(r));
-        }
-        if !(x_lo.is_finite() && y_lo.is_finite()) {
-            return Err("no Rrs error to plot".into());
-        }
-        let (x_lo, x_hi) = (x_lo - 15.0, x_hi + 15.0);
-        let (y_lo, y_hi) = (y_lo / 1.6, y_hi * 1.6);
-        let mut chart = ChartBuilder::on(root)
-            .caption(&self.title, (FONT, 16))
-            .margin(12)
-            .x_label_area_size(44)
-            .y_label_area_size(64)
-            .build_cartesian_2d(x_lo..x_hi, (y_lo..y_hi).log_scale())
-            .map_err(err)?;
-        chart
-            .configure_mesh()
-            .disable_mesh()
-            .x_desc("band centre (nm)")
-            .y_desc("Rrs error, log-space (%)")
-            .x_label_formatter(&|v| format!("{v:.0}"))
-            .y_label_formatter(&|v| tick_label(*v))
-            .label_style((FONT, 14))
-            .axis_desc_style((FONT, 15))
-            .draw()
-            .map_err(err)?;
+        let points = || self.series.iter().flat_map(|(_, p)| p.iter());
+        let requirement = self.requirement.map(|r| r.0);
+        let mut chart = band_log_chart(
+            root,
+            &self.title,
+            "Rrs error, log-space (%)",
+            points().map(|p| p.0),
+            points().flat_map(|p| [floor(p.1), floor(p.2)]).chain(requirement),
+            "no Rrs error to plot",
+        )?;
         if let Some((r, from, to)) = self.requirement {
             chart
                 .draw_series(DashedLineSeries::new(vec![(from, r), (to, r)], 8, 5, BLACK.stroke_width(2)))

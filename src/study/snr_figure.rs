@@ -7,7 +7,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::StudyResult;
-use super::render::{Draw, FONT, Placed, err, tick_label};
+use super::render::{Draw, FONT, Placed, band_log_chart, err};
 use crate::colormap::categorical;
 
 /// One instrument's points: its label and, per band, (centre nm, analytic SNR, measured SNR).
@@ -49,42 +49,17 @@ impl Draw for SnrFigure {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<Vec<Placed>, String> {
         root.fill(&WHITE).map_err(err)?;
         let finite = |v: f64| v.is_finite() && v > 0.0;
-        let all = self.series.iter().flat_map(|(_, p)| p.iter());
-        let (mut x_lo, mut x_hi, mut y_lo, mut y_hi) =
-            (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
-        for &(x, a, m) in all {
-            (x_lo, x_hi) = (x_lo.min(x), x_hi.max(x));
-            for v in [a, m].into_iter().filter(|v| finite(*v)) {
-                (y_lo, y_hi) = (y_lo.min(v), y_hi.max(v));
-            }
-        }
-        if let Some(r) = self.requirement.filter(|r| finite(*r)) {
-            (y_lo, y_hi) = (y_lo.min(r), y_hi.max(r));
-        }
-        if !(x_lo.is_finite() && y_lo.is_finite()) {
-            return Err("no finite SNR to plot".into());
-        }
-        let (x_lo, x_hi) = (x_lo - 15.0, x_hi + 15.0);
-        let (y_lo, y_hi) = (y_lo / 1.6, y_hi * 1.6);
-        let mut chart = ChartBuilder::on(root)
-            .caption(&self.title, (FONT, 17))
-            .margin(12)
-            .x_label_area_size(44)
-            .y_label_area_size(64)
-            .build_cartesian_2d(x_lo..x_hi, (y_lo..y_hi).log_scale())
-            .map_err(err)?;
-        chart
-            .configure_mesh()
-            .disable_mesh()
-            .x_desc("band centre (nm)")
-            .y_desc("SNR")
-            .x_label_formatter(&|v| format!("{v:.0}"))
-            .y_label_formatter(&|v| tick_label(*v))
-            .label_style((FONT, 14))
-            .axis_desc_style((FONT, 15))
-            .draw()
-            .map_err(err)?;
+        let points = || self.series.iter().flat_map(|(_, p)| p.iter());
+        let mut chart = band_log_chart(
+            root,
+            &self.title,
+            "SNR",
+            points().map(|p| p.0),
+            points().flat_map(|p| [p.1, p.2]).chain(self.requirement),
+            "no finite SNR to plot",
+        )?;
         if let Some(r) = self.requirement {
+            let (x_lo, x_hi) = (chart.x_range().start, chart.x_range().end);
             chart
                 .draw_series(DashedLineSeries::new(vec![(x_lo, r), (x_hi, r)], 8, 5, BLACK.stroke_width(2)))
                 .map_err(err)?
