@@ -60,6 +60,8 @@ macro_rules! embed_presets {
 
 /// Built-in presets (RON files under `presets/`), embedded so that names resolve anywhere.
 pub const PRESETS: &[Asset] = embed_presets![
+    "budgets/default.ron",
+    "budgets/cubesat_class.ron",
     "siop/heron_island.ron",
     "siop/cyanobacteria_reservoir.ron",
     "siop/almi_1.ron",

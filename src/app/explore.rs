@@ -185,6 +185,7 @@ impl Explore {
             fidelity: Some(state.fidelity.clone()),
             requirements: None,
             snr_reference: state.snr_reference.clone(),
+            budgets: None,
         };
         let spec = SweepSpec {
             name: format!("app_{key}"),

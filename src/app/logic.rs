@@ -160,6 +160,7 @@ impl ShoalApp {
             fidelity: (s.fidelity != crate::engine::Fidelity::default()).then(|| s.fidelity.clone()),
             requirements: Some(s.requirements.clone()),
             snr_reference: s.snr_reference.clone(),
+            budgets: None,
         }
     }
 

@@ -57,6 +57,7 @@ pub fn fallback_requirements() -> Requirements {
         snr: Some(100.0),
         substrate_pct: Some(70.0),
         rrs: None,
+        ..Requirements::default()
     }
 }
 
@@ -198,6 +199,7 @@ fn fallback_study() -> StudySpec {
         fidelity: None,
         requirements: None,
         snr_reference: None,
+        budgets: None,
     })
 }
 

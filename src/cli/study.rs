@@ -130,6 +130,7 @@ pub fn run(args: &StudyArgs) -> Result<(), CliError> {
     eprintln!("{}: {n} runs in {:.1} s", spec.name, start.elapsed().as_secs_f64());
     let mut table = String::new();
     print_metrics(&mut table, &result);
+    print_budgets(&mut table, &result);
     if let Some(r) = &spec.requirements {
         let _ = writeln!(
             table,
@@ -255,4 +256,30 @@ fn print_runs(out: &mut String, result: &crate::study::StudyResult) {
             );
         }
     }
+}
+
+/// The designs' budgets (first seed of each instrument), one column per instrument.
+fn print_budgets(out: &mut String, result: &crate::study::StudyResult) {
+    let mut labels: Vec<&str> = Vec::new();
+    let mut rows: Vec<Vec<(String, String)>> = Vec::new();
+    for run in &result.runs {
+        if !labels.contains(&run.label.as_str()) {
+            labels.push(&run.label);
+            rows.push(run.budget.rows());
+        }
+    }
+    let _ = writeln!(out, "\nbudgets (models `{}`)", result.study.budgets.name);
+    let _ = write!(out, "{:<32}", "");
+    for l in &labels {
+        let _ = write!(out, " {l:>36}");
+    }
+    let _ = writeln!(out);
+    for i in 0..rows.first().map_or(0, Vec::len) {
+        let _ = write!(out, "{:<32}", rows[0][i].0);
+        for r in &rows {
+            let _ = write!(out, " {:>36}", r[i].1);
+        }
+        let _ = writeln!(out);
+    }
+    let _ = writeln!(out);
 }

@@ -15,6 +15,7 @@
 //! | truth | [`truth`] | the scene's values under every pixel, scored against by the metrics |
 //! | truth shares | [`shares`] | depth bins and substrate shares of the water pixels seen |
 //! | SNR | [`snr`] | analytic SNR and SNR measured on a simulated uniform patch |
+//! | budgets | [`budgets`] | cost, envelope and form factor, mass and power, data rate and volume |
 //!
 //! Four kinds (see [`InstrumentKind`]): a band-pass multispectral imager, an ideal radiometer
 //! for reference runs, a long-slit dispersive spectrograph (CHICO-like) and a gradient /
@@ -29,6 +30,7 @@
 //!   Academic Press, ch. 3 (pushbroom geometry, system PSF = optics ⊗ detector ⊗ motion).
 
 pub mod band_atmosphere;
+pub mod budgets;
 pub mod detector;
 pub mod feasibility;
 pub mod focal;

@@ -286,7 +286,9 @@ fn derived_rows(runs: &[&StudyRun], configs: &[&RunConfig]) -> Vec<Derived> {
         name: name.into(),
         values: (0..runs.len()).map(f).collect(),
     };
-    vec![
+    let budget_rows: Vec<Vec<(String, String)>> = runs.iter().map(|r| r.budget.rows()).collect();
+    let budget = budget_rows.first().map_or(0, Vec::len);
+    let mut rows = vec![
         row("nadir GSD", &|k| format!("{:.1} m", configs[k].instrument.gsd_m())),
         row("swath", &|k| format!("{:.1} km", configs[k].instrument.swath_m() / 1000.0)),
         row("f-number", &|k| format!("f/{:.2}", runs[k].feasibility.f_number)),
@@ -306,7 +308,13 @@ fn derived_rows(runs: &[&StudyRun], configs: &[&RunConfig]) -> Vec<Derived> {
                 .min_by(|a, b| a.snr_analytic.total_cmp(&b.snr_analytic))
                 .map_or_else(|| "–".into(), |r| format!("{:.0} ({})", r.snr_analytic, r.band))
         }),
-    ]
+    ];
+    // The design's budgets under the study's models (src/instrument/budgets).
+    rows.extend((0..budget).map(|i| Derived {
+        name: budget_rows[0][i].0.clone(),
+        values: budget_rows.iter().map(|r| r[i].1.clone()).collect(),
+    }));
+    rows
 }
 
 fn instrument_summary(run: &StudyRun, config: &RunConfig) -> InstrumentSummary {

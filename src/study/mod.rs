@@ -51,6 +51,7 @@ use serde::{Deserialize, Serialize};
 use crate::calibration::CalibrationSpec;
 use crate::correction::CorrectionSpec;
 use crate::engine::{Fidelity, RunConfig};
+use crate::instrument::budgets::{BudgetError, BudgetModels};
 use crate::instrument::{DetectorMode, InstrumentSpec};
 use crate::parse::{FieldError, ParseError};
 use crate::retrieval::RetrievalSpec;
@@ -136,6 +137,9 @@ pub struct StudySpec {
     /// The radiance every run's SNR is stated at (see [`RunConfig::snr_reference`]).
     #[serde(default)]
     pub snr_reference: Option<crate::spectral::SpectrumSource>,
+    /// The models that cost, size and budget each design (built-in `default` when absent).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub budgets: Option<Source<BudgetModels>>,
 }
 
 fn default_seeds() -> Vec<u64> {
@@ -149,6 +153,8 @@ pub struct ResolvedStudy {
     pub spec: StudySpec,
     /// (instrument label, seed, configuration) per run.
     pub runs: Vec<(String, u64, RunConfig)>,
+    /// The budget models, read and checked.
+    pub budgets: BudgetModels,
 }
 
 /// Read a scene, instrument or study source: a built-in by name, a RON file relative to `dir`, or
@@ -220,8 +226,10 @@ impl StudySpec {
             }));
         }
         crate::parse::check_name("name", &self.name)?;
+        let budgets = self.budget_models(dir)?;
         if let Some(r) = &self.requirements {
             r.validate()?;
+            r.validate_design(&budgets)?;
         }
         let (scene, scene_dir) = load(&self.scene, dir, |n| SceneSpec::preset(n).map_err(|e| e.to_string()), "scene")?;
         let mut runs = Vec::new();
@@ -267,7 +275,18 @@ impl StudySpec {
                 runs.push((label.clone(), seed, config));
             }
         }
-        Ok(ResolvedStudy { spec: self.clone(), runs })
+        Ok(ResolvedStudy { spec: self.clone(), runs, budgets })
+    }
+
+    /// The study's budget models (`budgets:`, else the built-in `default`), checked.
+    pub fn budget_models(&self, dir: Option<&Path>) -> Result<BudgetModels, StudyError> {
+        let source = self.budgets.clone().unwrap_or_else(|| Source::Preset("default".into()));
+        let (models, _) = load(&source, dir, |n| BudgetModels::preset(n).map_err(|e| e.to_string()), "budgets")?;
+        models.validate().map_err(|e| match e {
+            BudgetError::Invalid(f) => StudyError::Invalid(f),
+            BudgetError::Parse(p) => StudyError::Parse(p),
+        })?;
+        Ok(models)
     }
 }
 

@@ -19,6 +19,7 @@ use serde::{Deserialize, Serialize};
 
 use super::{StudyError, StudyResult};
 use crate::instrument::SnrRow;
+use crate::instrument::budgets::{BudgetModels, DesignBudget};
 use crate::metrics::ProductMetrics;
 use crate::parse::FieldError;
 
@@ -57,6 +58,15 @@ pub struct Requirements {
     /// (as ACIX-Aqua states atmospheric-correction performance: Pahlevan et al. 2021).
     #[serde(default)]
     pub rrs: Option<RrsRequirement>,
+    /// Largest telescope cost, in the budget models' currency ([`BudgetModels`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cost_max: Option<f64>,
+    /// The box the instrument must fit (a form factor of the budget models: `"6U"`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fits: Option<String>,
+    /// Largest volume of a day's images after compression, Gbit.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub data_volume_gbit_day: Option<f64>,
 }
 
 /// The corrected Rrs's error per band, in the bands centred from `from_nm` to `to_nm`.
@@ -178,6 +188,74 @@ impl Requirements {
         Ok(())
     }
 
+    /// The design requirements against the study's budget models: a cost limit positive, a box
+    /// among the models' form factors, a data volume positive.
+    pub fn validate_design(&self, models: &BudgetModels) -> Result<(), StudyError> {
+        let bad = |field: &str, message: String| Err(StudyError::Invalid(FieldError { field: field.into(), message }));
+        if let Some(c) = self.cost_max
+            && !(c.is_finite() && c > 0.0 && c <= 1e6)
+        {
+            return bad("requirements.cost_max", format!("{c} (allowed: above 0 up to 1e6 {})", models.cost.currency));
+        }
+        if let Some(v) = self.data_volume_gbit_day
+            && !(v.is_finite() && v > 0.0 && v <= 1e6)
+        {
+            return bad("requirements.data_volume_gbit_day", format!("{v} (allowed: above 0 up to 1e6 Gbit)"));
+        }
+        if let Some(f) = &self.fits
+            && !models.has_form_factor(f)
+        {
+            let names: Vec<&str> = models.form_factors.iter().map(|f| f.name.as_str()).collect();
+            return bad(
+                "requirements.fits",
+                format!("`{f}` is not a box of budgets `{}` (allowed: {})", models.name, names.join(", ")),
+            );
+        }
+        Ok(())
+    }
+
+    /// Does the study ask anything of the design's budgets?
+    #[must_use]
+    pub fn has_design(&self) -> bool {
+        self.cost_max.is_some() || self.fits.is_some() || self.data_volume_gbit_day.is_some()
+    }
+
+    /// Check a design's budgets: cost (a refused cost fails, with the reason), the box, the
+    /// daily data volume.
+    #[must_use]
+    pub fn check_design(&self, label: &str, seed: u64, budget: &DesignBudget, models: &BudgetModels) -> Vec<Check> {
+        let mut out = Vec::new();
+        let check = |what: String, value: Option<f64>, limit: f64| {
+            let margin = value.map(|v| limit - v);
+            Check {
+                instrument: label.into(),
+                seed,
+                what,
+                variable: None,
+                value,
+                limit,
+                pass: margin.is_some_and(|m| m >= 0.0),
+                margin,
+            }
+        };
+        if let Some(l) = self.cost_max {
+            let note = if budget.cost.extrapolated { ", extrapolated" } else { "" };
+            out.push(check(format!("cost {}{note}", budget.currency), budget.cost.ota, l));
+        }
+        if let Some(name) = &self.fits {
+            // Value 1 when it fits, 0 when not: the margin says which, the label says where.
+            let fits = models.fits_within(budget.envelope.fits.as_deref(), name);
+            let found = budget.envelope.fits.as_deref().unwrap_or("none");
+            let mut c = check(format!("fits {name} (smallest: {found})"), Some(if fits { 0.0 } else { 1.0 }), 0.0);
+            c.limit = 0.0;
+            out.push(c);
+        }
+        if let Some(l) = self.data_volume_gbit_day {
+            out.push(check("data a day, Gbit".into(), Some(budget.data.daily_gbit), l));
+        }
+        out
+    }
+
     /// The limits of one variable (`depth_m_bottom_visible` is judged as `depth_m`).
     #[must_use]
     pub fn for_variable(&self, variable: &str) -> Option<&ProductRequirement> {
@@ -193,7 +271,9 @@ impl Requirements {
             .iter()
             .flat_map(|run| {
                 let metrics = run.retrievals.first().map(|r| &r.metrics);
-                self.check_run(&run.label, run.seed, metrics, &run.snr, &run.rrs_metrics)
+                let mut checks = self.check_run(&run.label, run.seed, metrics, &run.snr, &run.rrs_metrics);
+                checks.extend(self.check_design(&run.label, run.seed, &run.budget, &result.study.budgets));
+                checks
             })
             .collect()
     }
@@ -328,6 +408,7 @@ mod tests {
             snr: None,
             substrate_pct: None,
             rrs: None,
+            ..Requirements::default()
         }
     }
 

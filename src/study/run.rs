@@ -31,6 +31,8 @@ pub struct StudyRun {
     pub feasibility: Arc<crate::instrument::feasibility::Feasibility>,
     /// Per band: the corrected Rrs against the truth (log-space).
     pub rrs_metrics: Vec<crate::correction::BandRrsMetrics>,
+    /// The design's cost, envelope and data budgets (under the study's budget models).
+    pub budget: crate::instrument::budgets::DesignBudget,
 }
 
 /// All runs of a study.
@@ -80,7 +82,7 @@ pub fn run_study(
         if let Some(s) = spectrum.as_mut().filter(|_| first_seed) {
             s.instruments.push(crate::engine::spectrum::instrument_at(&out, label, s.point.ground_m));
         }
-        runs.push(StudyRun::of(label, *seed, &out));
+        runs.push(StudyRun::of(label, *seed, &out, &study.budgets));
     }
     Ok(StudyResult { study: study.clone(), runs, spectrum: spectrum.map(Arc::new) })
 }
@@ -88,7 +90,7 @@ pub fn run_study(
 impl StudyRun {
     /// What a study keeps of a run (`label`: the instrument's name in the study).
     #[must_use]
-    pub fn of(label: &str, seed: u64, out: &RunOutput) -> Self {
+    pub fn of(label: &str, seed: u64, out: &RunOutput, budgets: &crate::instrument::budgets::BudgetModels) -> Self {
         Self {
             label: label.to_string(),
             seed,
@@ -100,6 +102,7 @@ impl StudyRun {
             feasibility: Arc::clone(&out.feasibility),
             frame: out.scene.frame.clone(),
             rrs_metrics: out.correction.rrs_metrics.clone(),
+            budget: budgets.assess(&out.config.instrument, &out.response.plane_of_band),
         }
     }
 }
@@ -131,14 +134,18 @@ impl StudyResult {
             fidelity: None,
             requirements,
             snr_reference: first.snr_reference.clone(),
+            budgets: None,
         };
+        // The app judges under the built-in models (embedded and tested: they always load).
+        let budgets = crate::instrument::budgets::BudgetModels::default_models().ok()?;
         let resolved = ResolvedStudy {
             spec,
             runs: runs.iter().map(|(label, o)| (label.clone(), o.config.seed, o.config.clone())).collect(),
+            budgets,
         };
         // A spectrum that cannot be computed leaves the figure out, not the export.
         let spectrum = super::spectrum_figure::StudySpectrum::of(runs[0].1, runs).ok().flatten().map(Arc::new);
-        let runs = runs.iter().map(|(label, o)| StudyRun::of(label, o.config.seed, o)).collect();
+        let runs = runs.iter().map(|(label, o)| StudyRun::of(label, o.config.seed, o, &resolved.budgets)).collect();
         Some(Self { study: resolved, runs, spectrum })
     }
 }
