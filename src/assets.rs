@@ -91,6 +91,7 @@ pub const PRESETS: &[Asset] = embed_presets![
     "instruments/smallsat_swir.ron",
     "instruments/sentinel3a_olci.ron",
     "studies/cubesat_vs_smallsat.ron",
+    "studies/cubesat_design_lake_hume.ron",
     "studies/msi_vs_smallsat.ron",
     "studies/cubesat_vs_smallsat_image.ron",
     "studies/cubesat_vs_smallsat_dsf.ron",

@@ -37,6 +37,7 @@
 //! | [`engine`] | the chain as cached stages; the worker thread the app talks to |
 //! | [`study`] | studies: runs per instrument and seed, metrics tables, figures (PNG/SVG), cubes; the paper reproduced |
 //! | [`sweep`] | sweeps: a study over one parameter or a grid of two, with seeds; shards and merge |
+//! | [`design`] | design search: the cheapest design meeting every requirement, and the cost–error front |
 //! | [`report`] | the review pack: a study's verdict, figures and provenance as one self-contained HTML page |
 //! | [`library`] | the preset library: built-ins and the user's own; atomic saves |
 //! | [`parse`] | RON parse errors described with line, column and field |
@@ -54,6 +55,7 @@ pub mod cli;
 pub mod colormap;
 pub mod control;
 pub mod correction;
+pub mod design;
 pub mod engine;
 pub mod geotiff;
 pub mod instrument;

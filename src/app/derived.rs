@@ -45,7 +45,39 @@ pub(super) fn derived(app: &ShoalApp, ui: &mut egui::Ui) {
         });
         ui.small("Peak SNR: the best band at the scene's median radiance.");
     });
+    budgets(app, ui);
     feasibility(app, ui);
+}
+
+/// Cost, box and data budgets of A and B under the built-in models (src/instrument/budgets),
+/// from the bands of the run on screen.
+fn budgets(app: &ShoalApp, ui: &mut egui::Ui) {
+    use crate::instrument::budgets::BudgetModels;
+    static MODELS: std::sync::OnceLock<Option<BudgetModels>> = std::sync::OnceLock::new();
+    let Some(models) = MODELS.get_or_init(|| BudgetModels::default_models().ok()) else { return };
+    let rows: Vec<Option<Vec<(String, String)>>> = (0..2)
+        .map(|i| {
+            let spec = if i == 0 { &app.state.a.spec } else { &app.state.b.spec };
+            app.link.current(i).map(|s| models.assess(spec, &s.output.response.plane_of_band).rows())
+        })
+        .collect();
+    egui::CollapsingHeader::new("Budgets").default_open(false).show(ui, |ui| {
+        egui::Grid::new("budgets").num_columns(3).striped(true).show(ui, |ui| {
+            let n = rows.iter().flatten().map(Vec::len).next().unwrap_or(0);
+            for k in 0..n {
+                let name = rows.iter().flatten().next().map_or(String::new(), |r| r[k].0.clone());
+                ui.label(name);
+                for r in &rows {
+                    ui.label(r.as_ref().map_or_else(|| "–".to_string(), |r| r[k].1.clone()));
+                }
+                ui.end_row();
+            }
+        });
+        ui.small(format!(
+            "Models `{}`: telescope cost by Stahl (2020), FY2017 US$ M, for apertures of {}–{} m; box, packaging and downlink as in presets/budgets.",
+            models.name, models.cost.valid_aperture_m.0, models.cost.valid_aperture_m.1
+        ));
+    });
 }
 
 /// A value coloured by how far it is from sensible: red past a hard limit, amber near one.

@@ -18,6 +18,7 @@ mod bench_reference;
 mod bench_retrieval;
 mod budget;
 mod correct;
+mod design;
 mod grid;
 mod interrupt;
 mod lookup;
@@ -91,6 +92,10 @@ enum Command {
     /// The image-based atmospheric correction on TOA radiance spectra from a CSV (geometry and
     /// band radiances per row): Rrs per band, AOT and Ångström exponent per row.
     Correct(correct::CorrectArgs),
+    /// Search for the cheapest design of a study's instrument that meets every requirement
+    /// (constrained Bayesian optimisation over the parameters given with --vary) and the front
+    /// of cost against each product's error.
+    Design(design::DesignArgs),
     /// Error budget of a study: how much of each product's error each stage contributes
     /// (noise, calibration, atmospheric correction, SIOP set choice).
     Budget(budget::BudgetArgs),
@@ -211,6 +216,7 @@ pub fn main(app: impl FnOnce(&AppArgs) -> ExitCode) -> ExitCode {
         Command::Reproduce(args) => reproduce::run(&args),
         Command::Merge(args) => sweep::merge_run(&args),
         Command::Budget(args) => budget::run(&args),
+        Command::Design(args) => design::run(&args),
         Command::Correct(args) => correct::run(&args),
         Command::Report(args) => report::run(&args),
         Command::Bench(args) => bench::run(&args),

@@ -243,12 +243,8 @@ impl Requirements {
             out.push(check(format!("cost {}{note}", budget.currency), budget.cost.ota, l));
         }
         if let Some(name) = &self.fits {
-            // Value 1 when it fits, 0 when not: the margin says which, the label says where.
-            let fits = models.fits_within(budget.envelope.fits.as_deref(), name);
-            let found = budget.envelope.fits.as_deref().unwrap_or("none");
-            let mut c = check(format!("fits {name} (smallest: {found})"), Some(if fits { 0.0 } else { 1.0 }), 0.0);
-            c.limit = 0.0;
-            out.push(c);
+            // The share of the box's room the tightest dimension takes: 1 or less fits.
+            out.push(check(format!("fits {name}: size / room"), models.fit_ratio(&budget.envelope, name), 1.0));
         }
         if let Some(l) = self.data_volume_gbit_day {
             out.push(check("data a day, Gbit".into(), Some(budget.data.daily_gbit), l));

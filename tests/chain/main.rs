@@ -10,6 +10,7 @@ mod closure;
 mod coherence;
 #[path = "../common/mod.rs"]
 mod common;
+mod design;
 mod determinism;
 mod image_correction;
 mod incremental;

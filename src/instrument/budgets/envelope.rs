@@ -99,10 +99,19 @@ impl Packaging {
     /// the optical axis.
     #[must_use]
     pub fn fits(&self, length_mm: f64, cross_mm: f64, box_: &FormFactor) -> bool {
+        self.fit_ratio(length_mm, cross_mm, box_) <= 1.0
+    }
+
+    /// How much of `box_` the telescope needs: over the three orientations of its optical axis,
+    /// the least of max(length / room along the axis, cross-section / room across). At most 1:
+    /// it fits; 1.2: it is 20 % too large in its tightest dimension.
+    #[must_use]
+    pub fn fit_ratio(&self, length_mm: f64, cross_mm: f64, box_: &FormFactor) -> f64 {
         let (a, b, c) = box_.sides_mm;
         [(a, b.min(c)), (b, a.min(c)), (c, a.min(b))]
             .iter()
-            .any(|&(axis, face)| length_mm <= self.payload_length_share * axis && cross_mm <= face)
+            .map(|&(axis, face)| (length_mm / (self.payload_length_share * axis)).max(cross_mm / face))
+            .fold(f64::INFINITY, f64::min)
     }
 }
 

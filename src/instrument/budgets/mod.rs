@@ -153,17 +153,12 @@ impl BudgetModels {
         self.form_factors.iter().any(|f| f.name == name)
     }
 
-    /// Does a design whose smallest box is `fits` fit in the box `name`? A box fits in another
-    /// when the first is no larger in volume (the boxes are nested sizes of one family).
+    /// How much of the box `name` a design of `envelope` needs ([`Packaging::fit_ratio`]: at
+    /// most 1 when it fits); `None` for a box the models do not have.
     #[must_use]
-    pub fn fits_within(&self, fits: Option<&str>, name: &str) -> bool {
-        let volume = |n: &str| {
-            self.form_factors.iter().find(|f| f.name == n).map(|f| f.sides_mm.0 * f.sides_mm.1 * f.sides_mm.2)
-        };
-        match (fits.and_then(volume), volume(name)) {
-            (Some(a), Some(b)) => a <= b,
-            _ => false,
-        }
+    pub fn fit_ratio(&self, envelope: &Envelope, name: &str) -> Option<f64> {
+        let b = self.form_factors.iter().find(|f| f.name == name)?;
+        Some(self.packaging.fit_ratio(envelope.length_mm, envelope.cross_section_mm, b))
     }
 
     /// The budgets of `spec`, whose band `b` sits on focal plane `plane_of_band[b]` (0: the

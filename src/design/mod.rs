@@ -1,0 +1,244 @@
+//! Design search: the cheapest instrument that meets every requirement, and the front of cost
+//! against each product's error.
+//!
+//! The objective (telescope cost, [`crate::instrument::budgets`]) is cheap; the constraints
+//! (product errors, SNR, Rrs error, and the cheap box and data-volume limits) need a run of the
+//! chain per design and noise seed. The search is constrained efficient global optimisation
+//! (Jones, Schonlau & Welch 1998; constraints modelled by their own Gaussian processes,
+//! Sasena et al. 2002) through egobox's ask-and-tell interface (Lafage 2022): a Latin-hypercube
+//! start (McKay et al. 1979), then one design per step where the log expected improvement of
+//! ln(cost) is highest among designs whose modelled constraints are met. Integer and listed
+//! parameters use egobox's continuous relaxation (Garrido-Merchán & Hernández-Lobato 2020).
+//!
+//! A design is feasible when every requirement passes on every seed of the study (the worst
+//! seed decides each constraint). With all n seeds passing, the one-sided 95 % Clopper–Pearson
+//! lower bound on the probability that another seed passes is 0.05^(1/n)
+//! ([`pass_probability_lower_bound`]). The search runs at a reduced resolution
+//! (`decimation`); the cheapest feasible designs are then confirmed at the confirmation
+//! resolution, and the output says which figure came from which.
+//!
+//! ## References
+//! - Jones, D. R., Schonlau, M., Welch, W. J. (1998) Efficient global optimization of expensive
+//!   black-box functions. J. Global Optim. 13, 455–492.
+//! - Sasena, M. J., Papalambros, P., Goovaerts, P. (2002) Exploration of metamodeling sampling
+//!   criteria for constrained global optimization. Eng. Optim. 34, 263–278.
+//! - Lafage, R. (2022) egobox, a Rust toolbox for efficient global optimization. J. Open Source
+//!   Softw. 7(78), 4737.
+//! - McKay, M. D., Beckman, R. J., Conover, W. J. (1979) A comparison of three methods for
+//!   selecting values of input variables in the analysis of output from a computer code.
+//!   Technometrics 21, 239–245.
+//! - Garrido-Merchán, E. C., Hernández-Lobato, D. (2020) Dealing with categorical and
+//!   integer-valued variables in Bayesian optimization with Gaussian processes. Neurocomputing
+//!   380, 20–35.
+//! - Clopper, C. J., Pearson, E. S. (1934) The use of confidence or fiducial limits illustrated
+//!   in the case of the binomial. Biometrika 26, 404–413.
+
+pub mod evaluate;
+pub mod front;
+pub mod space;
+
+pub use evaluate::{Evaluation, Evaluator};
+pub use front::pareto_front;
+pub use space::{Kind, Variable, latin_hypercube};
+
+use crate::control::RunControl;
+use crate::engine::Engine;
+use crate::parse::FieldError;
+use crate::study::StudyError;
+
+/// How a search runs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Settings {
+    /// Designs evaluated in all, the start included.
+    pub evaluations: usize,
+    /// Designs of the Latin-hypercube start (0: 2 · parameters + 1).
+    pub initial: usize,
+    /// Decimation during the search.
+    pub decimation: usize,
+    /// Decimation the cheapest feasible designs are confirmed at (`None`: not confirmed).
+    pub confirm_decimation: Option<usize>,
+    /// Seed of the start and of the optimiser.
+    pub seed: u64,
+}
+
+/// A search's outcome.
+#[derive(Debug, Clone)]
+pub struct Search {
+    /// The varied fields.
+    pub vars: Vec<Variable>,
+    /// Every design evaluated, in order.
+    pub evaluations: Vec<Evaluation>,
+    /// The cheapest feasible design found during the search (index into `evaluations`).
+    pub cheapest: Option<usize>,
+    /// When nothing is feasible: the design closest to feasible.
+    pub closest: Option<usize>,
+    /// The confirmation runs (in the order tried; the first feasible one is the answer).
+    pub confirmed: Vec<Evaluation>,
+}
+
+impl Search {
+    /// The answer: the first confirmed feasible design, else the search's cheapest feasible.
+    #[must_use]
+    pub fn answer(&self) -> Option<&Evaluation> {
+        self.confirmed
+            .iter()
+            .find(|e| e.feasible())
+            .or_else(|| if self.confirmed.is_empty() { self.cheapest.map(|i| &self.evaluations[i]) } else { None })
+    }
+}
+
+/// Lower bound on the probability that a further seed passes when all `n` seeds passed
+/// (one-sided Clopper–Pearson at `confidence`): (1 − confidence)^(1/n).
+#[must_use]
+pub fn pass_probability_lower_bound(n: usize, confidence: f64) -> f64 {
+    if n == 0 { 0.0 } else { (1.0 - confidence).powf(1.0 / n as f64) }
+}
+
+/// Refuse a search that cannot answer before running anything: no requirement to meet, no
+/// parameter, too many or too few evaluations, or a cost model that refuses the aperture range.
+pub fn check(evaluator: &Evaluator<'_>, settings: &Settings) -> Result<(), StudyError> {
+    let bad = |field: &str, message: String| Err(StudyError::Invalid(FieldError { field: field.into(), message }));
+    let r = evaluator.requirements;
+    if r.products.is_empty() && r.snr.is_none() && r.rrs.is_none() && r.substrate_pct.is_none() && !r.has_design() {
+        return bad("requirements", "the study states no requirement: a search needs something to meet".into());
+    }
+    if evaluator.vars.is_empty() || evaluator.vars.len() > 8 {
+        return bad("--vary", format!("{} parameters (allowed: 1 to 8)", evaluator.vars.len()));
+    }
+    let initial = initial_count(settings, evaluator.vars.len());
+    if !(initial + 1..=2000).contains(&settings.evaluations) {
+        return bad("--evaluations", format!("{} (allowed: {} to 2000)", settings.evaluations, initial + 1));
+    }
+    let apertures = match evaluator.vars.iter().find(|v| v.path == "instrument.aperture_mm") {
+        Some(v) => v.bounds(),
+        None => (evaluator.base.instrument.aperture_mm, evaluator.base.instrument.aperture_mm),
+    };
+    for a in [apertures.0, apertures.1] {
+        let cost = evaluator.budgets.cost.ota(a * 1e-3);
+        if let (None, Some(note)) = (cost.ota, cost.note) {
+            return bad("budgets.cost.out_of_range", format!("the search needs a cost for every design: {note}"));
+        }
+    }
+    Ok(())
+}
+
+fn initial_count(settings: &Settings, nx: usize) -> usize {
+    if settings.initial == 0 { 2 * nx + 1 } else { settings.initial }
+}
+
+/// Run a search: the start, then one suggested design per step until `settings.evaluations`;
+/// `seen` is told of every evaluation (for progress) with the number done and the total.
+pub fn search(
+    evaluator: &Evaluator<'_>,
+    settings: &Settings,
+    control: &RunControl,
+    mut seen: impl FnMut(&Evaluation, usize, usize),
+) -> Result<Search, StudyError> {
+    check(evaluator, settings)?;
+    let mut engine = Engine::new();
+    let total = settings.evaluations + settings.confirm_decimation.map_or(0, |_| 3);
+    let mut evaluations: Vec<Evaluation> = Vec::new();
+    let mut run = |x: &[f64], evaluations: &mut Vec<Evaluation>| -> Result<(), StudyError> {
+        let e = evaluator.evaluate(&mut engine, x, control)?;
+        seen(&e, evaluations.len() + 1, total);
+        evaluations.push(e);
+        Ok(())
+    };
+    let nx = evaluator.vars.len();
+    for x in latin_hypercube(evaluator.vars, initial_count(settings, nx), settings.seed) {
+        run(&x, &mut evaluations)?;
+    }
+    let keys: Vec<String> = {
+        let mut k: Vec<String> = Vec::new();
+        for (name, _) in evaluations.iter().flat_map(|e| &e.constraints) {
+            if !k.contains(name) {
+                k.push(name.clone());
+            }
+        }
+        k
+    };
+    let xtypes: Vec<egobox_ego::XType> = evaluator.vars.iter().map(Variable::xtype).collect();
+    let mut step = 0u64;
+    while evaluations.len() < settings.evaluations {
+        step += 1;
+        let next = suggest(&evaluations, &keys, &xtypes, settings.seed.wrapping_add(step))
+            .filter(|x| !evaluations.iter().any(|e| same(&e.x, x)))
+            .unwrap_or_else(|| {
+                // The surrogate proposed a design already run (or could not be fitted): take a
+                // fresh space-filling one instead, so every evaluation teaches something.
+                latin_hypercube(evaluator.vars, 1, settings.seed.wrapping_add(1000 + step)).remove(0)
+            });
+        run(&next, &mut evaluations)?;
+    }
+    let cheapest = cheapest_feasible(&evaluations);
+    let closest = if cheapest.is_some() {
+        None
+    } else {
+        (0..evaluations.len())
+            .filter(|&i| evaluations[i].error.is_none())
+            .min_by(|&a, &b| evaluations[a].worst().total_cmp(&evaluations[b].worst()))
+    };
+    let mut confirmed = Vec::new();
+    if let Some(d) = settings.confirm_decimation {
+        let confirm = Evaluator { decimation: d, ..*evaluator };
+        let mut order: Vec<usize> = (0..evaluations.len()).filter(|&i| evaluations[i].feasible()).collect();
+        order.sort_by(|&a, &b| {
+            evaluations[a].cost.unwrap_or(f64::INFINITY).total_cmp(&evaluations[b].cost.unwrap_or(f64::INFINITY))
+        });
+        for &i in order.iter().take(3) {
+            let e = confirm.evaluate(&mut engine, &evaluations[i].x, control)?;
+            seen(&e, evaluations.len() + confirmed.len() + 1, total);
+            let done = e.feasible();
+            confirmed.push(e);
+            if done {
+                break;
+            }
+        }
+    }
+    Ok(Search { vars: evaluator.vars.to_vec(), evaluations, cheapest, closest, confirmed })
+}
+
+fn same(a: &[f64], b: &[f64]) -> bool {
+    a.iter().zip(b).all(|(x, y)| (x - y).abs() <= 1e-9 * x.abs().max(y.abs()).max(1e-12))
+}
+
+/// The cheapest feasible evaluation.
+#[must_use]
+pub fn cheapest_feasible(evaluations: &[Evaluation]) -> Option<usize> {
+    (0..evaluations.len()).filter(|&i| evaluations[i].feasible()).min_by(|&a, &b| {
+        evaluations[a].cost.unwrap_or(f64::INFINITY).total_cmp(&evaluations[b].cost.unwrap_or(f64::INFINITY))
+    })
+}
+
+/// egobox's next design from the evaluations so far: rows [ln cost, g₁ … g_k] (a constraint a
+/// design did not report counts as failed by 1). `None` when it cannot propose one.
+fn suggest(evaluations: &[Evaluation], keys: &[String], xtypes: &[egobox_ego::XType], seed: u64) -> Option<Vec<f64>> {
+    use ndarray_egobox::Array2;
+    let rows: Vec<&Evaluation> =
+        evaluations.iter().filter(|e| e.error.is_none() && e.cost.is_some_and(|c| c > 0.0)).collect();
+    if rows.len() < 2 {
+        return None;
+    }
+    let nx = xtypes.len();
+    let x = Array2::from_shape_fn((rows.len(), nx), |(i, j)| rows[i].x[j]);
+    let y = Array2::from_shape_fn((rows.len(), 1 + keys.len()), |(i, j)| {
+        if j == 0 {
+            rows[i].cost.unwrap_or(1.0).ln()
+        } else {
+            rows[i].constraints.iter().find(|(k, _)| *k == keys[j - 1]).map_or(1.0, |(_, g)| *g)
+        }
+    });
+    let xtypes = xtypes.to_vec();
+    let n_cstr = keys.len();
+    // egobox panics on a surrogate it cannot fit (all values equal, say); that is a step to
+    // skip, not a run to lose.
+    let result = std::panic::catch_unwind(move || {
+        let service = egobox_ego::EgorServiceBuilder::optimize()
+            .configure(|c| c.n_cstr(n_cstr).seed(seed))
+            .min_within_mixint_space(&xtypes)
+            .ok()?;
+        let next = service.suggest(&x, &y);
+        (next.nrows() > 0).then(|| next.row(0).to_vec())
+    });
+    result.ok().flatten().filter(|x| x.iter().all(|v| v.is_finite()))
+}
