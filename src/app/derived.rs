@@ -45,12 +45,11 @@ pub(super) fn derived(app: &ShoalApp, ui: &mut egui::Ui) {
         });
         ui.small("Peak SNR: the best band at the scene's median radiance.");
     });
-    budgets(app, ui);
     feasibility(app, ui);
 }
 
 /// Cost, box and data budgets of A and B under the built-in models (src/instrument/budgets),
-/// from the bands of the run on screen.
+/// from the bands of the run on screen; inside the folded Feasibility section.
 fn budgets(app: &ShoalApp, ui: &mut egui::Ui) {
     use crate::instrument::budgets::BudgetModels;
     static MODELS: std::sync::OnceLock<Option<BudgetModels>> = std::sync::OnceLock::new();
@@ -61,7 +60,9 @@ fn budgets(app: &ShoalApp, ui: &mut egui::Ui) {
             app.link.current(i).map(|s| models.assess(spec, &s.output.response.plane_of_band).rows())
         })
         .collect();
-    egui::CollapsingHeader::new("Budgets").default_open(false).show(ui, |ui| {
+    ui.separator();
+    ui.strong("Budgets");
+    {
         egui::Grid::new("budgets").num_columns(3).striped(true).show(ui, |ui| {
             let n = rows.iter().flatten().map(Vec::len).next().unwrap_or(0);
             for k in 0..n {
@@ -77,7 +78,7 @@ fn budgets(app: &ShoalApp, ui: &mut egui::Ui) {
             "Models `{}`: telescope cost by Stahl (2020), FY2017 US$ M, for apertures of {}–{} m; box, packaging and downlink as in presets/budgets.",
             models.name, models.cost.valid_aperture_m.0, models.cost.valid_aperture_m.1
         ));
-    });
+    }
 }
 
 /// A value coloured by how far it is from sensible: red past a hard limit, amber near one.
@@ -154,6 +155,7 @@ fn feasibility(app: &ShoalApp, ui: &mut egui::Ui) {
                 ui.end_row();
             }
         });
+        budgets(app, ui);
     });
 }
 
