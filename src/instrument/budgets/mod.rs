@@ -79,7 +79,7 @@ impl DesignBudget {
         let cost = match (self.cost.ota, self.cost.extrapolated) {
             (Some(c), false) => format!("{c:.2} {}", self.currency),
             (Some(c), true) => format!("{c:.2} {} (extrapolated)", self.currency),
-            (None, _) => "– (outside the cost model's data)".into(),
+            (None, _) => "– (outside the model)".into(),
         };
         let e = &self.envelope;
         let d = &self.data;
@@ -91,7 +91,7 @@ impl DesignBudget {
                 "mass, power (scaled)".into(),
                 match (e.mass_kg, e.power_w) {
                     (Some(m), Some(p)) => format!("{m:.2} kg, {p:.1} W"),
-                    _ => "– (no reference instrument)".into(),
+                    _ => "– (no reference)".into(),
                 },
             ),
             ("data rate while imaging".into(), format!("{:.1} Mbit/s", d.rate_mbit_s)),
