@@ -136,7 +136,7 @@ impl Evaluator<'_> {
             let metrics = out.retrievals.first().map(|r| &r.metrics);
             let label = &config.instrument.name;
             let mut checks = self.requirements.check_run(label, seed, metrics, &out.snr, &out.correction.rrs_metrics);
-            checks.extend(self.requirements.check_design(label, seed, &budget, self.budgets));
+            checks.extend(self.requirements.check_design(label, seed, &config.instrument, &budget, self.budgets));
             if checks.iter().all(|c| c.pass) {
                 e.seeds_passed += 1;
             }

@@ -210,8 +210,14 @@ pub fn cheapest_feasible(evaluations: &[Evaluation]) -> Option<usize> {
     })
 }
 
-/// egobox's next design from the evaluations so far: rows [ln cost, g₁ … g_k] (a constraint a
-/// design did not report counts as failed by 1). `None` when it cannot propose one.
+/// How far inside every limit the optimiser aims, as a share of the limit: egobox accepts a
+/// modelled constraint within its tolerance, and a design proposed exactly on a limit (the
+/// smear of the longest exposure allowed, say) lands just outside it as often as inside.
+pub const AIM_INSIDE: f64 = 1e-3;
+
+/// egobox's next design from the evaluations so far: rows [ln cost, g₁ + [`AIM_INSIDE`] …]
+/// (a constraint a design did not report counts as failed by 1). `None` when it cannot
+/// propose one.
 fn suggest(evaluations: &[Evaluation], keys: &[String], xtypes: &[egobox_ego::XType], seed: u64) -> Option<Vec<f64>> {
     use ndarray_egobox::Array2;
     let rows: Vec<&Evaluation> =
@@ -225,7 +231,7 @@ fn suggest(evaluations: &[Evaluation], keys: &[String], xtypes: &[egobox_ego::XT
         if j == 0 {
             rows[i].cost.unwrap_or(1.0).ln()
         } else {
-            rows[i].constraints.iter().find(|(k, _)| *k == keys[j - 1]).map_or(1.0, |(_, g)| *g)
+            rows[i].constraints.iter().find(|(k, _)| *k == keys[j - 1]).map_or(1.0, |(_, g)| *g) + AIM_INSIDE
         }
     });
     let xtypes = xtypes.to_vec();

@@ -18,8 +18,8 @@ use std::fmt::Write as _;
 use serde::{Deserialize, Serialize};
 
 use super::{StudyError, StudyResult};
-use crate::instrument::SnrRow;
 use crate::instrument::budgets::{BudgetModels, DesignBudget};
+use crate::instrument::{InstrumentSpec, SnrRow};
 use crate::metrics::ProductMetrics;
 use crate::parse::FieldError;
 
@@ -67,6 +67,13 @@ pub struct Requirements {
     /// Largest volume of a day's images after compression, Gbit.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub data_volume_gbit_day: Option<f64>,
+    /// Largest nadir ground sampling distance, m (altitude · pitch / focal length).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gsd_m_max: Option<f64>,
+    /// Largest along-track smear over one exposure, pixels (exposure / line period;
+    /// Schowengerdt 2007, §3.4): what bounds the exposure a design may use.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub smear_px_max: Option<f64>,
 }
 
 /// The corrected Rrs's error per band, in the bands centred from `from_nm` to `to_nm`.
@@ -202,6 +209,16 @@ impl Requirements {
         {
             return bad("requirements.data_volume_gbit_day", format!("{v} (allowed: above 0 up to 1e6 Gbit)"));
         }
+        if let Some(v) = self.gsd_m_max
+            && !(v.is_finite() && v > 0.0 && v <= 1e5)
+        {
+            return bad("requirements.gsd_m_max", format!("{v} (allowed: above 0 up to 100 000 m)"));
+        }
+        if let Some(v) = self.smear_px_max
+            && !(v.is_finite() && v > 0.0 && v <= 100.0)
+        {
+            return bad("requirements.smear_px_max", format!("{v} (allowed: above 0 up to 100 pixels)"));
+        }
         if let Some(f) = &self.fits
             && !models.has_form_factor(f)
         {
@@ -217,13 +234,25 @@ impl Requirements {
     /// Does the study ask anything of the design's budgets?
     #[must_use]
     pub fn has_design(&self) -> bool {
-        self.cost_max.is_some() || self.fits.is_some() || self.data_volume_gbit_day.is_some()
+        self.cost_max.is_some()
+            || self.fits.is_some()
+            || self.data_volume_gbit_day.is_some()
+            || self.smear_px_max.is_some()
+            || self.gsd_m_max.is_some()
     }
 
-    /// Check a design's budgets: cost (a refused cost fails, with the reason), the box, the
-    /// daily data volume.
+    /// Check a design `spec` and its budgets: cost (a refused cost fails, with the reason), the
+    /// box, the daily data volume, its nadir GSD and its along-track smear (exposure over the
+    /// line period GSD / ground speed, as the feasibility stage computes it).
     #[must_use]
-    pub fn check_design(&self, label: &str, seed: u64, budget: &DesignBudget, models: &BudgetModels) -> Vec<Check> {
+    pub fn check_design(
+        &self,
+        label: &str,
+        seed: u64,
+        spec: &InstrumentSpec,
+        budget: &DesignBudget,
+        models: &BudgetModels,
+    ) -> Vec<Check> {
         let mut out = Vec::new();
         let check = |what: String, value: Option<f64>, limit: f64| {
             let margin = value.map(|v| limit - v);
@@ -249,6 +278,13 @@ impl Requirements {
         if let Some(l) = self.data_volume_gbit_day {
             out.push(check("data a day, Gbit".into(), Some(budget.data.daily_gbit), l));
         }
+        if let Some(l) = self.gsd_m_max {
+            out.push(check("GSD, m".into(), Some(spec.gsd_m()), l));
+        }
+        if let Some(l) = self.smear_px_max {
+            let line_period_s = spec.gsd_m() / crate::instrument::ground_speed_m_s(spec.altitude_km);
+            out.push(check("smear, px".into(), Some(spec.exposure_s / line_period_s), l));
+        }
         out
     }
 
@@ -268,7 +304,10 @@ impl Requirements {
             .flat_map(|run| {
                 let metrics = run.retrievals.first().map(|r| &r.metrics);
                 let mut checks = self.check_run(&run.label, run.seed, metrics, &run.snr, &run.rrs_metrics);
-                checks.extend(self.check_design(&run.label, run.seed, &run.budget, &result.study.budgets));
+                let spec = result.study.runs.iter().find(|r| r.0 == run.label).map(|r| &r.2.instrument);
+                if let Some(spec) = spec {
+                    checks.extend(self.check_design(&run.label, run.seed, spec, &run.budget, &result.study.budgets));
+                }
                 checks
             })
             .collect()
