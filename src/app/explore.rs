@@ -2,7 +2,8 @@
 //! noise seeds; the chl MAE curve of each instrument grows point by point, with the seeds' range,
 //! the requirement and where it is first met. **Cost**: every fidelity setting's time against its
 //! error from the full-fidelity run (`sweep::cost`), to pick the cheapest setting whose error is
-//! acceptable.
+//! acceptable. **Design**: the cheapest design from A that meets the requirements
+//! (`crate::design`), with its cost–error plot and a click to put a design into A or B.
 //!
 //! Both run on a helper thread (not the engine thread, whose pool serves the maps) and stream
 //! their results; a new run or closing the window cancels the old one.
@@ -21,6 +22,10 @@ pub struct Explore {
     pub sweep_open: bool,
     /// Is the cost window open?
     pub cost_open: bool,
+    /// Is the design window open?
+    pub design_open: bool,
+    /// The design search's settings and results.
+    pub design: design::DesignState,
     /// The swept field's path in the run configuration (`instrument.aperture_mm`).
     param: String,
     /// A second parameter and its span (a curve per value), if any.
@@ -60,6 +65,8 @@ impl Default for Explore {
         Self {
             sweep_open: false,
             cost_open: false,
+            design_open: false,
+            design: design::DesignState::default(),
             param: "instrument.aperture_mm".into(),
             second: None,
             variable: "chl_mg_m3".into(),
@@ -91,7 +98,7 @@ impl Explore {
     /// Is a helper thread working?
     #[must_use]
     pub fn busy(&self) -> bool {
-        self.sweep_task.is_some() || self.cost_task.is_some()
+        self.sweep_task.is_some() || self.cost_task.is_some() || self.design.busy()
     }
 
     /// Rows of the sweep so far.
@@ -102,6 +109,7 @@ impl Explore {
 
     /// Take what the helper threads sent.
     pub fn poll(&mut self) {
+        self.design.poll();
         if let Some(task) = &self.sweep_task {
             let mut finished = None;
             while let Some(msg) = task.poll() {
@@ -306,6 +314,8 @@ fn fidelity_text(f: &Fidelity) -> String {
 
 mod cost;
 pub use cost::cost_window;
+mod design;
+pub use design::design_window;
 mod sweep;
 pub use sweep::sweep_window;
 

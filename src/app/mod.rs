@@ -291,6 +291,9 @@ impl ShoalApp {
         if self.ui.explore.cost_open {
             explore::cost_window(self, &ctx);
         }
+        if self.ui.explore.design_open {
+            explore::design_window(self, &ctx);
+        }
         if self.ui.spectrum.open {
             spectrum::spectrum_window(self, &ctx);
         }
@@ -356,6 +359,8 @@ impl ShoalApp {
                 .on_hover_text("A curve: one parameter of A and B over a range, with noise seeds");
             ui.toggle_value(&mut self.ui.explore.cost_open, "Cost")
                 .on_hover_text("Time against error for each fidelity setting");
+            ui.toggle_value(&mut self.ui.explore.design_open, "Design")
+                .on_hover_text("The cheapest design from A that meets the requirements, and its cost against error");
             ui.separator();
             ui.toggle_value(&mut self.ui.typed_export, "Path")
                 .on_hover_text("Export to a typed path (for desktops without a file-chooser portal)");

@@ -136,7 +136,8 @@ pub fn search(
 ) -> Result<Search, StudyError> {
     check(evaluator, settings)?;
     let mut engine = Engine::new();
-    let total = settings.evaluations + settings.confirm_decimation.map_or(0, |_| 3);
+    let confirms = settings.confirm_decimation.is_some_and(|d| d != settings.decimation);
+    let total = settings.evaluations + if confirms { 3 } else { 0 };
     let mut evaluations: Vec<Evaluation> = Vec::new();
     let mut run = |x: &[f64], evaluations: &mut Vec<Evaluation>| -> Result<(), StudyError> {
         let e = evaluator.evaluate(&mut engine, x, control)?;
@@ -179,7 +180,8 @@ pub fn search(
             .min_by(|&a, &b| evaluations[a].worst().total_cmp(&evaluations[b].worst()))
     };
     let mut confirmed = Vec::new();
-    if let Some(d) = settings.confirm_decimation {
+    // Confirmation at the search's own resolution would only repeat the search's runs.
+    if let Some(d) = settings.confirm_decimation.filter(|&d| d != settings.decimation) {
         let confirm = Evaluator { decimation: d, ..*evaluator };
         let mut order: Vec<usize> = (0..evaluations.len()).filter(|&i| evaluations[i].feasible()).collect();
         order.sort_by(|&a, &b| {

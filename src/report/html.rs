@@ -41,9 +41,10 @@ fn url_path(name: &str) -> String {
 /// The page's Content Security Policy: no script, no connection, no resource from outside the
 /// file (images only as `data:` URIs, the one inline style sheet). A second wall behind
 /// [`super::svg::clean`]: a figure that slipped through could still run nothing and fetch nothing.
-const CSP: &str = "default-src 'none'; img-src data:; style-src 'unsafe-inline'; form-action 'none'; base-uri 'none'";
+pub(super) const CSP: &str =
+    "default-src 'none'; img-src data:; style-src 'unsafe-inline'; form-action 'none'; base-uri 'none'";
 
-const STYLE: &str = "
+pub(super) const STYLE: &str = "
 body { font: 15px/1.45 'DejaVu Sans', Verdana, sans-serif; color: #1b1b1b; margin: 0 auto; max-width: 1180px; padding: 24px 28px 60px; }
 h1 { font-size: 26px; margin: 0 0 4px; } h2 { font-size: 20px; margin: 34px 0 10px; border-bottom: 2px solid #2a5d8f; padding-bottom: 3px; }
 h3 { font-size: 16px; margin: 22px 0 6px; }

@@ -7,6 +7,7 @@
 //! directory without rerunning, and `shoal report STUDY` runs the study and builds it at once.
 //! [`html::page`] turns it and the study's figures into the page.
 
+pub mod design_page;
 pub mod html;
 mod machine;
 mod pack;

@@ -18,6 +18,7 @@ use shoal::app::{AppOptions, ShoalApp};
 use shoal::instrument::InstrumentSpec;
 use shoal::library::Library;
 
+mod design;
 mod review;
 mod session;
 mod spectrum;
