@@ -179,6 +179,9 @@ fn a_raster_scene_takes_its_grid_place_and_crs_from_the_bathymetry() {
 
 #[test]
 fn resampling_matches_gdalwarp() {
+    if !crate::common::tool_available("gdalinfo", "gdal-bin") {
+        return;
+    }
     // GDAL is the independent reference: warp the 16 m habitat onto the bathymetry's 8 m grid
     // with bilinear (sand) and nearest (land) and compare every cell. Upsampling by 2 uses the
     // 2 × 2 neighbourhood in both codes, so they agree to Float32 rounding.
@@ -326,6 +329,9 @@ fn raster_mistakes_are_errors_that_say_what_to_do() {
 
 #[test]
 fn the_reader_reads_what_gdal_writes() {
+    if !crate::common::tool_available("gdalinfo", "gdal-bin") {
+        return;
+    }
     // GDAL writes the layouts survey data come in; our reader must give the same numbers.
     let dir = tempdir("gdal-variants");
     let habitat = rasters_dir().join("reef_survey_habitat.tif");
@@ -466,6 +472,9 @@ fn stats(values: impl Iterator<Item = (f64, bool)>) -> (f64, f64, f64) {
 
 #[test]
 fn gdal_reads_the_products_we_write_with_their_crs_transform_nodata_and_values() {
+    if !crate::common::tool_available("gdalinfo", "gdal-bin") {
+        return;
+    }
     use shoal::engine::RunConfig;
     use shoal::retrieval::RetrievalSpec;
     let scene = SceneSpec::preset("reef_survey_raster").unwrap();
@@ -534,6 +543,9 @@ fn gdal_reads_the_products_we_write_with_their_crs_transform_nodata_and_values()
 
 #[test]
 fn a_scene_without_a_georeference_is_written_in_a_local_metric_frame() {
+    if !crate::common::tool_available("gdalinfo", "gdal-bin") {
+        return;
+    }
     let mut config = shoal::engine::RunConfig::new(
         super::small_lake(),
         shoal::instrument::InstrumentSpec::preset("nominal").unwrap(),

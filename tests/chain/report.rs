@@ -87,6 +87,9 @@ window.addEventListener('load', async () => {
 
 #[test]
 fn the_review_pack_renders_in_chromium_with_every_image_and_nothing_external() {
+    if !crate::common::tool_available("chromium", "chromium") {
+        return;
+    }
     let dir = tempdir("pack");
     let results = dir.join("results");
     ok(shoal().args(["study", "cubesat_vs_smallsat", "--decimation", "8", "--no-cubes", "--out"]).arg(&results));
@@ -225,6 +228,9 @@ fn a_report_straight_from_a_study_carries_its_error_budget_and_bad_targets_are_r
 /// into the page raw, which only the page's Content-Security-Policy then stops.
 #[test]
 fn a_planted_figure_runs_no_script_and_calls_nowhere_in_chromium() {
+    if !crate::common::tool_available("chromium", "chromium") {
+        return;
+    }
     use std::io::Read as _;
     let dir = tempdir("planted");
     let results = dir.join("results");

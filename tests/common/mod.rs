@@ -68,3 +68,25 @@ pub fn with_dark_laws(instrument: &mut shoal::instrument::InstrumentSpec) {
         }
     }
 }
+
+/// Does the Debian tool `tool` (package `package`) run on this machine? The README's test
+/// command must pass on a machine with the Rust toolchain only, so a test that needs one prints
+/// one line naming the package and skips when it is absent. Under `.ci/run`, which installs the
+/// packages and sets `SHOAL_REQUIRE_TOOLS=1`, absence is a failure instead.
+#[must_use]
+pub fn tool_available(tool: &str, package: &str) -> bool {
+    let runs = std::process::Command::new(tool)
+        .arg("--version")
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .status()
+        .is_ok();
+    if !runs {
+        assert!(
+            std::env::var_os("SHOAL_REQUIRE_TOOLS").is_none(),
+            "{tool} does not run and SHOAL_REQUIRE_TOOLS is set: install {package} (`apt-get install {package}`)"
+        );
+        eprintln!("skipped: needs {tool}; install {package} (`apt-get install {package}`) to run this test");
+    }
+    runs
+}
