@@ -12,7 +12,7 @@
 //! below); the scalar one stays as the readable statement of the method.
 
 use super::almi::{AlmiFlags, AlmiPixel, AlmiSet, AlmiSettings, MAX_BANDS, Prepared};
-use super::nnls::{MIN_DET, column_scale, det3, nnls3};
+use super::nnls::{MIN_DET, column_scale, nnls3};
 
 /// Sets per chunk (one chunk of eight covers the built-in sets).
 pub const LANES: usize = 8;
@@ -96,70 +96,9 @@ struct Normal {
 /// One value per lane.
 type Lanes = [f64; LANES];
 
-/// A value per lane from `f(lane)`. A plain loop rather than `std::array::from_fn`, which the
-/// compiler left as a call (compiled without AVX2) inside the AVX2 build: 6 % of the default
-/// study's CPU time, in perf.
-#[inline(always)]
-fn lanewise<T: Copy + Default>(f: impl Fn(usize) -> T) -> [T; LANES] {
-    let mut out = [T::default(); LANES];
-    for (s, v) in out.iter_mut().enumerate() {
-        *v = f(s);
-    }
-    out
-}
+mod ops;
 
-const INF: f64 = f64::INFINITY;
-
-/// The lane mask of `b`: all bits set when true.
-#[inline(always)]
-fn mask(b: bool) -> u64 {
-    u64::from(b).wrapping_neg()
-}
-
-/// `a` where `mask` is set, else `b`, by bit operations (no branch).
-#[inline(always)]
-fn select(mask: u64, a: f64, b: f64) -> f64 {
-    f64::from_bits((a.to_bits() & mask) | (b.to_bits() & !mask))
-}
-
-/// `x.is_finite()` as a floating-point comparison: `is_finite` compiles to integer tests of the
-/// bits, one lane at a time, where a comparison runs four lanes per instruction. (NaN compares
-/// false, so the two agree on every input.)
-#[inline(always)]
-fn finite(x: f64) -> bool {
-    x.abs() < INF
-}
-
-/// The lane-wise [`det3`]: the same expression per lane, so the same bits.
-#[inline(always)]
-fn det3_lanes(c: &[[&Lanes; 3]; 3]) -> Lanes {
-    lanewise(|s| {
-        det3(&[
-            [c[0][0][s], c[0][1][s], c[0][2][s]],
-            [c[1][0][s], c[1][1][s], c[1][2][s]],
-            [c[2][0][s], c[2][1][s], c[2][2][s]],
-        ])
-    })
-}
-
-/// Component `j` of the solution of `rows`·x = `bs` by Cramer's rule (`inv_det` = 1/det(rows)),
-/// lane by lane as [`nnls3`] computes it. (A function, not a closure: the closure was left out
-/// of line.)
-#[inline(always)]
-fn cramer(rows: &[[&Lanes; 3]; 3], bs: &[Lanes; 3], inv_det: &Lanes, j: usize) -> Lanes {
-    let mut c = *rows;
-    for (i, row) in c.iter_mut().enumerate() {
-        row[j] = &bs[i];
-    }
-    let num = det3_lanes(&c);
-    lanewise(|s| num[s] * inv_det[s])
-}
-
-/// Whether `x` is feasible: every component finite and non-negative.
-#[inline(always)]
-fn feasible(x: &[f64; 3]) -> bool {
-    x.iter().fold(true, |ok, v| ok & (*v >= 0.0) & (*v < INF))
-}
+use ops::{INF, cramer, det3_lanes, feasible, finite, lanewise, mask, select};
 
 /// Index of (i, j) among the six stored entries of a symmetric 3 × 3 matrix.
 const AT: [[usize; 3]; 3] = [[0, 1, 2], [1, 3, 4], [2, 4, 5]];
