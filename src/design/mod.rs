@@ -59,6 +59,46 @@ pub struct Settings {
     pub confirm_decimation: Option<usize>,
     /// Seed of the start and of the optimiser.
     pub seed: u64,
+    /// Stop early after this many designs in a row that did not make the cheapest feasible
+    /// design at least [`Settings::stall_gain`] cheaper (`None`: run every evaluation).
+    pub stall_after: Option<usize>,
+    /// The relative cost reduction that counts as progress (0.001: 0.1 %).
+    pub stall_gain: f64,
+}
+
+impl Settings {
+    /// `evaluations` designs at `decimation`, confirmed at full resolution, no early stop.
+    #[must_use]
+    pub fn new(evaluations: usize, decimation: usize) -> Self {
+        Self {
+            evaluations,
+            initial: 0,
+            decimation,
+            confirm_decimation: Some(1),
+            seed: 1,
+            stall_after: None,
+            stall_gain: 0.001,
+        }
+    }
+}
+
+/// Counts designs in a row that did not make the cheapest feasible design cheaper by a share.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Stall {
+    best: Option<f64>,
+    run: usize,
+}
+
+impl Stall {
+    /// Take `cost` of a design (`None`: not feasible).
+    fn see(&mut self, cost: Option<f64>, gain: f64) {
+        match (cost, self.best) {
+            (Some(c), Some(b)) if c < b * (1.0 - gain) => (self.best, self.run) = (Some(c), 0),
+            (Some(c), None) => (self.best, self.run) = (Some(c), 0),
+            (Some(c), Some(b)) => (self.best, self.run) = (Some(c.min(b)), self.run + 1),
+            (None, _) => self.run += 1,
+        }
+    }
 }
 
 /// A search's outcome.
@@ -74,6 +114,8 @@ pub struct Search {
     pub closest: Option<usize>,
     /// The confirmation runs (in the order tried; the first feasible one is the answer).
     pub confirmed: Vec<Evaluation>,
+    /// Why the search stopped before its evaluations ran out, if it did.
+    pub stopped_early: Option<String>,
 }
 
 impl Search {
@@ -160,7 +202,23 @@ pub fn search(
     };
     let xtypes: Vec<egobox_ego::XType> = evaluator.vars.iter().map(Variable::xtype).collect();
     let mut step = 0u64;
+    let mut stall = Stall { best: None, run: 0 };
+    for e in &evaluations {
+        stall.see(e.feasible().then_some(e.cost).flatten(), settings.stall_gain);
+    }
+    let mut stopped_early = None;
     while evaluations.len() < settings.evaluations {
+        if let Some(n) = settings.stall_after
+            && stall.best.is_some()
+            && stall.run >= n
+        {
+            stopped_early = Some(format!(
+                "stopped after {} designs: {n} in a row made the cheapest feasible design less than {} % cheaper",
+                evaluations.len(),
+                100.0 * settings.stall_gain
+            ));
+            break;
+        }
         step += 1;
         let next = suggest(&evaluations, &keys, &xtypes, settings.seed.wrapping_add(step))
             .filter(|x| !evaluations.iter().any(|e| same(&e.x, x)))
@@ -170,6 +228,9 @@ pub fn search(
                 latin_hypercube(evaluator.vars, 1, settings.seed.wrapping_add(1000 + step)).remove(0)
             });
         run(&next, &mut evaluations)?;
+        if let Some(e) = evaluations.last() {
+            stall.see(e.feasible().then_some(e.cost).flatten(), settings.stall_gain);
+        }
     }
     let cheapest = cheapest_feasible(&evaluations);
     let closest = if cheapest.is_some() {
@@ -197,7 +258,7 @@ pub fn search(
             }
         }
     }
-    Ok(Search { vars: evaluator.vars.to_vec(), evaluations, cheapest, closest, confirmed })
+    Ok(Search { vars: evaluator.vars.to_vec(), evaluations, cheapest, closest, confirmed, stopped_early })
 }
 
 fn same(a: &[f64], b: &[f64]) -> bool {
@@ -249,4 +310,25 @@ fn suggest(evaluations: &[Evaluation], keys: &[String], xtypes: &[egobox_ego::XT
         (next.nrows() > 0).then(|| next.row(0).to_vec())
     });
     result.ok().flatten().filter(|x| x.iter().all(|v| v.is_finite()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_stall_counts_designs_that_do_not_cut_the_cheapest_feasible_cost() {
+        let mut s = Stall { best: None, run: 0 };
+        s.see(None, 0.001);
+        assert_eq!(s.run, 1, "nothing feasible yet counts");
+        s.see(Some(1.0), 0.001);
+        assert_eq!((s.best, s.run), (Some(1.0), 0), "the first feasible design resets");
+        s.see(Some(0.9995), 0.001);
+        assert_eq!((s.best, s.run), (Some(0.9995), 1), "0.05 % cheaper is not progress");
+        s.see(Some(0.99), 0.001);
+        assert_eq!(s.run, 0, "0.95 % cheaper is");
+        s.see(Some(2.0), 0.001);
+        assert_eq!((s.best, s.run), (Some(0.99), 1));
+        assert!((pass_probability_lower_bound(3, 0.95) - 0.368_403).abs() < 1e-6);
+    }
 }

@@ -49,6 +49,9 @@ pub fn design_page(search: &Search, c: &DesignContext, fronts: &[PageFigure]) ->
         env!("CARGO_PKG_VERSION"),
         escape(super::commit())
     );
+    if let Some(why) = &search.stopped_early {
+        let _ = writeln!(h, "<p class=\"note\">{}.</p>", escape(why));
+    }
     answer(&mut h, search, c);
     h.push_str("<section id=\"fronts\">\n<h2>Cost against each product's error</h2>\n");
     for f in fronts {
@@ -205,6 +208,7 @@ mod tests {
             cheapest: Some(1),
             closest: None,
             confirmed: vec![],
+            stopped_early: None,
         };
         let page = design_page(&search, &context(), &[]);
         assert!(page.contains("aperture_mm = 75"), "the answer");
@@ -221,6 +225,7 @@ mod tests {
             cheapest: None,
             closest: Some(0),
             confirmed: vec![],
+            stopped_early: None,
         };
         let page = design_page(&search, &context(), &[]);
         assert!(page.contains("No feasible design") && page.contains("Closest: aperture_mm = 60"));

@@ -44,7 +44,15 @@ fn the_search_finds_the_grids_cheapest_feasible_design_with_a_tenth_of_the_runs(
     }
     let best = &grid[cheapest_feasible(&grid).expect("the grid has a feasible design")];
     let budget = APERTURES * EXPOSURES / 10;
-    let settings = Settings { evaluations: budget, initial: 0, decimation: 8, confirm_decimation: None, seed: 1 };
+    let settings = Settings {
+        evaluations: budget,
+        initial: 0,
+        decimation: 8,
+        confirm_decimation: None,
+        seed: 1,
+        stall_after: None,
+        stall_gain: 0.001,
+    };
     let found = search(&evaluator, &settings, &control, |_, _, _| {}).unwrap();
     let answer = found.answer().expect("the search finds a feasible design");
     assert!(found.evaluations.len() <= budget, "{} runs", found.evaluations.len());
@@ -79,7 +87,15 @@ fn a_requirement_no_design_meets_names_the_closest() {
         budgets: &resolved.budgets,
         decimation: 8,
     };
-    let settings = Settings { evaluations: 5, initial: 0, decimation: 8, confirm_decimation: None, seed: 2 };
+    let settings = Settings {
+        evaluations: 5,
+        initial: 0,
+        decimation: 8,
+        confirm_decimation: None,
+        seed: 2,
+        stall_after: None,
+        stall_gain: 0.001,
+    };
     let found = search(&evaluator, &settings, &RunControl::default(), |_, _, _| {}).unwrap();
     assert!(found.answer().is_none());
     let closest = &found.evaluations[found.closest.expect("a closest design")];
@@ -104,7 +120,15 @@ fn a_cost_model_that_refuses_the_range_is_refused_before_any_run() {
         budgets: &resolved.budgets,
         decimation: 8,
     };
-    let settings = Settings { evaluations: 5, initial: 0, decimation: 8, confirm_decimation: None, seed: 1 };
+    let settings = Settings {
+        evaluations: 5,
+        initial: 0,
+        decimation: 8,
+        confirm_decimation: None,
+        seed: 1,
+        stall_after: None,
+        stall_gain: 0.001,
+    };
     let e = shoal::design::check(&evaluator, &settings).unwrap_err().to_string();
     assert!(e.contains("budgets.cost.out_of_range") && e.contains("0.3–6.5 m"), "{e}");
 }

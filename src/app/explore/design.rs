@@ -117,6 +117,8 @@ impl DesignState {
             decimation: self.decimation,
             confirm_decimation: None,
             seed: 1,
+            stall_after: Some(10),
+            stall_gain: 0.001,
         };
         {
             let evaluator = Evaluator {
