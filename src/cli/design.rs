@@ -8,6 +8,7 @@ use std::path::PathBuf;
 use clap::Args;
 
 use super::CliError;
+use crate::design::record::{self, Record};
 use crate::design::{Evaluation, Evaluator, Search, Settings, Variable, pareto_front, pass_probability_lower_bound};
 use crate::study::{CurvePoint, CurveSeries, Curves, curve_figure, write_bytes};
 
@@ -44,6 +45,14 @@ pub struct DesignArgs {
     /// than 0.1 % cheaper (0: run every evaluation).
     #[arg(long, default_value_t = 0)]
     stall: usize,
+    /// Evaluate only the designs `i`, `i + n`, … of the Latin-hypercube start and stop (`i/n`,
+    /// 0-based; one per job of a cluster's array). Each shard writes `evaluations.ron`.
+    #[arg(long)]
+    shard: Option<String>,
+    /// Shard output folders (or earlier searches) whose evaluations this search takes instead
+    /// of running them again; they must be of the same study, parameters, resolution and seeds.
+    #[arg(long, num_args = 1..)]
+    resume: Vec<PathBuf>,
     /// Output directory.
     #[arg(long, default_value = "results/design")]
     out: PathBuf,
@@ -97,8 +106,24 @@ pub fn run(args: &DesignArgs) -> Result<(), CliError> {
         seed: args.seed,
         stall_after: (args.stall > 0).then_some(args.stall),
         stall_gain: 0.001,
+        shard: args.shard.as_deref().map(crate::sweep::Shard::parse).transpose().map_err(CliError::Input)?,
     };
     crate::design::check(&evaluator, &settings)?;
+    let expected = Record {
+        study: spec.name.clone(),
+        instrument: (*label).clone(),
+        vars: record::vars_of(&vars),
+        decimation: args.decimation,
+        seeds: spec.seeds.clone(),
+        seed: args.seed,
+        evaluations: Vec::new(),
+    };
+    let mut prior = Vec::new();
+    for dir in &args.resume {
+        let r = Record::read(dir)?;
+        r.check_matches(&expected, &dir.display().to_string())?;
+        prior.extend(r.evaluations);
+    }
     let out = crate::study::OutputDir::create(&args.out, "shoal design")?;
     let pool = super::pool(args.threads.unwrap_or(0), "shoal-design")?;
     let bar = indicatif::ProgressBar::new(args.evaluations as u64);
@@ -111,7 +136,7 @@ pub fn run(args: &DesignArgs) -> Result<(), CliError> {
     let control = super::interrupt::control();
     let start = std::time::Instant::now();
     let search = pool.install(|| {
-        crate::design::search(&evaluator, &settings, &control, |e, done, total| {
+        crate::design::search_from(&evaluator, &settings, &prior, &control, |e, done, total| {
             bar.set_length(total as u64);
             bar.set_position(done as u64);
             let cost = e.cost.map_or_else(|| "–".into(), |c| format!("{c:.3}"));
@@ -125,6 +150,7 @@ pub fn run(args: &DesignArgs) -> Result<(), CliError> {
     print!("{summary}");
     let dir = out.path();
     write_bytes(&dir.join("design.md"), summary.as_bytes())?;
+    Record { evaluations: search.evaluations.clone(), ..expected }.write(dir)?;
     write_bytes(&dir.join("evaluations.csv"), evaluations_csv(&search).as_bytes())?;
     let mut fronts = Vec::new();
     for variable in front_variables(&search, &requirements) {
@@ -301,6 +327,14 @@ fn summary(search: &Search, study: &str, label: &str, currency: &str, seeds: usi
     let _ = writeln!(s, "# Design search: {study} ({label})\n");
     if let Some(why) = &search.stopped_early {
         let _ = writeln!(s, "{why}.\n");
+    }
+    if search.shard {
+        let _ = writeln!(
+            s,
+            "{} designs evaluated; resume the search from this folder and the other shards' (--resume).",
+            search.evaluations.len()
+        );
+        return s;
     }
     let _ = writeln!(
         s,

@@ -11,7 +11,7 @@ use crate::instrument::budgets::{BudgetModels, DesignBudget};
 use crate::study::{Check, Requirements, StudyError};
 
 /// A design and what it achieved.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Evaluation {
     /// The varied parameters' values.
     pub x: Vec<f64>,

@@ -35,6 +35,7 @@
 
 pub mod evaluate;
 pub mod front;
+pub mod record;
 pub mod space;
 
 pub use evaluate::{Evaluation, Evaluator};
@@ -64,6 +65,9 @@ pub struct Settings {
     pub stall_after: Option<usize>,
     /// The relative cost reduction that counts as progress (0.001: 0.1 %).
     pub stall_gain: f64,
+    /// Evaluate only this shard's share of the Latin-hypercube start, then stop (a cluster's
+    /// array job; a later search resumes from the shards' records).
+    pub shard: Option<crate::sweep::Shard>,
 }
 
 impl Settings {
@@ -78,6 +82,7 @@ impl Settings {
             seed: 1,
             stall_after: None,
             stall_gain: 0.001,
+            shard: None,
         }
     }
 }
@@ -116,6 +121,8 @@ pub struct Search {
     pub confirmed: Vec<Evaluation>,
     /// Why the search stopped before its evaluations ran out, if it did.
     pub stopped_early: Option<String>,
+    /// A shard of the start only: there is no answer to give, only evaluations to resume from.
+    pub shard: bool,
 }
 
 impl Search {
@@ -174,6 +181,18 @@ pub fn search(
     evaluator: &Evaluator<'_>,
     settings: &Settings,
     control: &RunControl,
+    seen: impl FnMut(&Evaluation, usize, usize),
+) -> Result<Search, StudyError> {
+    search_from(evaluator, settings, &[], control, seen)
+}
+
+/// [`search`] that takes designs already evaluated (`prior`, from shards' records, checked by
+/// [`record::Record::check_matches`]) instead of running them again.
+pub fn search_from(
+    evaluator: &Evaluator<'_>,
+    settings: &Settings,
+    prior: &[Evaluation],
+    control: &RunControl,
     mut seen: impl FnMut(&Evaluation, usize, usize),
 ) -> Result<Search, StudyError> {
     check(evaluator, settings)?;
@@ -182,13 +201,31 @@ pub fn search(
     let total = settings.evaluations + if confirms { 3 } else { 0 };
     let mut evaluations: Vec<Evaluation> = Vec::new();
     let mut run = |x: &[f64], evaluations: &mut Vec<Evaluation>| -> Result<(), StudyError> {
-        let e = evaluator.evaluate(&mut engine, x, control)?;
+        let e = match prior.iter().find(|e| same(&e.x, x)) {
+            Some(done) => done.clone(),
+            None => evaluator.evaluate(&mut engine, x, control)?,
+        };
         seen(&e, evaluations.len() + 1, total);
         evaluations.push(e);
         Ok(())
     };
     let nx = evaluator.vars.len();
-    for x in latin_hypercube(evaluator.vars, initial_count(settings, nx), settings.seed) {
+    let start = latin_hypercube(evaluator.vars, initial_count(settings, nx), settings.seed);
+    if let Some(shard) = settings.shard {
+        for x in start.iter().enumerate().filter(|(i, _)| shard.owns(*i)).map(|(_, x)| x) {
+            run(x, &mut evaluations)?;
+        }
+        return Ok(Search {
+            vars: evaluator.vars.to_vec(),
+            evaluations,
+            cheapest: None,
+            closest: None,
+            confirmed: Vec::new(),
+            stopped_early: Some(format!("shard {}/{}: the start's designs only", shard.index, shard.count)),
+            shard: true,
+        });
+    }
+    for x in start {
         run(&x, &mut evaluations)?;
     }
     let keys: Vec<String> = {
@@ -258,7 +295,7 @@ pub fn search(
             }
         }
     }
-    Ok(Search { vars: evaluator.vars.to_vec(), evaluations, cheapest, closest, confirmed, stopped_early })
+    Ok(Search { vars: evaluator.vars.to_vec(), evaluations, cheapest, closest, confirmed, stopped_early, shard: false })
 }
 
 fn same(a: &[f64], b: &[f64]) -> bool {

@@ -52,7 +52,9 @@ pub fn design_page(search: &Search, c: &DesignContext, fronts: &[PageFigure]) ->
     if let Some(why) = &search.stopped_early {
         let _ = writeln!(h, "<p class=\"note\">{}.</p>", escape(why));
     }
-    answer(&mut h, search, c);
+    if !search.shard {
+        answer(&mut h, search, c);
+    }
     h.push_str("<section id=\"fronts\">\n<h2>Cost against each product's error</h2>\n");
     for f in fronts {
         match super::svg::clean(&f.svg) {
@@ -209,6 +211,7 @@ mod tests {
             closest: None,
             confirmed: vec![],
             stopped_early: None,
+            shard: false,
         };
         let page = design_page(&search, &context(), &[]);
         assert!(page.contains("aperture_mm = 75"), "the answer");
@@ -226,6 +229,7 @@ mod tests {
             closest: Some(0),
             confirmed: vec![],
             stopped_early: None,
+            shard: false,
         };
         let page = design_page(&search, &context(), &[]);
         assert!(page.contains("No feasible design") && page.contains("Closest: aperture_mm = 60"));

@@ -3,7 +3,7 @@
 //! grid's runs; a requirement no design meets is answered with the closest design.
 
 use shoal::control::RunControl;
-use shoal::design::{Evaluator, Settings, Variable, cheapest_feasible, search};
+use shoal::design::{Evaluator, Settings, Variable, cheapest_feasible, search, search_from};
 use shoal::engine::Engine;
 use shoal::study::StudySpec;
 
@@ -52,6 +52,7 @@ fn the_search_finds_the_grids_cheapest_feasible_design_with_a_tenth_of_the_runs(
         seed: 1,
         stall_after: None,
         stall_gain: 0.001,
+        shard: None,
     };
     let found = search(&evaluator, &settings, &control, |_, _, _| {}).unwrap();
     let answer = found.answer().expect("the search finds a feasible design");
@@ -95,6 +96,7 @@ fn a_requirement_no_design_meets_names_the_closest() {
         seed: 2,
         stall_after: None,
         stall_gain: 0.001,
+        shard: None,
     };
     let found = search(&evaluator, &settings, &RunControl::default(), |_, _, _| {}).unwrap();
     assert!(found.answer().is_none());
@@ -128,7 +130,43 @@ fn a_cost_model_that_refuses_the_range_is_refused_before_any_run() {
         seed: 1,
         stall_after: None,
         stall_gain: 0.001,
+        shard: None,
     };
     let e = shoal::design::check(&evaluator, &settings).unwrap_err().to_string();
     assert!(e.contains("budgets.cost.out_of_range") && e.contains("0.3–6.5 m"), "{e}");
+}
+
+#[test]
+fn a_search_resumed_from_two_shards_of_its_start_is_the_search_run_whole() {
+    let (spec, resolved) = study();
+    let requirements = spec.requirements.clone().unwrap();
+    let vars = [Variable::parse("aperture_mm=40:200").unwrap(), Variable::parse("exposure_s=0.0005:0.003").unwrap()];
+    let evaluator = Evaluator {
+        base: &resolved.runs[0].2,
+        vars: &vars,
+        seeds: &spec.seeds,
+        requirements: &requirements,
+        budgets: &resolved.budgets,
+        decimation: 8,
+    };
+    let control = RunControl::default();
+    let whole = Settings { confirm_decimation: None, ..Settings::new(9, 8) };
+    let once = search(&evaluator, &whole, &control, |_, _, _| {}).unwrap();
+    // The start (5 designs) in two shards, as two jobs of a cluster would run it.
+    let mut prior = Vec::new();
+    for i in 0..2 {
+        let shard = Settings { shard: Some(shoal::sweep::Shard { index: i, count: 2 }), ..whole.clone() };
+        let part = search(&evaluator, &shard, &control, |_, _, _| {}).unwrap();
+        assert_eq!(part.evaluations.len(), if i == 0 { 3 } else { 2 });
+        prior.extend(part.evaluations);
+    }
+    let mut fresh = 0;
+    let resumed = search_from(&evaluator, &whole, &prior, &control, |e, _, _| {
+        fresh += usize::from(!prior.iter().any(|p| p.x == e.x));
+    })
+    .unwrap();
+    assert_eq!(fresh, 4, "only the four designs after the start run again");
+    let xs = |s: &shoal::design::Search| s.evaluations.iter().map(|e| e.x.clone()).collect::<Vec<_>>();
+    assert_eq!(xs(&resumed), xs(&once), "the same designs in the same order");
+    assert_eq!(resumed.cheapest, once.cheapest);
 }

@@ -119,6 +119,7 @@ impl DesignState {
             seed: 1,
             stall_after: Some(10),
             stall_gain: 0.001,
+            shard: None,
         };
         {
             let evaluator = Evaluator {

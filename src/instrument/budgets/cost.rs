@@ -75,7 +75,7 @@ fn one() -> f64 {
 }
 
 /// A design's cost, or why there is none.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Cost {
     /// OTA cost in [`CostModel::currency`]; `None` when refused.
     pub ota: Option<f64>,

@@ -47,7 +47,7 @@ pub struct PlaneReadout {
 }
 
 /// The data budget of a design.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct DataBudget {
     /// Rate while imaging, Mbit/s.
     pub rate_mbit_s: f64,

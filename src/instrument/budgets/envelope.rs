@@ -66,7 +66,7 @@ pub struct Reference {
 }
 
 /// The envelope of a design.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Envelope {
     /// Optical length, mm.
     pub length_mm: f64,

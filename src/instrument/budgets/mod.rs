@@ -60,7 +60,7 @@ pub enum BudgetError {
 }
 
 /// The budgets of one design.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct DesignBudget {
     /// Telescope cost.
     pub cost: Cost,
