@@ -25,6 +25,8 @@ pub struct DesignState {
     searched: Vec<Variable>,
     results: Vec<Evaluation>,
     status: String,
+    /// Currency of the costs shown (the budget models' of the last search).
+    currency: String,
 }
 
 impl Default for DesignState {
@@ -38,6 +40,7 @@ impl Default for DesignState {
             searched: Vec::new(),
             results: Vec::new(),
             status: String::new(),
+            currency: String::new(),
         }
     }
 }
@@ -136,6 +139,7 @@ impl DesignState {
             }
         }
         self.searched.clone_from(&vars);
+        self.currency.clone_from(&budgets.cost.currency);
         self.results.clear();
         self.status = format!("searching at 1/{} …", self.decimation);
         let wake = ctx.clone();
@@ -248,11 +252,11 @@ fn plot(ui: &mut egui::Ui, d: &DesignState, requirements: &crate::study::Require
     Plot::new("design-plot")
         .height(240.0)
         .legend(Legend::default())
-        .x_axis_label("telescope cost")
+        .x_axis_label(format!("telescope cost, {}", d.currency))
         .y_axis_label("chl-a log-space MAE, %")
         .allow_scroll(false)
         .show(ui, |p| {
-            p.points(Points::new("designs", all).radius(3.0));
+            p.points(Points::new("designs", all).radius(3.0).color(egui::Color32::GRAY));
             p.points(Points::new("feasible", feasible).radius(5.0).color(super::super::theme::PASS));
             p.line(Line::new("front", PlotPoints::from(front)));
             if let Some(limit) = requirements.for_variable(variable).and_then(|r| r.mae_pct) {
