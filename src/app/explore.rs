@@ -109,6 +109,10 @@ impl Explore {
 
     /// Take what the helper threads sent.
     pub fn poll(&mut self) {
+        // Closing the window, by its cross or the top bar's toggle, stops its search.
+        if !self.design_open {
+            self.design.cancel();
+        }
         self.design.poll();
         if let Some(task) = &self.sweep_task {
             let mut finished = None;

@@ -74,12 +74,7 @@ pub fn run(args: &DesignArgs) -> Result<(), CliError> {
     let vars = args.vary.iter().map(|v| Variable::parse(v)).collect::<Result<Vec<_>, _>>().map_err(CliError::Input)?;
     let (spec, dir) = super::study::load(Some(&args.study))?;
     let resolved = spec.resolve(dir.as_deref())?;
-    let labels: Vec<&String> = resolved.runs.iter().map(|r| &r.0).fold(Vec::new(), |mut v, l| {
-        if !v.contains(&l) {
-            v.push(l);
-        }
-        v
-    });
+    let labels: Vec<&String> = crate::design::unique(resolved.runs.iter().map(|r| &r.0));
     let label = labels.get(args.instrument).ok_or_else(|| {
         CliError::Input(format!("--instrument {} (allowed: 0 to {})", args.instrument, labels.len() - 1))
     })?;
@@ -195,12 +190,7 @@ fn front_variables(search: &Search, requirements: &crate::study::Requirements) -
     if !required.is_empty() {
         return required;
     }
-    search.evaluations.iter().flat_map(|e| e.mae_pct.iter().map(|(v, _)| v.clone())).fold(Vec::new(), |mut v, x| {
-        if !v.contains(&x) {
-            v.push(x);
-        }
-        v
-    })
+    crate::design::unique(search.evaluations.iter().flat_map(|e| e.mae_pct.iter().map(|(v, _)| v.clone())))
 }
 
 fn row(e: &Evaluation) -> String {
@@ -222,15 +212,7 @@ fn row(e: &Evaluation) -> String {
 }
 
 fn evaluations_csv(search: &Search) -> String {
-    let keys: Vec<String> = search.evaluations.iter().flat_map(|e| e.constraints.iter().map(|(k, _)| k.clone())).fold(
-        Vec::new(),
-        |mut v, k| {
-            if !v.contains(&k) {
-                v.push(k);
-            }
-            v
-        },
-    );
+    let keys = crate::design::constraint_keys(&search.evaluations);
     let mut s = String::from("step,phase,");
     for v in &search.vars {
         let _ = write!(s, "{},", v.name());

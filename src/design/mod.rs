@@ -228,15 +228,7 @@ pub fn search_from(
     for x in start {
         run(&x, &mut evaluations)?;
     }
-    let keys: Vec<String> = {
-        let mut k: Vec<String> = Vec::new();
-        for (name, _) in evaluations.iter().flat_map(|e| &e.constraints) {
-            if !k.contains(name) {
-                k.push(name.clone());
-            }
-        }
-        k
-    };
+    let keys = constraint_keys(&evaluations);
     let xtypes: Vec<egobox_ego::XType> = evaluator.vars.iter().map(Variable::xtype).collect();
     let mut step = 0u64;
     let mut stall = Stall { best: None, run: 0 };
@@ -296,6 +288,23 @@ pub fn search_from(
         }
     }
     Ok(Search { vars: evaluator.vars.to_vec(), evaluations, cheapest, closest, confirmed, stopped_early, shard: false })
+}
+
+/// The items of `items` in the order first seen, each once.
+pub fn unique<T: PartialEq>(items: impl IntoIterator<Item = T>) -> Vec<T> {
+    let mut out = Vec::new();
+    for item in items {
+        if !out.contains(&item) {
+            out.push(item);
+        }
+    }
+    out
+}
+
+/// Every requirement key the evaluations report, in the order first seen.
+#[must_use]
+pub fn constraint_keys(evaluations: &[Evaluation]) -> Vec<String> {
+    unique(evaluations.iter().flat_map(|e| e.constraints.iter().map(|(k, _)| k.clone())))
 }
 
 fn same(a: &[f64], b: &[f64]) -> bool {

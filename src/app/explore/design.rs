@@ -27,6 +27,9 @@ pub struct DesignState {
     status: String,
     /// Currency of the costs shown (the budget models' of the last search).
     currency: String,
+    /// A's run configuration and the requirements the last search started from: its designs are
+    /// that configuration with the varied fields set, and "→ A" builds them from it.
+    searched_from: Option<(crate::engine::RunConfig, crate::study::Requirements)>,
 }
 
 impl Default for DesignState {
@@ -41,6 +44,7 @@ impl Default for DesignState {
             results: Vec::new(),
             status: String::new(),
             currency: String::new(),
+            searched_from: None,
         }
     }
 }
@@ -56,6 +60,14 @@ impl DesignState {
     #[must_use]
     pub fn results(&self) -> &[Evaluation] {
         &self.results
+    }
+
+    /// Stop a running search (the window closed); what it evaluated stays, and the status says
+    /// it was cut short.
+    pub fn cancel(&mut self) {
+        if self.task.take().is_some() {
+            self.status = format!("cancelled after {} of {} designs", self.results.len(), self.evaluations);
+        }
     }
 
     /// Take what the search sent.
@@ -124,21 +136,9 @@ impl DesignState {
             stall_gain: 0.001,
             shard: None,
         };
-        {
-            let evaluator = Evaluator {
-                base: &base,
-                vars: &vars,
-                seeds: &seeds,
-                requirements: &requirements,
-                budgets: &budgets,
-                decimation: self.decimation,
-            };
-            if let Err(e) = crate::design::check(&evaluator, &settings) {
-                self.status = e.to_string();
-                return;
-            }
-        }
+        // Checked by the search itself: a refusal comes back as the task's error, in the status.
         self.searched.clone_from(&vars);
+        self.searched_from = Some((base.clone(), requirements.clone()));
         self.currency.clone_from(&budgets.cost.currency);
         self.results.clear();
         self.status = format!("searching at 1/{} …", self.decimation);
@@ -172,12 +172,11 @@ pub fn design_window(app: &mut super::super::ShoalApp, ctx: &egui::Context) {
     let mut open = app.ui.explore.design_open;
     let mut start = false;
     let mut put: Option<(Ab, usize)> = None;
-    let paths: Vec<&'static str> = app
-        .state
-        .configs()
-        .first()
-        .map(|c| super::sweep::sweepable(c).iter().map(|r| r.path).collect())
-        .unwrap_or_default();
+    // A as it is now: the parameters it can vary, and whether the last search still describes
+    // the scene and requirements on screen.
+    let current = app.state.configs().into_iter().next();
+    let paths: Vec<&'static str> =
+        current.as_ref().map(|c| super::sweep::sweepable(c).iter().map(|r| r.path).collect()).unwrap_or_default();
     egui::Window::new("Design search").open(&mut open).default_size([900.0, 600.0]).show(ctx, |ui| {
         ui.label("The cheapest design, starting from A, that meets the Requirements panel on the noise seed in use: constrained Bayesian optimisation (egobox) of the telescope cost under Gaussian-process models of every requirement.");
         let d = &mut app.ui.explore.design;
@@ -220,6 +219,16 @@ pub fn design_window(app: &mut super::super::ShoalApp, ctx: &egui::Context) {
             }
         });
         ui.label(&d.status);
+        let now = (current.as_ref(), &app.state.requirements);
+        if let Some((base, requirements)) = &d.searched_from
+            && !d.results.is_empty()
+            && (now.0.is_none_or(|c| c.scene != base.scene || c.seed != base.seed || c.retrievals != base.retrievals) || now.1 != requirements)
+        {
+            ui.colored_label(
+                super::super::theme::WARN,
+                "The scene, retrieval, noise seed or requirements changed since this search: its figures are for those it ran with. Search again.",
+            );
+        }
         plot(ui, d, &app.state.requirements);
         table(ui, d, &mut put);
     });
@@ -228,7 +237,7 @@ pub fn design_window(app: &mut super::super::ShoalApp, ctx: &egui::Context) {
     }
     if let Some((ab, i)) = put {
         let d = &app.ui.explore.design;
-        if let (Some(e), Some(base)) = (d.results.get(i), app.state.configs().first()) {
+        if let (Some(e), Some((base, _))) = (d.results.get(i), &d.searched_from) {
             match crate::design::space::configure(base, &d.searched, &e.x) {
                 Ok(config) => app.state.slot_mut(ab).spec = config.instrument,
                 Err(err) => app.ui.explore.design.status = err,
@@ -236,7 +245,7 @@ pub fn design_window(app: &mut super::super::ShoalApp, ctx: &egui::Context) {
         }
     }
     if !open {
-        app.ui.explore.design.task = None;
+        app.ui.explore.design.cancel();
     }
     app.ui.explore.design_open = open;
 }
@@ -252,13 +261,17 @@ fn plot(ui: &mut egui::Ui, d: &DesignState, requirements: &crate::study::Require
     Plot::new("design-plot")
         .height(240.0)
         .legend(Legend::default())
-        .x_axis_label(format!("telescope cost, {}", d.currency))
+        .x_axis_label(if d.currency.is_empty() {
+            "telescope cost".to_string()
+        } else {
+            format!("telescope cost, {}", d.currency)
+        })
         .y_axis_label("chl-a log-space MAE, %")
         .allow_scroll(false)
         .show(ui, |p| {
             p.points(Points::new("designs", all).radius(3.0).color(egui::Color32::GRAY));
             p.points(Points::new("feasible", feasible).radius(5.0).color(super::super::theme::PASS));
-            p.line(Line::new("front", PlotPoints::from(front)));
+            p.line(Line::new("front", PlotPoints::from(front)).color(super::super::theme::INSTRUMENT[1]));
             if let Some(limit) = requirements.for_variable(variable).and_then(|r| r.mae_pct) {
                 p.hline(HLine::new("requirement", limit).color(super::super::theme::FAIL));
             }
