@@ -304,8 +304,9 @@ fn summary(search: &Search, study: &str, label: &str, currency: &str, seeds: usi
     let mut s = String::new();
     let evaluated = search.evaluations.len();
     let feasible = search.evaluations.iter().filter(|e| e.feasible()).count();
-    let search_s: f64 = search.evaluations.iter().map(|e| e.seconds).sum();
-    let confirm_s: f64 = search.confirmed.iter().map(|e| e.seconds).sum();
+    let search_s: f64 = search.evaluations.iter().map(|e| e.seconds).sum::<f64>() + 0.0;
+    // `+ 0.0`: an empty sum is −0.0, which would print as "-0.0 s".
+    let confirm_s: f64 = search.confirmed.iter().map(|e| e.seconds).sum::<f64>() + 0.0;
     let _ = writeln!(s, "# Design search: {study} ({label})\n");
     if let Some(why) = &search.stopped_early {
         let _ = writeln!(s, "{why}.\n");
