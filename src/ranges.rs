@@ -249,6 +249,8 @@ ranges! {
     SCENE_LAND_REFLECTANCE = Range::closed("scene.land.reflectance", 0.0, 1.0, "", "land surface reflectance (Lambertian; every value of the spectrum)");
     /// Substrate fraction map values.
     SCENE_SUBSTRATE_FRACTION = Range::closed("scene.substrates[i].fraction", 0.0, 1.0, "", "areal fraction of a substrate (every value)");
+    /// Aerosol optical thickness map.
+    SCENE_AOT550_MAP = Range::closed("scene.aot550_map", 0.0, 5.0, "", "aerosol optical thickness at 550 nm (every value of the map)");
 
     // Spectra written as formulas (SpectrumSource::PowerLaw and Exponential, wherever one is
     // given: SIOP sets, land reflectance, QE).
@@ -272,6 +274,16 @@ ranges! {
     ATMOSPHERE_MIXTURE_WATER_SOLUBLE = Range::closed("scene.atmosphere.aerosol.Mixture.water_soluble", 0.0, 1.0, "", "volume fraction of the water-soluble component");
     /// A user's WMO mixture: oceanic fraction.
     ATMOSPHERE_MIXTURE_OCEANIC = Range::closed("scene.atmosphere.aerosol.Mixture.oceanic", 0.0, 1.0, "", "volume fraction of the oceanic component");
+    /// A user's log-normal mode: modal radius.
+    AEROSOL_MODE_RADIUS_UM = Range::closed("scene.atmosphere.aerosol.LogNormal.fine.mode_radius_um", 0.005, 5.0, "um", "modal radius of a log-normal mode's number distribution (fine or coarse)");
+    /// A user's log-normal mode: geometric standard deviation.
+    AEROSOL_MODE_SIGMA_G = Range::closed("scene.atmosphere.aerosol.LogNormal.fine.sigma_g", 1.05, 3.0, "", "geometric standard deviation of a log-normal mode");
+    /// A user's log-normal mode: real refractive index.
+    AEROSOL_MODE_REFRACTIVE_REAL = Range::closed("scene.atmosphere.aerosol.LogNormal.fine.refractive_real", 1.3, 1.8, "", "real part of a mode's refractive index");
+    /// A user's log-normal mode: imaginary refractive index.
+    AEROSOL_MODE_REFRACTIVE_IMAG = Range::closed("scene.atmosphere.aerosol.LogNormal.fine.refractive_imag", 0.0, 0.5, "", "imaginary part of a mode's refractive index (absorption)");
+    /// A user's log-normal aerosol: coarse volume fraction.
+    AEROSOL_COARSE_VOLUME_FRACTION = Range::closed("scene.atmosphere.aerosol.LogNormal.coarse_volume_fraction", 0.0, 1.0, "", "share of the aerosol volume in the coarse mode");
     /// A user's WMO mixture: soot fraction.
     ATMOSPHERE_MIXTURE_SOOT = Range::closed("scene.atmosphere.aerosol.Mixture.soot", 0.0, 1.0, "", "volume fraction of the soot component");
     /// Latitude.

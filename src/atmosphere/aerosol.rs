@@ -159,23 +159,29 @@ impl ComponentTable {
             });
         }
         let rows = &self.rows.iter().find(|(k, _)| *k == c).ok_or_else(|| AtmosphereError::Data("component".into()))?.1;
-        let j = TABLE_WAVELENGTHS_NM.partition_point(|&w| w <= wavelength_nm).clamp(1, TABLE_WAVELENGTHS_NM.len() - 1);
-        let (w0, w1) = (TABLE_WAVELENGTHS_NM[j - 1], TABLE_WAVELENGTHS_NM[j]);
-        let (a, b) = (&rows[j - 1], &rows[j]);
-        let t_log = (wavelength_nm / w0).ln() / (w1 / w0).ln();
-        let t = (wavelength_nm - w0) / (w1 - w0);
-        let loglog = |x: f64, y: f64| (x.ln() + t_log * (y.ln() - x.ln())).exp();
-        Ok(ComponentOptics {
-            c_ext_um2: loglog(a.c_ext_um2, b.c_ext_um2),
-            c_sca_um2: loglog(a.c_sca_um2, b.c_sca_um2),
-            p11: a.p11.iter().zip(&b.p11).map(|(x, y)| x + t * (y - x)).collect(),
-        })
+        Ok(interpolate(rows, wavelength_nm))
     }
 
     /// Scattering angles of the phase-function columns, degrees.
     #[must_use]
     pub fn angles_deg(&self) -> &[f64] {
         &self.angles_deg
+    }
+}
+
+/// Optics tabulated at [`TABLE_WAVELENGTHS_NM`] (`rows`), at `wavelength_nm` within the table:
+/// cross-sections log–log in λ, phase functions linearly.
+fn interpolate(rows: &[ComponentOptics], wavelength_nm: f64) -> ComponentOptics {
+    let j = TABLE_WAVELENGTHS_NM.partition_point(|&w| w <= wavelength_nm).clamp(1, TABLE_WAVELENGTHS_NM.len() - 1);
+    let (w0, w1) = (TABLE_WAVELENGTHS_NM[j - 1], TABLE_WAVELENGTHS_NM[j]);
+    let (a, b) = (&rows[j - 1], &rows[j]);
+    let t_log = (wavelength_nm / w0).ln() / (w1 / w0).ln();
+    let t = (wavelength_nm - w0) / (w1 - w0);
+    let loglog = |x: f64, y: f64| (x.ln() + t_log * (y.ln() - x.ln())).exp();
+    ComponentOptics {
+        c_ext_um2: loglog(a.c_ext_um2, b.c_ext_um2),
+        c_sca_um2: loglog(a.c_sca_um2, b.c_sca_um2),
+        p11: a.p11.iter().zip(&b.p11).map(|(x, y)| x + t * (y - x)).collect(),
     }
 }
 
@@ -196,13 +202,35 @@ pub fn mixture_optics(kind: AerosolType, wavelength_nm: f64) -> Result<Option<Ae
         return Ok(None);
     }
     let table = ComponentTable::embedded()?;
-    let mix = kind.number_fractions();
-    let k_ext = |w: f64| -> Result<f64, AtmosphereError> {
-        mix.iter().map(|(c, n)| Ok(n * table.component_at(*c, w)?.c_ext_um2)).sum()
+    // Every part's table and number fraction: the WMO components, or a user's modes.
+    let user: Vec<(std::sync::Arc<Vec<ComponentOptics>>, f64)> = match kind {
+        AerosolType::LogNormal(d) => d.number_fractions().iter().map(|(m, n)| (m.table(), *n)).collect(),
+        _ => Vec::new(),
     };
+    let parts: Vec<(&[ComponentOptics], f64)> = match kind {
+        AerosolType::LogNormal(_) => user.iter().map(|(rows, n)| (rows.as_slice(), *n)).collect(),
+        _ => kind
+            .number_fractions()
+            .iter()
+            .map(|(c, n)| {
+                let row = table.rows.iter().find(|(k, _)| k == c);
+                let rows = row.ok_or_else(|| AtmosphereError::Data("component".into()))?;
+                Ok((rows.1.as_slice(), *n))
+            })
+            .collect::<Result<_, AtmosphereError>>()?,
+    };
+    let (lo, hi) = (TABLE_WAVELENGTHS_NM[0], TABLE_WAVELENGTHS_NM[TABLE_WAVELENGTHS_NM.len() - 1]);
+    if !(lo..=hi).contains(&wavelength_nm) {
+        return Err(AtmosphereError::OutOfRange {
+            field: "wavelength_nm (aerosol)".into(),
+            value: wavelength_nm,
+            allowed: format!("{lo} to {hi} nm"),
+        });
+    }
+    let k_ext = |w: f64| -> f64 { parts.iter().map(|(rows, n)| n * interpolate(rows, w).c_ext_um2).sum() };
     let (mut k_sca, mut p) = (0.0, vec![0.0; table.angles_deg().len()]);
-    for (c, n) in &mix {
-        let o = table.component_at(*c, wavelength_nm)?;
+    for (rows, n) in &parts {
+        let o = interpolate(rows, wavelength_nm);
         k_sca += n * o.c_sca_um2;
         for (pi, v) in p.iter_mut().zip(&o.p11) {
             *pi += n * o.c_sca_um2 * v;
@@ -211,9 +239,9 @@ pub fn mixture_optics(kind: AerosolType, wavelength_nm: f64) -> Result<Option<Ae
     for v in &mut p {
         *v /= k_sca;
     }
-    let ext = k_ext(wavelength_nm)?;
+    let ext = k_ext(wavelength_nm);
     Ok(Some(AerosolOptics {
-        extinction_ratio: ext / k_ext(550.0)?,
+        extinction_ratio: ext / k_ext(550.0),
         ssa: k_sca / ext,
         phase: PhaseFunction::from_table(table.angles_deg(), &p)?,
     }))

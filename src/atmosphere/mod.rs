@@ -34,6 +34,7 @@ mod solar;
 mod sos;
 mod sos_transfer;
 mod spec;
+mod user_aerosol;
 mod wmo;
 
 pub use aerosol::{
@@ -58,6 +59,7 @@ pub use rt::{
 pub use solar::{e0_on_grid, sun_distance_factor, tsis1};
 pub use sos::Streams;
 pub use spec::{Atmosphere, AtmosphereSpec, AtmosphereTerms, Geometry, Normalised, Surface};
+pub use user_aerosol::{AerosolMode, R_MAX_UM, SizeDistribution};
 pub use wmo::{AerosolType, Component, WmoFractions};
 
 use crate::spectral::SpectralError;

@@ -141,6 +141,9 @@ impl AtmosphereSpec {
                 });
             }
         }
+        if let super::wmo::AerosolType::LogNormal(d) = self.aerosol {
+            d.validate()?;
+        }
         check(&r::ATMOSPHERE_LATITUDE_DEG, self.latitude_deg)?;
         check(&r::ATMOSPHERE_RAYLEIGH_SCALE_HEIGHT_KM, self.rayleigh_scale_height_km)?;
         check(&r::ATMOSPHERE_AEROSOL_SCALE_HEIGHT_KM, self.aerosol_scale_height_km)?;

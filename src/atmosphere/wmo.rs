@@ -25,6 +25,7 @@
 
 use super::complex::Complex;
 use super::mie::LogNormal;
+use super::user_aerosol::{AerosolMode, SizeDistribution};
 
 /// A WMO basic component.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -192,6 +193,9 @@ pub enum AerosolType {
     /// `-AER.WMO.Model 4`; 6S's "user defined" basic components): an aerosol outside the
     /// correction's family.
     Mixture(WmoFractions),
+    /// A user's own size distribution: one or two log-normal modes with their refractive
+    /// indices ([`super::user_aerosol`]).
+    LogNormal(SizeDistribution),
 }
 
 /// Volume fractions of the WMO components; they are normalised by their sum.
@@ -230,9 +234,36 @@ impl WmoFractions {
 
 impl AerosolType {
     /// Parse `none|maritime|continental|urban|mixture:DL,WS,OC,SO` (volume fractions of
-    /// dust-like, water-soluble, oceanic and soot).
+    /// dust-like, water-soluble, oceanic and soot) or `lognormal:R,SG,N,K` (one mode: modal
+    /// radius µm, geometric standard deviation, refractive index) with, for two modes,
+    /// `,R,SG,N,K,F` for the coarse mode and its volume fraction.
     pub fn parse(text: &str) -> Result<Self, String> {
         let text = text.trim().to_ascii_lowercase();
+        if let Some(list) = text.strip_prefix("lognormal:") {
+            let usage = "lognormal:R,SG,N,K (modal radius um, geometric sd, refractive index real, imaginary), then R,SG,N,K,F for a coarse mode and its volume fraction";
+            let v: Vec<f64> = list
+                .split(',')
+                .map(|x| x.trim().parse::<f64>())
+                .collect::<Result<_, _>>()
+                .map_err(|e| format!("lognormal:{list}: {e} ({usage})"))?;
+            let mode = |m: &[f64]| AerosolMode {
+                mode_radius_um: m[0],
+                sigma_g: m[1],
+                refractive_real: m[2],
+                refractive_imag: m[3],
+            };
+            return match v.len() {
+                4 => {
+                    Ok(Self::LogNormal(SizeDistribution { fine: mode(&v), coarse: None, coarse_volume_fraction: 0.0 }))
+                }
+                9 => Ok(Self::LogNormal(SizeDistribution {
+                    fine: mode(&v[..4]),
+                    coarse: Some(mode(&v[4..8])),
+                    coarse_volume_fraction: v[8],
+                })),
+                n => Err(format!("lognormal:{list}: {n} numbers ({usage})")),
+            };
+        }
         if let Some(list) = text.strip_prefix("mixture:") {
             let v: Vec<f64> =
                 list.split(',').map(|x| x.trim().parse::<f64>()).collect::<Result<_, _>>().map_err(|e| {
@@ -249,7 +280,7 @@ impl AerosolType {
             "continental" => Ok(Self::Continental),
             "urban" => Ok(Self::Urban),
             other => Err(format!(
-                "unknown aerosol model `{other}` (allowed: none, maritime, continental, urban, mixture:DL,WS,OC,SO)"
+                "unknown aerosol model `{other}` (allowed: none, maritime, continental, urban, mixture:DL,WS,OC,SO, lognormal:R,SG,N,K[,R,SG,N,K,F])"
             )),
         }
     }
@@ -261,15 +292,28 @@ impl AerosolType {
             Self::Mixture(f) => {
                 format!("mixture {:.2}/{:.2}/{:.2}/{:.2}", f.dust_like, f.water_soluble, f.oceanic, f.soot)
             }
+            Self::LogNormal(d) => {
+                let mode = |m: &AerosolMode| format!("{} um x{}", m.mode_radius_um, m.sigma_g);
+                match d.coarse {
+                    Some(c) => format!(
+                        "log-normal {} + {} ({:.0} % coarse)",
+                        mode(&d.fine),
+                        mode(&c),
+                        100.0 * d.coarse_volume_fraction
+                    ),
+                    None => format!("log-normal {}", mode(&d.fine)),
+                }
+            }
             other => format!("{other:?}").to_lowercase(),
         }
     }
 
-    /// Volume fractions of the components (OSOAA_AEROSOLS.F), summing to 1.
+    /// Volume fractions of the WMO components (OSOAA_AEROSOLS.F), summing to 1 (none for a
+    /// user's size distribution).
     #[must_use]
     pub fn volume_fractions(self) -> Vec<(Component, f64)> {
         match self {
-            Self::None => vec![],
+            Self::None | Self::LogNormal(_) => vec![],
             Self::Maritime => vec![(Component::WaterSoluble, 0.05), (Component::Oceanic, 0.95)],
             Self::Continental => {
                 vec![(Component::DustLike, 0.70), (Component::WaterSoluble, 0.29), (Component::Soot, 0.01)]

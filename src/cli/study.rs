@@ -242,12 +242,13 @@ fn print_runs(out: &mut String, result: &crate::study::StudyResult) {
         if let Some(a) = &run.report.aerosol {
             let _ = writeln!(
                 out,
-                "{:<12} aerosol  AOT(550) {:.3} (5–95 %: {:.3}–{:.3}; true {:.3}), Ångström {:.2} (true {:.2}); outside the family: {:.1} %; {}{}",
+                "{:<12} aerosol  AOT(550) {:.3} (5–95 %: {:.3}–{:.3}; true {:.3}; per-pixel error {:.3}), Ångström {:.2} (true {:.2}); outside the family: {:.1} %; {}{}",
                 run.label,
                 a.aot550.0,
                 a.aot550.1,
                 a.aot550.2,
                 a.aot550_true,
+                a.aot550_abs_error,
                 a.angstrom,
                 a.angstrom_true,
                 a.outside_family_pct,

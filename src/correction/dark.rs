@@ -21,8 +21,15 @@
 //! Bands are fitted only inside `wave_range_nm` and where the two-way gas transmittance at the
 //! tile's centre reaches `min_gas_transmittance` (ACOLITE's `min_tgas_aot`, which is what keeps
 //! the water-vapour and O₂ bands out). A tile with less than 10 % of its pixels valid in a
-//! fitted band takes the scene's fit (ACOLITE's `dsf_min_tile_cover`). Tiles are blocks: the
-//! AOT is not smoothed or interpolated between them (ACOLITE does both by default).
+//! fitted band takes the scene's fit (ACOLITE's `dsf_min_tile_cover`).
+//!
+//! With tiles and `smooth_tiles` (ACOLITE's defaults, `tiles_interp` in its `shared` module),
+//! the scene takes the tiles' most common model; that model's tile AOTs are smoothed with a
+//! 3 × 3 box (edges mirrored, as scipy's `uniform_filter`) and interpolated bilinearly between
+//! tile centres to every pixel (constant beyond the outermost centres), and each pixel is
+//! corrected at its own AOT. ACOLITE interpolates the tiles' atmospheric terms instead of their
+//! AOT; the terms are smooth in AOT, so the two differ at second order. Without smoothing,
+//! tiles are blocks, each with its own model and AOT.
 //!
 //! ## References
 //! - Vanhellemont, Q. & Ruddick, K. (2018) Atmospheric correction of metre-scale optical
@@ -63,6 +70,8 @@ pub struct TileFit {
     pub dark: Vec<f64>,
     /// The tile took the scene's fit (too few valid pixels of its own).
     pub from_scene: bool,
+    /// Every model's AOT(550) in this tile (the lowest over the bands), in the family's order.
+    pub aot550_models: Vec<f64>,
 }
 
 impl TileFit {
@@ -181,6 +190,7 @@ pub fn fit_tiles(
         let at = |b: usize| centre * nb + b;
         let signal = |m: usize, b: usize, k: usize| family.terms[m][k].l_path[at(b)] - rayleigh.l_path[at(b)];
         let mut best: Option<(f64, usize, f64, [usize; 2])> = None;
+        let mut aot550_models = Vec::with_capacity(family.models.len());
         for m in 0..family.models.len() {
             let mut per_band: Vec<(f64, usize)> = fitted
                 .iter()
@@ -191,6 +201,7 @@ pub fn fit_tiles(
                 .collect();
             per_band.sort_by(|a, b| a.0.total_cmp(&b.0));
             let tau = per_band[0].0;
+            aot550_models.push(tau);
             let two = [per_band[0].1, per_band.get(1).map_or(per_band[0].1, |p| p.1)];
             let nodes = locate(&family.aot550, tau);
             let rho = |b: usize, x: f64| std::f64::consts::PI * x / rayleigh.t_ed[at(b)];
@@ -215,6 +226,7 @@ pub fn fit_tiles(
             rmsd_reflectance: rmsd,
             dark,
             from_scene: false,
+            aot550_models,
         })
     };
     let scene = fit([0, rows], [0, cols]).ok_or_else(|| {
@@ -240,6 +252,99 @@ pub fn fit_tiles(
         .collect())
 }
 
+/// Tiles smoothed and interpolated to every pixel (see the module docs).
+pub(super) struct Smoothed {
+    /// The scene's model (the tiles' most common).
+    pub model_index: usize,
+    /// AOT(550) of every pixel, row-major.
+    pub aot550: Vec<f64>,
+}
+
+impl Smoothed {
+    /// Pixel `i`'s atmosphere as table entries of the family.
+    pub(super) fn fill<'f>(&self, family: &'f AerosolFamily, i: usize, mix: &mut Mixture<'f>) {
+        let (m, tau) = (self.model_index, self.aot550[i]);
+        let nodes = locate(&family.aot550, tau);
+        mix.entries.extend(nodes.iter().filter(|n| n.1 != 0.0).map(|&(k, w)| (&family.terms[m][k], w)));
+        (mix.aot550, mix.angstrom, mix.passes) = (tau, family.angstrom[m], 1);
+    }
+}
+
+/// The tiles of `fits` smoothed and interpolated to a rows × cols image; `None` with one tile
+/// or when smoothing is off.
+pub(super) fn smoothed(
+    fits: &[TileFit],
+    settings: &DarkSpectrumSettings,
+    rows: usize,
+    cols: usize,
+) -> Option<Smoothed> {
+    if !settings.smooth_tiles || fits.len() < 2 {
+        return None;
+    }
+    // The tile grid (fits are row-major over `tiles`).
+    let mut row_edges: Vec<[usize; 2]> = fits.iter().map(|f| f.rows).collect();
+    let mut col_edges: Vec<[usize; 2]> = fits.iter().map(|f| f.cols).collect();
+    row_edges.sort_unstable();
+    row_edges.dedup();
+    col_edges.sort_unstable();
+    col_edges.dedup();
+    let (nr, nc) = (row_edges.len(), col_edges.len());
+    if nr * nc != fits.len() {
+        return None;
+    }
+    let n_models = fits[0].aot550_models.len();
+    let mut votes = vec![0usize; n_models];
+    for f in fits {
+        votes[f.model_index] += 1;
+    }
+    // The most common model; a tie goes to the family's first.
+    let model_index = (0..n_models).max_by_key(|&m| (votes[m], std::cmp::Reverse(m)))?;
+    let grid: Vec<f64> = fits.iter().map(|f| f.aot550_models[model_index]).collect();
+    // 3 × 3 box with mirrored edges (index −1 reads 0, n reads n − 1).
+    let at = |r: isize, c: isize| {
+        let r = r.clamp(0, nr as isize - 1) as usize;
+        let c = c.clamp(0, nc as isize - 1) as usize;
+        grid[r * nc + c]
+    };
+    let box3: Vec<f64> = (0..nr * nc)
+        .map(|i| {
+            let (r, c) = ((i / nc) as isize, (i % nc) as isize);
+            let mut sum = 0.0;
+            for dr in -1..=1 {
+                for dc in -1..=1 {
+                    sum += at(r + dr, c + dc);
+                }
+            }
+            sum / 9.0
+        })
+        .collect();
+    let centre = |e: &[usize; 2]| (e[0] + e[1]) as f64 / 2.0;
+    let row_c: Vec<f64> = row_edges.iter().map(centre).collect();
+    let col_c: Vec<f64> = col_edges.iter().map(centre).collect();
+    // Bracketing centres and the weight of the upper one, constant beyond the ends.
+    let bracket = |centres: &[f64], x: f64| -> (usize, usize, f64) {
+        let k = centres.partition_point(|&v| v <= x);
+        if k == 0 {
+            (0, 0, 0.0)
+        } else if k == centres.len() {
+            (k - 1, k - 1, 0.0)
+        } else {
+            (k - 1, k, (x - centres[k - 1]) / (centres[k] - centres[k - 1]))
+        }
+    };
+    let mut aot550 = vec![0.0; rows * cols];
+    for r in 0..rows {
+        let (r0, r1, fr) = bracket(&row_c, r as f64 + 0.5);
+        for c in 0..cols {
+            let (c0, c1, fc) = bracket(&col_c, c as f64 + 0.5);
+            let v = |rr: usize, cc: usize| box3[rr * nc + cc];
+            aot550[r * cols + c] =
+                (1.0 - fr) * ((1.0 - fc) * v(r0, c0) + fc * v(r0, c1)) + fr * ((1.0 - fc) * v(r1, c0) + fc * v(r1, c1));
+        }
+    }
+    Some(Smoothed { model_index, aot550 })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -257,5 +362,46 @@ mod tests {
         let area: usize = t.iter().map(|(r, c)| (r[1] - r[0]) * (c[1] - c[0])).sum();
         assert_eq!(area, 70);
         assert_eq!(tiles(10, 7, 0), vec![([0, 10], [0, 7])]);
+    }
+
+    fn fit(rows: [usize; 2], cols: [usize; 2], model_index: usize, aot: [f64; 2]) -> TileFit {
+        TileFit {
+            rows,
+            cols,
+            model_index,
+            model: AerosolType::Maritime,
+            aot550: aot[model_index],
+            bands: [0, 0],
+            rmsd_reflectance: 0.0,
+            dark: Vec::new(),
+            from_scene: false,
+            aot550_models: aot.to_vec(),
+        }
+    }
+
+    #[test]
+    fn smoothing_takes_the_common_model_and_keeps_a_gradient_linear_inside() {
+        // 4 × 4 tiles of 10 px; model 1 in most tiles; its AOT rises by 0.01 per tile column.
+        let fits: Vec<TileFit> = tiles(40, 40, 10)
+            .into_iter()
+            .enumerate()
+            .map(|(i, (r, c))| {
+                let m = usize::from(i % 5 != 0);
+                fit(r, c, m, [0.5, 0.1 + 0.01 * (c[0] / 10) as f64])
+            })
+            .collect();
+        let settings = DarkSpectrumSettings { tile_px: 10, ..DarkSpectrumSettings::default() };
+        let s = smoothed(&fits, &settings, 40, 40).unwrap();
+        assert_eq!(s.model_index, 1);
+        // Between the inner tile centres (pixel centres 15 and 25) the box keeps the gradient
+        // (0.11 and 0.12 there), and the interpolation is linear: 0.001 per pixel.
+        let v = |r: usize, c: usize| s.aot550[r * 40 + c];
+        assert!((v(20, 24) - v(20, 15) - 0.009).abs() < 1e-12, "{} {}", v(20, 15), v(20, 24));
+        assert!((v(20, 19) - 0.1145).abs() < 1e-12, "{}", v(20, 19));
+        // Rows do not matter; the edges hold the mirrored box's value.
+        assert!((v(3, 19) - v(37, 19)).abs() < 1e-12);
+        assert!((v(20, 0) - (0.1 + (2.0 * 0.0 + 0.01) / 3.0)).abs() < 1e-12, "{}", v(20, 0));
+        let off = DarkSpectrumSettings { smooth_tiles: false, ..settings };
+        assert!(smoothed(&fits, &off, 40, 40).is_none());
     }
 }

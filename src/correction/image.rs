@@ -39,7 +39,9 @@
 use ndarray::Array2;
 use serde::{Deserialize, Serialize};
 
-use super::family::{AerosolFamily, BandTerms};
+use super::family::AerosolFamily;
+pub(super) use super::mixture::Mixture;
+use super::mixture::invert;
 use super::{CorrectionError, Reflectance, RrsFlags, assemble, flag_for, slice};
 use crate::atmosphere::AerosolType;
 use crate::calibration::Level1;
@@ -72,11 +74,22 @@ pub struct DarkSpectrumSettings {
     pub min_gas_transmittance: f64,
     /// Bands fitted, nm (ACOLITE's `dsf_wave_range`).
     pub wave_range_nm: [f64; 2],
+    /// With tiles: one model for the scene (the tiles' most common), its tile AOTs smoothed
+    /// with a 3 × 3 box and interpolated between tile centres to every pixel (ACOLITE's
+    /// defaults `dsf_aot_most_common_model`, `dsf_tile_smoothing`, kernel 3, linear). Off:
+    /// blocks, each tile its own model and AOT.
+    pub smooth_tiles: bool,
 }
 
 impl Default for DarkSpectrumSettings {
     fn default() -> Self {
-        Self { tile_px: 0, pixels: 200, min_gas_transmittance: 0.85, wave_range_nm: [400.0, 2500.0] }
+        Self {
+            tile_px: 0,
+            pixels: 200,
+            min_gas_transmittance: 0.85,
+            wave_range_nm: [400.0, 2500.0],
+            smooth_tiles: true,
+        }
     }
 }
 
@@ -140,7 +153,11 @@ impl ImageCorrection {
                 if self.nir_iteration { ", NIR iteration" } else { "" }
             ),
             AerosolFit::DarkSpectrum if self.dark.tile_px == 0 => "dark spectrum, scene".into(),
-            AerosolFit::DarkSpectrum => format!("dark spectrum, {} px tiles", self.dark.tile_px),
+            AerosolFit::DarkSpectrum => format!(
+                "dark spectrum, {} px tiles{}",
+                self.dark.tile_px,
+                if self.dark.smooth_tiles { ", smoothed" } else { "" }
+            ),
         }
     }
 }
@@ -307,75 +324,6 @@ impl Pixel<'_> {
     }
 }
 
-/// A pixel's atmosphere: up to six weighted table entries (two models, three AOT nodes each),
-/// its AOT(550) and Ångström exponent.
-#[derive(Default)]
-pub(super) struct Mixture<'f> {
-    /// (band terms, weight).
-    pub entries: Vec<(&'f BandTerms, f64)>,
-    /// AOT(550).
-    pub aot550: f64,
-    /// Ångström exponent 443–865 nm.
-    pub angstrom: f64,
-    /// The measured ε lay outside the family's range.
-    pub outside: bool,
-    /// Passes of the NIR iteration.
-    pub passes: usize,
-}
-
-impl Mixture<'_> {
-    /// (L_path, T·Ed, S) at index `i` (column·bands + band).
-    #[inline]
-    pub fn terms(&self, i: usize) -> (f64, f64, f64) {
-        let (mut lp, mut te, mut s) = (0.0, 0.0, 0.0);
-        for &(t, w) in &self.entries {
-            lp += w * t.l_path[i];
-            te += w * t.t_ed[i];
-            s += w * t.spherical_albedo[i];
-        }
-        (lp, te, s)
-    }
-
-    /// The terms of every band of a column at once (`span`: its indices), into `lp`, `te` and
-    /// `sa` (contiguous per column, so the loop vectorises).
-    #[inline]
-    pub fn column_terms(&self, span: std::ops::Range<usize>, lp: &mut [f64], te: &mut [f64], sa: &mut [f64]) {
-        lp.fill(0.0);
-        te.fill(0.0);
-        sa.fill(0.0);
-        for &(t, w) in &self.entries {
-            let (tl, tt, ts) = (&t.l_path[span.clone()], &t.t_ed[span.clone()], &t.spherical_albedo[span.clone()]);
-            for b in 0..lp.len() {
-                lp[b] += w * tl[b];
-                te[b] += w * tt[b];
-                sa[b] += w * ts[b];
-            }
-        }
-    }
-
-    /// Rrs from radiance `l1` at index `i`.
-    #[inline]
-    pub fn rrs(&self, i: usize, l1: f64) -> f64 {
-        let (lp, te, s) = self.terms(i);
-        invert(l1, lp, te, s)
-    }
-
-    /// The water's part of the TOA radiance at index `i` for above-surface `rrs`: the inverse
-    /// of [`Self::rrs`], (T·Ed)·Rrs/(1 − S·π·Rrs).
-    #[inline]
-    pub fn water_radiance(&self, i: usize, rrs: f64) -> f64 {
-        let (_, te, s) = self.terms(i);
-        te * rrs / (1.0 - s * std::f64::consts::PI * rrs)
-    }
-}
-
-/// The exact inversion with a band's terms: y = (L1 − L_path)/(T·Ed), Rrs = y/(1 + S·π·y).
-#[inline]
-fn invert(l1: f64, l_path: f64, t_ed: f64, spherical_albedo: f64) -> f64 {
-    let y = (l1 - l_path) / t_ed;
-    y / (1.0 + spherical_albedo * std::f64::consts::PI * y)
-}
-
 /// Correct `level1` with the family: see the module docs.
 pub fn correct_image(
     level1: &Level1,
@@ -397,14 +345,21 @@ pub fn correct_image(
         AerosolFit::DarkSpectrum => {
             let tiles = super::dark::fit_tiles(level1, family, &settings.dark, bands, control)?;
             let (rows, cols) = (level1.radiance.dim().0, level1.radiance.dim().1);
-            let index = super::dark::tile_index(&tiles, rows, cols);
-            let mixtures: Vec<Mixture<'_>> = tiles.iter().map(|t| t.mixture(family)).collect();
-            let (rrs, mut retrieval) = apply(level1, land, control, |p, mix, _: &mut ()| {
-                let m = &mixtures[index[p.row * cols + p.col]];
-                mix.entries.extend_from_slice(&m.entries);
-                (mix.aot550, mix.angstrom, mix.passes) = (m.aot550, m.angstrom, 1);
-                true
-            })?;
+            let (rrs, mut retrieval) = if let Some(smooth) = super::dark::smoothed(&tiles, &settings.dark, rows, cols) {
+                apply(level1, land, control, |p, mix, _: &mut ()| {
+                    smooth.fill(family, p.row * cols + p.col, mix);
+                    true
+                })?
+            } else {
+                let index = super::dark::tile_index(&tiles, rows, cols);
+                let mixtures: Vec<Mixture<'_>> = tiles.iter().map(|t| t.mixture(family)).collect();
+                apply(level1, land, control, |p, mix, _: &mut ()| {
+                    let m = &mixtures[index[p.row * cols + p.col]];
+                    mix.entries.extend_from_slice(&m.entries);
+                    (mix.aot550, mix.angstrom, mix.passes) = (m.aot550, m.angstrom, 1);
+                    true
+                })?
+            };
             retrieval.tiles = tiles;
             Ok((rrs, retrieval))
         }

@@ -24,6 +24,7 @@
 pub mod dark;
 pub mod family;
 pub mod image;
+mod mixture;
 pub mod nir_water;
 mod pair;
 mod rrs_metrics;
@@ -41,7 +42,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::calibration::Level1;
 use crate::control::RunControl;
-use crate::instrument::{BandAtmosphere, Flags};
+use crate::instrument::{AotNodes, BandAtmosphere, Flags};
 use crate::parse::FieldError;
 
 /// Errors from the atmospheric correction stage; each names the field and what is allowed.
@@ -173,33 +174,45 @@ pub(crate) fn assemble(
     })
 }
 
-/// Exact per-pixel correction of `level1` with the band-effective atmosphere of each column.
+/// Exact per-pixel correction of `level1` with the band-effective atmosphere of each column;
+/// where the scene's AOT is a map, `aerosol_map` holds the terms at its AOT nodes and the map
+/// under each pixel, and each pixel is corrected with the atmosphere at its own AOT.
 pub fn correct_exact(
     level1: &Level1,
     atmosphere: &BandAtmosphere,
+    aerosol_map: Option<(&AotNodes, &Array2<f32>)>,
     land: &Array2<u8>,
     control: &RunControl,
 ) -> Result<Reflectance, CorrectionError> {
     let (rows, cols, nb) = level1.radiance.dim();
     let (l1, l0_flags, land) = (slice(&level1.radiance)?, slice(&level1.flags)?, slice(land)?);
+    let aot = aerosol_map.map(|(_, a)| slice(a)).transpose()?;
     let mut rrs = vec![0.0f32; rows * cols * nb];
     let mut flags = vec![0u8; rows * cols * nb];
     let stride = cols * nb;
     control.fill_rows((rrs.as_mut_slice(), flags.as_mut_slice()), rows, stride, |at, (rrs_row, flag_row)| {
         let r = at.index();
         let base = r * stride;
+        // The pixel's own terms where the AOT is a map.
+        let (mut lp, mut te, mut sa) = if aerosol_map.is_some() {
+            (vec![0.0; nb], vec![0.0; nb], vec![0.0; nb])
+        } else {
+            (Vec::new(), Vec::new(), Vec::new())
+        };
         for c in 0..cols {
             at.column(c);
             let is_land = land[r * cols + c] != 0;
             // The column's slices, all of length nb, so the band loop runs without index
             // checks and the compiler can compute neighbouring bands together.
             let a = atmosphere.at(c, 0)..atmosphere.at(c, 0) + nb;
-            let (l_path, glint, t_ed, s_albedo) = (
-                &atmosphere.l_path[a.clone()],
-                &atmosphere.glint[a.clone()],
-                &atmosphere.t_ed[a.clone()],
-                &atmosphere.spherical_albedo[a],
-            );
+            let glint = &atmosphere.glint[a.clone()];
+            let (l_path, t_ed, s_albedo) = match (aerosol_map, aot) {
+                (Some((nodes, _)), Some(aot)) => {
+                    nodes.column_terms(c, f64::from(aot[r * cols + c]), &mut lp, &mut te, &mut sa);
+                    (&lp[..], &te[..], &sa[..])
+                }
+                _ => (&atmosphere.l_path[a.clone()], &atmosphere.t_ed[a.clone()], &atmosphere.spherical_albedo[a]),
+            };
             let k = c * nb..(c + 1) * nb;
             let (l1, l0_flags) = (&l1[base + k.start..base + k.end], &l0_flags[base + k.start..base + k.end]);
             let (rrs_out, flag_out) = (&mut rrs_row[k.clone()], &mut flag_row[k]);

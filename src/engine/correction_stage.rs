@@ -72,7 +72,11 @@ impl Engine {
             let against_truth = diagnostics;
             let diagnostics = diagnostics && image.is_none();
             let exact = if diagnostics || (!config.correction.use_approximation && image.is_none()) {
-                Some(correct_exact(level1, band_atmosphere, &radiance.truth.land, control).map_err(&fail)?)
+                let aerosol_map = side.aerosol_map.as_deref().zip(radiance.truth.aot550.as_ref());
+                Some(
+                    correct_exact(level1, band_atmosphere, aerosol_map, &radiance.truth.land, control)
+                        .map_err(&fail)?,
+                )
             } else {
                 None
             };
@@ -123,6 +127,7 @@ impl Engine {
                 a,
                 settings,
                 &config.scene.atmosphere,
+                radiance.truth.aot550.as_ref(),
                 &side.response.bands.centres_nm(),
             )),
             _ => None,

@@ -12,7 +12,7 @@ use crate::calibration::{Calibration, Level1};
 use crate::correction::{Reflectance, SceneApproximation};
 use crate::instrument::feasibility::Feasibility;
 use crate::instrument::sample::BandAtmosphere;
-use crate::instrument::{Detector, Level0, RadianceCube, Response, SnrRow, Viewing};
+use crate::instrument::{AotNodes, Detector, Level0, RadianceCube, Response, SnrRow, Viewing};
 use crate::metrics::ProductMetrics;
 use crate::retrieval::{Product, RetrievalSpec};
 use crate::scene::Scene;
@@ -95,6 +95,9 @@ pub(super) struct SceneSide {
     pub(super) geometry_key: Key,
     pub(super) optics: Arc<Vec<SceneOptics>>,
     pub(super) band_atmosphere: Arc<BandAtmosphere>,
+    /// The band terms at AOT nodes, where the scene's AOT is a map.
+    pub(super) aerosol_map: Option<Arc<AotNodes>>,
+    /// The band atmosphere's key (and the AOT nodes', where there are any).
     pub(super) band_key: Key,
 }
 

@@ -39,8 +39,11 @@ pub struct SkippedEffect {
 pub struct AerosolSummary {
     /// Retrieved AOT(550) over the water pixels: median, 5th and 95th percentiles.
     pub aot550: (f64, f64, f64),
-    /// The scene's AOT(550).
+    /// The scene's AOT(550): the atmosphere's, or the median of its map over the water pixels.
     pub aot550_true: f64,
+    /// Median over the water pixels of |retrieved − true AOT(550)|, each pixel against the
+    /// AOT under it.
+    pub aot550_abs_error: f64,
     /// Retrieved Ångström exponent (443–865 nm), median over the water pixels.
     pub angstrom: f64,
     /// The scene's aerosol model's Ångström exponent (443–865 nm).
@@ -143,9 +146,17 @@ pub(super) fn aerosol_summary(
     a: &crate::correction::AerosolRetrieval,
     settings: &crate::correction::ImageCorrection,
     truth: &crate::atmosphere::AtmosphereSpec,
+    truth_aot: Option<&ndarray::Array2<f32>>,
     centres_nm: &[f64],
 ) -> AerosolSummary {
     let mut aot: Vec<f64> = a.aot550.iter().filter(|v| v.is_finite()).map(|&v| f64::from(v)).collect();
+    // Retrieved pixels (land is NaN in the retrieval) against the AOT under each.
+    let true_at = |i: usize| truth_aot.and_then(|m| m.as_slice()).map_or(truth.aot550, |m| f64::from(m[i]));
+    let retrieved = a.aot550.iter().enumerate().filter(|(_, v)| v.is_finite());
+    let mut errors: Vec<f64> = retrieved.clone().map(|(i, v)| (f64::from(*v) - true_at(i)).abs()).collect();
+    let mut true_values: Vec<f64> = retrieved.map(|(i, _)| true_at(i)).collect();
+    errors.sort_by(f64::total_cmp);
+    true_values.sort_by(f64::total_cmp);
     let mut alpha: Vec<f64> = a.angstrom.iter().filter(|v| v.is_finite()).map(|&v| f64::from(v)).collect();
     aot.sort_by(f64::total_cmp);
     alpha.sort_by(f64::total_cmp);
@@ -160,7 +171,8 @@ pub(super) fn aerosol_summary(
         .unwrap_or(f64::NAN);
     AerosolSummary {
         aot550: (q(&aot, 0.5), q(&aot, 0.05), q(&aot, 0.95)),
-        aot550_true: truth.aot550,
+        aot550_true: if truth_aot.is_some() { q(&true_values, 0.5) } else { truth.aot550 },
+        aot550_abs_error: q(&errors, 0.5),
         angstrom: q(&alpha, 0.5),
         angstrom_true,
         outside_family_pct: if aot.is_empty() { 0.0 } else { 100.0 * a.outside_family as f64 / aot.len() as f64 },

@@ -11,15 +11,16 @@ use super::products::{InstrumentSide, SceneSide};
 use super::report::{RunReport, SkippedEffect};
 use super::run::Engine;
 use super::{EngineError, RunConfig};
-use crate::atmosphere::{AtmosphereLut, LutAxes};
+use crate::atmosphere::{AtmosphereLut, AtmosphereSpec, LutAxes};
 use crate::calibration::{Calibration, band_e0, calibrate};
 use crate::control::Cancellable;
 use crate::control::RunControl;
+use crate::instrument::aerosol_map;
 use crate::instrument::feasibility::Feasibility;
 use crate::instrument::sample::BandAtmosphere;
 use crate::instrument::{
-    Detector, RadianceCube, Response, SampleOptions, SnrRow, SpatialKernel, Viewing, analytic_snr, digitise_cube,
-    expose_cube, measured_snr, sample_radiance,
+    AotNodes, Detector, RadianceCube, Response, SampleOptions, SnrRow, SpatialKernel, Viewing, analytic_snr,
+    digitise_cube, expose_cube, measured_snr, sample_radiance,
 };
 use crate::scene::{Effect, Scene};
 use crate::toa::SceneOptics;
@@ -135,7 +136,68 @@ impl Engine {
             BandAtmosphere::new(&optics, &viewing, &response).map_err(failed(Stage::BandAtmosphere))
         })?;
 
-        Ok(SceneSide { scene, response, response_key, viewing, geometry_key, optics, band_atmosphere, band_key })
+        let (aerosol_map, band_key) = self.aerosol_map_stage(
+            (&scene, &response, &viewing),
+            (&atmosphere_spec, &axes),
+            band_key,
+            control,
+            report,
+        )?;
+
+        Ok(SceneSide {
+            scene,
+            response,
+            response_key,
+            viewing,
+            geometry_key,
+            optics,
+            band_atmosphere,
+            aerosol_map,
+            band_key,
+        })
+    }
+
+    /// A scene whose AOT varies: the band terms at AOT nodes spanning its map, each node's LUT
+    /// cached as a scene with that constant AOT would cache it. Returns them (none without a
+    /// map) and the key later stages build on.
+    fn aerosol_map_stage(
+        &mut self,
+        (scene, response, viewing): (&Arc<Scene>, &Arc<Response>, &Arc<Viewing>),
+        (atmosphere_spec, axes): (&AtmosphereSpec, &LutAxes),
+        band_key: Key,
+        control: &RunControl,
+        report: &mut RunReport,
+    ) -> Result<(Option<Arc<AotNodes>>, Key), EngineError> {
+        let Some(map) = &scene.aot550 else { return Ok((None, band_key)) };
+        let (lo, hi) = map.range();
+        let nodes = aerosol_map::node_values(lo, hi);
+        let mut luts = Vec::with_capacity(nodes.len());
+        let mut nodes_key = KeyBuilder::new(Stage::BandAtmosphere).after(band_key).with(&nodes);
+        for &tau in &nodes {
+            let spec = AtmosphereSpec { aot550: tau, ..atmosphere_spec.clone() };
+            let key = KeyBuilder::new(Stage::Lut).with(&spec).with(axes).finish();
+            luts.push(self.stage(key, report, control, || {
+                let atmosphere = spec.build().map_err(failed_any(Stage::Lut))?;
+                AtmosphereLut::build(&atmosphere, axes.clone()).map_err(failed_any(Stage::Lut))
+            })?);
+            nodes_key = nodes_key.after(key);
+        }
+        let nodes_key = nodes_key.finish();
+        let at_nodes = self.stage(nodes_key, report, control, || {
+            let optics = luts
+                .iter()
+                .map(|lut| {
+                    response
+                        .groups
+                        .iter()
+                        .map(|g| SceneOptics::new(scene, &g.grid, lut.clone()))
+                        .collect::<Result<Vec<_>, _>>()
+                })
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(failed_any(Stage::BandAtmosphere))?;
+            AotNodes::build(nodes.clone(), &optics, viewing, response).map_err(failed(Stage::BandAtmosphere))
+        })?;
+        Ok((Some(at_nodes), nodes_key))
     }
 
     /// The pupil radiance and the truth (the spatial response only when the scene asks for it).
@@ -149,7 +211,7 @@ impl Engine {
         let instrument = &config.instrument;
         let fid = &config.fidelity;
         let inputs = Inputs::of(config);
-        let SceneSide { scene, response, viewing, optics, band_atmosphere, band_key, .. } = side;
+        let SceneSide { scene, response, viewing, optics, band_atmosphere, aerosol_map, band_key, .. } = side;
         let band_key = *band_key;
         let spatial = scene.wants(Effect::SpatialResponse);
         let kernel = if spatial {
@@ -167,7 +229,8 @@ impl Engine {
         let executed_before = self.executions(Stage::Radiance);
         let radiance = self.stage(radiance_key, report, control, || {
             let options = SampleOptions { kernel: kernel.clone(), heading_deg: instrument.heading_deg };
-            sample_radiance(scene, optics, viewing, response, band_atmosphere, &options, control)
+            let aerosol_map = aerosol_map.as_deref();
+            sample_radiance(scene, optics, viewing, response, (band_atmosphere, aerosol_map), &options, control)
                 .map_err(failed(Stage::Radiance))
         })?;
         if self.executions(Stage::Radiance) > executed_before {

@@ -227,3 +227,88 @@ pub fn band_means(path: &PathSpectrum, first: usize, w: &[f64]) -> BandMeans {
         te_sum,
     }
 }
+
+/// Band-effective atmosphere of every column: index column·bands + band.
+#[derive(Debug, Clone, Default)]
+pub struct BandTerms {
+    /// Path radiance, W m⁻² sr⁻¹ nm⁻¹.
+    pub l_path: Vec<f64>,
+    /// (T_up·Ed), W m⁻² nm⁻¹.
+    pub t_ed: Vec<f64>,
+    /// Spherical albedo.
+    pub spherical_albedo: Vec<f64>,
+}
+
+/// The band terms of every column for one atmosphere (the photon-weighted means of
+/// `BandAtmosphere`, without what only the forward model needs). Where every detector has the
+/// same response (no smile) and the columns are a swath (`across_track`), the terms are computed
+/// at [`TERM_COLUMNS`] columns spread over it and interpolated linearly between them: they follow
+/// the view zenith, which changes smoothly across track. Otherwise (a user's spectra, one per
+/// column, `shoal correct`) every column is computed.
+pub fn band_terms(
+    optics: &[SceneOptics],
+    viewing: &Viewing,
+    response: &Response,
+    across_track: bool,
+) -> Result<BandTerms, InstrumentError> {
+    let nb = response.n_bands();
+    let nc = viewing.columns();
+    let one_response = response.smile_class.iter().all(|&c| c == response.smile_class.first().copied().unwrap_or(0));
+    let sampled: Vec<usize> = if across_track && one_response && nc > TERM_COLUMNS {
+        let mut v: Vec<usize> = (0..TERM_COLUMNS).map(|i| i * (nc - 1) / (TERM_COLUMNS - 1)).collect();
+        v.dedup();
+        v
+    } else {
+        (0..nc).collect()
+    };
+    let mut at_sampled = BandTerms {
+        l_path: vec![0.0; sampled.len() * nb],
+        t_ed: vec![0.0; sampled.len() * nb],
+        spherical_albedo: vec![0.0; sampled.len() * nb],
+    };
+    for (gi, group) in response.groups.iter().enumerate() {
+        let columns: Vec<Vec<(usize, f64, f64, f64)>> = sampled
+            .par_iter()
+            .enumerate()
+            .map(|(si, &c)| {
+                let look = &viewing.looks[gi][c];
+                let path = optics[gi].path_spectrum(&look.geometry).map_err(|e| InstrumentError::Scene(e.into()))?;
+                let j = viewing.detector_index[c];
+                Ok(group
+                    .bands
+                    .iter()
+                    .enumerate()
+                    .map(|(k, &b)| {
+                        let (first, w) = response.weights(gi, k, j);
+                        let m = band_means(&path, first, w);
+                        (si * nb + b, m.l_path, m.t_ed, m.spherical_albedo)
+                    })
+                    .collect())
+            })
+            .collect::<Result<_, InstrumentError>>()?;
+        for (i, l, te, s) in columns.into_iter().flatten() {
+            (at_sampled.l_path[i], at_sampled.t_ed[i], at_sampled.spherical_albedo[i]) = (l, te, s);
+        }
+    }
+    if sampled.len() == nc {
+        return Ok(at_sampled);
+    }
+    let mut out =
+        BandTerms { l_path: vec![0.0; nc * nb], t_ed: vec![0.0; nc * nb], spherical_albedo: vec![0.0; nc * nb] };
+    for c in 0..nc {
+        let s1 = sampled.partition_point(|&x| x < c).clamp(1, sampled.len() - 1);
+        let (a, z) = (sampled[s1 - 1], sampled[s1]);
+        let t = if z > a { (c - a) as f64 / (z - a) as f64 } else { 0.0 };
+        for b in 0..nb {
+            let (i0, i1, o) = ((s1 - 1) * nb + b, s1 * nb + b, c * nb + b);
+            out.l_path[o] = at_sampled.l_path[i0] + t * (at_sampled.l_path[i1] - at_sampled.l_path[i0]);
+            out.t_ed[o] = at_sampled.t_ed[i0] + t * (at_sampled.t_ed[i1] - at_sampled.t_ed[i0]);
+            out.spherical_albedo[o] = at_sampled.spherical_albedo[i0]
+                + t * (at_sampled.spherical_albedo[i1] - at_sampled.spherical_albedo[i0]);
+        }
+    }
+    Ok(out)
+}
+
+/// Columns at which [`band_terms`] computes the family's terms when it may interpolate.
+pub const TERM_COLUMNS: usize = 33;

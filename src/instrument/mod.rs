@@ -9,6 +9,7 @@
 //! | viewing geometry | [`geometry`] | pushbroom ground points, view zenith and azimuth, spherical Earth |
 //! | spatial response | [`spatial`] | diffraction, detector footprint, along-track smear (when asked) |
 //! | sampling | [`sample`] | band radiance of every pixel from the scene, and its truth |
+//! | aerosol map | [`aerosol_map`] | the atmosphere pixel by pixel where the scene's AOT varies |
 //! | detector | [`detector`] | photo-electrons, shot/dark/read noise, PRNU/DSNU, full well, ADC |
 //! | Level-0 | [`level0`] | the whole image exposed and read out, with flags |
 //! | plausibility | [`plausibility`] | saturation at the brightest water, smear, f-number warnings |
@@ -29,6 +30,7 @@
 //! - Schowengerdt, R. A. (2007) Remote Sensing: Models and Methods for Image Processing, 3rd ed.,
 //!   Academic Press, ch. 3 (pushbroom geometry, system PSF = optics ⊗ detector ⊗ motion).
 
+pub mod aerosol_map;
 pub mod band_atmosphere;
 pub mod budgets;
 pub mod detector;
@@ -50,7 +52,7 @@ pub use focal::{BandSelection, DarkLaw, DarkTemperature, DetectorMaterial, Focal
 pub use geometry::{Look, Viewing};
 pub use level0::{Level0, digitise_cube, expose_cube};
 pub use response::{GeometryGroup, Response};
-pub use sample::{BandAtmosphere, RadianceCube, SampleOptions, sample_radiance};
+pub use sample::{AotNodes, BandAtmosphere, RadianceCube, SampleOptions, sample_radiance};
 pub use snr::{SnrRow, analytic_snr, measured_snr};
 pub use spatial::SpatialKernel;
 pub use spec::{InstrumentKind, InstrumentSpec, ground_speed_m_s};

@@ -32,6 +32,7 @@ use crate::parse::FieldError;
 use crate::scene::Scene;
 use crate::toa::{SceneOptics, Scratch, Surface};
 
+pub use super::aerosol_map::AotNodes;
 pub use super::band_atmosphere::{BandAtmosphere, BandWeights, NodeWeights};
 
 /// Rows per work block of [`sample_radiance`].
@@ -70,13 +71,14 @@ pub struct RadianceCube {
 }
 
 /// Sample the scene through every pixel of `viewing`: `optics[g]` is the scene bound to group
-/// g's grid, `atmosphere` from [`BandAtmosphere::new`]. Checks `control` between rows.
+/// g's grid, the atmosphere from [`BandAtmosphere::new`] with, where the scene's AOT is a map,
+/// its terms at AOT nodes ([`super::aerosol_map`]). Checks `control` between rows.
 pub fn sample_radiance(
     scene: &Scene,
     optics: &[SceneOptics],
     viewing: &Viewing,
     response: &Response,
-    atmosphere: &BandAtmosphere,
+    (atmosphere, aerosol_map): (&BandAtmosphere, Option<&AotNodes>),
     options: &SampleOptions,
     control: &RunControl,
 ) -> Result<RadianceCube, InstrumentError> {
@@ -91,6 +93,9 @@ pub fn sample_radiance(
     let frac_stride = if shallow { (cols * n_sub).max(1) } else { 1 };
     let mut fractions = vec![0.0f32; rows * frac_stride];
     let mut land = vec![0u8; rows * cols];
+    // The aerosol map under each pixel centre (one unused float per row without a map).
+    let aot_stride = if aerosol_map.is_some() { cols } else { 1 };
+    let mut aot = vec![0.0f32; rows * aot_stride];
     let (along, right) = {
         let h = options.heading_deg.to_radians();
         ((h.sin(), h.cos()), (h.cos(), -h.sin()))
@@ -108,8 +113,9 @@ pub fn sample_radiance(
         .zip(maps.par_chunks_mut(cols * 4 * block))
         .zip(land.par_chunks_mut(cols * block))
         .zip(fractions.par_chunks_mut(frac_stride * block))
+        .zip(aot.par_chunks_mut(aot_stride * block))
         .enumerate()
-        .map(|(bi, ((((rad_block, rrs_block), map_block), land_block), frac_block))| {
+        .map(|(bi, (((((rad_block, rrs_block), map_block), land_block), frac_block), aot_block))| {
             if control.cancelled() {
                 return Err(InstrumentError::Cancelled);
             }
@@ -132,6 +138,11 @@ pub fn sample_radiance(
                     let at = rr * pixel + c * nb;
                     sampler.pixel(&mut work, r, c, &mut rad_block[at..at + nb], &mut rrs_block[at..at + nb])?;
                     let (x, y) = viewing.ground_m(0, r, c);
+                    if let Some(nodes) = aerosol_map {
+                        let tau = scene.aot550_at(x, y);
+                        nodes.exchange(atmosphere, c, tau, &mut rad_block[at..at + nb]);
+                        aot_block[rr * cols + c] = tau as f32;
+                    }
                     let at = rr * cols + c;
                     let fractions = if shallow {
                         Some(&mut frac_block[rr * frac_stride + c * n_sub..rr * frac_stride + (c + 1) * n_sub])
@@ -152,7 +163,8 @@ pub fn sample_radiance(
     let bad =
         |e: ndarray::ShapeError| InstrumentError::Invalid(FieldError { field: "cube".into(), message: e.to_string() });
     let radiance = Array3::from_shape_vec((rows, cols, nb), radiance).map_err(bad)?;
-    let truth = TruthBuffers { rrs: rrs_truth, maps, fractions, land }.into_truth(scene, (rows, cols, nb))?;
+    let aot = aerosol_map.is_some().then_some(aot);
+    let truth = TruthBuffers { rrs: rrs_truth, maps, fractions, land, aot }.into_truth(scene, (rows, cols, nb))?;
     Ok(RadianceCube {
         brightest_water_w_m2_sr_nm: super::plausibility::brightest_water(&radiance, &truth.land),
         typical_water_w_m2_sr_nm: super::plausibility::typical_water(&radiance, &truth.land),
@@ -268,6 +280,8 @@ struct TruthBuffers {
     fractions: Vec<f32>,
     /// Land flags, (row, column).
     land: Vec<u8>,
+    /// AOT(550) at each pixel centre, (row, column), when the scene has an aerosol map.
+    aot: Option<Vec<f32>>,
 }
 
 impl TruthBuffers {
@@ -291,6 +305,7 @@ impl TruthBuffers {
                 None
             },
             land: Array2::from_shape_vec((rows, cols), self.land).map_err(bad)?,
+            aot550: self.aot.map(|a| Array2::from_shape_vec((rows, cols), a)).transpose().map_err(bad)?,
             substrate_names: scene.substrates.iter().map(|(n, _)| n.clone()).collect(),
         };
         Ok(truth)

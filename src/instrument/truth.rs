@@ -28,6 +28,9 @@ pub struct Truth {
     pub substrate_names: Vec<String>,
     /// 1 where the pixel centre is land.
     pub land: Array2<u8>,
+    /// Aerosol optical thickness at 550 nm at each pixel centre, where the scene gives it as a
+    /// map (`aot550_map`; otherwise the atmosphere's `aot550` holds everywhere).
+    pub aot550: Option<Array2<f32>>,
 }
 
 impl Truth {

@@ -273,6 +273,7 @@ mod tests {
             })),
             substrate_names: vec!["sand".into(), "coral".into(), "seagrass".into()],
             land: Array2::from_shape_fn((rows, cols), |(_, c)| u8::from(c == 6)),
+            aot550: None,
         };
         let flags = Array2::from_shape_fn((rows, cols), |(r, c)| match (r * cols + c) % 13 {
             0 => ProductFlags::FAILED,

@@ -354,6 +354,15 @@ impl Map {
         }
     }
 
+    /// The raster's cell values (row 0 south), if the map is a raster.
+    #[must_use]
+    pub fn cells(&self) -> Option<&[f32]> {
+        match &self.kind {
+            Kind::Raster(values) => Some(values.as_slice()),
+            _ => None,
+        }
+    }
+
     /// The raster's cell values (row 0 south), if the map is a raster, for filling no-data
     /// cells.
     pub fn cells_mut(&mut self) -> Option<&mut [f32]> {

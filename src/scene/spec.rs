@@ -112,6 +112,11 @@ pub struct SceneSpec {
     /// Effects the scene calls for.
     #[serde(default)]
     pub effects: Vec<Effect>,
+    /// Aerosol optical thickness at 550 nm over the scene, when it varies (a haze front, a
+    /// plume): the aerosol model stays `atmosphere.aerosol`, its optical thickness follows this
+    /// map and `atmosphere.aot550` is unused. Absent: `atmosphere.aot550` everywhere.
+    #[serde(default)]
+    pub aot550_map: Option<MapSpec>,
 }
 
 /// Day of year of `YYYY-MM-DD`.
@@ -252,6 +257,8 @@ pub struct Scene {
     pub substrates: Vec<(String, Map)>,
     /// Land mask, when the scene has land.
     pub land: Option<Map>,
+    /// Aerosol optical thickness at 550 nm, when the scene gives it as a map.
+    pub aot550: Option<Map>,
     /// Directory of the scene file (for relative paths), if any.
     pub base_dir: Option<PathBuf>,
     /// Day of year.
@@ -319,6 +326,21 @@ impl Scene {
                 ),
             }));
         }
+        let aot550 = match &spec.aot550_map {
+            Some(m) => Some(map(m, "aot550_map")?),
+            None => None,
+        };
+        if let Some(cells) = aot550.as_ref().and_then(Map::cells)
+            && cells.iter().any(|v| v.is_nan())
+        {
+            return Err(SceneError::Invalid(FieldError {
+                field: "aot550_map".into(),
+                message: format!(
+                    "{} cells have no data; the aerosol map must cover the scene",
+                    cells.iter().filter(|v| v.is_nan()).count()
+                ),
+            }));
+        }
         let land_at = |col: usize, row: usize| {
             let (hx, hy) = extent.half_size_m();
             let (x, y) = (-hx + (col as f64 + 0.5) * extent.cell_m, -hy + (row as f64 + 0.5) * extent.cell_m);
@@ -343,6 +365,7 @@ impl Scene {
             depth,
             substrates,
             land,
+            aot550,
             base_dir: base_dir.map(Path::to_path_buf),
             day_of_year: day,
             frame,
@@ -379,6 +402,9 @@ impl Scene {
         for (name, m) in &self.substrates {
             check(&format!("substrates.{name}.fraction"), m, &r::SCENE_SUBSTRATE_FRACTION)?;
         }
+        if let Some(m) = &self.aot550 {
+            check("aot550_map", m, &r::SCENE_AOT550_MAP)?;
+        }
         Ok(())
     }
 
@@ -386,6 +412,12 @@ impl Scene {
     #[must_use]
     pub fn is_land(&self, x_m: f64, y_m: f64) -> bool {
         self.land.as_ref().is_some_and(|m| m.value_at(x_m, y_m) >= 0.5)
+    }
+
+    /// Aerosol optical thickness at 550 nm at (x, y): the map's value, or the atmosphere's.
+    #[must_use]
+    pub fn aot550_at(&self, x_m: f64, y_m: f64) -> f64 {
+        self.aot550.as_ref().map_or(self.spec.atmosphere.aot550, |m| m.value_at(x_m, y_m))
     }
 
     /// Effects the scene calls for.

@@ -75,6 +75,10 @@ fn base(path: &str) -> RunConfig {
         // A user's mixture (continental's fractions; the oceanic one 0 until changed).
         scene.atmosphere.aerosol = shoal::atmosphere::AerosolType::Mixture(Default::default());
     }
+    if path.starts_with("scene.atmosphere.aerosol.LogNormal") {
+        // A user's size distribution: the bushfire-smoke scene's two modes.
+        scene.atmosphere.aerosol = SceneSpec::preset("lake_hume_smoke").unwrap().atmosphere.aerosol;
+    }
     for e in [Effect::SunGlint, Effect::SpatialResponse] {
         if !scene.effects.contains(&e) {
             scene.effects.push(e);
@@ -216,6 +220,7 @@ fn try_set(config: &RunConfig, path: &str, value: f64) -> Result<RunConfig, Stri
         "scene.nap_g_m3" => c.scene.nap_g_m3 = m,
         "scene.cdom_per_m" => c.scene.cdom_per_m = m,
         "scene.depth_m" => c.scene.depth_m = Some(m),
+        "scene.aot550_map" => c.scene.aot550_map = Some(m),
         "scene.substrates[i].fraction" => c.scene.substrates[0].fraction = m,
         // A spectrum's values: the land's reflectance, constant over wavelength.
         "scene.land.reflectance" => {

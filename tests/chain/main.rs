@@ -3,6 +3,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 mod adjacency;
+mod aerosol_map;
 mod bad_input;
 mod band_nodes;
 mod cli;

@@ -14,7 +14,7 @@ use shoal::study::Requirements;
 use crate::common::{both_retrievals, instrument_for, sweep_path};
 
 /// A configuration in which every path of the table exists: both retrievals, a sun incidence,
-/// a wind-roughened surface; a user's aerosol mixture for its fields; a spectrograph or filter
+/// a wind-roughened surface; a user's aerosol mixture or size distribution for its fields; a spectrograph or filter
 /// imager for their `kind` fields.
 fn base(path: &str) -> RunConfig {
     let mut instrument = InstrumentSpec::preset(instrument_for(path)).unwrap();
@@ -25,6 +25,10 @@ fn base(path: &str) -> RunConfig {
     c.scene.atmosphere.surface = shoal::atmosphere::Surface::Wind { speed_m_s: 5.0 };
     if path.starts_with("scene.atmosphere.aerosol.Mixture") {
         c.scene.atmosphere.aerosol = shoal::atmosphere::AerosolType::Mixture(Default::default());
+    }
+    if path.starts_with("scene.atmosphere.aerosol.LogNormal") {
+        // The bushfire-smoke scene's two modes.
+        c.scene.atmosphere.aerosol = SceneSpec::preset("lake_hume_smoke").unwrap().atmosphere.aerosol;
     }
     c.validate().unwrap();
     c
@@ -39,6 +43,7 @@ fn refusal(range: &Range, value: f64) -> Option<String> {
             "scene.nap_g_m3" => spec.nap_g_m3 = m,
             "scene.cdom_per_m" => spec.cdom_per_m = m,
             "scene.depth_m" => spec.depth_m = Some(m),
+            "scene.aot550_map" => spec.aot550_map = Some(m),
             _ => spec.substrates[0].fraction = m,
         }
     };
@@ -92,7 +97,8 @@ fn refusal(range: &Range, value: f64) -> Option<String> {
             Err(other) => panic!("{}: not a refusal: {other}", range.path),
         };
     }
-    let map_field = ["scene.chl_mg_m3", "scene.nap_g_m3", "scene.cdom_per_m", "scene.depth_m"].contains(&range.path)
+    let map_field = ["scene.chl_mg_m3", "scene.nap_g_m3", "scene.cdom_per_m", "scene.depth_m", "scene.aot550_map"]
+        .contains(&range.path)
         || range.path.starts_with("scene.substrates");
     if map_field {
         // Map values are checked when the scene stage builds the maps.

@@ -13,6 +13,7 @@ mod osoaa;
 mod sambuca;
 mod sambuca_reference;
 mod sixs_swir;
+mod user_aerosol;
 mod water_limits;
 
 /// Path of a file under `tests/data/`.
