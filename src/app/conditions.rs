@@ -61,7 +61,20 @@ pub(super) fn conditions(app: &mut ShoalApp, ui: &mut egui::Ui) {
                 ui.selectable_value(&mut atm.aerosol, a, n);
             }
         });
-        refused = refused.or(checked(ui, &mut atm.aot550, (0.0, 1.0), &r::ATMOSPHERE_AOT550, "AOT(550)", ""));
+        if s.scene.aot550_map.is_some() {
+            // The scene's optical thickness is a map (`aot550_map`): one number would not say it.
+            ui.horizontal(|ui| {
+                ui.label("AOT(550): the scene's map").on_hover_text(
+                    "The scene file gives the aerosol optical thickness as a map (aot550_map); every pixel \
+                     sees the atmosphere of its own AOT.",
+                );
+                if ui.button("one value").on_hover_text("Replace the map by the atmosphere's aot550").clicked() {
+                    s.scene.aot550_map = None;
+                }
+            });
+        } else {
+            refused = refused.or(checked(ui, &mut atm.aot550, (0.0, 1.0), &r::ATMOSPHERE_AOT550, "AOT(550)", ""));
+        }
         refused = refused.or(checked(
             ui,
             &mut s.scene.sun.zenith_deg,

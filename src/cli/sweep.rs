@@ -81,6 +81,22 @@ fn write_outputs(table: &Table, spec: Option<&SweepSpec>, out: &Path, figures: b
             write_bytes(&out.join(format!("{}.png", fig.name)), &fig.png)?;
             write_bytes(&out.join(format!("{}.svg", fig.name)), fig.svg.as_bytes())?;
         }
+        // With a band-pair correction: the same curves against the pair's measured SNR.
+        if let Some(curves) = crate::sweep::figure::curves_by_pair_snr(table, v, requirement) {
+            for s in &curves.series {
+                let pts: Vec<String> = s.points.iter().map(|p| format!("SNR {:.1}: {:.1}", p.x, p.mean)).collect();
+                eprintln!("{v} MAE % by the pair's measured SNR, {}: {}", s.label, pts.join("  "));
+                if let (Some((limit, _)), Some(x)) = (&curves.requirement, s.crossing) {
+                    eprintln!("  meets MAE ≤ {limit} % from a long-band SNR of {x:.1}");
+                }
+            }
+            if figures {
+                let name = format!("sweep_{v}_by_pair_snr");
+                let fig = crate::study::curve_figure(&name, &curves).map_err(CliError::from)?;
+                write_bytes(&out.join(format!("{}.png", fig.name)), &fig.png)?;
+                write_bytes(&out.join(format!("{}.svg", fig.name)), fig.svg.as_bytes())?;
+            }
+        }
     }
     Ok(())
 }

@@ -89,6 +89,38 @@ fn trim(v: f64) -> String {
     s.trim_end_matches('0').trim_end_matches('.').to_string()
 }
 
+/// The curves of `variable` against the measured SNR of the image-based correction's long
+/// aerosol band (the mean over the seeds at each point), where the table has it: the form of
+/// Wang & Gordon's (2018) requirement, error against the pair's SNR. `None` without SNR.
+#[must_use]
+pub fn curves_by_pair_snr(table: &Table, variable: &str, requirement: Option<&Requirement>) -> Option<Curves> {
+    if !table.rows.iter().any(|r| r.snr_pair.is_some_and(|p| p[1].is_finite())) {
+        return None;
+    }
+    let mut c = curves(table, variable, requirement, true);
+    let limit = c.requirement.as_ref().map(|r| r.0);
+    for s in &mut c.series {
+        let instrument = s.label.split(", ").next().unwrap_or_default().to_string();
+        for p in &mut s.points {
+            let snr: Vec<f64> = table
+                .rows
+                .iter()
+                .filter(|r| r.instrument == instrument && r.values[0] == p.x)
+                .filter_map(|r| r.snr_pair.map(|p| p[1]))
+                .filter(|v| v.is_finite())
+                .collect();
+            p.x = if snr.is_empty() { f64::NAN } else { snr.iter().sum::<f64>() / snr.len() as f64 };
+        }
+        s.points.retain(|p| p.x.is_finite() && p.x > 0.0);
+        s.points.sort_by(|a, b| a.x.total_cmp(&b.x));
+        s.crossing = limit.and_then(|l| first_crossing(&s.points, l));
+    }
+    c.title = format!("{}: {variable} MAE against the aerosol pair's SNR", table.name);
+    c.x_label = "measured SNR, long band of the aerosol pair".into();
+    c.caption[0] = "Line: mean over the noise seeds at each swept value, placed at the mean measured SNR of the pair's long band; band: lowest to highest seed. Circle: the SNR above which the mean meets the requirement.".into();
+    Some(c)
+}
+
 /// The figure of `variable` (PNG and SVG).
 pub fn sweep_figure(
     table: &Table,

@@ -72,6 +72,16 @@ pub fn run_job(
     let secs = start.elapsed().as_secs_f64();
     let (r, c, b) = out.level0.dn.dim();
     let saturated_pct = 100.0 * out.report.saturated as f64 / (r * c * b).max(1) as f64;
+    // The measured SNR at the band-pair correction's two bands.
+    let snr_pair = match &config.correction.image {
+        Some(image) if image.fit == crate::correction::image::AerosolFit::BandPair => {
+            image.pair(&out.response.bands.centres_nm()).ok().map(|(s, l)| {
+                let at = |i: usize| out.snr.get(i).map_or(f64::NAN, |row| row.snr_measured);
+                [at(s), at(l)]
+            })
+        }
+        _ => None,
+    };
     let row = |product: &str, variable: &str, mae_pct: f64, bias_pct: f64, returned_pct: f64, n: usize| Row {
         job: job.index,
         point: job.point,
@@ -85,6 +95,7 @@ pub fn run_job(
         returned_pct,
         n,
         saturated_pct,
+        snr_pair,
     };
     let mut rows = Vec::new();
     // With an image-based correction, its own error: Rrs at 400–560 nm against the truth.

@@ -35,6 +35,11 @@ pub struct Row {
     /// Level-0 pixel-bands saturated (the well or the ADC full), % — where a curve jumps because
     /// the design saturates, the table says so. Tables written before the column read 0.
     pub saturated_pct: f64,
+    /// SNR measured on a uniform patch at the scene's median water radiance
+    /// ([`crate::instrument::measured_snr`]) at the image-based correction's aerosol pair
+    /// (short, long band): what a NIR/SWIR sweep varies. `None` (empty cells) without a
+    /// band-pair correction, and in tables written before the columns.
+    pub snr_pair: Option<[f64; 2]>,
 }
 
 /// A sweep table: identity, the runs it holds, and its rows.
@@ -67,14 +72,14 @@ impl Table {
             s.push_str(p);
             s.push(',');
         }
-        s.push_str("instrument,seed,product,variable,mae_pct,bias_pct,returned_pct,n,saturated_pct\n");
+        s.push_str("instrument,seed,product,variable,mae_pct,bias_pct,returned_pct,n,saturated_pct,snr_pair_short,snr_pair_long\n");
         for r in &self.rows {
             s.push_str(&format!("{},{},", r.job, r.point));
             for v in &r.values {
                 s.push_str(&format!("{v},"));
             }
             s.push_str(&format!(
-                "{},{},{},{},{},{},{},{},{}\n",
+                "{},{},{},{},{},{},{},{},{},{},{}\n",
                 r.instrument,
                 r.seed,
                 r.product,
@@ -83,7 +88,9 @@ impl Table {
                 r.bias_pct,
                 r.returned_pct,
                 r.n,
-                r.saturated_pct
+                r.saturated_pct,
+                r.snr_pair.map_or(String::new(), |p| p[0].to_string()),
+                r.snr_pair.map_or(String::new(), |p| p[1].to_string()),
             ));
         }
         s
@@ -116,8 +123,13 @@ impl Table {
             }
             if columns.is_empty() {
                 columns = line.split(',').map(str::to_string).collect();
-                // Tables written before the `saturated_pct` column end at `n`.
-                let trailing = if columns.last().map(String::as_str) == Some("saturated_pct") { 9 } else { 8 };
+                // Tables written before the `saturated_pct` column end at `n`, before the SNR
+                // columns at `saturated_pct`.
+                let trailing = match columns.last().map(String::as_str) {
+                    Some("snr_pair_long") => 11,
+                    Some("saturated_pct") => 9,
+                    _ => 8,
+                };
                 if columns.len() < trailing + 2 || columns[0] != "job" {
                     return Err(bad(i + 1, "expected the column header".into()));
                 }
@@ -152,6 +164,11 @@ impl Table {
                 returned_pct: num(8 + np)?,
                 n: int(9 + np)? as usize,
                 saturated_pct: if cells.len() > 10 + np { num(10 + np)? } else { 0.0 },
+                snr_pair: if cells.len() > 12 + np && !cells[11 + np].is_empty() {
+                    Some([num(11 + np)?, num(12 + np)?])
+                } else {
+                    None
+                },
             });
         }
         Ok(table)

@@ -94,6 +94,34 @@ fn shards_merged_equal_one_run_byte_for_byte() {
 type Change = Box<dyn Fn(&mut SweepSpec)>;
 
 #[test]
+fn a_nir_sweep_records_the_pairs_measured_snr() {
+    let mut spec = SweepSpec::preset("nir_snr_sweep_clear").unwrap();
+    spec.parameters[0].values = Values::List(vec![15.0, 3000.0]);
+    spec.seeds = vec![1];
+    let mut sweep = spec.resolve(None).unwrap();
+    for (_, c) in &mut sweep.bases {
+        c.fidelity.decimation = 16;
+    }
+    let result = run_sweep(&sweep, Shard::ALL, &RunControl::new(), |_, _| {}).unwrap();
+    let snr_at = |noise: f64| {
+        let row = result.table.rows.iter().find(|r| r.values[0] == noise).unwrap();
+        row.snr_pair.expect("a band-pair correction records its pair's SNR")
+    };
+    let (quiet, noisy) = (snr_at(15.0), snr_at(3000.0));
+    println!("pair SNR (short, long): read noise 15 e- {quiet:?}, 3000 e- {noisy:?}");
+    // Read noise 3000 e- dominates a signal whose shot-noise-limited SNR is ~100: the measured
+    // SNR must fall by more than tenfold at both bands.
+    assert!(quiet[0] > 10.0 * noisy[0] && quiet[1] > 10.0 * noisy[1], "{quiet:?} {noisy:?}");
+    assert_eq!(Table::from_csv(&result.table.to_csv(), "nir").unwrap(), result.table, "the SNR reads back");
+    // The curve against SNR orders its points by SNR.
+    let c = shoal::sweep::figure::curves_by_pair_snr(&result.table, "rrs_400_560", None).unwrap();
+    assert!(c.series[0].points.windows(2).all(|w| w[0].x < w[1].x));
+    // A table written before the SNR columns reads with none.
+    let old = "# sweep s | jobs 1 | key k\njob,point,x,instrument,seed,product,variable,mae_pct,bias_pct,returned_pct,n,saturated_pct\n0,0,1,a,1,aLMI,chl_mg_m3,10,1,99,5,0\n";
+    assert_eq!(Table::from_csv(old, "old").unwrap().rows[0].snr_pair, None);
+}
+
+#[test]
 fn bad_sweeps_are_refused_by_name() {
     let base = SweepSpec::preset("aperture_lake_hume").unwrap();
     let cases: Vec<(&str, Change)> = vec![
