@@ -82,6 +82,9 @@ pub enum Format {
     Npy,
     /// GeoTIFF (one file per product, bands with descriptions and units, georeferenced).
     Geotiff,
+    /// NetCDF with CF metadata (one file per instrument: bands as a coordinate, Level-1, Rrs,
+    /// the truth, every product and its flags, pixel positions, the configuration).
+    Netcdf,
 }
 
 impl From<Format> for crate::study::CubeFormat {
@@ -89,6 +92,7 @@ impl From<Format> for crate::study::CubeFormat {
         match f {
             Format::Npy => Self::Npy,
             Format::Geotiff => Self::GeoTiff,
+            Format::Netcdf => Self::NetCdf,
         }
     }
 }

@@ -19,6 +19,7 @@ mod curves;
 mod figures;
 mod geotiff_out;
 mod maps_figure;
+pub mod netcdf_out;
 mod outdir;
 mod output;
 mod render;

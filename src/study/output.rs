@@ -159,6 +159,8 @@ pub enum CubeFormat {
     Npy,
     /// GeoTIFF, one file per product with its bands, georeferenced ([`super::write_run_geotiff`]).
     GeoTiff,
+    /// NetCDF with CF metadata, one file per run ([`super::netcdf_out`]).
+    NetCdf,
 }
 
 /// Write a run's products in `format` (tables, report and configuration in both).
@@ -166,6 +168,13 @@ pub fn write_run_as(out: &RunOutput, dir: &Path, format: CubeFormat) -> Result<O
     match format {
         CubeFormat::Npy => write_run(out, dir),
         CubeFormat::GeoTiff => super::write_run_geotiff(out, dir),
+        CubeFormat::NetCdf => {
+            std::fs::create_dir_all(dir)
+                .map_err(|e| StudyError::Io(format!("cannot create {}: {e}", dir.display())))?;
+            let mut o = write_tables(out, dir)?;
+            super::netcdf_out::write_netcdf(out, dir, &mut o)?;
+            Ok(o)
+        }
     }
 }
 

@@ -15,6 +15,7 @@ mod design;
 mod determinism;
 mod image_correction;
 mod incremental;
+mod netcdf;
 mod noise;
 mod plausibility;
 mod rasters;

@@ -90,3 +90,28 @@ pub fn tool_available(tool: &str, package: &str) -> bool {
     }
     runs
 }
+
+/// A Python interpreter that imports `modules` (Debian's `/usr/bin/python3` first: a user's
+/// pyenv or virtualenv `python3` may lack the Debian packages), or `None` after one line naming
+/// the packages; under `SHOAL_REQUIRE_TOOLS` their absence fails, as in [`tool_available`].
+#[must_use]
+pub fn python_with(modules: &str, packages: &str) -> Option<&'static str> {
+    let found = ["/usr/bin/python3", "python3"].into_iter().find(|python| {
+        std::process::Command::new(python)
+            .args(["-c", &format!("import {modules}")])
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::null())
+            .status()
+            .is_ok_and(|s| s.success())
+    });
+    if found.is_none() {
+        assert!(
+            std::env::var_os("SHOAL_REQUIRE_TOOLS").is_none(),
+            "no python3 imports {modules} and SHOAL_REQUIRE_TOOLS is set: install {packages} (`apt-get install {packages}`)"
+        );
+        eprintln!(
+            "skipped: needs python3 with {modules}; install {packages} (`apt-get install {packages}`) to run this test"
+        );
+    }
+    found
+}

@@ -1,0 +1,127 @@
+//! NetCDF-CF products (`--format netcdf`): the file reads back with its dimensions, band
+//! coordinates, values and configuration; an independent reader of each kind opens it —
+//! `ncdump -h` (Debian's netcdf-bin, the NetCDF C library) and xarray (python3-xarray with
+//! python3-netcdf4) — and sees the CF metadata a scientist's script relies on.
+
+use shoal::instrument::DetectorMode;
+use shoal::study::{CubeFormat, write_run_as};
+
+use super::{run, small, small_lake};
+
+/// A small noise-free run written as NetCDF into a fresh folder (`name`: one per test, as tests
+/// run at once).
+fn written(name: &str) -> (shoal::engine::RunOutput, tempfile_dir::Dir) {
+    let mut c = shoal::engine::RunConfig::new(small_lake(), small("cubesat", 24, 16));
+    c.detector = DetectorMode::IDEAL;
+    let out = run(&c);
+    let dir = tempfile_dir::Dir::new(name);
+    let o = write_run_as(&out, dir.path(), CubeFormat::NetCdf).unwrap();
+    assert!(o.files.contains(&"products.nc".to_string()), "{:?}", o.files);
+    (out, dir)
+}
+
+/// A folder under the target directory, removed when dropped.
+mod tempfile_dir {
+    pub struct Dir(std::path::PathBuf);
+    impl Dir {
+        pub fn new(name: &str) -> Self {
+            let p = std::env::temp_dir().join(format!("shoal-test-{name}-{}", std::process::id()));
+            let _ = std::fs::remove_dir_all(&p);
+            std::fs::create_dir_all(&p).unwrap();
+            Self(p)
+        }
+        pub fn path(&self) -> &std::path::Path {
+            &self.0
+        }
+    }
+    impl Drop for Dir {
+        fn drop(&mut self) {
+            let _ = std::fs::remove_dir_all(&self.0);
+        }
+    }
+}
+
+#[test]
+fn a_netcdf_product_reads_back_with_its_bands_values_and_configuration() {
+    let (out, dir) = written("netcdf-read");
+    let mut reader = netcdf3::FileReader::open(dir.path().join("products.nc")).unwrap();
+    let (rows, cols, nb) = out.correction.rrs.rrs.dim();
+    let wavelength = reader.read_var_f32("wavelength").unwrap();
+    let rrs = reader.read_var_f32("rrs").unwrap();
+    let flags = reader.read_var_i32("rrs_flags").unwrap();
+    let chl = reader.read_var_f32("true_chl_mg_m3").unwrap();
+    let (ds, _) = reader.close();
+    assert_eq!((ds.dim_size("line"), ds.dim_size("pixel"), ds.dim_size("band")), (Some(rows), Some(cols), Some(nb)));
+    for (w, b) in wavelength.iter().zip(&out.response.bands.bands) {
+        assert_eq!(*w, b.centre_nm as f32);
+    }
+    // Rrs: the run's values where valid, the fill value elsewhere.
+    let fill = shoal::study::netcdf_out::FILL;
+    let mut valid = 0;
+    for ((v, f), (r, t)) in
+        rrs.iter().zip(&flags).zip(out.correction.rrs.rrs.iter().zip(out.correction.rrs.flags.iter()))
+    {
+        assert_eq!(*f, i32::from(*t));
+        if t & shoal::correction::RrsFlags::INVALID == 0 {
+            assert_eq!(v, r);
+            valid += 1;
+        } else {
+            assert_eq!(*v, fill);
+        }
+    }
+    assert!(valid > rows * cols * nb / 2, "{valid}");
+    assert_eq!(chl[0], out.radiance.truth.chl_mg_m3[[0, 0]]);
+    assert_eq!(
+        ds.get_var_attr_as_string("rrs", "standard_name").as_deref(),
+        Some("surface_ratio_of_upwelling_radiance_emerging_from_sea_water_to_downwelling_radiative_flux_in_air")
+    );
+    let config = ds.get_global_attr_as_string("shoal_configuration").unwrap();
+    assert!(config.starts_with("RunConfig(") && config.contains("cubesat"), "{}", &config[..80.min(config.len())]);
+    assert_eq!(ds.get_global_attr_as_string("Conventions").as_deref(), Some("CF-1.8"));
+}
+
+#[test]
+fn ncdump_reads_the_header() {
+    if !crate::common::tool_available("ncdump", "netcdf-bin") {
+        return;
+    }
+    let (_, dir) = written("netcdf-ncdump");
+    // ncdump has no --version: `tool_available` only needs it to start.
+    let o = std::process::Command::new("ncdump").arg("-h").arg(dir.path().join("products.nc")).output().unwrap();
+    let header = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for part in [
+        "band = 19 ;",
+        "float rrs(line, pixel, band) ;",
+        "rrs:units = \"sr-1\" ;",
+        ":Conventions = \"CF-1.8\" ;",
+        "rrs_flags:flag_meanings",
+    ] {
+        assert!(header.contains(part), "ncdump -h lacks `{part}`:\n{header}");
+    }
+}
+
+#[test]
+fn xarray_opens_the_product_with_its_coordinates_and_fill_values() {
+    let Some(python) = crate::common::python_with("xarray, netCDF4", "python3-xarray python3-netcdf4") else { return };
+    let (out, dir) = written("netcdf-xarray");
+    let script = r#"
+import sys, xarray as xr, numpy as np
+ds = xr.open_dataset(sys.argv[1])
+assert 'wavelength' in ds.coords and 'x' in ds.coords, list(ds.coords)
+rrs = ds.rrs
+assert rrs.dims == ('line', 'pixel', 'band'), rrs.dims
+# The fill value became NaN; what is left is the valid Rrs.
+print(int(rrs.isnull().sum()), float(np.nanmedian(rrs.isel(band=2).values)), float(ds.wavelength[2]))
+"#;
+    let o =
+        std::process::Command::new(python).args(["-c", script]).arg(dir.path().join("products.nc")).output().unwrap();
+    assert!(o.status.success(), "xarray: {}", String::from_utf8_lossy(&o.stderr));
+    let text = String::from_utf8_lossy(&o.stdout);
+    let parts: Vec<f64> = text.split_whitespace().map(|v| v.parse().unwrap()).collect();
+    let invalid =
+        out.correction.rrs.flags.iter().filter(|f| **f & shoal::correction::RrsFlags::INVALID != 0).count() as f64;
+    assert_eq!(parts[0], invalid, "NaN cells are the invalid ones");
+    assert!((parts[2] - out.response.bands.bands[2].centre_nm).abs() < 1e-3, "{text}");
+    assert!(parts[1] > 0.0 && parts[1] < 0.1, "median Rrs at band 3 {text}");
+}
