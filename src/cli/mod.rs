@@ -25,6 +25,7 @@ mod lookup;
 mod output;
 mod report;
 mod reproduce;
+mod score;
 pub mod simulate;
 mod study;
 mod sweep;
@@ -92,6 +93,9 @@ enum Command {
     /// The image-based atmospheric correction on TOA radiance spectra from a CSV (geometry and
     /// band radiances per row): Rrs per band, AOT and Ångström exponent per row.
     Correct(correct::CorrectArgs),
+    /// Score products made outside Shoal (a NetCDF file of chl_mg_m3, nap_g_m3, cdom_per_m or
+    /// depth_m maps) against the truth of the run whose Rrs they were made from.
+    Score(score::ScoreArgs),
     /// Search for the cheapest design of a study's instrument that meets every requirement
     /// (constrained Bayesian optimisation over the parameters given with --vary) and the front
     /// of cost against each product's error.
@@ -218,6 +222,7 @@ pub fn main(app: impl FnOnce(&AppArgs) -> ExitCode) -> ExitCode {
         Command::Budget(args) => budget::run(&args),
         Command::Design(args) => design::run(&args),
         Command::Correct(args) => correct::run(&args),
+        Command::Score(args) => score::run(&args),
         Command::Report(args) => report::run(&args),
         Command::Bench(args) => bench::run(&args),
         Command::Ranges => output::emit(&crate::ranges::markdown_table(), None),

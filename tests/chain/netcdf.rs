@@ -125,3 +125,121 @@ print(int(rrs.isnull().sum()), float(np.nanmedian(rrs.isel(band=2).values)), flo
     assert!((parts[2] - out.response.bands.bands[2].centre_nm).abs() < 1e-3, "{text}");
     assert!(parts[1] > 0.0 && parts[1] < 0.1, "median Rrs at band 3 {text}");
 }
+
+/// A product NetCDF of (line, pixel) maps `maps` (name, values) with a −9999 fill value.
+fn product_file(path: &std::path::Path, shape: (usize, usize), maps: &[(&str, Vec<f32>)]) {
+    let mut ds = netcdf3::DataSet::new();
+    ds.add_fixed_dim("line", shape.0).unwrap();
+    ds.add_fixed_dim("pixel", shape.1).unwrap();
+    for (name, _) in maps {
+        ds.add_var_f32(name, &["line", "pixel"]).unwrap();
+        ds.add_var_attr_f32(name, "_FillValue", vec![-9999.0]).unwrap();
+    }
+    let mut w = netcdf3::FileWriter::open(path).unwrap();
+    w.set_def(&ds, netcdf3::Version::Classic, 0).unwrap();
+    for (name, values) in maps {
+        w.write_var_f32(name, values).unwrap();
+    }
+    w.close().unwrap();
+}
+
+#[test]
+fn shoal_score_scores_an_outside_product_against_the_runs_truth() {
+    let (out, dir) = written("netcdf-score");
+    let truth = &out.radiance.truth;
+    let shape = truth.chl_mg_m3.dim();
+    // An outside algorithm 10 % high everywhere, missing (fill) on land and in one pixel.
+    let chl: Vec<f32> = truth
+        .chl_mg_m3
+        .indexed_iter()
+        .map(|((r, c), v)| if truth.land[[r, c]] != 0 || (r, c) == (0, 0) { -9999.0 } else { v * 1.1 })
+        .collect();
+    let product = dir.path().join("mine.nc");
+    product_file(&product, shape, &[("chl_mg_m3", chl)]);
+    let requirements = dir.path().join("req.ron");
+    std::fs::write(&requirements, "(products: [(variable: \"chl_mg_m3\", mae_pct: Some(5))])").unwrap();
+    let scored = dir.path().join("scored");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_shoal"))
+        .arg("score")
+        .arg(&product)
+        .arg("--truth")
+        .arg(dir.path())
+        .arg("--requirements")
+        .arg(&requirements)
+        .arg("--out")
+        .arg(&scored)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let table = String::from_utf8_lossy(&o.stdout);
+    println!("{table}");
+    let row = table.lines().find(|l| l.starts_with("chl_mg_m3")).unwrap();
+    let cells: Vec<&str> = row.split_whitespace().collect();
+    // Log-space MAE and bias of a uniform factor 1.1 are both 10 % (Seegers et al. 2018); one
+    // water pixel of the 24 × 16 image is missing.
+    assert_eq!(cells[3], "10.0", "{row}");
+    assert_eq!(cells[4], "+10.0", "{row}");
+    let water = truth.land.iter().filter(|l| **l == 0).count();
+    assert_eq!(cells[1].parse::<usize>().unwrap(), water - 1, "{row}");
+    assert_eq!(*cells.last().unwrap(), "FAIL", "MAE 10 % against a 5 % requirement: {row}");
+    assert!(std::fs::read_to_string(scored.join("score.csv")).unwrap().contains("chl_mg_m3,"));
+    // A product of another size is refused, naming both sizes.
+    product_file(&product, (shape.0 + 1, shape.1), &[("chl_mg_m3", vec![1.0; (shape.0 + 1) * shape.1])]);
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_shoal"))
+        .args(["score", &product.to_string_lossy(), "--truth", &dir.path().to_string_lossy(), "--out"])
+        .arg(&scored)
+        .output()
+        .unwrap();
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(
+        e.contains(&format!("{} × {}", shape.0 + 1, shape.1)) && e.contains(&format!("{} × {}", shape.0, shape.1)),
+        "{e}"
+    );
+}
+
+#[test]
+fn the_oc4_example_runs_outside_shoal_and_is_scored() {
+    let Some(python) = crate::common::python_with("xarray, netCDF4", "python3-xarray python3-netcdf4") else { return };
+    let (out, dir) = written("netcdf-oc4");
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/presets/examples/oc4.py");
+    let product = dir.path().join("oc4.nc");
+    let o = std::process::Command::new(python)
+        .arg(script)
+        .arg(dir.path().join("products.nc"))
+        .arg(&product)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "oc4.py: {}", String::from_utf8_lossy(&o.stderr));
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_shoal"))
+        .arg("score")
+        .arg(&product)
+        .arg("--truth")
+        .arg(dir.path())
+        .arg("--out")
+        .arg(dir.path().join("scored"))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let table = String::from_utf8_lossy(&o.stdout);
+    println!("{table}");
+    let row = table.lines().find(|l| l.starts_with("chl_mg_m3")).unwrap();
+    let cells: Vec<&str> = row.split_whitespace().collect();
+    // Every water pixel returned, and the script's value is OC4v6 of the run's own Rrs (computed
+    // here at one pixel; f32 file values, so 1e-5 relative).
+    let water = out.radiance.truth.land.iter().filter(|l| **l == 0).count();
+    assert_eq!(cells[1].parse::<usize>().unwrap(), water, "{row}");
+    let mut reader = netcdf3::FileReader::open(&product).unwrap();
+    let chl = reader.read_var_f32("chl_mg_m3").unwrap();
+    let (r, c) = (8, 12);
+    let cols = out.radiance.truth.land.dim().1;
+    let centres = out.response.bands.centres_nm();
+    let band = |nm: f64| {
+        (0..centres.len()).min_by(|&a, &b| (centres[a] - nm).abs().total_cmp(&(centres[b] - nm).abs())).unwrap()
+    };
+    let rrs = |nm: f64| f64::from(out.correction.rrs.rrs[[r, c, band(nm)]]);
+    let x = ([443.0, 490.0, 510.0].map(rrs).into_iter().fold(f64::MIN, f64::max) / rrs(555.0)).log10();
+    let oc4 = 10f64.powf([0.3272, -2.9940, 2.7218, -1.2259, -0.5683].iter().rev().fold(0.0, |acc, a| acc * x + a));
+    let got = f64::from(chl[r * cols + c]);
+    assert!((got / oc4 - 1.0).abs() < 1e-5, "pixel ({r}, {c}): oc4.py {got}, OC4v6 {oc4}");
+}
