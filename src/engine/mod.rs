@@ -53,7 +53,7 @@ pub use cache::Stage;
 pub use config::{DEFAULT_BAND_NODES, DEFAULT_WATER_SINGLE_PRECISION, Fidelity, RunConfig};
 pub use fault::{Fault, FaultKind};
 pub use products::{CorrectionProduct, RetrievalOutput, RunOutput};
-pub use report::{RunReport, StageReport, StageStatus};
+pub use report::{AerosolSummary, RunReport, StageReport, StageStatus};
 pub use run::Engine;
 pub use stages::lut_axes_covering;
 

@@ -35,7 +35,7 @@ pub struct SkippedEffect {
 }
 
 /// The image-based correction's aerosol against the scene's true aerosol.
-#[derive(Debug, Clone, PartialEq, Serialize, Default)]
+#[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize, Default)]
 pub struct AerosolSummary {
     /// Retrieved AOT(550) over the water pixels: median, 5th and 95th percentiles.
     pub aot550: (f64, f64, f64),

@@ -94,6 +94,15 @@ pub struct MetricRow {
     pub n: usize,
 }
 
+/// The aerosol an image-based correction found in one instrument's image.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AerosolRow {
+    /// Instrument.
+    pub instrument: String,
+    /// The run's aerosol summary (AOT, Ångström and their truths, per-pixel error, fit).
+    pub found: crate::engine::AerosolSummary,
+}
+
 /// One requirement check.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CheckRow {
@@ -190,6 +199,10 @@ pub struct ReviewData {
     /// Bottom type per instrument, when the retrieval unmixes substrates.
     #[serde(default)]
     pub substrates: Vec<substrate::SubstrateSummary>,
+    /// The aerosol an image-based correction found, per instrument (first seed); empty with the
+    /// exact correction (and in packs written before the section).
+    #[serde(default)]
+    pub aerosol: Vec<AerosolRow>,
 }
 
 /// The git commit this binary was built from (`src/build.rs`), or "unknown".
@@ -474,6 +487,10 @@ pub fn review_data(result: &StudyResult, budget: &[Budget], cost: &[CostRow]) ->
             .unwrap_or_default(),
         figures: Vec::new(),
         substrates: substrate::summaries(result),
+        aerosol: runs
+            .iter()
+            .filter_map(|r| r.report.aerosol.clone().map(|found| AerosolRow { instrument: r.label.clone(), found }))
+            .collect(),
     }
 }
 

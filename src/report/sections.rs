@@ -28,6 +28,32 @@ fn inline_markdown(s: &str) -> String {
     out
 }
 
+/// The aerosol an image-based correction found from each design's own bands, against the truth.
+pub(super) fn aerosol(h: &mut String, d: &ReviewData) {
+    if d.aerosol.is_empty() {
+        return;
+    }
+    h.push_str("<section id=\"aerosol\">\n<h2>Aerosol the correction found</h2>\n<p class=\"note\">The image-based correction knows nothing of the scene's atmosphere: it finds the aerosol from the design's own Level-1. AOT(550) over the water pixels (median, 5–95 %) against the scene's; the per-pixel error is the median |retrieved − true| with each pixel against the AOT under it; Ångström exponent 443–865 nm; the share of pixels whose band ratio lay outside the family of models.</p>\n<table>\n<tr><th>instrument</th><th>correction</th><th>AOT(550) found</th><th>5–95 %</th><th>true</th><th>per-pixel error</th><th>Ångström found</th><th>true</th><th>outside family %</th></tr>\n");
+    for row in &d.aerosol {
+        let a = &row.found;
+        let _ = writeln!(
+            h,
+            "<tr><td>{}</td><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}–{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td></tr>",
+            escape(&row.instrument),
+            escape(&a.fit),
+            num(a.aot550.0, 3),
+            num(a.aot550.1, 3),
+            num(a.aot550.2, 3),
+            num(a.aot550_true, 3),
+            num(a.aot550_abs_error, 3),
+            num(a.angstrom, 2),
+            num(a.angstrom_true, 2),
+            num(a.outside_family_pct, 1)
+        );
+    }
+    h.push_str("</table>\n</section>\n");
+}
+
 pub(super) fn budget_and_cost(h: &mut String, d: &ReviewData) {
     if !d.budget.is_empty() {
         h.push_str("<section id=\"budget\">\n<h2>Error budget</h2>\n<p class=\"note\">Each stage of the chain made perfect in turn (sequential share: the MAE it removes after those before it) and alone (the MAE with only this stage imperfect, above the floor). Points of %.</p>\n<table>\n<tr><th>instrument</th><th>variable</th><th>full MAE %</th><th>stage</th><th>sequential share</th><th>alone share</th><th>floor MAE %</th></tr>\n");

@@ -1,4 +1,5 @@
-//! Tests of the review data: the cost rows as the page prints them, the UTC text.
+//! Tests of the review data: the cost rows and the aerosol found as the page prints them, the
+//! UTC text.
 
 use super::*;
 use crate::timing::{Comparison, Paired};
@@ -60,8 +61,26 @@ fn the_review_pack_states_each_cost_row_with_its_range_and_95th_percentile() {
         study_ron: String::new(),
         figures: Vec::new(),
         substrates: Vec::new(),
+        aerosol: vec![AerosolRow {
+            instrument: "smallsat".into(),
+            found: crate::engine::AerosolSummary {
+                aot550: (0.121, 0.083, 0.17),
+                aot550_true: 0.124,
+                aot550_abs_error: 0.012,
+                angstrom: 0.22,
+                angstrom_true: 1.18,
+                outside_family_pct: 0.0,
+                passes_mean: 1.0,
+                fit: "dark spectrum <tiles>".into(),
+            },
+        }],
     };
     let html = html::page(&data, &[]);
+    // The aerosol the correction found, its text escaped.
+    assert!(html.contains(
+        "<tr><td>smallsat</td><td>dark spectrum &lt;tiles&gt;</td><td class=\"num\">0.121</td><td class=\"num\">0.083–0.170</td>\
+         <td class=\"num\">0.124</td><td class=\"num\">0.012</td>"
+    ));
     let row = |label: &str| {
         let at = html.find(&format!("<tr><td>{label}</td>")).unwrap_or_else(|| panic!("no row {label}"));
         html[at..at + html[at..].find("</tr>").unwrap()].to_string()
