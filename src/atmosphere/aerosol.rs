@@ -150,14 +150,7 @@ impl ComponentTable {
 
     /// A component's optics at `wavelength_nm` (325–2500 nm), interpolated.
     pub fn component_at(&self, c: Component, wavelength_nm: f64) -> Result<ComponentOptics, AtmosphereError> {
-        let (lo, hi) = (TABLE_WAVELENGTHS_NM[0], TABLE_WAVELENGTHS_NM[TABLE_WAVELENGTHS_NM.len() - 1]);
-        if !(lo..=hi).contains(&wavelength_nm) {
-            return Err(AtmosphereError::OutOfRange {
-                field: "wavelength_nm (aerosol)".into(),
-                value: wavelength_nm,
-                allowed: format!("{lo} to {hi} nm"),
-            });
-        }
+        within_table(wavelength_nm)?;
         let rows = &self.rows.iter().find(|(k, _)| *k == c).ok_or_else(|| AtmosphereError::Data("component".into()))?.1;
         Ok(interpolate(rows, wavelength_nm))
     }
@@ -167,6 +160,19 @@ impl ComponentTable {
     pub fn angles_deg(&self) -> &[f64] {
         &self.angles_deg
     }
+}
+
+/// `wavelength_nm` within the component table's range, or the error naming it.
+fn within_table(wavelength_nm: f64) -> Result<(), AtmosphereError> {
+    let (lo, hi) = (TABLE_WAVELENGTHS_NM[0], TABLE_WAVELENGTHS_NM[TABLE_WAVELENGTHS_NM.len() - 1]);
+    if (lo..=hi).contains(&wavelength_nm) {
+        return Ok(());
+    }
+    Err(AtmosphereError::OutOfRange {
+        field: "wavelength_nm (aerosol)".into(),
+        value: wavelength_nm,
+        allowed: format!("{lo} to {hi} nm"),
+    })
 }
 
 /// Optics tabulated at [`TABLE_WAVELENGTHS_NM`] (`rows`), at `wavelength_nm` within the table:
@@ -219,14 +225,7 @@ pub fn mixture_optics(kind: AerosolType, wavelength_nm: f64) -> Result<Option<Ae
             })
             .collect::<Result<_, AtmosphereError>>()?,
     };
-    let (lo, hi) = (TABLE_WAVELENGTHS_NM[0], TABLE_WAVELENGTHS_NM[TABLE_WAVELENGTHS_NM.len() - 1]);
-    if !(lo..=hi).contains(&wavelength_nm) {
-        return Err(AtmosphereError::OutOfRange {
-            field: "wavelength_nm (aerosol)".into(),
-            value: wavelength_nm,
-            allowed: format!("{lo} to {hi} nm"),
-        });
-    }
+    within_table(wavelength_nm)?;
     let k_ext = |w: f64| -> f64 { parts.iter().map(|(rows, n)| n * interpolate(rows, w).c_ext_um2).sum() };
     let (mut k_sca, mut p) = (0.0, vec![0.0; table.angles_deg().len()]);
     for (rows, n) in &parts {

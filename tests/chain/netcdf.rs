@@ -126,6 +126,16 @@ print(int(rrs.isnull().sum()), float(np.nanmedian(rrs.isel(band=2).values)), flo
     assert!(parts[1] > 0.0 && parts[1] < 0.1, "median Rrs at band 3 {text}");
 }
 
+/// `shoal score` with `args`: its chl-a row's cells (it must succeed).
+fn score_chl(args: &[&std::ffi::OsStr]) -> Vec<String> {
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_shoal")).arg("score").args(args).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let table = String::from_utf8_lossy(&o.stdout);
+    println!("{table}");
+    let row = table.lines().find(|l| l.starts_with("chl_mg_m3")).unwrap();
+    row.split_whitespace().map(str::to_string).collect()
+}
+
 /// A product NetCDF of (line, pixel) maps `maps` (name, values) with a −9999 fill value.
 fn product_file(path: &std::path::Path, shape: (usize, usize), maps: &[(&str, Vec<f32>)]) {
     let mut ds = netcdf3::DataSet::new();
@@ -159,29 +169,23 @@ fn shoal_score_scores_an_outside_product_against_the_runs_truth() {
     let requirements = dir.path().join("req.ron");
     std::fs::write(&requirements, "(products: [(variable: \"chl_mg_m3\", mae_pct: Some(5))])").unwrap();
     let scored = dir.path().join("scored");
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_shoal"))
-        .arg("score")
-        .arg(&product)
-        .arg("--truth")
-        .arg(dir.path())
-        .arg("--requirements")
-        .arg(&requirements)
-        .arg("--out")
-        .arg(&scored)
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let table = String::from_utf8_lossy(&o.stdout);
-    println!("{table}");
-    let row = table.lines().find(|l| l.starts_with("chl_mg_m3")).unwrap();
-    let cells: Vec<&str> = row.split_whitespace().collect();
+    let cells = score_chl(&[
+        product.as_os_str(),
+        "--truth".as_ref(),
+        dir.path().as_os_str(),
+        "--requirements".as_ref(),
+        requirements.as_os_str(),
+        "--out".as_ref(),
+        scored.as_os_str(),
+    ]);
+    let row = cells.join(" ");
     // Log-space MAE and bias of a uniform factor 1.1 are both 10 % (Seegers et al. 2018); one
     // water pixel of the 24 × 16 image is missing.
     assert_eq!(cells[3], "10.0", "{row}");
     assert_eq!(cells[4], "+10.0", "{row}");
     let water = truth.land.iter().filter(|l| **l == 0).count();
     assert_eq!(cells[1].parse::<usize>().unwrap(), water - 1, "{row}");
-    assert_eq!(*cells.last().unwrap(), "FAIL", "MAE 10 % against a 5 % requirement: {row}");
+    assert_eq!(cells.last().unwrap(), "FAIL", "MAE 10 % against a 5 % requirement: {row}");
     assert!(std::fs::read_to_string(scored.join("score.csv")).unwrap().contains("chl_mg_m3,"));
     // A product of another size is refused, naming both sizes.
     product_file(&product, (shape.0 + 1, shape.1), &[("chl_mg_m3", vec![1.0; (shape.0 + 1) * shape.1])]);
@@ -211,20 +215,15 @@ fn the_oc4_example_runs_outside_shoal_and_is_scored() {
         .output()
         .unwrap();
     assert!(o.status.success(), "oc4.py: {}", String::from_utf8_lossy(&o.stderr));
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_shoal"))
-        .arg("score")
-        .arg(&product)
-        .arg("--truth")
-        .arg(dir.path())
-        .arg("--out")
-        .arg(dir.path().join("scored"))
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let table = String::from_utf8_lossy(&o.stdout);
-    println!("{table}");
-    let row = table.lines().find(|l| l.starts_with("chl_mg_m3")).unwrap();
-    let cells: Vec<&str> = row.split_whitespace().collect();
+    let scored = dir.path().join("scored");
+    let cells = score_chl(&[
+        product.as_os_str(),
+        "--truth".as_ref(),
+        dir.path().as_os_str(),
+        "--out".as_ref(),
+        scored.as_os_str(),
+    ]);
+    let row = cells.join(" ");
     // Every water pixel returned, and the script's value is OC4v6 of the run's own Rrs (computed
     // here at one pixel; f32 file values, so 1e-5 relative).
     let water = out.radiance.truth.land.iter().filter(|l| **l == 0).count();
