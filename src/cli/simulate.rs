@@ -34,7 +34,7 @@ pub struct SimulateArgs {
     /// Output directory (written whole: a new folder, or one Shoal wrote, which is replaced).
     #[arg(long)]
     out: PathBuf,
-    /// Format of the cubes and maps: npy, or geotiff (georeferenced, for GIS tools).
+    /// Format of the cubes and maps: npy, geotiff (georeferenced, for GIS tools) or netcdf (one CF file).
     #[arg(long, value_enum, default_value_t)]
     format: super::output::Format,
     /// Simulate every n-th line and detector (a quick preview).

@@ -28,7 +28,7 @@ pub struct StudyArgs {
     /// Worker threads (default: all cores).
     #[arg(long)]
     threads: Option<usize>,
-    /// Format of the per-instrument cubes and maps: npy, or geotiff (georeferenced).
+    /// Format of the per-instrument cubes and maps: npy, geotiff (georeferenced) or netcdf (one CF file).
     #[arg(long, value_enum, default_value_t)]
     format: super::output::Format,
     /// Do not write the per-instrument cubes (tables and figures only).
