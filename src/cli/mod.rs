@@ -200,7 +200,8 @@ fn almi_sets(dir: &std::path::Path) -> Result<(), CliError> {
 }
 
 /// Entry point of the `shoal` binary; `app` opens the desktop app (the binary passes it, so that
-/// the command line never imports the app).
+/// the command line does not depend on the app to open it; only `shoal bench`'s app rows, in the
+/// `gui` build, call into `crate::app`).
 #[must_use]
 pub fn main(app: impl FnOnce(&AppArgs) -> ExitCode) -> ExitCode {
     let cli = match Cli::try_parse() {
