@@ -277,7 +277,7 @@ ranges! {
     /// A user's log-normal mode: modal radius.
     AEROSOL_MODE_RADIUS_UM = Range::closed("scene.atmosphere.aerosol.LogNormal.fine.mode_radius_um", 0.005, 5.0, "um", "modal radius of a log-normal mode's number distribution (fine or coarse)");
     /// A user's log-normal mode: geometric standard deviation.
-    AEROSOL_MODE_SIGMA_G = Range::closed("scene.atmosphere.aerosol.LogNormal.fine.sigma_g", 1.05, 3.0, "", "geometric standard deviation of a log-normal mode");
+    AEROSOL_MODE_SIGMA_G = Range::closed("scene.atmosphere.aerosol.LogNormal.fine.sigma_g", 1.05, 2.6, "", "geometric standard deviation of a log-normal mode");
     /// A user's log-normal mode: real refractive index.
     AEROSOL_MODE_REFRACTIVE_REAL = Range::closed("scene.atmosphere.aerosol.LogNormal.fine.refractive_real", 1.3, 1.8, "", "real part of a mode's refractive index");
     /// A user's log-normal mode: imaginary refractive index.

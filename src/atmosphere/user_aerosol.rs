@@ -12,7 +12,9 @@
 //! Sizes are integrated up to r_max = r_m·exp(2σ² + 4σ) (σ = ln σ_g): four standard deviations
 //! past the median of the cross-section-weighted distribution, whose median is r_m·exp(2σ²).
 //! r_max is capped at [`R_MAX_UM`]; the means are per particle of the distribution truncated
-//! there, as OSOAA truncates its components at their α_max.
+//! there, as OSOAA truncates its components at their α_max. A mode with more than
+//! [`MAX_VOLUME_BEYOND_CAP`] of its volume beyond the cap is refused: its number fraction (from
+//! the untruncated volume) would no longer match the volume fraction asked for.
 //!
 //! ## References
 //! - Chami, M. et al. (2015) OSOAA: a vector radiative transfer model of coupled
@@ -35,6 +37,20 @@ use super::mie::{LogNormal, SizeGrid, integrate_lognormal};
 
 /// Largest radius integrated, µm (α = 580 at 325 nm).
 pub const R_MAX_UM: f64 = 30.0;
+
+/// Largest share of a mode's volume allowed beyond [`R_MAX_UM`].
+pub const MAX_VOLUME_BEYOND_CAP: f64 = 0.02;
+
+/// P(Z > z) of a standard normal variable, from erfc (Abramowitz & Stegun 1964, 7.1.26:
+/// |error| ≤ 1.5e-7).
+fn normal_upper_tail(z: f64) -> f64 {
+    let x = z.abs() / std::f64::consts::SQRT_2;
+    let t = 1.0 / (1.0 + 0.327_591_1 * x);
+    let poly =
+        t * (0.254_829_592 + t * (-0.284_496_736 + t * (1.421_413_741 + t * (-1.453_152_027 + t * 1.061_405_429))));
+    let erfc = poly * (-x * x).exp();
+    if z >= 0.0 { 0.5 * erfc } else { 1.0 - 0.5 * erfc }
+}
 
 /// One log-normal mode of a user's aerosol: number distribution
 /// dN/dr ∝ exp(−½(ln(r/r_m)/ln σ_g)²)/r.
@@ -76,6 +92,15 @@ impl AerosolMode {
     pub fn volume_um3(&self) -> f64 {
         let s = self.ln_sigma();
         4.0 / 3.0 * std::f64::consts::PI * self.mode_radius_um.powi(3) * (4.5 * s * s).exp()
+    }
+
+    /// Share of the mode's volume beyond [`R_MAX_UM`]: the volume distribution is log-normal with
+    /// median r_m·exp(3σ²) and the same σ.
+    #[must_use]
+    pub fn volume_beyond_cap(&self) -> f64 {
+        let s = self.ln_sigma();
+        let volume_median = self.mode_radius_um * (3.0 * s * s).exp();
+        normal_upper_tail((R_MAX_UM / volume_median).ln() / s)
     }
 
     /// Largest radius integrated, µm (module docs).
@@ -152,6 +177,19 @@ impl SizeDistribution {
                     });
                 }
             }
+            let beyond = m.volume_beyond_cap();
+            if beyond > MAX_VOLUME_BEYOND_CAP {
+                return Err(AtmosphereError::OutOfRange {
+                    field: format!("aerosol.LogNormal.{name}.mode_radius_um"),
+                    value: m.mode_radius_um,
+                    allowed: format!(
+                        "a mode with at most {:.0} % of its volume beyond {R_MAX_UM} µm (this one, with sigma_g {}, has {:.0} %): a smaller radius or a narrower mode",
+                        100.0 * MAX_VOLUME_BEYOND_CAP,
+                        m.sigma_g,
+                        100.0 * beyond
+                    ),
+                });
+            }
         }
         let f = &r::AEROSOL_COARSE_VOLUME_FRACTION;
         if !f.contains(self.coarse_volume_fraction) {
@@ -168,6 +206,31 @@ impl SizeDistribution {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_wmo_oceanic_distribution_is_allowed() {
+        // r_m 0.3 µm, σ_g 2.51: 1.3 % of its volume beyond 30 µm, inside the 2 % allowed.
+        let oceanic = AerosolMode { mode_radius_um: 0.3, sigma_g: 2.51, refractive_real: 1.381, refractive_imag: 0.0 };
+        assert!(oceanic.volume_beyond_cap() < MAX_VOLUME_BEYOND_CAP, "{}", oceanic.volume_beyond_cap());
+        let d = SizeDistribution { fine: oceanic, coarse: None, coarse_volume_fraction: 0.0 };
+        assert!(d.validate().is_ok());
+    }
+
+    #[test]
+    fn the_normal_tail_and_the_cap() {
+        // Φ tables: P(Z > 0) = 0.5, P(Z > 1.96) = 0.025, P(Z > −1) = 0.8413.
+        assert!((normal_upper_tail(0.0) - 0.5).abs() < 1e-7);
+        assert!((normal_upper_tail(1.959_964) - 0.025).abs() < 1e-6);
+        assert!((normal_upper_tail(-1.0) - 0.841_345).abs() < 1e-6);
+        // r_m 2 µm, σ_g 2.5: volume median 2·exp(3·0.8396) = 24.7 µm, so ~40 % beyond 30 µm.
+        let coarse = AerosolMode { mode_radius_um: 2.0, sigma_g: 2.5, refractive_real: 1.5, refractive_imag: 0.0 };
+        assert!((coarse.volume_beyond_cap() - 0.41).abs() < 0.02, "{}", coarse.volume_beyond_cap());
+        let d = SizeDistribution { fine: coarse, coarse: None, coarse_volume_fraction: 0.0 };
+        assert!(d.validate().unwrap_err().to_string().contains("beyond 30 µm"));
+        // The smoke preset's coarse mode keeps all but 0.14 % (measured).
+        let smoke = AerosolMode { mode_radius_um: 0.67, sigma_g: 2.08, refractive_real: 1.51, refractive_imag: 0.021 };
+        assert!(smoke.volume_beyond_cap() < 2e-3, "{}", smoke.volume_beyond_cap());
+    }
 
     #[test]
     fn volume_is_the_third_moment() {

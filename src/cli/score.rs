@@ -77,7 +77,13 @@ fn read_maps(path: &Path, wanted: &[&str], what: &str) -> Result<Maps, CliError>
         if dims != ["line", "pixel"] {
             return Err(bad(format!("`{name}` has dimensions ({}); expected (line, pixel)", dims.join(", "))));
         }
-        let fill = ds.get_var_attr_f32(name, "_FillValue").and_then(|v| v.first().copied());
+        // `_FillValue` (or `missing_value`) in the variable's own type, f32 or f64.
+        let attr = |a: &str| {
+            ds.get_var_attr_f32(name, a)
+                .and_then(|v| v.first().map(|x| f64::from(*x)))
+                .or_else(|| ds.get_var_attr_f64(name, a).and_then(|v| v.first().copied()))
+        };
+        let fill = attr("_FillValue").or_else(|| attr("missing_value"));
         present.push((name, fill));
     }
     let mut maps = Vec::new();
@@ -88,7 +94,6 @@ fn read_maps(path: &Path, wanted: &[&str], what: &str) -> Result<Maps, CliError>
                 reader.read_var_f64(name).map_err(|e| bad(format!("`{name}` is not a float variable ({e:?})")))?
             }
         };
-        let fill = fill.map(f64::from);
         let values =
             values.into_iter().map(|v| if v.is_finite() && Some(v) != fill { Some(v) } else { None }).collect();
         maps.push((name.to_string(), values));
@@ -186,8 +191,10 @@ fn load_requirements(args: &ScoreArgs) -> Result<Option<Requirements>, CliError>
 /// pass / FAIL against the variable's requirement, or "–" without one.
 fn verdict(requirements: Option<&Requirements>, variable: &str, m: &Metrics) -> &'static str {
     let Some(req) = requirements.and_then(|r| r.for_variable(variable)) else { return "–" };
-    let ok = req.mae_pct.is_none_or(|l| m.mae_pct() <= l)
-        && req.bias_pct.is_none_or(|l| m.bias_pct().abs() <= l)
+    // Nothing returned: no MAE or bias to judge, which fails them (as a study's checks do).
+    let judged = m.n > 0;
+    let ok = req.mae_pct.is_none_or(|l| judged && m.mae_pct() <= l)
+        && req.bias_pct.is_none_or(|l| judged && m.bias_pct().abs() <= l)
         && req.returned_pct.is_none_or(|l| m.returned_pct >= l);
     if ok { "pass" } else { "FAIL" }
 }

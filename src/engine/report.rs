@@ -34,23 +34,43 @@ pub struct SkippedEffect {
     pub reason: String,
 }
 
+/// JSON has no NaN (serde_json writes `null`): read `null` back as NaN, so a summary with a
+/// missing value (no aerosol in the scene, no pixel retrieved) round-trips through `review.json`.
+fn nan_if_null<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    Ok(<Option<f64> as serde::Deserialize>::deserialize(d)?.unwrap_or(f64::NAN))
+}
+
+/// [`nan_if_null`] for a (median, 5th, 95th percentile) triple.
+fn nan_triple_if_null<'de, D: serde::Deserializer<'de>>(d: D) -> Result<(f64, f64, f64), D::Error> {
+    let (a, b, c) = <(Option<f64>, Option<f64>, Option<f64>) as serde::Deserialize>::deserialize(d)?;
+    let nan = |v: Option<f64>| v.unwrap_or(f64::NAN);
+    Ok((nan(a), nan(b), nan(c)))
+}
+
 /// The image-based correction's aerosol against the scene's true aerosol.
 #[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize, Default)]
 pub struct AerosolSummary {
     /// Retrieved AOT(550) over the water pixels: median, 5th and 95th percentiles.
+    #[serde(deserialize_with = "nan_triple_if_null")]
     pub aot550: (f64, f64, f64),
     /// The scene's AOT(550): the atmosphere's, or the median of its map over the water pixels.
+    #[serde(deserialize_with = "nan_if_null")]
     pub aot550_true: f64,
     /// Median over the water pixels of |retrieved − true AOT(550)|, each pixel against the
     /// AOT under it.
+    #[serde(deserialize_with = "nan_if_null")]
     pub aot550_abs_error: f64,
     /// Retrieved Ångström exponent (443–865 nm), median over the water pixels.
+    #[serde(deserialize_with = "nan_if_null")]
     pub angstrom: f64,
     /// The scene's aerosol model's Ångström exponent (443–865 nm).
+    #[serde(deserialize_with = "nan_if_null")]
     pub angstrom_true: f64,
     /// Share of retrieved pixels whose measured ε lay outside the family's range, %.
+    #[serde(deserialize_with = "nan_if_null")]
     pub outside_family_pct: f64,
     /// Mean passes of the NIR water-leaving iteration (1 without it).
+    #[serde(deserialize_with = "nan_if_null")]
     pub passes_mean: f64,
     /// What the correction did, in words (its fit; for dark-spectrum fitting the models the
     /// tiles chose).

@@ -168,9 +168,19 @@ impl Engine {
         control: &RunControl,
         report: &mut RunReport,
     ) -> Result<(Option<Arc<AotNodes>>, Key), EngineError> {
-        let Some(map) = &scene.aot550 else { return Ok((None, band_key)) };
-        let (lo, hi) = map.range();
-        let nodes = aerosol_map::node_values(lo, hi);
+        if scene.aot550.is_none() {
+            return Ok((None, band_key));
+        }
+        // The AOT under every pixel centre the image samples (the map's own range is sampled on
+        // at most 512² cells and could miss a corner or a narrow peak).
+        let (lo, hi) = (0..viewing.lines())
+            .flat_map(|r| (0..viewing.columns()).map(move |c| (r, c)))
+            .map(|(r, c)| {
+                let (x, y) = viewing.ground_m(0, r, c);
+                scene.aot550_at(x, y)
+            })
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)));
+        let nodes = aerosol_map::node_values(lo, hi.max(lo));
         let mut luts = Vec::with_capacity(nodes.len());
         let mut nodes_key = KeyBuilder::new(Stage::BandAtmosphere).after(band_key).with(&nodes);
         for &tau in &nodes {

@@ -98,6 +98,21 @@ fn the_review_pack_states_each_cost_row_with_its_range_and_95th_percentile() {
 }
 
 #[test]
+fn an_aerosol_summary_with_missing_values_round_trips_through_review_json() {
+    // No aerosol in the scene: the true Ångström exponent is NaN, written as JSON null.
+    let a = crate::engine::AerosolSummary {
+        aot550: (f64::NAN, 0.1, f64::NAN),
+        angstrom_true: f64::NAN,
+        fit: "pair".into(),
+        ..Default::default()
+    };
+    let text = serde_json::to_string(&a).unwrap();
+    let back: crate::engine::AerosolSummary = serde_json::from_str(&text).unwrap();
+    assert!(back.aot550.0.is_nan() && back.aot550.2.is_nan() && back.angstrom_true.is_nan(), "{text}");
+    assert_eq!((back.aot550.1, back.fit.as_str()), (0.1, "pair"));
+}
+
+#[test]
 fn utc_text_matches_the_calendar() {
     // Values from Python's datetime.utcfromtimestamp: the epoch, a leap day, this decade.
     assert_eq!(utc_text(0), "1970-01-01T00:00:00Z");

@@ -231,6 +231,12 @@ impl SceneSpec {
                 "SunGlint needs a wind-roughened surface: atmosphere.surface: Wind(speed_m_s: ..)".into(),
             );
         }
+        if self.aot550_map.is_some() && self.atmosphere.aerosol == crate::atmosphere::AerosolType::None {
+            return bad(
+                "aot550_map",
+                "an aerosol optical thickness map needs an aerosol model: atmosphere.aerosol is None".into(),
+            );
+        }
         if has(Effect::Adjacency) && self.land.is_none() {
             return bad("effects", "Adjacency needs `land` (a mask and a reflectance)".into());
         }

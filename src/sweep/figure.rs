@@ -99,13 +99,20 @@ pub fn curves_by_pair_snr(table: &Table, variable: &str, requirement: Option<&Re
     }
     let mut c = curves(table, variable, requirement, true);
     let limit = c.requirement.as_ref().map(|r| r.0);
-    for s in &mut c.series {
-        let instrument = s.label.split(", ").next().unwrap_or_default().to_string();
+    // The series' keys, in the order `curves` made them: (instrument, second parameter).
+    let mut keys: Vec<(String, Option<f64>)> = Vec::new();
+    for r in table.rows.iter().filter(|r| r.variable == variable) {
+        let key = (r.instrument.clone(), r.values.get(1).copied());
+        if !keys.contains(&key) {
+            keys.push(key);
+        }
+    }
+    for (s, (instrument, second)) in c.series.iter_mut().zip(&keys) {
         for p in &mut s.points {
             let snr: Vec<f64> = table
                 .rows
                 .iter()
-                .filter(|r| r.instrument == instrument && r.values[0] == p.x)
+                .filter(|r| &r.instrument == instrument && r.values.get(1).copied() == *second && r.values[0] == p.x)
                 .filter_map(|r| r.snr_pair.map(|p| p[1]))
                 .filter(|v| v.is_finite())
                 .collect();

@@ -76,7 +76,7 @@ fn a_size_distribution_out_of_range_names_its_field() {
         ..AtmosphereSpec::default()
     };
     let e = spec.validate().unwrap_err().to_string();
-    assert!(e.contains("aerosol.LogNormal.fine.sigma_g") && e.contains("1.05 to 3"), "{e}");
+    assert!(e.contains("aerosol.LogNormal.fine.sigma_g") && e.contains("1.05 to 2.6"), "{e}");
     spec.aerosol = AerosolType::LogNormal(SizeDistribution {
         fine: oceanic_like(),
         coarse: Some(AerosolMode { refractive_imag: -0.1, ..oceanic_like() }),
