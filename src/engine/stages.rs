@@ -172,14 +172,19 @@ impl Engine {
             return Ok((None, band_key));
         }
         // The AOT under every pixel centre the image samples (the map's own range is sampled on
-        // at most 512² cells and could miss a corner or a narrow peak).
-        let (lo, hi) = (0..viewing.lines())
-            .flat_map(|r| (0..viewing.columns()).map(move |c| (r, c)))
-            .map(|(r, c)| {
-                let (x, y) = viewing.ground_m(0, r, c);
-                scene.aot550_at(x, y)
-            })
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)));
+        // at most 512² cells and could miss a corner or a narrow peak); cached with the band
+        // atmosphere, so a run that changes only the electronics does not walk the image again.
+        let range_key = KeyBuilder::new(Stage::BandAtmosphere).after(band_key).with("aot550 range").finish();
+        let range = self.stage(range_key, report, control, || {
+            Ok((0..viewing.lines())
+                .flat_map(|r| (0..viewing.columns()).map(move |c| (r, c)))
+                .map(|(r, c)| {
+                    let (x, y) = viewing.ground_m(0, r, c);
+                    scene.aot550_at(x, y)
+                })
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v))))
+        })?;
+        let (lo, hi) = *range;
         let nodes = aerosol_map::node_values(lo, hi.max(lo));
         let mut luts = Vec::with_capacity(nodes.len());
         let mut nodes_key = KeyBuilder::new(Stage::BandAtmosphere).after(band_key).with(&nodes);

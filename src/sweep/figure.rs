@@ -7,9 +7,9 @@ use crate::study::{CurvePoint, CurveSeries, Curves, Figure, StudyError, curve_fi
 use super::Requirement;
 use super::table::Table;
 
-/// The curves of `variable` in `table` (points ordered by the first parameter).
-#[must_use]
-pub fn curves(table: &Table, variable: &str, requirement: Option<&Requirement>, log_x: bool) -> Curves {
+/// The series of `variable` in `table`: (instrument, second parameter's value), in the order of
+/// their first row.
+fn series_keys(table: &Table, variable: &str) -> Vec<(String, Option<f64>)> {
     let mut keys: Vec<(String, Option<f64>)> = Vec::new();
     for r in table.rows.iter().filter(|r| r.variable == variable) {
         let key = (r.instrument.clone(), r.values.get(1).copied());
@@ -17,6 +17,13 @@ pub fn curves(table: &Table, variable: &str, requirement: Option<&Requirement>, 
             keys.push(key);
         }
     }
+    keys
+}
+
+/// The curves of `variable` in `table` (points ordered by the first parameter).
+#[must_use]
+pub fn curves(table: &Table, variable: &str, requirement: Option<&Requirement>, log_x: bool) -> Curves {
+    let keys = series_keys(table, variable);
     let limit = requirement.filter(|q| q.variable == variable).map(|q| q.mae_pct);
     let series = keys
         .iter()
@@ -99,14 +106,8 @@ pub fn curves_by_pair_snr(table: &Table, variable: &str, requirement: Option<&Re
     }
     let mut c = curves(table, variable, requirement, true);
     let limit = c.requirement.as_ref().map(|r| r.0);
-    // The series' keys, in the order `curves` made them: (instrument, second parameter).
-    let mut keys: Vec<(String, Option<f64>)> = Vec::new();
-    for r in table.rows.iter().filter(|r| r.variable == variable) {
-        let key = (r.instrument.clone(), r.values.get(1).copied());
-        if !keys.contains(&key) {
-            keys.push(key);
-        }
-    }
+    // The series' keys, in the order `curves` made them.
+    let keys = series_keys(table, variable);
     for (s, (instrument, second)) in c.series.iter_mut().zip(&keys) {
         for p in &mut s.points {
             let snr: Vec<f64> = table
