@@ -23,6 +23,7 @@
 //! | [`jobs`] | background work: the newest-request-wins mailbox and the one rayon pool builder |
 //! | [`simd`] | hot loops compiled per instruction-set level (AVX-512, AVX2 + FMA), chosen at run time |
 //! | [`geotiff`] | GeoTIFF in and out: rasters with geotransform, CRS, nodata, band names and units |
+//! | [`netcdf`] | NetCDF-3 with CF metadata: the variables, writing atomically, reading (line, pixel) maps |
 //! | [`spectral`] | wavelength grid, spectra, band sets, `band_from_fine` |
 //! | [`water`] | SIOP sets, IOPs, deep/shallow reflectance (Lee et al. 1998/1999, SAMBUCA) |
 //! | [`ranges`] | the documented range of every number a user sets: one table the validators use |
@@ -62,6 +63,7 @@ pub mod instrument;
 pub mod jobs;
 pub mod library;
 pub mod metrics;
+pub mod netcdf;
 pub mod parse;
 pub mod ranges;
 pub mod report;

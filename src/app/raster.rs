@@ -47,9 +47,9 @@ pub fn product_map(out: &RunOutput, kind: ProductKind, band: usize, truth: bool)
     let nb = r.radiance.dim().2;
     let band = band.min(nb.saturating_sub(1));
     match kind {
-        ProductKind::Chl => product_or_truth(&r.truth.chl_mg_m3, |p| Some(&p.chl_mg_m3)),
-        ProductKind::Nap => product_or_truth(&r.truth.nap_g_m3, |p| Some(&p.nap_g_m3)),
-        ProductKind::Cdom => product_or_truth(&r.truth.cdom_per_m, |p| Some(&p.cdom_per_m)),
+        ProductKind::Chl => product_or_truth(&r.truth.chl_mg_m3, |p| p.chl_mg_m3.as_ref()),
+        ProductKind::Nap => product_or_truth(&r.truth.nap_g_m3, |p| p.nap_g_m3.as_ref()),
+        ProductKind::Cdom => product_or_truth(&r.truth.cdom_per_m, |p| p.cdom_per_m.as_ref()),
         ProductKind::Depth => product_or_truth(r.truth.depth_m.as_ref()?, |p| p.depth_m.as_ref()),
         ProductKind::Substrate => {
             let (f, names) = if truth {

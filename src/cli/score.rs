@@ -37,68 +37,15 @@ pub struct ScoreArgs {
 }
 
 /// Shoal's product variables, in table order.
-const VARIABLES: [&str; 4] = ["chl_mg_m3", "nap_g_m3", "cdom_per_m", "depth_m"];
+const VARIABLES: [&str; 4] = crate::netcdf::PRODUCT_VARIABLES;
 
 /// Largest NetCDF file read, bytes: a full-resolution default-study product is ~0.7 GB.
 const MAX_BYTES: u64 = 8 << 30;
 
-/// A NetCDF file's float (line, pixel) variables by name, with their fill values applied
-/// (`None` where missing), and the (line, pixel) size.
-struct Maps {
-    shape: (usize, usize),
-    maps: Vec<(String, Vec<Option<f64>>)>,
-}
-
-fn read_maps(path: &Path, wanted: &[&str], what: &str) -> Result<Maps, CliError> {
-    let size = std::fs::metadata(path).map_err(|e| CliError::Input(format!("{what} {}: {e}", path.display())))?.len();
-    if size > MAX_BYTES {
-        return Err(CliError::Input(format!(
-            "{what} {}: {:.1} GB is over the {} GB this command reads",
-            path.display(),
-            size as f64 / 1e9,
-            MAX_BYTES >> 30
-        )));
-    }
-    let bad = |m: String| CliError::Input(format!("{what} {}: {m}", path.display()));
-    let mut reader = netcdf3::FileReader::open(path).map_err(|e| {
-        // The reader's error can quote the whole header's bytes: its first words say enough.
-        let why: String = format!("{e:?}").chars().take(120).collect();
-        bad(format!("not a NetCDF-3 file Shoal can read ({why}…)"))
-    })?;
-    let ds = reader.data_set();
-    let (lines, pixels) = match (ds.dim_size("line"), ds.dim_size("pixel")) {
-        (Some(l), Some(p)) => (l, p),
-        _ => return Err(bad("needs dimensions `line` and `pixel`".into())),
-    };
-    let mut present = Vec::new();
-    for &name in wanted {
-        let Some(var) = ds.get_var(name) else { continue };
-        let dims: Vec<String> = var.dim_names();
-        if dims != ["line", "pixel"] {
-            return Err(bad(format!("`{name}` has dimensions ({}); expected (line, pixel)", dims.join(", "))));
-        }
-        // `_FillValue` (or `missing_value`) in the variable's own type, f32 or f64.
-        let attr = |a: &str| {
-            ds.get_var_attr_f32(name, a)
-                .and_then(|v| v.first().map(|x| f64::from(*x)))
-                .or_else(|| ds.get_var_attr_f64(name, a).and_then(|v| v.first().copied()))
-        };
-        let fill = attr("_FillValue").or_else(|| attr("missing_value"));
-        present.push((name, fill));
-    }
-    let mut maps = Vec::new();
-    for (name, fill) in present {
-        let values = match reader.read_var_f32(name) {
-            Ok(v) => v.into_iter().map(f64::from).collect::<Vec<f64>>(),
-            Err(_) => {
-                reader.read_var_f64(name).map_err(|e| bad(format!("`{name}` is not a float variable ({e:?})")))?
-            }
-        };
-        let values =
-            values.into_iter().map(|v| if v.is_finite() && Some(v) != fill { Some(v) } else { None }).collect();
-        maps.push((name.to_string(), values));
-    }
-    Ok(Maps { shape: (lines, pixels), maps })
+/// Read `wanted` from `path` (see [`crate::netcdf::read_maps`]); `what` names the file in errors.
+fn read_maps(path: &Path, wanted: &[&str], what: &str) -> Result<crate::netcdf::Maps, CliError> {
+    crate::netcdf::read_maps(path, wanted, MAX_BYTES)
+        .map_err(|m| CliError::Input(format!("{what} {}: {m}", path.display())))
 }
 
 /// `shoal score`.

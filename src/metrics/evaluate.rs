@@ -92,10 +92,11 @@ impl Plan<'_> {
         let (product, truth) = (self.product, self.truth);
         let cols = product.flags.dim().1;
         let mut b = self.empty_block();
+        // A variable the product lacks (an external retrieval's choice) adds nothing.
         let maps = [
-            (&product.chl_mg_m3, &truth.chl_mg_m3),
-            (&product.nap_g_m3, &truth.nap_g_m3),
-            (&product.cdom_per_m, &truth.cdom_per_m),
+            (product.chl_mg_m3.as_ref(), &truth.chl_mg_m3),
+            (product.nap_g_m3.as_ref(), &truth.nap_g_m3),
+            (product.cdom_per_m.as_ref(), &truth.cdom_per_m),
         ];
         for r in rows {
             for c in 0..cols {
@@ -106,7 +107,9 @@ impl Plan<'_> {
                 let returned = product.returned(r, c);
                 let got = |map: &Array2<f32>| returned.then(|| f64::from(map[[r, c]]));
                 for (sums, (m, o)) in b.constituents.iter_mut().zip(maps) {
-                    sums.add(got(m), Some(f64::from(o[[r, c]])));
+                    if let Some(m) = m {
+                        sums.add(got(m), Some(f64::from(o[[r, c]])));
+                    }
                 }
                 if let Some((depth, true_depth)) = self.depth {
                     let (m, o) = (got(depth), Some(f64::from(true_depth[[r, c]])));
@@ -207,6 +210,7 @@ pub fn evaluate(product: &Product, truth: &Truth) -> ProductMetrics {
     let mut variables: Vec<VariableMetrics> = names
         .iter()
         .zip(&all.constituents)
+        .filter(|(v, _)| product.map(v).is_some())
         .map(|(v, s)| VariableMetrics { variable: (*v).into(), metrics: s.metrics() })
         .collect();
     let mut depth_by_true_substrate = Vec::new();
@@ -285,9 +289,9 @@ mod tests {
             |t: &Array2<f32>, k: f32| Array2::from_shape_fn((rows, cols), |(r, c)| t[[r, c]] * wobble(r, c, k));
         let product = Product {
             name: "test".into(),
-            chl_mg_m3: retrieved(&truth.chl_mg_m3, 0.7),
-            cdom_per_m: retrieved(&truth.cdom_per_m, 1.3),
-            nap_g_m3: retrieved(&truth.nap_g_m3, 0.2),
+            chl_mg_m3: Some(retrieved(&truth.chl_mg_m3, 0.7)),
+            cdom_per_m: Some(retrieved(&truth.cdom_per_m, 1.3)),
+            nap_g_m3: Some(retrieved(&truth.nap_g_m3, 0.2)),
             depth_m: Some(retrieved(truth.depth_m.as_ref().unwrap(), 0.9)),
             substrate_names: vec!["coral".into(), "mud".into()],
             substrate_fractions: Some(Array3::from_shape_fn((rows, cols, 2), |(r, c, s)| ((r + c * 2 + s) % 3) as f32)),
@@ -332,8 +336,11 @@ mod tests {
         let (p, t) = scene();
         let m = evaluate(&p, &t);
         let all = |_: usize, _: usize| true;
-        assert_close(m.get("chl_mg_m3").unwrap(), &one_by_one(&p, &t, &p.chl_mg_m3, &t.chl_mg_m3, all));
-        assert_close(m.get("nap_g_m3").unwrap(), &one_by_one(&p, &t, &p.nap_g_m3, &t.nap_g_m3, all));
+        assert_close(
+            m.get("chl_mg_m3").unwrap(),
+            &one_by_one(&p, &t, p.chl_mg_m3.as_ref().unwrap(), &t.chl_mg_m3, all),
+        );
+        assert_close(m.get("nap_g_m3").unwrap(), &one_by_one(&p, &t, p.nap_g_m3.as_ref().unwrap(), &t.nap_g_m3, all));
         let (d, td) = (p.depth_m.as_ref().unwrap(), t.depth_m.as_ref().unwrap());
         let visible = |r: usize, c: usize| p.flags[[r, c]] & ProductFlags::BOTTOM_VISIBLE != 0;
         assert_close(m.get("depth_m_bottom_visible").unwrap(), &one_by_one(&p, &t, d, td, visible));

@@ -109,14 +109,15 @@ impl ProductFlags {
 /// A retrieval's products over the image.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Product {
-    /// "aLMI" or "SAMBUCA".
+    /// "aLMI", "SAMBUCA", or an external retrieval's name.
     pub name: String,
-    /// Chlorophyll-a, mg m⁻³ (0 where not returned).
-    pub chl_mg_m3: Array2<f32>,
-    /// CDOM absorption at the reference wavelength, m⁻¹.
-    pub cdom_per_m: Array2<f32>,
-    /// NAP, g m⁻³.
-    pub nap_g_m3: Array2<f32>,
+    /// Chlorophyll-a, mg m⁻³ (0 where not returned; `None`: an external retrieval that does not
+    /// return it).
+    pub chl_mg_m3: Option<Array2<f32>>,
+    /// CDOM absorption at the reference wavelength, m⁻¹ (as `chl_mg_m3`).
+    pub cdom_per_m: Option<Array2<f32>>,
+    /// NAP, g m⁻³ (as `chl_mg_m3`).
+    pub nap_g_m3: Option<Array2<f32>>,
     /// Depth, m (SAMBUCA).
     pub depth_m: Option<Array2<f32>>,
     /// Substrate names of `substrate_fractions`.
@@ -149,9 +150,9 @@ impl Product {
     #[must_use]
     pub fn map(&self, variable: &str) -> Option<&Array2<f32>> {
         match variable {
-            "chl_mg_m3" => Some(&self.chl_mg_m3),
-            "nap_g_m3" => Some(&self.nap_g_m3),
-            "cdom_per_m" => Some(&self.cdom_per_m),
+            "chl_mg_m3" => self.chl_mg_m3.as_ref(),
+            "nap_g_m3" => self.nap_g_m3.as_ref(),
+            "cdom_per_m" => self.cdom_per_m.as_ref(),
             "depth_m" => self.depth_m.as_ref(),
             _ => None,
         }
@@ -336,9 +337,9 @@ pub(super) fn retrieve_almi(
     let plane = |k: fn(&AlmiRow) -> f32| Array2::from_shape_fn((rows, cols), |(r, c)| k(&results[r][c]));
     Ok(Product {
         name: "aLMI".into(),
-        chl_mg_m3: plane(|p| p.0),
-        cdom_per_m: plane(|p| p.1),
-        nap_g_m3: plane(|p| p.2),
+        chl_mg_m3: Some(plane(|p| p.0)),
+        cdom_per_m: Some(plane(|p| p.1)),
+        nap_g_m3: Some(plane(|p| p.2)),
         depth_m: None,
         substrate_names: Vec::new(),
         substrate_fractions: None,

@@ -179,9 +179,9 @@ fn sambuca_product(results: &[Vec<SambucaRow>], names: Vec<String>, siop_name: &
     let plane = |k: fn(&SambucaRow) -> f32| Array2::from_shape_fn((rows, cols), |(r, c)| k(&results[r][c]));
     Product {
         name: "SAMBUCA".into(),
-        chl_mg_m3: plane(|p| p.0),
-        cdom_per_m: plane(|p| p.1),
-        nap_g_m3: plane(|p| p.2),
+        chl_mg_m3: Some(plane(|p| p.0)),
+        cdom_per_m: Some(plane(|p| p.1)),
+        nap_g_m3: Some(plane(|p| p.2)),
         depth_m: Some(plane(|p| p.3)),
         substrate_names: names,
         substrate_fractions: Some(fractions),

@@ -182,9 +182,15 @@ pub fn write_run_geotiff(out: &RunOutput, dir: &Path) -> Result<Outputs, StudyEr
         let returned = |r: usize, c: usize| p.flags[[r, c]] & ProductFlags::RETURNED != 0;
         let mut m = shared.clone();
         m.metadata.push(("RETRIEVAL".into(), p.name.clone()));
-        push(&mut m, plane(&p.chl_mg_m3, &returned), "retrieved chlorophyll-a", "mg m-3");
-        push(&mut m, plane(&p.nap_g_m3, &returned), "retrieved NAP", "g m-3");
-        push(&mut m, plane(&p.cdom_per_m, &returned), "retrieved CDOM absorption at 440 nm", "m-1");
+        for (map, what, unit) in [
+            (&p.chl_mg_m3, "retrieved chlorophyll-a", "mg m-3"),
+            (&p.nap_g_m3, "retrieved NAP", "g m-3"),
+            (&p.cdom_per_m, "retrieved CDOM absorption at 440 nm", "m-1"),
+        ] {
+            if let Some(map) = map {
+                push(&mut m, plane(map, &returned), what, unit);
+            }
+        }
         if let Some(d) = &p.depth_m {
             push(&mut m, plane(d, &returned), "retrieved depth", "m");
         }

@@ -14,115 +14,26 @@
 //! - CF Standard Name Table (chlorophyll, suspended matter, remote-sensing reflectance, depth).
 //! - Unidata, The NetCDF Classic and 64-bit Offset File Formats (NetCDF-3).
 
-use std::cell::RefCell;
-use std::io::{BufWriter, Seek, SeekFrom, Write};
 use std::path::Path;
-use std::rc::Rc;
 
-use netcdf3::{DataSet, FileWriter, Version};
+use netcdf3::DataSet;
 
 use super::StudyError;
 use super::output::Outputs;
 use crate::correction::RrsFlags;
 use crate::engine::RunOutput;
+use crate::netcdf::{CUBE, FlagVar, FloatVar, MAP, attrs, define_vars, masked, meaning, standard_name, write_file};
 use crate::retrieval::ProductFlags;
 
 /// The file a run's NetCDF product is written to.
 pub const FILE: &str = "products.nc";
 
+pub use crate::netcdf::FILL;
+
 /// Auxiliary coordinates of a (line, pixel) map: every pixel's ground position.
 const MAP_COORDINATES: &str = "y x";
 /// Auxiliary coordinates of a (line, pixel, band) cube: the ground position and the bands.
 const CUBE_COORDINATES: &str = "y x wavelength bandwidth";
-
-/// CF standard names of Shoal's product variables (those CF has).
-fn standard_name(variable: &str) -> Option<&'static str> {
-    Some(match variable {
-        "chl_mg_m3" => "mass_concentration_of_chlorophyll_a_in_sea_water",
-        "nap_g_m3" => "mass_concentration_of_suspended_matter_in_sea_water",
-        "depth_m" => "sea_floor_depth_below_sea_surface",
-        "rrs" => "surface_ratio_of_upwelling_radiance_emerging_from_sea_water_to_downwelling_radiative_flux_in_air",
-        _ => return None,
-    })
-}
-
-/// What a product variable is, and its unit (UDUNITS).
-fn meaning(variable: &str) -> (&'static str, &'static str) {
-    match variable {
-        "chl_mg_m3" => ("chlorophyll-a concentration", "mg m-3"),
-        "nap_g_m3" => ("non-algal particle (suspended matter) concentration", "g m-3"),
-        "cdom_per_m" => ("CDOM absorption coefficient at the SIOP set's reference wavelength", "m-1"),
-        "depth_m" => ("water depth", "m"),
-        _ => ("", "1"),
-    }
-}
-
-/// A float variable of the data set with its data: (name, dimensions, attributes, values).
-struct FloatVar {
-    name: String,
-    dims: Vec<&'static str>,
-    attrs: Vec<(&'static str, String)>,
-    values: Vec<f32>,
-}
-
-/// An integer flag variable: name, dimensions, what it is, masks and meanings, values. 32-bit:
-/// CF wants the masks in the variable's type, Shoal's product flags use all eight bits of a byte
-/// (128 is no NC_BYTE), and the `netcdf3` crate pads a 1- or 2-byte attribute list with fill
-/// values where the format wants zero bytes (its own reader then refuses the header; ncdump
-/// accepts it): 4-byte attributes need no padding.
-struct FlagVar {
-    name: String,
-    dims: Vec<&'static str>,
-    long_name: String,
-    flags: Vec<(i32, &'static str)>,
-    values: Vec<i32>,
-    /// Auxiliary coordinates (the `coordinates` attribute).
-    coordinates: &'static str,
-}
-
-/// Written where a value has no meaning (land, not returned, invalid Rrs), declared as
-/// `_FillValue` (readers such as xarray turn it into NaN): the GeoTIFF products' no-data value.
-/// Not NaN itself: the `netcdf3` crate finds a variable by comparing its attributes, and a NaN
-/// attribute never equals itself.
-pub const FILL: f32 = -9999.0;
-
-/// `keep`-masked values of a map, [`FILL`] elsewhere (and where not finite).
-fn masked(values: impl Iterator<Item = f32>, keep: impl Fn(usize) -> bool) -> Vec<f32> {
-    values.enumerate().map(|(i, v)| if keep(i) && v.is_finite() { v } else { FILL }).collect()
-}
-
-/// A shared, seekable, buffered file: the writer owns one handle, Shoal keeps the other to flush
-/// and sync it once the writer has closed.
-#[derive(Clone)]
-struct Shared(Rc<RefCell<BufWriter<std::fs::File>>>);
-
-impl Write for Shared {
-    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
-        self.0.borrow_mut().write(buf)
-    }
-    fn flush(&mut self) -> std::io::Result<()> {
-        self.0.borrow_mut().flush()
-    }
-}
-
-impl Seek for Shared {
-    fn seek(&mut self, pos: SeekFrom) -> std::io::Result<u64> {
-        self.0.borrow_mut().seek(pos)
-    }
-}
-
-/// Dimensions of a (line, pixel, band) cube and a (line, pixel) map.
-const CUBE: [&str; 3] = ["line", "pixel", "band"];
-const MAP: [&str; 2] = ["line", "pixel"];
-
-/// `long_name`, `units` and, where CF has one, `standard_name`.
-fn attrs(long: &str, units: &str, standard: Option<&str>) -> Vec<(&'static str, String)> {
-    let mut a = vec![("long_name", long.to_string()), ("units", units.to_string())];
-    if let Some(s) = standard {
-        a.push(("standard_name", s.to_string()));
-    }
-    a
-}
 
 /// Write `out`'s products into `dir/products.nc` (atomically: a temporary file, synced, then
 /// renamed).
@@ -136,7 +47,7 @@ pub fn write_netcdf(out: &RunOutput, dir: &Path, o: &mut Outputs) -> Result<(), 
     retrieval_vars(out, &mut floats, &mut flags);
     let data_set = define(out, (rows, cols, nb), &floats, &flags)?;
     let path = dir.join(FILE);
-    write_file(&path, &data_set, &floats, &flags)?;
+    write_file(&path, &data_set, &floats, &flags).map_err(StudyError::Io)?;
     o.files.push(FILE.to_string());
     Ok(())
 }
@@ -301,11 +212,8 @@ fn retrieval_vars(out: &RunOutput, floats: &mut Vec<FloatVar>, flags: &mut Vec<F
         let stem = ret.spec.name();
         let pf = p.flags.as_slice().unwrap_or_default();
         let returned = |i: usize| pf.get(i).is_some_and(|f| f & ProductFlags::RETURNED != 0);
-        let mut maps: Vec<(&str, &ndarray::Array2<f32>)> =
-            vec![("chl_mg_m3", &p.chl_mg_m3), ("nap_g_m3", &p.nap_g_m3), ("cdom_per_m", &p.cdom_per_m)];
-        if let Some(d) = &p.depth_m {
-            maps.push(("depth_m", d));
-        }
+        let maps: Vec<(&str, &ndarray::Array2<f32>)> =
+            crate::netcdf::PRODUCT_VARIABLES.iter().filter_map(|&v| p.map(v).map(|m| (v, m))).collect();
         for (variable, values) in maps {
             let (long, units) = meaning(variable);
             let mut a = attrs(&format!("{long} retrieved by {}", p.name), units, standard_name(variable));
@@ -350,29 +258,7 @@ fn define(
     ds.add_fixed_dim("line", rows).map_err(bad)?;
     ds.add_fixed_dim("pixel", cols).map_err(bad)?;
     ds.add_fixed_dim("band", nb).map_err(bad)?;
-    for v in floats {
-        ds.add_var_f32(&v.name, &v.dims).map_err(bad)?;
-        for (k, value) in &v.attrs {
-            ds.add_var_attr_string(&v.name, k, value).map_err(bad)?;
-        }
-        if v.dims.len() > 1 {
-            ds.add_var_attr_f32(&v.name, "_FillValue", vec![FILL]).map_err(bad)?;
-        }
-    }
-    for f in flags {
-        ds.add_var_i32(&f.name, &f.dims).map_err(bad)?;
-        ds.add_var_attr_string(&f.name, "long_name", &f.long_name).map_err(bad)?;
-        if f.flags.len() == 1 {
-            ds.add_var_attr_i32(&f.name, "flag_values", vec![0, f.flags[0].0]).map_err(bad)?;
-            ds.add_var_attr_string(&f.name, "flag_meanings", format!("not_{} {}", f.flags[0].1, f.flags[0].1))
-                .map_err(bad)?;
-        } else {
-            ds.add_var_attr_i32(&f.name, "flag_masks", f.flags.iter().map(|x| x.0).collect()).map_err(bad)?;
-            let meanings: Vec<&str> = f.flags.iter().map(|x| x.1).collect();
-            ds.add_var_attr_string(&f.name, "flag_meanings", meanings.join(" ")).map_err(bad)?;
-        }
-        ds.add_var_attr_string(&f.name, "coordinates", f.coordinates).map_err(bad)?;
-    }
+    define_vars(&mut ds, floats, flags).map_err(StudyError::Io)?;
     let config = out.config.to_ron().map_err(|e| StudyError::Io(e.to_string()))?;
     let geolocation = match &out.scene.frame {
         Some(f) => format!("pushbroom ground points in {} (scene centre at {:.3}, {:.3})", f.crs.describe(), f.centre.0, f.centre.1),
@@ -403,35 +289,4 @@ fn define(
         ds.add_global_attr_string(k, v).map_err(bad)?;
     }
     Ok(ds)
-}
-
-/// Write the data set and its values to `path` through a temporary file, synced, then renamed.
-fn write_file(path: &Path, ds: &DataSet, floats: &[FloatVar], flags: &[FlagVar]) -> Result<(), StudyError> {
-    let tmp = path.with_extension("nc.partial");
-    let fail = |m: String| StudyError::Io(format!("cannot write {}: {m}", path.display()));
-    let result = (|| -> Result<(), StudyError> {
-        let file = std::fs::File::create(&tmp).map_err(|e| fail(e.to_string()))?;
-        let shared = Shared(Rc::new(RefCell::new(BufWriter::with_capacity(1 << 20, file))));
-        let mut writer = FileWriter::open_seek_write(&tmp.to_string_lossy(), Box::new(shared.clone()))
-            .map_err(|e| fail(format!("{e:?}")))?;
-        writer.set_def(ds, Version::Offset64Bit, 0).map_err(|e| fail(format!("{e:?}")))?;
-        for v in floats {
-            writer.write_var_f32(&v.name, &v.values).map_err(|e| fail(format!("{}: {e:?}", v.name)))?;
-        }
-        for f in flags {
-            writer.write_var_i32(&f.name, &f.values).map_err(|e| fail(format!("{}: {e:?}", f.name)))?;
-        }
-        writer.close().map_err(|e| fail(format!("{e:?}")))?;
-        let mut buffered = shared.0.borrow_mut();
-        buffered.flush().map_err(|e| fail(e.to_string()))?;
-        buffered.get_ref().sync_all().map_err(|e| fail(e.to_string()))?;
-        Ok(())
-    })();
-    match result.and_then(|()| std::fs::rename(&tmp, path).map_err(|e| fail(e.to_string()))) {
-        Ok(()) => Ok(()),
-        Err(e) => {
-            let _ = std::fs::remove_file(&tmp);
-            Err(e)
-        }
-    }
 }

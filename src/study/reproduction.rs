@@ -370,7 +370,10 @@ fn points(run: &StudyRun, mode: usize, depth: bool) -> Vec<(f64, f64, f64)> {
             _ => return Vec::new(),
         }
     } else {
-        (&run.truth.chl_mg_m3, &p.chl_mg_m3)
+        match &p.chl_mg_m3 {
+            Some(g) => (&run.truth.chl_mg_m3, g),
+            None => return Vec::new(),
+        }
     };
     let acropora = p.substrate_names.iter().position(|n| n == "acropora");
     let all: Vec<(usize, usize)> = truth

@@ -164,7 +164,7 @@ fn bad_sweeps_are_refused_by_name() {
 fn chl_mae_pct(product: &shoal::retrieval::Product, truth: &Array2<f32>, land: &Array2<u8>) -> (f64, usize) {
     let (mut sum, mut n) = (0.0, 0usize);
     for ((r, c), &o) in truth.indexed_iter() {
-        let m = product.chl_mg_m3[[r, c]];
+        let m = product.chl_mg_m3.as_ref().unwrap()[[r, c]];
         if land[[r, c]] == 0 && o > 0.0 && product.returned(r, c) && m > 0.0 && m.is_finite() {
             sum += (f64::from(m).log10() - f64::from(o).log10()).abs();
             n += 1;

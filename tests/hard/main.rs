@@ -197,9 +197,11 @@ fn check_retrievals(out: &RunOutput, case: &str) -> usize {
                 continue;
             }
             returned += 1;
-            for (name, v) in
-                [("chl", p.chl_mg_m3[[r, col]]), ("nap", p.nap_g_m3[[r, col]]), ("cdom", p.cdom_per_m[[r, col]])]
-            {
+            for (name, v) in [
+                ("chl", p.map("chl_mg_m3").unwrap()[[r, col]]),
+                ("nap", p.map("nap_g_m3").unwrap()[[r, col]]),
+                ("cdom", p.map("cdom_per_m").unwrap()[[r, col]]),
+            ] {
                 assert!(v.is_finite() && v >= 0.0, "{case}: {name} {v} at ({r}, {col})");
             }
             if let Some(depth) = &p.depth_m {

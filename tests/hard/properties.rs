@@ -167,7 +167,7 @@ fn closure_case(chl: f64, nap: f64, cdom: f64, zenith: f64, aot: f64) -> Result<
             continue;
         }
         prop_assert!(f & shoal::retrieval::ProductFlags::RETURNED != 0, "not returned: flags {}", f);
-        let got = f64::from(p.chl_mg_m3[[r, c]]);
+        let got = f64::from(p.chl_mg_m3.as_ref().unwrap()[[r, c]]);
         let err = (got / chl - 1.0).abs();
         prop_assert!(
             err < CHL_TOLERANCE,

@@ -276,7 +276,7 @@ fn the_histograms_count_every_returned_pixel_and_the_scatter_is_a_capped_sample(
         with_truth += 1;
         let t = f64::from(*t).log10();
         (lo, hi) = (lo.min(t), hi.max(t));
-        let g = product.chl_mg_m3[[r, c]];
+        let g = product.chl_mg_m3.as_ref().unwrap()[[r, c]];
         if product.returned(r, c) && g > 0.0 {
             returned += 1;
             let g = f64::from(g).log10();

@@ -62,11 +62,13 @@ impl PerPixel {
     pub fn between(out: &RunOutput, reference: &RunOutput) -> Self {
         let (Some(a), Some(b)) = (out.retrievals.first(), reference.retrievals.first()) else { return Self::default() };
         let (a, b) = (&a.product, &b.product);
-        if a.chl_mg_m3.dim() != b.chl_mg_m3.dim() || out.correction.rrs.rrs.dim() != reference.correction.rrs.rrs.dim()
-        {
+        if a.flags.dim() != b.flags.dim() || out.correction.rrs.rrs.dim() != reference.correction.rrs.rrs.dim() {
             return Self::default();
         }
-        let (rows, cols) = a.chl_mg_m3.dim();
+        let (rows, cols) = a.flags.dim();
+        // A variable either product lacks (an external retrieval's choice) is not compared.
+        let pairs = |v: &str| a.map(v).zip(b.map(v));
+        let (chl_maps, nap_maps, cdom_maps) = (pairs("chl_mg_m3"), pairs("nap_g_m3"), pairs("cdom_per_m"));
         let (mut chl, mut nap, mut cdom, mut depth, mut rrs) =
             (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
         let (mut bottom_changed, mut bottom_pixels) = (0usize, 0usize);
@@ -89,9 +91,11 @@ impl PerPixel {
         for r in 0..rows {
             for c in 0..cols {
                 if a.returned(r, c) && b.returned(r, c) {
-                    relative(&mut chl, a.chl_mg_m3[[r, c]], b.chl_mg_m3[[r, c]]);
-                    relative(&mut nap, a.nap_g_m3[[r, c]], b.nap_g_m3[[r, c]]);
-                    relative(&mut cdom, a.cdom_per_m[[r, c]], b.cdom_per_m[[r, c]]);
+                    for (v, maps) in [(&mut chl, chl_maps), (&mut nap, nap_maps), (&mut cdom, cdom_maps)] {
+                        if let Some((ma, mb)) = maps {
+                            relative(v, ma[[r, c]], mb[[r, c]]);
+                        }
+                    }
                     if let Some((da, db)) = depths {
                         relative(&mut depth, da[[r, c]], db[[r, c]]);
                     }

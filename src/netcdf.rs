@@ -1,0 +1,246 @@
+//! NetCDF-3 files with CF metadata, written and read by the pure-Rust `netcdf3` crate (no C
+//! library): the pieces every NetCDF file of Shoal shares — the products a run writes
+//! (`study::netcdf_out`), the input an external retrieval reads and the output it writes back
+//! (`retrieval::external`), and the products `shoal score` reads.
+//!
+//! Files are NetCDF-3 in the 64-bit-offset form (any NetCDF reader opens them; a variable may
+//! exceed 2 GiB). Values without a meaning are [`FILL`], declared as `_FillValue`.
+//!
+//! ## References
+//! - Eaton, B. et al. (2020) NetCDF Climate and Forecast (CF) Metadata Conventions, version 1.8.
+//! - CF Standard Name Table (chlorophyll, suspended matter, remote-sensing reflectance, depth).
+//! - Unidata, The NetCDF Classic and 64-bit Offset File Formats (NetCDF-3).
+
+use std::cell::RefCell;
+use std::io::{BufWriter, Seek, SeekFrom, Write};
+use std::path::Path;
+use std::rc::Rc;
+
+use netcdf3::{DataSet, FileWriter, Version};
+
+/// Shoal's product variables (what a retrieval returns and the truth holds), in table order.
+pub const PRODUCT_VARIABLES: [&str; 4] = ["chl_mg_m3", "nap_g_m3", "cdom_per_m", "depth_m"];
+
+/// CF standard names of Shoal's product variables (those CF has).
+pub fn standard_name(variable: &str) -> Option<&'static str> {
+    Some(match variable {
+        "chl_mg_m3" => "mass_concentration_of_chlorophyll_a_in_sea_water",
+        "nap_g_m3" => "mass_concentration_of_suspended_matter_in_sea_water",
+        "depth_m" => "sea_floor_depth_below_sea_surface",
+        "rrs" => "surface_ratio_of_upwelling_radiance_emerging_from_sea_water_to_downwelling_radiative_flux_in_air",
+        _ => return None,
+    })
+}
+
+/// What a product variable is, and its unit (UDUNITS).
+pub fn meaning(variable: &str) -> (&'static str, &'static str) {
+    match variable {
+        "chl_mg_m3" => ("chlorophyll-a concentration", "mg m-3"),
+        "nap_g_m3" => ("non-algal particle (suspended matter) concentration", "g m-3"),
+        "cdom_per_m" => ("CDOM absorption coefficient at the SIOP set's reference wavelength", "m-1"),
+        "depth_m" => ("water depth", "m"),
+        _ => ("", "1"),
+    }
+}
+
+/// A float variable of the data set with its data.
+#[derive(Debug, Clone)]
+pub struct FloatVar {
+    /// Variable name.
+    pub name: String,
+    /// Its dimensions, slowest first.
+    pub dims: Vec<&'static str>,
+    /// Its attributes (`_FillValue` is added by [`define_vars`]).
+    pub attrs: Vec<(&'static str, String)>,
+    /// Its values, in the dimensions' order.
+    pub values: Vec<f32>,
+}
+
+/// An integer flag variable: name, dimensions, what it is, masks and meanings, values. 32-bit:
+/// CF wants the masks in the variable's type, Shoal's product flags use all eight bits of a byte
+/// (128 is no NC_BYTE), and the `netcdf3` crate pads a 1- or 2-byte attribute list with fill
+/// values where the format wants zero bytes (its own reader then refuses the header; ncdump
+/// accepts it): 4-byte attributes need no padding.
+#[derive(Debug, Clone)]
+pub struct FlagVar {
+    /// Variable name.
+    pub name: String,
+    /// Its dimensions, slowest first.
+    pub dims: Vec<&'static str>,
+    /// What it is.
+    pub long_name: String,
+    /// (mask, meaning) of each flag.
+    pub flags: Vec<(i32, &'static str)>,
+    /// Its values, in the dimensions' order.
+    pub values: Vec<i32>,
+    /// Auxiliary coordinates (the `coordinates` attribute).
+    pub coordinates: &'static str,
+}
+
+/// Written where a value has no meaning (land, not returned, invalid Rrs), declared as
+/// `_FillValue` (readers such as xarray turn it into NaN): the GeoTIFF products' no-data value.
+/// Not NaN itself: the `netcdf3` crate finds a variable by comparing its attributes, and a NaN
+/// attribute never equals itself.
+pub const FILL: f32 = -9999.0;
+
+/// `keep`-masked values of a map, [`FILL`] elsewhere (and where not finite).
+pub fn masked(values: impl Iterator<Item = f32>, keep: impl Fn(usize) -> bool) -> Vec<f32> {
+    values.enumerate().map(|(i, v)| if keep(i) && v.is_finite() { v } else { FILL }).collect()
+}
+
+/// A shared, seekable, buffered file: the writer owns one handle, Shoal keeps the other to flush
+/// and sync it once the writer has closed.
+#[derive(Clone)]
+struct Shared(Rc<RefCell<BufWriter<std::fs::File>>>);
+
+impl Write for Shared {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.0.borrow_mut().write(buf)
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.0.borrow_mut().flush()
+    }
+}
+
+impl Seek for Shared {
+    fn seek(&mut self, pos: SeekFrom) -> std::io::Result<u64> {
+        self.0.borrow_mut().seek(pos)
+    }
+}
+
+/// Dimensions of a (line, pixel, band) cube.
+pub const CUBE: [&str; 3] = ["line", "pixel", "band"];
+/// Dimensions of a (line, pixel) map.
+pub const MAP: [&str; 2] = ["line", "pixel"];
+
+/// `long_name`, `units` and, where CF has one, `standard_name`.
+pub fn attrs(long: &str, units: &str, standard: Option<&str>) -> Vec<(&'static str, String)> {
+    let mut a = vec![("long_name", long.to_string()), ("units", units.to_string())];
+    if let Some(s) = standard {
+        a.push(("standard_name", s.to_string()));
+    }
+    a
+}
+
+/// Write the data set and its values to `path` through a temporary file, synced, then renamed.
+pub fn write_file(path: &Path, ds: &DataSet, floats: &[FloatVar], flags: &[FlagVar]) -> Result<(), String> {
+    let tmp = path.with_extension("nc.partial");
+    let fail = |m: String| format!("cannot write {}: {m}", path.display());
+    let result = (|| -> Result<(), String> {
+        let file = std::fs::File::create(&tmp).map_err(|e| fail(e.to_string()))?;
+        let shared = Shared(Rc::new(RefCell::new(BufWriter::with_capacity(1 << 20, file))));
+        let mut writer = FileWriter::open_seek_write(&tmp.to_string_lossy(), Box::new(shared.clone()))
+            .map_err(|e| fail(format!("{e:?}")))?;
+        writer.set_def(ds, Version::Offset64Bit, 0).map_err(|e| fail(format!("{e:?}")))?;
+        for v in floats {
+            writer.write_var_f32(&v.name, &v.values).map_err(|e| fail(format!("{}: {e:?}", v.name)))?;
+        }
+        for f in flags {
+            writer.write_var_i32(&f.name, &f.values).map_err(|e| fail(format!("{}: {e:?}", f.name)))?;
+        }
+        writer.close().map_err(|e| fail(format!("{e:?}")))?;
+        let mut buffered = shared.0.borrow_mut();
+        buffered.flush().map_err(|e| fail(e.to_string()))?;
+        buffered.get_ref().sync_all().map_err(|e| fail(e.to_string()))?;
+        Ok(())
+    })();
+    match result.and_then(|()| std::fs::rename(&tmp, path).map_err(|e| fail(e.to_string()))) {
+        Ok(()) => Ok(()),
+        Err(e) => {
+            let _ = std::fs::remove_file(&tmp);
+            Err(e)
+        }
+    }
+}
+
+/// Add `floats` and `flags` to `ds` with their attributes: `_FillValue` on every float variable
+/// of more than one dimension, `flag_values`/`flag_masks` and `flag_meanings` on the flags.
+pub fn define_vars(ds: &mut DataSet, floats: &[FloatVar], flags: &[FlagVar]) -> Result<(), String> {
+    let bad = |e: netcdf3::error::InvalidDataSet| format!("NetCDF definition: {e:?}");
+    for v in floats {
+        ds.add_var_f32(&v.name, &v.dims).map_err(bad)?;
+        for (k, value) in &v.attrs {
+            ds.add_var_attr_string(&v.name, k, value).map_err(bad)?;
+        }
+        if v.dims.len() > 1 {
+            ds.add_var_attr_f32(&v.name, "_FillValue", vec![FILL]).map_err(bad)?;
+        }
+    }
+    for f in flags {
+        ds.add_var_i32(&f.name, &f.dims).map_err(bad)?;
+        ds.add_var_attr_string(&f.name, "long_name", &f.long_name).map_err(bad)?;
+        if f.flags.len() == 1 {
+            ds.add_var_attr_i32(&f.name, "flag_values", vec![0, f.flags[0].0]).map_err(bad)?;
+            ds.add_var_attr_string(&f.name, "flag_meanings", format!("not_{} {}", f.flags[0].1, f.flags[0].1))
+                .map_err(bad)?;
+        } else {
+            ds.add_var_attr_i32(&f.name, "flag_masks", f.flags.iter().map(|x| x.0).collect()).map_err(bad)?;
+            let meanings: Vec<&str> = f.flags.iter().map(|x| x.1).collect();
+            ds.add_var_attr_string(&f.name, "flag_meanings", meanings.join(" ")).map_err(bad)?;
+        }
+        if !f.coordinates.is_empty() {
+            ds.add_var_attr_string(&f.name, "coordinates", f.coordinates).map_err(bad)?;
+        }
+    }
+    Ok(())
+}
+
+/// A NetCDF file's float (line, pixel) variables by name, with their fill values applied
+/// (`None` where missing, NaN or the fill value), and the (line, pixel) size.
+#[derive(Debug, Clone)]
+pub struct Maps {
+    /// (lines, pixels).
+    pub shape: (usize, usize),
+    /// The variables of `wanted` the file has, in the order asked.
+    pub maps: Vec<(String, Vec<Option<f64>>)>,
+    /// Every variable the file has (for messages).
+    pub names: Vec<String>,
+}
+
+/// Read the (line, pixel) float variables of `wanted` that `path` has, refusing files over
+/// `max_bytes`, without `line` and `pixel` dimensions, or with a wanted variable of other
+/// dimensions or type. Messages name the file's problem; the caller adds which file it was.
+pub fn read_maps(path: &Path, wanted: &[&str], max_bytes: u64) -> Result<Maps, String> {
+    let size = std::fs::metadata(path).map_err(|e| e.to_string())?.len();
+    if size > max_bytes {
+        return Err(format!("{:.1} GB is over the {:.1} GB read", size as f64 / 1e9, max_bytes as f64 / 1e9));
+    }
+    let mut reader = netcdf3::FileReader::open(path).map_err(|e| {
+        // The reader's error can quote the whole header's bytes: its first words say enough.
+        let why: String = format!("{e:?}").chars().take(120).collect();
+        format!("not a NetCDF-3 file Shoal can read ({why}…)")
+    })?;
+    let ds = reader.data_set();
+    let names: Vec<String> = ds.get_var_names();
+    let (lines, pixels) = match (ds.dim_size("line"), ds.dim_size("pixel")) {
+        (Some(l), Some(p)) => (l, p),
+        _ => return Err("needs dimensions `line` and `pixel`".into()),
+    };
+    let mut present = Vec::new();
+    for &name in wanted {
+        let Some(var) = ds.get_var(name) else { continue };
+        let dims: Vec<String> = var.dim_names();
+        if dims != ["line", "pixel"] {
+            return Err(format!("`{name}` has dimensions ({}); expected (line, pixel)", dims.join(", ")));
+        }
+        // `_FillValue` (or `missing_value`) in the variable's own type, f32 or f64.
+        let attr = |a: &str| {
+            ds.get_var_attr_f32(name, a)
+                .and_then(|v| v.first().map(|x| f64::from(*x)))
+                .or_else(|| ds.get_var_attr_f64(name, a).and_then(|v| v.first().copied()))
+        };
+        let fill = attr("_FillValue").or_else(|| attr("missing_value"));
+        present.push((name, fill));
+    }
+    let mut maps = Vec::new();
+    for (name, fill) in present {
+        let values = match reader.read_var_f32(name) {
+            Ok(v) => v.into_iter().map(f64::from).collect::<Vec<f64>>(),
+            Err(_) => reader.read_var_f64(name).map_err(|e| format!("`{name}` is not a float variable ({e:?})"))?,
+        };
+        let values =
+            values.into_iter().map(|v| if v.is_finite() && Some(v) != fill { Some(v) } else { None }).collect();
+        maps.push((name.to_string(), values));
+    }
+    Ok(Maps { shape: (lines, pixels), maps, names })
+}
