@@ -378,6 +378,8 @@ ranges! {
     SAMBUCA_MAX_ITERATIONS = Range::count("retrievals[i].Sambuca.settings.max_iterations", 1.0, 10_000.0, "", "iterations per start");
     /// SAMBUCA quadrature.
     SAMBUCA_NODES_PER_BAND = Range::count("retrievals[i].Sambuca.settings.nodes_per_band", 1.0, 8.0, "", "Gauss nodes per band in the forward model");
+    /// An external retrieval's time limit.
+    EXTERNAL_TIME_LIMIT_S = Range::closed("retrievals[i].External.time_limit_s", 1.0, 86_400.0, "s", "wall-clock time the program may take per run before it is stopped");
 
     // Study requirements (Requirements::validate).
     /// Largest allowed MAE.

@@ -26,18 +26,34 @@ pub(super) fn retrieval_banner(app: &mut ShoalApp, ui: &mut egui::Ui) {
     }
 }
 
+/// The retrieval's name as tables and captions show it.
+pub(super) fn retrieval_name(state: &super::model::AppState) -> String {
+    use super::model::RetrievalKind;
+    match (state.retrieval, &state.external) {
+        (RetrievalKind::Almi, _) | (RetrievalKind::External, None) => "aLMI".into(),
+        (RetrievalKind::Sambuca, _) => "SAMBUCA".into(),
+        (RetrievalKind::External, Some(e)) => e.name.clone(),
+    }
+}
+
 /// What the shown product is when the retrieval does not make it.
 pub(super) fn product_note(app: &ShoalApp) -> Option<String> {
     use super::model::RetrievalKind;
-    let retrieval = match app.state.retrieval {
-        RetrievalKind::Almi => "aLMI",
-        RetrievalKind::Sambuca => "SAMBUCA",
+    let retrieval = retrieval_name(&app.state);
+    let missing = match (app.state.retrieval, &app.state.external) {
+        (RetrievalKind::External, Some(e)) => match app.state.product {
+            ProductKind::Depth | ProductKind::Chl | ProductKind::Nap | ProductKind::Cdom => {
+                app.state.product.variable().is_some_and(|v| !e.products.iter().any(|p| p == v))
+            }
+            ProductKind::Substrate | ProductKind::SiopSet => true,
+            ProductKind::Rrs | ProductKind::Level1 | ProductKind::Snr => false,
+        },
+        (kind, _) => matches!(
+            (kind, app.state.product),
+            (RetrievalKind::Almi | RetrievalKind::External, ProductKind::Depth | ProductKind::Substrate)
+                | (RetrievalKind::Sambuca, ProductKind::SiopSet)
+        ),
     };
-    let missing = matches!(
-        (app.state.retrieval, app.state.product),
-        (RetrievalKind::Almi, ProductKind::Depth | ProductKind::Substrate)
-            | (RetrievalKind::Sambuca, ProductKind::SiopSet)
-    );
     missing.then(|| {
         let product = app.state.product.label().split(" (").next().unwrap_or_default();
         format!("{retrieval} does not retrieve the {product}: A and B have no map of it.")
@@ -70,4 +86,42 @@ pub(super) fn failure_box(app: &mut ShoalApp, ui: &mut egui::Ui, index: usize, m
             });
         }
     });
+}
+
+/// An external retrieval runs a program the study names: ask before it runs, and say why it
+/// returned nothing when it failed (the rest of the run is shown as usual).
+pub(super) fn external_banner(app: &mut ShoalApp, ui: &mut egui::Ui) {
+    use super::model::RetrievalKind;
+    use crate::retrieval::external;
+    let Some(spec) = app.state.external.clone().filter(|_| app.state.retrieval == RetrievalKind::External) else {
+        return;
+    };
+    if !external::allowed(&spec.command) {
+        ui.horizontal_wrapped(|ui| {
+            ui.colored_label(
+                super::theme::NOTICE,
+                format!(
+                    "The retrieval `{}` runs a program on your machine: `{}`. Nothing runs until you allow it.",
+                    spec.name,
+                    spec.command.join(" ")
+                ),
+            );
+            if ui.button("Allow this program").on_hover_text("For this session only; never saved").clicked() {
+                external::allow(&spec.command);
+                app.link.refine();
+            }
+        });
+        return;
+    }
+    let failure = (0..2).find_map(|i| match app.link.standing(i) {
+        super::link::Standing::Current(s) => s.output.retrievals.first().and_then(|r| r.failure.clone()),
+        _ => None,
+    });
+    if let Some(message) = failure {
+        egui::Frame::group(ui.style()).stroke(egui::Stroke::new(1.5, super::theme::FAIL)).show(ui, |ui| {
+            ui.set_width(ui.available_width());
+            ui.colored_label(super::theme::FAIL, format!("`{}` returned nothing.", spec.name));
+            ui.add(egui::Label::new(egui::RichText::new(message).monospace()).wrap());
+        });
+    }
 }

@@ -129,7 +129,7 @@ impl ShoalApp {
                 self.state.retrieval = kind;
                 self.state.product = match kind {
                     RetrievalKind::Sambuca => ProductKind::Depth,
-                    RetrievalKind::Almi => ProductKind::Chl,
+                    RetrievalKind::Almi | RetrievalKind::External => ProductKind::Chl,
                 };
             }
             UiCommand::SaveStudy { name } => {

@@ -322,8 +322,9 @@ fn panel_states(app: &ShoalApp) -> PanelStates {
 
 /// The central panel.
 pub fn central(app: &mut ShoalApp, ui: &mut egui::Ui) {
-    use super::banners::{failure_box, product_note, retrieval_banner};
+    use super::banners::{external_banner, failure_box, product_note, retrieval_banner};
     retrieval_banner(app, ui);
+    external_banner(app, ui);
     product_menu(app, ui);
     if let Some(note) = product_note(app) {
         ui.label(note);

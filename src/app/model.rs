@@ -110,6 +110,8 @@ pub enum RetrievalKind {
     Almi,
     /// SAMBUCA-style with the scene's SIOP set and substrates.
     Sambuca,
+    /// The study's external program ([`AppState::external`]).
+    External,
 }
 
 /// The whole persisted state of the app.
@@ -140,6 +142,8 @@ pub struct AppState {
     pub almi: AlmiSettings,
     /// SAMBUCA settings.
     pub sambuca: SambucaSettings,
+    /// The external retrieval of the study the app opened, if it had one.
+    pub external: Option<crate::retrieval::external::ExternalSpec>,
     /// Preview decimations, coarsest first; the last is the final resolution (saved states
     /// before the rename call it `levels`, still read).
     #[serde(alias = "levels")]
@@ -217,6 +221,7 @@ impl AppState {
             retrieval: RetrievalKind::Almi,
             almi: AlmiSettings::default(),
             sambuca: SambucaSettings::default(),
+            external: None,
             decimations: vec![24, 4, 1],
             product: ProductKind::Chl,
             band: 3,
@@ -263,8 +268,14 @@ impl AppState {
                 s.retrieval = RetrievalKind::Almi;
                 s.almi = settings.clone();
             }
+            Some(RetrievalSpec::External(_)) => s.retrieval = RetrievalKind::External,
             None => {}
         }
+        // From the resolved run: `{dir}` in its command is the study file's directory by now.
+        s.external = first.2.retrievals.iter().find_map(|r| match r {
+            RetrievalSpec::External(e) => Some(e.clone()),
+            _ => None,
+        });
         if let Some(r) = &study.requirements {
             s.requirements = r.clone();
         }
@@ -308,6 +319,14 @@ impl AppState {
             RetrievalKind::Sambuca => {
                 RetrievalSpec::Sambuca { siop: None, substrates: None, settings: self.sambuca.clone() }
             }
+            RetrievalKind::External => match &self.external {
+                Some(e) => RetrievalSpec::External(e.clone()),
+                // A session naming an external retrieval it no longer holds runs aLMI.
+                None => RetrievalSpec::Almi {
+                    siop_sets: crate::retrieval::sets::default_almi_sets(),
+                    settings: self.almi.clone(),
+                },
+            },
         }
     }
 

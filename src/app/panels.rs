@@ -238,52 +238,22 @@ fn settings(app: &mut ShoalApp, ui: &mut egui::Ui) {
         ui.horizontal(|ui| {
             ui.selectable_value(&mut s.retrieval, RetrievalKind::Almi, "aLMI");
             ui.selectable_value(&mut s.retrieval, RetrievalKind::Sambuca, "SAMBUCA");
+            if let Some(e) = &s.external {
+                ui.selectable_value(&mut s.retrieval, RetrievalKind::External, e.name.as_str())
+                    .on_hover_text(format!("The study's own program: {}", e.command.join(" ")));
+            }
         });
-        // Reference: the published code's behaviour, to reproduce published numbers; Improved:
-        // Shoal's inversion, the design default.
-        let mode = match s.retrieval {
-            RetrievalKind::Almi => &mut s.almi.mode,
-            RetrievalKind::Sambuca => &mut s.sambuca.mode,
-        };
-        ui.horizontal(|ui| {
-            ui.label("Mode");
-            ui.selectable_value(mode, Mode::Improved, "Improved")
-                .on_hover_text("Shoal's inversion: what a design study should use");
-            ui.selectable_value(mode, Mode::Reference, "Reference").on_hover_text(
-                "The published code step for step (DEA aLMI; CSIRO SAMBUCA with SLSQP from one start), \
-                 to reproduce the paper's numbers",
-            );
-        });
-        let reference = *mode == Mode::Reference;
-        match s.retrieval {
-            RetrievalKind::Almi if reference => {
-                ui.small("As DEA's code: unweighted least squares per set, a set dropped below 1e-5.");
+        if s.retrieval == RetrievalKind::External {
+            if let Some(e) = &s.external {
+                ui.small(format!(
+                    "Runs `{}` on the Rrs (NetCDF) and scores its {} (time limit {} s).",
+                    e.command.join(" "),
+                    e.products.join(", "),
+                    e.time_limit_s
+                ));
             }
-            RetrievalKind::Sambuca if reference => {
-                ui.small("As the CSIRO package: distance f with NEDR, one start at (max − min)/2, SLSQP; stalls kept.");
-            }
-            RetrievalKind::Almi => {
-                ui.checkbox(&mut s.almi.noise_weighting, "Noise weighting")
-                    .on_hover_text("Weight each band by its noise (off: as the reference code)");
-            }
-            RetrievalKind::Sambuca => {
-                egui::ComboBox::from_label("Objective").selected_text(format!("{:?}", s.sambuca.objective)).show_ui(
-                    ui,
-                    |ui| {
-                        ui.selectable_value(&mut s.sambuca.objective, Objective::F, "F");
-                        ui.selectable_value(&mut s.sambuca.objective, Objective::AlphaF, "AlphaF");
-                        ui.selectable_value(&mut s.sambuca.objective, Objective::Lsq, "Lsq");
-                    },
-                );
-                egui::ComboBox::from_label("Starts").selected_text(format!("{:?}", s.sambuca.starts)).show_ui(
-                    ui,
-                    |ui| {
-                        ui.selectable_value(&mut s.sambuca.starts, Starts::Adaptive, "Adaptive");
-                        ui.selectable_value(&mut s.sambuca.starts, Starts::Shallow, "Shallow");
-                        ui.selectable_value(&mut s.sambuca.starts, Starts::ShallowAndDeep, "ShallowAndDeep");
-                    },
-                );
-            }
+        } else {
+            retrieval_mode(s, ui);
         }
         ui.horizontal(|ui| {
             let l = ui.label("Scene seed");
@@ -332,6 +302,53 @@ pub fn left(app: &mut ShoalApp, ui: &mut egui::Ui) {
     ui.separator();
     settings(app, ui);
     super::conditions::conditions(app, ui);
+}
+
+/// aLMI's or SAMBUCA's mode and settings.
+fn retrieval_mode(s: &mut super::model::AppState, ui: &mut egui::Ui) {
+    // Reference: the published code's behaviour, to reproduce published numbers; Improved:
+    // Shoal's inversion, the design default.
+    let mode = match s.retrieval {
+        RetrievalKind::Almi | RetrievalKind::External => &mut s.almi.mode,
+        RetrievalKind::Sambuca => &mut s.sambuca.mode,
+    };
+    ui.horizontal(|ui| {
+        ui.label("Mode");
+        ui.selectable_value(mode, Mode::Improved, "Improved")
+            .on_hover_text("Shoal's inversion: what a design study should use");
+        ui.selectable_value(mode, Mode::Reference, "Reference").on_hover_text(
+            "The published code step for step (DEA aLMI; CSIRO SAMBUCA with SLSQP from one start), \
+             to reproduce the paper's numbers",
+        );
+    });
+    let reference = *mode == Mode::Reference;
+    match s.retrieval {
+        RetrievalKind::Almi if reference => {
+            ui.small("As DEA's code: unweighted least squares per set, a set dropped below 1e-5.");
+        }
+        RetrievalKind::Sambuca if reference => {
+            ui.small("As the CSIRO package: distance f with NEDR, one start at (max − min)/2, SLSQP; stalls kept.");
+        }
+        RetrievalKind::Almi | RetrievalKind::External => {
+            ui.checkbox(&mut s.almi.noise_weighting, "Noise weighting")
+                .on_hover_text("Weight each band by its noise (off: as the reference code)");
+        }
+        RetrievalKind::Sambuca => {
+            egui::ComboBox::from_label("Objective").selected_text(format!("{:?}", s.sambuca.objective)).show_ui(
+                ui,
+                |ui| {
+                    ui.selectable_value(&mut s.sambuca.objective, Objective::F, "F");
+                    ui.selectable_value(&mut s.sambuca.objective, Objective::AlphaF, "AlphaF");
+                    ui.selectable_value(&mut s.sambuca.objective, Objective::Lsq, "Lsq");
+                },
+            );
+            egui::ComboBox::from_label("Starts").selected_text(format!("{:?}", s.sambuca.starts)).show_ui(ui, |ui| {
+                ui.selectable_value(&mut s.sambuca.starts, Starts::Adaptive, "Adaptive");
+                ui.selectable_value(&mut s.sambuca.starts, Starts::Shallow, "Shallow");
+                ui.selectable_value(&mut s.sambuca.starts, Starts::ShallowAndDeep, "ShallowAndDeep");
+            });
+        }
+    }
 }
 
 #[cfg(test)]

@@ -46,10 +46,7 @@ pub fn write_figure(snap: &Snapshot, stem: &Path) -> Result<Vec<PathBuf>, String
             state.a.preset,
             state.b.preset,
             state.scene_name,
-            match state.retrieval {
-                super::model::RetrievalKind::Almi => "aLMI",
-                super::model::RetrievalKind::Sambuca => "SAMBUCA",
-            },
+            super::banners::retrieval_name(state),
             snap.decimation
         ),
         if changes.is_empty() {

@@ -33,6 +33,7 @@ pub fn run(args: &BudgetArgs) -> Result<(), CliError> {
     }
     let (spec, dir) = super::study::load(args.study.as_deref())?;
     let resolved = spec.resolve(dir.as_deref())?;
+    super::refuse_unallowed_external(resolved.runs.iter().map(|r| &r.2))?;
     let out = crate::study::OutputDir::create(&args.out, "shoal budget")?;
     let pool = super::pool(args.threads.unwrap_or(0), "shoal-budget")?;
     let seeds: Vec<u64> = (1..=args.seeds).collect();

@@ -74,6 +74,7 @@ pub fn run(args: &DesignArgs) -> Result<(), CliError> {
     let vars = args.vary.iter().map(|v| Variable::parse(v)).collect::<Result<Vec<_>, _>>().map_err(CliError::Input)?;
     let (spec, dir) = super::study::load(Some(&args.study))?;
     let resolved = spec.resolve(dir.as_deref())?;
+    super::refuse_unallowed_external(resolved.runs.iter().map(|r| &r.2))?;
     let labels: Vec<&String> = crate::design::unique(resolved.runs.iter().map(|r| &r.0));
     let label = labels.get(args.instrument).ok_or_else(|| {
         CliError::Input(format!("--instrument {} (allowed: 0 to {})", args.instrument, labels.len() - 1))

@@ -41,6 +41,32 @@ use clap::{Parser, Subcommand};
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// Let external retrievals (`External(…)` in a study) run the programs they name. A study
+    /// file may be anyone's: without this flag a study that names a program is refused before it
+    /// runs anything.
+    #[arg(long, global = true)]
+    allow_external: bool,
+}
+
+/// Refuse, before anything runs, configurations with an external retrieval when
+/// `--allow-external` was not given (the message names the program).
+pub(crate) fn refuse_unallowed_external<'a>(
+    configs: impl IntoIterator<Item = &'a crate::engine::RunConfig>,
+) -> Result<(), CliError> {
+    for c in configs {
+        for r in &c.retrievals {
+            if let crate::retrieval::RetrievalSpec::External(e) = r
+                && !crate::retrieval::external::allowed(&e.command)
+            {
+                return Err(CliError::Input(format!(
+                    "the retrieval `{}` runs a program (`{}`); read the study, then pass --allow-external to run it",
+                    e.name,
+                    e.command.join(" ")
+                )));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Arguments of `shoal app` (the binary runs the app; the command line only parses them).
@@ -211,6 +237,9 @@ pub fn main(app: impl FnOnce(&AppArgs) -> ExitCode) -> ExitCode {
             return if e.use_stderr() { ExitCode::from(2) } else { ExitCode::SUCCESS };
         }
     };
+    if cli.allow_external {
+        crate::retrieval::external::allow_all();
+    }
     let result = match cli.command {
         Command::App(args) => return app(&args),
         Command::Water(args) => water::run(&args),

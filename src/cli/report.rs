@@ -113,6 +113,7 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
 fn run_for_report(args: &ReportArgs) -> Result<(crate::report::ReviewData, Vec<crate::study::Figure>), CliError> {
     let (spec, dir) = super::study::load(args.target.as_deref())?;
     let mut resolved = spec.resolve(dir.as_deref())?;
+    super::refuse_unallowed_external(resolved.runs.iter().map(|r| &r.2))?;
     if let Some(d) = args.decimation {
         if d == 0 || d > 64 {
             return Err(CliError::Input(format!("--decimation {d} (allowed: 1 to 64)")));

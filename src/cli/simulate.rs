@@ -114,6 +114,7 @@ pub fn config_from(args: &SimulateArgs) -> Result<RunConfig, CliError> {
         config.fidelity.decimation = d;
     }
     config.fault = crate::engine::Fault::from_env().map_err(CliError::Input)?;
+    super::refuse_unallowed_external([&config])?;
     if let Some(s) = args.seed {
         config.seed = s;
     }

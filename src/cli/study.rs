@@ -69,6 +69,7 @@ pub(super) fn load(arg: Option<&str>) -> Result<(StudySpec, Option<PathBuf>), Cl
 pub fn run(args: &StudyArgs) -> Result<(), CliError> {
     let (spec, dir) = load(args.study.as_deref())?;
     let mut resolved = spec.resolve(dir.as_deref())?;
+    super::refuse_unallowed_external(resolved.runs.iter().map(|r| &r.2))?;
     let fault = crate::engine::Fault::from_env().map_err(CliError::Input)?;
     for (_, _, c) in &mut resolved.runs {
         if let Some(d) = args.decimation {
@@ -161,6 +162,21 @@ pub fn run(args: &StudyArgs) -> Result<(), CliError> {
         }
     }
     eprintln!("wrote {} files to {}", outputs.files.len(), args.out.display());
+    // Everything is written; a retrieval whose program failed still fails the command.
+    let failures: Vec<String> = result
+        .runs
+        .iter()
+        .flat_map(|run| {
+            run.retrievals.iter().filter_map(move |r| r.failure.as_ref().map(|f| format!("{}: {f}", run.label)))
+        })
+        .collect();
+    if let Some(first) = failures.first() {
+        return Err(CliError::Run(format!(
+            "{} retrieval run(s) returned nothing; the rest of the study is in {}. First: {first}",
+            failures.len(),
+            args.out.display()
+        )));
+    }
     Ok(())
 }
 
@@ -220,6 +236,10 @@ fn print_runs(out: &mut String, result: &crate::study::StudyResult) {
                     "{:<12} {:<8} dominant substrate right in {a:.1} % of pixels",
                     run.label, ret.metrics.product
                 );
+            }
+            if let Some(f) = &ret.failure {
+                let _ = writeln!(out, "{:<12} {:<8} returned nothing: {f}", run.label, ret.metrics.product);
+                continue;
             }
             if ret.metrics.failed > 0 || ret.metrics.stalled > 0 {
                 let _ = writeln!(

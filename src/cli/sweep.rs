@@ -109,6 +109,7 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
         None => Shard::ALL,
     };
     let mut sweep = spec.resolve(dir.as_deref())?;
+    super::refuse_unallowed_external(sweep.bases.iter().map(|b| &b.1))?;
     if let Some(d) = args.decimation {
         if d == 0 || d > 64 {
             return Err(CliError::Input(format!("--decimation {d} (allowed: 1 to 64)")));

@@ -83,6 +83,9 @@ pub struct RetrievalOutput {
     pub bands: Vec<crate::retrieval::BandResponse>,
     /// The noise-equivalent ΔRrs per band it weighted with, sr⁻¹.
     pub nedr: Vec<f64>,
+    /// Why the retrieval returned nothing, when its program failed (an external retrieval:
+    /// the rest of the run is kept, and this says what went wrong).
+    pub failure: Option<String>,
 }
 
 /// Products of the scene side of the chain and their keys.

@@ -11,7 +11,7 @@ use crate::control::RunControl;
 use crate::instrument::{Detector, DetectorMode, RadianceCube};
 use crate::metrics::evaluate;
 use crate::retrieval::run::band_responses;
-use crate::retrieval::{RetrievalError, RetrievalInputs, invert, prepare};
+use crate::retrieval::{Product, ProductFlags, RetrievalError, RetrievalInputs, RetrievalSpec, invert, prepare};
 use crate::water::WaterGeometry;
 
 /// Noise-equivalent ΔRrs per band at the typical radiance: the detector's noise (on, whatever
@@ -72,12 +72,19 @@ impl Engine {
         for spec in &config.retrievals {
             // A SIOP or substrate file the retrieval names, edited on disk, is a new retrieval.
             let files = super::files::fingerprint(spec, config.scene_dir.as_deref());
+            // An external program the user has since allowed is a new retrieval (its refusal is
+            // not kept).
+            let allowed = match spec {
+                RetrievalSpec::External(e) => crate::retrieval::external::allowed(&e.command),
+                _ => true,
+            };
             let key = KeyBuilder::new(Stage::Retrieval)
                 .after(correction_key)
                 .after(side.band_key)
                 .with(&nedr)
                 .with(spec)
                 .with(&files)
+                .with(&allowed)
                 .finish();
             let inputs = RetrievalInputs {
                 rrs: &correction.rrs.rrs,
@@ -102,7 +109,12 @@ impl Engine {
             let model = self
                 .stage(model_key, report, control, || prepare(spec, &inputs).map_err(fail_in(Stage::RetrievalModel)))?;
             let result = self.stage(key, report, control, || {
-                let product = invert(spec, &model, &inputs, control).map_err(fail)?;
+                // A user's program that fails costs its own product, not the run's others.
+                let (product, failure) = match invert(spec, &model, &inputs, control) {
+                    Ok(p) => (p, None),
+                    Err(e @ RetrievalError::External { .. }) => (failed_product(spec, &inputs), Some(e.to_string())),
+                    Err(e) => return Err(fail(e)),
+                };
                 let metrics = evaluate(&product, &radiance.truth);
                 Ok(RetrievalOutput {
                     spec: spec.clone(),
@@ -110,10 +122,31 @@ impl Engine {
                     metrics,
                     bands: inputs.bands.clone(),
                     nedr: inputs.nedr.clone(),
+                    failure,
                 })
             })?;
             out.push(result);
         }
         Ok(out)
+    }
+}
+
+/// The product of a retrieval that returned nothing: every water pixel failed, no maps.
+fn failed_product(spec: &RetrievalSpec, inputs: &RetrievalInputs<'_>) -> Product {
+    let dim = inputs.land.dim();
+    Product {
+        name: spec.name().to_string(),
+        chl_mg_m3: None,
+        cdom_per_m: None,
+        nap_g_m3: None,
+        depth_m: None,
+        substrate_names: Vec::new(),
+        substrate_fractions: None,
+        siop_set_names: Vec::new(),
+        siop_set: None,
+        cost: ndarray::Array2::zeros(dim),
+        sdi: None,
+        iterations: None,
+        flags: inputs.land.mapv(|l| if l != 0 { ProductFlags::LAND } else { ProductFlags::FAILED }),
     }
 }

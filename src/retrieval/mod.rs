@@ -9,12 +9,15 @@
 //! | SAMBUCA | [`sambuca`] | bounded nonlinear least squares over depth and substrate pairs (Brando et al. 2009) |
 //! | SAMBUCA, reference mode | [`sambuca_reference`] | the CSIRO package's fit: one start, SLSQP, the stall kept |
 //! | solvers | [`nnls`], [`optimise`], [`slsqp`] | exact small NNLS; bounded Levenberg–Marquardt and BFGS; SciPy's SLSQP for bounds |
+//! | external | [`external`] | a user's own program, run on a NetCDF file of the Rrs, its products read back |
 //! | images | [`run`] | a retrieval over a whole Rrs cube, the products and their flags |
 
 pub mod almi;
 pub mod almi_lanes;
 pub mod almi_reference;
 pub mod band_model;
+pub mod external;
+mod external_io;
 pub mod nnls;
 pub mod optimise;
 pub mod quadrature;
@@ -59,6 +62,15 @@ pub enum RetrievalError {
     /// From the spectral layer.
     #[error(transparent)]
     Spectral(#[from] SpectralError),
+    /// An external retrieval's program failed (could not start, exited with an error, ran too
+    /// long, or wrote no product).
+    #[error("external retrieval `{name}`: {message}")]
+    External {
+        /// The retrieval's name.
+        name: String,
+        /// What went wrong, with the end of the program's standard error.
+        message: String,
+    },
     /// The run was cancelled.
     #[error("cancelled")]
     Cancelled,
@@ -84,6 +96,8 @@ pub enum Model {
     Almi(run::AlmiModel),
     /// SAMBUCA's set and substrates (boxed: the larger of the two by far).
     Sambuca(Box<run_sambuca::SambucaModel>),
+    /// An external program: nothing to prepare.
+    External,
 }
 
 /// Prepare `spec`'s model at `inputs.bands` (reads `bands`, `scene_siop`, `scene_substrates`
@@ -98,6 +112,7 @@ pub fn prepare(spec: &RetrievalSpec, inputs: &RetrievalInputs<'_>) -> Result<Mod
             settings,
             inputs,
         )?)),
+        RetrievalSpec::External(_) => Model::External,
     })
 }
 
@@ -113,6 +128,7 @@ pub fn invert(
         (RetrievalSpec::Sambuca { settings, .. }, Model::Sambuca(m)) => {
             run_sambuca::retrieve_sambuca(m, settings, inputs, control)
         }
+        (RetrievalSpec::External(e), Model::External) => external::retrieve_external(e, inputs, control),
         _ => Err(RetrievalError::Invalid(FieldError {
             field: "retrieval".into(),
             message: format!("the model given was prepared for another retrieval than {}", spec.name()),

@@ -46,15 +46,27 @@ pub enum RetrievalSpec {
         #[serde(default)]
         settings: SambucaSettings,
     },
+    /// A user's own program, run on a NetCDF file of the Rrs ([`super::external`]).
+    External(super::external::ExternalSpec),
 }
 
 impl RetrievalSpec {
     /// Short name for reports and file names.
     #[must_use]
-    pub fn name(&self) -> &'static str {
+    pub fn name(&self) -> &str {
         match self {
             Self::Almi { .. } => "alm",
             Self::Sambuca { .. } => "sambuca",
+            Self::External(e) => &e.name,
+        }
+    }
+
+    /// The spec with an external command's `{dir}` replaced by `dir`, the study file's directory
+    /// (the other retrievals take their relative paths from the scene's directory as they run).
+    pub fn with_dir(&self, dir: Option<&Path>) -> Result<Self, RetrievalError> {
+        match self {
+            Self::External(e) => Ok(Self::External(e.with_dir(dir)?)),
+            other => Ok(other.clone()),
         }
     }
 
@@ -78,6 +90,7 @@ impl RetrievalSpec {
                 check(&r::ALMI_G1, settings.g1)
             }
             Self::Sambuca { settings, .. } => validate_sambuca(settings),
+            Self::External(e) => e.validate(),
         }
     }
 }

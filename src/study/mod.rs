@@ -233,6 +233,12 @@ impl StudySpec {
             r.validate_design(&budgets)?;
         }
         let (scene, scene_dir) = load(&self.scene, dir, |n| SceneSpec::preset(n).map_err(|e| e.to_string()), "scene")?;
+        let retrievals = self
+            .retrievals
+            .iter()
+            .map(|r| r.with_dir(dir))
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(|e| StudyError::Invalid(FieldError { field: "retrievals".into(), message: e.to_string() }))?;
         let mut runs = Vec::new();
         let mut labels: Vec<String> = Vec::new();
         for (i, source) in self.instruments.iter().enumerate() {
@@ -257,7 +263,7 @@ impl StudySpec {
                 let mut config = RunConfig::new(scene.clone(), instrument.clone());
                 config.scene_dir.clone_from(&scene_dir);
                 config.seed = seed;
-                config.retrievals.clone_from(&self.retrievals);
+                config.retrievals.clone_from(&retrievals);
                 if let Some(d) = self.detector {
                     config.detector = d;
                 }

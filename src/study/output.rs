@@ -281,6 +281,7 @@ pub fn write_study(result: &StudyResult, dir: &Path, figures: bool) -> Result<Ou
                 "substrate_confusion": ret.metrics.substrate_confusion,
                 "depth_by_true_substrate": ret.metrics.depth_by_true_substrate,
                 "failed": ret.metrics.failed,
+                "failure": ret.failure,
             }));
         }
     }

@@ -295,7 +295,9 @@ impl Requirements {
         self.products.iter().find(|p| p.variable == variable)
     }
 
-    /// Check every run of `result` (its first retrieval, as the tables show it).
+    /// Check every run of `result`: its first retrieval as the tables show it, then each further
+    /// retrieval's products, named `"<product>: <check>"` (an external algorithm beside aLMI is
+    /// judged against the same limits).
     #[must_use]
     pub fn check(&self, result: &StudyResult) -> Vec<Check> {
         result
@@ -304,6 +306,13 @@ impl Requirements {
             .flat_map(|run| {
                 let metrics = run.retrievals.first().map(|r| &r.metrics);
                 let mut checks = self.check_run(&run.label, run.seed, metrics, &run.snr, &run.rrs_metrics);
+                for other in run.retrievals.iter().skip(1) {
+                    let m = &other.metrics;
+                    checks.extend(self.check_run(&run.label, run.seed, Some(m), &[], &[]).into_iter().map(|mut c| {
+                        c.what = format!("{}: {}", m.product, c.what);
+                        c
+                    }));
+                }
                 let spec = result.study.runs.iter().find(|r| r.0 == run.label).map(|r| &r.2.instrument);
                 if let Some(spec) = spec {
                     checks.extend(self.check_design(&run.label, run.seed, spec, &run.budget, &result.study.budgets));

@@ -13,6 +13,7 @@ mod coherence;
 mod common;
 mod design;
 mod determinism;
+mod external;
 mod image_correction;
 mod incremental;
 mod netcdf;

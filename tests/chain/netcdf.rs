@@ -10,7 +10,7 @@ use super::{run, small, small_lake};
 
 /// A small noise-free run written as NetCDF into a fresh folder (`name`: one per test, as tests
 /// run at once).
-fn written(name: &str) -> (shoal::engine::RunOutput, tempfile_dir::Dir) {
+pub(crate) fn written(name: &str) -> (shoal::engine::RunOutput, tempfile_dir::Dir) {
     let mut c = shoal::engine::RunConfig::new(small_lake(), small("cubesat", 24, 16));
     c.detector = DetectorMode::IDEAL;
     let out = run(&c);
@@ -21,7 +21,7 @@ fn written(name: &str) -> (shoal::engine::RunOutput, tempfile_dir::Dir) {
 }
 
 /// A folder under the target directory, removed when dropped.
-mod tempfile_dir {
+pub(crate) mod tempfile_dir {
     pub struct Dir(std::path::PathBuf);
     impl Dir {
         pub fn new(name: &str) -> Self {
@@ -137,7 +137,7 @@ fn score_chl(args: &[&std::ffi::OsStr]) -> Vec<String> {
 }
 
 /// A product NetCDF of (line, pixel) maps `maps` (name, values) with a −9999 fill value.
-fn product_file(path: &std::path::Path, shape: (usize, usize), maps: &[(&str, Vec<f32>)]) {
+pub(crate) fn product_file(path: &std::path::Path, shape: (usize, usize), maps: &[(&str, Vec<f32>)]) {
     let mut ds = netcdf3::DataSet::new();
     ds.add_fixed_dim("line", shape.0).unwrap();
     ds.add_fixed_dim("pixel", shape.1).unwrap();

@@ -1,0 +1,215 @@
+//! The files of an external retrieval ([`super::external`]): the NetCDF input Shoal writes for
+//! the program, and the program's output read back into a [`Product`].
+
+use std::path::Path;
+
+use ndarray::Array2;
+use netcdf3::DataSet;
+
+use super::RetrievalError;
+use super::external::ExternalSpec;
+use super::run::{Product, ProductFlags, RetrievalInputs};
+use crate::correction::RrsFlags;
+use crate::netcdf::{CUBE, FlagVar, FloatVar, MAP, Maps, attrs, define_vars, masked, standard_name, write_file};
+use crate::parse::FieldError;
+
+/// The instrument bands the program is given (`bands`, else every band), by index.
+pub(super) fn used_bands(spec: &ExternalSpec, inputs: &RetrievalInputs<'_>) -> Result<Vec<usize>, RetrievalError> {
+    let Some(names) = &spec.bands else { return Ok((0..inputs.bands.len()).collect()) };
+    if names.is_empty() {
+        return Err(RetrievalError::Invalid(FieldError {
+            field: "retrievals[i].External.bands".into(),
+            message: "is empty (leave it out to give every band)".into(),
+        }));
+    }
+    names
+        .iter()
+        .map(|n| {
+            inputs.bands.iter().position(|b| &b.name == n).ok_or_else(|| {
+                RetrievalError::Invalid(FieldError {
+                    field: "retrievals[i].External.bands".into(),
+                    message: format!(
+                        "no band `{}` (this instrument has {})",
+                        n.escape_debug(),
+                        inputs.bands.iter().map(|b| b.name.as_str()).collect::<Vec<_>>().join(", ")
+                    ),
+                })
+            })
+        })
+        .collect()
+}
+
+/// Equivalent width of a band response, nm: ∫w dλ / max w on its uniform grid.
+fn equivalent_width_nm(b: &super::BandResponse) -> f64 {
+    let n = b.wavelengths_nm.len();
+    if n < 2 {
+        return 0.0;
+    }
+    let step = (b.wavelengths_nm[n - 1] - b.wavelengths_nm[0]) / (n - 1) as f64;
+    let peak = b.weights.iter().copied().fold(0.0, f64::max);
+    if peak > 0.0 { b.weights.iter().sum::<f64>() * step / peak } else { 0.0 }
+}
+
+/// Write the program's input: the Rrs of `used` bands (fill where invalid, saturated or land),
+/// its flags, the land mask, the bands, their noise and the geometry. No truth.
+pub(super) fn write_input(
+    spec: &ExternalSpec,
+    inputs: &RetrievalInputs<'_>,
+    used: &[usize],
+    path: &Path,
+) -> Result<(), String> {
+    let (rows, cols, nb) = inputs.rrs.dim();
+    let bands: Vec<&super::BandResponse> = used.iter().map(|&b| &inputs.bands[b]).collect();
+    let mut floats = vec![
+        FloatVar {
+            name: "wavelength".into(),
+            dims: vec!["band"],
+            attrs: attrs("band response centroid wavelength", "nm", Some("radiation_wavelength")),
+            values: bands.iter().map(|b| b.centroid_nm() as f32).collect(),
+        },
+        FloatVar {
+            name: "bandwidth".into(),
+            dims: vec!["band"],
+            attrs: attrs("band response equivalent width (integral over peak)", "nm", None),
+            values: bands.iter().map(|b| equivalent_width_nm(b) as f32).collect(),
+        },
+        FloatVar {
+            name: "nedr".into(),
+            dims: vec!["band"],
+            attrs: attrs("noise-equivalent delta Rrs of the instrument at the typical radiance", "sr-1", None),
+            values: used.iter().map(|&b| inputs.nedr[b] as f32).collect(),
+        },
+    ];
+    let degrees = |f: fn(&crate::water::WaterGeometry) -> f64| -> Vec<f32> {
+        (0..cols).map(|c| inputs.geometry.get(c).map_or(f32::NAN, |g| f(g).to_degrees() as f32)).collect()
+    };
+    floats.push(FloatVar {
+        name: "solar_zenith_angle".into(),
+        dims: vec!["pixel"],
+        attrs: attrs("solar zenith angle at the ground", "degree", Some("solar_zenith_angle")),
+        values: degrees(|g| g.sun_zenith_rad),
+    });
+    floats.push(FloatVar {
+        name: "sensor_zenith_angle".into(),
+        dims: vec!["pixel"],
+        attrs: attrs("view zenith angle at the ground", "degree", Some("sensor_zenith_angle")),
+        values: degrees(|g| g.view_zenith_rad),
+    });
+    let n_used = used.len().max(1);
+    let value = |i: usize| {
+        let (pixel, k) = (i / n_used, i % n_used);
+        let (r, c, b) = (pixel / cols.max(1), pixel % cols.max(1), used[k]);
+        debug_assert!(b < nb);
+        (inputs.rrs[[r, c, b]], inputs.flags[[r, c, b]], inputs.land[[r, c]])
+    };
+    let total = rows * cols * used.len();
+    let bad = RrsFlags::INVALID | RrsFlags::SATURATED;
+    let mut rrs_attrs = attrs("remote-sensing reflectance above the surface, corrected", "sr-1", standard_name("rrs"));
+    rrs_attrs.push(("ancillary_variables", "rrs_flags land".into()));
+    floats.push(FloatVar {
+        name: "rrs".into(),
+        dims: CUBE.to_vec(),
+        attrs: rrs_attrs,
+        values: masked((0..total).map(|i| value(i).0), |i| {
+            let (_, f, land) = value(i);
+            f & bad == 0 && land == 0
+        }),
+    });
+    let flags = vec![
+        FlagVar {
+            name: "rrs_flags".into(),
+            dims: CUBE.to_vec(),
+            long_name: "Rrs quality flags".into(),
+            flags: vec![
+                (i32::from(RrsFlags::NEGATIVE), "negative"),
+                (i32::from(RrsFlags::SATURATED), "saturated"),
+                (i32::from(RrsFlags::INVALID), "invalid"),
+            ],
+            values: (0..total).map(|i| i32::from(value(i).1)).collect(),
+            coordinates: "",
+        },
+        FlagVar {
+            name: "land".into(),
+            dims: MAP.to_vec(),
+            long_name: "land under the pixel centre (not retrieved)".into(),
+            flags: vec![(1, "land")],
+            values: inputs.land.iter().map(|&v| i32::from(v)).collect(),
+            coordinates: "",
+        },
+    ];
+    let mut ds = DataSet::new();
+    let bad_def = |e: netcdf3::error::InvalidDataSet| format!("NetCDF definition: {e:?}");
+    ds.add_fixed_dim("line", rows).map_err(bad_def)?;
+    ds.add_fixed_dim("pixel", cols).map_err(bad_def)?;
+    ds.add_fixed_dim("band", used.len()).map_err(bad_def)?;
+    define_vars(&mut ds, &floats, &flags)?;
+    let band_names: Vec<&str> = bands.iter().map(|b| b.name.as_str()).collect();
+    for (k, v) in [
+        ("Conventions", "CF-1.8".to_string()),
+        ("title", format!("Shoal: corrected Rrs for the external retrieval `{}`", spec.name)),
+        ("source", format!("Shoal {} end-to-end simulator", env!("CARGO_PKG_VERSION"))),
+        ("band_names", band_names.join(" ")),
+        ("products_wanted", spec.products.join(" ")),
+        (
+            "products_convention",
+            "write each wanted product as a float (line, pixel) variable of this file's size, NaN or _FillValue where not returned".into(),
+        ),
+        ("image_order", "line 0 = first line acquired, pixel 0 = first detector".into()),
+    ] {
+        ds.add_global_attr_string(k, v).map_err(bad_def)?;
+    }
+    write_file(path, &ds, &floats, &flags)
+}
+
+/// The program's output as a [`Product`]: each wanted map (0 where missing), returned where every
+/// map is finite and positive, land where the input says so.
+pub(super) fn product(spec: &ExternalSpec, inputs: &RetrievalInputs<'_>, maps: &Maps) -> Result<Product, String> {
+    let (rows, cols) = inputs.land.dim();
+    if maps.shape != (rows, cols) {
+        return Err(format!(
+            "its output is {} × {} (line × pixel); the input was {rows} × {cols}",
+            maps.shape.0, maps.shape.1
+        ));
+    }
+    let mut planes: Vec<(&str, Array2<f32>)> = Vec::new();
+    for wanted in &spec.products {
+        let Some((_, values)) = maps.maps.iter().find(|(n, _)| n == wanted) else {
+            return Err(format!(
+                "its output has no `{wanted}` (it has: {}); `products` lists what the program must write",
+                if maps.names.is_empty() { "no variables".to_string() } else { maps.names.join(", ") }
+            ));
+        };
+        let plane = Array2::from_shape_fn((rows, cols), |(r, c)| values[r * cols + c].map_or(0.0, |v| v as f32));
+        planes.push((wanted.as_str(), plane));
+    }
+    let valid = |r: usize, c: usize| {
+        spec.products
+            .iter()
+            .all(|w| maps.maps.iter().find(|(n, _)| n == w).and_then(|(_, v)| v[r * cols + c]).is_some_and(|x| x > 0.0))
+    };
+    let flags = Array2::from_shape_fn((rows, cols), |(r, c)| {
+        if inputs.land[[r, c]] != 0 {
+            ProductFlags::LAND
+        } else if valid(r, c) {
+            ProductFlags::RETURNED
+        } else {
+            ProductFlags::FAILED
+        }
+    });
+    let mut take = |v: &str| planes.iter().position(|(n, _)| *n == v).map(|i| planes.remove(i).1);
+    Ok(Product {
+        name: spec.name.clone(),
+        chl_mg_m3: take("chl_mg_m3"),
+        cdom_per_m: take("cdom_per_m"),
+        nap_g_m3: take("nap_g_m3"),
+        depth_m: take("depth_m"),
+        substrate_names: Vec::new(),
+        substrate_fractions: None,
+        siop_set_names: Vec::new(),
+        siop_set: None,
+        cost: Array2::zeros((rows, cols)),
+        sdi: None,
+        iterations: None,
+        flags,
+    })
+}
