@@ -223,10 +223,11 @@ pub fn retrieve_external(
     }
     run_program(spec, &args, &folder.0, control)?;
     if !output.exists() {
-        return Err(spec.error(format!(
-            "the program exited without writing its output ({}): pass `{{output}}` in its command and write there",
-            output.display()
-        )));
+        // No path in the message: the run's folder is temporary, and the message is part of the
+        // run's output (the same run gives the same words).
+        return Err(spec.error(
+            "the program exited without writing its output: pass `{output}` in its command and write the products there",
+        ));
     }
     let products: Vec<&str> = spec.products.iter().map(String::as_str).collect();
     let maps = crate::netcdf::read_maps(&output, &products, MAX_OUTPUT_BYTES)

@@ -7,35 +7,49 @@ use crate::study::{CurvePoint, CurveSeries, Curves, Figure, StudyError, curve_fi
 use super::Requirement;
 use super::table::Table;
 
-/// The series of `variable` in `table`: (instrument, second parameter's value), in the order of
-/// their first row.
-fn series_keys(table: &Table, variable: &str) -> Vec<(String, Option<f64>)> {
-    let mut keys: Vec<(String, Option<f64>)> = Vec::new();
+/// One series of a variable: an instrument, a retrieval, a value of the second parameter.
+#[derive(Debug, Clone, PartialEq)]
+struct SeriesKey {
+    instrument: String,
+    product: String,
+    second: Option<f64>,
+}
+
+impl SeriesKey {
+    fn holds(&self, r: &super::table::Row) -> bool {
+        r.instrument == self.instrument && r.product == self.product && r.values.get(1).copied() == self.second
+    }
+}
+
+/// The series of `variable` in `table`, in the order of their first row, and whether the
+/// variable comes from more than one retrieval (an external algorithm beside aLMI: each is its
+/// own series, named).
+fn series_keys(table: &Table, variable: &str) -> (Vec<SeriesKey>, bool) {
+    let mut keys: Vec<SeriesKey> = Vec::new();
     for r in table.rows.iter().filter(|r| r.variable == variable) {
-        let key = (r.instrument.clone(), r.values.get(1).copied());
+        let key = SeriesKey {
+            instrument: r.instrument.clone(),
+            product: r.product.clone(),
+            second: r.values.get(1).copied(),
+        };
         if !keys.contains(&key) {
             keys.push(key);
         }
     }
-    keys
+    let several = keys.iter().any(|k| k.product != keys[0].product);
+    (keys, several)
 }
 
 /// The curves of `variable` in `table` (points ordered by the first parameter).
 #[must_use]
 pub fn curves(table: &Table, variable: &str, requirement: Option<&Requirement>, log_x: bool) -> Curves {
-    let keys = series_keys(table, variable);
+    let (keys, several) = series_keys(table, variable);
     let limit = requirement.filter(|q| q.variable == variable).map(|q| q.mae_pct);
     let series = keys
         .iter()
-        .map(|(instrument, second)| {
+        .map(|key| {
             let mut xs: Vec<f64> = Vec::new();
-            let rows: Vec<_> = table
-                .rows
-                .iter()
-                .filter(|r| {
-                    r.variable == variable && &r.instrument == instrument && r.values.get(1).copied() == *second
-                })
-                .collect();
+            let rows: Vec<_> = table.rows.iter().filter(|r| r.variable == variable && key.holds(r)).collect();
             for r in &rows {
                 if !xs.contains(&r.values[0]) {
                     xs.push(r.values[0]);
@@ -57,9 +71,10 @@ pub fn curves(table: &Table, variable: &str, requirement: Option<&Requirement>, 
                 })
                 .filter(|p| p.mean.is_finite())
                 .collect();
-            let label = match (second, table.parameters.get(1)) {
-                (Some(y), Some(name)) => format!("{instrument}, {name} = {}", trim(*y)),
-                _ => instrument.clone(),
+            let series = if several { format!("{} {}", key.instrument, key.product) } else { key.instrument.clone() };
+            let label = match (key.second, table.parameters.get(1)) {
+                (Some(y), Some(name)) => format!("{series}, {name} = {}", trim(y)),
+                _ => series,
             };
             let crossing = limit.and_then(|l| first_crossing(&points, l));
             CurveSeries { label, points, crossing }
@@ -107,13 +122,13 @@ pub fn curves_by_pair_snr(table: &Table, variable: &str, requirement: Option<&Re
     let mut c = curves(table, variable, requirement, true);
     let limit = c.requirement.as_ref().map(|r| r.0);
     // The series' keys, in the order `curves` made them.
-    let keys = series_keys(table, variable);
-    for (s, (instrument, second)) in c.series.iter_mut().zip(&keys) {
+    let (keys, _) = series_keys(table, variable);
+    for (s, key) in c.series.iter_mut().zip(&keys) {
         for p in &mut s.points {
             let snr: Vec<f64> = table
                 .rows
                 .iter()
-                .filter(|r| &r.instrument == instrument && r.values.get(1).copied() == *second && r.values[0] == p.x)
+                .filter(|r| r.variable == variable && key.holds(r) && r.values[0] == p.x)
                 .filter_map(|r| r.snr_pair.map(|p| p[1]))
                 .filter(|v| v.is_finite())
                 .collect();

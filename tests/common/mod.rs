@@ -28,11 +28,32 @@ pub fn both_retrievals() -> Vec<RetrievalSpec> {
     vec![ron::from_str("Almi()").unwrap(), ron::from_str("Sambuca()").unwrap()]
 }
 
+/// An external retrieval running `command` (allowed for this process), placed third after
+/// [`both_retrievals`] where a ranges path names `External`.
+#[must_use]
+pub fn external_retrieval(command: &[&str]) -> RetrievalSpec {
+    let command: Vec<String> = command.iter().map(|s| (*s).to_string()).collect();
+    shoal::retrieval::external::allow(&command);
+    RetrievalSpec::External(shoal::retrieval::external::ExternalSpec {
+        name: "mine".into(),
+        command,
+        products: vec!["chl_mg_m3".into()],
+        bands: None,
+        time_limit_s: 300.0,
+    })
+}
+
 /// A ranges-table path as `sweep::apply` walks it: `[i]` becomes the index of the retrieval
-/// the path names in [`both_retrievals`].
+/// the path names in [`both_retrievals`] (an external one is third: [`external_retrieval`]).
 #[must_use]
 pub fn sweep_path(path: &str) -> String {
-    let index = if path.contains("Sambuca") { ".1" } else { ".0" };
+    let index = if path.contains("Sambuca") {
+        ".1"
+    } else if path.contains("External") {
+        ".2"
+    } else {
+        ".0"
+    };
     // The ranges table names a further focal plane `focal_planes[]`; the SWIR SmallSat has one.
     // The dark-current laws: the first plane's doubles ([`with_dark_laws`]), the SWIR plane's is
     // Arrhenius.

@@ -21,6 +21,10 @@ fn base(path: &str) -> RunConfig {
     crate::common::with_dark_laws(&mut instrument);
     let mut c = RunConfig::new(SceneSpec::preset("lake_hume_bloom").unwrap(), instrument);
     c.retrievals = both_retrievals();
+    if path.contains(".External.") {
+        // Checked, never run.
+        c.retrievals.push(crate::common::external_retrieval(&["true"]));
+    }
     c.calibration.sun_incidence_deg = Some(30.0);
     c.scene.atmosphere.surface = shoal::atmosphere::Surface::Wind { speed_m_s: 5.0 };
     if path.starts_with("scene.atmosphere.aerosol.Mixture") {

@@ -20,6 +20,7 @@ use shoal::library::Library;
 
 mod design;
 mod editing;
+mod external;
 mod files;
 mod review;
 mod session;

@@ -1,0 +1,73 @@
+//! An external retrieval in the app: a study that names a program opens with it selectable; the
+//! app asks before the program runs (allowing is per session, never saved); a program that fails
+//! shows its standard error where its maps would be; sessions keep the retrieval.
+
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
+use shoal::app::model::{AppState, RetrievalKind};
+use shoal::app::{AppOptions, ShoalApp};
+use shoal::library::Library;
+use shoal::retrieval::external::ExternalSpec;
+use shoal::study::StudySpec;
+
+#[test]
+fn the_app_asks_before_a_program_runs_and_shows_why_it_returned_nothing() {
+    let dir = super::temp_library("external");
+    let state = AppState {
+        decimations: vec![16],
+        retrieval: RetrievalKind::External,
+        external: Some(ExternalSpec {
+            name: "mine".into(),
+            command: vec!["sh".into(), "-c".into(), "echo 'mine.py: no model for 865 nm' >&2; exit 2".into()],
+            products: vec!["chl_mg_m3".into()],
+            bands: None,
+            time_limit_s: 30.0,
+        }),
+        ..AppState::default()
+    };
+    let library = Library::at(&dir);
+    let mut h = Harness::builder().with_size(egui::vec2(1500.0, 960.0)).build_eframe(move |cc| {
+        let mut app =
+            ShoalApp::with_state(state, &cc.egui_ctx, AppOptions { engine_threads: 2, ..AppOptions::default() });
+        app.set_library(library);
+        app
+    });
+    super::wait_for_engine(&mut h);
+    let ask = "runs a program on your machine";
+    assert!(h.query_by_label_contains(ask).is_some(), "no prompt before the program runs");
+    let refused = h.state().link.shown[0].as_ref().unwrap().output.retrievals[0].failure.clone().unwrap();
+    assert!(refused.contains("allow it first"), "{refused}");
+    h.get_by_label("Allow this program").click();
+    h.step();
+    super::wait_for_engine(&mut h);
+    assert!(h.query_by_label_contains(ask).is_none(), "the prompt stays after allowing");
+    assert!(h.query_by_label_contains("`mine` returned nothing").is_some(), "no failure box");
+    assert!(h.query_all_by_label_contains("no model for 865 nm").next().is_some(), "its standard error is not shown");
+    // The rest of the run is there: the Rrs and the SNR of A.
+    let shown = &h.state().link.shown[0].as_ref().unwrap().output;
+    assert!(shown.correction.rrs.rrs.iter().any(|v| *v > 0.0));
+    assert!(!shown.snr.is_empty());
+    // Back to aLMI: the failure box goes and the metrics are aLMI's.
+    h.get_by_label("aLMI").click();
+    h.step();
+    assert_eq!(h.state().state.retrieval, RetrievalKind::Almi);
+    super::wait_for_engine(&mut h);
+    assert!(h.query_by_label_contains("returned nothing").is_none());
+    assert_eq!(h.state().link.shown[0].as_ref().unwrap().output.retrievals[0].product.name, "aLMI");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_study_with_a_program_opens_with_it_selectable_and_sessions_keep_it() {
+    let study = StudySpec::preset("lake_hume_oc4").unwrap();
+    let state = AppState::from_study(&study).unwrap();
+    assert_eq!(state.retrieval, RetrievalKind::Almi, "the study's first retrieval is shown");
+    let external = state.external.clone().expect("the study's program is kept");
+    assert_eq!((external.name.as_str(), external.products.as_slice()), ("oc4", &["chl_mg_m3".to_string()][..]));
+    // The session round trip keeps it; a session saved before the field existed loads without.
+    let text = ron::to_string(&state).unwrap();
+    assert_eq!(ron::from_str::<AppState>(&text).unwrap(), state);
+    let old = ron::to_string(&AppState::default()).unwrap().replace("external:None,", "");
+    assert!(!old.contains("external"), "{old}");
+    assert_eq!(ron::from_str::<AppState>(&old).unwrap().external, None);
+}
