@@ -51,7 +51,8 @@ fn equivalent_width_nm(b: &super::BandResponse) -> f64 {
 }
 
 /// Write the program's input: the Rrs of `used` bands (fill where invalid, saturated or land),
-/// its flags, the land mask, the bands, their noise and the geometry. No truth.
+/// the land mask, the bands, their noise and the geometry. No truth. (No Rrs flags: the fill
+/// value carries the ones that matter, and 32-bit flags would double the file.)
 pub(super) fn write_input(
     spec: &ExternalSpec,
     inputs: &RetrievalInputs<'_>,
@@ -105,7 +106,9 @@ pub(super) fn write_input(
     let total = rows * cols * used.len();
     let bad = RrsFlags::INVALID | RrsFlags::SATURATED;
     let mut rrs_attrs = attrs("remote-sensing reflectance above the surface, corrected", "sr-1", standard_name("rrs"));
-    rrs_attrs.push(("ancillary_variables", "rrs_flags land".into()));
+    rrs_attrs.push(("ancillary_variables", "land".into()));
+    rrs_attrs
+        .push(("comment", "_FillValue where the correction flagged the band invalid or saturated, and on land".into()));
     floats.push(FloatVar {
         name: "rrs".into(),
         dims: CUBE.to_vec(),
@@ -115,28 +118,14 @@ pub(super) fn write_input(
             f & bad == 0 && land == 0
         }),
     });
-    let flags = vec![
-        FlagVar {
-            name: "rrs_flags".into(),
-            dims: CUBE.to_vec(),
-            long_name: "Rrs quality flags".into(),
-            flags: vec![
-                (i32::from(RrsFlags::NEGATIVE), "negative"),
-                (i32::from(RrsFlags::SATURATED), "saturated"),
-                (i32::from(RrsFlags::INVALID), "invalid"),
-            ],
-            values: (0..total).map(|i| i32::from(value(i).1)).collect(),
-            coordinates: "",
-        },
-        FlagVar {
-            name: "land".into(),
-            dims: MAP.to_vec(),
-            long_name: "land under the pixel centre (not retrieved)".into(),
-            flags: vec![(1, "land")],
-            values: inputs.land.iter().map(|&v| i32::from(v)).collect(),
-            coordinates: "",
-        },
-    ];
+    let flags = vec![FlagVar {
+        name: "land".into(),
+        dims: MAP.to_vec(),
+        long_name: "land under the pixel centre (not retrieved)".into(),
+        flags: vec![(1, "land")],
+        values: inputs.land.iter().map(|&v| i32::from(v)).collect(),
+        coordinates: "",
+    }];
     let mut ds = DataSet::new();
     let bad_def = |e: netcdf3::error::InvalidDataSet| format!("NetCDF definition: {e:?}");
     ds.add_fixed_dim("line", rows).map_err(bad_def)?;
