@@ -263,3 +263,46 @@ fn the_built_in_oc4_example_runs_through_python_and_matches_its_formula() {
     let m = ext.metrics.get("chl_mg_m3").unwrap();
     assert!(m.n > 100 && m.mae_pct().is_finite(), "{m:?}");
 }
+
+#[test]
+fn the_command_line_refuses_a_program_unless_allowed_and_keeps_the_study_when_it_fails() {
+    let dir = Dir::new("external-cli");
+    let study = dir.path().join("mine.ron");
+    std::fs::write(
+        &study,
+        r#"StudySpec(
+    name: "mine",
+    scene: Preset("lake_hume_bloom"),
+    instruments: [Preset("cubesat")],
+    retrievals: [Almi(), External((name: "mine", command: ["sh", "-c", "echo 'mine: cannot read band 865' >&2; exit 4"], products: ["chl_mg_m3"]))],
+)"#,
+    )
+    .unwrap();
+    let shoal = |extra: &[&str], out: &str| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_shoal"))
+            .arg("study")
+            .arg(&study)
+            .args(["--decimation", "16", "--no-figures", "--out"])
+            .arg(dir.path().join(out))
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let refused = shoal(&[], "refused");
+    assert_eq!(refused.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&refused.stderr);
+    assert!(err.contains("--allow-external") && err.contains("cannot read band 865"), "names the program: {err}");
+    assert!(!dir.path().join("refused").exists(), "nothing is written before the refusal");
+
+    let failed = shoal(&["--allow-external"], "kept");
+    assert_eq!(failed.status.code(), Some(1), "{}", String::from_utf8_lossy(&failed.stderr));
+    let err = String::from_utf8_lossy(&failed.stderr);
+    assert!(err.contains("returned nothing") && err.contains("exit"), "{err}");
+    let table = String::from_utf8_lossy(&failed.stdout);
+    assert!(table.contains("cannot read band 865") && table.contains("aLMI"), "{table}");
+    // The study's outputs are all there: aLMI's products and the metrics with the failure.
+    let kept = dir.path().join("kept");
+    assert!(kept.join("cubesat/alm_chl_mg_m3.npy").exists());
+    let metrics = std::fs::read_to_string(kept.join("metrics.json")).unwrap();
+    assert!(metrics.contains("cannot read band 865"), "{metrics}");
+}
