@@ -109,7 +109,10 @@ impl ShoalApp {
             },
             UiCommand::LoadStudy(entry) => {
                 let loaded = self.library.load_study(&entry).map_err(|e| e.to_string());
-                match loaded.and_then(|study| AppState::from_study(&study).map(|s| (s, study.requirements.is_some()))) {
+                let dir = entry.path.as_deref().and_then(std::path::Path::parent);
+                let opened = loaded
+                    .and_then(|study| AppState::from_study(&study, dir).map(|s| (s, study.requirements.is_some())));
+                match opened {
                     Ok((mut s, requirements_from_study)) => {
                         s.dark = self.state.dark;
                         // The study's own requirements when it states them, else the ones in use.

@@ -180,7 +180,7 @@ pub struct AppState {
 
 impl Default for AppState {
     fn default() -> Self {
-        Self::from_study(&fallback_study()).unwrap_or_else(|_| {
+        Self::from_study(&fallback_study(), None).unwrap_or_else(|_| {
             let cubesat = InstrumentSpec::preset("cubesat").unwrap_or_else(|_| unreachable!("built-in preset"));
             let smallsat = InstrumentSpec::preset("smallsat").unwrap_or_else(|_| unreachable!("built-in preset"));
             let scene = SceneSpec::preset("lake_hume_bloom").unwrap_or_else(|_| unreachable!("built-in preset"));
@@ -237,10 +237,10 @@ impl AppState {
         }
     }
 
-    /// The state of a study: its first two instruments as A and B (the first twice if it has
-    /// one), its scene and its first retrieval.
-    pub fn from_study(study: &StudySpec) -> Result<Self, String> {
-        let resolved = study.resolve(None).map_err(|e| e.to_string())?;
+    /// The state of a study (`dir`: its file's directory, for its relative paths): its first two
+    /// instruments as A and B (the first twice if it has one), its scene and its first retrieval.
+    pub fn from_study(study: &StudySpec, dir: Option<&std::path::Path>) -> Result<Self, String> {
+        let resolved = study.resolve(dir).map_err(|e| e.to_string())?;
         let label = |i: usize| match study.instruments.get(i) {
             Some(Source::Preset(n)) => n.clone(),
             _ => format!("{} instrument {}", study.name, i + 1),

@@ -60,7 +60,7 @@ fn the_app_asks_before_a_program_runs_and_shows_why_it_returned_nothing() {
 #[test]
 fn a_study_with_a_program_opens_with_it_selectable_and_sessions_keep_it() {
     let study = StudySpec::preset("lake_hume_oc4").unwrap();
-    let state = AppState::from_study(&study).unwrap();
+    let state = AppState::from_study(&study, None).unwrap();
     assert_eq!(state.retrieval, RetrievalKind::Almi, "the study's first retrieval is shown");
     let external = state.external.clone().expect("the study's program is kept");
     assert_eq!((external.name.as_str(), external.products.as_slice()), ("oc4", &["chl_mg_m3".to_string()][..]));
