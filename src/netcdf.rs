@@ -122,8 +122,33 @@ pub fn attrs(long: &str, units: &str, standard: Option<&str>) -> Vec<(&'static s
     a
 }
 
+/// A text variable (NC_CHAR) and its bytes, as [`band_names`] defines it.
+pub type TextVar = (&'static str, Vec<u8>);
+
+/// Define `band_name(band, name_strlen)`, the bands' names as a CF string coordinate (a char
+/// array, NUL-padded), and return it to write: xarray reads it as an array of strings. The
+/// length is rounded up to 4 bytes, so the variable needs no padding in the file.
+pub fn band_names(ds: &mut DataSet, names: &[&str]) -> Result<TextVar, String> {
+    let bad = |e: netcdf3::error::InvalidDataSet| format!("NetCDF definition: {e:?}");
+    let len = names.iter().map(|n| n.len()).max().unwrap_or(1).max(1).div_ceil(4) * 4;
+    ds.add_fixed_dim("name_strlen", len).map_err(bad)?;
+    ds.add_var_u8("band_name", &["band", "name_strlen"]).map_err(bad)?;
+    ds.add_var_attr_string("band_name", "long_name", "band name").map_err(bad)?;
+    let mut bytes = vec![0u8; names.len() * len];
+    for (i, n) in names.iter().enumerate() {
+        bytes[i * len..i * len + n.len()].copy_from_slice(n.as_bytes());
+    }
+    Ok(("band_name", bytes))
+}
+
 /// Write the data set and its values to `path` through a temporary file, synced, then renamed.
-pub fn write_file(path: &Path, ds: &DataSet, floats: &[FloatVar], flags: &[FlagVar]) -> Result<(), String> {
+pub fn write_file(
+    path: &Path,
+    ds: &DataSet,
+    floats: &[FloatVar],
+    flags: &[FlagVar],
+    texts: &[TextVar],
+) -> Result<(), String> {
     let tmp = path.with_extension("nc.partial");
     let fail = |m: String| format!("cannot write {}: {m}", path.display());
     let result = (|| -> Result<(), String> {
@@ -137,6 +162,9 @@ pub fn write_file(path: &Path, ds: &DataSet, floats: &[FloatVar], flags: &[FlagV
         }
         for f in flags {
             writer.write_var_i32(&f.name, &f.values).map_err(|e| fail(format!("{}: {e:?}", f.name)))?;
+        }
+        for (name, bytes) in texts {
+            writer.write_var_u8(name, bytes).map_err(|e| fail(format!("{name}: {e:?}")))?;
         }
         writer.close().map_err(|e| fail(format!("{e:?}")))?;
         let mut buffered = shared.0.borrow_mut();

@@ -17,7 +17,8 @@
 //!   a built-in study has none), and `{example:NAME}` a built-in example script (`presets/examples/`)
 //!   written into the run's folder — so a built-in study runs from any directory.
 //! - The input ([`super::external_io`]) has dimensions (line, pixel, band): `rrs` with its
-//!   `_FillValue` where the correction flagged a band invalid or saturated or on land, `land`, the bands' `wavelength`, `bandwidth` and `nedr`, and per pixel column the
+//!   `_FillValue` where the correction flagged a band invalid or saturated or on land, `land`,
+//!   the bands' `wavelength`, `bandwidth`, `band_name` and `nedr`, and per pixel column the
 //!   `solar_zenith_angle` and `sensor_zenith_angle` in degrees.
 //! - The output must hold every variable of `products` (Shoal's names: `chl_mg_m3`, `nap_g_m3`,
 //!   `cdom_per_m`, `depth_m`) as float (line, pixel) of the input's size, NaN or a `_FillValue`

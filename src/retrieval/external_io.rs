@@ -133,6 +133,7 @@ pub(super) fn write_input(
     ds.add_fixed_dim("band", used.len()).map_err(bad_def)?;
     define_vars(&mut ds, &floats, &flags)?;
     let band_names: Vec<&str> = bands.iter().map(|b| b.name.as_str()).collect();
+    let names = crate::netcdf::band_names(&mut ds, &band_names)?;
     for (k, v) in [
         ("Conventions", "CF-1.8".to_string()),
         ("title", format!("Shoal: corrected Rrs for the external retrieval `{}`", spec.name)),
@@ -147,7 +148,7 @@ pub(super) fn write_input(
     ] {
         ds.add_global_attr_string(k, v).map_err(bad_def)?;
     }
-    write_file(path, &ds, &floats, &flags)
+    write_file(path, &ds, &floats, &flags, &[names])
 }
 
 /// The program's output as a [`Product`]: each wanted map (0 where missing), returned where every

@@ -33,7 +33,7 @@ pub use crate::netcdf::FILL;
 /// Auxiliary coordinates of a (line, pixel) map: every pixel's ground position.
 const MAP_COORDINATES: &str = "y x";
 /// Auxiliary coordinates of a (line, pixel, band) cube: the ground position and the bands.
-const CUBE_COORDINATES: &str = "y x wavelength bandwidth";
+const CUBE_COORDINATES: &str = "y x wavelength bandwidth band_name";
 
 /// Write `out`'s products into `dir/products.nc` (atomically: a temporary file, synced, then
 /// renamed).
@@ -45,9 +45,9 @@ pub fn write_netcdf(out: &RunOutput, dir: &Path, o: &mut Outputs) -> Result<(), 
     radiometry_vars(out, &mut floats, &mut flags);
     truth_vars(out, &mut floats, &mut flags);
     retrieval_vars(out, &mut floats, &mut flags);
-    let data_set = define(out, (rows, cols, nb), &floats, &flags)?;
+    let (data_set, names) = define(out, (rows, cols, nb), &floats, &flags)?;
     let path = dir.join(FILE);
-    write_file(&path, &data_set, &floats, &flags).map_err(StudyError::Io)?;
+    write_file(&path, &data_set, &floats, &flags, &[names]).map_err(StudyError::Io)?;
     o.files.push(FILE.to_string());
     Ok(())
 }
@@ -252,19 +252,20 @@ fn define(
     (rows, cols, nb): (usize, usize, usize),
     floats: &[FloatVar],
     flags: &[FlagVar],
-) -> Result<DataSet, StudyError> {
+) -> Result<(DataSet, crate::netcdf::TextVar), StudyError> {
     let bad = |e: netcdf3::error::InvalidDataSet| StudyError::Io(format!("NetCDF definition: {e:?}"));
     let mut ds = DataSet::new();
     ds.add_fixed_dim("line", rows).map_err(bad)?;
     ds.add_fixed_dim("pixel", cols).map_err(bad)?;
     ds.add_fixed_dim("band", nb).map_err(bad)?;
     define_vars(&mut ds, floats, flags).map_err(StudyError::Io)?;
+    let band_names: Vec<&str> = out.response.bands.bands.iter().map(|b| b.name.as_str()).collect();
+    let names = crate::netcdf::band_names(&mut ds, &band_names).map_err(StudyError::Io)?;
     let config = out.config.to_ron().map_err(|e| StudyError::Io(e.to_string()))?;
     let geolocation = match &out.scene.frame {
         Some(f) => format!("pushbroom ground points in {} (scene centre at {:.3}, {:.3})", f.crs.describe(), f.centre.0, f.centre.1),
         None => "pushbroom ground points in the scene's local frame (metres east and north of its centre; the scene has no georeference)".into(),
     };
-    let band_names: Vec<&str> = out.response.bands.bands.iter().map(|b| b.name.as_str()).collect();
     let globals = [
         ("Conventions", "CF-1.8".to_string()),
         ("title", format!("Shoal simulation: {} over {}", out.config.instrument.name, out.config.scene.name)),
@@ -288,5 +289,5 @@ fn define(
     for (k, v) in globals {
         ds.add_global_attr_string(k, v).map_err(bad)?;
     }
-    Ok(ds)
+    Ok((ds, names))
 }

@@ -109,13 +109,19 @@ fn xarray_opens_the_product_with_its_coordinates_and_fill_values() {
 import sys, xarray as xr, numpy as np
 ds = xr.open_dataset(sys.argv[1])
 assert 'wavelength' in ds.coords and 'x' in ds.coords, list(ds.coords)
+# The bands' names are a string coordinate.
+assert 'band_name' in ds.coords and ds.band_name.values[2].decode() == sys.argv[2], ds.band_name.values
 rrs = ds.rrs
 assert rrs.dims == ('line', 'pixel', 'band'), rrs.dims
 # The fill value became NaN; what is left is the valid Rrs.
 print(int(rrs.isnull().sum()), float(np.nanmedian(rrs.isel(band=2).values)), float(ds.wavelength[2]))
 "#;
-    let o =
-        std::process::Command::new(python).args(["-c", script]).arg(dir.path().join("products.nc")).output().unwrap();
+    let o = std::process::Command::new(python)
+        .args(["-c", script])
+        .arg(dir.path().join("products.nc"))
+        .arg(&out.response.bands.bands[2].name)
+        .output()
+        .unwrap();
     assert!(o.status.success(), "xarray: {}", String::from_utf8_lossy(&o.stderr));
     let text = String::from_utf8_lossy(&o.stdout);
     let parts: Vec<f64> = text.split_whitespace().map(|v| v.parse().unwrap()).collect();
