@@ -43,9 +43,29 @@ pub fn meaning(variable: &str) -> (&'static str, &'static str) {
     }
 }
 
+/// A variable's values, made when the variable is written: a file's cubes are made one at a time,
+/// so writing holds one cube beside the run rather than all of them.
+pub struct Values<'a, T>(Box<dyn Fn() -> Vec<T> + 'a>);
+
+impl<'a, T: Clone + 'a> Values<'a, T> {
+    /// Values made already (small variables; copied when written).
+    #[must_use]
+    pub fn ready(values: Vec<T>) -> Self {
+        Self(Box::new(move || values.clone()))
+    }
+
+    /// Values made by `make` when the variable is written.
+    pub fn lazy(make: impl Fn() -> Vec<T> + 'a) -> Self {
+        Self(Box::new(make))
+    }
+
+    fn make(&self) -> Vec<T> {
+        (self.0)()
+    }
+}
+
 /// A float variable of the data set with its data.
-#[derive(Debug, Clone)]
-pub struct FloatVar {
+pub struct FloatVar<'a> {
     /// Variable name.
     pub name: String,
     /// Its dimensions, slowest first.
@@ -53,7 +73,7 @@ pub struct FloatVar {
     /// Its attributes (`_FillValue` is added by [`define_vars`]).
     pub attrs: Vec<(&'static str, String)>,
     /// Its values, in the dimensions' order.
-    pub values: Vec<f32>,
+    pub values: Values<'a, f32>,
 }
 
 /// An integer flag variable: name, dimensions, what it is, masks and meanings, values. 32-bit:
@@ -61,8 +81,7 @@ pub struct FloatVar {
 /// (128 is no NC_BYTE), and the `netcdf3` crate pads a 1- or 2-byte attribute list with fill
 /// values where the format wants zero bytes (its own reader then refuses the header; ncdump
 /// accepts it): 4-byte attributes need no padding.
-#[derive(Debug, Clone)]
-pub struct FlagVar {
+pub struct FlagVar<'a> {
     /// Variable name.
     pub name: String,
     /// Its dimensions, slowest first.
@@ -72,7 +91,7 @@ pub struct FlagVar {
     /// (mask, meaning) of each flag.
     pub flags: Vec<(i32, &'static str)>,
     /// Its values, in the dimensions' order.
-    pub values: Vec<i32>,
+    pub values: Values<'a, i32>,
     /// Auxiliary coordinates (the `coordinates` attribute).
     pub coordinates: &'static str,
 }
@@ -145,8 +164,8 @@ pub fn band_names(ds: &mut DataSet, names: &[&str]) -> Result<TextVar, String> {
 pub fn write_file(
     path: &Path,
     ds: &DataSet,
-    floats: &[FloatVar],
-    flags: &[FlagVar],
+    floats: &[FloatVar<'_>],
+    flags: &[FlagVar<'_>],
     texts: &[TextVar],
 ) -> Result<(), String> {
     let tmp = path.with_extension("nc.partial");
@@ -158,10 +177,10 @@ pub fn write_file(
             .map_err(|e| fail(format!("{e:?}")))?;
         writer.set_def(ds, Version::Offset64Bit, 0).map_err(|e| fail(format!("{e:?}")))?;
         for v in floats {
-            writer.write_var_f32(&v.name, &v.values).map_err(|e| fail(format!("{}: {e:?}", v.name)))?;
+            writer.write_var_f32(&v.name, &v.values.make()).map_err(|e| fail(format!("{}: {e:?}", v.name)))?;
         }
         for f in flags {
-            writer.write_var_i32(&f.name, &f.values).map_err(|e| fail(format!("{}: {e:?}", f.name)))?;
+            writer.write_var_i32(&f.name, &f.values.make()).map_err(|e| fail(format!("{}: {e:?}", f.name)))?;
         }
         for (name, bytes) in texts {
             writer.write_var_u8(name, bytes).map_err(|e| fail(format!("{name}: {e:?}")))?;
@@ -183,7 +202,7 @@ pub fn write_file(
 
 /// Add `floats` and `flags` to `ds` with their attributes: `_FillValue` on every float variable
 /// of more than one dimension, `flag_values`/`flag_masks` and `flag_meanings` on the flags.
-pub fn define_vars(ds: &mut DataSet, floats: &[FloatVar], flags: &[FlagVar]) -> Result<(), String> {
+pub fn define_vars(ds: &mut DataSet, floats: &[FloatVar<'_>], flags: &[FlagVar<'_>]) -> Result<(), String> {
     let bad = |e: netcdf3::error::InvalidDataSet| format!("NetCDF definition: {e:?}");
     for v in floats {
         ds.add_var_f32(&v.name, &v.dims).map_err(bad)?;

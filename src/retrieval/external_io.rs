@@ -10,7 +10,9 @@ use super::RetrievalError;
 use super::external::ExternalSpec;
 use super::run::{Product, ProductFlags, RetrievalInputs};
 use crate::correction::RrsFlags;
-use crate::netcdf::{CUBE, FlagVar, FloatVar, MAP, Maps, attrs, define_vars, masked, standard_name, write_file};
+use crate::netcdf::{
+    CUBE, FlagVar, FloatVar, MAP, Maps, Values, attrs, define_vars, masked, standard_name, write_file,
+};
 use crate::parse::FieldError;
 
 /// The instrument bands the program is given (`bands`, else every band), by index.
@@ -66,19 +68,19 @@ pub(super) fn write_input(
             name: "wavelength".into(),
             dims: vec!["band"],
             attrs: attrs("band response centroid wavelength", "nm", Some("radiation_wavelength")),
-            values: bands.iter().map(|b| b.centroid_nm() as f32).collect(),
+            values: Values::ready(bands.iter().map(|b| b.centroid_nm() as f32).collect()),
         },
         FloatVar {
             name: "bandwidth".into(),
             dims: vec!["band"],
             attrs: attrs("band response equivalent width (integral over peak)", "nm", None),
-            values: bands.iter().map(|b| equivalent_width_nm(b) as f32).collect(),
+            values: Values::ready(bands.iter().map(|b| equivalent_width_nm(b) as f32).collect()),
         },
         FloatVar {
             name: "nedr".into(),
             dims: vec!["band"],
             attrs: attrs("noise-equivalent delta Rrs of the instrument at the typical radiance", "sr-1", None),
-            values: used.iter().map(|&b| inputs.nedr[b] as f32).collect(),
+            values: Values::ready(used.iter().map(|&b| inputs.nedr[b] as f32).collect()),
         },
     ];
     let degrees = |f: fn(&crate::water::WaterGeometry) -> f64| -> Vec<f32> {
@@ -88,16 +90,16 @@ pub(super) fn write_input(
         name: "solar_zenith_angle".into(),
         dims: vec!["pixel"],
         attrs: attrs("solar zenith angle at the ground", "degree", Some("solar_zenith_angle")),
-        values: degrees(|g| g.sun_zenith_rad),
+        values: Values::ready(degrees(|g| g.sun_zenith_rad)),
     });
     floats.push(FloatVar {
         name: "sensor_zenith_angle".into(),
         dims: vec!["pixel"],
         attrs: attrs("view zenith angle at the ground", "degree", Some("sensor_zenith_angle")),
-        values: degrees(|g| g.view_zenith_rad),
+        values: Values::ready(degrees(|g| g.view_zenith_rad)),
     });
     let n_used = used.len().max(1);
-    let value = |i: usize| {
+    let value = move |i: usize| {
         let (pixel, k) = (i / n_used, i % n_used);
         let (r, c, b) = (pixel / cols.max(1), pixel % cols.max(1), used[k]);
         debug_assert!(b < nb);
@@ -113,9 +115,11 @@ pub(super) fn write_input(
         name: "rrs".into(),
         dims: CUBE.to_vec(),
         attrs: rrs_attrs,
-        values: masked((0..total).map(|i| value(i).0), |i| {
-            let (_, f, land) = value(i);
-            f & bad == 0 && land == 0
+        values: Values::lazy(move || {
+            masked((0..total).map(|i| value(i).0), |i| {
+                let (_, f, land) = value(i);
+                f & bad == 0 && land == 0
+            })
         }),
     });
     let flags = vec![FlagVar {
@@ -123,7 +127,7 @@ pub(super) fn write_input(
         dims: MAP.to_vec(),
         long_name: "land under the pixel centre (not retrieved)".into(),
         flags: vec![(1, "land")],
-        values: inputs.land.iter().map(|&v| i32::from(v)).collect(),
+        values: Values::ready(inputs.land.iter().map(|&v| i32::from(v)).collect()),
         coordinates: "",
     }];
     let mut ds = DataSet::new();

@@ -22,7 +22,9 @@ use super::StudyError;
 use super::output::Outputs;
 use crate::correction::RrsFlags;
 use crate::engine::RunOutput;
-use crate::netcdf::{CUBE, FlagVar, FloatVar, MAP, attrs, define_vars, masked, meaning, standard_name, write_file};
+use crate::netcdf::{
+    CUBE, FlagVar, FloatVar, MAP, Values, attrs, define_vars, masked, meaning, standard_name, write_file,
+};
 use crate::retrieval::ProductFlags;
 
 /// The file a run's NetCDF product is written to.
@@ -53,20 +55,20 @@ pub fn write_netcdf(out: &RunOutput, dir: &Path, o: &mut Outputs) -> Result<(), 
 }
 
 /// The bands, and every pixel's ground position.
-fn coordinate_vars(out: &RunOutput, floats: &mut Vec<FloatVar>) {
+fn coordinate_vars<'a>(out: &'a RunOutput, floats: &mut Vec<FloatVar<'a>>) {
     let (rows, cols, _) = out.level1.radiance.dim();
     let bands = &out.response.bands.bands;
     floats.push(FloatVar {
         name: "wavelength".into(),
         dims: vec!["band"],
         attrs: attrs("band centre wavelength", "nm", Some("radiation_wavelength")),
-        values: bands.iter().map(|b| b.centre_nm as f32).collect(),
+        values: Values::ready(bands.iter().map(|b| b.centre_nm as f32).collect()),
     });
     floats.push(FloatVar {
         name: "bandwidth".into(),
         dims: vec!["band"],
         attrs: attrs("band full width at half maximum", "nm", None),
-        values: bands.iter().map(|b| b.fwhm_nm as f32).collect(),
+        values: Values::ready(bands.iter().map(|b| b.fwhm_nm as f32).collect()),
     });
     let projected = out.scene.frame.as_ref().filter(|f| matches!(f.crs, crate::geotiff::Crs::Projected { .. }));
     let (x0, y0) = projected.map_or((0.0, 0.0), |f| f.centre);
@@ -91,18 +93,18 @@ fn coordinate_vars(out: &RunOutput, floats: &mut Vec<FloatVar>) {
         name: "x".into(),
         dims: MAP.to_vec(),
         attrs: attrs(x_long, "m", std_or_none(x_std)),
-        values: ground.iter().map(|g| (x0 + g.0) as f32).collect(),
+        values: Values::ready(ground.iter().map(|g| (x0 + g.0) as f32).collect()),
     });
     floats.push(FloatVar {
         name: "y".into(),
         dims: MAP.to_vec(),
         attrs: attrs(y_long, "m", std_or_none(y_std)),
-        values: ground.iter().map(|g| (y0 + g.1) as f32).collect(),
+        values: Values::ready(ground.iter().map(|g| (y0 + g.1) as f32).collect()),
     });
 }
 
 /// Level-1 and Rrs with its flags.
-fn radiometry_vars(out: &RunOutput, floats: &mut Vec<FloatVar>, flags: &mut Vec<FlagVar>) {
+fn radiometry_vars<'a>(out: &'a RunOutput, floats: &mut Vec<FloatVar<'a>>, flags: &mut Vec<FlagVar<'a>>) {
     let cube_coordinates = ("coordinates", CUBE_COORDINATES.to_string());
     let mut l1 = attrs("top-of-atmosphere radiance (Level-1, calibrated)", "W m-2 sr-1 nm-1", None);
     l1.push(cube_coordinates.clone());
@@ -110,7 +112,7 @@ fn radiometry_vars(out: &RunOutput, floats: &mut Vec<FloatVar>, flags: &mut Vec<
         name: "level1_radiance".into(),
         dims: CUBE.to_vec(),
         attrs: l1,
-        values: masked(out.level1.radiance.iter().copied(), |_| true),
+        values: Values::lazy(move || masked(out.level1.radiance.iter().copied(), |_| true)),
     });
     let rrs = &out.correction.rrs;
     let rrs_flags = rrs.flags.as_slice().unwrap_or_default();
@@ -120,7 +122,9 @@ fn radiometry_vars(out: &RunOutput, floats: &mut Vec<FloatVar>, flags: &mut Vec<
         name: "rrs".into(),
         dims: CUBE.to_vec(),
         attrs: a,
-        values: masked(rrs.rrs.iter().copied(), |i| rrs_flags.get(i).is_some_and(|f| f & RrsFlags::INVALID == 0)),
+        values: Values::lazy(move || {
+            masked(rrs.rrs.iter().copied(), |i| rrs_flags.get(i).is_some_and(|f| f & RrsFlags::INVALID == 0))
+        }),
     });
     flags.push(FlagVar {
         name: "rrs_flags".into(),
@@ -131,13 +135,13 @@ fn radiometry_vars(out: &RunOutput, floats: &mut Vec<FloatVar>, flags: &mut Vec<
             (i32::from(RrsFlags::SATURATED), "saturated"),
             (i32::from(RrsFlags::INVALID), "invalid"),
         ],
-        values: rrs_flags.iter().map(|&f| i32::from(f)).collect(),
+        values: Values::lazy(move || rrs_flags.iter().map(|&f| i32::from(f)).collect()),
         coordinates: CUBE_COORDINATES,
     });
 }
 
 /// The truth, and the aerosol an image-based correction found.
-fn truth_vars(out: &RunOutput, floats: &mut Vec<FloatVar>, flags: &mut Vec<FlagVar>) {
+fn truth_vars<'a>(out: &'a RunOutput, floats: &mut Vec<FloatVar<'a>>, flags: &mut Vec<FlagVar<'a>>) {
     let truth = &out.radiance.truth;
     let nb = out.level1.radiance.dim().2;
     let water = |i: usize| truth.land.as_slice().is_some_and(|l| l[i] == 0);
@@ -151,7 +155,7 @@ fn truth_vars(out: &RunOutput, floats: &mut Vec<FloatVar>, flags: &mut Vec<FlagV
         name: "true_rrs".into(),
         dims: CUBE.to_vec(),
         attrs: a,
-        values: masked(truth.rrs_above.iter().copied(), |i| water(i / nbw)),
+        values: Values::lazy(move || masked(truth.rrs_above.iter().copied(), |i| water(i / nbw))),
     });
     let mut truth_maps: Vec<(&str, &ndarray::Array2<f32>)> =
         vec![("chl_mg_m3", &truth.chl_mg_m3), ("nap_g_m3", &truth.nap_g_m3), ("cdom_per_m", &truth.cdom_per_m)];
@@ -166,7 +170,7 @@ fn truth_vars(out: &RunOutput, floats: &mut Vec<FloatVar>, flags: &mut Vec<FlagV
             name: format!("true_{variable}"),
             dims: MAP.to_vec(),
             attrs: a,
-            values: masked(values.iter().copied(), water),
+            values: Values::lazy(move || masked(values.iter().copied(), water)),
         });
     }
     if let Some(aot) = &truth.aot550 {
@@ -180,7 +184,7 @@ fn truth_vars(out: &RunOutput, floats: &mut Vec<FloatVar>, flags: &mut Vec<FlagV
             name: "true_aot550".into(),
             dims: MAP.to_vec(),
             attrs: a,
-            values: aot.iter().copied().collect(),
+            values: Values::ready(aot.iter().copied().collect()),
         });
     }
     flags.push(FlagVar {
@@ -188,7 +192,7 @@ fn truth_vars(out: &RunOutput, floats: &mut Vec<FloatVar>, flags: &mut Vec<FlagV
         dims: MAP.to_vec(),
         long_name: "land under the pixel centre".into(),
         flags: vec![(1, "land")],
-        values: truth.land.iter().map(|&v| i32::from(v)).collect(),
+        values: Values::ready(truth.land.iter().map(|&v| i32::from(v)).collect()),
         coordinates: MAP_COORDINATES,
     });
 
@@ -199,13 +203,13 @@ fn truth_vars(out: &RunOutput, floats: &mut Vec<FloatVar>, flags: &mut Vec<FlagV
             name: "retrieved_aot550".into(),
             dims: MAP.to_vec(),
             attrs: at,
-            values: masked(a.aot550.iter().copied(), |_| true),
+            values: Values::ready(masked(a.aot550.iter().copied(), |_| true)),
         });
     }
 }
 
 /// Every retrieval's products and flags.
-fn retrieval_vars(out: &RunOutput, floats: &mut Vec<FloatVar>, flags: &mut Vec<FlagVar>) {
+fn retrieval_vars<'a>(out: &'a RunOutput, floats: &mut Vec<FloatVar<'a>>, flags: &mut Vec<FlagVar<'a>>) {
     let coordinates = ("coordinates", MAP_COORDINATES.to_string());
     for ret in &out.retrievals {
         let p = &ret.product;
@@ -223,7 +227,7 @@ fn retrieval_vars(out: &RunOutput, floats: &mut Vec<FloatVar>, flags: &mut Vec<F
                 name: format!("{stem}_{variable}"),
                 dims: MAP.to_vec(),
                 attrs: a,
-                values: masked(values.iter().copied(), returned),
+                values: Values::lazy(move || masked(values.iter().copied(), returned)),
             });
         }
         flags.push(FlagVar {
@@ -240,7 +244,7 @@ fn retrieval_vars(out: &RunOutput, floats: &mut Vec<FloatVar>, flags: &mut Vec<F
                 (i32::from(ProductFlags::LAND), "land"),
                 (i32::from(ProductFlags::STALLED), "stalled"),
             ],
-            values: pf.iter().map(|&f| i32::from(f)).collect(),
+            values: Values::lazy(move || pf.iter().map(|&f| i32::from(f)).collect()),
             coordinates: MAP_COORDINATES,
         });
     }
