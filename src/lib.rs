@@ -17,6 +17,7 @@
 //! |---|---|
 //! | [`colormap`] | viridis, diverging and class colours, value scales (figures and app) |
 //! | [`units`] | constants, unit conversions, angle helpers |
+//! | [`markup`] | the one escaping rule for text inside HTML, SVG and XML |
 //! | [`assets`] | cited spectra embedded in the binary |
 //! | [`control`] | cancellation and progress shared by a run and its watcher |
 //! | [`budget`] | what a run may use of the machine (memory, the atmosphere's time), checked before it starts |
@@ -62,6 +63,7 @@ pub mod geotiff;
 pub mod instrument;
 pub mod jobs;
 pub mod library;
+pub mod markup;
 pub mod metrics;
 pub mod netcdf;
 pub mod parse;

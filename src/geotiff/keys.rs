@@ -2,6 +2,7 @@
 //! in tag 34735, with text in 34737 and doubles in 34736; and GDAL's XML metadata (tag 42112).
 
 use super::Crs;
+use crate::markup::escape as xml_escape;
 
 /// GeoTIFF tag numbers.
 pub(super) const MODEL_PIXEL_SCALE: u16 = 33550;
@@ -140,12 +141,7 @@ pub(super) fn build(crs: &Crs) -> (Vec<u16>, String) {
     (dir, ascii)
 }
 
-/// Escape text for XML.
-fn xml_escape(s: &str) -> String {
-    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
-}
-
-/// Undo [`xml_escape`] and decode character references (`&#x207B;`, `&#8315;`).
+/// Undo [`crate::markup::escape`] and decode character references (`&#x207B;`, `&#8315;`).
 fn xml_unescape(s: &str) -> String {
     let mut out = String::with_capacity(s.len());
     let mut rest = s;

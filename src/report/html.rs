@@ -18,11 +18,7 @@ pub struct PageFigure {
     pub png: bool,
 }
 
-/// Escape text for HTML.
-#[must_use]
-pub fn escape(s: &str) -> String {
-    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
-}
+pub use crate::markup::escape;
 
 /// A file name as a URL path segment: unreserved characters kept, the rest percent-encoded
 /// (RFC 3986), so a name with `#`, `?`, `%` or spaces still links to its file.
