@@ -15,7 +15,7 @@
 use std::sync::OnceLock;
 
 use super::AtmosphereError;
-use super::complex::Complex;
+use super::Complex;
 use super::mie::{SizeGrid, integrate_lognormal};
 use super::phase::PhaseFunction;
 use super::wmo::{AerosolType, Component};

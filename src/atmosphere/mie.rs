@@ -15,7 +15,7 @@
 //!   Wiley, ch. 4 and appendix A.
 //! - Wiscombe, W. J. (1980) Improved Mie scattering algorithms. Appl. Opt. 19, 1505–1509.
 
-use super::complex::Complex;
+use super::Complex;
 
 /// Efficiencies and amplitude functions of one sphere.
 #[derive(Debug, Clone, PartialEq)]
@@ -50,8 +50,8 @@ pub fn mie_sphere(x: f64, m: Complex, mu: &[f64]) -> MieSphere {
     // Logarithmic derivative D_n(mx), downward recurrence (BH eq. 4.89).
     let mut d = vec![Complex::default(); n_mx + 1];
     for n in (1..=n_mx).rev() {
-        let en = Complex::new(n as f64, 0.0) / mx;
-        d[n - 1] = en - Complex::new(1.0, 0.0) / (d[n] + en);
+        let en = Complex::new(n as f64, 0.0).fdiv(mx);
+        d[n - 1] = en - Complex::new(1.0, 0.0).fdiv(d[n] + en);
     }
     let (mut psi0, mut psi1) = (x.cos(), x.sin());
     let (mut chi0, mut chi1) = (-x.sin(), x.cos());
@@ -69,10 +69,10 @@ pub fn mie_sphere(x: f64, m: Complex, mu: &[f64]) -> MieSphere {
         let psi = (2.0 * nf - 1.0) * psi1 / x - psi0;
         let chi = (2.0 * nf - 1.0) * chi1 / x - chi0;
         let xi = Complex::new(psi, -chi);
-        let da = d[n] / m + Complex::new(nf / x, 0.0);
+        let da = d[n].fdiv(m) + Complex::new(nf / x, 0.0);
         let db = m * d[n] + Complex::new(nf / x, 0.0);
-        let a = (da.scale(psi) - Complex::new(psi1, 0.0)) / (da * xi - xi1);
-        let b = (db.scale(psi) - Complex::new(psi1, 0.0)) / (db * xi - xi1);
+        let a = (da.scale(psi) - Complex::new(psi1, 0.0)).fdiv(da * xi - xi1);
+        let b = (db.scale(psi) - Complex::new(psi1, 0.0)).fdiv(db * xi - xi1);
         q_ext += (2.0 * nf + 1.0) * (a.re + b.re);
         q_sca += (2.0 * nf + 1.0) * (a.norm_sqr() + b.norm_sqr());
         // Asymmetry (BH eq. 4.82).

@@ -17,7 +17,6 @@
 //! | Ed(0⁺) | `ed_0plus` | downwelling irradiance just above the surface | W m⁻² nm⁻¹ |
 
 mod aerosol;
-mod complex;
 mod fresnel;
 mod gas;
 mod gas_swir;
@@ -41,7 +40,6 @@ pub use aerosol::{
     AerosolOptics, ComponentOptics, ComponentTable, TABLE_ASSET, TABLE_WAVELENGTHS_NM, component_table_csv,
     compute_component, mixture_optics, table_angles_deg,
 };
-pub use complex::Complex;
 pub use fresnel::{SEA_REFRACTIVE_INDEX, fresnel_matrix, fresnel_reflectance};
 pub use gas::{GasAmounts, air_mass, transmittance as gas_transmittance};
 pub use glint::{glint_radiance_norm, glint_reflectance};
@@ -56,6 +54,10 @@ pub use rt::{
     RtAccuracy, Scatterers, SsCoefficients, SunSolution, Transmittance, WavelengthColumn, fourier_sum, solve_sun,
     solve_transmittance,
 };
+/// Complex numbers of the Mie series: num-complex's (through rustfft, already a dependency).
+/// Divisions use [`Complex::fdiv`], which scales by |z| and cannot overflow where the textbook
+/// quotient would (the Mie code divides by terms that grow like the Riccati–Bessel functions).
+pub use rustfft::num_complex::Complex64 as Complex;
 pub use solar::{e0_on_grid, sun_distance_factor, tsis1};
 pub use sos::Streams;
 pub use spec::{Atmosphere, AtmosphereSpec, AtmosphereTerms, Geometry, Normalised, Surface};

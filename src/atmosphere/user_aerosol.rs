@@ -31,8 +31,8 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::AtmosphereError;
+use super::Complex;
 use super::aerosol::{ComponentOptics, TABLE_WAVELENGTHS_NM, table_angles_deg};
-use super::complex::Complex;
 use super::mie::{LogNormal, SizeGrid, integrate_lognormal};
 
 /// Largest radius integrated, µm (α = 580 at 325 nm).

@@ -23,7 +23,7 @@
 //!   reflectance to better process multi-angular satellite sensors data over the ocean.
 //!   Opt. Express 23, 27829–27852.
 
-use super::complex::Complex;
+use super::Complex;
 use super::mie::LogNormal;
 use super::user_aerosol::{AerosolMode, SizeDistribution};
 
