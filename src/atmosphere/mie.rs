@@ -83,8 +83,8 @@ pub fn mie_sphere(x: f64, m: Complex, mu: &[f64]) -> MieSphere {
         g_sum += (2.0 * nf + 1.0) / (nf * (nf + 1.0)) * (a * b.conj()).re;
         for j in 0..n_ang {
             let tau = nf * mu[j] * pi1[j] - (nf + 1.0) * pi0[j];
-            s1[j] = s1[j] + (a.scale(pi1[j]) + b.scale(tau)).scale(fn_);
-            s2[j] = s2[j] + (a.scale(tau) + b.scale(pi1[j])).scale(fn_);
+            s1[j] += (a.scale(pi1[j]) + b.scale(tau)).scale(fn_);
+            s2[j] += (a.scale(tau) + b.scale(pi1[j])).scale(fn_);
             let next = ((2.0 * nf + 1.0) * mu[j] * pi1[j] - (nf + 1.0) * pi0[j]) / nf;
             pi0[j] = pi1[j];
             pi1[j] = next;
