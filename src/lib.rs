@@ -43,6 +43,7 @@
 //! | [`report`] | the review pack: a study's verdict, figures and provenance as one self-contained HTML page |
 //! | [`library`] | the preset library: built-ins and the user's own; atomic saves |
 //! | [`parse`] | RON parse errors described with line, column and field |
+//! | [`schema`] | the file formats' version, and files of older versions brought up to date |
 //! | [`validation`] | comparisons with reference codes (OSOAA), shared by tests and `shoal bench` |
 //! | `app` | the desktop app (the `gui` feature; the only module that uses egui) |
 //! | [`cli`] | the headless command line (`shoal water`, `atmosphere`, `simulate`, `study`, `report`, `reproduce`, `sweep`, `merge`, `budget`, `bench`, `ranges`) |
@@ -71,6 +72,7 @@ pub mod ranges;
 pub mod report;
 pub mod retrieval;
 pub mod scene;
+pub mod schema;
 pub mod simd;
 pub mod spectral;
 pub mod study;

@@ -103,9 +103,11 @@ pub trait Preset: serde::de::DeserializeOwned {
     }
 }
 
-/// Parse `text` as a `T`; `origin` names the file in errors.
+/// Parse `text` as a `T`, brought up to date first ([`crate::schema::migrate`]); `origin` names
+/// the file in errors.
 pub fn from_ron<T: Preset>(text: &str, origin: &str) -> Result<T, T::Error> {
-    ron::from_str(text).map_err(|e| T::parse_error(origin, describe(text, &e)))
+    let text = crate::schema::migrate(text).map_err(|m| T::parse_error(origin, m))?;
+    ron::from_str(&text).map_err(|e| T::parse_error(origin, describe(&text, &e)))
 }
 
 /// The built-in `T` called `name`.

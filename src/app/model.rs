@@ -118,6 +118,8 @@ pub enum RetrievalKind {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct AppState {
+    /// The session format's version ([`crate::schema`]).
+    pub schema_version: u32,
     /// Instrument A.
     pub a: Slot,
     /// Instrument B.
@@ -145,8 +147,7 @@ pub struct AppState {
     /// The external retrieval of the study the app opened, if it had one.
     pub external: Option<crate::retrieval::external::ExternalSpec>,
     /// Preview decimations, coarsest first; the last is the final resolution (saved states
-    /// before the rename call it `levels`, still read).
-    #[serde(alias = "levels")]
+    /// before the rename call it `levels`: [`crate::schema::RENAMES`]).
     pub decimations: Vec<usize>,
     /// Product shown.
     pub product: ProductKind,
@@ -222,6 +223,7 @@ impl AppState {
             almi: AlmiSettings::default(),
             sambuca: SambucaSettings::default(),
             external: None,
+            schema_version: crate::schema::VERSION,
             decimations: vec![24, 4, 1],
             product: ProductKind::Chl,
             band: 3,
@@ -311,22 +313,17 @@ impl AppState {
     /// The retrieval as the engine runs it.
     #[must_use]
     pub fn retrieval_spec(&self) -> RetrievalSpec {
-        match self.retrieval {
-            RetrievalKind::Almi => RetrievalSpec::Almi {
-                siop_sets: crate::retrieval::sets::default_almi_sets(),
-                settings: self.almi.clone(),
-            },
-            RetrievalKind::Sambuca => {
+        let almi = || RetrievalSpec::Almi {
+            siop_sets: crate::retrieval::sets::default_almi_sets(),
+            settings: self.almi.clone(),
+        };
+        match (self.retrieval, &self.external) {
+            (RetrievalKind::Sambuca, _) => {
                 RetrievalSpec::Sambuca { siop: None, substrates: None, settings: self.sambuca.clone() }
             }
-            RetrievalKind::External => match &self.external {
-                Some(e) => RetrievalSpec::External(e.clone()),
-                // A session naming an external retrieval it no longer holds runs aLMI.
-                None => RetrievalSpec::Almi {
-                    siop_sets: crate::retrieval::sets::default_almi_sets(),
-                    settings: self.almi.clone(),
-                },
-            },
+            (RetrievalKind::External, Some(e)) => RetrievalSpec::External(e.clone()),
+            // A session naming an external retrieval it no longer holds runs aLMI.
+            (RetrievalKind::Almi | RetrievalKind::External, _) => almi(),
         }
     }
 

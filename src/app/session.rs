@@ -48,7 +48,11 @@ fn aside_name(path: &Path) -> PathBuf {
 pub fn load_session(path: &Path) -> SavedSession {
     let Ok(bytes) = std::fs::read(path) else { return SavedSession::None };
     let parsed = match String::from_utf8(bytes) {
-        Ok(text) => ron::from_str::<AppState>(&text).map_err(|e| crate::parse::describe(&text, &e)),
+        Ok(text) => crate::schema::migrate(&text).and_then(|text| {
+            let mut state = ron::from_str::<AppState>(&text).map_err(|e| crate::parse::describe(&text, &e))?;
+            state.schema_version = crate::schema::VERSION;
+            Ok(state)
+        }),
         Err(e) => Err(format!("byte {} is not UTF-8 text", e.utf8_error().valid_up_to())),
     };
     match parsed {
@@ -192,6 +196,22 @@ mod tests {
         let _ = std::fs::remove_dir_all(&home);
         std::fs::create_dir_all(&home).unwrap_or_else(|e| panic!("{e}"));
         home
+    }
+
+    #[test]
+    fn a_session_saved_before_the_schema_version_is_restored() {
+        let home = home("old");
+        let path = session_path(&home);
+        let today = AppState { decimations: vec![16, 2], ..AppState::default() };
+        let text = ron::to_string(&today).unwrap_or_else(|e| panic!("{e}"));
+        // As an older app saved it: no version, the decimations called `levels`.
+        let old = text.replace("schema_version:2,", "").replace("decimations:", "levels:");
+        assert!(!old.contains("schema_version") && old.contains("levels:[16,2]"), "{old}");
+        std::fs::write(&path, old).unwrap_or_else(|e| panic!("{e}"));
+        match load_session(&path) {
+            SavedSession::Restored(back, _) => assert_eq!(back.decimations, vec![16, 2]),
+            other => panic!("{other:?}"),
+        }
     }
 
     #[test]

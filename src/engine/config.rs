@@ -117,6 +117,9 @@ impl Fidelity {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RunConfig {
+    /// The file format's version ([`crate::schema`]); always the current one once read.
+    #[serde(default = "crate::schema::current")]
+    pub schema_version: u32,
     /// The scene.
     pub scene: SceneSpec,
     /// Directory relative paths in the scene are taken from (the scene file's).
@@ -158,6 +161,7 @@ impl RunConfig {
     #[must_use]
     pub fn new(scene: SceneSpec, instrument: InstrumentSpec) -> Self {
         Self {
+            schema_version: crate::schema::VERSION,
             scene,
             scene_dir: None,
             instrument,
@@ -205,11 +209,14 @@ impl RunConfig {
         Ok(())
     }
 
-    /// Parse RON; `origin` names the file in errors.
+    /// Parse RON, brought up to date first ([`crate::schema::migrate`]); `origin` names the file
+    /// in errors.
     pub fn from_ron(text: &str, origin: &str) -> Result<Self, InstrumentError> {
-        ron::from_str(text).map_err(|e| {
-            InstrumentError::Parse(ParseError { origin: origin.into(), message: crate::parse::describe(text, &e) })
-        })
+        let parse = |message| InstrumentError::Parse(ParseError { origin: origin.into(), message });
+        let text = crate::schema::migrate(text).map_err(parse)?;
+        let mut config: Self = ron::from_str(&text).map_err(|e| parse(crate::parse::describe(&text, &e)))?;
+        config.schema_version = crate::schema::VERSION;
+        Ok(config)
     }
 
     /// Pretty RON (the resolved configuration written beside outputs).
@@ -234,5 +241,21 @@ mod tests {
         assert_eq!(Fidelity::default().band_nodes, DEFAULT_BAND_NODES);
         assert_eq!(Fidelity::default().water_single_precision, DEFAULT_WATER_SINGLE_PRECISION);
         assert_eq!(Fidelity::full(), Fidelity { band_nodes: 0, water_single_precision: false, ..Fidelity::default() });
+    }
+
+    #[test]
+    fn a_configuration_written_before_the_schema_version_reads_as_today() {
+        let scene = crate::scene::SceneSpec::preset("lake_hume_bloom").unwrap_or_else(|e| panic!("{e}"));
+        let instrument = crate::instrument::InstrumentSpec::preset("cubesat").unwrap_or_else(|e| panic!("{e}"));
+        let today = RunConfig::new(scene, instrument);
+        let text = today.to_ron().unwrap_or_else(|e| panic!("{e}"));
+        assert!(text.contains("schema_version: 2"), "written with its version");
+        // As an older Shoal wrote it: no version, the instrument's `lines` called `exposures`.
+        let old = text.replace("    schema_version: 2,\n", "").replace("lines: 2000", "exposures: 2000");
+        assert!(!old.contains("schema_version") && old.contains("exposures: 2000"));
+        assert_eq!(RunConfig::from_ron(&old, "old.ron").unwrap_or_else(|e| panic!("{e}")), today);
+        let newer = text.replace("schema_version: 2", "schema_version: 3");
+        let e = RunConfig::from_ron(&newer, "new.ron").unwrap_err().to_string();
+        assert!(e.contains("new.ron") && e.contains("newer Shoal"), "{e}");
     }
 }

@@ -83,8 +83,7 @@ pub struct InstrumentSpec {
     /// Exposure (integration) time, s.
     pub exposure_s: f64,
     /// Lines (exposures) along track (1–100 000). Files written before the rename say
-    /// `exposures`, which is still read.
-    #[serde(alias = "exposures")]
+    /// `exposures` ([`crate::schema::RENAMES`]).
     pub lines: usize,
     /// Forward tilt of the line of sight, degrees (−60 to 60).
     #[serde(default)]
