@@ -183,6 +183,32 @@ impl Drop for RowGuard<'_> {
     }
 }
 
+/// Run `work` while an observer thread calls `report(control)` every `interval` — the one way a
+/// run's progress is watched (a progress bar, the app's engine events). The observer is parked,
+/// not asleep: the end of `work` wakes it at once, so a fast (cached) run is not held up by the
+/// interval, and it reports once more before it stops.
+pub fn observed<T>(
+    control: &RunControl,
+    interval: std::time::Duration,
+    report: impl Fn(&RunControl) + Send,
+    work: impl FnOnce() -> T,
+) -> T {
+    let done = &AtomicBool::new(false);
+    std::thread::scope(|s| {
+        let observer = s.spawn(move || {
+            while !done.load(Ordering::Acquire) {
+                report(control);
+                std::thread::park_timeout(interval);
+            }
+            report(control);
+        });
+        let result = work();
+        done.store(true, Ordering::Release);
+        observer.thread().unpark();
+        result
+    })
+}
+
 impl RunControl {
     /// A control that is not cancelled.
     #[must_use]
@@ -339,5 +365,44 @@ impl RunControl {
     /// Where a per-pixel loop panicked, if one did (and forget it).
     pub fn take_site(&self) -> Option<PixelSite> {
         self.site.lock().unwrap_or_else(PoisonError::into_inner).take()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_observer_reports_during_and_after_the_work_and_never_holds_it_up() {
+        let control = RunControl::new();
+        let reports = AtomicUsize::new(0);
+        let start = std::time::Instant::now();
+        // A long interval and instant work: the end wakes the observer, which reports once more.
+        let out = observed(
+            &control,
+            std::time::Duration::from_secs(30),
+            |_| {
+                reports.fetch_add(1, Ordering::SeqCst);
+            },
+            || 7,
+        );
+        assert_eq!(out, 7);
+        assert!(start.elapsed() < std::time::Duration::from_secs(5), "{:?}", start.elapsed());
+        assert!(reports.load(Ordering::SeqCst) >= 1);
+        // Work that ticks: the last report sees all of it.
+        let last = AtomicU64::new(0);
+        observed(
+            &control,
+            std::time::Duration::from_millis(1),
+            |c| last.store(c.progress().0, Ordering::SeqCst),
+            || {
+                control.add_total(10);
+                for _ in 0..10 {
+                    control.tick(1);
+                    std::thread::sleep(std::time::Duration::from_millis(2));
+                }
+            },
+        );
+        assert_eq!(last.load(Ordering::SeqCst), 10);
     }
 }

@@ -153,21 +153,14 @@ pub fn run_with_progress(config: &RunConfig, threads: Option<usize>, label: &str
             .progress_chars("=> "),
     );
     bar.set_prefix(label.to_string());
-    let result = std::thread::scope(|s| {
-        let done = Arc::new(std::sync::atomic::AtomicBool::new(false));
-        let (watch, flag, progress) = (control.clone(), done.clone(), bar.clone());
-        s.spawn(move || {
-            while !flag.load(std::sync::atomic::Ordering::Relaxed) {
-                let (d, t) = watch.progress();
-                progress.set_length(t.max(1));
-                progress.set_position(d);
-                std::thread::sleep(Duration::from_millis(100));
-            }
-        });
-        let mut engine = Engine::new();
-        let result = pool.install(|| engine.run(config, &control));
-        done.store(true, std::sync::atomic::Ordering::Relaxed);
-        result
+    let progress = bar.clone();
+    let report = move |c: &crate::control::RunControl| {
+        let (d, t) = c.progress();
+        progress.set_length(t.max(1));
+        progress.set_position(d);
+    };
+    let result = crate::control::observed(&control, Duration::from_millis(100), report, || {
+        pool.install(|| Engine::new().run(config, &control))
     });
     bar.finish_and_clear();
     result.map_err(|e| match e {

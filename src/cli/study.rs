@@ -5,7 +5,6 @@
 use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 use clap::Args;
@@ -90,19 +89,15 @@ pub fn run(args: &StudyArgs) -> Result<(), CliError> {
     bar.set_prefix(spec.name.clone());
     let control = Arc::new(super::interrupt::control());
     let start = std::time::Instant::now();
-    let result = std::thread::scope(|s| {
-        let done = Arc::new(AtomicBool::new(false));
-        let (watch, flag, progress) = (control.clone(), done.clone(), bar.clone());
-        s.spawn(move || {
-            while !flag.load(Ordering::Relaxed) {
-                let (d, t) = watch.progress();
-                if t > 0 {
-                    progress.set_message(format!("({:.0} % of rows)", 100.0 * d as f64 / t as f64));
-                }
-                std::thread::sleep(Duration::from_millis(200));
-            }
-        });
-        let result = pool.install(|| {
+    let progress = bar.clone();
+    let report = move |c: &crate::control::RunControl| {
+        let (d, t) = c.progress();
+        if t > 0 {
+            progress.set_message(format!("({:.0} % of rows)", 100.0 * d as f64 / t as f64));
+        }
+    };
+    let result = crate::control::observed(&control, Duration::from_millis(200), report, || {
+        pool.install(|| {
             run_study(&resolved, &control, |i, run_out| {
                 let (label, seed, _) = &resolved.runs[i];
                 if !args.no_cubes {
@@ -113,9 +108,7 @@ pub fn run(args: &StudyArgs) -> Result<(), CliError> {
                 bar.inc(1);
                 Ok(())
             })
-        });
-        done.store(true, Ordering::Relaxed);
-        result
+        })
     });
     bar.finish_and_clear();
     let result = result?;

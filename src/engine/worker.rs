@@ -336,29 +336,18 @@ fn worker(requests: &Mailbox<Request>, link: &Link<'_>, pause: &PreviewPause, po
                 config.fidelity.decimation = decimation;
                 let control = Arc::new(RunControl::for_generation(latest.clone(), request.generation));
                 let generation = request.generation;
-                let result = std::thread::scope(|s| {
-                    let watcher = control.clone();
-                    let done = Arc::new(std::sync::atomic::AtomicBool::new(false));
-                    let done_flag = done.clone();
-                    let reporter = s.spawn(move || {
-                        while !done_flag.load(Ordering::Acquire) {
-                            let (d, t) = watcher.progress();
-                            let stage = watcher.stage_progress();
-                            if events
-                                .try_send(Event::Progress { generation, index, decimation, done: d, total: t, stage })
-                                .is_ok()
-                            {
-                                wake();
-                            }
-                            // Parked, not asleep: the run's end unparks it at once, so a fast
-                            // (cached) run is not held up by the reporting interval.
-                            std::thread::park_timeout(Duration::from_millis(50));
-                        }
-                    });
-                    let result = pool.install(|| engine.run(&config, &control));
-                    done.store(true, Ordering::Release);
-                    reporter.thread().unpark();
-                    result
+                let report = |c: &RunControl| {
+                    let (d, t) = c.progress();
+                    let stage = c.stage_progress();
+                    if events
+                        .try_send(Event::Progress { generation, index, decimation, done: d, total: t, stage })
+                        .is_ok()
+                    {
+                        wake();
+                    }
+                };
+                let result = crate::control::observed(&control, Duration::from_millis(50), report, || {
+                    pool.install(|| engine.run(&config, &control))
                 });
                 counters.max_cached_products.fetch_max(engine.cached_products() as u64, Ordering::SeqCst);
                 if matches!(result, Err(EngineError::Cancelled)) {
