@@ -26,7 +26,10 @@ fn frame(ctx: &egui::Context, app: &mut ShoalApp) -> f64 {
         ..Default::default()
     };
     let start = Instant::now();
-    let out = ctx.run_ui(input, |ui| app.draw(ui));
+    let out = ctx.run_ui(input, |ui| {
+        app.tick(ui.ctx());
+        app.draw(ui);
+    });
     let _ = ctx.tessellate(out.shapes, out.pixels_per_point);
     start.elapsed().as_secs_f64() * 1e3
 }

@@ -254,12 +254,12 @@ impl ShoalApp {
         app
     }
 
-    /// Per frame, before drawing: submit changed configurations, take results and images.
-    /// Draw one frame into `ui` (everything but the eframe plumbing).
+    /// Draw one frame into `ui` (everything but the eframe plumbing). The per-frame logic
+    /// (submitting changed configurations, taking results and images) runs before it, in
+    /// eframe's `logic` ([`Self::tick`]), which eframe also calls while the window is hidden.
     pub fn draw(&mut self, ui: &mut egui::Ui) {
         let start = Instant::now();
         let ctx = ui.ctx().clone();
-        self.tick(&ctx);
         egui::Panel::top("top").show(ui, |ui| {
             self.top_bar(ui);
             // A second row always there, so a message or the typed-path row never moves the
@@ -421,6 +421,12 @@ impl Drop for ShoalApp {
 }
 
 impl eframe::App for ShoalApp {
+    /// Before each frame, and while the window is hidden: the engine's results are taken even
+    /// when nothing is drawn.
+    fn logic(&mut self, ctx: &egui::Context, _frame: &mut eframe::Frame) {
+        self.tick(ctx);
+    }
+
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         self.draw(ui);
         let ctx = ui.ctx().clone();
