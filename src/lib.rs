@@ -18,6 +18,7 @@
 //! | [`colormap`] | viridis, diverging and class colours, value scales (figures and app) |
 //! | [`units`] | constants, unit conversions, angle helpers |
 //! | [`markup`] | the one escaping rule for text inside HTML, SVG and XML |
+//! | [`variable`] | the product variables (chl-a, NAP, CDOM, depth): keys, names, units, CF names |
 //! | [`assets`] | cited spectra embedded in the binary |
 //! | [`control`] | cancellation and progress shared by a run and its watcher |
 //! | [`budget`] | what a run may use of the machine (memory, the atmosphere's time), checked before it starts |
@@ -81,4 +82,5 @@ pub mod timing;
 pub mod toa;
 pub mod units;
 pub mod validation;
+pub mod variable;
 pub mod water;

@@ -19,28 +19,23 @@ use std::rc::Rc;
 use netcdf3::{DataSet, FileWriter, Version};
 
 /// Shoal's product variables (what a retrieval returns and the truth holds), in table order.
-pub const PRODUCT_VARIABLES: [&str; 4] = ["chl_mg_m3", "nap_g_m3", "cdom_per_m", "depth_m"];
+pub const PRODUCT_VARIABLES: [&str; 4] = crate::variable::KEYS;
 
-/// CF standard names of Shoal's product variables (those CF has).
+/// CF standard names of Shoal's product variables and of Rrs (those CF has).
+#[must_use]
 pub fn standard_name(variable: &str) -> Option<&'static str> {
-    Some(match variable {
-        "chl_mg_m3" => "mass_concentration_of_chlorophyll_a_in_sea_water",
-        "nap_g_m3" => "mass_concentration_of_suspended_matter_in_sea_water",
-        "depth_m" => "sea_floor_depth_below_sea_surface",
-        "rrs" => "surface_ratio_of_upwelling_radiance_emerging_from_sea_water_to_downwelling_radiative_flux_in_air",
-        _ => return None,
-    })
+    match variable {
+        "rrs" => {
+            Some("surface_ratio_of_upwelling_radiance_emerging_from_sea_water_to_downwelling_radiative_flux_in_air")
+        }
+        v => crate::variable::of(v).and_then(|v| v.standard_name),
+    }
 }
 
 /// What a product variable is, and its unit (UDUNITS).
+#[must_use]
 pub fn meaning(variable: &str) -> (&'static str, &'static str) {
-    match variable {
-        "chl_mg_m3" => ("chlorophyll-a concentration", "mg m-3"),
-        "nap_g_m3" => ("non-algal particle (suspended matter) concentration", "g m-3"),
-        "cdom_per_m" => ("CDOM absorption coefficient at the SIOP set's reference wavelength", "m-1"),
-        "depth_m" => ("water depth", "m"),
-        _ => ("", "1"),
-    }
+    crate::variable::of(variable).map_or(("", "1"), |v| (v.long_name, v.udunits))
 }
 
 /// A variable's values, made when the variable is written: a file's cubes are made one at a time,

@@ -128,9 +128,7 @@ pub(super) fn requirements_editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
             ui.strong(h);
         }
         ui.end_row();
-        for (variable, label) in
-            [("chl_mg_m3", "chl-a"), ("nap_g_m3", "NAP"), ("cdom_per_m", "CDOM"), ("depth_m", "depth")]
-        {
+        for (variable, label) in crate::variable::PRODUCTS.map(|v| (v.key, v.name)) {
             // Edit a copy; the study's list changes only when a limit does (a product with no
             // limit left is dropped from it).
             let before = r.for_variable(variable).cloned();

@@ -70,11 +70,12 @@ impl ProductKind {
     /// The metrics variable it corresponds to.
     #[must_use]
     pub fn variable(self) -> Option<&'static str> {
+        use crate::variable::key;
         match self {
-            Self::Chl => Some("chl_mg_m3"),
-            Self::Nap => Some("nap_g_m3"),
-            Self::Cdom => Some("cdom_per_m"),
-            Self::Depth => Some("depth_m"),
+            Self::Chl => Some(key::CHL),
+            Self::Nap => Some(key::NAP),
+            Self::Cdom => Some(key::CDOM),
+            Self::Depth => Some(key::DEPTH),
             _ => None,
         }
     }

@@ -44,11 +44,12 @@ impl Truth {
     /// `depth_m`), if this truth has it.
     #[must_use]
     pub fn map(&self, variable: &str) -> Option<&Array2<f32>> {
+        use crate::variable::key;
         match variable {
-            "chl_mg_m3" => Some(&self.chl_mg_m3),
-            "nap_g_m3" => Some(&self.nap_g_m3),
-            "cdom_per_m" => Some(&self.cdom_per_m),
-            "depth_m" => self.depth_m.as_ref(),
+            key::CHL => Some(&self.chl_mg_m3),
+            key::NAP => Some(&self.nap_g_m3),
+            key::CDOM => Some(&self.cdom_per_m),
+            key::DEPTH => self.depth_m.as_ref(),
             _ => None,
         }
     }

@@ -63,13 +63,9 @@ impl Metrics {
 /// The unit of a metrics variable, for people (`depth_m` → "m").
 #[must_use]
 pub fn unit(variable: &str) -> &'static str {
-    match variable {
-        "chl_mg_m3" => "mg m⁻³",
-        "nap_g_m3" => "g m⁻³",
-        "cdom_per_m" => "m⁻¹",
-        v if v.starts_with("depth_m") => "m",
-        _ => "",
-    }
+    // `depth_m_bottom_visible` and `depth_m_over_sand` are depths.
+    let key = if variable.starts_with(crate::variable::key::DEPTH) { crate::variable::key::DEPTH } else { variable };
+    crate::variable::of(key).map_or("", |v| v.unit)
 }
 
 /// The name of a metrics variable, for people (`chl_mg_m3` → "chl-a"); substrate shares and
@@ -77,12 +73,8 @@ pub fn unit(variable: &str) -> &'static str {
 #[must_use]
 pub fn name(variable: &str) -> &str {
     match variable {
-        "chl_mg_m3" => "chl-a",
-        "nap_g_m3" => "NAP",
-        "cdom_per_m" => "CDOM",
-        "depth_m" => "depth",
         "depth_m_bottom_visible" => "depth, bottom visible",
-        v => v,
+        v => crate::variable::of(v).map_or(v, |v| v.name),
     }
 }
 

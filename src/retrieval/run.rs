@@ -162,11 +162,12 @@ impl Product {
     /// this product has it (the same names as `instrument::Truth::map`).
     #[must_use]
     pub fn map(&self, variable: &str) -> Option<&Array2<f32>> {
+        use crate::variable::key;
         match variable {
-            "chl_mg_m3" => self.chl_mg_m3.as_ref(),
-            "nap_g_m3" => self.nap_g_m3.as_ref(),
-            "cdom_per_m" => self.cdom_per_m.as_ref(),
-            "depth_m" => self.depth_m.as_ref(),
+            key::CHL => self.chl_mg_m3.as_ref(),
+            key::NAP => self.nap_g_m3.as_ref(),
+            key::CDOM => self.cdom_per_m.as_ref(),
+            key::DEPTH => self.depth_m.as_ref(),
             _ => None,
         }
     }

@@ -94,13 +94,7 @@ fn invalid(field: &str, message: String) -> SceneError {
 /// The unit a scene field's values are in (ASCII, as GeoTIFF files write units).
 #[must_use]
 pub fn field_unit(field: &str) -> &'static str {
-    match field {
-        "chl_mg_m3" => "mg m-3",
-        "nap_g_m3" => "g m-3",
-        "cdom_per_m" => "m-1",
-        "depth_m" => "m",
-        _ => "1",
-    }
+    crate::variable::of(field).map_or("1", |v| v.udunits)
 }
 
 /// Units compared the way people write them: `mg m⁻³`, `mg m-3`, `mg/m3`, `mg.m-3` agree.

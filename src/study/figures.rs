@@ -18,20 +18,6 @@ use crate::colormap::{Scale, categorical, viridis};
 use crate::metrics::{Metrics, bin_of, histogram_2d, log_edges};
 use crate::retrieval::ProductFlags;
 
-/// A variable of a product, with how to read it from truth and retrieval.
-#[derive(Clone, Copy)]
-struct Variable {
-    key: &'static str,
-    label: &'static str,
-}
-
-const VARIABLES: [Variable; 4] = [
-    Variable { key: "chl_mg_m3", label: "chl-a (mg m⁻³)" },
-    Variable { key: "nap_g_m3", label: "NAP (g m⁻³)" },
-    Variable { key: "cdom_per_m", label: "a_CDOM(440) (m⁻¹)" },
-    Variable { key: "depth_m", label: "depth (m)" },
-];
-
 struct Scatter {
     title: String,
     label: String,
@@ -198,15 +184,15 @@ fn metric_line(m: Option<&Metrics>) -> String {
 struct Context<'a> {
     runs: &'a [&'a StudyRun],
     index: usize,
-    var: Variable,
+    var: &'static str,
     scale: Scale,
     title: String,
 }
 
 /// One scale over the truth and every instrument's returned values (log for concentrations).
-fn shared_scale(runs: &[&StudyRun], index: usize, var: Variable) -> Option<Scale> {
+fn shared_scale(runs: &[&StudyRun], index: usize, var: &'static str) -> Option<Scale> {
     let first = runs.first()?;
-    let truth = first.truth.map(var.key)?;
+    let truth = first.truth.map(var)?;
     let mut values: Vec<f64> = truth
         .indexed_iter()
         .filter(|((r, c), _)| first.truth.land[[*r, *c]] == 0)
@@ -214,7 +200,7 @@ fn shared_scale(runs: &[&StudyRun], index: usize, var: Variable) -> Option<Scale
         .collect();
     for run in runs {
         if let Some(ret) = run.retrievals.get(index)
-            && let Some(map) = ret.product.map(var.key)
+            && let Some(map) = ret.product.map(var)
         {
             values.extend(
                 map.indexed_iter().filter(|((r, c), _)| ret.product.returned(*r, *c)).map(|(_, v)| f64::from(*v)),
@@ -222,7 +208,7 @@ fn shared_scale(runs: &[&StudyRun], index: usize, var: Variable) -> Option<Scale
         }
     }
     let mut scale = Scale::robust(values.iter().copied().filter(|v| *v > 0.0));
-    if !scale.log && scale.lo > 0.0 && var.key != "depth_m" {
+    if !scale.log && scale.lo > 0.0 && var != crate::variable::key::DEPTH {
         scale.log = true;
     }
     Some(scale)
@@ -230,7 +216,7 @@ fn shared_scale(runs: &[&StudyRun], index: usize, var: Variable) -> Option<Scale
 
 fn maps_figure(ctx: &Context<'_>) -> Option<Maps> {
     let first = ctx.runs.first()?;
-    let truth = first.truth.map(ctx.var.key)?;
+    let truth = first.truth.map(ctx.var)?;
     let mut panels = vec![Panel {
         title: "truth".into(),
         values: truth.clone(),
@@ -239,9 +225,9 @@ fn maps_figure(ctx: &Context<'_>) -> Option<Maps> {
     }];
     for run in ctx.runs {
         let Some(ret) = run.retrievals.get(ctx.index) else { continue };
-        let Some(map) = ret.product.map(ctx.var.key) else { continue };
+        let Some(map) = ret.product.map(ctx.var) else { continue };
         panels.push(Panel {
-            title: format!("{}: {}", run.label, metric_line(ret.metrics.get(ctx.var.key))),
+            title: format!("{}: {}", run.label, metric_line(ret.metrics.get(ctx.var))),
             values: map.clone(),
             valid: Array2::from_shape_fn(map.dim(), |(r, c)| ret.product.returned(r, c) && map[[r, c]] > 0.0),
             spacing_m: spacing_m(run),
@@ -249,7 +235,7 @@ fn maps_figure(ctx: &Context<'_>) -> Option<Maps> {
     }
     Some(Maps {
         title: ctx.title.clone(),
-        label: ctx.var.label.into(),
+        label: crate::metrics::label(ctx.var),
         scale: ctx.scale,
         panels,
         diverging: false,
@@ -267,7 +253,7 @@ fn spacing_m(run: &StudyRun) -> f64 {
 fn difference_figure(ctx: &Context<'_>) -> Option<Maps> {
     let [a, b] = ctx.runs else { return None };
     let (ra, rb) = (a.retrievals.get(ctx.index)?, b.retrievals.get(ctx.index)?);
-    let (ma, mb) = (ra.product.map(ctx.var.key)?, rb.product.map(ctx.var.key)?);
+    let (ma, mb) = (ra.product.map(ctx.var)?, rb.product.map(ctx.var)?);
     let heading = b.viewing.track_heading_deg();
     let mut values = Array2::zeros(ma.dim());
     let mut valid = Array2::from_elem(ma.dim(), false);
@@ -330,15 +316,15 @@ fn scatter_and_histograms(ctx: &Context<'_>) -> Option<(Scatter, Histograms)> {
     let mut scatter_panels = Vec::new();
     let mut hist_panels = Vec::new();
     for run in ctx.runs {
-        let (Some(ret), Some(truth)) = (run.retrievals.get(ctx.index), run.truth.map(ctx.var.key)) else { continue };
-        let Some(map) = ret.product.map(ctx.var.key) else { continue };
+        let (Some(ret), Some(truth)) = (run.retrievals.get(ctx.index), run.truth.map(ctx.var)) else { continue };
+        let Some(map) = ret.product.map(ctx.var) else { continue };
         let p = &ret.product;
         let water_returned = |r: usize, c: usize| run.truth.land[[r, c]] == 0 && p.returned(r, c);
         let pairs = map
             .indexed_iter()
             .filter(|((r, c), _)| water_returned(*r, *c))
             .map(|((r, c), v)| (f64::from(truth[[r, c]]), f64::from(*v)));
-        let caption = ret.metrics.get(ctx.var.key).map_or_else(String::new, |m| {
+        let caption = ret.metrics.get(ctx.var).map_or_else(String::new, |m| {
             format!("{}: N {}, MAE {:.0} %, bias {:+.0} %, R² {:.2}", run.label, m.n, m.mae_pct(), m.bias_pct(), m.r2)
         });
         scatter_panels.push((caption, histogram_2d(pairs, &edges)));
@@ -362,10 +348,10 @@ fn scatter_and_histograms(ctx: &Context<'_>) -> Option<(Scatter, Histograms)> {
         hist_panels.push((format!("{}{note}", run.label), counts, truth_counts));
     }
     Some((
-        Scatter { title: ctx.title.clone(), label: ctx.var.label.into(), edges, panels: scatter_panels },
+        Scatter { title: ctx.title.clone(), label: crate::metrics::label(ctx.var), edges, panels: scatter_panels },
         Histograms {
             title: ctx.title.clone(),
-            label: ctx.var.label.into(),
+            label: crate::metrics::label(ctx.var),
             edges: hist_edges,
             categories,
             panels: hist_panels,
@@ -407,14 +393,14 @@ pub fn figure_set(result: &StudyResult) -> Result<Vec<Figure>, StudyError> {
         figures.push(render("spectrum", &super::spectrum_figure::SpectrumFigure { title, data })?);
     }
     for (index, ret0) in first.retrievals.iter().enumerate() {
-        for var in VARIABLES {
-            if first.truth.map(var.key).is_none() || ret0.product.map(var.key).is_none() {
+        for var in crate::variable::KEYS {
+            if first.truth.map(var).is_none() || ret0.product.map(var).is_none() {
                 continue;
             }
             let Some(scale) = shared_scale(&runs, index, var) else { continue };
-            let title = format!("{} — {} {}", result.study.spec.name, ret0.metrics.product, var.label);
+            let title = format!("{} — {} {}", result.study.spec.name, ret0.metrics.product, crate::metrics::label(var));
             let ctx = Context { runs: &runs, index, var, scale, title };
-            let name = format!("{}_{}", ret0.spec.name(), var.key);
+            let name = format!("{}_{}", ret0.spec.name(), var);
             if let Some(maps) = maps_figure(&ctx) {
                 figures.push(render(&format!("maps_{name}"), &maps)?);
             }

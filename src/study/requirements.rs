@@ -153,10 +153,10 @@ impl Requirements {
     pub fn validate(&self) -> Result<(), StudyError> {
         let bad = |field: String, message: String| Err(StudyError::Invalid(FieldError { field, message }));
         for (i, p) in self.products.iter().enumerate() {
-            if !["chl_mg_m3", "nap_g_m3", "cdom_per_m", "depth_m"].contains(&p.variable.as_str()) {
+            if crate::variable::of(&p.variable).is_none() {
                 return bad(
                     format!("requirements.products[{i}].variable"),
-                    format!("`{}` (allowed: chl_mg_m3, nap_g_m3, cdom_per_m, depth_m)", p.variable),
+                    format!("`{}` (allowed: {})", p.variable, crate::variable::KEYS.join(", ")),
                 );
             }
             for (name, v, range) in [
