@@ -155,13 +155,14 @@ pub fn band_names(ds: &mut DataSet, names: &[&str]) -> Result<TextVar, String> {
     Ok(("band_name", bytes))
 }
 
-/// Write the data set and its values to `path` through a temporary file, synced, then renamed.
+/// Write the data set and its values to `path` through a temporary file, then renamed; `sync`:
+/// on disk before the rename (a product; an external program's input, read at once and deleted,
+/// skips it: 0.3 s for a full-resolution input).
 pub fn write_file(
     path: &Path,
     ds: &DataSet,
-    floats: &[FloatVar<'_>],
-    flags: &[FlagVar<'_>],
-    texts: &[TextVar],
+    (floats, flags, texts): (&[FloatVar<'_>], &[FlagVar<'_>], &[TextVar]),
+    sync: bool,
 ) -> Result<(), String> {
     let tmp = path.with_extension("nc.partial");
     let fail = |m: String| format!("cannot write {}: {m}", path.display());
@@ -183,7 +184,9 @@ pub fn write_file(
         writer.close().map_err(|e| fail(format!("{e:?}")))?;
         let mut buffered = shared.0.borrow_mut();
         buffered.flush().map_err(|e| fail(e.to_string()))?;
-        buffered.get_ref().sync_all().map_err(|e| fail(e.to_string()))?;
+        if sync {
+            buffered.get_ref().sync_all().map_err(|e| fail(e.to_string()))?;
+        }
         Ok(())
     })();
     match result.and_then(|()| std::fs::rename(&tmp, path).map_err(|e| fail(e.to_string()))) {

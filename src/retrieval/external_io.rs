@@ -152,7 +152,7 @@ pub(super) fn write_input(
     ] {
         ds.add_global_attr_string(k, v).map_err(bad_def)?;
     }
-    write_file(path, &ds, &floats, &flags, &[names])
+    write_file(path, &ds, (&floats, &flags, &[names]), false)
 }
 
 /// The program's output as a [`Product`]: each wanted map (0 where missing), returned where every

@@ -49,7 +49,7 @@ pub fn write_netcdf(out: &RunOutput, dir: &Path, o: &mut Outputs) -> Result<(), 
     retrieval_vars(out, &mut floats, &mut flags);
     let (data_set, names) = define(out, (rows, cols, nb), &floats, &flags)?;
     let path = dir.join(FILE);
-    write_file(&path, &data_set, &floats, &flags, &[names]).map_err(StudyError::Io)?;
+    write_file(&path, &data_set, (&floats, &flags, &[names]), true).map_err(StudyError::Io)?;
     o.files.push(FILE.to_string());
     Ok(())
 }
