@@ -268,14 +268,14 @@ fn run_program(
     let stderr_path = folder.join("stderr.txt");
     let stdout_path = folder.join("stdout.txt");
     let file = |p: &Path| std::fs::File::create(p).map_err(|e| spec.error(format!("{}: {e}", p.display())));
-    let mut child = Command::new(&args[0])
-        .args(&args[1..])
-        .current_dir(folder)
-        .stdin(Stdio::null())
-        .stdout(file(&stdout_path)?)
-        .stderr(file(&stderr_path)?)
-        .spawn()
-        .map_err(|e| spec.error(format!("cannot start `{}`: {e}", args[0])))?;
+    let mut command = Command::new(&args[0]);
+    command.args(&args[1..]).current_dir(folder).stdin(Stdio::null());
+    command.stdout(file(&stdout_path)?).stderr(file(&stderr_path)?);
+    // Its own process group, so that stopping it stops whatever it started (a shell's commands,
+    // Python's worker processes).
+    #[cfg(unix)]
+    std::os::unix::process::CommandExt::process_group(&mut command, 0);
+    let mut child = command.spawn().map_err(|e| spec.error(format!("cannot start `{}`: {e}", args[0])))?;
     let start = Instant::now();
     let limit = Duration::from_secs_f64(spec.time_limit_s);
     let mut wait = Duration::from_millis(2);
@@ -286,13 +286,11 @@ fn run_program(
             Err(e) => return Err(spec.error(format!("lost the program: {e}"))),
         }
         if control.cancelled() {
-            let _ = child.kill();
-            let _ = child.wait();
+            stop(&mut child);
             return Err(RetrievalError::Cancelled);
         }
         if start.elapsed() > limit {
-            let _ = child.kill();
-            let _ = child.wait();
+            stop(&mut child);
             return Err(spec.error(format!(
                 "stopped after its time limit of {} s (`time_limit_s`){}",
                 spec.time_limit_s,
@@ -306,6 +304,21 @@ fn run_program(
         return Err(spec.error(format!("`{}` exited with {status}{}", args[0], stderr_tail(&stderr_path))));
     }
     Ok(())
+}
+
+/// Stop the program and everything in its process group, then reap it. SIGKILL goes to the group
+/// through the POSIX shell's `kill` builtin (`sh` is on every Unix; procps's `kill` is not in a
+/// minimal system): std has no safe call for a group, and Shoal denies `unsafe` outside its SIMD
+/// kernels.
+fn stop(child: &mut std::process::Child) {
+    #[cfg(unix)]
+    {
+        let group = format!("-{}", child.id());
+        let kill = r#"kill -s KILL -- "$0""#;
+        let _ = Command::new("sh").args(["-c", kill, &group]).stdout(Stdio::null()).stderr(Stdio::null()).status();
+    }
+    let _ = child.kill();
+    let _ = child.wait();
 }
 
 /// The end of the program's standard error, as ": its standard error ended: …" (empty without).

@@ -155,6 +155,32 @@ fn a_program_past_its_time_limit_is_stopped() {
 }
 
 #[test]
+fn stopping_a_program_stops_what_it_started() {
+    // A shell that starts a long sleep in the background and waits: past the limit, the sleep
+    // (the shell's child, in the program's process group) must go too.
+    let dir = Dir::new("external-group");
+    let pid_file = dir.path().join("child.pid");
+    let script = format!("sleep 60 & echo $! > '{}'; wait", pid_file.display());
+    let mut spec = external("spawner", &["sh", "-c", &script], &["chl_mg_m3"]);
+    if let RetrievalSpec::External(e) = &mut spec {
+        e.time_limit_s = 1.0;
+    }
+    let out = run_with(spec);
+    assert!(out.retrievals[1].failure.as_deref().unwrap().contains("time limit"));
+    let pid = std::fs::read_to_string(&pid_file).unwrap().trim().to_string();
+    // Reaped by init once killed: give it a moment, then its /proc entry is gone or a zombie.
+    let gone = (0..50).any(|_| {
+        let state = std::fs::read_to_string(format!("/proc/{pid}/stat")).unwrap_or_default();
+        let alive = state.split(") ").nth(1).is_some_and(|s| !s.starts_with('Z'));
+        if alive {
+            std::thread::sleep(std::time::Duration::from_millis(100));
+        }
+        !alive
+    });
+    assert!(gone, "the program's child {pid} still runs");
+}
+
+#[test]
 fn an_output_without_the_product_or_of_another_size_is_refused_by_name() {
     let reference = run_with(external("ref_missing", &["true"], &["chl_mg_m3"]));
     let shape = reference.radiance.truth.chl_mg_m3.dim();
