@@ -82,6 +82,7 @@ pub fn page(d: &ReviewData, figures: &[PageFigure]) -> String {
     figures_section(&mut h, figures);
     super::substrate::section(&mut h, d);
     super::sections::aerosol(&mut h, d);
+    super::sections::failures(&mut h, d);
     super::sections::budget_and_cost(&mut h, d);
     super::sections::provenance(&mut h, d);
     h += "<footer class=\"note\"><p>Made by Shoal, an end-to-end simulator of satellite optical instruments over water. This page needs no network and no script; every figure is inside it.</p></footer>\n</body>\n</html>\n";

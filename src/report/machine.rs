@@ -1,5 +1,6 @@
-//! The machine results were made on, for the review pack's provenance (timings mean little
-//! without it). Read from Linux's /proc and /etc/os-release; "unknown" elsewhere.
+//! The machine results were made on, the build and the time, for the review pack's provenance
+//! (timings mean little without them). Read from Linux's /proc and /etc/os-release; "unknown"
+//! elsewhere.
 
 use serde::{Deserialize, Serialize};
 
@@ -48,6 +49,34 @@ impl Machine {
     pub fn line(&self) -> String {
         format!("{}, {} logical cores, {:.1} GiB, {}", self.cpu, self.cores, self.memory_gib, self.os)
     }
+}
+
+/// The git commit this binary was built from (`src/build.rs`), or "unknown".
+#[must_use]
+pub fn commit() -> &'static str {
+    option_env!("SHOAL_GIT_COMMIT").unwrap_or("unknown")
+}
+
+/// Now, UTC, as `YYYY-MM-DDTHH:MM:SSZ` (civil-from-days: Hinnant, "chrono-Compatible Low-Level
+/// Date Algorithms").
+#[must_use]
+pub fn now_utc() -> String {
+    utc_text(std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_secs()))
+}
+
+/// `secs` after the Unix epoch as `YYYY-MM-DDTHH:MM:SSZ`.
+pub(super) fn utc_text(secs: u64) -> String {
+    let (days, rem) = ((secs / 86_400) as i64, secs % 86_400);
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = doy - (153 * mp + 2) / 5 + 1;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 };
+    let y = yoe + era * 400 + i64::from(m <= 2);
+    format!("{y:04}-{m:02}-{d:02}T{:02}:{:02}:{:02}Z", rem / 3600, rem % 3600 / 60, rem % 60)
 }
 
 #[cfg(test)]

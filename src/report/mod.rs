@@ -17,7 +17,7 @@ pub mod svg;
 
 use serde::{Deserialize, Serialize};
 
-pub use machine::Machine;
+pub use machine::{Machine, commit, now_utc};
 pub use pack::{REVIEW_JSON, is_results_dir, load_results, review_json, write_pack};
 
 use crate::engine::RunConfig;
@@ -203,34 +203,9 @@ pub struct ReviewData {
     /// exact correction (and in packs written before the section).
     #[serde(default)]
     pub aerosol: Vec<AerosolRow>,
-}
-
-/// The git commit this binary was built from (`src/build.rs`), or "unknown".
-#[must_use]
-pub fn commit() -> &'static str {
-    option_env!("SHOAL_GIT_COMMIT").unwrap_or("unknown")
-}
-
-/// Now, UTC, as `YYYY-MM-DDTHH:MM:SSZ` (civil-from-days: Hinnant, "chrono-Compatible Low-Level
-/// Date Algorithms").
-#[must_use]
-pub fn now_utc() -> String {
-    utc_text(std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_secs()))
-}
-
-/// `secs` after the Unix epoch as `YYYY-MM-DDTHH:MM:SSZ`.
-fn utc_text(secs: u64) -> String {
-    let (days, rem) = ((secs / 86_400) as i64, secs % 86_400);
-    let z = days + 719_468;
-    let era = z.div_euclid(146_097);
-    let doe = z - era * 146_097;
-    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
-    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
-    let mp = (5 * doy + 2) / 153;
-    let d = doy - (153 * mp + 2) / 5 + 1;
-    let m = if mp < 10 { mp + 3 } else { mp - 9 };
-    let y = yoe + era * 400 + i64::from(m <= 2);
-    format!("{y:04}-{m:02}-{d:02}T{:02}:{:02}:{:02}Z", rem / 3600, rem % 3600 / 60, rem % 60)
+    /// Retrievals whose program returned nothing: (instrument, retrieval, why), first seed.
+    #[serde(default)]
+    pub failures: Vec<(String, String, String)>,
 }
 
 /// Flatten a JSON value into dotted (name, text) pairs; long arrays are summarised.
@@ -490,6 +465,11 @@ pub fn review_data(result: &StudyResult, budget: &[Budget], cost: &[CostRow]) ->
         aerosol: runs
             .iter()
             .filter_map(|r| r.report.aerosol.clone().map(|found| AerosolRow { instrument: r.label.clone(), found }))
+            .collect(),
+        failures: runs
+            .iter()
+            .flat_map(|r| r.retrievals.iter().map(move |x| (r, x)))
+            .filter_map(|(r, x)| x.failure.clone().map(|f| (r.label.clone(), x.metrics.product.clone(), f)))
             .collect(),
     }
 }

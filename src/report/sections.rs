@@ -28,6 +28,24 @@ fn inline_markdown(s: &str) -> String {
     out
 }
 
+/// Retrievals whose program returned nothing, and why (its own words, escaped).
+pub(super) fn failures(h: &mut String, d: &ReviewData) {
+    if d.failures.is_empty() {
+        return;
+    }
+    h.push_str("<section id=\"failures\">\n<h2>Retrievals that returned nothing</h2>\n<p class=\"note\">An external retrieval's program failed on these runs; the rest of each run is in the tables above. The reason ends with the program's own standard error.</p>\n<table>\n<tr><th>instrument</th><th>retrieval</th><th>why</th></tr>\n");
+    for (instrument, retrieval, why) in &d.failures {
+        let _ = writeln!(
+            h,
+            "<tr><td>{}</td><td>{}</td><td><pre>{}</pre></td></tr>",
+            escape(instrument),
+            escape(retrieval),
+            escape(why)
+        );
+    }
+    h.push_str("</table>\n</section>\n");
+}
+
 /// The aerosol an image-based correction found from each design's own bands, against the truth.
 pub(super) fn aerosol(h: &mut String, d: &ReviewData) {
     if d.aerosol.is_empty() {

@@ -2,6 +2,7 @@
 //! UTC text.
 
 use super::*;
+use crate::report::machine::utc_text;
 use crate::timing::{Comparison, Paired};
 
 #[test]
@@ -74,6 +75,7 @@ fn the_review_pack_states_each_cost_row_with_its_range_and_95th_percentile() {
                 fit: "dark spectrum <tiles>".into(),
             },
         }],
+        failures: vec![("cubesat".into(), "mine".into(), "exited with 2; <script>alert(1)</script>".into())],
     };
     let html = html::page(&data, &[]);
     // The aerosol the correction found, its text escaped.
@@ -95,6 +97,13 @@ fn the_review_pack_states_each_cost_row_with_its_range_and_95th_percentile() {
     assert!(row("preview 1/4").ends_with("<td class=\"num\">other grid</td><td class=\"num\">–</td>"));
     assert!(row("a setting whose percentile failed").ends_with("<td class=\"num\">0.100</td><td class=\"num\">–</td>"));
     assert!(!html.contains("NaN"));
+    // A program's own words are text, never markup.
+    assert!(html.contains("<h2>Retrievals that returned nothing</h2>"));
+    assert!(
+        html.contains("<td>mine</td><td><pre>exited with 2; &lt;script&gt;alert(1)&lt;/script&gt;</pre>"),
+        "escaped"
+    );
+    assert!(!html.contains("<script>"));
 }
 
 #[test]
