@@ -16,10 +16,9 @@
 //!   one machine.
 //! - The levels differ in vector width: AVX2 holds 4 doubles (8 floats), AVX-512 8 (16). On
 //!   AMD Zen 4 a 512-bit instruction takes two cycles, so AVX-512 pays where a loop is bound by
-//!   latency (more wavelengths in flight per instruction: the double-precision water kernel
-//!   went from 289 k to 446 k evaluations/s, 1.54×, with nothing else changed, in a harness
-//!   during issue 18's ninth round) and not where it is bound by throughput (the aLMI lanes
-//!   measured 0–3 % slower, the exact correction no different, so they ask for [`avx2`]).
+//!   latency (more wavelengths in flight per instruction: the double-precision water kernel) and
+//!   not where it is bound by throughput (the aLMI lanes, the exact correction, which ask for
+//!   [`avx2`]). `SHOAL_SIMD=… shoal bench` measures each level (docs/RESULTS.md).
 //!
 //! The one `unsafe` block of each level is here, with its safety argument.
 

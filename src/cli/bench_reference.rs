@@ -37,7 +37,7 @@ impl ReferenceFigure {
 }
 
 /// Where and when note 1's figures were measured.
-pub const SIDE_BY_SIDE: &str = "[1] Measured side by side with Shoal on one core of this machine class (AMD EPYC, 2 logical cores, 23 GB), 2026-11-23, by the session that filed issue 18: SAMBUCA core 1.2.3 (CSIRO, Python) forward model and its SciPy SLSQP fit, and the DEA-Water-Quality aLMI (Python) core loop, each on its own benchmark pixels.";
+pub const SIDE_BY_SIDE: &str = "[1] Measured side by side with Shoal on one core of this machine class (AMD EPYC, 2 logical cores, 23 GB), 2026-11-23: SAMBUCA core 1.2.3 (CSIRO, Python) forward model and its SciPy SLSQP fit, and the DEA-Water-Quality aLMI (Python) core loop, each on its own benchmark pixels.";
 
 /// The superseded figures and where they came from.
 pub const SUPERSEDED: &str = "Superseded: ../shared/reference/README.md gives 13–23 k forward calls/s and 13–58 SLSQP pixels/s for SAMBUCA and ~6 000 pixels/s for aLMI \"on this machine class\", without date or method; run side by side the codes were slower (note 1), so those figures are no longer used for ratios.";

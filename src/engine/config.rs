@@ -69,19 +69,16 @@ impl Default for Fidelity {
 }
 
 /// The default of [`Fidelity::band_nodes`], chosen from the cost table (`shoal bench
-/// --accuracy`, 2026-11-24, CubeSat over Lake Hume, full resolution, 3 interleaved rounds): the
-/// cheapest full-resolution setting within 1 % chl error per pixel, on the Pareto front —
-/// 10.41 s against the full grid's 12.09 s (0.86×), chl 0.003 % per pixel (median), chl MAE
-/// +0.08 points; 2 and 3 nodes per band were no faster and erred 1.7 % and 0.7 %.
+/// --accuracy`, CubeSat over Lake Hume, full resolution): the cheapest full-resolution setting
+/// within 1 % chl error per pixel, on the Pareto front; 2 and 3 nodes per band were no faster
+/// and erred more (the table: docs/RESULTS.md, "Cost of accuracy").
 pub const DEFAULT_BAND_NODES: usize = 4;
 
 /// The default of [`Fidelity::water_single_precision`], chosen from the cost table (`shoal bench
-/// --accuracy --pareto --tolerance-pct 1`, 2026-11-25, CubeSat over Lake Hume, full resolution,
-/// 3 interleaved rounds): with band nodes, the single-precision kernel was the cheapest
-/// full-resolution setting within 1 % chl error and on the Pareto front — 3.02 s (3.00–3.05)
-/// against 3.37 s (3.13–4.22) in double precision, the same chl error per pixel against the
-/// reference (0.003 % median, 1.713 % 95th percentile). A second run of the table, with the
-/// default switched, could not tell them apart: 3.12 s (3.08–3.19) against 3.16 s (3.09–3.17).
+/// --accuracy --pareto --tolerance-pct 1`, CubeSat over Lake Hume, full resolution): with band
+/// nodes, the single-precision kernel is on the Pareto front within 1 % chl error, with the same
+/// chl error per pixel against the reference as double precision and no slower (the table:
+/// docs/RESULTS.md, "Cost of accuracy").
 /// The stage itself, timed directly (the default study, back to back, three runs each): radiance
 /// 1.21–1.23 s in single against 1.33–1.34 s in double precision; the metrics move by about one
 /// part in 10⁷. The gain is small (0.1 s of the study's 6 s, about 2 %) and the error nil at

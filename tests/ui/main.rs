@@ -196,7 +196,7 @@ fn the_reference_mode_selector_reruns_alm_as_the_published_code() {
 fn an_instrument_that_returns_no_pixel_is_never_a_pass() {
     // A 10 e⁻ well saturates on every water pixel: nothing is retrieved. The metrics of an empty
     // product read MAE 0 %, bias 0 %; before the verdicts were shared with `shoal study` the table
-    // said "pass" for chl, NAP and CDOM here (issue 14).
+    // said "pass" for chl, NAP and CDOM here.
     let dir = temp_library("nothing");
     let mut broken = InstrumentSpec::preset("cubesat").unwrap();
     broken.well_depth_e = 10.0;
@@ -227,7 +227,7 @@ fn an_instrument_that_returns_no_pixel_is_never_a_pass() {
 
 #[test]
 fn a_shallow_scene_under_alm_shows_a_banner_whose_button_switches_to_sambuca() {
-    // Issue 14: loading the Heron Island reef kept aLMI (chl MAE ~985 %, all FAIL, no hint).
+    // Loading the Heron Island reef once kept aLMI (chl MAE ~985 %, all FAIL, no hint).
     let dir = temp_library("banner");
     let mut h = harness("cubesat", 16, &dir);
     h.step();

@@ -90,7 +90,7 @@ pub fn settings_for(base: &RunConfig) -> Vec<Setting> {
         out.extend([
             s("band nodes 2 per band", vec![("fidelity.band_nodes", 2.0)]),
             s("band nodes 3 per band", vec![("fidelity.band_nodes", 3.0)]),
-            // The defaults but for the kernel's precision (the defaults before 2026-11-25).
+            // The defaults but for the kernel's precision.
             e("band nodes 4, double precision", |c| {
                 c.fidelity.band_nodes = 4;
                 c.fidelity.water_single_precision = false;
