@@ -18,9 +18,6 @@ use std::rc::Rc;
 
 use netcdf3::{DataSet, FileWriter, Version};
 
-/// Shoal's product variables (what a retrieval returns and the truth holds), in table order.
-pub const PRODUCT_VARIABLES: [&str; 4] = crate::variable::KEYS;
-
 /// CF standard names of Shoal's product variables and of Rrs (those CF has).
 #[must_use]
 pub fn standard_name(variable: &str) -> Option<&'static str> {

@@ -37,7 +37,7 @@ pub struct ScoreArgs {
 }
 
 /// Shoal's product variables, in table order.
-const VARIABLES: [&str; 4] = crate::netcdf::PRODUCT_VARIABLES;
+const VARIABLES: [&str; 4] = crate::variable::KEYS;
 
 /// Largest NetCDF file read, bytes: a full-resolution default-study product is ~0.7 GB.
 const MAX_BYTES: u64 = 8 << 30;

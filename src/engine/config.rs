@@ -192,8 +192,17 @@ impl RunConfig {
         let mut atmosphere = self.scene.atmosphere.clone();
         atmosphere.day_of_year = crate::scene::day_of_year(&self.scene.date).map_err(at(Stage::Scene))?;
         atmosphere.validate().map_err(|e| at(Stage::Scene)(format!("atmosphere: {e}")))?;
-        for r in &self.retrievals {
+        for (i, r) in self.retrievals.iter().enumerate() {
             r.validate().map_err(|e| at(Stage::Retrieval)(format!("{}: {e}", r.name())))?;
+            // An external retrieval's name names its files and NetCDF variables: two of one name
+            // would overwrite each other.
+            let external = matches!(r, crate::retrieval::RetrievalSpec::External(_));
+            if external && self.retrievals[..i].iter().any(|o| o.name() == r.name()) {
+                return Err(at(Stage::Retrieval)(format!(
+                    "retrievals[{i}].External.name: `{}` is taken by an earlier retrieval; give each its own name",
+                    r.name()
+                )));
+            }
         }
         // What the run will ask of the machine, against its budget (`engine::resources`).
         let budget = crate::budget::Budget::from_env().map_err(at(Stage::Scene))?;

@@ -127,7 +127,7 @@ impl ExternalSpec {
         if self.command.len() > 64 || self.command.iter().any(|a| a.len() > 4096) {
             return Err(invalid("command", "is over 64 arguments or an argument over 4096 bytes".into()));
         }
-        let known = crate::netcdf::PRODUCT_VARIABLES;
+        let known = crate::variable::KEYS;
         if self.products.is_empty() {
             return Err(invalid("products", format!("is empty (allowed: one or more of {})", known.join(", "))));
         }

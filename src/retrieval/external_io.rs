@@ -14,6 +14,7 @@ use crate::netcdf::{
     CUBE, FlagVar, FloatVar, MAP, Maps, Values, attrs, define_vars, masked, standard_name, write_file,
 };
 use crate::parse::FieldError;
+use crate::variable::key;
 
 /// The instrument bands the program is given (`bands`, else every band), by index.
 pub(super) fn used_bands(spec: &ExternalSpec, inputs: &RetrievalInputs<'_>) -> Result<Vec<usize>, RetrievalError> {
@@ -165,7 +166,8 @@ pub(super) fn product(spec: &ExternalSpec, inputs: &RetrievalInputs<'_>, maps: &
             maps.shape.0, maps.shape.1
         ));
     }
-    let mut planes: Vec<(&str, Array2<f32>)> = Vec::new();
+    // Each wanted product's values, found once.
+    let mut columns: Vec<(&str, &[Option<f64>])> = Vec::new();
     for wanted in &spec.products {
         let Some((_, values)) = maps.maps.iter().find(|(n, _)| n == wanted) else {
             return Err(format!(
@@ -173,14 +175,15 @@ pub(super) fn product(spec: &ExternalSpec, inputs: &RetrievalInputs<'_>, maps: &
                 if maps.names.is_empty() { "no variables".to_string() } else { maps.names.join(", ") }
             ));
         };
-        let plane = Array2::from_shape_fn((rows, cols), |(r, c)| values[r * cols + c].map_or(0.0, |v| v as f32));
-        planes.push((wanted.as_str(), plane));
+        columns.push((wanted.as_str(), values.as_slice()));
     }
-    let valid = |r: usize, c: usize| {
-        spec.products
-            .iter()
-            .all(|w| maps.maps.iter().find(|(n, _)| n == w).and_then(|(_, v)| v[r * cols + c]).is_some_and(|x| x > 0.0))
-    };
+    let mut planes: Vec<(&str, Array2<f32>)> = columns
+        .iter()
+        .map(|(name, values)| {
+            (*name, Array2::from_shape_fn((rows, cols), |(r, c)| values[r * cols + c].map_or(0.0, |v| v as f32)))
+        })
+        .collect();
+    let valid = |r: usize, c: usize| columns.iter().all(|(_, v)| v[r * cols + c].is_some_and(|x| x > 0.0));
     let flags = Array2::from_shape_fn((rows, cols), |(r, c)| {
         if inputs.land[[r, c]] != 0 {
             ProductFlags::LAND
@@ -193,10 +196,10 @@ pub(super) fn product(spec: &ExternalSpec, inputs: &RetrievalInputs<'_>, maps: &
     let mut take = |v: &str| planes.iter().position(|(n, _)| *n == v).map(|i| planes.remove(i).1);
     Ok(Product {
         name: spec.name.clone(),
-        chl_mg_m3: take("chl_mg_m3"),
-        cdom_per_m: take("cdom_per_m"),
-        nap_g_m3: take("nap_g_m3"),
-        depth_m: take("depth_m"),
+        chl_mg_m3: take(key::CHL),
+        cdom_per_m: take(key::CDOM),
+        nap_g_m3: take(key::NAP),
+        depth_m: take(key::DEPTH),
         substrate_names: Vec::new(),
         substrate_fractions: None,
         siop_set_names: Vec::new(),

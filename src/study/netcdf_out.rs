@@ -217,7 +217,7 @@ fn retrieval_vars<'a>(out: &'a RunOutput, floats: &mut Vec<FloatVar<'a>>, flags:
         let pf = p.flags.as_slice().unwrap_or_default();
         let returned = |i: usize| pf.get(i).is_some_and(|f| f & ProductFlags::RETURNED != 0);
         let maps: Vec<(&str, &ndarray::Array2<f32>)> =
-            crate::netcdf::PRODUCT_VARIABLES.iter().filter_map(|&v| p.map(v).map(|m| (v, m))).collect();
+            crate::variable::KEYS.iter().filter_map(|&v| p.map(v).map(|m| (v, m))).collect();
         for (variable, values) in maps {
             let (long, units) = meaning(variable);
             let mut a = attrs(&format!("{long} retrieved by {}", p.name), units, standard_name(variable));

@@ -241,6 +241,12 @@ fn a_bad_external_spec_names_its_field() {
         let e = spec.validate().unwrap_err().to_string();
         assert!(e.contains(field), "{spec:?}: {e}");
     }
+    // Two retrievals of one name would write the same files: the run is refused, naming it.
+    let mut c = RunConfig::new(small_lake(), small("cubesat", 24, 16));
+    let twice = RetrievalSpec::External(base.clone());
+    c.retrievals = vec![twice.clone(), twice];
+    let e = c.validate().unwrap_err().to_string();
+    assert!(e.contains("retrievals[1].External.name") && e.contains("`mine`"), "{e}");
     // `{dir}` needs a study file; a study read from a file resolves it.
     let with_dir = ExternalSpec { command: vec!["{dir}/mine.py".into()], ..base };
     assert!(with_dir.with_dir(None).unwrap_err().to_string().contains("{dir}"));

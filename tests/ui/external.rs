@@ -2,11 +2,8 @@
 //! app asks before the program runs (allowing is per session, never saved); a program that fails
 //! shows its standard error where its maps would be; sessions keep the retrieval.
 
-use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use shoal::app::model::{AppState, RetrievalKind};
-use shoal::app::{AppOptions, ShoalApp};
-use shoal::library::Library;
 use shoal::retrieval::external::ExternalSpec;
 use shoal::study::StudySpec;
 
@@ -25,13 +22,7 @@ fn the_app_asks_before_a_program_runs_and_shows_why_it_returned_nothing() {
         }),
         ..AppState::default()
     };
-    let library = Library::at(&dir);
-    let mut h = Harness::builder().with_size(egui::vec2(1500.0, 960.0)).build_eframe(move |cc| {
-        let mut app =
-            ShoalApp::with_state(state, &cc.egui_ctx, AppOptions { engine_threads: 2, ..AppOptions::default() });
-        app.set_library(library);
-        app
-    });
+    let mut h = super::with_state(state, &dir);
     super::wait_for_engine(&mut h);
     let ask = "runs a program on your machine";
     assert!(h.query_by_label_contains(ask).is_some(), "no prompt before the program runs");

@@ -41,6 +41,11 @@ fn harness(a: &str, level: usize, library: &std::path::Path) -> Harness<'static,
         decimations: vec![level],
         ..AppState::default()
     };
+    with_state(state, library)
+}
+
+/// The app at 1500 × 960 with `state`, two engine threads and the user library at `library`.
+fn with_state(state: AppState, library: &std::path::Path) -> Harness<'static, ShoalApp> {
     let library = Library::at(library);
     Harness::builder().with_size(egui::vec2(1500.0, 960.0)).build_eframe(move |cc| {
         let mut app =
@@ -206,13 +211,7 @@ fn an_instrument_that_returns_no_pixel_is_never_a_pass() {
         decimations: vec![16],
         ..AppState::default()
     };
-    let library = Library::at(&dir);
-    let mut h = Harness::builder().with_size(egui::vec2(1500.0, 960.0)).build_eframe(move |cc| {
-        let mut app =
-            ShoalApp::with_state(state, &cc.egui_ctx, AppOptions { engine_threads: 2, ..AppOptions::default() });
-        app.set_library(library);
-        app
-    });
+    let mut h = with_state(state, &dir);
     wait_for_engine(&mut h);
     let shown = h.state().link.shown[0].as_ref().unwrap();
     let chl = shown.output.retrievals[0].metrics.get("chl_mg_m3").unwrap();
