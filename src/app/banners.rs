@@ -56,16 +56,16 @@ pub(super) fn product_note(app: &ShoalApp) -> Option<String> {
     };
     missing.then(|| {
         let product = app.state.product.label().split(" (").next().unwrap_or_default();
-        format!("{retrieval} does not retrieve the {product}: A and B have no map of it.")
+        format!("{retrieval} does not retrieve the {product}: no design has a map of it.")
     })
 }
 
-/// Where instrument `index`'s maps would be when its run of the configuration set failed: the
+/// Where design `index`'s maps would be when its run of the configuration set failed: the
 /// reason in full, and the way out when Shoal knows one.
 pub(super) fn failure_box(app: &mut ShoalApp, ui: &mut egui::Ui, index: usize, message: &str) {
     use super::logic::UiCommand;
     use super::model::RetrievalKind;
-    let ab = if index == 0 { "A" } else { "B" };
+    let ab = super::model::label(index);
     egui::Frame::group(ui.style()).stroke(egui::Stroke::new(1.5, super::theme::FAIL)).show(ui, |ui| {
         ui.set_width(ui.available_width());
         ui.colored_label(
@@ -113,7 +113,7 @@ pub(super) fn external_banner(app: &mut ShoalApp, ui: &mut egui::Ui) {
         });
         return;
     }
-    let failure = (0..2).find_map(|i| match app.link.standing(i) {
+    let failure = (0..app.state.designs.len()).find_map(|i| match app.link.standing(i) {
         super::link::Standing::Current(s) => s.output.retrievals.first().and_then(|r| r.failure.clone()),
         _ => None,
     });

@@ -34,10 +34,15 @@ fn frame(ctx: &egui::Context, app: &mut ShoalApp) -> f64 {
     start.elapsed().as_secs_f64() * 1e3
 }
 
-/// Is the current generation's result at decimation `level` or finer on screen for A and B?
+/// Is the current generation's result at decimation `level` or finer on screen for every design?
 fn on_screen(app: &ShoalApp, level: usize) -> bool {
     let generation = app.link.generation();
-    (0..2).all(|i| app.link.shown[i].as_ref().is_some_and(|s| s.generation == generation && s.decimation <= level))
+    !app.link.shown.is_empty()
+        && app
+            .link
+            .shown
+            .iter()
+            .all(|s| s.as_ref().is_some_and(|s| s.generation == generation && s.decimation <= level))
         && app.images.ready()
 }
 
@@ -82,8 +87,8 @@ struct Sweep {
 }
 
 const SWEEPS: [Sweep; 2] = [
-    Sweep { label: "aperture", set: |s, k| s.a.spec.aperture_mm *= 1.0 + 0.02 * (k as f64 + 1.0) },
-    Sweep { label: "pixel pitch", set: |s, k| s.a.spec.pixel_pitch_um *= 1.0 + 0.02 * (k as f64 + 1.0) },
+    Sweep { label: "aperture", set: |s, k| s.designs[0].spec.aperture_mm *= 1.0 + 0.02 * (k as f64 + 1.0) },
+    Sweep { label: "pixel pitch", set: |s, k| s.designs[0].spec.pixel_pitch_um *= 1.0 + 0.02 * (k as f64 + 1.0) },
 ];
 
 /// Latency and frame times of `steps` changes of `sweep` at the preview 1/`preview`, with B

@@ -134,7 +134,7 @@ pub(super) fn conditions(app: &mut ShoalApp, ui: &mut egui::Ui) {
         if let Some(m) = &app.ui.conditions_error {
             ui.add(egui::Label::new(egui::RichText::new(format!("refused: {m}")).color(super::theme::FAIL)).wrap());
         }
-        ui.small("These change the scene and the calibration of A and B alike.");
+        ui.small("These change the scene and the calibration of every design alike.");
     });
 }
 

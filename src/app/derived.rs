@@ -1,21 +1,28 @@
-//! The left panel's read-only figures of A and B: derived figures (GSD, swath, f-number,
-//! étendue, line period, peak SNR), the feasibility checks, and the parameters in which A and B
-//! differ.
+//! The left panel's read-only figures of every design: derived figures (GSD, swath, f-number,
+//! étendue, line period, peak SNR), the feasibility checks, and the parameters in which the
+//! designs differ from the reference design.
 
 use super::ShoalApp;
-use super::model::Ab;
+use super::model::label;
 use crate::instrument::InstrumentSpec;
+
+/// A grid's header row: an empty corner, then each design's letter in its colour.
+fn design_header(ui: &mut egui::Ui, designs: usize) {
+    ui.label("");
+    for i in 0..designs {
+        ui.colored_label(super::theme::design(i), label(i));
+    }
+    ui.end_row();
+}
 
 /// A derived figure: its name and how to compute it from an instrument.
 type DerivedRow = (&'static str, fn(&InstrumentSpec) -> String);
 
 pub(super) fn derived(app: &ShoalApp, ui: &mut egui::Ui) {
     egui::CollapsingHeader::new("Derived").default_open(true).show(ui, |ui| {
-        egui::Grid::new("derived").num_columns(3).striped(true).show(ui, |ui| {
-            ui.label("");
-            ui.label("A");
-            ui.label("B");
-            ui.end_row();
+        let n = app.state.designs.len();
+        egui::Grid::new("derived").num_columns(n + 1).striped(true).show(ui, |ui| {
+            design_header(ui, n);
             let rows: [DerivedRow; 5] = [
                 ("GSD", |s| format!("{:.1} m", s.gsd_m())),
                 ("Swath", |s| format!("{:.1} km", s.swath_m() / 1000.0)),
@@ -27,12 +34,13 @@ pub(super) fn derived(app: &ShoalApp, ui: &mut egui::Ui) {
             ];
             for (name, f) in rows {
                 ui.label(name);
-                ui.label(f(&app.state.a.spec));
-                ui.label(f(&app.state.b.spec));
+                for d in &app.state.designs {
+                    ui.label(f(&d.spec));
+                }
                 ui.end_row();
             }
             ui.label("Peak SNR");
-            for i in 0..2 {
+            for i in 0..n {
                 // Only the configuration set: a failed or pending run shows no figure.
                 let snr = app
                     .link
@@ -48,22 +56,20 @@ pub(super) fn derived(app: &ShoalApp, ui: &mut egui::Ui) {
     feasibility(app, ui);
 }
 
-/// Cost, box and data budgets of A and B under the built-in models (src/instrument/budgets),
+/// Cost, box and data budgets of every design under the built-in models (src/instrument/budgets),
 /// from the bands of the run on screen; inside the folded Feasibility section.
 fn budgets(app: &ShoalApp, ui: &mut egui::Ui) {
     use crate::instrument::budgets::BudgetModels;
     static MODELS: std::sync::OnceLock<Option<BudgetModels>> = std::sync::OnceLock::new();
     let Some(models) = MODELS.get_or_init(|| BudgetModels::default_models().ok()) else { return };
-    let rows: Vec<Option<Vec<(String, String)>>> = (0..2)
-        .map(|i| {
-            let spec = if i == 0 { &app.state.a.spec } else { &app.state.b.spec };
-            app.link.current(i).map(|s| models.assess(spec, &s.output.response.plane_of_band).rows())
-        })
+    let rows: Vec<Option<Vec<(String, String)>>> = (app.state.designs.iter().enumerate())
+        .map(|(i, d)| app.link.current(i).map(|s| models.assess(&d.spec, &s.output.response.plane_of_band).rows()))
         .collect();
     ui.separator();
     ui.strong("Budgets");
     {
-        egui::Grid::new("budgets").num_columns(3).striped(true).show(ui, |ui| {
+        egui::Grid::new("budgets").num_columns(rows.len() + 1).striped(true).show(ui, |ui| {
+            design_header(ui, rows.len());
             let n = rows.iter().flatten().map(Vec::len).next().unwrap_or(0);
             for k in 0..n {
                 let name = rows.iter().flatten().next().map_or(String::new(), |r| r[k].0.clone());
@@ -91,22 +97,21 @@ fn graded(ui: &mut egui::Ui, text: String, level: u8, why: &str) {
     ui.colored_label(colour, text).on_hover_text(why);
 }
 
-/// The engine's `Feasibility` stage for A and B over this scene (src/instrument/feasibility.rs).
+/// The engine's `Feasibility` stage for every design over this scene
+/// (src/instrument/feasibility.rs).
 fn feasibility(app: &ShoalApp, ui: &mut egui::Ui) {
     use crate::instrument::feasibility::{Q_DETECTOR_LIMITED, Q_OPTICS_LIMITED, SATURATION_HEADROOM};
-    let figures: Vec<_> = (0..2).map(|i| app.link.current(i).map(|s| s.output.feasibility.clone())).collect();
+    let figures: Vec<_> =
+        (0..app.state.designs.len()).map(|i| app.link.current(i).map(|s| s.output.feasibility.clone())).collect();
     // The warnings stay in sight; the figures behind them fold away.
-    for (ab, figure) in Ab::BOTH.iter().zip(&figures) {
+    for (i, figure) in figures.iter().enumerate() {
         for w in figure.iter().flat_map(|f| &f.warnings) {
-            ui.colored_label(super::theme::FAIL, format!("{}: {}", ab.label(), w.message));
+            ui.colored_label(super::theme::FAIL, format!("{}: {}", label(i), w.message));
         }
     }
     egui::CollapsingHeader::new("Feasibility").default_open(false).show(ui, |ui| {
-        egui::Grid::new("feasibility").num_columns(3).striped(true).show(ui, |ui| {
-            ui.label("");
-            ui.label("A");
-            ui.label("B");
-            ui.end_row();
+        egui::Grid::new("feasibility").num_columns(figures.len() + 1).striped(true).show(ui, |ui| {
+            design_header(ui, figures.len());
             type Row = (&'static str, fn(&crate::instrument::feasibility::Feasibility) -> (String, u8), &'static str);
             let rows: [Row; 4] = [
                 (
@@ -159,19 +164,41 @@ fn feasibility(app: &ShoalApp, ui: &mut egui::Ui) {
     });
 }
 
-/// The parameters in which A and B differ (the review slide shows the same table).
-pub(super) fn a_vs_b(app: &ShoalApp, ui: &mut egui::Ui) {
-    egui::CollapsingHeader::new("A vs B").default_open(false).show(ui, |ui| {
-        let bands =
-            [Ab::A, Ab::B].map(|ab| app.link.current(ab.index()).map_or(0, |s| s.output.response.bands.bands.len()));
-        let rows = super::params::differences(&app.state.a.spec, &app.state.b.spec, (bands[0], bands[1]));
-        egui::Grid::new("a_vs_b").num_columns(3).striped(true).show(ui, |ui| {
-            for row in &rows {
-                for cell in row {
-                    ui.label(cell);
+/// The parameters in which the designs differ from the reference design, which the user picks
+/// (the review slide shows the same table).
+pub(super) fn differences(app: &mut ShoalApp, ui: &mut egui::Ui) {
+    let reference = app.state.reference;
+    egui::CollapsingHeader::new(format!("Parameters against {}", label(reference)))
+        .id_salt("parameters-against")
+        .default_open(false)
+        .show(ui, |ui| {
+            let n = app.state.designs.len();
+            ui.horizontal(|ui| {
+                ui.label("Reference");
+                for i in 0..n {
+                    ui.selectable_value(&mut app.state.reference, i, label(i))
+                        .on_hover_text(format!("Compare every design with {}", app.state.design_name(i)));
                 }
-                ui.end_row();
-            }
+            });
+            // The reference first, then the others in order.
+            let order: Vec<usize> = std::iter::once(reference).chain((0..n).filter(|&i| i != reference)).collect();
+            let names: Vec<String> = order.iter().map(|&i| label(i)).collect();
+            let designs: Vec<(&str, &InstrumentSpec, usize)> = order
+                .iter()
+                .zip(&names)
+                .map(|(&i, name)| {
+                    let bands = app.link.current(i).map_or(0, |s| s.output.response.bands.bands.len());
+                    (name.as_str(), &app.state.designs[i].spec, bands)
+                })
+                .collect();
+            let rows = super::params::differences(&designs);
+            egui::Grid::new("differences").num_columns(n + 1).striped(true).show(ui, |ui| {
+                for row in &rows {
+                    for cell in row {
+                        ui.label(cell);
+                    }
+                    ui.end_row();
+                }
+            });
         });
-    });
 }

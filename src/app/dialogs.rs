@@ -65,12 +65,12 @@ impl ShoalApp {
     /// The run's state, in a box of fixed width (nothing beside it moves as the text changes):
     /// the stage running and how far its rows have gone, with the time left in it once its pace
     /// is known; Cancel; after a cancel, Refine; a failed instrument in red; "up to date" only
-    /// when both instruments show the configuration set, at the finest level asked for.
+    /// when every design shows the configuration set, at the finest level asked for.
     pub(super) fn status(&mut self, ui: &mut egui::Ui) {
         let size = egui::vec2(STATUS_WIDTH, ui.spacing().interact_size.y);
-        let failed: Vec<&str> = (0..2)
+        let failed: Vec<String> = (0..self.state.designs.len())
             .filter(|&i| matches!(self.link.standing(i), super::link::Standing::Failed(_)))
-            .map(|i| if i == 0 { "A" } else { "B" })
+            .map(super::model::label)
             .collect();
         let mut cancel = false;
         let mut refine = false;
@@ -141,7 +141,7 @@ const STATUS_WIDTH: f32 = 330.0;
 /// is known. Never a figure for the whole run: the stages' costs differ by orders of magnitude
 /// (a SAMBUCA row costs a thousand Level-0 rows), so no row count can say how much is left.
 fn progress_text(p: &super::link::Progress) -> (f32, String, String) {
-    let which = if p.index == 0 { "A" } else { "B" };
+    let which = super::model::label(p.index);
     let level = if p.decimation == 1 { "full res.".to_string() } else { format!("1/{}", p.decimation) };
     match p.stage {
         Some(stage) if stage.total > 0 => {

@@ -1,9 +1,9 @@
-//! Trade-off windows. **Sweep**: one instrument parameter of A and B over a range with several
+//! Trade-off windows. **Sweep**: one instrument parameter of every design over a range with several
 //! noise seeds; the chl MAE curve of each instrument grows point by point, with the seeds' range,
 //! the requirement and where it is first met. **Cost**: every fidelity setting's time against its
 //! error from the full-fidelity run (`sweep::cost`), to pick the cheapest setting whose error is
 //! acceptable. **Design**: the cheapest design from A that meets the requirements
-//! (`crate::design`), with its cost–error plot and a click to put a design into A or B.
+//! (`crate::design`), with its cost–error plot and a click to put a design into A or beside the others.
 //!
 //! Both run on a helper thread (not the engine thread, whose pool serves the maps) and stream
 //! their results; a new run or closing the window cancels the old one.
@@ -158,7 +158,7 @@ impl Explore {
         }
     }
 
-    /// Start the sweep of the chosen parameter (and the second, when set) over A and B as they
+    /// Start the sweep of the chosen parameter (and the second, when set) over the designs as they
     /// are now.
     pub fn start_sweep(&mut self, ctx: &egui::Context, state: &AppState) {
         let whole = |path: &str| crate::ranges::ALL.iter().any(|r| r.path == path && r.whole);
@@ -185,10 +185,7 @@ impl Explore {
             name: "app".into(),
             description: String::new(),
             scene: Source::Inline(Box::new(state.seeded_scene())),
-            instruments: vec![
-                Source::Inline(Box::new(state.a.spec.clone())),
-                Source::Inline(Box::new(state.b.spec.clone())),
-            ],
+            instruments: state.designs.iter().map(|d| Source::Inline(Box::new(d.spec.clone()))).collect(),
             retrievals: vec![state.retrieval_spec()],
             seeds: vec![1],
             detector: None,

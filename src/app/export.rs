@@ -1,6 +1,6 @@
 //! Export: the comparison figure (PNG and SVG: maps, colour bar, metrics table, a caption naming
 //! the presets and the changed parameters) with the resolved configurations beside it; and the
-//! data (cubes and metrics of A and B, as `shoal study` writes them). Every file is written
+//! data (cubes and metrics of every design, as `shoal study` writes them). Every file is written
 //! atomically; a failed write says why in the app.
 //!
 //! Off the UI thread: the save dialog (rfd, through the desktop's file-chooser portal) and the
@@ -24,12 +24,12 @@ use crate::study::{write_bytes, write_run};
 pub struct Snapshot {
     /// The app state.
     pub state: AppState,
-    /// A's and B's results.
-    pub runs: [Option<Arc<RunOutput>>; 2],
+    /// Each design's result, in order.
+    pub runs: Vec<Option<Arc<RunOutput>>>,
     /// A's decimation.
     pub decimation: usize,
-    /// Per instrument, why it has no result to export (failed, still running), if it has none.
-    pub missing: [Option<String>; 2],
+    /// Per design, why it has no result to export (failed, still running), if it has none.
+    pub missing: Vec<Option<String>>,
 }
 
 impl Snapshot {
@@ -38,56 +38,71 @@ impl Snapshot {
     #[must_use]
     pub fn of(app: &ShoalApp) -> Self {
         use super::link::Standing;
-        let missing = [0, 1].map(|i| {
-            let ab = if i == 0 { "A" } else { "B" };
-            match app.link.standing(i) {
-                Standing::Current(_) => None,
-                Standing::Failed(e) => Some(format!("{ab}'s run of the configuration set failed ({e})")),
-                Standing::Earlier(_) | Standing::Waiting => {
-                    Some(format!("{ab} is still running for the configuration set"))
+        let n = app.state.designs.len();
+        let missing = (0..n)
+            .map(|i| {
+                let ab = super::model::label(i);
+                match app.link.standing(i) {
+                    Standing::Current(_) => None,
+                    Standing::Failed(e) => Some(format!("{ab}'s run of the configuration set failed ({e})")),
+                    Standing::Earlier(_) | Standing::Waiting => {
+                        Some(format!("{ab} is still running for the configuration set"))
+                    }
                 }
-            }
-        });
+            })
+            .collect();
         Self {
             state: app.state.clone(),
-            runs: [0, 1].map(|i| app.link.current(i).map(|s| s.output.clone())),
+            runs: (0..n).map(|i| app.link.current(i).map(|s| s.output.clone())).collect(),
             decimation: app.link.current(0).map_or(1, |s| s.decimation),
             missing,
         }
     }
 
-    /// A's and B's results, or why there are none to export.
-    pub fn both(&self) -> Result<(&Arc<RunOutput>, &Arc<RunOutput>), String> {
-        match (&self.runs[0], &self.runs[1]) {
-            (Some(a), Some(b)) => Ok((a, b)),
-            _ => Err(self.missing.iter().flatten().cloned().collect::<Vec<_>>().join("; ")
-                + ": nothing exported (the results on screen do not all belong to the configuration set)"),
+    /// Every design's result, or why there are none to export.
+    pub fn all(&self) -> Result<Vec<&Arc<RunOutput>>, String> {
+        let runs: Vec<&Arc<RunOutput>> = self.runs.iter().flatten().collect();
+        if runs.len() == self.runs.len() && !runs.is_empty() {
+            return Ok(runs);
         }
+        Err(self.missing.iter().flatten().cloned().collect::<Vec<_>>().join("; ")
+            + ": nothing exported (the results on screen do not all belong to the configuration set)")
+    }
+
+    /// "cubesat vs smallsat vs nominal over lake_hume_bloom": what is compared now (a loaded
+    /// study's name would outlive a change of scene).
+    #[must_use]
+    pub fn title(&self) -> String {
+        let s = &self.state;
+        let names: Vec<&str> = s.designs.iter().map(|d| d.preset.as_str()).collect();
+        format!("{} over {}", names.join(" vs "), s.scene_name)
     }
 }
 
-/// A and B as a study, as set in the app: named after what is compared now (a loaded study's
-/// name would outlive a change of scene), with the app's requirements.
+/// The designs as a study, as set in the app, with the app's requirements.
 fn study_of(snap: &Snapshot) -> Result<crate::study::StudyResult, String> {
-    let (a, b) = snap.both()?;
+    let all = snap.all()?;
     let state = &snap.state;
-    let runs = [
-        (format!("{} (A)", a.config.instrument.name), a.as_ref()),
-        (format!("{} (B)", b.config.instrument.name), b.as_ref()),
-    ];
+    let runs: Vec<(String, &RunOutput)> = all
+        .iter()
+        .enumerate()
+        .map(|(i, r)| (format!("{} ({})", r.config.instrument.name, super::model::label(i)), r.as_ref()))
+        .collect();
     let changes = state.changes();
+    let letters: Vec<String> = (0..runs.len()).map(super::model::label).collect();
     let description = format!(
-        "A against B as set in the app, {} retrieval{}{}",
+        "{} as set in the app, {} retrieval{}{}",
+        letters.join(" against "),
         state.retrieval_spec().name(),
         if snap.decimation > 1 { format!(", at 1/{} resolution (a preview)", snap.decimation) } else { String::new() },
         if changes.is_empty() { String::new() } else { format!("; instrument edits: {}", changes.join("; ")) }
     );
-    let name = format!("{} vs {} over {}", state.a.preset, state.b.preset, state.scene_name);
+    let name = snap.title();
     crate::study::StudyResult::of_runs(&name, &description, &runs, Some(state.requirements.clone()))
         .ok_or_else(|| "no results to export yet".to_string())
 }
 
-/// Write the review pack of A and B into the folder `dir` (index.html, figures, review.json):
+/// Write the review pack of every design into the folder `dir` (index.html, figures, review.json):
 /// the same page `shoal report` writes, with the app's requirements.
 pub fn write_review_pack(snap: &Snapshot, dir: &Path) -> Result<PathBuf, String> {
     let result = study_of(snap)?;
@@ -99,14 +114,21 @@ pub fn write_review_pack(snap: &Snapshot, dir: &Path) -> Result<PathBuf, String>
     Ok(dir.join("index.html"))
 }
 
-/// Files an export to `path` would replace (empty: nothing of the user's is overwritten).
+/// The configuration file of design `i` beside the figure at `stem` (`…_config_A.ron`).
 #[must_use]
-pub fn existing(what: What, path: &Path) -> Vec<PathBuf> {
+pub fn config_path(stem: &Path, i: usize) -> PathBuf {
+    PathBuf::from(format!("{}_config_{}.ron", stem.display(), super::model::label(i)))
+}
+
+/// Files an export of `designs` designs to `path` would replace (empty: nothing of the user's
+/// is overwritten).
+#[must_use]
+pub fn existing(what: What, path: &Path, designs: usize) -> Vec<PathBuf> {
     let candidates: Vec<PathBuf> = match what {
         What::Figure => {
             let stem = path.with_extension("");
             let mut v = vec![stem.with_extension("png"), stem.with_extension("svg")];
-            v.extend(["A", "B"].map(|n| PathBuf::from(format!("{}_config_{n}.ron", stem.display()))));
+            v.extend((0..designs).map(|i| config_path(&stem, i)));
             v
         }
         // A folder is replaced whole ([`crate::study::OutputDir`]): anything in it counts.
@@ -118,7 +140,7 @@ pub fn existing(what: What, path: &Path) -> Vec<PathBuf> {
     candidates.into_iter().filter(|p| p.exists()).collect()
 }
 
-/// Write A's and B's data into the folder `dir` as `shoal study` writes a study: the metrics
+/// Write every design's data into the folder `dir` as `shoal study` writes a study: the metrics
 /// tables (CSV and JSON), the requirement checks, the seed spread, the figures, `review.json`
 /// (so `shoal report DIR` makes the pack) and per instrument its cubes, SNR table, report and
 /// configuration. Written whole: a new or empty folder, or one Shoal wrote, which is replaced.
@@ -126,9 +148,9 @@ pub fn write_data(snap: &Snapshot, dir: &Path) -> Result<usize, String> {
     let result = study_of(snap)?;
     let out = crate::study::OutputDir::create(dir, "Shoal app: data export").map_err(|e| e.to_string())?;
     let mut outputs = crate::study::write_study(&result, out.path(), true).map_err(|e| e.to_string())?;
-    for (name, run) in ["A", "B"].iter().zip(&snap.runs) {
+    for (i, run) in snap.runs.iter().enumerate() {
         let Some(run) = run else { continue };
-        let sub = format!("{name}_{}", run.config.instrument.name);
+        let sub = format!("{}_{}", super::model::label(i), run.config.instrument.name);
         let sub = crate::parse::join_name(out.path(), "instrument.name", &sub).map_err(|e| e.to_string())?;
         outputs.files.extend(write_run(run, &sub).map_err(|e| e.to_string())?.files);
     }

@@ -1,4 +1,4 @@
-//! Undo and redo of the design under review: instruments A and B and the scene.
+//! Undo and redo of the designs under review (the list of instruments) and the scene.
 //!
 //! The history watches the state once a frame, after the panels have changed it, instead of
 //! asking every widget to report its edits: whatever changed the design (a slider, a typed
@@ -7,14 +7,13 @@
 //! Ctrl+Z / Ctrl+Shift+Z (and Ctrl+Y) reach it when no text field has the keyboard, which then
 //! keeps its own text undo.
 
-use super::model::{AppState, Slot};
+use super::model::{AppState, Slot, label};
 use crate::scene::SceneSpec;
 
 /// What undo restores.
 #[derive(Debug, Clone, PartialEq)]
 struct Design {
-    a: Slot,
-    b: Slot,
+    designs: Vec<Slot>,
     scene: SceneSpec,
     scene_name: String,
     scene_seed: u64,
@@ -23,8 +22,7 @@ struct Design {
 impl Design {
     fn of(state: &AppState) -> Self {
         Self {
-            a: state.a.clone(),
-            b: state.b.clone(),
+            designs: state.designs.clone(),
             scene: state.scene.clone(),
             scene_name: state.scene_name.clone(),
             scene_seed: state.scene_seed,
@@ -34,25 +32,29 @@ impl Design {
     /// Is `state`'s design this one? (Compared in place: the history looks every frame, and
     /// should not copy the scene to do it.)
     fn matches(&self, state: &AppState) -> bool {
-        self.a == state.a
-            && self.b == state.b
+        self.designs == state.designs
             && self.scene == state.scene
             && self.scene_name == state.scene_name
             && self.scene_seed == state.scene_seed
     }
 
     fn restore(self, state: &mut AppState) {
-        state.a = self.a;
-        state.b = self.b;
+        state.designs = self.designs;
         state.scene = self.scene;
         state.scene_name = self.scene_name;
         state.scene_seed = self.scene_seed;
+        // The design edited, the maps' list and the pair may name a design no longer there.
+        state.settle();
     }
 
     /// What differs from `other`, in words, for the Undo button's tooltip.
     fn describe_change(&self, other: &Self) -> String {
         let mut what = Vec::new();
-        for (name, x, y) in [("A", &self.a, &other.a), ("B", &self.b, &other.b)] {
+        if self.designs.len() != other.designs.len() {
+            what.push(format!("designs {} → {}", self.designs.len(), other.designs.len()));
+        }
+        for (i, (x, y)) in self.designs.iter().zip(&other.designs).enumerate() {
+            let name = label(i);
             if x.preset != y.preset {
                 what.push(format!("{name} → {}", y.preset));
             } else if x.spec != y.spec {
@@ -144,30 +146,30 @@ mod tests {
         let mut state = AppState::default();
         let mut h = History::default();
         h.observe(&state, false);
-        let start = state.a.spec.aperture_mm;
+        let start = state.designs[0].spec.aperture_mm;
         // A drag over three frames, pointer held: no step yet.
         for v in [70.0, 80.0, 90.0] {
-            state.a.spec.aperture_mm = v;
+            state.designs[0].spec.aperture_mm = v;
             h.observe(&state, true);
         }
         assert!(h.undo_text().is_none());
         h.observe(&state, false);
         assert_eq!(h.undo_text().as_deref(), Some("A's parameters"));
-        state.b.spec.read_noise_e += 5.0;
+        state.designs[1].spec.read_noise_e += 5.0;
         h.observe(&state, false);
 
         assert!(h.undo(&mut state));
-        assert_eq!(state.a.spec.aperture_mm, 90.0, "the last step (B's read noise) went first");
+        assert_eq!(state.designs[0].spec.aperture_mm, 90.0, "the last step (B's read noise) went first");
         assert!(h.undo(&mut state));
-        assert_eq!(state.a.spec.aperture_mm, start, "the drag undoes as one step");
+        assert_eq!(state.designs[0].spec.aperture_mm, start, "the drag undoes as one step");
         assert!(!h.undo(&mut state), "nothing older");
         assert!(h.redo(&mut state));
-        assert_eq!(state.a.spec.aperture_mm, 90.0);
+        assert_eq!(state.designs[0].spec.aperture_mm, 90.0);
         // A new edit drops what could be redone.
-        state.a.spec.aperture_mm = 100.0;
+        state.designs[0].spec.aperture_mm = 100.0;
         h.observe(&state, false);
         assert!(!h.redo(&mut state));
-        assert_eq!(state.a.spec.aperture_mm, 100.0);
+        assert_eq!(state.designs[0].spec.aperture_mm, 100.0);
     }
 
     #[test]
@@ -175,10 +177,10 @@ mod tests {
         let mut state = AppState::default();
         let mut h = History::default();
         h.observe(&state, false);
-        let start = state.a.spec.exposure_s;
-        state.a.spec.exposure_s *= 2.0;
+        let start = state.designs[0].spec.exposure_s;
+        state.designs[0].spec.exposure_s *= 2.0;
         h.observe(&state, true);
         assert!(h.undo(&mut state));
-        assert_eq!(state.a.spec.exposure_s, start);
+        assert_eq!(state.designs[0].spec.exposure_s, start);
     }
 }

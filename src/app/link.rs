@@ -1,8 +1,9 @@
-//! The app's side of the engine thread: it submits the configuration snapshots of A and B with a
-//! new generation whenever they change, and keeps, per instrument, the newest result of the
+//! The app's side of the engine thread: it submits the configuration snapshots of the designs
+//! with a new generation whenever they change, and keeps, per design, the newest result of the
 //! newest generation (a coarser preview never replaces a finer result of the same generation;
 //! an older generation's result is shown only until the new one's first preview arrives, and is
-//! marked stale meanwhile).
+//! marked stale meanwhile). When the designs are reordered or one is removed, the results move
+//! with their designs ([`EngineLink::remap`]) rather than being computed again.
 
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -31,7 +32,7 @@ pub struct Shown {
 /// Progress of the run in flight.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Progress {
-    /// Instrument (0 = A, 1 = B).
+    /// Design (0 = A, 1 = B, …).
     pub index: usize,
     /// Decimation.
     pub decimation: usize,
@@ -76,15 +77,18 @@ pub struct EngineLink {
     submitted: Vec<RunConfig>,
     decimations: Vec<usize>,
     submitted_at: Instant,
-    /// Per instrument: the result shown.
-    pub shown: [Option<Shown>; 2],
-    /// Per instrument: the last error of the current generation.
-    pub errors: [Option<String>; 2],
+    /// Per design: the result shown.
+    pub shown: Vec<Option<Shown>>,
+    /// Per design: the last error of the current generation.
+    pub errors: Vec<Option<String>>,
     /// The run in flight, if any.
     pub progress: Option<Progress>,
-    /// Has the current generation's finest level finished for both instruments?
-    finished: [bool; 2],
-    /// Seconds from the last submission to its first results of A and B arriving.
+    /// Per design: has the current generation's finest level finished?
+    finished: Vec<bool>,
+    /// The designs moved since the last submission: submit even if the configurations read the
+    /// same (the runs in flight report by their old positions).
+    moved: bool,
+    /// Seconds from the last submission to the first results of every design arriving.
     pub last_latency_s: Option<f64>,
     latency_pending: bool,
     /// The user stopped the current generation's runs (the results shown stay, as far as they
@@ -103,10 +107,11 @@ impl EngineLink {
             submitted: Vec::new(),
             decimations: Vec::new(),
             submitted_at: Instant::now(),
-            shown: [None, None],
-            errors: [None, None],
+            shown: Vec::new(),
+            errors: Vec::new(),
             progress: None,
-            finished: [false, false],
+            finished: Vec::new(),
+            moved: false,
             last_latency_s: None,
             latency_pending: false,
             cancelled: false,
@@ -168,30 +173,40 @@ impl EngineLink {
 
     /// Submit `configs` at `decimations` if they differ from what is running; true if submitted.
     ///
-    /// An instrument whose configuration and decimations did not change and whose final result is
+    /// A design whose configuration and decimations did not change and whose final result is
     /// already shown is not run again: its result is carried over to the new generation (moving
     /// one slider of A re-runs only A).
     pub fn submit_if_changed(&mut self, configs: Vec<RunConfig>, decimations: Vec<usize>) -> bool {
-        if configs == self.submitted && decimations == self.decimations {
+        if !self.moved && configs == self.submitted && decimations == self.decimations {
             return false;
         }
+        self.moved = false;
         let finest = decimations.last().copied().unwrap_or(1);
         let keep: Vec<bool> = (0..configs.len())
             .map(|i| {
-                i < 2
-                    && decimations == self.decimations
+                decimations == self.decimations
                     && self.submitted.get(i) == configs.get(i)
-                    && self.finished[i]
-                    && self.errors[i].is_none()
-                    && self.shown[i].as_ref().is_some_and(|s| s.generation == self.generation && s.decimation == finest)
+                    && self.finished.get(i).copied().unwrap_or(false)
+                    && self.errors.get(i).is_some_and(Option::is_none)
+                    && self
+                        .shown
+                        .get(i)
+                        .and_then(Option::as_ref)
+                        .is_some_and(|s| s.generation == self.generation && s.decimation == finest)
             })
             .collect();
         self.generation += 1;
         self.cancelled = false;
         self.submitted.clone_from(&configs);
         self.decimations.clone_from(&decimations);
-        self.errors = [None, None];
-        self.finished = [false, false];
+        let n = configs.len();
+        self.errors = vec![None; n];
+        self.finished = vec![false; n];
+        // Results of designs no longer there are freed off the UI thread.
+        for old in self.shown.drain(n.min(self.shown.len())..).flatten() {
+            crate::jobs::free_later(old);
+        }
+        self.shown.resize(n, None);
         for (i, kept) in keep.iter().enumerate() {
             if *kept && let Some(shown) = self.shown[i].as_mut() {
                 shown.generation = self.generation;
@@ -214,11 +229,12 @@ impl EngineLink {
                 }
                 Event::Finished { generation, index, decimation, result } => {
                     let finest = self.decimations.last().copied().unwrap_or(1);
-                    if index < 2 && decimation == finest {
+                    let known = index < self.shown.len();
+                    if known && decimation == finest {
                         self.finished[index] = true;
                     }
                     match result {
-                        Ok(output) if index < 2 => {
+                        Ok(output) if known => {
                             let replace = match &self.shown[index] {
                                 None => true,
                                 Some(s) => s.generation < generation || s.decimation >= decimation,
@@ -243,7 +259,7 @@ impl EngineLink {
                         }
                         Ok(_) => {}
                         Err(EngineError::Cancelled) => {}
-                        Err(e) if index < 2 => {
+                        Err(e) if known => {
                             self.errors[index] = Some(e.to_string());
                             self.finished[index] = true;
                             changed = true;
@@ -259,14 +275,14 @@ impl EngineLink {
         changed
     }
 
-    /// The maps of what is shown are on screen: if that is the current generation's preview (an
-    /// instrument whose run failed counts as shown: its error is), the engine (paused for it)
-    /// goes on to the finer levels.
+    /// The maps of what is shown are on screen: if that is the current generation's preview (a
+    /// design whose run failed counts as shown: its error is), the engine (paused for it) goes on
+    /// to the finer levels.
     pub fn maps_on_screen(&self) {
         let current = |i: usize| {
             self.errors[i].is_some() || self.shown[i].as_ref().is_some_and(|s| s.generation == self.generation)
         };
-        if current(0) && current(1) {
+        if (0..self.shown.len()).all(current) {
             self.handle.preview_shown(self.generation);
         }
     }
@@ -277,19 +293,51 @@ impl EngineLink {
         !self.cancelled && !self.finished.iter().all(|f| *f)
     }
 
-    /// Is instrument `index`'s shown result from an older generation than the newest?
+    /// Is design `index`'s shown result from an older generation than the newest?
     #[must_use]
     pub fn stale(&self, index: usize) -> bool {
-        self.shown[index].as_ref().is_none_or(|s| s.generation != self.generation)
+        self.shown.get(index).and_then(Option::as_ref).is_none_or(|s| s.generation != self.generation)
     }
 
-    /// Wait (blocking, for tests and the bench) until both instruments show the current
+    /// The designs moved (`moved[old] = Some(new)`, `None`: removed): their results, errors and
+    /// submitted configurations go with them, so a design that did not change is not run
+    /// again, and the next submission starts a new generation whatever it holds.
+    pub fn remap(&mut self, moved: &[Option<usize>]) {
+        let n = moved.iter().flatten().map(|k| k + 1).max().unwrap_or(0);
+        let mut shown = vec![None; n];
+        let mut errors = vec![None; n];
+        let mut finished = vec![false; n];
+        let mut submitted: Vec<Option<RunConfig>> = vec![None; n];
+        for (old, new) in moved.iter().enumerate() {
+            let taken = self.shown.get_mut(old).and_then(Option::take);
+            match new {
+                Some(k) => {
+                    shown[*k] = taken;
+                    errors[*k] = self.errors.get_mut(old).and_then(Option::take);
+                    finished[*k] = self.finished.get(old).copied().unwrap_or(false);
+                    submitted[*k] = self.submitted.get(old).cloned();
+                }
+                None => {
+                    if let Some(old) = taken {
+                        crate::jobs::free_later(old);
+                    }
+                }
+            }
+        }
+        (self.shown, self.errors, self.finished) = (shown, errors, finished);
+        // A design with no submitted configuration (none was moved into its place) runs anew.
+        self.submitted = submitted.into_iter().map_while(|c| c).collect();
+        self.progress = None;
+        self.moved = true;
+    }
+
+    /// Wait (blocking, for tests and the bench) until every design shows the current
     /// generation at `decimation` or finer, or `timeout` passes; true if they do.
     pub fn wait_for(&mut self, decimation: usize, timeout: Duration) -> bool {
         let deadline = Instant::now() + timeout;
         loop {
             self.poll();
-            let ready = (0..2).all(|i| {
+            let ready = (0..self.shown.len()).all(|i| {
                 self.shown[i].as_ref().is_some_and(|s| s.generation == self.generation && s.decimation <= decimation)
             }) || self.errors.iter().any(Option::is_some);
             if ready {

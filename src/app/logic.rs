@@ -6,7 +6,7 @@
 use std::path::PathBuf;
 use std::time::Duration;
 
-use super::model::{Ab, AppState, ProductKind, RetrievalKind, Slot};
+use super::model::{AppState, ProductKind, RetrievalKind, Slot, label};
 use super::{Confirm, ShoalApp, model};
 use crate::library::{Entry, LibraryError};
 
@@ -16,10 +16,10 @@ const RASTER_WAIT: Duration = Duration::from_millis(6);
 /// Something a panel asked for, applied after the frame.
 #[derive(Debug, Clone)]
 pub enum UiCommand {
-    /// Load a library instrument into A or B.
+    /// Load a library instrument into a design.
     LoadInstrument {
-        /// Which.
-        ab: Ab,
+        /// Which (an index into the designs).
+        design: usize,
         /// The library entry.
         entry: Entry,
     },
@@ -27,14 +27,25 @@ pub enum UiCommand {
     LoadScene(Entry),
     /// Load a library study (instruments, scene, retrieval, requirements).
     LoadStudy(Entry),
-    /// Save A or B in the library under `name`.
+    /// Add a library instrument as a new design.
+    AddDesign(Entry),
+    /// Remove a design.
+    RemoveDesign(usize),
+    /// Move a design one place earlier or later in the list.
+    MoveDesign {
+        /// Which.
+        design: usize,
+        /// Towards A.
+        earlier: bool,
+    },
+    /// Save a design in the library under `name`.
     SaveInstrument {
         /// Which.
-        ab: Ab,
+        design: usize,
         /// The preset name.
         name: String,
     },
-    /// Save the study (A, B, the scene, the retrieval and the requirements) under `name`.
+    /// Save the study (the designs, the scene, the retrieval and the requirements) under `name`.
     SaveStudy {
         /// The preset name.
         name: String,
@@ -55,23 +66,27 @@ impl ShoalApp {
 
     /// The unsaved edits `command` would replace, in words; `None` when it replaces none.
     fn edits_lost_by(&self, command: &UiCommand) -> Option<String> {
-        let edited = |ab: Ab| {
-            let slot = self.state.slot(ab);
-            let prefix = format!("{} ", ab.label());
+        let edited = |i: usize| {
+            let slot = self.state.designs.get(i)?;
+            let prefix = format!("{} ", label(i));
             let changes: Vec<String> =
                 self.state.changes().iter().filter_map(|c| c.strip_prefix(&prefix).map(str::to_string)).collect();
-            slot.modified().then(|| format!("{} ({}: {})", ab.label(), slot.preset, changes.join("; ")))
+            slot.modified().then(|| format!("{} ({}: {})", label(i), slot.preset, changes.join("; ")))
         };
         let lost: Vec<String> = match command {
-            UiCommand::LoadInstrument { ab, .. } => edited(*ab).into_iter().collect(),
-            UiCommand::LoadStudy(_) => [Ab::A, Ab::B].into_iter().filter_map(edited).collect(),
+            UiCommand::LoadInstrument { design, .. } | UiCommand::RemoveDesign(design) => {
+                edited(*design).into_iter().collect()
+            }
+            UiCommand::LoadStudy(_) => (0..self.state.designs.len()).filter_map(edited).collect(),
             _ => Vec::new(),
         };
-        let target = match command {
-            UiCommand::LoadInstrument { entry, .. } | UiCommand::LoadStudy(entry) => entry.name.as_str(),
-            _ => "",
+        let doing = match command {
+            UiCommand::LoadInstrument { entry, .. } | UiCommand::LoadStudy(entry) => {
+                format!("Loading `{}` replaces", entry.name)
+            }
+            _ => "Removing the design loses".to_string(),
         };
-        (!lost.is_empty()).then(|| format!("Loading `{target}` replaces unsaved edits of {}.", lost.join(" and ")))
+        (!lost.is_empty()).then(|| format!("{doing} unsaved edits of {}.", lost.join(" and ")))
     }
 
     /// Ctrl+Z undoes, Ctrl+Shift+Z and Ctrl+Y redo — unless a text field has the keyboard (it
@@ -96,10 +111,36 @@ impl ShoalApp {
     /// Apply one command without asking.
     pub(super) fn apply_confirmed(&mut self, command: UiCommand) {
         match command {
-            UiCommand::LoadInstrument { ab, entry } => match self.library.load_instrument(&entry) {
-                Ok(spec) => *self.state.slot_mut(ab) = Slot::new(&entry.name, spec),
+            UiCommand::LoadInstrument { design, entry } => match self.library.load_instrument(&entry) {
+                Ok(spec) => {
+                    if let Some(slot) = self.state.designs.get_mut(design) {
+                        *slot = Slot::new(&entry.name, spec);
+                    }
+                }
                 Err(err) => self.ui.error = Some(format!("Cannot load instrument `{}`: {err}", entry.name)),
             },
+            UiCommand::AddDesign(entry) => match self.library.load_instrument(&entry) {
+                Ok(spec) => {
+                    if self.state.add_design(Slot::new(&entry.name, spec)).is_none() {
+                        self.ui.error = Some(format!(
+                            "Cannot add `{}`: the app compares {} designs at most",
+                            entry.name,
+                            super::model::MAX_DESIGNS
+                        ));
+                    }
+                }
+                Err(err) => self.ui.error = Some(format!("Cannot load instrument `{}`: {err}", entry.name)),
+            },
+            UiCommand::RemoveDesign(design) => {
+                if let Some(moved) = self.state.remove_design(design) {
+                    self.link.remap(&moved);
+                }
+            }
+            UiCommand::MoveDesign { design, earlier } => {
+                if let Some(moved) = self.state.move_design(design, earlier) {
+                    self.link.remap(&moved);
+                }
+            }
             UiCommand::LoadScene(entry) => match self.library.load_scene(&entry) {
                 Ok(spec) => {
                     self.state.scene = spec;
@@ -124,9 +165,10 @@ impl ShoalApp {
                     Err(err) => self.ui.error = Some(format!("Cannot load study `{}`: {err}", entry.name)),
                 }
             }
-            UiCommand::SaveInstrument { ab, name } => {
-                let spec = Box::new(self.state.slot(ab).spec.clone());
-                self.save(Confirm::Instrument { ab, name, spec }, false);
+            UiCommand::SaveInstrument { design, name } => {
+                let Some(slot) = self.state.designs.get(design) else { return };
+                let spec = Box::new(slot.spec.clone());
+                self.save(Confirm::Instrument { design, name, spec }, false);
             }
             UiCommand::UseRetrieval(kind) => {
                 self.state.retrieval = kind;
@@ -142,18 +184,17 @@ impl ShoalApp {
         }
     }
 
-    /// The study the app shows, as `shoal study` would run it: A and B, the scene with its seed,
-    /// the retrieval, the noise seed and the requirements in use.
+    /// The study the app shows, as `shoal study` would run it: the designs, the scene with its
+    /// seed, the retrieval, the noise seed and the requirements in use.
     fn study_to_save(&self, name: &str) -> crate::study::StudySpec {
         let s = &self.state;
+        let names: Vec<String> =
+            (0..s.designs.len()).map(|i| format!("{} {}", label(i), s.designs[i].preset)).collect();
         crate::study::StudySpec {
             name: name.into(),
-            description: format!("saved from the app: A {} vs B {} over {}", s.a.preset, s.b.preset, s.scene_name),
+            description: format!("saved from the app: {} over {}", names.join(" vs "), s.scene_name),
             scene: crate::study::Source::Inline(Box::new(s.seeded_scene())),
-            instruments: vec![
-                crate::study::Source::Inline(Box::new(s.a.spec.clone())),
-                crate::study::Source::Inline(Box::new(s.b.spec.clone())),
-            ],
+            instruments: s.designs.iter().map(|d| crate::study::Source::Inline(Box::new(d.spec.clone()))).collect(),
             retrievals: vec![s.retrieval_spec()],
             seeds: vec![s.noise_seed],
             detector: None,
@@ -223,7 +264,7 @@ impl ShoalApp {
     /// Export to a typed path, asking first if that would replace existing files.
     pub(super) fn export_to(&mut self, what: super::export::What, path: PathBuf) {
         let snap = super::export::Snapshot::of(self);
-        let existing = super::export::existing(what, &path);
+        let existing = super::export::existing(what, &path, self.state.designs.len());
         if existing.is_empty() {
             self.ui.exports.write_to(what, snap, path);
         } else {
@@ -231,7 +272,7 @@ impl ShoalApp {
         }
     }
 
-    /// Save A or B, or the study, in the library; asks before replacing a preset of that name.
+    /// Save a design, or the study, in the library; asks before replacing a preset of that name.
     pub(super) fn save(&mut self, confirm: Confirm, overwrite: bool) {
         let result = match &confirm {
             Confirm::Instrument { name, spec, .. } => self.library.save_instrument(name, spec, overwrite),
@@ -241,8 +282,10 @@ impl ShoalApp {
         match result {
             Ok(path) => {
                 self.listing.reread(&self.library);
-                if let Confirm::Instrument { ab, name, spec } = confirm {
-                    *self.state.slot_mut(ab) = model::Slot::new(&name, *spec);
+                if let Confirm::Instrument { design, name, spec } = confirm
+                    && let Some(slot) = self.state.designs.get_mut(design)
+                {
+                    *slot = model::Slot::new(&name, *spec);
                 }
                 self.ui.message = Some(format!("saved {}", path.display()));
             }

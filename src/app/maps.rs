@@ -1,15 +1,17 @@
-//! The central area: the product maps side by side (truth | A | B, or A | B | A − B) on one
-//! colour scale with a colour bar, zoomed and panned together, with the values under the cursor.
+//! The central area: the product maps as small multiples (the truth beside the designs chosen,
+//! or a pair of designs and their difference, A | B | A − B) on one colour scale with a colour
+//! bar, zoomed and panned together, with the values under the cursor.
 
 use std::hash::{DefaultHasher, Hash, Hasher};
 
 use egui::{Color32, Pos2, Rect, Sense, Vec2};
 
 use super::ShoalApp;
+pub(super) use super::legend::format_value;
+use super::legend::{colour_bar, scale_bar};
 use super::link::{EngineLink, Standing};
-use super::model::{AppState, Layout, ProductKind};
-use super::raster::{Done, Job, Palette, PanelImage, RasterThread};
-use crate::colormap::{categorical, diverging, viridis};
+use super::model::{AppState, Layout, ProductKind, label};
+use super::raster::{Done, Job, Palette, PanelImage, RasterThread, Role};
 
 /// Zoom and pan shared by every map: the visible part of the image in 0–1 coordinates.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -64,6 +66,12 @@ impl Images {
         self.panels.len()
     }
 
+    /// The titles of the panels on display.
+    #[must_use]
+    pub fn titles(&self) -> Vec<String> {
+        self.panels.iter().map(|(p, _)| p.title.clone()).collect()
+    }
+
     /// Are the newest images on display?
     #[must_use]
     pub fn ready(&self) -> bool {
@@ -77,13 +85,17 @@ impl Images {
         state.product.hash(&mut h);
         state.band.hash(&mut h);
         state.layout.hash(&mut h);
+        state.on_maps.hash(&mut h);
+        state.pair.hash(&mut h);
         // The results themselves, not their generation: a result carried over to a new
         // generation (the instrument did not change) keeps its images. A run that failed shows
         // no map (never the previous configuration's).
-        let runs = [0, 1].map(|i| match link.standing(i) {
-            Standing::Current(s) | Standing::Earlier(s) => Some(s.output.clone()),
-            Standing::Failed(_) | Standing::Waiting => None,
-        });
+        let runs: Vec<_> = (0..state.designs.len())
+            .map(|i| match link.standing(i) {
+                Standing::Current(s) | Standing::Earlier(s) => Some(s.output.clone()),
+                Standing::Failed(_) | Standing::Waiting => None,
+            })
+            .collect();
         for r in &runs {
             r.as_ref().map(std::sync::Arc::as_ptr).hash(&mut h);
         }
@@ -92,13 +104,22 @@ impl Images {
             return false;
         }
         if runs.iter().all(Option::is_none) {
-            // Nothing to show (both failed): no map of an earlier configuration stays up.
+            // Nothing to show (every run failed): no map of an earlier configuration stays up.
             self.panels.clear();
             self.plot = None;
             (self.requested, self.shown) = (Some(key), Some(key));
             return false;
         }
-        let job = Job { key, runs, kind: state.product, band: state.band, layout: state.layout, max_side: 720 };
+        let job = Job {
+            key,
+            runs,
+            on_maps: state.on_maps.clone(),
+            pair: state.pair,
+            kind: state.product,
+            band: state.band,
+            layout: state.layout,
+            max_side: 720,
+        };
         if matches!(raster.request(job), crate::jobs::Put::Closed(_)) {
             return false;
         }
@@ -136,7 +157,7 @@ fn product_menu(app: &mut ShoalApp, ui: &mut egui::Ui) {
             }
         });
         if state.product.per_band() {
-            let names: Vec<String> = (0..2)
+            let names: Vec<String> = (0..state.designs.len())
                 .find_map(|i| app.link.current(i))
                 .map(|s| {
                     s.output
@@ -156,8 +177,25 @@ fn product_menu(app: &mut ShoalApp, ui: &mut egui::Ui) {
             });
         }
         ui.separator();
-        ui.selectable_value(&mut state.layout, Layout::TruthAB, "truth | A | B");
-        ui.selectable_value(&mut state.layout, Layout::AbDifference, "A | B | A − B");
+        let mapped: Vec<String> = state.on_maps.iter().map(|&i| label(i)).collect();
+        ui.selectable_value(&mut state.layout, Layout::TruthAB, format!("truth | {}", mapped.join(" | ")))
+            .on_hover_text("The truth beside the designs ticked \"map\" in the design list");
+        let [p, q] = state.pair.map(label);
+        ui.selectable_value(&mut state.layout, Layout::AbDifference, format!("{p} | {q} | {p} − {q}"))
+            .on_hover_text("Two designs and their difference (the second sampled on the first's pixels)");
+        if state.layout == Layout::AbDifference && state.designs.len() > 2 {
+            for (k, id) in [(0, "pair-first"), (1, "pair-second")] {
+                let names: Vec<String> = (0..state.designs.len()).map(|i| state.design_name(i)).collect();
+                egui::ComboBox::from_id_salt(id).selected_text(label(state.pair[k])).width(40.0).show_ui(ui, |ui| {
+                    for (i, name) in names.into_iter().enumerate() {
+                        ui.selectable_value(&mut state.pair[k], i, name);
+                    }
+                });
+            }
+            if state.pair[0] == state.pair[1] {
+                state.settle();
+            }
+        }
         ui.separator();
         if ui.button("Reset zoom").clicked() {
             app.ui.zoom = View::default();
@@ -165,159 +203,134 @@ fn product_menu(app: &mut ShoalApp, ui: &mut egui::Ui) {
     });
 }
 
-fn colour_bar(ui: &mut egui::Ui, palette: Palette, height: f32, label: &str, classes: &[String]) {
-    let (rect, _) = ui.allocate_exact_size(Vec2::new(86.0, height), Sense::hover());
-    let painter = ui.painter_at(rect);
-    let bar = Rect::from_min_size(rect.min + Vec2::new(4.0, 16.0), Vec2::new(16.0, height - 40.0));
-    let steps = 64;
-    let text = ui.visuals().text_color();
-    painter.text(rect.min, egui::Align2::LEFT_TOP, label, egui::FontId::proportional(11.0), text);
-    // Classes by name (substrates, SIOP sets); A − B of classes as agree / differ.
-    let named: Option<Vec<([u8; 3], String)>> = match palette {
-        Palette::Classes => {
-            Some(classes.iter().take(12).enumerate().map(|(k, n)| (categorical(k), n.replace('_', " "))).collect())
-        }
-        Palette::Agreement => {
-            Some(vec![(super::theme::AGREEMENT[0], "same".into()), (super::theme::AGREEMENT[1], "different".into())])
-        }
-        _ => None,
-    };
-    if let Some(named) = named {
-        for (k, (c, name)) in named.iter().enumerate() {
-            let r = Rect::from_min_size(bar.min + Vec2::new(0.0, k as f32 * 16.0), Vec2::splat(12.0));
-            painter.rect_filled(r, 0.0, Color32::from_rgb(c[0], c[1], c[2]));
-            painter.text(
-                r.right_center() + Vec2::new(4.0, 0.0),
-                egui::Align2::LEFT_CENTER,
-                name,
-                egui::FontId::proportional(10.0),
-                text,
-            );
-        }
-        return;
-    }
-    for k in 0..steps {
-        let t = (k as f64 + 0.5) / steps as f64;
-        let c = match palette {
-            Palette::Sequential(_) => viridis(t),
-            Palette::Diverging(_) => diverging(2.0 * t - 1.0),
-            Palette::Classes | Palette::Agreement => [0, 0, 0],
-        };
-        let y1 = bar.max.y - bar.height() * k as f32 / steps as f32;
-        let y0 = bar.max.y - bar.height() * (k + 1) as f32 / steps as f32;
-        painter.rect_filled(Rect::from_x_y_ranges(bar.x_range(), y0..=y1), 0.0, Color32::from_rgb(c[0], c[1], c[2]));
-    }
-    // Round ticks (1, 3, 10, 30 …) where they fall on the bar, not the bar's odd ends.
-    let ticks: Vec<(f64, f64)> = match palette {
-        Palette::Sequential(s) => s.nice_ticks().into_iter().map(|v| (v, s.position(v))).collect(),
-        Palette::Diverging(b) => crate::colormap::Scale { lo: -b, hi: b, log: false }
-            .nice_ticks()
-            .into_iter()
-            .map(|v| (v, 0.5 * (v / b + 1.0)))
-            .collect(),
-        Palette::Classes | Palette::Agreement => Vec::new(),
-    };
-    let [r, g, b, a] = super::theme::NOT_RETURNED;
-    let swatch = Rect::from_min_size(Pos2::new(bar.min.x, bar.max.y + 6.0), Vec2::splat(10.0));
-    painter.rect_filled(swatch, 0.0, Color32::from_rgba_unmultiplied(r, g, b, a));
-    painter.text(
-        swatch.right_center() + Vec2::new(4.0, 0.0),
-        egui::Align2::LEFT_CENTER,
-        "not returned",
-        egui::FontId::proportional(9.0),
-        text,
-    );
-    for (v, t) in ticks {
-        if !(-1e-9..=1.0 + 1e-9).contains(&t) {
-            continue;
-        }
-        let y = bar.max.y - bar.height() * t as f32;
-        painter.text(
-            Pos2::new(bar.max.x + 4.0, y),
-            egui::Align2::LEFT_CENTER,
-            crate::colormap::significant(v, 4),
-            egui::FontId::proportional(10.0),
-            text,
-        );
-    }
-}
-
-/// A scale bar under a map `width_px` wide showing `ground_m` across: the longest round length
-/// (1-2-5 steps, 100 m to 500 km) that fits in 40 % of the width.
-fn scale_bar(ui: &mut egui::Ui, width_px: f32, ground_m: f64) {
-    let (rect, _) = ui.allocate_exact_size(Vec2::new(width_px, 16.0), Sense::hover());
-    if !(ground_m.is_finite() && ground_m > 0.0) {
-        return;
-    }
-    let m_per_px = ground_m / f64::from(width_px.max(1.0));
-    let lengths = [100.0, 200.0, 500.0, 1e3, 2e3, 5e3, 1e4, 2e4, 5e4, 1e5, 2e5, 5e5];
-    let Some(&length) = lengths.iter().rev().find(|&&l| l / m_per_px <= 0.4 * f64::from(width_px)) else { return };
-    let px = (length / m_per_px) as f32;
-    let colour = ui.visuals().text_color();
-    let painter = ui.painter_at(rect);
-    let y = rect.min.y + 4.0;
-    let (x0, x1) = (rect.min.x + 2.0, rect.min.x + 2.0 + px);
-    let stroke = egui::Stroke::new(1.5, colour);
-    painter.line_segment([Pos2::new(x0, y), Pos2::new(x1, y)], stroke);
-    for x in [x0, x1] {
-        painter.line_segment([Pos2::new(x, y - 3.0), Pos2::new(x, y + 3.0)], stroke);
-    }
-    let label = if length >= 1e3 { format!("{} km", length / 1e3) } else { format!("{length} m") };
-    painter.text(Pos2::new(x1 + 6.0, y), egui::Align2::LEFT_CENTER, label, egui::FontId::proportional(10.0), colour);
-}
-
-pub(super) fn format_value(v: f64) -> String {
-    let a = v.abs();
-    if a == 0.0 {
-        "0".into()
-    } else if !(1e-3..1e4).contains(&a) {
-        format!("{v:.2e}")
-    } else if a >= 100.0 {
-        format!("{v:.0}")
-    } else if a >= 1.0 {
-        format!("{v:.2}")
-    } else {
-        format!("{v:.4}")
-    }
-}
-
-/// Per instrument, for its panels: (shows the previous configuration, the preview's decimation
-/// if a preview), which run the truth panel comes from, each run's swath, and why a run
-/// returned no pixel.
+/// Per design, for its panels: (shows the previous configuration, the preview's decimation if
+/// a preview), its swath, and why its run returned no pixel.
 struct PanelStates {
     marks: Vec<(bool, Option<usize>)>,
-    truth_from: usize,
     swath_m: Vec<Option<f64>>,
     empty: Vec<Option<String>>,
 }
 
 fn panel_states(app: &ShoalApp) -> PanelStates {
-    // Per instrument: is what is shown the previous configuration's (greyed, marked), or the
-    // current one's preview?
     let finest = app.link.finest();
-    let marks: Vec<(bool, Option<usize>)> = (0..2)
+    let n = app.state.designs.len();
+    // Is what is shown the previous configuration's (greyed, marked), or the current one's preview?
+    let marks: Vec<(bool, Option<usize>)> = (0..n)
         .map(|i| match app.link.standing(i) {
             Standing::Earlier(_) => (true, None),
             Standing::Current(s) if s.decimation != finest => (false, Some(s.decimation)),
             _ => (false, None),
         })
         .collect();
-    // The truth comes from A's run (B's when A has none).
-    let truth_from = usize::from(!matches!(app.link.standing(0), Standing::Current(_) | Standing::Earlier(_)));
-    // Swath of the instrument whose grid each panel is on (B's panel on B's, the rest on A's).
-    let swath_m: Vec<Option<f64>> = (0..2)
+    let swath_m: Vec<Option<f64>> = (0..n)
         .map(|i| match app.link.standing(i) {
             Standing::Current(s) | Standing::Earlier(s) => Some(s.output.config.instrument.swath_m()),
             _ => None,
         })
         .collect();
-    let empty: Vec<Option<String>> = (0..2)
+    let empty: Vec<Option<String>> = (0..n)
         .map(|i| match app.link.standing(i) {
             Standing::Current(s) => super::metrics_table::no_pixel_reason(&s.output),
             _ => None,
         })
         .collect();
-    PanelStates { marks, truth_from, swath_m, empty }
+    PanelStates { marks, swath_m, empty }
+}
+
+/// Columns of the small multiples: the count that gives `n` panels of aspect `aspect` (width
+/// over height) the largest size in `avail`, and that panel width.
+fn grid_columns(n: usize, aspect: f32, avail: Vec2, title_h: f32) -> (usize, f32) {
+    let n = n.max(1);
+    (1..=n)
+        .map(|cols| {
+            let rows = n.div_ceil(cols);
+            let w = (avail.x - 8.0 * cols as f32) / cols as f32;
+            let h = (avail.y - (title_h + 26.0) * rows as f32) / rows as f32;
+            (cols, w.min(h * aspect).max(40.0))
+        })
+        .fold((n, 0.0), |best, c| if c.1 > best.1 + 0.5 { c } else { best })
+}
+
+/// One map panel in `room` (the most width and height it may take): its title, marked when it
+/// shows a preview or the previous configuration; the map, greyed when previous; the scale bar;
+/// drag to pan, scroll to zoom (`view`, shared by all). Returns where the pointer is on the map
+/// (0–1) and a click, for the spectrum.
+fn map_panel(
+    ui: &mut egui::Ui,
+    (panel, tex): (&PanelImage, &egui::TextureHandle),
+    states: &PanelStates,
+    room: Vec2,
+    view: &mut View,
+) -> (Option<Pos2>, Option<super::spectrum::Pick>) {
+    let PanelStates { marks, swath_m, empty } = states;
+    // The design a panel belongs to (the truth's and the difference's: their first design, on
+    // whose grid they are drawn).
+    let design = match panel.role {
+        Role::Truth(i) | Role::Design(i) | Role::Difference(i, _) => i,
+    };
+    let (earlier, preview) = match panel.role {
+        Role::Design(i) => marks.get(i).copied().unwrap_or_default(),
+        Role::Truth(i) => marks.get(i).map_or((false, None), |m| (m.0, None)),
+        Role::Difference(..) => (marks.iter().any(|m| m.0), None),
+    };
+    let title = match (earlier, preview) {
+        (true, _) => format!("{} (previous configuration, updating)", panel.title),
+        (false, Some(d)) => format!("{} (preview 1/{d})", panel.title),
+        _ => panel.title.clone(),
+    };
+    match panel.role {
+        Role::Design(i) => ui.colored_label(super::theme::design(i), title),
+        _ => ui.label(title),
+    };
+    let img = &panel.image;
+    let aspect = img.width as f32 / img.height.max(1) as f32;
+    let height = (room.x / aspect).min(room.y).max(40.0);
+    let w = (height * aspect).min(room.x);
+    let (rect, resp) = ui.allocate_exact_size(Vec2::new(w, height), Sense::click_and_drag());
+    let painter = ui.painter_at(rect);
+    painter.rect_filled(rect, 0.0, ui.visuals().extreme_bg_color);
+    // The previous configuration's map, greyed until the new one arrives.
+    let tint = if earlier { Color32::from_gray(110) } else { Color32::WHITE };
+    painter.image(tex.id(), rect, view.uv(), tint);
+    if let Role::Design(i) = panel.role
+        && let Some(why) = empty.get(i).and_then(Option::as_ref)
+    {
+        painter.text(
+            rect.center(),
+            egui::Align2::CENTER_CENTER,
+            "no pixel returned",
+            egui::FontId::proportional(14.0),
+            super::theme::FAIL,
+        );
+        resp.clone().on_hover_text(why);
+    }
+    if let Some(swath) = swath_m.get(design).copied().flatten() {
+        scale_bar(ui, w, swath * f64::from(view.uv().width()));
+    }
+    if resp.dragged() {
+        view.centre -= resp.drag_delta() / rect.size() / view.zoom;
+    }
+    let at = |p: Pos2, view: &View| {
+        let (uv, f) = (view.uv(), (p - rect.min) / rect.size());
+        Pos2::new(uv.min.x + f.x * uv.width(), uv.min.y + f.y * uv.height())
+    };
+    // A click opens the scene's spectrum at that point (on the grid of the panel's design).
+    let clicked = resp
+        .clicked()
+        .then(|| resp.interact_pointer_pos())
+        .flatten()
+        .map(|p| super::spectrum::Pick { run: design, uv: at(p, view).into() });
+    let mut hovered = None;
+    if resp.hovered() {
+        let scroll = ui.input_mut(|i| {
+            let s = i.smooth_scroll_delta;
+            i.smooth_scroll_delta = Vec2::ZERO;
+            (s.y, i.zoom_delta())
+        });
+        view.zoom = (view.zoom * scroll.1 * (scroll.0 * 0.003).exp()).clamp(1.0, 64.0);
+        hovered = resp.hover_pos().map(|p| at(p, view));
+    }
+    (hovered, clicked)
 }
 
 /// The central panel.
@@ -329,7 +342,7 @@ pub fn central(app: &mut ShoalApp, ui: &mut egui::Ui) {
     if let Some(note) = product_note(app) {
         ui.label(note);
     }
-    let failures: Vec<(usize, String)> = (0..2)
+    let failures: Vec<(usize, String)> = (0..app.state.designs.len())
         .filter_map(|i| match app.link.standing(i) {
             Standing::Failed(e) => Some((i, e.to_string())),
             _ => None,
@@ -351,91 +364,39 @@ pub fn central(app: &mut ShoalApp, ui: &mut egui::Ui) {
     let n = app.images.panels.len();
     let avail = ui.available_size();
     let bar_w = 96.0;
-    let width = ((avail.x - bar_w - 8.0 * n as f32) / n as f32).max(60.0);
+    let aspect = app.images.panels.first().map_or(1.0, |(p, _)| p.image.width as f32 / p.image.height.max(1) as f32);
+    let (cols, width) = grid_columns(n, aspect, Vec2::new(avail.x - bar_w, avail.y - 30.0), 14.0);
+    let rows = n.div_ceil(cols);
     let mut hovered: Option<Pos2> = None;
     let mut clicked = None;
     let mut view = app.ui.zoom;
-    let PanelStates { marks, truth_from, swath_m, empty } = panel_states(app);
+    let states = panel_states(app);
     ui.horizontal(|ui| {
-        for (panel, tex) in &app.images.panels {
-            ui.vertical(|ui| {
-                let index = match panel.title.as_str() {
-                    "A" => Some(0),
-                    "B" => Some(1),
-                    "truth" => Some(truth_from),
-                    _ => None,
-                };
-                let (earlier, preview) = index.map_or((marks[0].0 || marks[1].0, None), |i| marks[i]);
-                let title = match (earlier, preview) {
-                    (true, _) => format!("{} (previous configuration, updating)", panel.title),
-                    (false, Some(d)) => format!("{} (preview 1/{d})", panel.title),
-                    _ => panel.title.clone(),
-                };
-                ui.label(title);
-                let img = &panel.image;
-                let aspect = img.width as f32 / img.height.max(1) as f32;
-                let height = (width / aspect).min(avail.y - 58.0).max(40.0);
-                let w = (height * aspect).min(width);
-                let (rect, resp) = ui.allocate_exact_size(Vec2::new(w, height), Sense::click_and_drag());
-                let painter = ui.painter_at(rect);
-                painter.rect_filled(rect, 0.0, ui.visuals().extreme_bg_color);
-                // The previous configuration's map, greyed until the new one arrives.
-                let tint = if earlier { Color32::from_gray(110) } else { Color32::WHITE };
-                painter.image(tex.id(), rect, view.uv(), tint);
-                if let Some(why) = index.and_then(|i| empty[i].as_ref()).filter(|_| panel.title != "truth") {
-                    painter.text(
-                        rect.center(),
-                        egui::Align2::CENTER_CENTER,
-                        "no pixel returned",
-                        egui::FontId::proportional(14.0),
-                        super::theme::FAIL,
-                    );
-                    resp.clone().on_hover_text(why);
-                }
-                let swath = if panel.title == "B" { swath_m[1] } else { swath_m[0].or(swath_m[1]) };
-                if let Some(swath) = swath {
-                    scale_bar(ui, w, swath * f64::from(view.uv().width()));
-                }
-                if resp.dragged() {
-                    view.centre -= resp.drag_delta() / rect.size() / view.zoom;
-                }
-                // A click opens the scene's spectrum at that point (A's pixel for the truth and
-                // difference panels when A has a result).
-                if let Some(p) = resp.clicked().then(|| resp.interact_pointer_pos()).flatten() {
-                    let uv = view.uv();
-                    let f = (p - rect.min) / rect.size();
-                    let run = index.filter(|_| panel.title != "truth").unwrap_or(truth_from);
-                    clicked = Some(super::spectrum::Pick {
-                        run,
-                        uv: (uv.min.x + f.x * uv.width(), uv.min.y + f.y * uv.height()),
-                    });
-                }
-                if resp.hovered() {
-                    let scroll = ui.input_mut(|i| {
-                        let s = i.smooth_scroll_delta;
-                        i.smooth_scroll_delta = Vec2::ZERO;
-                        (s.y, i.zoom_delta())
-                    });
-                    view.zoom = (view.zoom * scroll.1 * (scroll.0 * 0.003).exp()).clamp(1.0, 64.0);
-                    if let Some(p) = resp.hover_pos() {
-                        let uv = view.uv();
-                        let f = (p - rect.min) / rect.size();
-                        hovered = Some(Pos2::new(uv.min.x + f.x * uv.width(), uv.min.y + f.y * uv.height()));
+        ui.vertical(|ui| {
+            for row in app.images.panels.chunks(cols) {
+                ui.horizontal(|ui| {
+                    for (panel, tex) in row {
+                        let room = Vec2::new(width, (avail.y - 30.0) / rows as f32 - 40.0);
+                        let (hover, click) =
+                            ui.vertical(|ui| map_panel(ui, (panel, tex), &states, room, &mut view)).inner;
+                        hovered = hovered.or(hover);
+                        clicked = clicked.or(click);
                     }
-                }
-            });
-        }
+                });
+            }
+        });
         let palette = app.images.palette;
-        let label = app.state.product.label().split(" (").next().unwrap_or("").to_string();
+        let label_text = app.state.product.label().split(" (").next().unwrap_or("").to_string();
         let classes = class_names(app);
         ui.vertical(|ui| {
             if let Some(p) = palette {
-                colour_bar(ui, p, 220.0, &label, &classes);
+                colour_bar(ui, p, 220.0, &label_text, &classes);
             }
             if let Some(p) = app.images.difference_palette {
                 // The difference in the product's own unit ("A − B (mg m⁻³)").
                 let unit = app.state.product.label().split_once(" (").map_or(String::new(), |(_, u)| format!(" ({u}"));
-                colour_bar(ui, p, 160.0, &format!("A − B{unit}"), &classes);
+                let [a, b] = app.state.pair.map(label);
+                colour_bar(ui, p, 160.0, &format!("{a} − {b}{unit}"), &classes);
             }
         });
     });
@@ -461,12 +422,12 @@ fn hover_readout(app: &mut ShoalApp, ui: &mut egui::Ui, hovered: Option<Pos2>) {
             let value = panel.data.values[[r, c]];
             let text = if !panel.data.valid[[r, c]] {
                 "–".into()
-            } else if app.state.product.categorical() && panel.title != "A − B" {
+            } else if app.state.product.categorical() && !matches!(panel.role, Role::Difference(..)) {
                 // A class map holds the class index: show its name.
                 classes
                     .get(value.max(0.0) as usize)
                     .map_or_else(|| format_value(f64::from(value)), |n| n.replace('_', " "))
-            } else if panel.title == "A − B" && app.state.product.categorical() {
+            } else if matches!(panel.role, Role::Difference(..)) && app.state.product.categorical() {
                 if value > 0.5 { "differ".into() } else { "agree".into() }
             } else {
                 format_value(f64::from(value))
@@ -484,7 +445,9 @@ fn hover_readout(app: &mut ShoalApp, ui: &mut egui::Ui, hovered: Option<Pos2>) {
 
 /// The names of the shown product's classes, in colour order (substrates or SIOP sets).
 fn class_names(app: &ShoalApp) -> Vec<String> {
-    let Some(out) = (0..2).find_map(|i| app.link.current(i)).map(|s| &s.output) else { return Vec::new() };
+    let Some(out) = (0..app.state.designs.len()).find_map(|i| app.link.current(i)).map(|s| &s.output) else {
+        return Vec::new();
+    };
     match app.state.product {
         ProductKind::Substrate => super::raster::substrate_classes(out),
         ProductKind::SiopSet => out.retrievals.first().map(|r| r.product.siop_set_names.clone()).unwrap_or_default(),

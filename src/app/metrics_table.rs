@@ -1,10 +1,11 @@
-//! The metrics table of A and B: per product, MAE, bias and the share returned against the
+//! The metrics table of every design: per product, MAE, bias and the share returned against the
 //! requirements (one judgement for the app, its exports and `shoal study`:
 //! `Requirements::check_run`), each column marked for what it is — the configuration set, its
 //! preview, the previous configuration's numbers greyed while the new ones run, or a failure —
 //! and every pass under a plausibility warning marked; the bottom-type and SNR rows; the
 //! dominant-substrate confusion tables; the seed-spread controls.
 
+use super::model::label;
 use super::{ShoalApp, theme};
 use crate::engine::RunOutput;
 use crate::metrics::Metrics;
@@ -31,10 +32,10 @@ fn verdict_cell(ui: &mut egui::Ui, checks: &[&Check]) {
     }
 }
 
-/// The dominant-substrate confusion tables of A and B (rows: true class; cells: % of the row
+/// The dominant-substrate confusion tables of every design (rows: true class; cells: % of the row
 /// retrieved as each class), when the retrieval unmixes substrates.
 pub(super) fn substrate_tables(app: &ShoalApp, ui: &mut egui::Ui) {
-    for i in 0..2 {
+    for i in 0..app.state.designs.len() {
         let Some(c) = app
             .link
             .current(i)
@@ -43,7 +44,7 @@ pub(super) fn substrate_tables(app: &ShoalApp, ui: &mut egui::Ui) {
         else {
             continue;
         };
-        let ab = if i == 0 { "A" } else { "B" };
+        let ab = label(i);
         let accuracy = c.accuracy_pct().map_or_else(|| "–".into(), |a| format!("{a:.1} %"));
         egui::CollapsingHeader::new(format!("{ab}: dominant substrate, {accuracy} of pixels correct"))
             .id_salt(format!("confusion-{ab}"))
@@ -152,7 +153,7 @@ fn guarded_verdict(ui: &mut egui::Ui, checks: &[&Check], column: Column<'_>) {
 }
 
 pub(super) fn metrics_table(app: &ShoalApp, ui: &mut egui::Ui, configs: &[crate::engine::RunConfig]) {
-    let columns: Vec<Column<'_>> = (0..2).map(|i| Column::of(app, i)).collect();
+    let columns: Vec<Column<'_>> = (0..app.state.designs.len()).map(|i| Column::of(app, i)).collect();
     // One judgement for app, export and CLI: `Requirements::check_run`.
     let checks: Vec<Vec<Check>> = columns
         .iter()
@@ -171,92 +172,100 @@ pub(super) fn metrics_table(app: &ShoalApp, ui: &mut egui::Ui, configs: &[crate:
         .collect();
     // The seed spread, when measured for these very designs.
     let spread = app.ui.seeds.spread_for(configs).unwrap_or_default();
-    egui::Grid::new("metrics").num_columns(9).striped(true).show(ui, |ui| {
-        ui.strong("product");
-        for (i, c) in columns.iter().enumerate() {
-            let ab = if i == 0 { "A" } else { "B" };
-            let h = c.heading(ab);
-            for (k, what) in ["MAE", "bias", "returned", ""].iter().enumerate() {
-                let text = if k == 3 { h.clone() } else { format!("{ab} {what}") };
-                ui.strong(text);
-            }
-        }
-        ui.end_row();
-        let variables: Vec<String> = columns
-            .iter()
-            .filter_map(|c| c.run())
-            .flat_map(|o| o.retrievals.iter().flat_map(|r| r.metrics.variables.iter().map(|v| v.variable.clone())))
-            .fold(Vec::new(), |mut acc, v| {
-                if !acc.contains(&v) {
-                    acc.push(v);
+    // Wider than the panel with many designs: it scrolls sideways rather than squeezing.
+    egui::ScrollArea::horizontal().id_salt("metrics-scroll").show(ui, |ui| {
+        egui::Grid::new("metrics").num_columns(1 + 4 * columns.len()).striped(true).show(ui, |ui| {
+            ui.strong("product");
+            for (i, c) in columns.iter().enumerate() {
+                let ab = label(i);
+                let h = c.heading(&ab);
+                for (k, what) in ["MAE", "bias", "returned", ""].iter().enumerate() {
+                    let text = if k == 3 { h.clone() } else { format!("{ab} {what}") };
+                    ui.label(egui::RichText::new(text).strong().color(theme::design(i)));
                 }
-                acc
-            });
-        for v in &variables {
-            ui.label(crate::metrics::label(v)).on_hover_text(format!("`{v}`"));
-            for (index, (column, checks)) in columns.iter().zip(&checks).enumerate() {
-                let m: Option<&Metrics> =
-                    column.run().and_then(|o| o.retrievals.first()).and_then(|r| r.metrics.get(v));
-                match m {
-                    Some(m) if m.n == 0 => {
-                        // Nothing returned: no MAE or bias to show (never "0.0 %").
-                        let why = column.run().and_then(no_pixel_reason).unwrap_or_else(|| "no pixel returned".into());
-                        ui.label(column.text("–")).on_hover_text(&why);
-                        ui.label(column.text("–")).on_hover_text(&why);
-                        ui.label(column.text(format!("{:.1} %", m.returned_pct))).on_hover_text(&why);
+            }
+            ui.end_row();
+            let variables: Vec<String> = columns
+                .iter()
+                .filter_map(|c| c.run())
+                .flat_map(|o| o.retrievals.iter().flat_map(|r| r.metrics.variables.iter().map(|v| v.variable.clone())))
+                .fold(Vec::new(), |mut acc, v| {
+                    if !acc.contains(&v) {
+                        acc.push(v);
                     }
-                    Some(m) => metric_cells(ui, *column, m, v, index, spread, app.ui.seeds.decimation),
-                    None => {
-                        let why = match column {
-                            Column::Failed(e) => format!("the run failed: {e}"),
-                            Column::Waiting => "running".into(),
-                            _ => "this retrieval does not make this product".into(),
-                        };
-                        for _ in 0..3 {
-                            ui.label("–").on_hover_text(&why);
+                    acc
+                });
+            for v in &variables {
+                ui.label(crate::metrics::label(v)).on_hover_text(format!("`{v}`"));
+                for (index, (column, checks)) in columns.iter().zip(&checks).enumerate() {
+                    let m: Option<&Metrics> =
+                        column.run().and_then(|o| o.retrievals.first()).and_then(|r| r.metrics.get(v));
+                    match m {
+                        Some(m) if m.n == 0 => {
+                            // Nothing returned: no MAE or bias to show (never "0.0 %").
+                            let why =
+                                column.run().and_then(no_pixel_reason).unwrap_or_else(|| "no pixel returned".into());
+                            ui.label(column.text("–")).on_hover_text(&why);
+                            ui.label(column.text("–")).on_hover_text(&why);
+                            ui.label(column.text(format!("{:.1} %", m.returned_pct))).on_hover_text(&why);
+                        }
+                        Some(m) => metric_cells(ui, *column, m, v, index, spread, app.ui.seeds.decimation),
+                        None => {
+                            let why = match column {
+                                Column::Failed(e) => format!("the run failed: {e}"),
+                                Column::Waiting => "running".into(),
+                                _ => "this retrieval does not make this product".into(),
+                            };
+                            for _ in 0..3 {
+                                ui.label("–").on_hover_text(&why);
+                            }
                         }
                     }
+                    let mine: Vec<&Check> =
+                        checks.iter().filter(|c| c.variable.as_deref() == Some(v.as_str())).collect();
+                    guarded_verdict(ui, &mine, *column);
                 }
-                let mine: Vec<&Check> = checks.iter().filter(|c| c.variable.as_deref() == Some(v.as_str())).collect();
-                guarded_verdict(ui, &mine, *column);
+                ui.end_row();
             }
-            ui.end_row();
-        }
-        let agreement =
-            |c: &Column<'_>| c.run().and_then(|o| o.retrievals.first()).and_then(|r| r.metrics.substrate_agreement_pct);
-        if columns.iter().any(|c| agreement(c).is_some()) {
-            ui.label("bottom type").on_hover_text("dominant substrate right, % of returned water pixels");
-            for (column, checks) in columns.iter().zip(&checks) {
-                ui.label(column.text(agreement(column).map_or_else(|| "–".into(), |a| format!("{a:.1} % right"))));
-                ui.label("");
-                ui.label("");
-                let mine: Vec<&Check> = checks.iter().filter(|c| c.variable.as_deref() == Some("substrate")).collect();
-                guarded_verdict(ui, &mine, *column);
+            let agreement = |c: &Column<'_>| {
+                c.run().and_then(|o| o.retrievals.first()).and_then(|r| r.metrics.substrate_agreement_pct)
+            };
+            if columns.iter().any(|c| agreement(c).is_some()) {
+                ui.label("bottom type").on_hover_text("dominant substrate right, % of returned water pixels");
+                for (column, checks) in columns.iter().zip(&checks) {
+                    ui.label(column.text(agreement(column).map_or_else(|| "–".into(), |a| format!("{a:.1} % right"))));
+                    ui.label("");
+                    ui.label("");
+                    let mine: Vec<&Check> =
+                        checks.iter().filter(|c| c.variable.as_deref() == Some("substrate")).collect();
+                    guarded_verdict(ui, &mine, *column);
+                }
+                ui.end_row();
             }
-            ui.end_row();
-        }
-        if app.state.requirements.snr.is_some() && columns.iter().any(|c| c.run().is_some()) {
-            ui.label("SNR, every band");
-            for (column, checks) in columns.iter().zip(&checks) {
-                let snr = column.run().map(|o| o.snr.as_slice()).unwrap_or_default();
-                let saturated = snr.iter().filter(|r| r.saturated()).count();
-                let lowest = snr.iter().map(|r| r.snr_analytic).reduce(f64::min);
-                if saturated > 0 {
-                    ui.label(egui::RichText::new(format!("{saturated} saturated")).color(theme::FAIL)).on_hover_text(
-                        "Bands whose signal at the scene's median water radiance fills the well or the ADC: \
+            if app.state.requirements.snr.is_some() && columns.iter().any(|c| c.run().is_some()) {
+                ui.label("SNR, every band");
+                for (column, checks) in columns.iter().zip(&checks) {
+                    let snr = column.run().map(|o| o.snr.as_slice()).unwrap_or_default();
+                    let saturated = snr.iter().filter(|r| r.saturated()).count();
+                    let lowest = snr.iter().map(|r| r.snr_analytic).reduce(f64::min);
+                    if saturated > 0 {
+                        ui.label(egui::RichText::new(format!("{saturated} saturated")).color(theme::FAIL))
+                            .on_hover_text(
+                                "Bands whose signal at the scene's median water radiance fills the well or the ADC: \
                          their SNR there is no figure of merit",
-                    );
-                } else {
-                    ui.label(column.text(lowest.map_or_else(|| "–".into(), |s| format!("lowest {s:.0}"))));
+                            );
+                    } else {
+                        ui.label(column.text(lowest.map_or_else(|| "–".into(), |s| format!("lowest {s:.0}"))));
+                    }
+                    ui.label("");
+                    ui.label("");
+                    let mine: Vec<&Check> = checks.iter().filter(|c| c.variable.is_none()).collect();
+                    guarded_verdict(ui, &mine, *column);
                 }
-                ui.label("");
-                ui.label("");
-                let mine: Vec<&Check> = checks.iter().filter(|c| c.variable.is_none()).collect();
-                guarded_verdict(ui, &mine, *column);
+                ui.end_row();
             }
-            ui.end_row();
-        }
-        correction_rows(ui, &columns);
+            correction_rows(ui, &columns);
+        });
     });
     if columns.iter().all(|c| c.run().is_none()) {
         ui.label("No results yet.");
@@ -317,7 +326,7 @@ fn correction_rows(ui: &mut egui::Ui, columns: &[Column<'_>]) {
 }
 
 /// The MAE (with its seed spread when measured), bias and returned cells of variable `v` of
-/// the column at `index` (0 A, 1 B).
+/// the column at `index` (0 A, 1 B, …).
 fn metric_cells(
     ui: &mut egui::Ui,
     column: Column<'_>,
@@ -346,7 +355,7 @@ fn metric_cells(
     if let Column::Earlier(_) = column {
         hover.push_str("\nThe previous configuration's value: the new one is being computed.");
     }
-    let ab = if index == 0 { "A" } else { "B" };
+    let ab = label(index);
     if let Some(s) = spread.iter().find(|s| s.instrument == ab && s.variable == *v).filter(|s| s.seeds > 1) {
         text.push_str(&format!(" ±{:.1}", s.mae_pct_std));
         hover.push_str(&format!(
@@ -394,7 +403,7 @@ pub(super) fn seed_controls(app: &mut ShoalApp, ui: &mut egui::Ui, configs: &[cr
         }
         let start = ui
             .button("Seed spread")
-            .on_hover_text("Rerun A and B over several detector-noise seeds; the table then shows ± the MAE's standard deviation over them");
+            .on_hover_text("Rerun every design over several detector-noise seeds; the table then shows ± the MAE's standard deviation over them");
         // Said as the spread's own settings: the table above is the runs on screen, at their
         // own resolution (its column headings say when that is a preview).
         ui.label("over");

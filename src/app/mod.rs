@@ -1,5 +1,5 @@
-//! The desktop app: a live trade-off explorer. Two instruments (A and B) over one scene, edited
-//! with sliders; the engine thread reruns the chain at preview resolution while a slider moves
+//! The desktop app: a live trade-off explorer. Designs A, B, … (two by default, up to eight)
+//! over one scene, edited with sliders; the engine thread reruns the chain at preview resolution while a slider moves
 //! and refines; maps, metrics, histograms, scatter and SNR side by side; figure and data export.
 //!
 //! The UI thread only draws: the chain runs on the engine thread (its own rayon pool), and the
@@ -7,16 +7,18 @@
 //!
 //! | part | file |
 //! |---|---|
-//! | persisted state, A/B configurations | [`model`] |
+//! | persisted state, the designs' configurations | [`model`] |
+//! | the list of designs: add, remove, reorder | `designs` |
 //! | the engine thread's results | [`link`] |
-//! | product maps, colours, A − B | [`raster`] |
+//! | product maps, colours, differences | [`raster`] |
 //! | histogram and scatter data, off the UI thread | [`plot_data`] |
 //! | colours and what they mean | [`theme`] |
 //! | presets and instrument editor | `panels` |
-//! | derived figures, feasibility, A vs B | `derived` |
+//! | derived figures, feasibility, parameter differences | `derived` |
 //! | status, typed export, Replace? and error dialogs | `dialogs` |
 //! | undo and redo | `history` |
-//! | maps with zoom, pan and hover | `maps` |
+//! | maps with zoom, pan and hover (small multiples) | `maps` |
+//! | colour bar, scale bar | `legend` |
 //! | the spectrum at a clicked point, 350–2500 nm | [`spectrum`] |
 //! | metrics table and plots | [`plots`] |
 //! | figure and data export | `export` |
@@ -28,11 +30,13 @@ pub mod bench;
 pub mod blocks;
 mod conditions;
 mod derived;
+mod designs;
 mod dialogs;
 mod editors;
 pub mod explore;
 mod export;
 mod history;
+mod legend;
 pub mod link;
 mod listing;
 mod logic;
@@ -78,12 +82,14 @@ pub struct AppOptions {
     pub size: Option<[f32; 2]>,
     /// The user's Shoal folder, where the session is kept (`None`: [`crate::library::home_dir`]).
     pub home: Option<PathBuf>,
+    /// Open this library study instead of the saved session (it becomes the session).
+    pub study: Option<String>,
 }
 
 /// A write that would replace a file of the user's, waiting for "Replace" or "Cancel".
 enum Confirm {
-    /// Save instrument A or B under `name`.
-    Instrument { ab: model::Ab, name: String, spec: Box<crate::instrument::InstrumentSpec> },
+    /// Save a design's instrument under `name`.
+    Instrument { design: usize, name: String, spec: Box<crate::instrument::InstrumentSpec> },
     /// Save the study under `name`.
     Study { name: String, study: Box<crate::study::StudySpec> },
     /// A typed-path export over existing files.
@@ -234,8 +240,17 @@ impl ShoalApp {
                 )),
             ),
         };
+        let study = options.study.clone();
         let mut app = Self::with_state(state.unwrap_or_default(), &cc.egui_ctx, options);
         app.ui.error = problem;
+        if let Some(name) = study {
+            match app.library.find(crate::library::Kind::Study, &name) {
+                Some(entry) => app.apply_confirmed(logic::UiCommand::LoadStudy(entry)),
+                None => {
+                    app.ui.error = Some(format!("No study `{name}` in the library: the app opens the session instead."))
+                }
+            }
+        }
         match lock {
             Ok(lock) => {
                 app.session_path = Some(path);
@@ -337,7 +352,7 @@ impl ShoalApp {
             // One menu for the three exports keeps the top bar within 1280 px.
             let exports = [
                 (export::What::Figure, "Figure…", "Choose where to write the comparison figure (PNG and SVG) and the configurations"),
-                (export::What::Data, "Data…", "Choose a folder for the cubes and metrics of A and B, as `shoal study` writes them"),
+                (export::What::Data, "Data…", "Choose a folder for the cubes and metrics of every design, as `shoal study` writes them"),
                 (
                     export::What::ReviewPack,
                     "Review pack…",
@@ -356,7 +371,7 @@ impl ShoalApp {
             .on_hover_text("Write the comparison figure, the data or the review pack");
             ui.separator();
             ui.toggle_value(&mut self.ui.explore.sweep_open, "Sweep")
-                .on_hover_text("A curve: one parameter of A and B over a range, with noise seeds");
+                .on_hover_text("A curve: one parameter of every design over a range, with noise seeds");
             ui.toggle_value(&mut self.ui.explore.cost_open, "Cost")
                 .on_hover_text("Time against error for each fidelity setting");
             ui.toggle_value(&mut self.ui.explore.design_open, "Design")
@@ -375,18 +390,20 @@ impl ShoalApp {
             ui.separator();
             let mark =
                 |s: &model::Slot| if s.modified() { format!("{} (modified)", s.preset) } else { s.preset.clone() };
-            let names =
-                format!("A: {}   B: {}   scene: {}", mark(&self.state.a), mark(&self.state.b), self.state.scene_name);
+            let designs: Vec<String> =
+                self.state.designs.iter().enumerate().map(|(i, s)| format!("{}: {}", model::label(i), mark(s))).collect();
+            let names = format!("{}   scene: {}", designs.join("   "), self.state.scene_name);
             ui.add(egui::Label::new(names.as_str()).truncate()).on_hover_text(names);
         });
     }
 
-    /// Screenshot mode: once both instruments show their final results, grab the window.
+    /// Screenshot mode: once every design shows its final results, grab the window.
     fn screenshot(&mut self, ctx: &egui::Context) {
         let Some(path) = self.options.screenshot.clone() else { return };
         let finest = self.state.decimations().last().copied().unwrap_or(1);
         let ready = !self.link.busy()
-            && (0..2).all(|i| self.link.shown[i].as_ref().is_some_and(|s| s.decimation == finest))
+            && self.link.shown.len() == self.state.designs.len()
+            && self.link.shown.iter().all(|s| s.as_ref().is_some_and(|s| s.decimation == finest))
             && self.images.ready();
         if ready && !self.screenshot_requested {
             self.screenshot_requested = true;

@@ -1,8 +1,9 @@
-//! What the app holds and persists: instruments A and B, the scene, the retrieval, seeds,
+//! What the app holds and persists: the designs (A, B, …), the scene, the retrieval, seeds,
 //! preview settings, requirements and the view. Nothing here draws.
 
 use serde::{Deserialize, Serialize};
 
+pub use super::designs::{MAPS_AT_OPEN, MAX_DESIGNS, label};
 pub use super::view::{Layout, ProductKind};
 
 use crate::engine::{Fidelity, RunConfig};
@@ -61,46 +62,20 @@ pub fn fallback_requirements() -> Requirements {
     }
 }
 
-/// One of the two instruments the app compares.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
-pub enum Ab {
-    /// Instrument A (index 0 of the engine link's results).
-    #[default]
+/// Sessions saved before the app held a list of designs named the instrument being edited
+/// `editing_instrument: A` or `B`; read, then moved to [`AppState::editing`] by
+/// [`AppState::settle`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum LegacyAb {
+    /// Instrument A (design 0).
     A,
-    /// Instrument B (index 1).
+    /// Instrument B (design 1).
     B,
 }
 
-impl Ab {
-    /// A, then B.
-    pub const BOTH: [Self; 2] = [Self::A, Self::B];
-
-    /// The index of its configuration and results (A 0, B 1).
-    #[must_use]
-    pub const fn index(self) -> usize {
-        match self {
-            Self::A => 0,
-            Self::B => 1,
-        }
-    }
-
-    /// "A" or "B".
-    #[must_use]
-    pub const fn label(self) -> &'static str {
-        match self {
-            Self::A => "A",
-            Self::B => "B",
-        }
-    }
-
-    /// The other one.
-    #[must_use]
-    pub const fn other(self) -> Self {
-        match self {
-            Self::A => Self::B,
-            Self::B => Self::A,
-        }
-    }
+/// `Some` of a value stored bare (`a: (preset: …)`, not `a: Some((…))`), for the legacy fields.
+fn bare_some<'de, D: serde::Deserializer<'de>, T: Deserialize<'de>>(d: D) -> Result<Option<T>, D::Error> {
+    T::deserialize(d).map(Some)
 }
 
 /// Which retrieval the app runs.
@@ -120,16 +95,29 @@ pub enum RetrievalKind {
 pub struct AppState {
     /// The session format's version ([`crate::schema`]).
     pub schema_version: u32,
-    /// Instrument A.
-    pub a: Slot,
-    /// Instrument B.
-    pub b: Slot,
-    /// Parameters linked across A and B (field names).
+    /// The designs compared, in order: A, B, C, … (at least one, at most [`MAX_DESIGNS`]).
+    pub designs: Vec<Slot>,
+    /// Instrument A of a session saved before `designs` (moved there by [`Self::settle`]).
+    #[serde(rename = "a", default, deserialize_with = "bare_some", skip_serializing)]
+    pub legacy_a: Option<Slot>,
+    /// Instrument B of such a session.
+    #[serde(rename = "b", default, deserialize_with = "bare_some", skip_serializing)]
+    pub legacy_b: Option<Slot>,
+    /// The instrument such a session was editing.
+    #[serde(rename = "editing_instrument", default, deserialize_with = "bare_some", skip_serializing)]
+    pub legacy_editing: Option<LegacyAb>,
+    /// Parameters linked across the designs (field names): an edit of one sets it in all.
     pub linked: Vec<String>,
-    /// Which instrument the editor shows. (Saved as `editing_instrument`: sessions from before
-    /// [`Ab`] saved a number, and are read with A rather than refused.)
-    #[serde(rename = "editing_instrument")]
-    pub editing: Ab,
+    /// The design the editor shows (an index into `designs`). (Saved as `editing_design`:
+    /// sessions from before [`LegacyAb`] saved a number under `editing`, which is ignored.)
+    #[serde(rename = "editing_design")]
+    pub editing: usize,
+    /// The design the others are compared with in the parameter table ("Parameters against A").
+    pub reference: usize,
+    /// The designs the maps show beside the truth (small multiples), in the designs' order.
+    pub on_maps: Vec<usize>,
+    /// The two designs of the difference layout (first − second).
+    pub pair: [usize; 2],
     /// Scene preset name.
     pub scene_name: String,
     /// The scene.
@@ -182,12 +170,17 @@ pub struct AppState {
 impl Default for AppState {
     fn default() -> Self {
         Self::from_study(&fallback_study(), None).unwrap_or_else(|_| {
-            let cubesat = InstrumentSpec::preset("cubesat").unwrap_or_else(|_| unreachable!("built-in preset"));
-            let smallsat = InstrumentSpec::preset("smallsat").unwrap_or_else(|_| unreachable!("built-in preset"));
             let scene = SceneSpec::preset("lake_hume_bloom").unwrap_or_else(|_| unreachable!("built-in preset"));
-            Self::new(Slot::new("cubesat", cubesat), Slot::new("smallsat", smallsat), "lake_hume_bloom", scene)
+            Self::new(fallback_designs(), "lake_hume_bloom", scene)
         })
     }
+}
+
+/// The default study's two instruments, when nothing else is to hand.
+fn fallback_designs() -> Vec<Slot> {
+    ["cubesat", "smallsat"]
+        .map(|n| Slot::new(n, InstrumentSpec::preset(n).unwrap_or_else(|_| unreachable!("built-in preset"))))
+        .to_vec()
 }
 
 fn fallback_study() -> StudySpec {
@@ -209,12 +202,18 @@ fn fallback_study() -> StudySpec {
 }
 
 impl AppState {
-    fn new(a: Slot, b: Slot, scene_name: &str, scene: SceneSpec) -> Self {
+    fn new(designs: Vec<Slot>, scene_name: &str, scene: SceneSpec) -> Self {
+        let shown = designs.len().clamp(1, MAPS_AT_OPEN);
         Self {
-            a,
-            b,
+            designs,
+            legacy_a: None,
+            legacy_b: None,
+            legacy_editing: None,
             linked: Vec::new(),
-            editing: Ab::A,
+            editing: 0,
+            reference: 0,
+            on_maps: (0..shown).collect(),
+            pair: [0, 1],
             scene_name: scene_name.into(),
             scene,
             scene_seed: 0,
@@ -239,8 +238,8 @@ impl AppState {
         }
     }
 
-    /// The state of a study (`dir`: its file's directory, for its relative paths): its first two
-    /// instruments as A and B (the first twice if it has one), its scene and its first retrieval.
+    /// The state of a study (`dir`: its file's directory, for its relative paths): its
+    /// instruments as the designs (the first [`MAX_DESIGNS`]), its scene and its first retrieval.
     pub fn from_study(study: &StudySpec, dir: Option<&std::path::Path>) -> Result<Self, String> {
         let resolved = study.resolve(dir).map_err(|e| e.to_string())?;
         let label = |i: usize| match study.instruments.get(i) {
@@ -248,17 +247,21 @@ impl AppState {
             _ => format!("{} instrument {}", study.name, i + 1),
         };
         let first = resolved.runs.first().ok_or("the study has no run")?;
-        let second = resolved.runs.iter().find(|r| r.0 != first.0).unwrap_or(first);
+        // One run per instrument (the first seed's), in the study's order.
+        let mut designs: Vec<Slot> = Vec::new();
+        let mut seen: Vec<&str> = Vec::new();
+        for run in &resolved.runs {
+            if !seen.contains(&run.0.as_str()) && designs.len() < MAX_DESIGNS {
+                designs.push(Slot::new(&label(seen.len()), run.2.instrument.clone()));
+                seen.push(&run.0);
+            }
+        }
         let scene_name = match &study.scene {
             Source::Preset(n) => n.clone(),
             _ => first.2.scene.name.clone(),
         };
-        let mut s = Self::new(
-            Slot::new(&label(0), first.2.instrument.clone()),
-            Slot::new(&label(usize::from(second.0 != first.0)), second.2.instrument.clone()),
-            &scene_name,
-            first.2.scene.clone(),
-        );
+        let mut s = Self::new(designs, &scene_name, first.2.scene.clone());
+        s.settle();
         s.study_name.clone_from(&study.name);
         match study.retrievals.first() {
             Some(RetrievalSpec::Sambuca { settings, .. }) => {
@@ -290,24 +293,8 @@ impl AppState {
 
     /// The slot being edited.
     pub fn editing_mut(&mut self) -> &mut Slot {
-        self.slot_mut(self.editing)
-    }
-
-    /// Instrument `ab`.
-    #[must_use]
-    pub const fn slot(&self, ab: Ab) -> &Slot {
-        match ab {
-            Ab::A => &self.a,
-            Ab::B => &self.b,
-        }
-    }
-
-    /// Instrument `ab`, to edit.
-    pub const fn slot_mut(&mut self, ab: Ab) -> &mut Slot {
-        match ab {
-            Ab::A => &mut self.a,
-            Ab::B => &mut self.b,
-        }
+        let i = self.editing.min(self.designs.len().saturating_sub(1));
+        &mut self.designs[i]
     }
 
     /// The retrieval as the engine runs it.
@@ -350,11 +337,11 @@ impl AppState {
         scene
     }
 
-    /// The run configurations of A and B.
+    /// The run configurations of the designs, in order.
     #[must_use]
     pub fn configs(&self) -> Vec<RunConfig> {
         let scene = self.seeded_scene();
-        [&self.a, &self.b]
+        self.designs
             .iter()
             .map(|slot| {
                 let mut c = RunConfig::new(scene.clone(), slot.spec.clone());
@@ -389,11 +376,12 @@ impl AppState {
         l
     }
 
-    /// The parameters edited away from each slot's preset, for captions ("A aperture_mm 60 → 80").
+    /// The parameters edited away from each design's preset, for captions ("A aperture_mm 60 → 80").
     #[must_use]
     pub fn changes(&self) -> Vec<String> {
         let mut out = Vec::new();
-        for (name, slot) in [("A", &self.a), ("B", &self.b)] {
+        for (i, slot) in self.designs.iter().enumerate() {
+            let name = label(i);
             let (Ok(now), Ok(then)) = (ron::to_string(&slot.spec), ron::to_string(&slot.original)) else { continue };
             if now == then {
                 continue;
@@ -448,18 +436,19 @@ mod tests {
     fn default_is_the_cubesat_vs_smallsat_study() {
         let s = AppState::default();
         assert_eq!(
-            (s.a.preset.as_str(), s.b.preset.as_str(), s.scene_name.as_str()),
+            (s.designs[0].preset.as_str(), s.designs[1].preset.as_str(), s.scene_name.as_str()),
             ("cubesat", "smallsat", "lake_hume_bloom")
         );
         assert_eq!(s.configs().len(), 2);
-        assert!(!s.a.modified());
+        assert_eq!((s.on_maps.as_slice(), s.pair), (&[0, 1][..], [0, 1]), "A vs B, as before designs were a list");
+        assert!(!s.designs[0].modified());
     }
 
     #[test]
     fn edits_are_listed_for_captions() {
         let mut s = AppState::default();
-        s.a.spec.aperture_mm = 80.0;
-        assert!(s.a.modified());
+        s.designs[0].spec.aperture_mm = 80.0;
+        assert!(s.designs[0].modified());
         assert_eq!(s.changes(), vec!["A aperture_mm 60.0 → 80.0".to_string()]);
     }
 

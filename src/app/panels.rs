@@ -1,22 +1,36 @@
-//! The left panel: the preset library (instruments A and B, scene, study), the instrument editor
-//! with units, tooltips and A/B links, the band editor, and the retrieval, seeds, preview and
+//! The left panel: the designs (each a library instrument, added, removed, reordered, on the
+//! maps or not), the scene and study presets, the instrument editor with units, tooltips and
+//! links across designs, the band editor, and the retrieval, seeds, preview and
 //! requirement settings (the derived figures and feasibility checks are in `derived`).
 
 use super::ShoalApp;
 use super::logic::UiCommand;
-use super::model::{Ab, RetrievalKind};
+use super::model::{MAX_DESIGNS, RetrievalKind, label};
 use super::params::PARAMS;
 use crate::library::{Entry, Kind};
 use crate::retrieval::{Mode, Objective, Starts};
 
 /// A preset picker: each entry with its description on hover, the chosen one's on the box.
 fn library_combo(ui: &mut egui::Ui, label: &str, current: &str, entries: &[Entry]) -> Option<Entry> {
+    library_combo_sized(ui, label, current, entries, None)
+}
+
+/// [`library_combo`] at a fixed width (`None`: egui's).
+fn library_combo_sized(
+    ui: &mut egui::Ui,
+    label: &str,
+    current: &str,
+    entries: &[Entry],
+    width: Option<f32>,
+) -> Option<Entry> {
     let mut picked = None;
     let chosen = entries.iter().find(|e| e.name == current).map(|e| e.description.as_str()).unwrap_or_default();
     // Tall enough for the whole library at 1280 × 720 (the default height hid user presets
     // below ten built-in instruments).
     let height = 0.6 * ui.ctx().content_rect().height();
-    let r = egui::ComboBox::from_label(label).selected_text(current).height(height).show_ui(ui, |ui| {
+    let combo = egui::ComboBox::from_label(label).selected_text(current).height(height);
+    let combo = if let Some(w) = width { combo.width(w) } else { combo };
+    let r = combo.show_ui(ui, |ui| {
         for e in entries {
             let text = if e.builtin { e.name.clone() } else { format!("{} (mine)", e.name) };
             let item = ui.selectable_label(e.name == current, text);
@@ -32,15 +46,83 @@ fn library_combo(ui: &mut egui::Ui, label: &str, current: &str, entries: &[Entry
     picked
 }
 
-fn presets(app: &mut ShoalApp, ui: &mut egui::Ui) {
-    ui.heading("Presets");
+/// The designs: per design its colour, its instrument preset, whether it is edited and on the
+/// maps, and buttons to move it up or down or remove it; then a menu to add one.
+fn designs(app: &mut ShoalApp, ui: &mut egui::Ui) {
+    ui.heading("Designs");
     let instruments = app.listing.get(Kind::Instrument).to_vec();
-    for ab in Ab::BOTH {
-        let current = app.state.slot(ab).preset.clone();
-        if let Some(entry) = library_combo(ui, &format!("Instrument {}", ab.label()), &current, &instruments) {
-            app.ui.commands.push(UiCommand::LoadInstrument { ab, entry });
+    let n = app.state.designs.len();
+    egui::Grid::new("designs").num_columns(5).spacing([6.0, 4.0]).show(ui, |ui| {
+        for i in 0..n {
+            let name = label(i);
+            ui.colored_label(super::theme::design(i), "■")
+                .on_hover_text(format!("Design {name}'s colour in the plots"));
+            let current = app.state.designs[i].preset.clone();
+            let current = if app.state.designs[i].modified() { format!("{current}*") } else { current };
+            if let Some(entry) = library_combo_sized(ui, &name, &current, &instruments, Some(118.0)) {
+                app.ui.commands.push(UiCommand::LoadInstrument { design: i, entry });
+            }
+            ui.radio_value(&mut app.state.editing, i, "edit")
+                .on_hover_text(format!("Show design {name} in the instrument editor below"));
+            let mut mapped = app.state.on_maps.contains(&i);
+            if ui.checkbox(&mut mapped, "map").on_hover_text(format!("Show design {name} on the maps")).changed() {
+                if mapped {
+                    app.state.on_maps.push(i);
+                    app.state.on_maps.sort_unstable();
+                } else {
+                    app.state.on_maps.retain(|&k| k != i);
+                }
+            }
+            ui.horizontal(|ui| {
+                ui.spacing_mut().item_spacing.x = 2.0;
+                if ui
+                    .add_enabled(i > 0, egui::Button::new("▲").small())
+                    .on_hover_text(format!("Move {name} up"))
+                    .clicked()
+                {
+                    app.ui.commands.push(UiCommand::MoveDesign { design: i, earlier: true });
+                }
+                if ui
+                    .add_enabled(i + 1 < n, egui::Button::new("▼").small())
+                    .on_hover_text(format!("Move {name} down"))
+                    .clicked()
+                {
+                    app.ui.commands.push(UiCommand::MoveDesign { design: i, earlier: false });
+                }
+                if ui
+                    .add_enabled(n > 1, egui::Button::new("✖").small())
+                    .on_hover_text(format!("Remove design {name}"))
+                    .clicked()
+                {
+                    app.ui.commands.push(UiCommand::RemoveDesign(i));
+                }
+            });
+            ui.end_row();
         }
-    }
+    });
+    ui.add_enabled_ui(n < MAX_DESIGNS, |ui| {
+        ui.menu_button("Add design", |ui| {
+            egui::ScrollArea::vertical().max_height(0.6 * ui.ctx().content_rect().height()).show(ui, |ui| {
+                for e in &instruments {
+                    let text = if e.builtin { e.name.clone() } else { format!("{} (mine)", e.name) };
+                    let item = ui.button(text);
+                    let item = if e.description.is_empty() { item } else { item.on_hover_text(&e.description) };
+                    if item.clicked() {
+                        app.ui.commands.push(UiCommand::AddDesign(e.clone()));
+                        ui.close();
+                    }
+                }
+            });
+        })
+        .response
+        .on_hover_text(format!("Compare another instrument (up to {MAX_DESIGNS} designs)"))
+        .on_disabled_hover_text(format!("The app compares {MAX_DESIGNS} designs at most"));
+    });
+}
+
+fn presets(app: &mut ShoalApp, ui: &mut egui::Ui) {
+    designs(app, ui);
+    ui.heading("Presets");
     let scenes = app.listing.get(Kind::Scene).to_vec();
     if let Some(entry) = library_combo(ui, "Scene", &app.state.scene_name.clone(), &scenes) {
         app.ui.commands.push(UiCommand::LoadScene(entry));
@@ -61,12 +143,11 @@ fn save_presets(app: &mut ShoalApp, ui: &mut egui::Ui) {
         ui.add(egui::TextEdit::singleline(&mut app.ui.preset_name).desired_width(130.0)).labelled_by(l.id);
     });
     ui.horizontal(|ui| {
-        for ab in Ab::BOTH {
-            let label = format!("Save {}", ab.label());
-            if ui.button(label).on_hover_text("Save this instrument in your preset library").clicked() {
-                let name = app.ui.preset_name.trim().to_string();
-                app.ui.commands.push(UiCommand::SaveInstrument { ab, name });
-            }
+        let design = app.state.editing;
+        let text = format!("Save {}", label(design));
+        if ui.button(text).on_hover_text("Save the design being edited in your preset library").clicked() {
+            let name = app.ui.preset_name.trim().to_string();
+            app.ui.commands.push(UiCommand::SaveInstrument { design, name });
         }
         if ui.button("Save study").clicked() {
             let name = app.ui.preset_name.trim().to_string();
@@ -99,12 +180,13 @@ fn fine_step(value: f64, fraction: f32, range: (f64, f64), log: bool) -> f64 {
 }
 
 fn editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
-    ui.heading("Instrument");
     ui.horizontal(|ui| {
-        ui.selectable_value(&mut app.state.editing, Ab::A, "Edit A");
-        ui.selectable_value(&mut app.state.editing, Ab::B, "Edit B");
+        ui.heading("Instrument");
+        for i in 0..app.state.designs.len() {
+            ui.selectable_value(&mut app.state.editing, i, format!("Edit {}", label(i)));
+        }
     });
-    let editing = app.state.editing;
+    let editing = app.state.editing.min(app.state.designs.len() - 1);
     let mut changed: Vec<(&'static str, f64)> = Vec::new();
     // Wider than egui's 100 px (on which a log slider jumped from 90 to 200 mm in a 20 px drag),
     // fixed so the panel does not grow with its own content; Shift held makes a drag of the rail
@@ -112,7 +194,7 @@ fn editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
     ui.spacing_mut().slider_width = 160.0;
     egui::Grid::new("params").num_columns(2).show(ui, |ui| {
         for p in &PARAMS {
-            let slot = app.state.slot_mut(editing);
+            let slot = &app.state.designs[editing];
             let mut v = (p.get)(&slot.spec) * p.scale;
             let before = v;
             // Never clamped: a preset outside the slider's span keeps its value, and a typed
@@ -172,7 +254,7 @@ fn editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
             let mut linked = app.state.linked.iter().any(|k| k == p.key);
             if ui
                 .checkbox(&mut linked, "link")
-                .on_hover_text(format!("Link {} across A and B", p.label.to_lowercase()))
+                .on_hover_text(format!("Link {} across the designs", p.label.to_lowercase()))
                 .changed()
             {
                 if linked {
@@ -183,7 +265,7 @@ fn editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
             }
             ui.end_row();
             if v != before {
-                let slot = app.state.slot_mut(editing);
+                let slot = &mut app.state.designs[editing];
                 let mut candidate = slot.spec.clone();
                 (p.set)(&mut candidate, v / p.scale);
                 match candidate.validate() {
@@ -207,18 +289,21 @@ fn editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
                 .wrap(),
         );
     }
-    // Linked parameters follow to the other instrument.
+    // Linked parameters follow to the other designs.
     for (key, value) in changed {
         if app.state.linked.iter().any(|k| k == key)
             && let Some(p) = PARAMS.iter().find(|p| p.key == key)
         {
-            let other = app.state.slot_mut(editing.other());
-            (p.set)(&mut other.spec, value);
+            for (i, other) in app.state.designs.iter_mut().enumerate() {
+                if i != editing {
+                    (p.set)(&mut other.spec, value);
+                }
+            }
         }
     }
-    let slot = app.state.slot_mut(editing);
+    let slot = &mut app.state.designs[editing];
     egui::CollapsingHeader::new("Bands").default_open(false).show(ui, |ui| super::editors::band_editor(slot, ui));
-    let slot = app.state.slot_mut(editing);
+    let slot = &mut app.state.designs[editing];
     let title = if slot.spec.focal_planes.is_empty() {
         "Focal planes".to_string()
     } else {
@@ -229,7 +314,7 @@ fn editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
         .default_open(false)
         .show(ui, |ui| super::planes::plane_editor(slot, ui, &mut app.ui.plane_error));
     super::derived::derived(app, ui);
-    super::derived::a_vs_b(app, ui);
+    super::derived::differences(app, ui);
 }
 
 fn settings(app: &mut ShoalApp, ui: &mut egui::Ui) {

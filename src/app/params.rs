@@ -172,27 +172,38 @@ pub const PARAMS: [Param; 13] = [
     },
 ];
 
-/// The parameters in which instruments `a` and `b` differ, as rows (parameter, A, B) with a
-/// header row, in the editor's names and units; `bands` the band counts. One row saying so when
-/// they do not differ. Shown in the app ("A vs B") and on the review slide.
+/// The parameters in which the designs differ from the first (the reference), as rows
+/// (parameter, a value per design) with a header row of the designs' names, in the editor's
+/// names and units; each design given as (name, instrument, band count). One row saying so when
+/// none differs. Shown in the app ("Parameters against A") and on the review slide.
 #[must_use]
-pub fn differences(a: &InstrumentSpec, b: &InstrumentSpec, bands: (usize, usize)) -> Vec<Vec<String>> {
-    let mut rows = vec![vec!["parameter".to_string(), "A".to_string(), "B".to_string()]];
+pub fn differences(designs: &[(&str, &InstrumentSpec, usize)]) -> Vec<Vec<String>> {
+    let mut header = vec!["parameter".to_string()];
+    header.extend(designs.iter().map(|d| d.0.to_string()));
+    let mut rows = vec![header];
     let show = |v: f64| {
         let m = v.abs();
         if m == 0.0 || (0.01..1e7).contains(&m) { format!("{}", (v * 1e4).round() / 1e4) } else { format!("{v:.3e}") }
     };
+    let Some((_, reference, reference_bands)) = designs.first() else { return rows };
     for p in &PARAMS {
-        let (x, y) = ((p.get)(a) * p.scale, (p.get)(b) * p.scale);
-        if (x - y).abs() > 1e-12 * x.abs().max(y.abs()) {
-            rows.push(vec![p.label.to_string(), format!("{}{}", show(x), p.unit), format!("{}{}", show(y), p.unit)]);
+        let x = (p.get)(reference) * p.scale;
+        let values: Vec<f64> = designs.iter().map(|d| (p.get)(d.1) * p.scale).collect();
+        if values.iter().any(|y| (x - y).abs() > 1e-12 * x.abs().max(y.abs())) {
+            let mut row = vec![p.label.to_string()];
+            row.extend(values.iter().map(|v| format!("{}{}", show(*v), p.unit)));
+            rows.push(row);
         }
     }
-    if bands.0 != bands.1 {
-        rows.push(vec!["bands".into(), bands.0.to_string(), bands.1.to_string()]);
+    if designs.iter().any(|d| d.2 != *reference_bands) {
+        let mut row = vec!["bands".to_string()];
+        row.extend(designs.iter().map(|d| d.2.to_string()));
+        rows.push(row);
     }
     if rows.len() == 1 {
-        rows.push(vec!["(none: A and B are the same instrument)".into(), String::new(), String::new()]);
+        let mut row = vec!["(none: the designs are the same instrument)".to_string()];
+        row.extend(designs.iter().map(|_| String::new()));
+        rows.push(row);
     }
     rows
 }
@@ -205,10 +216,13 @@ mod tests {
     fn differences_list_what_differs_in_the_editors_units() {
         let a = InstrumentSpec::preset("cubesat").unwrap();
         let b = InstrumentSpec::preset("smallsat").unwrap();
-        let rows = differences(&a, &b, (8, 8));
+        let rows = differences(&[("A", &a, 8), ("B", &b, 8)]);
         assert_eq!(rows[0], ["parameter", "A", "B"]);
         assert!(rows.contains(&vec!["Aperture".into(), "60 mm".into(), "240 mm".into()]), "{rows:?}");
         assert!(rows.iter().all(|r| r[0] != "Lines"), "equal parameters are not listed");
-        assert_eq!(differences(&a, &a, (8, 8))[1][0], "(none: A and B are the same instrument)");
+        assert_eq!(differences(&[("A", &a, 8), ("B", &a, 8)])[1][0], "(none: the designs are the same instrument)");
+        // A third design that differs only in bands from the reference adds that row alone.
+        let rows = differences(&[("A", &a, 8), ("B", &a, 8), ("C", &a, 19)]);
+        assert_eq!(rows, [vec!["parameter", "A", "B", "C"], vec!["bands", "8", "8", "19"]]);
     }
 }

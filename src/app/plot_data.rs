@@ -1,9 +1,9 @@
 //! The histogram and scatter data of the product on display, computed on the raster thread
 //! beside the maps, once per (results, variable): a frame only draws them.
 //!
-//! Histograms count every water pixel (the truth) and every returned pixel (A, B) over one
+//! Histograms count every water pixel (the truth) and every returned pixel (each design) over one
 //! shared set of log10 bins spanning the central 99 % of the values (the rest in the end bins);
-//! the scatter plots a strided sample of at most [`SCATTER_POINTS`] pixels per instrument
+//! the scatter plots a strided sample of at most [`SCATTER_POINTS`] pixels per design
 //! (enough to show the cloud; egui draws each point every frame). Each run's share
 //! ([`RunValues`]) is computed once and kept, so moving a slider of A does not revisit B's
 //! full-resolution pixels.
@@ -29,15 +29,15 @@ pub struct PlotData {
     pub edges_log10: Vec<f64>,
     /// Truth counts per bin (every water pixel of the first run with a truth value).
     pub truth: Vec<usize>,
-    /// A's and B's counts per bin (returned pixels).
-    pub counts: [Vec<usize>; 2],
-    /// A's and B's water pixels with a positive truth: what their counts are shares of (a
+    /// Each design's counts per bin (returned pixels), in the designs' order.
+    pub counts: Vec<Vec<usize>>,
+    /// Each design's water pixels with a positive truth: what its counts are shares of (a
     /// preview and a full-resolution run have very different numbers of pixels).
-    pub pixels: [usize; 2],
+    pub pixels: Vec<usize>,
     /// The water pixels of the run the truth histogram comes from.
     pub truth_pixels: usize,
-    /// A's and B's (log10 truth, log10 retrieved) samples.
-    pub scatter: [Vec<[f64; 2]>; 2],
+    /// Each design's (log10 truth, log10 retrieved) samples.
+    pub scatter: Vec<Vec<[f64; 2]>>,
 }
 
 impl PlotData {
@@ -116,18 +116,25 @@ fn bin_range(sorted: &[&[f64]]) -> (f64, f64) {
     if hi > lo { (lo, hi) } else { (at(0.0), at(1.0)) }
 }
 
-/// The plot data of `variable` for A's and B's runs.
+/// The plot data of `variable` for the designs' runs.
 #[must_use]
-pub fn plot_data(runs: &[Option<Arc<RunOutput>>; 2], variable: &str) -> PlotData {
-    let values = runs.each_ref().map(|r| r.as_ref().map(|o| RunValues::of(o, variable)));
-    combine(variable, [values[0].as_ref(), values[1].as_ref()])
+pub fn plot_data(runs: &[Option<Arc<RunOutput>>], variable: &str) -> PlotData {
+    let values: Vec<Option<RunValues>> = runs.iter().map(|r| r.as_ref().map(|o| RunValues::of(o, variable))).collect();
+    combine(variable, &values.iter().map(Option::as_ref).collect::<Vec<_>>())
 }
 
-/// The plot data of `variable` from A's and B's [`RunValues`]: bins shared by both, counted by
+/// The plot data of `variable` from the designs' [`RunValues`]: bins shared by all, counted by
 /// binary search in the sorted values (the bin of a value is monotone in it).
 #[must_use]
-pub fn combine(variable: &str, runs: [Option<&RunValues>; 2]) -> PlotData {
-    let mut out = PlotData { variable: variable.to_string(), ..PlotData::default() };
+pub fn combine(variable: &str, runs: &[Option<&RunValues>]) -> PlotData {
+    let n = runs.len();
+    let mut out = PlotData {
+        variable: variable.to_string(),
+        counts: vec![Vec::new(); n],
+        pixels: vec![0; n],
+        scatter: vec![Vec::new(); n],
+        ..PlotData::default()
+    };
     for (k, r) in runs.iter().enumerate() {
         if let Some(r) = r {
             out.scatter[k].clone_from(&r.scatter);

@@ -1,10 +1,11 @@
-//! The bottom panel: the metrics of A and B against the requirements, histograms of retrieved
+//! The bottom panel: the metrics of every design against the requirements, histograms of retrieved
 //! and true values, the truth-vs-retrieved scatter, and the SNR per band against its requirement,
 //! with the per-stage timings of the runs on display.
 
 use egui_plot::{Bar, BarChart, HLine, Line, Plot, PlotPoints, Points};
 
 use super::metrics_table::{metrics_table, seed_controls, substrate_tables};
+use super::model::label;
 use super::plot_data::PlotData;
 use super::{ShoalApp, theme};
 use crate::engine::StageStatus;
@@ -47,17 +48,35 @@ pub(super) fn log_label(mark: egui_plot::GridMark, range: &std::ops::RangeInclus
     }
 }
 
-/// A plot's key, above the plot rather than over its data: a coloured swatch and name each.
-fn key(ui: &mut egui::Ui, items: &[(&str, egui::Color32)]) {
-    ui.horizontal(|ui| {
+/// A plot's key, above the plot rather than over its data: a coloured swatch and name each,
+/// wrapped when the designs are many.
+fn key(ui: &mut egui::Ui, items: &[(String, egui::Color32)]) {
+    ui.horizontal_wrapped(|ui| {
         for (name, colour) in items {
             ui.colored_label(*colour, "■");
-            ui.small(*name);
+            ui.small(name.as_str());
         }
     });
 }
 
-/// The histograms of the truth, A and B. Computed on the raster thread with the maps
+/// The key items of the designs with results, then `extra`.
+fn design_key(
+    app: &ShoalApp,
+    first: &[(&str, egui::Color32)],
+    extra: &[(&str, egui::Color32)],
+) -> Vec<(String, egui::Color32)> {
+    let designs = (0..app.state.designs.len()).filter(|&i| {
+        !matches!(app.link.standing(i), super::link::Standing::Failed(_) | super::link::Standing::Waiting)
+    });
+    first
+        .iter()
+        .map(|(n, c)| ((*n).to_string(), *c))
+        .chain(designs.map(|i| (label(i), theme::design(i))))
+        .chain(extra.iter().map(|(n, c)| ((*n).to_string(), *c)))
+        .collect()
+}
+
+/// The histograms of the truth and every design. Computed on the raster thread with the maps
 /// (app/plot_data.rs): a frame only draws.
 fn histogram(app: &ShoalApp, ui: &mut egui::Ui, width: f32) -> egui::Rect {
     let empty = PlotData::default();
@@ -67,7 +86,7 @@ fn histogram(app: &ShoalApp, ui: &mut egui::Ui, width: f32) -> egui::Rect {
     let edges = &data.edges_log10;
     ui.vertical(|ui| {
         ui.label(format!("{name}: histograms"));
-        key(ui, &[("truth", theme::TRUTH), ("A", theme::INSTRUMENT[0]), ("B", theme::INSTRUMENT[1])]);
+        key(ui, &design_key(app, &[("truth", theme::TRUTH)], &[]));
         Plot::new("hist")
             .width(width)
             .height(plot_height(ui))
@@ -94,14 +113,17 @@ fn histogram(app: &ShoalApp, ui: &mut egui::Ui, width: f32) -> egui::Rect {
                     .map(|(b, n)| [centre(b), PlotData::percent(*n, data.truth_pixels)])
                     .collect();
                 p.line(Line::new("truth", PlotPoints::from(line)).color(theme::TRUTH).width(2.0));
-                for (i, c) in data.counts.iter().enumerate() {
-                    let offset = if i == 0 { -0.5 * bw } else { 0.5 * bw };
-                    let bars: Vec<Bar> = c
+                // The designs' bars side by side within each bin (two: half a bin each, as before).
+                let drawn: Vec<usize> = (0..data.counts.len()).filter(|&i| data.pixels[i] > 0).collect();
+                let width = 2.0 * bw / drawn.len().max(1) as f64;
+                for (k, &i) in drawn.iter().enumerate() {
+                    let offset = -bw + width * (k as f64 + 0.5);
+                    let bars: Vec<Bar> = data.counts[i]
                         .iter()
                         .enumerate()
-                        .map(|(b, n)| Bar::new(centre(b) + offset, PlotData::percent(*n, data.pixels[i])).width(bw))
+                        .map(|(b, n)| Bar::new(centre(b) + offset, PlotData::percent(*n, data.pixels[i])).width(width))
                         .collect();
-                    p.bar_chart(BarChart::new(if i == 0 { "A" } else { "B" }, bars).color(theme::INSTRUMENT[i]));
+                    p.bar_chart(BarChart::new(label(i), bars).color(theme::design(i)));
                 }
             });
     })
@@ -130,7 +152,7 @@ fn scatter(app: &ShoalApp, ui: &mut egui::Ui, width: f32) -> egui::Rect {
     let edges = &data.edges_log10;
     ui.vertical(|ui| {
         ui.label(format!("{name}: retrieved vs true"));
-        key(ui, &[("A", theme::INSTRUMENT[0]), ("B", theme::INSTRUMENT[1]), ("1:1", theme::REFERENCE)]);
+        key(ui, &design_key(app, &[], &[("1:1", theme::REFERENCE)]));
         Plot::new("scatter")
             .width(width)
             .height(plot_height(ui))
@@ -159,11 +181,7 @@ fn scatter(app: &ShoalApp, ui: &mut egui::Ui, width: f32) -> egui::Rect {
             })
             .show(ui, |p| {
                 for (i, d) in data.scatter.iter().enumerate() {
-                    p.points(
-                        Points::new(if i == 0 { "A" } else { "B" }, d.clone())
-                            .radius(1.2)
-                            .color(theme::INSTRUMENT[i].gamma_multiply(0.6)),
-                    );
+                    p.points(Points::new(label(i), d.clone()).radius(1.2).color(theme::design(i).gamma_multiply(0.6)));
                 }
                 if let (Some(lo), Some(hi)) = (edges.first(), edges.last()) {
                     p.line(Line::new("1:1", PlotPoints::from(vec![[*lo, *lo], [*hi, *hi]])).color(theme::REFERENCE));
@@ -177,7 +195,7 @@ fn scatter(app: &ShoalApp, ui: &mut egui::Ui, width: f32) -> egui::Rect {
 fn snr_plot(app: &ShoalApp, ui: &mut egui::Ui, width: f32) -> egui::Rect {
     ui.vertical(|ui| {
         ui.label("SNR per band (line: analytic, dots: measured)");
-        key(ui, &[("A", theme::INSTRUMENT[0]), ("B", theme::INSTRUMENT[1]), ("requirement", theme::PASS)]);
+        key(ui, &design_key(app, &[], &[("requirement", theme::PASS)]));
         Plot::new("snr")
             .width(width)
             .height(plot_height(ui))
@@ -194,9 +212,9 @@ fn snr_plot(app: &ShoalApp, ui: &mut egui::Ui, width: f32) -> egui::Rect {
                 Some(format!("{plot_name}: {:.0} nm, SNR {:.0}", position.x, position.y))
             })
             .show(ui, |p| {
-                for i in 0..2 {
+                for i in 0..app.state.designs.len() {
                     let Some(s) = app.link.current(i) else { continue };
-                    let name = if i == 0 { "A" } else { "B" };
+                    let name = label(i);
                     let line: Vec<[f64; 2]> = s
                         .output
                         .snr
@@ -211,8 +229,8 @@ fn snr_plot(app: &ShoalApp, ui: &mut egui::Ui, width: f32) -> egui::Rect {
                         .filter(|r| r.snr_measured.is_finite())
                         .map(|r| [r.centre_nm, r.snr_measured])
                         .collect();
-                    p.line(Line::new(name, PlotPoints::from(line)).color(theme::INSTRUMENT[i]).width(2.0));
-                    p.points(Points::new(format!("{name} measured"), dots).radius(2.5).color(theme::INSTRUMENT[i]));
+                    p.line(Line::new(name.as_str(), PlotPoints::from(line)).color(theme::design(i)).width(2.0));
+                    p.points(Points::new(format!("{name} measured"), dots).radius(2.5).color(theme::design(i)));
                 }
                 if let Some(snr) = app.state.requirements.snr {
                     p.hline(HLine::new("requirement", snr).color(theme::PASS));
@@ -225,7 +243,7 @@ fn snr_plot(app: &ShoalApp, ui: &mut egui::Ui, width: f32) -> egui::Rect {
 
 fn timings(app: &ShoalApp, ui: &mut egui::Ui) {
     egui::CollapsingHeader::new("Stage timings").default_open(false).show(ui, |ui| {
-        for i in 0..2 {
+        for i in 0..app.state.designs.len() {
             let Some(s) = app.link.current(i) else { continue };
             let r = &s.output.report;
             let ran: Vec<String> = r
@@ -239,7 +257,7 @@ fn timings(app: &ShoalApp, ui: &mut egui::Ui) {
             let skipped: Vec<String> = r.skipped_effects.iter().map(|e| format!("{:?}", e.effect)).collect();
             ui.label(format!(
                 "{} (1/{}): {:.0} ms — {}; skipped: {}",
-                if i == 0 { "A" } else { "B" },
+                label(i),
                 s.decimation,
                 r.total_seconds * 1e3,
                 ran.join(", "),
@@ -267,7 +285,7 @@ pub fn bottom(app: &mut ShoalApp, ui: &mut egui::Ui) {
         let beside = total - table - GAP >= 3.0 * MIN_PLOT_WIDTH + 2.0 * GAP;
         let plots = |app: &ShoalApp, ui: &mut egui::Ui, room: f32| -> Vec<egui::Rect> {
             // No axes without data: a failed or pending configuration has nothing to plot.
-            if (0..2).all(|i| {
+            if (0..app.state.designs.len()).all(|i| {
                 !matches!(app.link.standing(i), super::link::Standing::Current(_) | super::link::Standing::Earlier(_))
             }) {
                 // The plots' room kept, so the panel does not shrink to the note and jump back.
@@ -294,14 +312,14 @@ pub fn bottom(app: &mut ShoalApp, ui: &mut egui::Ui) {
         let metrics = |app: &mut ShoalApp, ui: &mut egui::Ui| {
             let r = ui.vertical(|ui| {
                 ui.strong("Metrics (log-space MAE and bias, Seegers et al. 2018)");
-                // A and B as the engine would run them, built once per frame for both.
+                // The designs as the engine would run them, built once per frame for all.
                 let configs = app.state.configs();
                 seed_controls(app, ui, &configs);
                 metrics_table(app, ui, &configs);
                 substrate_tables(app, ui);
                 for (i, e) in app.link.errors.iter().enumerate() {
                     if let Some(e) = e {
-                        ui.colored_label(theme::FAIL, format!("{}: {e}", if i == 0 { "A" } else { "B" }));
+                        ui.colored_label(theme::FAIL, format!("{}: {e}", label(i)));
                     }
                 }
             });

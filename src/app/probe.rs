@@ -38,6 +38,18 @@ impl ShoalApp {
         self.images.panel_count()
     }
 
+    /// The map panels' titles, in display order ("truth", "A", "C − A").
+    #[must_use]
+    pub fn panel_titles(&self) -> Vec<String> {
+        self.images.titles()
+    }
+
+    /// The histogram and scatter data on display.
+    #[must_use]
+    pub fn plot_data(&self) -> Option<&super::plot_data::PlotData> {
+        self.images.plot()
+    }
+
     /// Where the histogram, scatter and SNR plots were drawn in the last frame.
     #[must_use]
     pub fn plot_rects(&self) -> &[egui::Rect] {

@@ -1,5 +1,5 @@
-//! Product maps for display: the values of a product from a run (or its truth), the A − B
-//! difference on A's pixels, colour mapping and downsampling — computed on a raster thread so
+//! Product maps for display: the values of a product from a run (or its truth), the difference
+//! of a pair of designs on the first one's pixels, colour mapping and downsampling — computed on a raster thread so
 //! the UI thread only uploads the finished images.
 
 use std::sync::Arc;
@@ -107,7 +107,8 @@ pub fn product_map(out: &RunOutput, kind: ProductKind, band: usize, truth: bool)
     }
 }
 
-/// A − B on A's pixels: B is sampled at the pixel nearest each of A's ground points.
+/// A − B on A's pixels (A and B any two designs): B is sampled at the pixel nearest each of A's
+/// ground points.
 #[must_use]
 pub fn difference(a: &MapData, a_out: &RunOutput, b: &MapData, b_out: &RunOutput) -> MapData {
     let (rows, cols) = a.values.dim();
@@ -223,21 +224,36 @@ pub fn palette_of_samples(samples: &[&[f64]], kind: ProductKind, difference: boo
     Palette::Sequential(scale)
 }
 
-/// A request to the raster thread: the runs of A and B and what to show of them.
+/// A request to the raster thread: the runs of the designs and what to show of them.
 #[derive(Debug, Clone)]
 pub struct Job {
     /// Identifies the request (the app shows the images of the newest key).
     pub key: u64,
-    /// The runs of A and B (either may be missing).
-    pub runs: [Option<Arc<RunOutput>>; 2],
+    /// The runs of every design, in order (any may be missing).
+    pub runs: Vec<Option<Arc<RunOutput>>>,
+    /// The designs on the maps beside the truth ([`Layout::TruthAB`](super::model::Layout)).
+    pub on_maps: Vec<usize>,
+    /// The designs of the difference layout (first − second).
+    pub pair: [usize; 2],
     /// The product.
     pub kind: ProductKind,
     /// The band of band products.
     pub band: usize,
-    /// Truth | A | B, or A | B | A − B.
+    /// The truth beside the designs on the maps, or a pair and its difference.
     pub layout: super::model::Layout,
     /// Longest side of each image.
     pub max_side: usize,
+}
+
+/// What a map panel shows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Role {
+    /// The scene's truth (from the run of design `0`).
+    Truth(usize),
+    /// A design's product.
+    Design(usize),
+    /// The difference of a pair (first − second; for classes, where they agree).
+    Difference(usize, usize),
 }
 
 /// One map panel, ready to show.
@@ -245,6 +261,8 @@ pub struct Job {
 pub struct PanelImage {
     /// Title ("truth", "A", "B", "A − B").
     pub title: String,
+    /// What it shows.
+    pub role: Role,
     /// The values (for the value under the cursor).
     pub data: Arc<MapData>,
     /// The coloured image.
@@ -268,7 +286,8 @@ pub struct Done {
 
 /// Products derived from runs, by run (kept alive here, so pointer equality is identity) and a
 /// key, least recently used first: when only A changes, B's products are neither rebuilt nor
-/// revisited. Few entries, because each keeps its run (cubes and all) alive.
+/// revisited. Each entry keeps its run (cubes and all) alive, so runs no longer on display are
+/// let go ([`ByRun::keep_only`]) and the entries are few per run.
 pub struct ByRun<K, V> {
     entries: Vec<(Arc<RunOutput>, K, V)>,
 }
@@ -280,11 +299,22 @@ impl<K, V> Default for ByRun<K, V> {
 }
 
 impl<K: PartialEq + Send + 'static, V: Clone + Send + 'static> ByRun<K, V> {
-    /// Entries kept: A, A's truth, B and one more.
-    const CAPACITY: usize = 4;
+    /// Entries kept per run on display: its map, its truth and one more.
+    const PER_RUN: usize = 3;
 
-    /// The product of `out` under `key`, made by `make` if not kept.
-    fn get(&mut self, out: &Arc<RunOutput>, key: K, make: impl FnOnce() -> V) -> V {
+    /// Let go of every run not in `runs` (those no longer on display), and bound the entries.
+    fn keep_only(&mut self, runs: &[Option<Arc<RunOutput>>]) {
+        let shown = |e: &(Arc<RunOutput>, K, V)| runs.iter().flatten().any(|r| Arc::ptr_eq(r, &e.0));
+        let (kept, gone): (Vec<_>, Vec<_>) = std::mem::take(&mut self.entries).into_iter().partition(shown);
+        self.entries = kept;
+        // Possibly the last handles on runs at full resolution: freed off this thread.
+        if !gone.is_empty() {
+            crate::jobs::free_later(gone);
+        }
+    }
+
+    /// The product of `out` under `key`, made by `make` if not kept; at most `capacity` entries.
+    fn get(&mut self, out: &Arc<RunOutput>, key: K, capacity: usize, make: impl FnOnce() -> V) -> V {
         if let Some(i) = self.entries.iter().position(|e| Arc::ptr_eq(&e.0, out) && e.1 == key) {
             // Most recently used last: what is shown now stays, old runs leave first.
             let e = self.entries.remove(i);
@@ -293,7 +323,7 @@ impl<K: PartialEq + Send + 'static, V: Clone + Send + 'static> ByRun<K, V> {
             return value;
         }
         let value = make();
-        if self.entries.len() == Self::CAPACITY {
+        if self.entries.len() >= capacity.max(1) {
             // Possibly the last handle on a run at full resolution: freed off this thread.
             crate::jobs::free_later(self.entries.remove(0));
         }
@@ -313,9 +343,9 @@ impl MapCache {
         kind: ProductKind,
         band: usize,
         truth: bool,
-        max_side: usize,
+        (max_side, capacity): (usize, usize),
     ) -> Option<Arc<Prepared>> {
-        self.get(out, (kind, band, truth, max_side), || {
+        self.get(out, (kind, band, truth, max_side), capacity, || {
             product_map(out, kind, band, truth).map(|m| Arc::new(Prepared::new(Arc::new(m), max_side)))
         })
     }
@@ -324,46 +354,54 @@ impl MapCache {
 /// Compute the panels of `job`.
 #[must_use]
 pub fn panels(job: &Job, cache: &mut MapCache) -> Done {
-    use super::model::Layout;
+    use super::model::{Layout, label};
+    cache.keep_only(&job.runs);
+    let capacity = ByRun::<(), ()>::PER_RUN * job.runs.iter().flatten().count();
     let mut get = |i: usize, truth: bool| {
-        job.runs[i].as_ref().and_then(|o| cache.map(o, job.kind, job.band, truth, job.max_side))
+        let out = job.runs.get(i)?.as_ref()?;
+        cache.map(out, job.kind, job.band, truth, (job.max_side, capacity))
     };
-    let (a, b) = (get(0, false), get(1, false));
-    let mut named: Vec<(String, Arc<Prepared>)> = Vec::new();
+    let mut named: Vec<(String, Role, Arc<Prepared>)> = Vec::new();
     let mut diff = None;
     match job.layout {
         Layout::TruthAB => {
-            if let Some(t) = get(0, true) {
-                named.push(("truth".into(), t));
+            // The truth from the first design on the maps that has a run.
+            let truth = job.on_maps.iter().chain(&[0]).find_map(|&i| Some((i, get(i, true)?)));
+            if let Some((i, t)) = truth {
+                named.push(("truth".into(), Role::Truth(i), t));
             }
-            if let Some(a) = &a {
-                named.push(("A".into(), a.clone()));
-            }
-            if let Some(b) = &b {
-                named.push(("B".into(), b.clone()));
+            for &i in &job.on_maps {
+                if let Some(m) = get(i, false) {
+                    named.push((label(i), Role::Design(i), m));
+                }
             }
         }
         Layout::AbDifference => {
+            let [p, q] = job.pair;
+            let (a, b) = (get(p, false), get(q, false));
             if let Some(a) = &a {
-                named.push(("A".into(), a.clone()));
+                named.push((label(p), Role::Design(p), a.clone()));
             }
-            if let Some(b) = &b {
-                named.push(("B".into(), b.clone()));
+            if let Some(b) = &b.as_ref().filter(|_| q != p) {
+                named.push((label(q), Role::Design(q), (*b).clone()));
             }
-            if let (Some(a), Some(b), Some(ra), Some(rb)) = (&a, &b, &job.runs[0], &job.runs[1]) {
-                // Classes have no difference: A − B of a class map is where they agree.
+            let runs = (job.runs.get(p).and_then(Option::as_ref), job.runs.get(q).and_then(Option::as_ref));
+            if let (Some(a), Some(b), (Some(ra), Some(rb))) = (&a, &b, runs)
+                && p != q
+            {
+                // Classes have no difference: the difference of a class map is where they agree.
                 let d = if job.kind.categorical() {
                     agreement(&a.data, ra, &b.data, rb)
                 } else {
                     difference(&a.data, ra, &b.data, rb)
                 };
-                diff = Some(Prepared::new(Arc::new(d), job.max_side));
+                diff = Some((Prepared::new(Arc::new(d), job.max_side), Role::Difference(p, q)));
             }
         }
     }
-    let samples: Vec<&[f64]> = named.iter().map(|(_, m)| m.sample.as_slice()).collect();
+    let samples: Vec<&[f64]> = named.iter().map(|(_, _, m)| m.sample.as_slice()).collect();
     let palette = palette_of_samples(&samples, job.kind, false);
-    let difference_palette = diff.as_ref().map(|d| {
+    let difference_palette = diff.as_ref().map(|(d, _)| {
         if job.kind.categorical() {
             Palette::Agreement
         } else {
@@ -372,10 +410,11 @@ pub fn panels(job: &Job, cache: &mut MapCache) -> Done {
     });
     let mut panels: Vec<PanelImage> = named
         .into_iter()
-        .map(|(title, m)| PanelImage { image: m.blocks.colorize(palette), title, data: m.data.clone() })
+        .map(|(title, role, m)| PanelImage { image: m.blocks.colorize(palette), title, role, data: m.data.clone() })
         .collect();
-    if let (Some(d), Some(p)) = (diff, difference_palette) {
-        panels.push(PanelImage { title: "A − B".into(), image: d.blocks.colorize(p), data: d.data });
+    if let (Some((d, role)), Some(p)) = (diff, difference_palette) {
+        let title = format!("{} − {}", label(job.pair[0]), label(job.pair[1]));
+        panels.push(PanelImage { title, role, image: d.blocks.colorize(p), data: d.data });
     }
     Done { key: job.key, panels, palette, difference_palette, plot: Arc::default() }
 }
@@ -393,11 +432,15 @@ pub fn spawn_raster_thread(wake: impl Fn() + Send + 'static) -> std::io::Result<
     Worker::spawn("shoal-raster", wake, move |job: Job| {
         let mut done = panels(&job, &mut maps);
         let variable = job.kind.variable().unwrap_or("chl_mg_m3");
-        let runs = job
+        values.keep_only(&job.runs);
+        let capacity = 2 * job.runs.len();
+        let runs: Vec<Option<Arc<RunValues>>> = job
             .runs
-            .each_ref()
-            .map(|r| r.as_ref().map(|o| values.get(o, variable, || Arc::new(RunValues::of(o, variable)))));
-        done.plot = Arc::new(combine(variable, [runs[0].as_deref(), runs[1].as_deref()]));
+            .iter()
+            .map(|r| r.as_ref().map(|o| values.get(o, variable, capacity, || Arc::new(RunValues::of(o, variable)))))
+            .collect();
+        let refs: Vec<Option<&RunValues>> = runs.iter().map(Option::as_deref).collect();
+        done.plot = Arc::new(combine(variable, &refs));
         done
     })
 }

@@ -1,5 +1,5 @@
-//! The seed spread of the metrics in the app: A and B as shown, rerun over several detector-noise
-//! seeds on a helper thread, so the table can say how far one noise draw's MAE is from another's
+//! The seed spread of the metrics in the app: every design as shown, rerun over several
+//! detector-noise seeds on a helper thread, so the table can say how far one noise draw's MAE is from another's
 //! (`study::spread_of_runs`, the same reduction `shoal study` writes to seed_spread.csv).
 //!
 //! The spread belongs to the designs it was measured for: after any edit it is marked stale and
@@ -70,7 +70,7 @@ impl SeedSpreadJob {
         (self.runs.len(), self.total)
     }
 
-    /// Rerun `configs` (A, B) over seeds 1..=`self.seeds` at 1/`self.decimation`.
+    /// Rerun `configs` (the designs) over seeds 1..=`self.seeds` at 1/`self.decimation`.
     pub fn start(&mut self, ctx: &egui::Context, configs: &[RunConfig]) {
         let seeds = self.seeds.clamp(2, 20);
         let decimation = self.decimation.clamp(1, 64);
@@ -132,10 +132,9 @@ impl SeedSpreadJob {
             self.task = None;
             match r {
                 Ok(()) => {
-                    let labels = ["A", "B"];
-                    self.spread = spread_of_runs(
-                        self.runs.iter().map(|(i, r)| (labels.get(*i).copied().unwrap_or("?"), r.as_slice())),
-                    );
+                    let labels: Vec<String> = self.runs.iter().map(|(i, _)| super::model::label(*i)).collect();
+                    self.spread =
+                        spread_of_runs(self.runs.iter().zip(&labels).map(|((_, r), l)| (l.as_str(), r.as_slice())));
                     self.status = format!("{} seeds at 1/{}", self.seeds.clamp(2, 20), self.decimation);
                 }
                 Err(e) => self.status = e,

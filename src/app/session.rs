@@ -78,9 +78,12 @@ pub fn load_session(path: &Path) -> SavedSession {
 /// is out of range (a hand-edited or damaged file: a NaN aperture, a negative step) is reset to
 /// its default and named in the list returned, so the rest of the session is kept.
 pub fn repair(state: &mut AppState) -> Vec<String> {
+    // A session from before designs were a list gets its A and B as designs; indices in range.
+    state.settle();
     let defaults = AppState::default();
     let mut reset = Vec::new();
-    for (name, slot, default) in [("A", &mut state.a, &defaults.a), ("B", &mut state.b, &defaults.b)] {
+    for (i, slot) in state.designs.iter_mut().enumerate() {
+        let (name, default) = (super::model::label(i), &defaults.designs[i.min(defaults.designs.len() - 1)]);
         if let Err(e) = slot.spec.validate() {
             let back = [&slot.original, &default.spec].into_iter().find(|s| s.validate().is_ok()).cloned();
             let back = back.unwrap_or_else(|| default.spec.clone());
@@ -205,7 +208,7 @@ mod tests {
         let today = AppState { decimations: vec![16, 2], ..AppState::default() };
         let text = ron::to_string(&today).unwrap_or_else(|e| panic!("{e}"));
         // As an older app saved it: no version, the decimations called `levels`.
-        let old = text.replace("schema_version:2,", "").replace("decimations:", "levels:");
+        let old = text.replace("schema_version:3,", "").replace("decimations:", "levels:");
         assert!(!old.contains("schema_version") && old.contains("levels:[16,2]"), "{old}");
         std::fs::write(&path, old).unwrap_or_else(|e| panic!("{e}"));
         match load_session(&path) {
@@ -221,7 +224,7 @@ mod tests {
         assert!(path.starts_with(&home));
         assert!(matches!(load_session(&path), SavedSession::None));
         let mut s = AppState::default();
-        s.a.spec.aperture_mm = 77.0;
+        s.designs[0].spec.aperture_mm = 77.0;
         save_session(&path, &s).unwrap();
         match load_session(&path) {
             SavedSession::Restored(back, reset) => assert_eq!((*back, reset), (s, Vec::new())),
@@ -259,16 +262,16 @@ mod tests {
     #[test]
     fn a_nan_in_the_session_is_reset_with_its_field_named_and_the_rest_kept() {
         let mut s = AppState::default();
-        s.a.spec.aperture_mm = f64::NAN;
-        s.b.spec.read_noise_e = 12.0;
+        s.designs[0].spec.aperture_mm = f64::NAN;
+        s.designs[1].spec.read_noise_e = 12.0;
         s.fidelity.spectral_step_nm = -1.0;
         s.noise_seed = 9;
         let reset = repair(&mut s);
         assert_eq!(reset.len(), 2, "{reset:?}");
         assert!(reset[0].starts_with("instrument A (") && reset[0].contains("aperture_mm"), "{reset:?}");
         assert!(reset[1].starts_with("fidelity (") && reset[1].contains("spectral_step_nm"), "{reset:?}");
-        assert_eq!(s.a.spec, AppState::default().a.spec);
-        assert_eq!((s.b.spec.read_noise_e, s.noise_seed), (12.0, 9), "valid fields are kept");
+        assert_eq!(s.designs[0].spec, AppState::default().designs[0].spec);
+        assert_eq!((s.designs[1].spec.read_noise_e, s.noise_seed), (12.0, 9), "valid fields are kept");
         assert!(repair(&mut s).is_empty(), "a repaired session is valid");
     }
 

@@ -1,9 +1,10 @@
 //! The comparison figure an engineer takes to a design review: the maps on one scale, the SNR
 //! per band against the requirement, retrieved against true values, the verdicts and the
-//! parameters A and B differ in, as a 1920 × 1080 slide (PNG and SVG), with the resolved
+//! parameters the designs differ in, as a 1920 × 1080 slide (PNG and SVG), with the resolved
 //! configurations beside it.
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use super::export::Snapshot;
 use super::model::AppState;
@@ -15,17 +16,15 @@ use crate::study::{ComparisonPanel, ReviewSlide, SlideSeries, review_slide, writ
 /// Write the comparison figure and the configurations next to `stem`.
 pub fn write_figure(snap: &Snapshot, stem: &Path) -> Result<Vec<PathBuf>, String> {
     let state = &snap.state;
-    let (a, b) = snap.both()?;
+    let runs = snap.all()?;
     let kind = state.product;
     let mut panels = Vec::new();
-    for (title, out, truth) in [("truth", a, true), ("A", a, false), ("B", b, false)] {
-        if let Some(m) = product_map(out, kind, state.band, truth) {
-            let label = if truth {
-                title.to_string()
-            } else {
-                format!("{title}: {}", if title == "A" { &state.a.preset } else { &state.b.preset })
-            };
-            panels.push(ComparisonPanel { title: label, values: m.values, valid: m.valid });
+    // The truth, then every design (the figure carries them all, whatever the maps show).
+    let maps = std::iter::once((None, runs[0])).chain(runs.iter().enumerate().map(|(i, r)| (Some(i), *r)));
+    for (design, out) in maps {
+        if let Some(m) = product_map(out, kind, state.band, design.is_none()) {
+            let title = design.map_or_else(|| "truth".to_string(), |i| state.design_name(i));
+            panels.push(ComparisonPanel { title, values: m.values, valid: m.valid });
         }
     }
     if panels.is_empty() {
@@ -38,13 +37,13 @@ pub fn write_figure(snap: &Snapshot, stem: &Path) -> Result<Vec<PathBuf>, String
         Palette::Sequential(s) => s,
         _ => Scale { lo: 0.0, hi: 8.0, log: false },
     };
-    let table = verdict_table(state, a, b);
+    let table = verdict_table(state, &runs);
     let changes = state.changes();
+    let designs: Vec<String> = (0..runs.len()).map(|i| state.design_name(i)).collect();
     let caption = vec![
         format!(
-            "A: {}   B: {}   scene: {}   retrieval: {}   resolution 1/{}",
-            state.a.preset,
-            state.b.preset,
+            "{}   scene: {}   retrieval: {}   resolution 1/{}",
+            designs.join("   "),
             state.scene_name,
             super::banners::retrieval_name(state),
             snap.decimation
@@ -58,20 +57,20 @@ pub fn write_figure(snap: &Snapshot, stem: &Path) -> Result<Vec<PathBuf>, String
             .into(),
     ];
     // What is compared, as set now (a study's name would outlive a change of scene).
-    let title = format!("{} vs {} over {} — {}", state.a.preset, state.b.preset, state.scene_name, kind.label());
+    let title = format!("{} — {}", snap.title(), kind.label());
     let variable = kind.variable().unwrap_or("chl_mg_m3");
-    // One series per instrument, in A's and B's colours.
+    // One series per design, in the designs' colours.
     let series = |i: usize, out: &RunOutput, points: Vec<(f64, f64)>| {
-        let [r, g, b, _] = super::theme::INSTRUMENT[i].to_array();
+        let [r, g, b, _] = super::theme::design(i).to_array();
         SlideSeries {
-            name: format!("{}: {}", if i == 0 { "A" } else { "B" }, out.config.instrument.name),
+            name: format!("{}: {}", super::model::label(i), out.config.instrument.name),
             colour: [r, g, b],
             points,
         }
     };
     let plot = super::plot_data::plot_data(&snap.runs, variable);
     let (mut snr, mut scatter) = (Vec::new(), Vec::new());
-    for (i, out) in [a, b].into_iter().enumerate() {
+    for (i, out) in runs.iter().enumerate() {
         let analytic = out.snr.iter().filter(|r| r.snr_analytic.is_finite()).map(|r| (r.centre_nm, r.snr_analytic));
         snr.push(series(i, out, analytic.collect()));
         scatter.push(series(i, out, plot.scatter[i].iter().map(|p| (p[0], p[1])).collect()));
@@ -88,11 +87,7 @@ pub fn write_figure(snap: &Snapshot, stem: &Path) -> Result<Vec<PathBuf>, String
         scatter,
         scatter_label: format!("({})", crate::metrics::unit(variable)),
         verdicts: table,
-        parameters: super::params::differences(
-            &a.config.instrument,
-            &b.config.instrument,
-            (a.response.bands.bands.len(), b.response.bands.bands.len()),
-        ),
+        parameters: parameter_table(state, &runs),
     };
     let fig = review_slide("comparison", &slide).map_err(|e| e.to_string())?;
     let png = stem.with_extension("png");
@@ -100,8 +95,8 @@ pub fn write_figure(snap: &Snapshot, stem: &Path) -> Result<Vec<PathBuf>, String
     write_bytes(&png, &fig.png).map_err(|e| e.to_string())?;
     write_bytes(&svg, fig.svg.as_bytes()).map_err(|e| e.to_string())?;
     let mut written = vec![png, svg];
-    for (name, out) in [("A", a), ("B", b)] {
-        let path = PathBuf::from(format!("{}_config_{name}.ron", stem.display()));
+    for (i, out) in runs.iter().enumerate() {
+        let path = super::export::config_path(stem, i);
         let text = out.config.to_ron().map_err(|e| e.to_string())?;
         write_bytes(&path, text.as_bytes()).map_err(|e| e.to_string())?;
         written.push(path);
@@ -109,16 +104,29 @@ pub fn write_figure(snap: &Snapshot, stem: &Path) -> Result<Vec<PathBuf>, String
     Ok(written)
 }
 
-/// The verdict table of the slide: one row per product with A and B side by side (MAE, bias,
-/// returned share and the judgement of `Requirements::check_run`, the app's and `shoal
+/// The parameters the designs differ in, against the reference design chosen in the app.
+fn parameter_table(state: &AppState, runs: &[&Arc<RunOutput>]) -> Vec<Vec<String>> {
+    let reference = state.reference.min(runs.len() - 1);
+    let order: Vec<usize> = std::iter::once(reference).chain((0..runs.len()).filter(|&i| i != reference)).collect();
+    let names: Vec<String> = order.iter().map(|&i| super::model::label(i)).collect();
+    let designs: Vec<(&str, &crate::instrument::InstrumentSpec, usize)> = order
+        .iter()
+        .zip(&names)
+        .map(|(&i, n)| (n.as_str(), &runs[i].config.instrument, runs[i].response.bands.bands.len()))
+        .collect();
+    super::params::differences(&designs)
+}
+
+/// The verdict table of the slide: one row per product with the designs side by side (MAE,
+/// bias, returned share and the judgement of `Requirements::check_run`, the app's and `shoal
 /// study`'s), then the SNR floor's row.
-fn verdict_table(state: &AppState, a: &RunOutput, b: &RunOutput) -> Vec<Vec<String>> {
+fn verdict_table(state: &AppState, runs: &[&Arc<RunOutput>]) -> Vec<Vec<String>> {
     let mut header = vec!["product".to_string()];
-    for ab in ["A", "B"] {
+    for i in 0..runs.len() {
+        let ab = super::model::label(i);
         // Short headings (every value is a %): the table must leave room for the parameters'.
-        header.extend([format!("{ab} MAE"), format!("{ab} bias"), format!("{ab} ret."), ab.to_string()]);
+        header.extend([format!("{ab} MAE"), format!("{ab} bias"), format!("{ab} ret."), ab.clone()]);
     }
-    let runs = [a, b];
     let checks: Vec<Vec<crate::study::Check>> = runs
         .iter()
         .map(|out| {

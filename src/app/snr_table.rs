@@ -1,4 +1,4 @@
-//! The SNR and NEΔL of A and B per band, at the radiance a requirement states: the scene's
+//! The SNR and NEΔL of every design per band, at the radiance a requirement states: the scene's
 //! median water radiance, one radiance for every band, or a spectrum typed as (wavelength,
 //! radiance) points — as IOCCG reports and mission requirements state SNR ("SNR ≥ 1000 at
 //! L_typ"). NEΔL = L / SNR, the radiance difference the noise equals (W m⁻² sr⁻¹ µm⁻¹). The
@@ -92,50 +92,58 @@ fn reference_editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
     }
 }
 
-/// The section: the reference's editor and the table of A and B.
+/// The section: the reference's editor and the table of every design.
 pub(super) fn snr_section(app: &mut ShoalApp, ui: &mut egui::Ui) {
     egui::CollapsingHeader::new("SNR and NEΔL per band").default_open(false).show(ui, |ui| {
         reference_editor(app, ui);
         let runs: Vec<Option<&crate::engine::RunOutput>> =
-            (0..2).map(|i| app.link.current(i).map(|s| s.output.as_ref())).collect();
+            (0..app.state.designs.len()).map(|i| app.link.current(i).map(|s| s.output.as_ref())).collect();
         let Some(bands) = runs.iter().flatten().next().map(|o| o.snr.len()) else {
             ui.label("No results of the configuration set yet.");
             return;
         };
-        egui::Grid::new("snr-table").striped(true).num_columns(7).show(ui, |ui| {
-            for h in ["band", "nm", "L (W m⁻² sr⁻¹ µm⁻¹)", "A SNR", "A NEΔL", "B SNR", "B NEΔL"] {
-                ui.strong(h);
-            }
-            ui.end_row();
-            for b in 0..bands {
-                let first = runs.iter().flatten().next().and_then(|o| o.snr.get(b));
-                let Some(row) = first else { continue };
-                ui.label(&row.band);
-                ui.label(format!("{:.0}", row.centre_nm));
-                ui.label(format!("{:.2}", 1000.0 * row.radiance));
-                for run in &runs {
-                    match run.and_then(|o| o.snr.get(b)) {
-                        Some(r) if r.saturated() => {
-                            ui.colored_label(super::theme::FAIL, "saturated").on_hover_text(format!(
-                                "{:.0} % of full scale at this radiance",
-                                100.0 * r.full_scale_fraction
-                            ));
-                            ui.label("–");
-                        }
-                        Some(r) => {
-                            ui.label(format!("{:.0}", r.snr_analytic))
-                                .on_hover_text(format!("measured on the simulated patch: {:.0}", r.snr_measured));
-                            let nedl = 1000.0 * r.radiance / r.snr_analytic;
-                            ui.label(if nedl.is_finite() { format!("{nedl:.3}") } else { "–".into() });
-                        }
-                        None => {
-                            ui.label("–");
-                            ui.label("–");
-                        }
+        egui::ScrollArea::horizontal().id_salt("snr-scroll").show(ui, |ui| {
+            egui::Grid::new("snr-table").striped(true).num_columns(3 + 2 * runs.len()).show(ui, |ui| {
+                for h in ["band", "nm", "L (W m⁻² sr⁻¹ µm⁻¹)"] {
+                    ui.strong(h);
+                }
+                for i in 0..runs.len() {
+                    let ab = super::model::label(i);
+                    for h in [format!("{ab} SNR"), format!("{ab} NEΔL")] {
+                        ui.label(egui::RichText::new(h).strong().color(super::theme::design(i)));
                     }
                 }
                 ui.end_row();
-            }
+                for b in 0..bands {
+                    let first = runs.iter().flatten().next().and_then(|o| o.snr.get(b));
+                    let Some(row) = first else { continue };
+                    ui.label(&row.band);
+                    ui.label(format!("{:.0}", row.centre_nm));
+                    ui.label(format!("{:.2}", 1000.0 * row.radiance));
+                    for run in &runs {
+                        match run.and_then(|o| o.snr.get(b)) {
+                            Some(r) if r.saturated() => {
+                                ui.colored_label(super::theme::FAIL, "saturated").on_hover_text(format!(
+                                    "{:.0} % of full scale at this radiance",
+                                    100.0 * r.full_scale_fraction
+                                ));
+                                ui.label("–");
+                            }
+                            Some(r) => {
+                                ui.label(format!("{:.0}", r.snr_analytic))
+                                    .on_hover_text(format!("measured on the simulated patch: {:.0}", r.snr_measured));
+                                let nedl = 1000.0 * r.radiance / r.snr_analytic;
+                                ui.label(if nedl.is_finite() { format!("{nedl:.3}") } else { "–".into() });
+                            }
+                            None => {
+                                ui.label("–");
+                                ui.label("–");
+                            }
+                        }
+                    }
+                    ui.end_row();
+                }
+            });
         });
     });
 }

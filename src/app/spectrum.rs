@@ -2,7 +2,7 @@
 //! clicked on a map, with each instrument's bands drawn over them and what each measured there
 //! (its Level-1 radiance and corrected Rrs). Computed on a helper thread
 //! ([`crate::engine::spectrum`]); the window never shows a spectrum of runs no longer on screen:
-//! when A or B change, the same point is asked again of the new runs.
+//! when a design changes, the same point is asked again of the new runs.
 
 use std::sync::Arc;
 
@@ -18,7 +18,7 @@ use crate::jobs::Worker;
 /// What was clicked: which run's map, where on it (0–1 across and down the image).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Pick {
-    /// The run whose pixel is the point (0 = A, 1 = B).
+    /// The design whose pixel is the point (0 = A, 1 = B, …).
     pub run: usize,
     /// Position on the map, 0–1 (x right, y down, as drawn).
     pub uv: (f32, f32),
@@ -26,15 +26,19 @@ pub struct Pick {
 
 /// A request: the runs on display and the pixel.
 struct Request {
-    runs: [Option<Arc<RunOutput>>; 2],
+    runs: Vec<Option<Arc<RunOutput>>>,
     pick: Pick,
 }
 
+/// What the helper computes: the scene's spectrum, and per design with a run (its index) what its
+/// bands measured there.
+type AtPoint = (PointSpectrum, Vec<(usize, InstrumentAtPoint)>);
+
 /// The helper's answer, tagged with the runs it was computed from.
 struct Answer {
-    from: [Option<usize>; 2],
+    from: Vec<Option<usize>>,
     pick: Pick,
-    result: Result<(PointSpectrum, Vec<InstrumentAtPoint>), String>,
+    result: Result<AtPoint, String>,
 }
 
 /// The window's state.
@@ -44,7 +48,7 @@ pub struct SpectrumWindow {
     pub open: bool,
     pick: Option<Pick>,
     worker: Option<Worker<Request, Answer>>,
-    asked: Option<([Option<usize>; 2], Pick)>,
+    asked: Option<(Vec<Option<usize>>, Pick)>,
     shown: Option<Answer>,
 }
 
@@ -61,15 +65,15 @@ fn pixel(out: &RunOutput, uv: (f32, f32)) -> (usize, usize) {
     (r, c)
 }
 
-fn compute(maker: &mut SpectrumMaker, req: &Request) -> Result<(PointSpectrum, Vec<InstrumentAtPoint>), String> {
-    let out = req.runs[req.pick.run].as_ref().ok_or("no result of that instrument on display")?;
+fn compute(maker: &mut SpectrumMaker, req: &Request) -> Result<AtPoint, String> {
+    let out = req.runs.get(req.pick.run).and_then(Option::as_ref).ok_or("no result of that design on display")?;
     let (row, col) = pixel(out, req.pick.uv);
     let spectrum = maker.at(out, row, col).map_err(|e| e.to_string())?;
     let instruments = req
         .runs
         .iter()
-        .zip(["A", "B"])
-        .filter_map(|(r, label)| r.as_ref().map(|r| instrument_at(r, label, spectrum.ground_m)))
+        .enumerate()
+        .filter_map(|(i, r)| r.as_ref().map(|r| (i, instrument_at(r, &super::model::label(i), spectrum.ground_m))))
         .collect();
     Ok((spectrum, instruments))
 }
@@ -83,9 +87,9 @@ impl SpectrumWindow {
 
     /// Ask the helper for the picked point of the runs on display, unless already asked; take
     /// its answers.
-    fn update(&mut self, runs: [Option<Arc<RunOutput>>; 2], ctx: &egui::Context) -> Result<(), String> {
+    fn update(&mut self, runs: Vec<Option<Arc<RunOutput>>>, ctx: &egui::Context) -> Result<(), String> {
         let Some(pick) = self.pick else { return Ok(()) };
-        let from = [id(runs[0].as_ref()), id(runs[1].as_ref())];
+        let from: Vec<Option<usize>> = runs.iter().map(|r| id(r.as_ref())).collect();
         if self.worker.is_none() {
             let wake = ctx.clone();
             let mut maker = SpectrumMaker::default();
@@ -93,7 +97,7 @@ impl SpectrumWindow {
                 "shoal-spectrum",
                 move || wake.request_repaint(),
                 move |req: Request| Answer {
-                    from: [id(req.runs[0].as_ref()), id(req.runs[1].as_ref())],
+                    from: req.runs.iter().map(|r| id(r.as_ref())).collect(),
                     pick: req.pick,
                     result: compute(&mut maker, &req),
                 },
@@ -102,9 +106,10 @@ impl SpectrumWindow {
             self.worker = Some(worker);
         }
         let worker = self.worker.as_ref().ok_or("no helper thread")?;
-        if self.asked != Some((from, pick)) && runs[pick.run].is_some() {
+        let asked = Some((from, pick));
+        if self.asked != asked && runs.get(pick.run).is_some_and(Option::is_some) {
             let _ = worker.request(Request { runs, pick });
-            self.asked = Some((from, pick));
+            self.asked = asked;
         }
         if let Some(a) = worker.latest() {
             self.shown = Some(a);
@@ -115,11 +120,13 @@ impl SpectrumWindow {
 
 /// The window, when open.
 pub fn spectrum_window(app: &mut ShoalApp, ctx: &egui::Context) {
-    let runs = [0, 1].map(|i| match app.link.standing(i) {
-        Standing::Current(s) => Some(s.output.clone()),
-        _ => None,
-    });
-    let from = [id(runs[0].as_ref()), id(runs[1].as_ref())];
+    let runs: Vec<_> = (0..app.state.designs.len())
+        .map(|i| match app.link.standing(i) {
+            Standing::Current(s) => Some(s.output.clone()),
+            _ => None,
+        })
+        .collect();
+    let from: Vec<Option<usize>> = runs.iter().map(|r| id(r.as_ref())).collect();
     let w = &mut app.ui.spectrum;
     let failure = w.update(runs, ctx).err();
     let mut open = w.open;
@@ -135,8 +142,8 @@ pub fn spectrum_window(app: &mut ShoalApp, ctx: &egui::Context) {
         match current.map(|a| &a.result) {
             // The clicked instrument has no result of the configuration set (its run failed or
             // is on its way): nothing is computed from an earlier one.
-            None if from[pick.run].is_none() => {
-                let who = ["A", "B"][pick.run];
+            None if from.get(pick.run).is_none_or(Option::is_none) => {
+                let who = super::model::label(pick.run);
                 ui.label(format!(
                     "{who} has no result of the configuration set (failed or updating): the spectrum follows its run."
                 ));
@@ -150,15 +157,25 @@ pub fn spectrum_window(app: &mut ShoalApp, ctx: &egui::Context) {
             Some(Err(e)) => {
                 ui.colored_label(theme::FAIL, format!("No spectrum: {e}"));
             }
-            Some(Ok((s, instruments))) => draw(ui, s, instruments, pick),
+            Some(Ok((s, at))) => {
+                let (designs, instruments): (Vec<usize>, Vec<InstrumentAtPoint>) = at.iter().cloned().unzip();
+                let colours: Vec<egui::Color32> = designs.into_iter().map(theme::design).collect();
+                draw(ui, s, &instruments, &colours, pick);
+            }
         }
     });
     app.ui.spectrum.open = open;
 }
 
 /// Caption, key and the two plots.
-fn draw(ui: &mut egui::Ui, s: &PointSpectrum, instruments: &[InstrumentAtPoint], pick: Pick) {
-    let who = ["A", "B"][pick.run];
+fn draw(
+    ui: &mut egui::Ui,
+    s: &PointSpectrum,
+    instruments: &[InstrumentAtPoint],
+    colours: &[egui::Color32],
+    pick: Pick,
+) {
+    let who = super::model::label(pick.run);
     ui.label(format!(
         "{} at ({:.0}, {:.0}) m, row {}, column {} of {who}; sun zenith {:.1}°, view zenith {:.1}°; the model every nm{}.",
         if s.water { "Water" } else { "Land" },
@@ -176,7 +193,7 @@ fn draw(ui: &mut egui::Ui, s: &PointSpectrum, instruments: &[InstrumentAtPoint],
         ui.colored_label(theme::REFERENCE, "- -");
         ui.small("path radiance");
         for (k, inst) in instruments.iter().enumerate() {
-            let c = theme::INSTRUMENT[k % 2];
+            let c = colours[k];
             ui.colored_label(c, "▮ ●");
             let off = if inst.pixel.is_none() { " (point off its image)" } else { "" };
             ui.small(format!("{}: bands (FWHM) and what it measured{off}", inst.label));
@@ -203,7 +220,7 @@ fn draw(ui: &mut egui::Ui, s: &PointSpectrum, instruments: &[InstrumentAtPoint],
         "TOA radiance (W m⁻² sr⁻¹ µm⁻¹), log scale",
         height,
         toa_range,
-        instruments,
+        (instruments, colours),
         |p| {
             p.line(Line::new("scene", PlotPoints::from(l_toa)).color(theme::TRUTH).width(1.5));
             p.line(
@@ -213,17 +230,17 @@ fn draw(ui: &mut egui::Ui, s: &PointSpectrum, instruments: &[InstrumentAtPoint],
             );
             for (k, pts) in l1.into_iter().enumerate() {
                 let name = format!("{} Level-1", instruments[k].label);
-                p.points(Points::new(name, pts).radius(4.0).color(theme::INSTRUMENT[k % 2]));
+                p.points(Points::new(name, pts).radius(4.0).color(colours[k]));
             }
         },
     );
     let rrs_label = if s.water { "Rrs (sr⁻¹), log scale" } else { "Rrs (sr⁻¹): land, none" };
     let rrs_range = span(&[&rrs], &rrs_measured);
-    panel(ui, "spectrum-rrs", rrs_label, height, rrs_range, instruments, |p| {
+    panel(ui, "spectrum-rrs", rrs_label, height, rrs_range, (instruments, colours), |p| {
         p.line(Line::new("scene Rrs", PlotPoints::from(rrs)).color(theme::TRUTH).width(1.5));
         for (k, pts) in rrs_measured.into_iter().enumerate() {
             let name = format!("{} Rrs", instruments[k].label);
-            p.points(Points::new(name, pts).radius(4.0).color(theme::INSTRUMENT[k % 2]));
+            p.points(Points::new(name, pts).radius(4.0).color(colours[k]));
         }
     });
 }
@@ -250,7 +267,7 @@ fn panel(
     y_label: &str,
     height: f32,
     y_range: (f64, f64),
-    instruments: &[InstrumentAtPoint],
+    (instruments, colours): (&[InstrumentAtPoint], &[egui::Color32]),
     add: impl FnOnce(&mut egui_plot::PlotUi<'_>),
 ) {
     Plot::new(id)
@@ -274,7 +291,7 @@ fn panel(
             // The shading spans the data's decades (not the plot's bounds, which it would grow).
             let (lo, hi) = y_range;
             for (k, inst) in instruments.iter().enumerate() {
-                let fill = theme::INSTRUMENT[k % 2].gamma_multiply(0.18);
+                let fill = colours[k].gamma_multiply(0.18);
                 for b in &inst.bands {
                     let (a, z) = (b.centre_nm - b.fwhm_nm / 2.0, b.centre_nm + b.fwhm_nm / 2.0);
                     let corners = vec![[a, lo], [z, lo], [z, hi], [a, hi]];

@@ -1,14 +1,28 @@
 //! The app's colours, in one place: what each colour means is decided here, and panels, plots
 //! and maps name the meaning (`theme::FAIL`), not the RGB.
 //!
-//! Instrument colours are ColorBrewer Set1's red and blue (Harrower & Brewer 2003, The
-//! Cartographic Journal 40, 27–37), distinct for the common colour-vision deficiencies in
-//! lightness as well as hue.
+//! Design colours are ColorBrewer Set1 (Harrower & Brewer 2003, The Cartographic Journal 40,
+//! 27–37) in its order, red and blue first (A and B), without its yellow (unreadable on white).
 
 use egui::Color32;
 
-/// Instrument A, then B (plot lines, bars, points).
-pub const INSTRUMENT: [Color32; 2] = [Color32::from_rgb(228, 26, 28), Color32::from_rgb(55, 126, 184)];
+/// Design A, B, C, … (plot lines, bars, points, the design list's swatches).
+pub const DESIGN: [Color32; super::designs::MAX_DESIGNS] = [
+    Color32::from_rgb(228, 26, 28),
+    Color32::from_rgb(55, 126, 184),
+    Color32::from_rgb(77, 175, 74),
+    Color32::from_rgb(152, 78, 163),
+    Color32::from_rgb(255, 127, 0),
+    Color32::from_rgb(166, 86, 40),
+    Color32::from_rgb(247, 129, 191),
+    Color32::from_rgb(153, 153, 153),
+];
+
+/// Design `i`'s colour.
+#[must_use]
+pub fn design(i: usize) -> Color32 {
+    DESIGN[i % DESIGN.len()]
+}
 /// The truth in plots.
 pub const TRUTH: Color32 = Color32::GRAY;
 /// Reference lines (1:1).
@@ -21,7 +35,7 @@ pub const FAIL: Color32 = Color32::from_rgb(200, 40, 40);
 pub const WARN: Color32 = Color32::from_rgb(200, 130, 0);
 /// A banner that needs the user's attention (the scene does not suit the retrieval).
 pub const NOTICE: Color32 = Color32::from_rgb(200, 90, 0);
-/// Maps: pixels where A and B agree, then disagree (class products).
+/// Maps: pixels where the pair agrees, then disagree (class products).
 pub const AGREEMENT: [[u8; 3]; 2] = [[170, 200, 170], [215, 48, 39]];
 
 /// Maps: land and pixels not returned (RGBA, translucent over the panel).

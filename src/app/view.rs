@@ -84,8 +84,8 @@ impl ProductKind {
 /// How the three maps are arranged.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub enum Layout {
-    /// Truth | A | B.
+    /// The truth beside the designs on the maps (truth | A | B by default; `AppState::on_maps`).
     TruthAB,
-    /// A | B | A − B.
+    /// A pair of designs and their difference (A | B | A − B by default; `AppState::pair`).
     AbDifference,
 }

@@ -16,12 +16,12 @@ fn an_out_of_range_slider_value_is_refused_inline() {
     let expected = "aperture_mm: 5000 is out of range (allowed: above 0, at most 2000 mm)";
     assert_eq!(h.state().refused_value(), Some(expected));
     assert!(h.query_all_by_label(&format!("Aperture refused: {expected}")).next().is_some(), "not on screen");
-    assert!((h.state().state.a.spec.aperture_mm - 60.0).abs() < 1e-9, "the instrument keeps 60 mm");
+    assert!((h.state().state.designs[0].spec.aperture_mm - 60.0).abs() < 1e-9, "the instrument keeps 60 mm");
     h.get_by_role_and_label(Role::Slider, "Aperture").set_value_accesskit(100.0);
     h.step();
     h.step();
     assert_eq!(h.state().refused_value(), None);
-    assert!((h.state().state.a.spec.aperture_mm - 100.0).abs() < 1e-9);
+    assert!((h.state().state.designs[0].spec.aperture_mm - 100.0).abs() < 1e-9);
     let _ = std::fs::remove_dir_all(&lib);
 }
 
@@ -42,9 +42,9 @@ fn a_typed_value_is_applied_on_enter_not_per_keystroke() {
             h.event(egui::Event::Text(c.to_string()));
             h.step();
             assert!(
-                (h.state().state.a.spec.aperture_mm - 60.0).abs() < 1e-9,
+                (h.state().state.designs[0].spec.aperture_mm - 60.0).abs() < 1e-9,
                 "after typing `{c}` of `{text}` the aperture is {} mm: applied per keystroke",
-                h.state().state.a.spec.aperture_mm
+                h.state().state.designs[0].spec.aperture_mm
             );
         }
     };
@@ -54,13 +54,17 @@ fn a_typed_value_is_applied_on_enter_not_per_keystroke() {
     h.step();
     h.step();
     assert!(h.state().refused_value().is_some_and(|m| m.contains("99999")), "{:?}", h.state().refused_value());
-    assert!((h.state().state.a.spec.aperture_mm - 60.0).abs() < 1e-9, "a refused value is not applied");
+    assert!((h.state().state.designs[0].spec.aperture_mm - 60.0).abs() < 1e-9, "a refused value is not applied");
 
     type_into_aperture(&mut h, "150");
     h.key_press(egui::Key::Enter);
     h.step();
     h.step();
-    assert!((h.state().state.a.spec.aperture_mm - 150.0).abs() < 1e-9, "{}", h.state().state.a.spec.aperture_mm);
+    assert!(
+        (h.state().state.designs[0].spec.aperture_mm - 150.0).abs() < 1e-9,
+        "{}",
+        h.state().state.designs[0].spec.aperture_mm
+    );
     let _ = std::fs::remove_dir_all(&lib);
 }
 
@@ -76,8 +80,8 @@ fn undo_and_redo_walk_the_instrument_edits() {
     h.get_by_role_and_label(Role::Slider, "Read noise").set_value_accesskit(40.0);
     h.step();
     h.step();
-    let aperture = |h: &Harness<'static, ShoalApp>| h.state().state.a.spec.aperture_mm;
-    let read_noise = |h: &Harness<'static, ShoalApp>| h.state().state.a.spec.read_noise_e;
+    let aperture = |h: &Harness<'static, ShoalApp>| h.state().state.designs[0].spec.aperture_mm;
+    let read_noise = |h: &Harness<'static, ShoalApp>| h.state().state.designs[0].spec.read_noise_e;
     assert_eq!((aperture(&h), read_noise(&h)), (90.0, 40.0));
 
     h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
@@ -89,7 +93,7 @@ fn undo_and_redo_walk_the_instrument_edits() {
     h.step();
     h.step();
     assert!((aperture(&h) - 60.0).abs() < 1e-9, "back to the preset's 60 mm");
-    assert!(!h.state().state.a.modified(), "the preset as loaded is no longer marked modified");
+    assert!(!h.state().state.designs[0].modified(), "the preset as loaded is no longer marked modified");
 
     h.key_press_modifiers(egui::Modifiers::COMMAND | egui::Modifiers::SHIFT, egui::Key::Z);
     h.step();
@@ -106,7 +110,7 @@ fn shift_dragging_a_slider_rail_moves_the_value_a_tenth_as_far() {
     let dir = temp_library("finedrag");
     let mut h = harness("cubesat", 24, &dir);
     h.step();
-    let before = h.state().state.a.spec.aperture_mm;
+    let before = h.state().state.designs[0].spec.aperture_mm;
     let rail = h.get_by_role_and_label(Role::Slider, "Aperture").rect();
     let shift = egui::Modifiers::SHIFT;
     let at = |dx: f32| egui::pos2(rail.center().x + dx, rail.center().y);
@@ -133,7 +137,7 @@ fn shift_dragging_a_slider_rail_moves_the_value_a_tenth_as_far() {
     h.event(egui::Event::ModifiersChanged(egui::Modifiers::NONE));
     h.step();
     h.step();
-    let after = h.state().state.a.spec.aperture_mm;
+    let after = h.state().state.designs[0].spec.aperture_mm;
     let expected = before * 50f64.powf(0.1 * 80.0 / 160.0);
     // 1 %: the drag is in whole points, exact in f32; the rest is rounding of the displayed value.
     assert!((after / expected - 1.0).abs() < 0.01, "aperture {before} → {after} mm, expected {expected:.2} mm");

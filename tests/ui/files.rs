@@ -18,16 +18,16 @@ fn a_saved_preset_reloads_with_its_edits() {
     assert_eq!(h.state().error(), None);
     let file = dir.join("instruments").join("my_cube.ron");
     assert!(file.is_file(), "no {}", file.display());
-    assert_eq!(h.state().state.a.preset, "my_cube");
-    assert!(!h.state().state.a.modified(), "a saved preset is no longer marked modified");
+    assert_eq!(h.state().state.designs[0].preset, "my_cube");
+    assert!(!h.state().state.designs[0].modified(), "a saved preset is no longer marked modified");
 
     // Load something else, then the saved preset back.
-    pick(&mut h, "Instrument A", "smallsat");
-    assert!((h.state().state.a.spec.aperture_mm - 240.0).abs() < 1e-9);
-    pick(&mut h, "Instrument A", "my_cube (mine)");
-    assert_eq!(h.state().state.a.preset, "my_cube");
-    assert!((h.state().state.a.spec.aperture_mm - 77.0).abs() < 1e-9);
-    assert!(!h.state().state.a.modified());
+    pick(&mut h, "A", "smallsat");
+    assert!((h.state().state.designs[0].spec.aperture_mm - 240.0).abs() < 1e-9);
+    pick(&mut h, "A", "my_cube (mine)");
+    assert_eq!(h.state().state.designs[0].preset, "my_cube");
+    assert!((h.state().state.designs[0].spec.aperture_mm - 77.0).abs() < 1e-9);
+    assert!(!h.state().state.designs[0].modified());
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -46,8 +46,8 @@ fn saving_under_a_built_in_name_is_refused_inline() {
     assert!(error.contains("`smallsat` is a built-in instrument; save yours under another name"), "{error}");
     assert!(!dir.join("instruments").join("smallsat.ron").exists());
     // The edit is kept, still marked as modified, and B's built-in smallsat is untouched.
-    assert!((h.state().state.a.spec.aperture_mm - 77.0).abs() < 1e-9);
-    assert!(h.state().state.a.modified());
+    assert!((h.state().state.designs[0].spec.aperture_mm - 77.0).abs() < 1e-9);
+    assert!(h.state().state.designs[0].modified());
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -63,13 +63,13 @@ fn a_malformed_preset_shows_an_error_and_the_app_goes_on() {
     std::fs::write(instruments.join("broken.ron"), broken).unwrap();
 
     let mut h = harness("cubesat", 16, &dir);
-    let before = h.state().state.a.clone();
-    pick(&mut h, "Instrument A", "broken (mine)");
+    let before = h.state().state.designs[0].clone();
+    pick(&mut h, "A", "broken (mine)");
     let error = h.state().error().expect("an error is shown").to_string();
     assert!(error.contains("broken"), "{error}");
     assert!(error.contains("aperture_mm"), "the message names the field: {error}");
     assert!(error.contains("line 12"), "the message names the line: {error}");
-    assert_eq!(h.state().state.a, before, "the instrument is unchanged");
+    assert_eq!(h.state().state.designs[0], before, "the instrument is unchanged");
     // The dialog shows it; OK closes it and the app goes on drawing.
     assert!(h.query_by_label_contains("aperture_mm").is_some());
     h.get_by_label("OK").click();
@@ -78,7 +78,7 @@ fn a_malformed_preset_shows_an_error_and_the_app_goes_on() {
     assert_eq!(h.state().error(), None);
     h.get_by_role_and_label(Role::Slider, "Aperture").set_value_accesskit(90.0);
     h.step();
-    assert!((h.state().state.a.spec.aperture_mm - 90.0).abs() < 1e-6);
+    assert!((h.state().state.designs[0].spec.aperture_mm - 90.0).abs() < 1e-6);
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -173,8 +173,8 @@ fn a_preset_does_not_replace_edits_without_asking() {
     h.get_by_role_and_label(Role::Slider, "Aperture").set_value_accesskit(90.0);
     h.step();
     h.step();
-    pick(&mut h, "Instrument A", "smallsat");
-    assert_eq!(h.state().state.a.spec.aperture_mm, 90.0, "nothing replaced before the answer");
+    pick(&mut h, "A", "smallsat");
+    assert_eq!(h.state().state.designs[0].spec.aperture_mm, 90.0, "nothing replaced before the answer");
     assert!(
         h.query_all_by_label_contains("replaces unsaved edits of A (cubesat: aperture_mm 60.0 → 90.0)")
             .next()
@@ -184,14 +184,14 @@ fn a_preset_does_not_replace_edits_without_asking() {
     h.get_by_label("Cancel").click();
     h.step();
     h.step();
-    assert_eq!(h.state().state.a.preset, "cubesat");
-    assert_eq!(h.state().state.a.spec.aperture_mm, 90.0, "Cancel keeps the edits");
+    assert_eq!(h.state().state.designs[0].preset, "cubesat");
+    assert_eq!(h.state().state.designs[0].spec.aperture_mm, 90.0, "Cancel keeps the edits");
 
-    pick(&mut h, "Instrument A", "smallsat");
+    pick(&mut h, "A", "smallsat");
     h.get_by_label("Replace").click();
     h.step();
     h.step();
-    assert_eq!(h.state().state.a.preset, "smallsat");
-    assert!((h.state().state.a.spec.aperture_mm - 240.0).abs() < 1e-9);
+    assert_eq!(h.state().state.designs[0].preset, "smallsat");
+    assert!((h.state().state.designs[0].spec.aperture_mm - 240.0).abs() < 1e-9);
     let _ = std::fs::remove_dir_all(&lib);
 }

@@ -19,6 +19,7 @@ use shoal::instrument::InstrumentSpec;
 use shoal::library::Library;
 
 mod design;
+mod designs;
 mod editing;
 mod external;
 mod files;
@@ -36,11 +37,8 @@ fn temp_library(name: &str) -> PathBuf {
 
 /// The default study (CubeSat vs SmallSat over Lake Hume) with A set to `a`, run at 1/`level`.
 fn harness(a: &str, level: usize, library: &std::path::Path) -> Harness<'static, ShoalApp> {
-    let state = AppState {
-        a: Slot::new(a, InstrumentSpec::preset(a).unwrap()),
-        decimations: vec![level],
-        ..AppState::default()
-    };
+    let mut state = AppState { decimations: vec![level], ..AppState::default() };
+    state.designs[0] = Slot::new(a, InstrumentSpec::preset(a).unwrap());
     with_state(state, library)
 }
 
@@ -98,9 +96,9 @@ fn pick(h: &mut Harness<'static, ShoalApp>, combo: &str, item: &str) {
 fn a_bigger_aperture_lowers_the_cubesat_chl_error() {
     let dir = temp_library("aperture");
     let mut h = harness("smallsat", 8, &dir);
-    pick(&mut h, "Instrument A", "cubesat");
-    assert_eq!(h.state().state.a.preset, "cubesat");
-    assert!((h.state().state.a.spec.aperture_mm - 60.0).abs() < 1e-9);
+    pick(&mut h, "A", "cubesat");
+    assert_eq!(h.state().state.designs[0].preset, "cubesat");
+    assert!((h.state().state.designs[0].spec.aperture_mm - 60.0).abs() < 1e-9);
     wait_for_engine(&mut h);
     let before = displayed_chl_mae(&h);
 
@@ -109,8 +107,8 @@ fn a_bigger_aperture_lowers_the_cubesat_chl_error() {
     // 240 mm SmallSat has 11 % against the 60 mm CubeSat's 37 %).
     h.get_by_role_and_label(Role::Slider, "Aperture").set_value_accesskit(180.0);
     h.step();
-    assert!((h.state().state.a.spec.aperture_mm - 180.0).abs() < 1e-6);
-    assert!(h.state().state.a.modified(), "an edited preset is marked");
+    assert!((h.state().state.designs[0].spec.aperture_mm - 180.0).abs() < 1e-6);
+    assert!(h.state().state.designs[0].modified(), "an edited preset is marked");
     wait_for_engine(&mut h);
     let after = displayed_chl_mae(&h);
     assert!(
@@ -186,6 +184,10 @@ fn the_reference_mode_selector_reruns_alm_as_the_published_code() {
     let mut h = harness("cubesat", 16, &dir);
     wait_for_engine(&mut h);
     let improved = displayed_chl_mae(&h);
+    // Below the design list and the sliders: a taller window shows it without scrolling.
+    h.set_size(egui::vec2(1500.0, 1200.0));
+    h.step();
+    h.step();
     h.get_by_label("Reference").click();
     h.step();
     assert_eq!(h.state().state.almi.mode, shoal::retrieval::Mode::Reference);
@@ -205,12 +207,8 @@ fn an_instrument_that_returns_no_pixel_is_never_a_pass() {
     let dir = temp_library("nothing");
     let mut broken = InstrumentSpec::preset("cubesat").unwrap();
     broken.well_depth_e = 10.0;
-    let state = AppState {
-        a: Slot::new("cubesat", broken.clone()),
-        b: Slot::new("cubesat", broken),
-        decimations: vec![16],
-        ..AppState::default()
-    };
+    let mut state = AppState { decimations: vec![16], ..AppState::default() };
+    state.designs = vec![Slot::new("cubesat", broken.clone()), Slot::new("cubesat", broken)];
     let mut h = with_state(state, &dir);
     wait_for_engine(&mut h);
     let shown = h.state().link.shown[0].as_ref().unwrap();
@@ -289,7 +287,7 @@ fn the_histograms_count_every_returned_pixel_and_the_scatter_is_a_capped_sample(
     assert_eq!(data.counts[1].iter().sum::<usize>(), 0, "no B run");
     // Drawn as shares of each run's water pixels (a preview beside a full-resolution run): the
     // truth's shares sum to 100 %, A's to its returned %.
-    assert_eq!((data.pixels, data.truth_pixels), ([with_truth, 0], with_truth));
+    assert_eq!((data.pixels.as_slice(), data.truth_pixels), (&[with_truth, 0][..], with_truth));
     let share: f64 = data.counts[0].iter().map(|n| PlotData::percent(*n, data.pixels[0])).sum();
     assert!((share - 100.0 * returned as f64 / with_truth as f64).abs() < 1e-9, "{share}");
     assert_eq!(data.edges_log10.len(), BINS + 1);
@@ -356,7 +354,7 @@ fn the_seed_spread_shows_beside_the_mae_and_goes_stale_after_an_edit() {
     h.step();
     // chl, NAP and CDOM of A and B: six MAE cells carry a ±.
     assert_eq!(h.query_all_by_label_contains(" ±").count(), 6, "a ± on every MAE cell");
-    h.state_mut().state.a.spec.aperture_mm *= 1.5;
+    h.state_mut().state.designs[0].spec.aperture_mm *= 1.5;
     h.step();
     h.step();
     assert_eq!(h.query_all_by_label_contains(" ±").count(), 0, "a stale spread is not shown");

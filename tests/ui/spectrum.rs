@@ -49,7 +49,7 @@ fn a_click_on_a_map_shows_the_spectrum_there() {
     assert!(h.query_by_label_contains("A: bands (FWHM) and what it measured").is_some());
     assert!(h.query_by_label_contains("B: bands (FWHM) and what it measured").is_some());
     // A new A: the spectrum is computed again for its run, and the old one is not shown meanwhile.
-    h.state_mut().state.a.spec.aperture_mm *= 1.5;
+    h.state_mut().state.designs[0].spec.aperture_mm *= 1.5;
     h.step();
     h.step();
     assert!(h.query_by_label_contains("Water at (").is_none(), "the previous run's spectrum stays up");

@@ -78,7 +78,7 @@ pub fn cost_window(app: &mut super::super::ShoalApp, ctx: &egui::Context) {
                 let fidelity = e.cost_config.as_ref().and_then(|base| crate::sweep::fidelity_of(&c.label, base));
                 let button = ui.add_enabled(fidelity.is_some(), egui::Button::new("Apply to the app"));
                 let button = if fidelity.is_some() {
-                    button.on_hover_text("Run A and B (previews and full resolution) with this fidelity: the row's change from full fidelity (a study's own fidelity settings are replaced)")
+                    button.on_hover_text("Run every design (previews and full resolution) with this fidelity: the row's change from full fidelity (a study's own fidelity settings are replaced)")
                 } else {
                     button.on_disabled_hover_text("Not a fidelity setting alone (it changes the atmosphere's accuracy, the retrieval or the resolution): set it where it lives")
                 };

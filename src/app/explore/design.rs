@@ -3,11 +3,11 @@
 //! thread against the Requirements panel, under the built-in budget models chosen here, and
 //! streams every design it evaluates. The plot shows cost against the product's error (every
 //! design, the feasible ones, the front and the requirement); a design from the table goes into
-//! A or B with one click.
+//! A, or added beside the others, with one click.
 
 use egui_plot::{HLine, Legend, Line, Plot, PlotPoints, Points};
 
-use super::super::model::Ab;
+use super::super::model::Slot;
 use crate::design::{Evaluation, Evaluator, Settings, Variable, cheapest_feasible, pareto_front};
 use crate::instrument::budgets::BudgetModels;
 use crate::jobs::{Task, TaskNews};
@@ -171,7 +171,7 @@ impl DesignState {
 pub fn design_window(app: &mut super::super::ShoalApp, ctx: &egui::Context) {
     let mut open = app.ui.explore.design_open;
     let mut start = false;
-    let mut put: Option<(Ab, usize)> = None;
+    let mut put: Option<(Put, usize)> = None;
     // A as it is now: the parameters it can vary, and whether the last search still describes
     // the scene and requirements on screen.
     let current = app.state.configs().into_iter().next();
@@ -235,12 +235,18 @@ pub fn design_window(app: &mut super::super::ShoalApp, ctx: &egui::Context) {
     if start {
         app.ui.explore.design.start(ctx, &app.state);
     }
-    if let Some((ab, i)) = put {
+    if let Some((to, i)) = put {
         let d = &app.ui.explore.design;
         if let (Some(e), Some((base, _))) = (d.results.get(i), &d.searched_from) {
-            match crate::design::space::configure(base, &d.searched, &e.x) {
-                Ok(config) => app.state.slot_mut(ab).spec = config.instrument,
-                Err(err) => app.ui.explore.design.status = err,
+            match (crate::design::space::configure(base, &d.searched, &e.x), to) {
+                (Ok(config), Put::IntoA) => app.state.designs[0].spec = config.instrument,
+                (Ok(config), Put::New) => {
+                    let slot = Slot::new(&format!("search #{}", i + 1), config.instrument);
+                    if app.state.add_design(slot).is_none() {
+                        app.ui.explore.design.status = "the app already holds as many designs as it can".into();
+                    }
+                }
+                (Err(err), _) => app.ui.explore.design.status = err,
             }
         }
     }
@@ -271,15 +277,22 @@ fn plot(ui: &mut egui::Ui, d: &DesignState, requirements: &crate::study::Require
         .show(ui, |p| {
             p.points(Points::new("designs", all).radius(3.0).color(egui::Color32::GRAY));
             p.points(Points::new("feasible", feasible).radius(5.0).color(super::super::theme::PASS));
-            p.line(Line::new("front", PlotPoints::from(front)).color(super::super::theme::INSTRUMENT[1]));
+            p.line(Line::new("front", PlotPoints::from(front)).color(super::super::theme::design(1)));
             if let Some(limit) = requirements.for_variable(variable).and_then(|r| r.mae_pct) {
                 p.hline(HLine::new("requirement", limit).color(super::super::theme::FAIL));
             }
         });
 }
 
+/// Where a design found goes: into A (the design searched from), or beside the others.
+#[derive(Clone, Copy)]
+enum Put {
+    IntoA,
+    New,
+}
+
 /// The designs by cost, with their values, error and verdict, and buttons to use one.
-fn table(ui: &mut egui::Ui, d: &DesignState, put: &mut Option<(Ab, usize)>) {
+fn table(ui: &mut egui::Ui, d: &DesignState, put: &mut Option<(Put, usize)>) {
     let mut order: Vec<usize> = (0..d.results.len()).collect();
     order.sort_by(|&a, &b| {
         d.results[a].cost.unwrap_or(f64::INFINITY).total_cmp(&d.results[b].cost.unwrap_or(f64::INFINITY))
@@ -312,11 +325,12 @@ fn table(ui: &mut egui::Ui, d: &DesignState, put: &mut Option<(Ab, usize)>) {
                 ui.label(if e.constraints.is_empty() { "–".into() } else { format!("{:+.1}", 100.0 * e.worst()) })
                     .on_hover_text(if e.feasible() { "meets every requirement".into() } else { misses(e) });
                 ui.horizontal(|ui| {
-                    if ui.small_button("→ A").clicked() {
-                        *put = Some((Ab::A, i));
+                    if ui.small_button("→ A").on_hover_text("Set design A's parameters to these").clicked() {
+                        *put = Some((Put::IntoA, i));
                     }
-                    if ui.small_button("→ B").clicked() {
-                        *put = Some((Ab::B, i));
+                    if ui.small_button("+ design").on_hover_text("Add this as a new design beside the others").clicked()
+                    {
+                        *put = Some((Put::New, i));
                     }
                 });
                 ui.end_row();

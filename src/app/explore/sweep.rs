@@ -1,5 +1,5 @@
 //! The Sweep window: any number of the run configuration from the range table (`src/ranges.rs`)
-//! swept over a range for A and B, optionally against a second one (a curve per value), with
+//! swept over a range for every design, optionally against a second one (a curve per value), with
 //! noise seeds; the MAE of any product the retrieval makes, on a linear or log axis; where each
 //! curve first meets its requirement; and the points where the design saturates marked, so a
 //! jump in a curve is explained where it happens.
@@ -77,7 +77,7 @@ fn sweep_plot(ui: &mut egui::Ui, e: &Explore, table: &Table, curves: &crate::stu
     let (from, to) = (x_of(e.from), x_of(e.to));
     let colour_of = |k: usize| {
         if curves.series.len() <= 2 {
-            super::super::theme::INSTRUMENT.get(k).copied().unwrap_or_else(|| super::super::theme::category(k))
+            super::super::theme::DESIGN.get(k).copied().unwrap_or_else(|| super::super::theme::category(k))
         } else {
             super::super::theme::category(k)
         }
@@ -285,8 +285,12 @@ pub fn sweep_window(app: &mut super::super::ShoalApp, ctx: &egui::Context) {
                     ui.selectable_value(&mut e.decimation, d, format!("1/{d}"));
                 }
             });
-            let runs = 2 * e.steps * e.seeds as usize * if e.second.is_some() { 3 } else { 1 };
-            if ui.button("Run sweep").on_hover_text(format!("{runs} runs of A and B")).clicked() {
+            let runs = app.state.designs.len() * e.steps * e.seeds as usize * if e.second.is_some() { 3 } else { 1 };
+            if ui
+                .button("Run sweep")
+                .on_hover_text(format!("{runs} runs: every design at every value and seed"))
+                .clicked()
+            {
                 start = true;
             }
         });

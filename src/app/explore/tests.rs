@@ -66,7 +66,7 @@ fn the_cost_window_shows_the_95th_percentile_at_1280x720_and_marks_rows_of_an_ol
     }
     assert!(h.query_by_label_contains("Stale").is_none(), "rows of the current A are not stale");
     // A changes: the rows were measured for another instrument.
-    h.state_mut().state.a.spec.aperture_mm += 10.0;
+    h.state_mut().state.designs[0].spec.aperture_mm += 10.0;
     h.run_steps(2);
     assert!(h.query_by_label_contains("Stale").is_some(), "rows of an older A are marked stale");
 }

@@ -1,0 +1,118 @@
+//! Many designs in the app: a third and fourth added from the library, reordered and removed
+//! through the design list, every table and plot showing each one, and results that move with
+//! their designs rather than being computed again.
+
+use std::sync::Arc;
+
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
+use shoal::app::ShoalApp;
+use shoal::app::model::AppState;
+use shoal::engine::RunOutput;
+
+use super::{temp_library, wait_for_engine, with_state};
+
+/// The run on display of each design.
+fn runs(h: &Harness<'static, ShoalApp>) -> Vec<Arc<RunOutput>> {
+    h.state().link.shown.iter().map(|s| s.as_ref().expect("a result").output.clone()).collect()
+}
+
+fn presets(h: &Harness<'static, ShoalApp>) -> Vec<String> {
+    h.state().state.designs.iter().map(|d| d.preset.clone()).collect()
+}
+
+/// Add `preset` through the list's "Add design" menu.
+fn add(h: &mut Harness<'static, ShoalApp>, preset: &str) {
+    h.get_by_label("Add design").click();
+    h.step();
+    h.step();
+    h.get_by_label(preset).click();
+    h.step();
+    h.step();
+}
+
+#[test]
+fn a_third_and_fourth_design_are_added_reordered_and_removed_and_results_move_with_them() {
+    let dir = temp_library("designs");
+    let mut h = with_state(AppState { decimations: vec![16], ..AppState::default() }, &dir);
+    wait_for_engine(&mut h);
+    let before = runs(&h);
+    assert_eq!(before.len(), 2, "A vs B by default");
+
+    add(&mut h, "nominal");
+    add(&mut h, "filter_imager");
+    wait_for_engine(&mut h);
+    assert_eq!(presets(&h), ["cubesat", "smallsat", "nominal", "filter_imager"]);
+    let four = runs(&h);
+    assert_eq!(four.len(), 4, "every design has a result");
+    assert!(Arc::ptr_eq(&four[0], &before[0]) && Arc::ptr_eq(&four[1], &before[1]), "A and B were not run again");
+    assert_eq!(four[2].config.instrument.name, "nominal");
+    // Every table, key and map shows the new designs.
+    for text in ["C MAE", "D MAE", "Edit D", "truth | A | B | C | D"] {
+        assert!(h.query_by_label(text).is_some(), "`{text}` is not on screen");
+    }
+    maps_become(&mut h, &["truth", "A", "B", "C", "D"]);
+    let plot = h.state().plot_data().expect("plot data");
+    assert_eq!((plot.counts.len(), plot.scatter.len()), (4, 4), "histogram and scatter of every design");
+    assert!(plot.scatter.iter().all(|s| !s.is_empty()));
+
+    // C (nominal) up one place: it becomes B, and its result goes with it.
+    h.get_all_by_label("▲").nth(2).expect("C's up button").click();
+    h.step();
+    h.step();
+    assert_eq!(presets(&h), ["cubesat", "nominal", "smallsat", "filter_imager"]);
+    wait_for_engine(&mut h);
+    let moved = runs(&h);
+    assert!(Arc::ptr_eq(&moved[1], &four[2]) && Arc::ptr_eq(&moved[2], &four[1]), "results follow their designs");
+    assert!(Arc::ptr_eq(&moved[0], &four[0]) && Arc::ptr_eq(&moved[3], &four[3]));
+
+    // Remove A (cubesat): the others keep their results and move up a letter.
+    h.get_all_by_label("✖").next().expect("A's remove button").click();
+    h.step();
+    h.step();
+    wait_for_engine(&mut h);
+    assert_eq!(presets(&h), ["nominal", "smallsat", "filter_imager"]);
+    let left = runs(&h);
+    assert!(left.iter().zip(&moved[1..]).all(|(a, b)| Arc::ptr_eq(a, b)), "no design was run again");
+    assert!(h.query_by_label("D MAE").is_none(), "the table has no fourth design now");
+    assert_eq!(h.state().state.editing, 2, "the design being edited is still filter_imager");
+
+    // The session round trip keeps the list, the design edited and the maps' choice.
+    let mut state = h.state().state.clone();
+    state.on_maps = vec![0, 2];
+    state.pair = [2, 0];
+    let text = ron::to_string(&state).unwrap();
+    assert!(!text.contains("editing_instrument") && !text.contains(",a:("), "no legacy field is written");
+    let mut back: AppState = ron::from_str(&text).unwrap();
+    back.settle();
+    assert_eq!(back, state);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Draw frames until the maps' titles are `titles` (the raster thread answers within a few
+/// frames); fails after 30 s.
+fn maps_become(h: &mut Harness<'static, ShoalApp>, titles: &[&str]) {
+    let start = std::time::Instant::now();
+    while h.state().panel_titles() != titles {
+        assert!(start.elapsed().as_secs() < 30, "the maps are {:?}, not {titles:?}", h.state().panel_titles());
+        h.step();
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+}
+
+#[test]
+fn the_difference_layout_shows_the_chosen_pair() {
+    let dir = temp_library("pair");
+    let mut h = with_state(AppState { decimations: vec![16], ..AppState::default() }, &dir);
+    add(&mut h, "nominal");
+    wait_for_engine(&mut h);
+    h.state_mut().state.pair = [2, 0];
+    h.step();
+    h.get_by_label("C | A | C − A").click();
+    maps_become(&mut h, &["C", "A", "C − A"]);
+    // Design C alone on the small multiples: the truth and C.
+    h.state_mut().state.layout = shoal::app::model::Layout::TruthAB;
+    h.state_mut().state.on_maps = vec![2];
+    maps_become(&mut h, &["truth", "C"]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
