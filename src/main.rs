@@ -22,6 +22,7 @@ fn app(args: &AppArgs) -> ExitCode {
         fresh: args.fresh || args.screenshot.is_some(),
         screenshot: args.screenshot.clone(),
         size: args.size,
+        study: args.study.clone(),
         ..shoal::app::AppOptions::default()
     };
     match shoal::app::run(options) {

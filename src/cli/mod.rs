@@ -81,6 +81,10 @@ pub struct AppArgs {
     /// Window size in logical pixels, WIDTHxHEIGHT (default 1500x960; at least 900x600).
     #[arg(long, value_name = "WxH", value_parser = parse_size)]
     pub size: Option<[f32; 2]>,
+    /// Open this study of the library (built-in or yours) instead of the saved session; it
+    /// becomes the session.
+    #[arg(long, value_name = "NAME")]
+    pub study: Option<String>,
 }
 
 /// `1280x720` → [1280, 720], within 900x600 to 7680x4320.
