@@ -37,9 +37,11 @@ pub fn write_figure(snap: &Snapshot, stem: &Path) -> Result<Vec<PathBuf>, String
         Palette::Sequential(s) => s,
         _ => Scale { lo: 0.0, hi: 8.0, log: false },
     };
-    let table = verdict_table(state, &runs);
-    let changes = state.changes();
     let designs: Vec<String> = (0..runs.len()).map(|i| state.design_name(i)).collect();
+    let wide = verdict_table(state, &runs);
+    // Beyond two designs the products go across and the designs down, so the table fits.
+    let table = if runs.len() > 2 { by_design(&wide, &designs) } else { wide };
+    let changes = state.changes();
     let caption = vec![
         format!(
             "{}   scene: {}   retrieval: {}   resolution 1/{}",
@@ -115,6 +117,25 @@ fn parameter_table(state: &AppState, runs: &[&Arc<RunOutput>]) -> Vec<Vec<String
         .map(|(&i, n)| (n.as_str(), &runs[i].config.instrument, runs[i].response.bands.bands.len()))
         .collect();
     super::params::differences(&designs)
+}
+
+/// [`verdict_table`] turned round: a row per design ("C: nominal"), a column per product with
+/// "MAE / bias %" and its verdict ("pass", "FAIL"), the SNR and bottom-type rows as columns.
+fn by_design(wide: &[Vec<String>], names: &[String]) -> Vec<Vec<String>> {
+    let mut header = vec!["MAE / bias %".to_string()];
+    header.extend(wide.iter().skip(1).map(|r| r[0].clone()));
+    let mut out = vec![header];
+    for (i, name) in names.iter().enumerate() {
+        let mut row = vec![name.clone()];
+        for r in wide.iter().skip(1) {
+            let Some(c) = r.get(1 + 4 * i..5 + 4 * i) else { continue };
+            let value = if c[1].is_empty() { c[0].clone() } else { format!("{} / {}", c[0], c[1]) };
+            let verdict = if c[3].starts_with("FAIL") { "FAIL" } else { c[3].as_str() };
+            row.push(format!("{value} {verdict}").trim().to_string());
+        }
+        out.push(row);
+    }
+    out
 }
 
 /// The verdict table of the slide: one row per product with the designs side by side (MAE,

@@ -94,9 +94,10 @@ fn table<DB: DrawingBackend>(
         let ty = y + ROW_H * r as i32;
         let mut tx = x;
         for (c, cell) in row.iter().enumerate() {
+            // A verdict alone ("pass", "FAIL: …") or at the end of a value ("10.6 / +5.5 pass").
             let colour = match cell.as_str() {
-                "pass" => RGBColor(30, 130, 30),
-                s if s.starts_with("FAIL") => RGBColor(190, 30, 30),
+                s if s.starts_with("FAIL") || s.ends_with(" FAIL") => RGBColor(190, 30, 30),
+                s if s == "pass" || s.ends_with(" pass") => RGBColor(30, 130, 30),
                 _ => RGBColor(25, 25, 25),
             };
             root.draw_text(cell, &text_style(16, colour), (tx, ty)).map_err(err)?;
@@ -255,7 +256,15 @@ impl Draw for ReviewSlide {
         // row fit at three caption lines).
         let rows = usize::try_from((caption_y - table_y - 30) / ROW_H).unwrap_or(1).max(2);
         table(root, &self.verdicts, (MARGIN, table_y + 30), rows)?;
-        root.draw_text("A and B differ in", &text_style(20, BLACK), (PLOTS_X, table_y)).map_err(err)?;
+        // "A and B differ in" for a pair; with more designs, against the first column's.
+        let names: Vec<&str> =
+            self.parameters.first().map(|h| h.iter().skip(1).map(String::as_str).collect()).unwrap_or_default();
+        let heading = match names.as_slice() {
+            [a, b] => format!("{a} and {b} differ in"),
+            [a, ..] => format!("The designs against {a}"),
+            [] => "Parameters".to_string(),
+        };
+        root.draw_text(&heading, &text_style(20, BLACK), (PLOTS_X, table_y)).map_err(err)?;
         table(root, &self.parameters, (PLOTS_X, table_y + 30), rows)?;
         for (i, line) in self.caption.iter().enumerate() {
             root.draw_text(line, &text_style(15, RGBColor(60, 60, 60)), (MARGIN, caption_y + 24 * i as i32))

@@ -116,3 +116,41 @@ fn the_difference_layout_shows_the_chosen_pair() {
     maps_become(&mut h, &["truth", "C"]);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The figure and the review pack of four designs carry all four: maps, series, a verdict row
+/// and a configuration each.
+#[test]
+fn exports_carry_every_design() {
+    use egui::accesskit::Role;
+    let dir = temp_library("four-export");
+    let mut h = with_state(AppState { decimations: vec![16], ..AppState::default() }, &dir);
+    add(&mut h, "nominal");
+    add(&mut h, "filter_imager");
+    wait_for_engine(&mut h);
+    h.get_by_label("Path").click();
+    h.step();
+    h.step();
+    let stem = dir.join("review").join("four");
+    h.get_by_role_and_label(Role::TextInput, "Export to").set_text_value_accesskit(stem.to_str().unwrap());
+    h.step();
+    h.get_by_label("Write figure").click();
+    let configs: Vec<_> =
+        ["A", "B", "C", "D"].iter().map(|l| dir.join("review").join(format!("four_config_{l}.ron"))).collect();
+    let start = std::time::Instant::now();
+    while !configs.iter().all(|f| f.is_file()) || !stem.with_extension("svg").is_file() {
+        assert!(start.elapsed().as_secs() < 120, "the figure was not written");
+        assert_eq!(h.state().error(), None);
+        std::thread::sleep(std::time::Duration::from_millis(20));
+        h.step();
+    }
+    let svg = std::fs::read_to_string(stem.with_extension("svg")).unwrap();
+    for part in ["C: nominal", "D: filter_imager", "The designs against A", "MAE / bias %"] {
+        assert!(svg.contains(part), "the slide has no `{part}`");
+    }
+    if let Ok(keep) = std::env::var("SHOAL_KEEP_SLIDE") {
+        std::fs::copy(stem.with_extension("png"), std::path::Path::new(&keep).join("review_slide_four.png")).unwrap();
+    }
+    let config = std::fs::read_to_string(&configs[3]).unwrap();
+    assert!(shoal::engine::RunConfig::from_ron(&config, "D").unwrap().instrument.name == "filter_imager");
+    let _ = std::fs::remove_dir_all(&dir);
+}
