@@ -147,6 +147,7 @@ fn failed_product(spec: &RetrievalSpec, inputs: &RetrievalInputs<'_>) -> Product
         cost: ndarray::Array2::zeros(dim),
         sdi: None,
         iterations: None,
+        extras: Vec::new(),
         flags: inputs.land.mapv(|l| if l != 0 { ProductFlags::LAND } else { ProductFlags::FAILED }),
     }
 }

@@ -300,6 +300,7 @@ mod tests {
             cost: Array2::zeros((rows, cols)),
             sdi: None,
             iterations: None,
+            extras: Vec::new(),
             flags,
         };
         (product, truth)

@@ -207,6 +207,7 @@ pub(super) fn product(spec: &ExternalSpec, inputs: &RetrievalInputs<'_>, maps: &
         cost: Array2::zeros((rows, cols)),
         sdi: None,
         iterations: None,
+        extras: Vec::new(),
         flags,
     })
 }

@@ -10,8 +10,11 @@
 //! | SAMBUCA, reference mode | [`sambuca_reference`] | the CSIRO package's fit: one start, SLSQP, the stall kept |
 //! | solvers | [`nnls`], [`optimise`], [`slsqp`] | exact small NNLS; bounded Levenberg–Marquardt and BFGS; SciPy's SLSQP for bounds |
 //! | external | [`external`] | a user's own program, run on a NetCDF file of the Rrs, its products read back |
+//! | QAA v6 | [`qaa`] | the Quasi-Analytical Algorithm (Lee et al. 2002; v6 2014): IOPs, chl from a_ph(443) |
+//! | the seam | [`algorithm`] | the [`Algorithm`] trait every retrieval implements, and which spec runs which |
 //! | images | [`run`] | a retrieval over a whole Rrs cube, the products and their flags |
 
+pub mod algorithm;
 pub mod almi;
 pub mod almi_lanes;
 pub mod almi_reference;
@@ -20,6 +23,7 @@ pub mod external;
 mod external_io;
 pub mod nnls;
 pub mod optimise;
+pub mod qaa;
 pub mod quadrature;
 pub mod run;
 mod run_sambuca;
@@ -29,6 +33,7 @@ pub mod sets;
 pub mod slsqp;
 mod slsqp_qp;
 
+pub use algorithm::{Algorithm, Model};
 pub use almi::{AlmiFlags, AlmiSettings};
 pub use band_model::{BandModel, BandResponse, ModelScratch, Parameters};
 pub use run::{Product, ProductFlags, RetrievalInputs, RetrievalSpec};
@@ -86,34 +91,14 @@ impl crate::control::Cancellable for RetrievalError {
     }
 }
 
-/// A retrieval's model at the instrument's bands: what [`invert`] needs besides the Rrs (each SIOP
-/// set and substrate read and integrated over the band responses). It depends on the spec, the
-/// bands and the scene's SIOP and substrates, not on the Rrs, so the engine keeps it while a
-/// change of noise, aperture or electronics re-runs the pixels (stage `RetrievalModel`).
-#[derive(Debug, Clone)]
-pub enum Model {
-    /// aLMI's sets.
-    Almi(run::AlmiModel),
-    /// SAMBUCA's set and substrates (boxed: the larger of the two by far).
-    Sambuca(Box<run_sambuca::SambucaModel>),
-    /// An external program: nothing to prepare.
-    External,
-}
-
 /// Prepare `spec`'s model at `inputs.bands` (reads `bands`, `scene_siop`, `scene_substrates`
-/// and `base_dir` only).
+/// and `base_dir` only): what [`invert`] needs besides the Rrs. It depends on the spec, the bands
+/// and the scene's SIOP and substrates, not on the Rrs, so the engine keeps it while a change of
+/// noise, aperture or electronics re-runs the pixels (stage `RetrievalModel`).
 pub fn prepare(spec: &RetrievalSpec, inputs: &RetrievalInputs<'_>) -> Result<Model, RetrievalError> {
-    spec.validate()?;
-    Ok(match spec {
-        RetrievalSpec::Almi { siop_sets, settings } => Model::Almi(run::almi_model(siop_sets, settings, inputs)?),
-        RetrievalSpec::Sambuca { siop, substrates, settings } => Model::Sambuca(Box::new(run_sambuca::sambuca_model(
-            siop.as_ref(),
-            substrates.as_deref(),
-            settings,
-            inputs,
-        )?)),
-        RetrievalSpec::External(_) => Model::External,
-    })
+    let algorithm = spec.algorithm();
+    algorithm.validate()?;
+    algorithm.prepare(inputs)
 }
 
 /// Run `spec` over the image with `model`, prepared by [`prepare`] from the same spec and bands.
@@ -123,17 +108,7 @@ pub fn invert(
     inputs: &RetrievalInputs<'_>,
     control: &crate::control::RunControl,
 ) -> Result<Product, RetrievalError> {
-    match (spec, model) {
-        (RetrievalSpec::Almi { settings, .. }, Model::Almi(m)) => run::retrieve_almi(m, settings, inputs, control),
-        (RetrievalSpec::Sambuca { settings, .. }, Model::Sambuca(m)) => {
-            run_sambuca::retrieve_sambuca(m, settings, inputs, control)
-        }
-        (RetrievalSpec::External(e), Model::External) => external::retrieve_external(e, inputs, control),
-        _ => Err(RetrievalError::Invalid(FieldError {
-            field: "retrieval".into(),
-            message: format!("the model given was prepared for another retrieval than {}", spec.name()),
-        })),
-    }
+    spec.algorithm().invert(model, inputs, control)
 }
 
 /// Run `spec` over the image: [`prepare`], then [`invert`].

@@ -48,6 +48,13 @@ pub enum RetrievalSpec {
     },
     /// A user's own program, run on a NetCDF file of the Rrs ([`super::external`]).
     External(super::external::ExternalSpec),
+    /// The Quasi-Analytical Algorithm v6 ([`super::qaa`]): IOPs with no SIOP assumed, chl from
+    /// a_ph(443).
+    Qaa {
+        /// Settings.
+        #[serde(default)]
+        settings: super::qaa::QaaSettings,
+    },
 }
 
 impl RetrievalSpec {
@@ -58,6 +65,7 @@ impl RetrievalSpec {
             Self::Almi { .. } => "alm",
             Self::Sambuca { .. } => "sambuca",
             Self::External(e) => &e.name,
+            Self::Qaa { .. } => "qaa",
         }
     }
 
@@ -73,25 +81,7 @@ impl RetrievalSpec {
     /// Check the settings that need no image (counts, coefficients, bounds) against
     /// [`crate::ranges`], so a run can refuse them before any stage runs.
     pub fn validate(&self) -> Result<(), RetrievalError> {
-        use crate::ranges as r;
-        match self {
-            Self::Almi { siop_sets, settings } => {
-                if siop_sets.is_empty() || siop_sets.len() > 64 {
-                    return Err(RetrievalError::Invalid(FieldError {
-                        field: "siop_sets".into(),
-                        message: format!("{} sets (allowed: 1 to 64)", siop_sets.len()),
-                    }));
-                }
-                let check = |range: &r::Range, v: f64| {
-                    let field = range.field("retrievals[i].Almi.").into();
-                    range.check(v).map_err(|message| RetrievalError::Invalid(FieldError { field, message }))
-                };
-                check(&r::ALMI_G0, settings.g0)?;
-                check(&r::ALMI_G1, settings.g1)
-            }
-            Self::Sambuca { settings, .. } => validate_sambuca(settings),
-            Self::External(e) => e.validate(),
-        }
+        self.algorithm().validate()
     }
 }
 
@@ -147,6 +137,10 @@ pub struct Product {
     pub sdi: Option<Array2<f32>>,
     /// Iterations (SAMBUCA).
     pub iterations: Option<Array2<u16>>,
+    /// Further named maps the retrieval returns beside the core (QAA's IOPs: `adg443_per_m`, …),
+    /// keys of [`crate::variable::EXTRAS`]: mapped and written, scored only where the truth has
+    /// the same variable.
+    pub extras: Vec<(String, Array2<f32>)>,
     /// [`ProductFlags`].
     pub flags: Array2<u8>,
 }
@@ -168,8 +162,19 @@ impl Product {
             key::NAP => self.nap_g_m3.as_ref(),
             key::CDOM => self.cdom_per_m.as_ref(),
             key::DEPTH => self.depth_m.as_ref(),
-            _ => None,
+            other => self.extras.iter().find(|(k, _)| k == other).map(|(_, m)| m),
         }
+    }
+
+    /// Every scalar map it has, by key: the core variables ([`crate::variable::KEYS`]) it
+    /// returns, then its extras.
+    #[must_use]
+    pub fn maps(&self) -> Vec<(&str, &Array2<f32>)> {
+        crate::variable::KEYS
+            .iter()
+            .filter_map(|&v| self.map(v).map(|m| (v, m)))
+            .chain(self.extras.iter().map(|(k, m)| (k.as_str(), m)))
+            .collect()
     }
 }
 
@@ -362,12 +367,30 @@ pub(super) fn retrieve_almi(
         cost: plane(|p| p.4),
         sdi: None,
         iterations: None,
+        extras: Vec::new(),
         flags: Array2::from_shape_fn((rows, cols), |(r, c)| results[r][c].5),
     })
 }
 
 /// Check SAMBUCA's bounds and quadrature setting; the message names the field.
-fn validate_sambuca(settings: &SambucaSettings) -> Result<(), RetrievalError> {
+/// aLMI's settings against their ranges: 1–64 SIOP sets, g0 and g1.
+pub(super) fn validate_almi(siop_sets: &[SiopSource], settings: &AlmiSettings) -> Result<(), RetrievalError> {
+    use crate::ranges as r;
+    if siop_sets.is_empty() || siop_sets.len() > 64 {
+        return Err(RetrievalError::Invalid(FieldError {
+            field: "siop_sets".into(),
+            message: format!("{} sets (allowed: 1 to 64)", siop_sets.len()),
+        }));
+    }
+    let check = |range: &r::Range, v: f64| {
+        let field = range.field("retrievals[i].Almi.").into();
+        range.check(v).map_err(|message| RetrievalError::Invalid(FieldError { field, message }))
+    };
+    check(&r::ALMI_G0, settings.g0)?;
+    check(&r::ALMI_G1, settings.g1)
+}
+
+pub(super) fn validate_sambuca(settings: &SambucaSettings) -> Result<(), RetrievalError> {
     let b = &settings.bounds;
     for (field, (lo, hi)) in
         [("chl_mg_m3", b.chl_mg_m3), ("cdom_per_m", b.cdom_per_m), ("nap_g_m3", b.nap_g_m3), ("depth_m", b.depth_m)]

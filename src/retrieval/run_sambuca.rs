@@ -190,6 +190,7 @@ fn sambuca_product(results: &[Vec<SambucaRow>], names: Vec<String>, siop_name: &
         cost: plane(|p| p.6),
         sdi: Some(plane(|p| p.7)),
         iterations: Some(Array2::from_shape_fn((rows, cols), |(r, c)| results[r][c].8)),
+        extras: Vec::new(),
         flags: Array2::from_shape_fn((rows, cols), |(r, c)| results[r][c].9),
     }
 }
