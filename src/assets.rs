@@ -104,6 +104,7 @@ pub const PRESETS: &[Asset] = embed_presets![
     "studies/lake_hume_nominal.ron",
     "studies/lake_hume_oc4.ron",
     "studies/four_designs_lake_hume.ron",
+    "studies/lake_hume_qaa.ron",
     "studies/heron_island_depth.ron",
     "studies/paper_heron_island.ron",
     "studies/paper_lake_hume.ron",

@@ -67,13 +67,42 @@ pub const PRODUCTS: [Variable; 4] = [
     },
 ];
 
+/// Variables a retrieval may return beside [`PRODUCTS`] (`Product::extras`): mapped and written,
+/// not scored (the truth holds concentrations, not these IOPs).
+pub const EXTRAS: [Variable; 3] = [
+    Variable {
+        key: "adg443_per_m",
+        name: "a_dg(443)",
+        long_name: "absorption coefficient of detritus and CDOM at 443 nm",
+        unit: "m⁻¹",
+        udunits: "m-1",
+        standard_name: None,
+    },
+    Variable {
+        key: "aph443_per_m",
+        name: "a_ph(443)",
+        long_name: "absorption coefficient of phytoplankton at 443 nm",
+        unit: "m⁻¹",
+        udunits: "m-1",
+        standard_name: None,
+    },
+    Variable {
+        key: "bbp555_per_m",
+        name: "b_bp(555)",
+        long_name: "particulate backscattering coefficient at the band nearest 555 nm",
+        unit: "m⁻¹",
+        udunits: "m-1",
+        standard_name: None,
+    },
+];
+
 /// The keys of [`PRODUCTS`], in order.
 pub const KEYS: [&str; 4] = [key::CHL, key::NAP, key::CDOM, key::DEPTH];
 
-/// The variable called `key`, if it is one.
+/// The variable called `key`, if it is one (of [`PRODUCTS`] or [`EXTRAS`]).
 #[must_use]
 pub fn of(key: &str) -> Option<&'static Variable> {
-    PRODUCTS.iter().find(|v| v.key == key)
+    PRODUCTS.iter().chain(&EXTRAS).find(|v| v.key == key)
 }
 
 #[cfg(test)]

@@ -29,10 +29,10 @@ pub(super) fn retrieval_banner(app: &mut ShoalApp, ui: &mut egui::Ui) {
 /// The retrieval's name as tables and captions show it.
 pub(super) fn retrieval_name(state: &super::model::AppState) -> String {
     use super::model::RetrievalKind;
-    match (state.retrieval, &state.external) {
-        (RetrievalKind::Almi, _) | (RetrievalKind::External, None) => "aLMI".into(),
+    match (state.retrieval, &state.study_retrieval) {
+        (RetrievalKind::Almi, _) | (RetrievalKind::Study, None) => "aLMI".into(),
         (RetrievalKind::Sambuca, _) => "SAMBUCA".into(),
-        (RetrievalKind::External, Some(e)) => e.name.clone(),
+        (RetrievalKind::Study, Some(r)) => r.algorithm().title(),
     }
 }
 
@@ -40,17 +40,17 @@ pub(super) fn retrieval_name(state: &super::model::AppState) -> String {
 pub(super) fn product_note(app: &ShoalApp) -> Option<String> {
     use super::model::RetrievalKind;
     let retrieval = retrieval_name(&app.state);
-    let missing = match (app.state.retrieval, &app.state.external) {
-        (RetrievalKind::External, Some(e)) => match app.state.product {
+    let missing = match (app.state.retrieval, &app.state.study_retrieval) {
+        (RetrievalKind::Study, Some(r)) => match app.state.product {
             ProductKind::Depth | ProductKind::Chl | ProductKind::Nap | ProductKind::Cdom => {
-                app.state.product.variable().is_some_and(|v| !e.products.iter().any(|p| p == v))
+                app.state.product.variable().is_some_and(|v| !r.algorithm().variables().iter().any(|p| p == v))
             }
             ProductKind::Substrate | ProductKind::SiopSet => true,
             ProductKind::Rrs | ProductKind::Level1 | ProductKind::Snr => false,
         },
         (kind, _) => matches!(
             (kind, app.state.product),
-            (RetrievalKind::Almi | RetrievalKind::External, ProductKind::Depth | ProductKind::Substrate)
+            (RetrievalKind::Almi | RetrievalKind::Study, ProductKind::Depth | ProductKind::Substrate)
                 | (RetrievalKind::Sambuca, ProductKind::SiopSet)
         ),
     };
@@ -93,7 +93,9 @@ pub(super) fn failure_box(app: &mut ShoalApp, ui: &mut egui::Ui, index: usize, m
 pub(super) fn external_banner(app: &mut ShoalApp, ui: &mut egui::Ui) {
     use super::model::RetrievalKind;
     use crate::retrieval::external;
-    let Some(spec) = app.state.external.clone().filter(|_| app.state.retrieval == RetrievalKind::External) else {
+    let Some(crate::retrieval::RetrievalSpec::External(spec)) =
+        app.state.study_retrieval.clone().filter(|_| app.state.retrieval == RetrievalKind::Study)
+    else {
         return;
     };
     if !external::allowed(&spec.command) {

@@ -174,7 +174,7 @@ impl ShoalApp {
                 self.state.retrieval = kind;
                 self.state.product = match kind {
                     RetrievalKind::Sambuca => ProductKind::Depth,
-                    RetrievalKind::Almi | RetrievalKind::External => ProductKind::Chl,
+                    RetrievalKind::Almi | RetrievalKind::Study => ProductKind::Chl,
                 };
             }
             UiCommand::SaveStudy { name } => {

@@ -85,8 +85,10 @@ pub enum RetrievalKind {
     Almi,
     /// SAMBUCA-style with the scene's SIOP set and substrates.
     Sambuca,
-    /// The study's external program ([`AppState::external`]).
-    External,
+    /// The study's own retrieval beyond aLMI and SAMBUCA ([`AppState::study_retrieval`]: a
+    /// program, QAA). Saved as `External`, its name when it could only be a program.
+    #[serde(rename = "External")]
+    Study,
 }
 
 /// The whole persisted state of the app.
@@ -132,8 +134,13 @@ pub struct AppState {
     pub almi: AlmiSettings,
     /// SAMBUCA settings.
     pub sambuca: SambucaSettings,
-    /// The external retrieval of the study the app opened, if it had one.
-    pub external: Option<crate::retrieval::external::ExternalSpec>,
+    /// The study's own retrieval beyond aLMI and SAMBUCA, if the study the app opened has one
+    /// (an external program, QAA): offered beside them by its name.
+    pub study_retrieval: Option<RetrievalSpec>,
+    /// The external program of a session saved before `study_retrieval` (moved there by
+    /// [`Self::settle`]).
+    #[serde(rename = "external", default, skip_serializing)]
+    pub legacy_external: Option<crate::retrieval::external::ExternalSpec>,
     /// Preview decimations, coarsest first; the last is the final resolution (saved states
     /// before the rename call it `levels`: [`crate::schema::RENAMES`]).
     pub decimations: Vec<usize>,
@@ -221,7 +228,8 @@ impl AppState {
             retrieval: RetrievalKind::Almi,
             almi: AlmiSettings::default(),
             sambuca: SambucaSettings::default(),
-            external: None,
+            study_retrieval: None,
+            legacy_external: None,
             schema_version: crate::schema::VERSION,
             decimations: vec![24, 4, 1],
             product: ProductKind::Chl,
@@ -273,14 +281,16 @@ impl AppState {
                 s.retrieval = RetrievalKind::Almi;
                 s.almi = settings.clone();
             }
-            Some(RetrievalSpec::External(_)) => s.retrieval = RetrievalKind::External,
+            Some(RetrievalSpec::External(_) | RetrievalSpec::Qaa { .. }) => s.retrieval = RetrievalKind::Study,
             None => {}
         }
-        // From the resolved run: `{dir}` in its command is the study file's directory by now.
-        s.external = first.2.retrievals.iter().find_map(|r| match r {
-            RetrievalSpec::External(e) => Some(e.clone()),
-            _ => None,
-        });
+        // From the resolved run: `{dir}` in a program's command is the study file's directory by now.
+        s.study_retrieval = first
+            .2
+            .retrievals
+            .iter()
+            .find(|r| !matches!(r, RetrievalSpec::Almi { .. } | RetrievalSpec::Sambuca { .. }))
+            .cloned();
         if let Some(r) = &study.requirements {
             s.requirements = r.clone();
         }
@@ -304,13 +314,13 @@ impl AppState {
             siop_sets: crate::retrieval::sets::default_almi_sets(),
             settings: self.almi.clone(),
         };
-        match (self.retrieval, &self.external) {
+        match (self.retrieval, &self.study_retrieval) {
             (RetrievalKind::Sambuca, _) => {
                 RetrievalSpec::Sambuca { siop: None, substrates: None, settings: self.sambuca.clone() }
             }
-            (RetrievalKind::External, Some(e)) => RetrievalSpec::External(e.clone()),
-            // A session naming an external retrieval it no longer holds runs aLMI.
-            (RetrievalKind::Almi | RetrievalKind::External, _) => almi(),
+            (RetrievalKind::Study, Some(r)) => r.clone(),
+            // A session naming a study's retrieval it no longer holds runs aLMI.
+            (RetrievalKind::Almi | RetrievalKind::Study, _) => almi(),
         }
     }
 

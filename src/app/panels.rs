@@ -323,19 +323,33 @@ fn settings(app: &mut ShoalApp, ui: &mut egui::Ui) {
         ui.horizontal(|ui| {
             ui.selectable_value(&mut s.retrieval, RetrievalKind::Almi, "aLMI");
             ui.selectable_value(&mut s.retrieval, RetrievalKind::Sambuca, "SAMBUCA");
-            if let Some(e) = &s.external {
-                ui.selectable_value(&mut s.retrieval, RetrievalKind::External, e.name.as_str())
-                    .on_hover_text(format!("The study's own program: {}", e.command.join(" ")));
+            if let Some(r) = &s.study_retrieval {
+                let title = r.algorithm().title();
+                ui.selectable_value(&mut s.retrieval, RetrievalKind::Study, title)
+                    .on_hover_text("The study's own retrieval");
             }
         });
-        if s.retrieval == RetrievalKind::External {
-            if let Some(e) = &s.external {
-                ui.small(format!(
-                    "Runs `{}` on the Rrs (NetCDF) and scores its {} (time limit {} s).",
-                    e.command.join(" "),
-                    e.products.join(", "),
-                    e.time_limit_s
-                ));
+        if s.retrieval == RetrievalKind::Study {
+            match &mut s.study_retrieval {
+                Some(crate::retrieval::RetrievalSpec::External(e)) => {
+                    ui.small(format!(
+                        "Runs `{}` on the Rrs (NetCDF) and scores its {} (time limit {} s).",
+                        e.command.join(" "),
+                        e.products.join(", "),
+                        e.time_limit_s
+                    ));
+                }
+                Some(crate::retrieval::RetrievalSpec::Qaa { settings }) => {
+                    ui.horizontal(|ui| {
+                        ui.label("Mode");
+                        ui.selectable_value(&mut settings.mode, Mode::Improved, "Document")
+                            .on_hover_text("The QAA v6 document's equations (sub-surface ratios, as NASA's l2gen)");
+                        ui.selectable_value(&mut settings.mode, Mode::Reference, "IOCCG sheet")
+                            .on_hover_text("The IOCCG QAA_v6 spreadsheet's arithmetic, which gives its published numbers");
+                    });
+                    ui.small("IOPs from the Rrs with no SIOP assumed; chl from a_ph(443) (Bricaud et al. 1998).");
+                }
+                _ => {}
             }
         } else {
             retrieval_mode(s, ui);
@@ -394,7 +408,7 @@ fn retrieval_mode(s: &mut super::model::AppState, ui: &mut egui::Ui) {
     // Reference: the published code's behaviour, to reproduce published numbers; Improved:
     // Shoal's inversion, the design default.
     let mode = match s.retrieval {
-        RetrievalKind::Almi | RetrievalKind::External => &mut s.almi.mode,
+        RetrievalKind::Almi | RetrievalKind::Study => &mut s.almi.mode,
         RetrievalKind::Sambuca => &mut s.sambuca.mode,
     };
     ui.horizontal(|ui| {
@@ -414,7 +428,7 @@ fn retrieval_mode(s: &mut super::model::AppState, ui: &mut egui::Ui) {
         RetrievalKind::Sambuca if reference => {
             ui.small("As the CSIRO package: distance f with NEDR, one start at (max − min)/2, SLSQP; stalls kept.");
         }
-        RetrievalKind::Almi | RetrievalKind::External => {
+        RetrievalKind::Almi | RetrievalKind::Study => {
             ui.checkbox(&mut s.almi.noise_weighting, "Noise weighting")
                 .on_hover_text("Weight each band by its noise (off: as the reference code)");
         }

@@ -194,6 +194,10 @@ pub fn write_run_geotiff(out: &RunOutput, dir: &Path) -> Result<Outputs, StudyEr
         if let Some(d) = &p.depth_m {
             push(&mut m, plane(d, &returned), "retrieved depth", "m");
         }
+        for (key, map) in &p.extras {
+            let (long, unit) = crate::netcdf::meaning(key);
+            push(&mut m, plane(map, &returned), &format!("retrieved {long}"), unit);
+        }
         if let Some(f) = &p.substrate_fractions {
             for (k, name) in p.substrate_names.iter().enumerate() {
                 push(&mut m, cube_plane(f, k, &returned), &format!("retrieved {name} fraction"), "1");

@@ -216,9 +216,7 @@ fn retrieval_vars<'a>(out: &'a RunOutput, floats: &mut Vec<FloatVar<'a>>, flags:
         let stem = ret.spec.name();
         let pf = p.flags.as_slice().unwrap_or_default();
         let returned = |i: usize| pf.get(i).is_some_and(|f| f & ProductFlags::RETURNED != 0);
-        let maps: Vec<(&str, &ndarray::Array2<f32>)> =
-            crate::variable::KEYS.iter().filter_map(|&v| p.map(v).map(|m| (v, m))).collect();
-        for (variable, values) in maps {
+        for (variable, values) in p.maps() {
             let (long, units) = meaning(variable);
             let mut a = attrs(&format!("{long} retrieved by {}", p.name), units, standard_name(variable));
             a.push(coordinates.clone());

@@ -128,16 +128,11 @@ pub fn write_run(out: &RunOutput, dir: &Path) -> Result<Outputs, StudyError> {
     for ret in &out.retrievals {
         let p = &ret.product;
         let stem = ret.spec.name();
-        for (variable, map) in [("chl_mg_m3", &p.chl_mg_m3), ("nap_g_m3", &p.nap_g_m3), ("cdom_per_m", &p.cdom_per_m)] {
-            if let Some(map) = map {
-                npy(dir, &format!("{stem}_{variable}.npy"), map, &mut o)?;
-            }
+        for (variable, map) in p.maps() {
+            npy(dir, &format!("{stem}_{variable}.npy"), map, &mut o)?;
         }
         npy(dir, &format!("{stem}_flags.npy"), &p.flags, &mut o)?;
         npy(dir, &format!("{stem}_cost.npy"), &p.cost, &mut o)?;
-        if let Some(d) = &p.depth_m {
-            npy(dir, &format!("{stem}_depth_m.npy"), d, &mut o)?;
-        }
         if let Some(f) = &p.substrate_fractions {
             npy(dir, &format!("{stem}_substrate_fractions.npy"), f, &mut o)?;
         }

@@ -40,6 +40,7 @@ pub fn both_modes(name: &str) -> Result<StudySpec, StudyError> {
         match &mut r {
             RetrievalSpec::Almi { settings, .. } => settings.mode = mode,
             RetrievalSpec::Sambuca { settings, .. } => settings.mode = mode,
+            RetrievalSpec::Qaa { settings } => settings.mode = mode,
             // A user's program has one behaviour.
             RetrievalSpec::External(_) => {}
         }

@@ -19,6 +19,7 @@ mod incremental;
 mod netcdf;
 mod noise;
 mod plausibility;
+mod qaa;
 mod rasters;
 mod report;
 mod reproduction;

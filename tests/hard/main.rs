@@ -164,7 +164,9 @@ fn check_retrievals(out: &RunOutput, case: &str) -> usize {
                     .collect(),
             ),
             RetrievalSpec::Sambuca { .. } => (false, vec![true; nb]),
-            RetrievalSpec::External(_) => unreachable!("the hard cases run no external program"),
+            RetrievalSpec::External(_) | RetrievalSpec::Qaa { .. } => {
+                unreachable!("the hard cases run aLMI and SAMBUCA (QAA's: tests/chain/qaa.rs)")
+            }
         };
         let (mut failed, mut returned, mut too_few) = (0, 0, 0);
         for ((r, col), f) in p.flags.indexed_iter() {

@@ -10,6 +10,7 @@ mod atmosphere_limits;
 mod cli;
 mod missions;
 mod osoaa;
+mod qaa;
 mod sambuca;
 mod sambuca_reference;
 mod sixs_swir;

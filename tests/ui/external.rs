@@ -4,6 +4,7 @@
 
 use egui_kittest::kittest::Queryable;
 use shoal::app::model::{AppState, RetrievalKind};
+use shoal::retrieval::RetrievalSpec;
 use shoal::retrieval::external::ExternalSpec;
 use shoal::study::StudySpec;
 
@@ -12,14 +13,14 @@ fn the_app_asks_before_a_program_runs_and_shows_why_it_returned_nothing() {
     let dir = super::temp_library("external");
     let state = AppState {
         decimations: vec![16],
-        retrieval: RetrievalKind::External,
-        external: Some(ExternalSpec {
+        retrieval: RetrievalKind::Study,
+        study_retrieval: Some(RetrievalSpec::External(ExternalSpec {
             name: "mine".into(),
             command: vec!["sh".into(), "-c".into(), "echo 'mine.py: no model for 865 nm' >&2; exit 2".into()],
             products: vec!["chl_mg_m3".into()],
             bands: None,
             time_limit_s: 30.0,
-        }),
+        })),
         ..AppState::default()
     };
     let mut h = super::with_state(state, &dir);
@@ -53,12 +54,38 @@ fn a_study_with_a_program_opens_with_it_selectable_and_sessions_keep_it() {
     let study = StudySpec::preset("lake_hume_oc4").unwrap();
     let state = AppState::from_study(&study, None).unwrap();
     assert_eq!(state.retrieval, RetrievalKind::Almi, "the study's first retrieval is shown");
-    let external = state.external.clone().expect("the study's program is kept");
+    let Some(RetrievalSpec::External(external)) = state.study_retrieval.clone() else {
+        panic!("the study's program is not kept: {:?}", state.study_retrieval)
+    };
     assert_eq!((external.name.as_str(), external.products.as_slice()), ("oc4", &["chl_mg_m3".to_string()][..]));
     // The session round trip keeps it; a session saved before the field existed loads without.
     let text = ron::to_string(&state).unwrap();
     assert_eq!(ron::from_str::<AppState>(&text).unwrap(), state);
-    let old = ron::to_string(&AppState::default()).unwrap().replace("external:None,", "");
-    assert!(!old.contains("external"), "{old}");
-    assert_eq!(ron::from_str::<AppState>(&old).unwrap().external, None);
+    let old = ron::to_string(&AppState::default()).unwrap().replace("study_retrieval:None,", "");
+    assert!(!old.contains("study_retrieval"), "{old}");
+    assert_eq!(ron::from_str::<AppState>(&old).unwrap().study_retrieval, None);
+}
+
+/// A study with QAA opens with it beside aLMI and SAMBUCA, under its name; it runs, and says
+/// which products it does not make.
+#[test]
+fn a_study_with_qaa_offers_it_and_runs_it() {
+    let dir = super::temp_library("qaa");
+    let study = StudySpec::preset("lake_hume_qaa").unwrap();
+    let mut state = AppState::from_study(&study, None).unwrap();
+    assert!(matches!(state.study_retrieval, Some(RetrievalSpec::Qaa { .. })), "{:?}", state.study_retrieval);
+    state.decimations = vec![16];
+    let mut h = super::with_state(state, &dir);
+    super::wait_for_engine(&mut h);
+    h.get_by_label("QAA v6").click();
+    h.step();
+    assert_eq!(h.state().state.retrieval, RetrievalKind::Study);
+    super::wait_for_engine(&mut h);
+    let product = &h.state().link.shown[0].as_ref().unwrap().output.retrievals[0].product;
+    assert_eq!((product.name.as_str(), product.extras.len()), ("QAA", 3));
+    h.state_mut().state.product = shoal::app::model::ProductKind::Nap;
+    h.step();
+    h.step();
+    assert!(h.query_by_label_contains("QAA v6 does not retrieve the NAP").is_some());
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -144,8 +144,9 @@ pub fn settings_for(base: &RunConfig) -> Vec<Setting> {
             }),
             e("SAMBUCA unweighted", |c| sambuca(c).into_iter().for_each(|s| s.noise_weighting = false)),
         ]),
-        // A user's program has no settings Shoal could vary: its time is measured as it is.
-        Some(crate::retrieval::RetrievalSpec::External(_)) | None => {}
+        // A user's program has no settings Shoal could vary, nor has QAA (closed-form per pixel):
+        // their time is measured as it is.
+        Some(crate::retrieval::RetrievalSpec::External(_) | crate::retrieval::RetrievalSpec::Qaa { .. }) | None => {}
     }
     // The image-based corrections priced beside the exact one: the 779/865 nm pair where the
     // design has it, and dark-spectrum fitting.
