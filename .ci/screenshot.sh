@@ -5,7 +5,8 @@
 #
 #   bash .ci/screenshot.sh [OUT_DIR]      (default: assets/)
 #
-# Writes OUT_DIR/screenshot_1280x720.png and OUT_DIR/screenshot_1920x1080.png.
+# Writes OUT_DIR/screenshot_1280x720.png and OUT_DIR/screenshot_1920x1080.png, and the same of
+# the four-design study (four_designs_lake_hume) as OUT_DIR/screenshot_four_WxH.png.
 # Needs Xvfb and Mesa's software OpenGL (Debian/Ubuntu: apt install xvfb libgl1-mesa-dri).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -23,6 +24,13 @@ for size in 1280x720 1920x1080; do
         ./target/release/shoal app --size "$size" --screenshot "$out/screenshot_$size.png"
     rm -rf "$home"
     echo "wrote $out/screenshot_$size.png"
+    home=$(mktemp -d)
+    SHOAL_HOME="$home" XDG_DATA_HOME="$home" LIBGL_ALWAYS_SOFTWARE=1 \
+        timeout 900 xvfb-run -a -s "-screen 0 ${size}x24" \
+        ./target/release/shoal app --size "$size" --study four_designs_lake_hume \
+        --screenshot "$out/screenshot_four_$size.png"
+    rm -rf "$home"
+    echo "wrote $out/screenshot_four_$size.png"
 done
 
 # The review pack of the default study (at 1/4 resolution), rendered by headless Chromium as the
