@@ -93,7 +93,7 @@ impl RunValues {
         let mut retrieved_log10: Vec<f64> = all.iter().filter_map(|(_, g)| g.map(f64::log10)).collect();
         truth_log10.sort_unstable_by(f64::total_cmp);
         retrieved_log10.sort_unstable_by(f64::total_cmp);
-        let n = out.radiance.truth.land.len();
+        let n = out.radiance.truth.surface.codes().len();
         let scatter = values(out, variable, n / SCATTER_POINTS + 1)
             .into_iter()
             .filter_map(|(t, g)| g.map(|g| [t.log10(), g.log10()]))

@@ -28,7 +28,7 @@ pub struct MapData {
 #[must_use]
 pub fn product_map(out: &RunOutput, kind: ProductKind, band: usize, truth: bool) -> Option<MapData> {
     let r = &out.radiance;
-    let water = r.truth.land.mapv(|l| l == 0);
+    let water = r.truth.surface.water_mask();
     let ret = out.retrievals.first();
     let returned = |p: &crate::retrieval::Product| Array2::from_shape_fn(p.flags.dim(), |(i, j)| p.returned(i, j));
     let product_or_truth =

@@ -126,8 +126,8 @@ pub fn run(args: &CorrectArgs) -> Result<(), CliError> {
     let luts = FamilyLuts::build(&image, &atmosphere, &axes, &control).map_err(fail)?;
     let family = AerosolFamily::tabulate(&luts, &scene, &response, &viewing, false, &control).map_err(fail)?;
     let level1 = Level1 { radiance, flags: Array3::zeros((1, rows, nb)) };
-    let land = ndarray::Array2::zeros((1, rows));
-    let (rrs, aerosol) = correct_image(&level1, &family, &image, &response.bands, &land, &control).map_err(fail)?;
+    let water = crate::instrument::SurfaceMap::all_water((1, rows));
+    let (rrs, aerosol) = correct_image(&level1, &family, &image, &response.bands, &water, &control).map_err(fail)?;
     let mut csv = String::from("row");
     for n in &names {
         let _ = write!(csv, ",rrs_{n}_per_sr");

@@ -46,6 +46,7 @@ use super::{CorrectionError, Reflectance, RrsFlags, assemble, flag_for, slice};
 use crate::atmosphere::AerosolType;
 use crate::calibration::Level1;
 use crate::control::RunControl;
+use crate::instrument::SurfaceMap;
 use crate::parse::FieldError;
 
 /// How the correction finds the aerosol.
@@ -330,7 +331,7 @@ pub fn correct_image(
     family: &AerosolFamily,
     settings: &ImageCorrection,
     bands: &crate::spectral::BandSet,
-    land: &Array2<u8>,
+    surface: &SurfaceMap,
     control: &RunControl,
 ) -> Result<(Reflectance, AerosolRetrieval), CorrectionError> {
     let nb = level1.radiance.dim().2;
@@ -340,20 +341,20 @@ pub fn correct_image(
     match settings.fit {
         AerosolFit::BandPair => {
             let fit = super::pair::PairFit::new(family, settings, bands)?;
-            apply(level1, land, control, |p, mix, scratch| fit.fit(p, mix, scratch))
+            apply(level1, surface, control, |p, mix, scratch| fit.fit(p, mix, scratch))
         }
         AerosolFit::DarkSpectrum => {
             let tiles = super::dark::fit_tiles(level1, family, &settings.dark, bands, control)?;
             let (rows, cols) = (level1.radiance.dim().0, level1.radiance.dim().1);
             let (rrs, mut retrieval) = if let Some(smooth) = super::dark::smoothed(&tiles, &settings.dark, rows, cols) {
-                apply(level1, land, control, |p, mix, _: &mut ()| {
+                apply(level1, surface, control, |p, mix, _: &mut ()| {
                     smooth.fill(family, p.row * cols + p.col, mix);
                     true
                 })?
             } else {
                 let index = super::dark::tile_index(&tiles, rows, cols);
                 let mixtures: Vec<Mixture<'_>> = tiles.iter().map(|t| t.mixture(family)).collect();
-                apply(level1, land, control, |p, mix, _: &mut ()| {
+                apply(level1, surface, control, |p, mix, _: &mut ()| {
                     let m = &mixtures[index[p.row * cols + p.col]];
                     mix.entries.extend_from_slice(&m.entries);
                     (mix.aot550, mix.angstrom, mix.passes) = (m.aot550, m.angstrom, 1);
@@ -371,12 +372,12 @@ pub fn correct_image(
 /// scratch `S` (so the result does not depend on the threads).
 fn apply<'f, S: Default>(
     level1: &Level1,
-    land: &Array2<u8>,
+    surface: &SurfaceMap,
     control: &RunControl,
     fit: impl Fn(&Pixel<'_>, &mut Mixture<'f>, &mut S) -> bool + Sync,
 ) -> Result<(Reflectance, AerosolRetrieval), CorrectionError> {
     let (rows, cols, nb) = level1.radiance.dim();
-    let (l1, l0_flags, land_s) = (slice(&level1.radiance)?, slice(&level1.flags)?, slice(land)?);
+    let (l1, l0_flags) = (slice(&level1.radiance)?, slice(&level1.flags)?);
     let stride = cols * nb;
     let per_row = control.map_rows(rows, |at| {
         let r = at.index();
@@ -396,7 +397,7 @@ fn apply<'f, S: Default>(
                 nb,
                 l1: &l1[base + span.start..base + span.end],
                 flags: &l0_flags[base + span.start..base + span.end],
-                land: land_s[r * cols + c] != 0,
+                land: !surface.is_water(r, c),
             };
             mix.entries.clear();
             (mix.outside, mix.passes) = (false, 1);

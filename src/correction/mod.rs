@@ -42,7 +42,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::calibration::Level1;
 use crate::control::RunControl;
-use crate::instrument::{AotNodes, BandAtmosphere, Flags};
+use crate::instrument::{AotNodes, BandAtmosphere, Flags, SurfaceMap};
 use crate::parse::FieldError;
 
 /// Errors from the atmospheric correction stage; each names the field and what is allowed.
@@ -181,11 +181,11 @@ pub fn correct_exact(
     level1: &Level1,
     atmosphere: &BandAtmosphere,
     aerosol_map: Option<(&AotNodes, &Array2<f32>)>,
-    land: &Array2<u8>,
+    surface: &SurfaceMap,
     control: &RunControl,
 ) -> Result<Reflectance, CorrectionError> {
     let (rows, cols, nb) = level1.radiance.dim();
-    let (l1, l0_flags, land) = (slice(&level1.radiance)?, slice(&level1.flags)?, slice(land)?);
+    let (l1, l0_flags) = (slice(&level1.radiance)?, slice(&level1.flags)?);
     let aot = aerosol_map.map(|(_, a)| slice(a)).transpose()?;
     let mut rrs = vec![0.0f32; rows * cols * nb];
     let mut flags = vec![0u8; rows * cols * nb];
@@ -201,7 +201,7 @@ pub fn correct_exact(
         };
         for c in 0..cols {
             at.column(c);
-            let is_land = land[r * cols + c] != 0;
+            let is_land = !surface.is_water(r, c);
             // The column's slices, all of length nb, so the band loop runs without index
             // checks and the compiler can compute neighbouring bands together.
             let a = atmosphere.at(c, 0)..atmosphere.at(c, 0) + nb;
@@ -278,12 +278,12 @@ impl SceneApproximation {
         toa_radiance: &Array3<f32>,
         truth_rrs: &Array3<f32>,
         atmosphere: &BandAtmosphere,
-        land: &Array2<u8>,
+        surface: &SurfaceMap,
         points: usize,
         seed: u64,
     ) -> Result<Self, CorrectionError> {
         let (rows, cols, nb) = toa_radiance.dim();
-        let n_water = land.iter().filter(|&&l| l == 0).count();
+        let n_water = surface.water_count();
         if n_water == 0 || points == 0 {
             return Err(CorrectionError::Invalid(FieldError {
                 field: "correction.approx_points".into(),
@@ -296,8 +296,8 @@ impl SceneApproximation {
         picks.sort_unstable();
         let mut chosen = Vec::with_capacity(picks.len());
         let mut k = 0;
-        for (i, &l) in land.iter().enumerate() {
-            if l == 0 {
+        for i in 0..rows * cols {
+            if surface.is_water_at(i) {
                 if picks.binary_search(&k).is_ok() {
                     chosen.push((i / cols, i % cols));
                 }
@@ -327,11 +327,11 @@ impl SceneApproximation {
     pub fn correct(
         &self,
         level1: &Level1,
-        land: &Array2<u8>,
+        surface: &SurfaceMap,
         control: &RunControl,
     ) -> Result<Reflectance, CorrectionError> {
         let (rows, cols, nb) = level1.radiance.dim();
-        let (l1, l0_flags, land) = (slice(&level1.radiance)?, slice(&level1.flags)?, slice(land)?);
+        let (l1, l0_flags) = (slice(&level1.radiance)?, slice(&level1.flags)?);
         let mut rrs = vec![0.0f32; rows * cols * nb];
         let mut flags = vec![0u8; rows * cols * nb];
         let stride = cols * nb;
@@ -344,7 +344,7 @@ impl SceneApproximation {
                     let k = c * nb + b;
                     let lw = (f64::from(l1[base + k]) - self.l_path[b]) / self.t_up[b];
                     let value = lw / self.ed[b];
-                    let f = flag_for(l0_flags[base + k], land[r * cols + c] != 0, value);
+                    let f = flag_for(l0_flags[base + k], !surface.is_water(r, c), value);
                     flag_row[k] = f;
                     rrs_row[k] = if f & RrsFlags::INVALID != 0 { 0.0 } else { value as f32 };
                 }

@@ -2,11 +2,12 @@
 //! ACIX-Aqua reports an atmospheric correction: Pahlevan et al. 2021), and pooled over a band
 //! range.
 
-use ndarray::{Array2, Array3};
+use ndarray::Array3;
 use rayon::prelude::*;
 use serde::Serialize;
 
 use super::{Reflectance, RrsFlags};
+use crate::instrument::SurfaceMap;
 
 /// One band's corrected Rrs against the truth: log-space metrics (Seegers et al. 2018, as
 /// ACIX-Aqua reports Rrs: Pahlevan et al. 2021) over the water pixels.
@@ -50,13 +51,13 @@ pub fn pooled_rrs_error(bands: &[BandRrsMetrics], lo_nm: f64, hi_nm: f64) -> Opt
 pub fn band_rrs_metrics(
     rrs: &Reflectance,
     truth: &Array3<f32>,
-    land: &Array2<u8>,
+    surface: &SurfaceMap,
     names: &[String],
     centres_nm: &[f64],
 ) -> Vec<BandRrsMetrics> {
     let (rows, cols, nb) = rrs.rrs.dim();
     let water: Vec<(usize, usize)> =
-        (0..rows).flat_map(|r| (0..cols).map(move |c| (r, c))).filter(|&(r, c)| land[[r, c]] == 0).collect();
+        (0..rows).flat_map(|r| (0..cols).map(move |c| (r, c))).filter(|&(r, c)| surface.is_water(r, c)).collect();
     let stride = (water.len() / RRS_SAMPLES).max(1);
     (0..nb)
         .into_par_iter()

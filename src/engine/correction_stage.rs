@@ -52,7 +52,7 @@ impl Engine {
                 &radiance.radiance,
                 &radiance.truth.rrs_above,
                 band_atmosphere,
-                &radiance.truth.land,
+                &radiance.truth.surface,
                 config.correction.approx_points,
                 config.seed,
             )
@@ -62,7 +62,7 @@ impl Engine {
             let diagnostics = fid.decimation == 1;
             let image = match (&family, &config.correction.image) {
                 (Some((fam, _)), Some(settings)) => Some(
-                    correct_image(level1, fam, settings, &side.response.bands, &radiance.truth.land, control)
+                    correct_image(level1, fam, settings, &side.response.bands, &radiance.truth.surface, control)
                         .map_err(&fail)?,
                 ),
                 _ => None,
@@ -74,14 +74,14 @@ impl Engine {
             let exact = if diagnostics || (!config.correction.use_approximation && image.is_none()) {
                 let aerosol_map = side.aerosol_map.as_deref().zip(radiance.truth.aot550.as_ref());
                 Some(
-                    correct_exact(level1, band_atmosphere, aerosol_map, &radiance.truth.land, control)
+                    correct_exact(level1, band_atmosphere, aerosol_map, &radiance.truth.surface, control)
                         .map_err(&fail)?,
                 )
             } else {
                 None
             };
             let approx = if diagnostics || config.correction.use_approximation {
-                Some(approximation.correct(level1, &radiance.truth.land, control).map_err(&fail)?)
+                Some(approximation.correct(level1, &radiance.truth.surface, control).map_err(&fail)?)
             } else {
                 None
             };
@@ -105,7 +105,7 @@ impl Engine {
             let rrs_metrics = crate::correction::band_rrs_metrics(
                 &rrs,
                 &radiance.truth.rrs_above,
-                &radiance.truth.land,
+                &radiance.truth.surface,
                 &names,
                 &side.response.bands.centres_nm(),
             );

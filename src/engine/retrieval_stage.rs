@@ -89,7 +89,7 @@ impl Engine {
             let inputs = RetrievalInputs {
                 rrs: &correction.rrs.rrs,
                 flags: &correction.rrs.flags,
-                land: &radiance.truth.land,
+                surface: &radiance.truth.surface,
                 bands: bands.clone(),
                 geometry: geometry.clone(),
                 nedr: nedr.clone(),
@@ -133,7 +133,7 @@ impl Engine {
 
 /// The product of a retrieval that returned nothing: every water pixel failed, no maps.
 fn failed_product(spec: &RetrievalSpec, inputs: &RetrievalInputs<'_>) -> Product {
-    let dim = inputs.land.dim();
+    let dim = inputs.surface.dim();
     Product {
         name: spec.name().to_string(),
         chl_mg_m3: None,
@@ -148,6 +148,6 @@ fn failed_product(spec: &RetrievalSpec, inputs: &RetrievalInputs<'_>) -> Product
         sdi: None,
         iterations: None,
         extras: Vec::new(),
-        flags: inputs.land.mapv(|l| if l != 0 { ProductFlags::LAND } else { ProductFlags::FAILED }),
+        flags: inputs.surface.water_mask().mapv(|w| if w { ProductFlags::FAILED } else { ProductFlags::LAND }),
     }
 }

@@ -145,13 +145,13 @@ fn saturation(detector: &Detector, bands: &[String], brightest: &[f64]) -> Optio
 /// sampling error, under 1 %, is far below what an SNR figure needs); the SNR stage's typical
 /// radiance. Zero for a band without water pixels.
 #[must_use]
-pub fn typical_water(radiance: &ndarray::Array3<f32>, land: &ndarray::Array2<u8>) -> Vec<f64> {
+pub fn typical_water(radiance: &ndarray::Array3<f32>, surface: &super::SurfaceMap) -> Vec<f64> {
     let (rows, cols, nb) = radiance.dim();
-    let (Some(rad), Some(land)) = (radiance.as_slice(), land.as_slice()) else { return vec![0.0; nb] };
+    let Some(rad) = radiance.as_slice() else { return vec![0.0; nb] };
     let stride = (rows * cols / 20_000).max(1);
     let mut per_band: Vec<Vec<f32>> = vec![Vec::new(); nb];
     for (pixel, values) in rad.chunks(nb.max(1)).enumerate().step_by(stride) {
-        if land[pixel] == 0 {
+        if surface.is_water_at(pixel) {
             for (list, v) in per_band.iter_mut().zip(values) {
                 list.push(*v);
             }
@@ -169,22 +169,23 @@ pub fn typical_water(radiance: &ndarray::Array3<f32>, land: &ndarray::Array2<u8>
         .collect()
 }
 
-/// Brightest radiance per band over water pixels (`land` = 0) of a (rows, cols, bands) cube.
+/// Brightest radiance per band over the water pixels of a (rows, cols, bands) cube.
 #[must_use]
-pub fn brightest_water(radiance: &ndarray::Array3<f32>, land: &ndarray::Array2<u8>) -> Vec<f64> {
+pub fn brightest_water(radiance: &ndarray::Array3<f32>, surface: &super::SurfaceMap) -> Vec<f64> {
     let nb = radiance.dim().2;
     let mut out = vec![0.0f32; nb];
-    if let (Some(rad), Some(land)) = (radiance.as_slice(), land.as_slice()) {
-        for (values, &l) in rad.chunks_exact(nb.max(1)).zip(land) {
-            if l == 0 {
+    if let Some(rad) = radiance.as_slice() {
+        for (pixel, values) in rad.chunks_exact(nb.max(1)).enumerate() {
+            if surface.is_water_at(pixel) {
                 for (o, &v) in out.iter_mut().zip(values) {
                     *o = o.max(v);
                 }
             }
         }
     } else {
-        for ((r, c), &l) in land.indexed_iter() {
-            if l == 0 {
+        let (rows, cols) = surface.dim();
+        for (r, c) in (0..rows).flat_map(|r| (0..cols).map(move |c| (r, c))) {
+            if surface.is_water(r, c) {
                 for (b, o) in out.iter_mut().enumerate() {
                     *o = o.max(radiance[[r, c, b]]);
                 }

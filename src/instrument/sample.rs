@@ -26,7 +26,7 @@ use super::InstrumentError;
 use super::geometry::Viewing;
 use super::response::Response;
 use super::spatial::SpatialKernel;
-use super::truth::Truth;
+use super::truth::{SurfaceMap, Truth};
 use crate::control::RunControl;
 use crate::parse::FieldError;
 use crate::scene::Scene;
@@ -166,8 +166,8 @@ pub fn sample_radiance(
     let aot = aerosol_map.is_some().then_some(aot);
     let truth = TruthBuffers { rrs: rrs_truth, maps, fractions, land, aot }.into_truth(scene, (rows, cols, nb))?;
     Ok(RadianceCube {
-        brightest_water_w_m2_sr_nm: super::plausibility::brightest_water(&radiance, &truth.land),
-        typical_water_w_m2_sr_nm: super::plausibility::typical_water(&radiance, &truth.land),
+        brightest_water_w_m2_sr_nm: super::plausibility::brightest_water(&radiance, &truth.surface),
+        typical_water_w_m2_sr_nm: super::plausibility::typical_water(&radiance, &truth.surface),
         radiance,
         truth_shares: super::shares::SceneShares::of(&truth),
         truth: Arc::new(truth),
@@ -304,7 +304,7 @@ impl TruthBuffers {
             } else {
                 None
             },
-            land: Array2::from_shape_vec((rows, cols), self.land).map_err(bad)?,
+            surface: SurfaceMap::from_codes(Array2::from_shape_vec((rows, cols), self.land).map_err(bad)?),
             aot550: self.aot.map(|a| Array2::from_shape_vec((rows, cols), a)).transpose().map_err(bad)?,
             substrate_names: scene.substrates.iter().map(|(n, _)| n.clone()).collect(),
         };

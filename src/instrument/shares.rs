@@ -48,20 +48,21 @@ impl SceneShares {
     /// once per cube; runs that reuse the cube reuse the count).
     #[must_use]
     pub fn of(truth: &Truth) -> Self {
-        let land = truth.land.as_slice().unwrap_or(&[]);
+        let surface = &truth.surface;
+        let n = surface.codes().len();
         let depth = truth.depth_m.as_ref().and_then(|d| d.as_slice());
         let fractions = truth.substrate_fractions.as_ref().and_then(|f| f.as_slice());
         let n_sub = if fractions.is_some() { truth.substrate_names.len() } else { 0 };
-        let water = land.iter().filter(|&&l| l == 0).count();
+        let water = surface.water_count();
         let mut out = Self { water_pixels: water, ..Self::default() };
         if water == 0 {
             return out;
         }
         let (lo, hi) = depth.map_or((0.0, 0.0), |d| {
             d.iter()
-                .zip(land)
-                .filter(|(_, l)| **l == 0)
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), (&v, _)| (a.min(f64::from(v)), b.max(f64::from(v))))
+                .enumerate()
+                .filter(|(p, _)| surface.is_water_at(*p))
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), (_, &v)| (a.min(f64::from(v)), b.max(f64::from(v))))
         });
         let first = lo.floor();
         let bins = if depth.is_some() { ((hi - first).floor() as usize + 1).min(1000) } else { 0 };
@@ -69,7 +70,7 @@ impl SceneShares {
         let mut bin_dominant = vec![vec![0usize; n_sub]; bins];
         let mut fraction_sum = vec![0.0f64; n_sub];
         let mut dominant_count = vec![0usize; n_sub];
-        for (p, _) in land.iter().enumerate().filter(|(_, l)| **l == 0) {
+        for p in (0..n).filter(|&p| surface.is_water_at(p)) {
             // The largest fraction (the first of equals).
             let dominant = fractions.map(|f| {
                 let here = &f[p * n_sub..(p + 1) * n_sub];

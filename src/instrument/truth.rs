@@ -26,18 +26,116 @@ pub struct Truth {
     pub substrate_fractions: Option<Array3<f32>>,
     /// Names of the substrates of `substrate_fractions`, in its order.
     pub substrate_names: Vec<String>,
-    /// 1 where the pixel centre is land.
-    pub land: Array2<u8>,
+    /// What covers each pixel centre: water, land (and, when the scene makes them, cloud and
+    /// cloud shadow). Every stage asks [`SurfaceMap::is_water`], never the codes.
+    pub surface: SurfaceMap,
     /// Aerosol optical thickness at 550 nm at each pixel centre, where the scene gives it as a
     /// map (`aot550_map`; otherwise the atmosphere's `aot550` holds everywhere).
     pub aot550: Option<Array2<f32>>,
+}
+
+/// What covers a pixel centre.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[repr(u8)]
+pub enum Surface {
+    /// Open water: simulated, corrected and retrieved.
+    Water = 0,
+    /// Land (the scene's land mask).
+    Land = 1,
+    /// Cloud over the pixel (code reserved: no scene makes clouds yet).
+    Cloud = 2,
+    /// Water in a cloud's shadow (code reserved, as `Cloud`).
+    CloudShadow = 3,
+}
+
+impl Surface {
+    /// The class of a code as stored (an unknown code reads as land: never retrieved).
+    #[must_use]
+    pub const fn of_code(code: u8) -> Self {
+        match code {
+            0 => Self::Water,
+            2 => Self::Cloud,
+            3 => Self::CloudShadow,
+            _ => Self::Land,
+        }
+    }
+
+    /// Is it water the chain retrieves from?
+    #[must_use]
+    pub const fn is_water(self) -> bool {
+        matches!(self, Self::Water)
+    }
+}
+
+/// The surface class of every pixel, (row, column): the one place that says which pixels are
+/// water. Stored as the [`Surface`] codes, which the writers write as they are (`land_mask.npy`,
+/// NetCDF `land`, GeoTIFF: 0 water, 1 land).
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct SurfaceMap {
+    codes: Array2<u8>,
+}
+
+impl SurfaceMap {
+    /// The map of `codes` ([`Surface`] as `u8`).
+    #[must_use]
+    pub fn from_codes(codes: Array2<u8>) -> Self {
+        Self { codes }
+    }
+
+    /// Every pixel water, `dim` (rows, columns).
+    #[must_use]
+    pub fn all_water(dim: (usize, usize)) -> Self {
+        Self { codes: Array2::zeros(dim) }
+    }
+
+    /// (rows, columns).
+    #[must_use]
+    pub fn dim(&self) -> (usize, usize) {
+        self.codes.dim()
+    }
+
+    /// The class at (row, column).
+    #[must_use]
+    pub fn at(&self, row: usize, column: usize) -> Surface {
+        Surface::of_code(self.codes[[row, column]])
+    }
+
+    /// Is (row, column) water the chain retrieves from?
+    #[must_use]
+    pub fn is_water(&self, row: usize, column: usize) -> bool {
+        self.at(row, column).is_water()
+    }
+
+    /// Is the pixel at `index` (row-major) water?
+    #[must_use]
+    pub fn is_water_at(&self, index: usize) -> bool {
+        self.codes.as_slice().is_some_and(|c| c.get(index).is_some_and(|&v| Surface::of_code(v).is_water()))
+    }
+
+    /// The water pixels.
+    #[must_use]
+    pub fn water_count(&self) -> usize {
+        self.codes.iter().filter(|&&c| Surface::of_code(c).is_water()).count()
+    }
+
+    /// True where water.
+    #[must_use]
+    pub fn water_mask(&self) -> Array2<bool> {
+        self.codes.mapv(|c| Surface::of_code(c).is_water())
+    }
+
+    /// The codes as stored, for writers.
+    #[must_use]
+    pub fn codes(&self) -> &Array2<u8> {
+        &self.codes
+    }
 }
 
 impl Truth {
     /// Whether pixel (row, column) is water.
     #[must_use]
     pub fn is_water(&self, row: usize, column: usize) -> bool {
-        self.land[[row, column]] == 0
+        self.surface.is_water(row, column)
     }
 
     /// The truth map of a scalar product variable (`chl_mg_m3`, `nap_g_m3`, `cdom_per_m`,

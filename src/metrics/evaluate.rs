@@ -100,7 +100,7 @@ impl Plan<'_> {
         ];
         for r in rows {
             for c in 0..cols {
-                if truth.land[[r, c]] != 0 {
+                if !truth.surface.is_water(r, c) {
                     continue;
                 }
                 let flags = product.flags[[r, c]];
@@ -276,7 +276,9 @@ mod tests {
                 ((r * 3 + c * 5 + s * 11) % 7) as f32
             })),
             substrate_names: vec!["sand".into(), "coral".into(), "seagrass".into()],
-            land: Array2::from_shape_fn((rows, cols), |(_, c)| u8::from(c == 6)),
+            surface: crate::instrument::SurfaceMap::from_codes(Array2::from_shape_fn((rows, cols), |(_, c)| {
+                u8::from(c == 6)
+            })),
             aot550: None,
         };
         let flags = Array2::from_shape_fn((rows, cols), |(r, c)| match (r * cols + c) % 13 {
@@ -315,7 +317,7 @@ mod tests {
         keep: impl Fn(usize, usize) -> bool,
     ) -> Metrics {
         let (mut got, mut want) = (Vec::new(), Vec::new());
-        for ((r, c), &land) in t.land.indexed_iter() {
+        for ((r, c), &land) in t.surface.codes().indexed_iter() {
             if land == 0 && keep(r, c) {
                 got.push(p.returned(r, c).then(|| f64::from(m[[r, c]])));
                 want.push(Some(f64::from(o[[r, c]])));

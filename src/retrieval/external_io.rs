@@ -104,7 +104,7 @@ pub(super) fn write_input(
         let (pixel, k) = (i / n_used, i % n_used);
         let (r, c, b) = (pixel / cols.max(1), pixel % cols.max(1), used[k]);
         debug_assert!(b < nb);
-        (inputs.rrs[[r, c, b]], inputs.flags[[r, c, b]], inputs.land[[r, c]])
+        (inputs.rrs[[r, c, b]], inputs.flags[[r, c, b]], !inputs.surface.is_water(r, c))
     };
     let total = rows * cols * used.len();
     let bad = RrsFlags::INVALID | RrsFlags::SATURATED;
@@ -119,7 +119,7 @@ pub(super) fn write_input(
         values: Values::lazy(move || {
             masked((0..total).map(|i| value(i).0), |i| {
                 let (_, f, land) = value(i);
-                f & bad == 0 && land == 0
+                f & bad == 0 && !land
             })
         }),
     });
@@ -128,7 +128,7 @@ pub(super) fn write_input(
         dims: MAP.to_vec(),
         long_name: "land under the pixel centre (not retrieved)".into(),
         flags: vec![(1, "land")],
-        values: Values::ready(inputs.land.iter().map(|&v| i32::from(v)).collect()),
+        values: Values::ready(inputs.surface.codes().iter().map(|&v| i32::from(v)).collect()),
         coordinates: "",
     }];
     let mut ds = DataSet::new();
@@ -159,7 +159,7 @@ pub(super) fn write_input(
 /// The program's output as a [`Product`]: each wanted map (0 where missing), returned where every
 /// map is finite and positive, land where the input says so.
 pub(super) fn product(spec: &ExternalSpec, inputs: &RetrievalInputs<'_>, maps: &Maps) -> Result<Product, String> {
-    let (rows, cols) = inputs.land.dim();
+    let (rows, cols) = inputs.surface.dim();
     if maps.shape != (rows, cols) {
         return Err(format!(
             "its output is {} × {} (line × pixel); the input was {rows} × {cols}",
@@ -185,7 +185,7 @@ pub(super) fn product(spec: &ExternalSpec, inputs: &RetrievalInputs<'_>, maps: &
         .collect();
     let valid = |r: usize, c: usize| columns.iter().all(|(_, v)| v[r * cols + c].is_some_and(|x| x > 0.0));
     let flags = Array2::from_shape_fn((rows, cols), |(r, c)| {
-        if inputs.land[[r, c]] != 0 {
+        if !inputs.surface.is_water(r, c) {
             ProductFlags::LAND
         } else if valid(r, c) {
             ProductFlags::RETURNED

@@ -220,7 +220,7 @@ pub fn retrieve_qaa(
         let row = (0..cols)
             .map(|c| {
                 at.column(c);
-                if inputs.land[[r, c]] != 0 {
+                if !inputs.surface.is_water(r, c) {
                     return ([0.0; 4], ProductFlags::LAND);
                 }
                 let bad = RrsFlags::INVALID | RrsFlags::SATURATED;

@@ -185,8 +185,8 @@ pub struct RetrievalInputs<'a> {
     pub rrs: &'a Array3<f32>,
     /// Rrs flags.
     pub flags: &'a Array3<u8>,
-    /// Land mask.
-    pub land: &'a Array2<u8>,
+    /// What covers each pixel (only water is retrieved).
+    pub surface: &'a crate::instrument::SurfaceMap,
     /// The bands' responses (what a band Rrs averages over).
     pub bands: Vec<BandResponse>,
     /// Per column: sun and view zenith at the ground.
@@ -326,7 +326,7 @@ pub(super) fn retrieve_almi(
         let row = (0..cols)
             .map(|c| {
                 at.column(c);
-                if inputs.land[[r, c]] != 0 {
+                if !inputs.surface.is_water(r, c) {
                     return (0.0, 0.0, 0.0, -1, 0.0, ProductFlags::LAND);
                 }
                 for (k, &b) in used.iter().enumerate() {

@@ -126,7 +126,7 @@ pub(super) fn retrieve_sambuca(
             .map(|c| {
                 at.column(c);
                 let failed = (0.0, 0.0, 0.0, 0.0, 0.0, (0, 0), 0.0, 0.0, 0, ProductFlags::FAILED);
-                if inputs.land[[r, c]] != 0 {
+                if !inputs.surface.is_water(r, c) {
                     return (0.0, 0.0, 0.0, 0.0, 0.0, (0, 0), 0.0, 0.0, 0, ProductFlags::LAND);
                 }
                 for k in 0..nb {
@@ -225,7 +225,7 @@ fn retrieve_sambuca_reference(
             .map(|c| {
                 at.column(c);
                 let failed = (0.0, 0.0, 0.0, 0.0, 0.0, (0, 0), 0.0, 0.0, 0, ProductFlags::FAILED);
-                if inputs.land[[r, c]] != 0 {
+                if !inputs.surface.is_water(r, c) {
                     return (0.0, 0.0, 0.0, 0.0, 0.0, (0, 0), 0.0, 0.0, 0, ProductFlags::LAND);
                 }
                 let mut usable = true;

@@ -195,7 +195,7 @@ fn shared_scale(runs: &[&StudyRun], index: usize, var: &'static str) -> Option<S
     let truth = first.truth.map(var)?;
     let mut values: Vec<f64> = truth
         .indexed_iter()
-        .filter(|((r, c), _)| first.truth.land[[*r, *c]] == 0)
+        .filter(|((r, c), _)| first.truth.surface.is_water(*r, *c))
         .map(|(_, v)| f64::from(*v))
         .collect();
     for run in runs {
@@ -220,7 +220,7 @@ fn maps_figure(ctx: &Context<'_>) -> Option<Maps> {
     let mut panels = vec![Panel {
         title: "truth".into(),
         values: truth.clone(),
-        valid: first.truth.land.mapv(|l| l == 0),
+        valid: first.truth.surface.water_mask(),
         spacing_m: spacing_m(first),
     }];
     for run in ctx.runs {
@@ -319,7 +319,7 @@ fn scatter_and_histograms(ctx: &Context<'_>) -> Option<(Scatter, Histograms)> {
         let (Some(ret), Some(truth)) = (run.retrievals.get(ctx.index), run.truth.map(ctx.var)) else { continue };
         let Some(map) = ret.product.map(ctx.var) else { continue };
         let p = &ret.product;
-        let water_returned = |r: usize, c: usize| run.truth.land[[r, c]] == 0 && p.returned(r, c);
+        let water_returned = |r: usize, c: usize| run.truth.surface.is_water(r, c) && p.returned(r, c);
         let pairs = map
             .indexed_iter()
             .filter(|((r, c), _)| water_returned(*r, *c))
@@ -332,7 +332,7 @@ fn scatter_and_histograms(ctx: &Context<'_>) -> Option<(Scatter, Histograms)> {
         let mut counts = vec![vec![0usize; nb]; categories.len().max(1)];
         let mut truth_counts = vec![0usize; nb];
         for ((r, c), v) in map.indexed_iter() {
-            if run.truth.land[[r, c]] != 0 {
+            if !run.truth.surface.is_water(r, c) {
                 continue;
             }
             if let Some(b) = bin_of(&hist_edges, f64::from(truth[[r, c]])) {

@@ -134,7 +134,7 @@ pub fn write_run_geotiff(out: &RunOutput, dir: &Path) -> Result<Outputs, StudyEr
     // every pixel twice).
     let shared = base(out);
     let all = |_: usize, _: usize| true;
-    let water = |r: usize, c: usize| truth.land[[r, c]] == 0;
+    let water = |r: usize, c: usize| truth.surface.is_water(r, c);
 
     let mut l1 = shared.clone();
     for (b, band) in bands.iter().enumerate() {
@@ -173,7 +173,7 @@ pub fn write_run_geotiff(out: &RunOutput, dir: &Path) -> Result<Outputs, StudyEr
             push(&mut t, cube_plane(f, k, &water), &format!("true {name} fraction"), "1");
         }
     }
-    push(&mut t, truth.land.iter().map(|v| f64::from(*v)).collect(), "land (1) or water (0)", "1");
+    push(&mut t, truth.surface.codes().iter().map(|v| f64::from(*v)).collect(), "land (1) or water (0)", "1");
     t.nodata = Some(NODATA);
     file(dir, "truth.tif", &t, &mut o)?;
 

@@ -144,7 +144,7 @@ fn radiometry_vars<'a>(out: &'a RunOutput, floats: &mut Vec<FloatVar<'a>>, flags
 fn truth_vars<'a>(out: &'a RunOutput, floats: &mut Vec<FloatVar<'a>>, flags: &mut Vec<FlagVar<'a>>) {
     let truth = &out.radiance.truth;
     let nb = out.level1.radiance.dim().2;
-    let water = |i: usize| truth.land.as_slice().is_some_and(|l| l[i] == 0);
+    let water = |i: usize| truth.surface.is_water_at(i);
     let coordinates = ("coordinates", MAP_COORDINATES.to_string());
     let cube_coordinates = ("coordinates", CUBE_COORDINATES.to_string());
     let mut a =
@@ -192,7 +192,7 @@ fn truth_vars<'a>(out: &'a RunOutput, floats: &mut Vec<FloatVar<'a>>, flags: &mu
         dims: MAP.to_vec(),
         long_name: "land under the pixel centre".into(),
         flags: vec![(1, "land")],
-        values: Values::ready(truth.land.iter().map(|&v| i32::from(v)).collect()),
+        values: Values::ready(truth.surface.codes().iter().map(|&v| i32::from(v)).collect()),
         coordinates: MAP_COORDINATES,
     });
 

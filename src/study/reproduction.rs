@@ -126,7 +126,7 @@ pub fn numbers(lake: &StudyResult, heron: &StudyResult) -> Result<Numbers, Study
     };
     for (i, label) in ["nominal", "cubesat", "smallsat"].iter().enumerate() {
         let r = run(lake, label)?;
-        n.water_pixels[i] = r.truth.land.iter().filter(|l| **l == 0).count();
+        n.water_pixels[i] = r.truth.surface.water_count();
         for mode in 0..2 {
             n.chl_mae_pct[i][mode] = metric(r, mode, "chl_mg_m3");
             n.not_returned[i][mode] = r.retrievals.get(mode).map_or(0, |x| x.metrics.failed);
@@ -151,7 +151,7 @@ pub fn numbers(lake: &StudyResult, heron: &StudyResult) -> Result<Numbers, Study
     }
     n.seagrass_share_pct =
         h.report.truth_shares.substrates.iter().find(|s| s.name == "seagrass").map_or(f64::NAN, |s| s.dominant_pct);
-    let water = h.truth.land.iter().filter(|l| **l == 0).count().max(1);
+    let water = h.truth.surface.water_count().max(1);
     n.stalled_pct = h.retrievals.first().map_or(f64::NAN, |r| 100.0 * r.metrics.stalled as f64 / water as f64);
     n.depth_mae_pct_shallow_start = metric(h, 2, "depth_m");
     n.stalled_pct_shallow_start =
@@ -381,7 +381,7 @@ fn points(run: &StudyRun, mode: usize, depth: bool) -> Vec<(f64, f64, f64)> {
     let acropora = p.substrate_names.iter().position(|n| n == "acropora");
     let all: Vec<(usize, usize)> = truth
         .indexed_iter()
-        .filter(|((r, c), _)| run.truth.land[[*r, *c]] == 0 && p.returned(*r, *c))
+        .filter(|((r, c), _)| run.truth.surface.is_water(*r, *c) && p.returned(*r, *c))
         .map(|(rc, _)| rc)
         .collect();
     let step = all.len().div_ceil(MAX_POINTS).max(1);

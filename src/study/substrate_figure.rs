@@ -68,8 +68,8 @@ pub(super) fn substrate_figures(runs: &[&StudyRun], title: &str) -> Option<Vec<(
     let palette: Vec<[u8; 3]> = (0..classes.len()).map(categorical).collect();
     let legend: Vec<(String, [u8; 3])> = classes.iter().zip(&palette).map(|(n, c)| (n.replace('_', " "), *c)).collect();
     let water = |run: &StudyRun| {
-        let land = run.truth.land.clone();
-        move |r: usize, c: usize| land[[r, c]] == 0
+        let surface = run.truth.surface.clone();
+        move |r: usize, c: usize| surface.is_water(r, c)
     };
     let mut maps = vec![(
         "truth".to_string(),
@@ -81,9 +81,9 @@ pub(super) fn substrate_figures(runs: &[&StudyRun], title: &str) -> Option<Vec<(
         let Some(ret) = run.retrievals.get(index) else { continue };
         let (Some(f), Some(t)) = (&ret.product.substrate_fractions, &run.truth.substrate_fractions) else { continue };
         let p = &ret.product;
-        let land = &run.truth.land;
-        let retrieved = dominant(f, &p.substrate_names, &classes, |r, c| land[[r, c]] == 0 && p.returned(r, c));
-        let truth = dominant(t, &run.truth.substrate_names, &classes, |r, c| land[[r, c]] == 0);
+        let surface = &run.truth.surface;
+        let retrieved = dominant(f, &p.substrate_names, &classes, |r, c| surface.is_water(r, c) && p.returned(r, c));
+        let truth = dominant(t, &run.truth.substrate_names, &classes, |r, c| surface.is_water(r, c));
         let agree = Array2::from_shape_fn(retrieved.dim(), |(r, c)| match (retrieved[[r, c]], truth[[r, c]]) {
             (Some(a), Some(b)) => Some(usize::from(a != b)),
             _ => None,

@@ -78,7 +78,7 @@ fn land_and_adjacency_keep_the_full_grid() {
     };
     let grid = run(&whole(0));
     let nodes = run(&whole(4));
-    let land = &grid.radiance.truth.land;
+    let land = &grid.radiance.truth.surface.codes();
     let n_land = land.iter().filter(|&&l| l != 0).count();
     assert!(n_land > 0 && n_land < land.len(), "the scene has land and water in view ({n_land} land)");
     for ((r, c), &l) in land.indexed_iter() {

@@ -51,7 +51,7 @@ fn noise_free_level1_returns_pupil_radiance_and_rrs() {
         assert!(l1 < 1e-4, "{instrument}: Level-1 vs pupil radiance {l1:e}");
         // Exact correction: within-band covariance of order S·π·Rrs·var(Rrs)/Rrs² (module docs)
         // plus f32 rounding amplified by L_TOA/Lw; 1e-4 is the target.
-        let land = &rad.truth.land;
+        let land = &rad.truth.surface.codes();
         let rrs = max_rel(&out.correction.rrs.rrs, &rad.truth.rrs_above, |r, c, _| land[[r, c]] != 0, 1e-5);
         assert!(rrs < 1e-4, "{instrument} over {}: exact AC vs truth {rrs:e}", config.scene.name);
         // No water pixel is flagged.
@@ -80,7 +80,7 @@ fn adjacency_is_error_the_exact_correction_does_not_remove() {
     let nir = 16; // Oa17, 865 nm
     let mut brighter = 0;
     for ((r, c, k), x) in a.indexed_iter() {
-        if k == nir && with.radiance.truth.land[[r, c]] == 0 {
+        if k == nir && with.radiance.truth.surface.codes()[[r, c]] == 0 {
             let y = b[[r, c, k]];
             assert!(*x >= y * (1.0 - 1e-6), "({r},{c}): {x} < {y}");
             brighter += usize::from(*x > y * 1.001);

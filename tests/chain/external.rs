@@ -40,7 +40,10 @@ fn run_with(retrieval: RetrievalSpec) -> RunOutput {
 /// The truth's chl × `factor` on water, the fill value on land, as a (line, pixel) vector.
 fn scaled_truth(out: &RunOutput, factor: f32) -> Vec<f32> {
     let t = &out.radiance.truth;
-    t.chl_mg_m3.indexed_iter().map(|((r, c), v)| if t.land[[r, c]] != 0 { -9999.0 } else { v * factor }).collect()
+    t.chl_mg_m3
+        .indexed_iter()
+        .map(|((r, c), v)| if t.surface.codes()[[r, c]] != 0 { -9999.0 } else { v * factor })
+        .collect()
 }
 
 /// The run's aLMI is untouched by the external retrieval beside it.
@@ -77,7 +80,7 @@ fn a_program_s_products_are_read_back_and_scored_like_any_retrieval() {
     let nothing = &reference.retrievals[1];
     let why = nothing.failure.as_deref().unwrap();
     assert!(why.contains("without writing its output"), "{why}");
-    assert_eq!(nothing.metrics.failed, reference.radiance.truth.land.iter().filter(|l| **l == 0).count());
+    assert_eq!(nothing.metrics.failed, reference.radiance.truth.surface.codes().iter().filter(|l| **l == 0).count());
 }
 
 #[test]
@@ -99,7 +102,7 @@ fn the_program_sees_the_rrs_bands_and_geometry_but_never_the_truth() {
     let (rows, cols, nb) = out.correction.rrs.rrs.dim();
     assert_eq!((ds.dim_size("line"), ds.dim_size("pixel"), ds.dim_size("band")), (Some(rows), Some(cols), Some(nb)));
     // The run's Rrs where valid and on water, the fill value elsewhere.
-    let (flags, land) = (&out.correction.rrs.flags, &out.radiance.truth.land);
+    let (flags, land) = (&out.correction.rrs.flags, &out.radiance.truth.surface.codes());
     let mut valid = 0;
     for ((r, c, b), v) in out.correction.rrs.rrs.indexed_iter() {
         let keep = flags[[r, c, b]] & (RrsFlags::INVALID | RrsFlags::SATURATED) == 0 && land[[r, c]] == 0;

@@ -127,7 +127,7 @@ fn a_gain_error_at_865_nm_reaches_443_nm_as_the_extrapolation_predicts() {
         &family,
         &settings,
         &out.response.bands,
-        &out.radiance.truth.land,
+        &out.radiance.truth.surface,
         &control,
     )
     .unwrap();

@@ -168,7 +168,7 @@ fn shoal_score_scores_an_outside_product_against_the_runs_truth() {
     let chl: Vec<f32> = truth
         .chl_mg_m3
         .indexed_iter()
-        .map(|((r, c), v)| if truth.land[[r, c]] != 0 || (r, c) == (0, 0) { -9999.0 } else { v * 1.1 })
+        .map(|((r, c), v)| if truth.surface.codes()[[r, c]] != 0 || (r, c) == (0, 0) { -9999.0 } else { v * 1.1 })
         .collect();
     let product = dir.path().join("mine.nc");
     product_file(&product, shape, &[("chl_mg_m3", chl)]);
@@ -189,7 +189,7 @@ fn shoal_score_scores_an_outside_product_against_the_runs_truth() {
     // water pixel of the 24 × 16 image is missing.
     assert_eq!(cells[3], "10.0", "{row}");
     assert_eq!(cells[4], "+10.0", "{row}");
-    let water = truth.land.iter().filter(|l| **l == 0).count();
+    let water = truth.surface.codes().iter().filter(|l| **l == 0).count();
     assert_eq!(cells[1].parse::<usize>().unwrap(), water - 1, "{row}");
     assert_eq!(cells.last().unwrap(), "FAIL", "MAE 10 % against a 5 % requirement: {row}");
     assert!(std::fs::read_to_string(scored.join("score.csv")).unwrap().contains("chl_mg_m3,"));
@@ -232,12 +232,12 @@ fn the_oc4_example_runs_outside_shoal_and_is_scored() {
     let row = cells.join(" ");
     // Every water pixel returned, and the script's value is OC4v6 of the run's own Rrs (computed
     // here at one pixel; f32 file values, so 1e-5 relative).
-    let water = out.radiance.truth.land.iter().filter(|l| **l == 0).count();
+    let water = out.radiance.truth.surface.codes().iter().filter(|l| **l == 0).count();
     assert_eq!(cells[1].parse::<usize>().unwrap(), water, "{row}");
     let mut reader = netcdf3::FileReader::open(&product).unwrap();
     let chl = reader.read_var_f32("chl_mg_m3").unwrap();
     let (r, c) = (8, 12);
-    let cols = out.radiance.truth.land.dim().1;
+    let cols = out.radiance.truth.surface.codes().dim().1;
     let centres = out.response.bands.centres_nm();
     let band = |nm: f64| {
         (0..centres.len()).min_by(|&a, &b| (centres[a] - nm).abs().total_cmp(&(centres[b] - nm).abs())).unwrap()

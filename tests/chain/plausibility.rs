@@ -23,7 +23,7 @@ fn saturated_water(out: &shoal::engine::RunOutput) -> usize {
     let mut n = 0;
     for r in 0..rows {
         for c in 0..cols {
-            if out.radiance.truth.land[[r, c]] == 0 {
+            if out.radiance.truth.surface.codes()[[r, c]] == 0 {
                 n += (0..nb).filter(|&b| out.level0.flags[[r, c, b]] & Flags::SATURATED != 0).count();
             }
         }
@@ -46,7 +46,7 @@ fn a_ten_electron_well_warns_and_level_0_agrees() {
     assert!(w.value > 1.0);
     // The independent count: noise-free Level-0 flags every water pixel in every band.
     let (rows, cols, nb) = out.level0.flags.dim();
-    let water = out.radiance.truth.land.iter().filter(|&&l| l == 0).count();
+    let water = out.radiance.truth.surface.codes().iter().filter(|&&l| l == 0).count();
     assert!(water > 0 && rows * cols > 0);
     assert_eq!(saturated_water(&out), water * nb);
 }
@@ -60,7 +60,7 @@ fn the_guard_and_level_0_agree_at_the_edge_of_saturation() {
         .level0
         .dn
         .indexed_iter()
-        .filter(|((r, c, _), _)| probe.radiance.truth.land[[*r, *c]] == 0)
+        .filter(|((r, c, _), _)| probe.radiance.truth.surface.codes()[[*r, *c]] == 0)
         .map(|(_, &dn)| f64::from(dn))
         .fold(0.0, f64::max);
     let gain = probe.config.instrument.gain_e_per_dn;
@@ -137,7 +137,7 @@ fn the_report_counts_the_truths_depth_and_substrate_shares() {
     let fractions = out.radiance.truth.substrate_fractions.as_ref().unwrap();
     // Independent count: water pixels and, per substrate, the pixels where it is the largest.
     let water: Vec<(usize, usize)> =
-        out.radiance.truth.land.indexed_iter().filter(|(_, l)| **l == 0).map(|(rc, _)| rc).collect();
+        out.radiance.truth.surface.codes().indexed_iter().filter(|(_, l)| **l == 0).map(|(rc, _)| rc).collect();
     assert_eq!(s.water_pixels, water.len());
     let (lo, hi) = water
         .iter()

@@ -136,7 +136,7 @@ fn sambuca_noise_free_closure_on_the_reef() {
     let mut m = vec![0.0; nb];
     for r in 0..rows {
         for c in 0..cols {
-            if truth.truth.land[[r, c]] != 0 {
+            if truth.truth.surface.codes()[[r, c]] != 0 {
                 continue;
             }
             let mut order: Vec<usize> = (0..names.len()).collect();
@@ -251,7 +251,7 @@ fn hard_cases_are_finite_or_flagged() {
             let p = &out.retrievals[0].product;
             let (mut water, mut returned, mut at_zero) = (0, 0, 0);
             for ((r, c), f) in p.flags.indexed_iter() {
-                if out.radiance.truth.land[[r, c]] != 0 {
+                if out.radiance.truth.surface.codes()[[r, c]] != 0 {
                     continue;
                 }
                 water += 1;
@@ -278,7 +278,7 @@ fn hard_cases_are_finite_or_flagged() {
     let p = &out.retrievals[0].product;
     let mut pixels = 0;
     for ((r, c), f) in p.flags.indexed_iter() {
-        if out.radiance.truth.land[[r, c]] != 0 {
+        if out.radiance.truth.surface.codes()[[r, c]] != 0 {
             continue;
         }
         assert!(f & ProductFlags::RETURNED != 0, "no NAP, noise-free: ({r},{c}) not returned, flags {f}");

@@ -209,8 +209,11 @@ fn the_cubesat_error_budget_matches_runs_with_each_stage_made_perfect() {
             let mut c = c.clone();
             c.seed = seed;
             let out = engine.run(&c, &RunControl::new()).unwrap();
-            let (mae, n) =
-                chl_mae_pct(&out.retrievals[0].product, &out.radiance.truth.chl_mg_m3, &out.radiance.truth.land);
+            let (mae, n) = chl_mae_pct(
+                &out.retrievals[0].product,
+                &out.radiance.truth.chl_mg_m3,
+                out.radiance.truth.surface.codes(),
+            );
             assert!(n > 1000, "{n} pixels compared");
             sum += mae;
         }
@@ -263,7 +266,7 @@ fn the_default_study_checks_its_requirements_with_margins() {
     // computed here from the run's maps, and the margin is how far below 20 % it is.
     for (inst, passes) in [("cubesat", false), ("smallsat", true)] {
         let run = result.runs.iter().find(|r| r.label == inst).unwrap();
-        let (mae, n) = chl_mae_pct(&run.retrievals[0].product, &run.truth.chl_mg_m3, &run.truth.land);
+        let (mae, n) = chl_mae_pct(&run.retrievals[0].product, &run.truth.chl_mg_m3, run.truth.surface.codes());
         assert!(n > 1000, "{inst}: {n} pixels compared");
         let check = find(inst, "chl_mg_m3 MAE %");
         // Same maps and formula; only the order of the sums differs: 1e-9 points of %.

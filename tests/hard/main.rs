@@ -77,7 +77,7 @@ pub fn check(out: &RunOutput, case: &str) -> Degraded {
         assert!(v.iter().all(|x| x.is_finite() && *x >= 0.0), "{case}: {name} not finite or negative");
     }
     for ((r, col, _), x) in rad.truth.rrs_above.indexed_iter() {
-        if rad.truth.land[[r, col]] == 0 {
+        if rad.truth.surface.codes()[[r, col]] == 0 {
             assert!(f64::from(*x) <= RRS_MAX, "{case}: true Rrs {x} above 1/π");
         }
     }
@@ -143,7 +143,7 @@ fn check_retrievals(out: &RunOutput, case: &str) -> usize {
     // with fewer than three usable bands among those the retrieval fits must be FAILED (in every
     // case of tests/hard/chain.rs the aLMI failures are exactly these pixels). Every water pixel
     // (the truth's land mask) is either FAILED or RETURNED, never both.
-    let land = &out.radiance.truth.land;
+    let land = &out.radiance.truth.surface.codes();
     let water = land.iter().filter(|l| **l == 0).count();
     for (ret, spec) in out.retrievals.iter().zip(&c.retrievals) {
         let p = &ret.product;

@@ -268,7 +268,7 @@ fn the_histograms_count_every_returned_pixel_and_the_scatter_is_a_capped_sample(
     let (mut with_truth, mut returned) = (0, 0);
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     for ((r, c), t) in truth.chl_mg_m3.indexed_iter() {
-        if truth.land[[r, c]] != 0 || *t <= 0.0 {
+        if truth.surface.codes()[[r, c]] != 0 || *t <= 0.0 {
             continue;
         }
         with_truth += 1;
@@ -298,7 +298,7 @@ fn the_histograms_count_every_returned_pixel_and_the_scatter_is_a_capped_sample(
     let inside = truth
         .chl_mg_m3
         .indexed_iter()
-        .filter(|((r, c), t)| truth.land[[*r, *c]] == 0 && **t > 0.0)
+        .filter(|((r, c), t)| truth.surface.codes()[[*r, *c]] == 0 && **t > 0.0)
         .filter(|(_, t)| (first..=last).contains(&f64::from(**t).log10()))
         .count();
     assert!(inside as f64 >= 0.98 * with_truth as f64, "{inside} of {with_truth} truth values inside the bins");

@@ -106,7 +106,7 @@ impl PerPixel {
                         bottom_changed += usize::from(dominant(fa) != dominant(fb));
                     }
                 }
-                if out.radiance.truth.land[[r, c]] == 0 {
+                if out.radiance.truth.surface.is_water(r, c) {
                     let x = f64::from(out.correction.rrs.rrs[[r, c, band]]);
                     let y = f64::from(reference.correction.rrs.rrs[[r, c, band]]);
                     if y.abs() > 1e-6 {

@@ -185,17 +185,17 @@ fn gdal_reads_the_products_we_write_with_their_crs_transform_nodata_and_values()
     assert_eq!(bands[3]["description"], "true depth");
     assert_eq!(bands[3]["unit"], "m");
     assert_eq!(bands[3]["noDataValue"], -9999.0);
-    let water = |(r, c): (usize, usize)| truth.land[[r, c]] == 0;
+    let water = |(r, c): (usize, usize)| truth.surface.codes()[[r, c]] == 0;
     let depth = truth.depth_m.as_ref().unwrap();
     let (mean, lo, hi) = stats(depth.indexed_iter().map(|(i, v)| (f64::from(*v), water(i))));
     let s = &bands[3];
     // GDAL sums in double the Float32 values we wrote, as we do here: agreement to rounding.
     assert!((gdal_stat(s, "MEAN") - mean).abs() < 1e-9 * mean, "{s} vs {mean}");
     assert!((gdal_stat(s, "MINIMUM") - lo).abs() < 1e-9 && (gdal_stat(s, "MAXIMUM") - hi).abs() < 1e-9);
-    let land_pixels = truth.land.iter().filter(|v| **v != 0).count();
+    let land_pixels = truth.surface.codes().iter().filter(|v| **v != 0).count();
     assert!(land_pixels > 0, "the cay is in the image");
     assert_eq!(bands[7]["description"], "land (1) or water (0)");
-    let land_mean = land_pixels as f64 / truth.land.len() as f64;
+    let land_mean = land_pixels as f64 / truth.surface.codes().len() as f64;
     assert!((gdal_stat(&bands[7], "MEAN") - land_mean).abs() < 1e-9);
 
     let info = gdalinfo(&dir.join("sambuca.tif"));
