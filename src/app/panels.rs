@@ -6,7 +6,7 @@
 use super::ShoalApp;
 use super::logic::UiCommand;
 use super::model::{MAX_DESIGNS, RetrievalKind, label};
-use super::params::PARAMS;
+use super::params::{param, params};
 use crate::library::{Entry, Kind};
 use crate::retrieval::{Mode, Objective, Starts};
 
@@ -192,38 +192,37 @@ fn editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
     // fixed so the panel does not grow with its own content; Shift held makes a drag of the rail
     // or of the number 10× finer.
     ui.spacing_mut().slider_width = 160.0;
+    // The parameters and their values, read once a frame from the registry and the instrument.
+    let stored = super::params::values(&app.state.designs[editing].spec);
     egui::Grid::new("params").num_columns(2).show(ui, |ui| {
-        for p in &PARAMS {
-            let slot = &app.state.designs[editing];
-            let mut v = (p.get)(&slot.spec) * p.scale;
+        for (p, stored) in params().zip(stored) {
+            let (e, suffix) = (p.editor, p.suffix());
+            let mut v = stored * e.scale;
             let before = v;
             // Never clamped: a preset outside the slider's span keeps its value, and a typed
             // value outside it is checked against the instrument's documented range below.
             // A typed text that is not a number is refused aloud (egui would ignore it).
             let not_a_number: std::cell::Cell<Option<String>> = std::cell::Cell::new(None);
-            let slider = egui::Slider::new(&mut v, p.range.0..=p.range.1)
+            let slider = egui::Slider::new(&mut v, e.slider.0..=e.slider.1)
                 .update_while_editing(false)
-                .text(p.label)
-                .suffix(p.unit)
-                .logarithmic(p.log)
+                .text(e.label)
+                .suffix(suffix.as_str())
+                .logarithmic(e.log)
                 .clamping(egui::SliderClamping::Never)
                 .custom_parser(|text| {
-                    let parsed = parse_typed(text, p.unit);
+                    let parsed = parse_typed(text, &suffix);
                     if parsed.is_none() {
                         not_a_number.set(Some(text.to_string()));
                     }
                     parsed
                 });
-            let integer = matches!(p.key, "detectors" | "lines" | "adc_bits");
+            let integer = p.range.whole;
             let slider = if integer { slider.integer() } else { slider };
             // The hover text states the documented range (src/ranges.rs) a typed value must meet;
             // built only while the pointer is on the slider.
             let response = ui.add(slider);
             if let Some(text) = not_a_number.take() {
-                let allowed = crate::ranges::ALL
-                    .iter()
-                    .find(|r| r.field("instrument.") == p.key)
-                    .map_or_else(String::new, |r| format!(" (allowed: {})", r.allowed()));
+                let allowed = format!(" (allowed: {})", p.range.allowed());
                 app.ui.param_error = Some((p.key, format!("{}: `{text}` is not a number{allowed}", p.key)));
             }
             // Shift held on the rail: the pointer's motion moves the value a tenth as far, from
@@ -242,19 +241,17 @@ fn editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
                 }
             });
             if fine {
-                v = fine_step(before, response.drag_delta().x / ui.spacing().slider_width, p.range, p.log);
+                v = fine_step(before, response.drag_delta().x / ui.spacing().slider_width, e.slider, e.log);
             }
             response.on_hover_ui(|ui| {
-                ui.label(p.tip);
+                ui.label(e.tip);
                 ui.label("Type a value and press Enter; hold Shift while dragging the slider or the number for 10× finer steps.");
-                if let Some(r) = crate::ranges::ALL.iter().find(|r| r.field("instrument.") == p.key) {
-                    ui.label(format!("Allowed: {} (`{}`)", r.allowed(), p.key));
-                }
+                ui.label(format!("Allowed: {} (`{}`)", p.range.allowed(), p.key));
             });
             let mut linked = app.state.linked.iter().any(|k| k == p.key);
             if ui
                 .checkbox(&mut linked, "link")
-                .on_hover_text(format!("Link {} across the designs", p.label.to_lowercase()))
+                .on_hover_text(format!("Link {} across the designs", e.label.to_lowercase()))
                 .changed()
             {
                 if linked {
@@ -266,12 +263,12 @@ fn editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
             ui.end_row();
             if v != before {
                 let slot = &mut app.state.designs[editing];
-                let mut candidate = slot.spec.clone();
-                (p.set)(&mut candidate, v / p.scale);
-                match candidate.validate() {
-                    Ok(()) => {
+                let candidate = super::params::with_value(&slot.spec, p.key, v / e.scale)
+                    .map_err(|m| crate::instrument::InstrumentError::Invalid(crate::parse::FieldError { field: p.key.into(), message: m }));
+                match candidate.and_then(|c| c.validate().map(|()| c)) {
+                    Ok(candidate) => {
                         slot.spec = candidate;
-                        changed.push((p.key, v / p.scale));
+                        changed.push((p.key, v / e.scale));
                         app.ui.param_error = None;
                     }
                     // The value is refused and the instrument keeps its last valid one.
@@ -283,7 +280,7 @@ fn editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
     // A refused value, under the sliders and wrapped to the panel (inside the grid it widened
     // the panel for good).
     if let Some((key, message)) = &app.ui.param_error {
-        let label = PARAMS.iter().find(|p| p.key == *key).map_or(*key, |p| p.label);
+        let label = param(key).map_or(*key, |p| p.label());
         ui.add(
             egui::Label::new(egui::RichText::new(format!("{label} refused: {message}")).color(super::theme::FAIL))
                 .wrap(),
@@ -292,11 +289,13 @@ fn editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
     // Linked parameters follow to the other designs.
     for (key, value) in changed {
         if app.state.linked.iter().any(|k| k == key)
-            && let Some(p) = PARAMS.iter().find(|p| p.key == key)
+            && let Some(p) = param(key)
         {
             for (i, other) in app.state.designs.iter_mut().enumerate() {
-                if i != editing {
-                    (p.set)(&mut other.spec, value);
+                if i != editing
+                    && let Ok(spec) = super::params::with_value(&other.spec, p.key, value)
+                {
+                    other.spec = spec;
                 }
             }
         }

@@ -1,176 +1,76 @@
-//! The instrument parameters the editor offers: label, unit, slider span, scale and tip, and how
-//! each reads and writes the instrument.
+//! The instrument parameters the editor offers, read from the one parameter registry
+//! ([`crate::ranges::INSTRUMENT_EDITOR`]: label, unit, scale, slider span, tip, and the range a
+//! typed value must meet), and how each reads and writes an instrument — through the
+//! instrument's serde form, as sweeps set any field by its path (`crate::sweep::apply`).
+
+use serde_json::Value;
 
 use crate::instrument::InstrumentSpec;
+use crate::ranges::{Editor, INSTRUMENT_EDITOR, Range};
 
 /// One numeric instrument parameter as the editor shows it.
 pub struct Param {
-    /// The `InstrumentSpec` field (and `src/ranges.rs` path below `instrument.`).
+    /// The `InstrumentSpec` field (`aperture_mm`).
     pub key: &'static str,
+    /// Its range (what a typed value must meet).
+    pub range: &'static Range,
+    /// How the editor shows it.
+    pub editor: &'static Editor,
+}
+
+impl Param {
     /// The slider's label.
-    pub label: &'static str,
-    /// Unit suffix as shown.
-    pub unit: &'static str,
-    /// The slider's span (a typed value may leave it; the documented range decides).
-    pub range: (f64, f64),
-    /// Logarithmic slider.
-    pub log: bool,
-    /// Display = stored × scale (exposure in ms).
-    pub scale: f64,
-    /// Hover text.
-    pub tip: &'static str,
-    /// Read it from an instrument.
-    pub get: fn(&InstrumentSpec) -> f64,
-    /// Write it into an instrument.
-    pub set: fn(&mut InstrumentSpec, f64),
+    #[must_use]
+    pub fn label(&self) -> &'static str {
+        self.editor.label
+    }
+
+    /// The unit as a slider suffix (" mm"; empty: none).
+    #[must_use]
+    pub fn suffix(&self) -> String {
+        if self.editor.unit.is_empty() { String::new() } else { format!(" {}", self.editor.unit) }
+    }
 }
 
 /// The parameters, in the editor's order.
-pub const PARAMS: [Param; 13] = [
-    Param {
-        key: "aperture_mm",
-        label: "Aperture",
-        unit: " mm",
-        range: (10.0, 500.0),
-        log: true,
-        scale: 1.0,
-        tip: "Entrance pupil diameter: photons grow with its square",
-        get: |s| s.aperture_mm,
-        set: |s, v| s.aperture_mm = v,
-    },
-    Param {
-        key: "pixel_pitch_um",
-        label: "Pixel pitch",
-        unit: " µm",
-        range: (1.0, 30.0),
-        log: false,
-        scale: 1.0,
-        tip: "Detector pixel size: sets GSD with altitude and focal length",
-        get: |s| s.pixel_pitch_um,
-        set: |s, v| s.pixel_pitch_um = v,
-    },
-    Param {
-        key: "focal_length_mm",
-        label: "Focal length",
-        unit: " mm",
-        range: (20.0, 2000.0),
-        log: true,
-        scale: 1.0,
-        tip: "GSD = altitude × pitch / focal length",
-        get: |s| s.focal_length_mm,
-        set: |s, v| s.focal_length_mm = v,
-    },
-    Param {
-        key: "detectors",
-        label: "Detectors",
-        unit: "",
-        range: (16.0, 4096.0),
-        log: true,
-        scale: 1.0,
-        tip: "Detectors across track (swath = detectors × GSD)",
-        get: |s| s.detectors as f64,
-        set: |s, v| s.detectors = v.round() as usize,
-    },
-    Param {
-        key: "lines",
-        label: "Lines",
-        unit: "",
-        range: (16.0, 4000.0),
-        log: true,
-        scale: 1.0,
-        tip: "Exposures along track",
-        get: |s| s.lines as f64,
-        set: |s, v| s.lines = v.round() as usize,
-    },
-    Param {
-        key: "exposure_s",
-        label: "Exposure",
-        unit: " ms",
-        range: (0.1, 20.0),
-        log: true,
-        scale: 1000.0,
-        tip: "Integration time per line",
-        get: |s| s.exposure_s,
-        set: |s, v| s.exposure_s = v,
-    },
-    Param {
-        key: "well_depth_e",
-        label: "Well depth",
-        unit: " e⁻",
-        range: (1000.0, 2_000_000.0),
-        log: true,
-        scale: 1.0,
-        tip: "Full-well capacity: saturation above it",
-        get: |s| s.well_depth_e,
-        set: |s, v| s.well_depth_e = v,
-    },
-    Param {
-        key: "gain_e_per_dn",
-        label: "Gain",
-        unit: " e⁻/DN",
-        range: (0.1, 100.0),
-        log: true,
-        scale: 1.0,
-        tip: "Conversion gain: quantisation noise gain²/12",
-        get: |s| s.gain_e_per_dn,
-        set: |s, v| s.gain_e_per_dn = v,
-    },
-    Param {
-        key: "read_noise_e",
-        label: "Read noise",
-        unit: " e⁻",
-        range: (0.0, 100.0),
-        log: false,
-        scale: 1.0,
-        tip: "Readout noise, electrons rms",
-        get: |s| s.read_noise_e,
-        set: |s, v| s.read_noise_e = v,
-    },
-    Param {
-        key: "bias_dn",
-        label: "Bias",
-        unit: " DN",
-        range: (0.0, 1000.0),
-        log: false,
-        scale: 1.0,
-        tip: "ADC offset",
-        get: |s| s.bias_dn,
-        set: |s, v| s.bias_dn = v,
-    },
-    Param {
-        key: "adc_bits",
-        label: "ADC bits",
-        unit: "",
-        range: (4.0, 16.0),
-        log: false,
-        scale: 1.0,
-        tip: "Converter resolution: 2^bits − 1 is the largest count",
-        get: |s| f64::from(s.adc_bits),
-        set: |s, v| s.adc_bits = v.round() as u32,
-    },
-    Param {
-        key: "optical_transmission",
-        label: "Optical transmission",
-        unit: "",
-        range: (0.1, 1.0),
-        log: false,
-        scale: 1.0,
-        tip: "Throughput of the optics and filters",
-        get: |s| s.optical_transmission,
-        set: |s, v| s.optical_transmission = v,
-    },
-    Param {
-        key: "altitude_km",
-        label: "Altitude",
-        unit: " km",
-        range: (200.0, 1500.0),
-        log: false,
-        scale: 1.0,
-        tip: "Orbit altitude: GSD and ground speed",
-        get: |s| s.altitude_km,
-        set: |s, v| s.altitude_km = v,
-    },
-];
+pub fn params() -> impl Iterator<Item = Param> {
+    INSTRUMENT_EDITOR
+        .iter()
+        .filter_map(|range| range.editor.as_ref().map(|editor| Param { key: range.name(), range, editor }))
+}
+
+/// The editor's parameter called `key`.
+#[must_use]
+pub fn param(key: &str) -> Option<Param> {
+    params().find(|p| p.key == key)
+}
+
+/// Every editor parameter's stored value of `spec`, in [`params`] order (one pass over its serde
+/// form; NaN for a field it does not hold).
+#[must_use]
+pub fn values(spec: &InstrumentSpec) -> Vec<f64> {
+    let tree = serde_json::to_value(spec).unwrap_or(Value::Null);
+    params().map(|p| tree.get(p.key).and_then(Value::as_f64).unwrap_or(f64::NAN)).collect()
+}
+
+/// `spec` with field `key` set to `value` (stored units), or why not (not a field, a whole number
+/// given a fraction). Not validated: the caller checks the instrument.
+pub fn with_value(spec: &InstrumentSpec, key: &str, value: f64) -> Result<InstrumentSpec, String> {
+    let mut tree = serde_json::to_value(spec).map_err(|e| e.to_string())?;
+    let slot = tree.get_mut(key).ok_or_else(|| format!("no instrument field `{key}`"))?;
+    *slot = match slot {
+        Value::Number(n) if !n.is_f64() => {
+            if value.fract() != 0.0 || !(0.0..=9.0e15).contains(&value) {
+                return Err(format!("`{key}` is a whole number; {value} is not"));
+            }
+            Value::from(value as u64)
+        }
+        _ => serde_json::Number::from_f64(value)
+            .map(Value::Number)
+            .ok_or_else(|| format!("`{key}`: {value} is not finite"))?,
+    };
+    serde_json::from_value(tree).map_err(|e| e.to_string())
+}
 
 /// The parameters in which the designs differ from the first (the reference), as rows
 /// (parameter, a value per design) with a header row of the designs' names, in the editor's
@@ -185,13 +85,14 @@ pub fn differences(designs: &[(&str, &InstrumentSpec, usize)]) -> Vec<Vec<String
         let m = v.abs();
         if m == 0.0 || (0.01..1e7).contains(&m) { format!("{}", (v * 1e4).round() / 1e4) } else { format!("{v:.3e}") }
     };
-    let Some((_, reference, reference_bands)) = designs.first() else { return rows };
-    for p in &PARAMS {
-        let x = (p.get)(reference) * p.scale;
-        let values: Vec<f64> = designs.iter().map(|d| (p.get)(d.1) * p.scale).collect();
-        if values.iter().any(|y| (x - y).abs() > 1e-12 * x.abs().max(y.abs())) {
-            let mut row = vec![p.label.to_string()];
-            row.extend(values.iter().map(|v| format!("{}{}", show(*v), p.unit)));
+    let Some((_, _, reference_bands)) = designs.first() else { return rows };
+    let stored: Vec<Vec<f64>> = designs.iter().map(|d| values(d.1)).collect();
+    for (k, p) in params().enumerate() {
+        let shown: Vec<f64> = stored.iter().map(|v| v[k] * p.editor.scale).collect();
+        let x = shown[0];
+        if shown.iter().any(|y| (x - y).abs() > 1e-12 * x.abs().max(y.abs())) {
+            let mut row = vec![p.label().to_string()];
+            row.extend(shown.iter().map(|v| format!("{}{}", show(*v), p.suffix())));
             rows.push(row);
         }
     }
@@ -211,6 +112,22 @@ pub fn differences(designs: &[(&str, &InstrumentSpec, usize)]) -> Vec<Vec<String
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_editor_reads_and_writes_every_parameter_through_the_registry() {
+        let spec = InstrumentSpec::preset("cubesat").unwrap();
+        let v = values(&spec);
+        assert_eq!(v.len(), 13);
+        assert_eq!((v[0], v[5]), (60.0, 0.0015), "aperture, exposure (stored in s)");
+        for (k, p) in params().enumerate() {
+            let moved = if p.range.whole { v[k] + 1.0 } else { v[k] * 1.1 + 0.01 };
+            let edited = with_value(&spec, p.key, moved).unwrap();
+            assert_eq!(values(&edited)[k], moved, "{}", p.key);
+            assert!(p.range.path.ends_with(p.key) && !p.label().is_empty());
+        }
+        assert!(with_value(&spec, "adc_bits", 12.5).unwrap_err().contains("whole number"));
+        assert!(with_value(&spec, "no_such_field", 1.0).is_err());
+    }
 
     #[test]
     fn differences_list_what_differs_in_the_editors_units() {

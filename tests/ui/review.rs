@@ -123,7 +123,7 @@ fn the_sweep_takes_any_product_and_any_number_of_the_run() {
     h.get_by_label("Sweep").click();
     h.step();
     h.step();
-    pick(&mut h, "Parameter", "instrument.pixel_pitch_um (µm)");
+    pick(&mut h, "Parameter", "Pixel pitch: instrument.pixel_pitch_um (µm)");
     pick(&mut h, "MAE of", "NAP (g m⁻³)");
     h.get_by_role_and_label(Role::Slider, "Points").set_value_accesskit(2.0);
     h.get_by_role_and_label(Role::Slider, "Seeds").set_value_accesskit(1.0);

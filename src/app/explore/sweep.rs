@@ -182,7 +182,11 @@ fn labelled_drag(ui: &mut egui::Ui, label: &str, value: &mut f64, speed: f64) {
 /// A parameter choice: the field's path below its section and its meaning.
 fn choice_text(r: &Range) -> String {
     let unit = if r.unit.is_empty() { String::new() } else { format!(" ({})", r.unit) };
-    format!("{}{unit}", r.path)
+    // The editor's name first where the registry gives one ("Aperture: instrument.aperture_mm").
+    match &r.editor {
+        Some(e) => format!("{}: {}{unit}", e.label, r.path),
+        None => format!("{}{unit}", r.path),
+    }
 }
 
 /// Where each curve first meets its requirement, in words.
@@ -236,7 +240,8 @@ pub fn sweep_window(app: &mut super::super::ShoalApp, ctx: &egui::Context) {
                 && let Some(r) = fields.iter().find(|r| r.path == e.param)
             {
                 (e.from, e.to) = default_span(r, crate::sweep::value(&config, r.path).unwrap_or(0.0));
-                e.log = !r.whole && e.from > 0.0;
+                // The registry's scale where the editor has one (aperture on a log axis).
+                e.log = r.editor.map_or(!r.whole, |ed| ed.log) && e.from > 0.0;
             }
             let (from_speed, to_speed) = (0.01 * e.from.abs().max(1e-3), 0.01 * e.to.abs().max(1e-3));
             labelled_drag(ui, "From", &mut e.from, from_speed);

@@ -11,6 +11,10 @@
 //! name, `instrument.kind.Spectrograph.start_nm`). The study section holds the requirement
 //! thresholds of a study file.
 
+mod editor;
+
+pub use editor::{Editor, INSTRUMENT_EDITOR};
+
 use crate::water::limits;
 
 /// Shortest wavelength Shoal simulates, nm.
@@ -39,25 +43,34 @@ pub struct Range {
     pub whole: bool,
     /// What the field is.
     pub meaning: &'static str,
+    /// How an editor offers it (the app's instrument sliders, the sweep list's names); `None`:
+    /// set in files only.
+    pub editor: Option<Editor>,
 }
 
 impl Range {
+    /// The same range, offered by editors as `editor` says.
+    #[must_use]
+    pub const fn edited(self, editor: Editor) -> Self {
+        Self { editor: Some(editor), ..self }
+    }
+
     /// `lo` to `hi`, both allowed.
     #[must_use]
     pub const fn closed(path: &'static str, lo: f64, hi: f64, unit: &'static str, meaning: &'static str) -> Self {
-        Self { path, lo, lo_open: false, hi, hi_open: false, unit, whole: false, meaning }
+        Self { path, lo, lo_open: false, hi, hi_open: false, unit, whole: false, meaning, editor: None }
     }
 
     /// Above `lo`, at most `hi`.
     #[must_use]
     pub const fn above(path: &'static str, lo: f64, hi: f64, unit: &'static str, meaning: &'static str) -> Self {
-        Self { path, lo, lo_open: true, hi, hi_open: false, unit, whole: false, meaning }
+        Self { path, lo, lo_open: true, hi, hi_open: false, unit, whole: false, meaning, editor: None }
     }
 
     /// Whole numbers from `lo` to `hi`.
     #[must_use]
     pub const fn count(path: &'static str, lo: f64, hi: f64, unit: &'static str, meaning: &'static str) -> Self {
-        Self { path, lo, lo_open: false, hi, hi_open: false, unit, whole: true, meaning }
+        Self { path, lo, lo_open: false, hi, hi_open: false, unit, whole: true, meaning, editor: None }
     }
 
     /// The same range with `hi` refused.
@@ -148,35 +161,48 @@ macro_rules! ranges {
 ranges! {
     // Instrument (InstrumentSpec::validate).
     /// Orbit altitude.
-    INSTRUMENT_ALTITUDE_KM = Range::closed("instrument.altitude_km", 200.0, 1500.0, "km", "orbit altitude");
+    INSTRUMENT_ALTITUDE_KM = Range::closed("instrument.altitude_km", 200.0, 1500.0, "km", "orbit altitude")
+        .edited(Editor { label: "Altitude", unit: "km", scale: 1.0, slider: (200.0, 1_500.0), log: false, tip: "Orbit altitude: GSD and ground speed" });
     /// Orbital heading.
     INSTRUMENT_HEADING_DEG = Range::closed("instrument.heading_deg", -360.0, 360.0, "degrees", "ground-track azimuth, clockwise from north");
     /// Entrance aperture.
-    INSTRUMENT_APERTURE_MM = Range::above("instrument.aperture_mm", 0.0, 2000.0, "mm", "entrance pupil diameter");
+    INSTRUMENT_APERTURE_MM = Range::above("instrument.aperture_mm", 0.0, 2000.0, "mm", "entrance pupil diameter")
+        .edited(Editor { label: "Aperture", unit: "mm", scale: 1.0, slider: (10.0, 500.0), log: true, tip: "Entrance pupil diameter: photons grow with its square" });
     /// Pixel pitch.
-    INSTRUMENT_PIXEL_PITCH_UM = Range::above("instrument.pixel_pitch_um", 0.0, 100.0, "µm", "detector pixel pitch");
+    INSTRUMENT_PIXEL_PITCH_UM = Range::above("instrument.pixel_pitch_um", 0.0, 100.0, "µm", "detector pixel pitch")
+        .edited(Editor { label: "Pixel pitch", unit: "µm", scale: 1.0, slider: (1.0, 30.0), log: false, tip: "Detector pixel size: sets GSD with altitude and focal length" });
     /// Focal length.
-    INSTRUMENT_FOCAL_LENGTH_MM = Range::above("instrument.focal_length_mm", 0.0, 10_000.0, "mm", "effective focal length");
+    INSTRUMENT_FOCAL_LENGTH_MM = Range::above("instrument.focal_length_mm", 0.0, 10_000.0, "mm", "effective focal length")
+        .edited(Editor { label: "Focal length", unit: "mm", scale: 1.0, slider: (20.0, 2_000.0), log: true, tip: "GSD = altitude × pitch / focal length" });
     /// Detectors across track.
-    INSTRUMENT_DETECTORS = Range::count("instrument.detectors", 1.0, 20_000.0, "", "detectors across track (swath = detectors · GSD)");
+    INSTRUMENT_DETECTORS = Range::count("instrument.detectors", 1.0, 20_000.0, "", "detectors across track (swath = detectors · GSD)")
+        .edited(Editor { label: "Detectors", unit: "", scale: 1.0, slider: (16.0, 4_096.0), log: true, tip: "Detectors across track (swath = detectors × GSD)" });
     /// Exposure.
-    INSTRUMENT_EXPOSURE_S = Range::above("instrument.exposure_s", 0.0, 10.0, "s", "integration time of one frame");
+    INSTRUMENT_EXPOSURE_S = Range::above("instrument.exposure_s", 0.0, 10.0, "s", "integration time of one frame")
+        .edited(Editor { label: "Exposure", unit: "ms", scale: 1_000.0, slider: (0.1, 20.0), log: true, tip: "Integration time per line" });
     /// Frames along track.
-    INSTRUMENT_LINES = Range::count("instrument.lines", 1.0, 100_000.0, "", "lines (exposures) along track");
+    INSTRUMENT_LINES = Range::count("instrument.lines", 1.0, 100_000.0, "", "lines (exposures) along track")
+        .edited(Editor { label: "Lines", unit: "", scale: 1.0, slider: (16.0, 4_000.0), log: true, tip: "Exposures along track" });
     /// Forward tilt.
     INSTRUMENT_FORWARD_TILT_DEG = Range::closed("instrument.forward_tilt_deg", -60.0, 60.0, "degrees", "pointing along track (positive: forward)");
     /// Read noise.
-    INSTRUMENT_READ_NOISE_E = Range::closed("instrument.read_noise_e", 0.0, 1e5, "e-", "read noise, rms");
+    INSTRUMENT_READ_NOISE_E = Range::closed("instrument.read_noise_e", 0.0, 1e5, "e-", "read noise, rms")
+        .edited(Editor { label: "Read noise", unit: "e⁻", scale: 1.0, slider: (0.0, 100.0), log: false, tip: "Readout noise, electrons rms" });
     /// Full well.
-    INSTRUMENT_WELL_DEPTH_E = Range::above("instrument.well_depth_e", 0.0, 1e9, "e-", "full-well capacity");
+    INSTRUMENT_WELL_DEPTH_E = Range::above("instrument.well_depth_e", 0.0, 1e9, "e-", "full-well capacity")
+        .edited(Editor { label: "Well depth", unit: "e⁻", scale: 1.0, slider: (1_000.0, 2_000_000.0), log: true, tip: "Full-well capacity: saturation above it" });
     /// Conversion gain.
-    INSTRUMENT_GAIN_E_PER_DN = Range::closed("instrument.gain_e_per_dn", 0.01, 1e4, "e-/DN", "conversion gain");
+    INSTRUMENT_GAIN_E_PER_DN = Range::closed("instrument.gain_e_per_dn", 0.01, 1e4, "e-/DN", "conversion gain")
+        .edited(Editor { label: "Gain", unit: "e⁻/DN", scale: 1.0, slider: (0.1, 100.0), log: true, tip: "Conversion gain: quantisation noise gain²/12" });
     /// ADC offset.
-    INSTRUMENT_BIAS_DN = Range::closed("instrument.bias_dn", 0.0, 65_535.0, "DN", "ADC offset (below the ADC's largest count, 2^adc_bits − 1)").below_hi();
+    INSTRUMENT_BIAS_DN = Range::closed("instrument.bias_dn", 0.0, 65_535.0, "DN", "ADC offset (below the ADC's largest count, 2^adc_bits − 1)").below_hi()
+        .edited(Editor { label: "Bias", unit: "DN", scale: 1.0, slider: (0.0, 1_000.0), log: false, tip: "ADC offset" });
     /// ADC resolution.
-    INSTRUMENT_ADC_BITS = Range::count("instrument.adc_bits", 1.0, 16.0, "bits", "ADC resolution");
+    INSTRUMENT_ADC_BITS = Range::count("instrument.adc_bits", 1.0, 16.0, "bits", "ADC resolution")
+        .edited(Editor { label: "ADC bits", unit: "", scale: 1.0, slider: (4.0, 16.0), log: false, tip: "Converter resolution: 2^bits − 1 is the largest count" });
     /// Optics transmission.
-    INSTRUMENT_OPTICAL_TRANSMISSION = Range::above("instrument.optical_transmission", 0.0, 1.0, "", "optics transmission (spectrally flat factor)");
+    INSTRUMENT_OPTICAL_TRANSMISSION = Range::above("instrument.optical_transmission", 0.0, 1.0, "", "optics transmission (spectrally flat factor)")
+        .edited(Editor { label: "Optical transmission", unit: "", scale: 1.0, slider: (0.1, 1.0), log: false, tip: "Throughput of the optics and filters" });
     /// Dark current.
     INSTRUMENT_DARK_CURRENT_E_S = Range::closed("instrument.dark_current_e_s", 0.0, 1e9, "e-/s", "dark current per pixel");
     /// Photo-response non-uniformity.
@@ -446,7 +472,7 @@ mod tests {
     /// docs/MANUAL.md's table is `shoal ranges`'s output, so the documentation is the code's.
     #[test]
     fn manual_shows_the_table() {
-        let manual = include_str!("../docs/MANUAL.md");
+        let manual = include_str!("../../docs/MANUAL.md");
         let table = markdown_table();
         assert!(manual.contains(&table), "docs/MANUAL.md's table differs from `shoal ranges`; paste this:\n{table}");
     }
