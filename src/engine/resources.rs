@@ -12,7 +12,6 @@
 use crate::budget::{Demand, Lever, Part};
 use crate::instrument::InstrumentKind;
 use crate::scene::{Georeference, MapSpec, SceneSpec};
-use crate::spectral::BandSetSpec;
 
 use super::RunConfig;
 
@@ -51,22 +50,7 @@ const KEPT_BYTES_PER_PIXEL_BAND: f64 = 4.0;
 
 /// Bands an instrument will have (without reading its band files).
 fn band_count(kind: &InstrumentKind) -> usize {
-    fn set(b: &BandSetSpec) -> usize {
-        match b {
-            BandSetSpec::Olci { bands, .. } => bands.as_ref().map_or(19, Vec::len),
-            BandSetSpec::Msi { bands, .. } => bands.as_ref().map_or(9, Vec::len),
-            BandSetSpec::Gaussian(g) => g.len(),
-            BandSetSpec::Combined(parts) => parts.iter().map(set).sum(),
-        }
-    }
-    match kind {
-        InstrumentKind::Multispectral { bands } | InstrumentKind::IdealRadiometer { bands } => set(bands),
-        InstrumentKind::FilterImager { bands, .. } => set(bands),
-        InstrumentKind::Spectrograph { start_nm, end_nm, sampling_nm, .. } => {
-            let n = ((end_nm - start_nm) / sampling_nm).floor();
-            if n.is_finite() && n >= 0.0 { n as usize + 1 } else { 1 }
-        }
-    }
+    kind.model().band_count()
 }
 
 /// The scene's stored maps and their peak while built.

@@ -205,7 +205,7 @@ impl Detector {
     /// detector), so the grid pixels of one coarse pixel share its pattern.
     #[must_use]
     pub fn new(spec: &InstrumentSpec, response: &Response, mode: DetectorMode, seed: u64) -> Self {
-        let ideal = spec.is_ideal();
+        let ideal = !spec.kind.model().capabilities().real_detector;
         let mode = if ideal { DetectorMode::IDEAL } else { mode };
         let nb = response.n_bands();
         let nd = spec.detectors;

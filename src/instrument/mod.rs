@@ -37,6 +37,7 @@ pub mod detector;
 pub mod feasibility;
 pub mod focal;
 pub mod geometry;
+pub mod kind;
 pub mod level0;
 pub mod plausibility;
 pub mod response;

@@ -94,7 +94,7 @@ pub fn assess(
             });
         }
     }
-    if !spec.is_ideal() {
+    if spec.kind.model().capabilities().real_detector {
         out.extend(saturation(detector, bands, brightest_w_m2_sr_nm));
     }
     out

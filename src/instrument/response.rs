@@ -10,9 +10,9 @@
 use std::ops::Range;
 
 use super::InstrumentError;
-use super::spec::{InstrumentKind, InstrumentSpec};
+use super::spec::InstrumentSpec;
 use crate::parse::FieldError;
-use crate::spectral::{Band, BandAverager, BandSet, Extrapolation, GaussianBand, Spectrum, WavelengthGrid};
+use crate::spectral::{Band, BandAverager, BandSet, Extrapolation, Spectrum, WavelengthGrid};
 use crate::units::photon_energy_j;
 
 /// Bands that share a line of sight, and the simulation grid that covers their responses.
@@ -72,33 +72,13 @@ const SMILE_CLASSES: usize = 32;
 impl Response {
     /// Build the response of `spec` on grids of step `step_nm`.
     pub fn new(spec: &InstrumentSpec, step_nm: f64) -> Result<Self, InstrumentError> {
-        let bands = match &spec.kind {
-            InstrumentKind::Multispectral { bands }
-            | InstrumentKind::IdealRadiometer { bands }
-            | InstrumentKind::FilterImager { bands, .. } => BandSet::from_spec(bands)?,
-            InstrumentKind::Spectrograph { start_nm, end_nm, sampling_nm, resolution_nm, .. } => {
-                let n = ((end_nm - start_nm) / sampling_nm + 1e-9).floor() as usize + 1;
-                let list = (0..n)
-                    .map(|i| {
-                        let c = start_nm + i as f64 * sampling_nm;
-                        Band::gaussian(&GaussianBand {
-                            name: Some(format!("S{c:.1}")),
-                            centre_nm: c,
-                            fwhm_nm: *resolution_nm,
-                        })
-                    })
-                    .collect::<Result<Vec<_>, _>>()?;
-                BandSet { name: "spectrograph".into(), bands: list }
-            }
-        };
+        let kind = spec.kind.model();
+        let bands = kind.band_set()?;
         let plane_of_band = planes_of(spec, &bands)?;
         let qe_sources: Vec<&crate::spectral::SpectrumSource> = std::iter::once(&spec.quantum_efficiency)
             .chain(spec.focal_planes.iter().map(|p| &p.quantum_efficiency))
             .collect();
-        let (smile_nm, keystone) = match &spec.kind {
-            InstrumentKind::Spectrograph { smile_nm, keystone_px, .. } => (*smile_nm, *keystone_px),
-            _ => (0.0, 0.0),
-        };
+        let (smile_nm, keystone) = kind.distortions();
         let n_classes = if smile_nm == 0.0 { 1 } else { SMILE_CLASSES.min(spec.detectors) };
         let smile_class = (0..spec.detectors).map(|j| j * n_classes / spec.detectors).collect();
         // Smile shift of class c: quadratic in the normalised across-track position.
@@ -110,19 +90,7 @@ impl Response {
             smile_nm * x * x
         };
         let focal_m = spec.focal_length_mm * 1e-3;
-        let group_sets: Vec<(Vec<usize>, (f64, f64))> = match &spec.kind {
-            InstrumentKind::FilterImager { rows_per_band, .. } => {
-                let nb = bands.len();
-                (0..nb)
-                    .map(|b| {
-                        let y =
-                            (b as f64 - 0.5 * (nb as f64 - 1.0)) * *rows_per_band as f64 * spec.pixel_pitch_um * 1e-6;
-                        (vec![b], ((y / focal_m).atan(), 0.0))
-                    })
-                    .collect()
-            }
-            _ => vec![((0..bands.len()).collect(), (0.0, 0.0))],
-        };
+        let group_sets = kind.groups(bands.len(), spec.pixel_pitch_um, focal_m);
         let groups = group_sets
             .into_iter()
             .map(|(members, offset_rad)| {
@@ -305,6 +273,7 @@ fn shift(b: &Band, d: f64) -> Result<Band, InstrumentError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::instrument::InstrumentKind;
     use crate::spectral::{BandSetSpec, GaussianBand};
 
     fn spec_with(kind: InstrumentKind) -> InstrumentSpec {

@@ -200,63 +200,8 @@ impl InstrumentSpec {
             t.validate("instrument.dark_temperature")?;
         }
         self.validate_planes()?;
-        if let InstrumentKind::Spectrograph { start_nm, end_nm, sampling_nm, resolution_nm, smile_nm, keystone_px } =
-            &self.kind
-        {
-            check(&r::SPECTROGRAPH_START_NM, *start_nm)?;
-            check(&r::SPECTROGRAPH_END_NM, *end_nm)?;
-            check(&r::SPECTROGRAPH_SAMPLING_NM, *sampling_nm)?;
-            check(&r::SPECTROGRAPH_RESOLUTION_NM, *resolution_nm)?;
-            check(&r::SPECTROGRAPH_SMILE_NM, *smile_nm)?;
-            check(&r::SPECTROGRAPH_KEYSTONE_PX, *keystone_px)?;
-            if end_nm < start_nm {
-                return Err(InstrumentError::Invalid(FieldError {
-                    field: r::SPECTROGRAPH_END_NM.field("instrument.").into(),
-                    message: format!(
-                        "{end_nm} is below start_nm = {start_nm} (allowed: start_nm to {} nm)",
-                        crate::ranges::MAX_SIMULATED_NM
-                    ),
-                }));
-            }
-            // Each band's Gaussian response is tabulated over centre ± 2.5 FWHM (Band::gaussian),
-            // shifted by up to |smile|; it must lie where Shoal has atmospheric data.
-            let reach = 2.5 * resolution_nm + smile_nm.abs();
-            if end_nm + reach > crate::ranges::MAX_SIMULATED_NM {
-                return Err(InstrumentError::Invalid(FieldError {
-                    field: r::SPECTROGRAPH_END_NM.field("instrument.").into(),
-                    message: format!(
-                        "{end_nm} with resolution_nm = {resolution_nm} and smile_nm = {smile_nm} puts the last band's \
-                         response at {:.1} nm (allowed: end_nm + 2.5·resolution_nm + |smile_nm| ≤ {} nm, the end \
-                         of Shoal's atmospheric data)",
-                        end_nm + reach,
-                        crate::ranges::MAX_SIMULATED_NM
-                    ),
-                }));
-            }
-            if start_nm - reach < crate::ranges::MIN_SIMULATED_NM {
-                return Err(InstrumentError::Invalid(FieldError {
-                    field: r::SPECTROGRAPH_START_NM.field("instrument.").into(),
-                    message: format!(
-                        "{start_nm} with resolution_nm = {resolution_nm} and smile_nm = {smile_nm} puts the first \
-                         band's response at {:.1} nm (allowed: start_nm − 2.5·resolution_nm − |smile_nm| ≥ {} nm)",
-                        start_nm - reach,
-                        crate::ranges::MIN_SIMULATED_NM
-                    ),
-                }));
-            }
-            let samples = (end_nm - start_nm) / sampling_nm;
-            if samples > 2000.0 {
-                return Err(InstrumentError::Invalid(FieldError {
-                    field: r::SPECTROGRAPH_SAMPLING_NM.field("instrument.").into(),
-                    message: format!(
-                        "{sampling_nm} gives {samples:.0} spectral samples from start_nm to end_nm (allowed: at most 2000)"
-                    ),
-                }));
-            }
-        }
-        if let InstrumentKind::FilterImager { rows_per_band, .. } = &self.kind {
-            check(&r::FILTER_ROWS_PER_BAND, count(*rows_per_band))?;
-        }
+        // The kind's own fields (a spectrograph's span and sampling, a filter imager's rows).
+        self.kind.model().validate()?;
         Ok(())
     }
 
@@ -363,12 +308,6 @@ impl InstrumentSpec {
     #[must_use]
     pub fn dn_max(&self) -> f64 {
         f64::from((1u32 << self.adc_bits.min(16)) - 1)
-    }
-
-    /// Is this the noise-free reference radiometer?
-    #[must_use]
-    pub fn is_ideal(&self) -> bool {
-        matches!(self.kind, InstrumentKind::IdealRadiometer { .. })
     }
 }
 

@@ -248,7 +248,7 @@ fn level0_recount(out: &RunOutput, case: &str) -> (usize, usize, usize) {
     let l0 = &out.level0;
     let det = Detector::new(spec, &out.response, c.detector, c.seed);
     let mode = det.mode();
-    let ideal = spec.is_ideal();
+    let ideal = !spec.kind.model().capabilities().real_detector;
     // The converter's ceiling, 2^bits − 1, from the bit count (the ADC clips whether or not
     // Level-1 uses the quantised value).
     let adc_max = f64::from((1u32 << spec.adc_bits) - 1);
