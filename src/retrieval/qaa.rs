@@ -203,7 +203,7 @@ pub fn qaa_model(inputs: &RetrievalInputs<'_>) -> Result<QaaBands, RetrievalErro
 }
 
 /// Run QAA over the image: per water pixel whose five bands are valid, the IOPs, the chl they
-/// give and the flags (returned where a_ph(443) > 0 and a_dg(443) > 0).
+/// give and the flags (returned where a_ph(443), a_dg(443) and b_bp are positive).
 pub fn retrieve_qaa(
     bands: &QaaBands,
     settings: &QaaSettings,
@@ -228,7 +228,12 @@ pub fn retrieve_qaa(
                 for (b, v) in rrs.iter_mut().enumerate() {
                     *v = f64::from(inputs.rrs[[r, c, b]]);
                 }
-                let iops = valid.then(|| qaa_v6(&rrs, bands, &constants)).flatten().filter(|x| x.adg443 > 0.0);
+                // Physical IOPs only: a_dg(443) positive, and b_bp positive (b_bp(λ) has b_bp(λ0)'s
+                // sign at every band; over very clear water u·a/(1 − u) may fall below b_bw).
+                let iops = valid
+                    .then(|| qaa_v6(&rrs, bands, &constants))
+                    .flatten()
+                    .filter(|x| x.adg443 > 0.0 && x.bbp.first().is_some_and(|b| *b > 0.0));
                 match iops.as_ref().and_then(|x| Some((x, chl_from_aph443(x.aph443)?))) {
                     Some((x, chl)) => (
                         [chl as f32, x.adg443 as f32, x.aph443 as f32, x.bbp[i555] as f32],

@@ -14,6 +14,10 @@ fn almi() -> RetrievalSpec {
     RetrievalSpec::Almi { siop_sets: shoal::retrieval::sets::default_almi_sets(), settings: AlmiSettings::default() }
 }
 
+fn qaa() -> RetrievalSpec {
+    RetrievalSpec::Qaa { settings: Default::default() }
+}
+
 fn sambuca() -> RetrievalSpec {
     RetrievalSpec::Sambuca { siop: None, substrates: None, settings: SambucaSettings::default() }
 }
@@ -29,11 +33,11 @@ fn shallow(mut scene: SceneSpec, depth_m: f64, sand: f64) -> SceneSpec {
     scene
 }
 
-/// The nominal instrument, 16 × 16, over `scene`, with aLMI (and SAMBUCA when shallow).
+/// The nominal instrument, 16 × 16, over `scene`, with aLMI and QAA (and SAMBUCA when shallow).
 fn config(scene: SceneSpec) -> RunConfig {
     let shallow = scene.depth_m.is_some();
     let mut c = RunConfig::new(scene, instrument("nominal", 16, 16));
-    c.retrievals = if shallow { vec![almi(), sambuca()] } else { vec![almi()] };
+    c.retrievals = if shallow { vec![almi(), qaa(), sambuca()] } else { vec![almi(), qaa()] };
     c
 }
 
