@@ -254,14 +254,14 @@ fn grid_columns(n: usize, aspect: f32, avail: Vec2, title_h: f32) -> (usize, f32
 /// One map panel in `room` (the most width and height it may take): its title, marked when it
 /// shows a preview or the previous configuration; the map, greyed when previous; the scale bar;
 /// drag to pan, scroll to zoom (`view`, shared by all). Returns where the pointer is on the map
-/// (0–1) and a click, for the spectrum.
+/// (0–1) on the grid of the panel's design (with that design), and a click, for the spectrum.
 fn map_panel(
     ui: &mut egui::Ui,
     (panel, tex): (&PanelImage, &egui::TextureHandle),
     states: &PanelStates,
     room: Vec2,
     view: &mut View,
-) -> (Option<Pos2>, Option<super::spectrum::Pick>) {
+) -> (Option<(Pos2, usize)>, Option<super::spectrum::Pick>) {
     let PanelStates { marks, swath_m, empty } = states;
     // The design a panel belongs to (the truth's and the difference's: their first design, on
     // whose grid they are drawn).
@@ -328,7 +328,7 @@ fn map_panel(
             (s.y, i.zoom_delta())
         });
         view.zoom = (view.zoom * scroll.1 * (scroll.0 * 0.003).exp()).clamp(1.0, 64.0);
-        hovered = resp.hover_pos().map(|p| at(p, view));
+        hovered = resp.hover_pos().map(|p| (at(p, view), design));
     }
     (hovered, clicked)
 }
@@ -367,7 +367,7 @@ pub fn central(app: &mut ShoalApp, ui: &mut egui::Ui) {
     let aspect = app.images.panels.first().map_or(1.0, |(p, _)| p.image.width as f32 / p.image.height.max(1) as f32);
     let (cols, width) = grid_columns(n, aspect, Vec2::new(avail.x - bar_w, avail.y - 30.0), 14.0);
     let rows = n.div_ceil(cols);
-    let mut hovered: Option<Pos2> = None;
+    let mut hovered: Option<(Pos2, usize)> = None;
     let mut clicked = None;
     let mut view = app.ui.zoom;
     let states = panel_states(app);
@@ -407,18 +407,46 @@ pub fn central(app: &mut ShoalApp, ui: &mut egui::Ui) {
     hover_readout(app, ui, hovered);
 }
 
-/// The value under the cursor in every panel (rows are drawn bottom-up): class maps by class
-/// name, A − B of classes as agree or differ.
-fn hover_readout(app: &mut ShoalApp, ui: &mut egui::Ui, hovered: Option<Pos2>) {
+/// The run on display of design `i` (the configuration set's, or the previous one's meanwhile).
+fn run_of(app: &ShoalApp, i: usize) -> Option<&crate::engine::RunOutput> {
+    match app.link.standing(i) {
+        Standing::Current(s) | Standing::Earlier(s) => Some(&s.output),
+        _ => None,
+    }
+}
+
+/// The value under the cursor in every panel, at one ground point — the hovered panel's pixel;
+/// a panel on another design's grid reads its pixel nearest that point ("–" off its image). Rows
+/// are drawn bottom-up. Class maps by class name, the difference of classes as agree or differ.
+fn hover_readout(app: &mut ShoalApp, ui: &mut egui::Ui, hovered: Option<(Pos2, usize)>) {
     let classes = class_names(app);
-    if let Some(uv) = hovered {
+    if let Some((uv, d0)) = hovered {
         let mut parts = Vec::new();
-        let mut cell = None;
-        for (panel, _) in &app.images.panels {
-            let (rows, cols) = panel.data.values.dim();
+        let cell_of = |(rows, cols): (usize, usize)| {
             let c = ((uv.x * cols as f32) as usize).min(cols.saturating_sub(1));
             let r = (((1.0 - uv.y) * rows as f32) as usize).min(rows.saturating_sub(1));
-            cell.get_or_insert((r, c));
+            (r, c)
+        };
+        // The ground point under the cursor, on the hovered design's grid.
+        let ground = run_of(app, d0).map(|o| {
+            let (r, c) = cell_of((o.viewing.lines(), o.viewing.columns()));
+            o.viewing.ground_m(0, r, c)
+        });
+        let cell = run_of(app, d0).map(|o| cell_of((o.viewing.lines(), o.viewing.columns())));
+        for (panel, _) in &app.images.panels {
+            let d = match panel.role {
+                Role::Truth(i) | Role::Design(i) | Role::Difference(i, _) => i,
+            };
+            let at = match (d == d0, ground, run_of(app, d)) {
+                (true, _, _) | (_, None, _) => Some(cell_of(panel.data.values.dim())),
+                (false, Some((x, y)), Some(o)) => o.viewing.nearest_pixel(x, y, o.config.instrument.heading_deg),
+                (false, Some(_), None) => None,
+            };
+            let Some((r, c)) = at.filter(|&(r, c)| r < panel.data.values.nrows() && c < panel.data.values.ncols())
+            else {
+                parts.push(format!("{}: –", panel.title));
+                continue;
+            };
             let value = panel.data.values[[r, c]];
             let text = if !panel.data.valid[[r, c]] {
                 "–".into()
@@ -436,7 +464,8 @@ fn hover_readout(app: &mut ShoalApp, ui: &mut egui::Ui, hovered: Option<Pos2>) {
         }
         app.ui.hover = cell;
         if let Some((r, c)) = cell {
-            ui.label(format!("row {r}, column {c}   {}", parts.join("   ")));
+            let point = ground.map_or_else(String::new, |(x, y)| format!(" ({x:.0}, {y:.0}) m"));
+            ui.label(format!("{} row {r}, column {c}{point}   {}", super::model::label(d0), parts.join("   ")));
         }
     } else {
         ui.label("Drag to pan, scroll to zoom (the maps move together); click for the spectrum there.");

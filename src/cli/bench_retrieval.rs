@@ -303,7 +303,10 @@ pub fn retrieval_rows(out: &mut String, quick: bool) -> Result<(), CliError> {
             dea.ratio(rate)
         );
     }
-    let _ = writeln!(out, "| QAA v6 (document), the same pixels | {nb} | {qaa:.0} | – | – | IOCCG sheet to 1e-9 m⁻¹ (test) |");
+    let _ = writeln!(
+        out,
+        "| QAA v6 (document), the same pixels | {nb} | {qaa:.0} | – | – | IOCCG sheet to 1e-9 m⁻¹ (test) |"
+    );
     let casi: Vec<(f64, f64)> = (0..28).map(|i| (430.0 + 15.0 * f64::from(i), 10.0)).collect();
     let alos = [(460.0, 70.0), (560.0, 70.0), (650.0, 60.0), (825.0, 120.0)];
     let n = if quick { 200 } else { 1000 };
