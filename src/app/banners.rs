@@ -8,8 +8,7 @@ use super::model::ProductKind;
 /// The scene ↔ retrieval banner: a scene whose bottom shows needs a retrieval that models one.
 pub(super) fn retrieval_banner(app: &mut ShoalApp, ui: &mut egui::Ui) {
     use super::logic::UiCommand;
-    use super::model::RetrievalKind;
-    if app.state.retrieval == RetrievalKind::Almi && app.state.scene.needs_bottom_model() {
+    if app.state.runs("alm") && app.state.scene.needs_bottom_model() {
         ui.horizontal_wrapped(|ui| {
             ui.colored_label(
                 super::theme::NOTICE,
@@ -20,7 +19,7 @@ pub(super) fn retrieval_banner(app: &mut ShoalApp, ui: &mut egui::Ui) {
                 ),
             );
             if ui.button("Use SAMBUCA").on_hover_text("Retrieve depth, substrate and water together").clicked() {
-                app.ui.commands.push(UiCommand::UseRetrieval(RetrievalKind::Sambuca));
+                app.ui.commands.push(UiCommand::UseRetrieval("sambuca"));
             }
         });
     }
@@ -28,31 +27,22 @@ pub(super) fn retrieval_banner(app: &mut ShoalApp, ui: &mut egui::Ui) {
 
 /// The retrieval's name as tables and captions show it.
 pub(super) fn retrieval_name(state: &super::model::AppState) -> String {
-    use super::model::RetrievalKind;
-    match (state.retrieval, &state.study_retrieval) {
-        (RetrievalKind::Almi, _) | (RetrievalKind::Study, None) => "aLMI".into(),
-        (RetrievalKind::Sambuca, _) => "SAMBUCA".into(),
-        (RetrievalKind::Study, Some(r)) => r.algorithm().title(),
-    }
+    state.retrieval_spec().algorithm().title()
 }
 
 /// What the shown product is when the retrieval does not make it.
 pub(super) fn product_note(app: &ShoalApp) -> Option<String> {
-    use super::model::RetrievalKind;
-    let retrieval = retrieval_name(&app.state);
-    let missing = match (app.state.retrieval, &app.state.study_retrieval) {
-        (RetrievalKind::Study, Some(r)) => match app.state.product {
-            ProductKind::Depth | ProductKind::Chl | ProductKind::Nap | ProductKind::Cdom => {
-                app.state.product.variable().is_some_and(|v| !r.algorithm().variables().iter().any(|p| p == v))
-            }
-            ProductKind::Substrate | ProductKind::SiopSet => true,
-            ProductKind::Rrs | ProductKind::Level1 | ProductKind::Snr => false,
-        },
-        (kind, _) => matches!(
-            (kind, app.state.product),
-            (RetrievalKind::Almi | RetrievalKind::Study, ProductKind::Depth | ProductKind::Substrate)
-                | (RetrievalKind::Sambuca, ProductKind::SiopSet)
-        ),
+    use crate::retrieval::RetrievalSpec;
+    let spec = app.state.retrieval_spec();
+    let retrieval = spec.algorithm().title();
+    let missing = match app.state.product {
+        ProductKind::Depth | ProductKind::Chl | ProductKind::Nap | ProductKind::Cdom => {
+            app.state.product.variable().is_some_and(|v| !spec.algorithm().variables().iter().any(|p| p == v))
+        }
+        // Classes only the retrievals that choose them make.
+        ProductKind::Substrate => !matches!(spec, RetrievalSpec::Sambuca { .. }),
+        ProductKind::SiopSet => !matches!(spec, RetrievalSpec::Almi { .. }),
+        ProductKind::Rrs | ProductKind::Level1 | ProductKind::Snr => false,
     };
     missing.then(|| {
         let product = app.state.product.label().split(" (").next().unwrap_or_default();
@@ -64,7 +54,6 @@ pub(super) fn product_note(app: &ShoalApp) -> Option<String> {
 /// reason in full, and the way out when Shoal knows one.
 pub(super) fn failure_box(app: &mut ShoalApp, ui: &mut egui::Ui, index: usize, message: &str) {
     use super::logic::UiCommand;
-    use super::model::RetrievalKind;
     let ab = super::model::label(index);
     egui::Frame::group(ui.style()).stroke(egui::Stroke::new(1.5, super::theme::FAIL)).show(ui, |ui| {
         ui.set_width(ui.available_width());
@@ -74,14 +63,14 @@ pub(super) fn failure_box(app: &mut ShoalApp, ui: &mut egui::Ui, index: usize, m
         );
         ui.add(egui::Label::new(message).wrap());
         let deep = !app.state.scene.needs_bottom_model();
-        if app.state.retrieval == RetrievalKind::Sambuca && deep {
+        if app.state.runs("sambuca") && deep {
             ui.horizontal_wrapped(|ui| {
                 ui.label(format!(
                     "`{}` is optically deep: SAMBUCA fits a bottom it does not have.",
                     app.state.scene_name
                 ));
                 if ui.button("Use aLMI").on_hover_text("Retrieve chl-a, NAP and CDOM for deep water").clicked() {
-                    app.ui.commands.push(UiCommand::UseRetrieval(RetrievalKind::Almi));
+                    app.ui.commands.push(UiCommand::UseRetrieval("alm"));
                 }
             });
         }
@@ -91,13 +80,8 @@ pub(super) fn failure_box(app: &mut ShoalApp, ui: &mut egui::Ui, index: usize, m
 /// An external retrieval runs a program the study names: ask before it runs, and say why it
 /// returned nothing when it failed (the rest of the run is shown as usual).
 pub(super) fn external_banner(app: &mut ShoalApp, ui: &mut egui::Ui) {
-    use super::model::RetrievalKind;
     use crate::retrieval::external;
-    let Some(crate::retrieval::RetrievalSpec::External(spec)) =
-        app.state.study_retrieval.clone().filter(|_| app.state.retrieval == RetrievalKind::Study)
-    else {
-        return;
-    };
+    let crate::retrieval::RetrievalSpec::External(spec) = app.state.retrieval_spec() else { return };
     if !external::allowed(&spec.command) {
         ui.horizontal_wrapped(|ui| {
             ui.colored_label(

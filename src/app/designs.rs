@@ -34,9 +34,7 @@ impl AppState {
             (self.reference, self.on_maps, self.pair) = (0, vec![0, 1], [0, 1]);
         }
         (self.legacy_b, self.legacy_editing) = (None, None);
-        if let Some(e) = self.legacy_external.take() {
-            self.study_retrieval = Some(crate::retrieval::RetrievalSpec::External(e));
-        }
+        self.settle_retrievals();
         if self.designs.is_empty() {
             self.designs = AppState::default().designs;
         }

@@ -6,7 +6,7 @@
 use std::path::PathBuf;
 use std::time::Duration;
 
-use super::model::{AppState, ProductKind, RetrievalKind, Slot, label};
+use super::model::{AppState, ProductKind, Slot, label};
 use super::{Confirm, ShoalApp, model};
 use crate::library::{Entry, LibraryError};
 
@@ -50,8 +50,9 @@ pub enum UiCommand {
         /// The preset name.
         name: String,
     },
-    /// Run this retrieval (the scene/retrieval banner's switch), showing its main product.
-    UseRetrieval(RetrievalKind),
+    /// Run the retrieval of this name (`alm`, `sambuca`: the scene/retrieval banner's switch),
+    /// showing its main product.
+    UseRetrieval(&'static str),
 }
 
 impl ShoalApp {
@@ -170,12 +171,10 @@ impl ShoalApp {
                 let spec = Box::new(slot.spec.clone());
                 self.save(Confirm::Instrument { design, name, spec }, false);
             }
-            UiCommand::UseRetrieval(kind) => {
-                self.state.retrieval = kind;
-                self.state.product = match kind {
-                    RetrievalKind::Sambuca => ProductKind::Depth,
-                    RetrievalKind::Almi | RetrievalKind::Study => ProductKind::Chl,
-                };
+            UiCommand::UseRetrieval(name) => {
+                if self.state.select_retrieval(name) {
+                    self.state.product = if name == "sambuca" { ProductKind::Depth } else { ProductKind::Chl };
+                }
             }
             UiCommand::SaveStudy { name } => {
                 let study = Box::new(self.study_to_save(&name));

@@ -9,6 +9,7 @@
 //! |---|---|
 //! | persisted state, the designs' configurations | [`model`] |
 //! | the list of designs: add, remove, reorder | `designs` |
+//! | the retrievals offered, as specs | `retrievals` |
 //! | the engine thread's results | [`link`] |
 //! | product maps, colours, differences | [`raster`] |
 //! | histogram and scatter data, off the UI thread | [`plot_data`] |
@@ -50,6 +51,7 @@ pub mod plot_data;
 pub mod plots;
 mod probe;
 pub mod raster;
+mod retrievals;
 mod seeds;
 mod session;
 mod slide;

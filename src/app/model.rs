@@ -78,17 +78,16 @@ fn bare_some<'de, D: serde::Deserializer<'de>, T: Deserialize<'de>>(d: D) -> Res
     T::deserialize(d).map(Some)
 }
 
-/// Which retrieval the app runs.
+/// The retrieval a session saved before [`AppState::retrievals`] ran (`retrieval: Almi`):
+/// read, then turned into the selection by [`AppState::settle`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-pub enum RetrievalKind {
-    /// aLMI with the eight built-in SIOP sets.
+pub enum LegacyRetrieval {
+    /// aLMI.
     Almi,
-    /// SAMBUCA-style with the scene's SIOP set and substrates.
+    /// SAMBUCA.
     Sambuca,
-    /// The study's own retrieval beyond aLMI and SAMBUCA ([`AppState::study_retrieval`]: a
-    /// program, QAA). Saved as `External`, its name when it could only be a program.
-    #[serde(rename = "External")]
-    Study,
+    /// The study's external program.
+    External,
 }
 
 /// The whole persisted state of the app.
@@ -128,17 +127,23 @@ pub struct AppState {
     pub scene_seed: u64,
     /// Instrument noise seed.
     pub noise_seed: u64,
-    /// The retrieval.
-    pub retrieval: RetrievalKind,
-    /// aLMI settings.
-    pub almi: AlmiSettings,
-    /// SAMBUCA settings.
-    pub sambuca: SambucaSettings,
-    /// The study's own retrieval beyond aLMI and SAMBUCA, if the study the app opened has one
-    /// (an external program, QAA): offered beside them by its name.
-    pub study_retrieval: Option<RetrievalSpec>,
-    /// The external program of a session saved before `study_retrieval` (moved there by
-    /// [`Self::settle`]).
+    /// The retrievals the app offers, as the engine runs them: aLMI and SAMBUCA with their
+    /// settings, then the study's own (a program, QAA). The app edits these specs; no mirror of
+    /// them is kept.
+    pub retrievals: Vec<RetrievalSpec>,
+    /// The one that runs (an index into `retrievals`).
+    pub selected_retrieval: usize,
+    /// A session saved before `retrievals`: the retrieval it ran, its aLMI and SAMBUCA settings
+    /// and its study's program (moved into `retrievals` by [`Self::settle`]; never written).
+    #[serde(rename = "retrieval", default, deserialize_with = "bare_some", skip_serializing)]
+    pub legacy_retrieval: Option<LegacyRetrieval>,
+    /// (See `legacy_retrieval`.)
+    #[serde(rename = "almi", default, deserialize_with = "bare_some", skip_serializing)]
+    pub legacy_almi: Option<AlmiSettings>,
+    /// (See `legacy_retrieval`.)
+    #[serde(rename = "sambuca", default, deserialize_with = "bare_some", skip_serializing)]
+    pub legacy_sambuca: Option<SambucaSettings>,
+    /// (See `legacy_retrieval`.)
     #[serde(rename = "external", default, skip_serializing)]
     pub legacy_external: Option<crate::retrieval::external::ExternalSpec>,
     /// Preview decimations, coarsest first; the last is the final resolution (saved states
@@ -225,10 +230,11 @@ impl AppState {
             scene,
             scene_seed: 0,
             noise_seed: 1,
-            retrieval: RetrievalKind::Almi,
-            almi: AlmiSettings::default(),
-            sambuca: SambucaSettings::default(),
-            study_retrieval: None,
+            retrievals: super::retrievals::built_in(AlmiSettings::default(), SambucaSettings::default()),
+            selected_retrieval: 0,
+            legacy_retrieval: None,
+            legacy_almi: None,
+            legacy_sambuca: None,
             legacy_external: None,
             schema_version: crate::schema::VERSION,
             decimations: vec![24, 4, 1],
@@ -271,26 +277,12 @@ impl AppState {
         let mut s = Self::new(designs, &scene_name, first.2.scene.clone());
         s.settle();
         s.study_name.clone_from(&study.name);
-        match study.retrievals.first() {
-            Some(RetrievalSpec::Sambuca { settings, .. }) => {
-                s.retrieval = RetrievalKind::Sambuca;
-                s.sambuca = settings.clone();
-                s.product = ProductKind::Depth;
-            }
-            Some(RetrievalSpec::Almi { settings, .. }) => {
-                s.retrieval = RetrievalKind::Almi;
-                s.almi = settings.clone();
-            }
-            Some(RetrievalSpec::External(_) | RetrievalSpec::Qaa { .. }) => s.retrieval = RetrievalKind::Study,
-            None => {}
+        // The study's retrievals as they run (`{dir}` in a program's command is the study file's
+        // directory by now), its first selected.
+        s.offer_study_retrievals(&first.2.retrievals);
+        if matches!(s.retrievals.get(s.selected_retrieval), Some(RetrievalSpec::Sambuca { .. })) {
+            s.product = ProductKind::Depth;
         }
-        // From the resolved run: `{dir}` in a program's command is the study file's directory by now.
-        s.study_retrieval = first
-            .2
-            .retrievals
-            .iter()
-            .find(|r| !matches!(r, RetrievalSpec::Almi { .. } | RetrievalSpec::Sambuca { .. }))
-            .cloned();
         if let Some(r) = &study.requirements {
             s.requirements = r.clone();
         }
@@ -305,23 +297,6 @@ impl AppState {
     pub fn editing_mut(&mut self) -> &mut Slot {
         let i = self.editing.min(self.designs.len().saturating_sub(1));
         &mut self.designs[i]
-    }
-
-    /// The retrieval as the engine runs it.
-    #[must_use]
-    pub fn retrieval_spec(&self) -> RetrievalSpec {
-        let almi = || RetrievalSpec::Almi {
-            siop_sets: crate::retrieval::sets::default_almi_sets(),
-            settings: self.almi.clone(),
-        };
-        match (self.retrieval, &self.study_retrieval) {
-            (RetrievalKind::Sambuca, _) => {
-                RetrievalSpec::Sambuca { siop: None, substrates: None, settings: self.sambuca.clone() }
-            }
-            (RetrievalKind::Study, Some(r)) => r.clone(),
-            // A session naming a study's retrieval it no longer holds runs aLMI.
-            (RetrievalKind::Almi | RetrievalKind::Study, _) => almi(),
-        }
     }
 
     /// The scene with the scene seed added to its random fields.

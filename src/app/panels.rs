@@ -5,7 +5,7 @@
 
 use super::ShoalApp;
 use super::logic::UiCommand;
-use super::model::{MAX_DESIGNS, RetrievalKind, label};
+use super::model::{MAX_DESIGNS, label};
 use super::params::{param, params};
 use crate::library::{Entry, Kind};
 use crate::retrieval::{Mode, Objective, Starts};
@@ -319,39 +319,15 @@ fn editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
 fn settings(app: &mut ShoalApp, ui: &mut egui::Ui) {
     egui::CollapsingHeader::new("Retrieval, seeds, preview").default_open(true).show(ui, |ui| {
         let s = &mut app.state;
+        // The retrievals offered: aLMI, SAMBUCA and the study's own, each by its title.
         ui.horizontal(|ui| {
-            ui.selectable_value(&mut s.retrieval, RetrievalKind::Almi, "aLMI");
-            ui.selectable_value(&mut s.retrieval, RetrievalKind::Sambuca, "SAMBUCA");
-            if let Some(r) = &s.study_retrieval {
-                let title = r.algorithm().title();
-                ui.selectable_value(&mut s.retrieval, RetrievalKind::Study, title)
-                    .on_hover_text("The study's own retrieval");
+            for i in 0..s.retrievals.len() {
+                let title = s.retrievals[i].algorithm().title();
+                ui.selectable_value(&mut s.selected_retrieval, i, title);
             }
         });
-        if s.retrieval == RetrievalKind::Study {
-            match &mut s.study_retrieval {
-                Some(crate::retrieval::RetrievalSpec::External(e)) => {
-                    ui.small(format!(
-                        "Runs `{}` on the Rrs (NetCDF) and scores its {} (time limit {} s).",
-                        e.command.join(" "),
-                        e.products.join(", "),
-                        e.time_limit_s
-                    ));
-                }
-                Some(crate::retrieval::RetrievalSpec::Qaa { settings }) => {
-                    ui.horizontal(|ui| {
-                        ui.label("Mode");
-                        ui.selectable_value(&mut settings.mode, Mode::Improved, "Document")
-                            .on_hover_text("The QAA v6 document's equations (sub-surface ratios, as NASA's l2gen)");
-                        ui.selectable_value(&mut settings.mode, Mode::Reference, "IOCCG sheet")
-                            .on_hover_text("The IOCCG QAA_v6 spreadsheet's arithmetic, which gives its published numbers");
-                    });
-                    ui.small("IOPs from the Rrs with no SIOP assumed; chl from a_ph(443) (Bricaud et al. 1998).");
-                }
-                _ => {}
-            }
-        } else {
-            retrieval_mode(s, ui);
+        if let Some(spec) = s.retrieval_mut() {
+            retrieval_settings(spec, ui);
         }
         ui.horizontal(|ui| {
             let l = ui.label("Scene seed");
@@ -402,50 +378,67 @@ pub fn left(app: &mut ShoalApp, ui: &mut egui::Ui) {
     super::conditions::conditions(app, ui);
 }
 
-/// aLMI's or SAMBUCA's mode and settings.
-fn retrieval_mode(s: &mut super::model::AppState, ui: &mut egui::Ui) {
+/// The settings of the retrieval that runs, edited in its spec: the mode of aLMI, SAMBUCA and
+/// QAA, aLMI's noise weighting, SAMBUCA's objective and starts; a program's command, shown.
+fn retrieval_settings(spec: &mut crate::retrieval::RetrievalSpec, ui: &mut egui::Ui) {
+    use crate::retrieval::RetrievalSpec;
     // Reference: the published code's behaviour, to reproduce published numbers; Improved:
-    // Shoal's inversion, the design default.
-    let mode = match s.retrieval {
-        RetrievalKind::Almi | RetrievalKind::Study => &mut s.almi.mode,
-        RetrievalKind::Sambuca => &mut s.sambuca.mode,
+    // Shoal's inversion, the design default (QAA: the v6 document against the IOCCG sheet).
+    let (mode, names) = match spec {
+        RetrievalSpec::Almi { settings, .. } => (&mut settings.mode, ("Improved", "Reference")),
+        RetrievalSpec::Sambuca { settings, .. } => (&mut settings.mode, ("Improved", "Reference")),
+        RetrievalSpec::Qaa { settings } => (&mut settings.mode, ("Document", "IOCCG sheet")),
+        RetrievalSpec::External(e) => {
+            ui.small(format!(
+                "Runs `{}` on the Rrs (NetCDF) and scores its {} (time limit {} s).",
+                e.command.join(" "),
+                e.products.join(", "),
+                e.time_limit_s
+            ));
+            return;
+        }
     };
     ui.horizontal(|ui| {
         ui.label("Mode");
-        ui.selectable_value(mode, Mode::Improved, "Improved")
-            .on_hover_text("Shoal's inversion: what a design study should use");
-        ui.selectable_value(mode, Mode::Reference, "Reference").on_hover_text(
-            "The published code step for step (DEA aLMI; CSIRO SAMBUCA with SLSQP from one start), \
-             to reproduce the paper's numbers",
+        ui.selectable_value(mode, Mode::Improved, names.0).on_hover_text(
+            "Shoal's inversion (QAA: the v6 document's equations, as NASA's l2gen): what a design study should use",
+        );
+        ui.selectable_value(mode, Mode::Reference, names.1).on_hover_text(
+            "The published code step for step (DEA aLMI; CSIRO SAMBUCA with SLSQP from one start; the IOCCG QAA_v6 \
+             spreadsheet), to reproduce published numbers",
         );
     });
     let reference = *mode == Mode::Reference;
-    match s.retrieval {
-        RetrievalKind::Almi if reference => {
+    match spec {
+        RetrievalSpec::Almi { .. } if reference => {
             ui.small("As DEA's code: unweighted least squares per set, a set dropped below 1e-5.");
         }
-        RetrievalKind::Sambuca if reference => {
+        RetrievalSpec::Sambuca { .. } if reference => {
             ui.small("As the CSIRO package: distance f with NEDR, one start at (max − min)/2, SLSQP; stalls kept.");
         }
-        RetrievalKind::Almi | RetrievalKind::Study => {
-            ui.checkbox(&mut s.almi.noise_weighting, "Noise weighting")
+        RetrievalSpec::Almi { settings, .. } => {
+            ui.checkbox(&mut settings.noise_weighting, "Noise weighting")
                 .on_hover_text("Weight each band by its noise (off: as the reference code)");
         }
-        RetrievalKind::Sambuca => {
-            egui::ComboBox::from_label("Objective").selected_text(format!("{:?}", s.sambuca.objective)).show_ui(
+        RetrievalSpec::Sambuca { settings, .. } => {
+            egui::ComboBox::from_label("Objective").selected_text(format!("{:?}", settings.objective)).show_ui(
                 ui,
                 |ui| {
-                    ui.selectable_value(&mut s.sambuca.objective, Objective::F, "F");
-                    ui.selectable_value(&mut s.sambuca.objective, Objective::AlphaF, "AlphaF");
-                    ui.selectable_value(&mut s.sambuca.objective, Objective::Lsq, "Lsq");
+                    ui.selectable_value(&mut settings.objective, Objective::F, "F");
+                    ui.selectable_value(&mut settings.objective, Objective::AlphaF, "AlphaF");
+                    ui.selectable_value(&mut settings.objective, Objective::Lsq, "Lsq");
                 },
             );
-            egui::ComboBox::from_label("Starts").selected_text(format!("{:?}", s.sambuca.starts)).show_ui(ui, |ui| {
-                ui.selectable_value(&mut s.sambuca.starts, Starts::Adaptive, "Adaptive");
-                ui.selectable_value(&mut s.sambuca.starts, Starts::Shallow, "Shallow");
-                ui.selectable_value(&mut s.sambuca.starts, Starts::ShallowAndDeep, "ShallowAndDeep");
+            egui::ComboBox::from_label("Starts").selected_text(format!("{:?}", settings.starts)).show_ui(ui, |ui| {
+                ui.selectable_value(&mut settings.starts, Starts::Adaptive, "Adaptive");
+                ui.selectable_value(&mut settings.starts, Starts::Shallow, "Shallow");
+                ui.selectable_value(&mut settings.starts, Starts::ShallowAndDeep, "ShallowAndDeep");
             });
         }
+        RetrievalSpec::Qaa { .. } => {
+            ui.small("IOPs from the Rrs with no SIOP assumed; chl from a_ph(443) (Bricaud et al. 1998).");
+        }
+        RetrievalSpec::External(_) => {}
     }
 }
 

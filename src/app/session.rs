@@ -122,10 +122,24 @@ pub fn repair(state: &mut AppState) -> Vec<String> {
         reset.push(format!("requirements ({e}): back to the defaults"));
         state.requirements = fallback_requirements();
     }
-    if let Err(e) = state.retrieval_spec().validate() {
-        reset.push(format!("retrieval settings ({e}): back to the defaults"));
-        (state.almi, state.sambuca) = (defaults.almi.clone(), defaults.sambuca.clone());
+    // Each retrieval checked as a study would check it: aLMI's or SAMBUCA's settings out of range
+    // go back to the defaults; a study's own retrieval that does not check out is dropped.
+    let (mut kept, mut selected) = (Vec::new(), 0);
+    for (i, mut r) in std::mem::take(&mut state.retrievals).into_iter().enumerate() {
+        if let Err(e) = r.validate() {
+            reset.push(format!("retrieval {} settings ({e}): back to the defaults", r.algorithm().title()));
+            let builtin = super::retrievals::built_in(Default::default(), Default::default());
+            match builtin.into_iter().find(|b| b.name() == r.name()) {
+                Some(b) => r = b,
+                None => continue,
+            }
+        }
+        if i == state.selected_retrieval {
+            selected = kept.len();
+        }
+        kept.push(r);
     }
+    (state.retrievals, state.selected_retrieval) = (kept, selected);
     reset
 }
 

@@ -3,7 +3,7 @@
 //! shows its standard error where its maps would be; sessions keep the retrieval.
 
 use egui_kittest::kittest::Queryable;
-use shoal::app::model::{AppState, RetrievalKind};
+use shoal::app::model::AppState;
 use shoal::retrieval::RetrievalSpec;
 use shoal::retrieval::external::ExternalSpec;
 use shoal::study::StudySpec;
@@ -11,18 +11,15 @@ use shoal::study::StudySpec;
 #[test]
 fn the_app_asks_before_a_program_runs_and_shows_why_it_returned_nothing() {
     let dir = super::temp_library("external");
-    let state = AppState {
-        decimations: vec![16],
-        retrieval: RetrievalKind::Study,
-        study_retrieval: Some(RetrievalSpec::External(ExternalSpec {
-            name: "mine".into(),
-            command: vec!["sh".into(), "-c".into(), "echo 'mine.py: no model for 865 nm' >&2; exit 2".into()],
-            products: vec!["chl_mg_m3".into()],
-            bands: None,
-            time_limit_s: 30.0,
-        })),
-        ..AppState::default()
-    };
+    let mut state = AppState { decimations: vec![16], ..AppState::default() };
+    state.offer_study_retrievals(&[RetrievalSpec::External(ExternalSpec {
+        name: "mine".into(),
+        command: vec!["sh".into(), "-c".into(), "echo 'mine.py: no model for 865 nm' >&2; exit 2".into()],
+        products: vec!["chl_mg_m3".into()],
+        bands: None,
+        time_limit_s: 30.0,
+    })]);
+    assert!(state.runs("mine"), "the study's first retrieval runs");
     let mut h = super::with_state(state, &dir);
     super::wait_for_engine(&mut h);
     let ask = "runs a program on your machine";
@@ -42,7 +39,7 @@ fn the_app_asks_before_a_program_runs_and_shows_why_it_returned_nothing() {
     // Back to aLMI: the failure box goes and the metrics are aLMI's.
     h.get_by_label("aLMI").click();
     h.step();
-    assert_eq!(h.state().state.retrieval, RetrievalKind::Almi);
+    assert!(h.state().state.runs("alm"));
     super::wait_for_engine(&mut h);
     assert!(h.query_by_label_contains("returned nothing").is_none());
     assert_eq!(h.state().link.shown[0].as_ref().unwrap().output.retrievals[0].product.name, "aLMI");
@@ -53,17 +50,22 @@ fn the_app_asks_before_a_program_runs_and_shows_why_it_returned_nothing() {
 fn a_study_with_a_program_opens_with_it_selectable_and_sessions_keep_it() {
     let study = StudySpec::preset("lake_hume_oc4").unwrap();
     let state = AppState::from_study(&study, None).unwrap();
-    assert_eq!(state.retrieval, RetrievalKind::Almi, "the study's first retrieval is shown");
-    let Some(RetrievalSpec::External(external)) = state.study_retrieval.clone() else {
-        panic!("the study's program is not kept: {:?}", state.study_retrieval)
+    assert!(state.runs("alm"), "the study's first retrieval is shown");
+    let Some(RetrievalSpec::External(external)) = state.retrievals.get(2).cloned() else {
+        panic!("the study's program is not kept: {:?}", state.retrievals)
     };
     assert_eq!((external.name.as_str(), external.products.as_slice()), ("oc4", &["chl_mg_m3".to_string()][..]));
     // The session round trip keeps it; a session saved before the field existed loads without.
     let text = ron::to_string(&state).unwrap();
     assert_eq!(ron::from_str::<AppState>(&text).unwrap(), state);
-    let old = ron::to_string(&AppState::default()).unwrap().replace("study_retrieval:None,", "");
-    assert!(!old.contains("study_retrieval"), "{old}");
-    assert_eq!(ron::from_str::<AppState>(&old).unwrap().study_retrieval, None);
+    // A session saved before the list (`retrieval: Almi`, `almi`, `sambuca`, `external`) reads
+    // as the list with its selection.
+    let mut legacy = ron::from_str::<AppState>(
+        &ron::to_string(&AppState::default()).unwrap().replace("selected_retrieval:0,", "retrieval:Sambuca,"),
+    )
+    .unwrap();
+    legacy.settle();
+    assert!(legacy.runs("sambuca"));
 }
 
 /// A study with QAA opens with it beside aLMI and SAMBUCA, under its name; it runs, and says
@@ -73,13 +75,13 @@ fn a_study_with_qaa_offers_it_and_runs_it() {
     let dir = super::temp_library("qaa");
     let study = StudySpec::preset("lake_hume_qaa").unwrap();
     let mut state = AppState::from_study(&study, None).unwrap();
-    assert!(matches!(state.study_retrieval, Some(RetrievalSpec::Qaa { .. })), "{:?}", state.study_retrieval);
+    assert!(matches!(state.retrievals.get(2), Some(RetrievalSpec::Qaa { .. })), "{:?}", state.retrievals);
     state.decimations = vec![16];
     let mut h = super::with_state(state, &dir);
     super::wait_for_engine(&mut h);
     h.get_by_label("QAA v6").click();
     h.step();
-    assert_eq!(h.state().state.retrieval, RetrievalKind::Study);
+    assert!(h.state().state.runs("qaa"));
     super::wait_for_engine(&mut h);
     let product = &h.state().link.shown[0].as_ref().unwrap().output.retrievals[0].product;
     assert_eq!((product.name.as_str(), product.extras.len()), ("QAA", 3));
