@@ -68,7 +68,8 @@ pub const PRODUCTS: [Variable; 4] = [
 ];
 
 /// Variables a retrieval may return beside [`PRODUCTS`] (`Product::extras`): mapped and written,
-/// not scored (the truth holds concentrations, not these IOPs).
+/// and scored where the retrieval says what their truth is (`Algorithm::extra_truths`: QAA's
+/// IOPs from the true concentrations and the scene's SIOP set).
 pub const EXTRAS: [Variable; 3] = [
     Variable {
         key: "adg443_per_m",

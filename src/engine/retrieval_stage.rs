@@ -115,7 +115,13 @@ impl Engine {
                     Err(e @ RetrievalError::External { .. }) => (failed_product(spec, &inputs), Some(e.to_string())),
                     Err(e) => return Err(fail(e)),
                 };
-                let metrics = evaluate(&product, &radiance.truth);
+                let mut metrics = evaluate(&product, &radiance.truth);
+                // Extra products scored where the algorithm says what their truth is.
+                for (key, truth) in spec.algorithm().extra_truths(&model, &radiance.truth) {
+                    if let Some(m) = product.map(&key) {
+                        metrics.variables.push(score_map(&product, m, &truth, &radiance.truth.surface, key));
+                    }
+                }
                 Ok(RetrievalOutput {
                     spec: spec.clone(),
                     product,
@@ -129,6 +135,26 @@ impl Engine {
         }
         Ok(out)
     }
+}
+
+/// `retrieved` against `truth` over the water pixels: a pixel the product did not return counts as
+/// not returned ([`crate::metrics::compare`]).
+fn score_map(
+    product: &Product,
+    retrieved: &ndarray::Array2<f32>,
+    truth: &ndarray::Array2<f32>,
+    surface: &crate::instrument::SurfaceMap,
+    key: String,
+) -> crate::metrics::VariableMetrics {
+    let mut got = Vec::new();
+    let mut want = Vec::new();
+    for ((r, c), &t) in truth.indexed_iter() {
+        if surface.is_water(r, c) {
+            got.push(product.returned(r, c).then(|| f64::from(retrieved[[r, c]])));
+            want.push(Some(f64::from(t)));
+        }
+    }
+    crate::metrics::VariableMetrics { variable: key, metrics: crate::metrics::compare(&got, &want) }
 }
 
 /// The product of a retrieval that returned nothing: every water pixel failed, no maps.

@@ -42,6 +42,12 @@ pub trait Algorithm {
         inputs: &RetrievalInputs<'_>,
         control: &RunControl,
     ) -> Result<Product, RetrievalError>;
+
+    /// The true maps of the extra products it returns (by key), when the truth's concentrations
+    /// and its model say what they are; none by default (an extra is then mapped, not scored).
+    fn extra_truths(&self, _model: &Model, _truth: &crate::instrument::Truth) -> Vec<(String, ndarray::Array2<f32>)> {
+        Vec::new()
+    }
 }
 
 /// `model` as the type `name`'s prepare made, or an error saying it was made for another.
@@ -171,6 +177,9 @@ impl Algorithm for Qaa<'_> {
         control: &RunControl,
     ) -> Result<Product, RetrievalError> {
         qaa::retrieve_qaa(model_of(model, self.name())?, self.0, inputs, control)
+    }
+    fn extra_truths(&self, model: &Model, truth: &crate::instrument::Truth) -> Vec<(String, ndarray::Array2<f32>)> {
+        model_of::<qaa::QaaModel>(model, self.name()).map(|m| qaa::truth_iops(m, truth)).unwrap_or_default()
     }
 }
 

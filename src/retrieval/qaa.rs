@@ -24,8 +24,8 @@
 //! (1998, J. Geophys. Res. 103(C13), 31033, Table 2): a_ph(443) = 0.0654 chl^0.728, so
 //! chl = (a_ph(443) / 0.0654)^(1/0.728) — an open-ocean relation, which is the point of running
 //! it over inland water beside a retrieval that knows the lake's SIOPs. a_dg(443), a_ph(443) and
-//! b_bp at the band nearest 555 nm are its extra products, mapped and written but not scored (the
-//! truth holds concentrations, not these IOPs).
+//! b_bp at the band nearest 555 nm are its extra products, scored against the IOPs the scene's
+//! own SIOP set gives the truth's concentrations ([`truth_iops`]).
 
 use ndarray::Array2;
 use serde::{Deserialize, Serialize};
@@ -192,25 +192,62 @@ pub fn chl_from_aph443(aph443_per_m: f64) -> Option<f64> {
     (aph443_per_m > 0.0 && aph443_per_m.is_finite()).then(|| (aph443_per_m / 0.0654).powf(1.0 / 0.728))
 }
 
-/// QAA's model at the instrument's bands: the bands it reads and pure water there (the scene's
-/// SIOP set's water spectra averaged over each band's response).
-pub fn qaa_model(inputs: &RetrievalInputs<'_>) -> Result<QaaBands, RetrievalError> {
+/// QAA's model at the instrument's bands: the bands it reads and pure water there, and the scene
+/// SIOP set's specific IOPs there (each averaged over the band's response), which turn the
+/// truth's concentrations into the IOPs QAA retrieves ([`truth_iops`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct QaaModel {
+    /// The bands QAA reads, with pure water.
+    pub bands: QaaBands,
+    /// The scene's SIOP set per band.
+    pub scene: crate::retrieval::band_model::BandIops,
+}
+
+/// [`QaaModel`] at `inputs.bands`.
+pub fn qaa_model(inputs: &RetrievalInputs<'_>) -> Result<QaaModel, RetrievalError> {
     let (siop, dir) = &inputs.scene_siop;
     let model =
         BandModel::new(siop, dir.as_deref(), &crate::water::SubstrateLibrary::embedded()?, &[], &inputs.bands, 5)?;
-    let iops = model.band_iops();
-    QaaBands::new(inputs.bands.iter().map(BandResponse::centroid_nm).collect(), iops.a_w, iops.bb_w)
+    let scene = model.band_iops();
+    let bands = QaaBands::new(
+        inputs.bands.iter().map(BandResponse::centroid_nm).collect(),
+        scene.a_w.clone(),
+        scene.bb_w.clone(),
+    )?;
+    Ok(QaaModel { bands, scene })
+}
+
+/// The true values of QAA's extra products, from the truth's concentrations and the scene's SIOP
+/// set at the bands QAA reads (the forward model's own IOPs, Lee et al. 1999 as in
+/// [`crate::water`]): a_dg(443) = CDOM·a*_CDOM(443) + NAP·a*_NAP(443), a_ph(443) =
+/// chl·a*_ph(443), b_bp(555) = chl·b*_bph(555) + NAP·b*_bNAP(555), at the bands nearest 443 and
+/// 555 nm; by key of [`crate::variable::EXTRAS`].
+#[must_use]
+pub fn truth_iops(model: &QaaModel, truth: &crate::instrument::Truth) -> Vec<(String, ndarray::Array2<f32>)> {
+    let (i443, i555, s) = (model.bands.at[1], model.bands.at[3], &model.scene);
+    let (chl, nap, cdom) = (&truth.chl_mg_m3, &truth.nap_g_m3, &truth.cdom_per_m);
+    let at = |f: &dyn Fn(usize) -> f64| {
+        ndarray::Array2::from_shape_fn(chl.dim(), |(r, c)| {
+            if truth.is_water(r, c) { f(r * chl.ncols() + c) as f32 } else { 0.0 }
+        })
+    };
+    let v = |m: &ndarray::Array2<f32>, k: usize| f64::from(m.as_slice().map_or(0.0, |x| x[k]));
+    let adg = at(&|k| v(cdom, k) * s.a_cdom[i443] + v(nap, k) * s.a_nap[i443]);
+    let aph = at(&|k| v(chl, k) * s.a_ph[i443]);
+    let bbp = at(&|k| v(chl, k) * s.bb_ph[i555] + v(nap, k) * s.bb_nap[i555]);
+    crate::variable::EXTRAS.iter().map(|x| x.key.to_string()).zip([adg, aph, bbp]).collect()
 }
 
 /// Run QAA over the image: per water pixel whose five bands are valid, the IOPs, the chl they
 /// give and the flags (returned where a_ph(443), a_dg(443) and b_bp are positive).
 pub fn retrieve_qaa(
-    bands: &QaaBands,
+    model: &QaaModel,
     settings: &QaaSettings,
     inputs: &RetrievalInputs<'_>,
     control: &RunControl,
 ) -> Result<Product, RetrievalError> {
     let constants = Constants::of(settings.mode);
+    let bands = &model.bands;
     let (rows, cols, nb) = inputs.rrs.dim();
     // Per pixel: chl, adg443, aph443, bbp near 555; and the flags. Rows in parallel.
     let i555 = bands.at[3];

@@ -138,8 +138,8 @@ pub struct Product {
     /// Iterations (SAMBUCA).
     pub iterations: Option<Array2<u16>>,
     /// Further named maps the retrieval returns beside the core (QAA's IOPs: `adg443_per_m`, …),
-    /// keys of [`crate::variable::EXTRAS`]: mapped and written, scored only where the truth has
-    /// the same variable.
+    /// keys of [`crate::variable::EXTRAS`]: mapped and written, scored where the algorithm says
+    /// what their truth is.
     pub extras: Vec<(String, Array2<f32>)>,
     /// [`ProductFlags`].
     pub flags: Array2<u8>,

@@ -50,6 +50,12 @@ fn qaa_returns_chl_and_its_iops_on_every_pixel_it_can_and_flags_the_rest() {
     let metrics = one.retrievals[0].metrics.get("chl_mg_m3").unwrap();
     assert_eq!(metrics.n, returned, "the metrics score the returned pixels");
     assert!(metrics.mae_pct().is_finite());
+    // Its IOPs are scored against the ones the scene's SIOP set gives the true concentrations.
+    for key in ["adg443_per_m", "aph443_per_m", "bbp555_per_m"] {
+        let m = one.retrievals[0].metrics.get(key).unwrap_or_else(|| panic!("{key} not scored"));
+        assert_eq!(m.n, returned, "{key}");
+        assert!(m.mae_pct().is_finite() && m.bias_pct().is_finite(), "{key}: {m:?}");
+    }
     // Determinism: the same bits on one and two threads.
     let q = &two.retrievals[0].product;
     let bits = |p: &shoal::retrieval::Product| -> Vec<u32> {
