@@ -427,12 +427,9 @@ fn hover_readout(app: &mut ShoalApp, ui: &mut egui::Ui, hovered: Option<(Pos2, u
             let r = (((1.0 - uv.y) * rows as f32) as usize).min(rows.saturating_sub(1));
             (r, c)
         };
-        // The ground point under the cursor, on the hovered design's grid.
-        let ground = run_of(app, d0).map(|o| {
-            let (r, c) = cell_of((o.viewing.lines(), o.viewing.columns()));
-            o.viewing.ground_m(0, r, c)
-        });
+        // The cell and ground point under the cursor, on the hovered design's grid.
         let cell = run_of(app, d0).map(|o| cell_of((o.viewing.lines(), o.viewing.columns())));
+        let ground = run_of(app, d0).zip(cell).map(|(o, (r, c))| o.viewing.ground_m(0, r, c));
         for (panel, _) in &app.images.panels {
             let d = match panel.role {
                 Role::Truth(i) | Role::Design(i) | Role::Difference(i, _) => i,

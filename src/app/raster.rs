@@ -284,6 +284,9 @@ pub struct Done {
     pub plot: Arc<PlotData>,
 }
 
+/// Entries [`ByRun`] keeps per run on display: its map, its truth and one more.
+const PER_RUN: usize = 3;
+
 /// Products derived from runs, by run (kept alive here, so pointer equality is identity) and a
 /// key, least recently used first: when only A changes, B's products are neither rebuilt nor
 /// revisited. Each entry keeps its run (cubes and all) alive, so runs no longer on display are
@@ -299,9 +302,6 @@ impl<K, V> Default for ByRun<K, V> {
 }
 
 impl<K: PartialEq + Send + 'static, V: Clone + Send + 'static> ByRun<K, V> {
-    /// Entries kept per run on display: its map, its truth and one more.
-    const PER_RUN: usize = 3;
-
     /// Let go of every run not in `runs` (those no longer on display), and bound the entries.
     fn keep_only(&mut self, runs: &[Option<Arc<RunOutput>>]) {
         let shown = |e: &(Arc<RunOutput>, K, V)| runs.iter().flatten().any(|r| Arc::ptr_eq(r, &e.0));
@@ -356,7 +356,7 @@ impl MapCache {
 pub fn panels(job: &Job, cache: &mut MapCache) -> Done {
     use super::model::{Layout, label};
     cache.keep_only(&job.runs);
-    let capacity = ByRun::<(), ()>::PER_RUN * job.runs.iter().flatten().count();
+    let capacity = PER_RUN * job.runs.iter().flatten().count();
     let mut get = |i: usize, truth: bool| {
         let out = job.runs.get(i)?.as_ref()?;
         cache.map(out, job.kind, job.band, truth, (job.max_side, capacity))

@@ -159,21 +159,6 @@ fn score_map(
 
 /// The product of a retrieval that returned nothing: every water pixel failed, no maps.
 fn failed_product(spec: &RetrievalSpec, inputs: &RetrievalInputs<'_>) -> Product {
-    let dim = inputs.surface.dim();
-    Product {
-        name: spec.name().to_string(),
-        chl_mg_m3: None,
-        cdom_per_m: None,
-        nap_g_m3: None,
-        depth_m: None,
-        substrate_names: Vec::new(),
-        substrate_fractions: None,
-        siop_set_names: Vec::new(),
-        siop_set: None,
-        cost: ndarray::Array2::zeros(dim),
-        sdi: None,
-        iterations: None,
-        extras: Vec::new(),
-        flags: inputs.surface.water_mask().mapv(|w| if w { ProductFlags::FAILED } else { ProductFlags::LAND }),
-    }
+    let flags = inputs.surface.water_mask().mapv(|w| if w { ProductFlags::FAILED } else { ProductFlags::LAND });
+    Product::bare(spec.name().to_string(), flags)
 }

@@ -195,19 +195,10 @@ pub(super) fn product(spec: &ExternalSpec, inputs: &RetrievalInputs<'_>, maps: &
     });
     let mut take = |v: &str| planes.iter().position(|(n, _)| *n == v).map(|i| planes.remove(i).1);
     Ok(Product {
-        name: spec.name.clone(),
         chl_mg_m3: take(key::CHL),
         cdom_per_m: take(key::CDOM),
         nap_g_m3: take(key::NAP),
         depth_m: take(key::DEPTH),
-        substrate_names: Vec::new(),
-        substrate_fractions: None,
-        siop_set_names: Vec::new(),
-        siop_set: None,
-        cost: Array2::zeros((rows, cols)),
-        sdi: None,
-        iterations: None,
-        extras: Vec::new(),
-        flags,
+        ..Product::bare(spec.name.clone(), flags)
     })
 }

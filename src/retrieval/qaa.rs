@@ -285,23 +285,9 @@ pub fn retrieve_qaa(
     let out = Array2::from_shape_fn((rows, cols), |(r, c)| rows_out[r][c].0);
     let flags = Array2::from_shape_fn((rows, cols), |(r, c)| rows_out[r][c].1);
     let plane = |k: usize| out.mapv(|v| v[k]);
-    Ok(Product {
-        name: "QAA".into(),
-        chl_mg_m3: Some(plane(0)),
-        cdom_per_m: None,
-        nap_g_m3: None,
-        depth_m: None,
-        substrate_names: Vec::new(),
-        substrate_fractions: None,
-        siop_set_names: Vec::new(),
-        siop_set: None,
-        cost: Array2::zeros((rows, cols)),
-        sdi: None,
-        iterations: None,
-        // a_dg(443), a_ph(443), b_bp(555): the order of `crate::variable::EXTRAS`.
-        extras: crate::variable::EXTRAS.iter().enumerate().map(|(k, v)| (v.key.to_string(), plane(k + 1))).collect(),
-        flags,
-    })
+    // a_dg(443), a_ph(443), b_bp(555): the order of `crate::variable::EXTRAS`.
+    let extras = crate::variable::EXTRAS.iter().enumerate().map(|(k, v)| (v.key.to_string(), plane(k + 1))).collect();
+    Ok(Product { chl_mg_m3: Some(plane(0)), extras, ..Product::bare("QAA".into(), flags) })
 }
 
 #[cfg(test)]

@@ -146,6 +146,28 @@ pub struct Product {
 }
 
 impl Product {
+    /// A product named `name` with `flags` and no map yet (no cost, classes or solver fields):
+    /// what a retrieval that returns only scalar maps fills in.
+    #[must_use]
+    pub fn bare(name: String, flags: Array2<u8>) -> Self {
+        Self {
+            name,
+            chl_mg_m3: None,
+            cdom_per_m: None,
+            nap_g_m3: None,
+            depth_m: None,
+            substrate_names: Vec::new(),
+            substrate_fractions: None,
+            siop_set_names: Vec::new(),
+            siop_set: None,
+            cost: Array2::zeros(flags.dim()),
+            sdi: None,
+            iterations: None,
+            extras: Vec::new(),
+            flags,
+        }
+    }
+
     /// Did the retrieval return a value at (row, column)?
     #[must_use]
     pub fn returned(&self, r: usize, c: usize) -> bool {
