@@ -204,9 +204,10 @@ fn product_menu(app: &mut ShoalApp, ui: &mut egui::Ui) {
 }
 
 /// Per design, for its panels: (shows the previous configuration, the preview's decimation if
-/// a preview), its swath, and why its run returned no pixel.
+/// a preview), the address of its current run, its swath, and why its run returned no pixel.
 struct PanelStates {
     marks: Vec<(bool, Option<usize>)>,
+    current: Vec<Option<usize>>,
     swath_m: Vec<Option<f64>>,
     empty: Vec<Option<String>>,
 }
@@ -222,6 +223,8 @@ fn panel_states(app: &ShoalApp) -> PanelStates {
             _ => (false, None),
         })
         .collect();
+    let current: Vec<Option<usize>> =
+        (0..n).map(|i| app.link.current(i).map(|s| std::sync::Arc::as_ptr(&s.output) as usize)).collect();
     let swath_m: Vec<Option<f64>> = (0..n)
         .map(|i| match app.link.standing(i) {
             Standing::Current(s) | Standing::Earlier(s) => Some(s.output.config.instrument.swath_m()),
@@ -234,7 +237,7 @@ fn panel_states(app: &ShoalApp) -> PanelStates {
             _ => None,
         })
         .collect();
-    PanelStates { marks, swath_m, empty }
+    PanelStates { marks, current, swath_m, empty }
 }
 
 /// Columns of the small multiples: the count that gives `n` panels of aspect `aspect` (width
@@ -262,7 +265,7 @@ fn map_panel(
     room: Vec2,
     view: &mut View,
 ) -> (Option<(Pos2, usize)>, Option<super::spectrum::Pick>) {
-    let PanelStates { marks, swath_m, empty } = states;
+    let PanelStates { marks, current, swath_m, empty } = states;
     // The design a panel belongs to (the truth's and the difference's: their first design, on
     // whose grid they are drawn).
     let design = match panel.role {
@@ -273,11 +276,16 @@ fn map_panel(
         Role::Truth(i) => marks.get(i).map_or((false, None), |m| (m.0, None)),
         Role::Difference(..) => (marks.iter().any(|m| m.0), None),
     };
-    let title = match (earlier, preview) {
-        (true, _) => format!("{} (previous configuration, updating)", panel.title),
-        (false, Some(d)) => format!("{} (preview 1/{d})", panel.title),
+    // Made from runs that are no longer the current ones (a newer result is being coloured):
+    // greyed and said so, never titled as the result the link now holds.
+    let superseded = panel.made_from.iter().any(|&(d, run)| current.get(d).copied().flatten() != Some(run));
+    let title = match (earlier, superseded, preview) {
+        (true, _, _) => format!("{} (previous configuration, updating)", panel.title),
+        (false, true, _) => format!("{} (updating)", panel.title),
+        (false, false, Some(d)) => format!("{} (preview 1/{d})", panel.title),
         _ => panel.title.clone(),
     };
+    let earlier = earlier || superseded;
     match panel.role {
         Role::Design(i) => ui.colored_label(super::theme::design(i), title),
         _ => ui.label(title),

@@ -267,6 +267,25 @@ pub struct PanelImage {
     pub data: Arc<MapData>,
     /// The coloured image.
     pub image: Image,
+    /// The runs it was made from, as (design, the run's address): the app marks a panel whose
+    /// runs are no longer the designs' current ones as updating, whatever the link holds meanwhile.
+    pub made_from: Vec<(usize, usize)>,
+}
+
+/// The address of design `i`'s run in `runs` (0: none), which identifies it while it is alive.
+fn address(runs: &[Option<Arc<RunOutput>>], i: usize) -> usize {
+    runs.get(i).and_then(Option::as_ref).map_or(0, |r| Arc::as_ptr(r) as usize)
+}
+
+impl Role {
+    /// The designs whose runs a panel of this role is made from.
+    #[must_use]
+    pub fn designs(self) -> Vec<usize> {
+        match self {
+            Self::Truth(i) | Self::Design(i) => vec![i],
+            Self::Difference(i, j) => vec![i, j],
+        }
+    }
 }
 
 /// The raster thread's answer.
@@ -410,11 +429,18 @@ pub fn panels(job: &Job, cache: &mut MapCache) -> Done {
     });
     let mut panels: Vec<PanelImage> = named
         .into_iter()
-        .map(|(title, role, m)| PanelImage { image: m.blocks.colorize(palette), title, role, data: m.data.clone() })
+        .map(|(title, role, m)| PanelImage {
+            image: m.blocks.colorize(palette),
+            made_from: role.designs().into_iter().map(|i| (i, address(&job.runs, i))).collect(),
+            title,
+            role,
+            data: m.data.clone(),
+        })
         .collect();
     if let (Some((d, role)), Some(p)) = (diff, difference_palette) {
         let title = format!("{} − {}", label(job.pair[0]), label(job.pair[1]));
-        panels.push(PanelImage { title, role, image: d.blocks.colorize(p), data: d.data });
+        let made_from = role.designs().into_iter().map(|i| (i, address(&job.runs, i))).collect();
+        panels.push(PanelImage { title, role, image: d.blocks.colorize(p), data: d.data, made_from });
     }
     Done { key: job.key, panels, palette, difference_palette, plot: Arc::default() }
 }
