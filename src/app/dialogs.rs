@@ -90,14 +90,17 @@ impl ShoalApp {
                         ui.label("starting");
                     }
                 }
+            } else if self.link.cancelled() {
+                // Before a failure: with several designs, one that failed must not keep the others
+                // at their previews.
+                refine = ui.button("Refine").on_hover_text("Run on to full resolution").clicked();
+                let also = if failed.is_empty() { String::new() } else { format!("; {} failed", failed.join(", ")) };
+                ui.colored_label(super::theme::WARN, format!("stopped: previews{also}"));
             } else if !failed.is_empty() {
                 ui.colored_label(super::theme::FAIL, format!("{} failed: see the maps", failed.join(" and ")))
                     .on_hover_text(
                         "The run of the configuration set failed; its reason is shown where its maps would be.",
                     );
-            } else if self.link.cancelled() {
-                refine = ui.button("Refine").on_hover_text("Run on to full resolution").clicked();
-                ui.colored_label(super::theme::WARN, "stopped: previews");
             } else if self.state.preview_only {
                 ui.label("preview only (settings)");
             } else {

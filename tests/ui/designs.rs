@@ -154,3 +154,30 @@ fn exports_carry_every_design() {
     assert!(shoal::engine::RunConfig::from_ron(&config, "D").unwrap().instrument.name == "filter_imager");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// One design that fails does not keep the others at their previews: after a cancel, Refine is
+/// offered beside the failure.
+#[test]
+fn a_failed_design_does_not_take_refine_from_the_others() {
+    use shoal::engine::{Fault, FaultKind, Stage};
+    let dir = temp_library("fail-refine");
+    let mut h = with_state(AppState { decimations: vec![24, 1], ..AppState::default() }, &dir);
+    h.state_mut().inject_fault(Some(Fault { stage: Stage::Level0, row: 3, column: 5, kind: FaultKind::Error }));
+    let start = std::time::Instant::now();
+    loop {
+        h.step();
+        let link = &h.state().link;
+        let previewed = link.current(1).is_some_and(|s| s.decimation == 24);
+        if previewed && link.errors[0].is_some() && link.busy() {
+            break;
+        }
+        assert!(start.elapsed().as_secs() < 120, "no preview of B beside A's failure");
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+    h.get_by_label("Cancel run").click();
+    h.step();
+    h.step();
+    assert!(h.query_by_label("Refine").is_some(), "Refine is not offered beside A's failure");
+    assert!(h.query_by_label_contains("stopped: previews; A failed").is_some());
+    let _ = std::fs::remove_dir_all(&dir);
+}
