@@ -18,6 +18,8 @@
 //! | [`colormap`] | viridis, diverging and class colours, value scales (figures and app) |
 //! | [`units`] | constants, unit conversions, angle helpers |
 //! | [`markup`] | the one escaping rule for text inside HTML, SVG and XML |
+//! | [`csvtext`] | CSV text: the one writer every table goes through (quoted per RFC 4180) and its reader |
+//! | [`infile`] | reading a file someone else made: regular files only, sized before reading, never blocking |
 //! | [`variable`] | the product variables (chl-a, NAP, CDOM, depth): keys, names, units, CF names |
 //! | [`assets`] | cited spectra embedded in the binary |
 //! | [`control`] | cancellation and progress shared by a run and its watcher |
@@ -59,9 +61,11 @@ pub mod cli;
 pub mod colormap;
 pub mod control;
 pub mod correction;
+pub mod csvtext;
 pub mod design;
 pub mod engine;
 pub mod geotiff;
+pub mod infile;
 pub mod instrument;
 pub mod jobs;
 pub mod library;

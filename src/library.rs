@@ -184,10 +184,8 @@ impl Library {
                             builtin: false,
                             path: Some(path.clone()),
                             // A user's file larger than a preset can be is not read for this.
-                            description: std::fs::metadata(&path)
+                            description: crate::infile::read_text(&path, 1 << 20)
                                 .ok()
-                                .filter(|m| m.len() < 1 << 20)
-                                .and_then(|_| std::fs::read_to_string(&path).ok())
                                 .map(|t| description_of(&t))
                                 .unwrap_or_default(),
                         })
@@ -209,7 +207,8 @@ impl Library {
 
     fn read(entry: &Entry) -> Result<(String, String), LibraryError> {
         let path = entry.path.as_ref().ok_or_else(|| LibraryError::Invalid(format!("`{}` has no file", entry.name)))?;
-        let text = std::fs::read_to_string(path).map_err(|e| LibraryError::Io(format!("{}: {e}", path.display())))?;
+        let text = crate::infile::read_text(path, crate::infile::RON_MAX_BYTES)
+            .map_err(|e| LibraryError::Io(e.to_string()))?;
         Ok((text, path.display().to_string()))
     }
 

@@ -46,7 +46,9 @@ fn aside_name(path: &Path) -> PathBuf {
 /// `*.unreadable*` name; one that reads is checked field by field ([`repair`]).
 #[must_use]
 pub fn load_session(path: &Path) -> SavedSession {
-    let Ok(bytes) = std::fs::read(path) else { return SavedSession::None };
+    // A session is the app's own file, but it may be a colleague's copy: a regular file within
+    // the RON limit (anything else is not read, and the app starts afresh).
+    let Ok(bytes) = crate::infile::read(path, crate::infile::RON_MAX_BYTES) else { return SavedSession::None };
     let parsed = match String::from_utf8(bytes) {
         Ok(text) => crate::schema::migrate(&text).and_then(|text| {
             let mut state = ron::from_str::<AppState>(&text).map_err(|e| crate::parse::describe(&text, &e))?;
@@ -180,7 +182,7 @@ impl SessionLock {
                     return Ok(Self { path });
                 }
                 Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
-                    let holder = std::fs::read_to_string(&path).ok().and_then(|t| t.trim().parse::<u32>().ok());
+                    let holder = crate::infile::read_text(&path, 64).ok().and_then(|t| t.trim().parse::<u32>().ok());
                     match holder {
                         Some(pid) if running(pid) && pid != std::process::id() => {
                             return Err(format!("another Shoal window (process {pid}) has the session open"));

@@ -25,8 +25,8 @@ impl<T> Lookup<T> {
     /// The value `arg` names and the directory its own relative paths are read from.
     pub(super) fn resolve(&self, arg: &str) -> Result<(T, Option<PathBuf>), CliError> {
         if arg.ends_with(".ron") || Path::new(arg).exists() {
-            let text =
-                std::fs::read_to_string(arg).map_err(|e| CliError::Input(format!("{} {arg}: {e}", self.flag)))?;
+            let text = crate::infile::read_text(Path::new(arg), crate::infile::RON_MAX_BYTES)
+                .map_err(|e| CliError::Input(format!("{} {e}", self.flag)))?;
             return Ok(((self.from_ron)(&text, arg)?, Path::new(arg).parent().map(Path::to_path_buf)));
         }
         if arg.contains(std::path::MAIN_SEPARATOR) || arg.contains('/') {

@@ -60,8 +60,10 @@ fn sweep_figures(dir: &Path) -> Result<Vec<crate::study::Figure>, CliError> {
     let tag = dir.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned());
     svgs.into_iter()
         .map(|p| {
-            let svg = std::fs::read_to_string(&p).map_err(|e| CliError::Run(format!("{}: {e}", p.display())))?;
-            let png = std::fs::read(p.with_extension("png")).unwrap_or_default();
+            let svg = crate::infile::read_text(&p, crate::report::svg::MAX_SVG_BYTES as u64)
+                .map_err(|e| CliError::Input(format!("--sweep {e}")))?;
+            // Optional: anything but a regular file within the limit is left out.
+            let png = crate::infile::read(&p.with_extension("png"), 64 << 20).unwrap_or_default();
             let stem = p.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
             Ok(crate::study::Figure { name: format!("{stem}_{tag}"), png, svg })
         })

@@ -99,8 +99,8 @@ pub(super) const INSTRUMENTS: Lookup<InstrumentSpec> = Lookup {
 pub fn config_from(args: &SimulateArgs) -> Result<RunConfig, CliError> {
     let mut config = match &args.config {
         Some(path) => {
-            let text = std::fs::read_to_string(path)
-                .map_err(|e| CliError::Input(format!("--config {}: {e}", path.display())))?;
+            let text = crate::infile::read_text(path, crate::infile::RON_MAX_BYTES)
+                .map_err(|e| CliError::Input(format!("--config {e}")))?;
             RunConfig::from_ron(&text, &path.display().to_string())?
         }
         None => {

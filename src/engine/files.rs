@@ -73,7 +73,7 @@ enum State {
 fn state_of(path: &Path) -> State {
     let Ok(meta) = std::fs::metadata(path) else { return State::Unreadable };
     if meta.len() <= HASHED_BYTES
-        && let Ok(bytes) = std::fs::read(path)
+        && let Ok(bytes) = crate::infile::read(path, HASHED_BYTES)
     {
         return State::Contents(bytes);
     }

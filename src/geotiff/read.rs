@@ -22,7 +22,9 @@ pub fn read(path: &Path) -> Result<Raster, GeoTiffError> {
 /// Read the GeoTIFF at `path` if it holds at most `max_samples` samples (all bands), checked
 /// from its header before anything is decoded: a small compressed file can claim gigabytes.
 pub fn read_limited(path: &Path, max_samples: usize) -> Result<Raster, GeoTiffError> {
-    let bytes = std::fs::read(path).map_err(|e| GeoTiffError(format!("cannot read {}: {e}", path.display())))?;
+    // No sample takes more than 8 bytes uncompressed: a larger file holds more than it may.
+    let max_bytes = (max_samples as u64).saturating_mul(8).saturating_add(1 << 20);
+    let bytes = crate::infile::read(path, max_bytes).map_err(|e| GeoTiffError(format!("cannot read {e}")))?;
     read_bytes_limited(&bytes, &path.display().to_string(), max_samples)
 }
 

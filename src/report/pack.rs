@@ -39,6 +39,11 @@ pub fn write_pack(data: &ReviewData, figures: &[Figure], out: &Path) -> Result<P
     Ok(index)
 }
 
+/// The largest `review.json` read (a study of eight designs and many seeds writes well under 1 MB).
+const REVIEW_JSON_MAX_BYTES: u64 = 64 << 20;
+/// The largest figure PNG read (a 1920 × 1080 slide is a few MB).
+const MAX_PNG_BYTES: u64 = 64 << 20;
+
 /// Is `dir` a results directory `shoal report` can read (it has `review.json`)?
 #[must_use]
 pub fn is_results_dir(dir: &Path) -> bool {
@@ -54,20 +59,24 @@ pub fn load_results(dir: &Path) -> Result<(ReviewData, Vec<Figure>), StudyError>
     let path = dir.join(REVIEW_JSON);
     let bad =
         |message: String| StudyError::Invalid(crate::parse::FieldError { field: path.display().to_string(), message });
-    let text = std::fs::read_to_string(&path).map_err(|e| bad(format!("cannot be read: {e}")))?;
+    let text = crate::infile::read_text(&path, REVIEW_JSON_MAX_BYTES)
+        .map_err(|e| bad(format!("cannot be read: {}", e.message)))?;
     let data: ReviewData = serde_json::from_str(&text)
         .map_err(|e| bad(format!("{e} (written by another version of Shoal, or changed? rerun `shoal study`)")))?;
     let mut figures = Vec::with_capacity(data.figures.len());
     for name in &data.figures {
         let svg_path = crate::parse::join_name(&dir.join("figures"), "review.json figures", &format!("{name}.svg"))
             .map_err(|e| bad(e.to_string()))?;
-        let svg = std::fs::read_to_string(&svg_path).map_err(|e| {
+        let svg = crate::infile::read_text(&svg_path, super::svg::MAX_SVG_BYTES as u64).map_err(|e| {
             bad(format!(
-                "lists the figure `{name}`, but {} cannot be read ({e}): an incomplete folder? rerun `shoal study`",
-                svg_path.display()
+                "lists the figure `{name}`, but {} cannot be read ({}): an incomplete folder? rerun `shoal study`",
+                svg_path.display(),
+                e.message
             ))
         })?;
-        let png = std::fs::read(svg_path.with_extension("png")).unwrap_or_default();
+        // The PNG is optional (the page shows the SVG without it): anything but a regular file
+        // within the limit is left out, never waited on.
+        let png = crate::infile::read(&svg_path.with_extension("png"), MAX_PNG_BYTES).unwrap_or_default();
         figures.push(Figure { name: name.clone(), png, svg });
     }
     Ok((data, figures))

@@ -108,8 +108,8 @@ impl Table {
 
     /// Read a table from a file on disk.
     pub fn from_file(path: &std::path::Path) -> Result<Self, SpectralError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| SpectralError::Io { path: path.display().to_string(), message: e.to_string() })?;
+        let text = crate::infile::read_text(path, crate::infile::TABLE_MAX_BYTES)
+            .map_err(|e| SpectralError::Io { path: path.display().to_string(), message: e.message })?;
         Self::parse(&text, &path.display().to_string())
     }
 

@@ -175,9 +175,8 @@ pub(crate) fn load<T: serde::de::DeserializeOwned + Clone>(
                 Some(d) if path.is_relative() => d.join(path),
                 _ => path.clone(),
             };
-            let text = std::fs::read_to_string(&full).map_err(|e| {
-                StudyError::Invalid(FieldError { field: field.into(), message: format!("{}: {e}", full.display()) })
-            })?;
+            let text = crate::infile::read_text(&full, crate::infile::RON_MAX_BYTES)
+                .map_err(|e| StudyError::Invalid(FieldError { field: field.into(), message: e.to_string() }))?;
             let value = ron::from_str(&text).map_err(|e| {
                 StudyError::Parse(ParseError {
                     origin: full.display().to_string(),

@@ -55,9 +55,8 @@ impl SiopSpec {
 
     /// Read a SIOP set from a RON file.
     pub fn from_file(path: &Path) -> Result<Self, WaterError> {
-        let text = std::fs::read_to_string(path).map_err(|e| {
-            WaterError::Parse(ParseError { origin: path.display().to_string(), message: e.to_string() })
-        })?;
+        let text = crate::infile::read_text(path, crate::infile::RON_MAX_BYTES)
+            .map_err(|e| WaterError::Parse(ParseError { origin: path.display().to_string(), message: e.message }))?;
         Self::from_ron(&text, &path.display().to_string())
     }
 

@@ -1,7 +1,8 @@
-//! NetCDF-3 files with CF metadata, written and read by the pure-Rust `netcdf3` crate (no C
-//! library): the pieces every NetCDF file of Shoal shares — the products a run writes
-//! (`study::netcdf_out`), the input an external retrieval reads and the output it writes back
-//! (`retrieval::external`), and the products `shoal score` reads.
+//! NetCDF-3 files with CF metadata, written by the pure-Rust `netcdf3` crate (no C library) and
+//! read by our own checked parser ([`read_maps`], [`parse_maps`]): the pieces every NetCDF file
+//! of Shoal shares — the products a run writes (`study::netcdf_out`), the input an external
+//! retrieval reads and the output it writes back (`retrieval::external`), and the products
+//! `shoal score` reads.
 //!
 //! Files are NetCDF-3 in the 64-bit-offset form (any NetCDF reader opens them; a variable may
 //! exceed 2 GiB). Values without a meaning are [`FILL`], declared as `_FillValue`.
@@ -17,6 +18,9 @@ use std::path::Path;
 use std::rc::Rc;
 
 use netcdf3::{DataSet, FileWriter, Version};
+
+mod read;
+pub use read::{Maps, parse_maps, read_maps};
 
 /// CF standard names of Shoal's product variables and of Rrs (those CF has).
 #[must_use]
@@ -225,64 +229,4 @@ pub fn define_vars(ds: &mut DataSet, floats: &[FloatVar<'_>], flags: &[FlagVar<'
         }
     }
     Ok(())
-}
-
-/// A NetCDF file's float (line, pixel) variables by name, with their fill values applied
-/// (`None` where missing, NaN or the fill value), and the (line, pixel) size.
-#[derive(Debug, Clone)]
-pub struct Maps {
-    /// (lines, pixels).
-    pub shape: (usize, usize),
-    /// The variables of `wanted` the file has, in the order asked.
-    pub maps: Vec<(String, Vec<Option<f64>>)>,
-    /// Every variable the file has (for messages).
-    pub names: Vec<String>,
-}
-
-/// Read the (line, pixel) float variables of `wanted` that `path` has, refusing files over
-/// `max_bytes`, without `line` and `pixel` dimensions, or with a wanted variable of other
-/// dimensions or type. Messages name the file's problem; the caller adds which file it was.
-pub fn read_maps(path: &Path, wanted: &[&str], max_bytes: u64) -> Result<Maps, String> {
-    let size = std::fs::metadata(path).map_err(|e| e.to_string())?.len();
-    if size > max_bytes {
-        return Err(format!("{:.1} GB is over the {:.1} GB read", size as f64 / 1e9, max_bytes as f64 / 1e9));
-    }
-    let mut reader = netcdf3::FileReader::open(path).map_err(|e| {
-        // The reader's error can quote the whole header's bytes: its first words say enough.
-        let why: String = format!("{e:?}").chars().take(120).collect();
-        format!("not a NetCDF-3 file Shoal can read ({why}…)")
-    })?;
-    let ds = reader.data_set();
-    let names: Vec<String> = ds.get_var_names();
-    let (lines, pixels) = match (ds.dim_size("line"), ds.dim_size("pixel")) {
-        (Some(l), Some(p)) => (l, p),
-        _ => return Err("needs dimensions `line` and `pixel`".into()),
-    };
-    let mut present = Vec::new();
-    for &name in wanted {
-        let Some(var) = ds.get_var(name) else { continue };
-        let dims: Vec<String> = var.dim_names();
-        if dims != ["line", "pixel"] {
-            return Err(format!("`{name}` has dimensions ({}); expected (line, pixel)", dims.join(", ")));
-        }
-        // `_FillValue` (or `missing_value`) in the variable's own type, f32 or f64.
-        let attr = |a: &str| {
-            ds.get_var_attr_f32(name, a)
-                .and_then(|v| v.first().map(|x| f64::from(*x)))
-                .or_else(|| ds.get_var_attr_f64(name, a).and_then(|v| v.first().copied()))
-        };
-        let fill = attr("_FillValue").or_else(|| attr("missing_value"));
-        present.push((name, fill));
-    }
-    let mut maps = Vec::new();
-    for (name, fill) in present {
-        let values = match reader.read_var_f32(name) {
-            Ok(v) => v.into_iter().map(f64::from).collect::<Vec<f64>>(),
-            Err(_) => reader.read_var_f64(name).map_err(|e| format!("`{name}` is not a float variable ({e:?})"))?,
-        };
-        let values =
-            values.into_iter().map(|v| if v.is_finite() && Some(v) != fill { Some(v) } else { None }).collect();
-        maps.push((name.to_string(), values));
-    }
-    Ok(Maps { shape: (lines, pixels), maps, names })
 }
