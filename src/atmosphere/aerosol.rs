@@ -81,31 +81,36 @@ pub fn component_table_csv() -> String {
     let angles = table_angles_deg();
     let jobs: Vec<(Component, f64)> =
         Component::ALL.iter().flat_map(|c| TABLE_WAVELENGTHS_NM.iter().map(move |w| (*c, *w))).collect();
-    let rows: Vec<String> = jobs
+    let rows: Vec<Vec<String>> = jobs
         .par_iter()
         .map(|(c, w)| {
             let o = compute_component(*c, *w, SizeGrid::Osoaa);
-            let p: Vec<String> = o.p11.iter().map(|v| format!("{v:.6e}")).collect();
-            format!("{},{w},{:.8e},{:.8e},{}", c.key(), o.c_ext_um2, o.c_sca_um2, p.join(","))
+            let mut cells = vec![
+                c.key().to_string(),
+                w.to_string(),
+                format!("{:.8e}", o.c_ext_um2),
+                format!("{:.8e}", o.c_sca_um2),
+            ];
+            cells.extend(o.p11.iter().map(|v| format!("{v:.6e}")));
+            cells
         })
         .collect();
-    let mut out = String::new();
-    out.push_str("# name: WMO aerosol basic components (dust-like, water-soluble, oceanic, soot): mean extinction and scattering cross-sections per particle and phase function P11, 325-1025 nm every 25 nm and 1050-2500 nm every 50 nm\n");
-    out.push_str("# units: wavelength_nm: nm; c_ext_um2, c_sca_um2: um2 per particle; p11_<angle>: phase function at scattering angle <angle> degrees, normalised so that (1/2) int P11 dcos = 1\n");
-    out.push_str("# source: computed by Shoal's Mie code (src/atmosphere/mie.rs, Bohren & Huffman 1983 algorithm) with `shoal dev aerosol-table`; component parameters (log-normal r_m, sigma, volume per particle, size-parameter limits, refractive indices linearly interpolated in wavelength and rounded as OSOAA does) from OSOAA V2.0 fic/Data_WMO_cor_2015_12_16 and OSOAA.h\n");
-    out.push_str("# citation: WMO (1983) WCP-55; d'Almeida, Koepke & Shettle (1991) Atmospheric Aerosols; Chami et al. (2015) Opt. Express 23, 27829 (OSOAA); Bohren & Huffman (1983) Absorption and Scattering of Light by Small Particles\n");
-    out.push_str("# license: computed values (CC0)\n");
-    out.push_str("# processing: rectangle rule in size parameter on OSOAA's grid (steps 1e-4 to 0.1, 1e-3 to 1, 0.01 to 10, 0.05 to 30, 0.1 to 100, 1 above) from 1e-4 to the component's alpha_max (dust-like 4000, water-soluble 50, oceanic 800, soot 10)\n");
-    out.push_str("component,wavelength_nm,c_ext_um2,c_sca_um2");
-    for a in &angles {
-        out.push_str(&format!(",p11_{a}"));
+    let columns: Vec<String> = ["component", "wavelength_nm", "c_ext_um2", "c_sca_um2"]
+        .into_iter()
+        .map(str::to_string)
+        .chain(angles.iter().map(|a| format!("p11_{a}")))
+        .collect();
+    let mut out = crate::csvtext::Csv::new(&columns.iter().map(String::as_str).collect::<Vec<_>>());
+    out.comment("# name: WMO aerosol basic components (dust-like, water-soluble, oceanic, soot): mean extinction and scattering cross-sections per particle and phase function P11, 325-1025 nm every 25 nm and 1050-2500 nm every 50 nm");
+    out.comment("# units: wavelength_nm: nm; c_ext_um2, c_sca_um2: um2 per particle; p11_<angle>: phase function at scattering angle <angle> degrees, normalised so that (1/2) int P11 dcos = 1");
+    out.comment("# source: computed by Shoal's Mie code (src/atmosphere/mie.rs, Bohren & Huffman 1983 algorithm) with `shoal dev aerosol-table`; component parameters (log-normal r_m, sigma, volume per particle, size-parameter limits, refractive indices linearly interpolated in wavelength and rounded as OSOAA does) from OSOAA V2.0 fic/Data_WMO_cor_2015_12_16 and OSOAA.h");
+    out.comment("# citation: WMO (1983) WCP-55; d'Almeida, Koepke & Shettle (1991) Atmospheric Aerosols; Chami et al. (2015) Opt. Express 23, 27829 (OSOAA); Bohren & Huffman (1983) Absorption and Scattering of Light by Small Particles");
+    out.comment("# license: computed values (CC0)");
+    out.comment("# processing: rectangle rule in size parameter on OSOAA's grid (steps 1e-4 to 0.1, 1e-3 to 1, 0.01 to 10, 0.05 to 30, 0.1 to 100, 1 above) from 1e-4 to the component's alpha_max (dust-like 4000, water-soluble 50, oceanic 800, soot 10)");
+    for r in &rows {
+        out.row(r);
     }
-    out.push('\n');
-    for r in rows {
-        out.push_str(&r);
-        out.push('\n');
-    }
-    out
+    out.finish()
 }
 
 /// The parsed component table: per component, optics at [`TABLE_WAVELENGTHS_NM`].

@@ -62,15 +62,14 @@ impl Csv {
         Ok(())
     }
 
-    /// The CSV text.
+    /// The CSV text (through [`crate::csvtext::Csv`]: a label or column name with a comma is
+    /// quoted).
     pub fn render(&self) -> String {
-        let mut s = self.header.join(",");
-        s.push('\n');
+        let mut csv = crate::csvtext::Csv::new(&self.header.iter().map(String::as_str).collect::<Vec<_>>());
         for r in &self.rows {
-            s.push_str(&r.join(","));
-            s.push('\n');
+            csv.row(r);
         }
-        s
+        csv.finish()
     }
 }
 

@@ -47,7 +47,8 @@ pub struct MergeArgs {
 
 fn load(arg: &str) -> Result<(SweepSpec, Option<PathBuf>), CliError> {
     if arg.ends_with(".ron") || Path::new(arg).exists() {
-        let text = std::fs::read_to_string(arg).map_err(|e| CliError::Input(format!("{arg}: {e}")))?;
+        let text = crate::infile::read_text(Path::new(arg), crate::infile::RON_MAX_BYTES)
+            .map_err(|e| CliError::Input(e.to_string()))?;
         Ok((SweepSpec::from_ron(&text, arg)?, Path::new(arg).parent().map(Path::to_path_buf)))
     } else {
         Ok((SweepSpec::preset(arg)?, None))
@@ -132,11 +133,11 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
     let start = std::time::Instant::now();
     let result = pool.install(|| run_sweep(&sweep, shard, &control, |_, _| bar.inc(1)))?;
     bar.finish_and_clear();
-    let mut timings = String::from("job,seconds\n");
+    let mut timings = crate::csvtext::Csv::new(&["job", "seconds"]);
     for (j, s) in &result.seconds {
-        timings.push_str(&format!("{j},{s:.3}\n"));
+        timings.row([j.to_string(), format!("{s:.3}")]);
     }
-    write_bytes(&out.path().join("timings.csv"), timings.as_bytes())?;
+    write_bytes(&out.path().join("timings.csv"), timings.finish().as_bytes())?;
     write_bytes(
         &out.path().join("sweep.ron"),
         ron::ser::to_string_pretty(&spec, ron::ser::PrettyConfig::default()).unwrap_or_default().as_bytes(),
@@ -164,10 +165,11 @@ pub fn merge_run(args: &MergeArgs) -> Result<(), CliError> {
     let mut spec = None;
     for dir in &args.shards {
         let path = dir.join("table.csv");
-        let text = std::fs::read_to_string(&path).map_err(|e| CliError::Input(format!("{}: {e}", path.display())))?;
+        let text = crate::infile::read_text(&path, crate::infile::TABLE_MAX_BYTES)
+            .map_err(|e| CliError::Input(e.to_string()))?;
         parts.push(Table::from_csv(&text, &path.display().to_string())?);
         if spec.is_none()
-            && let Ok(t) = std::fs::read_to_string(dir.join("sweep.ron"))
+            && let Ok(t) = crate::infile::read_text(&dir.join("sweep.ron"), crate::infile::RON_MAX_BYTES)
         {
             spec = SweepSpec::from_ron(&t, "sweep.ron").ok();
         }

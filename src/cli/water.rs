@@ -110,8 +110,8 @@ pub struct WaterArgs {
 
 /// Read a run file; its relative paths are taken relative to the file's own directory.
 fn read_spec(path: &Path) -> Result<(WaterRun, Option<PathBuf>), CliError> {
-    let text =
-        std::fs::read_to_string(path).map_err(|e| CliError::Input(format!("cannot read {}: {e}", path.display())))?;
+    let text = crate::infile::read_text(path, crate::infile::RON_MAX_BYTES)
+        .map_err(|e| CliError::Input(format!("cannot read {e}")))?;
     let mut run: WaterRun = ron::from_str(&text).map_err(|e| CliError::Input(format!("{}: {e}", path.display())))?;
     let dir = path.parent().map(Path::to_path_buf);
     let near = |p: &PathBuf| dir.as_ref().filter(|_| p.is_relative()).map_or_else(|| p.clone(), |d| d.join(p));
@@ -164,10 +164,11 @@ fn merged(args: &WaterArgs) -> Result<(WaterRun, Option<PathBuf>), CliError> {
 pub fn run(args: &WaterArgs) -> Result<(), CliError> {
     let mut library = SubstrateLibrary::embedded()?;
     if args.list_substrates {
-        let mut text = String::from("substrate,description\n");
+        let mut csv = crate::csvtext::Csv::new(&["substrate", "description"]);
         for e in library.entries() {
-            text.push_str(&format!("{},{}\n", e.name, e.description));
+            csv.row([&e.name, &e.description]);
         }
+        let mut text = csv.finish();
         text.push_str(&format!("# SIOP sets: {}\n", SiopSpec::preset_names().join(", ")));
         return emit(&text, args.out.as_deref());
     }

@@ -2,7 +2,6 @@
 //! SVG, and the resolved configuration as RON. Every file is written atomically (a temporary
 //! file beside it, then a rename), so a failed or cancelled run never leaves half a file.
 
-use std::fmt::Write as _;
 use std::path::Path;
 
 use ndarray_npy::WriteNpyExt;
@@ -10,6 +9,7 @@ use serde::Serialize;
 
 use super::figures::figure_set;
 use super::{StudyError, StudyResult};
+use crate::csvtext::Csv;
 use crate::engine::RunOutput;
 
 /// What was written, relative to the output directory.
@@ -86,20 +86,25 @@ fn number(v: f64) -> String {
 /// The SNR table of a run as CSV.
 #[must_use]
 pub fn snr_csv(out: &RunOutput) -> String {
-    let mut s = String::from("band,centre_nm,radiance_w_m2_sr_nm,snr_analytic,snr_measured,signal_over_full_scale\n");
+    let mut csv = Csv::new(&[
+        "band",
+        "centre_nm",
+        "radiance_w_m2_sr_nm",
+        "snr_analytic",
+        "snr_measured",
+        "signal_over_full_scale",
+    ]);
     for r in out.snr.iter() {
-        let _ = writeln!(
-            s,
-            "{},{},{},{},{},{}",
-            r.band,
+        csv.row([
+            r.band.clone(),
             number(r.centre_nm),
             number(r.radiance),
             number(r.snr_analytic),
             number(r.snr_measured),
-            number(r.full_scale_fraction)
-        );
+            number(r.full_scale_fraction),
+        ]);
     }
-    s
+    csv.finish()
 }
 
 /// Write every product of one run into `dir`: Level-0, Level-1, Rrs, the truth, the retrievals'
@@ -178,11 +183,11 @@ pub fn write_run_as(out: &RunOutput, dir: &Path, format: CubeFormat) -> Result<O
 /// The run's band table, SNR table, report and resolved configuration.
 pub(super) fn write_tables(out: &RunOutput, dir: &Path) -> Result<Outputs, StudyError> {
     let mut o = Outputs::default();
-    let mut bands = String::from("band,centre_nm,fwhm_nm\n");
+    let mut bands = Csv::new(&["band", "centre_nm", "fwhm_nm"]);
     for b in &out.response.bands.bands {
-        let _ = writeln!(bands, "{},{},{}", b.name, number(b.centre_nm), number(b.fwhm_nm));
+        bands.row([b.name.clone(), number(b.centre_nm), number(b.fwhm_nm)]);
     }
-    text(dir, "bands.csv", &bands, &mut o)?;
+    text(dir, "bands.csv", &bands.finish(), &mut o)?;
     text(dir, "snr.csv", &snr_csv(out), &mut o)?;
     text(dir, "report.json", &json(&out.report)?, &mut o)?;
     let config = out.config.to_ron().map_err(|e| StudyError::Io(e.to_string()))?;
@@ -208,37 +213,50 @@ struct MetricsRow<'a> {
 /// and mean error in the product's units (`unit`: a depth error in metres).
 #[must_use]
 pub fn metrics_csv(result: &StudyResult) -> String {
-    let mut s = String::from(
-        "instrument,seed,product,variable,mae,bias,mae_pct,bias_pct,n,candidates,returned_pct,rmse,r2,mean_abs_error,mean_error,unit\n",
-    );
+    let mut csv = Csv::new(&[
+        "instrument",
+        "seed",
+        "product",
+        "variable",
+        "mae",
+        "bias",
+        "mae_pct",
+        "bias_pct",
+        "n",
+        "candidates",
+        "returned_pct",
+        "rmse",
+        "r2",
+        "mean_abs_error",
+        "mean_error",
+        "unit",
+    ]);
     for run in &result.runs {
         for ret in &run.retrievals {
             for v in &ret.metrics.variables {
                 let m = &v.metrics;
-                let _ = writeln!(
-                    s,
-                    "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
-                    run.label,
-                    run.seed,
-                    ret.metrics.product,
-                    v.variable,
+                csv.row([
+                    run.label.clone(),
+                    run.seed.to_string(),
+                    ret.metrics.product.to_string(),
+                    v.variable.to_string(),
                     number(m.mae),
                     number(m.bias),
                     number(m.mae_pct()),
                     number(m.bias_pct()),
-                    m.n,
-                    m.candidates,
+                    m.n.to_string(),
+                    m.candidates.to_string(),
                     number(m.returned_pct),
                     number(m.rmse),
                     number(m.r2),
                     number(m.mean_abs_error),
                     number(m.mean_error),
-                    crate::metrics::unit(&v.variable)
-                );
+                    crate::metrics::unit(&v.variable).to_string(),
+                ]);
             }
         }
     }
-    s
+    csv.finish()
 }
 
 /// Write a study's tables, figures and resolved configuration into `dir` (the runs' cubes are

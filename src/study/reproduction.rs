@@ -256,19 +256,12 @@ pub fn rows(n: &Numbers, decimation: Option<usize>) -> Vec<Row> {
 /// The table as CSV (quantity, paper, shoal_reference, shoal_improved, note).
 #[must_use]
 pub fn csv(rows: &[Row]) -> String {
-    let quote = |s: &str| format!("\"{}\"", s.replace('"', "\"\""));
-    let mut out = String::from("quantity,paper,shoal_reference,shoal_improved,note\n");
+    let mut csv =
+        crate::csvtext::Csv::quoting_every_field(&["quantity", "paper", "shoal_reference", "shoal_improved", "note"]);
     for r in rows {
-        out.push_str(
-            &[&r.quantity, &r.paper, &r.shoal_reference, &r.shoal_improved, &r.note]
-                .iter()
-                .map(|s| quote(s))
-                .collect::<Vec<_>>()
-                .join(","),
-        );
-        out.push('\n');
+        csv.row([&r.quantity, &r.paper, &r.shoal_reference, &r.shoal_improved, &r.note]);
     }
-    out
+    csv.finish()
 }
 
 /// The table as Markdown.

@@ -13,8 +13,6 @@
 //! )),
 //! ```
 
-use std::fmt::Write as _;
-
 use serde::{Deserialize, Serialize};
 
 use super::{StudyError, StudyResult};
@@ -405,21 +403,19 @@ impl Requirements {
 /// The checks as CSV.
 #[must_use]
 pub fn checks_csv(checks: &[Check]) -> String {
-    let mut s = String::from("instrument,seed,requirement,value,limit,pass,margin\n");
+    let mut csv = crate::csvtext::Csv::new(&["instrument", "seed", "requirement", "value", "limit", "pass", "margin"]);
     for c in checks {
-        let _ = writeln!(
-            s,
-            "{},{},{},{},{},{},{}",
-            c.instrument,
-            c.seed,
-            c.what,
+        csv.row([
+            c.instrument.clone(),
+            c.seed.to_string(),
+            c.what.clone(),
             c.value.map_or_else(String::new, |v| format!("{v:.4}")),
-            c.limit,
-            if c.pass { "pass" } else { "FAIL" },
+            c.limit.to_string(),
+            (if c.pass { "pass" } else { "FAIL" }).to_string(),
             c.margin.map_or_else(String::new, |m| format!("{m:.4}")),
-        );
+        ]);
     }
-    s
+    csv.finish()
 }
 
 #[cfg(test)]

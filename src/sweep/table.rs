@@ -4,6 +4,7 @@
 //! form, rows in run order, so the same runs always give the same bytes — which is what lets
 //! `shoal merge` prove that n shards equal one run.
 
+use crate::csvtext::{Csv, records};
 use crate::parse::{FieldError, ParseError};
 use crate::study::StudyError;
 
@@ -63,37 +64,45 @@ impl Table {
     /// The CSV text.
     #[must_use]
     pub fn to_csv(&self) -> String {
-        let mut s = format!("# sweep {} | jobs {} | key {}\n", self.name, self.jobs, self.key);
+        const TRAILING: [&str; 11] = [
+            "instrument",
+            "seed",
+            "product",
+            "variable",
+            "mae_pct",
+            "bias_pct",
+            "returned_pct",
+            "n",
+            "saturated_pct",
+            "snr_pair_short",
+            "snr_pair_long",
+        ];
+        let header: Vec<&str> =
+            ["job", "point"].into_iter().chain(self.parameters.iter().map(String::as_str)).chain(TRAILING).collect();
+        let mut csv = Csv::new(&header);
+        csv.comment(&format!("# sweep {} | jobs {} | key {}", self.name, self.jobs, self.key));
         if let Some((i, n)) = self.shard {
-            s.push_str(&format!("# shard {i}/{n}\n"));
+            csv.comment(&format!("# shard {i}/{n}"));
         }
-        s.push_str("job,point,");
-        for p in &self.parameters {
-            s.push_str(p);
-            s.push(',');
-        }
-        s.push_str("instrument,seed,product,variable,mae_pct,bias_pct,returned_pct,n,saturated_pct,snr_pair_short,snr_pair_long\n");
         for r in &self.rows {
-            s.push_str(&format!("{},{},", r.job, r.point));
-            for v in &r.values {
-                s.push_str(&format!("{v},"));
-            }
-            s.push_str(&format!(
-                "{},{},{},{},{},{},{},{},{},{},{}\n",
-                r.instrument,
-                r.seed,
-                r.product,
-                r.variable,
-                r.mae_pct,
-                r.bias_pct,
-                r.returned_pct,
-                r.n,
-                r.saturated_pct,
+            let mut cells = vec![r.job.to_string(), r.point.to_string()];
+            cells.extend(r.values.iter().map(ToString::to_string));
+            cells.extend([
+                r.instrument.clone(),
+                r.seed.to_string(),
+                r.product.clone(),
+                r.variable.clone(),
+                r.mae_pct.to_string(),
+                r.bias_pct.to_string(),
+                r.returned_pct.to_string(),
+                r.n.to_string(),
+                r.saturated_pct.to_string(),
                 r.snr_pair.map_or(String::new(), |p| p[0].to_string()),
                 r.snr_pair.map_or(String::new(), |p| p[1].to_string()),
-            ));
+            ]);
+            csv.row(&cells);
         }
-        s
+        csv.finish()
     }
 
     /// Read a table written by [`Table::to_csv`]; `origin` names it in errors.
@@ -101,8 +110,7 @@ impl Table {
         let bad = |line: usize, m: String| {
             StudyError::Parse(ParseError { origin: origin.into(), message: format!("line {line}: {m}") })
         };
-        let mut lines = text.lines().enumerate();
-        let (_, head) = lines.next().ok_or_else(|| bad(1, "empty file".into()))?;
+        let head = text.lines().next().ok_or_else(|| bad(1, "empty file".into()))?;
         let fields: Vec<&str> = head.trim_start_matches("# sweep ").split(" | ").collect();
         let [name, jobs, key] = fields.as_slice() else { return Err(bad(1, "not a sweep table header".into())) };
         let jobs: usize = jobs.trim_start_matches("jobs ").parse().map_err(|_| bad(1, format!("bad `{jobs}`")))?;
@@ -114,15 +122,21 @@ impl Table {
             parameters: Vec::new(),
             rows: Vec::new(),
         };
-        let mut columns = Vec::new();
-        for (i, line) in lines {
+        // After the first line, the CSV: `#` lines are comments (the shard's among them), line
+        // numbers count from the first line.
+        let rest = &text[text.find('\n').map_or(text.len(), |k| k + 1)..];
+        for (i, line) in rest.lines().enumerate() {
             if let Some(shard) = line.strip_prefix("# shard ") {
-                let s = super::Shard::parse(shard).map_err(|m| bad(i + 1, m))?;
+                let s = super::Shard::parse(shard).map_err(|m| bad(i + 2, m))?;
                 table.shard = Some((s.index, s.count));
-                continue;
             }
+        }
+        let mut columns: Vec<String> = Vec::new();
+        for record in records(rest) {
+            let record = record.map_err(|e| bad(e.line + 1, e.message))?;
+            let line = record.line + 1;
             if columns.is_empty() {
-                columns = line.split(',').map(str::to_string).collect();
+                columns = record.fields;
                 // Tables written before the `saturated_pct` column end at `n`, before the SNR
                 // columns at `saturated_pct`.
                 let trailing = match columns.last().map(String::as_str) {
@@ -131,34 +145,32 @@ impl Table {
                     _ => 8,
                 };
                 if columns.len() < trailing + 2 || columns[0] != "job" {
-                    return Err(bad(i + 1, "expected the column header".into()));
+                    return Err(bad(line, "expected the column header".into()));
                 }
                 table.parameters = columns[2..columns.len() - trailing].to_vec();
                 continue;
             }
-            let cells: Vec<&str> = line.split(',').collect();
-            if cells.len() != columns.len() {
-                return Err(bad(i + 1, format!("{} cells, expected {}", cells.len(), columns.len())));
-            }
+            // As wide as the header: the reader refuses a record that is not.
+            let cells = record.fields;
             let np = table.parameters.len();
             let num = |k: usize| -> Result<f64, StudyError> {
                 cells[k]
                     .parse::<f64>()
-                    .map_err(|_| bad(i + 1, format!("column `{}`: `{}` is not a number", columns[k], cells[k])))
+                    .map_err(|_| bad(line, format!("column `{}`: `{}` is not a number", columns[k], cells[k])))
             };
             let int = |k: usize| -> Result<u64, StudyError> {
                 cells[k]
                     .parse::<u64>()
-                    .map_err(|_| bad(i + 1, format!("column `{}`: `{}` is not a whole number", columns[k], cells[k])))
+                    .map_err(|_| bad(line, format!("column `{}`: `{}` is not a whole number", columns[k], cells[k])))
             };
             table.rows.push(Row {
                 job: int(0)? as usize,
                 point: int(1)? as usize,
                 values: (0..np).map(|k| num(2 + k)).collect::<Result<_, _>>()?,
-                instrument: cells[2 + np].to_string(),
+                instrument: cells[2 + np].clone(),
                 seed: int(3 + np)?,
-                product: cells[4 + np].to_string(),
-                variable: cells[5 + np].to_string(),
+                product: cells[4 + np].clone(),
+                variable: cells[5 + np].clone(),
                 mae_pct: num(6 + np)?,
                 bias_pct: num(7 + np)?,
                 returned_pct: num(8 + np)?,
@@ -230,4 +242,69 @@ pub fn merge(parts: &[Table]) -> Result<Table, StudyError> {
     // Stable: rows of one run keep their order.
     rows.sort_by_key(|r| r.job);
     Ok(Table { shard: None, rows, ..first.clone() })
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    fn table(instrument: &str, product: &str) -> Table {
+        let row = |job: usize, snr_pair: Option<[f64; 2]>| Row {
+            job,
+            point: job,
+            values: vec![0.25 * job as f64, 3e-7],
+            instrument: instrument.into(),
+            seed: 7,
+            product: product.into(),
+            variable: "chl_mg_m3".into(),
+            mae_pct: 12.5,
+            bias_pct: -0.125,
+            returned_pct: 99.0,
+            n: 400,
+            saturated_pct: 0.0,
+            snr_pair,
+        };
+        Table {
+            name: "focal, ratio".into(),
+            key: "abc123".into(),
+            jobs: 4,
+            shard: Some((1, 2)),
+            parameters: vec!["telescope.f_number".into(), "detector.read_noise_e".into()],
+            rows: vec![row(1, None), row(3, Some([150.5, 42.0]))],
+        }
+    }
+
+    #[test]
+    fn names_with_commas_and_quotes_write_and_read_back() {
+        let t = table("SmallSat (2x, f/4)", "my \"algo\"");
+        let text = t.to_csv();
+        assert!(text.contains(",\"SmallSat (2x, f/4)\",7,\"my \"\"algo\"\"\",chl_mg_m3,"), "{text}");
+        assert_eq!(Table::from_csv(&text, "t").unwrap(), t);
+    }
+
+    #[test]
+    fn plain_names_write_the_same_bytes_as_ever() {
+        let text = table("nominal", "aLMI").to_csv();
+        assert_eq!(
+            text,
+            "# sweep focal, ratio | jobs 4 | key abc123\n# shard 1/2\n\
+             job,point,telescope.f_number,detector.read_noise_e,instrument,seed,product,variable,mae_pct,bias_pct,\
+             returned_pct,n,saturated_pct,snr_pair_short,snr_pair_long\n\
+             1,1,0.25,0.0000003,nominal,7,aLMI,chl_mg_m3,12.5,-0.125,99,400,0,,\n\
+             3,3,0.75,0.0000003,nominal,7,aLMI,chl_mg_m3,12.5,-0.125,99,400,0,150.5,42\n"
+        );
+    }
+
+    #[test]
+    fn bad_rows_are_refused_naming_the_line() {
+        let text = table("a", "b").to_csv();
+        let short = text.replace(",150.5,42\n", ",150.5\n");
+        let e = Table::from_csv(&short, "t").unwrap_err().to_string();
+        assert!(e.contains("line 5: 14 cells, expected 15"), "{e}");
+        let e = Table::from_csv(&text.replace("12.5", "x"), "t").unwrap_err().to_string();
+        assert!(e.contains("line 4: column `mae_pct`: `x` is not a number"), "{e}");
+        let e = Table::from_csv(&text.replace("# shard 1/2", "# shard 3/2"), "t").unwrap_err().to_string();
+        assert!(e.contains("line 2:"), "{e}");
+    }
 }
