@@ -114,10 +114,16 @@ pub fn run(args: &DesignArgs) -> Result<(), CliError> {
         seed: args.seed,
         evaluations: Vec::new(),
     };
+    // The variables the study's retrieval makes: the fronts' file names come from them (never
+    // from a record), and a record's constraints are judged against them.
+    let made: Vec<String> = base.retrievals.first().map(|r| r.algorithm().variables()).unwrap_or_default();
+    let plan = crate::design::evaluate::constraint_plan(&requirements, &made);
     let mut prior = Vec::new();
     for dir in &args.resume {
         let r = Record::read(dir)?;
-        r.check_matches(&expected, &dir.display().to_string())?;
+        let origin = dir.display().to_string();
+        r.check_matches(&expected, &origin)?;
+        r.check_evaluations(&vars, &plan, &resolved.budgets.cost.currency, &origin)?;
         prior.extend(r.evaluations);
     }
     let out = crate::study::OutputDir::create(&args.out, "shoal design")?;
@@ -149,7 +155,7 @@ pub fn run(args: &DesignArgs) -> Result<(), CliError> {
     Record { evaluations: search.evaluations.clone(), ..expected }.write(dir)?;
     write_bytes(&dir.join("evaluations.csv"), evaluations_csv(&search).as_bytes())?;
     let mut fronts = Vec::new();
-    for variable in front_variables(&search, &requirements) {
+    for variable in front_variables(&made, &requirements) {
         let front = pareto_front(&search.evaluations, &variable);
         let name = format!("front_{variable}");
         write_bytes(&dir.join(format!("{name}.csv")), front_csv(&search, &front, &variable).as_bytes())?;
@@ -184,74 +190,71 @@ pub fn run(args: &DesignArgs) -> Result<(), CliError> {
     Ok(())
 }
 
-/// The product variables a front is drawn for: the required ones, else every one made.
-fn front_variables(search: &Search, requirements: &crate::study::Requirements) -> Vec<String> {
+/// The product variables a front is drawn for: the required ones, else every one the study's
+/// retrieval makes. Shoal's own keys, so each is a safe file name (`front_chl_mg_m3.csv`).
+fn front_variables(made: &[String], requirements: &crate::study::Requirements) -> Vec<String> {
     let required: Vec<String> =
         requirements.products.iter().filter(|p| p.mae_pct.is_some()).map(|p| p.variable.clone()).collect();
-    if !required.is_empty() {
-        return required;
-    }
-    crate::design::unique(search.evaluations.iter().flat_map(|e| e.mae_pct.iter().map(|(v, _)| v.clone())))
+    let chosen = if required.is_empty() { made.to_vec() } else { required };
+    chosen.into_iter().filter(|v| crate::variable::of(v).is_some()).collect()
 }
 
-fn row(e: &Evaluation) -> String {
-    let mut s = String::new();
-    for x in &e.x {
-        let _ = write!(s, "{x},");
-    }
-    let _ = write!(
-        s,
-        "{},{},{},{}/{},{:.2}",
+fn row(e: &Evaluation) -> Vec<String> {
+    let mut cells: Vec<String> = e.x.iter().map(ToString::to_string).collect();
+    cells.extend([
         e.cost.map_or_else(String::new, |c| format!("{c:.4}")),
-        if e.feasible() { "yes" } else { "no" },
-        e.decimation,
-        e.seeds_passed,
-        e.seeds,
-        e.seconds
-    );
-    s
+        (if e.feasible() { "yes" } else { "no" }).to_string(),
+        e.decimation.to_string(),
+        format!("{}/{}", e.seeds_passed, e.seeds),
+        format!("{:.2}", e.seconds),
+    ]);
+    cells
 }
 
 fn evaluations_csv(search: &Search) -> String {
     let keys = crate::design::constraint_keys(&search.evaluations);
-    let mut s = String::from("step,phase,");
-    for v in &search.vars {
-        let _ = write!(s, "{},", v.name());
-    }
-    s.push_str("cost,feasible,decimation,seeds_passed,seconds");
-    for k in &keys {
-        let _ = write!(s, ",excess {}", k.replace(',', ";"));
-    }
-    s.push_str(",error\n");
+    // The constraint columns keep the `;` they have always had for a comma in a key.
+    let excess: Vec<String> = keys.iter().map(|k| format!("excess {}", k.replace(',', ";"))).collect();
+    let header: Vec<&str> = ["step", "phase"]
+        .into_iter()
+        .chain(search.vars.iter().map(Variable::name))
+        .chain(["cost", "feasible", "decimation", "seeds_passed", "seconds"])
+        .chain(excess.iter().map(String::as_str))
+        .chain(["error"])
+        .collect();
+    let mut csv = crate::csvtext::Csv::new(&header);
     let n = search.evaluations.len();
     for (i, e) in search.evaluations.iter().chain(&search.confirmed).enumerate() {
         let phase = if i >= n { "confirm" } else { "search" };
-        let _ = write!(s, "{},{phase},{}", i + 1, row(e));
+        let mut cells = vec![(i + 1).to_string(), phase.to_string()];
+        cells.extend(row(e));
         for k in &keys {
             let g =
                 e.constraints.iter().find(|(name, _)| name == k).map_or_else(String::new, |(_, g)| format!("{g:.4}"));
-            let _ = write!(s, ",{g}");
+            cells.push(g);
         }
-        let _ = writeln!(s, ",{}", e.error.as_deref().unwrap_or("").replace([',', '\n'], ";"));
+        cells.push(e.error.as_deref().unwrap_or("").replace([',', '\n'], ";"));
+        csv.row(&cells);
     }
-    s
+    csv.finish()
 }
 
 fn front_csv(search: &Search, front: &[usize], variable: &str) -> String {
-    let mut s = String::new();
-    for v in &search.vars {
-        let _ = write!(s, "{},", v.name());
-    }
-    let _ = writeln!(s, "cost,{variable}_mae_pct,feasible");
+    let mae = format!("{variable}_mae_pct");
+    let header: Vec<&str> = search.vars.iter().map(Variable::name).chain(["cost", mae.as_str(), "feasible"]).collect();
+    let mut csv = crate::csvtext::Csv::new(&header);
     for &i in front {
         let e = &search.evaluations[i];
-        for x in &e.x {
-            let _ = write!(s, "{x},");
-        }
+        let mut cells: Vec<String> = e.x.iter().map(ToString::to_string).collect();
         let mae = e.mae_pct.iter().find(|(v, _)| v == variable).map_or(f64::NAN, |m| m.1);
-        let _ = writeln!(s, "{:.4},{mae:.2},{}", e.cost.unwrap_or(f64::NAN), if e.feasible() { "yes" } else { "no" });
+        cells.extend([
+            format!("{:.4}", e.cost.unwrap_or(f64::NAN)),
+            format!("{mae:.2}"),
+            (if e.feasible() { "yes" } else { "no" }).to_string(),
+        ]);
+        csv.row(&cells);
     }
-    s
+    csv.finish()
 }
 
 fn front_curves(search: &Search, front: &[usize], variable: &str, limit: Option<f64>, currency: &str) -> Curves {

@@ -86,6 +86,49 @@ fn key(c: &Check) -> String {
     c.what.clone()
 }
 
+/// The constraint keys a search over `requirements` can report, and those every evaluation
+/// without an error must report, when its retrieval makes the variables `made` (the same keys
+/// [`key`] gives the checks of [`Requirements::check_run`] and [`Requirements::check_design`]).
+/// A shard record is judged against them: a forged record without its constraints would be
+/// taken for a feasible design.
+#[must_use]
+pub fn constraint_plan(requirements: &Requirements, made: &[String]) -> (Vec<String>, Vec<String>) {
+    let (mut possible, mut required) = (Vec::new(), Vec::new());
+    for p in &requirements.products {
+        let is_made = made.contains(&p.variable);
+        for (limit, what) in [(p.mae_pct, "MAE %"), (p.bias_pct, "|bias| %"), (p.returned_pct, "returned %")] {
+            if limit.is_some() {
+                let k = format!("{} {what}", p.variable);
+                if is_made {
+                    required.push(k.clone());
+                }
+                possible.push(k);
+            }
+        }
+    }
+    if requirements.substrate_pct.is_some() {
+        possible.push("substrate right %".into());
+    }
+    if requirements.rrs.is_some() {
+        possible.push("Rrs MAE, worst band".into());
+    }
+    let design = [
+        (requirements.snr.is_some(), "SNR, worst band"),
+        (requirements.cost_max.is_some(), "cost"),
+        (requirements.fits.is_some(), "fits"),
+        (requirements.data_volume_gbit_day.is_some(), "data a day"),
+        (requirements.gsd_m_max.is_some(), "GSD, m"),
+        (requirements.smear_px_max.is_some(), "smear, px"),
+    ];
+    for (stated, k) in design {
+        if stated {
+            possible.push(k.into());
+            required.push(k.into());
+        }
+    }
+    (possible, required)
+}
+
 /// The normalised excess of a check (positive: it fails); a check without a value fails by 1.
 fn excess(c: &Check) -> f64 {
     match c.margin {
