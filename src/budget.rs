@@ -51,6 +51,8 @@ pub enum Lever {
     },
     /// The radiative transfer's layers (bytes ∝ 1 / max_layer_depth).
     Layers,
+    /// Files read whole (bytes ∝ their size).
+    Files,
 }
 
 impl Lever {
@@ -70,6 +72,10 @@ impl Lever {
                 ((decimation as f64) / side.max(1e-9)).ceil()
             ),
             Self::Layers => format!("raise max_layer_depth by {:.1}× or more", 1.0 / share.max(1e-9)),
+            Self::Files => format!(
+                "give files at most {:.0} % of their size (crop them), or raise SHOAL_MEMORY_BUDGET",
+                100.0 * share.max(0.0)
+            ),
         }
     }
 }

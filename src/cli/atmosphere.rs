@@ -166,8 +166,8 @@ fn merged(args: &AtmosphereArgs) -> Result<AtmosphereRun, CliError> {
 }
 
 fn read_spec(path: &Path) -> Result<AtmosphereRun, CliError> {
-    let text =
-        std::fs::read_to_string(path).map_err(|e| CliError::Input(format!("cannot read {}: {e}", path.display())))?;
+    let text = crate::infile::read_text(path, crate::infile::RON_MAX_BYTES)
+        .map_err(|e| CliError::Input(format!("cannot read {e}")))?;
     ron::from_str(&text).map_err(|e| CliError::Input(format!("{}: {e}", path.display())))
 }
 
@@ -208,7 +208,6 @@ fn values(t: &AtmosphereTerms) -> [f64; 13] {
 /// Run `shoal atmosphere`.
 pub fn run(args: &AtmosphereArgs) -> Result<(), CliError> {
     let run = merged(args)?;
-    let atm = run.atmosphere.build()?;
     let g = Geometry::from_degrees(run.sun_zenith_deg, run.view_zenith_deg, run.relative_azimuth_deg);
     g.validate()?;
     let band_mode = args.grid.bands.is_some() || run.bands.is_some();
@@ -227,6 +226,11 @@ pub fn run(args: &AtmosphereArgs) -> Result<(), CliError> {
             (0..grid.len()).map(|i| dense.column(i).iter().any(|w| *w != 0.0)).collect()
         }
     };
+    let solves = needed.iter().filter(|n| **n).count();
+    // Ranges first (their message names the field), then the work they add up to.
+    run.atmosphere.validate()?;
+    super::within_budget(&crate::engine::resources::atmosphere_command_demand(&run.atmosphere, solves))?;
+    let atm = run.atmosphere.build()?;
     let wl = grid.wavelengths_nm();
     let terms: Vec<Option<AtmosphereTerms>> = (0..grid.len())
         .into_par_iter()

@@ -11,7 +11,6 @@
 //! Output: `rrs.csv` (per row: Rrs per band, sr⁻¹, empty where flagged; AOT(550) and Ångström
 //! exponent found) in `--out`.
 
-use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use ndarray::Array3;
@@ -74,6 +73,14 @@ pub fn run(args: &CorrectArgs) -> Result<(), CliError> {
     if rows == 0 || rows > MAX_ROWS {
         return Err(CliError::Input(format!("--toa: {rows} rows (allowed: 1 to {MAX_ROWS})")));
     }
+    // Dark-spectrum fitting fits a line to each band's darkest `pixels` of the whole set: with
+    // fewer rows it would extrapolate below the darkest spectrum and read no aerosol.
+    if image.fit == crate::correction::AerosolFit::DarkSpectrum && rows < image.dark.pixels {
+        return Err(CliError::Input(format!(
+            "--correction dark: {rows} spectra, but dark-spectrum fitting needs at least correction.image.dark.pixels = {} (an image's darkest pixels, not a handful of spectra); use pair or pair-black",
+            image.dark.pixels
+        )));
+    }
     let fid = Fidelity::default();
     let response = Response::new(&instrument, fid.spectral_step_nm)?;
     let names: Vec<String> = response.bands.bands.iter().map(|b| b.name.clone()).collect();
@@ -99,6 +106,9 @@ pub fn run(args: &CorrectArgs) -> Result<(), CliError> {
         }
         looks.push(Look { dx_m: 0.0, dy_m: 0.0, geometry: Geometry::from_degrees(sza[r], vza[r], raa[r]) });
     }
+    // The scene is built for its atmosphere and water: sized against the budget first, with the
+    // family's radiative transfer and tables.
+    super::within_budget(&crate::engine::resources::correct_demand(&scene_spec, &image, rows, nb))?;
     let out = crate::study::OutputDir::create(&args.out, "shoal correct")?;
     let control = super::interrupt::control();
     let groups = response.groups.len();
@@ -128,23 +138,22 @@ pub fn run(args: &CorrectArgs) -> Result<(), CliError> {
     let level1 = Level1 { radiance, flags: Array3::zeros((1, rows, nb)) };
     let water = crate::instrument::SurfaceMap::all_water((1, rows));
     let (rrs, aerosol) = correct_image(&level1, &family, &image, &response.bands, &water, &control).map_err(fail)?;
-    let mut csv = String::from("row");
-    for n in &names {
-        let _ = write!(csv, ",rrs_{n}_per_sr");
-    }
-    csv.push_str(",aot550,angstrom\n");
+    let columns: Vec<String> = std::iter::once("row".to_string())
+        .chain(names.iter().map(|n| format!("rrs_{n}_per_sr")))
+        .chain(["aot550".to_string(), "angstrom".to_string()])
+        .collect();
+    let mut csv = crate::csvtext::Csv::new(&columns.iter().map(String::as_str).collect::<Vec<_>>());
     for r in 0..rows {
-        let _ = write!(csv, "{}", r + 1);
+        let mut cells = vec![(r + 1).to_string()];
         for b in 0..nb {
-            if rrs.flags[[0, r, b]] & RrsFlags::INVALID == 0 {
-                let _ = write!(csv, ",{:.6e}", rrs.rrs[[0, r, b]]);
-            } else {
-                csv.push(',');
-            }
+            let valid = rrs.flags[[0, r, b]] & RrsFlags::INVALID == 0;
+            cells.push(if valid { format!("{:.6e}", rrs.rrs[[0, r, b]]) } else { String::new() });
         }
-        let _ = writeln!(csv, ",{:.4},{:.3}", aerosol.aot550[[0, r]], aerosol.angstrom[[0, r]]);
+        cells.push(format!("{:.4}", aerosol.aot550[[0, r]]));
+        cells.push(format!("{:.3}", aerosol.angstrom[[0, r]]));
+        csv.row(&cells);
     }
-    crate::study::write_bytes(&out.path().join("rrs.csv"), csv.as_bytes())?;
+    crate::study::write_bytes(&out.path().join("rrs.csv"), csv.finish().as_bytes())?;
     out.commit()?;
     eprintln!("{rows} spectra corrected ({}) into {}", image.label(), args.out.display());
     Ok(())

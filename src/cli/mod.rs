@@ -218,6 +218,13 @@ fn pool(threads: usize, name: &'static str) -> Result<rayon::ThreadPool, CliErro
     crate::jobs::pool(threads, name).map_err(|e| CliError::Run(e.to_string()))
 }
 
+/// Refuse, before it starts, work that would not fit the machine's budget
+/// ([`crate::budget::Budget::from_env`]): the one resource plan every heavy command passes.
+pub(crate) fn within_budget(demand: &crate::budget::Demand) -> Result<(), CliError> {
+    let budget = crate::budget::Budget::from_env().map_err(CliError::Input)?;
+    budget.check(demand).map_err(|e| CliError::Input(e.to_string()))
+}
+
 /// `shoal dev almi-sets DIR`.
 fn almi_sets(dir: &std::path::Path) -> Result<(), CliError> {
     use crate::retrieval::sets::{ALMI_SETS, almi_clusters, set_ron};
@@ -243,6 +250,12 @@ pub fn main(app: impl FnOnce(&AppArgs) -> ExitCode) -> ExitCode {
     };
     if cli.allow_external {
         crate::retrieval::external::allow_all();
+    }
+    // The budget's environment variables are read by every command alike: one that does not
+    // read is refused here, whatever the command.
+    if let Err(m) = crate::budget::Budget::from_env() {
+        eprintln!("error: {m}");
+        return ExitCode::from(2);
     }
     let result = match cli.command {
         Command::App(args) => return app(&args),

@@ -41,6 +41,9 @@ const VARIABLES: [&str; 4] = crate::variable::KEYS;
 
 /// Largest NetCDF file read, bytes: a full-resolution default-study product is ~0.7 GB.
 const MAX_BYTES: u64 = 8 << 30;
+/// Memory per byte of a NetCDF file read: the file's bytes, and its (line, pixel) float values
+/// as `Option<f64>` (16 bytes for 4 of an f32), at most.
+const HELD_PER_FILE_BYTE: f64 = 5.0;
 
 /// Read `wanted` from `path` (see [`crate::netcdf::read_maps`]); `what` names the file in errors.
 fn read_maps(path: &Path, wanted: &[&str], what: &str) -> Result<crate::netcdf::Maps, CliError> {
@@ -54,6 +57,18 @@ pub fn run(args: &ScoreArgs) -> Result<(), CliError> {
     let truth_names: Vec<String> = VARIABLES.iter().map(|v| format!("true_{v}")).collect();
     // The truth maps hold the fill value on land: land pixels are not candidates.
     let wanted: Vec<&str> = truth_names.iter().map(String::as_str).collect();
+    // Both files are held at once: sized against the budget before either is read.
+    let size = |p: &Path| std::fs::metadata(p).map_or(0, |m| m.len());
+    let bytes = (size(&truth_file) + size(&args.product)) as f64 * HELD_PER_FILE_BYTE;
+    super::within_budget(&crate::budget::Demand {
+        parts: vec![crate::budget::Part {
+            what: "the truth and the product, read".into(),
+            bytes,
+            fields: "the NetCDF files' sizes",
+            lever: crate::budget::Lever::Files,
+        }],
+        atmosphere_s: 0.0,
+    })?;
     let truth = read_maps(&truth_file, &wanted, "--truth")?;
     let product = read_maps(&args.product, &VARIABLES, "the product")?;
     if product.maps.is_empty() {
@@ -81,7 +96,8 @@ pub fn run(args: &ScoreArgs) -> Result<(), CliError> {
         rows.push((name.clone(), compare(&retrieved, truth_values)));
     }
     let mut table = String::new();
-    let mut csv = String::from("variable,n,returned_pct,mae_pct,bias_pct,rmse,r2,verdict\n");
+    let mut csv =
+        crate::csvtext::Csv::new(&["variable", "n", "returned_pct", "mae_pct", "bias_pct", "rmse", "r2", "verdict"]);
     let _ = writeln!(
         table,
         "{:<12} {:>8} {:>10} {:>8} {:>8} {:>10} {:>6}  verdict",
@@ -101,20 +117,20 @@ pub fn run(args: &ScoreArgs) -> Result<(), CliError> {
             m.r2,
             verdict
         );
-        let _ = writeln!(
-            csv,
-            "{name},{},{},{},{},{},{},{verdict}",
-            m.n,
-            m.returned_pct,
-            m.mae_pct(),
-            m.bias_pct(),
-            m.rmse,
-            m.r2
-        );
+        csv.row([
+            name.clone(),
+            m.n.to_string(),
+            m.returned_pct.to_string(),
+            m.mae_pct().to_string(),
+            m.bias_pct().to_string(),
+            m.rmse.to_string(),
+            m.r2.to_string(),
+            verdict.to_string(),
+        ]);
     }
     print!("{table}");
     let out = crate::study::OutputDir::create(&args.out, "shoal score")?;
-    crate::study::write_bytes(&out.path().join("score.csv"), csv.as_bytes())?;
+    crate::study::write_bytes(&out.path().join("score.csv"), csv.finish().as_bytes())?;
     out.commit()?;
     eprintln!("scored {} against {} into {}", args.product.display(), truth_file.display(), args.out.display());
     Ok(())
@@ -123,15 +139,17 @@ pub fn run(args: &ScoreArgs) -> Result<(), CliError> {
 /// The requirements to judge against: `--requirements`, else the study's next to the run folder.
 fn load_requirements(args: &ScoreArgs) -> Result<Option<Requirements>, CliError> {
     if let Some(path) = &args.requirements {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| CliError::Input(format!("--requirements {}: {e}", path.display())))?;
+        let text = crate::infile::read_text(path, crate::infile::RON_MAX_BYTES)
+            .map_err(|e| CliError::Input(format!("--requirements {e}")))?;
         let r: Requirements =
             ron::from_str(&text).map_err(|e| CliError::Input(format!("--requirements {}: {e}", path.display())))?;
         r.validate().map_err(|e| CliError::Input(e.to_string()))?;
         return Ok(Some(r));
     }
     let study = args.truth.parent().map(|p| p.join("study.ron"));
-    let Some(text) = study.and_then(|p| std::fs::read_to_string(p).ok()) else { return Ok(None) };
+    let Some(text) = study.and_then(|p| crate::infile::read_text(&p, crate::infile::RON_MAX_BYTES).ok()) else {
+        return Ok(None);
+    };
     Ok(crate::study::StudySpec::from_ron(&text, "study.ron").ok().and_then(|s| s.requirements))
 }
 

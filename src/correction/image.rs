@@ -129,6 +129,10 @@ impl Default for ImageCorrection {
     }
 }
 
+/// The most AOT nodes a family may have (the default has 5; LUT interpolation gains nothing
+/// from more than a few tens).
+pub const MAX_AOT_NODES: usize = 32;
+
 impl ImageCorrection {
     /// Dark-spectrum fitting with ACOLITE's two models (its MOD1 and MOD2 are continental and
     /// maritime). Urban and continental differ too little in the NIR for two adjacent bands to
@@ -177,18 +181,26 @@ impl ImageCorrection {
         if self.pair_nm[0] >= self.pair_nm[1] {
             return Err(invalid(r.path, format!("{:?}: the short band first, then the long one", self.pair_nm)));
         }
-        if self.models.is_empty() || self.models.contains(&AerosolType::None) {
+        let repeated = self.models.iter().enumerate().any(|(i, m)| self.models[..i].contains(m));
+        if self.models.is_empty() || self.models.contains(&AerosolType::None) || repeated {
             return Err(invalid(
                 "correction.image.models",
-                "one or more of maritime, continental, urban (none is the family's τ = 0)".into(),
+                "one or more of maritime, continental, urban, each once (none is the family's τ = 0)".into(),
             ));
         }
         let a = &crate::ranges::CORRECTION_AOT_NODE;
         for &v in &self.aot_nodes {
             a.check(v).map_err(|m| invalid(a.path, m))?;
         }
-        if self.aot_nodes.is_empty() || self.aot_nodes.windows(2).any(|w| w[1] <= w[0]) {
-            return Err(invalid(a.path, format!("{:?}: one or more nodes, increasing", self.aot_nodes)));
+        // Each node is a radiative transfer solve per model: the family's time grows with them.
+        if self.aot_nodes.is_empty()
+            || self.aot_nodes.len() > MAX_AOT_NODES
+            || self.aot_nodes.windows(2).any(|w| w[1] <= w[0])
+        {
+            return Err(invalid(
+                a.path,
+                format!("{} nodes (allowed: 1 to {MAX_AOT_NODES}, increasing)", self.aot_nodes.len()),
+            ));
         }
         let d = &self.dark;
         let tile = &crate::ranges::CORRECTION_DARK_TILE_PX;

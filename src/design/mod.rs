@@ -168,6 +168,33 @@ pub fn check(evaluator: &Evaluator<'_>, settings: &Settings) -> Result<(), Study
             return bad("budgets.cost.out_of_range", format!("the search needs a cost for every design: {note}"));
         }
     }
+    within_budget(evaluator)
+}
+
+/// Every corner of the search's box (each parameter at its lowest or highest) against the
+/// machine's budget, so that a search whose largest designs would not fit is refused before its
+/// first run rather than recording every evaluation as failed.
+fn within_budget(evaluator: &Evaluator<'_>) -> Result<(), StudyError> {
+    let budget = crate::budget::Budget::from_env()
+        .map_err(|m| StudyError::Invalid(FieldError { field: "budget".into(), message: m }))?;
+    let n = evaluator.vars.len();
+    for corner in 0..1u32 << n {
+        let x: Vec<f64> = evaluator
+            .vars
+            .iter()
+            .enumerate()
+            .map(|(j, v)| if corner >> j & 1 == 1 { v.bounds().1 } else { v.bounds().0 })
+            .collect();
+        // A corner the configuration refuses is no design; the search records it as such.
+        let Ok(mut config) = space::configure(evaluator.base, evaluator.vars, &x) else { continue };
+        config.fidelity.decimation = evaluator.decimation;
+        budget.check(&crate::engine::resources::run_demand(&config)).map_err(|e| {
+            StudyError::Invalid(FieldError {
+                field: "--vary".into(),
+                message: format!("the design at {x:?} would not fit: {}: {}", e.field, e.message),
+            })
+        })?;
+    }
     Ok(())
 }
 

@@ -9,7 +9,9 @@
 //!
 //! The budget it is held to is [`crate::budget::Budget`].
 
+use crate::atmosphere::{AtmosphereSpec, RtAccuracy};
 use crate::budget::{Demand, Lever, Part};
+use crate::correction::ImageCorrection;
 use crate::instrument::InstrumentKind;
 use crate::scene::{Georeference, MapSpec, SceneSpec};
 
@@ -36,6 +38,9 @@ const SECONDS_PER_RT_WORK: f64 = 1e-9;
 /// Orders the successive-orders solver runs at most in practice: it stops when an order adds less
 /// than `order_tolerance`, within a few tens of orders for any atmosphere Shoal accepts.
 const ORDERS_COUNTED: f64 = 100.0;
+/// Wavelength nodes a LUT build solves (the fit of `SECONDS_PER_RT_WORK` is per build);
+/// `shoal atmosphere` solves one column per wavelength it prints.
+const LUT_NODES: f64 = 20.0;
 /// A fixed part of every LUT build, s.
 const RT_OVERHEAD_S: f64 = 0.05;
 /// Bytes per level and pair of quadrature streams the solver holds while it solves a Fourier
@@ -88,39 +93,47 @@ fn scene_parts(scene: &SceneSpec, parts: &mut Vec<Part>) {
     }
 }
 
-/// Optical depth of the column as the solver layers it, an upper bound: Rayleigh at the
-/// shortest wavelength (~1.2 at 325 nm, sea level) plus the aerosol's (its τ at 550 nm, up to ×3
-/// in the UV).
-fn column_depth(config: &RunConfig) -> f64 {
-    1.3 + 3.0 * config.scene.atmosphere.aot550
+/// Optical depth of a column as the solver layers it, an upper bound: Rayleigh at the shortest
+/// wavelength (~1.2 at 325 nm, sea level) plus the aerosol's (its τ at 550 nm, up to ×3 in the
+/// UV).
+fn column_depth(aot550: f64) -> f64 {
+    1.3 + 3.0 * aot550
 }
 
-/// Planned seconds of the atmosphere's radiative transfer: each successive order of scattering
-/// visits every layer, stream pair and Fourier term, once per LUT wavelength node; the fit
-/// (`SECONDS_PER_RT_WORK`) absorbs the nodes.
+/// Layers the solver makes of a column with aerosol `aot550`.
+fn layers(acc: &RtAccuracy, aot550: f64) -> f64 {
+    (column_depth(aot550) / acc.max_layer_depth).ceil().max(acc.min_layers as f64)
+}
+
+/// Planned seconds of one radiative-transfer solve of a column with aerosol `aot550` at the
+/// nodes of a LUT: each successive order of scattering visits every layer, stream pair and
+/// Fourier term, once per wavelength node; the fit (`SECONDS_PER_RT_WORK`) absorbs the nodes.
+fn rt_seconds(acc: &RtAccuracy, aot550: f64) -> f64 {
+    let streams = acc.streams as f64;
+    let orders = (acc.max_orders as f64).min(ORDERS_COUNTED);
+    RT_OVERHEAD_S + layers(acc, aot550) * streams * streams * acc.fourier_terms as f64 * orders * SECONDS_PER_RT_WORK
+}
+
+/// Planned seconds of the atmosphere's radiative transfer: the scene's atmosphere, and the
+/// image-based correction's family when there is one.
 #[must_use]
 pub fn atmosphere_seconds(config: &RunConfig) -> f64 {
     let acc = &config.scene.atmosphere.accuracy;
-    let layers = (column_depth(config) / acc.max_layer_depth).ceil().max(acc.min_layers as f64);
-    let streams = acc.streams as f64;
-    let orders = (acc.max_orders as f64).min(ORDERS_COUNTED);
-    let one = RT_OVERHEAD_S + layers * streams * streams * acc.fourier_terms as f64 * orders * SECONDS_PER_RT_WORK;
-    // The image-based correction solves one more atmosphere per model and AOT node, and the
-    // shared Rayleigh one; their columns are no deeper than the family's largest AOT.
-    let family = config.correction.image.as_ref().map_or(0.0, |i| {
-        let deepest = i.aot_nodes.iter().copied().fold(0.0, f64::max);
-        let layers = ((1.3 + 3.0 * deepest) / acc.max_layer_depth).ceil().max(acc.min_layers as f64);
-        let each = RT_OVERHEAD_S + layers * streams * streams * acc.fourier_terms as f64 * orders * SECONDS_PER_RT_WORK;
-        (i.models.len() * i.aot_nodes.len() + 1) as f64 * each
-    });
-    one + family
+    rt_seconds(acc, config.scene.atmosphere.aot550)
+        + config.correction.image.as_ref().map_or(0.0, |i| family_seconds(acc, i))
+}
+
+/// The image-based correction's family: one more atmosphere per model and AOT node, and the
+/// shared Rayleigh one; their columns are no deeper than the family's largest AOT.
+fn family_seconds(acc: &RtAccuracy, image: &ImageCorrection) -> f64 {
+    let deepest = image.aot_nodes.iter().copied().fold(0.0, f64::max);
+    (image.models.len() * image.aot_nodes.len() + 1) as f64 * rt_seconds(acc, deepest)
 }
 
 /// The solver's memory: per level, the scattering kernel of every pair of quadrature streams
 /// (2·streams per hemisphere pair), on each worker thread solving a Fourier term.
-fn atmosphere_part(config: &RunConfig) -> Part {
-    let acc = &config.scene.atmosphere.accuracy;
-    let layers = (column_depth(config) / acc.max_layer_depth).ceil().max(acc.min_layers as f64);
+fn rt_part(acc: &RtAccuracy, aot550: f64) -> Part {
+    let layers = layers(acc, aot550);
     let quadrature = 2.0 * acc.streams as f64;
     let threads = rayon::current_num_threads() as f64;
     Part {
@@ -129,6 +142,40 @@ fn atmosphere_part(config: &RunConfig) -> Part {
         fields: "scene.atmosphere.accuracy.max_layer_depth, streams",
         lever: Lever::Layers,
     }
+}
+
+fn atmosphere_part(config: &RunConfig) -> Part {
+    rt_part(&config.scene.atmosphere.accuracy, config.scene.atmosphere.aot550)
+}
+
+/// What `shoal atmosphere` will ask for: `solves` wavelengths, each a radiative transfer solve
+/// of `spec`'s column at one wavelength (a LUT build solves [`LUT_NODES`] of them).
+#[must_use]
+pub fn atmosphere_command_demand(spec: &AtmosphereSpec, solves: usize) -> Demand {
+    let one = rt_seconds(&spec.accuracy, spec.aot550) - RT_OVERHEAD_S;
+    Demand {
+        parts: vec![rt_part(&spec.accuracy, spec.aot550)],
+        atmosphere_s: RT_OVERHEAD_S + one * solves as f64 / LUT_NODES,
+    }
+}
+
+/// What `shoal correct` will ask for: the scene it reads the atmosphere from, the family's
+/// radiative transfer, and its tables for `rows` spectra of `bands` bands (16 atmospheres × 3
+/// terms × 8 bytes per row and band).
+#[must_use]
+pub fn correct_demand(scene: &SceneSpec, image: &ImageCorrection, rows: usize, bands: usize) -> Demand {
+    let mut parts = Vec::new();
+    scene_parts(scene, &mut parts);
+    let deepest = image.aot_nodes.iter().copied().fold(0.0, f64::max);
+    parts.push(rt_part(&scene.atmosphere.accuracy, deepest));
+    let atmospheres = (image.models.len() * image.aot_nodes.len() + 1) as f64;
+    parts.push(Part {
+        what: format!("the correction's tables ({rows} spectra × {bands} bands)"),
+        bytes: rows as f64 * bands as f64 * atmospheres * 3.0 * 8.0,
+        fields: "the --toa rows, correction.image.models, aot_nodes",
+        lever: Lever::Image { rows, columns: 1, decimation: 1 },
+    });
+    Demand { parts, atmosphere_s: family_seconds(&scene.atmosphere.accuracy, image) }
 }
 
 /// What `config` will ask for, alone.
