@@ -51,7 +51,7 @@ use crate::parse::FieldError;
 #[serde(deny_unknown_fields)]
 pub struct ExternalSpec {
     /// Name in tables, maps and file names: 1 to 32 ASCII letters, digits and `_`, starting with a
-    /// letter (not `alm` or `sambuca`, the built-in retrievals' names).
+    /// letter (not a built-in retrieval's name: [`super::run::BUILT_IN_NAMES`]).
     pub name: String,
     /// The program and its arguments (see the module documentation for `{input}`, `{output}`,
     /// `{dir}` and `{example:NAME}`).
@@ -112,12 +112,14 @@ impl ExternalSpec {
         let name_ok = (1..=32).contains(&self.name.len())
             && self.name.starts_with(|c: char| c.is_ascii_alphabetic())
             && self.name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
-        if !name_ok || self.name == "alm" || self.name == "sambuca" {
+        let reserved = super::run::BUILT_IN_NAMES;
+        if !name_ok || reserved.iter().any(|r| r.eq_ignore_ascii_case(&self.name)) {
             return Err(invalid(
                 "name",
                 format!(
-                    "`{}` (allowed: 1 to 32 ASCII letters, digits and _, starting with a letter; not alm or sambuca)",
-                    self.name.escape_debug()
+                    "`{}` (allowed: 1 to 32 ASCII letters, digits and _, starting with a letter; not {}, the built-in retrievals' names)",
+                    self.name.escape_debug(),
+                    reserved.join(", ")
                 ),
             ));
         }
@@ -166,8 +168,22 @@ impl ExternalSpec {
                         message: format!("`{a}` names {{dir}}, but this study has no file to be relative to"),
                     }));
                 };
+                // A study named by its bare file name (`s.ron`) has the empty path as its
+                // directory: that is the current directory.
+                let d = if d.as_os_str().is_empty() { Path::new(".") } else { d };
                 let d = std::path::absolute(d).unwrap_or_else(|_| d.to_path_buf());
-                *a = a.replace("{dir}", &d.to_string_lossy());
+                let d = d.to_string_lossy();
+                // The run expands the other placeholders in the result: a folder whose name
+                // held one would be expanded a second time.
+                if d.contains(['{', '}']) {
+                    return Err(RetrievalError::Invalid(FieldError {
+                        field: "retrievals[i].External.command".into(),
+                        message: format!(
+                            "`{a}`: the study's folder `{d}` holds a brace, which placeholders use; move the study to a folder without one"
+                        ),
+                    }));
+                }
+                *a = a.replace("{dir}", &d);
             }
         }
         Ok(out)
@@ -235,7 +251,9 @@ pub fn retrieve_external(
     super::external_io::product(spec, inputs, &maps).map_err(|m| spec.error(m))
 }
 
-/// One argument with `{input}`, `{output}` and `{example:NAME}` replaced.
+/// One argument with `{input}`, `{output}` and `{example:NAME}` replaced in one pass from left
+/// to right: the text put in is never read again, so a path holding a placeholder's name (a
+/// temporary folder called `{output}`) stays as it is.
 fn expand(
     spec: &ExternalSpec,
     arg: &str,
@@ -246,16 +264,43 @@ fn expand(
     if arg.contains("{dir}") {
         return Err(spec.error(format!("`{arg}`: {{dir}} is only known in a study file")));
     }
-    let mut a = arg.replace("{input}", &input.to_string_lossy()).replace("{output}", &output.to_string_lossy());
-    for (name, text) in EXAMPLES {
-        let key = format!("{{example:{name}}}");
-        if a.contains(&key) {
-            let path = folder.join(name);
-            std::fs::write(&path, text).map_err(|e| spec.error(format!("cannot write {}: {e}", path.display())))?;
-            a = a.replace(&key, &path.to_string_lossy());
+    let mut out = String::with_capacity(arg.len());
+    let mut rest = arg;
+    while let Some(at) = rest.find('{') {
+        out.push_str(&rest[..at]);
+        let tail = &rest[at..];
+        let token = tail.find('}').map(|end| &tail[..=end]);
+        let value = match token {
+            Some("{input}") => Some(input.to_string_lossy().into_owned()),
+            Some("{output}") => Some(output.to_string_lossy().into_owned()),
+            Some(t) if t.starts_with("{example:") => {
+                let name = &t["{example:".len()..t.len() - 1];
+                match EXAMPLES.iter().find(|(n, _)| *n == name) {
+                    Some((n, text)) => {
+                        let path = folder.join(n);
+                        std::fs::write(&path, text)
+                            .map_err(|e| spec.error(format!("cannot write {}: {e}", path.display())))?;
+                        Some(path.to_string_lossy().into_owned())
+                    }
+                    None => None,
+                }
+            }
+            _ => None,
+        };
+        match (token, value) {
+            (Some(t), Some(v)) => {
+                out.push_str(&v);
+                rest = &tail[t.len()..];
+            }
+            // Not a placeholder: the brace is text.
+            _ => {
+                out.push('{');
+                rest = &tail[1..];
+            }
         }
     }
-    Ok(a)
+    out.push_str(rest);
+    Ok(out)
 }
 
 /// Run `args` in `folder` to the end, within the time limit, stopping it when the run is cancelled.
@@ -300,6 +345,9 @@ fn run_program(
         std::thread::sleep(wait);
         wait = (wait * 2).min(Duration::from_millis(50));
     };
+    // Whatever the program started and left running (a shell's background job, a worker
+    // process) ends with it: its group is stopped after any exit.
+    stop_group(child.id());
     if !status.success() {
         return Err(spec.error(format!("`{}` exited with {status}{}", args[0], stderr_tail(&stderr_path))));
     }
@@ -311,19 +359,31 @@ fn run_program(
 /// minimal system): std has no safe call for a group, and Shoal denies `unsafe` outside its SIMD
 /// kernels.
 fn stop(child: &mut std::process::Child) {
-    #[cfg(unix)]
-    {
-        let group = format!("-{}", child.id());
-        let kill = r#"kill -s KILL -- "$0""#;
-        let _ = Command::new("sh").args(["-c", kill, &group]).stdout(Stdio::null()).stderr(Stdio::null()).status();
-    }
+    stop_group(child.id());
     let _ = child.kill();
     let _ = child.wait();
 }
 
+/// SIGKILL to every process of the group `leader` started (its id is the group's). After the
+/// leader has exited the group lives on while any member does, and its id is not reused until
+/// it is empty.
+fn stop_group(leader: u32) {
+    #[cfg(unix)]
+    {
+        let group = format!("-{leader}");
+        let kill = r#"kill -s KILL -- "$0" 2>/dev/null"#;
+        let _ = Command::new("sh").args(["-c", kill, &group]).stdout(Stdio::null()).stderr(Stdio::null()).status();
+    }
+    #[cfg(not(unix))]
+    let _ = leader;
+}
+
 /// The end of the program's standard error, as ": its standard error ended: …" (empty without).
 fn stderr_tail(path: &Path) -> String {
-    let text = std::fs::read(path).map(|b| String::from_utf8_lossy(&b).into_owned()).unwrap_or_default();
+    // The program may have replaced its standard error's file (by a FIFO, say): read only a
+    // regular file, and only its first megabytes.
+    let text =
+        crate::infile::read(path, 16 << 20).map(|b| String::from_utf8_lossy(&b).into_owned()).unwrap_or_default();
     let text = text.trim_end();
     if text.is_empty() {
         return String::new();

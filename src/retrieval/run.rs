@@ -57,6 +57,10 @@ pub enum RetrievalSpec {
     },
 }
 
+/// The built-in retrievals' names ([`RetrievalSpec::name`]): a retrieval of the user's may
+/// not take one (its files and variables would overwrite the built-in's), in any case.
+pub const BUILT_IN_NAMES: [&str; 3] = ["alm", "sambuca", "qaa"];
+
 impl RetrievalSpec {
     /// Short name for reports and file names.
     #[must_use]
