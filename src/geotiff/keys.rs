@@ -207,29 +207,51 @@ pub(super) fn metadata_xml(
     s + "</GDALMetadata>"
 }
 
-/// One `<Item …>value</Item>` of GDAL's metadata: (attributes, value).
-fn items(xml: &str) -> Vec<(Vec<(String, String)>, String)> {
+/// One `<Item …>value</Item>`: its (name, value) attributes and its value.
+type Item = (Vec<(String, String)>, String);
+
+/// Every `<Item …>value</Item>` of GDAL's metadata: (attributes, value). Attributes are
+/// `name="value"` or `name='value'` (both are XML). An item that does not close, or whose
+/// attributes do not read, is an error: a unit lost to a typo would read feet as metres.
+fn items(xml: &str) -> Result<Vec<Item>, String> {
     let mut out = Vec::new();
     let mut rest = xml;
     while let Some(start) = rest.find("<Item") {
         let after = &rest[start + 5..];
-        let (Some(close), Some(end)) = (after.find('>'), after.find("</Item>")) else { break };
+        let n = out.len() + 1;
+        let (Some(close), Some(end)) = (after.find('>'), after.find("</Item>")) else {
+            return Err(format!("GDAL_METADATA item {n} does not close (`</Item>`)"));
+        };
         if close > end {
-            break;
+            return Err(format!("GDAL_METADATA item {n} is malformed"));
         }
-        let attributes = after[..close]
-            .split('"')
-            .collect::<Vec<_>>()
-            .chunks(2)
-            .filter_map(|c| match c {
-                [name, value] => Some((name.trim().trim_end_matches('=').to_string(), xml_unescape(value))),
-                _ => None,
-            })
-            .collect();
+        let attributes = attributes(&after[..close]).ok_or_else(|| {
+            format!("GDAL_METADATA item {n}'s attributes `{}` do not read as name=\"value\"", after[..close].trim())
+        })?;
         out.push((attributes, xml_unescape(&after[close + 1..end])));
         rest = &after[end + 7..];
     }
-    out
+    Ok(out)
+}
+
+/// `name="value" other='value'` (a trailing `/` aside) as (name, value) pairs; `None` when the
+/// text is anything else.
+fn attributes(text: &str) -> Option<Vec<(String, String)>> {
+    let mut out = Vec::new();
+    let mut rest = text.trim().trim_end_matches('/').trim();
+    while !rest.is_empty() {
+        let eq = rest.find('=')?;
+        let name = rest[..eq].trim();
+        if name.is_empty() || !name.chars().all(|c| c.is_ascii_alphanumeric() || "_-:".contains(c)) {
+            return None;
+        }
+        let value_part = rest[eq + 1..].trim_start();
+        let quote = value_part.chars().next().filter(|q| *q == '"' || *q == '\'')?;
+        let close = value_part[1..].find(quote)?;
+        out.push((name.to_string(), xml_unescape(&value_part[1..=close])));
+        rest = value_part[close + 2..].trim_start();
+    }
+    Some(out)
 }
 
 /// GDAL's metadata of a file with `bands` bands, read back.
@@ -250,9 +272,28 @@ pub(super) fn parse_metadata(xml: &str, bands: usize) -> Result<Metadata, String
         scales: vec![(1.0, 0.0); bands],
         items: Vec::new(),
     };
-    for (attributes, value) in items(xml) {
+    for (attributes, value) in items(xml)? {
         let get = |k: &str| attributes.iter().find(|(n, _)| n == k).map(|(_, v)| v.as_str());
-        let sample = get("sample").and_then(|s| s.parse::<usize>().ok());
+        let sample = match get("sample") {
+            None => None,
+            Some(s) => match s.trim().parse::<usize>() {
+                Ok(b) if b < bands => Some(b),
+                _ => {
+                    return Err(format!(
+                        "GDAL band item's sample `{s}` is not a band of the file (0 to {})",
+                        bands.saturating_sub(1)
+                    ));
+                }
+            },
+        };
+        // A per-band role without its band would drop the band's unit or scale unseen (a band
+        // item without a role is GDAL's band metadata, such as statistics).
+        if get("role").is_some() && sample.is_none() {
+            return Err(format!(
+                "GDAL metadata item `{}` has a role but no sample (the band it is of)",
+                get("name").unwrap_or("")
+            ));
+        }
         let number = |what: &str| {
             value
                 .trim()
@@ -262,13 +303,40 @@ pub(super) fn parse_metadata(xml: &str, bands: usize) -> Result<Metadata, String
                 .ok_or_else(|| format!("GDAL band {what} `{value}` is not a number"))
         };
         match (get("role"), sample) {
-            (Some("description"), Some(b)) if b < bands => m.descriptions[b] = value,
-            (Some("unittype"), Some(b)) if b < bands => m.units[b] = value,
-            (Some("scale"), Some(b)) if b < bands => m.scales[b].0 = number("scale")?,
-            (Some("offset"), Some(b)) if b < bands => m.scales[b].1 = number("offset")?,
+            (Some("description"), Some(b)) => m.descriptions[b] = value,
+            (Some("unittype"), Some(b)) => m.units[b] = value,
+            (Some("scale"), Some(b)) => m.scales[b].0 = number("scale")?,
+            (Some("offset"), Some(b)) => m.scales[b].1 = number("offset")?,
             (None, None) => m.items.push((get("name").unwrap_or("").to_string(), value)),
+            // Other band items (statistics, colour interpretation) carry no unit or scale.
             _ => {}
         }
     }
     Ok(m)
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    #[test]
+    fn metadata_reads_units_in_either_quote_and_refuses_what_it_cannot_read() {
+        let good = "<GDALMetadata><Item name='UNITTYPE' sample='0' role='unittype'>ft</Item>\
+            <Item name=\"STATISTICS_MEAN\" sample=\"0\">3.2</Item><Item name=\"AREA\">lake</Item></GDALMetadata>";
+        let m = parse_metadata(good, 1).unwrap();
+        assert_eq!(m.units, vec!["ft".to_string()]);
+        assert_eq!(m.items, vec![("AREA".to_string(), "lake".to_string())]);
+        // Each of these would have lost the unit `ft` and read feet as metres.
+        for bad in [
+            "<Item name=\"UNITTYPE\" sample=\"0\" role=\"unittype\">ft",
+            "<Item name=UNITTYPE sample=0 role=unittype>ft</Item>",
+            "<Item name=\"UNITTYPE\" sample=\"zero\" role=\"unittype\">ft</Item>",
+            "<Item name=\"UNITTYPE\" sample=\"3\" role=\"unittype\">ft</Item>",
+            "<Item name=\"UNITTYPE\" role=\"unittype\">ft</Item>",
+            "<Item name=\"UNITTYPE\" sample=\"0\" role=\"unittype>ft</Item>",
+        ] {
+            assert!(parse_metadata(bad, 1).is_err(), "{bad}");
+        }
+    }
 }

@@ -189,7 +189,7 @@ ranges! {
     INSTRUMENT_READ_NOISE_E = Range::closed("instrument.read_noise_e", 0.0, 1e5, "e-", "read noise, rms")
         .edited(Editor { label: "Read noise", unit: "e⁻", scale: 1.0, slider: (0.0, 100.0), log: false, tip: "Readout noise, electrons rms" });
     /// Full well.
-    INSTRUMENT_WELL_DEPTH_E = Range::above("instrument.well_depth_e", 0.0, 1e9, "e-", "full-well capacity")
+    INSTRUMENT_WELL_DEPTH_E = Range::closed("instrument.well_depth_e", 1.0, 1e9, "e-", "full-well capacity (at least one electron: the signal over full scale divides by it)")
         .edited(Editor { label: "Well depth", unit: "e⁻", scale: 1.0, slider: (1_000.0, 2_000_000.0), log: true, tip: "Full-well capacity: saturation above it" });
     /// Conversion gain.
     INSTRUMENT_GAIN_E_PER_DN = Range::closed("instrument.gain_e_per_dn", 0.01, 1e4, "e-/DN", "conversion gain")
@@ -224,7 +224,7 @@ ranges! {
     /// A further focal plane: read noise.
     PLANE_READ_NOISE_E = Range::closed("instrument.focal_planes[].read_noise_e", 0.0, 1e5, "e-", "the plane's read noise, rms");
     /// A further focal plane: full well.
-    PLANE_WELL_DEPTH_E = Range::above("instrument.focal_planes[].well_depth_e", 0.0, 1e9, "e-", "the plane's full-well capacity");
+    PLANE_WELL_DEPTH_E = Range::closed("instrument.focal_planes[].well_depth_e", 1.0, 1e9, "e-", "the plane's full-well capacity (at least one electron)");
     /// A further focal plane: conversion gain.
     PLANE_GAIN_E_PER_DN = Range::closed("instrument.focal_planes[].gain_e_per_dn", 0.01, 1e4, "e-/DN", "the plane's conversion gain");
     /// A further focal plane: ADC offset.

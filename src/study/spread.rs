@@ -31,10 +31,13 @@ pub struct SeedSpread {
 }
 
 impl SeedSpread {
-    /// "37.0 ± 0.4 %" (the ± only when there are two seeds or more).
+    /// "37.0 ± 0.4 %" (the ± only when there are two seeds or more; "–" when no seed returned a
+    /// pixel).
     #[must_use]
     pub fn mae_text(&self) -> String {
-        if self.seeds > 1 {
+        if self.seeds == 0 {
+            "– (nothing returned)".into()
+        } else if self.seeds > 1 {
             format!("{:.1} ± {:.1} %", self.mae_pct_mean, self.mae_pct_std)
         } else {
             format!("{:.1} %", self.mae_pct_mean)
@@ -100,22 +103,54 @@ pub fn spread_of_runs<'a>(runs: impl IntoIterator<Item = (&'a str, &'a [Arc<Retr
 /// The spread as CSV: instrument, product, variable, seeds, MAE mean, std, min, max, bias mean.
 #[must_use]
 pub fn seed_spread_csv(rows: &[SeedSpread]) -> String {
-    let mut s = String::from(
-        "instrument,product,variable,seeds,mae_pct_mean,mae_pct_std,mae_pct_min,mae_pct_max,bias_pct_mean\n",
-    );
+    let mut csv = crate::csvtext::Csv::new(&[
+        "instrument",
+        "product",
+        "variable",
+        "seeds",
+        "mae_pct_mean",
+        "mae_pct_std",
+        "mae_pct_min",
+        "mae_pct_max",
+        "bias_pct_mean",
+    ]);
+    // No seed returned a pixel: the statistics are empty fields, not NaN.
+    let value = |v: f64| if v.is_finite() { v.to_string() } else { String::new() };
     for r in rows {
-        s.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{}\n",
-            r.instrument,
-            r.product,
-            r.variable,
-            r.seeds,
-            r.mae_pct_mean,
-            r.mae_pct_std,
-            r.mae_pct_range.0,
-            r.mae_pct_range.1,
-            r.bias_pct_mean
-        ));
+        csv.row([
+            r.instrument.clone(),
+            r.product.clone(),
+            r.variable.clone(),
+            r.seeds.to_string(),
+            value(r.mae_pct_mean),
+            value(r.mae_pct_std),
+            value(r.mae_pct_range.0),
+            value(r.mae_pct_range.1),
+            value(r.bias_pct_mean),
+        ]);
     }
-    s
+    csv.finish()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_variable_with_nothing_returned_writes_empty_fields_not_nan() {
+        let none = SeedSpread {
+            instrument: "cubesat".into(),
+            product: "QAA v6".into(),
+            variable: "nap_g_m3".into(),
+            seeds: 0,
+            mae_pct_mean: f64::NAN,
+            mae_pct_std: 0.0,
+            mae_pct_range: (f64::NAN, f64::NAN),
+            bias_pct_mean: f64::NAN,
+        };
+        let csv = seed_spread_csv(&[none.clone()]);
+        assert_eq!(csv.lines().nth(1), Some("cubesat,QAA v6,nap_g_m3,0,,0,,,"));
+        assert!(!csv.contains("NaN"));
+        assert_eq!(none.mae_text(), "– (nothing returned)");
+    }
 }
