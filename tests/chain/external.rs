@@ -14,7 +14,7 @@ use super::{run, small, small_lake};
 
 /// An external retrieval of `products` running `command` (allowed for this process: commands
 /// are allowed one by one, so a test that needs a refusal uses a command no other test allows).
-fn external(name: &str, command: &[&str], products: &[&str]) -> RetrievalSpec {
+pub(super) fn external(name: &str, command: &[&str], products: &[&str]) -> RetrievalSpec {
     let command: Vec<String> = command.iter().map(|s| (*s).to_string()).collect();
     allow(&command);
     RetrievalSpec::External(ExternalSpec {
@@ -27,7 +27,7 @@ fn external(name: &str, command: &[&str], products: &[&str]) -> RetrievalSpec {
 }
 
 /// A small noise-free lake with aLMI and `retrieval` after it.
-fn run_with(retrieval: RetrievalSpec) -> RunOutput {
+pub(super) fn run_with(retrieval: RetrievalSpec) -> RunOutput {
     let mut c = RunConfig::new(small_lake(), small("cubesat", 24, 16));
     c.detector = DetectorMode::IDEAL;
     c.retrievals = vec![
@@ -47,7 +47,7 @@ fn scaled_truth(out: &RunOutput, factor: f32) -> Vec<f32> {
 }
 
 /// The run's aLMI is untouched by the external retrieval beside it.
-fn assert_almi_kept(out: &RunOutput) {
+pub(super) fn assert_almi_kept(out: &RunOutput) {
     let almi = &out.retrievals[0];
     assert_eq!(almi.product.name, "aLMI");
     assert!(almi.failure.is_none());

@@ -14,6 +14,7 @@ mod common;
 mod design;
 mod determinism;
 mod external;
+mod external_hostile;
 mod image_correction;
 mod incremental;
 mod netcdf;

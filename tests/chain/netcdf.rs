@@ -248,3 +248,39 @@ fn the_oc4_example_runs_outside_shoal_and_is_scored() {
     let got = f64::from(chl[r * cols + c]);
     assert!((got / oc4 - 1.0).abs() < 1e-5, "pixel ({r}, {c}): oc4.py {got}, OC4v6 {oc4}");
 }
+
+/// Files built by hand from the format's specification (`tests/fuzz/corpus/netcdf/`; `ncdump`
+/// reads them as the values below): classic with a double variable and `missing_value`, 64-bit
+/// offset with `_FillValue` and a NaN, and classic with `line` as the record dimension.
+#[test]
+fn hand_built_netcdf_files_read_as_ncdump_reads_them() {
+    let corpus = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fuzz/corpus/netcdf");
+    let read = |name: &str, wanted: &[&str]| shoal::netcdf::read_maps(&corpus.join(name), wanted, 1 << 20).unwrap();
+    let some = |v: &[f64]| v.iter().map(|x| Some(*x)).collect::<Vec<_>>();
+
+    let m = read("cdf1_double_missing.nc", &["depth_m"]);
+    assert_eq!(m.shape, (4, 3));
+    let mut depth = some(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0, 10.0, 11.0]);
+    depth.push(None); // 12.5 is the missing_value
+    assert_eq!(m.maps, vec![("depth_m".to_string(), depth)]);
+
+    let m = read("cdf2_maps.nc", &["chl_mg_m3", "true_chl_mg_m3", "rrs_absent"]);
+    assert_eq!(m.shape, (4, 3));
+    let chl = vec![Some(1.5), Some(2.0), None, Some(3.25), Some(0.5), None];
+    assert_eq!(m.maps[0].1[..6], chl[..], "the fill value and NaN are not returned");
+    assert_eq!(m.maps[0].1[6..], some(&[7.0, 8.0, 9.0, 10.0, 11.0, 12.0])[..]);
+    // Written as f32 of the double i × 1.1.
+    let truth: Vec<Option<f64>> = (1..=12).map(|i| Some(f64::from((f64::from(i) * 1.1) as f32))).collect();
+    assert_eq!(m.maps[1].1, truth);
+    assert_eq!(m.maps.len(), 2, "a wanted variable the file lacks is left out");
+    assert_eq!(m.names, ["chl_mg_m3", "true_chl_mg_m3", "rrs"]);
+    // A wanted variable of other dimensions is refused by name.
+    let e = shoal::netcdf::read_maps(&corpus.join("cdf2_maps.nc"), &["rrs"], 1 << 20).unwrap_err();
+    assert!(e.contains("`rrs`") && e.contains("line, pixel, band"), "{e}");
+
+    let m = read("cdf1_record_line.nc", &["chl_mg_m3", "true_chl_mg_m3"]);
+    assert_eq!(m.shape, (4, 3));
+    let chl: Vec<f64> = (1..=12).map(f64::from).collect();
+    assert_eq!(m.maps[0].1, some(&chl));
+    assert_eq!(m.maps[1].1, some(&chl.iter().map(|x| 2.0 * x).collect::<Vec<_>>()));
+}

@@ -14,7 +14,9 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::{Duration, Instant};
 
+mod files;
 mod runs;
+use files::{budgets_everywhere, netcdf_bombs, shard_records, special_and_oversized};
 use runs::{folders, gaps, resources};
 
 /// The binary under attack.
@@ -442,6 +444,10 @@ fn untrusted_files_and_folders_are_handled_cleanly() {
     resources(&mut tally);
     gaps(&mut tally);
     folders(&mut tally);
+    shard_records(&mut tally);
+    netcdf_bombs(&mut tally);
+    special_and_oversized(&mut tally);
+    budgets_everywhere(&mut tally);
     mutations(&mut tally, per_kind);
     tally.finish();
 }

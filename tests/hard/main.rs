@@ -12,6 +12,7 @@ mod chain;
 #[path = "../common/mod.rs"]
 mod common;
 mod faults;
+mod fuzz;
 mod loaders;
 mod properties;
 mod ranges;
