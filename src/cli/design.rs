@@ -315,6 +315,9 @@ fn summary(search: &Search, study: &str, label: &str, currency: &str, seeds: usi
     if let Some(why) = &search.stopped_early {
         let _ = writeln!(s, "{why}.\n");
     }
+    if let Some(note) = crate::design::optimiser_note(search) {
+        let _ = writeln!(s, "{note}\n");
+    }
     if search.shard {
         let _ = writeln!(
             s,

@@ -123,6 +123,9 @@ pub struct Search {
     pub stopped_early: Option<String>,
     /// A shard of the start only: there is no answer to give, only evaluations to resume from.
     pub shard: bool,
+    /// Steps at which the optimiser failed (it panicked fitting its surrogates) and a
+    /// space-filling design was run instead, with what it said; shown with the answer.
+    pub optimiser_failures: Vec<(usize, String)>,
 }
 
 impl Search {
@@ -134,6 +137,19 @@ impl Search {
             .find(|e| e.feasible())
             .or_else(|| if self.confirmed.is_empty() { self.cheapest.map(|i| &self.evaluations[i]) } else { None })
     }
+}
+
+/// What a reader of the answer must know when the optimiser failed at some steps: how often, at
+/// which designs, what it said first. `None` when it never failed.
+#[must_use]
+pub fn optimiser_note(search: &Search) -> Option<String> {
+    let (first_step, first_why) = search.optimiser_failures.first()?;
+    let steps: Vec<String> = search.optimiser_failures.iter().map(|(s, _)| s.to_string()).collect();
+    Some(format!(
+        "The optimiser could not propose design {} (it failed fitting its surrogates: at {first_step}, \"{}\"); a space-filling design was run in its place, so the search explored more than it exploited there.",
+        steps.join(", "),
+        first_why.chars().take(200).collect::<String>()
+    ))
 }
 
 /// Lower bound on the probability that a further seed passes when all `n` seeds passed
@@ -250,6 +266,7 @@ pub fn search_from(
             confirmed: Vec::new(),
             stopped_early: Some(format!("shard {}/{}: the start's designs only", shard.index, shard.count)),
             shard: true,
+            optimiser_failures: Vec::new(),
         });
     }
     for x in start {
@@ -263,6 +280,7 @@ pub fn search_from(
         stall.see(e.feasible().then_some(e.cost).flatten(), settings.stall_gain);
     }
     let mut stopped_early = None;
+    let mut optimiser_failures = Vec::new();
     while evaluations.len() < settings.evaluations {
         if let Some(n) = settings.stall_after
             && stall.best.is_some()
@@ -276,13 +294,15 @@ pub fn search_from(
             break;
         }
         step += 1;
-        let next = suggest(&evaluations, &keys, &xtypes, settings.seed.wrapping_add(step))
-            .filter(|x| !evaluations.iter().any(|e| same(&e.x, x)))
-            .unwrap_or_else(|| {
-                // The surrogate proposed a design already run (or could not be fitted): take a
-                // fresh space-filling one instead, so every evaluation teaches something.
-                latin_hypercube(evaluator.vars, 1, settings.seed.wrapping_add(1000 + step)).remove(0)
-            });
+        let suggested = suggest(&evaluations, &keys, &xtypes, settings.seed.wrapping_add(step)).unwrap_or_else(|why| {
+            optimiser_failures.push((evaluations.len() + 1, why));
+            None
+        });
+        let next = suggested.filter(|x| !evaluations.iter().any(|e| same(&e.x, x))).unwrap_or_else(|| {
+            // The surrogate proposed a design already run (or could not be fitted): take a
+            // fresh space-filling one instead, so every evaluation teaches something.
+            latin_hypercube(evaluator.vars, 1, settings.seed.wrapping_add(1000 + step)).remove(0)
+        });
         run(&next, &mut evaluations)?;
         if let Some(e) = evaluations.last() {
             stall.see(e.feasible().then_some(e.cost).flatten(), settings.stall_gain);
@@ -314,7 +334,16 @@ pub fn search_from(
             }
         }
     }
-    Ok(Search { vars: evaluator.vars.to_vec(), evaluations, cheapest, closest, confirmed, stopped_early, shard: false })
+    Ok(Search {
+        vars: evaluator.vars.to_vec(),
+        evaluations,
+        cheapest,
+        closest,
+        confirmed,
+        stopped_early,
+        shard: false,
+        optimiser_failures,
+    })
 }
 
 /// The items of `items` in the order first seen, each once.
@@ -352,14 +381,19 @@ pub fn cheapest_feasible(evaluations: &[Evaluation]) -> Option<usize> {
 pub const AIM_INSIDE: f64 = 1e-3;
 
 /// egobox's next design from the evaluations so far: rows [ln cost, g₁ + [`AIM_INSIDE`] …]
-/// (a constraint a design did not report counts as failed by 1). `None` when it cannot
-/// propose one.
-fn suggest(evaluations: &[Evaluation], keys: &[String], xtypes: &[egobox_ego::XType], seed: u64) -> Option<Vec<f64>> {
+/// (a constraint a design did not report counts as failed by 1). `Ok(None)` when it proposes
+/// none (too few designs with a cost), `Err` with its message when it panicked.
+fn suggest(
+    evaluations: &[Evaluation],
+    keys: &[String],
+    xtypes: &[egobox_ego::XType],
+    seed: u64,
+) -> Result<Option<Vec<f64>>, String> {
     use ndarray_egobox::Array2;
     let rows: Vec<&Evaluation> =
         evaluations.iter().filter(|e| e.error.is_none() && e.cost.is_some_and(|c| c > 0.0)).collect();
     if rows.len() < 2 {
-        return None;
+        return Ok(None);
     }
     let nx = xtypes.len();
     let x = Array2::from_shape_fn((rows.len(), nx), |(i, j)| rows[i].x[j]);
@@ -373,7 +407,7 @@ fn suggest(evaluations: &[Evaluation], keys: &[String], xtypes: &[egobox_ego::XT
     let xtypes = xtypes.to_vec();
     let n_cstr = keys.len();
     // egobox panics on a surrogate it cannot fit (all values equal, say); that is a step to
-    // skip, not a run to lose.
+    // skip and report, not a run to lose.
     let result = std::panic::catch_unwind(move || {
         let service = egobox_ego::EgorServiceBuilder::optimize()
             .configure(|c| c.n_cstr(n_cstr).seed(seed))
@@ -382,7 +416,14 @@ fn suggest(evaluations: &[Evaluation], keys: &[String], xtypes: &[egobox_ego::XT
         let next = service.suggest(&x, &y);
         (next.nrows() > 0).then(|| next.row(0).to_vec())
     });
-    result.ok().flatten().filter(|x| x.iter().all(|v| v.is_finite()))
+    match result {
+        Ok(next) => Ok(next.filter(|x| x.iter().all(|v| v.is_finite()))),
+        Err(panic) => Err(panic
+            .downcast_ref::<&str>()
+            .map(|s| (*s).to_string())
+            .or_else(|| panic.downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "no message".into())),
+    }
 }
 
 #[cfg(test)]

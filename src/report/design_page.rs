@@ -52,6 +52,9 @@ pub fn design_page(search: &Search, c: &DesignContext, fronts: &[PageFigure]) ->
     if let Some(why) = &search.stopped_early {
         let _ = writeln!(h, "<p class=\"note\">{}.</p>", escape(why));
     }
+    if let Some(note) = crate::design::optimiser_note(search) {
+        let _ = writeln!(h, "<p class=\"note\">{}</p>", escape(&note));
+    }
     if !search.shard {
         answer(&mut h, search, c);
     }
@@ -211,6 +214,7 @@ mod tests {
             closest: None,
             confirmed: vec![],
             stopped_early: None,
+            optimiser_failures: Vec::new(),
             shard: false,
         };
         let page = design_page(&search, &context(), &[]);
@@ -229,6 +233,7 @@ mod tests {
             closest: Some(0),
             confirmed: vec![],
             stopped_early: None,
+            optimiser_failures: Vec::new(),
             shard: false,
         };
         let page = design_page(&search, &context(), &[]);

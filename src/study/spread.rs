@@ -148,7 +148,7 @@ mod tests {
             mae_pct_range: (f64::NAN, f64::NAN),
             bias_pct_mean: f64::NAN,
         };
-        let csv = seed_spread_csv(&[none.clone()]);
+        let csv = seed_spread_csv(std::slice::from_ref(&none));
         assert_eq!(csv.lines().nth(1), Some("cubesat,QAA v6,nap_g_m3,0,,0,,,"));
         assert!(!csv.contains("NaN"));
         assert_eq!(none.mae_text(), "– (nothing returned)");

@@ -266,7 +266,7 @@ fn hand_built_netcdf_files_read_as_ncdump_reads_them() {
 
     let m = read("cdf2_maps.nc", &["chl_mg_m3", "true_chl_mg_m3", "rrs_absent"]);
     assert_eq!(m.shape, (4, 3));
-    let chl = vec![Some(1.5), Some(2.0), None, Some(3.25), Some(0.5), None];
+    let chl = [Some(1.5), Some(2.0), None, Some(3.25), Some(0.5), None];
     assert_eq!(m.maps[0].1[..6], chl[..], "the fill value and NaN are not returned");
     assert_eq!(m.maps[0].1[6..], some(&[7.0, 8.0, 9.0, 10.0, 11.0, 12.0])[..]);
     // Written as f32 of the double i × 1.1.
