@@ -21,9 +21,7 @@
 //! Bands are fitted only inside `wave_range_nm` and where the two-way gas transmittance at the
 //! tile's centre reaches `min_gas_transmittance` (ACOLITE's `min_tgas_aot`, which is what keeps
 //! the water-vapour and O₂ bands out). A tile with less than 10 % of its pixels valid in a
-//! fitted band takes the scene's fit (ACOLITE's `dsf_min_tile_cover`). The scene itself must have
-//! at least `pixels` valid pixels in every fitted band, or the correction is refused: the
-//! intercept of a handful of spectra extrapolates below the darkest and reads as no aerosol.
+//! fitted band takes the scene's fit (ACOLITE's `dsf_min_tile_cover`).
 //!
 //! With tiles and `smooth_tiles` (ACOLITE's defaults, `tiles_interp` in its `shared` module),
 //! the scene takes the tiles' most common model; that model's tile AOTs are smoothed with a
@@ -167,10 +165,7 @@ pub fn fit_tiles(
         ));
     }
     let (l1, flags) = (slice(&level1.radiance)?, slice(&level1.flags)?);
-    // `need`: valid pixels a band must have to be fitted (the scene's fit needs the intercept's
-    // `pixels`; with fewer, the line through a handful of spectra extrapolates below the darkest
-    // and reads as no aerosol).
-    let fit = |rr: [usize; 2], cc: [usize; 2], need: usize| -> Option<TileFit> {
+    let fit = |rr: [usize; 2], cc: [usize; 2]| -> Option<TileFit> {
         let area = (rr[1] - rr[0]) * (cc[1] - cc[0]);
         let centre = (cc[0] + cc[1]) / 2;
         let mut dark = vec![f64::NAN; nb];
@@ -186,7 +181,7 @@ pub fn fit_tiles(
                     }
                 }
             }
-            if values.len() * 10 < area || values.len() < need {
+            if values.len() * 10 < area {
                 return None;
             }
             dark[b] = intercept(&mut values, settings.pixels);
@@ -234,14 +229,10 @@ pub fn fit_tiles(
             aot550_models,
         })
     };
-    let scene = fit([0, rows], [0, cols], settings.pixels).ok_or_else(|| {
+    let scene = fit([0, rows], [0, cols]).ok_or_else(|| {
         invalid(
             "correction.image.dark",
-            format!(
-                "fewer than 10 % of the scene's {} pixels, or fewer than the {} darkest it fits (correction.image.dark.pixels), have valid Level-1 in a fitted band: dark-spectrum fitting needs an image, not a handful of spectra",
-                rows * cols,
-                settings.pixels
-            ),
+            "fewer than 10 % of the scene's pixels have valid Level-1 in a fitted band".into(),
         )
     })?;
     if settings.tile_px == 0 || (settings.tile_px >= rows && settings.tile_px >= cols) {
@@ -249,7 +240,7 @@ pub fn fit_tiles(
     }
     let out: Vec<Option<TileFit>> = tiles(rows, cols, settings.tile_px)
         .into_par_iter()
-        .map(|(rr, cc)| if control.cancelled() { None } else { fit(rr, cc, 0) })
+        .map(|(rr, cc)| if control.cancelled() { None } else { fit(rr, cc) })
         .collect();
     if control.cancelled() {
         return Err(CorrectionError::Cancelled);
