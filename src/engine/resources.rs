@@ -39,7 +39,9 @@ const SECONDS_PER_RT_WORK: f64 = 1e-9;
 /// than `order_tolerance`, within a few tens of orders for any atmosphere Shoal accepts.
 const ORDERS_COUNTED: f64 = 100.0;
 /// Wavelength nodes a LUT build solves (the fit of `SECONDS_PER_RT_WORK` is per build);
-/// `shoal atmosphere` solves one column per wavelength it prints.
+/// `shoal atmosphere` solves one column per wavelength it prints. With 20, the plan
+/// overestimates `shoal atmosphere`'s measured time on its default grid by 1.3–2× (default and
+/// high accuracy, AOT 0.1 and 2, on the machine of `shoal bench`).
 const LUT_NODES: f64 = 20.0;
 /// A fixed part of every LUT build, s.
 const RT_OVERHEAD_S: f64 = 0.05;
