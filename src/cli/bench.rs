@@ -179,15 +179,22 @@ fn water_rows(out: &mut String, quick: bool) -> Result<(), CliError> {
     std::hint::black_box(sink);
     say!(out, "## Water model (Lee 1998/1999), 451 bands, one thread");
     say!(out);
-    let reference = super::bench_reference::SAMBUCA_FORWARD;
-    say!(out, "| evaluation | evaluations/s | {} | × reference |", reference.what);
+    let (shallow_ref, deep_ref) =
+        (super::bench_reference::SAMBUCA_FORWARD, super::bench_reference::SAMBUCA_FORWARD_DEEP);
+    say!(
+        out,
+        "| evaluation | evaluations/s | {} (deep rows: {}), calls/s | × reference |",
+        shallow_ref.what,
+        deep_ref.what
+    );
     say!(out, "|---|---|---|---|");
-    for (label, r) in [
-        ("shallow, Rrs only (per-pixel path)", fast_shallow),
-        ("optically deep, Rrs only", fast_deep),
-        ("shallow, every intermediate", full),
-        ("shallow, Rrs only, single precision (setting `water_single_precision`)", single_shallow),
-        ("optically deep, Rrs only, single precision", single_deep),
+    // Deep rows against the reference's deep call, shallow rows against its shallow call.
+    for (label, r, reference) in [
+        ("shallow, Rrs only (per-pixel path)", fast_shallow, shallow_ref),
+        ("optically deep, Rrs only", fast_deep, deep_ref),
+        ("shallow, every intermediate", full, shallow_ref),
+        ("shallow, Rrs only, single precision (setting `water_single_precision`)", single_shallow, shallow_ref),
+        ("optically deep, Rrs only, single precision", single_deep, deep_ref),
     ] {
         say!(out, "| {label} | {:.0} | {} | {} |", r, reference.text(), reference.ratio(r));
     }

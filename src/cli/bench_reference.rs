@@ -1,8 +1,8 @@
-//! The reference codes' speeds `shoal bench` prints beside its own rows, each with where and when
-//! it was measured. Only figures measured side by side with Shoal (same machine, same day, one
-//! core) are used for the ratios; the older, unattributed figures from
-//! `../shared/reference/README.md` are listed as superseded, since run side by side the codes
-//! were slower than those figures and the ratios built on them flattered nobody honestly.
+//! The reference codes' speeds `shoal bench` prints beside its own rows, each with where, when and
+//! how it was measured. Only figures measured side by side with Shoal on an idle core (same
+//! machine class, one core each, interleaved rounds) are used for the ratios; earlier figures,
+//! measured on a loaded machine, are listed as superseded. `tests/bench/reference_codes.py`
+//! re-measures them where the user has the reference codes, paired round by round with Shoal.
 
 /// One reference code's measured speed.
 #[derive(Debug, Clone, Copy)]
@@ -16,7 +16,7 @@ pub struct ReferenceFigure {
 }
 
 impl ReferenceFigure {
-    /// "9 200 [1]" or "14–17 [1]".
+    /// "23973 [1]" or "14.0–17.0 [1]".
     #[must_use]
     pub fn text(&self) -> String {
         let f = |v: f64| if v >= 100.0 { format!("{v:.0}") } else { format!("{v:.1}") };
@@ -36,27 +36,32 @@ impl ReferenceFigure {
     }
 }
 
-/// Where and when note 1's figures were measured.
-pub const SIDE_BY_SIDE: &str = "[1] Measured side by side with Shoal on one core of this machine class (AMD EPYC, 2 logical cores, 23 GB), 2026-11-23: SAMBUCA core 1.2.3 (CSIRO, Python) forward model and its SciPy SLSQP fit, and the DEA-Water-Quality aLMI (Python) core loop, each on its own benchmark pixels.";
+/// Where, when and how note 1's figures were measured.
+pub const SIDE_BY_SIDE: &str = "[1] Measured side by side with Shoal (commit 080ae1e, 2026-11-27) on an idle core of this machine class (AMD EPYC, 2 logical cores, 23 GB): one core each under taskset, 8 interleaved rounds, load at most 1.1, every paired ratio within 6 % of its median; sambuca d153684 and sambuca_core 64483a0 (CSIRO, Python: forward model and SciPy SLSQP fit), DEA-Water-Quality dd794b0 (aLMI, `chunkProcessLMI`), numpy 1.26. The workloads differ: the reference forward model recomputes its SIOP spectra and returns sub-surface rrs each call; Shoal's aLMI row uses 8 MODIS-like 10 nm bands and synthetic pixels, DEA's 8 monochromatic OLCI centres and its stored pixels; Shoal's SLSQP rows use the heron_island SIOPs and Gaussian bands, its reference mode summing 863 (28 bands) or 1215 (4 bands) wavelengths against SAMBUCA's 451 (tests/bench/README.md). Re-measure: tests/bench/reference_codes.py.";
 
-/// The superseded figures and where they came from.
-pub const SUPERSEDED: &str = "Superseded: ../shared/reference/README.md gives 13–23 k forward calls/s and 13–58 SLSQP pixels/s for SAMBUCA and ~6 000 pixels/s for aLMI \"on this machine class\", without date or method; run side by side the codes were slower (note 1), so those figures are no longer used for ratios.";
+/// The superseded figures and why.
+pub const SUPERSEDED: &str = "Superseded: the figures of 2026-11-23 (SAMBUCA 9 200 forward calls/s, SLSQP 6.4 and 14-17 pixels/s; aLMI 3 600 pixels/s) were measured on a loaded machine: on an idle core the reference codes ran 2.3-3.4 times faster (note 1), so ratios built on them overstated Shoal's lead by that much. ../shared/reference/README.md's figures (13-23 k forward calls/s, 13-58 SLSQP pixels/s, ~6 000 aLMI pixels/s) give no date or method.";
 
 /// SAMBUCA's forward model, shallow, 451 bands.
 pub const SAMBUCA_FORWARD: ReferenceFigure =
-    ReferenceFigure { note: 1, what: "SAMBUCA forward model, 451 bands", range: (9_200.0, 9_200.0) };
+    ReferenceFigure { note: 1, what: "SAMBUCA forward model, 451 bands", range: (23_973.0, 23_973.0) };
+
+/// SAMBUCA's forward model at infinite depth (it has no deep-only path: a full call), 451 bands:
+/// the reference of Shoal's optically deep rows.
+pub const SAMBUCA_FORWARD_DEEP: ReferenceFigure =
+    ReferenceFigure { note: 1, what: "SAMBUCA forward model, deep, 451 bands", range: (21_888.0, 21_888.0) };
 
 /// The DEA aLMI core, 8 bands and 8 SIOP sets.
 pub const DEA_ALMI: ReferenceFigure =
-    ReferenceFigure { note: 1, what: "DEA aLMI core, 8 bands, 8 sets", range: (3_600.0, 3_600.0) };
+    ReferenceFigure { note: 1, what: "DEA aLMI core, 8 bands, 8 sets", range: (8_209.0, 8_209.0) };
 
 /// SAMBUCA's SLSQP fit, 28 bands and 3 substrate pairs.
 pub const SAMBUCA_FIT_28: ReferenceFigure =
-    ReferenceFigure { note: 1, what: "SAMBUCA SLSQP, 28 bands, 3 pairs", range: (6.4, 6.4) };
+    ReferenceFigure { note: 1, what: "SAMBUCA SLSQP, 28 bands, 3 pairs", range: (18.2, 18.2) };
 
 /// SAMBUCA's SLSQP fit, 4 bands and 1 substrate pair.
 pub const SAMBUCA_FIT_4: ReferenceFigure =
-    ReferenceFigure { note: 1, what: "SAMBUCA SLSQP, 4 bands, 1 pair", range: (14.0, 17.0) };
+    ReferenceFigure { note: 1, what: "SAMBUCA SLSQP, 4 bands, 1 pair", range: (47.6, 47.6) };
 
 #[cfg(test)]
 mod tests {
@@ -64,9 +69,11 @@ mod tests {
 
     #[test]
     fn figures_print_with_their_note_and_ratios_span_the_range() {
-        assert_eq!(SAMBUCA_FORWARD.text(), "9200 [1]");
-        assert_eq!(SAMBUCA_FIT_4.text(), "14.0–17.0 [1]");
-        assert_eq!(SAMBUCA_FIT_4.ratio(34.0), "2.00–2.43×");
-        assert_eq!(DEA_ALMI.ratio(360_000.0), "100×");
+        assert_eq!(SAMBUCA_FORWARD.text(), "23973 [1]");
+        assert_eq!(SAMBUCA_FIT_4.text(), "47.6 [1]");
+        assert_eq!(SAMBUCA_FIT_4.ratio(95.2), "2.00×");
+        assert_eq!(DEA_ALMI.ratio(820_900.0), "100×");
+        let range = ReferenceFigure { note: 1, what: "", range: (14.0, 17.0) };
+        assert_eq!((range.text(), range.ratio(34.0)), ("14.0–17.0 [1]".to_string(), "2.00–2.43×".to_string()));
     }
 }
