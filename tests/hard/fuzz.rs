@@ -10,29 +10,16 @@
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
+use super::attacks::Rng;
+
 #[path = "../fuzz/targets.rs"]
-mod targets;
+pub(crate) mod targets;
 
 /// Cases per target at most, and its time at most (CI runs every target on 2 cores).
 const CASES: usize = 50_000;
 const TIME: Duration = Duration::from_secs(5);
 /// One case longer than this is a hang.
 const HANG: Duration = Duration::from_secs(20);
-
-/// A deterministic generator (xorshift64*): the same cases on every machine.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
-    }
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n.max(1) as u64) as usize
-    }
-}
 
 /// One to four stacked mutations of `seed` (with `other`, another seed, to splice from).
 fn mutate(seed: &[u8], other: &[u8], rng: &mut Rng) -> Vec<u8> {

@@ -6,29 +6,8 @@ use proptest::prelude::*;
 
 /// Every loader on `text`: errors are fine, panics are not.
 fn load_all(text: &str) {
-    if let Ok(i) = shoal::instrument::InstrumentSpec::from_ron(text, "t") {
-        let _ = i.validate();
-    }
-    if let Ok(s) = shoal::scene::SceneSpec::from_ron(text, "t") {
-        let _ = s.validate();
-    }
-    if let Ok(c) = shoal::engine::RunConfig::from_ron(text, "t") {
-        let _ = c.validate();
-    }
-    if let Ok(s) = shoal::study::StudySpec::from_ron(text, "t") {
-        let _ = s.resolve(None);
-    }
-    if let Ok(s) = shoal::sweep::SweepSpec::from_ron(text, "t") {
-        let _ = s.resolve(None);
-    }
-    if let Ok(t) = shoal::spectral::Table::parse(text, "t.csv") {
-        let grid = shoal::spectral::WavelengthGrid::uniform(400.0, 700.0, 10.0).unwrap();
-        for column in t.columns.iter().skip(1) {
-            if let Ok(s) = shoal::spectral::Spectrum::from_table(&t, column) {
-                let _ = s.resample(&grid, shoal::spectral::Extrapolation::Clamp);
-            }
-        }
-    }
+    super::fuzz::targets::preset_loaders(text.as_bytes());
+    super::fuzz::targets::spectrum_csv(text.as_bytes());
 }
 
 /// The built-in files the mutations start from.
