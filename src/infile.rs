@@ -104,13 +104,6 @@ pub fn read_text(path: &Path, max_bytes: u64) -> Result<String, InFileError> {
     })
 }
 
-/// Is `path` a regular file (following links)? For optional files such as a folder's figures,
-/// which are skipped, not read, when they are anything else.
-#[must_use]
-pub fn is_regular(path: &Path) -> bool {
-    std::fs::metadata(path).is_ok_and(|m| m.is_file())
-}
-
 #[cfg(test)]
 mod tests {
     #![allow(clippy::unwrap_used)]
@@ -141,7 +134,6 @@ mod tests {
         let d = tempdir("dir");
         assert_eq!(read(&d, 100).unwrap_err().message, "is a directory, not a regular file");
         assert!(read(&d.join("none"), 100).is_err());
-        assert!(!is_regular(&d));
         let _ = std::fs::remove_dir_all(&d);
     }
 
@@ -159,7 +151,6 @@ mod tests {
         let e = read(&p, 100).unwrap_err();
         assert_eq!(e.message, "is a FIFO, not a regular file");
         assert!(start.elapsed().as_secs_f64() < 5.0);
-        assert!(!is_regular(&p));
         let _ = std::fs::remove_dir_all(&d);
     }
 }

@@ -47,16 +47,21 @@ fn aside_name(path: &Path) -> PathBuf {
 #[must_use]
 pub fn load_session(path: &Path) -> SavedSession {
     // A session is the app's own file, but it may be a colleague's copy: a regular file within
-    // the RON limit (anything else is not read, and the app starts afresh).
-    let Ok(bytes) = crate::infile::read(path, crate::infile::RON_MAX_BYTES) else { return SavedSession::None };
-    let parsed = match String::from_utf8(bytes) {
+    // the RON limit. Anything else that is there (too large, a FIFO, a folder) is unreadable and
+    // moved aside like a damaged file, so the next save cannot replace it.
+    let bytes = match crate::infile::read(path, crate::infile::RON_MAX_BYTES) {
+        Ok(bytes) => Ok(bytes),
+        Err(_) if std::fs::symlink_metadata(path).is_err() => return SavedSession::None,
+        Err(e) => Err(e.message),
+    };
+    let parsed = bytes.and_then(|bytes| match String::from_utf8(bytes) {
         Ok(text) => crate::schema::migrate(&text).and_then(|text| {
             let mut state = ron::from_str::<AppState>(&text).map_err(|e| crate::parse::describe(&text, &e))?;
             state.schema_version = crate::schema::VERSION;
             Ok(state)
         }),
         Err(e) => Err(format!("byte {} is not UTF-8 text", e.utf8_error().valid_up_to())),
-    };
+    });
     match parsed {
         Ok(mut state) => {
             let reset = repair(&mut state);
@@ -272,6 +277,23 @@ mod tests {
         assert_ne!(first, second);
         assert_eq!(std::fs::read(&first).unwrap(), text, "the first one kept aside is untouched");
         assert_eq!(std::fs::read_to_string(&second).unwrap(), "AppState(");
+        let _ = std::fs::remove_dir_all(&home);
+    }
+
+    #[test]
+    fn a_session_too_large_or_not_a_file_is_moved_aside_not_replaced() {
+        let home = home("special");
+        let path = session_path(&home);
+        // 100 MB of zeros (sparse): refused before a byte is read, and kept.
+        std::fs::File::create(&path).unwrap().set_len(100 << 20).unwrap();
+        let SavedSession::Unreadable { message, kept_at } = load_session(&path) else { panic!("read") };
+        assert!(message.contains("allowed: at most"), "{message}");
+        assert_eq!(std::fs::metadata(&kept_at).unwrap().len(), 100 << 20);
+        assert!(!path.exists());
+        std::fs::create_dir(&path).unwrap();
+        let SavedSession::Unreadable { message, kept_at } = load_session(&path) else { panic!("read") };
+        assert!(message.contains("directory"), "{message}");
+        assert!(kept_at.is_dir() && !path.exists());
         let _ = std::fs::remove_dir_all(&home);
     }
 

@@ -171,16 +171,19 @@ fn stopping_a_program_stops_what_it_started() {
     let out = run_with(spec);
     assert!(out.retrievals[1].failure.as_deref().unwrap().contains("time limit"));
     let pid = std::fs::read_to_string(&pid_file).unwrap().trim().to_string();
-    // Reaped by init once killed: give it a moment, then its /proc entry is gone or a zombie.
-    let gone = (0..50).any(|_| {
+    assert!(gone(&pid), "the program's child {pid} still runs");
+}
+
+/// Is process `pid` gone (or a zombie waiting for init to reap it)? Waits up to 5 s for it.
+pub(super) fn gone(pid: &str) -> bool {
+    (0..50).any(|_| {
         let state = std::fs::read_to_string(format!("/proc/{pid}/stat")).unwrap_or_default();
         let alive = state.split(") ").nth(1).is_some_and(|s| !s.starts_with('Z'));
         if alive {
             std::thread::sleep(std::time::Duration::from_millis(100));
         }
         !alive
-    });
-    assert!(gone, "the program's child {pid} still runs");
+    })
 }
 
 #[test]

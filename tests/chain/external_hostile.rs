@@ -5,20 +5,8 @@
 use shoal::retrieval::RetrievalSpec;
 use shoal::retrieval::external::ExternalSpec;
 
-use super::external::{assert_almi_kept, external, run_with};
+use super::external::{assert_almi_kept, external, gone, run_with};
 use super::netcdf::tempfile_dir::Dir;
-
-/// Is process `pid` gone (or a zombie waiting for init)? Waits up to 5 s for it to go.
-fn gone(pid: &str) -> bool {
-    (0..50).any(|_| {
-        let state = std::fs::read_to_string(format!("/proc/{pid}/stat")).unwrap_or_default();
-        let alive = state.split(") ").nth(1).is_some_and(|s| !s.starts_with('Z'));
-        if alive {
-            std::thread::sleep(std::time::Duration::from_millis(100));
-        }
-        !alive
-    })
-}
 
 #[test]
 fn an_output_that_is_a_fifo_is_refused_at_once_not_waited_on() {
