@@ -44,6 +44,18 @@ impl<'a, T: Send> RowSplit<'a> for &'a mut [T] {
     }
 }
 
+/// A buffer split into `rows` equal rows whatever the stride the others are split at (a map of
+/// one value per pixel beside a cube of one per pixel and band).
+pub struct OwnRows<'a, T>(pub &'a mut [T]);
+
+impl<'a, T: Send> RowSplit<'a> for OwnRows<'a, T> {
+    type Row = &'a mut [T];
+    fn split(self, rows: usize, _stride: usize) -> Vec<Self::Row> {
+        let stride = self.0.len() / rows.max(1);
+        self.0.split(rows, stride)
+    }
+}
+
 impl<'a, A: RowSplit<'a>, B: RowSplit<'a>> RowSplit<'a> for (A, B) {
     type Row = (A::Row, B::Row);
     fn split(self, rows: usize, stride: usize) -> Vec<Self::Row> {

@@ -36,6 +36,8 @@
 //! - Wang, M. & Gordon, H. R. (2018) Sensor performance requirements for atmospheric correction
 //!   of satellite ocean color remote sensing. Opt. Express 26, 7390–7403.
 
+use std::sync::atomic::{AtomicUsize, Ordering};
+
 use ndarray::Array2;
 use serde::{Deserialize, Serialize};
 
@@ -45,7 +47,7 @@ use super::mixture::invert;
 use super::{CorrectionError, Reflectance, RrsFlags, assemble, flag_for, slice};
 use crate::atmosphere::AerosolType;
 use crate::calibration::Level1;
-use crate::control::RunControl;
+use crate::control::{OwnRows, RunControl};
 use crate::instrument::SurfaceMap;
 use crate::parse::FieldError;
 
@@ -391,12 +393,16 @@ fn apply<'f, S: Default>(
     let (rows, cols, nb) = level1.radiance.dim();
     let (l1, l0_flags) = (slice(&level1.radiance)?, slice(&level1.flags)?);
     let stride = cols * nb;
-    let per_row = control.map_rows(rows, |at| {
+    // Written in place, row by row (rows of per-row vectors joined at the end held the cube twice).
+    let (mut rrs, mut flags) = (vec![0.0f32; rows * stride], vec![0u8; rows * stride]);
+    let (mut aot, mut alpha) = (vec![f32::NAN; rows * cols], vec![f32::NAN; rows * cols]);
+    let (outside, passes) = (AtomicUsize::new(0), AtomicUsize::new(0));
+    let outputs =
+        ((rrs.as_mut_slice(), flags.as_mut_slice()), (OwnRows(aot.as_mut_slice()), OwnRows(alpha.as_mut_slice())));
+    control.fill_rows(outputs, rows, stride, |at, ((rrs_row, flag_row), (aot_row, alpha_row))| {
         let r = at.index();
         let base = r * stride;
-        let (mut rrs_row, mut flag_row) = (vec![0.0f32; stride], vec![0u8; stride]);
-        let (mut aot_row, mut alpha_row) = (vec![f32::NAN; cols], vec![f32::NAN; cols]);
-        let (mut outside, mut passes) = (0usize, 0usize);
+        let (mut row_outside, mut row_passes) = (0usize, 0usize);
         let mut scratch = S::default();
         let mut mix = Mixture::default();
         let (mut lp, mut te, mut sa) = (vec![0.0f64; nb], vec![0.0f64; nb], vec![0.0f64; nb]);
@@ -424,23 +430,15 @@ fn apply<'f, S: Default>(
             if usable {
                 aot_row[c] = mix.aot550 as f32;
                 alpha_row[c] = mix.angstrom as f32;
-                outside += usize::from(mix.outside);
-                passes += mix.passes;
+                row_outside += usize::from(mix.outside);
+                row_passes += mix.passes;
             }
         }
-        Ok::<_, CorrectionError>((rrs_row, flag_row, aot_row, alpha_row, outside, passes))
+        outside.fetch_add(row_outside, Ordering::Relaxed);
+        passes.fetch_add(row_passes, Ordering::Relaxed);
+        Ok::<_, CorrectionError>(())
     })?;
-    let (mut rrs, mut flags) = (Vec::with_capacity(rows * stride), Vec::with_capacity(rows * stride));
-    let (mut aot, mut alpha) = (Vec::with_capacity(rows * cols), Vec::with_capacity(rows * cols));
-    let (mut outside, mut passes) = (0, 0);
-    for (a, b, c, d, e, f) in per_row {
-        rrs.extend_from_slice(&a);
-        flags.extend_from_slice(&b);
-        aot.extend_from_slice(&c);
-        alpha.extend_from_slice(&d);
-        outside += e;
-        passes += f;
-    }
+    let (outside, passes) = (outside.into_inner(), passes.into_inner());
     let retrieved = aot.iter().filter(|v| v.is_finite()).count();
     let shape = (rows, cols);
     let bad = |e: ndarray::ShapeError| invalid("cube", e.to_string());

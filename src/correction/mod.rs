@@ -22,6 +22,7 @@
 //! - Vermote, E. F. et al. (1997) 6S: an overview. IEEE TGRS 35, 675–686.
 
 pub mod dark;
+mod difference;
 pub mod family;
 pub mod image;
 mod mixture;
@@ -30,6 +31,7 @@ mod pair;
 mod rrs_metrics;
 
 pub use dark::TileFit;
+pub use difference::{BandDifference, compare};
 pub use family::{AerosolFamily, FamilyLuts};
 pub use image::{AerosolFit, AerosolRetrieval, DarkSpectrumSettings, ImageCorrection, correct_image};
 pub use rrs_metrics::{BandRrsMetrics, RRS_SAMPLES, band_rrs_metrics, pooled_rrs_error};
@@ -37,7 +39,6 @@ pub use rrs_metrics::{BandRrsMetrics, RRS_SAMPLES, band_rrs_metrics, pooled_rrs_
 use ndarray::{Array2, Array3};
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
-use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::calibration::Level1;
@@ -323,6 +324,36 @@ impl SceneApproximation {
         Ok(Self { points: chosen, l_path, t_up, ed })
     }
 
+    /// Band `b`'s Rrs and flags from its Level-1 radiance and flags (A1–A3 inverted).
+    #[inline]
+    fn value(&self, b: usize, level1: f32, level1_flags: u8, land: bool) -> (f32, u8) {
+        let lw = (f64::from(level1) - self.l_path[b]) / self.t_up[b];
+        let value = lw / self.ed[b];
+        let f = flag_for(level1_flags, land, value);
+        (if f & RrsFlags::INVALID != 0 { 0.0 } else { value as f32 }, f)
+    }
+
+    /// [`Self::correct`] compared with `exact` ([`compare`]) without holding the approximation's
+    /// cube: each pixel is corrected as the comparison reads it (the same values). `None` for a
+    /// cube of more bands than the comparison takes per pixel.
+    #[must_use]
+    pub fn compare_with(
+        &self,
+        level1: &Level1,
+        surface: &SurfaceMap,
+        exact: &Reflectance,
+    ) -> Option<Vec<BandDifference>> {
+        let (_, cols, nb) = level1.radiance.dim();
+        let (l1, l0_flags) = (slice(&level1.radiance).ok()?, slice(&level1.flags).ok()?);
+        let pixel = |p: usize, values: &mut [f32], flags: &mut [u8]| {
+            let land = !surface.is_water(p / cols.max(1), p % cols.max(1));
+            for b in 0..nb {
+                (values[b], flags[b]) = self.value(b, l1[p * nb + b], l0_flags[p * nb + b], land);
+            }
+        };
+        difference::compare_pixels(&pixel, &exact.rrs, Some(&exact.flags))
+    }
+
     /// Apply the per-scene terms to every pixel (A2, A3).
     pub fn correct(
         &self,
@@ -340,13 +371,10 @@ impl SceneApproximation {
             let base = r * stride;
             for c in 0..cols {
                 at.column(c);
+                let land = !surface.is_water(r, c);
                 for b in 0..nb {
                     let k = c * nb + b;
-                    let lw = (f64::from(l1[base + k]) - self.l_path[b]) / self.t_up[b];
-                    let value = lw / self.ed[b];
-                    let f = flag_for(l0_flags[base + k], !surface.is_water(r, c), value);
-                    flag_row[k] = f;
-                    rrs_row[k] = if f & RrsFlags::INVALID != 0 { 0.0 } else { value as f32 };
+                    (rrs_row[k], flag_row[k]) = self.value(b, l1[base + k], l0_flags[base + k], land);
                 }
             }
             Ok::<_, CorrectionError>(())
@@ -354,91 +382,3 @@ impl SceneApproximation {
         assemble(rows, cols, nb, rrs, flags)
     }
 }
-
-/// Per-band comparison of two Rrs products over pixels valid in both (water, unflagged,
-/// positive): median relative difference and mean relative difference (bias), both of `a`
-/// against `b`.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct BandDifference {
-    /// Band index.
-    pub band: usize,
-    /// Pixels compared.
-    pub n: usize,
-    /// Median |a − b|/b.
-    pub median_abs_rel: f64,
-    /// Mean (a − b)/b.
-    pub mean_rel: f64,
-    /// Largest |a − b|/b.
-    pub max_abs_rel: f64,
-}
-
-/// Compare `a` with the reference `b`, band by band.
-#[must_use]
-pub fn compare(a: &Reflectance, b: &Array3<f32>, b_flags: Option<&Array3<u8>>) -> Vec<BandDifference> {
-    let (_, _, nb) = a.rrs.dim();
-    let (Ok(ar), Ok(af), Ok(br)) = (slice(&a.rrs), slice(&a.flags), slice(b)) else { return Vec::new() };
-    let bf = b_flags.and_then(|f| slice(f).ok());
-    let nb = nb.max(1);
-    let pixels = ar.len() / nb;
-    // Count, sum and maximum over every pixel; the median from at most ~200 000 evenly strided
-    // pixels per band (its sampling error is far below the differences it reports).
-    let stride = (pixels / MEDIAN_SAMPLES).max(1);
-    #[derive(Clone)]
-    struct Acc {
-        n: Vec<usize>,
-        sum: Vec<f64>,
-        max: Vec<f64>,
-        sample: Vec<Vec<f64>>,
-    }
-    let empty = || Acc { n: vec![0; nb], sum: vec![0.0; nb], max: vec![0.0; nb], sample: vec![Vec::new(); nb] };
-    let acc = (0..pixels)
-        .into_par_iter()
-        .fold(empty, |mut acc, p| {
-            // One pixel's bands as slices (no per-value bounds checks), and whether it is a
-            // median sample decided once per pixel: the modulo per value was half the stage.
-            let span = p * nb..(p + 1) * nb;
-            let (a, a_flags, b) = (&ar[span.clone()], &af[span.clone()], &br[span.clone()]);
-            let b_flags = bf.map(|f| &f[span]);
-            let sampled = p % stride == 0;
-            for band in 0..nb {
-                let fb = b_flags.map_or(0, |f| f[band]);
-                let (x, y) = (f64::from(a[band]), f64::from(b[band]));
-                if a_flags[band] == 0 && fb == 0 && y > 0.0 && x.is_finite() {
-                    let rel = (x - y) / y;
-                    acc.n[band] += 1;
-                    acc.sum[band] += rel;
-                    acc.max[band] = acc.max[band].max(rel.abs());
-                    if sampled {
-                        acc.sample[band].push(rel.abs());
-                    }
-                }
-            }
-            acc
-        })
-        .reduce(empty, |mut a, b| {
-            for band in 0..nb {
-                a.n[band] += b.n[band];
-                a.sum[band] += b.sum[band];
-                a.max[band] = a.max[band].max(b.max[band]);
-                a.sample[band].extend_from_slice(&b.sample[band]);
-            }
-            a
-        });
-    (0..nb)
-        .map(|band| {
-            let n = acc.n[band];
-            let mut sample = acc.sample[band].clone();
-            let m = sample.len();
-            BandDifference {
-                band,
-                n,
-                median_abs_rel: if m > 0 { *sample.select_nth_unstable_by(m / 2, f64::total_cmp).1 } else { 0.0 },
-                mean_rel: if n > 0 { acc.sum[band] / n as f64 } else { 0.0 },
-                max_abs_rel: acc.max[band],
-            }
-        })
-        .collect()
-}
-
-/// Pixels per band the median of [`compare`] is taken from, at most.
-const MEDIAN_SAMPLES: usize = 200_000;

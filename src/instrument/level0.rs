@@ -1,7 +1,8 @@
 //! Whole-image exposure and readout: band radiance cube → electrons cube → Level-0.
 //!
 //! Two stages, so that a change of the electronics (gain, bias, ADC bits, read noise) re-runs
-//! only the readout and never the photon counts. Each pixel draws its noise from its own
+//! only the readout and never the photon counts; or one pass row by row
+//! ([`expose_and_digitise`]) for a run that keeps no cubes. Each pixel draws its noise from its own
 //! generator (see [`super::detector`]): results do not depend on the number of threads.
 
 use ndarray::Array3;
@@ -129,6 +130,61 @@ fn shape_error(e: ndarray::ShapeError) -> InstrumentError {
     InstrumentError::Invalid(FieldError { field: "cube".into(), message: e.to_string() })
 }
 
+/// The radiance a pixel sees, contiguous (row, column, band): a coarse focal plane's pixel sees
+/// the mean radiance of its block.
+fn exposure_input<'a>(
+    detector: &Detector,
+    radiance: &'a Array3<f32>,
+    viewing: &Viewing,
+) -> Result<std::borrow::Cow<'a, [f32]>, InstrumentError> {
+    let (_, cols, nb) = radiance.dim();
+    let input = radiance.as_slice().ok_or_else(|| {
+        InstrumentError::Invalid(FieldError { field: "cube".into(), message: "not contiguous".into() })
+    })?;
+    Ok(match block_means(detector, input, viewing, cols, nb) {
+        Some(averaged) => std::borrow::Cow::Owned(averaged),
+        None => std::borrow::Cow::Borrowed(input),
+    })
+}
+
+/// Row `r`'s electrons from `input` (the row's radiance, column after column of `nb` bands)
+/// into `row`: photo-electrons, dark signal, shot noise, full well.
+fn expose_row(
+    detector: &Detector,
+    (input, nb): (&[f32], usize),
+    viewing: &Viewing,
+    seed: u64,
+    at: &mut crate::control::RowGuard<'_>,
+    row: &mut [f32],
+) {
+    let r = at.index();
+    let cols = row.len() / nb.max(1);
+    let t = detector.exposure_s();
+    let line = viewing.line_index[r];
+    let mut e = vec![0.0f64; nb];
+    let every_band_on_grid = on_grid(detector);
+    for c in 0..cols {
+        at.column(c);
+        let j = viewing.detector_index[c];
+        let pixel = &input[c * nb..(c + 1) * nb];
+        if every_band_on_grid {
+            // The pixel's own generator, band after band, straight into the row (the loop
+            // the one-plane instruments of the default study spend their Level-0 time in).
+            let mut rng = pixel_rng(seed, Stream::Exposure, line, j);
+            for (b, o) in row[c * nb..(c + 1) * nb].iter_mut().enumerate() {
+                *o = detector.expose(j, b, f64::from(pixel[b]), t, &mut rng) as f32;
+            }
+            continue;
+        }
+        draw_bands(detector, seed, Stream::Exposure, line, j, &mut e, |b, rng| {
+            detector.expose(j, b, f64::from(pixel[b]), t, rng)
+        });
+        for (o, v) in row[c * nb..(c + 1) * nb].iter_mut().zip(&e) {
+            *o = *v as f32;
+        }
+    }
+}
+
 /// Electrons collected by every pixel from `radiance` (row, column, band) at the nominal
 /// exposure: photo-electrons, dark signal, shot noise, full well.
 pub fn expose_cube(
@@ -139,43 +195,76 @@ pub fn expose_cube(
     control: &RunControl,
 ) -> Result<Array3<f32>, InstrumentError> {
     let (rows, cols, nb) = radiance.dim();
-    let t = detector.exposure_s();
-    let input = radiance.as_standard_layout();
-    let input = input.as_slice().ok_or_else(|| {
-        InstrumentError::Invalid(FieldError { field: "cube".into(), message: "not contiguous".into() })
-    })?;
-    // A coarse focal plane's pixel sees the mean radiance of its block.
-    let averaged = block_means(detector, input, viewing, cols, nb);
-    let input = averaged.as_deref().unwrap_or(input);
-    let every_band_on_grid = on_grid(detector);
+    let input = exposure_input(detector, radiance, viewing)?;
     let mut out = vec![0.0f32; rows * cols * nb];
     control.fill_rows(out.as_mut_slice(), rows, cols * nb, |at, row| {
         let r = at.index();
-        let line = viewing.line_index[r];
-        let mut e = vec![0.0f64; nb];
-        for c in 0..cols {
-            at.column(c);
-            let j = viewing.detector_index[c];
-            let pixel = &input[(r * cols + c) * nb..(r * cols + c + 1) * nb];
-            if every_band_on_grid {
-                // The pixel's own generator, band after band, straight into the row (the loop
-                // the one-plane instruments of the default study spend their Level-0 time in).
-                let mut rng = pixel_rng(seed, Stream::Exposure, line, j);
-                for (b, o) in row[c * nb..(c + 1) * nb].iter_mut().enumerate() {
-                    *o = detector.expose(j, b, f64::from(pixel[b]), t, &mut rng) as f32;
-                }
-                continue;
-            }
-            draw_bands(detector, seed, Stream::Exposure, line, j, &mut e, |b, rng| {
-                detector.expose(j, b, f64::from(pixel[b]), t, rng)
-            });
-            for (o, v) in row[c * nb..(c + 1) * nb].iter_mut().zip(&e) {
-                *o = *v as f32;
-            }
-        }
+        expose_row(detector, (&input[r * cols * nb..(r + 1) * cols * nb], nb), viewing, seed, at, row);
         Ok::<_, InstrumentError>(())
     })?;
     Array3::from_shape_vec((rows, cols, nb), out).map_err(shape_error)
+}
+
+/// One row of Level-0 outputs: counts, flags and (without quantisation) the analogue signal.
+type Level0Row<'r> = (&'r mut [u16], &'r mut [u8], &'r mut [f32]);
+
+/// Row `r` of `electrons` read out into `outputs`: read noise, gain, bias, ADC; flags.
+fn read_out_row(
+    detector: &Detector,
+    (electrons, nb): (&[f32], usize),
+    viewing: &Viewing,
+    seed: u64,
+    at: &mut crate::control::RowGuard<'_>,
+    (dn_row, flag_row, analog_row): Level0Row<'_>,
+) {
+    let r = at.index();
+    let cols = electrons.len() / nb.max(1);
+    let line = viewing.line_index[r];
+    let noise = detector.mode().noise;
+    // The row's read-noise draws first, pixel by pixel from each pixel's generator, then the
+    // arithmetic over the whole row in vector lanes. Every column is visited, with the noise
+    // off too, so that a fault armed at a pixel fires there.
+    let mut z = vec![0.0; cols * nb];
+    let every_band_on_grid = on_grid(detector);
+    for c in 0..cols {
+        at.column(c);
+        if noise && every_band_on_grid {
+            let mut rng = pixel_rng(seed, Stream::Readout, line, viewing.detector_index[c]);
+            z[c * nb..(c + 1) * nb].iter_mut().for_each(|z| *z = normal(&mut rng));
+        } else if noise {
+            let j = viewing.detector_index[c];
+            draw_bands(detector, seed, Stream::Readout, line, j, &mut z[c * nb..(c + 1) * nb], |_, rng| normal(rng));
+        }
+    }
+    let bands: Vec<usize> = (0..nb).collect();
+    let keep_analog = !detector.mode().quantise;
+    detector.read_out_run(&bands, electrons, &z, dn_row, flag_row, keep_analog.then_some(analog_row));
+}
+
+/// Level-0 buffers for `n` values, and the cube they make.
+struct Level0Buffers {
+    dn: Vec<u16>,
+    flags: Vec<u8>,
+    analog: Vec<f32>,
+}
+
+impl Level0Buffers {
+    fn new(detector: &Detector, n: usize) -> Self {
+        let keep_analog = !detector.mode().quantise;
+        Self { dn: vec![0; n], flags: vec![0; n], analog: vec![0.0; if keep_analog { n } else { 0 }] }
+    }
+
+    fn into_level0(self, shape: (usize, usize, usize)) -> Result<Level0, InstrumentError> {
+        let (saturated, zero_counts) = count_flags(&self.flags);
+        let analog = (!self.analog.is_empty()).then_some(self.analog);
+        Ok(Level0 {
+            dn: Array3::from_shape_vec(shape, self.dn).map_err(shape_error)?,
+            analog: analog.map(|a| Array3::from_shape_vec(shape, a)).transpose().map_err(shape_error)?,
+            flags: Array3::from_shape_vec(shape, self.flags).map_err(shape_error)?,
+            saturated,
+            zero_counts,
+        })
+    }
 }
 
 /// Read out every pixel: read noise, gain, bias, ADC; flags for saturation and zero counts.
@@ -187,51 +276,41 @@ pub fn digitise_cube(
     control: &RunControl,
 ) -> Result<Level0, InstrumentError> {
     let (rows, cols, nb) = electrons.dim();
-    let input = electrons.as_standard_layout();
-    let input = input.as_slice().ok_or_else(|| {
+    let input = electrons.as_slice().ok_or_else(|| {
         InstrumentError::Invalid(FieldError { field: "cube".into(), message: "not contiguous".into() })
     })?;
-    let keep_analog = !detector.mode().quantise;
-    let noise = detector.mode().noise;
-    let bands: Vec<usize> = (0..nb).collect();
-    let every_band_on_grid = on_grid(detector);
-    let n = rows * cols * nb;
-    let mut dn = vec![0u16; n];
-    let mut flags = vec![0u8; n];
-    let mut analog = vec![0.0f32; if keep_analog { n } else { 0 }];
-    let outputs = (dn.as_mut_slice(), flags.as_mut_slice(), analog.as_mut_slice());
-    control.fill_rows(outputs, rows, cols * nb, |at, (dn_row, flag_row, analog_row)| {
+    let mut out = Level0Buffers::new(detector, rows * cols * nb);
+    let outputs = (out.dn.as_mut_slice(), out.flags.as_mut_slice(), out.analog.as_mut_slice());
+    control.fill_rows(outputs, rows, cols * nb, |at, row| {
         let r = at.index();
-        let line = viewing.line_index[r];
-        // The row's read-noise draws first, pixel by pixel from each pixel's generator, then
-        // the arithmetic over the whole row in vector lanes. Every column is visited, with the
-        // noise off too, so that a fault armed at a pixel fires there.
-        let mut z = vec![0.0; cols * nb];
-        for c in 0..cols {
-            at.column(c);
-            if noise && every_band_on_grid {
-                let mut rng = pixel_rng(seed, Stream::Readout, line, viewing.detector_index[c]);
-                z[c * nb..(c + 1) * nb].iter_mut().for_each(|z| *z = normal(&mut rng));
-            } else if noise {
-                let j = viewing.detector_index[c];
-                draw_bands(detector, seed, Stream::Readout, line, j, &mut z[c * nb..(c + 1) * nb], |_, rng| {
-                    normal(rng)
-                });
-            }
-        }
-        let electrons = &input[r * cols * nb..(r + 1) * cols * nb];
-        detector.read_out_run(&bands, electrons, &z, dn_row, flag_row, keep_analog.then_some(analog_row));
+        read_out_row(detector, (&input[r * cols * nb..(r + 1) * cols * nb], nb), viewing, seed, at, row);
         Ok::<_, InstrumentError>(())
     })?;
-    let (saturated, zero_counts) = count_flags(&flags);
-    let shape = (rows, cols, nb);
-    Ok(Level0 {
-        dn: Array3::from_shape_vec(shape, dn).map_err(shape_error)?,
-        analog: if keep_analog { Some(Array3::from_shape_vec(shape, analog).map_err(shape_error)?) } else { None },
-        flags: Array3::from_shape_vec(shape, flags).map_err(shape_error)?,
-        saturated,
-        zero_counts,
-    })
+    out.into_level0((rows, cols, nb))
+}
+
+/// [`expose_cube`] then [`digitise_cube`] row by row, without the electrons cube: the same
+/// counts and flags bit for bit (each pixel draws from its own generators, one per stream),
+/// for a run that would not keep the electrons anyway (it cannot rerun only the readout).
+pub fn expose_and_digitise(
+    detector: &Detector,
+    radiance: &Array3<f32>,
+    viewing: &Viewing,
+    seed: u64,
+    control: &RunControl,
+) -> Result<Level0, InstrumentError> {
+    let (rows, cols, nb) = radiance.dim();
+    let input = exposure_input(detector, radiance, viewing)?;
+    let mut out = Level0Buffers::new(detector, rows * cols * nb);
+    let outputs = (out.dn.as_mut_slice(), out.flags.as_mut_slice(), out.analog.as_mut_slice());
+    control.fill_rows(outputs, rows, cols * nb, |at, row| {
+        let r = at.index();
+        let mut electrons = vec![0.0f32; cols * nb];
+        expose_row(detector, (&input[r * cols * nb..(r + 1) * cols * nb], nb), viewing, seed, at, &mut electrons);
+        read_out_row(detector, (&electrons, nb), viewing, seed, at, row);
+        Ok::<_, InstrumentError>(())
+    })?;
+    out.into_level0((rows, cols, nb))
 }
 
 /// Values flagged saturated and zero, counted in one parallel pass (two filtered counts on one

@@ -1,0 +1,134 @@
+//! Two Rrs products compared band by band over the pixels valid in both: what the
+//! correction's diagnostics report (the approximation against the exact correction, the delivered
+//! Rrs against the truth).
+
+use ndarray::Array3;
+use rayon::prelude::*;
+use serde::Serialize;
+
+use super::{Reflectance, slice};
+
+/// Per-band comparison of two Rrs products over pixels valid in both (water, unflagged,
+/// positive): median relative difference and mean relative difference (bias), both of `a`
+/// against `b`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct BandDifference {
+    /// Band index.
+    pub band: usize,
+    /// Pixels compared.
+    pub n: usize,
+    /// Median |a − b|/b.
+    pub median_abs_rel: f64,
+    /// Mean (a − b)/b.
+    pub mean_rel: f64,
+    /// Largest |a − b|/b.
+    pub max_abs_rel: f64,
+}
+
+/// Bands a pixel source fills at most (a spectrograph's cube is compared from its slices).
+const MAX_BANDS: usize = 64;
+
+/// A pixel's bands made on the fly: `f(pixel, values, flags)`.
+pub type PixelBands<'a> = &'a (dyn Fn(usize, &mut [f32], &mut [u8]) + Sync);
+
+/// Where the values compared come from: a cube, or each pixel's bands computed on the fly
+/// (`f(pixel, values, flags)`), so that a product made only to be compared need not be held whole.
+enum Source<'a> {
+    Cube(&'a [f32], &'a [u8]),
+    Pixels(PixelBands<'a>),
+}
+
+/// Compare `a` with the reference `b`, band by band.
+#[must_use]
+pub fn compare(a: &Reflectance, b: &Array3<f32>, b_flags: Option<&Array3<u8>>) -> Vec<BandDifference> {
+    let (Ok(ar), Ok(af)) = (slice(&a.rrs), slice(&a.flags)) else { return Vec::new() };
+    compare_source(Source::Cube(ar, af), a.rrs.dim().2, b, b_flags)
+}
+
+/// [`compare`] with `a`'s values and flags at each pixel (row-major, `nb` bands) made by `a`
+/// (at most [`MAX_BANDS`] bands; `None` past that).
+#[must_use]
+pub fn compare_pixels(
+    a: PixelBands<'_>,
+    b: &Array3<f32>,
+    b_flags: Option<&Array3<u8>>,
+) -> Option<Vec<BandDifference>> {
+    let nb = b.dim().2;
+    (nb <= MAX_BANDS).then(|| compare_source(Source::Pixels(a), nb, b, b_flags))
+}
+
+fn compare_source(source: Source<'_>, nb: usize, b: &Array3<f32>, b_flags: Option<&Array3<u8>>) -> Vec<BandDifference> {
+    let Ok(br) = slice(b) else { return Vec::new() };
+    let bf = b_flags.and_then(|f| slice(f).ok());
+    let nb = nb.max(1);
+    let pixels = br.len() / nb;
+    // Count, sum and maximum over every pixel; the median from at most ~200 000 evenly strided
+    // pixels per band (its sampling error is far below the differences it reports).
+    let stride = (pixels / MEDIAN_SAMPLES).max(1);
+    #[derive(Clone)]
+    struct Acc {
+        n: Vec<usize>,
+        sum: Vec<f64>,
+        max: Vec<f64>,
+        sample: Vec<Vec<f64>>,
+    }
+    let empty = || Acc { n: vec![0; nb], sum: vec![0.0; nb], max: vec![0.0; nb], sample: vec![Vec::new(); nb] };
+    let acc = (0..pixels)
+        .into_par_iter()
+        .fold(empty, |mut acc, p| {
+            // One pixel's bands as slices (no per-value bounds checks), and whether it is a
+            // median sample decided once per pixel: the modulo per value was half the stage.
+            let span = p * nb..(p + 1) * nb;
+            let (mut a, mut a_flags) = ([0.0f32; MAX_BANDS], [0u8; MAX_BANDS]);
+            let (a, a_flags) = match &source {
+                Source::Cube(ar, af) => (&ar[span.clone()], &af[span.clone()]),
+                Source::Pixels(f) => {
+                    f(p, &mut a[..nb], &mut a_flags[..nb]);
+                    (&a[..nb], &a_flags[..nb])
+                }
+            };
+            let b = &br[span.clone()];
+            let b_flags = bf.map(|f| &f[span]);
+            let sampled = p % stride == 0;
+            for band in 0..nb {
+                let fb = b_flags.map_or(0, |f| f[band]);
+                let (x, y) = (f64::from(a[band]), f64::from(b[band]));
+                if a_flags[band] == 0 && fb == 0 && y > 0.0 && x.is_finite() {
+                    let rel = (x - y) / y;
+                    acc.n[band] += 1;
+                    acc.sum[band] += rel;
+                    acc.max[band] = acc.max[band].max(rel.abs());
+                    if sampled {
+                        acc.sample[band].push(rel.abs());
+                    }
+                }
+            }
+            acc
+        })
+        .reduce(empty, |mut a, b| {
+            for band in 0..nb {
+                a.n[band] += b.n[band];
+                a.sum[band] += b.sum[band];
+                a.max[band] = a.max[band].max(b.max[band]);
+                a.sample[band].extend_from_slice(&b.sample[band]);
+            }
+            a
+        });
+    (0..nb)
+        .map(|band| {
+            let n = acc.n[band];
+            let mut sample = acc.sample[band].clone();
+            let m = sample.len();
+            BandDifference {
+                band,
+                n,
+                median_abs_rel: if m > 0 { *sample.select_nth_unstable_by(m / 2, f64::total_cmp).1 } else { 0.0 },
+                mean_rel: if n > 0 { acc.sum[band] / n as f64 } else { 0.0 },
+                max_abs_rel: acc.max[band],
+            }
+        })
+        .collect()
+}
+
+/// Pixels per band the median of [`compare`] is taken from, at most.
+const MEDIAN_SAMPLES: usize = 200_000;
