@@ -372,7 +372,7 @@ fn metric_cells(
 /// at zero counts; `None` when neither explains it (the retrieval found no physical solution).
 #[must_use]
 pub(super) fn no_pixel_reason(out: &RunOutput) -> Option<String> {
-    let (rows, cols, bands) = out.level0.dn.dim();
+    let (rows, cols, bands) = out.report.shape;
     let total = (rows * cols * bands).max(1) as f64;
     let saturated = out.report.saturated as f64 / total;
     let zero = out.report.zero_counts as f64 / total;

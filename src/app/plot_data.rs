@@ -51,7 +51,7 @@ impl PlotData {
 /// Water pixels with a positive truth and, for the retrieval, a returned positive value:
 /// (truth, retrieved or `None`) per pixel, visiting every `step`-th pixel.
 fn values(out: &RunOutput, variable: &str, step: usize) -> Vec<(f64, Option<f64>)> {
-    let truth = &out.radiance.truth;
+    let truth = &out.truth;
     let Some(t) = truth.map(variable) else { return Vec::new() };
     let product = out.retrievals.first().map(|r| &r.product);
     let got = product.and_then(|p| p.map(variable));
@@ -93,7 +93,7 @@ impl RunValues {
         let mut retrieved_log10: Vec<f64> = all.iter().filter_map(|(_, g)| g.map(f64::log10)).collect();
         truth_log10.sort_unstable_by(f64::total_cmp);
         retrieved_log10.sort_unstable_by(f64::total_cmp);
-        let n = out.radiance.truth.surface.codes().len();
+        let n = out.truth.surface.codes().len();
         let scatter = values(out, variable, n / SCATTER_POINTS + 1)
             .into_iter()
             .filter_map(|(t, g)| g.map(|g| [t.log10(), g.log10()]))

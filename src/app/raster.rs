@@ -27,8 +27,8 @@ pub struct MapData {
 /// retrieval where there is one. `None` when the run has no such product.
 #[must_use]
 pub fn product_map(out: &RunOutput, kind: ProductKind, band: usize, truth: bool) -> Option<MapData> {
-    let r = &out.radiance;
-    let water = r.truth.surface.water_mask();
+    let truth_maps = &out.truth;
+    let water = truth_maps.surface.water_mask();
     let ret = out.retrievals.first();
     let returned = |p: &crate::retrieval::Product| Array2::from_shape_fn(p.flags.dim(), |(i, j)| p.returned(i, j));
     let product_or_truth =
@@ -44,16 +44,16 @@ pub fn product_map(out: &RunOutput, kind: ProductKind, band: usize, truth: bool)
                 values: map.clone(),
             })
         };
-    let nb = r.radiance.dim().2;
+    let nb = out.report.shape.2;
     let band = band.min(nb.saturating_sub(1));
     match kind {
-        ProductKind::Chl => product_or_truth(&r.truth.chl_mg_m3, |p| p.chl_mg_m3.as_ref()),
-        ProductKind::Nap => product_or_truth(&r.truth.nap_g_m3, |p| p.nap_g_m3.as_ref()),
-        ProductKind::Cdom => product_or_truth(&r.truth.cdom_per_m, |p| p.cdom_per_m.as_ref()),
-        ProductKind::Depth => product_or_truth(r.truth.depth_m.as_ref()?, |p| p.depth_m.as_ref()),
+        ProductKind::Chl => product_or_truth(&truth_maps.chl_mg_m3, |p| p.chl_mg_m3.as_ref()),
+        ProductKind::Nap => product_or_truth(&truth_maps.nap_g_m3, |p| p.nap_g_m3.as_ref()),
+        ProductKind::Cdom => product_or_truth(&truth_maps.cdom_per_m, |p| p.cdom_per_m.as_ref()),
+        ProductKind::Depth => product_or_truth(truth_maps.depth_m.as_ref()?, |p| p.depth_m.as_ref()),
         ProductKind::Substrate => {
             let (f, names) = if truth {
-                (r.truth.substrate_fractions.as_ref()?, &r.truth.substrate_names)
+                (truth_maps.substrate_fractions.as_ref()?, &truth_maps.substrate_names)
             } else {
                 let p = &ret?.product;
                 (p.substrate_fractions.as_ref()?, &p.substrate_names)
@@ -81,15 +81,17 @@ pub fn product_map(out: &RunOutput, kind: ProductKind, band: usize, truth: bool)
             })
         }
         ProductKind::Rrs => {
-            let cube = if truth { &r.truth.rrs_above } else { &out.correction.rrs.rrs };
+            let cubes = out.cubes.as_ref()?;
+            let cube = if truth { &*cubes.radiance.truth_rrs } else { &cubes.rrs.rrs };
             let values = cube.index_axis(ndarray::Axis(2), band).to_owned();
-            let flags = &out.correction.rrs.flags;
+            let flags = &cubes.rrs.flags;
             let valid =
                 Array2::from_shape_fn(values.dim(), |(i, j)| water[[i, j]] && (truth || flags[[i, j, band]] == 0));
             Some(MapData { values, valid })
         }
         ProductKind::Level1 => {
-            let cube = if truth { &r.radiance } else { &out.level1.radiance };
+            let cubes = out.cubes.as_ref()?;
+            let cube = if truth { &cubes.radiance.radiance } else { &cubes.level1.radiance };
             let values = cube.index_axis(ndarray::Axis(2), band).to_owned();
             Some(MapData { valid: values.mapv(|v| v.is_finite() && v > 0.0), values })
         }
@@ -97,7 +99,7 @@ pub fn product_map(out: &RunOutput, kind: ProductKind, band: usize, truth: bool)
             // Analytic SNR at each pixel's own radiance (detector noise model, noise on).
             let detector =
                 Detector::new(&out.config.instrument, &out.response, DetectorMode::default(), out.config.seed);
-            let l = r.radiance.index_axis(ndarray::Axis(2), band);
+            let l = out.cubes.as_ref()?.radiance.radiance.index_axis(ndarray::Axis(2), band);
             let values = Array2::from_shape_fn(l.dim(), |(i, j)| {
                 let d = out.viewing.detector_index[j];
                 crate::instrument::analytic_snr(&detector, d, band, f64::from(l[[i, j]])) as f32
@@ -135,7 +137,7 @@ pub fn difference(a: &MapData, a_out: &RunOutput, b: &MapData, b_out: &RunOutput
 /// retrieval unmixes that the scene does not have.
 #[must_use]
 pub fn substrate_classes(out: &RunOutput) -> Vec<String> {
-    let mut classes = out.radiance.truth.substrate_names.clone();
+    let mut classes = out.truth.substrate_names.clone();
     for r in &out.retrievals {
         for n in &r.product.substrate_names {
             if !classes.contains(n) {

@@ -358,7 +358,7 @@ pub fn retrieval_rows(out: &mut String, quick: bool) -> Result<(), CliError> {
     let mut samples = Vec::new();
     let mut result = None;
     for _ in 0..if quick { 1 } else { 3 } {
-        let (r, sample) = measure(|| run_study(&resolved, &RunControl::new(), |_, _| Ok(())));
+        let (r, sample) = measure(|| run_study(&resolved, &RunControl::new(), false, |_, _| Ok(())));
         result = Some(r.map_err(err)?);
         samples.push(sample);
     }

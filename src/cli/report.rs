@@ -132,7 +132,7 @@ fn run_for_report(args: &ReportArgs) -> Result<(crate::report::ReviewData, Vec<c
     let pool = super::pool(args.threads.unwrap_or(0), "shoal-report")?;
     let control = super::interrupt::control();
     eprintln!("{}: running {} runs …", spec.name, resolved.runs.len());
-    let result = pool.install(|| run_study(&resolved, &control, |_, _| Ok(())))?;
+    let result = pool.install(|| run_study(&resolved, &control, false, |_, _| Ok(())))?;
     let mut budgets = Vec::new();
     if args.budget {
         let seeds: Vec<u64> = spec.seeds.clone();

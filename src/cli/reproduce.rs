@@ -35,7 +35,7 @@ fn run_one(name: &str, decimation: Option<usize>) -> Result<StudyResult, CliErro
     }
     let control = super::interrupt::control();
     let start = Instant::now();
-    let result = run_study(&resolved, &control, |_, _| Ok(()))?;
+    let result = run_study(&resolved, &control, false, |_, _| Ok(()))?;
     eprintln!("{name}: {} runs, both modes, in {:.1} s", resolved.runs.len(), start.elapsed().as_secs_f64());
     Ok(result)
 }

@@ -98,7 +98,7 @@ pub fn run(args: &StudyArgs) -> Result<(), CliError> {
     };
     let result = crate::control::observed(&control, Duration::from_millis(200), report, || {
         pool.install(|| {
-            run_study(&resolved, &control, |i, run_out| {
+            run_study(&resolved, &control, !args.no_cubes, |i, run_out| {
                 let (label, seed, _) = &resolved.runs[i];
                 if !args.no_cubes {
                     let sub = if spec.seeds.len() > 1 { format!("{label}_seed{seed}") } else { label.clone() };

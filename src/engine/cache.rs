@@ -172,36 +172,108 @@ impl KeyBuilder {
 
 type Product = Arc<dyn Any + Send + Sync>;
 
-/// Products by stage, most recent first, a few per stage.
-#[derive(Default)]
+/// One kept product: its key, the product, its bytes ([`super::footprint::Footprint`]) and when
+/// it was last used (the cache's own clock).
+struct Entry {
+    key: Key,
+    product: Product,
+    bytes: usize,
+    used: u64,
+}
+
+/// Products by stage, most recent first, a few per stage, and at most `budget` bytes over all
+/// stages: past the budget the least recently used products go first (whatever their stage), and
+/// a product there is no room for is not kept (it pushes nothing out).
 pub struct Cache {
-    entries: HashMap<Stage, VecDeque<(Key, Product)>>,
+    entries: HashMap<Stage, VecDeque<Entry>>,
+    budget: usize,
+    held: usize,
+    clock: u64,
+    /// The clock when the current run began.
+    run_start: u64,
+}
+
+impl Default for Cache {
+    fn default() -> Self {
+        Self::with_budget(usize::MAX)
+    }
 }
 
 impl std::fmt::Debug for Cache {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Cache").field("stages", &self.entries.len()).finish()
+        f.debug_struct("Cache").field("stages", &self.entries.len()).field("bytes", &self.held).finish()
     }
 }
 
 impl Cache {
+    /// An empty cache that keeps at most `budget` bytes.
+    #[must_use]
+    pub fn with_budget(budget: usize) -> Self {
+        Self { entries: HashMap::new(), budget, held: 0, clock: 0, run_start: 0 }
+    }
+
     /// The product under `key`, if kept (and moves it to the front).
     pub fn get<T: Send + Sync + 'static>(&mut self, key: Key) -> Option<Arc<T>> {
+        self.clock += 1;
         let list = self.entries.get_mut(&key.stage)?;
-        let i = list.iter().position(|(k, _)| *k == key)?;
-        let entry = list.remove(i)?;
-        let product = entry.1.clone().downcast::<T>().ok();
+        let i = list.iter().position(|e| e.key == key)?;
+        let mut entry = list.remove(i)?;
+        entry.used = self.clock;
+        let product = entry.product.clone().downcast::<T>().ok();
         list.push_front(entry);
         product
     }
 
-    /// Keep `product` under `key`.
-    pub fn put<T: Send + Sync + 'static>(&mut self, key: Key, product: Arc<T>) {
+    /// A run starts: the products it uses from now on are not pushed out by its own later ones.
+    pub fn begin_run(&mut self) {
+        self.clock += 1;
+        self.run_start = self.clock;
+    }
+
+    /// Keep `product` (of `bytes`) under `key`, then drop what is over the stage's capacity.
+    /// Within the budget, room is made by dropping the least recently used products the current
+    /// run has not used ([`Self::begin_run`]); a product there is no such room for is not kept
+    /// (a run's pupil radiance, kept for the next noise seed, is not pushed out by the run's own
+    /// Level-0).
+    pub fn put<T: Send + Sync + 'static>(&mut self, key: Key, product: Arc<T>, bytes: usize) {
+        self.clock += 1;
         let stage = key.stage;
+        self.remove(key);
+        let evictable: usize =
+            self.entries.values().flatten().filter(|e| e.used < self.run_start).map(|e| e.bytes).sum();
+        if self.held + bytes > self.budget.saturating_add(evictable) {
+            return;
+        }
+        while self.held + bytes > self.budget {
+            let oldest = self
+                .entries
+                .iter()
+                .flat_map(|(s, l)| l.iter().map(move |e| (e.used, *s, e.key)))
+                .filter(|(used, s, k)| *used < self.run_start && self.bytes_of(*s, *k) > 0)
+                .min_by_key(|(used, ..)| *used);
+            match oldest {
+                Some((_, _, k)) => self.remove(k),
+                None => return,
+            }
+        }
         let list = self.entries.entry(stage).or_default();
-        list.retain(|(k, _)| *k != key);
-        list.push_front((key, product));
-        list.truncate(stage.capacity());
+        list.push_front(Entry { key, product, bytes, used: self.clock });
+        self.held += bytes;
+        let dropped: Vec<Entry> = list.drain(stage.capacity().min(list.len())..).collect();
+        self.held -= dropped.iter().map(|e| e.bytes).sum::<usize>();
+    }
+
+    fn bytes_of(&self, stage: Stage, key: Key) -> usize {
+        self.entries.get(&stage).and_then(|l| l.iter().find(|e| e.key == key)).map_or(0, |e| e.bytes)
+    }
+
+    fn remove(&mut self, key: Key) {
+        if let Some(list) = self.entries.get_mut(&key.stage)
+            && let Some(i) = list.iter().position(|e| e.key == key)
+            && let Some(e) = list.remove(i)
+        {
+            self.held -= e.bytes;
+        }
     }
 
     /// Products kept, over all stages (at most the sum of [`Stage::capacity`]).
@@ -210,8 +282,82 @@ impl Cache {
         self.entries.values().map(VecDeque::len).sum()
     }
 
+    /// Bytes the kept products hold (at most the budget).
+    #[must_use]
+    pub fn bytes(&self) -> usize {
+        self.held
+    }
+
     /// Drop everything.
     pub fn clear(&mut self) {
         self.entries.clear();
+        self.held = 0;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn key(stage: Stage, n: u32) -> Key {
+        KeyBuilder::new(stage).with(&n).finish()
+    }
+
+    #[test]
+    fn the_budget_drops_the_least_recently_used_bytes_first() {
+        let mut cache = Cache::with_budget(100);
+        cache.begin_run();
+        cache.put(key(Stage::Radiance, 1), Arc::new(1u8), 60);
+        cache.put(key(Stage::Scene, 1), Arc::new(2u8), 30);
+        cache.begin_run();
+        // The next run uses the radiance: the scene is now the older one, and not used by it.
+        assert!(cache.get::<u8>(key(Stage::Radiance, 1)).is_some());
+        cache.put(key(Stage::Level0, 1), Arc::new(3u8), 30);
+        assert!(cache.get::<u8>(key(Stage::Scene, 1)).is_none(), "the least recently used goes first");
+        assert!(cache.get::<u8>(key(Stage::Radiance, 1)).is_some());
+        assert_eq!(cache.bytes(), 90);
+        // A product over the whole budget is not kept, and pushes nothing out.
+        cache.put(key(Stage::Level1, 1), Arc::new(4u8), 101);
+        assert!(cache.get::<u8>(key(Stage::Level1, 1)).is_none());
+        assert_eq!(cache.bytes(), 90);
+        // Small products (0 bytes) stay, bounded by their stage's capacity.
+        for n in 0..20 {
+            cache.put(key(Stage::Response, n), Arc::new(0u8), 0);
+        }
+        assert_eq!(cache.len(), 2 + Stage::Response.capacity());
+    }
+
+    #[test]
+    fn a_run_does_not_push_out_what_it_used() {
+        let mut cache = Cache::with_budget(100);
+        cache.begin_run();
+        cache.put(key(Stage::Radiance, 1), Arc::new(1u8), 70);
+        // The same run's Level-0 finds no room it may make: not kept, the radiance stays.
+        cache.put(key(Stage::Level0, 1), Arc::new(2u8), 40);
+        assert!(cache.get::<u8>(key(Stage::Level0, 1)).is_none());
+        cache.begin_run();
+        assert!(cache.get::<u8>(key(Stage::Radiance, 1)).is_some(), "the next seed reuses the radiance");
+        cache.put(key(Stage::Level0, 2), Arc::new(2u8), 40);
+        assert!(cache.get::<u8>(key(Stage::Radiance, 1)).is_some());
+        assert_eq!(cache.bytes(), 70);
+        // A later run that does not use the radiance may push it out.
+        cache.begin_run();
+        cache.put(key(Stage::Level0, 3), Arc::new(2u8), 40);
+        assert!(cache.get::<u8>(key(Stage::Level0, 3)).is_some());
+        assert!(cache.get::<u8>(key(Stage::Radiance, 1)).is_none());
+    }
+
+    #[test]
+    fn replacing_a_product_counts_its_bytes_once() {
+        let mut cache = Cache::with_budget(100);
+        for _ in 0..5 {
+            cache.put(key(Stage::Radiance, 1), Arc::new(1u8), 40);
+        }
+        assert_eq!((cache.len(), cache.bytes()), (1, 40));
+        for n in 0..6 {
+            cache.put(key(Stage::Level0, n), Arc::new(1u8), 10);
+        }
+        // Level-0 keeps 4 (its capacity): 40 + 4 × 10.
+        assert_eq!((cache.len(), cache.bytes()), (5, 80));
     }
 }

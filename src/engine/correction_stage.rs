@@ -6,14 +6,15 @@ use std::sync::Arc;
 
 use super::cache::{Key, KeyBuilder, Stage};
 use super::keys::Inputs;
-use super::products::{CorrectionProduct, InstrumentSide, SceneSide};
+use super::products::{Corrected, CorrectionProduct, InstrumentSide, SceneSide};
 use super::report::RunReport;
 use super::run::Engine;
 use super::stages::{failed, lut_axes};
 use super::{EngineError, RunConfig};
 use crate::control::RunControl;
 use crate::correction::{AerosolFamily, FamilyLuts, SceneApproximation, compare, correct_exact, correct_image};
-use crate::instrument::RadianceCube;
+use crate::instrument::Truth;
+use ndarray::Array3;
 
 impl Engine {
     /// Atmospheric correction: the delivered Rrs and the diagnostics.
@@ -22,16 +23,18 @@ impl Engine {
         &mut self,
         config: &RunConfig,
         side: &SceneSide,
-        radiance: &RadianceCube,
-        radiance_key: Key,
+        (truth, truth_rrs, radiance_key): (&Truth, &Array3<f32>, Key),
+        approximation: SceneApproximation,
         inst: &InstrumentSide,
         control: &RunControl,
         report: &mut RunReport,
-    ) -> Result<(Arc<CorrectionProduct>, Key), EngineError> {
+    ) -> Result<(Arc<Corrected>, Key), EngineError> {
         let fid = &config.fidelity;
         let inputs = Inputs::of(config);
-        let (band_atmosphere, band_key, level1, level1_key) =
-            (&side.band_atmosphere, side.band_key, &inst.level1, inst.level1_key);
+        let Some(level1) = inst.level1.as_deref() else {
+            return Err(EngineError::Failed { stage: Stage::Correction, message: "no Level-1 to correct".into() });
+        };
+        let (band_atmosphere, band_key, level1_key) = (&side.band_atmosphere, side.band_key, inst.level1_key);
         // Atmospheric correction.
         let correction_key = KeyBuilder::new(Stage::Correction)
             .after(level1_key)
@@ -48,21 +51,12 @@ impl Engine {
         };
         let correction = self.stage(correction_key, report, control, || {
             let fail = failed(Stage::Correction);
-            let approximation = SceneApproximation::new(
-                &radiance.radiance,
-                &radiance.truth.rrs_above,
-                band_atmosphere,
-                &radiance.truth.surface,
-                config.correction.approx_points,
-                config.seed,
-            )
-            .map_err(&fail)?;
             // A preview computes only the product it shows; the diagnostics (the approximation
             // against the exact correction, and both against the truth) come with full resolution.
             let diagnostics = fid.decimation == 1;
             let image = match (&family, &config.correction.image) {
                 (Some((fam, _)), Some(settings)) => Some(
-                    correct_image(level1, fam, settings, &side.response.bands, &radiance.truth.surface, control)
+                    correct_image(level1, fam, settings, &side.response.bands, &truth.surface, control)
                         .map_err(&fail)?,
                 ),
                 _ => None,
@@ -72,21 +66,25 @@ impl Engine {
             let against_truth = diagnostics;
             let diagnostics = diagnostics && image.is_none();
             let exact = if diagnostics || (!config.correction.use_approximation && image.is_none()) {
-                let aerosol_map = side.aerosol_map.as_deref().zip(radiance.truth.aot550.as_ref());
-                Some(
-                    correct_exact(level1, band_atmosphere, aerosol_map, &radiance.truth.surface, control)
-                        .map_err(&fail)?,
-                )
+                let aerosol_map = side.aerosol_map.as_deref().zip(truth.aot550.as_ref());
+                Some(correct_exact(level1, band_atmosphere, aerosol_map, &truth.surface, control).map_err(&fail)?)
             } else {
                 None
             };
-            let approx = if diagnostics || config.correction.use_approximation {
-                Some(approximation.correct(level1, &radiance.truth.surface, control).map_err(&fail)?)
+            // The approximation is held whole only when it is the product; as a diagnostic it is
+            // compared with the exact correction pixel by pixel.
+            let streamed = match (&exact, diagnostics && !config.correction.use_approximation) {
+                (Some(e), true) => approximation.compare_with(level1, &truth.surface, e),
+                _ => None,
+            };
+            let approx = if (diagnostics && streamed.is_none()) || config.correction.use_approximation {
+                Some(approximation.correct(level1, &truth.surface, control).map_err(&fail)?)
             } else {
                 None
             };
-            let approximation_vs_exact = match (&approx, &exact, diagnostics) {
-                (Some(a), Some(e), true) => compare(a, &e.rrs, Some(&e.flags)),
+            let approximation_vs_exact = match (streamed, &approx, &exact, diagnostics) {
+                (Some(d), ..) => d,
+                (None, Some(a), Some(e), true) => compare(a, &e.rrs, Some(&e.flags)),
                 _ => Vec::new(),
             };
             let (image, aerosol) = image.map_or((None, None), |(r, a)| (Some(r), Some(a)));
@@ -99,35 +97,30 @@ impl Engine {
                     return Err(EngineError::Failed { stage: Stage::Correction, message: "no correction ran".into() });
                 }
             };
-            let rrs_vs_truth = if against_truth { compare(&rrs, &radiance.truth.rrs_above, None) } else { Vec::new() };
+            let rrs_vs_truth = if against_truth { compare(&rrs, truth_rrs, None) } else { Vec::new() };
             let family = family.as_ref().map(|(f, _)| f.clone());
             let names: Vec<String> = side.response.bands.bands.iter().map(|b| b.name.clone()).collect();
             let rrs_metrics = crate::correction::band_rrs_metrics(
                 &rrs,
-                &radiance.truth.rrs_above,
-                &radiance.truth.surface,
+                truth_rrs,
+                &truth.surface,
                 &names,
                 &side.response.bands.centres_nm(),
             );
-            Ok(CorrectionProduct {
-                rrs,
-                approximation,
-                approximation_vs_exact,
-                rrs_vs_truth,
-                rrs_metrics,
-                aerosol,
-                family,
-            })
+            let product =
+                CorrectionProduct { approximation, approximation_vs_exact, rrs_vs_truth, rrs_metrics, aerosol, family };
+            Ok(Corrected { rrs: Arc::new(rrs), product: Arc::new(product) })
         })?;
-        report.approximation = Some(correction.approximation.clone());
-        report.approximation_vs_exact = correction.approximation_vs_exact.clone();
-        report.rrs_vs_truth = correction.rrs_vs_truth.clone();
-        report.aerosol = match (&correction.aerosol, &config.correction.image) {
+        let product = &correction.product;
+        report.approximation = Some(product.approximation.clone());
+        report.approximation_vs_exact = product.approximation_vs_exact.clone();
+        report.rrs_vs_truth = product.rrs_vs_truth.clone();
+        report.aerosol = match (&product.aerosol, &config.correction.image) {
             (Some(a), Some(settings)) => Some(super::report::aerosol_summary(
                 a,
                 settings,
                 &config.scene.atmosphere,
-                radiance.truth.aot550.as_ref(),
+                truth.aot550.as_ref(),
                 &side.response.bands.centres_nm(),
             )),
             _ => None,

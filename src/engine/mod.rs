@@ -39,7 +39,9 @@ mod config;
 mod correction_stage;
 mod fault;
 mod files;
+pub mod footprint;
 mod keys;
+pub mod probe;
 mod products;
 mod report;
 pub mod resources;
@@ -52,9 +54,10 @@ pub mod worker;
 pub use cache::Stage;
 pub use config::{DEFAULT_BAND_NODES, DEFAULT_WATER_SINGLE_PRECISION, Fidelity, RunConfig};
 pub use fault::{Fault, FaultKind};
-pub use products::{CorrectionProduct, RetrievalOutput, RunOutput};
+pub use probe::{Probe, Probed};
+pub use products::{CorrectionProduct, Cubes, RetrievalOutput, RunOutput};
 pub use report::{AerosolSummary, RunReport, StageReport, StageStatus};
-pub use run::Engine;
+pub use run::{Engine, LEAN_CACHE_BYTES};
 pub use stages::lut_axes_covering;
 
 /// An engine failure: the stage and what went wrong (the message names the field).

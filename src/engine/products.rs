@@ -12,17 +12,27 @@ use crate::calibration::{Calibration, Level1};
 use crate::correction::{Reflectance, SceneApproximation};
 use crate::instrument::feasibility::Feasibility;
 use crate::instrument::sample::BandAtmosphere;
-use crate::instrument::{AotNodes, Detector, Level0, RadianceCube, Response, SnrRow, Viewing};
+use crate::instrument::{AotNodes, Detector, Level0, RadianceCube, Response, SnrRow, Truth, Viewing};
 use crate::metrics::ProductMetrics;
 use crate::retrieval::{Product, RetrievalSpec};
 use crate::scene::Scene;
 use crate::toa::SceneOptics;
 
-/// The atmospheric correction stage's product.
+/// The atmospheric correction stage's product as the cache keeps it: the delivered Rrs cube
+/// (exact, the approximation when the config asks for it, or the image-based correction's) and
+/// the diagnostics. A run hands on the diagnostics always and the cube only when it keeps its
+/// cubes.
+#[derive(Debug)]
+pub(super) struct Corrected {
+    /// The delivered Rrs.
+    pub(super) rrs: Arc<Reflectance>,
+    /// What the correction found about it.
+    pub(super) product: Arc<CorrectionProduct>,
+}
+
+/// The atmospheric correction's diagnostics (the Rrs cube itself is [`Cubes::rrs`]).
 #[derive(Debug, Clone)]
 pub struct CorrectionProduct {
-    /// The delivered Rrs (exact, or the approximation when the config asks for it).
-    pub rrs: Reflectance,
     /// The paper's per-scene approximation terms.
     pub approximation: SceneApproximation,
     /// Per band: approximation against exact correction.
@@ -35,6 +45,22 @@ pub struct CorrectionProduct {
     pub aerosol: Option<crate::correction::AerosolRetrieval>,
     /// The image-based correction's aerosol family, when it ran.
     pub family: Option<Arc<crate::correction::AerosolFamily>>,
+}
+
+/// The full-resolution cubes of a run: what `shoal simulate` and a study with cubes write, and
+/// what a spectrum at a pixel reads. Held only by an engine that keeps cubes
+/// ([`super::Engine::keep_cubes`]); a run that does not keep them holds its products, metrics
+/// and truth maps, and frees each cube as soon as the next stage has read it.
+#[derive(Debug, Clone)]
+pub struct Cubes {
+    /// Pupil radiance (and the true Rrs).
+    pub radiance: Arc<RadianceCube>,
+    /// Level-0.
+    pub level0: Arc<Level0>,
+    /// Level-1.
+    pub level1: Arc<Level1>,
+    /// The delivered Rrs.
+    pub rrs: Arc<Reflectance>,
 }
 
 /// Everything a run produced (shared with the cache: cheap to clone).
@@ -50,15 +76,13 @@ pub struct RunOutput {
     pub viewing: Arc<Viewing>,
     /// The band-effective atmosphere of each column (what the exact correction used).
     pub band_atmosphere: Arc<BandAtmosphere>,
-    /// Pupil radiance and truth.
-    pub radiance: Arc<RadianceCube>,
-    /// Level-0.
-    pub level0: Arc<Level0>,
+    /// The truth under each pixel (maps; the true Rrs cube is in [`Cubes::radiance`]).
+    pub truth: Arc<Truth>,
+    /// The full-resolution cubes, when the engine keeps them.
+    pub cubes: Option<Cubes>,
     /// Calibration coefficients.
     pub calibration: Arc<Calibration>,
-    /// Level-1.
-    pub level1: Arc<Level1>,
-    /// Rrs and the correction's diagnostics.
+    /// The correction's diagnostics.
     pub correction: Arc<CorrectionProduct>,
     /// SNR per band.
     pub snr: Arc<Vec<SnrRow>>,
@@ -66,6 +90,8 @@ pub struct RunOutput {
     pub feasibility: Arc<Feasibility>,
     /// Retrieved products and their metrics, one per configured retrieval.
     pub retrievals: Vec<Arc<RetrievalOutput>>,
+    /// The pixels the run was asked to keep ([`super::Engine::run_with`]).
+    pub probes: Vec<super::probe::Probed>,
     /// The report.
     pub report: RunReport,
 }
@@ -106,11 +132,15 @@ pub(super) struct SceneSide {
 
 /// Products of the instrument side and the keys later stages build on.
 pub(super) struct InstrumentSide {
+    /// The pupil radiance, when the run keeps its cubes.
+    pub(super) radiance: Option<Arc<RadianceCube>>,
     pub(super) detector: Arc<Detector>,
     pub(super) detector_key: Key,
     pub(super) feasibility: Arc<Feasibility>,
-    pub(super) level0: Arc<Level0>,
+    /// Level-0, until the run lets it go.
+    pub(super) level0: Option<Arc<Level0>>,
     pub(super) calibration: Arc<Calibration>,
-    pub(super) level1: Arc<Level1>,
+    /// Level-1, until the run lets it go.
+    pub(super) level1: Option<Arc<Level1>>,
     pub(super) level1_key: Key,
 }

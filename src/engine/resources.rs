@@ -49,11 +49,20 @@ const RT_OVERHEAD_S: f64 = 0.05;
 /// term: the level's mixed scattering kernel, one 3 × 3 Stokes block of f64 per stream pair
 /// (`atmosphere::sos::solve`); the fields per level and stream are smaller by a factor of streams.
 const RT_BYTES_PER_LEVEL_STREAM_PAIR: f64 = 72.0;
-/// Runs whose full products the engine's cache can hold at once (`Stage::capacity` of the image
-/// stages); a study keeps only the truth and products of the others.
-const CACHED_RUNS: usize = 4;
-/// Bytes a study keeps per pixel-band of a run no longer cached: the truth's Rrs (f32).
-const KEPT_BYTES_PER_PIXEL_BAND: f64 = 4.0;
+/// Bytes per pixel and band of a run that does not keep its cubes, at its peak: the true Rrs,
+/// Level-1 and Rrs with their flags side by side while the correction runs (4 + 5 + 5), plus the
+/// stages' working copies (the exact correction's diagnostic is compared pixel by pixel, not
+/// held). Measured: the default study peaks at 0.82 GB with the exact correction, 0.87 GB with
+/// the image-based one (see the tests).
+const LEAN_BYTES_PER_PIXEL_BAND: f64 = 16.0;
+/// Bytes per pixel a study keeps of each run until its tables and figures are written: the
+/// truth's maps (chl, NAP, CDOM, depth, three substrate fractions, surface: at most 29) and an
+/// image-based correction's aerosol maps (8), with [`PRODUCT_BYTES_PER_PIXEL`] per retrieval.
+const KEPT_BYTES_PER_PIXEL: f64 = 40.0;
+/// Bytes per pixel of one retrieval's products: aLMI's three maps, cost, SIOP set and flags (19),
+/// SAMBUCA's depth, three substrate fractions, cost, SDI, iterations and flags (27), rounded up
+/// for a retrieval's extra maps.
+const PRODUCT_BYTES_PER_PIXEL: f64 = 32.0;
 
 /// Bands an instrument will have (without reading its band files).
 fn band_count(kind: &InstrumentKind) -> usize {
@@ -216,11 +225,23 @@ fn cube_part(config: &RunConfig, bytes_per_pixel_band: f64) -> Part {
     }
 }
 
-/// What a study's runs ask for together: a study keeps the truth and products of every run
-/// until its tables and figures are written, and the engine's cache the full cubes of the last
-/// few (`CACHED_RUNS`); scenes and atmospheres are built one at a time.
+/// Bytes of `config`'s pupil radiance product as the cache counts it (the radiance and the true
+/// Rrs, f32 per pixel and band, and the truth's maps): what a study with several seeds keeps
+/// cached so that each seed after the first reuses it.
 #[must_use]
-pub fn study_demand(configs: &[&RunConfig]) -> Demand {
+pub fn radiance_bytes(config: &RunConfig) -> usize {
+    let (rows, cols) = image_size(config);
+    let pixels = rows as f64 * cols as f64;
+    (pixels * (band_count(&config.instrument.kind) as f64 * 8.0 + 16.0)) as usize
+}
+
+/// What a study's runs ask for together. The runs are made one at a time by a lean engine
+/// ([`super::Engine::lean`]): the largest run's working set (its cubes as the stages hand them
+/// on, all of them when `keep_cubes`, to be written), the products and truth maps every run
+/// leaves behind until the tables and figures are written, the engine's bounded cache, and the
+/// largest scene and atmosphere (built one at a time).
+#[must_use]
+pub fn study_demand(configs: &[&RunConfig], keep_cubes: bool, cache_bytes: usize) -> Demand {
     let mut demand = Demand::default();
     for c in configs {
         let one = run_demand(c);
@@ -230,18 +251,26 @@ pub fn study_demand(configs: &[&RunConfig]) -> Demand {
             demand.parts = shared;
         }
     }
-    // The largest runs' full cubes (the cache may hold any of them), the others' kept truth.
-    let mut by_size: Vec<&RunConfig> = configs.to_vec();
-    by_size
-        .sort_by(|a, b| cube_part(b, BYTES_PER_PIXEL_BAND).bytes.total_cmp(&cube_part(a, BYTES_PER_PIXEL_BAND).bytes));
-    for (i, c) in by_size.iter().enumerate() {
-        if i < CACHED_RUNS {
-            demand.parts.push(cube_part(c, BYTES_PER_PIXEL_BAND));
-        } else {
-            let kept = cube_part(c, KEPT_BYTES_PER_PIXEL_BAND);
-            demand.parts.push(Part { what: kept.what.replacen("cubes", "the truth kept", 1), ..kept });
-        }
+    let per_band = if keep_cubes { BYTES_PER_PIXEL_BAND } else { LEAN_BYTES_PER_PIXEL_BAND };
+    let largest = configs.iter().max_by(|a, b| cube_part(a, per_band).bytes.total_cmp(&cube_part(b, per_band).bytes));
+    if let Some(c) = largest {
+        demand.parts.push(cube_part(c, per_band));
     }
+    for c in configs {
+        let (rows, cols) = image_size(c);
+        let per_pixel = KEPT_BYTES_PER_PIXEL + c.retrievals.len() as f64 * PRODUCT_BYTES_PER_PIXEL;
+        demand.parts.push(Part {
+            what: format!("the products and truth maps of {} ({rows} × {cols} pixels)", c.instrument.name),
+            bytes: rows as f64 * cols as f64 * per_pixel,
+            ..cube_part(c, 0.0)
+        });
+    }
+    demand.parts.push(Part {
+        what: "the engine's cache".into(),
+        bytes: cache_bytes as f64,
+        fields: "",
+        lever: Lever::Files,
+    });
     demand
 }
 
@@ -258,11 +287,13 @@ mod tests {
     #[test]
     fn the_default_study_fits_and_its_estimate_bounds_the_measured_peak() {
         let runs = default_runs();
-        let demand = study_demand(&runs.iter().collect::<Vec<_>>());
-        // Measured with /usr/bin/time on `shoal study` at full resolution: 2.33 GB peak. The
-        // estimate is an upper bound within a factor 1.6 (it plans for the working copies).
+        let demand = study_demand(&runs.iter().collect::<Vec<_>>(), false, crate::engine::LEAN_CACHE_BYTES);
+        // Measured with /usr/bin/time on `shoal study --no-cubes` at full resolution: 0.82 GB
+        // peak (0.87 GB with the image-based correction). The estimate is an upper bound within
+        // a factor 1.6 (it plans for the working copies, and counts the scene's synthesis and
+        // the runs' cubes as if they were held at once).
         let gb = demand.bytes() / 1024.0_f64.powi(3);
-        assert!((2.33..2.33 * 1.6).contains(&gb), "{gb} GB: {demand:?}");
+        assert!((0.87..0.87 * 1.6).contains(&gb), "{gb} GB: {demand:?}");
         assert!(demand.atmosphere_s < 60.0, "{}", demand.atmosphere_s);
         let budget = Budget { memory_bytes: 14e9, atmosphere_s: DEFAULT_ATMOSPHERE_S };
         assert!(budget.check(&demand).is_ok());

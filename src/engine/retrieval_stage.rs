@@ -3,12 +3,13 @@
 use std::sync::Arc;
 
 use super::cache::{Key, KeyBuilder, Stage};
-use super::products::{CorrectionProduct, RetrievalOutput, SceneSide};
+use super::products::{RetrievalOutput, SceneSide};
 use super::report::RunReport;
 use super::run::Engine;
 use super::{EngineError, RunConfig};
 use crate::control::RunControl;
-use crate::instrument::{Detector, DetectorMode, RadianceCube};
+use crate::correction::Reflectance;
+use crate::instrument::{Detector, DetectorMode, Truth};
 use crate::metrics::evaluate;
 use crate::retrieval::run::band_responses;
 use crate::retrieval::{Product, ProductFlags, RetrievalError, RetrievalInputs, RetrievalSpec, invert, prepare};
@@ -40,8 +41,8 @@ impl Engine {
         &mut self,
         config: &RunConfig,
         side: &SceneSide,
-        radiance: &Arc<RadianceCube>,
-        (correction, correction_key): (&Arc<CorrectionProduct>, Key),
+        truth: &Truth,
+        (rrs, correction_key): (&Reflectance, Key),
         typical: &[f64],
         control: &RunControl,
         report: &mut RunReport,
@@ -87,9 +88,9 @@ impl Engine {
                 .with(&allowed)
                 .finish();
             let inputs = RetrievalInputs {
-                rrs: &correction.rrs.rrs,
-                flags: &correction.rrs.flags,
-                surface: &radiance.truth.surface,
+                rrs: &rrs.rrs,
+                flags: &rrs.flags,
+                surface: &truth.surface,
                 bands: bands.clone(),
                 geometry: geometry.clone(),
                 nedr: nedr.clone(),
@@ -115,11 +116,11 @@ impl Engine {
                     Err(e @ RetrievalError::External { .. }) => (failed_product(spec, &inputs), Some(e.to_string())),
                     Err(e) => return Err(fail(e)),
                 };
-                let mut metrics = evaluate(&product, &radiance.truth);
+                let mut metrics = evaluate(&product, truth);
                 // Extra products scored where the algorithm says what their truth is.
-                for (key, truth) in spec.algorithm().extra_truths(&model, &radiance.truth) {
+                for (key, want) in spec.algorithm().extra_truths(&model, truth) {
                     if let Some(m) = product.map(&key) {
-                        metrics.variables.push(score_map(&product, m, &truth, &radiance.truth.surface, key));
+                        metrics.variables.push(score_map(&product, m, &want, &truth.surface, key));
                     }
                 }
                 Ok(RetrievalOutput {

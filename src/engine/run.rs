@@ -6,29 +6,78 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use super::cache::{Cache, Key, Stage};
-use super::products::RunOutput;
+use super::footprint::Footprint;
+use super::probe::{Probe, Probed};
+use super::products::{Cubes, RunOutput};
 use super::report::{RunReport, StageReport, StageStatus};
 use super::{EngineError, Fault, FaultKind, RunConfig};
 use crate::control::{PixelSite, RunControl};
 
 /// The engine: a stage cache and execution counters.
-#[derive(Debug, Default)]
+#[derive(Debug)]
 pub struct Engine {
     cache: Cache,
     executions: HashMap<Stage, u64>,
     /// The fault the current run injects, if any.
     fault: Option<Fault>,
+    /// Whether a run hands back its full-resolution cubes ([`RunOutput::cubes`]).
+    keep_cubes: bool,
 }
+
+impl Default for Engine {
+    fn default() -> Self {
+        Self { cache: Cache::default(), executions: HashMap::new(), fault: None, keep_cubes: true }
+    }
+}
+
+/// The cache budget of [`Engine::lean`]: the scene's maps, the atmosphere, the small products and
+/// a run's retrieval products, not a cube of a full-resolution image (a 1024 × 2000 × 19 f32
+/// cube is 156 MB; its Level-0 counts and flags 117 MB).
+pub const LEAN_CACHE_BYTES: usize = 64 << 20;
 
 /// Stages whose per-pixel loops report the pixel they fail at (an injected panic fires there).
 const PIXEL_STAGES: [Stage; 6] =
     [Stage::Radiance, Stage::Electrons, Stage::Level0, Stage::Level1, Stage::Correction, Stage::Retrieval];
 
 impl Engine {
-    /// An engine with an empty cache.
+    /// An engine with an empty, unbounded cache whose runs keep their cubes (what the app's
+    /// incremental reruns and `shoal simulate` want).
     #[must_use]
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// An engine for runs that keep products, not cubes (studies, sweeps, searches): each cube
+    /// is freed as soon as the next stage has read it, and the cache keeps at most
+    /// [`LEAN_CACHE_BYTES`].
+    #[must_use]
+    pub fn lean() -> Self {
+        Self { keep_cubes: false, ..Self::default() }.with_cache_budget(LEAN_CACHE_BYTES)
+    }
+
+    /// The same engine, its cache emptied and bounded to `bytes` (products past it are dropped,
+    /// least recently used first).
+    #[must_use]
+    pub fn with_cache_budget(mut self, bytes: usize) -> Self {
+        self.cache = Cache::with_budget(bytes);
+        self
+    }
+
+    /// Whether runs hand back their full-resolution cubes.
+    #[must_use]
+    pub fn keeps_cubes(&self) -> bool {
+        self.keep_cubes
+    }
+
+    /// Set whether runs hand back their full-resolution cubes ([`RunOutput::cubes`]).
+    pub fn keep_cubes(&mut self, keep: bool) {
+        self.keep_cubes = keep;
+    }
+
+    /// Bytes the cache holds now.
+    #[must_use]
+    pub fn cached_bytes(&self) -> usize {
+        self.cache.bytes()
     }
 
     /// How many times `stage` has been computed (not served from the cache) by this engine.
@@ -58,7 +107,7 @@ impl Engine {
         f: F,
     ) -> Result<Arc<T>, EngineError>
     where
-        T: Send + Sync + 'static,
+        T: Footprint + Send + Sync + 'static,
         F: FnOnce() -> Result<T, EngineError>,
     {
         if control.cancelled() {
@@ -100,14 +149,27 @@ impl Engine {
         };
         *self.executions.entry(stage).or_default() += 1;
         report.stages.push(StageReport { stage, status: StageStatus::Ran, seconds: start.elapsed().as_secs_f64() });
-        self.cache.put(key, product.clone());
+        let bytes = product.bytes();
+        self.cache.put(key, product.clone(), bytes);
         Ok(product)
     }
 
     /// Run the chain for `config`, reusing every stage whose inputs did not change. Checks
     /// `control` between stages and between rows of the heavy ones.
     pub fn run(&mut self, config: &RunConfig, control: &RunControl) -> Result<RunOutput, EngineError> {
+        self.run_with(config, control, &[])
+    }
+
+    /// [`Self::run`], keeping the Level-1 radiance and the corrected Rrs of the pixels `probes`
+    /// name ([`RunOutput::probes`]), whether or not the run keeps its cubes.
+    pub fn run_with(
+        &mut self,
+        config: &RunConfig,
+        control: &RunControl,
+        probes: &[Probe],
+    ) -> Result<RunOutput, EngineError> {
         let start = Instant::now();
+        self.cache.begin_run();
         self.fault = config.fault;
         config.validate()?;
         let mut report = RunReport {
@@ -118,19 +180,56 @@ impl Engine {
         };
         let side = self.scene_side(config, control, &mut report)?;
         let (radiance, radiance_key) = self.radiance_stage(config, &side, control, &mut report)?;
-        let inst = self.instrument_side(config, &side, &radiance, radiance_key, control, &mut report)?;
-        let (correction, correction_key) =
-            self.correction_stage(config, &side, &radiance, radiance_key, &inst, control, &mut report)?;
-        let (snr, typical) = self.snr_stage(config, &side, &radiance, &inst, control, &mut report)?;
+        let truth = radiance.truth.clone();
+        let mut probed: Vec<Probed> = probes.iter().map(|p| Probed::locate(*p, &truth, &side.viewing)).collect();
+        let typical = radiance.typical_water_w_m2_sr_nm.clone();
+        // The paper's per-scene approximation reads the pupil radiance at a few hundred pixels:
+        // taken now, so that the pupil radiance cube can go once the detector has seen it.
+        let approximation = crate::correction::SceneApproximation::new(
+            &radiance.radiance,
+            &radiance.truth_rrs,
+            &side.band_atmosphere,
+            &truth.surface,
+            config.correction.approx_points,
+            config.seed,
+        )
+        .map_err(super::stages::failed(Stage::Correction))?;
+        let truth_rrs = radiance.truth_rrs.clone();
+        let mut inst = self.instrument_side(config, &side, radiance, radiance_key, control, &mut report)?;
+        let kept_radiance = inst.radiance.take();
+        // Each cube is let go once read (the cache may still keep it, within its budget).
+        let kept_level0 = inst.level0.take().filter(|_| self.keep_cubes);
+        if let Some(level1) = &inst.level1 {
+            probed.iter_mut().for_each(|p| p.read_level1(level1));
+        }
+        let (corrected, correction_key) = self.correction_stage(
+            config,
+            &side,
+            (&truth, &truth_rrs, radiance_key),
+            approximation,
+            &inst,
+            control,
+            &mut report,
+        )?;
+        drop(truth_rrs);
+        probed.iter_mut().for_each(|p| p.read_rrs(&corrected.rrs));
+        let kept_level1 = inst.level1.take().filter(|_| self.keep_cubes);
+        let (snr, typical) = self.snr_stage(config, &side, typical, &inst, control, &mut report)?;
         let retrievals = self.retrieval_stage(
             config,
             &side,
-            &radiance,
-            (&correction, correction_key),
+            &truth,
+            (&corrected.rrs, correction_key),
             &typical,
             control,
             &mut report,
         )?;
+        let cubes = match (kept_radiance, kept_level0, kept_level1) {
+            (Some(radiance), Some(level0), Some(level1)) => {
+                Some(Cubes { radiance, level0, level1, rrs: corrected.rrs.clone() })
+            }
+            _ => None,
+        };
         report.total_seconds = start.elapsed().as_secs_f64();
         Ok(RunOutput {
             config: config.clone(),
@@ -138,14 +237,14 @@ impl Engine {
             response: side.response,
             viewing: side.viewing.clone(),
             band_atmosphere: side.band_atmosphere.clone(),
-            radiance,
-            level0: inst.level0,
+            truth,
+            cubes,
             calibration: inst.calibration,
-            level1: inst.level1,
-            correction,
+            correction: corrected.product.clone(),
             snr,
             feasibility: inst.feasibility,
             retrievals,
+            probes: probed,
             report,
         })
     }

@@ -181,12 +181,7 @@ pub fn instrument_at(out: &RunOutput, label: &str, ground_m: (f64, f64)) -> Inst
         .map(|(b, band)| {
             let peak = band.srf.values.iter().copied().fold(0.0_f64, f64::max).max(f64::MIN_POSITIVE);
             let srf = band.srf.wavelength_nm.iter().zip(&band.srf.values).map(|(&w, &v)| (w, v / peak)).collect();
-            let ok = |flags: &ndarray::Array3<u8>, r: usize, c: usize| flags[[r, c, b]] == 0;
-            let (level1, rrs) = pixel.map_or((None, None), |(r, c)| {
-                let l1 = ok(&out.level1.flags, r, c).then(|| f64::from(out.level1.radiance[[r, c, b]]) * 1000.0);
-                let rrs = ok(&out.correction.rrs.flags, r, c).then(|| f64::from(out.correction.rrs.rrs[[r, c, b]]));
-                (l1, rrs)
-            });
+            let (level1, rrs) = pixel.map_or((None, None), |(r, c)| measured_at(out, (r, c), b));
             BandAtPoint {
                 name: band.name.clone(),
                 centre_nm: band.centre_nm,
@@ -198,4 +193,19 @@ pub fn instrument_at(out: &RunOutput, label: &str, ground_m: (f64, f64)) -> Inst
         })
         .collect();
     InstrumentAtPoint { label: label.to_string(), pixel, bands }
+}
+
+/// Band `b`'s Level-1 radiance (W m⁻² sr⁻¹ µm⁻¹) and corrected Rrs (sr⁻¹) at `pixel` of `out`,
+/// each `None` where flagged: from the run's cubes when it kept them, else from a pixel it was
+/// asked to keep ([`super::Probe`]); `None` where it has neither.
+fn measured_at(out: &RunOutput, (r, c): (usize, usize), b: usize) -> (Option<f64>, Option<f64>) {
+    let good = |(v, flag): (f32, u8)| (flag == 0).then_some(f64::from(v));
+    if let Some(cubes) = &out.cubes {
+        let l1 = good((cubes.level1.radiance[[r, c, b]], cubes.level1.flags[[r, c, b]])).map(|v| v * 1000.0);
+        return (l1, good((cubes.rrs.rrs[[r, c, b]], cubes.rrs.flags[[r, c, b]])));
+    }
+    out.probes.iter().find(|p| p.pixel == Some((r, c))).map_or((None, None), |p| {
+        let l1 = p.level1.get(b).copied().and_then(good).map(|v| v * 1000.0);
+        (l1, p.rrs.get(b).copied().and_then(good))
+    })
 }

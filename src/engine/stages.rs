@@ -20,7 +20,7 @@ use crate::instrument::feasibility::Feasibility;
 use crate::instrument::sample::BandAtmosphere;
 use crate::instrument::{
     AotNodes, Detector, RadianceCube, Response, SampleOptions, SnrRow, SpatialKernel, Viewing, analytic_snr,
-    digitise_cube, expose_cube, measured_snr, sample_radiance,
+    digitise_cube, expose_and_digitise, expose_cube, measured_snr, sample_radiance,
 };
 use crate::scene::{Effect, Scene};
 use crate::toa::SceneOptics;
@@ -264,7 +264,7 @@ impl Engine {
         &mut self,
         config: &RunConfig,
         side: &SceneSide,
-        radiance: &RadianceCube,
+        radiance: Arc<RadianceCube>,
         radiance_key: Key,
         control: &RunControl,
         report: &mut RunReport,
@@ -298,14 +298,25 @@ impl Engine {
         report.warnings.clone_from(&feasibility.warnings);
         let electrons_key =
             KeyBuilder::new(Stage::Electrons).after(radiance_key).after(response_key).with(&inputs.photon).finish();
-        let electrons = self.stage(electrons_key, report, control, || {
-            expose_cube(&detector, &radiance.radiance, viewing, config.seed, control).map_err(failed(Stage::Electrons))
-        })?;
         let level0_key = KeyBuilder::new(Stage::Level0).after(electrons_key).with(&inputs.electronics).finish();
-        let level0 = self.stage(level0_key, report, control, || {
-            digitise_cube(&detector, &electrons, viewing, config.seed, control).map_err(failed(Stage::Level0))
-        })?;
-        drop(electrons);
+        let level0 = if self.keeps_cubes() {
+            // The electrons kept apart, so that a change of the electronics reruns only the readout.
+            let electrons = self.stage(electrons_key, report, control, || {
+                expose_cube(&detector, &radiance.radiance, viewing, config.seed, control)
+                    .map_err(failed(Stage::Electrons))
+            })?;
+            self.stage(level0_key, report, control, || {
+                digitise_cube(&detector, &electrons, viewing, config.seed, control).map_err(failed(Stage::Level0))
+            })?
+        } else {
+            // A lean run keeps no electrons cube: exposure and readout row by row (the same counts).
+            self.stage(level0_key, report, control, || {
+                expose_and_digitise(&detector, &radiance.radiance, viewing, config.seed, control)
+                    .map_err(failed(Stage::Level0))
+            })?
+        };
+        // The pupil radiance is let go once the detector has seen it, unless the run keeps it.
+        let radiance = self.keeps_cubes().then_some(radiance);
         (report.saturated, report.zero_counts) = (level0.saturated, level0.zero_counts);
 
         // Calibration and Level-1.
@@ -329,7 +340,16 @@ impl Engine {
             calibrate(&level0, &calibration, viewing, control).map_err(failed(Stage::Level1))
         })?;
 
-        Ok(InstrumentSide { detector, detector_key, feasibility, level0, calibration, level1, level1_key })
+        Ok(InstrumentSide {
+            radiance,
+            detector,
+            detector_key,
+            feasibility,
+            level0: self.keeps_cubes().then_some(level0),
+            calibration,
+            level1: Some(level1),
+            level1_key,
+        })
     }
 
     /// SNR at the scene's typical (median water) radiance.
@@ -337,7 +357,7 @@ impl Engine {
         &mut self,
         config: &RunConfig,
         side: &SceneSide,
-        radiance: &RadianceCube,
+        typical: Vec<f64>,
         inst: &InstrumentSide,
         control: &RunControl,
         report: &mut RunReport,
@@ -346,7 +366,6 @@ impl Engine {
         let inputs = Inputs::of(config);
         let (detector, detector_key) = (&inst.detector, inst.detector_key);
         let nb = response.n_bands();
-        let typical = radiance.typical_water_w_m2_sr_nm.clone();
         // The SNR at the user's reference radiance when one is set (the retrievals keep
         // weighting by the scene's own typical radiance).
         let at = match &config.snr_reference {

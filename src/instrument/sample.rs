@@ -52,8 +52,13 @@ pub struct SampleOptions {
 pub struct RadianceCube {
     /// Band radiance at the entrance pupil, W m⁻² sr⁻¹ nm⁻¹, (row, column, band).
     pub radiance: Array3<f32>,
-    /// The scene's truth under each pixel.
+    /// The scene's truth under each pixel (its maps).
     pub truth: Arc<Truth>,
+    /// True band remote-sensing reflectance above the surface, Rrs(0+), sr⁻¹ (0 on land),
+    /// (row, column, band), weighted by each band's response as the radiance is (the water
+    /// model's `rrs` is below the surface, rrs(0−)). A cube: kept apart from the truth's maps,
+    /// so that a run that does not keep its cubes keeps the maps alone.
+    pub truth_rrs: Arc<Array3<f32>>,
     /// Depth bins and substrate shares of the truth's water pixels, counted once per cube (runs
     /// that reuse the cube from the cache reuse them).
     pub truth_shares: super::shares::SceneShares,
@@ -164,13 +169,15 @@ pub fn sample_radiance(
         |e: ndarray::ShapeError| InstrumentError::Invalid(FieldError { field: "cube".into(), message: e.to_string() });
     let radiance = Array3::from_shape_vec((rows, cols, nb), radiance).map_err(bad)?;
     let aot = aerosol_map.is_some().then_some(aot);
-    let truth = TruthBuffers { rrs: rrs_truth, maps, fractions, land, aot }.into_truth(scene, (rows, cols, nb))?;
+    let (truth, truth_rrs) =
+        TruthBuffers { rrs: rrs_truth, maps, fractions, land, aot }.into_truth(scene, (rows, cols, nb))?;
     Ok(RadianceCube {
         brightest_water_w_m2_sr_nm: super::plausibility::brightest_water(&radiance, &truth.surface),
         typical_water_w_m2_sr_nm: super::plausibility::typical_water(&radiance, &truth.surface),
         radiance,
         truth_shares: super::shares::SceneShares::of(&truth),
         truth: Arc::new(truth),
+        truth_rrs: Arc::new(truth_rrs),
         water_evaluations: counters.iter().map(|c| c.0).sum(),
         bottom_evaluations: counters.iter().map(|c| c.1).sum(),
     })
@@ -285,16 +292,20 @@ struct TruthBuffers {
 }
 
 impl TruthBuffers {
-    /// Shape the buffers into a [`Truth`].
-    fn into_truth(self, scene: &Scene, (rows, cols, nb): (usize, usize, usize)) -> Result<Truth, InstrumentError> {
+    /// Shape the buffers into a [`Truth`] and the true Rrs cube.
+    fn into_truth(
+        self,
+        scene: &Scene,
+        (rows, cols, nb): (usize, usize, usize),
+    ) -> Result<(Truth, Array3<f32>), InstrumentError> {
         let bad = |e: ndarray::ShapeError| {
             InstrumentError::Invalid(FieldError { field: "truth".into(), message: e.to_string() })
         };
         let shallow = scene.depth.is_some();
         let maps = self.maps;
         let plane = |k: usize| Array2::from_shape_fn((rows, cols), |(r, c)| maps[(r * cols + c) * 4 + k]);
+        let rrs = Array3::from_shape_vec((rows, cols, nb), self.rrs).map_err(bad)?;
         let truth = Truth {
-            rrs_above: Array3::from_shape_vec((rows, cols, nb), self.rrs).map_err(bad)?,
             chl_mg_m3: plane(0),
             nap_g_m3: plane(1),
             cdom_per_m: plane(2),
@@ -308,7 +319,7 @@ impl TruthBuffers {
             aot550: self.aot.map(|a| Array2::from_shape_vec((rows, cols), a)).transpose().map_err(bad)?,
             substrate_names: scene.substrates.iter().map(|(n, _)| n.clone()).collect(),
         };
-        Ok(truth)
+        Ok((truth, rrs))
     }
 }
 

@@ -10,10 +10,6 @@ use ndarray::{Array2, Array3};
 /// The scene's truth at each pixel centre, (row, column) maps on the instrument's grid.
 #[derive(Debug, Clone, Default)]
 pub struct Truth {
-    /// True band remote-sensing reflectance above the surface, Rrs(0+), sr⁻¹ (0 on land),
-    /// (row, column, band), weighted by each band's response as the radiance is.
-    /// (The water model's `rrs` is below the surface, rrs(0−).)
-    pub rrs_above: Array3<f32>,
     /// Chlorophyll-a, mg m⁻³.
     pub chl_mg_m3: Array2<f32>,
     /// Non-algal particles, g m⁻³.

@@ -267,7 +267,6 @@ mod tests {
         let wobble = |r: usize, c: usize, k: f32| 1.0 + 0.3 * ((r * 7 + c) as f32 * k).sin();
         let truth_map = |k: f32| Array2::from_shape_fn((rows, cols), |(r, c)| 0.5 + (r + c) as f32 * 0.05 * k);
         let truth = Truth {
-            rrs_above: Array3::zeros((rows, cols, 1)),
             chl_mg_m3: truth_map(1.0),
             nap_g_m3: truth_map(2.0),
             cdom_per_m: truth_map(0.1),

@@ -209,6 +209,15 @@ fn finite(field: &str, v: f64) -> Result<(), SceneError> {
 }
 
 impl Map {
+    /// Bytes the map holds (a raster's cells; an analytic map holds none).
+    #[must_use]
+    pub fn bytes(&self) -> usize {
+        match &self.kind {
+            Kind::Raster(cells) => cells.len() * std::mem::size_of::<f32>(),
+            _ => 0,
+        }
+    }
+
     /// Build a map over `extent`; `field` names it in errors, `ctx` resolves files. A raster
     /// map may hold NaN where its file has no data (see [`super::raster::fill_nodata`]).
     pub fn build(spec: &MapSpec, extent: Extent, field: &str, ctx: &mut MapContext<'_>) -> Result<Self, SceneError> {

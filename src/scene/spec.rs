@@ -274,6 +274,15 @@ pub struct Scene {
 }
 
 impl Scene {
+    /// Bytes the scene's maps hold.
+    #[must_use]
+    pub fn map_bytes(&self) -> usize {
+        let optional = [&self.depth, &self.land, &self.aot550];
+        [&self.chl, &self.nap, &self.cdom].iter().map(|m| m.bytes()).sum::<usize>()
+            + optional.iter().filter_map(|m| m.as_ref()).map(Map::bytes).sum::<usize>()
+            + self.substrates.iter().map(|(_, m)| m.bytes()).sum::<usize>()
+    }
+
     /// Validate `spec` and build its maps; `base_dir` is the scene file's directory.
     pub fn build(spec: &SceneSpec, base_dir: Option<&Path>) -> Result<Self, SceneError> {
         spec.validate()?;

@@ -126,10 +126,11 @@ fn file(dir: &Path, name: &str, raster: &Raster, o: &mut Outputs) -> Result<(), 
 /// Write the run's products as GeoTIFF into `dir`, with the same tables, report and resolved
 /// configuration as [`super::write_run`] writes beside its `.npy` cubes.
 pub fn write_run_geotiff(out: &RunOutput, dir: &Path) -> Result<Outputs, StudyError> {
+    let cubes = super::output::kept_cubes(out)?;
     std::fs::create_dir_all(dir).map_err(|e| StudyError::Io(format!("cannot create {}: {e}", dir.display())))?;
     let mut o = Outputs::default();
     let bands = &out.response.bands.bands;
-    let truth = &out.radiance.truth;
+    let truth = &out.truth;
     // The georeference and metadata every file shares, computed once (the affine fit visits
     // every pixel twice).
     let shared = base(out);
@@ -138,14 +139,14 @@ pub fn write_run_geotiff(out: &RunOutput, dir: &Path) -> Result<Outputs, StudyEr
 
     let mut l1 = shared.clone();
     for (b, band) in bands.iter().enumerate() {
-        l1.bands.push(cube_plane(&out.level1.radiance, b, &all));
+        l1.bands.push(cube_plane(&cubes.level1.radiance, b, &all));
         l1.descriptions.push(format!("L1 radiance {} ({:.1} nm)", band.name, band.centre_nm));
         l1.units.push("W m-2 sr-1 nm-1".into());
     }
     l1.nodata = Some(NODATA);
     file(dir, "level1_radiance.tif", &l1, &mut o)?;
 
-    let rrs = &out.correction.rrs;
+    let rrs = &cubes.rrs;
     let valid = |b: usize| move |r: usize, c: usize| rrs.flags[[r, c, b]] & crate::correction::RrsFlags::INVALID == 0;
     let mut rr = shared.clone();
     for (b, band) in bands.iter().enumerate() {

@@ -21,7 +21,7 @@ use netcdf3::DataSet;
 use super::StudyError;
 use super::output::Outputs;
 use crate::correction::RrsFlags;
-use crate::engine::RunOutput;
+use crate::engine::{Cubes, RunOutput};
 use crate::netcdf::{
     CUBE, FlagVar, FloatVar, MAP, Values, attrs, define_vars, masked, meaning, standard_name, write_file,
 };
@@ -40,12 +40,13 @@ const CUBE_COORDINATES: &str = "y x wavelength bandwidth band_name";
 /// Write `out`'s products into `dir/products.nc` (atomically: a temporary file, synced, then
 /// renamed).
 pub fn write_netcdf(out: &RunOutput, dir: &Path, o: &mut Outputs) -> Result<(), StudyError> {
-    let (rows, cols, nb) = out.level1.radiance.dim();
+    let cubes = super::output::kept_cubes(out)?;
+    let (rows, cols, nb) = cubes.level1.radiance.dim();
     let mut floats: Vec<FloatVar> = Vec::new();
     let mut flags: Vec<FlagVar> = Vec::new();
     coordinate_vars(out, &mut floats);
-    radiometry_vars(out, &mut floats, &mut flags);
-    truth_vars(out, &mut floats, &mut flags);
+    radiometry_vars(cubes, &mut floats, &mut flags);
+    truth_vars(out, cubes, &mut floats, &mut flags);
     retrieval_vars(out, &mut floats, &mut flags);
     let (data_set, names) = define(out, (rows, cols, nb), &floats, &flags)?;
     let path = dir.join(FILE);
@@ -56,7 +57,7 @@ pub fn write_netcdf(out: &RunOutput, dir: &Path, o: &mut Outputs) -> Result<(), 
 
 /// The bands, and every pixel's ground position.
 fn coordinate_vars<'a>(out: &'a RunOutput, floats: &mut Vec<FloatVar<'a>>) {
-    let (rows, cols, _) = out.level1.radiance.dim();
+    let (rows, cols, _) = out.report.shape;
     let bands = &out.response.bands.bands;
     floats.push(FloatVar {
         name: "wavelength".into(),
@@ -104,7 +105,7 @@ fn coordinate_vars<'a>(out: &'a RunOutput, floats: &mut Vec<FloatVar<'a>>) {
 }
 
 /// Level-1 and Rrs with its flags.
-fn radiometry_vars<'a>(out: &'a RunOutput, floats: &mut Vec<FloatVar<'a>>, flags: &mut Vec<FlagVar<'a>>) {
+fn radiometry_vars<'a>(cubes: &'a Cubes, floats: &mut Vec<FloatVar<'a>>, flags: &mut Vec<FlagVar<'a>>) {
     let cube_coordinates = ("coordinates", CUBE_COORDINATES.to_string());
     let mut l1 = attrs("top-of-atmosphere radiance (Level-1, calibrated)", "W m-2 sr-1 nm-1", None);
     l1.push(cube_coordinates.clone());
@@ -112,9 +113,9 @@ fn radiometry_vars<'a>(out: &'a RunOutput, floats: &mut Vec<FloatVar<'a>>, flags
         name: "level1_radiance".into(),
         dims: CUBE.to_vec(),
         attrs: l1,
-        values: Values::lazy(move || masked(out.level1.radiance.iter().copied(), |_| true)),
+        values: Values::lazy(move || masked(cubes.level1.radiance.iter().copied(), |_| true)),
     });
-    let rrs = &out.correction.rrs;
+    let rrs = &cubes.rrs;
     let rrs_flags = rrs.flags.as_slice().unwrap_or_default();
     let mut a = attrs("remote-sensing reflectance above the surface, corrected", "sr-1", standard_name("rrs"));
     a.push(cube_coordinates.clone());
@@ -141,9 +142,10 @@ fn radiometry_vars<'a>(out: &'a RunOutput, floats: &mut Vec<FloatVar<'a>>, flags
 }
 
 /// The truth, and the aerosol an image-based correction found.
-fn truth_vars<'a>(out: &'a RunOutput, floats: &mut Vec<FloatVar<'a>>, flags: &mut Vec<FlagVar<'a>>) {
-    let truth = &out.radiance.truth;
-    let nb = out.level1.radiance.dim().2;
+fn truth_vars<'a>(out: &'a RunOutput, cubes: &'a Cubes, floats: &mut Vec<FloatVar<'a>>, flags: &mut Vec<FlagVar<'a>>) {
+    let truth = &out.truth;
+    let true_rrs = &*cubes.radiance.truth_rrs;
+    let nb = cubes.level1.radiance.dim().2;
     let water = |i: usize| truth.surface.is_water_at(i);
     let coordinates = ("coordinates", MAP_COORDINATES.to_string());
     let cube_coordinates = ("coordinates", CUBE_COORDINATES.to_string());
@@ -155,7 +157,7 @@ fn truth_vars<'a>(out: &'a RunOutput, floats: &mut Vec<FloatVar<'a>>, flags: &mu
         name: "true_rrs".into(),
         dims: CUBE.to_vec(),
         attrs: a,
-        values: Values::lazy(move || masked(truth.rrs_above.iter().copied(), |i| water(i / nbw))),
+        values: Values::lazy(move || masked(true_rrs.iter().copied(), |i| water(i / nbw))),
     });
     let mut truth_maps: Vec<(&str, &ndarray::Array2<f32>)> =
         vec![("chl_mg_m3", &truth.chl_mg_m3), ("nap_g_m3", &truth.nap_g_m3), ("cdom_per_m", &truth.cdom_per_m)];

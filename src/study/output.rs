@@ -107,19 +107,29 @@ pub fn snr_csv(out: &RunOutput) -> String {
     csv.finish()
 }
 
+/// The cubes of `out`, which a writer of cubes needs: a run of an engine that does not keep
+/// them ([`crate::engine::Engine::lean`]) has none, and says so.
+pub(crate) fn kept_cubes(out: &RunOutput) -> Result<&crate::engine::Cubes, StudyError> {
+    out.cubes.as_ref().ok_or_else(|| StudyError::Run {
+        instrument: out.config.instrument.name.clone(),
+        message: "the run kept no cubes to write (its engine was asked for products only)".into(),
+    })
+}
+
 /// Write every product of one run into `dir`: Level-0, Level-1, Rrs, the truth, the retrievals'
 /// maps, the SNR table, the report and the resolved configuration.
 pub fn write_run(out: &RunOutput, dir: &Path) -> Result<Outputs, StudyError> {
+    let cubes = kept_cubes(out)?;
     std::fs::create_dir_all(dir).map_err(|e| StudyError::Io(format!("cannot create {}: {e}", dir.display())))?;
     let mut o = Outputs::default();
-    let r = &out.radiance.truth;
-    npy(dir, "level0_dn.npy", &out.level0.dn, &mut o)?;
-    npy(dir, "level0_flags.npy", &out.level0.flags, &mut o)?;
-    npy(dir, "level1_radiance.npy", &out.level1.radiance, &mut o)?;
-    npy(dir, "rrs.npy", &out.correction.rrs.rrs, &mut o)?;
-    npy(dir, "rrs_flags.npy", &out.correction.rrs.flags, &mut o)?;
-    npy(dir, "pupil_radiance.npy", &out.radiance.radiance, &mut o)?;
-    npy(dir, "truth_rrs.npy", &r.rrs_above, &mut o)?;
+    let r = &out.truth;
+    npy(dir, "level0_dn.npy", &cubes.level0.dn, &mut o)?;
+    npy(dir, "level0_flags.npy", &cubes.level0.flags, &mut o)?;
+    npy(dir, "level1_radiance.npy", &cubes.level1.radiance, &mut o)?;
+    npy(dir, "rrs.npy", &cubes.rrs.rrs, &mut o)?;
+    npy(dir, "rrs_flags.npy", &cubes.rrs.flags, &mut o)?;
+    npy(dir, "pupil_radiance.npy", &cubes.radiance.radiance, &mut o)?;
+    npy(dir, "truth_rrs.npy", &*cubes.radiance.truth_rrs, &mut o)?;
     npy(dir, "truth_chl_mg_m3.npy", &r.chl_mg_m3, &mut o)?;
     npy(dir, "truth_nap_g_m3.npy", &r.nap_g_m3, &mut o)?;
     npy(dir, "truth_cdom_per_m.npy", &r.cdom_per_m, &mut o)?;

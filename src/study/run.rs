@@ -47,11 +47,14 @@ pub struct StudyResult {
     pub spectrum: Option<Arc<super::spectrum_figure::StudySpectrum>>,
 }
 
-/// Run every configuration of `study`; `on_run` sees each full run output (to write its cubes)
-/// before it is reduced to what the tables and figures need.
+/// Run every configuration of `study`; `on_run` sees each run output (with its cubes, to write
+/// them, when `keep_cubes`) before it is reduced to what the tables and figures need. Runs are
+/// made one at a time by a lean engine ([`Engine::lean`]): a study holds its runs' products and
+/// truth maps, never more than one run's cubes.
 pub fn run_study(
     study: &ResolvedStudy,
     control: &RunControl,
+    keep_cubes: bool,
     mut on_run: impl FnMut(usize, &RunOutput) -> Result<(), StudyError>,
 ) -> Result<StudyResult, StudyError> {
     // The runs together against the machine's budget, before any runs (each run checks itself
@@ -59,12 +62,24 @@ pub fn run_study(
     let budget = crate::budget::Budget::from_env()
         .map_err(|m| StudyError::Invalid(crate::parse::FieldError { field: "budget".into(), message: m }))?;
     let configs: Vec<&crate::engine::RunConfig> = study.runs.iter().map(|r| &r.2).collect();
-    budget.check(&crate::engine::resources::study_demand(&configs))?;
-    let mut engine = Engine::new();
+    // Seeds after an instrument's first reuse its pupil radiance: the cache keeps the largest.
+    let seeds = study.runs.iter().filter(|r| r.0 == study.runs[0].0).count();
+    let radiance = configs.iter().map(|c| crate::engine::resources::radiance_bytes(c)).max().unwrap_or(0);
+    let cache_bytes = crate::engine::LEAN_CACHE_BYTES + if seeds > 1 { radiance } else { 0 };
+    budget.check(&crate::engine::resources::study_demand(&configs, keep_cubes, cache_bytes))?;
+    let mut engine = Engine::lean().with_cache_budget(cache_bytes);
+    engine.keep_cubes(keep_cubes);
     let mut runs: Vec<StudyRun> = Vec::with_capacity(study.runs.len());
     let mut spectrum: Option<super::spectrum_figure::StudySpectrum> = None;
     for (i, (label, seed, config)) in study.runs.iter().enumerate() {
-        let out = engine.run(config, control).map_err(|e| match e {
+        // The spectrum figure's pixel: the first run's typical water pixel, then the point it
+        // falls on in each later run (kept by the run, which does not keep its cubes).
+        let probes = match &spectrum {
+            None if i == 0 => vec![crate::engine::Probe::TypicalWater],
+            None => Vec::new(),
+            Some(s) => vec![crate::engine::Probe::Ground(s.point.ground_m.0, s.point.ground_m.1)],
+        };
+        let out = engine.run_with(config, control, &probes).map_err(|e| match e {
             EngineError::Cancelled => StudyError::Cancelled,
             internal @ EngineError::Internal { .. } => {
                 StudyError::Internal { instrument: label.clone(), message: internal.to_string() }
@@ -97,7 +112,7 @@ impl StudyRun {
             report: out.report.clone(),
             snr: out.snr.clone(),
             retrievals: out.retrievals.clone(),
-            truth: Arc::clone(&out.radiance.truth),
+            truth: Arc::clone(&out.truth),
             viewing: Arc::clone(&out.viewing),
             feasibility: Arc::clone(&out.feasibility),
             frame: out.scene.frame.clone(),

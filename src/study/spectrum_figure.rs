@@ -21,23 +21,10 @@ pub struct StudySpectrum {
     pub instruments: Vec<InstrumentAtPoint>,
 }
 
-/// A typical water pixel of `out`: the one whose true chl-a is the median of the water pixels
-/// (the first such in row order); `None` without water.
+/// A typical water pixel of `out` ([`crate::engine::probe::typical_water_pixel`]).
 #[must_use]
 pub fn typical_water_pixel(out: &RunOutput) -> Option<(usize, usize)> {
-    let truth = &out.radiance.truth;
-    let mut water: Vec<(f32, usize, usize)> = truth
-        .chl_mg_m3
-        .indexed_iter()
-        .filter(|((r, c), v)| truth.is_water(*r, *c) && v.is_finite())
-        .map(|((r, c), v)| (*v, r, c))
-        .collect();
-    if water.is_empty() {
-        return None;
-    }
-    let mid = water.len() / 2;
-    water.select_nth_unstable_by(mid, |a, b| a.0.total_cmp(&b.0).then((a.1, a.2).cmp(&(b.1, b.2))));
-    Some((water[mid].1, water[mid].2))
+    crate::engine::probe::typical_water_pixel(&out.truth)
 }
 
 impl StudySpectrum {

@@ -70,7 +70,7 @@ pub fn run_job(
         other => StudyError::Run { instrument: format!("{label} at {settings:?}"), message: other.to_string() },
     })?;
     let secs = start.elapsed().as_secs_f64();
-    let (r, c, b) = out.level0.dn.dim();
+    let (r, c, b) = out.report.shape;
     let saturated_pct = 100.0 * out.report.saturated as f64 / (r * c * b).max(1) as f64;
     // The measured SNR at the band-pair correction's two bands.
     let snr_pair = match &config.correction.image {

@@ -3,6 +3,7 @@
 //! to it. (Renormalising the environment kernel to the scene's window made the small scene's
 //! adjacency 1.34× larger at 443 nm and 1.18× at 865 nm.)
 
+use crate::common::Kept;
 use shoal::engine::RunConfig;
 use shoal::instrument::InstrumentSpec;
 use shoal::scene::{Effect, MapSpec, SceneSpec};
@@ -40,7 +41,7 @@ fn adjacency_radiance(size_m: f64) -> (f64, f64) {
     let radiance = |adjacency: bool| {
         let mut c = RunConfig::new(island_scene(size_m, adjacency), instrument.clone());
         c.detector.noise = false;
-        run(&c).radiance.radiance.clone()
+        run(&c).kept().radiance.radiance.clone()
     };
     let (with, without) = (radiance(true), radiance(false));
     // Detector 33 of 40 looks ~13 GSD (≈ 260 m) east of the centre line; line 1 is the middle one.

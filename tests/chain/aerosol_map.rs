@@ -2,6 +2,7 @@
 //! atmosphere pixel by pixel, the exact correction that knows it, and dark-spectrum fitting in
 //! tiles that follows it.
 
+use crate::common::Kept;
 use shoal::atmosphere::AerosolType;
 use shoal::correction::{ImageCorrection, RrsFlags};
 use shoal::engine::{RunConfig, RunOutput};
@@ -33,10 +34,11 @@ fn front() -> MapSpec {
 
 /// Largest |a/b − 1| over every pixel and band of two radiance cubes.
 fn max_relative(a: &RunOutput, b: &RunOutput) -> f64 {
-    a.radiance
+    a.kept()
+        .radiance
         .radiance
         .iter()
-        .zip(b.radiance.radiance.iter())
+        .zip(b.kept().radiance.radiance.iter())
         .map(|(x, y)| (f64::from(*x) / f64::from(*y) - 1.0).abs())
         .fold(0.0, f64::max)
 }
@@ -51,14 +53,14 @@ fn a_pixel_under_the_map_sees_the_atmosphere_of_its_own_optical_thickness() {
     // A front: a pixel between nodes, against a scene whose constant AOT is that pixel's, adds
     // the quadratic interpolation between nodes 0.05 apart.
     let front_run = run(&hazy(Some(front()), 0.1));
-    let aot = front_run.radiance.truth.aot550.as_ref().expect("the truth holds the map");
+    let aot = front_run.truth.aot550.as_ref().expect("the truth holds the map");
     let (rows, cols) = aot.dim();
     let (r, c) = (rows / 2, cols / 3);
     let tau = f64::from(aot[[r, c]]);
     let at_tau = run(&hazy(None, tau));
-    let pixel = (0..front_run.radiance.radiance.dim().2)
+    let pixel = (0..front_run.kept().radiance.radiance.dim().2)
         .map(|b| {
-            let (x, y) = (front_run.radiance.radiance[[r, c, b]], at_tau.radiance.radiance[[r, c, b]]);
+            let (x, y) = (front_run.kept().radiance.radiance[[r, c, b]], at_tau.kept().radiance.radiance[[r, c, b]]);
             (f64::from(x) / f64::from(y) - 1.0).abs()
         })
         .fold(0.0, f64::max);
@@ -78,16 +80,16 @@ fn a_pixel_under_the_map_sees_the_atmosphere_of_its_own_optical_thickness() {
 #[test]
 fn the_exact_correction_knows_each_pixels_atmosphere() {
     let out = run(&hazy(Some(front()), 0.1));
-    let (rows, cols, nb) = out.correction.rrs.rrs.dim();
+    let (rows, cols, nb) = out.kept().rrs.rrs.dim();
     let mut worst: f64 = 0.0;
     for r in 0..rows {
         for c in 0..cols {
             for b in 0..nb {
-                let t = f64::from(out.radiance.truth.rrs_above[[r, c, b]]);
-                if out.correction.rrs.flags[[r, c, b]] & RrsFlags::INVALID != 0 || t < 1e-4 {
+                let t = f64::from(out.kept().radiance.truth_rrs[[r, c, b]]);
+                if out.kept().rrs.flags[[r, c, b]] & RrsFlags::INVALID != 0 || t < 1e-4 {
                     continue;
                 }
-                worst = worst.max((f64::from(out.correction.rrs.rrs[[r, c, b]]) / t - 1.0).abs());
+                worst = worst.max((f64::from(out.kept().rrs.rrs[[r, c, b]]) / t - 1.0).abs());
             }
         }
     }

@@ -2,6 +2,7 @@
 //! grid, noise-free, on a deep lake, a shallow reef (bottom and substrate mixture) and a
 //! hyperspectral instrument (many narrow bands), and the land and adjacency fallbacks.
 
+use crate::common::Kept;
 use shoal::engine::RunConfig;
 use shoal::instrument::DetectorMode;
 
@@ -47,8 +48,8 @@ fn band_nodes_reproduce_the_grid_radiance_and_truth() {
     ] {
         let grid = run(&config(scene.clone(), instrument, 0));
         let nodes_run = run(&config(scene.clone(), instrument, nodes));
-        let radiance = worst(&nodes_run.radiance.radiance, &grid.radiance.radiance, 0.0);
-        let truth = worst(&nodes_run.radiance.truth.rrs_above, &grid.radiance.truth.rrs_above, 1e-4);
+        let radiance = worst(&nodes_run.kept().radiance.radiance, &grid.kept().radiance.radiance, 0.0);
+        let truth = worst(&nodes_run.kept().radiance.truth_rrs, &grid.kept().radiance.truth_rrs, 1e-4);
         println!("{} / {instrument}, {nodes} nodes: radiance {radiance:.2e}, truth Rrs {truth:.2e}", scene.name);
         assert!(radiance > 0.0, "{instrument}: the node path did not run");
         assert!(radiance < radiance_tol, "{} / {instrument}: radiance off by {radiance:.2e}", scene.name);
@@ -65,7 +66,7 @@ fn land_and_adjacency_keep_the_full_grid() {
     assert!(scene.effects.contains(&Effect::Adjacency));
     let grid = run(&config(scene.clone(), "cubesat", 0));
     let nodes = run(&config(scene, "cubesat", 4));
-    assert_eq!(nodes.radiance.radiance, grid.radiance.radiance);
+    assert_eq!(nodes.kept().radiance.radiance, grid.kept().radiance.radiance);
     // Land pixels take the grid path: their radiance is the grid's, bit for bit.
     // The whole swath at 1/8 resolution, so the shore is in view.
     let scene = without_adjacency(SceneSpec::preset("reservoir_chl_cdom").unwrap());
@@ -78,17 +79,21 @@ fn land_and_adjacency_keep_the_full_grid() {
     };
     let grid = run(&whole(0));
     let nodes = run(&whole(4));
-    let land = &grid.radiance.truth.surface.codes();
+    let land = &grid.truth.surface.codes();
     let n_land = land.iter().filter(|&&l| l != 0).count();
     assert!(n_land > 0 && n_land < land.len(), "the scene has land and water in view ({n_land} land)");
     for ((r, c), &l) in land.indexed_iter() {
         if l != 0 {
-            for b in 0..grid.radiance.radiance.dim().2 {
-                assert_eq!(nodes.radiance.radiance[[r, c, b]], grid.radiance.radiance[[r, c, b]], "land ({r}, {c})");
+            for b in 0..grid.kept().radiance.radiance.dim().2 {
+                assert_eq!(
+                    nodes.kept().radiance.radiance[[r, c, b]],
+                    grid.kept().radiance.radiance[[r, c, b]],
+                    "land ({r}, {c})"
+                );
             }
         }
     }
-    assert!(nodes.radiance.radiance != grid.radiance.radiance, "the water took the node path");
+    assert!(nodes.kept().radiance.radiance != grid.kept().radiance.radiance, "the water took the node path");
 }
 
 #[test]
@@ -102,8 +107,8 @@ fn the_single_precision_water_kernel_gives_the_same_products_within_its_rounding
         let mut c = config(scene.clone(), instrument, 4);
         c.fidelity.water_single_precision = true;
         let single = run(&c);
-        let radiance = worst(&single.radiance.radiance, &double.radiance.radiance, 0.0);
-        let truth = worst(&single.radiance.truth.rrs_above, &double.radiance.truth.rrs_above, 1e-4);
+        let radiance = worst(&single.kept().radiance.radiance, &double.kept().radiance.radiance, 0.0);
+        let truth = worst(&single.kept().radiance.truth_rrs, &double.kept().radiance.truth_rrs, 1e-4);
         println!("{} / {instrument}: radiance {radiance:.2e}, truth Rrs {truth:.2e}", scene.name);
         assert!(radiance > 0.0, "{instrument}: the single-precision kernel did not run");
         assert!(radiance < 1e-5 && truth < 1e-5, "{}: radiance {radiance:.2e}, truth {truth:.2e}", scene.name);

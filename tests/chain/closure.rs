@@ -1,6 +1,7 @@
 //! Closure: with noise and quantisation off, Level-1 returns the pupil radiance and the exact
 //! atmospheric correction returns the true Rrs; the paper's approximation has its error reported.
 
+use crate::common::Kept;
 use shoal::correction::RrsFlags;
 use shoal::engine::RunConfig;
 use shoal::instrument::DetectorMode;
@@ -45,17 +46,17 @@ fn noise_free_level1_returns_pupil_radiance_and_rrs() {
         // scene without it (adjacency's own test is below).
         config.scene.effects.retain(|e| *e != shoal::scene::Effect::Adjacency);
         let out = run(&config);
-        let rad = &out.radiance;
+        let rad = &out.kept().radiance;
         // Level-1: f32 storage (6e-8) and the calibration's own arithmetic; 1e-4 is the target.
-        let l1 = max_rel(&out.level1.radiance, &rad.radiance, |_, _, _| false, 0.0);
+        let l1 = max_rel(&out.kept().level1.radiance, &rad.radiance, |_, _, _| false, 0.0);
         assert!(l1 < 1e-4, "{instrument}: Level-1 vs pupil radiance {l1:e}");
         // Exact correction: within-band covariance of order S·π·Rrs·var(Rrs)/Rrs² (module docs)
         // plus f32 rounding amplified by L_TOA/Lw; 1e-4 is the target.
         let land = &rad.truth.surface.codes();
-        let rrs = max_rel(&out.correction.rrs.rrs, &rad.truth.rrs_above, |r, c, _| land[[r, c]] != 0, 1e-5);
+        let rrs = max_rel(&out.kept().rrs.rrs, &rad.truth_rrs, |r, c, _| land[[r, c]] != 0, 1e-5);
         assert!(rrs < 1e-4, "{instrument} over {}: exact AC vs truth {rrs:e}", config.scene.name);
         // No water pixel is flagged.
-        for ((r, c, _), f) in out.correction.rrs.flags.indexed_iter() {
+        for ((r, c, _), f) in out.kept().rrs.flags.indexed_iter() {
             if land[[r, c]] == 0 {
                 assert_eq!(*f & (RrsFlags::INVALID | RrsFlags::SATURATED), 0);
             }
@@ -76,11 +77,11 @@ fn adjacency_is_error_the_exact_correction_does_not_remove() {
     let without = run(&config);
     // Over water, the bright cay adds light in the near infrared (vegetation reflects 0.42 at
     // 865 nm, water far less): never less, within f32 rounding; somewhere noticeably more.
-    let (a, b) = (&with.radiance.radiance, &without.radiance.radiance);
+    let (a, b) = (&with.kept().radiance.radiance, &without.kept().radiance.radiance);
     let nir = 16; // Oa17, 865 nm
     let mut brighter = 0;
     for ((r, c, k), x) in a.indexed_iter() {
-        if k == nir && with.radiance.truth.surface.codes()[[r, c]] == 0 {
+        if k == nir && with.truth.surface.codes()[[r, c]] == 0 {
             let y = b[[r, c, k]];
             assert!(*x >= y * (1.0 - 1e-6), "({r},{c}): {x} < {y}");
             brighter += usize::from(*x > y * 1.001);
@@ -98,7 +99,7 @@ fn optically_deep_limit_never_evaluates_the_bottom() {
     let out = run(&closure_config(small_lake(), "nominal"));
     assert!(out.report.water_evaluations > 0);
     assert_eq!(out.report.bottom_evaluations, 0);
-    assert!(out.radiance.truth.depth_m.is_none());
+    assert!(out.truth.depth_m.is_none());
     let skipped: Vec<_> = out.report.skipped_effects.iter().map(|s| s.effect).collect();
     assert!(skipped.contains(&shoal::scene::Effect::ShallowBottom));
     // The reef evaluates the bottom at every water sample.
@@ -119,8 +120,8 @@ fn zero_second_dark_frames_leave_the_dark_signal_in_level1() {
     let det = shoal::instrument::Detector::new(&config.instrument, &out.response, DetectorMode::IDEAL, config.seed);
     let j = out.viewing.detector_index[10];
     for b in [0, 8, 16] {
-        let l = f64::from(out.radiance.radiance[[5, 10, b]]);
-        let excess = f64::from(out.level1.radiance[[5, 10, b]]) - l;
+        let l = f64::from(out.kept().radiance.radiance[[5, 10, b]]);
+        let excess = f64::from(out.kept().level1.radiance[[5, 10, b]]) - l;
         let l_d = out.calibration.diffuser_radiance[j * 19 + b];
         let k = det.responsivity(j, b);
         let expected = 300.0 * (l_d - l) / (k * l_d + 300.0);
@@ -136,7 +137,7 @@ fn keystone_misregisters_bands_and_shows_as_error() {
         *keystone_px = 0.0;
     }
     let without = run(&config);
-    let (a, b) = (&with.radiance.radiance, &without.radiance.radiance);
+    let (a, b) = (&with.kept().radiance.radiance, &without.kept().radiance.radiance);
     let nb = a.dim().2;
     // The first band is shifted by −0.1 pixel, the last by +0.1: interpolated between columns.
     for (k, shift) in [(0usize, -0.1f32), (nb - 1, 0.1)] {

@@ -10,6 +10,7 @@
 //! diffuser incidence; a spectrograph or filter imager for their `kind` fields. It is small (a
 //! 16 × 12 image) so that each edit costs two short runs.
 
+use crate::common::Kept;
 use std::hash::{Hash, Hasher};
 
 use shoal::control::RunControl;
@@ -118,14 +119,14 @@ fn fingerprint(out: &RunOutput) -> Fingerprint {
     let bits = |a: &ndarray::Array3<f32>| h(&a.iter().map(|v| v.to_bits()).collect::<Vec<_>>());
     let bits2 = |a: &ndarray::Array2<f32>| h(&a.iter().map(|v| v.to_bits()).collect::<Vec<_>>());
     let mut f = vec![
-        ("pupil radiance".to_string(), bits(&out.radiance.radiance)),
-        ("true Rrs".into(), bits(&out.radiance.truth.rrs_above)),
-        ("true chl".into(), bits2(&out.radiance.truth.chl_mg_m3)),
-        ("level-0 DN".into(), h(&out.level0.dn.iter().collect::<Vec<_>>())),
-        ("level-0 flags".into(), h(&out.level0.flags.iter().collect::<Vec<_>>())),
-        ("level-1".into(), bits(&out.level1.radiance)),
-        ("Rrs".into(), bits(&out.correction.rrs.rrs)),
-        ("Rrs flags".into(), h(&out.correction.rrs.flags.iter().collect::<Vec<_>>())),
+        ("pupil radiance".to_string(), bits(&out.kept().radiance.radiance)),
+        ("true Rrs".into(), bits(&out.kept().radiance.truth_rrs)),
+        ("true chl".into(), bits2(&out.truth.chl_mg_m3)),
+        ("level-0 DN".into(), h(&out.kept().level0.dn.iter().collect::<Vec<_>>())),
+        ("level-0 flags".into(), h(&out.kept().level0.flags.iter().collect::<Vec<_>>())),
+        ("level-1".into(), bits(&out.kept().level1.radiance)),
+        ("Rrs".into(), bits(&out.kept().rrs.rrs)),
+        ("Rrs flags".into(), h(&out.kept().rrs.flags.iter().collect::<Vec<_>>())),
         ("correction diagnostics".into(), h(&format!("{:?}", out.report.approximation))),
         ("SNR".into(), h(&format!("{:?}", out.snr))),
         ("warnings".into(), h(&format!("{:?}", out.report.warnings))),

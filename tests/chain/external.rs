@@ -3,6 +3,7 @@
 //! runs too long, writes the wrong thing, was not allowed) costs its own product only, with a
 //! message that says why.
 
+use crate::common::Kept;
 use shoal::correction::RrsFlags;
 use shoal::engine::{RunConfig, RunOutput};
 use shoal::instrument::DetectorMode;
@@ -39,7 +40,7 @@ pub(super) fn run_with(retrieval: RetrievalSpec) -> RunOutput {
 
 /// The truth's chl × `factor` on water, the fill value on land, as a (line, pixel) vector.
 fn scaled_truth(out: &RunOutput, factor: f32) -> Vec<f32> {
-    let t = &out.radiance.truth;
+    let t = &out.truth;
     t.chl_mg_m3
         .indexed_iter()
         .map(|((r, c), v)| if t.surface.codes()[[r, c]] != 0 { -9999.0 } else { v * factor })
@@ -59,7 +60,7 @@ fn a_program_s_products_are_read_back_and_scored_like_any_retrieval() {
     let reference = run_with(external("copy_missing", &["true"], &["chl_mg_m3"]));
     let dir = Dir::new("external-copy");
     let file = dir.path().join("made.nc");
-    product_file(&file, reference.radiance.truth.chl_mg_m3.dim(), &[("chl_mg_m3", scaled_truth(&reference, 1.1))]);
+    product_file(&file, reference.truth.chl_mg_m3.dim(), &[("chl_mg_m3", scaled_truth(&reference, 1.1))]);
     let out = run_with(external("copier", &["cp", file.to_str().unwrap(), "{output}"], &["chl_mg_m3"]));
     assert_almi_kept(&out);
     let ext = &out.retrievals[1];
@@ -80,7 +81,7 @@ fn a_program_s_products_are_read_back_and_scored_like_any_retrieval() {
     let nothing = &reference.retrievals[1];
     let why = nothing.failure.as_deref().unwrap();
     assert!(why.contains("without writing its output"), "{why}");
-    assert_eq!(nothing.metrics.failed, reference.radiance.truth.surface.codes().iter().filter(|l| **l == 0).count());
+    assert_eq!(nothing.metrics.failed, reference.truth.surface.codes().iter().filter(|l| **l == 0).count());
 }
 
 #[test]
@@ -99,12 +100,12 @@ fn the_program_sees_the_rrs_bands_and_geometry_but_never_the_truth() {
         assert!(names.iter().any(|n| n == v), "{v} in {names:?}");
     }
     assert!(!names.iter().any(|n| n.starts_with("true")), "no truth: {names:?}");
-    let (rows, cols, nb) = out.correction.rrs.rrs.dim();
+    let (rows, cols, nb) = out.kept().rrs.rrs.dim();
     assert_eq!((ds.dim_size("line"), ds.dim_size("pixel"), ds.dim_size("band")), (Some(rows), Some(cols), Some(nb)));
     // The run's Rrs where valid and on water, the fill value elsewhere.
-    let (flags, land) = (&out.correction.rrs.flags, &out.radiance.truth.surface.codes());
+    let (flags, land) = (&out.kept().rrs.flags, &out.truth.surface.codes());
     let mut valid = 0;
-    for ((r, c, b), v) in out.correction.rrs.rrs.indexed_iter() {
+    for ((r, c, b), v) in out.kept().rrs.rrs.indexed_iter() {
         let keep = flags[[r, c, b]] & (RrsFlags::INVALID | RrsFlags::SATURATED) == 0 && land[[r, c]] == 0;
         let got = rrs[(r * cols + c) * nb + b];
         if keep && v.is_finite() {
@@ -132,7 +133,7 @@ fn a_failing_program_costs_only_its_own_product_and_says_why() {
         &["chl_mg_m3"],
     ));
     assert_almi_kept(&out);
-    assert!(out.correction.rrs.rrs.iter().any(|v| *v > 0.0), "the Rrs is kept");
+    assert!(out.kept().rrs.rrs.iter().any(|v| *v > 0.0), "the Rrs is kept");
     let why = out.retrievals[1].failure.as_deref().unwrap();
     assert!(why.contains("`boom`") && why.contains("exit") && why.contains("3"), "{why}");
     assert!(why.contains("no module named xarray"), "its standard error is quoted: {why}");
@@ -189,7 +190,7 @@ pub(super) fn gone(pid: &str) -> bool {
 #[test]
 fn an_output_without_the_product_or_of_another_size_is_refused_by_name() {
     let reference = run_with(external("ref_missing", &["true"], &["chl_mg_m3"]));
-    let shape = reference.radiance.truth.chl_mg_m3.dim();
+    let shape = reference.truth.chl_mg_m3.dim();
     let dir = Dir::new("external-wrong");
     let only_nap = dir.path().join("only_nap.nc");
     product_file(&only_nap, shape, &[("nap_g_m3", vec![1.0; shape.0 * shape.1])]);
@@ -282,7 +283,7 @@ fn the_built_in_oc4_example_runs_through_python_and_matches_its_formula() {
         (0..ext.bands.len()).min_by(|&i, &j| (centroid(i) - w).abs().total_cmp(&(centroid(j) - w).abs())).unwrap()
     };
     let (blue, green) = ([nearest(443.0), nearest(490.0), nearest(510.0)], nearest(555.0));
-    let rrs = &out.correction.rrs;
+    let rrs = &out.kept().rrs;
     let mut compared = 0;
     for ((r, c), got) in chl.indexed_iter() {
         if !ext.product.returned(r, c) {

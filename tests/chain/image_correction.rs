@@ -3,6 +3,7 @@
 //! is one of the family's and the water is black in the NIR; an aerosol-free scene; a gain error
 //! at 865 nm reaching 443 nm as the extrapolation says; the NIR iteration over turbid water.
 
+use crate::common::Kept;
 use shoal::atmosphere::AerosolType;
 use shoal::correction::{ImageCorrection, RrsFlags};
 use shoal::engine::{RunConfig, RunOutput};
@@ -30,20 +31,20 @@ fn clear_water(aerosol: AerosolType, aot550: f64) -> RunConfig {
 /// Per band: the median over valid water pixels of retrieved − true Rrs (sr⁻¹), and the
 /// median true Rrs.
 fn median_error(out: &RunOutput) -> Vec<(f64, f64)> {
-    let (rows, cols, nb) = out.correction.rrs.rrs.dim();
+    let (rows, cols, nb) = out.kept().rrs.rrs.dim();
     (0..nb)
         .map(|b| {
             let pixels = || {
                 (0..rows)
                     .flat_map(|r| (0..cols).map(move |c| (r, c)))
-                    .filter(|&(r, c)| out.correction.rrs.flags[[r, c, b]] & RrsFlags::INVALID == 0)
+                    .filter(|&(r, c)| out.kept().rrs.flags[[r, c, b]] & RrsFlags::INVALID == 0)
             };
             let mut d: Vec<f64> = pixels()
                 .map(|(r, c)| {
-                    f64::from(out.correction.rrs.rrs[[r, c, b]]) - f64::from(out.radiance.truth.rrs_above[[r, c, b]])
+                    f64::from(out.kept().rrs.rrs[[r, c, b]]) - f64::from(out.kept().radiance.truth_rrs[[r, c, b]])
                 })
                 .collect();
-            let mut t: Vec<f64> = pixels().map(|(r, c)| f64::from(out.radiance.truth.rrs_above[[r, c, b]])).collect();
+            let mut t: Vec<f64> = pixels().map(|(r, c)| f64::from(out.kept().radiance.truth_rrs[[r, c, b]])).collect();
             d.sort_by(f64::total_cmp);
             t.sort_by(f64::total_cmp);
             (d[d.len() / 2], t[t.len() / 2])
@@ -118,7 +119,7 @@ fn a_gain_error_at_865_nm_reaches_443_nm_as_the_extrapolation_predicts() {
     let family = out.correction.family.clone().expect("the family");
     let l = settings.pair(&out.response.bands.centres_nm()).unwrap().1;
     let blue = out.response.bands.bands.iter().position(|b| b.name == "Oa03").unwrap();
-    let mut level1 = (*out.level1).clone();
+    let mut level1 = (*out.kept().level1).clone();
     let gain = 0.02;
     level1.radiance.index_axis_mut(ndarray::Axis(2), l).mapv_inplace(|v| v * (1.0 + gain as f32));
     let control = shoal::control::RunControl::new();
@@ -127,7 +128,7 @@ fn a_gain_error_at_865_nm_reaches_443_nm_as_the_extrapolation_predicts() {
         &family,
         &settings,
         &out.response.bands,
-        &out.radiance.truth.surface,
+        &out.truth.surface,
         &control,
     )
     .unwrap();
@@ -140,8 +141,8 @@ fn a_gain_error_at_865_nm_reaches_443_nm_as_the_extrapolation_predicts() {
     let (k0, k1) = (2, 3); // AOT nodes 0.1 and 0.2 (after the 0 node and 0.05)
     assert_eq!((family.aot550[k0], family.aot550[k1]), (0.1, 0.2));
     let slope = |b: usize| terms[k1].l_path[i(b)] - terms[k0].l_path[i(b)];
-    let d_path = gain * f64::from(out.level1.radiance[[r, col, l]]) * slope(blue) / slope(l);
-    let rrs = f64::from(out.correction.rrs.rrs[[r, col, blue]]);
+    let d_path = gain * f64::from(out.kept().level1.radiance[[r, col, l]]) * slope(blue) / slope(l);
+    let rrs = f64::from(out.kept().rrs.rrs[[r, col, blue]]);
     let s_pi = terms[k0].spherical_albedo[i(blue)] * std::f64::consts::PI;
     let predicted = -d_path / terms[k0].t_ed[i(blue)] * (1.0f64 - s_pi * rrs).powi(2);
     let measured = f64::from(biased.rrs[[r, col, blue]]) - rrs;
@@ -298,7 +299,7 @@ fn correct_on_csv_spectra_matches_the_runs_own_correction() {
             g.relative_azimuth_rad.to_degrees()
         ));
         for b in 0..names.len() {
-            csv.push_str(&format!(",{}", 1000.0 * f64::from(out.level1.radiance[[r, col, b]])));
+            csv.push_str(&format!(",{}", 1000.0 * f64::from(out.kept().level1.radiance[[r, col, b]])));
         }
         csv.push('\n');
     }
@@ -317,7 +318,7 @@ fn correct_on_csv_spectra_matches_the_runs_own_correction() {
         let cells: Vec<&str> = line.split(',').collect();
         for b in 0..names.len() {
             let mine: f64 = cells[1 + b].parse().unwrap();
-            let run = f64::from(out.correction.rrs.rrs[[r, col, b]]);
+            let run = f64::from(out.kept().rrs.rrs[[r, col, b]]);
             worst = worst.max((mine - run).abs());
         }
     }

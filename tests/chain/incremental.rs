@@ -1,5 +1,6 @@
 //! Incremental re-runs: a change re-runs only the stages downstream of it.
 
+use crate::common::Kept;
 use shoal::control::RunControl;
 use shoal::engine::{Engine, RunConfig, Stage};
 
@@ -42,8 +43,8 @@ fn a_gain_change_reruns_only_digitisation_onward() {
     assert!(!second.report.ran(Stage::Radiance) && !second.report.ran(Stage::Electrons));
     assert!(second.report.ran(Stage::Level0));
     // The counts changed; the photon-side products are the very same objects.
-    assert!(std::sync::Arc::ptr_eq(&first.radiance, &second.radiance));
-    assert_ne!(first.level0.dn, second.level0.dn);
+    assert!(std::sync::Arc::ptr_eq(&first.kept().radiance, &second.kept().radiance));
+    assert_ne!(first.kept().level0.dn, second.kept().level0.dn);
 
     // Back to the first gain (an A/B toggle): everything comes from the cache.
     config.instrument.gain_e_per_dn = 3.0;
@@ -53,7 +54,7 @@ fn a_gain_change_reruns_only_digitisation_onward() {
         "{}",
         again.report.table()
     );
-    assert_eq!(again.level0.dn, first.level0.dn);
+    assert_eq!(again.kept().level0.dn, first.kept().level0.dn);
 
     // The aperture changes the photon counts but not the scene or its radiance.
     config.instrument.aperture_mm = 100.0;
@@ -128,7 +129,7 @@ fn a_siop_file_edited_on_disk_reruns_the_scene_and_matches_a_fresh_engine() {
     std::fs::write(&csv, doubled).unwrap();
     let second = engine.run(&config, &RunControl::new()).unwrap();
     assert_eq!(engine.executions(Stage::Scene), 2, "the edit re-ran the scene");
-    assert_ne!(first.radiance.radiance, second.radiance.radiance, "the edit changed the radiance");
+    assert_ne!(first.kept().radiance.radiance, second.kept().radiance.radiance, "the edit changed the radiance");
     let fresh = Engine::new().run(&config, &RunControl::new()).unwrap();
     assert_eq!(fingerprint(&second), fingerprint(&fresh), "the warm engine returns what a fresh one does");
     // Unchanged, it comes from the cache.
@@ -153,10 +154,10 @@ type Fingerprint = (Vec<f32>, Vec<u16>, Vec<f32>, Vec<f32>, Vec<shoal::instrumen
 /// Every product a run hands on, for bit-wise comparison.
 fn fingerprint(out: &shoal::engine::RunOutput) -> Fingerprint {
     (
-        out.radiance.radiance.iter().copied().collect(),
-        out.level0.dn.iter().copied().collect(),
-        out.level1.radiance.iter().copied().collect(),
-        out.correction.rrs.rrs.iter().copied().collect(),
+        out.kept().radiance.radiance.iter().copied().collect(),
+        out.kept().level0.dn.iter().copied().collect(),
+        out.kept().level1.radiance.iter().copied().collect(),
+        out.kept().rrs.rrs.iter().copied().collect(),
         out.snr.as_ref().clone(),
     )
 }

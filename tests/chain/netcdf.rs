@@ -3,6 +3,7 @@
 //! `ncdump -h` (Debian's netcdf-bin, the NetCDF C library) and xarray (python3-xarray with
 //! python3-netcdf4) — and sees the CF metadata a scientist's script relies on.
 
+use crate::common::Kept;
 use shoal::instrument::DetectorMode;
 use shoal::study::{CubeFormat, write_run_as};
 
@@ -45,7 +46,7 @@ pub(crate) mod tempfile_dir {
 fn a_netcdf_product_reads_back_with_its_bands_values_and_configuration() {
     let (out, dir) = written("netcdf-read");
     let mut reader = netcdf3::FileReader::open(dir.path().join("products.nc")).unwrap();
-    let (rows, cols, nb) = out.correction.rrs.rrs.dim();
+    let (rows, cols, nb) = out.kept().rrs.rrs.dim();
     let wavelength = reader.read_var_f32("wavelength").unwrap();
     let rrs = reader.read_var_f32("rrs").unwrap();
     let flags = reader.read_var_i32("rrs_flags").unwrap();
@@ -58,9 +59,7 @@ fn a_netcdf_product_reads_back_with_its_bands_values_and_configuration() {
     // Rrs: the run's values where valid, the fill value elsewhere.
     let fill = shoal::study::netcdf_out::FILL;
     let mut valid = 0;
-    for ((v, f), (r, t)) in
-        rrs.iter().zip(&flags).zip(out.correction.rrs.rrs.iter().zip(out.correction.rrs.flags.iter()))
-    {
+    for ((v, f), (r, t)) in rrs.iter().zip(&flags).zip(out.kept().rrs.rrs.iter().zip(out.kept().rrs.flags.iter())) {
         assert_eq!(*f, i32::from(*t));
         if t & shoal::correction::RrsFlags::INVALID == 0 {
             assert_eq!(v, r);
@@ -70,7 +69,7 @@ fn a_netcdf_product_reads_back_with_its_bands_values_and_configuration() {
         }
     }
     assert!(valid > rows * cols * nb / 2, "{valid}");
-    assert_eq!(chl[0], out.radiance.truth.chl_mg_m3[[0, 0]]);
+    assert_eq!(chl[0], out.truth.chl_mg_m3[[0, 0]]);
     assert_eq!(
         ds.get_var_attr_as_string("rrs", "standard_name").as_deref(),
         Some("surface_ratio_of_upwelling_radiance_emerging_from_sea_water_to_downwelling_radiative_flux_in_air")
@@ -126,7 +125,7 @@ print(int(rrs.isnull().sum()), float(np.nanmedian(rrs.isel(band=2).values)), flo
     let text = String::from_utf8_lossy(&o.stdout);
     let parts: Vec<f64> = text.split_whitespace().map(|v| v.parse().unwrap()).collect();
     let invalid =
-        out.correction.rrs.flags.iter().filter(|f| **f & shoal::correction::RrsFlags::INVALID != 0).count() as f64;
+        out.kept().rrs.flags.iter().filter(|f| **f & shoal::correction::RrsFlags::INVALID != 0).count() as f64;
     assert_eq!(parts[0], invalid, "NaN cells are the invalid ones");
     assert!((parts[2] - out.response.bands.bands[2].centre_nm).abs() < 1e-3, "{text}");
     assert!(parts[1] > 0.0 && parts[1] < 0.1, "median Rrs at band 3 {text}");
@@ -162,7 +161,7 @@ pub(crate) fn product_file(path: &std::path::Path, shape: (usize, usize), maps: 
 #[test]
 fn shoal_score_scores_an_outside_product_against_the_runs_truth() {
     let (out, dir) = written("netcdf-score");
-    let truth = &out.radiance.truth;
+    let truth = &out.truth;
     let shape = truth.chl_mg_m3.dim();
     // An outside algorithm 10 % high everywhere, missing (fill) on land and in one pixel.
     let chl: Vec<f32> = truth
@@ -232,17 +231,17 @@ fn the_oc4_example_runs_outside_shoal_and_is_scored() {
     let row = cells.join(" ");
     // Every water pixel returned, and the script's value is OC4v6 of the run's own Rrs (computed
     // here at one pixel; f32 file values, so 1e-5 relative).
-    let water = out.radiance.truth.surface.codes().iter().filter(|l| **l == 0).count();
+    let water = out.truth.surface.codes().iter().filter(|l| **l == 0).count();
     assert_eq!(cells[1].parse::<usize>().unwrap(), water, "{row}");
     let mut reader = netcdf3::FileReader::open(&product).unwrap();
     let chl = reader.read_var_f32("chl_mg_m3").unwrap();
     let (r, c) = (8, 12);
-    let cols = out.radiance.truth.surface.codes().dim().1;
+    let cols = out.truth.surface.codes().dim().1;
     let centres = out.response.bands.centres_nm();
     let band = |nm: f64| {
         (0..centres.len()).min_by(|&a, &b| (centres[a] - nm).abs().total_cmp(&(centres[b] - nm).abs())).unwrap()
     };
-    let rrs = |nm: f64| f64::from(out.correction.rrs.rrs[[r, c, band(nm)]]);
+    let rrs = |nm: f64| f64::from(out.kept().rrs.rrs[[r, c, band(nm)]]);
     let x = ([443.0, 490.0, 510.0].map(rrs).into_iter().fold(f64::MIN, f64::max) / rrs(555.0)).log10();
     let oc4 = 10f64.powf([0.3272, -2.9940, 2.7218, -1.2259, -0.5683].iter().rev().fold(0.0, |acc, a| acc * x + a));
     let got = f64::from(chl[r * cols + c]);

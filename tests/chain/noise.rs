@@ -2,6 +2,7 @@
 //! counts, and the CubeSat and SmallSat SNR against the instrument equation with Table 1's
 //! parameters (Matthews et al. 2023, Sensors 23, 7824).
 
+use crate::common::Kept;
 use shoal::engine::RunConfig;
 use shoal::instrument::detector::{Stream, pixel_rng};
 use shoal::instrument::{Detector, DetectorMode, Flags, InstrumentSpec, Response};
@@ -77,9 +78,13 @@ fn saturation_at_the_well_and_at_the_adc_limit() {
     c.instrument.well_depth_e = 12_345.6;
     c.instrument.exposure_s = 10.0;
     let out = run(&c);
-    assert_eq!(out.report.saturated, out.level0.dn.len(), "pixel-bands at the well, flagged");
-    assert!(out.level0.flags.iter().all(|f| f & Flags::SATURATED != 0));
-    assert!(out.level0.dn.iter().all(|&d| (f64::from(d) - 4_125.6).abs() < 8.0 * 5.0 + 0.5), "{:?}", out.level0.dn);
+    assert_eq!(out.report.saturated, out.kept().level0.dn.len(), "pixel-bands at the well, flagged");
+    assert!(out.kept().level0.flags.iter().all(|f| f & Flags::SATURATED != 0));
+    assert!(
+        out.kept().level0.dn.iter().all(|&d| (f64::from(d) - 4_125.6).abs() < 8.0 * 5.0 + 0.5),
+        "{:?}",
+        out.kept().level0.dn
+    );
     // Below the ADC's range: zero counts are flagged. Without noise, 0 e- with no bias reads 0.
     spec.bias_dn = 0.0;
     let det = detector(&spec);

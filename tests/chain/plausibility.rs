@@ -1,6 +1,7 @@
 //! Plausibility guards: saturation at the brightest water radiance, smear over a pixel, an
 //! f-number below 1 — each against an oracle computed here, and printed and written by the CLI.
 
+use crate::common::Kept;
 use std::process::Command;
 
 use shoal::engine::RunConfig;
@@ -19,12 +20,12 @@ fn config(edit: impl Fn(&mut shoal::instrument::InstrumentSpec)) -> RunConfig {
 
 /// Water pixel-bands flagged saturated in Level-0, counted from the product itself.
 fn saturated_water(out: &shoal::engine::RunOutput) -> usize {
-    let (rows, cols, nb) = out.level0.flags.dim();
+    let (rows, cols, nb) = out.kept().level0.flags.dim();
     let mut n = 0;
     for r in 0..rows {
         for c in 0..cols {
-            if out.radiance.truth.surface.codes()[[r, c]] == 0 {
-                n += (0..nb).filter(|&b| out.level0.flags[[r, c, b]] & Flags::SATURATED != 0).count();
+            if out.truth.surface.codes()[[r, c]] == 0 {
+                n += (0..nb).filter(|&b| out.kept().level0.flags[[r, c, b]] & Flags::SATURATED != 0).count();
             }
         }
     }
@@ -45,8 +46,8 @@ fn a_ten_electron_well_warns_and_level_0_agrees() {
     assert!(w.message.contains("19 of 19 bands"), "{}", w.message);
     assert!(w.value > 1.0);
     // The independent count: noise-free Level-0 flags every water pixel in every band.
-    let (rows, cols, nb) = out.level0.flags.dim();
-    let water = out.radiance.truth.surface.codes().iter().filter(|&&l| l == 0).count();
+    let (rows, cols, nb) = out.kept().level0.flags.dim();
+    let water = out.truth.surface.codes().iter().filter(|&&l| l == 0).count();
     assert!(water > 0 && rows * cols > 0);
     assert_eq!(saturated_water(&out), water * nb);
 }
@@ -57,10 +58,11 @@ fn the_guard_and_level_0_agree_at_the_edge_of_saturation() {
     // noise-free electrons of a first run: the guard must flip exactly where Level-0 does.
     let probe = run(&config(|i| i.well_depth_e = 1e9));
     let detector_peak_dn = probe
+        .kept()
         .level0
         .dn
         .indexed_iter()
-        .filter(|((r, c, _), _)| probe.radiance.truth.surface.codes()[[*r, *c]] == 0)
+        .filter(|((r, c, _), _)| probe.truth.surface.codes()[[*r, *c]] == 0)
         .map(|(_, &dn)| f64::from(dn))
         .fold(0.0, f64::max);
     let gain = probe.config.instrument.gain_e_per_dn;
@@ -133,11 +135,11 @@ fn the_report_counts_the_truths_depth_and_substrate_shares() {
     c.fidelity.decimation = 1;
     let out = run(&c);
     let s = &out.report.truth_shares;
-    let depth = out.radiance.truth.depth_m.as_ref().unwrap();
-    let fractions = out.radiance.truth.substrate_fractions.as_ref().unwrap();
+    let depth = out.truth.depth_m.as_ref().unwrap();
+    let fractions = out.truth.substrate_fractions.as_ref().unwrap();
     // Independent count: water pixels and, per substrate, the pixels where it is the largest.
     let water: Vec<(usize, usize)> =
-        out.radiance.truth.surface.codes().indexed_iter().filter(|(_, l)| **l == 0).map(|(rc, _)| rc).collect();
+        out.truth.surface.codes().indexed_iter().filter(|(_, l)| **l == 0).map(|(rc, _)| rc).collect();
     assert_eq!(s.water_pixels, water.len());
     let (lo, hi) = water
         .iter()

@@ -30,7 +30,7 @@ fn qaa_returns_chl_and_its_iops_on_every_pixel_it_can_and_flags_the_rest() {
     let chl = p.chl_mg_m3.as_ref().unwrap();
     let keys: Vec<&str> = p.extras.iter().map(|(k, _)| k.as_str()).collect();
     assert_eq!(keys, ["adg443_per_m", "aph443_per_m", "bbp555_per_m"]);
-    let land = &one.radiance.truth.surface.codes();
+    let land = &one.truth.surface.codes();
     let mut returned = 0;
     for ((r, col), f) in p.flags.indexed_iter() {
         if land[[r, col]] != 0 {

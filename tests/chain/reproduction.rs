@@ -16,7 +16,7 @@ fn run(name: &str) -> StudyResult {
     for (_, _, c) in &mut resolved.runs {
         c.fidelity.decimation = DECIMATION;
     }
-    run_study(&resolved, &RunControl::new(), |_, _| Ok(())).unwrap()
+    run_study(&resolved, &RunControl::new(), false, |_, _| Ok(())).unwrap()
 }
 
 fn within(what: &str, value: f64, (lo, hi): (f64, f64)) {

@@ -1,6 +1,7 @@
 //! Retrievals: noise-free closure of aLMI and of the SAMBUCA-style inversion, and hard cases that
 //! must come back finite or flagged.
 
+use crate::common::Kept;
 use shoal::control::RunControl;
 use shoal::engine::{Engine, Fidelity, RunConfig, RunOutput};
 use shoal::instrument::{DetectorMode, InstrumentSpec, Response};
@@ -128,9 +129,9 @@ fn sambuca_noise_free_closure_on_the_reef() {
         settings.nodes_per_band,
     )
     .unwrap();
-    let truth = &out.radiance;
+    let truth = &out.kept().radiance;
     let fractions = truth.truth.substrate_fractions.as_ref().unwrap();
-    let (rows, cols, nb) = out.correction.rrs.rrs.dim();
+    let (rows, cols, nb) = out.kept().rrs.rrs.dim();
     let weights: Vec<f64> = ret.nedr.iter().map(|v| 1.0 / v).collect();
     let (mut pixels, mut worse, mut visible, mut depth_off, mut three_way) = (0, 0, 0, 0, 0);
     let mut m = vec![0.0; nb];
@@ -159,7 +160,7 @@ fn sambuca_noise_free_closure_on_the_reef() {
             let g = WaterGeometry { sun_zenith_rad: look.sun_zenith_rad, view_zenith_rad: look.view_zenith_rad };
             let inv = g.inverse_cosines_in_water(model.refractive_index);
             model.evaluate(&p, inv, &mut m, None);
-            let obs: Vec<f64> = (0..nb).map(|b| f64::from(out.correction.rrs.rrs[[r, c, b]])).collect();
+            let obs: Vec<f64> = (0..nb).map(|b| f64::from(out.kept().rrs.rrs[[r, c, b]])).collect();
             let valid = vec![true; nb];
             let o = Observation { rrs: &obs, valid: &valid, nedr: &ret.nedr, inv_cos: inv };
             let at_truth = objective_value(settings.objective, &o, &weights, &m);
@@ -219,7 +220,7 @@ fn assert_finite(out: &RunOutput, case: &str) {
             );
         }
     }
-    for v in out.correction.rrs.rrs.iter() {
+    for v in out.kept().rrs.rrs.iter() {
         assert!(v.is_finite(), "{case}: Rrs not finite");
     }
 }
@@ -251,7 +252,7 @@ fn hard_cases_are_finite_or_flagged() {
             let p = &out.retrievals[0].product;
             let (mut water, mut returned, mut at_zero) = (0, 0, 0);
             for ((r, c), f) in p.flags.indexed_iter() {
-                if out.radiance.truth.surface.codes()[[r, c]] != 0 {
+                if out.truth.surface.codes()[[r, c]] != 0 {
                     continue;
                 }
                 water += 1;
@@ -278,7 +279,7 @@ fn hard_cases_are_finite_or_flagged() {
     let p = &out.retrievals[0].product;
     let mut pixels = 0;
     for ((r, c), f) in p.flags.indexed_iter() {
-        if out.radiance.truth.surface.codes()[[r, c]] != 0 {
+        if out.truth.surface.codes()[[r, c]] != 0 {
             continue;
         }
         assert!(f & ProductFlags::RETURNED != 0, "no NAP, noise-free: ({r},{c}) not returned, flags {f}");

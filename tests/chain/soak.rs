@@ -10,6 +10,7 @@
 //! - cancellation stops work: rows finished after a cancel are at most the rows already started
 //!   (one block per pool thread per heavy stage).
 
+use crate::common::Kept;
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
@@ -73,9 +74,9 @@ fn edit(c: &mut RunConfig, rng: &mut rand::rngs::Xoshiro256PlusPlus) -> &'static
 }
 
 fn same_products(a: &shoal::engine::RunOutput, b: &shoal::engine::RunOutput) -> bool {
-    a.level0.dn == b.level0.dn
-        && a.level1.radiance.iter().zip(&b.level1.radiance).all(|(x, y)| x.to_bits() == y.to_bits())
-        && a.correction.rrs.rrs.iter().zip(&b.correction.rrs.rrs).all(|(x, y)| x.to_bits() == y.to_bits())
+    a.kept().level0.dn == b.kept().level0.dn
+        && a.kept().level1.radiance.iter().zip(&b.kept().level1.radiance).all(|(x, y)| x.to_bits() == y.to_bits())
+        && a.kept().rrs.rrs.iter().zip(&b.kept().rrs.rrs).all(|(x, y)| x.to_bits() == y.to_bits())
         && a.retrievals.len() == b.retrievals.len()
         && a.retrievals.iter().zip(&b.retrievals).all(|(x, y)| {
             x.product

@@ -1,5 +1,6 @@
 //! Spatial response and the atmosphere's wavelength interpolation.
 
+use crate::common::Kept;
 use std::sync::Arc;
 
 use shoal::atmosphere::{AtmosphereLut, Geometry, LutAxes};
@@ -22,7 +23,7 @@ fn spatial_response_keeps_a_uniform_scene_and_blurs_an_edge() {
     let blurred = run(&config);
     assert!(blurred.report.spatial_samples > 1);
     // Uniform water: the PSF weights sum to one, so the radiance is unchanged (f32 rounding).
-    for (a, b) in point.radiance.radiance.iter().zip(blurred.radiance.radiance.iter()) {
+    for (a, b) in point.kept().radiance.radiance.iter().zip(blurred.kept().radiance.radiance.iter()) {
         assert!((a - b).abs() <= 2e-6 * a.abs(), "{a} vs {b}");
     }
     // A sharp north–south edge in chl: the spatial response smooths it across track.
@@ -46,7 +47,7 @@ fn spatial_response_keeps_a_uniform_scene_and_blurs_an_edge() {
     let band = 10; // 709 nm: the chl red-edge peak
     let row = 10;
     let values = |o: &shoal::engine::RunOutput| {
-        (0..o.radiance.radiance.dim().1).map(|c| o.radiance.radiance[[row, c, band]]).collect::<Vec<_>>()
+        (0..o.kept().radiance.radiance.dim().1).map(|c| o.kept().radiance.radiance[[row, c, band]]).collect::<Vec<_>>()
     };
     let (s, b) = (values(&sharp), values(&soft));
     let jump = |v: &[f32]| v.windows(2).map(|w| (w[1] - w[0]).abs()).fold(0.0f32, f32::max);

@@ -2,6 +2,7 @@
 //! with the run's own band radiance there, shows the gas bands and the water's darkness in the
 //! SWIR, and carries each instrument's measurement at the point.
 
+use crate::common::Kept;
 use shoal::engine::RunConfig;
 use shoal::engine::spectrum::{SPECTRUM_END_NM, SPECTRUM_START_NM, SPECTRUM_STEP_NM, SpectrumMaker, instrument_at};
 use shoal::instrument::DetectorMode;
@@ -57,7 +58,7 @@ fn the_point_spectrum_integrates_to_the_runs_band_radiance() {
                 den += wt;
             }
             let from_spectrum = num / den;
-            let from_run = f64::from(out.radiance.radiance[[row, col, b]]) * 1000.0;
+            let from_run = f64::from(out.kept().radiance.radiance[[row, col, b]]) * 1000.0;
             let rel = (from_spectrum - from_run) / from_run;
             println!("{name}: spectrum {from_spectrum:.4}, run {from_run:.4} W m-2 sr-1 um-1, {:+.3} %", 100.0 * rel);
             worst = worst.max(rel.abs());

@@ -22,7 +22,7 @@ fn a_study_writes_tables_and_figures() {
     for (_, _, c) in &mut resolved.runs {
         c.fidelity.decimation = 8;
     }
-    let result = run_study(&resolved, &RunControl::new(), |_, _| Ok(())).unwrap();
+    let result = run_study(&resolved, &RunControl::new(), false, |_, _| Ok(())).unwrap();
     assert_eq!(result.runs.len(), 2);
     let dir = std::env::temp_dir().join(format!("shoal-study-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
@@ -111,7 +111,7 @@ fn the_seed_spread_is_the_mean_and_scatter_of_the_seeds() {
     for (_, _, c) in &mut resolved.runs {
         c.fidelity.decimation = 8;
     }
-    let result = run_study(&resolved, &RunControl::new(), |_, _| Ok(())).unwrap();
+    let result = run_study(&resolved, &RunControl::new(), false, |_, _| Ok(())).unwrap();
     assert_eq!(result.runs.len(), 6, "2 instruments × 3 seeds");
     let spread = shoal::study::seed_spread(&result);
     let row = spread.iter().find(|s| s.instrument == "cubesat" && s.variable == "chl_mg_m3").unwrap();

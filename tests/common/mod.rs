@@ -136,3 +136,15 @@ pub fn python_with(modules: &str, packages: &str) -> Option<&'static str> {
     }
     found
 }
+
+/// The cubes of a run of an engine that keeps them (`Engine::new`), for tests that read them.
+pub trait Kept {
+    /// The run's cubes.
+    fn kept(&self) -> &shoal::engine::Cubes;
+}
+
+impl Kept for shoal::engine::RunOutput {
+    fn kept(&self) -> &shoal::engine::Cubes {
+        self.cubes.as_ref().expect("an engine made by Engine::new keeps its cubes")
+    }
+}

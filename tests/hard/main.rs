@@ -18,6 +18,7 @@ mod properties;
 mod ranges;
 mod water;
 
+use crate::common::Kept;
 use shoal::correction::RrsFlags;
 use shoal::engine::{RunConfig, RunOutput};
 use shoal::instrument::{Detector, Flags, InstrumentSpec};
@@ -73,11 +74,11 @@ pub struct Degraded {
 /// must agree with).
 pub fn check(out: &RunOutput, case: &str) -> Degraded {
     let c = &out.config;
-    let rad = &out.radiance;
-    for (name, v) in [("radiance", &rad.radiance), ("true Rrs", &rad.truth.rrs_above)] {
+    let rad = &out.kept().radiance;
+    for (name, v) in [("radiance", &rad.radiance), ("true Rrs", &rad.truth_rrs)] {
         assert!(v.iter().all(|x| x.is_finite() && *x >= 0.0), "{case}: {name} not finite or negative");
     }
-    for ((r, col, _), x) in rad.truth.rrs_above.indexed_iter() {
+    for ((r, col, _), x) in rad.truth_rrs.indexed_iter() {
         if rad.truth.surface.codes()[[r, col]] == 0 {
             assert!(f64::from(*x) <= RRS_MAX, "{case}: true Rrs {x} above 1/π");
         }
@@ -89,7 +90,7 @@ pub fn check(out: &RunOutput, case: &str) -> Degraded {
     }
     assert!(atm.spherical_albedo.iter().all(|s| (0.0..=1.0).contains(s)), "{case}: spherical albedo out of 0–1");
     // Level-0, recounted from the counts and the mean photo-electrons rather than from the flags.
-    let l0 = &out.level0;
+    let l0 = &out.kept().level0;
     let (rows, cols, nb) = l0.dn.dim();
     let count = |flags: &ndarray::Array3<u8>, bit: u8| flags.iter().filter(|f| **f & bit != 0).count();
     let mut d = Degraded {
@@ -109,9 +110,9 @@ pub fn check(out: &RunOutput, case: &str) -> Degraded {
         d.saturated
     );
     assert_eq!(d.zero, zero, "{case}: zero counts flagged vs counted from the DN");
-    assert!(out.level1.radiance.iter().all(|x| x.is_finite()), "{case}: Level-1 not finite");
+    assert!(out.kept().level1.radiance.iter().all(|x| x.is_finite()), "{case}: Level-1 not finite");
     // Rrs: finite everywhere; a pixel-band made invalid is flagged, never a silent number.
-    let rrs = &out.correction.rrs;
+    let rrs = &out.kept().rrs;
     assert!(rrs.rrs.iter().all(|x| x.is_finite()), "{case}: Rrs not finite");
     for (x, f) in rrs.rrs.iter().zip(&rrs.flags) {
         if *x < 0.0 {
@@ -134,7 +135,7 @@ pub fn check(out: &RunOutput, case: &str) -> Degraded {
 /// The retrievals' part of [`check`]; returns the fewest pixels any retrieval failed on.
 fn check_retrievals(out: &RunOutput, case: &str) -> usize {
     let c = &out.config;
-    let rrs = &out.correction.rrs;
+    let rrs = &out.kept().rrs;
     let nb = rrs.rrs.dim().2;
     let mut fewest_failed = usize::MAX;
     // Retrievals: returned pixels are finite and non-negative; failures are flagged, counted
@@ -144,7 +145,7 @@ fn check_retrievals(out: &RunOutput, case: &str) -> usize {
     // positive Rrs — so a water pixel with fewer usable bands among those the retrieval fits
     // must be FAILED (in every case of tests/hard/chain.rs the aLMI failures are exactly these
     // pixels). Every water pixel (the truth's land mask) is either FAILED or RETURNED, never both.
-    let land = &out.radiance.truth.surface.codes();
+    let land = &out.truth.surface.codes();
     let water = land.iter().filter(|l| **l == 0).count();
     for (ret, spec) in out.retrievals.iter().zip(&c.retrievals) {
         let p = &ret.product;
@@ -249,7 +250,7 @@ fn check_retrievals(out: &RunOutput, case: &str) -> usize {
 fn level0_recount(out: &RunOutput, case: &str) -> (usize, usize, usize) {
     let c = &out.config;
     let spec = &c.instrument;
-    let l0 = &out.level0;
+    let l0 = &out.kept().level0;
     let det = Detector::new(spec, &out.response, c.detector, c.seed);
     let mode = det.mode();
     let ideal = !spec.kind.model().capabilities().real_detector;
@@ -283,7 +284,7 @@ fn level0_recount(out: &RunOutput, case: &str) -> (usize, usize, usize) {
                         "{case}: analog DN {a} at ({r},{col},{b})"
                     );
                 }
-                let l = f64::from(out.radiance.radiance[[r, col, b]]).max(0.0);
+                let l = f64::from(out.kept().radiance.radiance[[r, col, b]]).max(0.0);
                 let mu = det.responsivity(j, b) * l + det.dark_mean_e(j, b, t);
                 let (well_sure, well_possible) = if ideal {
                     (false, false)

@@ -24,6 +24,7 @@
 //! CI runs `PROPTEST_CASES` cases per property (default 16: about a minute on 2 cores). A long
 //! run: `PROPTEST_CASES=1000 cargo test --release --test hard properties`.
 
+use crate::common::Kept;
 use proptest::prelude::*;
 use shoal::control::RunControl;
 use shoal::engine::{Engine, RunConfig, RunOutput};
@@ -126,8 +127,8 @@ proptest! {
         let one = run_on(1, &c);
         check(&one, &format!("{s:?} {i:?}"));
         let two = run_on(2, &c);
-        prop_assert_eq!(&one.level0.dn, &two.level0.dn);
-        prop_assert_eq!(&one.correction.rrs.rrs, &two.correction.rrs.rrs);
+        prop_assert_eq!(&one.kept().level0.dn, &two.kept().level0.dn);
+        prop_assert_eq!(&one.kept().rrs.rrs, &two.kept().rrs.rrs);
         for (a, b) in one.retrievals.iter().zip(&two.retrievals) {
             prop_assert_eq!(&a.product.chl_mg_m3, &b.product.chl_mg_m3);
             prop_assert_eq!(&a.product.flags, &b.product.flags);
@@ -157,7 +158,7 @@ fn closure_case(chl: f64, nap: f64, cdom: f64, zenith: f64, aot: f64) -> Result<
     let out = super::run(&c);
     check(&out, "closure");
     let p = &out.retrievals[0].product;
-    let rrs_flags = &out.correction.rrs.flags;
+    let rrs_flags = &out.kept().rrs.flags;
     let (mut checked, mut skipped, mut worst) = (0, 0, 0.0f64);
     for ((r, c), f) in p.flags.indexed_iter() {
         let saturated =

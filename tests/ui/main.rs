@@ -266,7 +266,7 @@ fn the_histograms_count_every_returned_pixel_and_the_scatter_is_a_capped_sample(
         shoal::engine::Engine::new().run(&config, &shoal::control::RunControl::new()).expect("runs"),
     );
     let data = plot_data(&[Some(out.clone()), None], "chl_mg_m3");
-    let truth = &out.radiance.truth;
+    let truth = &out.truth;
     let product = &out.retrievals[0].product;
     let (mut with_truth, mut returned) = (0, 0);
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);

@@ -62,7 +62,9 @@ impl PerPixel {
     pub fn between(out: &RunOutput, reference: &RunOutput) -> Self {
         let (Some(a), Some(b)) = (out.retrievals.first(), reference.retrievals.first()) else { return Self::default() };
         let (a, b) = (&a.product, &b.product);
-        if a.flags.dim() != b.flags.dim() || out.correction.rrs.rrs.dim() != reference.correction.rrs.rrs.dim() {
+        // The Rrs is compared where both runs kept their cubes (the engine of the cost table does).
+        let rrs_cubes = out.cubes.as_ref().zip(reference.cubes.as_ref()).map(|(x, y)| (&x.rrs.rrs, &y.rrs.rrs));
+        if a.flags.dim() != b.flags.dim() || rrs_cubes.is_some_and(|(x, y)| x.dim() != y.dim()) {
             return Self::default();
         }
         let (rows, cols) = a.flags.dim();
@@ -106,9 +108,8 @@ impl PerPixel {
                         bottom_changed += usize::from(dominant(fa) != dominant(fb));
                     }
                 }
-                if out.radiance.truth.surface.is_water(r, c) {
-                    let x = f64::from(out.correction.rrs.rrs[[r, c, band]]);
-                    let y = f64::from(reference.correction.rrs.rrs[[r, c, band]]);
+                if let Some((x, y)) = rrs_cubes.filter(|_| out.truth.surface.is_water(r, c)) {
+                    let (x, y) = (f64::from(x[[r, c, band]]), f64::from(y[[r, c, band]]));
                     if y.abs() > 1e-6 {
                         rrs.push((x / y - 1.0).abs());
                     }

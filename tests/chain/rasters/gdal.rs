@@ -161,7 +161,7 @@ fn gdal_reads_the_products_we_write_with_their_crs_transform_nodata_and_values()
     let dir = tempdir("products");
     let written = shoal::study::write_run_geotiff(&out, &dir).unwrap();
     assert!(written.files.iter().any(|f| f == "sambuca.tif"), "{:?}", written.files);
-    let truth = &out.radiance.truth;
+    let truth = &out.truth;
     let (g, residual_m) = shoal::study::swath_geotransform(&out.viewing, (ORIGIN.0 + 1200.0, ORIGIN.1 - 800.0));
     assert!(residual_m < 0.01, "a nadir 2 km swath is affine to well under a centimetre: {residual_m} m");
 
