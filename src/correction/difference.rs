@@ -25,9 +25,6 @@ pub struct BandDifference {
     pub max_abs_rel: f64,
 }
 
-/// Bands a pixel source fills at most (a spectrograph's cube is compared from its slices).
-const MAX_BANDS: usize = 64;
-
 /// A pixel's bands made on the fly: `f(pixel, values, flags)`.
 pub type PixelBands<'a> = &'a (dyn Fn(usize, &mut [f32], &mut [u8]) + Sync);
 
@@ -45,16 +42,10 @@ pub fn compare(a: &Reflectance, b: &Array3<f32>, b_flags: Option<&Array3<u8>>) -
     compare_source(Source::Cube(ar, af), a.rrs.dim().2, b, b_flags)
 }
 
-/// [`compare`] with `a`'s values and flags at each pixel (row-major, `nb` bands) made by `a`
-/// (at most [`MAX_BANDS`] bands; `None` past that).
+/// [`compare`] with `a`'s values and flags at each pixel (row-major, `b`'s bands) made by `a`.
 #[must_use]
-pub fn compare_pixels(
-    a: PixelBands<'_>,
-    b: &Array3<f32>,
-    b_flags: Option<&Array3<u8>>,
-) -> Option<Vec<BandDifference>> {
-    let nb = b.dim().2;
-    (nb <= MAX_BANDS).then(|| compare_source(Source::Pixels(a), nb, b, b_flags))
+pub fn compare_pixels(a: PixelBands<'_>, b: &Array3<f32>, b_flags: Option<&Array3<u8>>) -> Vec<BandDifference> {
+    compare_source(Source::Pixels(a), b.dim().2, b, b_flags)
 }
 
 fn compare_source(source: Source<'_>, nb: usize, b: &Array3<f32>, b_flags: Option<&Array3<u8>>) -> Vec<BandDifference> {
@@ -71,20 +62,30 @@ fn compare_source(source: Source<'_>, nb: usize, b: &Array3<f32>, b_flags: Optio
         sum: Vec<f64>,
         max: Vec<f64>,
         sample: Vec<Vec<f64>>,
+        /// A pixel's bands and flags as a [`Source::Pixels`] makes them (not combined).
+        values: Vec<f32>,
+        flags: Vec<u8>,
     }
-    let empty = || Acc { n: vec![0; nb], sum: vec![0.0; nb], max: vec![0.0; nb], sample: vec![Vec::new(); nb] };
+    let scratch = usize::from(matches!(source, Source::Pixels(_))) * nb;
+    let empty = || Acc {
+        n: vec![0; nb],
+        sum: vec![0.0; nb],
+        max: vec![0.0; nb],
+        sample: vec![Vec::new(); nb],
+        values: vec![0.0; scratch],
+        flags: vec![0; scratch],
+    };
     let acc = (0..pixels)
         .into_par_iter()
         .fold(empty, |mut acc, p| {
             // One pixel's bands as slices (no per-value bounds checks), and whether it is a
             // median sample decided once per pixel: the modulo per value was half the stage.
             let span = p * nb..(p + 1) * nb;
-            let (mut a, mut a_flags) = ([0.0f32; MAX_BANDS], [0u8; MAX_BANDS]);
             let (a, a_flags) = match &source {
                 Source::Cube(ar, af) => (&ar[span.clone()], &af[span.clone()]),
                 Source::Pixels(f) => {
-                    f(p, &mut a[..nb], &mut a_flags[..nb]);
-                    (&a[..nb], &a_flags[..nb])
+                    f(p, &mut acc.values, &mut acc.flags);
+                    (&acc.values[..], &acc.flags[..])
                 }
             };
             let b = &br[span.clone()];

@@ -334,8 +334,8 @@ impl SceneApproximation {
     }
 
     /// [`Self::correct`] compared with `exact` ([`compare`]) without holding the approximation's
-    /// cube: each pixel is corrected as the comparison reads it (the same values). `None` for a
-    /// cube of more bands than the comparison takes per pixel.
+    /// cube: each pixel is corrected as the comparison reads it (the same values). `None` when a
+    /// Level-1 array is not contiguous.
     #[must_use]
     pub fn compare_with(
         &self,
@@ -351,7 +351,7 @@ impl SceneApproximation {
                 (values[b], flags[b]) = self.value(b, l1[p * nb + b], l0_flags[p * nb + b], land);
             }
         };
-        difference::compare_pixels(&pixel, &exact.rrs, Some(&exact.flags))
+        Some(difference::compare_pixels(&pixel, &exact.rrs, Some(&exact.flags)))
     }
 
     /// Apply the per-scene terms to every pixel (A2, A3).
