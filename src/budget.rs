@@ -119,6 +119,18 @@ fn parse_bytes(text: &str) -> Option<f64> {
     num.trim().parse::<f64>().ok().map(|v| v * scale).filter(|v| v.is_finite() && *v > 0.0)
 }
 
+/// The most memory this process has held resident so far, bytes (Linux's `VmHWM`; `None`
+/// elsewhere): what a run reports beside its plan.
+#[must_use]
+pub fn peak_resident_bytes() -> Option<f64> {
+    std::fs::read_to_string("/proc/self/status").ok().and_then(|t| {
+        t.lines()
+            .find_map(|l| l.strip_prefix("VmHWM:"))
+            .and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<f64>().ok())
+            .map(|kb| kb * 1024.0)
+    })
+}
+
 /// The machine's memory, bytes: the smaller of its RAM and this process's cgroup limit (Linux);
 /// `None` when neither can be read.
 #[must_use]

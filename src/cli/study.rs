@@ -16,7 +16,9 @@ use crate::study::{StudyError, StudySpec, run_study, write_run_as, write_study};
 /// Arguments of `shoal study`.
 #[derive(Debug, Args)]
 pub struct StudyArgs {
-    /// A study RON file or a built-in study name (default: cubesat_vs_smallsat).
+    /// A study RON file or a built-in study name (default: cubesat_vs_smallsat_image, the paper's
+    /// CubeSat vs SmallSat corrected from the designs' own 779/865 nm bands; cubesat_vs_smallsat
+    /// keeps the paper's perfect correction).
     study: Option<String>,
     /// Output directory.
     #[arg(long, default_value = "results/study")]
@@ -121,7 +123,13 @@ pub fn run(args: &StudyArgs) -> Result<(), CliError> {
     crate::study::write_bytes(&out_dir.path().join(crate::report::REVIEW_JSON), review.as_bytes())?;
     outputs.files.push(crate::report::REVIEW_JSON.into());
     out_dir.commit()?;
-    eprintln!("{}: {n} runs in {:.1} s", spec.name, start.elapsed().as_secs_f64());
+    const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
+    let planned = crate::study::study_plan(&resolved, !args.no_cubes).0.bytes();
+    let memory = match crate::budget::peak_resident_bytes() {
+        Some(peak) => format!(", peak memory {:.2} GB (planned {:.2} GB)", peak / GIB, planned / GIB),
+        None => String::new(),
+    };
+    eprintln!("{}: {n} runs in {:.1} s{memory}", spec.name, start.elapsed().as_secs_f64());
     let mut table = String::new();
     print_metrics(&mut table, &result);
     print_budgets(&mut table, &result);

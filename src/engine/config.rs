@@ -180,6 +180,12 @@ impl RunConfig {
     /// stage runs, named with the stage that owns it. (The maps' values are checked when the
     /// scene stage builds them.)
     pub fn validate(&self) -> Result<(), super::EngineError> {
+        self.validate_keeping(true)
+    }
+
+    /// [`Self::validate`] for an engine that keeps its cubes (`keep_cubes`) or a lean one
+    /// ([`super::Engine::lean`]), whose run is planned at what it holds.
+    pub fn validate_keeping(&self, keep_cubes: bool) -> Result<(), super::EngineError> {
         use super::{EngineError, Stage};
         fn at<E: std::fmt::Display>(stage: Stage) -> impl Fn(E) -> EngineError {
             move |e| EngineError::Failed { stage, message: e.to_string() }
@@ -206,7 +212,7 @@ impl RunConfig {
         }
         // What the run will ask of the machine, against its budget (`engine::resources`).
         let budget = crate::budget::Budget::from_env().map_err(at(Stage::Scene))?;
-        let demand = super::resources::run_demand(self);
+        let demand = super::resources::run_demand_keeping(self, keep_cubes);
         budget.check(&demand).map_err(at(if demand.atmosphere_s > budget.atmosphere_s {
             Stage::Lut
         } else {

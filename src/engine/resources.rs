@@ -52,9 +52,14 @@ const RT_BYTES_PER_LEVEL_STREAM_PAIR: f64 = 72.0;
 /// Bytes per pixel and band of a run that does not keep its cubes, at its peak: the true Rrs,
 /// Level-1 and Rrs with their flags side by side while the correction runs (4 + 5 + 5), plus the
 /// stages' working copies (the exact correction's diagnostic is compared pixel by pixel, not
-/// held). Measured: the default study peaks at 0.82 GB with the exact correction, 0.87 GB with
-/// the image-based one (see the tests).
+/// held). Measured peaks (VmHWM, `shoal study --no-cubes`): the default study 0.83 GiB (plan
+/// 0.96), the paper's study with the exact correction 0.78 GiB, `four_designs_lake_hume` (the
+/// 101-band spectrograph the largest run) 2.74 GiB (plan 2.83).
 const LEAN_BYTES_PER_PIXEL_BAND: f64 = 16.0;
+/// Bytes per pixel of a lean run beyond its bands: its truth maps (13), its products as they are
+/// made and the retrieval's rows before they are joined (about 45), an image-based correction's
+/// aerosol maps (8), rounded up.
+const LEAN_BYTES_PER_PIXEL: f64 = 80.0;
 /// Bytes per pixel a study keeps of each run until its tables and figures are written: the
 /// truth's maps (chl, NAP, CDOM, depth, three substrate fractions, surface: at most 29) and an
 /// image-based correction's aerosol maps (8), with [`PRODUCT_BYTES_PER_PIXEL`] per retrieval.
@@ -63,6 +68,9 @@ const KEPT_BYTES_PER_PIXEL: f64 = 40.0;
 /// SAMBUCA's depth, three substrate fractions, cost, SDI, iterations and flags (27), rounded up
 /// for a retrieval's extra maps.
 const PRODUCT_BYTES_PER_PIXEL: f64 = 32.0;
+
+/// The part that is the random fields' synthesis: held while the scene is built, before any cube.
+const SYNTHESIS: &str = "the scene's random-field synthesis (while the scene is built)";
 
 /// Bands an instrument will have (without reading its band files).
 fn band_count(kind: &InstrumentKind) -> usize {
@@ -83,12 +91,17 @@ fn scene_parts(scene: &SceneSpec, parts: &mut Vec<Part>) {
     let random = maps.iter().any(|m| matches!(m, MapSpec::RandomField { .. }));
     let transient = if random { BYTES_PER_CELL_RANDOM_FIELD } else { 0.0 };
     if stored > 0 {
+        let lever = Lever::SceneGrid { width: scene.width, height: scene.height };
+        let fields = "scene.width, scene.height (or the georeference raster's grid)";
         parts.push(Part {
             what: format!("scene maps ({stored} stored, {} × {} cells)", scene.width, scene.height),
-            bytes: cells * (stored as f64 * BYTES_PER_CELL_MAP + transient),
-            fields: "scene.width, scene.height (or the georeference raster's grid)",
-            lever: Lever::SceneGrid { width: scene.width, height: scene.height },
+            bytes: cells * stored as f64 * BYTES_PER_CELL_MAP,
+            fields,
+            lever,
         });
+        if transient > 0.0 {
+            parts.push(Part { what: SYNTHESIS.into(), bytes: cells * transient, fields, lever });
+        }
     }
     if matches!(scene.georeference, Some(Georeference::Raster(_)))
         || maps.iter().any(|m| matches!(m, MapSpec::Raster { .. }))
@@ -189,13 +202,33 @@ pub fn correct_demand(scene: &SceneSpec, image: &ImageCorrection, rows: usize, b
     Demand { parts, atmosphere_s: family_seconds(&scene.atmosphere.accuracy, image) }
 }
 
-/// What `config` will ask for, alone.
+/// What `config` will ask for, alone, run by an engine that keeps its cubes.
 #[must_use]
 pub fn run_demand(config: &RunConfig) -> Demand {
+    run_demand_keeping(config, true)
+}
+
+/// What `config` will ask for, alone: run by an engine that keeps its cubes (`keep_cubes`) or by
+/// a lean one, which holds a cube only until the next stage has read it.
+#[must_use]
+pub fn run_demand_keeping(config: &RunConfig, keep_cubes: bool) -> Demand {
     let mut parts = Vec::new();
     scene_parts(&config.scene, &mut parts);
     parts.push(atmosphere_part(config));
-    parts.push(cube_part(config, BYTES_PER_PIXEL_BAND));
+    parts.push(if keep_cubes {
+        cube_part(config, BYTES_PER_PIXEL_BAND)
+    } else {
+        cube_part_with(config, LEAN_BYTES_PER_PIXEL_BAND, LEAN_BYTES_PER_PIXEL)
+    });
+    // The scene's synthesis is over before the cubes are made: the larger of the two counts.
+    if let Some(i) = parts.iter().position(|p| p.what == SYNTHESIS) {
+        let cubes = parts.last().map_or(0.0, |p| p.bytes);
+        if parts[i].bytes <= cubes {
+            parts.remove(i);
+        } else {
+            parts.pop();
+        }
+    }
     Demand { parts, atmosphere_s: atmosphere_seconds(config) }
 }
 
@@ -213,13 +246,17 @@ fn image_size(config: &RunConfig) -> (usize, usize) {
 }
 
 fn cube_part(config: &RunConfig, bytes_per_pixel_band: f64) -> Part {
+    cube_part_with(config, bytes_per_pixel_band, BYTES_PER_PIXEL)
+}
+
+fn cube_part_with(config: &RunConfig, bytes_per_pixel_band: f64, bytes_per_pixel: f64) -> Part {
     let i = &config.instrument;
     let (rows, cols) = image_size(config);
     let bands = band_count(&i.kind);
     let pixels = rows as f64 * cols as f64;
     Part {
         what: format!("cubes of {} ({rows} × {cols} pixels × {bands} bands)", i.name),
-        bytes: pixels * (bands as f64 * bytes_per_pixel_band + BYTES_PER_PIXEL),
+        bytes: pixels * (bands as f64 * bytes_per_pixel_band + bytes_per_pixel),
         fields: "instrument.lines, instrument.detectors, the bands, fidelity.decimation",
         lever: Lever::Image { rows, columns: cols, decimation: config.fidelity.decimation.max(1) },
     }
@@ -251,19 +288,39 @@ pub fn study_demand(configs: &[&RunConfig], keep_cubes: bool, cache_bytes: usize
             demand.parts = shared;
         }
     }
-    let per_band = if keep_cubes { BYTES_PER_PIXEL_BAND } else { LEAN_BYTES_PER_PIXEL_BAND };
-    let largest = configs.iter().max_by(|a, b| cube_part(a, per_band).bytes.total_cmp(&cube_part(b, per_band).bytes));
-    if let Some(c) = largest {
-        demand.parts.push(cube_part(c, per_band));
-    }
-    for c in configs {
+    // The largest run at work: its cubes as the stages hand them on (all of them when kept, to
+    // be written) and its products as they are made.
+    let (per_band, per_pixel) = if keep_cubes {
+        (BYTES_PER_PIXEL_BAND, BYTES_PER_PIXEL)
+    } else {
+        (LEAN_BYTES_PER_PIXEL_BAND, LEAN_BYTES_PER_PIXEL)
+    };
+    let part = |c: &RunConfig| cube_part_with(c, per_band, per_pixel);
+    let largest = configs.iter().enumerate().max_by(|(_, a), (_, b)| part(a).bytes.total_cmp(&part(b).bytes));
+    let largest = largest.map(|(i, c)| (i, part(c)));
+    // The products and truth maps every other run leaves behind.
+    for (i, c) in configs.iter().enumerate() {
+        if largest.as_ref().is_some_and(|(l, _)| *l == i) {
+            continue;
+        }
         let (rows, cols) = image_size(c);
-        let per_pixel = KEPT_BYTES_PER_PIXEL + c.retrievals.len() as f64 * PRODUCT_BYTES_PER_PIXEL;
+        let kept = KEPT_BYTES_PER_PIXEL + c.retrievals.len() as f64 * PRODUCT_BYTES_PER_PIXEL;
         demand.parts.push(Part {
             what: format!("the products and truth maps of {} ({rows} × {cols} pixels)", c.instrument.name),
-            bytes: rows as f64 * cols as f64 * per_pixel,
+            bytes: rows as f64 * cols as f64 * kept,
             ..cube_part(c, 0.0)
         });
+    }
+    if let Some((_, run)) = largest {
+        // The scene's synthesis is over before the first run starts: the larger of the two counts.
+        if let Some(i) = demand.parts.iter().position(|p| p.what == SYNTHESIS) {
+            if demand.parts[i].bytes <= run.bytes {
+                demand.parts.remove(i);
+                demand.parts.push(run);
+            }
+        } else {
+            demand.parts.push(run);
+        }
     }
     demand.parts.push(Part {
         what: "the engine's cache".into(),
@@ -288,12 +345,12 @@ mod tests {
     fn the_default_study_fits_and_its_estimate_bounds_the_measured_peak() {
         let runs = default_runs();
         let demand = study_demand(&runs.iter().collect::<Vec<_>>(), false, crate::engine::LEAN_CACHE_BYTES);
-        // Measured with /usr/bin/time on `shoal study --no-cubes` at full resolution: 0.82 GB
-        // peak (0.87 GB with the image-based correction). The estimate is an upper bound within
-        // a factor 1.6 (it plans for the working copies, and counts the scene's synthesis and
-        // the runs' cubes as if they were held at once).
+        // Measured on `shoal study --no-cubes` at full resolution: 0.83 GiB peak resident (the
+        // study prints it; tests/chain/memory.rs holds it under 1 GiB). The estimate is an upper
+        // bound within a factor 1.6 (it plans for the working copies).
         let gb = demand.bytes() / 1024.0_f64.powi(3);
-        assert!((0.87..0.87 * 1.6).contains(&gb), "{gb} GB: {demand:?}");
+        assert!((0.83..0.83 * 1.6).contains(&gb), "{gb} GB: {demand:?}");
+        assert!(gb < 1.0, "the default study is planned within 1 GiB: {gb}");
         assert!(demand.atmosphere_s < 60.0, "{}", demand.atmosphere_s);
         let budget = Budget { memory_bytes: 14e9, atmosphere_s: DEFAULT_ATMOSPHERE_S };
         assert!(budget.check(&demand).is_ok());
@@ -331,7 +388,10 @@ mod tests {
         assert!(budget.check(&run_demand(&c)).is_ok());
         let e = short.check(&run_demand(&c)).unwrap_err();
         assert_eq!(e.field, "scene.atmosphere.accuracy", "{e}");
-        // The defaults plan well under a second.
-        assert!(atmosphere_seconds(&default_runs()[0]) < 0.5);
+        // The paper's study plans well under a second (the default study adds the image-based
+        // correction's aerosol family: its own demand, `family_seconds`).
+        let paper = crate::study::StudySpec::preset(crate::study::PAPER_STUDY).unwrap_or_else(|e| panic!("{e}"));
+        let paper = paper.resolve(None).unwrap_or_else(|e| panic!("{e}"));
+        assert!(atmosphere_seconds(&paper.runs[0].2) < 0.5);
     }
 }

@@ -171,7 +171,7 @@ impl Engine {
         let start = Instant::now();
         self.cache.begin_run();
         self.fault = config.fault;
-        config.validate()?;
+        config.validate_keeping(self.keep_cubes)?;
         let mut report = RunReport {
             scene: config.scene.name.clone(),
             instrument: config.instrument.name.clone(),

@@ -14,6 +14,14 @@
 //! )
 //! ```
 
+/// The study `shoal study` and the app open with: the paper's trade-off (CubeSat vs SmallSat
+/// over the Lake Hume bloom) corrected as a mission would correct it, from each design's own
+/// 779/865 nm bands with the NIR iteration, not with the atmosphere the scene was made with.
+pub const DEFAULT_STUDY: &str = "cubesat_vs_smallsat_image";
+/// The paper's trade-off study (Matthews et al. 2023, §3.2) with its perfect (exact)
+/// atmospheric correction: what `shoal reproduce` and the paper's comparisons keep.
+pub const PAPER_STUDY: &str = "cubesat_vs_smallsat";
+
 mod budget;
 mod curves;
 mod figures;
@@ -41,7 +49,7 @@ pub use outdir::{MARKER, OutputDir};
 pub use output::{CubeFormat, Outputs, metrics_csv, write_bytes, write_run, write_run_as, write_study};
 pub use render::{Figure, base64};
 pub use requirements::{Check, ProductRequirement, Requirements, RrsRequirement, checks_csv, verdict};
-pub use run::{StudyResult, StudyRun, run_study};
+pub use run::{StudyResult, StudyRun, run_study, study_plan};
 pub use slide::{ComparisonPanel, ReviewSlide, SLIDE, SlideSeries, review_slide};
 pub use spread::{SeedSpread, seed_spread, seed_spread_csv, spread_of_runs};
 
@@ -206,9 +214,11 @@ impl StudySpec {
         crate::parse::preset_names::<Self>()
     }
 
-    /// The built-in default: CubeSat vs SmallSat over Lake Hume.
+    /// The built-in default: CubeSat vs SmallSat over Lake Hume with the correction a mission's
+    /// processor would make ([`DEFAULT_STUDY`]: the aerosol from each design's own 779/865 nm
+    /// bands). The paper's study with its perfect correction is [`PAPER_STUDY`].
     pub fn default_study() -> Result<Self, StudyError> {
-        Self::preset("cubesat_vs_smallsat")
+        Self::preset(DEFAULT_STUDY)
     }
 
     /// Read the scene and instruments (`dir`: the study file's directory) and build the runs.

@@ -47,6 +47,18 @@ pub struct StudyResult {
     pub spectrum: Option<Arc<super::spectrum_figure::StudySpectrum>>,
 }
 
+/// What [`run_study`] will hold (its resource plan) and its engine's cache budget: seeds after
+/// an instrument's first reuse its pupil radiance, so with several seeds the cache keeps the
+/// largest one.
+#[must_use]
+pub fn study_plan(study: &ResolvedStudy, keep_cubes: bool) -> (crate::budget::Demand, usize) {
+    let configs: Vec<&crate::engine::RunConfig> = study.runs.iter().map(|r| &r.2).collect();
+    let seeds = study.runs.iter().filter(|r| study.runs.first().is_some_and(|f| f.0 == r.0)).count();
+    let radiance = configs.iter().map(|c| crate::engine::resources::radiance_bytes(c)).max().unwrap_or(0);
+    let cache_bytes = crate::engine::LEAN_CACHE_BYTES + if seeds > 1 { radiance } else { 0 };
+    (crate::engine::resources::study_demand(&configs, keep_cubes, cache_bytes), cache_bytes)
+}
+
 /// Run every configuration of `study`; `on_run` sees each run output (with its cubes, to write
 /// them, when `keep_cubes`) before it is reduced to what the tables and figures need. Runs are
 /// made one at a time by a lean engine ([`Engine::lean`]): a study holds its runs' products and
@@ -61,12 +73,8 @@ pub fn run_study(
     // alone when the engine validates it).
     let budget = crate::budget::Budget::from_env()
         .map_err(|m| StudyError::Invalid(crate::parse::FieldError { field: "budget".into(), message: m }))?;
-    let configs: Vec<&crate::engine::RunConfig> = study.runs.iter().map(|r| &r.2).collect();
-    // Seeds after an instrument's first reuse its pupil radiance: the cache keeps the largest.
-    let seeds = study.runs.iter().filter(|r| r.0 == study.runs[0].0).count();
-    let radiance = configs.iter().map(|c| crate::engine::resources::radiance_bytes(c)).max().unwrap_or(0);
-    let cache_bytes = crate::engine::LEAN_CACHE_BYTES + if seeds > 1 { radiance } else { 0 };
-    budget.check(&crate::engine::resources::study_demand(&configs, keep_cubes, cache_bytes))?;
+    let (demand, cache_bytes) = study_plan(study, keep_cubes);
+    budget.check(&demand)?;
     let mut engine = Engine::lean().with_cache_budget(cache_bytes);
     engine.keep_cubes(keep_cubes);
     let mut runs: Vec<StudyRun> = Vec::with_capacity(study.runs.len());

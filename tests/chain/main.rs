@@ -17,6 +17,7 @@ mod external;
 mod external_hostile;
 mod image_correction;
 mod incremental;
+mod memory;
 mod netcdf;
 mod noise;
 mod plausibility;
