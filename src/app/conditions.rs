@@ -146,7 +146,13 @@ fn correction_choice(ui: &mut egui::Ui, spec: &mut crate::correction::Correction
     use crate::correction::{AerosolFit, ImageCorrection};
     let pair = |p: [f64; 2]| Some(ImageCorrection { pair_nm: p, ..ImageCorrection::default() });
     let choices: [(&str, &str, Option<ImageCorrection>, bool); 5] = [
-        ("exact", "The forward model's own atmosphere, per pixel: the perfect correction", None, false),
+        (
+            "perfect processor (exact)",
+            "The forward model's own atmosphere, per pixel: the paper's perfect correction (no mission \
+             knows its atmosphere this well; the default corrects from the design's own bands)",
+            None,
+            false,
+        ),
         ("per-scene (paper)", "Matthews et al. 2023, Appendix A: one set of terms from 20 water pixels", None, true),
         (
             "image: 779/865 nm",

@@ -279,7 +279,7 @@ fn correction_rows(ui: &mut egui::Ui, columns: &[Column<'_>]) {
     if !columns.iter().any(|c| aerosol(c).is_some()) {
         return;
     }
-    ui.label("aerosol found").on_hover_text(
+    ui.label("aerosol found (image-based correction)").on_hover_text(
         "AOT(550) the image-based correction found from the design's own bands (median over the water \
          pixels), against the scene's true AOT",
     );

@@ -197,7 +197,7 @@ fn fallback_designs() -> Vec<Slot> {
 
 fn fallback_study() -> StudySpec {
     StudySpec::default_study().unwrap_or_else(|_| StudySpec {
-        name: "cubesat_vs_smallsat".into(),
+        name: crate::study::DEFAULT_STUDY.into(),
         description: String::new(),
         scene: Source::Preset("lake_hume_bloom".into()),
         instruments: vec![Source::Preset("cubesat".into()), Source::Preset("smallsat".into())],
@@ -243,7 +243,7 @@ impl AppState {
             layout: Layout::TruthAB,
             requirements: fallback_requirements(),
             dark: false,
-            study_name: "cubesat_vs_smallsat".into(),
+            study_name: crate::study::DEFAULT_STUDY.into(),
             fidelity: Fidelity::default(),
             preview_only: false,
             calibration: crate::calibration::CalibrationSpec::default(),
@@ -418,8 +418,12 @@ mod tests {
     use super::*;
 
     #[test]
-    fn default_is_the_cubesat_vs_smallsat_study() {
+    fn default_is_the_cubesat_vs_smallsat_study_with_a_missions_correction() {
         let s = AppState::default();
+        // The realistic processor: the aerosol from the designs' own 779/865 nm bands.
+        let image = s.correction.image.as_ref().expect("the default corrects from the image");
+        assert_eq!(image.pair_nm, [779.0, 865.0]);
+        assert_eq!(s.study_name, crate::study::DEFAULT_STUDY);
         assert_eq!(
             (s.designs[0].preset.as_str(), s.designs[1].preset.as_str(), s.scene_name.as_str()),
             ("cubesat", "smallsat", "lake_hume_bloom")

@@ -10,7 +10,9 @@ use crate::study::{budget_table, error_budget, write_bytes};
 /// Arguments of `shoal budget`.
 #[derive(Debug, Args)]
 pub struct BudgetArgs {
-    /// A study RON file or a built-in study name (default: cubesat_vs_smallsat).
+    /// A study RON file or a built-in study name (default: cubesat_vs_smallsat_image, the paper's
+    /// CubeSat vs SmallSat corrected from the designs' own 779/865 nm bands; cubesat_vs_smallsat
+    /// keeps the paper's perfect correction).
     study: Option<String>,
     /// Noise seeds per configuration (the spread of the full error comes from them).
     #[arg(long, default_value_t = 5)]

@@ -13,7 +13,7 @@ use crate::study::{error_budget, figure_set, run_study};
 #[derive(Debug, Args)]
 pub struct ReportArgs {
     /// A results directory written by `shoal study`, or a study (RON file or built-in name) to
-    /// run first (default: cubesat_vs_smallsat).
+    /// run first (default: cubesat_vs_smallsat_image).
     target: Option<String>,
     /// Output directory of the pack (index.html, figures/, review.json).
     #[arg(long, default_value = "results/review")]

@@ -175,7 +175,7 @@ fn chl_mae_pct(product: &shoal::retrieval::Product, truth: &Array2<f32>, land: &
 
 #[test]
 fn the_cubesat_error_budget_matches_runs_with_each_stage_made_perfect() {
-    let study = shoal::study::StudySpec::default_study().unwrap().resolve(None).unwrap();
+    let study = shoal::study::StudySpec::preset(shoal::study::PAPER_STUDY).unwrap().resolve(None).unwrap();
     let (label, _, config) = &study.runs[0];
     assert_eq!(label, "cubesat");
     let mut config = config.clone();
@@ -247,8 +247,8 @@ fn the_cubesat_error_budget_matches_runs_with_each_stage_made_perfect() {
 }
 
 #[test]
-fn the_default_study_checks_its_requirements_with_margins() {
-    let spec = shoal::study::StudySpec::default_study().unwrap();
+fn the_papers_study_checks_its_requirements_with_margins() {
+    let spec = shoal::study::StudySpec::preset(shoal::study::PAPER_STUDY).unwrap();
     let req = spec.requirements.clone().expect("the default study states requirements");
     let mut study = spec.resolve(None).unwrap();
     for (_, _, c) in &mut study.runs {

@@ -103,7 +103,7 @@ fn cancelling_mid_stage_leaves_only_whole_files_of_finished_runs() {
     use shoal::study::{StudySpec, run_study, write_run};
     let dir = std::env::temp_dir().join(format!("shoal-cancel-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
-    let mut study = StudySpec::default_study().unwrap().resolve(None).unwrap();
+    let mut study = StudySpec::preset(shoal::study::PAPER_STUDY).unwrap().resolve(None).unwrap();
     for (_, _, c) in &mut study.runs {
         c.fidelity.decimation = 16;
     }

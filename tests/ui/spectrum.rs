@@ -59,15 +59,11 @@ fn a_click_on_a_map_shows_the_spectrum_there() {
 }
 
 #[test]
-fn the_image_based_correction_set_in_the_app_reaches_both_runs() {
+fn the_image_based_correction_is_the_default_and_the_perfect_processor_one_choice_away() {
     let dir = temp_library("imagecorr");
     let mut h = harness("cubesat", 8, &dir);
     wait_for_engine(&mut h);
-    assert!(h.state().link.shown[0].as_ref().unwrap().output.correction.aerosol.is_none(), "exact by default");
-    // What the scene panel's "Atmospheric correction" choice sets.
-    h.state_mut().state.correction.image = Some(shoal::correction::ImageCorrection::default());
-    h.step();
-    wait_for_engine(&mut h);
+    // The default study corrects as a mission would: the aerosol from each design's own bands.
     for i in 0..2 {
         let out = &h.state().link.shown[i].as_ref().unwrap().output;
         let aerosol = out.correction.aerosol.as_ref().expect("the image-based correction ran");
@@ -79,5 +75,14 @@ fn the_image_based_correction_set_in_the_app_reaches_both_runs() {
     assert!(h.query_by_label_contains("aerosol found").is_some(), "the aerosol row is shown");
     assert_eq!(h.query_all_by_label_contains("(true 0.100)").count(), 2, "the AOT found for A and B");
     assert!(h.query_by_label_contains("Rrs 400–560 nm").is_some(), "the Rrs row is shown");
+    assert!(h.query_by_label_contains("aerosol found (image-based correction)").is_some(), "said on screen");
+    // The scene panel's "Atmospheric correction" choice "perfect processor (exact)".
+    h.state_mut().state.correction.image = None;
+    h.step();
+    wait_for_engine(&mut h);
+    for i in 0..2 {
+        let out = &h.state().link.shown[i].as_ref().unwrap().output;
+        assert!(out.correction.aerosol.is_none() && out.config.correction.image.is_none(), "the exact correction");
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }
