@@ -33,6 +33,11 @@
 //! atmosphere or the photon counts. Effects a scene does not ask for
 //! are never computed and the report lists them as skipped. [`worker`] runs the engine on its own
 //! thread with its own rayon pool for the app.
+//!
+//! What a run holds: [`Engine::new`] hands back every cube ([`Cubes`]) and caches them within its
+//! byte budget; [`Engine::lean`] (studies) frees each cube once the next stage has read it, makes
+//! `Electrons` and `Level0` in one pass row by row (no electrons product), and hands back the truth
+//! maps, products, metrics and the pixels asked for ([`Probe`]).
 
 mod cache;
 mod config;

@@ -307,9 +307,19 @@ fn pause_after_preview(pause: &PreviewPause, latest: &AtomicU64, generation: u64
     }
 }
 
+/// The app engine's cache: a quarter of the memory budget (`SHOAL_MEMORY_BUDGET`, default 60 %
+/// of the machine's memory), so that the designs' cubes kept for incremental reruns cannot grow
+/// without bound (eight designs at full resolution filled 14.8 GB before it); products past it go
+/// least recently used first, and a rerun of a design whose cubes went recomputes them.
+fn app_cache_bytes() -> usize {
+    const SHARE: f64 = 0.25;
+    // A budget that cannot be read (a malformed variable: the CLI refuses it) gets 2 GiB.
+    crate::budget::Budget::from_env().map_or(2 << 30, |b| (b.memory_bytes * SHARE) as usize)
+}
+
 fn worker(requests: &Mailbox<Request>, link: &Link<'_>, pause: &PreviewPause, pool: &rayon::ThreadPool) {
     let Link { events, latest, counters, wake } = *link;
-    let mut engine = Engine::new();
+    let mut engine = Engine::new().with_cache_budget(app_cache_bytes());
     // The mailbox holds only the newest request: an older one was replaced (and counted) there.
     while let Some(request) = requests.take() {
         // A configuration that failed is not run at finer levels; the others go on (one
