@@ -68,3 +68,46 @@ fn the_default_study_completes_with_its_address_space_capped_at_one_gigabyte() {
     let (peak, _) = peak_and_plan(&stderr);
     assert!(peak < 0.5, "peak {peak} GB at half resolution: {stderr}");
 }
+
+#[test]
+fn a_lean_run_makes_the_same_products_as_one_that_keeps_its_cubes() {
+    use shoal::control::RunControl;
+    use shoal::engine::{Engine, Probe, RunConfig};
+    // A small lake, aLMI, with the image-based correction and then the exact one (whose
+    // approximation diagnostic a lean run compares pixel by pixel).
+    let mut config = RunConfig::new(super::small_lake(), super::small("cubesat", 96, 64));
+    config.retrievals = vec![ron::from_str("Almi()").unwrap()];
+    for image in [Some(shoal::correction::ImageCorrection::default()), None] {
+        config.correction.image = image;
+        let keeping = Engine::new().run(&config, &RunControl::new()).unwrap();
+        let mut lean = Engine::lean();
+        let probes = [Probe::TypicalWater];
+        let light = lean.run_with(&config, &RunControl::new(), &probes).unwrap();
+        assert!(light.cubes.is_none() && keeping.cubes.is_some());
+        let (a, b) = (&keeping.retrievals[0], &light.retrievals[0]);
+        assert_eq!(a.product, b.product, "the same maps, bit for bit");
+        assert_eq!(format!("{:?}", a.metrics), format!("{:?}", b.metrics));
+        // The diagnostic's counts, medians and maxima are the same; its mean is a parallel sum
+        // whose grouping follows rayon's work stealing, so it may differ in the last bits
+        // (1e-12 relative, as between any two runs).
+        let (x, y) = (&keeping.correction.approximation_vs_exact, &light.correction.approximation_vs_exact);
+        assert_eq!(x.len(), y.len());
+        for (p, q) in x.iter().zip(y) {
+            assert_eq!((p.band, p.n, p.median_abs_rel, p.max_abs_rel), (q.band, q.n, q.median_abs_rel, q.max_abs_rel));
+            assert!((p.mean_rel - q.mean_rel).abs() <= 1e-12 * p.mean_rel.abs().max(1e-300), "{p:?} vs {q:?}");
+        }
+        assert_eq!(keeping.correction.rrs_metrics.len(), light.correction.rrs_metrics.len());
+        assert_eq!(
+            (keeping.report.saturated, keeping.report.zero_counts),
+            (light.report.saturated, light.report.zero_counts)
+        );
+        // The probed pixel holds the cubes' own values.
+        let probed = &light.probes[0];
+        let (r, c) = probed.pixel.expect("a lake has water");
+        let cubes = keeping.cubes.as_ref().unwrap();
+        for (b, (l1, rrs)) in probed.level1.iter().zip(&probed.rrs).enumerate() {
+            assert_eq!(l1.0.to_bits(), cubes.level1.radiance[[r, c, b]].to_bits());
+            assert_eq!(rrs.0.to_bits(), cubes.rrs.rrs[[r, c, b]].to_bits());
+        }
+    }
+}
