@@ -50,6 +50,7 @@ mod planes;
 pub mod plot_data;
 pub mod plots;
 mod probe;
+pub mod product_map;
 pub mod raster;
 mod retrievals;
 mod seeds;

@@ -239,32 +239,30 @@ impl Cache {
         self.clock += 1;
         let stage = key.stage;
         self.remove(key);
-        let evictable: usize =
-            self.entries.values().flatten().filter(|e| e.used < self.run_start).map(|e| e.bytes).sum();
-        if self.held + bytes > self.budget.saturating_add(evictable) {
+        // What may go to make room: products the current run has not used, oldest first.
+        let mut evictable: Vec<(u64, Key, usize)> = self
+            .entries
+            .values()
+            .flatten()
+            .filter(|e| e.used < self.run_start && e.bytes > 0)
+            .map(|e| (e.used, e.key, e.bytes))
+            .collect();
+        let room = self.budget.saturating_add(evictable.iter().map(|e| e.2).sum());
+        if self.held + bytes > room {
             return;
         }
-        while self.held + bytes > self.budget {
-            let oldest = self
-                .entries
-                .iter()
-                .flat_map(|(s, l)| l.iter().map(move |e| (e.used, *s, e.key)))
-                .filter(|(used, s, k)| *used < self.run_start && self.bytes_of(*s, *k) > 0)
-                .min_by_key(|(used, ..)| *used);
-            match oldest {
-                Some((_, _, k)) => self.remove(k),
-                None => return,
+        evictable.sort_unstable_by_key(|e| e.0);
+        for (_, old, _) in evictable {
+            if self.held + bytes <= self.budget {
+                break;
             }
+            self.remove(old);
         }
         let list = self.entries.entry(stage).or_default();
         list.push_front(Entry { key, product, bytes, used: self.clock });
         self.held += bytes;
         let dropped: Vec<Entry> = list.drain(stage.capacity().min(list.len())..).collect();
         self.held -= dropped.iter().map(|e| e.bytes).sum::<usize>();
-    }
-
-    fn bytes_of(&self, stage: Stage, key: Key) -> usize {
-        self.entries.get(&stage).and_then(|l| l.iter().find(|e| e.key == key)).map_or(0, |e| e.bytes)
     }
 
     fn remove(&mut self, key: Key) {

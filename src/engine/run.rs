@@ -198,7 +198,7 @@ impl Engine {
         let mut inst = self.instrument_side(config, &side, radiance, radiance_key, control, &mut report)?;
         let kept_radiance = inst.radiance.take();
         // Each cube is let go once read (the cache may still keep it, within its budget).
-        let kept_level0 = inst.level0.take().filter(|_| self.keep_cubes);
+        let kept_level0 = inst.level0.take();
         if let Some(level1) = &inst.level1 {
             probed.iter_mut().for_each(|p| p.read_level1(level1));
         }
