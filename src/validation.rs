@@ -150,3 +150,38 @@ pub fn compare_water_runs(acc: &RtAccuracy) -> Result<Vec<Comparison>, Atmospher
     }
     Ok(out)
 }
+
+/// Compare the polarised radiance at the top of the atmosphere, √(Q² + U²), with OSOAA's
+/// (its degree of linear polarisation times its TOA radiance) on the flat-surface vector rows.
+/// Shoal's is the path's (the vector solution, [`crate::atmosphere::stokes`]): the water-leaving
+/// radiance is taken as unpolarised, as the instrument's polarisation effect takes it.
+pub fn compare_polarisation(acc: &RtAccuracy) -> Result<Vec<Comparison>, AtmosphereError> {
+    use crate::atmosphere::stokes;
+    let t = Table::parse(WATER_REF_CSV, "water_ref.csv")?;
+    let (scenario, rt, wind) = (t.column_str("scenario")?, t.column_str("rt")?, t.column_f64("wind")?);
+    let (wl, sza, vza, phi) =
+        (t.column_f64("wl_nm")?, t.column_f64("sza")?, t.column_f64("vza")?, t.column_f64("phi")?);
+    let (aer, tau_r, e0) = (t.column_str("aer")?, t.column_f64("tau_ray")?, t.column_f64("E0")?);
+    let (dolp, l_toa, lw) = (t.column_f64("dolp_toa_pct")?, t.column_f64("L_toa")?, t.column_f64("Lw")?);
+    let mut out = Vec::new();
+    for i in (0..t.len()).filter(|&i| rt[i] == "vector" && wind[i] == 0.0) {
+        let kind = parse_aerosol(aer[i])?;
+        let c = column(wl[i], tau_r[i], kind)?;
+        let (mu0, muv) = (sza[i].to_radians().cos(), vza[i].to_radians().cos());
+        // A second, off-nadir view keeps the azimuthal terms m ≤ 2 that Q and U need at nadir.
+        let s = solve_sun(&c, mu0, &[muv, 0.9], acc);
+        let Some(qu) = s.qu_fourier.first() else { continue };
+        let dphi = phi[i].to_radians();
+        let shoal = stokes::q_sum(qu, dphi).hypot(stokes::u_sum(qu, dphi)) * e0[i];
+        out.push(Comparison {
+            case: format!("{} {} nm sza {} vza {}", scenario[i], wl[i], sza[i], vza[i]),
+            quantity: "polarised_radiance",
+            aerosol: kind,
+            wavelength_nm: wl[i],
+            shoal,
+            osoaa: dolp[i] / 100.0 * l_toa[i],
+            lw_fraction: Some(lw[i] / l_toa[i]),
+        });
+    }
+    Ok(out)
+}

@@ -17,6 +17,7 @@ use rayon::prelude::*;
 use super::AtmosphereError;
 use super::rt::{Scatterers, SsCoefficients, WavelengthColumn, fourier_sum, solve_sun, solve_transmittance};
 use super::spec::{Atmosphere, AtmosphereTerms, Geometry, Normalised};
+use super::stokes;
 
 /// Node positions of the table (the azimuth axis sets where `shoal bench` and tests probe; the
 /// table itself is exact in azimuth).
@@ -95,6 +96,9 @@ pub struct AtmosphereLut {
     tau_total: Vec<f64>,
     tau_rayleigh: Vec<f64>,
     forward_scattering: Vec<(f64, f64)>,
+    /// Per node, the path's `[Q₀, Q₁, Q₂, U₁, U₂]` ([`super::stokes`]); empty when the table was
+    /// built without the vector solution.
+    qu: Vec<[f64; 5]>,
 }
 
 /// Bracketing nodes and weight for linear interpolation on `nodes`; `x` must lie within the
@@ -137,6 +141,9 @@ impl AtmosphereLut {
         let mut ms = vec![0.0; nw * ns * nv * n_fourier];
         let mut ss = vec![SsCoefficients::default(); nw * ns * nv];
         let mut ed = vec![0.0; nw * ns];
+        // Q and U need the vector solution up to m = 2 at every node.
+        let polarised = n_fourier >= 3 && sun.iter().all(|s| s.qu_fourier.len() == nv);
+        let mut qu = if polarised { vec![[0.0; 5]; nw * ns * nv] } else { Vec::new() };
         for (job, sol) in jobs.iter().zip(&sun) {
             let (w, s) = *job;
             ed[w * ns + s] = sol.ed();
@@ -144,6 +151,9 @@ impl AtmosphereLut {
                 let node = (w * ns + s) * nv + v;
                 ms[node * n_fourier..node * n_fourier + sol.ms_fourier[v].len()].copy_from_slice(&sol.ms_fourier[v]);
                 ss[node] = sol.ss[v];
+                if polarised {
+                    qu[node] = sol.qu_fourier[v];
+                }
             }
         }
         let scatterers = (0..nw).map(|w| sun[w * ns].scatterers.clone()).collect();
@@ -164,7 +174,36 @@ impl AtmosphereLut {
             t_up,
             t_up_direct,
             spherical_albedo,
+            qu,
         })
+    }
+
+    /// The path radiance's (Q/I, U/I) at wavelength node `w` and geometry `g`, in the meridian
+    /// frame of the view ([`super::stokes`]); `None` when the table holds no vector solution
+    /// (single-scattering mode, or the polarisation correction switched off).
+    pub fn path_polarisation(&self, w: usize, g: &Geometry) -> Result<Option<(f64, f64)>, AtmosphereError> {
+        if self.qu.is_empty() {
+            return Ok(None);
+        }
+        let intensity = self.normalised_with(w, g, false)?.radiance;
+        let a = &self.axes;
+        let (ns, nv) = (a.sun_zenith_deg.len(), a.view_zenith_deg.len());
+        let (s0, s1, ts) = bracket("sun_zenith", &a.sun_zenith_deg, g.sun_zenith_rad.to_degrees())?;
+        let (v0, v1, tv) = bracket("view_zenith", &a.view_zenith_deg, g.view_zenith_rad.to_degrees())?;
+        let corners = [
+            (s0, v0, (1.0 - ts) * (1.0 - tv)),
+            (s0, v1, (1.0 - ts) * tv),
+            (s1, v0, ts * (1.0 - tv)),
+            (s1, v1, ts * tv),
+        ];
+        let mut c = [0.0; 5];
+        for &(s, v, weight) in &corners {
+            for (acc, x) in c.iter_mut().zip(&self.qu[(w * ns + s) * nv + v]) {
+                *acc += weight * x;
+            }
+        }
+        let (q, u) = (stokes::q_sum(&c, g.relative_azimuth_rad), stokes::u_sum(&c, g.relative_azimuth_rad));
+        Ok((intensity > 0.0).then(|| (q / intensity, u / intensity)))
     }
 
     /// The axes.

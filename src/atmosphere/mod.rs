@@ -33,6 +33,7 @@ mod solar;
 mod sos;
 mod sos_transfer;
 mod spec;
+pub mod stokes;
 mod user_aerosol;
 mod wmo;
 

@@ -264,6 +264,9 @@ pub struct SunSolution {
     pub ed_diffuse: f64,
     /// Scattering orders used in the m = 0 term.
     pub orders: usize,
+    /// Per view, the TOA path's Q and U Fourier coefficients from the vector solution (all
+    /// orders), `[Q₀, Q₁, Q₂, U₁, U₂]` ([`super::stokes`]); empty without the vector solution.
+    pub qu_fourier: Vec<[f64; 5]>,
 }
 
 impl SunSolution {
@@ -320,6 +323,7 @@ pub fn solve_sun(column: &WavelengthColumn, mu0: f64, user_mu: &[f64], acc: &RtA
     let vector = if polarize { vector_rayleigh_kernels(&streams, column.depolarization, mu0, n) } else { Vec::new() };
     let (vq, vu) = (fresnel_blocks3(&streams.mu, n), fresnel_blocks3(user_mu, n));
     let mut ms_fourier = vec![Vec::new(); user_mu.len()];
+    let mut qu_fourier = vec![[0.0; 5]; if polarize { user_mu.len() } else { 0 }];
     let (mut ed_diffuse, mut orders, mut small) = (0.0, 0, 0);
     for m in 0..=m_max {
         let kr = scalar_kernel(&streams, &beta_r, m, mu0, n);
@@ -343,6 +347,12 @@ pub fn solve_sun(column: &WavelengthColumn, mu0: f64, user_mu: &[f64], acc: &RtA
                 let delta = (fv.toa_user[i][0] + fv.toa_user_first[i][0]) - (f.toa_user[i][0] + f.toa_user_first[i][0]);
                 if let Some(c) = coeffs.last_mut() {
                     *c += delta;
+                }
+                // The path's own polarisation, kept for the instrument's polarisation sensitivity.
+                let total = |s: usize| fv.toa_user[i][s] + fv.toa_user_first[i][s];
+                qu_fourier[i][m] = total(1);
+                if m > 0 {
+                    qu_fourier[i][2 + m] = total(2);
                 }
             }
             if m == 0 {
@@ -378,6 +388,7 @@ pub fn solve_sun(column: &WavelengthColumn, mu0: f64, user_mu: &[f64], acc: &RtA
         ed_direct,
         ed_diffuse: ed_total - ed_direct,
         orders,
+        qu_fourier,
     }
 }
 

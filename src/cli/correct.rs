@@ -104,7 +104,12 @@ pub fn run(args: &CorrectArgs) -> Result<(), CliError> {
         if !raa[r].is_finite() {
             return Err(row(format!("relative_azimuth_deg {}", raa[r])));
         }
-        looks.push(Look { dx_m: 0.0, dy_m: 0.0, geometry: Geometry::from_degrees(sza[r], vza[r], raa[r]) });
+        looks.push(Look {
+            dx_m: 0.0,
+            dy_m: 0.0,
+            geometry: Geometry::from_degrees(sza[r], vza[r], raa[r]),
+            view_azimuth_rad: raa[r].to_radians(),
+        });
     }
     // The scene is built for its atmosphere and water: sized against the budget first, with the
     // family's radiative transfer and tables.

@@ -24,6 +24,8 @@ pub enum Stage {
     BandAtmosphere,
     /// Pupil radiance and truth.
     Radiance,
+    /// The instrument's optical effects on the pupil radiance (stray light, polarisation).
+    Effects,
     /// Detector responsivity and fixed patterns.
     Detector,
     /// Feasibility figures: f-number, Q, Airy disc, smear, peak signal against full scale,
@@ -54,7 +56,7 @@ pub enum Stage {
 
 impl Stage {
     /// Every stage, in chain order.
-    pub const ALL: [Self; 19] = [
+    pub const ALL: [Self; 20] = [
         Self::Scene,
         Self::Response,
         Self::Geometry,
@@ -62,6 +64,7 @@ impl Stage {
         Self::Optics,
         Self::BandAtmosphere,
         Self::Radiance,
+        Self::Effects,
         Self::Detector,
         Self::Feasibility,
         Self::Electrons,
@@ -81,7 +84,13 @@ impl Stage {
     #[must_use]
     pub fn capacity(self) -> usize {
         match self {
-            Self::Radiance | Self::Electrons | Self::Level0 | Self::Level1 | Self::Correction | Self::Retrieval => 4,
+            Self::Radiance
+            | Self::Effects
+            | Self::Electrons
+            | Self::Level0
+            | Self::Level1
+            | Self::Correction
+            | Self::Retrieval => 4,
             _ => 8,
         }
     }
@@ -99,6 +108,7 @@ impl Stage {
             Self::Optics => "optics",
             Self::BandAtmosphere => "band atmosphere",
             Self::Radiance => "radiance",
+            Self::Effects => "optical effects",
             Self::Detector => "detector",
             Self::Feasibility => "feasibility",
             Self::Electrons => "electrons",

@@ -14,7 +14,9 @@ use serde::Serialize;
 
 use super::RunConfig;
 use super::config::Fidelity;
-use crate::instrument::{BandSelection, DarkTemperature, DetectorMode, FocalPlane, InstrumentKind, InstrumentSpec};
+use crate::instrument::{
+    BandSelection, DarkTemperature, DetectorMode, FocalPlane, InstrumentEffect, InstrumentKind, InstrumentSpec,
+};
 use crate::spectral::SpectrumSource;
 
 /// What the spectral response is computed from.
@@ -171,6 +173,9 @@ pub(super) struct Inputs<'a> {
     /// (offsets and weights, from the aperture, altitude, exposure and GSD and
     /// `spatial_samples_per_gsd`) enters the radiance key by value.
     pub heading_deg: f64,
+    /// The optics between pupil and detector: the `Effects` stage applies them to the pupil
+    /// radiance and `Level1` corrects them as the processor knows them.
+    pub effects: &'a [InstrumentEffect],
     /// Nodes per band of the per-pixel water spectra (the optics stage: 0 = every grid
     /// wavelength).
     pub band_nodes: usize,
@@ -212,6 +217,7 @@ impl<'a> Inputs<'a> {
             // A label: the first plane's numbers are the fields above.
             material: _,
             focal_planes,
+            effects,
         } = &config.instrument;
         let (mut plane_response, mut plane_photon, mut plane_electronics) = (Vec::new(), Vec::new(), Vec::new());
         for p in focal_planes {
@@ -283,6 +289,7 @@ impl<'a> Inputs<'a> {
             },
             snr: SnrPatch { frames: snr_frames, detectors: snr_detectors, decimation, seed },
             heading_deg: *heading_deg,
+            effects,
             band_nodes,
             water_single_precision,
             decimation,

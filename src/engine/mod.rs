@@ -42,6 +42,7 @@
 mod cache;
 mod config;
 mod correction_stage;
+mod effects_stage;
 mod fault;
 mod files;
 pub mod footprint;

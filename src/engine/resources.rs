@@ -56,6 +56,10 @@ const RT_BYTES_PER_LEVEL_STREAM_PAIR: f64 = 72.0;
 /// 0.96), the paper's study with the exact correction 0.78 GiB, `four_designs_lake_hume` (the
 /// 101-band spectrograph the largest run) 2.74 GiB (plan 2.83).
 const LEAN_BYTES_PER_PIXEL_BAND: f64 = 16.0;
+/// Bytes per pixel and band an instrument's optical effects add (`instrument::effects`): the
+/// radiance at the detector, then the measured Level-1 and its stray part while the processor
+/// corrects it.
+const EFFECTS_BYTES_PER_PIXEL_BAND: f64 = 8.0;
 /// Bytes per pixel of a lean run beyond its bands: its truth maps (13), its products as they are
 /// made and the retrieval's rows before they are joined (about 45), an image-based correction's
 /// aerosol maps (8), rounded up.
@@ -254,9 +258,12 @@ fn cube_part_with(config: &RunConfig, bytes_per_pixel_band: f64, bytes_per_pixel
     let (rows, cols) = image_size(config);
     let bands = band_count(&i.kind);
     let pixels = rows as f64 * cols as f64;
+    // Optical effects: the radiance at the detector beside the pupil's, and the processor's
+    // copy of Level-1 with its stray part while it corrects (f32 each).
+    let effects = if i.effects.is_empty() { 0.0 } else { EFFECTS_BYTES_PER_PIXEL_BAND };
     Part {
         what: format!("cubes of {} ({rows} × {cols} pixels × {bands} bands)", i.name),
-        bytes: pixels * (bands as f64 * bytes_per_pixel_band + bytes_per_pixel),
+        bytes: pixels * (bands as f64 * (bytes_per_pixel_band + effects) + bytes_per_pixel),
         fields: "instrument.lines, instrument.detectors, the bands, fidelity.decimation",
         lever: Lever::Image { rows, columns: cols, decimation: config.fidelity.decimation.max(1) },
     }

@@ -296,13 +296,16 @@ impl Engine {
             ))
         })?;
         report.warnings.clone_from(&feasibility.warnings);
+        // The optics between pupil and detector (none: the detector sees the pupil radiance).
+        let (at_detector, optics_key) = self.effects_stage(config, side, &radiance, radiance_key, control, report)?;
+        let detector_radiance = at_detector.as_deref().unwrap_or(&radiance.radiance);
         let electrons_key =
-            KeyBuilder::new(Stage::Electrons).after(radiance_key).after(response_key).with(&inputs.photon).finish();
+            KeyBuilder::new(Stage::Electrons).after(optics_key).after(response_key).with(&inputs.photon).finish();
         let level0_key = KeyBuilder::new(Stage::Level0).after(electrons_key).with(&inputs.electronics).finish();
         let level0 = if self.keeps_cubes() {
             // The electrons kept apart, so that a change of the electronics reruns only the readout.
             let electrons = self.stage(electrons_key, report, control, || {
-                expose_cube(&detector, &radiance.radiance, viewing, config.seed, control)
+                expose_cube(&detector, detector_radiance, viewing, config.seed, control)
                     .map_err(failed(Stage::Electrons))
             })?;
             self.stage(level0_key, report, control, || {
@@ -311,7 +314,7 @@ impl Engine {
         } else {
             // A lean run keeps no electrons cube: exposure and readout row by row (the same counts).
             self.stage(level0_key, report, control, || {
-                expose_and_digitise(&detector, &radiance.radiance, viewing, config.seed, control)
+                expose_and_digitise(&detector, detector_radiance, viewing, config.seed, control)
                     .map_err(failed(Stage::Level0))
             })?
         };
@@ -335,9 +338,12 @@ impl Engine {
         })?;
         report.diffuser_incidence_deg = calibration.sun_incidence_deg;
         report.diffuser_saturated_frames = calibration.saturated_frames;
-        let level1_key = KeyBuilder::new(Stage::Level1).after(level0_key).after(calibration_key).finish();
+        let level1_key =
+            KeyBuilder::new(Stage::Level1).after(level0_key).after(calibration_key).with(&inputs.effects).finish();
         let level1 = self.stage(level1_key, report, control, || {
-            calibrate(&level0, &calibration, viewing, control).map_err(failed(Stage::Level1))
+            let mut level1 = calibrate(&level0, &calibration, viewing, control).map_err(failed(Stage::Level1))?;
+            super::effects_stage::correct_level1(config, side, &mut level1.radiance, control)?;
+            Ok(level1)
         })?;
 
         Ok(InstrumentSide {

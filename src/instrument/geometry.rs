@@ -31,6 +31,10 @@ pub struct Look {
     pub dy_m: f64,
     /// Sun and view geometry at the ground point.
     pub geometry: Geometry,
+    /// Azimuth of the sensor seen from the ground point, rad clockwise from north (the sun's
+    /// azimuth at nadir, where the relative azimuth is taken as 0); with the sun's azimuth it
+    /// gives the signed relative azimuth that Stokes U needs ([`crate::atmosphere::stokes`]).
+    pub view_azimuth_rad: f64,
 }
 
 /// The viewing geometry of a run (possibly decimated for a preview).
@@ -96,7 +100,7 @@ impl Viewing {
         let line_index: Vec<usize> = (0..spec.lines).step_by(decimation).collect();
         let mut max_vza: f64 = 0.0;
         // Ground offset (along, across) and geometry of a look at angles (β, α).
-        let look = |beta: f64, alpha: f64| -> Result<(f64, f64, Geometry), InstrumentError> {
+        let look = |beta: f64, alpha: f64| -> Result<(f64, f64, Geometry, f64), InstrumentError> {
             let (tb, ta) = (beta.tan(), alpha.tan());
             let norm = (1.0 + tb * tb + ta * ta).sqrt();
             let gamma = (1.0 / norm).acos();
@@ -123,21 +127,21 @@ impl Viewing {
                 rel = 2.0 * std::f64::consts::PI - rel;
             }
             let geometry = Geometry { sun_zenith_rad, view_zenith_rad: vza, relative_azimuth_rad: rel };
-            Ok((dx, dy, geometry))
+            Ok((dx, dy, geometry, sensor_azimuth))
         };
         // The image centre (central detector of the mean group offset) lands on the scene centre.
         let mean_offset =
             response.groups.iter().map(|g| g.offset_rad.0).sum::<f64>() / response.groups.len().max(1) as f64;
-        let (cx, cy, _) = look(tilt + mean_offset, 0.0)?;
+        let (cx, cy, ..) = look(tilt + mean_offset, 0.0)?;
         let mut looks = Vec::with_capacity(response.groups.len());
         for g in &response.groups {
             let row = detector_index
                 .iter()
                 .map(|&j| {
                     let alpha = ((j as f64 - 0.5 * (n as f64 - 1.0)) * pitch_over_f).atan() + g.offset_rad.1;
-                    let (dx, dy, geometry) = look(tilt + g.offset_rad.0, alpha)?;
+                    let (dx, dy, geometry, view_azimuth_rad) = look(tilt + g.offset_rad.0, alpha)?;
                     max_vza = max_vza.max(geometry.view_zenith_rad.to_degrees());
-                    Ok(Look { dx_m: dx - cx, dy_m: dy - cy, geometry })
+                    Ok(Look { dx_m: dx - cx, dy_m: dy - cy, geometry, view_azimuth_rad })
                 })
                 .collect::<Result<Vec<_>, InstrumentError>>()?;
             looks.push(row);
@@ -155,7 +159,7 @@ impl Viewing {
                 .iter()
                 .map(|&j| {
                     let alpha = ((j as f64 - 0.5 * (n as f64 - 1.0)) * pitch_over_f).atan();
-                    look(tilt + mean_offset, alpha).map(|(dx, dy, _)| (dx - cx, dy - cy))
+                    look(tilt + mean_offset, alpha).map(|(dx, dy, ..)| (dx - cx, dy - cy))
                 })
                 .collect::<Result<Vec<_>, InstrumentError>>()?;
             for group in &mut looks {

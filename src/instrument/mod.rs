@@ -10,6 +10,7 @@
 //! | spatial response | [`spatial`] | diffraction, detector footprint, along-track smear (when asked) |
 //! | sampling | [`sample`] | band radiance of every pixel from the scene, and its truth |
 //! | aerosol map | [`aerosol_map`] | the atmosphere pixel by pixel where the scene's AOT varies |
+//! | effects | [`effects`] | stray light, polarisation sensitivity: the optics between pupil and detector |
 //! | detector | [`detector`] | photo-electrons, shot/dark/read noise, PRNU/DSNU, full well, ADC |
 //! | Level-0 | [`level0`] | the whole image exposed and read out, with flags |
 //! | plausibility | [`plausibility`] | saturation at the brightest water, smear, f-number warnings |
@@ -34,6 +35,7 @@ pub mod aerosol_map;
 pub mod band_atmosphere;
 pub mod budgets;
 pub mod detector;
+pub mod effects;
 pub mod feasibility;
 pub mod focal;
 pub mod geometry;
@@ -49,6 +51,7 @@ pub mod spec;
 pub mod truth;
 
 pub use detector::{Detector, DetectorMode, Flags};
+pub use effects::InstrumentEffect;
 pub use focal::{BandSelection, DarkLaw, DarkTemperature, DetectorMaterial, FocalPlane, Sampling};
 pub use geometry::{Look, Viewing};
 pub use level0::{Level0, digitise_cube, expose_and_digitise, expose_cube};

@@ -4,6 +4,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::InstrumentError;
+use super::effects::InstrumentEffect;
 use super::focal::{DarkTemperature, DetectorMaterial, FocalPlane, Sampling};
 use crate::parse::{FieldError, ParseError};
 use crate::spectral::{BandSetSpec, SpectrumSource};
@@ -124,6 +125,10 @@ pub struct InstrumentSpec {
     /// these claims it.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub focal_planes: Vec<FocalPlane>,
+    /// The optics between the entrance pupil and the detector ([`super::effects`]: stray light,
+    /// polarisation sensitivity), applied in order; none: an ideal optic.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub effects: Vec<InstrumentEffect>,
 }
 
 fn is_silicon(m: &DetectorMaterial) -> bool {
@@ -200,6 +205,7 @@ impl InstrumentSpec {
             t.validate("instrument.dark_temperature")?;
         }
         self.validate_planes()?;
+        super::effects::validate(&self.effects)?;
         // The kind's own fields (a spectrograph's span and sampling, a filter imager's rows).
         self.kind.model().validate()?;
         Ok(())

@@ -254,6 +254,28 @@ ranges! {
     /// Filter imager: rows per band.
     FILTER_ROWS_PER_BAND = Range::count("instrument.kind.FilterImager.rows_per_band", 1.0, 10_000.0, "", "detector rows between band centres");
 
+    // Instrument effects (instrument::effects; `effects[]` is the entry's index).
+    /// Stray light: halo share at 550 nm.
+    STRAY_HALO_FRACTION = Range::closed("instrument.effects[].StrayLight.halo_fraction", 0.0, 0.5, "", "share of the light the far-field halo spreads, at 550 nm");
+    /// Stray light: the halo's knee.
+    STRAY_KNEE_M = Range::above("instrument.effects[].StrayLight.knee_m", 0.0, 1e5, "m", "knee of the halo's Harvey profile on the ground");
+    /// Stray light: the halo's slope.
+    STRAY_SLOPE = Range::closed("instrument.effects[].StrayLight.slope", 0.5, 6.0, "", "power-law slope of the halo beyond its knee");
+    /// Stray light: the halo's extent.
+    STRAY_RADIUS_M = Range::above("instrument.effects[].StrayLight.radius_m", 0.0, 50_000.0, "m", "extent of the halo on the ground");
+    /// Stray light: out-of-field veil.
+    STRAY_OUT_OF_FIELD = Range::closed("instrument.effects[].StrayLight.out_of_field_fraction", 0.0, 0.5, "", "share of the light from beyond the field of view (a veil of the image's mean)");
+    /// Stray light: wavelength law.
+    STRAY_WAVELENGTH_EXPONENT = Range::closed("instrument.effects[].StrayLight.wavelength_exponent", 0.0, 4.0, "", "p in halo_fraction·(550/λ)^p (2: micro-roughness scatter)");
+    /// Stray light: the processor's error.
+    STRAY_KNOWLEDGE_ERROR = Range::closed("instrument.effects[].StrayLight.correction.error", -1.0, 1.0, "", "relative error of the processor's halo and veil");
+    /// Polarisation sensitivity.
+    POLARISATION_SENSITIVITY = Range::closed("instrument.effects[].Polarisation.sensitivity", 0.0, 0.2, "", "polarisation sensitivity √(m12² + m13²) of every band (or of each in per_band)");
+    /// Polarisation axis.
+    POLARISATION_AXIS_DEG = Range::closed("instrument.effects[].Polarisation.axis_deg", -180.0, 180.0, "degrees", "most transmitted polarisation, from the along-track axis");
+    /// Polarisation: the processor's error.
+    POLARISATION_KNOWLEDGE_ERROR = Range::closed("instrument.effects[].Polarisation.correction.error", -1.0, 1.0, "", "relative error of the processor's sensitivity");
+
     // Scene (SceneSpec::validate and the maps' values in Scene::build).
     /// Scene width.
     SCENE_WIDTH = Range::count("scene.width", 1.0, 20_000.0, "cells", "cells along x (east)");
@@ -433,47 +455,4 @@ pub fn markdown_table() -> String {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn words_and_bounds() {
-        assert_eq!(INSTRUMENT_APERTURE_MM.allowed(), "above 0, at most 2000 mm");
-        assert_eq!(INSTRUMENT_ADC_BITS.allowed(), "1 to 16 bits (whole number)");
-        assert_eq!(ACCURACY_ORDER_TOLERANCE.allowed(), "above 0, below 0.1");
-        assert_eq!(CALIBRATION_SUN_INCIDENCE_DEG.allowed(), "0 to below 89 degrees");
-        assert_eq!(
-            INSTRUMENT_GAIN_E_PER_DN.check(0.001),
-            Err("0.001 is out of range (allowed: 0.01 to 10000 e-/DN)".into())
-        );
-        assert!(INSTRUMENT_ADC_BITS.check(12.5).is_err() && INSTRUMENT_ADC_BITS.check(12.0).is_ok());
-        assert!(!CALIBRATION_SUN_INCIDENCE_DEG.contains(89.0) && CALIBRATION_SUN_INCIDENCE_DEG.contains(88.9));
-        assert_eq!(INSTRUMENT_APERTURE_MM.just_outside(), vec![0.0, 2020.0]);
-        assert_eq!(INSTRUMENT_ADC_BITS.just_outside(), vec![0.0, 17.0]);
-        assert_eq!(CALIBRATION_DIFFUSER_BIAS_PCT.just_outside(), vec![-50.5, 50.5]);
-        assert_eq!(INSTRUMENT_APERTURE_MM.name(), "aperture_mm");
-    }
-
-    #[test]
-    fn every_range_is_well_formed_and_named_once() {
-        let mut paths: Vec<&str> = ALL.iter().map(|r| r.path).collect();
-        paths.sort_unstable();
-        paths.dedup();
-        assert_eq!(paths.len(), ALL.len(), "a path is listed twice");
-        for r in ALL {
-            assert!(r.lo < r.hi && r.lo.is_finite() && r.hi.is_finite(), "{}", r.path);
-            for v in r.just_outside() {
-                assert!(!r.contains(v), "{}: {v}", r.path);
-            }
-            assert!(!r.contains(f64::NAN) && !r.contains(f64::INFINITY), "{}", r.path);
-        }
-    }
-
-    /// docs/MANUAL.md's table is `shoal ranges`'s output, so the documentation is the code's.
-    #[test]
-    fn manual_shows_the_table() {
-        let manual = include_str!("../../docs/MANUAL.md");
-        let table = markdown_table();
-        assert!(manual.contains(&table), "docs/MANUAL.md's table differs from `shoal ranges`; paste this:\n{table}");
-    }
-}
+mod tests;

@@ -237,6 +237,25 @@ impl SceneOptics {
         &self.e0
     }
 
+    /// The path radiance's (Q/I, U/I) at `wavelength_nm` (linear in ln λ between the table's
+    /// wavelength nodes, constant beyond its ends) in the view's meridian frame; `None` when the
+    /// table holds no vector solution ([`AtmosphereLut::path_polarisation`]).
+    pub fn path_polarisation(&self, g: &Geometry, wavelength_nm: f64) -> Result<Option<(f64, f64)>, AtmosphereError> {
+        let nodes = &self.lut.axes().wavelengths_nm;
+        let k = nodes.partition_point(|&v| v <= wavelength_nm);
+        let (j0, j1, t) = if k == 0 {
+            (0, 0, 0.0)
+        } else if k >= nodes.len() {
+            (nodes.len() - 1, nodes.len() - 1, 0.0)
+        } else {
+            (k - 1, k, (wavelength_nm / nodes[k - 1]).ln() / (nodes[k] / nodes[k - 1]).ln())
+        };
+        let (Some(a), Some(b)) = (self.lut.path_polarisation(j0, g)?, self.lut.path_polarisation(j1, g)?) else {
+            return Ok(None);
+        };
+        Ok(Some((a.0 + t * (b.0 - a.0), a.1 + t * (b.1 - a.1))))
+    }
+
     /// The atmosphere on the grid for geometry `g` (LUT nodes interpolated log–log in λ, then
     /// the 1-nm solar spectrum and the gases applied).
     pub fn path_spectrum(&self, g: &Geometry) -> Result<PathSpectrum, AtmosphereError> {

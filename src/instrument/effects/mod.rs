@@ -1,0 +1,168 @@
+//! Instrument effects: what the optics do to the light between the entrance pupil and the
+//! detector, declared in the instrument file (each design its own), applied at one place and,
+//! where a mission's Level-1 processor would, corrected there with the processor's knowledge.
+//!
+//! | effect | module | what it needs from the scene | corrected by |
+//! |---|---|---|---|
+//! | stray light (halo, out-of-field veil) | [`stray_light`] | the whole band image | deconvolution with the known PSF (Zong et al. 2006) |
+//! | polarisation sensitivity | [`polarisation`] | the path's Stokes Q and U per column | l2gen's polcor (Meister et al. 2005) |
+//!
+//! Every effect is a type behind [`Effect`], listed in [`InstrumentEffect`] (the one place an
+//! effect is registered: its module and one arm of [`InstrumentEffect::effect`]). The engine
+//! applies the list in order to the pupil radiance (stage `Effects`) before the detector sees
+//! it, and undoes it in reverse order on Level-1 (stage `Level1`), each effect with what the
+//! processor believes: [`Knowledge`]. An instrument with no effects runs exactly as before.
+//!
+//! ## References
+//! - Zong, Y., Brown, S. W., Johnson, B. C., Lykke, K. R., Ohno, Y. (2006) Simple spectral stray
+//!   light correction method for array spectroradiometers. Appl. Opt. 45, 1111–1119.
+//! - Meister, G., Kwiatkowska, E. J., Franz, B. A., Patt, F. S., Feldman, G. C., McClain, C. R.
+//!   (2005) Moderate-Resolution Imaging Spectroradiometer ocean color polarization correction.
+//!   Appl. Opt. 44, 5524–5535.
+
+pub mod convolve;
+pub mod polarisation;
+pub mod stokes_columns;
+pub mod stray_light;
+
+use ndarray::Array3;
+use serde::{Deserialize, Serialize};
+
+pub use polarisation::Polarisation;
+pub use stokes_columns::StokesColumns;
+pub use stray_light::StrayLight;
+
+use super::InstrumentError;
+use crate::control::RunControl;
+use crate::parse::FieldError;
+
+/// One instrument effect as the file states it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum InstrumentEffect {
+    /// Spatial stray light: a far-field halo around every pixel's PSF and a veil from beyond the
+    /// field of view.
+    StrayLight(StrayLight),
+    /// Polarisation sensitivity: the response depends on the light's linear polarisation.
+    Polarisation(Polarisation),
+}
+
+impl InstrumentEffect {
+    /// The effect behind the file's entry (the registry: one arm per effect).
+    #[must_use]
+    pub fn effect(&self) -> &dyn Effect {
+        match self {
+            Self::StrayLight(e) => e,
+            Self::Polarisation(e) => e,
+        }
+    }
+}
+
+/// What the processor knows of an effect: whether it corrects it, and how wrong its model is.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Knowledge {
+    /// The Level-1 processor corrects the effect.
+    pub corrected: bool,
+    /// Relative error of the processor's model of the effect's size (0.1: it believes the
+    /// effect 10 % stronger than it is; −1 to 1).
+    pub error: f64,
+}
+
+impl Default for Knowledge {
+    fn default() -> Self {
+        Self { corrected: true, error: 0.0 }
+    }
+}
+
+impl Knowledge {
+    /// The processor's factor on the effect's true size (0 when it does not correct).
+    #[must_use]
+    pub fn factor(&self) -> f64 {
+        if self.corrected { 1.0 + self.error } else { 0.0 }
+    }
+
+    fn validate(&self, range: &crate::ranges::Range, at: &str) -> Result<(), InstrumentError> {
+        check(range, self.error, &format!("{at}.correction.error"))
+    }
+}
+
+/// What an effect reads besides the radiance cube.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Needs {
+    /// The path radiance's Stokes Q and U per column and band ([`StokesColumns`]).
+    pub stokes: bool,
+}
+
+/// The run's facts an effect may use.
+#[derive(Debug, Clone, Copy)]
+pub struct Context<'a> {
+    /// Ground distance between output rows and between output columns, m (decimation included).
+    pub spacing_m: (f64, f64),
+    /// Band centres, nm.
+    pub centres_nm: &'a [f64],
+    /// The path's Q and U in the instrument's frame, when an effect asks for them.
+    pub stokes: Option<&'a StokesColumns>,
+}
+
+/// One instrument effect.
+pub trait Effect: Sync {
+    /// Its name in messages and tables.
+    fn name(&self) -> &'static str;
+    /// Check the fields (`at` names the entry: `effects[0].StrayLight`).
+    fn validate(&self, at: &str) -> Result<(), InstrumentError>;
+    /// What it reads besides the cube.
+    fn needs(&self) -> Needs {
+        Needs::default()
+    }
+    /// Turn the radiance reaching the pupil into what reaches the detector, in place.
+    fn apply(&self, cube: &mut Array3<f32>, ctx: &Context, control: &RunControl) -> Result<(), InstrumentError>;
+    /// The Level-1 processor's correction, in place, with its [`Knowledge`].
+    fn correct(&self, cube: &mut Array3<f32>, ctx: &Context, control: &RunControl) -> Result<(), InstrumentError>;
+}
+
+/// Check every entry of an instrument's list.
+pub fn validate(effects: &[InstrumentEffect]) -> Result<(), InstrumentError> {
+    for (i, e) in effects.iter().enumerate() {
+        let effect = e.effect();
+        effect.validate(&format!("instrument.effects[{i}].{}", effect.name()))?;
+    }
+    Ok(())
+}
+
+/// Does any entry need the path's Stokes vector?
+#[must_use]
+pub fn needs_stokes(effects: &[InstrumentEffect]) -> bool {
+    effects.iter().any(|e| e.effect().needs().stokes)
+}
+
+/// Apply the list in order.
+pub fn apply_all(
+    effects: &[InstrumentEffect],
+    cube: &mut Array3<f32>,
+    ctx: &Context,
+    control: &RunControl,
+) -> Result<(), InstrumentError> {
+    for e in effects {
+        e.effect().apply(cube, ctx, control)?;
+    }
+    Ok(())
+}
+
+/// The processor's corrections, last effect first.
+pub fn correct_all(
+    effects: &[InstrumentEffect],
+    cube: &mut Array3<f32>,
+    ctx: &Context,
+    control: &RunControl,
+) -> Result<(), InstrumentError> {
+    for e in effects.iter().rev() {
+        e.effect().correct(cube, ctx, control)?;
+    }
+    Ok(())
+}
+
+/// A field checked against its entry in [`crate::ranges`], reported under `field`.
+pub(crate) fn check(range: &crate::ranges::Range, value: f64, field: &str) -> Result<(), InstrumentError> {
+    range.check(value).map_err(|message| InstrumentError::Invalid(FieldError { field: field.to_string(), message }))
+}
