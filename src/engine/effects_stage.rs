@@ -61,7 +61,8 @@ impl Engine {
         if list.is_empty() {
             return Ok((None, radiance_key));
         }
-        let key = KeyBuilder::new(Stage::Effects).after(radiance_key).with(list).finish();
+        let applied: Vec<_> = list.iter().map(effects::InstrumentEffect::as_applied).collect();
+        let key = KeyBuilder::new(Stage::Effects).after(radiance_key).with(&applied).finish();
         let cube = self.stage(key, report, control, || {
             with_context(config, side, |ctx| {
                 let mut cube = radiance.radiance.clone();

@@ -1,6 +1,8 @@
 //! Error budget: how much of a product's error each stage of the chain contributes.
 //!
-//! Each stage that makes error has a "perfect" switch: instrument noise and quantisation off,
+//! Each stage that makes error has a "perfect" switch: the instrument's optical effects removed
+//! (stray light, polarisation sensitivity: an ideal optic; only where the design states any),
+//! instrument noise and quantisation off,
 //! calibration perfect (gains and offsets exact), atmospheric correction exact (the per-pixel
 //! inversion of the same radiative transfer instead of the per-scene approximation or the
 //! image-based correction's aerosol from the design's own bands), and the
@@ -26,6 +28,8 @@ use super::StudyError;
 /// The stages with a perfect switch, in chain order.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Stage {
+    /// The instrument's optical effects, as the processor leaves them (`instrument::effects`).
+    Optics,
     /// Photon, dark and read noise; quantisation.
     Noise,
     /// Gain and offset estimation from diffuser and dark frames.
@@ -38,12 +42,20 @@ pub enum Stage {
 
 impl Stage {
     /// All, in chain order.
-    pub const ALL: [Self; 4] = [Self::Noise, Self::Calibration, Self::Correction, Self::SiopChoice];
+    pub const ALL: [Self; 5] = [Self::Optics, Self::Noise, Self::Calibration, Self::Correction, Self::SiopChoice];
+
+    /// Does `config` have this source of error? (Only a design with optical effects has the
+    /// first.)
+    #[must_use]
+    pub fn applies(self, config: &RunConfig) -> bool {
+        self != Self::Optics || !config.instrument.effects.is_empty()
+    }
 
     /// Name in tables.
     #[must_use]
     pub fn name(self) -> &'static str {
         match self {
+            Self::Optics => "optical effects",
             Self::Noise => "noise and quantisation",
             Self::Calibration => "calibration",
             Self::Correction => "atmospheric correction",
@@ -54,6 +66,7 @@ impl Stage {
     /// Make this stage perfect in `config`.
     fn perfect(self, config: &mut RunConfig) {
         match self {
+            Self::Optics => config.instrument.effects.clear(),
             Self::Noise => {
                 config.detector.noise = false;
                 config.detector.quantise = false;
@@ -143,8 +156,8 @@ fn get(values: &[(String, Vec<f64>)], variable: &str) -> f64 {
     values.iter().find(|(n, _)| n == variable).map_or(f64::NAN, |(_, v)| mean(v))
 }
 
-/// The budget of `config` (labelled `label`) over `seeds`: 2 + 2 × 4 configurations, each run
-/// with every seed.
+/// The budget of `config` (labelled `label`) over `seeds`: 2 + 2 × (4 or 5) configurations,
+/// each run with every seed.
 pub fn error_budget(
     label: &str,
     config: &RunConfig,
@@ -155,20 +168,21 @@ pub fn error_budget(
         return Err(StudyError::Invalid(FieldError { field: "seeds".into(), message: "at least one seed".into() }));
     }
     let mut engine = Engine::new();
+    let stages: Vec<Stage> = Stage::ALL.into_iter().filter(|s| s.applies(config)).collect();
     let full = mae(&mut engine, config, seeds, control)?;
     // Sequential: perfect stages cumulatively in chain order.
     let mut cumulative = config.clone();
     let mut after = Vec::new();
-    for stage in Stage::ALL {
+    for &stage in &stages {
         stage.perfect(&mut cumulative);
         after.push(mae(&mut engine, &cumulative, seeds, control)?);
     }
     let floor = after.last().cloned().unwrap_or_default();
     // One at a time: everything perfect except `stage`.
     let mut alone = Vec::new();
-    for stage in Stage::ALL {
+    for &stage in &stages {
         let mut c = config.clone();
-        for other in Stage::ALL.into_iter().filter(|s| *s != stage) {
+        for &other in stages.iter().filter(|s| **s != stage) {
             other.perfect(&mut c);
         }
         alone.push(mae(&mut engine, &c, seeds, control)?);
@@ -180,7 +194,7 @@ pub fn error_budget(
             let spread =
                 (values.iter().map(|v| (v - full_pct).powi(2)).sum::<f64>() / (values.len().max(2) - 1) as f64).sqrt();
             let floor_pct = get(&floor, variable);
-            let lines = Stage::ALL
+            let lines = stages
                 .iter()
                 .enumerate()
                 .map(|(k, &stage)| {

@@ -52,6 +52,9 @@ fn base(path: &str) -> RunConfig {
     instrument.prnu = 0.01;
     instrument.dsnu_e = 5.0;
     crate::common::with_dark_laws(&mut instrument);
+    if path.contains("effects[]") {
+        crate::common::with_optical_effects(&mut instrument);
+    }
     for p in &mut instrument.focal_planes {
         p.prnu = 0.01;
         p.dsnu_e = 5.0;
@@ -287,8 +290,12 @@ fn every_range_field_changes_the_output_or_is_documented_and_the_cache_follows()
         let image =
             config.correction.image.as_ref().map_or(String::new(), |i| format!(" image-corrected, {}", i.label()));
         let aerosol = config.scene.atmosphere.aerosol.name();
-        let key =
-            format!("{}{adjacency}{image}, {aerosol}, {} retrievals", config.instrument.name, config.retrievals.len());
+        let effects = if config.instrument.effects.is_empty() { "" } else { " with optical effects" };
+        let key = format!(
+            "{}{adjacency}{image}{effects}, {aerosol}, {} retrievals",
+            config.instrument.name,
+            config.retrievals.len()
+        );
         if !engines.iter().any(|(k, _, _)| *k == key) {
             let mut e = Engine::new();
             let before = fingerprint(&e.run(&config, &RunControl::new()).unwrap());

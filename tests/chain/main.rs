@@ -13,6 +13,7 @@ mod coherence;
 mod common;
 mod design;
 mod determinism;
+mod effects;
 mod external;
 mod external_hostile;
 mod image_correction;

@@ -57,7 +57,12 @@ pub fn sweep_path(path: &str) -> String {
     // The ranges table names a further focal plane `focal_planes[]`; the SWIR SmallSat has one.
     // The dark-current laws: the first plane's doubles ([`with_dark_laws`]), the SWIR plane's is
     // Arrhenius.
-    let path = path.replace("[i]", index).replace("focal_planes[]", "focal_planes.0");
+    // The optical effects: stray light first, polarisation second ([`with_optical_effects`]).
+    let path = path
+        .replace("[i]", index)
+        .replace("focal_planes[]", "focal_planes.0")
+        .replace("effects[].StrayLight", "effects.0.StrayLight")
+        .replace("effects[].Polarisation", "effects.1.Polarisation");
     // The image-based correction's lists: the pair's long band, the AOT node 0.2, the start of
     // dark-spectrum fitting's band range.
     let path = match path.as_str() {
@@ -88,6 +93,18 @@ pub fn with_dark_laws(instrument: &mut shoal::instrument::InstrumentSpec) {
             p.exposure_s = Some(2.0 * t);
         }
     }
+}
+
+/// Give an instrument both optical effects the ranges table names, every field set away from
+/// its default: stray light (a 5 % halo over 600 m, a 1 % veil, the processor 10 % wrong) and
+/// a 2 % polarisation sensitivity at 10° (the processor 10 % wrong).
+pub fn with_optical_effects(instrument: &mut shoal::instrument::InstrumentSpec) {
+    instrument.effects = ron::from_str(
+        "[StrayLight((halo_fraction: 0.05, knee_m: 60.0, slope: 2.5, radius_m: 600.0, out_of_field_fraction: 0.01, \
+          wavelength_exponent: 2.0, correction: (corrected: true, error: 0.1))), \
+          Polarisation((sensitivity: 0.02, axis_deg: 10.0, correction: (corrected: true, error: 0.1)))]",
+    )
+    .unwrap();
 }
 
 /// Does the Debian tool `tool` (package `package`) run on this machine? The README's test

@@ -19,6 +19,9 @@ use crate::common::{both_retrievals, instrument_for, sweep_path};
 fn base(path: &str) -> RunConfig {
     let mut instrument = InstrumentSpec::preset(instrument_for(path)).unwrap();
     crate::common::with_dark_laws(&mut instrument);
+    if path.contains("effects[]") {
+        crate::common::with_optical_effects(&mut instrument);
+    }
     let mut c = RunConfig::new(SceneSpec::preset("lake_hume_bloom").unwrap(), instrument);
     c.retrievals = both_retrievals();
     if path.contains(".External.") {

@@ -56,6 +56,17 @@ impl InstrumentEffect {
             Self::Polarisation(e) => e,
         }
     }
+
+    /// The entry as the optics apply it, the processor's knowledge left out: the key of the
+    /// radiance at the detector, which a change of the processor's knowledge does not touch.
+    #[must_use]
+    pub fn as_applied(&self) -> Self {
+        let correction = Knowledge::default();
+        match self {
+            Self::StrayLight(e) => Self::StrayLight(StrayLight { correction, ..e.clone() }),
+            Self::Polarisation(e) => Self::Polarisation(Polarisation { correction, ..e.clone() }),
+        }
+    }
 }
 
 /// What the processor knows of an effect: whether it corrects it, and how wrong its model is.
