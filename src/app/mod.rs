@@ -44,6 +44,7 @@ mod logic;
 mod maps;
 mod metrics_table;
 pub mod model;
+mod optics;
 mod panels;
 mod params;
 mod planes;
@@ -130,6 +131,8 @@ struct UiState {
     conditions_error: Option<String>,
     /// A focal-plane edit refused by the instrument's validation.
     plane_error: Option<String>,
+    /// Why the last edit of the optical effects was refused.
+    optics_error: Option<String>,
     /// The spectrum at the point last clicked on a map.
     spectrum: spectrum::SpectrumWindow,
     /// What the panels asked for this frame, applied after it is drawn (`logic.rs`).

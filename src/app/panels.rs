@@ -302,6 +302,13 @@ fn editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
     }
     let slot = &mut app.state.designs[editing];
     egui::CollapsingHeader::new("Bands").default_open(false).show(ui, |ui| super::editors::band_editor(slot, ui));
+    planes_and_optics(app, ui, editing);
+    super::derived::derived(app, ui);
+    super::derived::differences(app, ui);
+}
+
+/// The editing design's further focal planes and its optical effects.
+fn planes_and_optics(app: &mut ShoalApp, ui: &mut egui::Ui, editing: usize) {
     let slot = &mut app.state.designs[editing];
     let title = if slot.spec.focal_planes.is_empty() {
         "Focal planes".to_string()
@@ -312,8 +319,16 @@ fn editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
         .id_salt("focal-planes")
         .default_open(false)
         .show(ui, |ui| super::planes::plane_editor(slot, ui, &mut app.ui.plane_error));
-    super::derived::derived(app, ui);
-    super::derived::differences(app, ui);
+    let slot = &mut app.state.designs[editing];
+    let title = if slot.spec.effects.is_empty() {
+        "Optics".to_string()
+    } else {
+        format!("Optics ({})", slot.spec.effects.len())
+    };
+    egui::CollapsingHeader::new(title)
+        .id_salt("optics")
+        .default_open(false)
+        .show(ui, |ui| super::optics::optics_editor(slot, ui, &mut app.ui.optics_error));
 }
 
 fn settings(app: &mut ShoalApp, ui: &mut egui::Ui) {

@@ -16,6 +16,9 @@ use crate::control::RunControl;
 use crate::instrument::RadianceCube;
 use crate::instrument::effects::{self, Context, StokesColumns};
 
+/// The radiance reaching the detector when the optics change it (`None`: the pupil's).
+pub(super) type AtDetector = Option<Arc<Array3<f32>>>;
+
 /// The path's Q and U per column and band, when an effect of `config`'s instrument reads them.
 fn stokes_for(config: &RunConfig, side: &SceneSide) -> Result<Option<StokesColumns>, EngineError> {
     if !effects::needs_stokes(&config.instrument.effects) {
@@ -56,7 +59,7 @@ impl Engine {
         radiance_key: Key,
         control: &RunControl,
         report: &mut RunReport,
-    ) -> Result<(Option<Arc<Array3<f32>>>, Key), EngineError> {
+    ) -> Result<(AtDetector, Key), EngineError> {
         let list = &config.instrument.effects;
         if list.is_empty() {
             return Ok((None, radiance_key));

@@ -1,0 +1,120 @@
+//! The left panel's optics editor: the instrument's optical effects (stray light, polarisation
+//! sensitivity; `instrument::effects`), each with what the processor knows of it. An edit is kept
+//! only if the whole instrument still validates; otherwise the message says why.
+
+use super::model::Slot;
+use crate::instrument::effects::{InstrumentEffect, Knowledge, Polarisation, StrayLight};
+
+/// One number: a drag value with its unit, shown in `scale` × its stored unit.
+fn number(ui: &mut egui::Ui, label: &str, value: &mut f64, range: (f64, f64), scale: f64, unit: &str) {
+    ui.label(label);
+    let mut shown = *value * scale;
+    let speed = 0.01 * shown.abs().max(0.1);
+    ui.add(
+        egui::DragValue::new(&mut shown)
+            .range(range.0 * scale..=range.1 * scale)
+            .speed(speed)
+            .suffix(unit)
+            .update_while_editing(false),
+    );
+    *value = shown / scale;
+    ui.end_row();
+}
+
+/// What the processor knows of an effect.
+fn knowledge(ui: &mut egui::Ui, k: &mut Knowledge) {
+    ui.label("processor corrects it");
+    ui.checkbox(&mut k.corrected, "");
+    ui.end_row();
+    if k.corrected {
+        number(ui, "  its model's error", &mut k.error, (-1.0, 1.0), 100.0, " %");
+    }
+}
+
+/// A stray light to start from: a 3 % halo at 550 nm out to 3 km, a 0.5 % veil (assumptions).
+fn stray_light() -> InstrumentEffect {
+    InstrumentEffect::StrayLight(StrayLight {
+        halo_fraction: 0.03,
+        knee_m: 40.0,
+        slope: 2.5,
+        radius_m: 3000.0,
+        out_of_field_fraction: 0.005,
+        wavelength_exponent: 2.0,
+        correction: Knowledge::default(),
+    })
+}
+
+/// A polarisation sensitivity to start from: 1 % (PACE OCI's requirement), axis along track.
+fn polarisation() -> InstrumentEffect {
+    InstrumentEffect::Polarisation(Polarisation {
+        sensitivity: 0.01,
+        per_band: Vec::new(),
+        axis_deg: 0.0,
+        correction: Knowledge::default(),
+    })
+}
+
+/// The optical effects of `slot`'s instrument.
+pub(super) fn optics_editor(slot: &mut Slot, ui: &mut egui::Ui, error: &mut Option<String>) {
+    ui.label("What the optics do between the pupil and the detector; none: an ideal optic.");
+    let mut candidate = slot.spec.clone();
+    let mut remove = None;
+    for (i, effect) in candidate.effects.iter_mut().enumerate() {
+        let title = match effect {
+            InstrumentEffect::StrayLight(_) => "Stray light",
+            InstrumentEffect::Polarisation(_) => "Polarisation sensitivity",
+        };
+        egui::CollapsingHeader::new(title).id_salt(("effect", i)).default_open(true).show(ui, |ui| {
+            egui::Grid::new(("effect-grid", i)).num_columns(2).show(ui, |ui| match effect {
+                InstrumentEffect::StrayLight(s) => {
+                    number(ui, "halo at 550 nm", &mut s.halo_fraction, (0.0, 0.5), 100.0, " %");
+                    number(ui, "knee", &mut s.knee_m, (0.1, 1e5), 1.0, " m");
+                    number(ui, "slope", &mut s.slope, (0.5, 6.0), 1.0, "");
+                    number(ui, "extent", &mut s.radius_m, (1.0, 50_000.0), 1.0, " m");
+                    number(ui, "out-of-field veil", &mut s.out_of_field_fraction, (0.0, 0.5), 100.0, " %");
+                    knowledge(ui, &mut s.correction);
+                }
+                InstrumentEffect::Polarisation(p) => {
+                    number(ui, "sensitivity", &mut p.sensitivity, (0.0, 0.2), 100.0, " %");
+                    number(ui, "axis from along track", &mut p.axis_deg, (-180.0, 180.0), 1.0, "°");
+                    knowledge(ui, &mut p.correction);
+                }
+            });
+            if ui.small_button("Remove").clicked() {
+                remove = Some(i);
+            }
+        });
+    }
+    if let Some(i) = remove {
+        candidate.effects.remove(i);
+    }
+    let has_stray = candidate.effects.iter().any(|e| matches!(e, InstrumentEffect::StrayLight(_)));
+    let has_polarisation = candidate.effects.iter().any(|e| matches!(e, InstrumentEffect::Polarisation(_)));
+    ui.horizontal(|ui| {
+        if !has_stray
+            && ui.button("Add stray light").on_hover_text("A far-field halo and an out-of-field veil").clicked()
+        {
+            candidate.effects.push(stray_light());
+        }
+        if !has_polarisation
+            && ui
+                .button("Add polarisation sensitivity")
+                .on_hover_text("The response depends on the light's linear polarisation")
+                .clicked()
+        {
+            candidate.effects.push(polarisation());
+        }
+    });
+    if candidate != slot.spec {
+        match candidate.validate() {
+            Ok(()) => {
+                slot.spec = candidate;
+                *error = None;
+            }
+            Err(e) => *error = Some(e.to_string()),
+        }
+    }
+    if let Some(e) = error {
+        ui.add(egui::Label::new(egui::RichText::new(format!("Optics refused: {e}")).color(super::theme::FAIL)).wrap());
+    }
+}
