@@ -3,7 +3,9 @@
 //!
 //! The paper's study's CubeSat run (exact atmospheric correction, aLMI) with noise and
 //! quantisation off, so that what changes between the cases is the stray light alone, at
-//! decimation 2. The halo (an assumption, not a published design's): 3 % at 550 nm, knee 40 m,
+//! decimation 2. The Lake Hume bloom scene has no land, so the example gives it a shore: the
+//! pasture of the `reservoir_chl_cdom` scene (bright in the NIR) west of a curved shore 5 km
+//! west of the image centre. The halo (an assumption, not a published design's): 3 % at 550 nm, knee 40 m,
 //! slope 2.5, out to 3 km, a 0.5 % out-of-field veil. Distance from the shore by a two-pass
 //! chamfer distance transform with weights 3 and 4 (Borgefors 1986, within 8 % of Euclidean).
 //!
@@ -18,6 +20,7 @@ use ndarray::Array2;
 use shoal::control::RunControl;
 use shoal::engine::{Engine, RunConfig, RunOutput, Stage};
 use shoal::instrument::DetectorMode;
+use shoal::scene::SceneSpec;
 use shoal::study::{PAPER_STUDY, StudySpec};
 
 /// Chamfer (3, 4) distance to the nearest land pixel, in pixels.
@@ -87,6 +90,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut base: RunConfig = study.runs.first().ok_or("the paper's study has runs")?.2.clone();
     base.detector = DetectorMode::IDEAL;
     base.fidelity.decimation = 2;
+    let mut land = SceneSpec::preset("reservoir_chl_cdom")?.land.ok_or("the reservoir has land")?;
+    land.mask = ron::from_str(
+        "Shapes(background: 0.0, shapes: [Ellipse(centre_m: (-25000.0, 0.0), radii_m: (20000.0, 60000.0), \
+         angle_deg: 0.0, value: 1.0, edge_m: 0.0)])",
+    )?;
+    base.scene.land = Some(land);
     let halo = |corrected: bool| {
         format!(
             "[StrayLight((halo_fraction: 0.03, knee_m: 40.0, slope: 2.5, radius_m: 3000.0, \

@@ -23,13 +23,21 @@ pub(super) fn derived(app: &ShoalApp, ui: &mut egui::Ui) {
         let n = app.state.designs.len();
         egui::Grid::new("derived").num_columns(n + 1).striped(true).show(ui, |ui| {
             design_header(ui, n);
-            let rows: [DerivedRow; 5] = [
+            let rows: [DerivedRow; 7] = [
                 ("GSD", |s| format!("{:.1} m", s.gsd_m())),
                 ("Swath", |s| format!("{:.1} km", s.swath_m() / 1000.0)),
                 ("f-number", |s| format!("f/{:.2}", s.f_number())),
                 ("Étendue", |s| format!("{:.2e} m² sr", s.etendue_m2_sr())),
                 ("Line period", |s| {
                     format!("{:.2} ms", 1e3 * s.gsd_m() / crate::instrument::ground_speed_m_s(s.altitude_km))
+                }),
+                ("Stray light 1 km past an edge", |s| {
+                    crate::instrument::effects::edge_ratio(&s.effects, s.gsd_m(), 1000.0, 443.0)
+                        .map_or_else(|| "–".to_string(), |r| format!("{:.3} %", 100.0 * r))
+                }),
+                ("Polarisation sensitivity", |s| {
+                    crate::instrument::effects::polarisation_sensitivity(&s.effects)
+                        .map_or_else(|| "–".to_string(), |v| format!("{:.2} %", 100.0 * v))
                 }),
             ];
             for (name, f) in rows {
@@ -51,7 +59,10 @@ pub(super) fn derived(app: &ShoalApp, ui: &mut egui::Ui) {
             }
             ui.end_row();
         });
-        ui.small("Peak SNR: the best band at the scene's median radiance.");
+        ui.small(
+            "Peak SNR: the best band at the scene's median radiance. Stray light: the 443 nm signal 1 km \
+             into the dark half of a half-bright field, relative to the bright half (Optics).",
+        );
     });
     feasibility(app, ui);
 }

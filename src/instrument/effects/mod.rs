@@ -173,6 +173,26 @@ pub fn correct_all(
     Ok(())
 }
 
+/// The stray-light figure reviews state (3MI's half-bright, half-dark field): the stray signal
+/// `distance_m` into the dark half relative to the bright half, in a band at `centre_nm`, on a
+/// grid of `gsd_m`; `None` without stray light.
+#[must_use]
+pub fn edge_ratio(effects: &[InstrumentEffect], gsd_m: f64, distance_m: f64, centre_nm: f64) -> Option<f64> {
+    effects.iter().find_map(|e| match e {
+        InstrumentEffect::StrayLight(s) => Some(s.edge_ratio((gsd_m, gsd_m), distance_m, centre_nm)),
+        InstrumentEffect::Polarisation(_) => None,
+    })
+}
+
+/// The largest polarisation sensitivity of any band; `None` without the effect.
+#[must_use]
+pub fn polarisation_sensitivity(effects: &[InstrumentEffect]) -> Option<f64> {
+    effects.iter().find_map(|e| match e {
+        InstrumentEffect::Polarisation(p) => Some(p.per_band.iter().copied().fold(p.sensitivity, f64::max)),
+        InstrumentEffect::StrayLight(_) => None,
+    })
+}
+
 /// A field checked against its entry in [`crate::ranges`], reported under `field`.
 pub(crate) fn check(range: &crate::ranges::Range, value: f64, field: &str) -> Result<(), InstrumentError> {
     range.check(value).map_err(|message| InstrumentError::Invalid(FieldError { field: field.to_string(), message }))
