@@ -143,3 +143,27 @@ fn shift_dragging_a_slider_rail_moves_the_value_a_tenth_as_far() {
     assert!((after / expected - 1.0).abs() < 0.01, "aperture {before} → {after} mm, expected {expected:.2} mm");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The optics editor adds a design's optical effects, each entry kept only when the instrument
+/// validates, and the derived figures show what a review asks of them.
+#[test]
+fn optical_effects_are_added_per_design_and_shown_in_the_derived_figures() {
+    let lib = temp_library("optics");
+    let mut h = harness("cubesat", 16, &lib);
+    h.step();
+    h.get_by_label("Optics").click();
+    h.step();
+    h.get_by_label("Add polarisation sensitivity").click();
+    h.step();
+    h.step();
+    h.get_by_label("Add stray light").click();
+    h.step();
+    h.step();
+    let effects = &h.state().state.designs[0].spec.effects;
+    assert_eq!(effects.len(), 2, "{effects:?}");
+    assert!(matches!(effects[0], shoal::instrument::InstrumentEffect::Polarisation(_)));
+    assert!(matches!(effects[1], shoal::instrument::InstrumentEffect::StrayLight(_)));
+    assert!(h.query_all_by_label("1.00 %").next().is_some(), "the derived polarisation sensitivity");
+    assert!(h.query_all_by_label("Add stray light").next().is_none(), "one stray light per design");
+    let _ = std::fs::remove_dir_all(&lib);
+}
