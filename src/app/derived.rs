@@ -32,7 +32,7 @@ pub(super) fn derived(app: &ShoalApp, ui: &mut egui::Ui) {
                     format!("{:.2} ms", 1e3 * s.gsd_m() / crate::instrument::ground_speed_m_s(s.altitude_km))
                 }),
                 ("Stray light 1 km past an edge", |s| {
-                    crate::instrument::effects::edge_ratio(&s.effects, s.gsd_m(), 1000.0, 443.0)
+                    crate::instrument::effects::edge_ratio(&s.effects, 1000.0, 443.0)
                         .map_or_else(|| "–".to_string(), |r| format!("{:.3} %", 100.0 * r))
                 }),
                 ("Polarisation sensitivity", |s| {
@@ -40,7 +40,15 @@ pub(super) fn derived(app: &ShoalApp, ui: &mut egui::Ui) {
                         .map_or_else(|| "–".to_string(), |v| format!("{:.2} %", 100.0 * v))
                 }),
             ];
-            for (name, f) in rows {
+            // The optics rows only where a design has the effect (an ideal optic has no figure).
+            let any = |has: fn(&InstrumentSpec) -> bool| app.state.designs.iter().any(|d| has(&d.spec));
+            let stray =
+                any(|s| s.effects.iter().any(|e| matches!(e, crate::instrument::InstrumentEffect::StrayLight(_))));
+            let polarised = any(|s| crate::instrument::effects::polarisation_sensitivity(&s.effects).is_some());
+            for (k, (name, f)) in rows.into_iter().enumerate() {
+                if (k == 5 && !stray) || (k == 6 && !polarised) {
+                    continue;
+                }
                 ui.label(name);
                 for d in &app.state.designs {
                     ui.label(f(&d.spec));
@@ -59,10 +67,13 @@ pub(super) fn derived(app: &ShoalApp, ui: &mut egui::Ui) {
             }
             ui.end_row();
         });
-        ui.small(
-            "Peak SNR: the best band at the scene's median radiance. Stray light: the 443 nm signal 1 km \
-             into the dark half of a half-bright field, relative to the bright half (Optics).",
-        );
+        ui.small("Peak SNR: the best band at the scene's median radiance.");
+        if app.state.designs.iter().any(|d| !d.spec.effects.is_empty()) {
+            ui.small(
+                "Stray light: the 443 nm signal 1 km into the dark half of a half-bright field, relative \
+                 to the bright half (Optics).",
+            );
+        }
     });
     feasibility(app, ui);
 }

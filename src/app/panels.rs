@@ -309,26 +309,21 @@ fn editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
 
 /// The editing design's further focal planes and its optical effects.
 fn planes_and_optics(app: &mut ShoalApp, ui: &mut egui::Ui, editing: usize) {
-    let slot = &mut app.state.designs[editing];
-    let title = if slot.spec.focal_planes.is_empty() {
-        "Focal planes".to_string()
-    } else {
-        format!("Focal planes ({})", slot.spec.focal_planes.len() + 1)
-    };
-    egui::CollapsingHeader::new(title)
-        .id_salt("focal-planes")
-        .default_open(false)
-        .show(ui, |ui| super::planes::plane_editor(slot, ui, &mut app.ui.plane_error));
-    let slot = &mut app.state.designs[editing];
-    let title = if slot.spec.effects.is_empty() {
-        "Optics".to_string()
-    } else {
-        format!("Optics ({})", slot.spec.effects.len())
-    };
-    egui::CollapsingHeader::new(title)
-        .id_salt("optics")
-        .default_open(false)
-        .show(ui, |ui| super::optics::optics_editor(slot, ui, &mut app.ui.optics_error));
+    // One header for both (the panel keeps its height): the focal planes beyond the first, then
+    // the optics between the pupil and the detector.
+    let slot = &app.state.designs[editing];
+    let mut title = String::from("Focal planes and optics");
+    if !slot.spec.focal_planes.is_empty() || !slot.spec.effects.is_empty() {
+        title = format!("{title} ({} planes, {} effects)", slot.spec.focal_planes.len() + 1, slot.spec.effects.len());
+    }
+    egui::CollapsingHeader::new(title).id_salt("focal-planes").default_open(false).show(ui, |ui| {
+        let slot = &mut app.state.designs[editing];
+        super::planes::plane_editor(slot, ui, &mut app.ui.plane_error);
+        ui.separator();
+        ui.strong("Optics");
+        let slot = &mut app.state.designs[editing];
+        super::optics::optics_editor(slot, ui, &mut app.ui.optics_error);
+    });
 }
 
 fn settings(app: &mut ShoalApp, ui: &mut egui::Ui) {

@@ -15,10 +15,15 @@ fn a_gain_change_reruns_only_digitisation_onward() {
     let mut engine = Engine::new();
     let mut config = RunConfig::new(small_lake(), small("nominal", 64, 48));
     let first = engine.run(&config, &RunControl::new()).unwrap();
-    // Every stage ran once, except the retrieval and its model (none is configured) and the
-    // image-based correction's family (the correction is exact).
-    let retrieval =
-        |s: Stage| matches!(s, Stage::Retrieval | Stage::RetrievalModel | Stage::AerosolLuts | Stage::AerosolFamily);
+    // Every stage ran once, except the retrieval and its model (none is configured), the
+    // image-based correction's family (the correction is exact) and the optical effects (the
+    // instrument lists none).
+    let retrieval = |s: Stage| {
+        matches!(
+            s,
+            Stage::Retrieval | Stage::RetrievalModel | Stage::AerosolLuts | Stage::AerosolFamily | Stage::Effects
+        )
+    };
     assert!(Stage::ALL.iter().all(|&s| engine.executions(s) == u64::from(!retrieval(s))), "{:?}", counts(&engine));
 
     config.instrument.gain_e_per_dn = 2.0;
@@ -34,7 +39,7 @@ fn a_gain_change_reruns_only_digitisation_onward() {
             | Stage::Level1
             | Stage::Correction
             | Stage::Snr => 2,
-            Stage::RetrievalModel | Stage::Retrieval | Stage::AerosolLuts | Stage::AerosolFamily => 0,
+            Stage::RetrievalModel | Stage::Retrieval | Stage::AerosolLuts | Stage::AerosolFamily | Stage::Effects => 0,
             // Never the scene, the atmosphere or the photon counts.
             _ => 1,
         };

@@ -151,7 +151,7 @@ fn optical_effects_are_added_per_design_and_shown_in_the_derived_figures() {
     let lib = temp_library("optics");
     let mut h = harness("cubesat", 16, &lib);
     h.step();
-    h.get_by_label("Optics").click();
+    h.get_by_label("Focal planes and optics").click();
     h.step();
     h.get_by_label("Add polarisation sensitivity").click();
     h.step();

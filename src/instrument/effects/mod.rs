@@ -174,12 +174,12 @@ pub fn correct_all(
 }
 
 /// The stray-light figure reviews state (3MI's half-bright, half-dark field): the stray signal
-/// `distance_m` into the dark half relative to the bright half, in a band at `centre_nm`, on a
-/// grid of `gsd_m`; `None` without stray light.
+/// `distance_m` into the dark half relative to the bright half, in a band at `centre_nm`, of the
+/// continuous halo ([`StrayLight::edge_ratio`]); `None` without stray light.
 #[must_use]
-pub fn edge_ratio(effects: &[InstrumentEffect], gsd_m: f64, distance_m: f64, centre_nm: f64) -> Option<f64> {
+pub fn edge_ratio(effects: &[InstrumentEffect], distance_m: f64, centre_nm: f64) -> Option<f64> {
     effects.iter().find_map(|e| match e {
-        InstrumentEffect::StrayLight(s) => Some(s.edge_ratio((gsd_m, gsd_m), distance_m, centre_nm)),
+        InstrumentEffect::StrayLight(s) => Some(s.edge_ratio(distance_m, centre_nm)),
         InstrumentEffect::Polarisation(_) => None,
     })
 }
