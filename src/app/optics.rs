@@ -5,20 +5,11 @@
 use super::model::Slot;
 use crate::instrument::effects::{InstrumentEffect, Knowledge, Polarisation, StrayLight};
 
-/// One number: a drag value with its unit, shown in `scale` × its stored unit.
+/// One number shown in `scale` × its stored unit (a focal plane's number otherwise).
 fn number(ui: &mut egui::Ui, label: &str, value: &mut f64, range: (f64, f64), scale: f64, unit: &str) {
-    ui.label(label);
     let mut shown = *value * scale;
-    let speed = 0.01 * shown.abs().max(0.1);
-    ui.add(
-        egui::DragValue::new(&mut shown)
-            .range(range.0 * scale..=range.1 * scale)
-            .speed(speed)
-            .suffix(unit)
-            .update_while_editing(false),
-    );
+    super::planes::number(ui, label, &mut shown, range.0 * scale..=range.1 * scale, unit);
     *value = shown / scale;
-    ui.end_row();
 }
 
 /// What the processor knows of an effect.

@@ -34,7 +34,13 @@ fn swir_plane(first_pitch_um: f64, first_detectors: usize) -> FocalPlane {
 }
 
 /// One number of a plane: a drag value with its unit.
-fn number(ui: &mut egui::Ui, label: &str, value: &mut f64, range: std::ops::RangeInclusive<f64>, unit: &str) {
+pub(super) fn number(
+    ui: &mut egui::Ui,
+    label: &str,
+    value: &mut f64,
+    range: std::ops::RangeInclusive<f64>,
+    unit: &str,
+) {
     ui.label(label);
     let speed = 0.01 * value.abs().max(0.1);
     ui.add(egui::DragValue::new(value).range(range).speed(speed).suffix(unit).update_while_editing(false));

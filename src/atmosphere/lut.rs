@@ -123,6 +123,20 @@ fn bracket(name: &str, nodes: &[f64], x: f64) -> Result<(usize, usize, f64), Atm
     Ok((j - 1, j, (x - nodes[j - 1]) / (nodes[j] - nodes[j - 1])))
 }
 
+/// A node bracket: lower and upper node and the upper one's weight.
+type Bracket = (usize, usize, f64);
+/// The four (sun, view) nodes of a geometry with their bilinear weights, and both brackets.
+type Corners = ([(usize, usize, f64); 4], Bracket, Bracket);
+
+/// The four (sun, view) nodes around `g` with their bilinear weights, and the brackets.
+fn corners(a: &LutAxes, g: &Geometry) -> Result<Corners, AtmosphereError> {
+    let (s0, s1, ts) = bracket("sun_zenith", &a.sun_zenith_deg, g.sun_zenith_rad.to_degrees())?;
+    let (v0, v1, tv) = bracket("view_zenith", &a.view_zenith_deg, g.view_zenith_rad.to_degrees())?;
+    let corners =
+        [(s0, v0, (1.0 - ts) * (1.0 - tv)), (s0, v1, (1.0 - ts) * tv), (s1, v0, ts * (1.0 - tv)), (s1, v1, ts * tv)];
+    Ok((corners, (s0, s1, ts), (v0, v1, tv)))
+}
+
 impl AtmosphereLut {
     /// Build the table (parallel over wavelength × sun zenith in the caller's rayon pool).
     pub fn build(atmosphere: &Atmosphere, axes: LutAxes) -> Result<Self, AtmosphereError> {
@@ -188,14 +202,7 @@ impl AtmosphereLut {
         let intensity = self.normalised_with(w, g, false)?.radiance;
         let a = &self.axes;
         let (ns, nv) = (a.sun_zenith_deg.len(), a.view_zenith_deg.len());
-        let (s0, s1, ts) = bracket("sun_zenith", &a.sun_zenith_deg, g.sun_zenith_rad.to_degrees())?;
-        let (v0, v1, tv) = bracket("view_zenith", &a.view_zenith_deg, g.view_zenith_rad.to_degrees())?;
-        let corners = [
-            (s0, v0, (1.0 - ts) * (1.0 - tv)),
-            (s0, v1, (1.0 - ts) * tv),
-            (s1, v0, ts * (1.0 - tv)),
-            (s1, v1, ts * tv),
-        ];
+        let (corners, ..) = corners(a, g)?;
         let mut c = [0.0; 5];
         for &(s, v, weight) in &corners {
             for (acc, x) in c.iter_mut().zip(&self.qu[(w * ns + s) * nv + v]) {
@@ -235,8 +242,7 @@ impl AtmosphereLut {
         g.validate()?;
         let a = &self.axes;
         let (ns, nv, nf) = (a.sun_zenith_deg.len(), a.view_zenith_deg.len(), self.n_fourier);
-        let (s0, s1, ts) = bracket("sun_zenith", &a.sun_zenith_deg, g.sun_zenith_rad.to_degrees())?;
-        let (v0, v1, tv) = bracket("view_zenith", &a.view_zenith_deg, g.view_zenith_rad.to_degrees())?;
+        let (corners, (s0, s1, ts), (v0, v1, tv)) = corners(a, g)?;
         if w >= a.wavelengths_nm.len() {
             return Err(AtmosphereError::OutOfRange {
                 field: "wavelength index".into(),
@@ -244,12 +250,6 @@ impl AtmosphereLut {
                 allowed: format!("0 to {}", a.wavelengths_nm.len() - 1),
             });
         }
-        let corners = [
-            (s0, v0, (1.0 - ts) * (1.0 - tv)),
-            (s0, v1, (1.0 - ts) * tv),
-            (s1, v0, ts * (1.0 - tv)),
-            (s1, v1, ts * tv),
-        ];
         let mut fourier = vec![0.0; nf];
         for &(s, v, weight) in &corners {
             let node = (w * ns + s) * nv + v;

@@ -104,6 +104,17 @@ pub enum Surface {
     Land,
 }
 
+/// The LUT wavelength nodes either side of `wavelength_nm` and the weight of the upper one,
+/// linear in ln λ; constant beyond the first and last node.
+fn ln_bracket(node_wl: &[f64], wavelength_nm: f64) -> (usize, usize, f64) {
+    if node_wl.len() == 1 {
+        return (0, 0, 0.0);
+    }
+    let j = node_wl.partition_point(|&v| v <= wavelength_nm).clamp(1, node_wl.len() - 1);
+    let t = (wavelength_nm / node_wl[j - 1]).ln() / (node_wl[j] / node_wl[j - 1]).ln();
+    (j - 1, j, t.clamp(0.0, 1.0))
+}
+
 impl SceneOptics {
     /// Bind a scene to a simulation grid and an atmosphere LUT built for that scene (its
     /// wavelength nodes must bracket the grid).
@@ -146,12 +157,7 @@ impl SceneOptics {
                         allowed: format!("{first} to {last} nm"),
                     }));
                 }
-                if node_wl.len() == 1 {
-                    return Ok((0, 0, 0.0));
-                }
-                let j = node_wl.partition_point(|&v| v <= w).clamp(1, node_wl.len() - 1);
-                let t = (w / node_wl[j - 1]).ln() / (node_wl[j] / node_wl[j - 1]).ln();
-                Ok((j - 1, j, t.clamp(0.0, 1.0)))
+                Ok(ln_bracket(node_wl, w))
             })
             .collect::<Result<Vec<_>, SceneError>>()?;
         let adjacency = if scene.wants(Effect::Adjacency) { Some(Adjacency::new(scene)) } else { None };
@@ -241,15 +247,7 @@ impl SceneOptics {
     /// wavelength nodes, constant beyond its ends) in the view's meridian frame; `None` when the
     /// table holds no vector solution ([`AtmosphereLut::path_polarisation`]).
     pub fn path_polarisation(&self, g: &Geometry, wavelength_nm: f64) -> Result<Option<(f64, f64)>, AtmosphereError> {
-        let nodes = &self.lut.axes().wavelengths_nm;
-        let k = nodes.partition_point(|&v| v <= wavelength_nm);
-        let (j0, j1, t) = if k == 0 {
-            (0, 0, 0.0)
-        } else if k >= nodes.len() {
-            (nodes.len() - 1, nodes.len() - 1, 0.0)
-        } else {
-            (k - 1, k, (wavelength_nm / nodes[k - 1]).ln() / (nodes[k] / nodes[k - 1]).ln())
-        };
+        let (j0, j1, t) = ln_bracket(&self.lut.axes().wavelengths_nm, wavelength_nm);
         let (Some(a), Some(b)) = (self.lut.path_polarisation(j0, g)?, self.lut.path_polarisation(j1, g)?) else {
             return Ok(None);
         };

@@ -72,12 +72,6 @@ impl KernelSpectrum {
         out
     }
 
-    /// Transform size (rows, columns).
-    #[must_use]
-    pub fn size(&self) -> (usize, usize) {
-        self.n
-    }
-
     /// 2-D transform in place: every row, then every column (through a transpose).
     fn transform(&self, data: &mut [Complex64], forward: bool) {
         let (nr, nc) = self.n;
