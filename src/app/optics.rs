@@ -1,9 +1,9 @@
 //! The left panel's optics editor: the instrument's optical effects (stray light, polarisation
-//! sensitivity; `instrument::effects`), each with what the processor knows of it. An edit is kept
+//! sensitivity, the MTF budget; `instrument::effects`), each with what the processor knows of it. An edit is kept
 //! only if the whole instrument still validates; otherwise the message says why.
 
 use super::model::Slot;
-use crate::instrument::effects::{InstrumentEffect, Knowledge, Polarisation, StrayLight};
+use crate::instrument::effects::{InstrumentEffect, Knowledge, MtfBudget, Polarisation, StrayLight};
 
 /// One number shown in `scale` × its stored unit (a focal plane's number otherwise).
 fn number(ui: &mut egui::Ui, label: &str, value: &mut f64, range: (f64, f64), scale: f64, unit: &str) {
@@ -45,6 +45,19 @@ fn polarisation() -> InstrumentEffect {
     })
 }
 
+/// An MTF budget to start from (assumptions of a good small telescope): a 30 % obstruction,
+/// λ/16 RMS wavefront error at 550 nm, 2 µm diffusion, 2 % crosstalk, 2 µrad jitter.
+fn mtf_budget() -> InstrumentEffect {
+    InstrumentEffect::SpatialResponse(MtfBudget {
+        obstruction: 0.3,
+        wavefront_rms_nm: 34.0,
+        pixel_fill: 1.0,
+        diffusion_um: 2.0,
+        crosstalk: 0.02,
+        jitter_urad: 2.0,
+    })
+}
+
 /// The optical effects of `slot`'s instrument.
 pub(super) fn optics_editor(slot: &mut Slot, ui: &mut egui::Ui, error: &mut Option<String>) {
     ui.label("What the optics do between the pupil and the detector; none: an ideal optic.");
@@ -54,6 +67,7 @@ pub(super) fn optics_editor(slot: &mut Slot, ui: &mut egui::Ui, error: &mut Opti
         let title = match effect {
             InstrumentEffect::StrayLight(_) => "Stray light",
             InstrumentEffect::Polarisation(_) => "Polarisation sensitivity",
+            InstrumentEffect::SpatialResponse(_) => "MTF budget",
         };
         egui::CollapsingHeader::new(title).id_salt(("effect", i)).default_open(true).show(ui, |ui| {
             egui::Grid::new(("effect-grid", i)).num_columns(2).show(ui, |ui| match effect {
@@ -70,6 +84,14 @@ pub(super) fn optics_editor(slot: &mut Slot, ui: &mut egui::Ui, error: &mut Opti
                     number(ui, "axis from along track", &mut p.axis_deg, (-180.0, 180.0), 1.0, "°");
                     knowledge(ui, &mut p.correction);
                 }
+                InstrumentEffect::SpatialResponse(m) => {
+                    number(ui, "central obstruction", &mut m.obstruction, (0.0, 0.8), 100.0, " %");
+                    number(ui, "wavefront error RMS", &mut m.wavefront_rms_nm, (0.0, 70.0), 1.0, " nm");
+                    number(ui, "pixel fill", &mut m.pixel_fill, (0.3, 1.0), 100.0, " %");
+                    number(ui, "charge diffusion σ", &mut m.diffusion_um, (0.0, 20.0), 1.0, " µm");
+                    number(ui, "crosstalk per neighbour", &mut m.crosstalk, (0.0, 0.2), 100.0, " %");
+                    number(ui, "jitter RMS", &mut m.jitter_urad, (0.0, 100.0), 1.0, " µrad");
+                }
             });
             if ui.small_button("Remove").clicked() {
                 remove = Some(i);
@@ -81,7 +103,8 @@ pub(super) fn optics_editor(slot: &mut Slot, ui: &mut egui::Ui, error: &mut Opti
     }
     let has_stray = candidate.effects.iter().any(|e| matches!(e, InstrumentEffect::StrayLight(_)));
     let has_polarisation = candidate.effects.iter().any(|e| matches!(e, InstrumentEffect::Polarisation(_)));
-    ui.horizontal(|ui| {
+    let has_mtf = candidate.effects.iter().any(|e| matches!(e, InstrumentEffect::SpatialResponse(_)));
+    ui.horizontal_wrapped(|ui| {
         if !has_stray
             && ui.button("Add stray light").on_hover_text("A far-field halo and an out-of-field veil").clicked()
         {
@@ -94,6 +117,14 @@ pub(super) fn optics_editor(slot: &mut Slot, ui: &mut egui::Ui, error: &mut Opti
                 .clicked()
         {
             candidate.effects.push(polarisation());
+        }
+        if !has_mtf
+            && ui
+                .button("Add MTF budget")
+                .on_hover_text("Sample the scene with the PSF of the optics, detector and motion")
+                .clicked()
+        {
+            candidate.effects.push(mtf_budget());
         }
     });
     if candidate != slot.spec {

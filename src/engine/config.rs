@@ -18,8 +18,8 @@ use crate::scene::SceneSpec;
 pub struct Fidelity {
     /// Spectral step of the simulation grids, nm (0.1–10).
     pub spectral_step_nm: f64,
-    /// Spatial-response quadrature points per GSD along each axis (1–8), when the scene asks for
-    /// `SpatialResponse`.
+    /// Spatial-response quadrature points per GSD along each axis (1–8), when the instrument
+    /// states an MTF budget (or the scene the legacy `SpatialResponse`).
     pub spatial_samples_per_gsd: usize,
     /// Per-pixel water spectra at this many nodes per band (0–8; 0: at every grid wavelength;
     /// default [`DEFAULT_BAND_NODES`]). A configuration file written before the field existed

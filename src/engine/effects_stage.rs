@@ -61,7 +61,7 @@ impl Engine {
         report: &mut RunReport,
     ) -> Result<(AtDetector, Key), EngineError> {
         let list = &config.instrument.effects;
-        if list.is_empty() {
+        if !effects::any_on_the_cube(list) {
             return Ok((None, radiance_key));
         }
         let applied: Vec<_> = list.iter().map(effects::InstrumentEffect::as_applied).collect();
@@ -85,7 +85,7 @@ pub(super) fn correct_level1(
     control: &RunControl,
 ) -> Result<(), EngineError> {
     let list = &config.instrument.effects;
-    if list.is_empty() {
+    if !effects::any_on_the_cube(list) {
         return Ok(());
     }
     with_context(config, side, |ctx| effects::correct_all(list, level1, ctx, control).map_err(failed(Stage::Level1)))

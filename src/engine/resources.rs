@@ -260,7 +260,8 @@ fn cube_part_with(config: &RunConfig, bytes_per_pixel_band: f64, bytes_per_pixel
     let pixels = rows as f64 * cols as f64;
     // Optical effects: the radiance at the detector beside the pupil's, and the processor's
     // copy of Level-1 with its stray part while it corrects (f32 each).
-    let effects = if i.effects.is_empty() { 0.0 } else { EFFECTS_BYTES_PER_PIXEL_BAND };
+    let effects =
+        if !crate::instrument::effects::any_on_the_cube(&i.effects) { 0.0 } else { EFFECTS_BYTES_PER_PIXEL_BAND };
     Part {
         what: format!("cubes of {} ({rows} × {cols} pixels × {bands} bands)", i.name),
         bytes: pixels * (bands as f64 * (bytes_per_pixel_band + effects) + bytes_per_pixel),

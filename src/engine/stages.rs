@@ -16,6 +16,7 @@ use crate::calibration::{Calibration, band_e0, calibrate};
 use crate::control::Cancellable;
 use crate::control::RunControl;
 use crate::instrument::aerosol_map;
+use crate::instrument::effects::{self, MtfBudget};
 use crate::instrument::feasibility::Feasibility;
 use crate::instrument::sample::BandAtmosphere;
 use crate::instrument::{
@@ -61,8 +62,11 @@ impl Engine {
         let scene = self.stage(scene_key, report, control, || {
             Scene::build(&config.scene, config.scene_dir.as_deref()).map_err(failed_any(Stage::Scene))
         })?;
+        // A design's own MTF budget samples with its PSF whatever the scene says.
+        let states_mtf = effects::spatial_response(&config.instrument.effects).is_some();
         for effect in Effect::ALL {
-            if !scene.wants(effect) {
+            let wanted = scene.wants(effect) || (effect == Effect::SpatialResponse && states_mtf);
+            if !wanted {
                 report.skipped_effects.push(SkippedEffect { effect, reason: "not asked for by the scene".into() });
             }
         }
@@ -228,11 +232,14 @@ impl Engine {
         let inputs = Inputs::of(config);
         let SceneSide { scene, response, viewing, optics, band_atmosphere, aerosol_map, band_key, .. } = side;
         let band_key = *band_key;
-        let spatial = scene.wants(Effect::SpatialResponse);
-        let kernel = if spatial {
-            SpatialKernel::new(instrument, &response.bands.centres_nm(), fid.spatial_samples_per_gsd)
-        } else {
-            SpatialKernel::point(response.n_bands())
+        // The design's own MTF budget; else, where the scene asks for a spatial response (the
+        // legacy switch), an ideal optic's.
+        let ideal = MtfBudget::default();
+        let budget = effects::spatial_response(&instrument.effects)
+            .or_else(|| scene.wants(Effect::SpatialResponse).then_some(&ideal));
+        let kernel = match budget {
+            Some(b) => SpatialKernel::new(instrument, b, &response.bands.centres_nm(), fid.spatial_samples_per_gsd),
+            None => SpatialKernel::point(response.n_bands()),
         };
         report.spatial_samples = kernel.len();
         let radiance_key = KeyBuilder::new(Stage::Radiance)

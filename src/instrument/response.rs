@@ -47,7 +47,7 @@ pub struct Response {
 
 /// Each band's focal plane (0: the first; i + 1: `spec.focal_planes[i]`, the first that claims
 /// it). A further plane that claims no band is an error: its numbers would change nothing.
-fn planes_of(spec: &InstrumentSpec, bands: &BandSet) -> Result<Vec<usize>, InstrumentError> {
+pub fn planes_of(spec: &InstrumentSpec, bands: &BandSet) -> Result<Vec<usize>, InstrumentError> {
     let plane_of: Vec<usize> = bands
         .bands
         .iter()

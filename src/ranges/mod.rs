@@ -275,6 +275,18 @@ ranges! {
     POLARISATION_AXIS_DEG = Range::closed("instrument.effects[].Polarisation.axis_deg", -180.0, 180.0, "degrees", "most transmitted polarisation, from the along-track axis");
     /// Polarisation: the processor's error.
     POLARISATION_KNOWLEDGE_ERROR = Range::closed("instrument.effects[].Polarisation.correction.error", -1.0, 1.0, "", "relative error of the processor's sensitivity");
+    /// MTF budget: central obstruction.
+    MTF_OBSTRUCTION = Range::closed("instrument.effects[].SpatialResponse.obstruction", 0.0, 0.8, "", "secondary's diameter over the aperture's");
+    /// MTF budget: wavefront error.
+    MTF_WAVEFRONT_RMS_NM = Range::closed("instrument.effects[].SpatialResponse.wavefront_rms_nm", 0.0, 70.0, "nm", "RMS wavefront error (Shannon's fit holds to 0.18 waves: 72 nm at 400 nm)");
+    /// MTF budget: pixel fill.
+    MTF_PIXEL_FILL = Range::closed("instrument.effects[].SpatialResponse.pixel_fill", 0.3, 1.0, "", "width of a pixel's sensitive aperture over its pitch");
+    /// MTF budget: charge diffusion.
+    MTF_DIFFUSION_UM = Range::closed("instrument.effects[].SpatialResponse.diffusion_um", 0.0, 20.0, "µm", "Gaussian σ of charge diffusion in the focal plane");
+    /// MTF budget: crosstalk.
+    MTF_CROSSTALK = Range::closed("instrument.effects[].SpatialResponse.crosstalk", 0.0, 0.2, "", "share of a pixel's signal on each neighbour");
+    /// MTF budget: jitter.
+    MTF_JITTER_URAD = Range::closed("instrument.effects[].SpatialResponse.jitter_urad", 0.0, 100.0, "µrad", "RMS line-of-sight jitter during an exposure");
 
     // Scene (SceneSpec::validate and the maps' values in Scene::build).
     /// Scene width.

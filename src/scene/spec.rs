@@ -52,7 +52,10 @@ pub enum Effect {
     SunGlint,
     /// Light from bright surroundings scattered into a pixel's path (needs `land`).
     Adjacency,
-    /// The instrument's spatial response: diffraction, detector footprint, along-track smear.
+    /// Legacy switch, kept so that older scenes and sessions load: every design that states no
+    /// MTF budget of its own (`instrument.effects: [SpatialResponse(...)]`, where each design
+    /// now states its optics) is sampled with an ideal optic's PSF — diffraction, the pixel's
+    /// footprint, the along-track smear.
     SpatialResponse,
 }
 

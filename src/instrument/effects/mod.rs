@@ -6,6 +6,7 @@
 //! |---|---|---|---|
 //! | stray light (halo, out-of-field veil) | [`stray_light`] | the whole band image | deconvolution with the known PSF (Zong et al. 2006) |
 //! | polarisation sensitivity | [`polarisation`] | the path's Stokes Q and U per column | l2gen's polcor (Meister et al. 2005) |
+//! | spatial response (MTF budget) | [`mtf`] | the scene around each pixel (it sets the sampling's PSF) | not corrected (as most Level-1 processors) |
 //!
 //! Every effect is a type behind [`Effect`], listed in [`InstrumentEffect`] (the one place an
 //! effect is registered: its module and one arm of [`InstrumentEffect::effect`]). The engine
@@ -21,6 +22,7 @@
 //!   Appl. Opt. 44, 5524–5535.
 
 pub mod convolve;
+pub mod mtf;
 pub mod polarisation;
 pub mod stokes_columns;
 pub mod stray_light;
@@ -28,6 +30,7 @@ pub mod stray_light;
 use ndarray::Array3;
 use serde::{Deserialize, Serialize};
 
+pub use mtf::MtfBudget;
 pub use polarisation::Polarisation;
 pub use stokes_columns::StokesColumns;
 pub use stray_light::StrayLight;
@@ -45,6 +48,8 @@ pub enum InstrumentEffect {
     StrayLight(StrayLight),
     /// Polarisation sensitivity: the response depends on the light's linear polarisation.
     Polarisation(Polarisation),
+    /// The spatial response: the MTF budget whose PSF the scene is sampled with.
+    SpatialResponse(MtfBudget),
 }
 
 impl InstrumentEffect {
@@ -54,6 +59,7 @@ impl InstrumentEffect {
         match self {
             Self::StrayLight(e) => e,
             Self::Polarisation(e) => e,
+            Self::SpatialResponse(e) => e,
         }
     }
 
@@ -65,6 +71,7 @@ impl InstrumentEffect {
         match self {
             Self::StrayLight(e) => Self::StrayLight(StrayLight { correction, ..e.clone() }),
             Self::Polarisation(e) => Self::Polarisation(Polarisation { correction, ..e.clone() }),
+            Self::SpatialResponse(e) => Self::SpatialResponse(*e),
         }
     }
 }
@@ -126,6 +133,11 @@ pub trait Effect: Sync {
     fn needs(&self) -> Needs {
         Needs::default()
     }
+    /// Does it change the radiance cube (`false`: it acts elsewhere, as the spatial response in
+    /// the sampling)?
+    fn on_the_cube(&self) -> bool {
+        true
+    }
     /// Turn the radiance reaching the pupil into what reaches the detector, in place.
     fn apply(&self, cube: &mut Array3<f32>, ctx: &Context, control: &RunControl) -> Result<(), InstrumentError>;
     /// The Level-1 processor's correction, in place, with its [`Knowledge`].
@@ -145,6 +157,21 @@ pub fn validate(effects: &[InstrumentEffect]) -> Result<(), InstrumentError> {
 #[must_use]
 pub fn needs_stokes(effects: &[InstrumentEffect]) -> bool {
     effects.iter().any(|e| e.effect().needs().stokes)
+}
+
+/// Does any entry change the radiance cube (else the `Effects` stage has nothing to do)?
+#[must_use]
+pub fn any_on_the_cube(effects: &[InstrumentEffect]) -> bool {
+    effects.iter().any(|e| e.effect().on_the_cube())
+}
+
+/// The MTF budget the instrument states, if it states one.
+#[must_use]
+pub fn spatial_response(effects: &[InstrumentEffect]) -> Option<&MtfBudget> {
+    effects.iter().find_map(|e| match e {
+        InstrumentEffect::SpatialResponse(m) => Some(m),
+        _ => None,
+    })
 }
 
 /// Apply the list in order.
@@ -180,7 +207,7 @@ pub fn correct_all(
 pub fn edge_ratio(effects: &[InstrumentEffect], distance_m: f64, centre_nm: f64) -> Option<f64> {
     effects.iter().find_map(|e| match e {
         InstrumentEffect::StrayLight(s) => Some(s.edge_ratio(distance_m, centre_nm)),
-        InstrumentEffect::Polarisation(_) => None,
+        _ => None,
     })
 }
 
@@ -189,7 +216,7 @@ pub fn edge_ratio(effects: &[InstrumentEffect], distance_m: f64, centre_nm: f64)
 pub fn polarisation_sensitivity(effects: &[InstrumentEffect]) -> Option<f64> {
     effects.iter().find_map(|e| match e {
         InstrumentEffect::Polarisation(p) => Some(p.per_band.iter().copied().fold(p.sensitivity, f64::max)),
-        InstrumentEffect::StrayLight(_) => None,
+        _ => None,
     })
 }
 
