@@ -8,6 +8,7 @@
 //! | `shoal simulate` | scene × instrument → Level-0, Level-1, Rrs cubes, SNR, report, config |
 //! | `shoal study` | a study: instruments × seeds × retrievals → metrics.csv/json, figures, cubes |
 //! | `shoal report` | the review pack: one self-contained HTML page of a study (verdict, figures, provenance) |
+//! | `shoal mtf` | the system MTF at Nyquist per band and focal plane, with the budget's parts |
 //! | `shoal bench` | performance and accuracy figures (water evaluations/s, LUT build time vs OSOAA) |
 
 mod atmosphere;
@@ -22,6 +23,7 @@ mod design;
 mod grid;
 mod interrupt;
 mod lookup;
+mod mtf;
 mod output;
 mod report;
 mod reproduce;
@@ -141,6 +143,9 @@ enum Command {
     /// Measure speed and accuracy: water evaluations per second, atmosphere LUT build times
     /// with their errors against OSOAA.
     Bench(bench::BenchArgs),
+    /// The system MTF at Nyquist of every band of instruments (default: every built-in preset)
+    /// from the MTF budget each states, with the budget's parts.
+    Mtf(mtf::MtfArgs),
     /// Print the allowed range of every number a user sets (Markdown table; docs/MANUAL.md "Ranges").
     Ranges,
     /// Developer tools that regenerate computed assets.
@@ -272,6 +277,7 @@ pub fn main(app: impl FnOnce(&AppArgs) -> ExitCode) -> ExitCode {
         Command::Score(args) => score::run(&args),
         Command::Report(args) => report::run(&args),
         Command::Bench(args) => bench::run(&args),
+        Command::Mtf(args) => mtf::run(&args),
         Command::Ranges => output::emit(&crate::ranges::markdown_table(), None),
         Command::Dev(DevCommand::AerosolTable) => output::emit(&crate::atmosphere::component_table_csv(), None),
         Command::Dev(DevCommand::OsoaaTable) => bench::osoaa_table(),

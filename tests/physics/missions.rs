@@ -109,3 +109,31 @@ fn the_swir_smallsat_keeps_the_smallsats_visible_bands_and_adds_a_cooled_swir_pl
     let dark = spec.focal_planes[0].dark_current_at_operating_e_s();
     assert!((dark / 2e6 - 0.0255).abs() < 0.001, "{dark}");
 }
+
+/// Sentinel-2 MSI's MTF requirement at Nyquist in its 10 m bands (Drusch et al. 2012, §3):
+/// 0.15–0.30, along and across track.
+#[test]
+fn msi_with_its_mtf_budget_meets_its_nyquist_requirement_and_an_ideal_optic_does_not() {
+    use shoal::instrument::InstrumentEffect;
+    use shoal::instrument::effects::MtfBudget;
+    use shoal::instrument::spatial::nyquist_table;
+    let ten_m = ["B2", "B3", "B4", "B8"];
+    let mut msi = InstrumentSpec::preset("sentinel2a_msi").unwrap();
+    // The ideal optic (diffraction, a full pixel, the smear of one line period) is too sharp
+    // across track: 0.46 at 833 nm, above the 0.30 the specification allows against aliasing.
+    let ideal = nyquist_table(&msi).unwrap();
+    let b8 = ideal.iter().find(|r| r.band == "B8").unwrap();
+    assert!(b8.across > 0.30, "ideal B8 across {}", b8.across);
+    let text =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/sentinel2a_msi_mtf_budget.ron"))
+            .unwrap();
+    let budget: MtfBudget = ron::from_str(&text).unwrap();
+    msi.effects.push(InstrumentEffect::SpatialResponse(budget));
+    msi.validate().unwrap();
+    for r in nyquist_table(&msi).unwrap().iter().filter(|r| ten_m.contains(&r.band.as_str())) {
+        assert!((r.gsd_m - 10.0).abs() < 0.1, "{}: GSD {}", r.band, r.gsd_m);
+        for (axis, v) in [("along", r.along), ("across", r.across)] {
+            assert!((0.15..=0.30).contains(&v), "{} {axis}: MTF at Nyquist {v:.3} outside 0.15–0.30", r.band);
+        }
+    }
+}
