@@ -120,10 +120,16 @@ pub fn constraint_plan(requirements: &Requirements, made: &[String]) -> (Vec<Str
         (requirements.gsd_m_max.is_some(), "GSD, m"),
         (requirements.smear_px_max.is_some(), "smear, px"),
     ];
-    for (stated, k) in design {
+    let optics = [
+        (requirements.mtf_nyquist_min.is_some(), crate::study::MTF_MIN_WHAT.to_string()),
+        (requirements.mtf_nyquist_max.is_some(), crate::study::MTF_MAX_WHAT.to_string()),
+        (requirements.polarisation_pct_max.is_some(), crate::study::POLARISATION_WHAT.to_string()),
+        (requirements.stray_light.is_some(), requirements.stray_light.as_ref().map_or_else(String::new, |s| s.what())),
+    ];
+    for (stated, k) in design.into_iter().map(|(s, k)| (s, k.to_string())).chain(optics) {
         if stated {
-            possible.push(k.into());
-            required.push(k.into());
+            possible.push(k.clone());
+            required.push(k);
         }
     }
     (possible, required)

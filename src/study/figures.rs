@@ -377,6 +377,9 @@ pub fn figure_set(result: &StudyResult) -> Result<Vec<Figure>, StudyError> {
     if let Some(snr) = super::snr_figure::SnrFigure::of(result) {
         figures.push(render("snr", &snr)?);
     }
+    if let Some(optics) = super::optics_figure::OpticsFigure::of(result) {
+        figures.push(render("optics", &optics)?);
+    }
     if let Some(rrs) = super::rrs_figure::RrsFigure::of(result) {
         figures.push(render("rrs_error", &rrs)?);
     }

@@ -72,7 +72,58 @@ pub struct Requirements {
     /// Schowengerdt 2007, §3.4): what bounds the exposure a design may use.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub smear_px_max: Option<f64>,
+    /// Smallest system MTF at Nyquist of any band, along or across track, from the design's MTF
+    /// budget (an ideal optic's where it states none; `instrument::effects::mtf`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mtf_nyquist_min: Option<f64>,
+    /// Largest system MTF at Nyquist of any band (against aliasing: Sentinel-2 MSI allows 0.30).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mtf_nyquist_max: Option<f64>,
+    /// Largest polarisation sensitivity of any band, % (PACE OCI: 1 %).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub polarisation_pct_max: Option<f64>,
+    /// Largest stray-light ratio at a distance from a bright edge (3MI's half-bright field).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stray_light: Option<StrayLightRequirement>,
 }
+
+/// The stray signal `distance_m` into the dark half of a half-bright, half-dark field, relative
+/// to the bright half, in a band at `centre_nm` (Metop-3MI's convention).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StrayLightRequirement {
+    /// Largest ratio, %.
+    pub ratio_pct_max: f64,
+    /// Distance from the edge, m.
+    #[serde(default = "default_stray_distance_m")]
+    pub distance_m: f64,
+    /// Band centre, nm.
+    #[serde(default = "default_stray_centre_nm")]
+    pub centre_nm: f64,
+}
+
+fn default_stray_distance_m() -> f64 {
+    1000.0
+}
+
+fn default_stray_centre_nm() -> f64 {
+    443.0
+}
+
+impl StrayLightRequirement {
+    /// What its check is called (and the design search's constraint).
+    #[must_use]
+    pub fn what(&self) -> String {
+        format!("stray light {:.0} m past an edge at {:.0} nm, %", self.distance_m, self.centre_nm)
+    }
+}
+
+/// The optics checks' names (and the design search's constraints).
+pub const MTF_MIN_WHAT: &str = "MTF at Nyquist, worst band";
+/// See [`MTF_MIN_WHAT`].
+pub const MTF_MAX_WHAT: &str = "MTF at Nyquist, sharpest band";
+/// See [`MTF_MIN_WHAT`].
+pub const POLARISATION_WHAT: &str = "polarisation sensitivity, %";
 
 /// The corrected Rrs's error per band, in the bands centred from `from_nm` to `to_nm`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -217,6 +268,38 @@ impl Requirements {
         {
             return bad("requirements.smear_px_max", format!("{v} (allowed: above 0 up to 100 pixels)"));
         }
+        for (field, v) in [
+            ("requirements.mtf_nyquist_min", self.mtf_nyquist_min),
+            ("requirements.mtf_nyquist_max", self.mtf_nyquist_max),
+        ] {
+            if let Some(v) = v
+                && !(v.is_finite() && v > 0.0 && v < 1.0)
+            {
+                return bad(field, format!("{v} (allowed: above 0, below 1)"));
+            }
+        }
+        if let Some(v) = self.polarisation_pct_max
+            && !(v.is_finite() && v > 0.0 && v <= 20.0)
+        {
+            return bad("requirements.polarisation_pct_max", format!("{v} (allowed: above 0 up to 20 %)"));
+        }
+        if let Some(s) = &self.stray_light {
+            if !(s.ratio_pct_max.is_finite() && s.ratio_pct_max > 0.0 && s.ratio_pct_max <= 100.0) {
+                return bad(
+                    "requirements.stray_light.ratio_pct_max",
+                    format!("{} (allowed: above 0 up to 100 %)", s.ratio_pct_max),
+                );
+            }
+            if !(s.distance_m.is_finite() && s.distance_m > 0.0 && s.distance_m <= 1e5) {
+                return bad(
+                    "requirements.stray_light.distance_m",
+                    format!("{} (allowed: above 0 up to 100 000 m)", s.distance_m),
+                );
+            }
+            if !(350.0..=2500.0).contains(&s.centre_nm) {
+                return bad("requirements.stray_light.centre_nm", format!("{} (allowed: 350 to 2500 nm)", s.centre_nm));
+            }
+        }
         if let Some(f) = &self.fits
             && !models.has_form_factor(f)
         {
@@ -237,6 +320,10 @@ impl Requirements {
             || self.data_volume_gbit_day.is_some()
             || self.smear_px_max.is_some()
             || self.gsd_m_max.is_some()
+            || self.mtf_nyquist_min.is_some()
+            || self.mtf_nyquist_max.is_some()
+            || self.polarisation_pct_max.is_some()
+            || self.stray_light.is_some()
     }
 
     /// Check a design `spec` and its budgets: cost (a refused cost fails, with the reason), the
@@ -283,6 +370,7 @@ impl Requirements {
             let line_period_s = spec.gsd_m() / crate::instrument::ground_speed_m_s(spec.altitude_km);
             out.push(check("smear, px".into(), Some(spec.exposure_s / line_period_s), l));
         }
+        out.extend(self.check_optics(label, seed, spec));
         out
     }
 
@@ -419,68 +507,4 @@ pub fn checks_csv(checks: &[Check]) -> String {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::metrics::{VariableMetrics, compare};
-
-    fn product(variable: &str, metrics: crate::metrics::Metrics) -> ProductMetrics {
-        ProductMetrics {
-            product: "aLMI".into(),
-            variables: vec![VariableMetrics { variable: variable.into(), metrics }],
-            substrate_agreement_pct: None,
-            substrate_confusion: None,
-            depth_by_true_substrate: Vec::new(),
-            siop_set_counts: Vec::new(),
-            siop_sets_used: 0,
-            failed: 0,
-            stalled: 0,
-        }
-    }
-
-    fn chl_limits(returned_pct: Option<f64>) -> Requirements {
-        Requirements {
-            products: vec![ProductRequirement {
-                variable: "chl_mg_m3".into(),
-                mae_pct: Some(20.0),
-                bias_pct: Some(10.0),
-                returned_pct,
-            }],
-            snr: None,
-            substrate_pct: None,
-            rrs: None,
-            ..Requirements::default()
-        }
-    }
-
-    #[test]
-    fn a_product_with_no_pixel_returned_fails_every_check_even_without_a_returned_limit() {
-        // The metrics of an empty product read MAE 0 %, bias 0 %: the false pass this guards.
-        let empty = product("chl_mg_m3", compare(&[None, None, None], &[Some(1.0), Some(2.0), Some(3.0)]));
-        assert_eq!(empty.get("chl_mg_m3").unwrap().mae_pct(), 0.0);
-        let checks = chl_limits(None).check_run("A", 1, Some(&empty), &[], &[]);
-        assert_eq!(checks.len(), 2);
-        for c in &checks {
-            assert!(!c.pass && c.value.is_none() && c.margin.is_none(), "{c:?}");
-            assert!(c.describe().contains("no pixel returned"), "{}", c.describe());
-        }
-        assert_eq!(verdict(&checks), Some(false));
-        let csv = checks_csv(&checks);
-        assert!(csv.lines().nth(1).unwrap().starts_with("A,1,chl_mg_m3 MAE %,,20,FAIL,"), "{csv}");
-    }
-
-    #[test]
-    fn a_returned_product_is_judged_by_mae_bias_and_share_with_margins() {
-        // Retrieved 1.05× the truth on 3 of 4 pixels: MAE = bias = 5 %, 75 % returned.
-        let m = compare(&[Some(1.05), Some(2.1), Some(3.15), None], &[Some(1.0), Some(2.0), Some(3.0), Some(4.0)]);
-        let p = product("chl_mg_m3", m);
-        let checks = chl_limits(Some(70.0)).check_run("A", 1, Some(&p), &[], &[]);
-        let values: Vec<(bool, f64)> = checks.iter().map(|c| (c.pass, c.margin.unwrap())).collect();
-        assert!((values[0].1 - 15.0).abs() < 1e-9 && values[0].0, "MAE 5 % under 20 %: {values:?}");
-        assert!((values[1].1 - 5.0).abs() < 1e-9 && values[1].0, "|bias| 5 % under 10 %: {values:?}");
-        assert!((values[2].1 - 5.0).abs() < 1e-9 && values[2].0, "75 % returned over 70 %: {values:?}");
-        assert_eq!(verdict(&checks), Some(true));
-        let checks = chl_limits(Some(80.0)).check_run("A", 1, Some(&p), &[], &[]);
-        assert_eq!(verdict(&checks), Some(false), "75 % returned under an 80 % floor fails");
-        assert_eq!(verdict(&[]), None, "nothing checked: no verdict");
-    }
-}
+mod tests;
