@@ -23,7 +23,7 @@ pub(super) fn derived(app: &ShoalApp, ui: &mut egui::Ui) {
         let n = app.state.designs.len();
         egui::Grid::new("derived").num_columns(n + 1).striped(true).show(ui, |ui| {
             design_header(ui, n);
-            let rows: [DerivedRow; 7] = [
+            let rows: [DerivedRow; 8] = [
                 ("GSD", |s| format!("{:.1} m", s.gsd_m())),
                 ("Swath", |s| format!("{:.1} km", s.swath_m() / 1000.0)),
                 ("f-number", |s| format!("f/{:.2}", s.f_number())),
@@ -39,14 +39,22 @@ pub(super) fn derived(app: &ShoalApp, ui: &mut egui::Ui) {
                     crate::instrument::effects::polarisation_sensitivity(&s.effects)
                         .map_or_else(|| "–".to_string(), |v| format!("{:.2} %", 100.0 * v))
                 }),
+                ("MTF at Nyquist, 560 nm", |s| {
+                    use crate::instrument::effects::{MtfBudget, mtf::Axis, spatial_response};
+                    let g = crate::instrument::spatial::first_plane_geometry(s);
+                    let b = spatial_response(&s.effects).copied().unwrap_or_default();
+                    let at = |axis| MtfBudget::at_nyquist(&b, &g, 560.0, axis);
+                    format!("{:.2} / {:.2}", at(Axis::Along), at(Axis::Across))
+                }),
             ];
             // The optics rows only where a design has the effect (an ideal optic has no figure).
             let any = |has: fn(&InstrumentSpec) -> bool| app.state.designs.iter().any(|d| has(&d.spec));
             let stray =
                 any(|s| s.effects.iter().any(|e| matches!(e, crate::instrument::InstrumentEffect::StrayLight(_))));
             let polarised = any(|s| crate::instrument::effects::polarisation_sensitivity(&s.effects).is_some());
+            let mtf = any(|s| crate::instrument::effects::spatial_response(&s.effects).is_some());
             for (k, (name, f)) in rows.into_iter().enumerate() {
-                if (k == 5 && !stray) || (k == 6 && !polarised) {
+                if (k == 5 && !stray) || (k == 6 && !polarised) || (k == 7 && !mtf) {
                     continue;
                 }
                 ui.label(name);
@@ -71,7 +79,8 @@ pub(super) fn derived(app: &ShoalApp, ui: &mut egui::Ui) {
         if app.state.designs.iter().any(|d| !d.spec.effects.is_empty()) {
             ui.small(
                 "Stray light: the 443 nm signal 1 km into the dark half of a half-bright field, relative \
-                 to the bright half (Optics).",
+                 to the bright half. MTF: along / across track on the first focal plane (an ideal \
+                 optic's for a design with no MTF budget; `shoal mtf` gives every band).",
             );
         }
     });

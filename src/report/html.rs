@@ -323,6 +323,7 @@ fn caption(name: &str) -> String {
     match kind {
         "snr" => "SNR per band at the scene's median water radiance: analytic (line) and measured in the noisy cube (open circles); a dashed line, when drawn, is the study's SNR requirement.".into(),
         "rrs" if rest == "error" => "The corrected Rrs against the truth per band, log-space over the water pixels (as ACIX-Aqua reports an atmospheric correction): MAE (filled, line) and |bias| (open circles) per instrument; a dashed line, when drawn, is the study's Rrs requirement over its band range.".into(),
+        "optics" => "The designs' optics: the system MTF against spatial frequency along (solid) and across (dashed) track at 560 nm from each design's MTF budget (an ideal optic's where it states none), Nyquist dashed; and, for designs that state stray light, the stray signal at 443 nm past the edge of a half-bright field relative to the bright half (Metop-3MI's test).".into(),
         "spectrum" => "The scene at a typical water pixel (median true chl-a), 350–2500 nm: TOA radiance (black), path radiance (grey) and true Rrs, the forward model every nm; each instrument's bands shaded at their FWHM, its Level-1 radiance and corrected Rrs there as dots.".into(),
         "maps" if rest.ends_with("substrate") => "The dominant substrate of the truth and of each instrument's retrieval, one colour per substrate; grey: land or not returned; scale bars give the ground distance.".into(),
         "maps" => format!("Truth and each instrument's retrieval ({what}) on one colour scale; grey: land or not returned; scale bars give the ground distance."),
@@ -371,7 +372,7 @@ fn figures_section(h: &mut String, figures: &[PageFigure]) {
     };
     // SNR, Rrs error and the spectrum first, then per variable: maps beside their A − B, scatter and histograms.
     for (i, f) in figures.iter().enumerate() {
-        if ["snr", "rrs_error", "spectrum"].contains(&f.name.as_str()) {
+        if ["snr", "optics", "rrs_error", "spectrum"].contains(&f.name.as_str()) {
             put(h, f);
             shown[i] = true;
         }

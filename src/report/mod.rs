@@ -10,6 +10,7 @@
 pub mod design_page;
 pub mod html;
 mod machine;
+mod optics_rows;
 mod pack;
 mod sections;
 pub mod substrate;
@@ -303,6 +304,7 @@ fn derived_rows(runs: &[&StudyRun], configs: &[&RunConfig]) -> Vec<Derived> {
         name: budget_rows[0][i].0.clone(),
         values: budget_rows.iter().map(|r| r[i].1.clone()).collect(),
     }));
+    rows.extend(optics_rows::optics_rows(configs));
     rows
 }
 

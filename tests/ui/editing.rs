@@ -159,11 +159,28 @@ fn optical_effects_are_added_per_design_and_shown_in_the_derived_figures() {
     h.get_by_label("Add stray light").click();
     h.step();
     h.step();
+    // Two open effect editors push the third button below the panel's fold: the accessibility
+    // action reaches it where a pointer would have to scroll.
+    h.get_by_label("Add MTF budget").click_accesskit();
+    h.step();
+    h.step();
     let effects = &h.state().state.designs[0].spec.effects;
-    assert_eq!(effects.len(), 2, "{effects:?}");
+    let refused: Vec<String> = h.query_all_by_label_contains("Optics refused").map(|n| format!("{n:?}")).collect();
+    assert_eq!(effects.len(), 3, "{effects:?} {refused:?}");
     assert!(matches!(effects[0], shoal::instrument::InstrumentEffect::Polarisation(_)));
     assert!(matches!(effects[1], shoal::instrument::InstrumentEffect::StrayLight(_)));
+    assert!(matches!(effects[2], shoal::instrument::InstrumentEffect::SpatialResponse(_)));
     assert!(h.query_all_by_label("1.00 %").next().is_some(), "the derived polarisation sensitivity");
+    // The CubeSat's MTF at Nyquist at 560 nm with the starting budget (shoal mtf's numbers).
+    let g = shoal::instrument::spatial::first_plane_geometry(&h.state().state.designs[0].spec);
+    let shoal::instrument::InstrumentEffect::SpatialResponse(b) = effects[2] else { unreachable!() };
+    let at = |axis| b.at_nyquist(&g, 560.0, axis);
+    let text = format!(
+        "{:.2} / {:.2}",
+        at(shoal::instrument::effects::mtf::Axis::Along),
+        at(shoal::instrument::effects::mtf::Axis::Across)
+    );
+    assert!(h.query_all_by_label(&text).next().is_some(), "the derived MTF at Nyquist {text}");
     assert!(h.query_all_by_label("Add stray light").next().is_none(), "one stray light per design");
     let _ = std::fs::remove_dir_all(&lib);
 }
