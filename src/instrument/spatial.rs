@@ -39,6 +39,10 @@ pub struct SpatialKernel {
 /// Fraction of the PSF dropped at each tail of each axis.
 const TAIL: f64 = 0.005;
 
+/// Most sub-cells on either side of the centre along an axis before trimming (at most
+/// (2·48 + 1)² points per pixel).
+const MAX_HALF_CELLS: usize = 48;
+
 /// The MTF geometry of `spec`'s first focal plane (the image's grid), at nadir.
 #[must_use]
 pub fn first_plane_geometry(spec: &InstrumentSpec) -> MtfGeometry {
@@ -62,12 +66,14 @@ impl SpatialKernel {
     #[must_use]
     pub fn new(spec: &InstrumentSpec, budget: &MtfBudget, centres_nm: &[f64], samples_per_gsd: usize) -> Self {
         let g = first_plane_geometry(spec);
-        let h = g.pitch_ground_m / samples_per_gsd.max(1) as f64;
         // Every band shares the positions: the widest band's reach sets them.
-        let cells = |axis: Axis| {
-            let reach = centres_nm.iter().map(|&w| budget.reach_m(&g, w, axis)).fold(0.0, f64::max);
-            (reach / h + 0.5).ceil() as usize
-        };
+        let reach = |axis: Axis| centres_nm.iter().map(|&w| budget.reach_m(&g, w, axis)).fold(0.0, f64::max);
+        let widest = reach(Axis::Along).max(reach(Axis::Across));
+        // Sub-cells of GSD/samples, widened where the PSF would need more than MAX_HALF_CELLS on
+        // a side (a tiny aperture's blur many pixels wide): the quadrature coarsens rather than
+        // the run exploding.
+        let h = (g.pitch_ground_m / samples_per_gsd.max(1) as f64).max(widest / MAX_HALF_CELLS as f64);
+        let cells = |axis: Axis| ((reach(axis) / h + 0.5).ceil() as usize).min(MAX_HALF_CELLS + 1);
         let (k_along, k_across) = (cells(Axis::Along), cells(Axis::Across));
         let along: Vec<Vec<f64>> =
             centres_nm.iter().map(|&w| budget.cell_weights(&g, w, Axis::Along, h, k_along)).collect();
@@ -220,6 +226,21 @@ mod tests {
         // The smear makes the kernel longer along track than across.
         let span = |f: fn(&(f64, f64)) -> f64| k.offsets_m.iter().map(f).fold(0.0, f64::max);
         assert!(span(|o| o.0) >= span(|o| o.1));
+    }
+
+    #[test]
+    fn a_pinhole_aperture_coarsens_the_quadrature_rather_than_exploding() {
+        // 1 mm at 1500 km: the Airy core is kilometres wide on a 0.15 m pixel.
+        let mut spec = InstrumentSpec::preset("cubesat").unwrap();
+        spec.aperture_mm = 1.0;
+        spec.altitude_km = 1500.0;
+        spec.pixel_pitch_um = 1.0;
+        spec.focal_length_mm = 10_000.0;
+        let k = SpatialKernel::new(&spec, &MtfBudget::default(), &[400.0, 2500.0], 8);
+        assert!(k.len() <= 97 * 97, "{} points", k.len());
+        for w in &k.weights {
+            assert!((w.iter().sum::<f64>() - 1.0).abs() < 1e-9 && w.iter().all(|v| v.is_finite()));
+        }
     }
 
     #[test]

@@ -109,7 +109,9 @@ pub fn settings_for(base: &RunConfig) -> Vec<Setting> {
         s("RT 8 Fourier terms", vec![("scene.atmosphere.accuracy.fourier_terms", 8.0)]),
         s("SNR patch 16 frames", vec![("fidelity.snr_frames", 16.0)]),
     ]);
-    if effects.contains(&Effect::SpatialResponse) {
+    let sampled_with_psf = effects.contains(&Effect::SpatialResponse)
+        || crate::instrument::effects::spatial_response(&base.instrument.effects).is_some();
+    if sampled_with_psf {
         // The default is 2 points per GSD and axis.
         out.extend([
             s("spatial response 1 point per GSD", vec![("fidelity.spatial_samples_per_gsd", 1.0)]),
