@@ -1,9 +1,11 @@
 //! The left panel's optics editor: the instrument's optical effects (stray light, polarisation
-//! sensitivity, the MTF budget; `instrument::effects`), each with what the processor knows of it. An edit is kept
+//! sensitivity, the MTF budget, spectral stray light; `instrument::effects`), each with what the processor knows of it. An edit is kept
 //! only if the whole instrument still validates; otherwise the message says why.
 
 use super::model::Slot;
-use crate::instrument::effects::{InstrumentEffect, Knowledge, MtfBudget, Polarisation, StrayLight};
+use crate::instrument::effects::{
+    InstrumentEffect, Knowledge, MtfBudget, Polarisation, SpectralStrayLight, StrayLight,
+};
 
 /// One number shown in `scale` × its stored unit (a focal plane's number otherwise).
 fn number(ui: &mut egui::Ui, label: &str, value: &mut f64, range: (f64, f64), scale: f64, unit: &str) {
@@ -58,6 +60,15 @@ fn mtf_budget() -> InstrumentEffect {
     })
 }
 
+/// A spectral stray light to start from: 0.2 % of each band's light, over ~100 nm (assumption).
+fn spectral_stray() -> InstrumentEffect {
+    InstrumentEffect::SpectralStrayLight(SpectralStrayLight {
+        fraction: 0.002,
+        width_nm: 100.0,
+        correction: Knowledge::default(),
+    })
+}
+
 /// The optical effects of `slot`'s instrument.
 pub(super) fn optics_editor(slot: &mut Slot, ui: &mut egui::Ui, error: &mut Option<String>) {
     ui.label("What the optics do between the pupil and the detector; none: an ideal optic.");
@@ -68,6 +79,7 @@ pub(super) fn optics_editor(slot: &mut Slot, ui: &mut egui::Ui, error: &mut Opti
             InstrumentEffect::StrayLight(_) => "Stray light",
             InstrumentEffect::Polarisation(_) => "Polarisation sensitivity",
             InstrumentEffect::SpatialResponse(_) => "MTF budget",
+            InstrumentEffect::SpectralStrayLight(_) => "Spectral stray light",
         };
         egui::CollapsingHeader::new(title).id_salt(("effect", i)).default_open(true).show(ui, |ui| {
             egui::Grid::new(("effect-grid", i)).num_columns(2).show(ui, |ui| match effect {
@@ -92,6 +104,11 @@ pub(super) fn optics_editor(slot: &mut Slot, ui: &mut egui::Ui, error: &mut Opti
                     number(ui, "crosstalk per neighbour", &mut m.crosstalk, (0.0, 0.2), 100.0, " %");
                     number(ui, "jitter RMS", &mut m.jitter_urad, (0.0, 100.0), 1.0, " µrad");
                 }
+                InstrumentEffect::SpectralStrayLight(s) => {
+                    number(ui, "share scattered", &mut s.fraction, (0.0, 0.2), 100.0, " %");
+                    number(ui, "spectral scale", &mut s.width_nm, (1.0, 5000.0), 1.0, " nm");
+                    knowledge(ui, &mut s.correction);
+                }
             });
             if ui.small_button("Remove").clicked() {
                 remove = Some(i);
@@ -104,6 +121,7 @@ pub(super) fn optics_editor(slot: &mut Slot, ui: &mut egui::Ui, error: &mut Opti
     let has_stray = candidate.effects.iter().any(|e| matches!(e, InstrumentEffect::StrayLight(_)));
     let has_polarisation = candidate.effects.iter().any(|e| matches!(e, InstrumentEffect::Polarisation(_)));
     let has_mtf = candidate.effects.iter().any(|e| matches!(e, InstrumentEffect::SpatialResponse(_)));
+    let has_spectral = candidate.effects.iter().any(|e| matches!(e, InstrumentEffect::SpectralStrayLight(_)));
     ui.horizontal_wrapped(|ui| {
         if !has_stray
             && ui.button("Add stray light").on_hover_text("A far-field halo and an out-of-field veil").clicked()
@@ -125,6 +143,14 @@ pub(super) fn optics_editor(slot: &mut Slot, ui: &mut egui::Ui, error: &mut Opti
                 .clicked()
         {
             candidate.effects.push(mtf_budget());
+        }
+        if !has_spectral
+            && ui
+                .button("Add spectral stray light")
+                .on_hover_text("Each band's light partly scattered into the others")
+                .clicked()
+        {
+            candidate.effects.push(spectral_stray());
         }
     });
     if candidate != slot.spec {

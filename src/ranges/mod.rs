@@ -275,6 +275,12 @@ ranges! {
     POLARISATION_AXIS_DEG = Range::closed("instrument.effects[].Polarisation.axis_deg", -180.0, 180.0, "degrees", "most transmitted polarisation, from the along-track axis");
     /// Polarisation: the processor's error.
     POLARISATION_KNOWLEDGE_ERROR = Range::closed("instrument.effects[].Polarisation.correction.error", -1.0, 1.0, "", "relative error of the processor's sensitivity");
+    /// Spectral stray light: share scattered.
+    SPECTRAL_STRAY_FRACTION = Range::closed("instrument.effects[].SpectralStrayLight.fraction", 0.0, 0.2, "", "share of each band's light scattered into the other bands");
+    /// Spectral stray light: spectral scale.
+    SPECTRAL_STRAY_WIDTH_NM = Range::above("instrument.effects[].SpectralStrayLight.width_nm", 0.0, 5000.0, "nm", "spectral scale of the scatter (large: spread evenly over the bands)");
+    /// Spectral stray light: the processor's error.
+    SPECTRAL_STRAY_KNOWLEDGE_ERROR = Range::closed("instrument.effects[].SpectralStrayLight.correction.error", -1.0, 1.0, "", "relative error of the processor's stray-light matrix");
     /// MTF budget: central obstruction.
     MTF_OBSTRUCTION = Range::closed("instrument.effects[].SpatialResponse.obstruction", 0.0, 0.8, "", "secondary's diameter over the aperture's");
     /// MTF budget: wavefront error.

@@ -57,14 +57,15 @@ pub fn sweep_path(path: &str) -> String {
     // The ranges table names a further focal plane `focal_planes[]`; the SWIR SmallSat has one.
     // The dark-current laws: the first plane's doubles ([`with_dark_laws`]), the SWIR plane's is
     // Arrhenius.
-    // The optical effects: stray light first, polarisation second, the MTF budget third
+    // The optical effects: stray light, polarisation, the MTF budget, spectral stray light
     // ([`with_optical_effects`]).
     let path = path
         .replace("[i]", index)
         .replace("focal_planes[]", "focal_planes.0")
         .replace("effects[].StrayLight", "effects.0.StrayLight")
         .replace("effects[].Polarisation", "effects.1.Polarisation")
-        .replace("effects[].SpatialResponse", "effects.2.SpatialResponse");
+        .replace("effects[].SpatialResponse", "effects.2.SpatialResponse")
+        .replace("effects[].SpectralStrayLight", "effects.3.SpectralStrayLight");
     // The image-based correction's lists: the pair's long band, the AOT node 0.2, the start of
     // dark-spectrum fitting's band range.
     let path = match path.as_str() {
@@ -99,14 +100,16 @@ pub fn with_dark_laws(instrument: &mut shoal::instrument::InstrumentSpec) {
 
 /// Give an instrument the optical effects the ranges table names, every field set away from
 /// its default: stray light (a 5 % halo over 600 m, a 1 % veil, the processor 10 % wrong),
-/// a 2 % polarisation sensitivity at 10° (the processor 10 % wrong) and an MTF budget.
+/// a 2 % polarisation sensitivity at 10° (the processor 10 % wrong), an MTF budget and 1 %
+/// spectral stray light (the processor 10 % wrong).
 pub fn with_optical_effects(instrument: &mut shoal::instrument::InstrumentSpec) {
     instrument.effects = ron::from_str(
         "[StrayLight((halo_fraction: 0.05, knee_m: 60.0, slope: 2.5, radius_m: 600.0, out_of_field_fraction: 0.01, \
           wavelength_exponent: 2.0, correction: (corrected: true, error: 0.1))), \
           Polarisation((sensitivity: 0.02, axis_deg: 10.0, correction: (corrected: true, error: 0.1))), \
           SpatialResponse((obstruction: 0.3, wavefront_rms_nm: 30.0, pixel_fill: 0.9, diffusion_um: 2.0, \
-          crosstalk: 0.02, jitter_urad: 3.0))]",
+          crosstalk: 0.02, jitter_urad: 3.0)), \
+          SpectralStrayLight((fraction: 0.01, width_nm: 80.0, correction: (corrected: true, error: 0.1)))]",
     )
     .unwrap();
 }

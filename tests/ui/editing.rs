@@ -181,6 +181,11 @@ fn optical_effects_are_added_per_design_and_shown_in_the_derived_figures() {
         at(shoal::instrument::effects::mtf::Axis::Across)
     );
     assert!(h.query_all_by_label(&text).next().is_some(), "the derived MTF at Nyquist {text}");
+    h.get_by_label("Add spectral stray light").click_accesskit();
+    h.step();
+    h.step();
+    let effects = &h.state().state.designs[0].spec.effects;
+    assert!(matches!(effects.get(3), Some(shoal::instrument::InstrumentEffect::SpectralStrayLight(_))), "{effects:?}");
     assert!(h.query_all_by_label("Add stray light").next().is_none(), "one stray light per design");
     let _ = std::fs::remove_dir_all(&lib);
 }

@@ -6,6 +6,7 @@
 //! |---|---|---|---|
 //! | stray light (halo, out-of-field veil) | [`stray_light`] | the whole band image | deconvolution with the known PSF (Zong et al. 2006) |
 //! | polarisation sensitivity | [`polarisation`] | the path's Stokes Q and U per column | l2gen's polcor (Meister et al. 2005) |
+//! | spectral stray light | [`spectral_stray`] | each pixel's band vector | the inverse of the known matrix (Zong et al. 2006) |
 //! | spatial response (MTF budget) | [`mtf`] | the scene around each pixel (it sets the sampling's PSF) | not corrected (as most Level-1 processors) |
 //!
 //! Every effect is a type behind [`Effect`], listed in [`InstrumentEffect`] (the one place an
@@ -24,6 +25,7 @@
 pub mod convolve;
 pub mod mtf;
 pub mod polarisation;
+pub mod spectral_stray;
 pub mod stokes_columns;
 pub mod stray_light;
 
@@ -32,6 +34,7 @@ use serde::{Deserialize, Serialize};
 
 pub use mtf::MtfBudget;
 pub use polarisation::Polarisation;
+pub use spectral_stray::SpectralStrayLight;
 pub use stokes_columns::StokesColumns;
 pub use stray_light::StrayLight;
 
@@ -50,6 +53,8 @@ pub enum InstrumentEffect {
     Polarisation(Polarisation),
     /// The spatial response: the MTF budget whose PSF the scene is sampled with.
     SpatialResponse(MtfBudget),
+    /// Spectral stray light: each band's light partly scattered into the others.
+    SpectralStrayLight(SpectralStrayLight),
 }
 
 impl InstrumentEffect {
@@ -60,6 +65,7 @@ impl InstrumentEffect {
             Self::StrayLight(e) => e,
             Self::Polarisation(e) => e,
             Self::SpatialResponse(e) => e,
+            Self::SpectralStrayLight(e) => e,
         }
     }
 
@@ -72,6 +78,7 @@ impl InstrumentEffect {
             Self::StrayLight(e) => Self::StrayLight(StrayLight { correction, ..e.clone() }),
             Self::Polarisation(e) => Self::Polarisation(Polarisation { correction, ..e.clone() }),
             Self::SpatialResponse(e) => Self::SpatialResponse(*e),
+            Self::SpectralStrayLight(e) => Self::SpectralStrayLight(SpectralStrayLight { correction, ..e.clone() }),
         }
     }
 }
