@@ -59,15 +59,24 @@ impl SpectralStrayLight {
         m
     }
 
-    /// Multiply every pixel's band vector by the n × n `m`.
+    /// Multiply every pixel's band vector by the n × n `m` (pixels in parallel: each is its own,
+    /// so the result does not depend on the threads).
     fn transform(cube: &mut Array3<f32>, m: &[f64], control: &RunControl) -> Result<(), InstrumentError> {
+        use rayon::prelude::*;
         let nb = cube.dim().2;
-        let mut input = vec![0.0; nb];
-        for mut row in cube.outer_iter_mut() {
+        let Some(values) = cube.as_slice_mut() else {
+            return Err(InstrumentError::Invalid(FieldError {
+                field: "effects[].SpectralStrayLight".into(),
+                message: "the radiance cube is not in standard layout".into(),
+            }));
+        };
+        // Blocks of 256 pixels: enough work per task, and a cancellation check per block.
+        values.par_chunks_mut(256 * nb).try_for_each(|block| {
             if control.cancelled() {
                 return Err(InstrumentError::Cancelled);
             }
-            for mut pixel in row.outer_iter_mut() {
+            let mut input = vec![0.0; nb];
+            for pixel in block.chunks_exact_mut(nb) {
                 for (x, v) in input.iter_mut().zip(pixel.iter()) {
                     *x = f64::from(*v);
                 }
@@ -75,8 +84,8 @@ impl SpectralStrayLight {
                     *out = m[i * nb..(i + 1) * nb].iter().zip(&input).map(|(a, x)| a * x).sum::<f64>() as f32;
                 }
             }
-        }
-        Ok(())
+            Ok(())
+        })
     }
 }
 
