@@ -47,13 +47,11 @@ pub use budget::{Budget, BudgetLine, Stage, budget_table, error_budget};
 pub use curves::{CurvePoint, CurveSeries, Curves, curve_figure, first_crossing};
 pub use figures::figure_set;
 pub use geotiff_out::{NODATA, swath_geotransform, write_run_geotiff};
+pub use optics_checks::{MTF_MAX_WHAT, MTF_MIN_WHAT, POLARISATION_WHAT, StrayLightRequirement};
 pub use outdir::{MARKER, OutputDir};
 pub use output::{CubeFormat, Outputs, metrics_csv, write_bytes, write_run, write_run_as, write_study};
 pub use render::{Figure, base64};
-pub use requirements::{
-    Check, MTF_MAX_WHAT, MTF_MIN_WHAT, POLARISATION_WHAT, ProductRequirement, Requirements, RrsRequirement,
-    StrayLightRequirement, checks_csv, verdict,
-};
+pub use requirements::{Check, ProductRequirement, Requirements, RrsRequirement, checks_csv, verdict};
 pub use run::{StudyResult, StudyRun, run_study, study_plan};
 pub use slide::{ComparisonPanel, ReviewSlide, SLIDE, SlideSeries, review_slide};
 pub use spread::{SeedSpread, seed_spread, seed_spread_csv, spread_of_runs};

@@ -2,10 +2,50 @@
 //! sensitivity, stray light past a bright edge), judged from the design's stated effects
 //! (`instrument::effects`; an ideal optic where it states none).
 
-use super::requirements::{Check, MTF_MAX_WHAT, MTF_MIN_WHAT, POLARISATION_WHAT, Requirements};
+use serde::{Deserialize, Serialize};
+
+use super::requirements::{Check, Requirements};
 use crate::instrument::InstrumentSpec;
 use crate::instrument::effects;
 use crate::instrument::spatial::nyquist_table;
+
+/// The stray signal `distance_m` into the dark half of a half-bright, half-dark field, relative
+/// to the bright half, in a band at `centre_nm` (Metop-3MI's convention).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StrayLightRequirement {
+    /// Largest ratio, %.
+    pub ratio_pct_max: f64,
+    /// Distance from the edge, m.
+    #[serde(default = "default_stray_distance_m")]
+    pub distance_m: f64,
+    /// Band centre, nm.
+    #[serde(default = "default_stray_centre_nm")]
+    pub centre_nm: f64,
+}
+
+fn default_stray_distance_m() -> f64 {
+    1000.0
+}
+
+fn default_stray_centre_nm() -> f64 {
+    443.0
+}
+
+impl StrayLightRequirement {
+    /// What its check is called (and the design search's constraint).
+    #[must_use]
+    pub fn what(&self) -> String {
+        format!("stray light {:.0} m past an edge at {:.0} nm, %", self.distance_m, self.centre_nm)
+    }
+}
+
+/// The optics checks' names (and the design search's constraints).
+pub const MTF_MIN_WHAT: &str = "MTF at Nyquist, worst band";
+/// See [`MTF_MIN_WHAT`].
+pub const MTF_MAX_WHAT: &str = "MTF at Nyquist, sharpest band";
+/// See [`MTF_MIN_WHAT`].
+pub const POLARISATION_WHAT: &str = "polarisation sensitivity, %";
 
 impl Requirements {
     /// Check `spec`'s optics: the worst and sharpest band's MTF at Nyquist (both axes, each
@@ -57,7 +97,6 @@ mod tests {
     use super::*;
     use crate::instrument::InstrumentEffect;
     use crate::instrument::effects::{Knowledge, MtfBudget, Polarisation};
-    use crate::study::requirements::StrayLightRequirement;
 
     #[test]
     fn optics_checks_judge_the_designs_stated_effects() {

@@ -21,6 +21,8 @@ use crate::instrument::{InstrumentSpec, SnrRow};
 use crate::metrics::ProductMetrics;
 use crate::parse::FieldError;
 
+use super::optics_checks::StrayLightRequirement;
+
 /// Limits on one variable (`None`: not required).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -86,44 +88,6 @@ pub struct Requirements {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub stray_light: Option<StrayLightRequirement>,
 }
-
-/// The stray signal `distance_m` into the dark half of a half-bright, half-dark field, relative
-/// to the bright half, in a band at `centre_nm` (Metop-3MI's convention).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct StrayLightRequirement {
-    /// Largest ratio, %.
-    pub ratio_pct_max: f64,
-    /// Distance from the edge, m.
-    #[serde(default = "default_stray_distance_m")]
-    pub distance_m: f64,
-    /// Band centre, nm.
-    #[serde(default = "default_stray_centre_nm")]
-    pub centre_nm: f64,
-}
-
-fn default_stray_distance_m() -> f64 {
-    1000.0
-}
-
-fn default_stray_centre_nm() -> f64 {
-    443.0
-}
-
-impl StrayLightRequirement {
-    /// What its check is called (and the design search's constraint).
-    #[must_use]
-    pub fn what(&self) -> String {
-        format!("stray light {:.0} m past an edge at {:.0} nm, %", self.distance_m, self.centre_nm)
-    }
-}
-
-/// The optics checks' names (and the design search's constraints).
-pub const MTF_MIN_WHAT: &str = "MTF at Nyquist, worst band";
-/// See [`MTF_MIN_WHAT`].
-pub const MTF_MAX_WHAT: &str = "MTF at Nyquist, sharpest band";
-/// See [`MTF_MIN_WHAT`].
-pub const POLARISATION_WHAT: &str = "polarisation sensitivity, %";
 
 /// The corrected Rrs's error per band, in the bands centred from `from_nm` to `to_nm`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
