@@ -54,18 +54,8 @@ impl Requirements {
     #[must_use]
     pub fn check_optics(&self, label: &str, seed: u64, spec: &InstrumentSpec) -> Vec<Check> {
         let mut out = Vec::new();
-        let check = |what: String, value: Option<f64>, limit: f64, below: bool| {
-            let margin = value.map(|v| if below { limit - v } else { v - limit });
-            Check {
-                instrument: label.into(),
-                seed,
-                what,
-                variable: None,
-                value,
-                limit,
-                pass: margin.is_some_and(|m| m >= 0.0),
-                margin,
-            }
+        let check = |what: String, value: Option<f64>, limit: f64, at_most: bool| {
+            Check::of_design(label, seed, what, value, limit, at_most)
         };
         if self.mtf_nyquist_min.is_some() || self.mtf_nyquist_max.is_some() {
             // A band set that does not build has no MTF: the checks fail without a value.

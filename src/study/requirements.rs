@@ -133,6 +133,23 @@ pub struct Check {
 }
 
 impl Check {
+    /// A check of the design (no product variable): `value` at most `limit` when `at_most`, at
+    /// least `limit` otherwise; no value fails.
+    #[must_use]
+    pub fn of_design(label: &str, seed: u64, what: String, value: Option<f64>, limit: f64, at_most: bool) -> Self {
+        let margin = value.map(|v| if at_most { limit - v } else { v - limit });
+        Self {
+            instrument: label.into(),
+            seed,
+            what,
+            variable: None,
+            value,
+            limit,
+            pass: margin.is_some_and(|m| m >= 0.0),
+            margin,
+        }
+    }
+
     /// The value for a table: `"–"` when there is none.
     #[must_use]
     pub fn value_text(&self, decimals: usize) -> String {
@@ -303,19 +320,8 @@ impl Requirements {
         models: &BudgetModels,
     ) -> Vec<Check> {
         let mut out = Vec::new();
-        let check = |what: String, value: Option<f64>, limit: f64| {
-            let margin = value.map(|v| limit - v);
-            Check {
-                instrument: label.into(),
-                seed,
-                what,
-                variable: None,
-                value,
-                limit,
-                pass: margin.is_some_and(|m| m >= 0.0),
-                margin,
-            }
-        };
+        let check =
+            |what: String, value: Option<f64>, limit: f64| Check::of_design(label, seed, what, value, limit, true);
         if let Some(l) = self.cost_max {
             let note = if budget.cost.extrapolated { ", extrapolated" } else { "" };
             out.push(check(format!("cost {}{note}", budget.currency), budget.cost.ota, l));
