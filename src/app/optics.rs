@@ -1,10 +1,12 @@
-//! The left panel's optics editor: the instrument's optical effects (stray light, polarisation
-//! sensitivity, the MTF budget, spectral stray light; `instrument::effects`), each with what the processor knows of it. An edit is kept
-//! only if the whole instrument still validates; otherwise the message says why.
+//! The left panel's optics and focal-plane editor: the instrument's effects (stray light,
+//! polarisation sensitivity, the MTF budget, spectral stray light, non-linearity, fixed patterns,
+//! misregistration, compression; `instrument::effects`), each with what the processor knows of it. An edit is kept only if the
+//! whole instrument still validates; otherwise the message says why.
 
 use super::model::Slot;
 use crate::instrument::effects::{
-    InstrumentEffect, Knowledge, MtfBudget, Polarisation, SpectralStrayLight, StrayLight,
+    Compression, FixedPatterns, InstrumentEffect, Knowledge, Misregistration, MtfBudget, NonLinearity, Polarisation,
+    SpectralStrayLight, StrayLight,
 };
 
 /// One number shown in `scale` × its stored unit (a focal plane's number otherwise).
@@ -69,19 +71,68 @@ fn spectral_stray() -> InstrumentEffect {
     })
 }
 
-/// The optical effects of `slot`'s instrument.
+/// A non-linearity to start from: 1 % low at full well, a quadratic (a typical CMOS data sheet's
+/// integral non-linearity), the calibration's curve 10 % wrong.
+fn non_linearity() -> InstrumentEffect {
+    InstrumentEffect::NonLinearity(NonLinearity {
+        quadratic: -0.01,
+        cubic: 0.0,
+        per_band: Vec::new(),
+        column_spread: 0.0,
+        correction: Knowledge { corrected: true, error: 0.1 },
+    })
+}
+
+/// Fixed patterns to start from: 0.1 % gain drift since calibration, 0.1 % dead elements
+/// filled by the processor (assumptions).
+fn fixed_patterns() -> InstrumentEffect {
+    InstrumentEffect::FixedPatterns(FixedPatterns {
+        gain_drift: 0.001,
+        dead_fraction: 0.001,
+        ..FixedPatterns::default()
+    })
+}
+
+/// An effect the editor offers: its title, what it does, and where to start.
+type Offer = (&'static str, &'static str, fn() -> InstrumentEffect);
+
+/// Every effect the editor offers, in the order of its buttons.
+const OFFERED: [Offer; 8] = [
+    ("stray light", "A far-field halo and an out-of-field veil", stray_light),
+    ("polarisation sensitivity", "The response depends on the light's linear polarisation", polarisation),
+    ("MTF budget", "Sample the scene with the PSF of the optics, detector and motion", mtf_budget),
+    ("spectral stray light", "Each band's light partly scattered into the others", spectral_stray),
+    ("non-linearity", "The detector's response departs from a straight line", non_linearity),
+    ("fixed patterns", "Striping, dead and hot elements left after the calibration", fixed_patterns),
+    ("misregistration", "Each band's grid shifted from the others by a fraction of a pixel", misregistration),
+    ("compression", "On-board coding of Level-0: lossless, or near-lossless to a rate", compression),
+];
+
+/// A misregistration to start from: 0.1 px rms per band (a filter imager's requirement class),
+/// co-registered by the processor to 20 % (assumptions).
+fn misregistration() -> InstrumentEffect {
+    InstrumentEffect::Misregistration(Misregistration {
+        sigma_px: 0.1,
+        per_band: Vec::new(),
+        draw: 0,
+        correction: Knowledge { corrected: true, error: 0.2 },
+    })
+}
+
+/// Compression to start from: lossless (the rate is measured on the scene).
+fn compression() -> InstrumentEffect {
+    InstrumentEffect::Compression(Compression::default())
+}
+
+/// The effects of `slot`'s instrument.
 pub(super) fn optics_editor(slot: &mut Slot, ui: &mut egui::Ui, error: &mut Option<String>) {
     ui.label("What the optics do between the pupil and the detector; none: an ideal optic.");
     let mut candidate = slot.spec.clone();
     let mut remove = None;
     for (i, effect) in candidate.effects.iter_mut().enumerate() {
-        let title = match effect {
-            InstrumentEffect::StrayLight(_) => "Stray light",
-            InstrumentEffect::Polarisation(_) => "Polarisation sensitivity",
-            InstrumentEffect::SpatialResponse(_) => "MTF budget",
-            InstrumentEffect::SpectralStrayLight(_) => "Spectral stray light",
-        };
-        egui::CollapsingHeader::new(title).id_salt(("effect", i)).default_open(true).show(ui, |ui| {
+        let kind = std::mem::discriminant(effect);
+        let title = OFFERED.iter().find(|o| std::mem::discriminant(&o.2()) == kind).map_or("effect", |o| o.0);
+        egui::CollapsingHeader::new(capitalised(title)).id_salt(("effect", i)).default_open(true).show(ui, |ui| {
             egui::Grid::new(("effect-grid", i)).num_columns(2).show(ui, |ui| match effect {
                 InstrumentEffect::StrayLight(s) => {
                     number(ui, "halo at 550 nm", &mut s.halo_fraction, (0.0, 0.5), 100.0, " %");
@@ -109,6 +160,32 @@ pub(super) fn optics_editor(slot: &mut Slot, ui: &mut egui::Ui, error: &mut Opti
                     number(ui, "spectral scale", &mut s.width_nm, (1.0, 5000.0), 1.0, " nm");
                     knowledge(ui, &mut s.correction);
                 }
+                InstrumentEffect::NonLinearity(n) => {
+                    number(ui, "quadratic at full well", &mut n.quadratic, (-0.2, 0.2), 100.0, " %");
+                    number(ui, "cubic at full well", &mut n.cubic, (-0.2, 0.2), 100.0, " %");
+                    number(ui, "spread between columns", &mut n.column_spread, (0.0, 1.0), 100.0, " %");
+                    knowledge(ui, &mut n.correction);
+                }
+                InstrumentEffect::FixedPatterns(p) => {
+                    number(ui, "gain drift since calibration", &mut p.gain_drift, (0.0, 0.1), 100.0, " %");
+                    number(ui, "dark drift since calibration", &mut p.offset_drift_e, (0.0, 1000.0), 1.0, " e⁻");
+                    number(ui, "dead elements", &mut p.dead_fraction, (0.0, 0.2), 100.0, " %");
+                    number(ui, "hot elements", &mut p.hot_fraction, (0.0, 0.2), 100.0, " %");
+                    number(ui, "  their extra dark current", &mut p.hot_dark_current_e_s, (0.0, 1e6), 1.0, " e⁻/s");
+                    ui.label("processor fills dead elements");
+                    ui.checkbox(&mut p.interpolate_dead, "");
+                    ui.end_row();
+                }
+                InstrumentEffect::Misregistration(m) => {
+                    number(ui, "band-to-band shift RMS", &mut m.sigma_px, (0.0, 5.0), 1.0, " px");
+                    knowledge(ui, &mut m.correction);
+                }
+                InstrumentEffect::Compression(c) => {
+                    let mut bound = f64::from(c.max_error_dn);
+                    number(ui, "largest error", &mut bound, (0.0, 4096.0), 1.0, " DN");
+                    c.max_error_dn = bound.round() as u32;
+                    number(ui, "rate target (0: none)", &mut c.bits_per_sample, (0.0, 16.0), 1.0, " bit");
+                }
             });
             if ui.small_button("Remove").clicked() {
                 remove = Some(i);
@@ -118,39 +195,13 @@ pub(super) fn optics_editor(slot: &mut Slot, ui: &mut egui::Ui, error: &mut Opti
     if let Some(i) = remove {
         candidate.effects.remove(i);
     }
-    let has_stray = candidate.effects.iter().any(|e| matches!(e, InstrumentEffect::StrayLight(_)));
-    let has_polarisation = candidate.effects.iter().any(|e| matches!(e, InstrumentEffect::Polarisation(_)));
-    let has_mtf = candidate.effects.iter().any(|e| matches!(e, InstrumentEffect::SpatialResponse(_)));
-    let has_spectral = candidate.effects.iter().any(|e| matches!(e, InstrumentEffect::SpectralStrayLight(_)));
     ui.horizontal_wrapped(|ui| {
-        if !has_stray
-            && ui.button("Add stray light").on_hover_text("A far-field halo and an out-of-field veil").clicked()
-        {
-            candidate.effects.push(stray_light());
-        }
-        if !has_polarisation
-            && ui
-                .button("Add polarisation sensitivity")
-                .on_hover_text("The response depends on the light's linear polarisation")
-                .clicked()
-        {
-            candidate.effects.push(polarisation());
-        }
-        if !has_mtf
-            && ui
-                .button("Add MTF budget")
-                .on_hover_text("Sample the scene with the PSF of the optics, detector and motion")
-                .clicked()
-        {
-            candidate.effects.push(mtf_budget());
-        }
-        if !has_spectral
-            && ui
-                .button("Add spectral stray light")
-                .on_hover_text("Each band's light partly scattered into the others")
-                .clicked()
-        {
-            candidate.effects.push(spectral_stray());
+        for (title, what, start) in OFFERED {
+            let fresh = start();
+            let stated = candidate.effects.iter().any(|e| std::mem::discriminant(e) == std::mem::discriminant(&fresh));
+            if !stated && ui.button(format!("Add {title}")).on_hover_text(what).clicked() {
+                candidate.effects.push(fresh);
+            }
         }
     });
     if candidate != slot.spec {
@@ -165,4 +216,10 @@ pub(super) fn optics_editor(slot: &mut Slot, ui: &mut egui::Ui, error: &mut Opti
     if let Some(e) = error {
         ui.add(egui::Label::new(egui::RichText::new(format!("Optics refused: {e}")).color(super::theme::FAIL)).wrap());
     }
+}
+
+/// `text` with its first letter capitalised.
+fn capitalised(text: &str) -> String {
+    let mut chars = text.chars();
+    chars.next().map_or_else(String::new, |first| first.to_uppercase().chain(chars).collect())
 }

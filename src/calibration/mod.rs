@@ -30,6 +30,10 @@ use crate::instrument::detector::{Detector, Exposure, Stream, pixel_rng};
 use crate::instrument::{Flags, Level0, Response, Viewing};
 use crate::parse::FieldError;
 
+mod focal;
+
+pub use focal::{Defects, Linearisation};
+
 /// Errors from the calibration stage; each names the field and what is allowed.
 #[derive(Debug, thiserror::Error, Clone, PartialEq)]
 pub enum CalibrationError {
@@ -124,6 +128,11 @@ pub struct Calibration {
     pub sun_incidence_deg: f64,
     /// Diffuser frames that saturated (any band): a calibration that cannot be trusted.
     pub saturated_frames: usize,
+    /// The response curves every value is linearised with (`None`: the detector is taken as
+    /// linear).
+    pub linearise: Option<Linearisation>,
+    /// The dead elements found (`None`: none).
+    pub defects: Option<Defects>,
 }
 
 /// Response-weighted extraterrestrial irradiance of every detector × band (smile included),
@@ -178,6 +187,8 @@ impl Calibration {
         let assumed = 1.0 + spec.diffuser_bias_pct / 100.0;
         let drift = 1.0 + spec.gain_drift_pct / 100.0;
         let t = detector.exposure_s();
+        let linearise = Linearisation::of(detector, nd, spec.perfect);
+        let lin = |j: usize, b: usize, v: f64| linearise.as_ref().map_or(v, |l| l.value(j, b, v));
         let per_detector: Vec<(usize, Vec<f64>, Vec<f64>, usize)> = used
             .par_iter()
             .filter(|&&j| j < nd)
@@ -201,8 +212,10 @@ impl Calibration {
                     frames(&lit, spec.light_frames, (Stream::CalibrationLightSum, Stream::CalibrationLight));
                 let (dark, _) = frames(&dark, spec.dark_frames, (Stream::CalibrationDarkSum, Stream::CalibrationDark));
                 for b in 0..nb {
-                    offset[b] = dark[b];
-                    gain[b] = (light[b] - dark[b]) / (diffuser_radiance[j * nb + b] * assumed) / drift;
+                    // The frames' means linearised (the curve of the mean: see `frames_mean`).
+                    let (light, dark) = (lin(j, b, light[b]), lin(j, b, dark[b]));
+                    offset[b] = dark;
+                    gain[b] = (light - dark) / (diffuser_radiance[j * nb + b] * assumed) / drift;
                 }
                 (j, offset, gain, saturated)
             })
@@ -213,6 +226,7 @@ impl Calibration {
             offset_dn[j * nb..(j + 1) * nb].copy_from_slice(offset);
             gain_dn_per_radiance[j * nb..(j + 1) * nb].copy_from_slice(gain);
         }
+        let defects = Defects::find(&gain_dn_per_radiance, nb, used, detector.interpolates_dead());
         Ok(Self {
             n_bands: nb,
             offset_dn,
@@ -220,6 +234,8 @@ impl Calibration {
             diffuser_radiance,
             sun_incidence_deg: cos_inc.acos().to_degrees(),
             saturated_frames: per_detector.iter().map(|p| p.3).sum(),
+            linearise,
+            defects,
         })
     }
 
@@ -227,6 +243,7 @@ impl Calibration {
     #[must_use]
     pub fn radiance(&self, j: usize, b: usize, value: f64) -> f64 {
         let i = j * self.n_bands + b;
+        let value = self.linearise.as_ref().map_or(value, |l| l.value(j, b, value));
         radiance_of(value, self.offset_dn[i], self.gain_dn_per_radiance[i])
     }
 }
@@ -253,7 +270,7 @@ fn frame_means(
     if !left.is_empty() {
         let mut frame_saturated = vec![false; frames];
         let rng_of = |f| pixel_rng(seed, by_frame, f, j);
-        detector.read_out_frames(exposures, &left, frames, rng_of, |f, b, r| {
+        detector.read_out_frames(j, exposures, &left, frames, rng_of, |f, b, r| {
             frame_saturated[f] |= r.flags & Flags::SATURATED != 0;
             sums[b] += detector.level0_value(&r);
         });
@@ -304,6 +321,15 @@ pub fn calibrate(
             let at_pixel = (r * cols + c) * nb..(r * cols + c + 1) * nb;
             let out = &mut row[c * nb..(c + 1) * nb];
             let radiance = |value: f64, b: usize| radiance_of(value, offset[b], gain[b]) as f32;
+            if let Some(lin) = &calibration.linearise {
+                let j = viewing.detector_index[c];
+                for (b, o) in out.iter_mut().enumerate() {
+                    let value =
+                        analog.map_or_else(|| f64::from(dn[at_pixel.start + b]), |a| f64::from(a[at_pixel.start + b]));
+                    *o = radiance(lin.value(j, b, value), b);
+                }
+                continue;
+            }
             match analog {
                 Some(a) => {
                     for (b, (o, &v)) in out.iter_mut().zip(&a[at_pixel]).enumerate() {
@@ -319,9 +345,16 @@ pub fn calibrate(
         }
         Ok::<_, CalibrationError>(())
     })?;
+    let mut flags = level0.flags.clone();
+    if let Some(defects) = &calibration.defects {
+        let flag_rows = flags.as_slice_mut().ok_or_else(not_standard)?;
+        out.par_chunks_mut(cols * nb).zip(flag_rows.par_chunks_mut(cols * nb)).for_each(|(row, flags)| {
+            defects.repair_row(row, flags, &viewing.detector_index);
+        });
+    }
     Ok(Level1 {
         radiance: Array3::from_shape_vec((rows, cols, nb), out)
             .map_err(|e| CalibrationError::Invalid(FieldError { field: "cube".into(), message: e.to_string() }))?,
-        flags: level0.flags.clone(),
+        flags,
     })
 }

@@ -146,7 +146,7 @@ pub(crate) fn flag_for(level0_flags: u8, land: bool, value: f64) -> u8 {
     // Without branches (selects), and finiteness as a comparison: the flags of a column's bands
     // are then computed side by side.
     let saturated = level0_flags & Flags::SATURATED != 0;
-    let invalid = land | (level0_flags & Flags::ZERO != 0) | !(value.abs() < f64::INFINITY);
+    let invalid = land | (level0_flags & (Flags::ZERO | Flags::DEFECTIVE) != 0) | !(value.abs() < f64::INFINITY);
     let negative = !invalid & (value < 0.0);
     (u8::from(saturated) * RrsFlags::SATURATED)
         | (u8::from(invalid) * RrsFlags::INVALID)

@@ -45,7 +45,8 @@ fn with_context<T>(
     let stokes = stokes_for(config, side)?;
     let spacing = side.viewing.gsd_m * side.viewing.decimation as f64;
     let centres = side.response.bands.centres_nm();
-    f(&Context { spacing_m: (spacing, spacing), centres_nm: &centres, stokes: stokes.as_ref() })
+    let pixel_m = side.viewing.gsd_m;
+    f(&Context { spacing_m: (spacing, spacing), pixel_m, centres_nm: &centres, stokes: stokes.as_ref() })
 }
 
 impl Engine {
@@ -64,7 +65,9 @@ impl Engine {
         if !effects::any_on_the_cube(list) {
             return Ok((None, radiance_key));
         }
-        let applied: Vec<_> = list.iter().map(effects::InstrumentEffect::as_applied).collect();
+        // Only the effects on the cube: the detector's and the coder's enter their own stages' keys.
+        let applied: Vec<_> =
+            list.iter().filter(|e| e.effect().on_the_cube()).map(effects::InstrumentEffect::as_applied).collect();
         let key = KeyBuilder::new(Stage::Effects).after(radiance_key).with(&applied).finish();
         let cube = self.stage(key, report, control, || {
             with_context(config, side, |ctx| {

@@ -106,6 +106,8 @@ pub struct RunReport {
     pub saturated: usize,
     /// Level-0 pixel-bands at zero counts.
     pub zero_counts: usize,
+    /// What on-board compression did to Level-0 (`None`: not compressed).
+    pub compression: Option<crate::instrument::compression::CompressionReport>,
     /// Sun incidence on the calibration diffuser, degrees.
     pub diffuser_incidence_deg: f64,
     /// Calibration frames that saturated.

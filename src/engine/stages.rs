@@ -16,11 +16,12 @@ use crate::calibration::{Calibration, band_e0, calibrate};
 use crate::control::Cancellable;
 use crate::control::RunControl;
 use crate::instrument::aerosol_map;
+use crate::instrument::compression::compress_level0;
 use crate::instrument::effects::{self, MtfBudget};
 use crate::instrument::feasibility::Feasibility;
 use crate::instrument::sample::BandAtmosphere;
 use crate::instrument::{
-    AotNodes, Detector, RadianceCube, Response, SampleOptions, SnrRow, SpatialKernel, Viewing, analytic_snr,
+    AotNodes, Detector, Level0, RadianceCube, Response, SampleOptions, SnrRow, SpatialKernel, Viewing, analytic_snr,
     digitise_cube, expose_and_digitise, expose_cube, measured_snr, sample_radiance,
 };
 use crate::scene::{Effect, Scene};
@@ -281,10 +282,15 @@ impl Engine {
         let response_key = *response_key;
         // Detector, electrons, Level-0.
         let inputs = Inputs::of(config);
+        // The focal-plane effects the detector carries: as applied for the detector and its
+        // electrons, with the processor's knowledge for the calibration.
+        let on_the_detector = effects::on_the_detector(&instrument.effects);
+        let applied: Vec<_> = on_the_detector.iter().map(effects::InstrumentEffect::as_applied).collect();
         let detector_key = KeyBuilder::new(Stage::Detector)
             .after(response_key)
             .with(&inputs.photon)
             .with(&inputs.electronics)
+            .with(&applied)
             .finish();
         let detector = self.stage(detector_key, report, control, || {
             Ok(Detector::new(instrument, response, config.detector, config.seed))
@@ -306,9 +312,20 @@ impl Engine {
         // The optics between pupil and detector (none: the detector sees the pupil radiance).
         let (at_detector, optics_key) = self.effects_stage(config, side, &radiance, radiance_key, control, report)?;
         let detector_radiance = at_detector.as_deref().unwrap_or(&radiance.radiance);
-        let electrons_key =
-            KeyBuilder::new(Stage::Electrons).after(optics_key).after(response_key).with(&inputs.photon).finish();
-        let level0_key = KeyBuilder::new(Stage::Level0).after(electrons_key).with(&inputs.electronics).finish();
+        let electrons_key = KeyBuilder::new(Stage::Electrons)
+            .after(optics_key)
+            .after(response_key)
+            .with(&inputs.photon)
+            .with(&applied)
+            .finish();
+        // On-board compression codes the counts as the Level-0 stage makes them.
+        let compression = effects::compression(&instrument.effects).copied();
+        let level0_key =
+            KeyBuilder::new(Stage::Level0).after(electrons_key).with(&inputs.electronics).with(&compression).finish();
+        let coded = |mut level0: Level0| match &compression {
+            Some(c) => compress_level0(&mut level0, &detector, c, control).map(|_| level0),
+            None => Ok(level0),
+        };
         let level0 = if self.keeps_cubes() {
             // The electrons kept apart, so that a change of the electronics reruns only the readout.
             let electrons = self.stage(electrons_key, report, control, || {
@@ -316,18 +333,22 @@ impl Engine {
                     .map_err(failed(Stage::Electrons))
             })?;
             self.stage(level0_key, report, control, || {
-                digitise_cube(&detector, &electrons, viewing, config.seed, control).map_err(failed(Stage::Level0))
+                digitise_cube(&detector, &electrons, viewing, config.seed, control)
+                    .and_then(coded)
+                    .map_err(failed(Stage::Level0))
             })?
         } else {
             // A lean run keeps no electrons cube: exposure and readout row by row (the same counts).
             self.stage(level0_key, report, control, || {
                 expose_and_digitise(&detector, detector_radiance, viewing, config.seed, control)
+                    .and_then(coded)
                     .map_err(failed(Stage::Level0))
             })?
         };
         // The pupil radiance is let go once the detector has seen it, unless the run keeps it.
         let radiance = self.keeps_cubes().then_some(radiance);
         (report.saturated, report.zero_counts) = (level0.saturated, level0.zero_counts);
+        report.compression = level0.compression;
 
         // Calibration and Level-1.
         let calibration_key = KeyBuilder::new(Stage::Calibration)
@@ -336,6 +357,7 @@ impl Engine {
             .with(&scene.day_of_year)
             .with(&inputs.seed)
             .with(&viewing.detector_index)
+            .with(&on_the_detector)
             .finish();
         let calibration = self.stage(calibration_key, report, control, || {
             let e0: Vec<Vec<f64>> = optics.iter().map(|o| o.e0().to_vec()).collect();

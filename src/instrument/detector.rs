@@ -22,6 +22,8 @@
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
 use rand_distr::{Distribution, Poisson, StandardNormal};
+
+use exposure::{Shot, shot};
 use serde::{Deserialize, Serialize};
 
 use super::response::Response;
@@ -57,6 +59,8 @@ impl Flags {
     pub const SATURATED: u8 = 1;
     /// The ADC read 0 (signal below the converter's range).
     pub const ZERO: u8 = 2;
+    /// A dead detector element the calibration found and did not fill (Level-1 only).
+    pub const DEFECTIVE: u8 = 4;
 }
 
 /// Stream tags that keep the noise of different stages independent.
@@ -79,6 +83,9 @@ pub enum Stream {
     CalibrationLightSum = 7,
     /// Calibration dark frames drawn as their sum.
     CalibrationDarkSum = 8,
+    /// The focal-plane effects' patterns (non-linearity per column, drifts, dead and hot
+    /// elements: [`patterns`]).
+    FocalPlane = 9,
 }
 
 /// SplitMix64 finaliser (Steele, Lea & Flood 2014): a bijective 64-bit mixer.
@@ -96,68 +103,6 @@ pub fn pixel_rng(seed: u64, stream: Stream, line: usize, detector: usize) -> Xos
     let key =
         mix64(mix64(mix64(seed ^ (stream as u64).wrapping_mul(0xA24B_AED4_963E_E407)) ^ line as u64) ^ detector as u64);
     Xoshiro256PlusPlus::seed_from_u64(key)
-}
-
-/// Shot noise: a Poisson draw of mean `mean` electrons (normal approximation above 1000).
-#[inline(always)]
-fn shot<R: rand::Rng + ?Sized>(mean: f64, rng: &mut R) -> f64 {
-    if !(mean > 0.0) {
-        return 0.0;
-    }
-    if mean < 1000.0 {
-        return Poisson::new(mean).map_or(mean, |p| p.sample(rng));
-    }
-    let z: f64 = StandardNormal.sample(rng);
-    round_non_negative(mean + mean.sqrt() * z)
-}
-
-/// Shot noise set up for one mean (see [`shot`]).
-#[derive(Debug, Clone, Copy)]
-enum Shot {
-    /// No draw: noise off, or no signal.
-    Fixed(f64),
-    /// An exact Poisson draw (mean below 1000).
-    Poisson(Poisson<f64>),
-    /// The normal approximation.
-    Normal { mean: f64, sd: f64 },
-}
-
-/// One detector and band's exposure to a constant radiance, from [`Detector::exposure`].
-#[derive(Debug, Clone, Copy)]
-pub struct Exposure {
-    /// The draw of the electrons of all `binned` pixels together.
-    shot: Shot,
-    /// Pixels averaged into the value (m² for a finer focal plane, 1 otherwise).
-    binned: f64,
-    /// An ideal detector does not clip at the well.
-    ideal: bool,
-    well_e: f64,
-    /// Mean electrons of a frame (per pixel).
-    mean_e: f64,
-}
-
-impl Exposure {
-    /// Electrons of one frame: the same value as [`Detector::expose`] with the same generator.
-    #[inline]
-    pub fn draw<R: rand::Rng + ?Sized>(&self, rng: &mut R) -> f64 {
-        let e = match &self.shot {
-            Shot::Fixed(v) => *v,
-            Shot::Poisson(p) => p.sample(rng),
-            Shot::Normal { mean, sd } => {
-                let z: f64 = StandardNormal.sample(rng);
-                round_non_negative(mean + sd * z)
-            }
-        };
-        let e = if self.binned > 1.0 { e / self.binned } else { e };
-        if self.ideal { e } else { e.min(self.well_e) }
-    }
-}
-
-/// Round half up to a whole number, negative values to 0. (`f64::round` is a libm call on the
-/// baseline x86-64 target; the truncating conversion is one instruction.)
-#[inline]
-fn round_non_negative(x: f64) -> f64 {
-    if x > 0.0 { (x + 0.5) as i64 as f64 } else { 0.0 }
 }
 
 /// A standard normal draw.
@@ -183,6 +128,8 @@ pub struct Detector {
     exposure_s: f64,
     ideal: bool,
     mode: DetectorMode,
+    /// Non-linearity and fixed patterns, when the instrument states them.
+    focal: Option<Box<patterns::FocalEffects>>,
 }
 
 /// One pixel read out.
@@ -238,7 +185,31 @@ impl Detector {
                 }
             }
         }
-        Self { n_bands: nb, responsivity, dark_e, plane_of_band, planes, exposure_s: spec.exposure_s, ideal, mode }
+        // Dead elements respond to nothing; hot ones collect more dark current (both seen by the
+        // calibration frames as by the scene).
+        let focal = if ideal { None } else { patterns::FocalEffects::of(spec, nd, &planes, &plane_of_band, seed) };
+        if let Some(f) = &focal {
+            for (i, r) in responsivity.iter_mut().enumerate() {
+                if f.dead.get(i).copied().unwrap_or(false) {
+                    *r = 0.0;
+                }
+            }
+            for (i, (d, hot)) in dark_e.iter_mut().zip(&f.hot_e_s).enumerate() {
+                *d += hot * spec.exposure_s * planes[plane_of_band[i % nb]].exposure_ratio;
+            }
+        }
+        let focal = focal.map(Box::new);
+        Self {
+            n_bands: nb,
+            responsivity,
+            dark_e,
+            plane_of_band,
+            planes,
+            exposure_s: spec.exposure_s,
+            ideal,
+            mode,
+            focal,
+        }
     }
 
     /// Noise and quantisation switches in effect (the ideal radiometer has neither).
@@ -339,7 +310,14 @@ impl Detector {
         exposure_s: f64,
         rng: &mut R,
     ) -> f64 {
-        let mean = self.mean_e(j, b, radiance, exposure_s);
+        let mean = match &self.focal {
+            None => self.mean_e(j, b, radiance, exposure_s),
+            Some(f) => {
+                // The gain and dark signal drifted since the calibration.
+                let dark = self.dark_mean_e(j, b, exposure_s);
+                f.in_the_scene(j, b, self.mean_e(j, b, radiance, exposure_s) - dark, dark)
+            }
+        };
         let plane = self.plane(b);
         let q = plane.binned();
         // m × m binned pixels: the shot noise of their summed electrons, averaged.
@@ -381,7 +359,7 @@ impl Detector {
         } else {
             Shot::Normal { mean: summed, sd: summed.sqrt() }
         };
-        Exposure { shot, binned: q, ideal: self.ideal, well_e: plane.well_e, mean_e: mean }
+        Exposure { shot, binned: q, ideal: self.ideal, well_e: plane.well_e, mean_e: mean, curve: self.curve(j, b) }
     }
 
     /// Read out band `b`'s `electrons`: read noise, gain, bias and the ADC.
@@ -450,7 +428,10 @@ impl Detector {
             Shot::Poisson(_) => Poisson::new(n * q * mu).map_or(n * q * mu, |p| p.sample(rng)),
             Shot::Normal { mean, sd } => n * mean + sd * n.sqrt() * normal(rng),
         };
-        let electrons = summed / q;
+        // The frames' mean electrons through the response curve: the curve of the mean, not the
+        // mean of the curve, which differs by ½·f″·σ² ≈ a₂·μ/W e⁻ (under 0.02 e⁻ for a 1 %
+        // curve: far below the mean's own noise).
+        let electrons = exposure.curve.apply(summed / q / n) * n;
         let read_e = plane.read_noise_e * n.sqrt() * normal(rng);
         let mut value = (electrons + read_e) / n * plane.dn_per_e + plane.bias_dn;
         if self.mode.quantise {
@@ -463,7 +444,7 @@ impl Detector {
     /// is off). The arithmetic is [`readout::value`], shared with Level-0's vector lanes.
     #[inline(always)]
     fn read_out_with(&self, b: usize, electrons: f64, z: f64) -> Readout {
-        readout::value(readout::Adc::of(self, b), electrons, z)
+        readout::value(readout::Adc::of(self, 0, b), electrons, z)
     }
 
     /// The value Level-1 calibrates: the DN, or the analogue value when quantisation is off.
@@ -487,8 +468,12 @@ impl Detector {
     }
 }
 
+mod exposure;
+mod patterns;
 mod plane;
 mod readout;
+
+pub use exposure::Exposure;
 
 pub use plane::PlaneElectronics;
 #[cfg(test)]

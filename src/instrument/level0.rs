@@ -27,6 +27,8 @@ pub struct Level0 {
     pub saturated: usize,
     /// Values flagged [`super::Flags::ZERO`].
     pub zero_counts: usize,
+    /// What on-board compression did to the counts (`None`: not compressed).
+    pub compression: Option<super::compression::CompressionReport>,
 }
 
 impl Level0 {
@@ -236,9 +238,14 @@ fn read_out_row(
             draw_bands(detector, seed, Stream::Readout, line, j, &mut z[c * nb..(c + 1) * nb], |_, rng| normal(rng));
         }
     }
-    let bands: Vec<usize> = (0..nb).collect();
+    // One converter per band; per column too where the response curve differs between columns.
+    let elements: Vec<(usize, usize)> = if detector.curve_varies_by_column() {
+        (0..cols).flat_map(|c| (0..nb).map(move |b| (viewing.detector_index[c], b))).collect()
+    } else {
+        (0..nb).map(|b| (0, b)).collect()
+    };
     let keep_analog = !detector.mode().quantise;
-    detector.read_out_run(&bands, electrons, &z, dn_row, flag_row, keep_analog.then_some(analog_row));
+    detector.read_out_run(&elements, electrons, &z, dn_row, flag_row, keep_analog.then_some(analog_row));
 }
 
 /// Level-0 buffers for `n` values, and the cube they make.
@@ -263,6 +270,7 @@ impl Level0Buffers {
             flags: Array3::from_shape_vec(shape, self.flags).map_err(shape_error)?,
             saturated,
             zero_counts,
+            compression: None,
         })
     }
 }

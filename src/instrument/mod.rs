@@ -13,6 +13,7 @@
 //! | effects | [`effects`] | stray light, polarisation sensitivity: the optics between pupil and detector |
 //! | detector | [`detector`] | photo-electrons, shot/dark/read noise, PRNU/DSNU, full well, ADC |
 //! | Level-0 | [`level0`] | the whole image exposed and read out, with flags |
+//! | compression | [`compression`] | the on-board coder: its rate and the error it leaves in the counts |
 //! | plausibility | [`plausibility`] | saturation at the brightest water, smear, f-number warnings |
 //! | truth | [`truth`] | the scene's values under every pixel, scored against by the metrics |
 //! | truth shares | [`shares`] | depth bins and substrate shares of the water pixels seen |
@@ -34,6 +35,7 @@
 pub mod aerosol_map;
 pub mod band_atmosphere;
 pub mod budgets;
+pub mod compression;
 pub mod detector;
 pub mod effects;
 pub mod feasibility;

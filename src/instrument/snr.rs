@@ -84,14 +84,14 @@ pub fn measured_snr(detector: &Detector, radiance: &[f64], detectors: &[usize], 
             // Frame f's light frame draws from generator 2f, its dark frame from 2f + 1.
             let bands: Vec<usize> = (0..nb).collect();
             let light_rng = |f: usize| pixel_rng(seed, Stream::SnrPatch, 2 * f, j);
-            detector.read_out_frames(&lit, &bands, frames, light_rng, |_, b, out| {
+            detector.read_out_frames(j, &lit, &bands, frames, light_rng, |_, b, out| {
                 saturated[b] |= out.flags & Flags::SATURATED != 0;
                 let v = detector.level0_value(&out);
                 s1[b] += v;
                 s2[b] += v * v;
             });
             let dark_rng = |f: usize| pixel_rng(seed, Stream::SnrPatch, 2 * f + 1, j);
-            detector.read_out_frames(&dark, &bands, frames, dark_rng, |_, b, out| {
+            detector.read_out_frames(j, &dark, &bands, frames, dark_rng, |_, b, out| {
                 d1[b] += detector.level0_value(&out);
             });
             let n = frames as f64;

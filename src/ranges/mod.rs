@@ -281,6 +281,32 @@ ranges! {
     SPECTRAL_STRAY_WIDTH_NM = Range::above("instrument.effects[].SpectralStrayLight.width_nm", 0.0, 5000.0, "nm", "spectral scale of the scatter (large: spread evenly over the bands)");
     /// Spectral stray light: the processor's error.
     SPECTRAL_STRAY_KNOWLEDGE_ERROR = Range::closed("instrument.effects[].SpectralStrayLight.correction.error", -1.0, 1.0, "", "relative error of the processor's stray-light matrix");
+    /// Non-linearity: quadratic term.
+    NONLINEARITY_QUADRATIC = Range::closed("instrument.effects[].NonLinearity.quadratic", -0.2, 0.2, "", "a₂ of e′ = e(1 + a₂x + a₃x²), x = e/W: departure at full well from the quadratic term");
+    /// Non-linearity: cubic term.
+    NONLINEARITY_CUBIC = Range::closed("instrument.effects[].NonLinearity.cubic", -0.2, 0.2, "", "a₃ of the same curve");
+    /// Non-linearity: column spread.
+    NONLINEARITY_COLUMN_SPREAD = Range::closed("instrument.effects[].NonLinearity.column_spread", 0.0, 1.0, "", "relative rms of each column's curve about its band's");
+    /// Non-linearity: the calibration's error.
+    NONLINEARITY_KNOWLEDGE_ERROR = Range::closed("instrument.effects[].NonLinearity.correction.error", -1.0, 1.0, "", "relative error of the curve the calibration linearises with");
+    /// Fixed patterns: gain drift.
+    PATTERN_GAIN_DRIFT = Range::closed("instrument.effects[].FixedPatterns.gain_drift", 0.0, 0.1, "", "relative rms change of each element's gain since calibration (striping)");
+    /// Fixed patterns: dark-signal drift.
+    PATTERN_OFFSET_DRIFT_E = Range::closed("instrument.effects[].FixedPatterns.offset_drift_e", 0.0, 1000.0, "e⁻", "rms change of each element's dark signal since calibration");
+    /// Fixed patterns: dead elements.
+    PATTERN_DEAD_FRACTION = Range::closed("instrument.effects[].FixedPatterns.dead_fraction", 0.0, 0.2, "", "share of detector elements with no response");
+    /// Fixed patterns: hot elements.
+    PATTERN_HOT_FRACTION = Range::closed("instrument.effects[].FixedPatterns.hot_fraction", 0.0, 0.2, "", "share of detector elements with extra dark current");
+    /// Fixed patterns: a hot element's extra dark current.
+    PATTERN_HOT_DARK_E_S = Range::closed("instrument.effects[].FixedPatterns.hot_dark_current_e_s", 0.0, 1e6, "e⁻/s", "extra dark current of a hot element");
+    /// Compression: error bound.
+    COMPRESSION_MAX_ERROR_DN = Range::count("instrument.effects[].Compression.max_error_dn", 0.0, 4096.0, "DN", "largest reconstruction error of the near-lossless coder (0: lossless)");
+    /// Compression: rate target.
+    COMPRESSION_BITS_PER_SAMPLE = Range::closed("instrument.effects[].Compression.bits_per_sample", 0.0, 16.0, "bits", "rate the downlink allows (0: none; else the smallest error bound meeting it)");
+    /// Misregistration: rms shift.
+    MISREGISTRATION_SIGMA_PX = Range::closed("instrument.effects[].Misregistration.sigma_px", 0.0, 5.0, "pixels", "rms of each band's shift along and across track");
+    /// Misregistration: the processor's error.
+    MISREGISTRATION_KNOWLEDGE_ERROR = Range::closed("instrument.effects[].Misregistration.correction.error", -1.0, 1.0, "", "relative error of the shifts the co-registration believes");
     /// MTF budget: central obstruction.
     MTF_OBSTRUCTION = Range::closed("instrument.effects[].SpatialResponse.obstruction", 0.0, 0.8, "", "secondary's diameter over the aperture's");
     /// MTF budget: wavefront error.

@@ -16,6 +16,7 @@ mod determinism;
 mod effects;
 mod external;
 mod external_hostile;
+mod focal_plane;
 mod image_correction;
 mod incremental;
 mod memory;

@@ -57,15 +57,19 @@ pub fn sweep_path(path: &str) -> String {
     // The ranges table names a further focal plane `focal_planes[]`; the SWIR SmallSat has one.
     // The dark-current laws: the first plane's doubles ([`with_dark_laws`]), the SWIR plane's is
     // Arrhenius.
-    // The optical effects: stray light, polarisation, the MTF budget, spectral stray light
-    // ([`with_optical_effects`]).
+    // The instrument's effects: stray light, polarisation, the MTF budget, spectral stray light,
+    // non-linearity, fixed patterns, misregistration, compression ([`with_optical_effects`]).
     let path = path
         .replace("[i]", index)
         .replace("focal_planes[]", "focal_planes.0")
         .replace("effects[].StrayLight", "effects.0.StrayLight")
         .replace("effects[].Polarisation", "effects.1.Polarisation")
         .replace("effects[].SpatialResponse", "effects.2.SpatialResponse")
-        .replace("effects[].SpectralStrayLight", "effects.3.SpectralStrayLight");
+        .replace("effects[].SpectralStrayLight", "effects.3.SpectralStrayLight")
+        .replace("effects[].NonLinearity", "effects.4.NonLinearity")
+        .replace("effects[].FixedPatterns", "effects.5.FixedPatterns")
+        .replace("effects[].Misregistration", "effects.6.Misregistration")
+        .replace("effects[].Compression", "effects.7.Compression");
     // The image-based correction's lists: the pair's long band, the AOT node 0.2, the start of
     // dark-spectrum fitting's band range.
     let path = match path.as_str() {
@@ -98,10 +102,12 @@ pub fn with_dark_laws(instrument: &mut shoal::instrument::InstrumentSpec) {
     }
 }
 
-/// Give an instrument the optical effects the ranges table names, every field set away from
-/// its default: stray light (a 5 % halo over 600 m, a 1 % veil, the processor 10 % wrong),
-/// a 2 % polarisation sensitivity at 10° (the processor 10 % wrong), an MTF budget and 1 %
-/// spectral stray light (the processor 10 % wrong).
+/// Give an instrument the effects the ranges table names, every field set away from its
+/// default: stray light (a 5 % halo over 600 m, a 1 % veil, the processor 10 % wrong), a 2 %
+/// polarisation sensitivity at 10° (the processor 10 % wrong), an MTF budget, 1 % spectral stray
+/// light (the processor 10 % wrong), a 2 % non-linearity (the calibration 10 % wrong), fixed
+/// patterns (15 % dead and 15 % hot elements, so that a 10 % change of either share changes
+/// which elements of a small image are), a 0.2 px misregistration and a near-lossless coder.
 pub fn with_optical_effects(instrument: &mut shoal::instrument::InstrumentSpec) {
     instrument.effects = ron::from_str(
         "[StrayLight((halo_fraction: 0.05, knee_m: 60.0, slope: 2.5, radius_m: 600.0, out_of_field_fraction: 0.01, \
@@ -109,7 +115,12 @@ pub fn with_optical_effects(instrument: &mut shoal::instrument::InstrumentSpec) 
           Polarisation((sensitivity: 0.02, axis_deg: 10.0, correction: (corrected: true, error: 0.1))), \
           SpatialResponse((obstruction: 0.3, wavefront_rms_nm: 30.0, pixel_fill: 0.9, diffusion_um: 2.0, \
           crosstalk: 0.02, jitter_urad: 3.0)), \
-          SpectralStrayLight((fraction: 0.01, width_nm: 80.0, correction: (corrected: true, error: 0.1)))]",
+          SpectralStrayLight((fraction: 0.01, width_nm: 80.0, correction: (corrected: true, error: 0.1))), \
+          NonLinearity((quadratic: -0.02, cubic: 0.004, column_spread: 0.1, correction: (corrected: true, error: 0.1))), \
+          FixedPatterns((gain_drift: 0.002, offset_drift_e: 5.0, dead_fraction: 0.15, hot_fraction: 0.15, \
+          hot_dark_current_e_s: 5000.0)), \
+          Misregistration((sigma_px: 0.2, correction: (corrected: true, error: 0.1))), \
+          Compression((max_error_dn: 2))]",
     )
     .unwrap();
 }

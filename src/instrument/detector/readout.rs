@@ -14,6 +14,7 @@
 use rand::rngs::Xoshiro256PlusPlus;
 
 use super::{Detector, Exposure, Flags, Readout, normal};
+use crate::instrument::effects::nonlinearity::Curve;
 use crate::simd::{self, Kernel, Level};
 
 /// One run of values to read out (see [`Detector::read_out_run`]); electrons in `f32` (the
@@ -29,9 +30,12 @@ struct Run<'a, E> {
 }
 
 /// Read out `electrons` with the standard normal read-noise draw `z` (not read with the noise
-/// off): read noise, gain, bias and the ADC (Janesick 2007, ch. 2–3; see [`super`]).
+/// off): response curve, read noise, gain, bias and the ADC (Janesick 2007, ch. 2–3; see
+/// [`super`]).
 ///
-/// - analogue value a = (e + σ_read·z)/gain + bias, DN;
+/// - measured electrons e′ = f(e), the element's curve (e itself unless the instrument states a
+///   non-linearity: [`crate::instrument::effects::nonlinearity`]);
+/// - analogue value a = (e′ + σ_read·z)/gain + bias, DN;
 /// - DN = round(a) = ⌊a + ½⌋ (the floor of the sum a + ½ as rounded in `f64`), clipped to
 ///   0 … `dn_max` (= 2^bits − 1, an integer ≤ 2¹⁶ − 1);
 /// - flags: saturated where the well filled (electrons ≥ well, not for an ideal radiometer) or
@@ -46,7 +50,9 @@ struct Run<'a, E> {
 /// (round half up after the sum, then clip) on every edge.
 #[inline(always)]
 pub(super) fn value(adc: Adc, electrons: f64, z: f64) -> Readout {
-    let noisy = if adc.noise { electrons + adc.read_noise_e * z } else { electrons };
+    // The response curve acts on the collected electrons; the well is judged on them.
+    let measured = if adc.curve.is_linear() { electrons } else { adc.curve.apply(electrons) };
+    let noisy = if adc.noise { measured + adc.read_noise_e * z } else { measured };
     let analog = noisy * adc.dn_per_e + adc.bias_dn;
     let clamped = if analog > 0.0 { analog.min(adc.dn_max) } else { 0.0 };
     let (dn, dn_f) = floor_small(clamped + 0.5);
@@ -93,12 +99,13 @@ pub(super) struct Adc {
     bias_dn: f64,
     dn_max: f64,
     well_e: f64,
+    curve: Curve,
 }
 
 impl Adc {
-    /// Band `b`'s converter (its focal plane's).
+    /// The converter of detector `j`'s band `b` (its focal plane's, with the element's curve).
     #[inline(always)]
-    pub(super) fn of(d: &Detector, b: usize) -> Self {
+    pub(super) fn of(d: &Detector, j: usize, b: usize) -> Self {
         let p = d.plane(b);
         Self {
             noise: d.mode.noise,
@@ -109,6 +116,7 @@ impl Adc {
             bias_dn: p.bias_dn,
             dn_max: p.dn_max,
             well_e: p.well_e,
+            curve: d.curve(j, b),
         }
     }
 }
@@ -153,15 +161,16 @@ impl<E: Copy + Into<f64>> Kernel for Run<'_, E> {
 impl Detector {
     /// Read out a run of values whose standard normal read-noise draws are given:
     /// `electrons[i]` and `z[i]` to `dn[i]`, `flags[i]` and, when given, `analog[i]`, value i
-    /// being of band `bands[i % bands.len()]`. The values [`Self::read_out`] gives with the same
-    /// draws (tested), computed in vector lanes when every band shares one focal plane. With the
-    /// noise off the draws are not read.
+    /// being of element (detector, band) `elements[i % elements.len()]`. The values
+    /// [`Self::read_out`] gives with the same draws (tested), computed in vector lanes when every
+    /// element shares one converter (one focal plane, one response curve). With the noise off
+    /// the draws are not read.
     ///
     /// # Panics
-    /// If the slices' lengths differ or `bands` is empty.
+    /// If the slices' lengths differ or `elements` is empty.
     pub fn read_out_run<E: Copy + Into<f64>>(
         &self,
-        bands: &[usize],
+        elements: &[(usize, usize)],
         electrons: &[E],
         z: &[f64],
         dn: &mut [u16],
@@ -173,12 +182,13 @@ impl Detector {
             z.len() == n && dn.len() == n && flags.len() == n && analog.as_ref().is_none_or(|a| a.len() == n),
             "readout run: slices of different lengths"
         );
-        let lanes: Vec<Adc> = bands.iter().map(|&b| Adc::of(self, b)).collect();
+        let lanes: Vec<Adc> = elements.iter().map(|&(j, b)| Adc::of(self, j, b)).collect();
         let lanes: &[Adc] = if lanes.iter().all(|a| *a == lanes[0]) { &lanes[..1] } else { &lanes };
         simd::widest(Run { lanes, electrons, z, dn, flags, analog });
     }
 
-    /// `frames` frames of `exposures[b]` for each band `b` in `bands`, read out: frame `f`'s
+    /// `frames` frames of `exposures[b]` for each band `b` in `bands` of detector `detector`,
+    /// read out: frame `f`'s
     /// generator `rng_of(f)` draws each band's electrons then its read noise, in the order of
     /// `bands`, exactly as [`Exposure::draw`] then [`Self::read_out`] would; the readouts are
     /// then computed in vector lanes ([`Self::read_out_run`]) and handed to
@@ -188,6 +198,7 @@ impl Detector {
     /// (16 384) values, so the memory held does not grow with the frames or the bands.
     pub fn read_out_frames(
         &self,
+        detector: usize,
         exposures: &[Exposure],
         bands: &[usize],
         frames: usize,
@@ -198,6 +209,7 @@ impl Detector {
             return;
         }
         let per_block = (FRAME_BLOCK_VALUES / bands.len()).max(1);
+        let elements: Vec<(usize, usize)> = bands.iter().map(|&b| (detector, b)).collect();
         let n = per_block.min(frames) * bands.len();
         let (mut electrons, mut z) = (Vec::with_capacity(n), Vec::with_capacity(n));
         let (mut dn, mut flags, mut analog) = (vec![0u16; n], vec![0u8; n], vec![0.0f32; n]);
@@ -213,7 +225,7 @@ impl Detector {
                 }
             }
             let m = electrons.len();
-            self.read_out_run(bands, &electrons, &z, &mut dn[..m], &mut flags[..m], Some(&mut analog[..m]));
+            self.read_out_run(&elements, &electrons, &z, &mut dn[..m], &mut flags[..m], Some(&mut analog[..m]));
             for (i, ((&dn, &flags), &analog_dn)) in dn.iter().zip(&flags).zip(&analog).take(m).enumerate() {
                 each(block.start + i / bands.len(), bands[i % bands.len()], Readout { dn, analog_dn, flags });
             }

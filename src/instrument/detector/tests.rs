@@ -198,9 +198,9 @@ fn readout_matches_as_written(spec: &InstrumentSpec) {
                 .collect();
             let n = electrons.len();
             let (mut dn, mut flags, mut analog) = (vec![0u16; n], vec![0u8; n], vec![0.0f32; n]);
-            d.read_out_run(&[0], &electrons, &z, &mut dn, &mut flags, Some(&mut analog));
+            d.read_out_run(&[(0, 0)], &electrons, &z, &mut dn, &mut flags, Some(&mut analog));
             let mut dn_only = vec![0u16; n];
-            d.read_out_run(&[0], &electrons, &z, &mut dn_only, &mut flags.clone(), None);
+            d.read_out_run(&[(0, 0)], &electrons, &z, &mut dn_only, &mut flags.clone(), None);
             for i in 0..n {
                 let one = readout_as_written(&d, f64::from(electrons[i]), z[i]);
                 let scalar = d.read_out_with(0, f64::from(electrons[i]), z[i]);
@@ -239,7 +239,7 @@ fn frames_read_out_at_once_are_the_frames_read_out_one_by_one() {
         let bands = [2, 0, 3];
         let rng_of = |f: usize| pixel_rng(9, Stream::CalibrationDark, f, 4);
         let mut batched = Vec::new();
-        d.read_out_frames(&exposures, &bands, 5, rng_of, |f, b, r| batched.push((f, b, r.dn, r.flags, r.analog_dn)));
+        d.read_out_frames(0, &exposures, &bands, 5, rng_of, |f, b, r| batched.push((f, b, r.dn, r.flags, r.analog_dn)));
         let mut one_by_one = Vec::new();
         for f in 0..5 {
             let mut rng = rng_of(f);

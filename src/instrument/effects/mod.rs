@@ -8,6 +8,10 @@
 //! | polarisation sensitivity | [`polarisation`] | the path's Stokes Q and U per column | l2gen's polcor (Meister et al. 2005) |
 //! | spectral stray light | [`spectral_stray`] | each pixel's band vector | the inverse of the known matrix (Zong et al. 2006) |
 //! | spatial response (MTF budget) | [`mtf`] | the scene around each pixel (it sets the sampling's PSF) | not corrected (as most Level-1 processors) |
+//! | non-linearity | [`nonlinearity`] | the electrons each element collects (the detector applies it) | the calibration's linearisation with the believed curve |
+//! | fixed patterns (striping, dead and hot elements) | [`fixed_patterns`] | the detector's elements | dead elements filled or flagged by the calibration |
+//! | band-to-band misregistration | [`misregistration`] | each band's whole image | co-registration with the believed shifts |
+//! | compression | [`compression`] | Level-0's counts (the coder: [`crate::instrument::compression`]) | decoded on the ground (near-lossless: its error stays) |
 //!
 //! Every effect is a type behind [`Effect`], listed in [`InstrumentEffect`] (the one place an
 //! effect is registered: its module and one arm of [`InstrumentEffect::effect`]). The engine
@@ -22,8 +26,12 @@
 //!   (2005) Moderate-Resolution Imaging Spectroradiometer ocean color polarization correction.
 //!   Appl. Opt. 44, 5524–5535.
 
+pub mod compression;
 pub mod convolve;
+pub mod fixed_patterns;
+pub mod misregistration;
 pub mod mtf;
+pub mod nonlinearity;
 pub mod polarisation;
 pub mod spectral_stray;
 pub mod stokes_columns;
@@ -32,7 +40,11 @@ pub mod stray_light;
 use ndarray::Array3;
 use serde::{Deserialize, Serialize};
 
+pub use compression::Compression;
+pub use fixed_patterns::FixedPatterns;
+pub use misregistration::Misregistration;
 pub use mtf::MtfBudget;
+pub use nonlinearity::NonLinearity;
 pub use polarisation::Polarisation;
 pub use spectral_stray::SpectralStrayLight;
 pub use stokes_columns::StokesColumns;
@@ -55,6 +67,14 @@ pub enum InstrumentEffect {
     SpatialResponse(MtfBudget),
     /// Spectral stray light: each band's light partly scattered into the others.
     SpectralStrayLight(SpectralStrayLight),
+    /// The detector's response departs from a straight line.
+    NonLinearity(NonLinearity),
+    /// Striping, dead and hot elements left after the calibration.
+    FixedPatterns(FixedPatterns),
+    /// On-board compression of Level-0.
+    Compression(Compression),
+    /// Band-to-band misregistration: each band's grid shifted from the others.
+    Misregistration(Misregistration),
 }
 
 impl InstrumentEffect {
@@ -66,6 +86,10 @@ impl InstrumentEffect {
             Self::Polarisation(e) => e,
             Self::SpatialResponse(e) => e,
             Self::SpectralStrayLight(e) => e,
+            Self::NonLinearity(e) => e,
+            Self::FixedPatterns(e) => e,
+            Self::Compression(e) => e,
+            Self::Misregistration(e) => e,
         }
     }
 
@@ -79,6 +103,10 @@ impl InstrumentEffect {
             Self::Polarisation(e) => Self::Polarisation(Polarisation { correction, ..e.clone() }),
             Self::SpatialResponse(e) => Self::SpatialResponse(*e),
             Self::SpectralStrayLight(e) => Self::SpectralStrayLight(SpectralStrayLight { correction, ..e.clone() }),
+            Self::NonLinearity(e) => Self::NonLinearity(NonLinearity { correction, ..e.clone() }),
+            Self::FixedPatterns(e) => Self::FixedPatterns(FixedPatterns { interpolate_dead: true, ..e.clone() }),
+            Self::Compression(e) => Self::Compression(*e),
+            Self::Misregistration(e) => Self::Misregistration(Misregistration { correction, ..e.clone() }),
         }
     }
 }
@@ -124,6 +152,8 @@ pub struct Needs {
 pub struct Context<'a> {
     /// Ground distance between output rows and between output columns, m (decimation included).
     pub spacing_m: (f64, f64),
+    /// The instrument's own ground sample distance, m (a pixel of the full-resolution grid).
+    pub pixel_m: f64,
     /// Band centres, nm.
     pub centres_nm: &'a [f64],
     /// The path's Q and U in the instrument's frame, when an effect asks for them.
@@ -160,6 +190,17 @@ pub fn validate(effects: &[InstrumentEffect]) -> Result<(), InstrumentError> {
     Ok(())
 }
 
+/// The entries the detector carries (non-linearity, fixed patterns), in order: part of the
+/// detector's key (as applied) and of the calibration's (with what the processor knows).
+#[must_use]
+pub fn on_the_detector(effects: &[InstrumentEffect]) -> Vec<InstrumentEffect> {
+    effects
+        .iter()
+        .filter(|e| matches!(e, InstrumentEffect::NonLinearity(_) | InstrumentEffect::FixedPatterns(_)))
+        .cloned()
+        .collect()
+}
+
 /// Does any entry need the path's Stokes vector?
 #[must_use]
 pub fn needs_stokes(effects: &[InstrumentEffect]) -> bool {
@@ -170,6 +211,33 @@ pub fn needs_stokes(effects: &[InstrumentEffect]) -> bool {
 #[must_use]
 pub fn any_on_the_cube(effects: &[InstrumentEffect]) -> bool {
     effects.iter().any(|e| e.effect().on_the_cube())
+}
+
+/// The non-linearity the instrument states, if it states one.
+#[must_use]
+pub fn non_linearity(effects: &[InstrumentEffect]) -> Option<&NonLinearity> {
+    effects.iter().find_map(|e| match e {
+        InstrumentEffect::NonLinearity(n) => Some(n),
+        _ => None,
+    })
+}
+
+/// The fixed patterns the instrument states, if it states them.
+#[must_use]
+pub fn fixed_patterns(effects: &[InstrumentEffect]) -> Option<&FixedPatterns> {
+    effects.iter().find_map(|e| match e {
+        InstrumentEffect::FixedPatterns(p) => Some(p),
+        _ => None,
+    })
+}
+
+/// The compression the instrument states, if it states one.
+#[must_use]
+pub fn compression(effects: &[InstrumentEffect]) -> Option<&Compression> {
+    effects.iter().find_map(|e| match e {
+        InstrumentEffect::Compression(c) => Some(c),
+        _ => None,
+    })
 }
 
 /// The MTF budget the instrument states, if it states one.

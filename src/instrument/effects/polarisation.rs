@@ -119,7 +119,7 @@ mod tests {
     use crate::instrument::effects::StokesColumns;
 
     fn ctx<'a>(stokes: &'a StokesColumns, centres: &'a [f64]) -> Context<'a> {
-        Context { spacing_m: (30.0, 30.0), centres_nm: centres, stokes: Some(stokes) }
+        Context { spacing_m: (30.0, 30.0), pixel_m: 30.0, centres_nm: centres, stokes: Some(stokes) }
     }
 
     #[test]

@@ -159,7 +159,7 @@ mod tests {
     use super::*;
 
     fn ctx(centres: &[f64]) -> Context<'_> {
-        Context { spacing_m: (30.0, 30.0), centres_nm: centres, stokes: None }
+        Context { spacing_m: (30.0, 30.0), pixel_m: 30.0, centres_nm: centres, stokes: None }
     }
 
     #[test]
