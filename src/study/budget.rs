@@ -1,8 +1,9 @@
 //! Error budget: how much of a product's error each stage of the chain contributes.
 //!
 //! Each stage that makes error has a "perfect" switch: the instrument's optical effects removed
-//! (stray light, polarisation sensitivity: an ideal optic; only where the design states any),
-//! instrument noise and quantisation off,
+//! (stray light, polarisation sensitivity, spectral stray light, the MTF budget: an ideal optic;
+//! only where the design states any), its focal-plane effects removed (non-linearity, fixed
+//! patterns, misregistration, compression; likewise), instrument noise and quantisation off,
 //! calibration perfect (gains and offsets exact), atmospheric correction exact (the per-pixel
 //! inversion of the same radiative transfer instead of the per-scene approximation or the
 //! image-based correction's aerosol from the design's own bands), and the
@@ -30,6 +31,8 @@ use super::StudyError;
 pub enum Stage {
     /// The instrument's optical effects, as the processor leaves them (`instrument::effects`).
     Optics,
+    /// The focal plane's and electronics' effects, as the calibration and the ground leave them.
+    FocalPlane,
     /// Photon, dark and read noise; quantisation.
     Noise,
     /// Gain and offset estimation from diffuser and dark frames.
@@ -42,13 +45,19 @@ pub enum Stage {
 
 impl Stage {
     /// All, in chain order.
-    pub const ALL: [Self; 5] = [Self::Optics, Self::Noise, Self::Calibration, Self::Correction, Self::SiopChoice];
+    pub const ALL: [Self; 6] =
+        [Self::Optics, Self::FocalPlane, Self::Noise, Self::Calibration, Self::Correction, Self::SiopChoice];
 
-    /// Does `config` have this source of error? (Only a design with optical effects has the
-    /// first.)
+    /// Does `config` have this source of error? (Only a design that states optical or
+    /// focal-plane effects has the first two.)
     #[must_use]
     pub fn applies(self, config: &RunConfig) -> bool {
-        self != Self::Optics || !config.instrument.effects.is_empty()
+        let effects = &config.instrument.effects;
+        match self {
+            Self::Optics => effects.iter().any(|e| !e.on_the_focal_plane()),
+            Self::FocalPlane => effects.iter().any(crate::instrument::InstrumentEffect::on_the_focal_plane),
+            _ => true,
+        }
     }
 
     /// Name in tables.
@@ -56,6 +65,7 @@ impl Stage {
     pub fn name(self) -> &'static str {
         match self {
             Self::Optics => "optical effects",
+            Self::FocalPlane => "focal-plane effects",
             Self::Noise => "noise and quantisation",
             Self::Calibration => "calibration",
             Self::Correction => "atmospheric correction",
@@ -66,7 +76,8 @@ impl Stage {
     /// Make this stage perfect in `config`.
     fn perfect(self, config: &mut RunConfig) {
         match self {
-            Self::Optics => config.instrument.effects.clear(),
+            Self::Optics => config.instrument.effects.retain(crate::instrument::InstrumentEffect::on_the_focal_plane),
+            Self::FocalPlane => config.instrument.effects.retain(|e| !e.on_the_focal_plane()),
             Self::Noise => {
                 config.detector.noise = false;
                 config.detector.quantise = false;

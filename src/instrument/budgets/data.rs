@@ -7,7 +7,8 @@
 //!   A plane with a finer pitch than the first has a shorter line period in the same ratio.
 //! - An image is the instrument's `lines` lines of its first plane: duration lines · t₀.
 //! - Daily volume = images per day · image volume / compression ratio (Wertz & Larson 1999,
-//!   §13.2: data volume against link capacity).
+//!   §13.2: data volume against link capacity); a design whose coder holds a rate target
+//!   (`instrument::effects::Compression`) sends that many bits per sample instead of the ADC's.
 //! - Downlink capacity per day = link rate · contact time per day.
 //!
 //! ## References
@@ -17,6 +18,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::envelope::check;
+use crate::instrument::effects::Compression;
 use crate::parse::FieldError;
 
 /// How the instrument is operated and what the ground segment takes.
@@ -76,6 +78,30 @@ impl Operations {
         check("budgets.operations.contact_min_per_day", self.contact_min_per_day, 0.0, 1440.0)
     }
 
+    /// [`Self::budget`] for a design whose on-board coder the instrument states: a rate target
+    /// replaces the stated ratio (the coder holds every band to that many bits per sample); a
+    /// coder without one keeps the stated ratio (its real rate depends on the scene: a study
+    /// reports it, `CompressionReport`).
+    #[must_use]
+    pub fn budget_with(&self, planes: &[PlaneReadout], lines: usize, coder: Option<&Compression>) -> DataBudget {
+        let rate = coder.map_or(0.0, |c| c.bits_per_sample);
+        if rate <= 0.0 {
+            return self.budget(planes, lines);
+        }
+        let mut budget = Self { compression_ratio: 1.0, ..self.clone() }.budget(planes, lines);
+        // Bits a second raw and coded, each plane at its own line rate.
+        let per_second = |bits: &dyn Fn(&PlaneReadout) -> f64| -> f64 {
+            let timed = planes.iter().filter(|p| p.line_period_s > 0.0);
+            timed.map(|p| (p.detectors * p.bands) as f64 * bits(p) / p.line_period_s).sum()
+        };
+        let raw_bits = per_second(&|p| f64::from(p.bits));
+        let coded_bits = per_second(&|p| rate.min(f64::from(p.bits)));
+        if raw_bits > 0.0 {
+            budget.daily_gbit *= coded_bits / raw_bits;
+        }
+        budget
+    }
+
     /// The data budget of planes read out as `planes`, an image being `lines` lines of the first.
     #[must_use]
     pub fn budget(&self, planes: &[PlaneReadout], lines: usize) -> DataBudget {
@@ -117,6 +143,13 @@ mod tests {
         assert!((d.rate_mbit_s - 52.736).abs() < 1e-9);
         // 2000 lines × 2 ms = 4 s: 0.210944 Gbit; 10 a day halved: 1.05472 Gbit.
         assert!((d.image_gbit - 0.210_944).abs() < 1e-12);
+        // A coder held to 3 bits per sample: the first plane sends 3 of 12 bits, the SWIR plane
+        // 3 of 14; (1024·8·3/0.002 + 512·2·3/0.004)/(52.736e6) of 10 uncompressed images.
+        let coder = Compression { max_error_dn: 0, bits_per_sample: 3.0 };
+        let coded = ops.budget_with(&planes, 2000, Some(&coder));
+        let share = (1024.0 * 8.0 * 3.0 / 0.002 + 512.0 * 2.0 * 3.0 / 0.004) / 52.736e6;
+        assert!((coded.daily_gbit - 10.0 * 0.210_944 * share).abs() < 1e-12, "{coded:?}");
+        assert_eq!(ops.budget_with(&planes, 2000, Some(&Compression::default())), d);
         assert!((d.daily_gbit - 1.054_72).abs() < 1e-12);
         // 50 Mbit/s × 20 min = 60 Gbit a day.
         assert!((d.downlink_gbit_day - 60.0).abs() < 1e-12);

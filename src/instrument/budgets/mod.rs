@@ -189,7 +189,7 @@ impl BudgetModels {
                 spec.aperture_mm,
                 spec.focal_length_mm,
             ),
-            data: self.operations.budget(&planes, spec.lines),
+            data: self.operations.budget_with(&planes, spec.lines, super::effects::compression(&spec.effects)),
         }
     }
 }

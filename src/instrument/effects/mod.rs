@@ -93,6 +93,13 @@ impl InstrumentEffect {
         }
     }
 
+    /// Does the focal plane or its electronics make it (non-linearity, fixed patterns,
+    /// misregistration, compression), rather than the optics?
+    #[must_use]
+    pub fn on_the_focal_plane(&self) -> bool {
+        matches!(self, Self::NonLinearity(_) | Self::FixedPatterns(_) | Self::Misregistration(_) | Self::Compression(_))
+    }
+
     /// The entry as the optics apply it, the processor's knowledge left out: the key of the
     /// radiance at the detector, which a change of the processor's knowledge does not touch.
     #[must_use]
