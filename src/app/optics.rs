@@ -6,7 +6,7 @@
 use super::model::Slot;
 use crate::instrument::effects::{
     Compression, FixedPatterns, InstrumentEffect, Knowledge, Misregistration, MtfBudget, NonLinearity, Polarisation,
-    SpectralStrayLight, StrayLight,
+    SpectralStrayLight, StrayLight, Tdi,
 };
 
 /// One number shown in `scale` × its stored unit (a focal plane's number otherwise).
@@ -97,7 +97,7 @@ fn fixed_patterns() -> InstrumentEffect {
 type Offer = (&'static str, &'static str, fn() -> InstrumentEffect);
 
 /// Every effect the editor offers, in the order of its buttons.
-const OFFERED: [Offer; 8] = [
+const OFFERED: [Offer; 9] = [
     ("stray light", "A far-field halo and an out-of-field veil", stray_light),
     ("polarisation sensitivity", "The response depends on the light's linear polarisation", polarisation),
     ("MTF budget", "Sample the scene with the PSF of the optics, detector and motion", mtf_budget),
@@ -105,8 +105,15 @@ const OFFERED: [Offer; 8] = [
     ("non-linearity", "The detector's response departs from a straight line", non_linearity),
     ("fixed patterns", "Striping, dead and hot elements left after the calibration", fixed_patterns),
     ("misregistration", "Each band's grid shifted from the others by a fraction of a pixel", misregistration),
+    ("TDI", "Time-delay integration: each ground line integrated over N rows", tdi),
     ("compression", "On-board coding of Level-0: lossless, or near-lossless to a rate", compression),
 ];
+
+/// TDI to start from: 8 charge-domain stages, the line rate right to 0.1 %, a CTE of 0.99999
+/// (assumptions of a good CCD).
+fn tdi() -> InstrumentEffect {
+    InstrumentEffect::Tdi(Tdi { stages: 8, digital: false, line_rate_error: 0.001, cte: 0.99999 })
+}
 
 /// A misregistration to start from: 0.1 px rms per band (a filter imager's requirement class),
 /// co-registered by the processor to 20 % (assumptions).
@@ -179,6 +186,16 @@ pub(super) fn optics_editor(slot: &mut Slot, ui: &mut egui::Ui, error: &mut Opti
                 InstrumentEffect::Misregistration(m) => {
                     number(ui, "band-to-band shift RMS", &mut m.sigma_px, (0.0, 5.0), 1.0, " px");
                     knowledge(ui, &mut m.correction);
+                }
+                InstrumentEffect::Tdi(t) => {
+                    let mut stages = f64::from(t.stages);
+                    number(ui, "stages", &mut stages, (1.0, 256.0), 1.0, "");
+                    t.stages = stages.round() as u32;
+                    ui.label("digital (summed reads)");
+                    ui.checkbox(&mut t.digital, "");
+                    ui.end_row();
+                    number(ui, "line-rate error", &mut t.line_rate_error, (-0.1, 0.1), 100.0, " %");
+                    number(ui, "charge transfer efficiency", &mut t.cte, (0.99, 1.0), 100.0, " %");
                 }
                 InstrumentEffect::Compression(c) => {
                     let mut bound = f64::from(c.max_error_dn);

@@ -6,6 +6,29 @@
 use crate::instrument::Flags;
 use crate::instrument::detector::Detector;
 use crate::instrument::effects::nonlinearity::Curve;
+use crate::instrument::effects::{self, InstrumentEffect};
+
+/// What the processor knows of the focal-plane effects (the instrument file's `correction` and
+/// `interpolate_dead`): the calibration's input, kept apart from the detector, which is the
+/// same whatever the processor believes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FocalKnowledge {
+    /// The calibration's factor on the true response curve (0: it does not linearise).
+    pub curve_factor: f64,
+    /// It fills dead elements from their neighbours (else it flags them).
+    pub fill_dead: bool,
+}
+
+impl FocalKnowledge {
+    /// What an instrument's `effects` say the processor knows.
+    #[must_use]
+    pub fn of(list: &[InstrumentEffect]) -> Self {
+        Self {
+            curve_factor: effects::non_linearity(list).map_or(0.0, |n| n.correction.factor()),
+            fill_dead: effects::fixed_patterns(list).is_none_or(|p| p.interpolate_dead),
+        }
+    }
+}
 
 /// An element whose gain is below this share of its band's median gain is dead.
 const DEAD_GAIN_SHARE: f64 = 0.1;
@@ -22,19 +45,17 @@ pub struct Linearisation {
 }
 
 impl Linearisation {
-    /// The curves `detector`'s calibration believes for detectors `0..nd` (the true ones when
-    /// `exact`: the perfect calibration); `None` when it linearises nothing.
+    /// The curves the calibration believes for `detector`'s detectors `0..nd`: the true ones
+    /// times `factor` (the true ones when `exact`: the perfect calibration); `None` when it
+    /// linearises nothing.
     #[must_use]
-    pub fn of(detector: &Detector, nd: usize, exact: bool) -> Option<Self> {
+    pub fn of(detector: &Detector, nd: usize, factor: f64, exact: bool) -> Option<Self> {
         let nb = detector.n_bands();
         let curves: Vec<Option<Curve>> = (0..nd * nb)
             .map(|i| {
                 let (j, b) = (i / nb, i % nb);
-                if exact {
-                    Some(detector.curve(j, b)).filter(|c| !c.is_linear())
-                } else {
-                    detector.believed_curve(j, b)
-                }
+                let factor = if exact { 1.0 } else { factor };
+                Some(detector.curve(j, b)).filter(|c| !c.is_linear() && factor != 0.0).map(|c| c.scaled(factor))
             })
             .collect();
         curves.iter().any(Option::is_some).then(|| Self {

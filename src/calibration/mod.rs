@@ -32,7 +32,7 @@ use crate::parse::FieldError;
 
 mod focal;
 
-pub use focal::{Defects, Linearisation};
+pub use focal::{Defects, FocalKnowledge, Linearisation};
 
 /// Errors from the calibration stage; each names the field and what is allowed.
 #[derive(Debug, thiserror::Error, Clone, PartialEq)]
@@ -157,10 +157,12 @@ pub fn band_e0(response: &Response, detectors: usize, e0: &[Vec<f64>]) -> Vec<f6
 impl Calibration {
     /// Simulate the calibration frames of `detector` and derive the coefficients of the
     /// detectors in `used` (a preview calibrates only the detectors it reads; the others keep
-    /// zero gain). `e0_band` from [`band_e0`].
+    /// zero gain), with what the processor `knowledge` of the focal-plane effects (the
+    /// response curve it linearises with, whether it fills dead elements). `e0_band` from
+    /// [`band_e0`].
     pub fn derive(
         spec: &CalibrationSpec,
-        detector: &Detector,
+        (detector, knowledge): (&Detector, FocalKnowledge),
         e0_band: &[f64],
         used: &[usize],
         seed: u64,
@@ -187,7 +189,7 @@ impl Calibration {
         let assumed = 1.0 + spec.diffuser_bias_pct / 100.0;
         let drift = 1.0 + spec.gain_drift_pct / 100.0;
         let t = detector.exposure_s();
-        let linearise = Linearisation::of(detector, nd, spec.perfect);
+        let linearise = Linearisation::of(detector, nd, knowledge.curve_factor, spec.perfect);
         let lin = |j: usize, b: usize, v: f64| linearise.as_ref().map_or(v, |l| l.value(j, b, v));
         let per_detector: Vec<(usize, Vec<f64>, Vec<f64>, usize)> = used
             .par_iter()
@@ -226,7 +228,7 @@ impl Calibration {
             offset_dn[j * nb..(j + 1) * nb].copy_from_slice(offset);
             gain_dn_per_radiance[j * nb..(j + 1) * nb].copy_from_slice(gain);
         }
-        let defects = Defects::find(&gain_dn_per_radiance, nb, used, detector.interpolates_dead());
+        let defects = Defects::find(&gain_dn_per_radiance, nb, used, knowledge.fill_dead);
         Ok(Self {
             n_bands: nb,
             offset_dn,

@@ -33,8 +33,8 @@ pub fn run(args: &MtfArgs) -> Result<(), CliError> {
 /// The Markdown table of `specs`.
 pub(crate) fn table(specs: &[InstrumentSpec], worst: bool) -> Result<String, CliError> {
     let mut out = String::from(
-        "| instrument | budget | plane | band | centre nm | GSD m | MTF along | MTF across | diffraction | wavefront | pixel | diffusion | crosstalk | jitter | smear |\n\
-         |---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| instrument | budget | plane | band | centre nm | GSD m | MTF along | MTF across | diffraction | wavefront | pixel | diffusion | crosstalk | jitter | smear | TDI line rate | TDI transfer |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for spec in specs {
         let rows = nyquist_table(spec).map_err(|e| CliError::Input(format!("{}: {e}", spec.name)))?;

@@ -12,7 +12,7 @@ use super::report::{RunReport, SkippedEffect};
 use super::run::Engine;
 use super::{EngineError, RunConfig};
 use crate::atmosphere::{AtmosphereLut, AtmosphereSpec, LutAxes};
-use crate::calibration::{Calibration, band_e0, calibrate};
+use crate::calibration::{Calibration, FocalKnowledge, band_e0, calibrate};
 use crate::control::Cancellable;
 use crate::control::RunControl;
 use crate::instrument::aerosol_map;
@@ -362,7 +362,9 @@ impl Engine {
         let calibration = self.stage(calibration_key, report, control, || {
             let e0: Vec<Vec<f64>> = optics.iter().map(|o| o.e0().to_vec()).collect();
             let e0_band = band_e0(response, instrument.detectors, &e0);
-            Calibration::derive(&config.calibration, &detector, &e0_band, &viewing.detector_index, config.seed)
+            let knowledge = FocalKnowledge::of(&instrument.effects);
+            let used = &viewing.detector_index;
+            Calibration::derive(&config.calibration, (&detector, knowledge), &e0_band, used, config.seed)
                 .map_err(failed(Stage::Calibration))
         })?;
         report.diffuser_incidence_deg = calibration.sun_incidence_deg;

@@ -46,12 +46,15 @@ const MAX_HALF_CELLS: usize = 48;
 /// The MTF geometry of `spec`'s first focal plane (the image's grid), at nadir.
 #[must_use]
 pub fn first_plane_geometry(spec: &InstrumentSpec) -> MtfGeometry {
+    let tdi = crate::instrument::effects::tdi(&spec.effects).copied().unwrap_or_default();
     MtfGeometry {
         aperture_m: spec.aperture_mm * 1e-3,
         altitude_m: spec.altitude_km * 1e3,
         focal_length_m: spec.focal_length_mm * 1e-3,
         pitch_ground_m: spec.gsd_m(),
         smear_m: ground_speed_m_s(spec.altitude_km) * spec.exposure_s,
+        tdi_slip_m: tdi.slip_m(spec.gsd_m()),
+        tdi_transfer_loss: tdi.transfer_loss(),
     }
 }
 
@@ -144,7 +147,7 @@ pub struct NyquistRow {
     /// System MTF at the plane's Nyquist frequency across track.
     pub across: f64,
     /// Each part's transfer function at Nyquist along track.
-    pub parts_along: [Part; 7],
+    pub parts_along: [Part; 9],
 }
 
 /// The MTF at Nyquist of every band of `spec` on its own focal plane (its pitch and its
@@ -164,8 +167,10 @@ pub fn nyquist_table(spec: &InstrumentSpec) -> Result<Vec<NyquistRow>, Instrumen
             let (plane, g) = match p.checked_sub(1).map(|i| &spec.focal_planes[i]) {
                 None => ("main".to_string(), first),
                 Some(fp) => {
+                    let ratio = fp.pixel_pitch_um / spec.pixel_pitch_um;
                     let g = MtfGeometry {
-                        pitch_ground_m: first.pitch_ground_m * fp.pixel_pitch_um / spec.pixel_pitch_um,
+                        pitch_ground_m: first.pitch_ground_m * ratio,
+                        tdi_slip_m: first.tdi_slip_m * ratio,
                         smear_m: speed * fp.exposure_on(spec.pixel_pitch_um, spec.exposure_s),
                         ..first
                     };

@@ -206,6 +206,7 @@ impl InstrumentSpec {
         }
         self.validate_planes()?;
         super::effects::validate(&self.effects)?;
+        self.validate_tdi()?;
         // The kind's own fields (a spectrograph's span and sampling, a filter imager's rows).
         self.kind.model().validate()?;
         Ok(())
@@ -213,6 +214,25 @@ impl InstrumentSpec {
 
     /// Check the focal planes beyond the first: each number in its range, a pitch that tiles the
     /// first plane's grid, enough detectors for its swath.
+    /// TDI integrates along track: not on a spectrograph (whose along-track axis is its
+    /// spectrum), and within a filter imager's rows per band.
+    fn validate_tdi(&self) -> Result<(), InstrumentError> {
+        let Some(tdi) = super::effects::tdi(&self.effects) else { return Ok(()) };
+        let refuse = |message: String| {
+            Err(InstrumentError::Invalid(FieldError { field: "instrument.effects[].Tdi.stages".into(), message }))
+        };
+        match &self.kind {
+            InstrumentKind::Spectrograph { .. } if tdi.stages > 1 => refuse(format!(
+                "{} stages on a spectrograph, whose along-track axis is its spectrum (allowed: 1)",
+                tdi.stages
+            )),
+            InstrumentKind::FilterImager { rows_per_band, .. } if tdi.stages as usize > *rows_per_band => refuse(
+                format!("{} stages on {rows_per_band} rows per band (allowed: 1 to {rows_per_band})", tdi.stages),
+            ),
+            _ => Ok(()),
+        }
+    }
+
     fn validate_planes(&self) -> Result<(), InstrumentError> {
         use crate::ranges as r;
         for (i, p) in self.focal_planes.iter().enumerate() {

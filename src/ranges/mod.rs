@@ -307,6 +307,12 @@ ranges! {
     MISREGISTRATION_SIGMA_PX = Range::closed("instrument.effects[].Misregistration.sigma_px", 0.0, 5.0, "pixels", "rms of each band's shift along and across track");
     /// Misregistration: the processor's error.
     MISREGISTRATION_KNOWLEDGE_ERROR = Range::closed("instrument.effects[].Misregistration.correction.error", -1.0, 1.0, "", "relative error of the shifts the co-registration believes");
+    /// TDI: stages.
+    TDI_STAGES = Range::count("instrument.effects[].Tdi.stages", 1.0, 256.0, "", "rows integrated per band");
+    /// TDI: line-rate error.
+    TDI_LINE_RATE_ERROR = Range::closed("instrument.effects[].Tdi.line_rate_error", -0.1, 0.1, "", "relative error of the line rate against the image's motion");
+    /// TDI: charge transfer efficiency.
+    TDI_CTE = Range::closed("instrument.effects[].Tdi.cte", 0.99, 1.0, "", "charge transfer efficiency per stage (charge-domain TDI)");
     /// MTF budget: central obstruction.
     MTF_OBSTRUCTION = Range::closed("instrument.effects[].SpatialResponse.obstruction", 0.0, 0.8, "", "secondary's diameter over the aperture's");
     /// MTF budget: wavefront error.

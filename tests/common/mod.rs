@@ -58,7 +58,7 @@ pub fn sweep_path(path: &str) -> String {
     // The dark-current laws: the first plane's doubles ([`with_dark_laws`]), the SWIR plane's is
     // Arrhenius.
     // The instrument's effects: stray light, polarisation, the MTF budget, spectral stray light,
-    // non-linearity, fixed patterns, misregistration, compression ([`with_optical_effects`]).
+    // non-linearity, fixed patterns, misregistration, compression, TDI ([`with_optical_effects`]).
     let path = path
         .replace("[i]", index)
         .replace("focal_planes[]", "focal_planes.0")
@@ -69,7 +69,8 @@ pub fn sweep_path(path: &str) -> String {
         .replace("effects[].NonLinearity", "effects.4.NonLinearity")
         .replace("effects[].FixedPatterns", "effects.5.FixedPatterns")
         .replace("effects[].Misregistration", "effects.6.Misregistration")
-        .replace("effects[].Compression", "effects.7.Compression");
+        .replace("effects[].Compression", "effects.7.Compression")
+        .replace("effects[].Tdi", "effects.8.Tdi");
     // The image-based correction's lists: the pair's long band, the AOT node 0.2, the start of
     // dark-spectrum fitting's band range.
     let path = match path.as_str() {
@@ -107,7 +108,8 @@ pub fn with_dark_laws(instrument: &mut shoal::instrument::InstrumentSpec) {
 /// polarisation sensitivity at 10° (the processor 10 % wrong), an MTF budget, 1 % spectral stray
 /// light (the processor 10 % wrong), a 2 % non-linearity (the calibration 10 % wrong), fixed
 /// patterns (15 % dead and 15 % hot elements, so that a 10 % change of either share changes
-/// which elements of a small image are), a 0.2 px misregistration and a near-lossless coder.
+/// which elements of a small image are), a 0.2 px misregistration, a near-lossless coder and
+/// 4 TDI stages with a 0.5 % line-rate error and a CTE of 0.9999.
 pub fn with_optical_effects(instrument: &mut shoal::instrument::InstrumentSpec) {
     instrument.effects = ron::from_str(
         "[StrayLight((halo_fraction: 0.05, knee_m: 60.0, slope: 2.5, radius_m: 600.0, out_of_field_fraction: 0.01, \
@@ -120,7 +122,8 @@ pub fn with_optical_effects(instrument: &mut shoal::instrument::InstrumentSpec) 
           FixedPatterns((gain_drift: 0.002, offset_drift_e: 5.0, dead_fraction: 0.15, hot_fraction: 0.15, \
           hot_dark_current_e_s: 5000.0)), \
           Misregistration((sigma_px: 0.2, correction: (corrected: true, error: 0.1))), \
-          Compression((max_error_dn: 2))]",
+          Compression((max_error_dn: 2)), \
+          Tdi((stages: 4, line_rate_error: 0.005, cte: 0.9999))]",
     )
     .unwrap();
 }

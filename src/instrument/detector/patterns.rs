@@ -31,8 +31,6 @@ pub(super) struct FocalEffects {
     curves: Vec<Curve>,
     /// Each element's factor on its band's curve (empty: 1).
     column_factor: Vec<f64>,
-    /// The calibration's factor on the true curve (0: it does not linearise).
-    believed: f64,
     /// Each element's gain in the scene over its gain at calibration (empty: 1).
     gain_drift: Vec<f64>,
     /// Each element's dark signal in the scene over its dark signal at calibration, e⁻ (empty: 0).
@@ -41,8 +39,6 @@ pub(super) struct FocalEffects {
     pub(super) dead: Vec<bool>,
     /// Extra dark current per element, e⁻ s⁻¹ (empty: none).
     pub(super) hot_e_s: Vec<f64>,
-    /// The processor fills dead elements from their neighbours.
-    pub(super) interpolate_dead: bool,
 }
 
 /// `n` values of `f` from the generator of (`draw`, detector `j`), in band order.
@@ -82,7 +78,6 @@ impl FocalEffects {
             Some(n) if n.column_spread > 0.0 => every(Draw::ColumnCurve, &|rng| 1.0 + n.column_spread * normal(rng)),
             _ => Vec::new(),
         };
-        let believed = nl.map_or(0.0, |n| n.correction.factor());
         let fp = fp.cloned().unwrap_or_default();
         let gain_drift = if fp.gain_drift > 0.0 {
             every(Draw::GainDrift, &|rng| (1.0 + fp.gain_drift * normal(rng)).max(0.0))
@@ -108,17 +103,7 @@ impl FocalEffects {
         } else {
             Vec::new()
         };
-        Some(Self {
-            n_bands: nb,
-            curves,
-            column_factor,
-            believed,
-            gain_drift,
-            offset_drift_e,
-            dead,
-            hot_e_s,
-            interpolate_dead: fp.interpolate_dead,
-        })
+        Some(Self { n_bands: nb, curves, column_factor, gain_drift, offset_drift_e, dead, hot_e_s })
     }
 
     /// Element (j, b)'s response curve.
@@ -133,11 +118,6 @@ impl FocalEffects {
     /// Does the curve differ between the columns of a band?
     pub(super) fn curve_varies_by_column(&self) -> bool {
         !self.column_factor.is_empty()
-    }
-
-    /// The curve the calibration linearises element (j, b) with (`None`: it does not).
-    pub(super) fn believed_curve(&self, j: usize, b: usize) -> Option<Curve> {
-        (!self.curves.is_empty() && self.believed != 0.0).then(|| self.curve(j, b).scaled(self.believed))
     }
 
     /// Mean electrons of element (j, b) in the scene from `signal_e` photo-electrons and
@@ -164,22 +144,10 @@ impl super::Detector {
         self.focal.as_ref().map_or(Curve::LINEAR, |f| f.curve(j, b))
     }
 
-    /// The curve the calibration linearises element (`j`, `b`) with (`None`: it does not).
-    #[must_use]
-    pub fn believed_curve(&self, j: usize, b: usize) -> Option<Curve> {
-        self.focal.as_ref().and_then(|f| f.believed_curve(j, b))
-    }
-
     /// Is element (`j`, `b`) dead (no response)?
     #[must_use]
     pub fn is_dead(&self, j: usize, b: usize) -> bool {
         self.focal.as_ref().is_some_and(|f| f.is_dead(j, b))
-    }
-
-    /// Does the calibration fill dead elements from their neighbours (else it flags them)?
-    #[must_use]
-    pub fn interpolates_dead(&self) -> bool {
-        self.focal.as_ref().is_none_or(|f| f.interpolate_dead)
     }
 
     /// Does a band's response curve differ between its columns?

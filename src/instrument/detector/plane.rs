@@ -32,6 +32,8 @@ pub struct PlaneElectronics {
     pub bias_dn: f64,
     /// Largest DN, 2^bits − 1.
     pub dn_max: f64,
+    /// Reads averaged into one value (digital TDI's N; 1 otherwise).
+    pub reads: f64,
 }
 
 impl PlaneElectronics {
@@ -56,6 +58,7 @@ impl PlaneElectronics {
             dn_per_e: 1.0 / spec.gain_e_per_dn,
             bias_dn: spec.bias_dn,
             dn_max: spec.dn_max(),
+            reads: 1.0,
         };
         std::iter::once(first)
             .chain(spec.focal_planes.iter().map(|p| {
@@ -76,15 +79,46 @@ impl PlaneElectronics {
                     dn_per_e: 1.0 / p.gain_e_per_dn,
                     bias_dn: p.bias_dn,
                     dn_max: p.dn_max(),
+                    reads: 1.0,
                 }
             }))
+            .map(|plane| match crate::instrument::effects::tdi(&spec.effects) {
+                Some(tdi) => plane.integrated(tdi),
+                None => plane,
+            })
             .collect()
     }
 
-    /// Pixels binned into one grid pixel (m² for a finer plane, 1 otherwise).
+    /// The plane integrating over `tdi`'s N stages ([`crate::instrument::effects::tdi`]):
+    /// charge-domain, N times the signal and dark signal in one read (the integration time N
+    /// times one row's), DSNU·√N and PRNU/√N of N pooled pixels; digital, N reads averaged
+    /// (shot and read noise, PRNU and DSNU all over √N).
+    #[must_use]
+    pub fn integrated(self, tdi: &crate::instrument::effects::Tdi) -> Self {
+        let n = tdi.n();
+        if tdi.digital {
+            Self {
+                prnu: self.prnu / n.sqrt(),
+                dsnu_e: self.dsnu_e / n.sqrt(),
+                read_noise_e: self.read_noise_e / n.sqrt(),
+                reads: self.reads * n,
+                ..self
+            }
+        } else {
+            Self {
+                prnu: self.prnu / n.sqrt(),
+                dsnu_e: self.dsnu_e * n.sqrt(),
+                exposure_ratio: self.exposure_ratio * n,
+                ..self
+            }
+        }
+    }
+
+    /// Values averaged into one grid pixel's (m² pixels of a finer plane, times digital TDI's
+    /// reads; 1 otherwise).
     #[must_use]
     pub fn binned(&self) -> f64 {
-        self.sampling.binned() as f64
+        self.sampling.binned() as f64 * self.reads
     }
 
     /// Grid pixels per plane pixel along a side (k for a coarser plane, 1 otherwise).

@@ -251,3 +251,41 @@ fn frames_read_out_at_once_are_the_frames_read_out_one_by_one() {
         assert_eq!(batched, one_by_one, "mode {mode:?}");
     }
 }
+
+/// TDI over N stages: √N in SNR where shot noise dominates, for charge-domain and digital TDI
+/// alike; where read noise dominates, N (charge: one read) against √N (digital: N reads).
+#[test]
+fn tdi_gains_root_n_when_shot_limited() {
+    use crate::instrument::effects::{InstrumentEffect, Tdi};
+    let mut spec = InstrumentSpec::preset("cubesat").unwrap();
+    spec.dark_current_e_s = 0.0;
+    let snr = |spec: &InstrumentSpec, electrons: f64| {
+        let response = Response::new(spec, 1.0).unwrap();
+        let one = Detector::new(&InstrumentSpec { effects: vec![], ..spec.clone() }, &response, DetectorMode::default(), 1);
+        let d = Detector::new(spec, &response, DetectorMode { noise: true, quantise: false }, 1);
+        crate::instrument::analytic_snr(&d, 0, 3, electrons / one.responsivity(0, 3))
+    };
+    for digital in [false, true] {
+        let n = 9;
+        let mut tdi = spec.clone();
+        tdi.effects = vec![InstrumentEffect::Tdi(Tdi { stages: n, digital, ..Tdi::default() })];
+        // Shot-limited: no read noise, 1000 e⁻ a row.
+        let (mut quiet, mut quiet_tdi) = (spec.clone(), tdi.clone());
+        quiet.read_noise_e = 0.0;
+        quiet_tdi.read_noise_e = 0.0;
+        let gain = snr(&quiet_tdi, 1000.0) / snr(&quiet, 1000.0);
+        assert!((gain - 3.0).abs() < 1e-9, "digital {digital}: {gain}");
+        // Read-limited: 1 e⁻ a row under 100 e⁻ of read noise.
+        let (mut loud, mut loud_tdi) = (spec.clone(), tdi.clone());
+        loud.read_noise_e = 100.0;
+        loud_tdi.read_noise_e = 100.0;
+        let gain = snr(&loud_tdi, 1.0) / snr(&loud, 1.0);
+        let expected = if digital { 3.0 } else { 9.0 };
+        assert!((gain / expected - 1.0).abs() < 0.01, "digital {digital}: {gain} against {expected}");
+    }
+    // A spectrograph's along-track axis is its spectrum.
+    let mut spectrograph = InstrumentSpec::preset("hyperspectral").unwrap();
+    spectrograph.effects = vec![InstrumentEffect::Tdi(Tdi { stages: 4, ..Tdi::default() })];
+    let e = spectrograph.validate().unwrap_err().to_string();
+    assert!(e.contains("Tdi.stages") && e.contains("spectrograph"), "{e}");
+}

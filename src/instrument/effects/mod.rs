@@ -11,6 +11,7 @@
 //! | non-linearity | [`nonlinearity`] | the electrons each element collects (the detector applies it) | the calibration's linearisation with the believed curve |
 //! | fixed patterns (striping, dead and hot elements) | [`fixed_patterns`] | the detector's elements | dead elements filled or flagged by the calibration |
 //! | band-to-band misregistration | [`misregistration`] | each band's whole image | co-registration with the believed shifts |
+//! | time-delay integration | [`tdi`] | the focal planes' electronics (and the MTF budget's along-track losses) | calibrated through the same stages |
 //! | compression | [`compression`] | Level-0's counts (the coder: [`crate::instrument::compression`]) | decoded on the ground (near-lossless: its error stays) |
 //!
 //! Every effect is a type behind [`Effect`], listed in [`InstrumentEffect`] (the one place an
@@ -36,6 +37,7 @@ pub mod polarisation;
 pub mod spectral_stray;
 pub mod stokes_columns;
 pub mod stray_light;
+pub mod tdi;
 
 use ndarray::Array3;
 use serde::{Deserialize, Serialize};
@@ -49,6 +51,7 @@ pub use polarisation::Polarisation;
 pub use spectral_stray::SpectralStrayLight;
 pub use stokes_columns::StokesColumns;
 pub use stray_light::StrayLight;
+pub use tdi::Tdi;
 
 use super::InstrumentError;
 use crate::control::RunControl;
@@ -75,6 +78,8 @@ pub enum InstrumentEffect {
     Compression(Compression),
     /// Band-to-band misregistration: each band's grid shifted from the others.
     Misregistration(Misregistration),
+    /// Time-delay integration on every focal plane.
+    Tdi(Tdi),
 }
 
 impl InstrumentEffect {
@@ -90,6 +95,7 @@ impl InstrumentEffect {
             Self::FixedPatterns(e) => e,
             Self::Compression(e) => e,
             Self::Misregistration(e) => e,
+            Self::Tdi(e) => e,
         }
     }
 
@@ -97,7 +103,14 @@ impl InstrumentEffect {
     /// misregistration, compression), rather than the optics?
     #[must_use]
     pub fn on_the_focal_plane(&self) -> bool {
-        matches!(self, Self::NonLinearity(_) | Self::FixedPatterns(_) | Self::Misregistration(_) | Self::Compression(_))
+        matches!(
+            self,
+            Self::NonLinearity(_)
+                | Self::FixedPatterns(_)
+                | Self::Misregistration(_)
+                | Self::Compression(_)
+                | Self::Tdi(_)
+        )
     }
 
     /// The entry as the optics apply it, the processor's knowledge left out: the key of the
@@ -114,6 +127,7 @@ impl InstrumentEffect {
             Self::FixedPatterns(e) => Self::FixedPatterns(FixedPatterns { interpolate_dead: true, ..e.clone() }),
             Self::Compression(e) => Self::Compression(*e),
             Self::Misregistration(e) => Self::Misregistration(Misregistration { correction, ..e.clone() }),
+            Self::Tdi(e) => Self::Tdi(*e),
         }
     }
 }
@@ -201,11 +215,10 @@ pub fn validate(effects: &[InstrumentEffect]) -> Result<(), InstrumentError> {
 /// detector's key (as applied) and of the calibration's (with what the processor knows).
 #[must_use]
 pub fn on_the_detector(effects: &[InstrumentEffect]) -> Vec<InstrumentEffect> {
-    effects
-        .iter()
-        .filter(|e| matches!(e, InstrumentEffect::NonLinearity(_) | InstrumentEffect::FixedPatterns(_)))
-        .cloned()
-        .collect()
+    let carried = |e: &&InstrumentEffect| {
+        matches!(e, InstrumentEffect::NonLinearity(_) | InstrumentEffect::FixedPatterns(_) | InstrumentEffect::Tdi(_))
+    };
+    effects.iter().filter(carried).cloned().collect()
 }
 
 /// Does any entry need the path's Stokes vector?
@@ -243,6 +256,15 @@ pub fn fixed_patterns(effects: &[InstrumentEffect]) -> Option<&FixedPatterns> {
 pub fn compression(effects: &[InstrumentEffect]) -> Option<&Compression> {
     effects.iter().find_map(|e| match e {
         InstrumentEffect::Compression(c) => Some(c),
+        _ => None,
+    })
+}
+
+/// The time-delay integration the instrument states, if it states one.
+#[must_use]
+pub fn tdi(effects: &[InstrumentEffect]) -> Option<&Tdi> {
+    effects.iter().find_map(|e| match e {
+        InstrumentEffect::Tdi(t) => Some(t),
         _ => None,
     })
 }

@@ -14,6 +14,8 @@
 //! | crosstalk, a share c to each neighbour | 1 − 2c·(1 − cos 2π g ν) | kernel [c, 1 − 2c, c] |
 //! | line-of-sight jitter, σ_j rad RMS | exp(−2π² (σ_j H)² ν²) | Fiete 2010, eq. 4.45 |
 //! | smear over the exposure (along track) | sinc(v t ν) | Fiete 2010, eq. 4.40 |
+//! | TDI line-rate mismatch (along track) | sinc(N·|δ|·g·ν) | [`super::tdi`] |
+//! | TDI charge transfer (along track) | exp(−N·ε·(1 − cos 2πgν)) | Janesick 2001, §5.3 |
 //!
 //! with sinc(x) = sin(πx)/(πx). H is the altitude, f the focal length, v the ground speed, t
 //! the exposure: the geometry is nadir's. Shannon's aberration factor is an empirical fit good to
@@ -103,6 +105,10 @@ pub struct MtfGeometry {
     pub pitch_ground_m: f64,
     /// Ground distance moved during one exposure, m.
     pub smear_m: f64,
+    /// Ground distance the image slips against TDI's charge over its stages, m (0 without TDI).
+    pub tdi_slip_m: f64,
+    /// N·(1 − CTE) of charge-domain TDI (0 without).
+    pub tdi_transfer_loss: f64,
 }
 
 impl MtfGeometry {
@@ -169,17 +175,17 @@ impl MtfBudget {
     /// Each part's transfer function at ground frequency `nu_per_m` along `axis`, for a band at
     /// `wavelength_nm` (the table in the module's documentation).
     #[must_use]
-    pub fn parts(&self, g: &MtfGeometry, wavelength_nm: f64, nu_per_m: f64, axis: Axis) -> [Part; 7] {
+    pub fn parts(&self, g: &MtfGeometry, wavelength_nm: f64, nu_per_m: f64, axis: Axis) -> [Part; 9] {
         let v = nu_per_m / g.cutoff_per_m(wavelength_nm);
         let waves = self.wavefront_rms_nm / wavelength_nm;
         let aberration =
             if v >= 1.0 { 1.0 } else { (1.0 - (waves / 0.18).powi(2) * (1.0 - 4.0 * (v - 0.5).powi(2))).max(0.0) };
         let gauss = |sigma_m: f64| (-2.0 * PI * PI * sigma_m * sigma_m * nu_per_m * nu_per_m).exp();
         let scale = g.altitude_m / g.focal_length_m;
-        let smear = match axis {
-            Axis::Along => sinc(g.smear_m * nu_per_m),
-            Axis::Across => 1.0,
-        };
+        let along = |f: f64| if axis == Axis::Along { f } else { 1.0 };
+        let smear = along(sinc(g.smear_m * nu_per_m));
+        let slip = along(sinc(g.tdi_slip_m * nu_per_m));
+        let transfer = along((-g.tdi_transfer_loss * (1.0 - (2.0 * PI * g.pitch_ground_m * nu_per_m).cos())).exp());
         [
             ("diffraction", annular_otf(v, self.obstruction)),
             ("wavefront error", aberration),
@@ -188,6 +194,8 @@ impl MtfBudget {
             ("crosstalk", 1.0 - 2.0 * self.crosstalk * (1.0 - (2.0 * PI * g.pitch_ground_m * nu_per_m).cos())),
             ("jitter", gauss(self.jitter_urad * 1e-6 * g.altitude_m)),
             ("smear", smear),
+            ("TDI line rate", slip),
+            ("TDI transfer", transfer),
         ]
     }
 
@@ -246,8 +254,11 @@ impl MtfBudget {
             + (self.diffusion_um * 1e-6 * scale).powi(2)
             + (self.jitter_urad * 1e-6 * g.altitude_m).powi(2))
         .sqrt();
-        let smear = if axis == Axis::Along { 0.5 * g.smear_m } else { 0.0 };
-        let crosstalk = if self.crosstalk > 0.0 { g.pitch_ground_m } else { 0.0 };
+        let smear = if axis == Axis::Along { 0.5 * (g.smear_m + g.tdi_slip_m) } else { 0.0 };
+        // Crosstalk and TDI's lost charge reach the neighbours (N·ε of them a pixel further on).
+        let neighbours = if self.crosstalk > 0.0 || g.tdi_transfer_loss > 0.0 { g.pitch_ground_m } else { 0.0 };
+        let trail = if axis == Axis::Along { 4.0 * g.tdi_transfer_loss * g.pitch_ground_m } else { 0.0 };
+        let crosstalk = neighbours + trail;
         0.5 * self.pixel_fill * g.pitch_ground_m + smear + crosstalk + 16.0 * sigma
     }
 }

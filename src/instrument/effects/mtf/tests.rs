@@ -100,3 +100,24 @@ fn fields_out_of_range_are_named() {
     let e = b.validate("instrument.effects[0].SpatialResponse").unwrap_err().to_string();
     assert!(e.contains("instrument.effects[0].SpatialResponse.crosstalk") && e.contains("0.2"), "{e}");
 }
+
+#[test]
+fn tdi_costs_contrast_along_track_only() {
+    // 16 stages, the line rate 1 % off, a CTE of 0.9999: at Nyquist the slip passes
+    // sinc(16·0.01/2) and the transfers exp(−2·16·1e-4) (cos π = −1).
+    let mut spec = crate::instrument::InstrumentSpec::preset("cubesat").unwrap();
+    let tdi = crate::instrument::effects::Tdi { stages: 16, digital: false, line_rate_error: -0.01, cte: 0.9999 };
+    spec.effects = vec![crate::instrument::InstrumentEffect::Tdi(tdi)];
+    let g = crate::instrument::spatial::first_plane_geometry(&spec);
+    let b = MtfBudget::default();
+    let parts = b.parts(&g, 550.0, g.nyquist_per_m(), Axis::Along);
+    let part = |name: &str| parts.iter().find(|p| p.0 == name).unwrap().1;
+    let x = PI * 0.08;
+    assert!((part("TDI line rate") - x.sin() / x).abs() < 1e-12);
+    assert!((part("TDI transfer") - (-2.0 * 16.0 * 1e-4f64).exp()).abs() < 1e-12);
+    let across = b.parts(&g, 550.0, g.nyquist_per_m(), Axis::Across);
+    assert!(across[7].1 == 1.0 && across[8].1 == 1.0, "{across:?}");
+    // Digital TDI moves no charge: no transfer loss.
+    spec.effects = vec![crate::instrument::InstrumentEffect::Tdi(crate::instrument::effects::Tdi { digital: true, ..tdi })];
+    assert_eq!(crate::instrument::spatial::first_plane_geometry(&spec).tdi_transfer_loss, 0.0);
+}
