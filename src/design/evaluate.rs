@@ -125,6 +125,8 @@ pub fn constraint_plan(requirements: &Requirements, made: &[String]) -> (Vec<Str
         (requirements.mtf_nyquist_max.is_some(), crate::study::MTF_MAX_WHAT.to_string()),
         (requirements.polarisation_pct_max.is_some(), crate::study::POLARISATION_WHAT.to_string()),
         (requirements.stray_light.is_some(), requirements.stray_light.as_ref().map_or_else(String::new, |s| s.what())),
+        (requirements.registration_px_max.is_some(), crate::study::REGISTRATION_WHAT.to_string()),
+        (requirements.nonlinearity_pct_max.is_some(), crate::study::NONLINEARITY_WHAT.to_string()),
     ];
     for (stated, k) in design.into_iter().map(|(s, k)| (s, k.to_string())).chain(optics) {
         if stated {

@@ -47,7 +47,9 @@ pub use budget::{Budget, BudgetLine, Stage, budget_table, error_budget};
 pub use curves::{CurvePoint, CurveSeries, Curves, curve_figure, first_crossing};
 pub use figures::figure_set;
 pub use geotiff_out::{NODATA, swath_geotransform, write_run_geotiff};
-pub use optics_checks::{MTF_MAX_WHAT, MTF_MIN_WHAT, POLARISATION_WHAT, StrayLightRequirement};
+pub use optics_checks::{
+    MTF_MAX_WHAT, MTF_MIN_WHAT, NONLINEARITY_WHAT, POLARISATION_WHAT, REGISTRATION_WHAT, StrayLightRequirement,
+};
 pub use outdir::{MARKER, OutputDir};
 pub use output::{CubeFormat, Outputs, metrics_csv, write_bytes, write_run, write_run_as, write_study};
 pub use render::{Figure, base64};

@@ -87,6 +87,12 @@ pub struct Requirements {
     /// Largest stray-light ratio at a distance from a bright edge (3MI's half-bright field).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub stray_light: Option<StrayLightRequirement>,
+    /// Largest rms band-to-band misregistration left in Level-1 after co-registration, pixels.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub registration_px_max: Option<f64>,
+    /// Largest non-linearity at full well left after the calibration's linearisation, %.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub nonlinearity_pct_max: Option<f64>,
 }
 
 /// The corrected Rrs's error per band, in the bands centred from `from_nm` to `to_nm`.
@@ -264,6 +270,7 @@ impl Requirements {
         {
             return bad("requirements.polarisation_pct_max", format!("{v} (allowed: above 0 up to 20 %)"));
         }
+        self.validate_focal_plane()?;
         if let Some(s) = &self.stray_light {
             if !(s.ratio_pct_max.is_finite() && s.ratio_pct_max > 0.0 && s.ratio_pct_max <= 100.0) {
                 return bad(
@@ -305,6 +312,8 @@ impl Requirements {
             || self.mtf_nyquist_max.is_some()
             || self.polarisation_pct_max.is_some()
             || self.stray_light.is_some()
+            || self.registration_px_max.is_some()
+            || self.nonlinearity_pct_max.is_some()
     }
 
     /// Check a design `spec` and its budgets: cost (a refused cost fails, with the reason), the

@@ -187,5 +187,14 @@ fn optical_effects_are_added_per_design_and_shown_in_the_derived_figures() {
     let effects = &h.state().state.designs[0].spec.effects;
     assert!(matches!(effects.get(3), Some(shoal::instrument::InstrumentEffect::SpectralStrayLight(_))), "{effects:?}");
     assert!(h.query_all_by_label("Add stray light").next().is_none(), "one stray light per design");
+    // The focal plane's effects sit in the same editor.
+    for (label, at) in [("Add non-linearity", 4), ("Add TDI", 5), ("Add compression", 6)] {
+        h.get_by_label(label).click_accesskit();
+        h.step();
+        h.step();
+        let effects = &h.state().state.designs[0].spec.effects;
+        assert_eq!(effects.len(), at + 1, "{label}: {effects:?}");
+        assert!(effects[at].on_the_focal_plane(), "{label}: {:?}", effects[at]);
+    }
     let _ = std::fs::remove_dir_all(&lib);
 }

@@ -261,7 +261,8 @@ fn tdi_gains_root_n_when_shot_limited() {
     spec.dark_current_e_s = 0.0;
     let snr = |spec: &InstrumentSpec, electrons: f64| {
         let response = Response::new(spec, 1.0).unwrap();
-        let one = Detector::new(&InstrumentSpec { effects: vec![], ..spec.clone() }, &response, DetectorMode::default(), 1);
+        let one =
+            Detector::new(&InstrumentSpec { effects: vec![], ..spec.clone() }, &response, DetectorMode::default(), 1);
         let d = Detector::new(spec, &response, DetectorMode { noise: true, quantise: false }, 1);
         crate::instrument::analytic_snr(&d, 0, 3, electrons / one.responsivity(0, 3))
     };

@@ -260,6 +260,15 @@ pub fn compression(effects: &[InstrumentEffect]) -> Option<&Compression> {
     })
 }
 
+/// The misregistration the instrument states, if it states one.
+#[must_use]
+pub fn misregistration(effects: &[InstrumentEffect]) -> Option<&Misregistration> {
+    effects.iter().find_map(|e| match e {
+        InstrumentEffect::Misregistration(m) => Some(m),
+        _ => None,
+    })
+}
+
 /// The time-delay integration the instrument states, if it states one.
 #[must_use]
 pub fn tdi(effects: &[InstrumentEffect]) -> Option<&Tdi> {

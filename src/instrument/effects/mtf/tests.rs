@@ -118,6 +118,7 @@ fn tdi_costs_contrast_along_track_only() {
     let across = b.parts(&g, 550.0, g.nyquist_per_m(), Axis::Across);
     assert!(across[7].1 == 1.0 && across[8].1 == 1.0, "{across:?}");
     // Digital TDI moves no charge: no transfer loss.
-    spec.effects = vec![crate::instrument::InstrumentEffect::Tdi(crate::instrument::effects::Tdi { digital: true, ..tdi })];
+    spec.effects =
+        vec![crate::instrument::InstrumentEffect::Tdi(crate::instrument::effects::Tdi { digital: true, ..tdi })];
     assert_eq!(crate::instrument::spatial::first_plane_geometry(&spec).tdi_transfer_loss, 0.0);
 }
