@@ -23,7 +23,7 @@ pub(super) fn derived(app: &ShoalApp, ui: &mut egui::Ui) {
         let n = app.state.designs.len();
         egui::Grid::new("derived").num_columns(n + 1).striped(true).show(ui, |ui| {
             design_header(ui, n);
-            let rows: [DerivedRow; 8] = [
+            let rows: [DerivedRow; 9] = [
                 ("GSD", |s| format!("{:.1} m", s.gsd_m())),
                 ("Swath", |s| format!("{:.1} km", s.swath_m() / 1000.0)),
                 ("f-number", |s| format!("f/{:.2}", s.f_number())),
@@ -46,6 +46,7 @@ pub(super) fn derived(app: &ShoalApp, ui: &mut egui::Ui) {
                     let at = |axis| MtfBudget::at_nyquist(&b, &g, 560.0, axis);
                     format!("{:.2} / {:.2}", at(Axis::Along), at(Axis::Across))
                 }),
+                ("Focal plane", crate::report::focal_plane_summary),
             ];
             // The optics rows only where a design has the effect (an ideal optic has no figure).
             let any = |has: fn(&InstrumentSpec) -> bool| app.state.designs.iter().any(|d| has(&d.spec));
@@ -53,8 +54,9 @@ pub(super) fn derived(app: &ShoalApp, ui: &mut egui::Ui) {
                 any(|s| s.effects.iter().any(|e| matches!(e, crate::instrument::InstrumentEffect::StrayLight(_))));
             let polarised = any(|s| crate::instrument::effects::polarisation_sensitivity(&s.effects).is_some());
             let mtf = any(|s| crate::instrument::effects::spatial_response(&s.effects).is_some());
+            let focal = any(|s| s.effects.iter().any(crate::instrument::InstrumentEffect::on_the_focal_plane));
             for (k, (name, f)) in rows.into_iter().enumerate() {
-                if (k == 5 && !stray) || (k == 6 && !polarised) || (k == 7 && !mtf) {
+                if (k == 5 && !stray) || (k == 6 && !polarised) || (k == 7 && !mtf) || (k == 8 && !focal) {
                     continue;
                 }
                 ui.label(name);

@@ -19,6 +19,7 @@ pub mod svg;
 use serde::{Deserialize, Serialize};
 
 pub use machine::{Machine, commit, now_utc};
+pub use optics_rows::focal_plane_summary;
 pub use pack::{REVIEW_JSON, is_results_dir, load_results, review_json, write_pack};
 
 use crate::engine::RunConfig;

@@ -1,6 +1,6 @@
-//! The review pack's derived figures of the designs' optics, shown when any design states an
-//! optical effect (`instrument::effects`): the same figures as the app's Derived table and the
-//! study's optics requirements.
+//! The review pack's derived figures of the designs' optics and focal planes, shown when any
+//! design states an effect (`instrument::effects`): the same figures as the app's Derived table
+//! and the study's optics and focal-plane requirements.
 
 use super::Derived;
 use crate::engine::RunConfig;
@@ -36,5 +36,36 @@ pub(super) fn optics_rows(configs: &[&RunConfig]) -> Vec<Derived> {
             effects::edge_ratio(&c.instrument.effects, 1000.0, 443.0)
                 .map_or_else(|| "–".into(), |v| format!("{:.3} %", 100.0 * v))
         }),
+        row("focal plane (TDI; non-linearity and registration left; coder)", &|c| focal_plane_summary(&c.instrument)),
     ]
+}
+
+/// One line of what a design's focal plane does: TDI stages, the non-linearity and band-to-band
+/// registration the processor leaves, the coder's bound or rate target ("–" for an ideal one).
+#[must_use]
+pub fn focal_plane_summary(spec: &crate::instrument::InstrumentSpec) -> String {
+    let list = &spec.effects;
+    let mut parts = Vec::new();
+    if let Some(t) = effects::tdi(list) {
+        parts.push(format!("TDI {} ({})", t.stages, if t.digital { "digital" } else { "charge" }));
+    }
+    if effects::non_linearity(list).is_some() {
+        parts.push(format!("{:.2} % at full well", crate::study::nonlinearity_left_pct(spec)));
+    }
+    if effects::misregistration(list).is_some() {
+        parts.push(format!("{:.3} px rms", crate::study::registration_px(spec)));
+    }
+    if let Some(p) = effects::fixed_patterns(list) {
+        parts.push(format!("striping {:.2} %, {:.2} % dead", 100.0 * p.gain_drift, 100.0 * p.dead_fraction));
+    }
+    if let Some(c) = effects::compression(list) {
+        parts.push(if c.bits_per_sample > 0.0 {
+            format!("coder ≤ {:.1} bit/sample", c.bits_per_sample)
+        } else if c.max_error_dn > 0 {
+            format!("coder ±{} DN", c.max_error_dn)
+        } else {
+            "lossless coder".into()
+        });
+    }
+    if parts.is_empty() { "–".into() } else { parts.join("; ") }
 }

@@ -50,6 +50,7 @@ pub use geotiff_out::{NODATA, swath_geotransform, write_run_geotiff};
 pub use optics_checks::{
     MTF_MAX_WHAT, MTF_MIN_WHAT, NONLINEARITY_WHAT, POLARISATION_WHAT, REGISTRATION_WHAT, StrayLightRequirement,
 };
+pub use optics_checks::{nonlinearity_left_pct, registration_px};
 pub use outdir::{MARKER, OutputDir};
 pub use output::{CubeFormat, Outputs, metrics_csv, write_bytes, write_run, write_run_as, write_study};
 pub use render::{Figure, base64};
