@@ -160,6 +160,12 @@ pub fn run(args: &StudyArgs) -> Result<(), CliError> {
             for w in &run.report.warnings {
                 eprintln!("warning: {}: {}", run.label, w.message);
             }
+            if let Some(c) = run.report.compression {
+                eprintln!(
+                    "{}: on-board coder {:.2} bits per sample (ratio {:.2}), error bound {} DN, largest error {} DN",
+                    run.label, c.bits_per_sample, c.ratio, c.max_error_dn, c.largest_error_dn
+                );
+            }
         }
     }
     eprintln!("wrote {} files to {}", outputs.files.len(), args.out.display());
