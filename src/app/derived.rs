@@ -23,7 +23,7 @@ pub(super) fn derived(app: &ShoalApp, ui: &mut egui::Ui) {
         let n = app.state.designs.len();
         egui::Grid::new("derived").num_columns(n + 1).striped(true).show(ui, |ui| {
             design_header(ui, n);
-            let rows: [DerivedRow; 9] = [
+            let rows: [DerivedRow; 12] = [
                 ("GSD", |s| format!("{:.1} m", s.gsd_m())),
                 ("Swath", |s| format!("{:.1} km", s.swath_m() / 1000.0)),
                 ("f-number", |s| format!("f/{:.2}", s.f_number())),
@@ -46,7 +46,24 @@ pub(super) fn derived(app: &ShoalApp, ui: &mut egui::Ui) {
                     let at = |axis| MtfBudget::at_nyquist(&b, &g, 560.0, axis);
                     format!("{:.2} / {:.2}", at(Axis::Along), at(Axis::Across))
                 }),
-                ("Focal plane", crate::report::focal_plane_summary),
+                ("TDI stages", |s| {
+                    crate::instrument::effects::tdi(&s.effects).map_or_else(
+                        || "–".to_string(),
+                        |t| format!("{} {}", t.stages, if t.digital { "digital" } else { "charge" }),
+                    )
+                }),
+                ("Non-linearity left", |s| format!("{:.2} %", crate::study::nonlinearity_left_pct(s))),
+                ("Registration left", |s| format!("{:.3} px", crate::study::registration_px(s))),
+                ("On-board coder", |s| {
+                    crate::instrument::effects::compression(&s.effects).map_or_else(
+                        || "–".to_string(),
+                        |c| match (c.bits_per_sample > 0.0, c.max_error_dn) {
+                            (true, _) => format!("≤ {:.1} bit", c.bits_per_sample),
+                            (false, 0) => "lossless".to_string(),
+                            (false, m) => format!("±{m} DN"),
+                        },
+                    )
+                }),
             ];
             // The optics rows only where a design has the effect (an ideal optic has no figure).
             let any = |has: fn(&InstrumentSpec) -> bool| app.state.designs.iter().any(|d| has(&d.spec));
@@ -54,9 +71,19 @@ pub(super) fn derived(app: &ShoalApp, ui: &mut egui::Ui) {
                 any(|s| s.effects.iter().any(|e| matches!(e, crate::instrument::InstrumentEffect::StrayLight(_))));
             let polarised = any(|s| crate::instrument::effects::polarisation_sensitivity(&s.effects).is_some());
             let mtf = any(|s| crate::instrument::effects::spatial_response(&s.effects).is_some());
-            let focal = any(|s| s.effects.iter().any(crate::instrument::InstrumentEffect::on_the_focal_plane));
+            use crate::instrument::effects as fx;
+            let shown = [
+                stray,
+                polarised,
+                mtf,
+                any(|s| fx::tdi(&s.effects).is_some()),
+                any(|s| fx::non_linearity(&s.effects).is_some()),
+                any(|s| fx::misregistration(&s.effects).is_some()),
+                any(|s| fx::compression(&s.effects).is_some()),
+            ];
             for (k, (name, f)) in rows.into_iter().enumerate() {
-                if (k == 5 && !stray) || (k == 6 && !polarised) || (k == 7 && !mtf) || (k == 8 && !focal) {
+                // The first five rows always; each effect's only where a design states it.
+                if k >= 5 && !shown[k - 5] {
                     continue;
                 }
                 ui.label(name);

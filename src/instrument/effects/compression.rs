@@ -1,11 +1,9 @@
 //! On-board compression of Level-0 as an instrument file states it; the coder itself is
 //! [`crate::instrument::compression`] (it acts on the counts, after the detector).
 
-use ndarray::Array3;
 use serde::{Deserialize, Serialize};
 
-use super::{Context, Effect, InstrumentError, check};
-use crate::control::RunControl;
+use super::{Effect, InstrumentError, check};
 use crate::ranges as r;
 
 /// Compression as an instrument file states it: near-lossless with an error bound, optionally
@@ -38,15 +36,5 @@ impl Effect for Compression {
 
     fn on_the_cube(&self) -> bool {
         false
-    }
-
-    /// Nothing to do on the radiance: the coder acts on Level-0.
-    fn apply(&self, _cube: &mut Array3<f32>, _ctx: &Context, _control: &RunControl) -> Result<(), InstrumentError> {
-        Ok(())
-    }
-
-    /// Nothing to undo on Level-1: the ground decodes what the coder kept.
-    fn correct(&self, _cube: &mut Array3<f32>, _ctx: &Context, _control: &RunControl) -> Result<(), InstrumentError> {
-        Ok(())
     }
 }

@@ -27,11 +27,9 @@
 //! - Gascon, F. et al. (2017) Copernicus Sentinel-2A calibration and products validation
 //!   status. Remote Sens. 9, 584.
 
-use ndarray::Array3;
 use serde::{Deserialize, Serialize};
 
-use super::{Context, Effect, InstrumentError, check};
-use crate::control::RunControl;
+use super::{Effect, InstrumentError, check};
 use crate::ranges as r;
 
 /// Fixed patterns as an instrument file states them.
@@ -80,15 +78,5 @@ impl Effect for FixedPatterns {
 
     fn on_the_cube(&self) -> bool {
         false
-    }
-
-    /// Nothing to do on the radiance: the detector carries the patterns.
-    fn apply(&self, _cube: &mut Array3<f32>, _ctx: &Context, _control: &RunControl) -> Result<(), InstrumentError> {
-        Ok(())
-    }
-
-    /// Nothing to do on Level-1: the calibration finds and fills the dead elements.
-    fn correct(&self, _cube: &mut Array3<f32>, _ctx: &Context, _control: &RunControl) -> Result<(), InstrumentError> {
-        Ok(())
     }
 }

@@ -196,10 +196,16 @@ pub trait Effect: Sync {
     fn on_the_cube(&self) -> bool {
         true
     }
-    /// Turn the radiance reaching the pupil into what reaches the detector, in place.
-    fn apply(&self, cube: &mut Array3<f32>, ctx: &Context, control: &RunControl) -> Result<(), InstrumentError>;
-    /// The Level-1 processor's correction, in place, with its [`Knowledge`].
-    fn correct(&self, cube: &mut Array3<f32>, ctx: &Context, control: &RunControl) -> Result<(), InstrumentError>;
+    /// Turn the radiance reaching the pupil into what reaches the detector, in place (nothing
+    /// for an effect that acts elsewhere: [`Self::on_the_cube`] false).
+    fn apply(&self, _cube: &mut Array3<f32>, _ctx: &Context, _control: &RunControl) -> Result<(), InstrumentError> {
+        Ok(())
+    }
+    /// The Level-1 processor's correction, in place, with its [`Knowledge`] (nothing for an
+    /// effect the calibration or the ground handles, or that no processor corrects).
+    fn correct(&self, _cube: &mut Array3<f32>, _ctx: &Context, _control: &RunControl) -> Result<(), InstrumentError> {
+        Ok(())
+    }
 }
 
 /// Check every entry of an instrument's list.

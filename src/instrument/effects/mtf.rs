@@ -275,26 +275,6 @@ impl super::Effect for MtfBudget {
     fn on_the_cube(&self) -> bool {
         false
     }
-
-    /// Nothing to do on the cube: the radiance stage samples the scene with this PSF.
-    fn apply(
-        &self,
-        _cube: &mut ndarray::Array3<f32>,
-        _ctx: &super::Context,
-        _control: &crate::control::RunControl,
-    ) -> Result<(), InstrumentError> {
-        Ok(())
-    }
-
-    /// Not corrected: a Level-1 processor resamples but does not restore the MTF.
-    fn correct(
-        &self,
-        _cube: &mut ndarray::Array3<f32>,
-        _ctx: &super::Context,
-        _control: &crate::control::RunControl,
-    ) -> Result<(), InstrumentError> {
-        Ok(())
-    }
 }
 
 #[cfg(test)]

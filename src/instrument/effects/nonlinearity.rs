@@ -21,11 +21,9 @@
 //! - Gascon, F. et al. (2017) Copernicus Sentinel-2A calibration and products validation
 //!   status. Remote Sens. 9, 584.
 
-use ndarray::Array3;
 use serde::{Deserialize, Serialize};
 
-use super::{Context, Effect, InstrumentError, Knowledge, check};
-use crate::control::RunControl;
+use super::{Effect, InstrumentError, Knowledge, check};
 use crate::parse::FieldError;
 use crate::ranges as r;
 
@@ -168,16 +166,6 @@ impl Effect for NonLinearity {
 
     fn on_the_cube(&self) -> bool {
         false
-    }
-
-    /// Nothing to do on the radiance: the detector applies the curve to its electrons.
-    fn apply(&self, _cube: &mut Array3<f32>, _ctx: &Context, _control: &RunControl) -> Result<(), InstrumentError> {
-        Ok(())
-    }
-
-    /// Nothing to do on Level-1: the calibration linearises the counts.
-    fn correct(&self, _cube: &mut Array3<f32>, _ctx: &Context, _control: &RunControl) -> Result<(), InstrumentError> {
-        Ok(())
     }
 }
 

@@ -31,11 +31,9 @@
 //! - Janesick, J. R. (2001) Scientific Charge-Coupled Devices. SPIE Press, §5.3 (CTE and MTF).
 //! - Fiete, R. D. (2010) Modeling the Imaging Chain of Digital Cameras. SPIE TT92.
 
-use ndarray::Array3;
 use serde::{Deserialize, Serialize};
 
-use super::{Context, Effect, InstrumentError, check};
-use crate::control::RunControl;
+use super::{Effect, InstrumentError, check};
 use crate::ranges as r;
 
 /// Time-delay integration as an instrument file states it (every focal plane of the design).
@@ -92,16 +90,5 @@ impl Effect for Tdi {
 
     fn on_the_cube(&self) -> bool {
         false
-    }
-
-    /// Nothing to do on the radiance: the focal plane integrates N times (and the MTF budget
-    /// carries its losses).
-    fn apply(&self, _cube: &mut Array3<f32>, _ctx: &Context, _control: &RunControl) -> Result<(), InstrumentError> {
-        Ok(())
-    }
-
-    /// Nothing to undo: Level-1 is calibrated through the same stages.
-    fn correct(&self, _cube: &mut Array3<f32>, _ctx: &Context, _control: &RunControl) -> Result<(), InstrumentError> {
-        Ok(())
     }
 }
