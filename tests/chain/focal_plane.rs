@@ -77,7 +77,7 @@ fn a_straight_line_changes_nothing_and_a_known_curve_closes() {
 fn a_curve_that_falls_is_refused_by_name() {
     let mut c = config(&non_linearity(-0.2, -0.2, true, 0.0));
     let e = c.validate().unwrap_err().to_string();
-    assert!(e.contains("NonLinearity.quadratic") && e.contains("0.5"), "{e}");
+    assert!(e.contains("NonLinearity.cubic") && e.contains("0.5"), "{e}");
     c.instrument.effects = ron::from_str("[NonLinearity((quadratic: 0.3))]").unwrap();
     let e = c.validate().unwrap_err().to_string();
     assert!(e.contains("quadratic") && e.contains("0.2"), "{e}");

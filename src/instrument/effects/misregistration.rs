@@ -3,8 +3,10 @@
 //! different times, a keystone, the platform's motion between band exposures).
 //!
 //! Band b's image is the scene's moved by (Δr_b, Δc_b) pixels along and across track,
-//! L′_b(r, c) = L_b(r − Δr_b, c − Δc_b), resampled bilinearly (Schowengerdt 2007, §7.5; edges
-//! held). The shifts are either stated per band or drawn, each component normal with the stated
+//! L′_b(r, c) = L_b(r − Δr_b, c − Δc_b), resampled by cubic convolution (Keys 1981, a = −½; the
+//! resampler of Level-1 processors, Schowengerdt 2007, §7.5; edges held). Unlike bilinear
+//! resampling, which averages neighbours and so lowers the noise by a fifth at a 0.1 px shift,
+//! it keeps the noise within 4 % there. The shifts are either stated per band or drawn, each component normal with the stated
 //! rms `sigma_px` (the convention of the Φsat-2 simulator's band-to-band shifts), from a
 //! generator of the design's own (`draw`): the same design misregisters the same way in every
 //! run and preview. Shifts are in pixels of the instrument's grid; a decimated preview moves by
@@ -12,9 +14,11 @@
 //!
 //! The Level-1 processor co-registers each band with the shift it believes, (1 + error)·Δ,
 //! resampling it back: known exactly, the bands line up again, left with the smoothing of two
-//! bilinear resamplings; known to 10 %, a tenth of each shift remains.
+//! resamplings; known to 10 %, a tenth of each shift remains.
 //!
 //! ## References
+//! - Keys, R. G. (1981) Cubic convolution interpolation for digital image processing. IEEE
+//!   Trans. Acoust. Speech Signal Process. 29, 1153–1160.
 //! - Schowengerdt, R. A. (2007) Remote Sensing: Models and Methods for Image Processing, 3rd
 //!   ed., Academic Press, §7.5 (resampling).
 
@@ -80,25 +84,69 @@ impl Misregistration {
         let data = cube.as_slice_mut().ok_or_else(|| {
             InstrumentError::Invalid(FieldError { field: "cube".into(), message: "not contiguous".into() })
         })?;
+        // Each band's shift is the same over the image: its taps and weights along each axis
+        // once per band (`Taps`), then 4 × 4 taps per value, edges held.
+        let taps: Vec<(Taps, Taps)> = shifts
+            .iter()
+            .map(|&(along, across)| (Taps::of(factor * along * scale.0), Taps::of(factor * across * scale.1)))
+            .collect();
         data.par_chunks_mut(cols * nb).enumerate().for_each(|(r, row)| {
-            for (b, &(along, across)) in shifts.iter().enumerate() {
-                let (dr, dc) = (factor * along * scale.0, factor * across * scale.1);
-                // Where this pixel's value comes from, and its bilinear weights (edges held).
-                let y = (r as f64 - dr).clamp(0.0, (rows - 1) as f64);
-                let (r0, fy) = (y.floor() as usize, y - y.floor());
-                let r1 = (r0 + 1).min(rows - 1);
+            for (b, (down, across)) in taps.iter().enumerate() {
+                let rows_at = down.indices(r, rows);
                 for c in 0..cols {
-                    let x = (c as f64 - dc).clamp(0.0, (cols - 1) as f64);
-                    let (c0, fx) = (x.floor() as usize, x - x.floor());
-                    let c1 = (c0 + 1).min(cols - 1);
-                    let at = |r: usize, c: usize| f64::from(source[(r, c, b)]);
-                    let top = at(r0, c0) * (1.0 - fx) + at(r0, c1) * fx;
-                    let bottom = at(r1, c0) * (1.0 - fx) + at(r1, c1) * fx;
-                    row[c * nb + b] = (top * (1.0 - fy) + bottom * fy) as f32;
+                    let cols_at = across.indices(c, cols);
+                    let mut value = 0.0;
+                    for (&ri, &wy) in rows_at.iter().zip(&down.weights) {
+                        let line: f64 = cols_at
+                            .iter()
+                            .zip(&across.weights)
+                            .map(|(&ci, &wx)| wx * f64::from(source[(ri, ci, b)]))
+                            .sum();
+                        value += wy * line;
+                    }
+                    row[c * nb + b] = value as f32;
                 }
             }
         });
         Ok(())
+    }
+}
+
+/// Cubic convolution's four taps for a shift of `d` pixels along one axis: output pixel i reads
+/// i − d, i.e. input pixels ⌊i − d⌋ − 1 … ⌊i − d⌋ + 2 with Keys's (1981) weights, a = −½.
+#[derive(Debug, Clone, Copy)]
+struct Taps {
+    /// ⌊−d⌋: the first tap's offset from the output pixel, plus 1.
+    offset: i64,
+    weights: [f64; 4],
+}
+
+impl Taps {
+    fn of(d: f64) -> Self {
+        let x = -d;
+        let offset = x.floor();
+        let t = x - offset;
+        Self { offset: offset as i64, weights: [keys(t + 1.0), keys(t), keys(1.0 - t), keys(2.0 - t)] }
+    }
+
+    /// The four input indices output `i` of `n` reads (held at the edges).
+    fn indices(&self, i: usize, n: usize) -> [usize; 4] {
+        let last = n as i64 - 1;
+        std::array::from_fn(|k| (i as i64 + self.offset + k as i64 - 1).clamp(0, last) as usize)
+    }
+}
+
+/// Keys's (1981) cubic convolution kernel with a = −½: it reproduces quadratics exactly, and its
+/// four weights sum to 1 at any phase.
+fn keys(s: f64) -> f64 {
+    const A: f64 = -0.5;
+    let s = s.abs();
+    if s <= 1.0 {
+        ((A + 2.0) * s - (A + 3.0)) * s * s + 1.0
+    } else if s < 2.0 {
+        ((A * s - 5.0 * A) * s + 8.0 * A) * s - 4.0 * A
+    } else {
+        0.0
     }
 }
 
@@ -170,6 +218,22 @@ mod tests {
         let mut left = moved.clone();
         wrong.correct(&mut left, &ctx(&centres), &RunControl::new()).unwrap();
         assert!((edge(&left, 1) - edge(&cube, 1) + 0.03).abs() < 1e-5, "{}", edge(&left, 1));
+    }
+
+    #[test]
+    fn cubic_weights_sum_to_one_and_keep_the_noise() {
+        for d in [0.0, 0.1, 0.3, 0.5, -0.7, 2.25] {
+            let t = Taps::of(d);
+            assert!((t.weights.iter().sum::<f64>() - 1.0).abs() < 1e-12, "{d}: {t:?}");
+            // The first moment moves a ramp by exactly the shift.
+            let moment: f64 = t.weights.iter().enumerate().map(|(k, w)| w * (t.offset + k as i64 - 1) as f64).sum();
+            assert!((moment + d).abs() < 1e-12, "{d}: {moment}");
+        }
+        // White noise's variance through one axis at 0.1 px: Σw² = 0.960 (bilinear: 0.82).
+        let w = Taps::of(0.1).weights;
+        let kept: f64 = w.iter().map(|w| w * w).sum();
+        assert!((kept - 0.960).abs() < 1e-3, "{kept}");
+        assert_eq!(Taps::of(0.0).weights, [0.0, 1.0, 0.0, 0.0]);
     }
 
     #[test]

@@ -151,8 +151,10 @@ impl Effect for NonLinearity {
             check(&r::NONLINEARITY_QUADRATIC, q, &format!("{field}.quadratic"))?;
             check(&r::NONLINEARITY_CUBIC, c, &format!("{field}.cubic"))?;
             if !rises(q, c) {
+                // Named by the term that pulls the slope down more at the well's end (x = 1.2).
+                let term = if 3.0 * c * 1.2 < 2.0 * q { "cubic" } else { "quadratic" };
                 return Err(InstrumentError::Invalid(FieldError {
-                    field: format!("{field}.quadratic"),
+                    field: format!("{field}.{term}"),
                     message: format!(
                         "a₂ = {q}, a₃ = {c} make the response fall within the well (allowed: \
                          1 + 2a₂x + 3a₃x² above 0.5 for x = e/W up to 1.2)"
@@ -195,7 +197,7 @@ mod tests {
             correction: Knowledge::default(),
         };
         let e = n.validate("instrument.effects[0].NonLinearity").unwrap_err().to_string();
-        assert!(e.contains("quadratic") && e.contains("0.5"), "{e}");
+        assert!(e.contains("NonLinearity.cubic") && e.contains("0.5"), "{e}");
         let ok = NonLinearity { quadratic: -0.02, cubic: 0.005, ..n };
         assert!(ok.validate("instrument.effects[0].NonLinearity").is_ok());
         let two = NonLinearity { per_band: vec![(0.0, 0.0); 2], ..ok };
