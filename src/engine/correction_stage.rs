@@ -6,10 +6,11 @@ use std::sync::Arc;
 
 use super::cache::{Key, KeyBuilder, Stage};
 use super::keys::Inputs;
+use super::lut_axes::lut_axes;
 use super::products::{Corrected, CorrectionProduct, InstrumentSide, SceneSide};
 use super::report::RunReport;
 use super::run::Engine;
-use super::stages::{failed, lut_axes};
+use super::stages::failed;
 use super::{EngineError, RunConfig};
 use crate::control::RunControl;
 use crate::correction::{AerosolFamily, FamilyLuts, SceneApproximation, compare, correct_exact, correct_image};

@@ -47,6 +47,7 @@ mod fault;
 mod files;
 pub mod footprint;
 mod keys;
+mod lut_axes;
 pub mod probe;
 mod products;
 mod report;
@@ -60,11 +61,11 @@ pub mod worker;
 pub use cache::Stage;
 pub use config::{DEFAULT_BAND_NODES, DEFAULT_WATER_SINGLE_PRECISION, Fidelity, RunConfig};
 pub use fault::{Fault, FaultKind};
+pub use lut_axes::lut_axes_covering;
 pub use probe::{Probe, Probed};
 pub use products::{CorrectionProduct, Cubes, RetrievalOutput, RunOutput};
 pub use report::{AerosolSummary, RunReport, StageReport, StageStatus};
 pub use run::{Engine, LEAN_CACHE_BYTES};
-pub use stages::lut_axes_covering;
 
 /// An engine failure: the stage and what went wrong (the message names the field).
 #[derive(Debug, thiserror::Error, Clone, PartialEq)]

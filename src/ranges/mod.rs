@@ -145,11 +145,6 @@ impl Range {
     }
 }
 
-/// A range end as written: plain up to 65 535, powers of ten from 10⁵ as `1e5`.
-fn number(v: f64) -> String {
-    if v.abs() >= 1e5 { format!("{v:e}") } else { format!("{v}") }
-}
-
 macro_rules! ranges {
     ($( $(#[$doc:meta])* $name:ident = $range:expr; )*) => {
         $( $(#[$doc])* pub const $name: Range = $range; )*
@@ -494,15 +489,10 @@ ranges! {
     REQUIREMENT_SNR = Range::above("requirements.snr", 0.0, 1e6, "", "smallest SNR of every band at the typical radiance").below_hi();
 }
 
-/// The table as Markdown (`shoal ranges`; docs/MANUAL.md's "Ranges" section).
-#[must_use]
-pub fn markdown_table() -> String {
-    let mut out = String::from("| field | allowed | what |\n|---|---|---|\n");
-    for r in ALL {
-        out.push_str(&format!("| `{}` | {} | {} |\n", r.path, r.allowed(), r.meaning));
-    }
-    out
-}
+mod table;
+
+pub use table::markdown_table;
+use table::number;
 
 #[cfg(test)]
 mod tests;
