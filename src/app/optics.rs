@@ -1,12 +1,12 @@
 //! The left panel's optics and focal-plane editor: the instrument's effects (stray light,
 //! polarisation sensitivity, the MTF budget, spectral stray light, non-linearity, fixed patterns,
-//! misregistration, compression; `instrument::effects`), each with what the processor knows of it. An edit is kept only if the
+//! misregistration, TDI, compression, spectral knowledge; `instrument::effects`), each with what the processor knows of it. An edit is kept only if the
 //! whole instrument still validates; otherwise the message says why.
 
 use super::model::Slot;
 use crate::instrument::effects::{
     Compression, FixedPatterns, InstrumentEffect, Knowledge, Misregistration, MtfBudget, NonLinearity, Polarisation,
-    SpectralStrayLight, StrayLight, Tdi,
+    SpectralKnowledge, SpectralStrayLight, StrayLight, Tdi,
 };
 
 /// One number shown in `scale` × its stored unit (a focal plane's number otherwise).
@@ -97,7 +97,7 @@ fn fixed_patterns() -> InstrumentEffect {
 type Offer = (&'static str, &'static str, fn() -> InstrumentEffect);
 
 /// Every effect the editor offers, in the order of its buttons.
-const OFFERED: [Offer; 9] = [
+const OFFERED: [Offer; 10] = [
     ("stray light", "A far-field halo and an out-of-field veil", stray_light),
     ("polarisation sensitivity", "The response depends on the light's linear polarisation", polarisation),
     ("MTF budget", "Sample the scene with the PSF of the optics, detector and motion", mtf_budget),
@@ -107,7 +107,21 @@ const OFFERED: [Offer; 9] = [
     ("misregistration", "Each band's grid shifted from the others by a fraction of a pixel", misregistration),
     ("TDI", "Time-delay integration: each ground line integrated over N rows", tdi),
     ("compression", "On-board coding of Level-0: lossless, or near-lossless to a rate", compression),
+    ("spectral knowledge error", "The bands' centres and widths differ from what the processor believes", spectral),
 ];
+
+/// A spectral knowledge error to start from: each band's centre known to 0.5 nm rms (an
+/// assumption; Green (1998) asks a few per cent of the FWHM).
+fn spectral() -> InstrumentEffect {
+    InstrumentEffect::SpectralKnowledge(SpectralKnowledge {
+        centre_nm: 0.0,
+        sigma_nm: 0.5,
+        per_band_nm: Vec::new(),
+        draw: 0,
+        width_pct: 0.0,
+        smile_pct: 0.0,
+    })
+}
 
 /// TDI to start from: 8 charge-domain stages, the line rate right to 0.1 %, a CTE of 0.99999
 /// (assumptions of a good CCD).
@@ -196,6 +210,12 @@ pub(super) fn optics_editor(slot: &mut Slot, ui: &mut egui::Ui, error: &mut Opti
                     ui.end_row();
                     number(ui, "line-rate error", &mut t.line_rate_error, (-0.1, 0.1), 100.0, " %");
                     number(ui, "charge transfer efficiency", &mut t.cte, (0.99, 1.0), 100.0, " %");
+                }
+                InstrumentEffect::SpectralKnowledge(k) => {
+                    number(ui, "centre error, every band", &mut k.centre_nm, (-10.0, 10.0), 1.0, " nm");
+                    number(ui, "  and per band RMS", &mut k.sigma_nm, (0.0, 5.0), 1.0, " nm");
+                    number(ui, "width error", &mut k.width_pct, (-50.0, 100.0), 1.0, " %");
+                    number(ui, "smile error", &mut k.smile_pct, (-100.0, 100.0), 1.0, " %");
                 }
                 InstrumentEffect::Compression(c) => {
                     let mut bound = f64::from(c.max_error_dn);

@@ -159,11 +159,14 @@ impl Calibration {
     /// detectors in `used` (a preview calibrates only the detectors it reads; the others keep
     /// zero gain), with what the processor `knowledge` of the focal-plane effects (the
     /// response curve it linearises with, whether it fills dead elements). `e0_band` from
-    /// [`band_e0`].
+    /// [`band_e0`]: through the bands the detector has, and through those the processor believes
+    /// (the same unless the instrument states a spectral knowledge error). The frames see the
+    /// first; the gain divides by the diffuser radiance of the second, so a band's error leaves
+    /// Level-1 scaled by their ratio.
     pub fn derive(
         spec: &CalibrationSpec,
         (detector, knowledge): (&Detector, FocalKnowledge),
-        e0_band: &[f64],
+        (e0_band, believed_e0_band): (&[f64], &[f64]),
         used: &[usize],
         seed: u64,
     ) -> Result<Self, CalibrationError> {
@@ -172,6 +175,9 @@ impl Calibration {
         let nd = e0_band.len() / nb.max(1);
         // Diffuser radiance at normal incidence, then the incidence that fills 60 % of the range.
         let normal: Vec<f64> = e0_band.iter().map(|e| spec.diffuser_reflectance * e / std::f64::consts::PI).collect();
+        // What the processor believes of each band's diffuser radiance, relative to the truth.
+        let believed: Vec<f64> =
+            e0_band.iter().zip(believed_e0_band).map(|(t, b)| if *t > 0.0 { b / t } else { 1.0 }).collect();
         // Each band's range in electrons (its focal plane's well or ADC top, the smaller), and
         // the incidence at which the band closest to its top fills 60 % of it.
         let range_e = |b: usize| {
@@ -200,7 +206,8 @@ impl Calibration {
                 if spec.perfect {
                     for b in 0..nb {
                         offset[b] = detector.bias_dn(b) + detector.dark_mean_e(j, b, t) / detector.gain_e_per_dn(b);
-                        gain[b] = detector.responsivity(j, b) / detector.gain_e_per_dn(b) / drift;
+                        gain[b] =
+                            detector.responsivity(j, b) / detector.gain_e_per_dn(b) / drift / believed[j * nb + b];
                     }
                     return (j, offset, gain, 0);
                 }
@@ -217,7 +224,7 @@ impl Calibration {
                     // The frames' means linearised (the curve of the mean: see `frames_mean`).
                     let (light, dark) = (lin(j, b, light[b]), lin(j, b, dark[b]));
                     offset[b] = dark;
-                    gain[b] = (light - dark) / (diffuser_radiance[j * nb + b] * assumed) / drift;
+                    gain[b] = (light - dark) / (diffuser_radiance[j * nb + b] * believed[j * nb + b] * assumed) / drift;
                 }
                 (j, offset, gain, saturated)
             })

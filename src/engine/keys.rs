@@ -14,6 +14,7 @@ use serde::Serialize;
 
 use super::RunConfig;
 use super::config::Fidelity;
+use crate::instrument::effects::SpectralKnowledge;
 use crate::instrument::{
     BandSelection, DarkTemperature, DetectorMode, FocalPlane, InstrumentEffect, InstrumentKind, InstrumentSpec,
 };
@@ -32,6 +33,9 @@ pub(super) struct ResponseInputs<'a> {
     pub spectral_step_nm: f64,
     /// Which bands each further focal plane holds, and its QE.
     pub planes: Vec<PlaneResponse<'a>>,
+    /// The bands as the instrument really has them, where they differ from the stated ones
+    /// (the grids cover both).
+    pub spectral_knowledge: Option<&'a SpectralKnowledge>,
 }
 
 /// A further focal plane's part of the spectral response.
@@ -250,6 +254,7 @@ impl<'a> Inputs<'a> {
                 focal_length_mm: *focal_length_mm,
                 spectral_step_nm,
                 planes: plane_response,
+                spectral_knowledge: crate::instrument::effects::spectral_knowledge(effects),
             },
             orbit: Orbit {
                 altitude_km: *altitude_km,

@@ -128,6 +128,30 @@ pub(super) struct SceneSide {
     pub(super) aerosol_map: Option<Arc<AotNodes>>,
     /// The band atmosphere's key (and the AOT nodes', where there are any).
     pub(super) band_key: Key,
+    /// The bands the instrument really has, where they differ from the stated ones.
+    pub(super) sensed: Option<Sensed>,
+}
+
+/// The scene seen through the bands the instrument really has, where the processor's knowledge
+/// of them is wrong (a spectral knowledge error): the radiance is sampled, and the detector
+/// and its calibration frames respond, through these.
+pub(super) struct Sensed {
+    pub(super) response: Arc<Response>,
+    pub(super) band_atmosphere: Arc<BandAtmosphere>,
+    pub(super) aerosol_map: Option<Arc<AotNodes>>,
+    /// The key of its band atmosphere (and AOT nodes): after the stated one's.
+    pub(super) band_key: Key,
+}
+
+impl SceneSide {
+    /// The response, band atmosphere, AOT nodes and key the scene is sampled with: the true
+    /// bands' where they differ, else the stated ones.
+    pub(super) fn sampled(&self) -> (&Arc<Response>, &Arc<BandAtmosphere>, Option<&AotNodes>, Key) {
+        match &self.sensed {
+            Some(s) => (&s.response, &s.band_atmosphere, s.aerosol_map.as_deref(), s.band_key),
+            None => (&self.response, &self.band_atmosphere, self.aerosol_map.as_deref(), self.band_key),
+        }
+    }
 }
 
 /// Products of the instrument side and the keys later stages build on.

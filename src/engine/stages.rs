@@ -8,7 +8,7 @@ use super::cache::{Key, KeyBuilder, Stage};
 use super::files;
 use super::keys::Inputs;
 use super::lut_axes::lut_axes;
-use super::products::{InstrumentSide, SceneSide};
+use super::products::{InstrumentSide, SceneSide, Sensed};
 use super::report::{RunReport, SkippedEffect};
 use super::run::Engine;
 use super::{EngineError, RunConfig};
@@ -82,6 +82,17 @@ impl Engine {
             Response::new(instrument, fid.spectral_step_nm).map_err(failed(Stage::Response))
         })?;
         report.grid_points = response.groups.iter().map(|g| g.grid.len()).collect();
+        // The bands the instrument really has, where the processor's knowledge of them is wrong
+        // (the response key holds the error: the same grids, other weights).
+        let sensed_response = match effects::spectral_knowledge(&instrument.effects) {
+            Some(_) => {
+                let key = KeyBuilder::new(Stage::Response).after(response_key).with("sensed").finish();
+                Some(self.stage(key, report, control, || {
+                    Response::sensed(instrument, fid.spectral_step_nm).map_err(failed(Stage::Response))
+                })?)
+            }
+            None => None,
+        };
 
         // Geometry.
         let sun = config.scene.sun;
@@ -130,7 +141,14 @@ impl Engine {
                     if fid.band_nodes == 0 {
                         Ok(optics)
                     } else {
-                        optics.with_band_nodes(response.band_nodes(gi, fid.band_nodes), fid.water_single_precision)
+                        // Nodes under the believed bands and the true ones.
+                        let mut nodes = response.band_nodes(gi, fid.band_nodes);
+                        if let Some(sensed) = &sensed_response {
+                            nodes.extend(sensed.band_nodes(gi, fid.band_nodes));
+                            nodes.sort_unstable();
+                            nodes.dedup();
+                        }
+                        optics.with_band_nodes(nodes, fid.water_single_precision)
                     }
                 })
                 .collect::<Result<Vec<_>, _>>()
@@ -149,6 +167,24 @@ impl Engine {
             control,
             report,
         )?;
+        // The same through the bands the instrument really has: what the scene is sampled with.
+        let sensed = match sensed_response {
+            Some(response) => {
+                let key = KeyBuilder::new(Stage::BandAtmosphere).after(band_key).with("sensed").finish();
+                let band_atmosphere = self.stage(key, report, control, || {
+                    BandAtmosphere::new(&optics, &viewing, &response).map_err(failed(Stage::BandAtmosphere))
+                })?;
+                let (aerosol_map, band_key) = self.aerosol_map_stage(
+                    (&scene, &response, &viewing),
+                    (&atmosphere_spec, &axes),
+                    key,
+                    control,
+                    report,
+                )?;
+                Some(Sensed { response, band_atmosphere, aerosol_map, band_key })
+            }
+            None => None,
+        };
 
         Ok(SceneSide {
             scene,
@@ -160,6 +196,7 @@ impl Engine {
             band_atmosphere,
             aerosol_map,
             band_key,
+            sensed,
         })
     }
 
@@ -232,8 +269,10 @@ impl Engine {
         let instrument = &config.instrument;
         let fid = &config.fidelity;
         let inputs = Inputs::of(config);
-        let SceneSide { scene, response, viewing, optics, band_atmosphere, aerosol_map, band_key, .. } = side;
-        let band_key = *band_key;
+        let SceneSide { scene, response, viewing, optics, band_atmosphere, .. } = side;
+        // The scene is sampled through the bands the instrument has; the truth through the
+        // stated ones (what the products claim to be).
+        let (sampled_response, sampled_atmosphere, aerosol_map, band_key) = side.sampled();
         // The design's own MTF budget; else, where the scene asks for a spatial response (the
         // legacy switch), an ideal optic's.
         let ideal = MtfBudget::default();
@@ -254,7 +293,8 @@ impl Engine {
         let radiance = self.stage(radiance_key, report, control, || {
             let options = SampleOptions { kernel: kernel.clone(), heading_deg: instrument.heading_deg };
             let aerosol_map = aerosol_map.as_deref();
-            sample_radiance(scene, optics, viewing, response, (band_atmosphere, aerosol_map), &options, control)
+            let atmospheres = (sampled_atmosphere.as_ref(), aerosol_map, band_atmosphere.as_ref());
+            sample_radiance(scene, optics, viewing, sampled_response, atmospheres, &options, control)
                 .map_err(failed(Stage::Radiance))
         })?;
         if self.executions(Stage::Radiance) > executed_before {
@@ -293,8 +333,9 @@ impl Engine {
             .with(&inputs.electronics)
             .with(&applied)
             .finish();
+        // The detector's bands are those the instrument has.
         let detector = self.stage(detector_key, report, control, || {
-            Ok(Detector::new(instrument, response, config.detector, config.seed))
+            Ok(Detector::new(instrument, side.sampled().0, config.detector, config.seed))
         })?;
         // Feasibility: the detector over this scene's brightest water, at this line period.
         let feasibility_key = KeyBuilder::new(Stage::Feasibility).after(detector_key).after(radiance_key).finish();
@@ -362,11 +403,19 @@ impl Engine {
             .finish();
         let calibration = self.stage(calibration_key, report, control, || {
             let e0: Vec<Vec<f64>> = optics.iter().map(|o| o.e0().to_vec()).collect();
-            let e0_band = band_e0(response, instrument.detectors, &e0);
+            // The diffuser as the bands see it, and as the processor believes they see it.
+            let e0_band =
+                (band_e0(side.sampled().0, instrument.detectors, &e0), band_e0(response, instrument.detectors, &e0));
             let knowledge = FocalKnowledge::of(&instrument.effects);
             let used = &viewing.detector_index;
-            Calibration::derive(&config.calibration, (&detector, knowledge), &e0_band, used, config.seed)
-                .map_err(failed(Stage::Calibration))
+            Calibration::derive(
+                &config.calibration,
+                (&detector, knowledge),
+                (&e0_band.0, &e0_band.1),
+                used,
+                config.seed,
+            )
+            .map_err(failed(Stage::Calibration))
         })?;
         report.diffuser_incidence_deg = calibration.sun_incidence_deg;
         report.diffuser_saturated_frames = calibration.saturated_frames;

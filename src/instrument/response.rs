@@ -10,6 +10,7 @@
 use std::ops::Range;
 
 use super::InstrumentError;
+use super::effects;
 use super::spec::InstrumentSpec;
 use crate::parse::FieldError;
 use crate::spectral::{Band, BandAverager, BandSet, Extrapolation, Spectrum, WavelengthGrid};
@@ -70,10 +71,33 @@ pub fn planes_of(spec: &InstrumentSpec, bands: &BandSet) -> Result<Vec<usize>, I
 const SMILE_CLASSES: usize = 32;
 
 impl Response {
-    /// Build the response of `spec` on grids of step `step_nm`.
+    /// The response of `spec` on grids of step `step_nm`, as stated: the bands the processor
+    /// believes. Where the instrument states a spectral knowledge error, the grids also cover
+    /// the bands it really has ([`Self::sensed`] shares them).
     pub fn new(spec: &InstrumentSpec, step_nm: f64) -> Result<Self, InstrumentError> {
+        Self::build(spec, step_nm, false)
+    }
+
+    /// The response the instrument really has where it states a spectral knowledge error
+    /// ([`super::effects::SpectralKnowledge`]; else the same as [`Self::new`]), on
+    /// [`Self::new`]'s grids: each band's SRF stretched about its centre and shifted, the smile
+    /// scaled. Its `bands` stay the stated ones (names and centres label the products).
+    pub fn sensed(spec: &InstrumentSpec, step_nm: f64) -> Result<Self, InstrumentError> {
+        Self::build(spec, step_nm, true)
+    }
+
+    /// The stated response (`sensing` false) or the true one.
+    fn build(spec: &InstrumentSpec, step_nm: f64, sensing: bool) -> Result<Self, InstrumentError> {
         let kind = spec.kind.model();
         let bands = kind.band_set()?;
+        let error = effects::spectral_knowledge(&spec.effects);
+        let shifts = match error {
+            Some(k) => k.shifts_nm(bands.len())?,
+            None => vec![0.0; bands.len()],
+        };
+        let (width, smile_factor) = error.map_or((1.0, 1.0), |k| (k.width_factor(), k.smile_factor()));
+        // A band as the instrument really has it.
+        let true_band = |b: usize| shift(&widen(&bands.bands[b], width)?, shifts[b]);
         let plane_of_band = planes_of(spec, &bands)?;
         let qe_sources: Vec<&crate::spectral::SpectrumSource> = std::iter::once(&spec.quantum_efficiency)
             .chain(spec.focal_planes.iter().map(|p| &p.quantum_efficiency))
@@ -87,15 +111,20 @@ impl Response {
                 return 0.0;
             }
             let x = 2.0 * (c as f64 + 0.5) / n_classes as f64 - 1.0;
-            smile_nm * x * x
+            smile_nm * x * x * if sensing { smile_factor } else { 1.0 }
         };
         let focal_m = spec.focal_length_mm * 1e-3;
         let group_sets = kind.groups(bands.len(), spec.pixel_pitch_um, focal_m);
         let groups = group_sets
             .into_iter()
             .map(|(members, offset_rad)| {
-                let margin = smile_nm.abs() + step_nm;
-                let supports: Vec<(f64, f64)> = members.iter().map(|&b| bands.bands[b].srf.range_nm()).collect();
+                let margin = smile_nm.abs() * smile_factor.abs().max(1.0) + step_nm;
+                let mut supports: Vec<(f64, f64)> = members.iter().map(|&b| bands.bands[b].srf.range_nm()).collect();
+                if error.is_some() {
+                    for &b in &members {
+                        supports.push(true_band(b)?.srf.range_nm());
+                    }
+                }
                 let grid = support_grid(&supports, margin, step_nm)?;
                 let mut qe_of_plane = Vec::with_capacity(qe_sources.len());
                 for (p, source) in qe_sources.iter().enumerate() {
@@ -119,7 +148,13 @@ impl Response {
                             name: bands.name.clone(),
                             bands: members
                                 .iter()
-                                .map(|&b| shift(&bands.bands[b], class_shift(c)))
+                                .map(|&b| {
+                                    if sensing {
+                                        shift(&true_band(b)?, class_shift(c))
+                                    } else {
+                                        shift(&bands.bands[b], class_shift(c))
+                                    }
+                                })
                                 .collect::<Result<_, _>>()?,
                         };
                         let avg = BandAverager::new(&grid, &shifted)?;
@@ -260,7 +295,18 @@ fn support_grid(supports: &[(f64, f64)], margin_nm: f64, step_nm: f64) -> Result
     Ok(WavelengthGrid::from_wavelengths(nodes.into_iter().map(|k| k as f64 * step_nm).collect())?)
 }
 
-/// A band with its SRF shifted by `d` nm (smile).
+/// A band with its SRF stretched about its centre by `factor` (its FWHM with it).
+fn widen(b: &Band, factor: f64) -> Result<Band, InstrumentError> {
+    if factor == 1.0 {
+        return Ok(b.clone());
+    }
+    let c = b.centre_nm;
+    let wavelengths = b.srf.wavelength_nm.iter().map(|w| c + (w - c) * factor).collect();
+    let srf = Spectrum::new(b.srf.name.clone(), wavelengths, b.srf.values.clone())?;
+    Ok(Band { srf, fwhm_nm: b.fwhm_nm * factor, ..b.clone() })
+}
+
+/// A band with its SRF shifted by `d` nm (smile, a centre error).
 fn shift(b: &Band, d: f64) -> Result<Band, InstrumentError> {
     if d == 0.0 {
         return Ok(b.clone());
@@ -337,5 +383,66 @@ mod tests {
         let step = (64.0 * 5.5e-6 / 0.165_f64).atan();
         assert!((offsets[1] - offsets[0] - step).abs() < 1e-6);
         assert!((offsets[0] + offsets[9]).abs() < 1e-12);
+    }
+}
+
+#[cfg(test)]
+mod knowledge_tests {
+    use super::*;
+    use crate::instrument::InstrumentKind;
+    use crate::instrument::effects::{InstrumentEffect, SpectralKnowledge};
+    use crate::spectral::{BandSetSpec, GaussianBand};
+
+    /// Band `k`'s photon-weighted centroid and rms width, nm.
+    fn moments(r: &Response, k: usize) -> (f64, f64) {
+        let (first, w) = r.weights(0, k, 0);
+        let grid = &r.groups[0].grid;
+        let total: f64 = w.iter().sum();
+        let mean = w.iter().enumerate().map(|(i, v)| v * grid.wavelength_nm(first + i)).sum::<f64>() / total;
+        let var =
+            w.iter().enumerate().map(|(i, v)| v * (grid.wavelength_nm(first + i) - mean).powi(2)).sum::<f64>() / total;
+        (mean, var.sqrt())
+    }
+
+    #[test]
+    fn a_band_shift_and_width_error_move_the_band_integral() {
+        let bands = BandSetSpec::Gaussian(vec![
+            GaussianBand { name: None, centre_nm: 490.0, fwhm_nm: 10.0 },
+            GaussianBand { name: None, centre_nm: 665.0, fwhm_nm: 15.0 },
+        ]);
+        let mut spec = InstrumentSpec::preset("nominal").unwrap();
+        spec.kind = InstrumentKind::Multispectral { bands };
+        // A flat QE: the photon weighting λ/(hc) is then the only slope under the bands.
+        spec.quantum_efficiency = crate::spectral::SpectrumSource::Constant(0.7);
+        spec.effects = vec![InstrumentEffect::SpectralKnowledge(SpectralKnowledge {
+            centre_nm: 0.0,
+            sigma_nm: 0.0,
+            per_band_nm: vec![1.5, -0.7],
+            draw: 0,
+            width_pct: 10.0,
+            smile_pct: 0.0,
+        })];
+        let (believed, sensed) = (Response::new(&spec, 0.1).unwrap(), Response::sensed(&spec, 0.1).unwrap());
+        // One grid for both, covering the true bands.
+        assert_eq!(believed.groups[0].grid, sensed.groups[0].grid);
+        for (k, centre, shift) in [(0, 490.0, 1.5), (1, 665.0, -0.7)] {
+            let ((m0, s0), (m1, s1)) = (moments(&believed, k), moments(&sensed, k));
+            // The photon weighting λ moves a symmetric band's centroid from its centre c by
+            // σ²/c: the true band's centroid is c + d + σ₁²/c, the believed one's c + σ₀²/c
+            // (to 1e-4 nm: terms in σ⁴/c³ and the 0.1 nm grid).
+            let expected = shift + (s1 * s1 - s0 * s0) / centre;
+            assert!((m1 - m0 - expected).abs() < 1e-3, "band {k}: {m1} − {m0} against {expected}");
+            // Stretched 10 % about its centre: the rms width grows by 10 % (less the λ weighting's
+            // skew, σ²/c² relative; the 0.1 nm grid).
+            assert!((s1 / s0 - 1.1).abs() < 1e-3, "band {k}: {s1} / {s0}");
+            // And the band collects 10 % more photons (its SRF's area grows with its width), each
+            // of energy hc/λ at its centre: ∫SRF·λ is the area times the centre.
+            let area = |r: &Response| r.weights(0, k, 0).1.iter().sum::<f64>();
+            let expected = 1.1 * (centre + shift) / centre;
+            assert!((area(&sensed) / area(&believed) / expected - 1.0).abs() < 1e-4, "band {k}");
+        }
+        // Without the effect, the sensed response is the stated one.
+        spec.effects.clear();
+        assert_eq!(Response::sensed(&spec, 0.1).unwrap(), Response::new(&spec, 0.1).unwrap());
     }
 }

@@ -77,13 +77,15 @@ pub struct RadianceCube {
 
 /// Sample the scene through every pixel of `viewing`: `optics[g]` is the scene bound to group
 /// g's grid, the atmosphere from [`BandAtmosphere::new`] with, where the scene's AOT is a map,
-/// its terms at AOT nodes ([`super::aerosol_map`]). Checks `control` between rows.
+/// its terms at AOT nodes ([`super::aerosol_map`]), and the truth's band Rrs through the
+/// `truth` atmosphere's weights (the same atmosphere, or the stated bands' where the instrument
+/// has others: [`Response::sensed`]). Checks `control` between rows.
 pub fn sample_radiance(
     scene: &Scene,
     optics: &[SceneOptics],
     viewing: &Viewing,
     response: &Response,
-    (atmosphere, aerosol_map): (&BandAtmosphere, Option<&AotNodes>),
+    (atmosphere, aerosol_map, truth_atmosphere): (&BandAtmosphere, Option<&AotNodes>, &BandAtmosphere),
     options: &SampleOptions,
     control: &RunControl,
 ) -> Result<RadianceCube, InstrumentError> {
@@ -133,7 +135,16 @@ pub fn sample_radiance(
             rrs_block.fill(0.0);
             let first_row = bi * block;
             let n_rows = land_block.len() / cols.max(1);
-            let sampler = PixelSampler { scene, optics, viewing, response, atmosphere, kernel, offsets: &offsets };
+            let sampler = PixelSampler {
+                scene,
+                optics,
+                viewing,
+                response,
+                atmosphere,
+                truth_atmosphere,
+                kernel,
+                offsets: &offsets,
+            };
             let mut work = PixelWork::new(optics);
             for c in 0..cols {
                 for rr in 0..n_rows {
@@ -190,6 +201,8 @@ struct PixelSampler<'a> {
     viewing: &'a Viewing,
     response: &'a Response,
     atmosphere: &'a BandAtmosphere,
+    /// Whose weights the truth's band Rrs is taken with.
+    truth_atmosphere: &'a BandAtmosphere,
     kernel: &'a SpatialKernel,
     /// The kernel's offsets turned with the ground track, m (east, north).
     offsets: &'a [(f64, f64)],
@@ -246,8 +259,9 @@ impl PixelSampler<'_> {
                     for (kb, &b) in group.bands.iter().enumerate() {
                         let nw = &atmosphere.node_weights[gi][c][kb];
                         let span = nw.first..nw.first + nw.radiance.len();
-                        let water: f64 = nw.radiance.iter().zip(&node_f[span.clone()]).map(|(a, v)| a * v).sum();
-                        let t: f64 = nw.truth.iter().zip(&node_rrs[span]).map(|(a, v)| a * v).sum();
+                        let water: f64 = nw.radiance.iter().zip(&node_f[span]).map(|(a, v)| a * v).sum();
+                        let tw = &self.truth_atmosphere.node_weights[gi][c][kb];
+                        let t: f64 = tw.truth.iter().zip(&node_rrs[tw.first..]).map(|(a, v)| a * v).sum();
                         let i = atmosphere.at(c, b);
                         let weight = kernel.weights[b][k];
                         out[b] += (weight * (atmosphere.l_path[i] + atmosphere.glint[i] + water)) as f32;
@@ -266,7 +280,7 @@ impl PixelSampler<'_> {
                     let weight = kernel.weights[b][k];
                     out[b] += (weight * num / den) as f32;
                     if surface == Surface::Water {
-                        let (tf, tw) = &atmosphere.truth_weights[gi][c][kb];
+                        let (tf, tw) = &self.truth_atmosphere.truth_weights[gi][c][kb];
                         let t: f64 = tw.iter().zip(&rrs[*tf..*tf + tw.len()]).map(|(a, v)| a * v).sum();
                         truth[b] += (weight * t) as f32;
                     }

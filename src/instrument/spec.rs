@@ -209,6 +209,12 @@ impl InstrumentSpec {
         self.validate_tdi()?;
         // The kind's own fields (a spectrograph's span and sampling, a filter imager's rows).
         self.kind.model().validate()?;
+        // One stated band shift per band.
+        if let Some(k) = super::effects::spectral_knowledge(&self.effects)
+            && !k.per_band_nm.is_empty()
+        {
+            k.shifts_nm(self.kind.model().band_set()?.len())?;
+        }
         Ok(())
     }
 

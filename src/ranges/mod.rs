@@ -302,6 +302,14 @@ ranges! {
     MISREGISTRATION_SIGMA_PX = Range::closed("instrument.effects[].Misregistration.sigma_px", 0.0, 5.0, "pixels", "rms of each band's shift along and across track");
     /// Misregistration: the processor's error.
     MISREGISTRATION_KNOWLEDGE_ERROR = Range::closed("instrument.effects[].Misregistration.correction.error", -1.0, 1.0, "", "relative error of the shifts the co-registration believes");
+    /// Spectral knowledge: common centre error.
+    SPECTRAL_CENTRE_NM = Range::closed("instrument.effects[].SpectralKnowledge.centre_nm", -10.0, 10.0, "nm", "every band's true centre minus the believed one (per_band_nm: each band's)");
+    /// Spectral knowledge: drawn centre error.
+    SPECTRAL_SIGMA_NM = Range::closed("instrument.effects[].SpectralKnowledge.sigma_nm", 0.0, 5.0, "nm", "rms of a further centre error drawn per band");
+    /// Spectral knowledge: width error.
+    SPECTRAL_WIDTH_PCT = Range::closed("instrument.effects[].SpectralKnowledge.width_pct", -50.0, 100.0, "%", "every band's true width relative to the believed");
+    /// Spectral knowledge: smile error.
+    SPECTRAL_SMILE_PCT = Range::closed("instrument.effects[].SpectralKnowledge.smile_pct", -100.0, 100.0, "%", "a spectrograph's true smile relative to the stated one");
     /// TDI: stages.
     TDI_STAGES = Range::count("instrument.effects[].Tdi.stages", 1.0, 256.0, "", "rows integrated per band");
     /// TDI: line-rate error.

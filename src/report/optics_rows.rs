@@ -67,5 +67,8 @@ pub fn focal_plane_summary(spec: &crate::instrument::InstrumentSpec) -> String {
             "lossless coder".into()
         });
     }
+    if let Some(k) = effects::spectral_knowledge(list) {
+        parts.push(k.describe());
+    }
     if parts.is_empty() { "–".into() } else { parts.join("; ") }
 }

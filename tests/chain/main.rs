@@ -30,6 +30,7 @@ mod reproduction;
 mod retrieval;
 mod soak;
 mod spatial;
+mod spectral_knowledge;
 mod spectrum;
 mod study;
 mod sweep;

@@ -13,6 +13,7 @@
 //! | band-to-band misregistration | [`misregistration`] | each band's whole image | co-registration with the believed shifts |
 //! | time-delay integration | [`tdi`] | the focal planes' electronics (and the MTF budget's along-track losses) | calibrated through the same stages |
 //! | compression | [`compression`] | Level-0's counts (the coder: [`crate::instrument::compression`]) | decoded on the ground (near-lossless: its error stays) |
+//! | spectral knowledge error (band centre, width, smile) | [`spectral_knowledge`] | the spectral response the scene is sampled with | not correctable: the processor's bands are its knowledge |
 //!
 //! Every effect is a type behind [`Effect`], listed in [`InstrumentEffect`] (the one place an
 //! effect is registered: its module and one arm of [`InstrumentEffect::effect`]). The engine
@@ -34,6 +35,7 @@ pub mod misregistration;
 pub mod mtf;
 pub mod nonlinearity;
 pub mod polarisation;
+pub mod spectral_knowledge;
 pub mod spectral_stray;
 pub mod stokes_columns;
 pub mod stray_light;
@@ -48,6 +50,7 @@ pub use misregistration::Misregistration;
 pub use mtf::MtfBudget;
 pub use nonlinearity::NonLinearity;
 pub use polarisation::Polarisation;
+pub use spectral_knowledge::SpectralKnowledge;
 pub use spectral_stray::SpectralStrayLight;
 pub use stokes_columns::StokesColumns;
 pub use stray_light::StrayLight;
@@ -80,6 +83,8 @@ pub enum InstrumentEffect {
     Misregistration(Misregistration),
     /// Time-delay integration on every focal plane.
     Tdi(Tdi),
+    /// The bands' centres, widths or smile differ from what the processor believes.
+    SpectralKnowledge(SpectralKnowledge),
 }
 
 impl InstrumentEffect {
@@ -96,11 +101,12 @@ impl InstrumentEffect {
             Self::Compression(e) => e,
             Self::Misregistration(e) => e,
             Self::Tdi(e) => e,
+            Self::SpectralKnowledge(e) => e,
         }
     }
 
     /// Does the focal plane or its electronics make it (non-linearity, fixed patterns,
-    /// misregistration, compression), rather than the optics?
+    /// misregistration, compression, TDI, the bands' spectral knowledge), rather than the optics?
     #[must_use]
     pub fn on_the_focal_plane(&self) -> bool {
         matches!(
@@ -110,6 +116,7 @@ impl InstrumentEffect {
                 | Self::Misregistration(_)
                 | Self::Compression(_)
                 | Self::Tdi(_)
+                | Self::SpectralKnowledge(_)
         )
     }
 
@@ -128,6 +135,7 @@ impl InstrumentEffect {
             Self::Compression(e) => Self::Compression(*e),
             Self::Misregistration(e) => Self::Misregistration(Misregistration { correction, ..e.clone() }),
             Self::Tdi(e) => Self::Tdi(*e),
+            Self::SpectralKnowledge(e) => Self::SpectralKnowledge(e.clone()),
         }
     }
 }
@@ -280,6 +288,15 @@ pub fn misregistration(effects: &[InstrumentEffect]) -> Option<&Misregistration>
 pub fn tdi(effects: &[InstrumentEffect]) -> Option<&Tdi> {
     effects.iter().find_map(|e| match e {
         InstrumentEffect::Tdi(t) => Some(t),
+        _ => None,
+    })
+}
+
+/// The spectral knowledge error the instrument states, if it states one that changes a band.
+#[must_use]
+pub fn spectral_knowledge(effects: &[InstrumentEffect]) -> Option<&SpectralKnowledge> {
+    effects.iter().find_map(|e| match e {
+        InstrumentEffect::SpectralKnowledge(k) if !k.is_exact() => Some(k),
         _ => None,
     })
 }
