@@ -92,6 +92,7 @@ pub const PRESETS: &[Asset] = embed_presets![
     "instruments/landsat8_oli.ron",
     "instruments/smallsat_swir.ron",
     "instruments/sentinel3a_olci.ron",
+    "instruments/modis_aqua.ron",
     "studies/cubesat_vs_smallsat.ron",
     "studies/cubesat_design_lake_hume.ron",
     "studies/msi_vs_smallsat.ron",

@@ -137,3 +137,24 @@ fn msi_with_its_mtf_budget_meets_its_nyquist_requirement_and_an_ideal_optic_does
         }
     }
 }
+
+/// Aqua MODIS's ocean bands: typical radiance Ltyp and required SNR from NASA's MODIS
+/// specification page (modis.gsfc.nasa.gov/about/specifications.php, "Spectral Radiance" and
+/// "Required SNR" of bands 8–16).
+const MODIS: [Requirement; 9] = [
+    ("B8", 44.9, 880.0),
+    ("B9", 41.9, 838.0),
+    ("B10", 32.1, 802.0),
+    ("B11", 27.9, 754.0),
+    ("B12", 21.0, 750.0),
+    ("B13", 9.5, 910.0),
+    ("B14", 8.7, 1087.0),
+    ("B15", 10.2, 586.0),
+    ("B16", 6.2, 516.0),
+];
+
+#[test]
+fn aqua_modis_meets_its_snr_requirement() {
+    // Each plane's weakest band against its requirement: B12 (visible), B14 (near infrared).
+    holds("MODIS", &snr_against("modis_aqua", &MODIS), &["B12", "B14"]);
+}
