@@ -25,7 +25,7 @@ pub struct SimulateArgs {
     scene: String,
     /// Instrument: a preset name (yours in the library first, then the built-ins nominal,
     /// cubesat, smallsat, hyperspectral, filter_imager, sentinel2a_msi, landsat8_oli,
-    /// sentinel3a_olci, smallsat_swir) or an instrument RON file.
+    /// sentinel3a_olci, modis_aqua, smallsat_swir) or an instrument RON file.
     #[arg(long, default_value = "nominal")]
     instrument: String,
     /// A full run configuration (RON, as written to config.ron); flags override it.
