@@ -23,12 +23,15 @@ pub(super) fn derived(app: &ShoalApp, ui: &mut egui::Ui) {
         let n = app.state.designs.len();
         egui::Grid::new("derived").num_columns(n + 1).striped(true).show(ui, |ui| {
             design_header(ui, n);
-            let rows: [DerivedRow; 12] = [
-                ("GSD", |s| format!("{:.1} m", s.gsd_m())),
-                ("Swath", |s| format!("{:.1} km", s.swath_m() / 1000.0)),
+            // A binned design's GSD, swath, étendue and line period are its binned pixel's
+            // (the instrument as flown).
+            let rows: [DerivedRow; 13] = [
+                ("GSD", |s| format!("{:.1} m", s.as_flown().gsd_m())),
+                ("Swath", |s| format!("{:.1} km", s.as_flown().swath_m() / 1000.0)),
                 ("f-number", |s| format!("f/{:.2}", s.f_number())),
-                ("Étendue", |s| format!("{:.2e} m² sr", s.etendue_m2_sr())),
+                ("Étendue", |s| format!("{:.2e} m² sr", s.as_flown().etendue_m2_sr())),
                 ("Line period", |s| {
+                    let s = s.as_flown();
                     format!("{:.2} ms", 1e3 * s.gsd_m() / crate::instrument::ground_speed_m_s(s.altitude_km))
                 }),
                 ("Stray light 1 km past an edge", |s| {
@@ -53,7 +56,7 @@ pub(super) fn derived(app: &ShoalApp, ui: &mut egui::Ui) {
                     )
                 }),
                 ("Non-linearity left", |s| format!("{:.2} %", crate::study::nonlinearity_left_pct(s))),
-                ("Registration left", |s| format!("{:.3} px", crate::study::registration_px(s))),
+                ("Registration left", |s| format!("{:.3} px", crate::study::registration_px(&s.as_flown()))),
                 ("On-board coder", |s| {
                     crate::instrument::effects::compression(&s.effects).map_or_else(
                         || "–".to_string(),
@@ -62,6 +65,12 @@ pub(super) fn derived(app: &ShoalApp, ui: &mut egui::Ui) {
                             (false, 0) => "lossless".to_string(),
                             (false, m) => format!("±{m} DN"),
                         },
+                    )
+                }),
+                ("On-board binning", |s| {
+                    crate::instrument::effects::binning(&s.effects).map_or_else(
+                        || "–".to_string(),
+                        |b| format!("{0} × {0} {1}", b.factor, if b.digital { "digital" } else { "charge" }),
                     )
                 }),
             ];
@@ -80,6 +89,7 @@ pub(super) fn derived(app: &ShoalApp, ui: &mut egui::Ui) {
                 any(|s| fx::non_linearity(&s.effects).is_some()),
                 any(|s| fx::misregistration(&s.effects).is_some()),
                 any(|s| fx::compression(&s.effects).is_some()),
+                any(|s| fx::binning(&s.effects).is_some()),
             ];
             for (k, (name, f)) in rows.into_iter().enumerate() {
                 // The first five rows always; each effect's only where a design states it.
@@ -123,7 +133,9 @@ fn budgets(app: &ShoalApp, ui: &mut egui::Ui) {
     static MODELS: std::sync::OnceLock<Option<BudgetModels>> = std::sync::OnceLock::new();
     let Some(models) = MODELS.get_or_init(|| BudgetModels::default_models().ok()) else { return };
     let rows: Vec<Option<Vec<(String, String)>>> = (app.state.designs.iter().enumerate())
-        .map(|(i, d)| app.link.current(i).map(|s| models.assess(&d.spec, &s.output.response.plane_of_band).rows()))
+        .map(|(i, d)| {
+            app.link.current(i).map(|s| models.assess(&d.spec.as_flown(), &s.output.response.plane_of_band).rows())
+        })
         .collect();
     ui.separator();
     ui.strong("Budgets");

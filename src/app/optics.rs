@@ -1,12 +1,12 @@
 //! The left panel's optics and focal-plane editor: the instrument's effects (stray light,
 //! polarisation sensitivity, the MTF budget, spectral stray light, non-linearity, fixed patterns,
-//! misregistration, TDI, compression, spectral knowledge; `instrument::effects`), each with what the processor knows of it. An edit is kept only if the
+//! misregistration, TDI, compression, spectral knowledge, binning; `instrument::effects`), each with what the processor knows of it. An edit is kept only if the
 //! whole instrument still validates; otherwise the message says why.
 
 use super::model::Slot;
 use crate::instrument::effects::{
-    Compression, FixedPatterns, InstrumentEffect, Knowledge, Misregistration, MtfBudget, NonLinearity, Polarisation,
-    SpectralKnowledge, SpectralStrayLight, StrayLight, Tdi,
+    Binning, Compression, FixedPatterns, InstrumentEffect, Knowledge, Misregistration, MtfBudget, NonLinearity,
+    Polarisation, SpectralKnowledge, SpectralStrayLight, StrayLight, Tdi,
 };
 
 /// One number shown in `scale` × its stored unit (a focal plane's number otherwise).
@@ -97,7 +97,7 @@ fn fixed_patterns() -> InstrumentEffect {
 type Offer = (&'static str, &'static str, fn() -> InstrumentEffect);
 
 /// Every effect the editor offers, in the order of its buttons.
-const OFFERED: [Offer; 10] = [
+const OFFERED: [Offer; 11] = [
     ("stray light", "A far-field halo and an out-of-field veil", stray_light),
     ("polarisation sensitivity", "The response depends on the light's linear polarisation", polarisation),
     ("MTF budget", "Sample the scene with the PSF of the optics, detector and motion", mtf_budget),
@@ -108,7 +108,13 @@ const OFFERED: [Offer; 10] = [
     ("TDI", "Time-delay integration: each ground line integrated over N rows", tdi),
     ("compression", "On-board coding of Level-0: lossless, or near-lossless to a rate", compression),
     ("spectral knowledge error", "The bands' centres and widths differ from what the processor believes", spectral),
+    ("on-board binning", "k × k pixels summed into one: SNR up, GSD and data down", binning),
 ];
+
+/// Binning to start from: 2 × 2 in charge (a CCD's summing well).
+fn binning() -> InstrumentEffect {
+    InstrumentEffect::Binning(Binning { factor: 2, digital: false })
+}
 
 /// A spectral knowledge error to start from: each band's centre known to 0.5 nm rms (an
 /// assumption; Green (1998) asks a few per cent of the FWHM).
@@ -216,6 +222,14 @@ pub(super) fn optics_editor(slot: &mut Slot, ui: &mut egui::Ui, error: &mut Opti
                     number(ui, "  and per band RMS", &mut k.sigma_nm, (0.0, 5.0), 1.0, " nm");
                     number(ui, "width error", &mut k.width_pct, (-50.0, 100.0), 1.0, " %");
                     number(ui, "smile error", &mut k.smile_pct, (-100.0, 100.0), 1.0, " %");
+                }
+                InstrumentEffect::Binning(b) => {
+                    let mut factor = f64::from(b.factor);
+                    number(ui, "pixels summed (k × k)", &mut factor, (1.0, 16.0), 1.0, "");
+                    b.factor = factor.round() as u32;
+                    ui.label("digital (summed reads)");
+                    ui.checkbox(&mut b.digital, "");
+                    ui.end_row();
                 }
                 InstrumentEffect::Compression(c) => {
                     let mut bound = f64::from(c.max_error_dn);

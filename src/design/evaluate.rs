@@ -183,11 +183,17 @@ impl Evaluator<'_> {
                     return Ok(e);
                 }
             };
-            let budget = self.budgets.assess(&config.instrument, &out.response.plane_of_band);
+            let budget = self.budgets.assess(&config.instrument.as_flown(), &out.response.plane_of_band);
             let metrics = out.retrievals.first().map(|r| &r.metrics);
             let label = &config.instrument.name;
             let mut checks = self.requirements.check_run(label, seed, metrics, &out.snr, &out.correction.rrs_metrics);
-            checks.extend(self.requirements.check_design(label, seed, &config.instrument, &budget, self.budgets));
+            checks.extend(self.requirements.check_design(
+                label,
+                seed,
+                &config.instrument.as_flown(),
+                &budget,
+                self.budgets,
+            ));
             if checks.iter().all(|c| c.pass) {
                 e.seeds_passed += 1;
             }

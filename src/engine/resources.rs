@@ -216,6 +216,15 @@ pub fn run_demand(config: &RunConfig) -> Demand {
 /// a lean one, which holds a cube only until the next stage has read it.
 #[must_use]
 pub fn run_demand_keeping(config: &RunConfig, keep_cubes: bool) -> Demand {
+    // The instrument as flown: a binned one simulates its binned pixels.
+    let flown;
+    let config = match config.instrument.as_flown() {
+        std::borrow::Cow::Borrowed(_) => config,
+        std::borrow::Cow::Owned(instrument) => {
+            flown = RunConfig { instrument, ..config.clone() };
+            &flown
+        }
+    };
     let mut parts = Vec::new();
     scene_parts(&config.scene, &mut parts);
     parts.push(atmosphere_part(config));

@@ -172,6 +172,16 @@ impl Engine {
         self.cache.begin_run();
         self.fault = config.fault;
         config.validate_keeping(self.keep_cubes)?;
+        // The instrument as flown (on-board binning folded into its pixels): what every stage
+        // simulates and the output reports.
+        let flown;
+        let config = match config.instrument.as_flown() {
+            std::borrow::Cow::Borrowed(_) => config,
+            std::borrow::Cow::Owned(instrument) => {
+                flown = RunConfig { instrument, ..config.clone() };
+                &flown
+            }
+        };
         let mut report = RunReport {
             scene: config.scene.name.clone(),
             instrument: config.instrument.name.clone(),

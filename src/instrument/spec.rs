@@ -209,6 +209,9 @@ impl InstrumentSpec {
         self.validate_tdi()?;
         // The kind's own fields (a spectrograph's span and sampling, a filter imager's rows).
         self.kind.model().validate()?;
+        if let Some(b) = super::effects::binning(&self.effects) {
+            super::effects::binning::check_fits(b, self)?;
+        }
         // One stated band shift per band.
         if let Some(k) = super::effects::spectral_knowledge(&self.effects)
             && !k.per_band_nm.is_empty()
@@ -303,6 +306,17 @@ impl InstrumentSpec {
     #[must_use]
     pub fn dark_current_at_operating_e_s(&self) -> f64 {
         self.dark_current_e_s * self.dark_temperature.map_or(1.0, |t| t.factor())
+    }
+
+    /// The instrument as flown: with on-board binning folded into its pixels
+    /// ([`super::effects::Binning::flown`]), else itself. The engine simulates this one, and its
+    /// GSD, SNR and data budget are the design's.
+    #[must_use]
+    pub fn as_flown(&self) -> std::borrow::Cow<'_, Self> {
+        match super::effects::binning(&self.effects) {
+            Some(b) => std::borrow::Cow::Owned(b.flown(self)),
+            None => std::borrow::Cow::Borrowed(self),
+        }
     }
 
     /// Ground sampling distance at nadir, m: GSD = altitude · pitch / focal length.

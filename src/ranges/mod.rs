@@ -302,6 +302,8 @@ ranges! {
     MISREGISTRATION_SIGMA_PX = Range::closed("instrument.effects[].Misregistration.sigma_px", 0.0, 5.0, "pixels", "rms of each band's shift along and across track");
     /// Misregistration: the processor's error.
     MISREGISTRATION_KNOWLEDGE_ERROR = Range::closed("instrument.effects[].Misregistration.correction.error", -1.0, 1.0, "", "relative error of the shifts the co-registration believes");
+    /// Binning: pixels summed along and across track.
+    BINNING_FACTOR = Range::count("instrument.effects[].Binning.factor", 1.0, 16.0, "", "k: k × k pixels summed into one on board");
     /// Spectral knowledge: common centre error.
     SPECTRAL_CENTRE_NM = Range::closed("instrument.effects[].SpectralKnowledge.centre_nm", -10.0, 10.0, "nm", "every band's true centre minus the believed one (per_band_nm: each band's)");
     /// Spectral knowledge: drawn centre error.

@@ -280,8 +280,8 @@ fn derived_rows(runs: &[&StudyRun], configs: &[&RunConfig]) -> Vec<Derived> {
     let budget_rows: Vec<Vec<(String, String)>> = runs.iter().map(|r| r.budget.rows()).collect();
     let budget = budget_rows.first().map_or(0, Vec::len);
     let mut rows = vec![
-        row("nadir GSD", &|k| format!("{:.1} m", configs[k].instrument.gsd_m())),
-        row("swath", &|k| format!("{:.1} km", configs[k].instrument.swath_m() / 1000.0)),
+        row("nadir GSD", &|k| format!("{:.1} m", configs[k].instrument.as_flown().gsd_m())),
+        row("swath", &|k| format!("{:.1} km", configs[k].instrument.as_flown().swath_m() / 1000.0)),
         row("f-number", &|k| format!("f/{:.2}", runs[k].feasibility.f_number)),
         row("along-track smear", &|k| format!("{:.2} px", runs[k].feasibility.smear_px)),
         row("read noise", &|k| format!("{:.1} e⁻", runs[k].feasibility.read_noise_e)),

@@ -67,6 +67,9 @@ pub fn focal_plane_summary(spec: &crate::instrument::InstrumentSpec) -> String {
             "lossless coder".into()
         });
     }
+    if let Some(b) = effects::binning(list) {
+        parts.push(format!("binned {0} × {0} ({1})", b.factor, if b.digital { "digital" } else { "charge" }));
+    }
     if let Some(k) = effects::spectral_knowledge(list) {
         parts.push(k.describe());
     }

@@ -55,7 +55,7 @@ impl Stage {
         let effects = &config.instrument.effects;
         match self {
             Self::Optics => effects.iter().any(|e| !e.on_the_focal_plane()),
-            Self::FocalPlane => effects.iter().any(crate::instrument::InstrumentEffect::on_the_focal_plane),
+            Self::FocalPlane => effects.iter().any(|e| e.on_the_focal_plane() && e.makes_error()),
             _ => true,
         }
     }
@@ -76,8 +76,9 @@ impl Stage {
     /// Make this stage perfect in `config`.
     fn perfect(self, config: &mut RunConfig) {
         match self {
-            Self::Optics => config.instrument.effects.retain(crate::instrument::InstrumentEffect::on_the_focal_plane),
-            Self::FocalPlane => config.instrument.effects.retain(|e| !e.on_the_focal_plane()),
+            // A design choice (binning) stays: it is the design, not an error of it.
+            Self::Optics => config.instrument.effects.retain(|e| e.on_the_focal_plane() || !e.makes_error()),
+            Self::FocalPlane => config.instrument.effects.retain(|e| !e.on_the_focal_plane() || !e.makes_error()),
             Self::Noise => {
                 config.detector.noise = false;
                 config.detector.quantise = false;

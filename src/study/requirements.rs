@@ -380,7 +380,8 @@ impl Requirements {
                 }
                 let spec = result.study.runs.iter().find(|r| r.0 == run.label).map(|r| &r.2.instrument);
                 if let Some(spec) = spec {
-                    checks.extend(self.check_design(&run.label, run.seed, spec, &run.budget, &result.study.budgets));
+                    let spec = spec.as_flown();
+                    checks.extend(self.check_design(&run.label, run.seed, &spec, &run.budget, &result.study.budgets));
                 }
                 checks
             })

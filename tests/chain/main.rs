@@ -6,6 +6,7 @@ mod adjacency;
 mod aerosol_map;
 mod bad_input;
 mod band_nodes;
+mod binning;
 mod cli;
 mod closure;
 mod coherence;

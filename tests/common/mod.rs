@@ -10,7 +10,7 @@ use shoal::retrieval::RetrievalSpec;
 /// imager's `kind` fields need that kind; everything else is on the Table 1 CubeSat.
 #[must_use]
 pub fn instrument_for(path: &str) -> &'static str {
-    if path.contains("Spectrograph") {
+    if path.contains("Spectrograph") || path.contains("smile_pct") {
         "hyperspectral"
     } else if path.contains("FilterImager") {
         "filter_imager"
@@ -58,7 +58,8 @@ pub fn sweep_path(path: &str) -> String {
     // The dark-current laws: the first plane's doubles ([`with_dark_laws`]), the SWIR plane's is
     // Arrhenius.
     // The instrument's effects: stray light, polarisation, the MTF budget, spectral stray light,
-    // non-linearity, fixed patterns, misregistration, compression, TDI ([`with_optical_effects`]).
+    // non-linearity, fixed patterns, misregistration, compression, spectral knowledge, binning,
+    // TDI ([`with_optical_effects`]).
     let path = path
         .replace("[i]", index)
         .replace("focal_planes[]", "focal_planes.0")
@@ -70,7 +71,10 @@ pub fn sweep_path(path: &str) -> String {
         .replace("effects[].FixedPatterns", "effects.5.FixedPatterns")
         .replace("effects[].Misregistration", "effects.6.Misregistration")
         .replace("effects[].Compression", "effects.7.Compression")
-        .replace("effects[].Tdi", "effects.8.Tdi");
+        .replace("effects[].SpectralKnowledge", "effects.8.SpectralKnowledge")
+        .replace("effects[].Binning", "effects.9.Binning")
+        // Last: a spectrograph's list has no TDI ([`with_optical_effects`]).
+        .replace("effects[].Tdi", "effects.10.Tdi");
     // The image-based correction's lists: the pair's long band, the AOT node 0.2, the start of
     // dark-spectrum fitting's band range.
     let path = match path.as_str() {
@@ -108,8 +112,10 @@ pub fn with_dark_laws(instrument: &mut shoal::instrument::InstrumentSpec) {
 /// polarisation sensitivity at 10° (the processor 10 % wrong), an MTF budget, 1 % spectral stray
 /// light (the processor 10 % wrong), a 2 % non-linearity (the calibration 10 % wrong), fixed
 /// patterns (15 % dead and 15 % hot elements, so that a 10 % change of either share changes
-/// which elements of a small image are), a 0.2 px misregistration, a near-lossless coder and
-/// 4 TDI stages with a 0.5 % line-rate error and a CTE of 0.9999.
+/// which elements of a small image are), a 0.2 px misregistration, a near-lossless coder,
+/// bands 0.3 nm off what the processor believes (0.2 nm rms more, 5 % wider, the smile 10 %
+/// larger), binning of 1 (none: a change to 2 bins) and 4 TDI stages with a 0.5 % line-rate error
+/// and a CTE of 0.9999 (last, and not on a spectrograph, which refuses TDI).
 pub fn with_optical_effects(instrument: &mut shoal::instrument::InstrumentSpec) {
     instrument.effects = ron::from_str(
         "[StrayLight((halo_fraction: 0.05, knee_m: 60.0, slope: 2.5, radius_m: 600.0, out_of_field_fraction: 0.01, \
@@ -123,9 +129,14 @@ pub fn with_optical_effects(instrument: &mut shoal::instrument::InstrumentSpec) 
           hot_dark_current_e_s: 5000.0)), \
           Misregistration((sigma_px: 0.2, correction: (corrected: true, error: 0.1))), \
           Compression((max_error_dn: 2)), \
+          SpectralKnowledge((centre_nm: 0.3, sigma_nm: 0.2, width_pct: 5.0, smile_pct: 10.0)), \
+          Binning((factor: 1)), \
           Tdi((stages: 4, line_rate_error: 0.005, cte: 0.9999))]",
     )
     .unwrap();
+    if matches!(instrument.kind, shoal::instrument::InstrumentKind::Spectrograph { .. }) {
+        instrument.effects.retain(|e| !matches!(e, shoal::instrument::InstrumentEffect::Tdi(_)));
+    }
 }
 
 /// Does the Debian tool `tool` (package `package`) run on this machine? The README's test

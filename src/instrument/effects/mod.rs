@@ -13,6 +13,7 @@
 //! | band-to-band misregistration | [`misregistration`] | each band's whole image | co-registration with the believed shifts |
 //! | time-delay integration | [`tdi`] | the focal planes' electronics (and the MTF budget's along-track losses) | calibrated through the same stages |
 //! | compression | [`compression`] | Level-0's counts (the coder: [`crate::instrument::compression`]) | decoded on the ground (near-lossless: its error stays) |
+//! | on-board binning | [`binning`] | the instrument itself (the instrument as flown) | – (a design choice) |
 //! | spectral knowledge error (band centre, width, smile) | [`spectral_knowledge`] | the spectral response the scene is sampled with | not correctable: the processor's bands are its knowledge |
 //!
 //! Every effect is a type behind [`Effect`], listed in [`InstrumentEffect`] (the one place an
@@ -28,6 +29,7 @@
 //!   (2005) Moderate-Resolution Imaging Spectroradiometer ocean color polarization correction.
 //!   Appl. Opt. 44, 5524–5535.
 
+pub mod binning;
 pub mod compression;
 pub mod convolve;
 pub mod fixed_patterns;
@@ -44,6 +46,7 @@ pub mod tdi;
 use ndarray::Array3;
 use serde::{Deserialize, Serialize};
 
+pub use binning::Binning;
 pub use compression::Compression;
 pub use fixed_patterns::FixedPatterns;
 pub use misregistration::Misregistration;
@@ -85,6 +88,8 @@ pub enum InstrumentEffect {
     Tdi(Tdi),
     /// The bands' centres, widths or smile differ from what the processor believes.
     SpectralKnowledge(SpectralKnowledge),
+    /// On-board binning of k × k pixels into one.
+    Binning(Binning),
 }
 
 impl InstrumentEffect {
@@ -102,6 +107,7 @@ impl InstrumentEffect {
             Self::Misregistration(e) => e,
             Self::Tdi(e) => e,
             Self::SpectralKnowledge(e) => e,
+            Self::Binning(e) => e,
         }
     }
 
@@ -117,7 +123,15 @@ impl InstrumentEffect {
                 | Self::Compression(_)
                 | Self::Tdi(_)
                 | Self::SpectralKnowledge(_)
+                | Self::Binning(_)
         )
+    }
+
+    /// Is it an error source (which `shoal budget`'s perfect switches remove), rather than a
+    /// design choice (binning)?
+    #[must_use]
+    pub fn makes_error(&self) -> bool {
+        !matches!(self, Self::Binning(_))
     }
 
     /// The entry as the optics apply it, the processor's knowledge left out: the key of the
@@ -136,6 +150,7 @@ impl InstrumentEffect {
             Self::Misregistration(e) => Self::Misregistration(Misregistration { correction, ..e.clone() }),
             Self::Tdi(e) => Self::Tdi(*e),
             Self::SpectralKnowledge(e) => Self::SpectralKnowledge(e.clone()),
+            Self::Binning(e) => Self::Binning(*e),
         }
     }
 }
@@ -288,6 +303,15 @@ pub fn misregistration(effects: &[InstrumentEffect]) -> Option<&Misregistration>
 pub fn tdi(effects: &[InstrumentEffect]) -> Option<&Tdi> {
     effects.iter().find_map(|e| match e {
         InstrumentEffect::Tdi(t) => Some(t),
+        _ => None,
+    })
+}
+
+/// The binning the instrument states, if it bins (a factor above 1).
+#[must_use]
+pub fn binning(effects: &[InstrumentEffect]) -> Option<&Binning> {
+    effects.iter().find_map(|e| match e {
+        InstrumentEffect::Binning(b) if b.factor > 1 => Some(b),
         _ => None,
     })
 }

@@ -1,0 +1,69 @@
+//! On-board binning through the chain (`instrument::effects::binning`): the engine simulates
+//! the instrument as flown, and SNR, GSD and the data budget follow.
+
+use crate::common::Kept;
+
+use shoal::engine::RunConfig;
+use shoal::instrument::InstrumentEffect;
+use shoal::instrument::budgets::BudgetModels;
+use shoal::instrument::effects::Binning;
+
+use super::{run, small, small_lake};
+
+fn config(binning: Option<Binning>) -> RunConfig {
+    let mut instrument = small("cubesat", 96, 64);
+    instrument.effects = binning.map(InstrumentEffect::Binning).into_iter().collect();
+    RunConfig::new(small_lake(), instrument)
+}
+
+#[test]
+fn a_binned_run_is_the_instrument_as_flown() {
+    let binning = Binning { factor: 2, digital: false };
+    let binned = run(&config(Some(binning)));
+    // The same run as the flown instrument stated by hand: the same bits.
+    let mut by_hand = config(None);
+    by_hand.instrument = binning.flown(&by_hand.instrument);
+    let flown = run(&by_hand);
+    assert_eq!(binned.kept().level1.radiance, flown.kept().level1.radiance);
+    // Half the pixels each way, each twice the GSD.
+    let native = run(&config(None));
+    let (r0, c0, _) = native.kept().level1.radiance.dim();
+    let (r1, c1, _) = binned.kept().level1.radiance.dim();
+    assert_eq!((r1, c1), (r0 / 2, c0 / 2));
+    assert!((binned.config.instrument.gsd_m() / native.config.instrument.gsd_m() - 2.0).abs() < 1e-12);
+    // The SNR at the scene's typical radiance: 2 × 2 in charge gains from 2 (shot-limited)
+    // towards 4 (read-limited: four pixels' signal, one read), less the coarser rounding.
+    for (a, b) in binned.snr.iter().zip(native.snr.iter()) {
+        let gain = a.snr_analytic / b.snr_analytic;
+        eprintln!("{}: SNR {:.0} → {:.0} (× {gain:.2})", a.band, b.snr_analytic, a.snr_analytic);
+        assert!((1.5..=4.0).contains(&gain), "{}: {gain}", a.band);
+    }
+    // The data a day fall by k² (the same bits per sample).
+    let models = BudgetModels::preset("cubesat_class").unwrap();
+    let data = |c: &RunConfig, out: &shoal::engine::RunOutput| {
+        models.assess(&c.instrument.as_flown(), &out.response.plane_of_band).data.daily_gbit
+    };
+    let ratio = data(&config(Some(binning)), &binned) / data(&config(None), &native);
+    assert!((ratio - 0.25).abs() < 0.02, "{ratio}");
+}
+
+#[test]
+fn binning_does_not_depend_on_threads() {
+    let c = config(Some(Binning { factor: 3, digital: true }));
+    let pool = |n| rayon::ThreadPoolBuilder::new().num_threads(n).build().unwrap();
+    let one = pool(1).install(|| run(&c));
+    let two = pool(2).install(|| run(&c));
+    assert_eq!(one.kept().level0.dn, two.kept().level0.dn);
+    assert_eq!(one.kept().level1.radiance, two.kept().level1.radiance);
+}
+
+#[test]
+fn a_binning_the_array_cannot_make_is_refused_by_name() {
+    let mut c = config(Some(Binning { factor: 16, digital: false }));
+    c.instrument.detectors = 10;
+    let e = c.validate().unwrap_err().to_string();
+    assert!(e.contains("Binning.factor") && e.contains("10 detectors"), "{e}");
+    let c = config(Some(Binning { factor: 40, digital: false }));
+    let e = c.validate().unwrap_err().to_string();
+    assert!(e.contains("Binning.factor") && e.contains("16"), "{e}");
+}
