@@ -188,7 +188,13 @@ fn optical_effects_are_added_per_design_and_shown_in_the_derived_figures() {
     assert!(matches!(effects.get(3), Some(shoal::instrument::InstrumentEffect::SpectralStrayLight(_))), "{effects:?}");
     assert!(h.query_all_by_label("Add stray light").next().is_none(), "one stray light per design");
     // The focal plane's effects sit in the same editor.
-    for (label, at) in [("Add non-linearity", 4), ("Add TDI", 5), ("Add compression", 6)] {
+    for (label, at) in [
+        ("Add non-linearity", 4),
+        ("Add TDI", 5),
+        ("Add compression", 6),
+        ("Add spectral knowledge error", 7),
+        ("Add on-board binning", 8),
+    ] {
         h.get_by_label(label).click_accesskit();
         h.step();
         h.step();
@@ -196,5 +202,9 @@ fn optical_effects_are_added_per_design_and_shown_in_the_derived_figures() {
         assert_eq!(effects.len(), at + 1, "{label}: {effects:?}");
         assert!(effects[at].on_the_focal_plane(), "{label}: {:?}", effects[at]);
     }
+    // Binned 2 × 2: the Derived table's GSD is the binned pixel's (the CubeSat's 19.9 m twice).
+    let gsd = 2.0 * h.state().state.designs[0].spec.gsd_m();
+    assert!(h.query_all_by_label(&format!("{gsd:.1} m")).next().is_some(), "the binned GSD {gsd:.1} m");
+    assert!(h.query_all_by_label("2 × 2 charge").next().is_some(), "the binning row");
     let _ = std::fs::remove_dir_all(&lib);
 }
