@@ -54,6 +54,7 @@ mod report;
 pub mod resources;
 mod retrieval_stage;
 mod run;
+mod scene_stages;
 pub mod spectrum;
 mod stages;
 pub mod worker;

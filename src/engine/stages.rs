@@ -8,21 +8,20 @@ use super::cache::{Key, KeyBuilder, Stage};
 use super::files;
 use super::keys::Inputs;
 use super::lut_axes::lut_axes;
-use super::products::{InstrumentSide, SceneSide, Sensed};
+use super::products::{InstrumentSide, SceneSide};
 use super::report::{RunReport, SkippedEffect};
 use super::run::Engine;
 use super::{EngineError, RunConfig};
-use crate::atmosphere::{AtmosphereLut, AtmosphereSpec, LutAxes};
+use crate::atmosphere::AtmosphereLut;
 use crate::calibration::{Calibration, FocalKnowledge, band_e0, calibrate};
 use crate::control::Cancellable;
 use crate::control::RunControl;
-use crate::instrument::aerosol_map;
 use crate::instrument::compression::compress_level0;
 use crate::instrument::effects::{self, MtfBudget};
 use crate::instrument::feasibility::Feasibility;
 use crate::instrument::sample::BandAtmosphere;
 use crate::instrument::{
-    AotNodes, Detector, Level0, RadianceCube, Response, SampleOptions, SnrRow, SpatialKernel, Viewing, analytic_snr,
+    Detector, Level0, RadianceCube, Response, SampleOptions, SnrRow, SpatialKernel, Viewing, analytic_snr,
     digitise_cube, expose_and_digitise, expose_cube, measured_snr, sample_radiance,
 };
 use crate::scene::{Effect, Scene};
@@ -36,7 +35,7 @@ pub(super) fn failed<E: Cancellable + std::fmt::Display>(stage: Stage) -> impl F
     }
 }
 
-fn failed_any<E: std::fmt::Display>(stage: Stage) -> impl Fn(E) -> EngineError {
+pub(super) fn failed_any<E: std::fmt::Display>(stage: Stage) -> impl Fn(E) -> EngineError {
     move |e| EngineError::Failed { stage, message: e.to_string() }
 }
 
@@ -168,23 +167,14 @@ impl Engine {
             report,
         )?;
         // The same through the bands the instrument really has: what the scene is sampled with.
-        let sensed = match sensed_response {
-            Some(response) => {
-                let key = KeyBuilder::new(Stage::BandAtmosphere).after(band_key).with("sensed").finish();
-                let band_atmosphere = self.stage(key, report, control, || {
-                    BandAtmosphere::new(&optics, &viewing, &response).map_err(failed(Stage::BandAtmosphere))
-                })?;
-                let (aerosol_map, band_key) = self.aerosol_map_stage(
-                    (&scene, &response, &viewing),
-                    (&atmosphere_spec, &axes),
-                    key,
-                    control,
-                    report,
-                )?;
-                Some(Sensed { response, band_atmosphere, aerosol_map, band_key })
-            }
-            None => None,
-        };
+        let sensed = self.sensed_side(
+            sensed_response,
+            (&scene, &optics, &viewing),
+            (&atmosphere_spec, &axes),
+            band_key,
+            control,
+            report,
+        )?;
 
         Ok(SceneSide {
             scene,
@@ -198,64 +188,6 @@ impl Engine {
             band_key,
             sensed,
         })
-    }
-
-    /// A scene whose AOT varies: the band terms at AOT nodes spanning its map, each node's LUT
-    /// cached as a scene with that constant AOT would cache it. Returns them (none without a
-    /// map) and the key later stages build on.
-    fn aerosol_map_stage(
-        &mut self,
-        (scene, response, viewing): (&Arc<Scene>, &Arc<Response>, &Arc<Viewing>),
-        (atmosphere_spec, axes): (&AtmosphereSpec, &LutAxes),
-        band_key: Key,
-        control: &RunControl,
-        report: &mut RunReport,
-    ) -> Result<(Option<Arc<AotNodes>>, Key), EngineError> {
-        if scene.aot550.is_none() {
-            return Ok((None, band_key));
-        }
-        // The AOT under every pixel centre the image samples (the map's own range is sampled on
-        // at most 512² cells and could miss a corner or a narrow peak); cached with the band
-        // atmosphere, so a run that changes only the electronics does not walk the image again.
-        let range_key = KeyBuilder::new(Stage::BandAtmosphere).after(band_key).with("aot550 range").finish();
-        let range = self.stage(range_key, report, control, || {
-            Ok((0..viewing.lines())
-                .flat_map(|r| (0..viewing.columns()).map(move |c| (r, c)))
-                .map(|(r, c)| {
-                    let (x, y) = viewing.ground_m(0, r, c);
-                    scene.aot550_at(x, y)
-                })
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v))))
-        })?;
-        let (lo, hi) = *range;
-        let nodes = aerosol_map::node_values(lo, hi.max(lo));
-        let mut luts = Vec::with_capacity(nodes.len());
-        let mut nodes_key = KeyBuilder::new(Stage::BandAtmosphere).after(band_key).with(&nodes);
-        for &tau in &nodes {
-            let spec = AtmosphereSpec { aot550: tau, ..atmosphere_spec.clone() };
-            let key = KeyBuilder::new(Stage::Lut).with(&spec).with(axes).finish();
-            luts.push(self.stage(key, report, control, || {
-                let atmosphere = spec.build().map_err(failed_any(Stage::Lut))?;
-                AtmosphereLut::build(&atmosphere, axes.clone()).map_err(failed_any(Stage::Lut))
-            })?);
-            nodes_key = nodes_key.after(key);
-        }
-        let nodes_key = nodes_key.finish();
-        let at_nodes = self.stage(nodes_key, report, control, || {
-            let optics = luts
-                .iter()
-                .map(|lut| {
-                    response
-                        .groups
-                        .iter()
-                        .map(|g| SceneOptics::new(scene, &g.grid, lut.clone()))
-                        .collect::<Result<Vec<_>, _>>()
-                })
-                .collect::<Result<Vec<_>, _>>()
-                .map_err(failed_any(Stage::BandAtmosphere))?;
-            AotNodes::build(nodes.clone(), &optics, viewing, response).map_err(failed(Stage::BandAtmosphere))
-        })?;
-        Ok((Some(at_nodes), nodes_key))
     }
 
     /// The pupil radiance and the truth (the spatial response only when the scene asks for it).
@@ -292,7 +224,6 @@ impl Engine {
         let executed_before = self.executions(Stage::Radiance);
         let radiance = self.stage(radiance_key, report, control, || {
             let options = SampleOptions { kernel: kernel.clone(), heading_deg: instrument.heading_deg };
-            let aerosol_map = aerosol_map.as_deref();
             let atmospheres = (sampled_atmosphere.as_ref(), aerosol_map, band_atmosphere.as_ref());
             sample_radiance(scene, optics, viewing, sampled_response, atmospheres, &options, control)
                 .map_err(failed(Stage::Radiance))
