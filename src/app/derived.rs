@@ -68,10 +68,8 @@ pub(super) fn derived(app: &ShoalApp, ui: &mut egui::Ui) {
                     )
                 }),
                 ("On-board binning", |s| {
-                    crate::instrument::effects::binning(&s.effects).map_or_else(
-                        || "–".to_string(),
-                        |b| format!("{0} × {0} {1}", b.factor, if b.digital { "digital" } else { "charge" }),
-                    )
+                    crate::instrument::effects::binning(&s.effects)
+                        .map_or_else(|| "–".to_string(), crate::instrument::effects::Binning::describe)
                 }),
             ];
             // The optics rows only where a design has the effect (an ideal optic has no figure).

@@ -113,7 +113,7 @@ const OFFERED: [Offer; 11] = [
 
 /// Binning to start from: 2 × 2 in charge (a CCD's summing well).
 fn binning() -> InstrumentEffect {
-    InstrumentEffect::Binning(Binning { factor: 2, digital: false })
+    InstrumentEffect::Binning(Binning { factor: 2, spectral: 1, digital: false })
 }
 
 /// A spectral knowledge error to start from: each band's centre known to 0.5 nm rms (an
@@ -227,6 +227,9 @@ pub(super) fn optics_editor(slot: &mut Slot, ui: &mut egui::Ui, error: &mut Opti
                     let mut factor = f64::from(b.factor);
                     number(ui, "pixels summed (k × k)", &mut factor, (1.0, 16.0), 1.0, "");
                     b.factor = factor.round() as u32;
+                    let mut spectral = f64::from(b.spectral);
+                    number(ui, "spectral samples summed", &mut spectral, (1.0, 16.0), 1.0, "");
+                    b.spectral = spectral.round() as u32;
                     ui.label("digital (summed reads)");
                     ui.checkbox(&mut b.digital, "");
                     ui.end_row();

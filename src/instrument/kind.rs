@@ -99,26 +99,54 @@ struct Spectrograph {
     resolution_nm: f64,
     smile_nm: f64,
     keystone_px: f64,
+    channels_summed: usize,
+}
+
+impl Spectrograph {
+    /// Spectral samples from `start_nm` to `end_nm`.
+    fn channels(&self) -> usize {
+        let n = ((self.end_nm - self.start_nm) / self.sampling_nm + 1e-9).floor();
+        if n.is_finite() && n >= 0.0 { n as usize + 1 } else { 1 }
+    }
 }
 
 impl Kind for Spectrograph {
+    /// One Gaussian band per spectral sample; binned, each band is the sum of `channels_summed`
+    /// adjacent samples' Gaussians (tabulated every FWHM/20 over ±2.5 FWHM of its ends), its
+    /// centre their mean and its area theirs summed (so it collects their light).
     fn band_set(&self) -> Result<BandSet, InstrumentError> {
-        let n = ((self.end_nm - self.start_nm) / self.sampling_nm + 1e-9).floor() as usize + 1;
-        let list = (0..n)
+        let m = self.channels_summed.max(1);
+        let at = |i: usize| self.start_nm + i as f64 * self.sampling_nm;
+        let list = (0..self.band_count())
             .map(|i| {
-                let c = self.start_nm + i as f64 * self.sampling_nm;
-                Band::gaussian(&GaussianBand {
-                    name: Some(format!("S{c:.1}")),
-                    centre_nm: c,
-                    fwhm_nm: self.resolution_nm,
-                })
+                if m == 1 {
+                    let c = at(i);
+                    return Band::gaussian(&GaussianBand {
+                        name: Some(format!("S{c:.1}")),
+                        centre_nm: c,
+                        fwhm_nm: self.resolution_nm,
+                    });
+                }
+                let (first, last) = (at(i * m), at(i * m + m - 1));
+                let w = self.resolution_nm;
+                let step = w / 20.0;
+                let nodes = ((last - first + 5.0 * w) / step).ceil() as usize + 1;
+                let wavelengths: Vec<f64> = (0..nodes).map(|k| first - 2.5 * w + k as f64 * step).collect();
+                let values = wavelengths
+                    .iter()
+                    .map(|x| {
+                        (0..m).map(|j| (-4.0 * std::f64::consts::LN_2 * ((x - at(i * m + j)) / w).powi(2)).exp()).sum()
+                    })
+                    .collect();
+                let c = 0.5 * (first + last);
+                let srf = crate::spectral::Spectrum::new(format!("S{c:.1}"), wavelengths, values)?;
+                Band::from_srf(&format!("S{c:.1}"), srf)
             })
             .collect::<Result<Vec<_>, _>>()?;
         Ok(BandSet { name: "spectrograph".into(), bands: list })
     }
     fn band_count(&self) -> usize {
-        let n = ((self.end_nm - self.start_nm) / self.sampling_nm).floor();
-        if n.is_finite() && n >= 0.0 { n as usize + 1 } else { 1 }
+        (self.channels() / self.channels_summed.max(1)).max(1)
     }
     fn distortions(&self) -> (f64, f64) {
         (self.smile_nm, self.keystone_px)
@@ -128,7 +156,7 @@ impl Kind for Spectrograph {
         let check = |range: &r::Range, v: f64| {
             range.check(v).map_err(|message| FieldError { field: range.field("instrument.").into(), message })
         };
-        let Self { start_nm, end_nm, sampling_nm, resolution_nm, smile_nm, keystone_px } = *self;
+        let Self { start_nm, end_nm, sampling_nm, resolution_nm, smile_nm, keystone_px, channels_summed } = *self;
         // Each field checked as `InstrumentSpec::validate` checks the common ones.
         check(&r::SPECTROGRAPH_START_NM, start_nm)?;
         check(&r::SPECTROGRAPH_END_NM, end_nm)?;
@@ -136,6 +164,7 @@ impl Kind for Spectrograph {
         check(&r::SPECTROGRAPH_RESOLUTION_NM, resolution_nm)?;
         check(&r::SPECTROGRAPH_SMILE_NM, smile_nm)?;
         check(&r::SPECTROGRAPH_KEYSTONE_PX, keystone_px)?;
+        check(&r::SPECTROGRAPH_CHANNELS_SUMMED, channels_summed as f64)?;
         let fail = |range: &r::Range, message: String| {
             InstrumentError::Invalid(FieldError { field: range.field("instrument.").into(), message })
         };
@@ -168,6 +197,16 @@ impl Kind for Spectrograph {
                      band's response at {:.1} nm (allowed: start_nm − 2.5·resolution_nm − |smile_nm| ≥ {} nm)",
                     start_nm - reach,
                     r::MIN_SIMULATED_NM
+                ),
+            ));
+        }
+        if channels_summed > self.channels() {
+            return Err(fail(
+                &r::SPECTROGRAPH_CHANNELS_SUMMED,
+                format!(
+                    "{channels_summed} with {} spectral samples (allowed: 1 to {})",
+                    self.channels(),
+                    self.channels()
                 ),
             ));
         }
@@ -225,16 +264,23 @@ impl InstrumentKind {
         match self {
             Self::Multispectral { bands } => Box::new(Multispectral(bands)),
             Self::IdealRadiometer { bands } => Box::new(IdealRadiometer(bands)),
-            Self::Spectrograph { start_nm, end_nm, sampling_nm, resolution_nm, smile_nm, keystone_px } => {
-                Box::new(Spectrograph {
-                    start_nm: *start_nm,
-                    end_nm: *end_nm,
-                    sampling_nm: *sampling_nm,
-                    resolution_nm: *resolution_nm,
-                    smile_nm: *smile_nm,
-                    keystone_px: *keystone_px,
-                })
-            }
+            Self::Spectrograph {
+                start_nm,
+                end_nm,
+                sampling_nm,
+                resolution_nm,
+                smile_nm,
+                keystone_px,
+                channels_summed,
+            } => Box::new(Spectrograph {
+                start_nm: *start_nm,
+                end_nm: *end_nm,
+                sampling_nm: *sampling_nm,
+                resolution_nm: *resolution_nm,
+                smile_nm: *smile_nm,
+                keystone_px: *keystone_px,
+                channels_summed: *channels_summed,
+            }),
             Self::FilterImager { bands, rows_per_band } => {
                 Box::new(FilterImager { bands, rows_per_band: *rows_per_band })
             }

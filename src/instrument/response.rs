@@ -356,6 +356,7 @@ mod tests {
             resolution_nm: 7.0,
             smile_nm: 1.0,
             keystone_px: 0.4,
+            channels_summed: 1,
         };
         let r = Response::new(&spec_with(kind), 0.5).unwrap();
         assert_eq!(r.n_bands(), 101);

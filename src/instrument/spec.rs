@@ -41,6 +41,10 @@ pub enum InstrumentKind {
         /// Keystone: across-track misregistration between the first and last band, pixels.
         #[serde(default)]
         keystone_px: f64,
+        /// Adjacent spectral samples summed into one band (spectral binning: the instrument as
+        /// flown sets it from a `Binning` effect's `spectral`; 1: none).
+        #[serde(default = "one", skip_serializing_if = "is_one")]
+        channels_summed: usize,
     },
     /// Gradient / linear-variable-filter imager (CyanoSat-like): the pass band changes along
     /// track across the focal plane, so each band looks at the ground from a different along-track
@@ -51,6 +55,14 @@ pub enum InstrumentKind {
         /// Detector rows between successive band centres on the focal plane.
         rows_per_band: usize,
     },
+}
+
+fn one() -> usize {
+    1
+}
+
+fn is_one(n: &usize) -> bool {
+    *n == 1
 }
 
 fn default_qe() -> SpectrumSource {

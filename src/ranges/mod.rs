@@ -127,6 +127,8 @@ ranges! {
     SPECTROGRAPH_RESOLUTION_NM = Range::above("instrument.kind.Spectrograph.resolution_nm", 0.0, 100.0, "nm", "spectral resolution, FWHM (every band's response, centre ± 2.5 FWHM, within 325–2500 nm)");
     /// Spectrograph: smile.
     SPECTROGRAPH_SMILE_NM = Range::closed("instrument.kind.Spectrograph.smile_nm", -20.0, 20.0, "nm", "band-centre shift at the swath edges");
+    /// Spectrograph: spectral samples summed per band.
+    SPECTROGRAPH_CHANNELS_SUMMED = Range::count("instrument.kind.Spectrograph.channels_summed", 1.0, 64.0, "", "adjacent spectral samples summed into one band (spectral binning)");
     /// Spectrograph: keystone.
     SPECTROGRAPH_KEYSTONE_PX = Range::closed("instrument.kind.Spectrograph.keystone_px", -20.0, 20.0, "pixels", "across-track misregistration, first to last band");
     /// Filter imager: rows per band.
@@ -187,6 +189,8 @@ ranges! {
     MISREGISTRATION_KNOWLEDGE_ERROR = Range::closed("instrument.effects[].Misregistration.correction.error", -1.0, 1.0, "", "relative error of the shifts the co-registration believes");
     /// Binning: pixels summed along and across track.
     BINNING_FACTOR = Range::count("instrument.effects[].Binning.factor", 1.0, 16.0, "", "k: k × k pixels summed into one on board");
+    /// Binning: spectral samples summed.
+    BINNING_SPECTRAL = Range::count("instrument.effects[].Binning.spectral", 1.0, 16.0, "", "m: adjacent spectral samples summed on board (a spectrograph only)");
     /// Spectral knowledge: common centre error.
     SPECTRAL_CENTRE_NM = Range::closed("instrument.effects[].SpectralKnowledge.centre_nm", -10.0, 10.0, "nm", "every band's true centre minus the believed one (per_band_nm: each band's)");
     /// Spectral knowledge: drawn centre error.

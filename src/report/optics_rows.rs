@@ -68,7 +68,7 @@ pub fn focal_plane_summary(spec: &crate::instrument::InstrumentSpec) -> String {
         });
     }
     if let Some(b) = effects::binning(list) {
-        parts.push(format!("binned {0} × {0} ({1})", b.factor, if b.digital { "digital" } else { "charge" }));
+        parts.push(format!("binned {}", b.describe()));
     }
     if let Some(k) = effects::spectral_knowledge(list) {
         parts.push(k.describe());

@@ -18,7 +18,7 @@ fn config(binning: Option<Binning>) -> RunConfig {
 
 #[test]
 fn a_binned_run_is_the_instrument_as_flown() {
-    let binning = Binning { factor: 2, digital: false };
+    let binning = Binning { factor: 2, spectral: 1, digital: false };
     let binned = run(&config(Some(binning)));
     // The same run as the flown instrument stated by hand: the same bits.
     let mut by_hand = config(None);
@@ -49,7 +49,7 @@ fn a_binned_run_is_the_instrument_as_flown() {
 
 #[test]
 fn binning_does_not_depend_on_threads() {
-    let c = config(Some(Binning { factor: 3, digital: true }));
+    let c = config(Some(Binning { factor: 3, spectral: 1, digital: true }));
     let pool = |n| rayon::ThreadPoolBuilder::new().num_threads(n).build().unwrap();
     let one = pool(1).install(|| run(&c));
     let two = pool(2).install(|| run(&c));
@@ -59,11 +59,29 @@ fn binning_does_not_depend_on_threads() {
 
 #[test]
 fn a_binning_the_array_cannot_make_is_refused_by_name() {
-    let mut c = config(Some(Binning { factor: 16, digital: false }));
+    let mut c = config(Some(Binning { factor: 16, spectral: 1, digital: false }));
     c.instrument.detectors = 10;
     let e = c.validate().unwrap_err().to_string();
     assert!(e.contains("Binning.factor") && e.contains("10 detectors"), "{e}");
-    let c = config(Some(Binning { factor: 40, digital: false }));
+    let c = config(Some(Binning { factor: 40, spectral: 1, digital: false }));
     let e = c.validate().unwrap_err().to_string();
     assert!(e.contains("Binning.factor") && e.contains("16"), "{e}");
+}
+
+#[test]
+fn a_spectrograph_binned_spectrally_runs_with_half_the_bands() {
+    let mut instrument = small("hyperspectral", 48, 32);
+    instrument.effects = vec![InstrumentEffect::Binning(Binning { factor: 1, spectral: 2, digital: true })];
+    let binned = run(&RunConfig::new(small_lake(), instrument));
+    let native = run(&RunConfig::new(small_lake(), small("hyperspectral", 48, 32)));
+    let (nb, bb) = (native.kept().level1.radiance.dim().2, binned.kept().level1.radiance.dim().2);
+    assert_eq!(bb, nb / 2);
+    // Two samples' light in each band, with two reads: the SNR at the scene's typical radiance
+    // gains between √2 (read noise negligible) and 2 (read-limited: twice the signal, √2 the
+    // read noise), band by band against the two samples it sums.
+    for (i, row) in binned.snr.iter().enumerate() {
+        let pair = (native.snr[2 * i].snr_analytic + native.snr[2 * i + 1].snr_analytic) / 2.0;
+        let gain = row.snr_analytic / pair;
+        assert!((1.3..=2.1).contains(&gain), "{}: {gain}", row.band);
+    }
 }

@@ -10,7 +10,7 @@ use shoal::retrieval::RetrievalSpec;
 /// imager's `kind` fields need that kind; everything else is on the Table 1 CubeSat.
 #[must_use]
 pub fn instrument_for(path: &str) -> &'static str {
-    if path.contains("Spectrograph") || path.contains("smile_pct") {
+    if path.contains("Spectrograph") || path.contains("smile_pct") || path.contains("Binning.spectral") {
         "hyperspectral"
     } else if path.contains("FilterImager") {
         "filter_imager"

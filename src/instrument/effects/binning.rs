@@ -29,7 +29,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::{Effect, InstrumentEffect, InstrumentError, check};
-use crate::instrument::InstrumentSpec;
+use crate::instrument::{InstrumentKind, InstrumentSpec};
 use crate::parse::FieldError;
 use crate::ranges as r;
 
@@ -38,23 +38,51 @@ use crate::ranges as r;
 #[serde(deny_unknown_fields)]
 pub struct Binning {
     /// Pixels summed along and across track: k × k make one.
+    #[serde(default = "one")]
     pub factor: u32,
+    /// A spectrograph's adjacent spectral samples summed: m make one band.
+    #[serde(default = "one")]
+    pub spectral: u32,
     /// Summed after digitisation (k² reads) rather than as charge (one read).
     #[serde(default)]
     pub digital: bool,
 }
 
+fn one() -> u32 {
+    1
+}
+
 impl Binning {
+    /// A short statement for tables ("2 × 2 charge", "1 × 1 × 3 spectral, digital").
+    #[must_use]
+    pub fn describe(&self) -> String {
+        let spectral = if self.spectral > 1 { format!(" × {} spectral", self.spectral) } else { String::new() };
+        let how = if self.digital { "digital" } else { "charge" };
+        if spectral.is_empty() {
+            format!("{0} × {0} {how}", self.factor)
+        } else {
+            format!("{0} × {0}{spectral}, {how}", self.factor)
+        }
+    }
+
+    /// Pixels summed into one binned value, k²·m.
+    #[must_use]
+    pub fn summed(&self) -> f64 {
+        f64::from(self.factor.max(1)).powi(2) * f64::from(self.spectral.max(1))
+    }
+
     /// The instrument as flown: `spec` with every focal plane binned (the module docs), the
     /// binning entry itself removed and a misregistration's shifts in binned pixels.
     #[must_use]
     pub fn flown(&self, spec: &InstrumentSpec) -> InstrumentSpec {
         let k = f64::from(self.factor.max(1));
         let n = self.factor.max(1) as usize;
+        // Pixels in one binned value: k² spatially, times m spectral samples.
+        let summed = self.summed();
         let mut out = spec.clone();
         let read = |read_noise_e: f64, gain_e_per_dn: f64| {
             if self.digital {
-                k * (read_noise_e * read_noise_e + gain_e_per_dn * gain_e_per_dn / 12.0).sqrt()
+                (summed * (read_noise_e * read_noise_e + gain_e_per_dn * gain_e_per_dn / 12.0)).sqrt()
             } else {
                 read_noise_e
             }
@@ -62,22 +90,25 @@ impl Binning {
         out.pixel_pitch_um *= k;
         out.detectors = (spec.detectors / n).max(1);
         out.lines = (spec.lines / n).max(1);
-        out.well_depth_e *= k * k;
+        out.well_depth_e *= summed;
         out.read_noise_e = read(spec.read_noise_e, spec.gain_e_per_dn);
-        out.gain_e_per_dn *= k * k;
-        out.dark_current_e_s *= k * k;
-        out.dsnu_e *= k;
-        out.prnu /= k;
+        out.gain_e_per_dn *= summed;
+        out.dark_current_e_s *= summed;
+        out.dsnu_e *= summed.sqrt();
+        out.prnu /= summed.sqrt();
+        if let InstrumentKind::Spectrograph { channels_summed, .. } = &mut out.kind {
+            *channels_summed *= self.spectral.max(1) as usize;
+        }
         for (p, q) in out.focal_planes.iter_mut().zip(&spec.focal_planes) {
             p.pixel_pitch_um *= k;
             // Rounded up: a coarser plane still covers the first plane's binned swath.
             p.detectors = q.detectors.div_ceil(n).max(1);
-            p.well_depth_e *= k * k;
+            p.well_depth_e *= summed;
             p.read_noise_e = read(q.read_noise_e, q.gain_e_per_dn);
-            p.gain_e_per_dn *= k * k;
-            p.dark_current_e_s *= k * k;
-            p.dsnu_e *= k;
-            p.prnu /= k;
+            p.gain_e_per_dn *= summed;
+            p.dark_current_e_s *= summed;
+            p.dsnu_e *= summed.sqrt();
+            p.prnu /= summed.sqrt();
         }
         out.effects.retain(|e| !matches!(e, InstrumentEffect::Binning(_)));
         for e in &mut out.effects {
@@ -98,7 +129,8 @@ impl Effect for Binning {
     }
 
     fn validate(&self, at: &str) -> Result<(), InstrumentError> {
-        check(&r::BINNING_FACTOR, f64::from(self.factor), &format!("{at}.factor"))
+        check(&r::BINNING_FACTOR, f64::from(self.factor), &format!("{at}.factor"))?;
+        check(&r::BINNING_SPECTRAL, f64::from(self.spectral), &format!("{at}.spectral"))
     }
 
     /// It changes the instrument (its pixels), not the cube.
@@ -107,8 +139,18 @@ impl Effect for Binning {
     }
 }
 
-/// A binning the instrument cannot make: fewer detectors or lines than one binned pixel needs.
+/// A binning the instrument cannot make: fewer detectors or lines than one binned pixel needs,
+/// or spectral binning on an instrument without a spectrum on its detector.
 pub(crate) fn check_fits(b: &Binning, spec: &InstrumentSpec) -> Result<(), InstrumentError> {
+    if b.spectral > 1 && !matches!(spec.kind, InstrumentKind::Spectrograph { .. }) {
+        return Err(InstrumentError::Invalid(FieldError {
+            field: "instrument.effects[].Binning.spectral".into(),
+            message: format!(
+                "{} on an instrument whose bands are filters (allowed: 1; a Spectrograph sums adjacent samples)",
+                b.spectral
+            ),
+        }));
+    }
     let k = b.factor as usize;
     let short =
         [("instrument.detectors", spec.detectors), ("instrument.lines", spec.lines)].into_iter().find(|(_, n)| *n < k);
@@ -128,7 +170,7 @@ mod tests {
     #[test]
     fn the_flown_instrument_is_the_sum_of_k_squared_pixels() {
         let spec = InstrumentSpec::preset("cubesat").unwrap();
-        let charge = Binning { factor: 2, digital: false }.flown(&spec);
+        let charge = Binning { factor: 2, spectral: 1, digital: false }.flown(&spec);
         assert_eq!(charge.pixel_pitch_um, 2.0 * spec.pixel_pitch_um);
         assert_eq!(charge.detectors, spec.detectors / 2);
         assert_eq!(charge.lines, spec.lines / 2);
@@ -137,7 +179,7 @@ mod tests {
         assert_eq!(charge.read_noise_e, spec.read_noise_e, "charge: one read");
         assert_eq!(charge.gain_e_per_dn, 4.0 * spec.gain_e_per_dn);
         assert_eq!(charge.adc_bits, spec.adc_bits);
-        let digital = Binning { factor: 2, digital: true }.flown(&spec);
+        let digital = Binning { factor: 2, spectral: 1, digital: true }.flown(&spec);
         let g = spec.gain_e_per_dn;
         let expected = 2.0 * (spec.read_noise_e.powi(2) + g * g / 12.0).sqrt();
         assert!((digital.read_noise_e - expected).abs() < 1e-12, "digital: four reads and roundings");
@@ -159,7 +201,7 @@ mod tests {
         let (signal, dark) = (native.responsivity(j, b) * radiance, native.dark_mean_e(j, b, t));
         let (read, g) = (spec.read_noise_e, spec.gain_e_per_dn);
         for (k, digital) in [(2u32, false), (2, true), (3, false)] {
-            let flown = Binning { factor: k, digital }.flown(&spec);
+            let flown = Binning { factor: k, spectral: 1, digital }.flown(&spec);
             let binned = of(&flown);
             let (kk, jb) = (f64::from(k * k), flown.detectors / 2);
             // The binned pixel collects k² times the light and the dark current.
@@ -180,19 +222,55 @@ mod tests {
         // Shot-limited, 2 × 2 gains 2 in SNR; in charge, the one read makes it more than 2
         // exactly where the read noise outweighs the coarser rounding, σ_r > g/√3 (from the
         // variances above: 4(S + D + σ_r² + g²/12) against S + D + σ_r²/4 + g²/3).
-        let flown = Binning { factor: 2, digital: false }.flown(&spec);
+        let flown = Binning { factor: 2, spectral: 1, digital: false }.flown(&spec);
         let gain = analytic_snr(&of(&flown), flown.detectors / 2, b, radiance) / analytic_snr(&native, j, b, radiance);
         assert_eq!(gain > 2.0, read > g / 3f64.sqrt(), "{gain}");
         assert!(gain > 1.5, "{gain}");
     }
 
     #[test]
+    fn spectral_binning_sums_adjacent_samples() {
+        use crate::instrument::{Detector, DetectorMode, Response};
+        let mut spec = InstrumentSpec::preset("hyperspectral").unwrap();
+        // No PRNU: each element's own draw would hide the sum.
+        spec.prnu = 0.0;
+        let flown = Binning { factor: 1, spectral: 2, digital: true }.flown(&spec);
+        let of = |s: &InstrumentSpec| {
+            let r = Response::new(s, 0.5).unwrap();
+            (Detector::new(s, &r, DetectorMode::default(), 5), r)
+        };
+        let ((native, nr), (binned, br)) = (of(&spec), of(&flown));
+        // 101 samples 400–900 nm every 5 nm: 50 bands of two, the first centred at 402.5 nm.
+        assert_eq!(br.n_bands(), nr.n_bands() / 2);
+        assert!((br.bands.bands[0].centre_nm - 402.5).abs() < 0.05, "{}", br.bands.bands[0].centre_nm);
+        // Each band collects its two samples' light: the responsivities add (to the tabulation
+        // of the summed Gaussians, 1e-3).
+        let j = spec.detectors / 2;
+        for i in [0, 10, 49] {
+            let sum = native.responsivity(j, 2 * i) + native.responsivity(j, 2 * i + 1);
+            assert!(
+                (binned.responsivity(j, i) / sum - 1.0).abs() < 1e-3,
+                "band {i}: {} against {sum}",
+                binned.responsivity(j, i)
+            );
+        }
+        // Two reads and roundings summed: the read noise of the pair.
+        let g = spec.gain_e_per_dn;
+        let expected = (2.0 * (spec.read_noise_e.powi(2) + g * g / 12.0)).sqrt();
+        assert!((flown.read_noise_e - expected).abs() < 1e-12);
+        // On filters there is nothing to sum.
+        let cubesat = InstrumentSpec::preset("cubesat").unwrap();
+        let e = check_fits(&Binning { factor: 1, spectral: 2, digital: false }, &cubesat).unwrap_err().to_string();
+        assert!(e.contains("Binning.spectral"), "{e}");
+    }
+
+    #[test]
     fn a_binning_larger_than_the_array_is_refused_by_name() {
         let mut spec = InstrumentSpec::preset("cubesat").unwrap();
         spec.lines = 3;
-        let e = check_fits(&Binning { factor: 4, digital: false }, &spec).unwrap_err().to_string();
+        let e = check_fits(&Binning { factor: 4, spectral: 1, digital: false }, &spec).unwrap_err().to_string();
         assert!(e.contains("Binning.factor") && e.contains("3 lines"), "{e}");
-        let e = Binning { factor: 0, digital: false }.validate("b").unwrap_err().to_string();
+        let e = Binning { factor: 0, spectral: 1, digital: false }.validate("b").unwrap_err().to_string();
         assert!(e.contains("b.factor"), "{e}");
     }
 }

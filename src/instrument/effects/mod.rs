@@ -307,11 +307,11 @@ pub fn tdi(effects: &[InstrumentEffect]) -> Option<&Tdi> {
     })
 }
 
-/// The binning the instrument states, if it bins (a factor above 1).
+/// The binning the instrument states, if it bins (a factor or spectral count above 1).
 #[must_use]
 pub fn binning(effects: &[InstrumentEffect]) -> Option<&Binning> {
     effects.iter().find_map(|e| match e {
-        InstrumentEffect::Binning(b) if b.factor > 1 => Some(b),
+        InstrumentEffect::Binning(b) if b.factor > 1 || b.spectral > 1 => Some(b),
         _ => None,
     })
 }
