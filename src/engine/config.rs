@@ -154,6 +154,16 @@ pub struct RunConfig {
 }
 
 impl RunConfig {
+    /// The configuration as flown: the instrument with on-board binning folded into its pixels
+    /// ([`InstrumentSpec::as_flown`]), what the engine simulates; itself when nothing is binned.
+    #[must_use]
+    pub fn flown(&self) -> std::borrow::Cow<'_, Self> {
+        match self.instrument.as_flown() {
+            std::borrow::Cow::Borrowed(_) => std::borrow::Cow::Borrowed(self),
+            std::borrow::Cow::Owned(instrument) => std::borrow::Cow::Owned(Self { instrument, ..self.clone() }),
+        }
+    }
+
     /// A run of `instrument` over `scene` with default settings.
     #[must_use]
     pub fn new(scene: SceneSpec, instrument: InstrumentSpec) -> Self {

@@ -217,14 +217,8 @@ pub fn run_demand(config: &RunConfig) -> Demand {
 #[must_use]
 pub fn run_demand_keeping(config: &RunConfig, keep_cubes: bool) -> Demand {
     // The instrument as flown: a binned one simulates its binned pixels.
-    let flown;
-    let config = match config.instrument.as_flown() {
-        std::borrow::Cow::Borrowed(_) => config,
-        std::borrow::Cow::Owned(instrument) => {
-            flown = RunConfig { instrument, ..config.clone() };
-            &flown
-        }
-    };
+    let flown = config.flown();
+    let config: &RunConfig = &flown;
     let mut parts = Vec::new();
     scene_parts(&config.scene, &mut parts);
     parts.push(atmosphere_part(config));

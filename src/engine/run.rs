@@ -174,14 +174,8 @@ impl Engine {
         config.validate_keeping(self.keep_cubes)?;
         // The instrument as flown (on-board binning folded into its pixels): what every stage
         // simulates and the output reports.
-        let flown;
-        let config = match config.instrument.as_flown() {
-            std::borrow::Cow::Borrowed(_) => config,
-            std::borrow::Cow::Owned(instrument) => {
-                flown = RunConfig { instrument, ..config.clone() };
-                &flown
-            }
-        };
+        let flown = config.flown();
+        let config: &RunConfig = &flown;
         let mut report = RunReport {
             scene: config.scene.name.clone(),
             instrument: config.instrument.name.clone(),

@@ -43,7 +43,7 @@ pub enum InstrumentKind {
         keystone_px: f64,
         /// Adjacent spectral samples summed into one band (spectral binning: the instrument as
         /// flown sets it from a `Binning` effect's `spectral`; 1: none).
-        #[serde(default = "one", skip_serializing_if = "is_one")]
+        #[serde(default = "one")]
         channels_summed: usize,
     },
     /// Gradient / linear-variable-filter imager (CyanoSat-like): the pass band changes along
@@ -59,10 +59,6 @@ pub enum InstrumentKind {
 
 fn one() -> usize {
     1
-}
-
-fn is_one(n: &usize) -> bool {
-    *n == 1
 }
 
 fn default_qe() -> SpectrumSource {

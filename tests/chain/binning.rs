@@ -8,7 +8,7 @@ use shoal::instrument::InstrumentEffect;
 use shoal::instrument::budgets::BudgetModels;
 use shoal::instrument::effects::Binning;
 
-use super::{run, small, small_lake};
+use super::{on_one_and_two_threads, run, small, small_lake};
 
 fn config(binning: Option<Binning>) -> RunConfig {
     let mut instrument = small("cubesat", 96, 64);
@@ -50,9 +50,7 @@ fn a_binned_run_is_the_instrument_as_flown() {
 #[test]
 fn binning_does_not_depend_on_threads() {
     let c = config(Some(Binning { factor: 3, spectral: 1, digital: true }));
-    let pool = |n| rayon::ThreadPoolBuilder::new().num_threads(n).build().unwrap();
-    let one = pool(1).install(|| run(&c));
-    let two = pool(2).install(|| run(&c));
+    let (one, two) = on_one_and_two_threads(&c);
     assert_eq!(one.kept().level0.dn, two.kept().level0.dn);
     assert_eq!(one.kept().level1.radiance, two.kept().level1.radiance);
 }

@@ -6,7 +6,7 @@ use crate::common::Kept;
 use shoal::engine::{RunConfig, RunOutput};
 use shoal::instrument::{DetectorMode, Flags};
 
-use super::{run, small, small_lake};
+use super::{on_one_and_two_threads, run, small, small_lake};
 
 /// A noise-free CubeSat over a cut of Lake Hume with `effects` (RON), calibrated from its
 /// diffuser frames (the analogue values: no quantisation).
@@ -171,9 +171,7 @@ fn focal_plane_effects_do_not_depend_on_threads() {
     let mut noisy = c.clone();
     noisy.detector = DetectorMode::default();
     for c in [c, noisy] {
-        let pool = |n| rayon::ThreadPoolBuilder::new().num_threads(n).build().unwrap();
-        let one = pool(1).install(|| run(&c));
-        let two = pool(2).install(|| run(&c));
+        let (one, two) = on_one_and_two_threads(&c);
         assert_eq!(one.kept().level0.dn, two.kept().level0.dn);
         assert_eq!(one.kept().level1.radiance, two.kept().level1.radiance);
     }

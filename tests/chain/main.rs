@@ -68,3 +68,9 @@ pub fn small(name: &str, detectors: usize, lines: usize) -> InstrumentSpec {
 pub fn run(config: &RunConfig) -> RunOutput {
     Engine::new().run(config, &RunControl::new()).unwrap()
 }
+
+/// `config` run on one thread and on two (determinism tests compare the two).
+pub fn on_one_and_two_threads(config: &RunConfig) -> (RunOutput, RunOutput) {
+    let pool = |n| rayon::ThreadPoolBuilder::new().num_threads(n).build().unwrap();
+    (pool(1).install(|| run(config)), pool(2).install(|| run(config)))
+}

@@ -8,7 +8,7 @@ use shoal::calibration::band_e0;
 use shoal::engine::{Fidelity, RunConfig, RunOutput};
 use shoal::instrument::{DetectorMode, Response};
 
-use super::{run, small, small_lake};
+use super::{on_one_and_two_threads, run, small, small_lake};
 
 /// A noise-free CubeSat over a cut of Lake Hume with `effects` (RON), calibrated from its
 /// diffuser frames (the analogue values: no quantisation).
@@ -108,9 +108,7 @@ fn a_spectral_error_grows_the_product_error_and_does_not_depend_on_threads() {
     };
     let none = run(&almi("[]"));
     let c = almi("[SpectralKnowledge((centre_nm: 2.0))]");
-    let pool = |n| rayon::ThreadPoolBuilder::new().num_threads(n).build().unwrap();
-    let one = pool(1).install(|| run(&c));
-    let two = pool(2).install(|| run(&c));
+    let (one, two) = on_one_and_two_threads(&c);
     assert_eq!(one.kept().level1.radiance, two.kept().level1.radiance);
     eprintln!("chl MAE (10^mean|Δlog|): bands as believed {:.4}, 2 nm redder {:.4}", chl(&none), chl(&one));
     assert!(chl(&one) > chl(&none), "{} against {}", chl(&one), chl(&none));

@@ -71,44 +71,53 @@ impl Binning {
         f64::from(self.factor.max(1)).powi(2) * f64::from(self.spectral.max(1))
     }
 
+    /// One focal plane's numbers as binned, in place: well, read noise, gain, dark current,
+    /// DSNU and PRNU (the module docs), for the k²·m elements in one binned value.
+    fn bin_electronics(&self, [well_e, read_e, gain_e_per_dn, dark_e_s, dsnu_e, prnu]: [&mut f64; 6]) {
+        let summed = self.summed();
+        if self.digital {
+            *read_e = (summed * (*read_e * *read_e + *gain_e_per_dn * *gain_e_per_dn / 12.0)).sqrt();
+        }
+        *well_e *= summed;
+        *gain_e_per_dn *= summed;
+        *dark_e_s *= summed;
+        *dsnu_e *= summed.sqrt();
+        *prnu /= summed.sqrt();
+    }
+
     /// The instrument as flown: `spec` with every focal plane binned (the module docs), the
     /// binning entry itself removed and a misregistration's shifts in binned pixels.
     #[must_use]
     pub fn flown(&self, spec: &InstrumentSpec) -> InstrumentSpec {
         let k = f64::from(self.factor.max(1));
         let n = self.factor.max(1) as usize;
-        // Pixels in one binned value: k² spatially, times m spectral samples.
-        let summed = self.summed();
         let mut out = spec.clone();
-        let read = |read_noise_e: f64, gain_e_per_dn: f64| {
-            if self.digital {
-                (summed * (read_noise_e * read_noise_e + gain_e_per_dn * gain_e_per_dn / 12.0)).sqrt()
-            } else {
-                read_noise_e
-            }
-        };
         out.pixel_pitch_um *= k;
         out.detectors = (spec.detectors / n).max(1);
         out.lines = (spec.lines / n).max(1);
-        out.well_depth_e *= summed;
-        out.read_noise_e = read(spec.read_noise_e, spec.gain_e_per_dn);
-        out.gain_e_per_dn *= summed;
-        out.dark_current_e_s *= summed;
-        out.dsnu_e *= summed.sqrt();
-        out.prnu /= summed.sqrt();
+        self.bin_electronics([
+            &mut out.well_depth_e,
+            &mut out.read_noise_e,
+            &mut out.gain_e_per_dn,
+            &mut out.dark_current_e_s,
+            &mut out.dsnu_e,
+            &mut out.prnu,
+        ]);
         if let InstrumentKind::Spectrograph { channels_summed, .. } = &mut out.kind {
             *channels_summed *= self.spectral.max(1) as usize;
         }
-        for (p, q) in out.focal_planes.iter_mut().zip(&spec.focal_planes) {
+        for p in &mut out.focal_planes {
             p.pixel_pitch_um *= k;
             // Rounded up: a coarser plane still covers the first plane's binned swath.
-            p.detectors = q.detectors.div_ceil(n).max(1);
-            p.well_depth_e *= summed;
-            p.read_noise_e = read(q.read_noise_e, q.gain_e_per_dn);
-            p.gain_e_per_dn *= summed;
-            p.dark_current_e_s *= summed;
-            p.dsnu_e *= summed.sqrt();
-            p.prnu /= summed.sqrt();
+            p.detectors = p.detectors.div_ceil(n).max(1);
+            self.bin_electronics([
+                &mut p.well_depth_e,
+                &mut p.read_noise_e,
+                &mut p.gain_e_per_dn,
+                &mut p.dark_current_e_s,
+                &mut p.dsnu_e,
+                &mut p.prnu,
+            ]);
         }
         out.effects.retain(|e| !matches!(e, InstrumentEffect::Binning(_)));
         for e in &mut out.effects {
