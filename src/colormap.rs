@@ -5,7 +5,8 @@
 //!   colours at k/7, linearly interpolated in sRGB.
 //! - [`diverging`]: ColorBrewer RdBu reversed (Brewer 2002), blue below zero, red above, for
 //!   differences (A − B, retrieved − true).
-//! - [`categorical`]: ColorBrewer Set1 and Dark2 colours for classes (SIOP sets, substrates).
+//! - [`categorical`]: ColorBrewer Set1 (its grey replaced by matplotlib's `tab:cyan`, apart from the
+//!   truth's grey) and Dark2 colours for classes (SIOP sets, substrates) and designs.
 //!
 //! ## References
 //! - Nuñez, J. R., Anderton, C. R., Renslow, R. S. (2018) Optimizing colormaps with consideration
@@ -49,7 +50,7 @@ const CLASSES: [Rgb; 12] = [
     [255, 127, 0],
     [166, 86, 40],
     [247, 129, 191],
-    [153, 153, 153],
+    [23, 190, 207],
     [27, 158, 119],
     [217, 95, 2],
     [117, 112, 179],
