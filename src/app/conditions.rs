@@ -43,6 +43,13 @@ fn checked(
 /// The scene and atmosphere controls.
 pub(super) fn conditions(app: &mut ShoalApp, ui: &mut egui::Ui) {
     use crate::ranges as r;
+    // Each design's band centres, from its latest result (a pair the bands lack is not offered).
+    let bands: Vec<(String, Vec<f64>)> = (0..app.state.designs.len())
+        .filter_map(|i| {
+            let shown = app.link.current(i)?;
+            Some((super::designs::label(i), shown.output.response.bands.centres_nm()))
+        })
+        .collect();
     egui::CollapsingHeader::new("Scene and atmosphere").default_open(false).show(ui, |ui| {
         let s = &mut app.state;
         let mut refused = None;
@@ -109,7 +116,7 @@ pub(super) fn conditions(app: &mut ShoalApp, ui: &mut egui::Ui) {
                 }
             }
         }
-        correction_choice(ui, &mut s.correction);
+        correction_choice(ui, &mut s.correction, &bands);
         ui.label("Calibration errors (systematic)");
         let c = &mut s.calibration;
         refused = refused.or(checked(
@@ -141,8 +148,10 @@ pub(super) fn conditions(app: &mut ShoalApp, ui: &mut egui::Ui) {
 /// The atmospheric correction both instruments' Level-1 goes through: exact (the forward
 /// model's own atmosphere, the "perfect correction"), the paper's per-scene approximation, or
 /// image-based (the aerosol from the design's own bands; `correction::image`): a band pair with
-/// the NIR water iteration, a SWIR pair, or dark-spectrum fitting.
-fn correction_choice(ui: &mut egui::Ui, spec: &mut crate::correction::CorrectionSpec) {
+/// the NIR water iteration, a SWIR pair, or dark-spectrum fitting. A pair some design's bands
+/// (`bands`: each design's letter and band centres) lack is shown greyed, with which design and
+/// why.
+fn correction_choice(ui: &mut egui::Ui, spec: &mut crate::correction::CorrectionSpec, bands: &[(String, Vec<f64>)]) {
     use crate::correction::{AerosolFit, ImageCorrection};
     let pair = |p: [f64; 2]| Some(ImageCorrection { pair_nm: p, ..ImageCorrection::default() });
     let choices: [(&str, &str, Option<ImageCorrection>, bool); 5] = [
@@ -185,7 +194,16 @@ fn correction_choice(ui: &mut egui::Ui, spec: &mut crate::correction::Correction
         .map_or("image: custom", |i| choices[i].0);
     egui::ComboBox::from_label("Atmospheric correction").selected_text(current).show_ui(ui, |ui| {
         for (name, hover, image, approx) in choices {
-            if ui.selectable_label(current == name, name).on_hover_text(hover).clicked() {
+            // The first design whose bands cannot make the pair, and why.
+            let lacking = image.as_ref().filter(|i| i.fit != AerosolFit::DarkSpectrum).and_then(|i| {
+                bands.iter().find_map(|(design, centres)| i.pair(centres).err().map(|e| format!("{design}: {e}")))
+            });
+            let label = ui.add_enabled(lacking.is_none(), egui::Button::selectable(current == name, name));
+            let label = match &lacking {
+                Some(why) => label.on_disabled_hover_text(format!("{hover}\n\nNot offered: design {why}")),
+                None => label.on_hover_text(hover),
+            };
+            if label.clicked() {
                 spec.use_approximation = approx;
                 spec.image = image;
             }

@@ -4,7 +4,8 @@
 
 use std::time::{Duration, Instant};
 
-use egui_kittest::kittest::Queryable;
+use egui::accesskit::Role;
+use egui_kittest::kittest::{NodeT, Queryable};
 
 use super::{harness, temp_library, wait_for_engine};
 
@@ -84,5 +85,35 @@ fn the_image_based_correction_is_the_default_and_the_perfect_processor_one_choic
         let out = &h.state().link.shown[i].as_ref().unwrap().output;
         assert!(out.correction.aerosol.is_none() && out.config.correction.image.is_none(), "the exact correction");
     }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_swir_pair_the_designs_lack_is_not_offered() {
+    let dir = temp_library("swirpair");
+    let mut h = harness("cubesat", 8, &dir);
+    wait_for_engine(&mut h);
+    // The scene panel sits below the left panel's fold: the accessibility actions reach it
+    // where a pointer would have to scroll.
+    let settle = |h: &mut egui_kittest::Harness<'static, shoal::app::ShoalApp>| {
+        h.step();
+        h.step();
+    };
+    h.get_by_label("Scene and atmosphere").click_accesskit();
+    settle(&mut h);
+    h.get_by_role_and_label(Role::ComboBox, "Atmospheric correction").click_accesskit();
+    settle(&mut h);
+    // The CubeSat has no band near 1610 or 2200 nm: the SWIR pair is greyed, and choosing it
+    // changes nothing; dark-spectrum fitting needs no pair.
+    assert!(h.get_by_label("image: 1610/2200 nm").accesskit_node().is_disabled(), "the SWIR pair is offered");
+    assert!(!h.get_by_label("image: dark spectrum").accesskit_node().is_disabled());
+    h.get_by_label("image: 1610/2200 nm").click_accesskit();
+    settle(&mut h);
+    let image = h.state().state.correction.image.clone().expect("the default image-based correction");
+    assert_eq!(image.pair_nm, [779.0, 865.0], "a pair the design lacks was taken");
+    h.get_by_label("image: dark spectrum").click_accesskit();
+    settle(&mut h);
+    let image = h.state().state.correction.image.clone().unwrap();
+    assert_eq!(image.fit, shoal::correction::AerosolFit::DarkSpectrum);
     let _ = std::fs::remove_dir_all(&dir);
 }
