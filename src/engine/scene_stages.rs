@@ -1,32 +1,53 @@
-//! The scene side's stages beyond the stated response's band atmosphere: the band terms at AOT
-//! nodes where the scene's AOT is a map, and the scene seen through the bands the instrument
-//! really has where the processor's knowledge of them is wrong.
+//! The scene side's stages beyond the stated response and its band atmosphere: the band terms
+//! at AOT nodes where the scene's AOT is a map, and the bands the instrument really has (their
+//! response, band atmosphere and AOT nodes) where the processor's knowledge of them is wrong.
 
 use std::sync::Arc;
 
-use super::EngineError;
 use super::cache::{Key, KeyBuilder, Stage};
 use super::products::Sensed;
 use super::report::RunReport;
 use super::run::Engine;
 use super::stages::{failed, failed_any};
+use super::{EngineError, RunConfig};
 use crate::atmosphere::{AtmosphereLut, AtmosphereSpec, LutAxes};
 use crate::control::RunControl;
 use crate::instrument::aerosol_map;
+use crate::instrument::effects;
 use crate::instrument::sample::BandAtmosphere;
 use crate::instrument::{AotNodes, Response, Viewing};
 use crate::scene::Scene;
 use crate::toa::SceneOptics;
 
 impl Engine {
+    /// The bands the instrument really has, where the processor's knowledge of them is wrong
+    /// (`None` otherwise). The response key holds the error: the same grids, other weights.
+    pub(super) fn sensed_response(
+        &mut self,
+        config: &RunConfig,
+        response_key: Key,
+        control: &RunControl,
+        report: &mut RunReport,
+    ) -> Result<Option<Arc<Response>>, EngineError> {
+        if effects::spectral_knowledge(&config.instrument.effects).is_none() {
+            return Ok(None);
+        }
+        let key = KeyBuilder::new(Stage::Response).after(response_key).with("sensed").finish();
+        let response = self.stage(key, report, control, || {
+            Response::sensed(&config.instrument, config.fidelity.spectral_step_nm).map_err(failed(Stage::Response))
+        })?;
+        Ok(Some(response))
+    }
+
     /// Where the instrument states a spectral knowledge error (`sensed_response`, its true
-    /// bands): their band atmosphere and AOT nodes, keyed after the stated ones'.
+    /// bands): their band atmosphere and AOT nodes, keyed after the stated ones' (`band_key`),
+    /// with the AOT range the stated bands' found (`range_after`, see [`Self::aerosol_map_stage`]).
     pub(super) fn sensed_side(
         &mut self,
         sensed_response: Option<Arc<Response>>,
         (scene, optics, viewing): (&Arc<Scene>, &Arc<Vec<SceneOptics>>, &Arc<Viewing>),
         (atmosphere_spec, axes): (&AtmosphereSpec, &LutAxes),
-        band_key: Key,
+        (band_key, range_after): (Key, Key),
         control: &RunControl,
         report: &mut RunReport,
     ) -> Result<Option<Sensed>, EngineError> {
@@ -35,19 +56,25 @@ impl Engine {
         let band_atmosphere = self.stage(key, report, control, || {
             BandAtmosphere::new(optics, viewing, &response).map_err(failed(Stage::BandAtmosphere))
         })?;
-        let (aerosol_map, band_key) =
-            self.aerosol_map_stage((scene, &response, viewing), (atmosphere_spec, axes), key, control, report)?;
+        let (aerosol_map, band_key) = self.aerosol_map_stage(
+            (scene, &response, viewing),
+            (atmosphere_spec, axes),
+            (key, range_after),
+            control,
+            report,
+        )?;
         Ok(Some(Sensed { response, band_atmosphere, aerosol_map, band_key }))
     }
 
     /// A scene whose AOT varies: the band terms at AOT nodes spanning its map, each node's LUT
-    /// cached as a scene with that constant AOT would cache it. Returns them (none without a
-    /// map) and the key later stages build on.
+    /// cached as a scene with that constant AOT would cache it, after `band_key`; the AOT range
+    /// under the pixels keyed after `range_after` (it follows the scene and the geometry, not
+    /// the bands). Returns them (none without a map) and the key later stages build on.
     pub(super) fn aerosol_map_stage(
         &mut self,
         (scene, response, viewing): (&Arc<Scene>, &Arc<Response>, &Arc<Viewing>),
         (atmosphere_spec, axes): (&AtmosphereSpec, &LutAxes),
-        band_key: Key,
+        (band_key, range_after): (Key, Key),
         control: &RunControl,
         report: &mut RunReport,
     ) -> Result<(Option<Arc<AotNodes>>, Key), EngineError> {
@@ -57,7 +84,7 @@ impl Engine {
         // The AOT under every pixel centre the image samples (the map's own range is sampled on
         // at most 512² cells and could miss a corner or a narrow peak); cached with the band
         // atmosphere, so a run that changes only the electronics does not walk the image again.
-        let range_key = KeyBuilder::new(Stage::BandAtmosphere).after(band_key).with("aot550 range").finish();
+        let range_key = KeyBuilder::new(Stage::BandAtmosphere).after(range_after).with("aot550 range").finish();
         let range = self.stage(range_key, report, control, || {
             Ok((0..viewing.lines())
                 .flat_map(|r| (0..viewing.columns()).map(move |c| (r, c)))

@@ -81,17 +81,7 @@ impl Engine {
             Response::new(instrument, fid.spectral_step_nm).map_err(failed(Stage::Response))
         })?;
         report.grid_points = response.groups.iter().map(|g| g.grid.len()).collect();
-        // The bands the instrument really has, where the processor's knowledge of them is wrong
-        // (the response key holds the error: the same grids, other weights).
-        let sensed_response = match effects::spectral_knowledge(&instrument.effects) {
-            Some(_) => {
-                let key = KeyBuilder::new(Stage::Response).after(response_key).with("sensed").finish();
-                Some(self.stage(key, report, control, || {
-                    Response::sensed(instrument, fid.spectral_step_nm).map_err(failed(Stage::Response))
-                })?)
-            }
-            None => None,
-        };
+        let sensed_response = self.sensed_response(config, response_key, control, report)?;
 
         // Geometry.
         let sun = config.scene.sun;
@@ -159,10 +149,13 @@ impl Engine {
             BandAtmosphere::new(&optics, &viewing, &response).map_err(failed(Stage::BandAtmosphere))
         })?;
 
+        // The AOT range under the pixels is the scene's and the geometry's: keyed after the
+        // stated band atmosphere, and found once for both sets of bands.
+        let range_after = band_key;
         let (aerosol_map, band_key) = self.aerosol_map_stage(
             (&scene, &response, &viewing),
             (&atmosphere_spec, &axes),
-            band_key,
+            (band_key, range_after),
             control,
             report,
         )?;
@@ -171,7 +164,7 @@ impl Engine {
             sensed_response,
             (&scene, &optics, &viewing),
             (&atmosphere_spec, &axes),
-            band_key,
+            (band_key, range_after),
             control,
             report,
         )?;
@@ -334,19 +327,15 @@ impl Engine {
             .finish();
         let calibration = self.stage(calibration_key, report, control, || {
             let e0: Vec<Vec<f64>> = optics.iter().map(|o| o.e0().to_vec()).collect();
-            // The diffuser as the bands see it, and as the processor believes they see it.
-            let e0_band =
-                (band_e0(side.sampled().0, instrument.detectors, &e0), band_e0(response, instrument.detectors, &e0));
+            // The diffuser as the processor believes the bands see it, and as they do (the same
+            // unless the instrument states a spectral knowledge error).
+            let believed = band_e0(response, instrument.detectors, &e0);
+            let sensed = side.sensed.as_ref().map(|s| band_e0(&s.response, instrument.detectors, &e0));
+            let e0_band = (sensed.as_deref().unwrap_or(&believed), believed.as_slice());
             let knowledge = FocalKnowledge::of(&instrument.effects);
             let used = &viewing.detector_index;
-            Calibration::derive(
-                &config.calibration,
-                (&detector, knowledge),
-                (&e0_band.0, &e0_band.1),
-                used,
-                config.seed,
-            )
-            .map_err(failed(Stage::Calibration))
+            Calibration::derive(&config.calibration, (&detector, knowledge), e0_band, used, config.seed)
+                .map_err(failed(Stage::Calibration))
         })?;
         report.diffuser_incidence_deg = calibration.sun_incidence_deg;
         report.diffuser_saturated_frames = calibration.saturated_frames;

@@ -10,7 +10,7 @@
 use std::ops::Range;
 
 use super::InstrumentError;
-use super::effects;
+use super::effects::{self, SpectralKnowledge};
 use super::spec::InstrumentSpec;
 use crate::parse::FieldError;
 use crate::spectral::{Band, BandAverager, BandSet, Extrapolation, Spectrum, WavelengthGrid};
@@ -90,14 +90,22 @@ impl Response {
     fn build(spec: &InstrumentSpec, step_nm: f64, sensing: bool) -> Result<Self, InstrumentError> {
         let kind = spec.kind.model();
         let bands = kind.band_set()?;
+        // The bands as the instrument really has them, where they differ from the stated ones.
         let error = effects::spectral_knowledge(&spec.effects);
-        let shifts = match error {
-            Some(k) => k.shifts_nm(bands.len())?,
-            None => vec![0.0; bands.len()],
+        let smile_factor = error.map_or(1.0, SpectralKnowledge::smile_factor);
+        let true_bands: Option<Vec<Band>> = match error {
+            Some(k) => {
+                let shifts = k.shifts_nm(bands.len())?;
+                let true_band = |(b, d): (&Band, &f64)| shift(&widen(b, k.width_factor())?, *d);
+                Some(bands.bands.iter().zip(&shifts).map(true_band).collect::<Result<_, _>>()?)
+            }
+            None => None,
         };
-        let (width, smile_factor) = error.map_or((1.0, 1.0), |k| (k.width_factor(), k.smile_factor()));
-        // A band as the instrument really has it.
-        let true_band = |b: usize| shift(&widen(&bands.bands[b], width)?, shifts[b]);
+        // What the weights are built from: the true bands when sensing, the stated otherwise.
+        let weighed = match (&true_bands, sensing) {
+            (Some(t), true) => t,
+            _ => &bands.bands,
+        };
         let plane_of_band = planes_of(spec, &bands)?;
         let qe_sources: Vec<&crate::spectral::SpectrumSource> = std::iter::once(&spec.quantum_efficiency)
             .chain(spec.focal_planes.iter().map(|p| &p.quantum_efficiency))
@@ -120,10 +128,8 @@ impl Response {
             .map(|(members, offset_rad)| {
                 let margin = smile_nm.abs() * smile_factor.abs().max(1.0) + step_nm;
                 let mut supports: Vec<(f64, f64)> = members.iter().map(|&b| bands.bands[b].srf.range_nm()).collect();
-                if error.is_some() {
-                    for &b in &members {
-                        supports.push(true_band(b)?.srf.range_nm());
-                    }
+                if let Some(t) = &true_bands {
+                    supports.extend(members.iter().map(|&b| t[b].srf.range_nm()));
                 }
                 let grid = support_grid(&supports, margin, step_nm)?;
                 let mut qe_of_plane = Vec::with_capacity(qe_sources.len());
@@ -148,13 +154,7 @@ impl Response {
                             name: bands.name.clone(),
                             bands: members
                                 .iter()
-                                .map(|&b| {
-                                    if sensing {
-                                        shift(&true_band(b)?, class_shift(c))
-                                    } else {
-                                        shift(&bands.bands[b], class_shift(c))
-                                    }
-                                })
+                                .map(|&b| shift(&weighed[b], class_shift(c)))
                                 .collect::<Result<_, _>>()?,
                         };
                         let avg = BandAverager::new(&grid, &shifted)?;

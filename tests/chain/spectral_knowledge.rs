@@ -123,3 +123,25 @@ fn per_band_shifts_of_the_wrong_length_are_refused_by_name() {
     let e = c.validate().unwrap_err().to_string();
     assert!(e.contains("SpectralKnowledge.centre_nm") && e.contains("10"), "{e}");
 }
+
+#[test]
+fn over_an_aerosol_map_the_true_bands_get_their_own_nodes_and_share_the_aot_range() {
+    use shoal::engine::{Engine, Stage};
+    let mut c = config("[SpectralKnowledge((centre_nm: 1.5))]");
+    c.scene.aot550_map = Some(shoal::scene::MapSpec::Gradient { from: 0.05, to: 0.35, angle_deg: 0.0 });
+    let mut engine = Engine::new();
+    let out = engine.run(&c, &shoal::control::RunControl::new()).unwrap();
+    // The band-atmosphere stage: the stated bands' terms, the AOT range under the pixels, the
+    // stated bands' AOT nodes, the true bands' terms and their AOT nodes; the range once.
+    assert_eq!(engine.executions(Stage::BandAtmosphere), 5);
+    // The calibration's relation holds under the haze front as under one AOT.
+    let (got, expected) = (ratios(&out), e0_ratios(&c));
+    let base = ratios(&run(&{
+        let mut none = config("[]");
+        none.scene.aot550_map = c.scene.aot550_map.clone();
+        none
+    }));
+    for ((g, e), b) in got.iter().zip(&expected).zip(&base) {
+        assert!((g - b - e).abs() < 5e-6, "{g} against {e} (base {b})");
+    }
+}

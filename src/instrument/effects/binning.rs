@@ -161,12 +161,11 @@ pub(crate) fn check_fits(b: &Binning, spec: &InstrumentSpec) -> Result<(), Instr
         }));
     }
     let k = b.factor as usize;
-    let short =
-        [("instrument.detectors", spec.detectors), ("instrument.lines", spec.lines)].into_iter().find(|(_, n)| *n < k);
+    let short = [("detectors", spec.detectors), ("lines", spec.lines)].into_iter().find(|(_, n)| *n < k);
     match short {
-        Some((field, n)) => Err(InstrumentError::Invalid(FieldError {
+        Some((what, n)) => Err(InstrumentError::Invalid(FieldError {
             field: "instrument.effects[].Binning.factor".into(),
-            message: format!("{k} × {k} binning with {n} {} (allowed: 1 to {n})", &field[11..]),
+            message: format!("{k} × {k} binning with {n} {what} (allowed: 1 to {n})"),
         })),
         None => Ok(()),
     }

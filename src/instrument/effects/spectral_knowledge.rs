@@ -135,14 +135,6 @@ impl SpectralKnowledge {
             && self.width_pct == 0.0
             && self.smile_pct == 0.0
     }
-
-    /// The largest distance, nm, a band's response may move beyond its believed support, for a
-    /// band of believed support half-width `half_width_nm`: what the simulation grid adds.
-    #[must_use]
-    pub fn reach_nm(&self, bands: usize, half_width_nm: f64) -> f64 {
-        let shift = self.shifts_nm(bands).map_or(0.0, |s| s.iter().fold(0.0_f64, |m, d| m.max(d.abs())));
-        shift + half_width_nm * (self.width_factor() - 1.0).max(0.0)
-    }
 }
 
 impl Effect for SpectralKnowledge {
