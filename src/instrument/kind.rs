@@ -294,6 +294,15 @@ mod tests {
     use crate::instrument::InstrumentSpec;
 
     #[test]
+    fn every_preset_is_within_the_ranges_a_user_is_held_to() {
+        for name in InstrumentSpec::preset_names() {
+            let spec = InstrumentSpec::preset(&name).unwrap_or_else(|e| panic!("{name}: {e}"));
+            spec.validate().unwrap_or_else(|e| panic!("{name}: {e}"));
+            spec.as_flown().validate().unwrap_or_else(|e| panic!("{name} as flown: {e}"));
+        }
+    }
+
+    #[test]
     fn every_preset_kind_counts_the_bands_it_builds_and_says_what_it_can_do() {
         for name in InstrumentSpec::preset_names() {
             let spec = InstrumentSpec::preset(&name).unwrap_or_else(|e| panic!("{name}: {e}"));

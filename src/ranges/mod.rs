@@ -47,7 +47,7 @@ ranges! {
     INSTRUMENT_APERTURE_MM = Range::above("instrument.aperture_mm", 0.0, 2000.0, "mm", "entrance pupil diameter")
         .edited(Editor { label: "Aperture", unit: "mm", scale: 1.0, slider: (10.0, 500.0), log: true, tip: "Entrance pupil diameter: photons grow with its square" });
     /// Pixel pitch.
-    INSTRUMENT_PIXEL_PITCH_UM = Range::above("instrument.pixel_pitch_um", 0.0, 100.0, "µm", "detector pixel pitch")
+    INSTRUMENT_PIXEL_PITCH_UM = Range::above("instrument.pixel_pitch_um", 0.0, 1000.0, "µm", "detector pixel pitch (MODIS's 1 km whiskbroom detectors: 540 µm)")
         .edited(Editor { label: "Pixel pitch", unit: "µm", scale: 1.0, slider: (1.0, 30.0), log: false, tip: "Detector pixel size: sets GSD with altitude and focal length" });
     /// Focal length.
     INSTRUMENT_FOCAL_LENGTH_MM = Range::above("instrument.focal_length_mm", 0.0, 10_000.0, "mm", "effective focal length")
@@ -96,7 +96,7 @@ ranges! {
     /// Dark current: activation energy.
     DARK_ACTIVATION_EV = Range::closed("instrument.dark_temperature.law.Arrhenius.activation_ev", 0.05, 2.0, "eV", "activation energy of the dark current (Arrhenius law)");
     /// A further focal plane: pixel pitch.
-    PLANE_PIXEL_PITCH_UM = Range::above("instrument.focal_planes[].pixel_pitch_um", 0.0, 100.0, "µm", "the plane's pixel pitch (a whole multiple or fraction of the first plane's)");
+    PLANE_PIXEL_PITCH_UM = Range::above("instrument.focal_planes[].pixel_pitch_um", 0.0, 1000.0, "µm", "the plane's pixel pitch (a whole multiple or fraction of the first plane's)");
     /// A further focal plane: detectors.
     PLANE_DETECTORS = Range::count("instrument.focal_planes[].detectors", 1.0, 40_000.0, "", "the plane's detectors across track (its swath must cover the first plane's)");
     /// A further focal plane: read noise.
