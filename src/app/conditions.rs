@@ -166,7 +166,8 @@ fn correction_choice(ui: &mut egui::Ui, spec: &mut crate::correction::Correction
         (
             "image: 779/865 nm",
             "Aerosol from the design's 779 and 865 nm bands (Gordon & Wang 1994; l2gen's OLCI pair), \
-             the water's NIR signal estimated from the red band (Bailey et al. 2010)",
+             the water's NIR signal estimated from the red band (Bailey et al. 2010); a design \
+             without them uses its own mission pair (MODIS 748/869 nm, or a SWIR pair)",
             pair([779.0, 865.0]),
             false,
         ),
@@ -195,8 +196,14 @@ fn correction_choice(ui: &mut egui::Ui, spec: &mut crate::correction::Correction
     egui::ComboBox::from_label("Atmospheric correction").selected_text(current).show_ui(ui, |ui| {
         for (name, hover, image, approx) in choices {
             // The first design whose bands cannot make the pair, and why.
+            // The default pair falls back to each design's own ([`super::model::design_pair`]).
+            let default_pair = ImageCorrection::default().pair_nm;
             let lacking = image.as_ref().filter(|i| i.fit != AerosolFit::DarkSpectrum).and_then(|i| {
-                bands.iter().find_map(|(design, centres)| i.pair(centres).err().map(|e| format!("{design}: {e}")))
+                bands.iter().find_map(|(design, centres)| {
+                    let usable = if i.pair_nm == default_pair { i.for_bands(centres) } else { Some(i.clone()) };
+                    let err = usable.map_or_else(|| i.pair(centres).err(), |u| u.pair(centres).err());
+                    err.map(|e| format!("{design}: {e}"))
+                })
             });
             let label = ui.add_enabled(lacking.is_none(), egui::Button::selectable(current == name, name));
             let label = match &lacking {

@@ -322,7 +322,8 @@ impl AppState {
         scene
     }
 
-    /// The run configurations of the designs, in order.
+    /// The run configurations of the designs, in order (the default image-based correction
+    /// takes the aerosol from each design's own best pair: [`design_pair`]).
     #[must_use]
     pub fn configs(&self) -> Vec<RunConfig> {
         let scene = self.seeded_scene();
@@ -336,6 +337,7 @@ impl AppState {
                 c.calibration = self.calibration.clone();
                 c.snr_reference.clone_from(&self.snr_reference);
                 c.correction = self.correction.clone();
+                c.correction.image = c.correction.image.take().map(|i| design_pair(i, &slot.spec));
                 c
             })
             .collect()
@@ -411,6 +413,22 @@ fn split_top_level(s: &str) -> Vec<&str> {
         out.push(&s[start..]);
     }
     out
+}
+
+/// The image-based correction `image` as design `spec` runs it: the default pair (779/865 nm),
+/// where the design lacks it, becomes the first mission pair its bands make (MODIS 748/869, a
+/// SWIR pair: [`crate::correction::MISSION_PAIRS_NM`]); the aerosol row of the metrics names the
+/// pair each design used. A pair the user chose is kept (the menu greys it for designs without it).
+#[must_use]
+pub fn design_pair(
+    image: crate::correction::ImageCorrection,
+    spec: &InstrumentSpec,
+) -> crate::correction::ImageCorrection {
+    if image.pair_nm != crate::correction::ImageCorrection::default().pair_nm {
+        return image;
+    }
+    let Ok(bands) = spec.kind.model().band_set() else { return image };
+    image.for_bands(&bands.centres_nm()).unwrap_or(image)
 }
 
 #[cfg(test)]

@@ -253,6 +253,26 @@ impl ImageCorrection {
 /// How far a pair's centre may be from the band it picks, nm.
 pub const PAIR_TOLERANCE_NM: f64 = 30.0;
 
+/// The band pairs missions' processors take the aerosol from, in the order a design is offered
+/// them when it lacks the pair asked for (nm): OLCI's 779/865 (l2gen), MODIS's 748/869 (l2gen;
+/// Gordon & Wang 1994), the SWIR pairs of l2gen for OLI and MSI, 865/2200 and 1610/2200 (Wang &
+/// Shi 2007), and 865/1610.
+pub const MISSION_PAIRS_NM: [[f64; 2]; 5] =
+    [[779.0, 865.0], [748.0, 869.0], [865.0, 2200.0], [1610.0, 2200.0], [865.0, 1610.0]];
+
+impl ImageCorrection {
+    /// This correction for a design with bands at `centres_nm`: unchanged where the bands make
+    /// its pair (or it fits the dark spectrum, which needs none), else with the first of
+    /// [`MISSION_PAIRS_NM`] they make ("the design's best pair"); `None` where they make none.
+    #[must_use]
+    pub fn for_bands(&self, centres_nm: &[f64]) -> Option<Self> {
+        if self.fit == AerosolFit::DarkSpectrum || self.pair(centres_nm).is_ok() {
+            return Some(self.clone());
+        }
+        MISSION_PAIRS_NM.iter().map(|&pair_nm| Self { pair_nm, ..self.clone() }).find(|c| c.pair(centres_nm).is_ok())
+    }
+}
+
 /// Where the measured long-band aerosol signal lies in a model's table: up to three nodes and
 /// their weights, so that any tabulated quantity at the model's τ is Σ wᵢ·vᵢ. `a_long[k]` is the
 /// model's aerosol signal at the long band at node k (increasing with τ). Inside the table the

@@ -33,7 +33,7 @@ mod rrs_metrics;
 pub use dark::TileFit;
 pub use difference::{BandDifference, compare};
 pub use family::{AerosolFamily, FamilyLuts};
-pub use image::{AerosolFit, AerosolRetrieval, DarkSpectrumSettings, ImageCorrection, correct_image};
+pub use image::{AerosolFit, AerosolRetrieval, DarkSpectrumSettings, ImageCorrection, MISSION_PAIRS_NM, correct_image};
 pub use rrs_metrics::{BandRrsMetrics, RRS_SAMPLES, band_rrs_metrics, pooled_rrs_error};
 
 use ndarray::{Array2, Array3};

@@ -328,3 +328,19 @@ fn correct_on_csv_spectra_matches_the_runs_own_correction() {
     // interpolation of its terms (measured together 4.9e-10).
     assert!(worst < 1e-8, "{worst:e}");
 }
+
+#[test]
+fn a_design_without_the_default_pair_corrects_from_its_own_mission_pair() {
+    use shoal::correction::ImageCorrection;
+    let centres = |name: &str| {
+        let spec = shoal::instrument::InstrumentSpec::preset(name).unwrap();
+        spec.kind.model().band_set().unwrap().centres_nm()
+    };
+    let default = ImageCorrection::default();
+    assert_eq!(default.for_bands(&centres("cubesat")).unwrap().pair_nm, [779.0, 865.0]);
+    // MODIS: l2gen's 748/869 nm; OLI: its SWIR pair 865/2200 nm.
+    assert_eq!(default.for_bands(&centres("modis_aqua")).unwrap().pair_nm, [748.0, 869.0]);
+    assert_eq!(default.for_bands(&centres("landsat8_oli")).unwrap().pair_nm, [865.0, 2200.0]);
+    // Three visible bands make no pair.
+    assert!(default.for_bands(&[443.0, 560.0, 665.0]).is_none());
+}
