@@ -144,6 +144,10 @@ pub fn existing(what: What, path: &Path, designs: usize) -> Vec<PathBuf> {
 /// tables (CSV and JSON), the requirement checks, the seed spread, the figures, `review.json`
 /// (so `shoal report DIR` makes the pack) and per instrument its cubes, SNR table, report and
 /// configuration. Written whole: a new or empty folder, or one Shoal wrote, which is replaced.
+///
+/// The app's runs keep views of their cubes, not the cubes ([`crate::engine::Engine::for_app`]):
+/// each design is run again here, one at a time, by an engine that keeps them (the same
+/// configuration and seed make the same cubes), and its cubes are let go once written.
 pub fn write_data(snap: &Snapshot, dir: &Path) -> Result<usize, String> {
     let result = study_of(snap)?;
     let out = crate::study::OutputDir::create(dir, "Shoal app: data export").map_err(|e| e.to_string())?;
@@ -152,6 +156,14 @@ pub fn write_data(snap: &Snapshot, dir: &Path) -> Result<usize, String> {
         let Some(run) = run else { continue };
         let sub = format!("{}_{}", super::model::label(i), run.config.instrument.name);
         let sub = crate::parse::join_name(out.path(), "instrument.name", &sub).map_err(|e| e.to_string())?;
+        let rerun;
+        let run = if run.cubes.is_some() {
+            &**run
+        } else {
+            let control = crate::control::RunControl::default();
+            rerun = crate::engine::Engine::new().run(&run.config, &control).map_err(|e| e.to_string())?;
+            &rerun
+        };
         outputs.files.extend(write_run(run, &sub).map_err(|e| e.to_string())?.files);
     }
     let mut review = crate::report::review_data(&result, &[], &[]);

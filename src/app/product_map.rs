@@ -5,7 +5,7 @@
 use ndarray::Array2;
 
 use super::model::ProductKind;
-use crate::engine::RunOutput;
+use crate::engine::{RunOutput, ViewOf};
 use crate::instrument::{Detector, DetectorMode};
 
 /// A map's values and where they are valid.
@@ -21,7 +21,7 @@ pub struct MapData {
 /// retrieval where there is one. `None` when the run has no such product.
 #[must_use]
 pub fn product_map(out: &RunOutput, kind: ProductKind, band: usize, truth: bool) -> Option<MapData> {
-    let (truth_maps, cubes) = (&out.truth, out.cubes.as_ref());
+    let truth_maps = &out.truth;
     let water = truth_maps.surface.water_mask();
     let ret = out.retrievals.first();
     let returned = |p: &crate::retrieval::Product| Array2::from_shape_fn(p.flags.dim(), |(i, j)| p.returned(i, j));
@@ -75,24 +75,19 @@ pub fn product_map(out: &RunOutput, kind: ProductKind, band: usize, truth: bool)
             })
         }
         ProductKind::Rrs => {
-            let cubes = cubes?;
-            let cube = if truth { &*cubes.radiance.truth_rrs } else { &cubes.rrs.rrs };
-            let values = cube.index_axis(ndarray::Axis(2), band).to_owned();
-            let flags = &cubes.rrs.flags;
-            let valid =
-                Array2::from_shape_fn(values.dim(), |(i, j)| water[[i, j]] && (truth || flags[[i, j, band]] == 0));
+            let (values, flags) = cube_band(out, if truth { ViewOf::TruthRrs } else { ViewOf::Rrs }, band)?;
+            let valid = Array2::from_shape_fn(values.dim(), |(i, j)| water[[i, j]] && (truth || flags[[i, j]] == 0));
             Some(MapData { values, valid })
         }
         ProductKind::Level1 => {
-            let cube = if truth { &cubes?.radiance.radiance } else { &cubes?.level1.radiance };
-            let values = cube.index_axis(ndarray::Axis(2), band).to_owned();
+            let (values, _) = cube_band(out, if truth { ViewOf::Toa } else { ViewOf::Level1 }, band)?;
             Some(MapData { valid: values.mapv(|v| v.is_finite() && v > 0.0), values })
         }
         ProductKind::Snr => {
             // Analytic SNR at each pixel's own radiance (detector noise model, noise on).
             let detector =
                 Detector::new(&out.config.instrument, &out.response, DetectorMode::default(), out.config.seed);
-            let l = cubes?.radiance.radiance.index_axis(ndarray::Axis(2), band);
+            let (l, _) = cube_band(out, ViewOf::Toa, band)?;
             let values = Array2::from_shape_fn(l.dim(), |(i, j)| {
                 let d = out.viewing.detector_index[j];
                 crate::instrument::analytic_snr(&detector, d, band, f64::from(l[[i, j]])) as f32
@@ -100,6 +95,22 @@ pub fn product_map(out: &RunOutput, kind: ProductKind, band: usize, truth: bool)
             Some(MapData { valid: values.mapv(|v| v.is_finite() && v > 0.0), values })
         }
     }
+}
+
+/// Band `band` of one of a run's cubes at full resolution and its flags (zero for the truth and
+/// the pupil radiance): from the cubes when the run kept them, else from its views, each kept
+/// pixel standing for its block ([`crate::engine::CubeViews`]).
+fn cube_band(out: &RunOutput, of: ViewOf, band: usize) -> Option<(Array2<f32>, Array2<u8>)> {
+    let Some(cubes) = out.cubes.as_ref() else { return out.views.as_ref()?.band(of, band) };
+    let (cube, flags) = match of {
+        ViewOf::Toa => (&cubes.radiance.radiance, None),
+        ViewOf::TruthRrs => (&*cubes.radiance.truth_rrs, None),
+        ViewOf::Level1 => (&cubes.level1.radiance, Some(&cubes.level1.flags)),
+        ViewOf::Rrs => (&cubes.rrs.rrs, Some(&cubes.rrs.flags)),
+    };
+    let values = cube.index_axis(ndarray::Axis(2), band).to_owned();
+    let flags = flags.map_or_else(|| Array2::zeros(values.dim()), |f| f.index_axis(ndarray::Axis(2), band).to_owned());
+    Some((values, flags))
 }
 
 /// A − B on A's pixels (A and B any two designs): B is sampled at the pixel nearest each of A's

@@ -201,6 +201,8 @@ pub struct Cache {
     clock: u64,
     /// The clock when the current run began.
     run_start: u64,
+    /// Products kept per stage of the large cubes (in place of [`Stage::capacity`]'s 4).
+    large_capacity: Option<usize>,
 }
 
 impl Default for Cache {
@@ -219,7 +221,22 @@ impl Cache {
     /// An empty cache that keeps at most `budget` bytes.
     #[must_use]
     pub fn with_budget(budget: usize) -> Self {
-        Self { entries: HashMap::new(), budget, held: 0, clock: 0, run_start: 0 }
+        Self { entries: HashMap::new(), budget, held: 0, clock: 0, run_start: 0, large_capacity: None }
+    }
+
+    /// The same cache keeping up to `n` products per stage of the large cubes (the app keeps one
+    /// per design and decimation; the byte budget still bounds them).
+    #[must_use]
+    pub fn with_large_capacity(mut self, n: usize) -> Self {
+        self.large_capacity = Some(n.max(1));
+        self
+    }
+
+    fn capacity(&self, stage: Stage) -> usize {
+        match self.large_capacity {
+            Some(n) if stage.capacity() < Stage::Scene.capacity() => n,
+            _ => stage.capacity(),
+        }
     }
 
     /// The product under `key`, if kept (and moves it to the front).
@@ -268,10 +285,11 @@ impl Cache {
             }
             self.remove(old);
         }
+        let keep = self.capacity(stage);
         let list = self.entries.entry(stage).or_default();
         list.push_front(Entry { key, product, bytes, used: self.clock });
         self.held += bytes;
-        let dropped: Vec<Entry> = list.drain(stage.capacity().min(list.len())..).collect();
+        let dropped: Vec<Entry> = list.drain(keep.min(list.len())..).collect();
         self.held -= dropped.iter().map(|e| e.bytes).sum::<usize>();
     }
 
@@ -301,6 +319,21 @@ impl Cache {
         self.entries.clear();
         self.held = 0;
     }
+
+    /// Keep at most `budget` bytes from now on: the least recently used products go first,
+    /// whichever run used them (called between runs, to make room for a large one).
+    pub fn set_budget(&mut self, budget: usize) {
+        self.budget = budget;
+        let mut held: Vec<(u64, Key)> =
+            self.entries.values().flatten().filter(|e| e.bytes > 0).map(|e| (e.used, e.key)).collect();
+        held.sort_unstable_by_key(|e| e.0);
+        for (_, key) in held {
+            if self.held <= self.budget {
+                break;
+            }
+            self.remove(key);
+        }
+    }
 }
 
 #[cfg(test)]
@@ -309,6 +342,25 @@ mod tests {
 
     fn key(stage: Stage, n: u32) -> Key {
         KeyBuilder::new(stage).with(&n).finish()
+    }
+
+    #[test]
+    fn a_lower_budget_lets_the_least_recently_used_go_and_a_large_capacity_keeps_more() {
+        let mut cache = Cache::with_budget(1000).with_large_capacity(6);
+        for n in 0..6 {
+            cache.begin_run();
+            cache.put(key(Stage::Radiance, n), Arc::new(n), 100);
+        }
+        // Six cubes of one stage: past the default four, within the larger capacity.
+        assert_eq!(cache.len(), 6);
+        cache.begin_run();
+        assert!(cache.get::<u32>(key(Stage::Radiance, 0)).is_some());
+        cache.set_budget(250);
+        assert_eq!(cache.bytes(), 200);
+        // The one just used and the newest stay.
+        assert!(cache.get::<u32>(key(Stage::Radiance, 0)).is_some());
+        assert!(cache.get::<u32>(key(Stage::Radiance, 5)).is_some());
+        assert!(cache.get::<u32>(key(Stage::Radiance, 1)).is_none());
     }
 
     #[test]

@@ -57,6 +57,7 @@ mod run;
 mod scene_stages;
 pub mod spectrum;
 mod stages;
+pub mod views;
 pub mod worker;
 
 pub use cache::Stage;
@@ -67,6 +68,7 @@ pub use probe::{Probe, Probed};
 pub use products::{CorrectionProduct, Cubes, RetrievalOutput, RunOutput};
 pub use report::{AerosolSummary, RunReport, StageReport, StageStatus};
 pub use run::{Engine, LEAN_CACHE_BYTES};
+pub use views::{CubeViews, VIEW_BYTES, ViewOf};
 
 /// An engine failure: the stage and what went wrong (the message names the field).
 #[derive(Debug, thiserror::Error, Clone, PartialEq)]

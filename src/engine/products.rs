@@ -80,6 +80,8 @@ pub struct RunOutput {
     pub truth: Arc<Truth>,
     /// The full-resolution cubes, when the engine keeps them.
     pub cubes: Option<Cubes>,
+    /// Every n-th pixel of the cubes, when the engine keeps views ([`super::Engine::for_app`]).
+    pub views: Option<Arc<super::views::CubeViews>>,
     /// Calibration coefficients.
     pub calibration: Arc<Calibration>,
     /// The correction's diagnostics.

@@ -10,6 +10,7 @@ use super::footprint::Footprint;
 use super::probe::{Probe, Probed};
 use super::products::{Cubes, RunOutput};
 use super::report::{RunReport, StageReport, StageStatus};
+use super::views::CubeViews;
 use super::{EngineError, Fault, FaultKind, RunConfig};
 use crate::control::{PixelSite, RunControl};
 
@@ -22,11 +23,13 @@ pub struct Engine {
     fault: Option<Fault>,
     /// Whether a run hands back its full-resolution cubes ([`RunOutput::cubes`]).
     keep_cubes: bool,
+    /// Whether a run hands back every n-th pixel of its cubes ([`RunOutput::views`]).
+    keep_views: bool,
 }
 
 impl Default for Engine {
     fn default() -> Self {
-        Self { cache: Cache::default(), executions: HashMap::new(), fault: None, keep_cubes: true }
+        Self { cache: Cache::default(), executions: HashMap::new(), fault: None, keep_cubes: true, keep_views: false }
     }
 }
 
@@ -55,12 +58,28 @@ impl Engine {
         Self { keep_cubes: false, ..Self::default() }.with_cache_budget(LEAN_CACHE_BYTES)
     }
 
+    /// An engine for the app: runs keep products and views of their cubes at a bounded size
+    /// ([`super::views::VIEW_BYTES`]), not the cubes; the cache keeps at most `cache_bytes` (so
+    /// a change to the retrieval restarts from the Rrs while the cache still holds it) and up to
+    /// `designs` cubes per stage at each of two decimations.
+    #[must_use]
+    pub fn for_app(cache_bytes: usize, designs: usize) -> Self {
+        let mut engine = Self { keep_cubes: false, keep_views: true, ..Self::default() };
+        engine.cache = Cache::with_budget(cache_bytes).with_large_capacity(2 * designs.max(2));
+        engine
+    }
+
     /// The same engine, its cache emptied and bounded to `bytes` (products past it are dropped,
     /// least recently used first).
     #[must_use]
     pub fn with_cache_budget(mut self, bytes: usize) -> Self {
         self.cache = Cache::with_budget(bytes);
         self
+    }
+
+    /// Bound the cache to `bytes` from now on, letting the least recently used products go.
+    pub fn set_cache_budget(&mut self, bytes: usize) {
+        self.cache.set_budget(bytes);
     }
 
     /// Whether runs hand back their full-resolution cubes.
@@ -199,12 +218,19 @@ impl Engine {
         )
         .map_err(super::stages::failed(Stage::Correction))?;
         let truth_rrs = radiance.truth_rrs.clone();
+        let mut views = self.keep_views.then(|| {
+            let (rows, cols, bands) = radiance.radiance.dim();
+            CubeViews::of_radiance(&radiance, super::views::stride_for(rows, cols, bands, super::views::VIEW_BYTES))
+        });
         let mut inst = self.instrument_side(config, &side, radiance, radiance_key, control, &mut report)?;
         let kept_radiance = inst.radiance.take();
         // Each cube is let go once read (the cache may still keep it, within its budget).
         let kept_level0 = inst.level0.take();
         if let Some(level1) = &inst.level1 {
             probed.iter_mut().for_each(|p| p.read_level1(level1));
+            if let Some(v) = &mut views {
+                v.keep_level1(level1);
+            }
         }
         let (corrected, correction_key) = self.correction_stage(
             config,
@@ -217,6 +243,9 @@ impl Engine {
         )?;
         drop(truth_rrs);
         probed.iter_mut().for_each(|p| p.read_rrs(&corrected.rrs));
+        if let Some(v) = &mut views {
+            v.keep_rrs(&corrected.rrs);
+        }
         let kept_level1 = inst.level1.take().filter(|_| self.keep_cubes);
         let (snr, typical) = self.snr_stage(config, &side, typical, &inst, control, &mut report)?;
         let retrievals = self.retrieval_stage(
@@ -243,6 +272,7 @@ impl Engine {
             band_atmosphere: side.band_atmosphere.clone(),
             truth,
             cubes,
+            views: views.map(Arc::new),
             calibration: inst.calibration,
             correction: corrected.product.clone(),
             snr,

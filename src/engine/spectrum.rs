@@ -167,11 +167,16 @@ impl SpectrumMaker {
     }
 }
 
-/// What instrument `label` of run `out` measured at ground point `ground_m` (its nearest pixel).
+/// What instrument `label` of run `out` measured at ground point `ground_m` (its nearest pixel;
+/// for a run that kept views of its cubes, the kept pixel of that pixel's block).
 #[must_use]
 pub fn instrument_at(out: &RunOutput, label: &str, ground_m: (f64, f64)) -> InstrumentAtPoint {
     let heading = out.viewing.track_heading_deg();
     let pixel = out.viewing.nearest_pixel(ground_m.0, ground_m.1, heading);
+    let pixel = match (&out.cubes, &out.views) {
+        (None, Some(v)) => pixel.map(|p| v.kept(p)),
+        _ => pixel,
+    };
     let bands = out
         .response
         .bands
@@ -196,13 +201,18 @@ pub fn instrument_at(out: &RunOutput, label: &str, ground_m: (f64, f64)) -> Inst
 }
 
 /// Band `b`'s Level-1 radiance (W m⁻² sr⁻¹ µm⁻¹) and corrected Rrs (sr⁻¹) at `pixel` of `out`,
-/// each `None` where flagged: from the run's cubes when it kept them, else from a pixel it was
-/// asked to keep ([`super::Probe`]); `None` where it has neither.
+/// each `None` where flagged: from the run's cubes when it kept them, else from its views (at the
+/// kept pixel of `pixel`'s block), else from a pixel it was asked to keep ([`super::Probe`]);
+/// `None` where it has none of them.
 fn measured_at(out: &RunOutput, (r, c): (usize, usize), b: usize) -> (Option<f64>, Option<f64>) {
     let good = |(v, flag): (f32, u8)| (flag == 0).then_some(f64::from(v));
     if let Some(cubes) = &out.cubes {
         let l1 = good((cubes.level1.radiance[[r, c, b]], cubes.level1.flags[[r, c, b]])).map(|v| v * 1000.0);
         return (l1, good((cubes.rrs.rrs[[r, c, b]], cubes.rrs.flags[[r, c, b]])));
+    }
+    if let Some(views) = &out.views {
+        let l1 = views.at(super::ViewOf::Level1, (r, c), b).and_then(good).map(|v| v * 1000.0);
+        return (l1, views.at(super::ViewOf::Rrs, (r, c), b).and_then(good));
     }
     out.probes.iter().find(|p| p.pixel == Some((r, c))).map_or((None, None), |p| {
         let l1 = p.level1.get(b).copied().and_then(good).map(|v| v * 1000.0);

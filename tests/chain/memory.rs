@@ -111,3 +111,32 @@ fn a_lean_run_makes_the_same_products_as_one_that_keeps_its_cubes() {
         }
     }
 }
+
+#[test]
+fn the_app_engine_keeps_views_with_the_cubes_values_and_the_same_products() {
+    use shoal::control::RunControl;
+    use shoal::engine::{Engine, RunConfig, ViewOf};
+    let mut config = RunConfig::new(super::small_lake(), super::small("cubesat", 96, 64));
+    config.retrievals = vec![ron::from_str("Almi()").unwrap()];
+    let keeping = Engine::new().run(&config, &RunControl::new()).unwrap();
+    let app = Engine::for_app(64 << 20, 8).run(&config, &RunControl::new()).unwrap();
+    assert!(app.cubes.is_none(), "the app's runs hand back views, not cubes");
+    assert_eq!(keeping.retrievals[0].product, app.retrievals[0].product, "the same maps, bit for bit");
+    let views = app.views.as_ref().expect("the app engine keeps views");
+    let cubes = keeping.cubes.as_ref().unwrap();
+    let (rows, cols, bands) = cubes.rrs.rrs.dim();
+    // A small image fits the view budget whole: every pixel, the cubes' own bits.
+    assert_eq!(views.stride, 1);
+    assert_eq!(views.full, (rows, cols));
+    for b in [0, bands / 2, bands - 1] {
+        let (rrs, flags) = views.band(ViewOf::Rrs, b).unwrap();
+        assert_eq!(rrs, cubes.rrs.rrs.index_axis(ndarray::Axis(2), b));
+        assert_eq!(flags, cubes.rrs.flags.index_axis(ndarray::Axis(2), b));
+        let (l1, _) = views.band(ViewOf::Level1, b).unwrap();
+        assert_eq!(l1, cubes.level1.radiance.index_axis(ndarray::Axis(2), b));
+        let (toa, _) = views.band(ViewOf::Toa, b).unwrap();
+        assert_eq!(toa, cubes.radiance.radiance.index_axis(ndarray::Axis(2), b));
+        let (truth, _) = views.band(ViewOf::TruthRrs, b).unwrap();
+        assert_eq!(truth, cubes.radiance.truth_rrs.index_axis(ndarray::Axis(2), b));
+    }
+}

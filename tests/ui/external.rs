@@ -34,7 +34,7 @@ fn the_app_asks_before_a_program_runs_and_shows_why_it_returned_nothing() {
     assert!(h.query_all_by_label_contains("no model for 865 nm").next().is_some(), "its standard error is not shown");
     // The rest of the run is there: the Rrs and the SNR of A.
     let shown = &h.state().link.shown[0].as_ref().unwrap().output;
-    assert!(shown.cubes.as_ref().is_some_and(|c| c.rrs.rrs.iter().any(|v| *v > 0.0)));
+    assert!(shown.views.as_ref().is_some_and(|v| v.rrs.iter().any(|v| *v > 0.0)));
     assert!(!shown.snr.is_empty());
     // Back to aLMI: the failure box goes and the metrics are aLMI's.
     h.get_by_label("aLMI").click();
