@@ -7,8 +7,8 @@
 use super::model::{AppState, LegacyAb, Slot};
 
 /// The designs the app holds at most: one colour each (`theme::DESIGN`), and a metrics table
-/// that still fits a 1920-pixel window.
-pub const MAX_DESIGNS: usize = 8;
+/// that still fits a 1920-pixel window (the engine sizes its cache for them).
+pub use crate::engine::worker::MAX_DESIGNS;
 
 /// The designs on the maps when a study opens (the rest can be ticked on).
 pub const MAPS_AT_OPEN: usize = 4;

@@ -114,11 +114,33 @@ impl ShoalApp {
             self.link.refine();
         }
         if let Some(ms) = self.median_frame_ms() {
-            ui.small("diagnostics").on_hover_text(format!(
-                "Diagnostics: the UI thread lays out a frame in {ms:.1} ms (median); the engine works \
-                 on its own threads."
-            ));
+            ui.small("diagnostics").on_hover_ui(|ui| {
+                ui.label(format!(
+                    "Diagnostics: the UI thread lays out a frame in {ms:.1} ms (median); the engine works \
+                     on its own threads."
+                ));
+                ui.label(self.memory_plan());
+            });
         }
+    }
+
+    /// What the designs hold at full resolution, planned ([`crate::engine::resources::app_demand`]).
+    #[must_use]
+    pub fn memory_plan(&self) -> String {
+        let configs = self.state.configs();
+        let demand = crate::engine::resources::app_demand(
+            &configs.iter().collect::<Vec<_>>(),
+            crate::engine::worker::app_cache_bytes(),
+        );
+        let budget = crate::budget::Budget::from_env().map(|b| b.memory_bytes / 1e9);
+        let gb = demand.bytes() / 1e9;
+        let of = budget.map_or(String::new(), |b| format!(" of the {b:.1} GB budget (SHOAL_MEMORY_BUDGET)"));
+        format!(
+            "Memory at full resolution, planned: {gb:.2} GB{of}. Each design keeps its products and a view \
+             of its cubes (every n-th pixel, at most {} MB); the engine's cache keeps what lets a change \
+             restart mid-chain.",
+            crate::engine::VIEW_BYTES >> 20
+        )
     }
 
     pub(super) fn dialogs(&mut self, ctx: &egui::Context) {

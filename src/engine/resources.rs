@@ -342,6 +342,35 @@ pub fn study_demand(configs: &[&RunConfig], keep_cubes: bool, cache_bytes: usize
     demand
 }
 
+/// What the app holds for `configs` at full resolution ([`super::Engine::for_app`]): each design's
+/// views of its cubes ([`super::views::VIEW_BYTES`] at most) and its products and truth maps, the
+/// largest run at work, and the cache (`cache_bytes`, less what a large run takes of
+/// [`super::worker::APP_RUN_ENVELOPE_BYTES`]).
+#[must_use]
+pub fn app_demand(configs: &[&RunConfig], cache_bytes: usize) -> Demand {
+    let working = |c: &RunConfig| run_demand_keeping(c, false).bytes();
+    let largest = configs.iter().map(|c| working(c)).fold(0.0, f64::max);
+    let envelope = super::worker::APP_RUN_ENVELOPE_BYTES as f64;
+    let cache = (cache_bytes as f64).min((envelope - largest).max(0.0));
+    let mut demand = study_demand(configs, false, 0);
+    if let Some(p) = demand.parts.iter_mut().find(|p| p.what == "the engine's cache") {
+        p.bytes = cache;
+    }
+    for c in configs {
+        let flown = c.flown();
+        let (rows, cols) = image_size(&flown);
+        let bands = band_count(&flown.instrument.kind);
+        let stride = super::views::stride_for(rows, cols, bands, super::views::VIEW_BYTES);
+        let kept = rows.div_ceil(stride) * cols.div_ceil(stride) * bands * super::views::VIEW_BYTES_PER_PIXEL_BAND;
+        demand.parts.push(Part {
+            what: format!("the views of {}'s cubes (every {stride} pixels)", c.instrument.name),
+            bytes: kept as f64,
+            ..cube_part(&flown, 0.0)
+        });
+    }
+    demand
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -365,6 +394,25 @@ mod tests {
         assert!(demand.atmosphere_s < 60.0, "{}", demand.atmosphere_s);
         let budget = Budget { memory_bytes: 14e9, atmosphere_s: DEFAULT_ATMOSPHERE_S };
         assert!(budget.check(&demand).is_ok());
+    }
+
+    #[test]
+    fn the_app_plans_eight_designs_as_an_upper_bound_of_their_measured_peak() {
+        // The app with the four designs of `four_designs_lake_hume` and four more from the
+        // library (OLCI for the 10 m MSI, whose 16 Mpx run alone takes ~3 GB): measured at
+        // 3.91 GiB peak resident at full resolution (VmHWM, 1920 × 1080 under Xvfb). The plan is
+        // an upper bound within 1.2× of it.
+        let mut runs = default_runs();
+        let names = ["nominal", "hyperspectral", "filter_imager", "sentinel3a_olci", "smallsat_swir", "modis_aqua"];
+        for name in names {
+            let mut c = runs[0].clone();
+            c.instrument = crate::instrument::InstrumentSpec::preset(name).unwrap_or_else(|e| panic!("{e}"));
+            runs.push(c);
+        }
+        let demand = app_demand(&runs.iter().collect::<Vec<_>>(), crate::engine::worker::APP_CACHE_MAX_BYTES);
+        let gb = demand.bytes() / 1024.0_f64.powi(3);
+        assert!((3.91..3.91 * 1.2).contains(&gb), "{gb} GiB: {demand:?}");
+        assert_eq!(demand.parts.iter().filter(|p| p.what.starts_with("the views")).count(), 8);
     }
 
     #[test]

@@ -307,19 +307,33 @@ fn pause_after_preview(pause: &PreviewPause, latest: &AtomicU64, generation: u64
     }
 }
 
+/// The designs the app holds at most.
+pub const MAX_DESIGNS: usize = 8;
+
+/// The most the app engine's cache keeps: what lets a change restart mid-chain (the Rrs for a
+/// retrieval change, Level-1 for a correction change, the pupil radiance for a change to the
+/// detector), least recently used first, so the designs being edited keep theirs.
+pub const APP_CACHE_MAX_BYTES: usize = 1 << 30;
+
+/// The most a run's working set and the app engine's cache hold together: before a run whose
+/// working set would take the cache past it, the cache lets its least recently used products go.
+pub const APP_RUN_ENVELOPE_BYTES: usize = 5 << 29;
+
 /// The app engine's cache: a quarter of the memory budget (`SHOAL_MEMORY_BUDGET`, default 60 %
-/// of the machine's memory), so that the designs' cubes kept for incremental reruns cannot grow
-/// without bound (eight designs at full resolution filled 14.8 GB before it); products past it go
-/// least recently used first, and a rerun of a design whose cubes went recomputes them.
-fn app_cache_bytes() -> usize {
+/// of the machine's memory), at most [`APP_CACHE_MAX_BYTES`]. The runs themselves hand back
+/// products and bounded views, not cubes ([`Engine::for_app`]); a rerun of a design whose
+/// cubes the cache let go recomputes them.
+pub fn app_cache_bytes() -> usize {
     const SHARE: f64 = 0.25;
-    // A budget that cannot be read (a malformed variable: the CLI refuses it) gets 2 GiB.
-    crate::budget::Budget::from_env().map_or(2 << 30, |b| (b.memory_bytes * SHARE) as usize)
+    // A budget that cannot be read (a malformed variable: the CLI refuses it) gets the most.
+    crate::budget::Budget::from_env()
+        .map_or(APP_CACHE_MAX_BYTES, |b| ((b.memory_bytes * SHARE) as usize).min(APP_CACHE_MAX_BYTES))
 }
 
 fn worker(requests: &Mailbox<Request>, link: &Link<'_>, pause: &PreviewPause, pool: &rayon::ThreadPool) {
     let Link { events, latest, counters, wake } = *link;
-    let mut engine = Engine::new().with_cache_budget(app_cache_bytes());
+    let cache_bytes = app_cache_bytes();
+    let mut engine = Engine::for_app(cache_bytes, MAX_DESIGNS);
     // The mailbox holds only the newest request: an older one was replaced (and counted) there.
     while let Some(request) = requests.take() {
         // A configuration that failed is not run at finer levels; the others go on (one
@@ -344,6 +358,11 @@ fn worker(requests: &Mailbox<Request>, link: &Link<'_>, pause: &PreviewPause, po
                 started = true;
                 let mut config = base.clone();
                 config.fidelity.decimation = decimation;
+                // Room for a large run: the run's working set and the cache together stay within
+                // [`APP_RUN_ENVELOPE_BYTES`] (a 10 m imager's run empties the cache; a CubeSat's
+                // leaves it whole).
+                let working = super::resources::run_demand_keeping(&config, false).bytes() as usize;
+                engine.set_cache_budget(cache_bytes.min(APP_RUN_ENVELOPE_BYTES.saturating_sub(working)));
                 let control = Arc::new(RunControl::for_generation(latest.clone(), request.generation));
                 let generation = request.generation;
                 let report = |c: &RunControl| {
