@@ -474,6 +474,15 @@ fn hover_readout(app: &mut ShoalApp, ui: &mut egui::Ui, hovered: Option<(Pos2, u
         }
     } else {
         ui.label("Drag to pan, scroll to zoom (the maps move together); click for the spectrum there.");
+        // The app keeps every n-th pixel of the cubes (`engine::views`): say so on their maps.
+        let cube = matches!(app.state.product, ProductKind::Rrs | ProductKind::Level1 | ProductKind::Snr);
+        let strides = app.link.shown.iter().flatten().filter_map(|s| s.output.views.as_ref()).map(|v| v.stride);
+        if let Some(n) = strides.max().filter(|&n| cube && n > 1) {
+            ui.small(format!(
+                "Cube maps keep one pixel in {n} × {n} at most, drawn over its block, so eight designs fit \
+                 a laptop's memory; products are at full resolution."
+            ));
+        }
     }
 }
 
