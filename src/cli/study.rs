@@ -38,6 +38,10 @@ pub struct StudyArgs {
     /// Do not draw figures.
     #[arg(long)]
     no_figures: bool,
+
+    /// Print each run's stages and their wall time (what ran, what came from the cache)
+    #[arg(long)]
+    timings: bool,
 }
 
 impl From<StudyError> for CliError {
@@ -126,10 +130,22 @@ pub fn run(args: &StudyArgs) -> Result<(), CliError> {
     const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
     let planned = crate::study::study_plan(&resolved, !args.no_cubes).0.bytes();
     let memory = match crate::budget::peak_resident_bytes() {
-        Some(peak) => format!(", peak memory {:.2} GB (planned {:.2} GB)", peak / GIB, planned / GIB),
+        Some(peak) => format!(", peak memory {:.2} GiB (planned {:.2} GiB)", peak / GIB, planned / GIB),
         None => String::new(),
     };
     eprintln!("{}: {n} runs in {:.1} s{memory}", spec.name, start.elapsed().as_secs_f64());
+    if args.timings {
+        for run in &result.runs {
+            let stages: Vec<String> = run
+                .report
+                .stages
+                .iter()
+                .filter(|s| s.status == crate::engine::StageStatus::Ran && s.seconds >= 0.005)
+                .map(|s| format!("{} {:.2}", s.stage, s.seconds))
+                .collect();
+            eprintln!("  {} (seed {}): {:.2} s: {}", run.label, run.seed, run.report.total_seconds, stages.join(", "));
+        }
+    }
     let mut table = String::new();
     print_metrics(&mut table, &result);
     print_budgets(&mut table, &result);
