@@ -132,7 +132,16 @@ pub fn run(args: &CorrectArgs) -> Result<(), CliError> {
         cropped: (0, 0),
     };
     let sun_range = (sza.iter().copied().fold(f64::INFINITY, f64::min), sza.iter().copied().fold(0.0, f64::max));
-    let axes = crate::engine::lut_axes_covering(&response, sun_range, max_vza, &fid);
+    let mut axes = crate::engine::lut_axes_covering(&response, sun_range, max_vza, &fid);
+    // A radiative-transfer solve per sun node: where the rows have fewer distinct sun zeniths
+    // than the grid over their range has nodes, the family is built at exactly those (each row
+    // then reads its own node, with no interpolation in the sun's angle).
+    let mut suns = sza.clone();
+    suns.sort_by(f64::total_cmp);
+    suns.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
+    if suns.len() < axes.sun_zenith_deg.len() {
+        axes.sun_zenith_deg = suns;
+    }
     let scene = Scene::build(&scene_spec, dir.as_deref()).map_err(|e| CliError::Input(format!("--scene: {e}")))?;
     let mut atmosphere = scene_spec.atmosphere.clone();
     atmosphere.day_of_year = scene.day_of_year;

@@ -344,3 +344,47 @@ fn a_design_without_the_default_pair_corrects_from_its_own_mission_pair() {
     // Three visible bands make no pair.
     assert!(default.for_bands(&[443.0, 560.0, 665.0]).is_none());
 }
+
+/// `shoal correct --toa` builds its family at the rows' own sun zeniths (one radiative-transfer
+/// solve per distinct angle, not one per degree of their range): rows corrected together give
+/// what each gives alone.
+#[test]
+fn correct_reads_each_rows_own_sun_node_whatever_the_other_rows() {
+    let names: Vec<String> = (1..=19).map(|i| format!("Oa{i:02}")).collect();
+    let header = format!("sun_zenith_deg,view_zenith_deg,relative_azimuth_deg,{}\n", names.join(","));
+    // A dark-water TOA spectrum (Rayleigh-like and aerosol-like terms, W m⁻² sr⁻¹ µm⁻¹).
+    let row = |sza: f64| {
+        let centres = [
+            400.0, 412.5, 442.5, 490.0, 510.0, 560.0, 620.0, 665.0, 673.75, 681.25, 708.75, 753.75, 761.25, 764.375,
+            767.5, 778.75, 865.0, 885.0, 900.0,
+        ];
+        let l: Vec<String> = centres
+            .iter()
+            .map(|w: &f64| {
+                format!("{:.4}", (120.0 * (400.0 / w).powi(4) + 9.0 * (550.0 / w).powf(1.2)) * sza.to_radians().cos())
+            })
+            .collect();
+        format!("{sza},10,90,{}\n", l.join(","))
+    };
+    let dir = std::env::temp_dir().join(format!("shoal-correct-suns-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let correct = |csv: String, tag: &str| -> Vec<Vec<String>> {
+        std::fs::write(dir.join(format!("{tag}.csv")), csv).unwrap();
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_shoal"))
+            .args(["correct", "--toa", &format!("{tag}.csv"), "--instrument", "cubesat", "--correction", "pair-black"])
+            .args(["--out", tag])
+            .current_dir(&dir)
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let text = std::fs::read_to_string(dir.join(tag).join("rrs.csv")).unwrap();
+        text.lines().skip(1).map(|l| l.split(',').skip(1).map(String::from).collect()).collect()
+    };
+    let both = correct(format!("{header}{}{}", row(25.0), row(55.0)), "both");
+    let first = correct(format!("{header}{}", row(25.0)), "first");
+    let second = correct(format!("{header}{}", row(55.0)), "second");
+    std::fs::remove_dir_all(&dir).ok();
+    // The same node, the same numbers: every cell as written (Rrs to 7 significant digits).
+    assert_eq!(both[0], first[0]);
+    assert_eq!(both[1], second[0]);
+}
