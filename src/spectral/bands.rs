@@ -133,6 +133,16 @@ impl BandSet {
     /// assert!((olci.bands[7].centre_nm - 665.0).abs() < 1.5);
     /// ```
     pub fn from_spec(spec: &BandSetSpec) -> Result<Self, SpectralError> {
+        /// Band sets read from the embedded response tables (OLCI, MSI), kept once built: the
+        /// files never change, and parsing them (~1 ms) is too slow for the app, which builds its
+        /// designs' configurations every frame. At most `KEPT` (a user's subsets of bands).
+        static BUILT: std::sync::Mutex<Vec<(BandSetSpec, BandSet)>> = std::sync::Mutex::new(Vec::new());
+        const KEPT: usize = 64;
+        let tabled = matches!(spec, BandSetSpec::Olci { .. } | BandSetSpec::Msi { .. });
+        let lock = || BUILT.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+        if tabled && let Some((_, set)) = lock().iter().find(|(s, _)| s == spec) {
+            return Ok(set.clone());
+        }
         let set = Self::build(spec)?;
         // Retrieval settings, cubes and reports address bands by name: two bands of one name
         // would make the second unreachable (a look-up takes the first).
@@ -143,6 +153,13 @@ impl BandSet {
                     b.name
                 )));
             }
+        }
+        if tabled {
+            let mut built = lock();
+            if built.len() >= KEPT {
+                built.remove(0);
+            }
+            built.push((spec.clone(), set.clone()));
         }
         Ok(set)
     }
