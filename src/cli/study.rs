@@ -70,6 +70,20 @@ pub(super) fn load(arg: Option<&str>) -> Result<(StudySpec, Option<PathBuf>), Cl
     }
 }
 
+/// Each run's stages that ran, and their wall time (`--timings`), on standard error.
+fn print_timings(result: &crate::study::StudyResult) {
+    for run in &result.runs {
+        let stages: Vec<String> = run
+            .report
+            .stages
+            .iter()
+            .filter(|s| s.status == crate::engine::StageStatus::Ran && s.seconds >= 0.005)
+            .map(|s| format!("{} {:.2}", s.stage, s.seconds))
+            .collect();
+        eprintln!("  {} (seed {}): {:.2} s: {}", run.label, run.seed, run.report.total_seconds, stages.join(", "));
+    }
+}
+
 /// `shoal study`.
 pub fn run(args: &StudyArgs) -> Result<(), CliError> {
     let (spec, dir) = load(args.study.as_deref())?;
@@ -135,16 +149,7 @@ pub fn run(args: &StudyArgs) -> Result<(), CliError> {
     };
     eprintln!("{}: {n} runs in {:.1} s{memory}", spec.name, start.elapsed().as_secs_f64());
     if args.timings {
-        for run in &result.runs {
-            let stages: Vec<String> = run
-                .report
-                .stages
-                .iter()
-                .filter(|s| s.status == crate::engine::StageStatus::Ran && s.seconds >= 0.005)
-                .map(|s| format!("{} {:.2}", s.stage, s.seconds))
-                .collect();
-            eprintln!("  {} (seed {}): {:.2} s: {}", run.label, run.seed, run.report.total_seconds, stages.join(", "));
-        }
+        print_timings(&result);
     }
     let mut table = String::new();
     print_metrics(&mut table, &result);
