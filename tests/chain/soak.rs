@@ -73,10 +73,19 @@ fn edit(c: &mut RunConfig, rng: &mut rand::rngs::Xoshiro256PlusPlus) -> &'static
     }
 }
 
+/// The worker's run `a` (views of its cubes, as the app keeps them) against a fresh run `b` that
+/// kept its cubes: the views hold the cubes' own bits at every kept pixel, and the products are
+/// the same.
 fn same_products(a: &shoal::engine::RunOutput, b: &shoal::engine::RunOutput) -> bool {
-    a.kept().level0.dn == b.kept().level0.dn
-        && a.kept().level1.radiance.iter().zip(&b.kept().level1.radiance).all(|(x, y)| x.to_bits() == y.to_bits())
-        && a.kept().rrs.rrs.iter().zip(&b.kept().rrs.rrs).all(|(x, y)| x.to_bits() == y.to_bits())
+    let views = a.views.as_ref().expect("the app's engine keeps views");
+    let every = views.stride as isize;
+    let kept = |cube: &ndarray::Array3<f32>| cube.slice(ndarray::s![..;every, ..;every, ..]).to_owned();
+    let bits = |x: &ndarray::Array3<f32>, y: &ndarray::Array3<f32>| {
+        x.dim() == y.dim() && x.iter().zip(y).all(|(p, q)| p.to_bits() == q.to_bits())
+    };
+    bits(&views.level1, &kept(&b.kept().level1.radiance))
+        && bits(&views.rrs, &kept(&b.kept().rrs.rrs))
+        && bits(&views.toa, &kept(&b.kept().radiance.radiance))
         && a.retrievals.len() == b.retrievals.len()
         && a.retrievals.iter().zip(&b.retrievals).all(|(x, y)| {
             x.product
@@ -181,7 +190,10 @@ fn soak() -> Soak {
     // first in, first out, so every result the worker sent has been either displayed or dropped
     // as stale by the handle — none lost, none shown twice.
     assert_eq!(stats.results_sent, displayed as u64 + stats.stale_results_dropped, "{stats:?}, {displayed} displayed");
-    let capacity: usize = Stage::ALL.iter().map(|s| s.capacity()).sum();
+    // The app engine keeps one large cube per design and decimation (`Engine::for_app`).
+    let large = 2 * shoal::engine::worker::MAX_DESIGNS;
+    let capacity: usize =
+        Stage::ALL.iter().map(|s| if s.capacity() < Stage::Scene.capacity() { large } else { s.capacity() }).sum();
     assert!(load.max_cached_products <= capacity as u64, "{} cached products > {capacity}", load.max_cached_products);
     assert!(
         stats.runs_cancelled > 100,
