@@ -318,6 +318,9 @@ impl AppState {
             for (k, layer) in scene.substrates.iter_mut().enumerate() {
                 bump(&mut layer.fraction, 5 + k as u64);
             }
+            // The aerosol's map and the land mask are drawn from the seed too.
+            scene.aot550_map.iter_mut().for_each(|m| bump(m, 1000));
+            scene.land.iter_mut().for_each(|l| bump(&mut l.mask, 1001));
         }
         scene
     }
@@ -487,5 +490,8 @@ mod tests {
         s.scene_seed = 3;
         assert_ne!(s.seeded_scene().chl_mg_m3, before.chl_mg_m3);
         assert_eq!(s.seeded_scene().nap_g_m3, before.nap_g_m3, "constant maps have no seed");
+        let hazy = crate::scene::SceneSpec::preset("lake_hume_haze").unwrap();
+        let s = AppState { scene: hazy.clone(), scene_seed: 3, ..AppState::default() };
+        assert_ne!(s.seeded_scene().aot550_map, hazy.aot550_map, "the aerosol's map is reseeded");
     }
 }
