@@ -140,3 +140,27 @@ fn the_app_engine_keeps_views_with_the_cubes_values_and_the_same_products() {
         assert_eq!(truth, cubes.radiance.truth_rrs.index_axis(ndarray::Axis(2), b));
     }
 }
+
+#[test]
+fn the_app_engine_restarts_a_retrieval_change_from_the_rrs_it_kept() {
+    use shoal::control::RunControl;
+    use shoal::engine::{Engine, RunConfig, Stage};
+    let mut a = RunConfig::new(super::small_lake(), super::small("cubesat", 96, 64));
+    a.retrievals = vec![ron::from_str("Almi()").unwrap()];
+    let mut b = a.clone();
+    b.instrument = super::small("smallsat", 96, 64);
+    let mut engine = Engine::for_app(64 << 20, 8);
+    for c in [&a, &b] {
+        engine.run(c, &RunControl::new()).unwrap();
+    }
+    let (level0, corrections) = (engine.executions(Stage::Level0), engine.executions(Stage::Correction));
+    // The retrieval changes for both designs: each restarts from its kept Rrs.
+    for c in [&mut a, &mut b] {
+        c.retrievals = vec![ron::from_str("Almi(settings: (noise_weighting: false))").unwrap()];
+        let out = engine.run(c, &RunControl::new()).unwrap();
+        assert!(out.views.is_some(), "a rerun from the cache still hands back views");
+    }
+    assert_eq!(engine.executions(Stage::Level0), level0, "the instrument was not run again");
+    assert_eq!(engine.executions(Stage::Correction), corrections, "nor the correction");
+    assert_eq!(engine.executions(Stage::Retrieval), 4);
+}
