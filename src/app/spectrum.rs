@@ -187,6 +187,15 @@ fn draw(
         s.view_zenith_deg,
         if s.gases { ", gases included" } else { "; this scene's atmosphere leaves the gases out" },
     ));
+    let at: Vec<String> =
+        instruments.iter().filter_map(|i| i.pixel.map(|(r, c)| format!("{} row {r}, column {c}", i.label))).collect();
+    if !at.is_empty() {
+        ui.small(format!(
+            "Measured at {}: each design's pixel nearest the point (the first of its block where the app keeps \
+             one pixel per block).",
+            at.join("; ")
+        ));
+    }
     ui.horizontal_wrapped(|ui| {
         ui.colored_label(theme::TRUTH, "—");
         ui.small("scene (truth)");
