@@ -161,9 +161,12 @@ fn verdict_table(state: &AppState, runs: &[&Arc<RunOutput>]) -> Vec<Vec<String>>
             )
         })
         .collect();
-    let judged = |checks: &[crate::study::Check], variable: Option<&str>| {
+    // A pass under a plausibility warning (saturation, smear, no buildable f-number) reads
+    // "pass?", as in the app's metrics table.
+    let judged = |checks: &[crate::study::Check], variable: Option<&str>, out: &RunOutput| {
         let mine: Vec<&crate::study::Check> = checks.iter().filter(|c| c.variable.as_deref() == variable).collect();
         match crate::study::verdict(mine.iter().copied()) {
+            Some(true) if !out.report.warnings.is_empty() => "pass?".to_string(),
             Some(true) => "pass".to_string(),
             Some(false) if variable.is_none() => {
                 // The SNR floor: how many bands miss it (the SNR chart beside shows which).
@@ -208,7 +211,7 @@ fn verdict_table(state: &AppState, runs: &[&Arc<RunOutput>]) -> Vec<Vec<String>>
                 Some(m) => row.extend(["–".into(), "–".into(), format!("{:.1}", m.returned_pct)]),
                 None => row.extend(["–".into(), "–".into(), "–".into()]),
             }
-            row.push(judged(checks, Some(v)));
+            row.push(judged(checks, Some(v), out));
         }
         table.push(row);
     }
@@ -217,7 +220,7 @@ fn verdict_table(state: &AppState, runs: &[&Arc<RunOutput>]) -> Vec<Vec<String>>
         let mut row = vec!["bottom type".to_string()];
         for (out, checks) in runs.iter().zip(&checks) {
             let right = agreement(out).map_or_else(|| "–".into(), |a| format!("{a:.1} % right"));
-            row.extend([right, String::new(), String::new(), judged(checks, Some("substrate"))]);
+            row.extend([right, String::new(), String::new(), judged(checks, Some("substrate"), out)]);
         }
         table.push(row);
     }
@@ -231,7 +234,7 @@ fn verdict_table(state: &AppState, runs: &[&Arc<RunOutput>]) -> Vec<Vec<String>>
             } else {
                 lowest.map_or_else(|| "–".into(), |l| format!("lowest {l:.0}"))
             };
-            row.extend([value, String::new(), String::new(), judged(checks, None)]);
+            row.extend([value, String::new(), String::new(), judged(checks, None, out)]);
         }
         table.push(row);
     }

@@ -49,7 +49,7 @@ table { border-collapse: collapse; margin: 6px 0 14px; font-size: 13.5px; }
 th, td { border: 1px solid #c9ced6; padding: 3px 8px; text-align: left; vertical-align: top; }
 th { background: #eef2f7; } td.num { text-align: right; font-variant-numeric: tabular-nums; }
 tr.differs td { background: #fff6dc; }
-.pass { color: #0d6b2f; font-weight: bold; } .fail { color: #b3141b; font-weight: bold; }
+.pass { color: #0d6b2f; font-weight: bold; } .fail { color: #b3141b; font-weight: bold; } .warn { color: #a35f00; font-weight: bold; }
 .meta td:first-child { font-weight: bold; background: #f5f7fa; }
 figure { margin: 14px 0 22px; } figure svg { max-width: 100%; height: auto; display: block; border: 1px solid #e1e4e8; }
 figcaption { font-size: 13px; color: #444; margin-top: 4px; }
@@ -154,13 +154,19 @@ fn verdict(h: &mut String, d: &ReviewData) {
         }
         let passed = mine.iter().filter(|c| c.pass).count();
         let all = passed == mine.len();
+        // A design that meets every number but is implausible over the scene (saturation,
+        // smear, no buildable f-number) is not a plain pass: the app reads "pass?".
+        let (class, word, but) = match (all, inst.warnings.is_empty()) {
+            (true, true) => ("pass", "MEETS ALL", String::new()),
+            (true, false) => ("warn", "MEETS ALL?", format!("; but implausible here: {}", inst.warnings.join("; "))),
+            (false, _) => ("fail", "FAILS", String::new()),
+        };
         let _ = writeln!(
             h,
-            "<div class=\"card\">{}<br><b class=\"{}\">{}</b> — {passed} of {} checks met</div>",
+            "<div class=\"card\">{}<br><b class=\"{class}\">{word}</b> — {passed} of {} checks met{}</div>",
             escape(&inst.label),
-            if all { "pass" } else { "fail" },
-            if all { "MEETS ALL" } else { "FAILS" },
-            mine.len()
+            mine.len(),
+            escape(&but)
         );
     }
     let judged = if d.judged_retrieval.is_empty() {
@@ -170,10 +176,11 @@ fn verdict(h: &mut String, d: &ReviewData) {
     };
     let _ = writeln!(
         h,
-        "</div>\n<p class=\"note\">Margin: how far inside the limit (negative: outside), in the value's unit. A product with no pixel returned has no value and fails.{judged}</p>"
+        "</div>\n<p class=\"note\">Margin: how far inside the limit (negative: outside), in the value's unit. A product with no pixel returned has no value and fails. <span class=\"warn\">pass?</span>: the numbers pass, but the design is implausible over this scene (it saturates, smears or has no buildable f-number; its warnings are under the instruments).{judged}</p>"
     );
     // One row per requirement (and seed), the instruments side by side.
     let labels: Vec<&str> = d.instruments.iter().map(|i| i.label.as_str()).collect();
+    let warned: Vec<bool> = d.instruments.iter().map(|i| !i.warnings.is_empty()).collect();
     let mut keys: Vec<(u64, &str, f64)> = Vec::new();
     for c in &d.checks {
         if !keys.iter().any(|k| k.0 == c.seed && k.1 == c.what) {
@@ -189,16 +196,19 @@ fn verdict(h: &mut String, d: &ReviewData) {
     for (seed, what, limit) in keys {
         let name = if several_seeds { format!("{what} (seed {seed})") } else { what.to_string() };
         let _ = write!(h, "<tr><td>{}</td><td class=\"num\">{}</td>", escape(&name), num(limit, 1));
-        for l in &labels {
+        for (l, warned) in labels.iter().zip(&warned) {
             match d.checks.iter().find(|c| c.instrument == *l && c.seed == seed && c.what == what) {
                 Some(c) => {
+                    let (class, word) = match (c.pass, *warned) {
+                        (true, false) => ("pass", "pass"),
+                        (true, true) => ("warn", "pass?"),
+                        (false, _) => ("fail", "FAIL"),
+                    };
                     let _ = write!(
                         h,
-                        "<td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"{}\">{}</td>",
+                        "<td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"{class}\">{word}</td>",
                         c.value.map_or_else(|| "none".into(), |v| num(v, 1)),
                         c.margin.map_or_else(|| "no pixel".into(), |m| format!("{m:+.1}")),
-                        if c.pass { "pass" } else { "fail" },
-                        if c.pass { "pass" } else { "FAIL" }
                     );
                 }
                 None => h.push_str("<td colspan=\"3\">–</td>"),

@@ -48,11 +48,32 @@ fn the_review_pack_states_each_cost_row_with_its_range_and_95th_percentile() {
         created_utc: String::new(),
         version: String::new(),
         commit: String::new(),
-        instruments: Vec::new(),
+        instruments: ["olci", "cubesat"]
+            .map(|label| InstrumentSummary {
+                label: label.into(),
+                description: String::new(),
+                config_ron: String::new(),
+                stages: Vec::new(),
+                total_seconds: 1.0,
+                shape: (1, 1, 1, 1),
+                warnings: if label == "olci" { vec!["saturates in 7 of 21 bands".into()] } else { Vec::new() },
+                feasibility: Vec::new(),
+            })
+            .to_vec(),
         parameters: Vec::new(),
         derived: Vec::new(),
-        checks: Vec::new(),
-        has_requirements: false,
+        checks: ["olci", "cubesat"]
+            .map(|instrument| CheckRow {
+                instrument: instrument.into(),
+                seed: 1,
+                what: "chl_mg_m3 MAE %".into(),
+                value: Some(10.0),
+                limit: 20.0,
+                pass: true,
+                margin: Some(10.0),
+            })
+            .to_vec(),
+        has_requirements: true,
         judged_retrieval: String::new(),
         metrics: Vec::new(),
         budget: Vec::new(),
@@ -97,6 +118,12 @@ fn the_review_pack_states_each_cost_row_with_its_range_and_95th_percentile() {
     assert!(row("preview 1/4").ends_with("<td class=\"num\">other grid</td><td class=\"num\">–</td>"));
     assert!(row("a setting whose percentile failed").ends_with("<td class=\"num\">0.100</td><td class=\"num\">–</td>"));
     assert!(!html.contains("NaN"));
+    // A design that passes under a plausibility warning is "pass?", as in the app; one without
+    // a warning is a plain pass.
+    assert!(html.contains("<b class=\"warn\">MEETS ALL?</b> — 1 of 1 checks met; but implausible here: saturates"));
+    assert!(html.contains("cubesat<br><b class=\"pass\">MEETS ALL</b>"));
+    let verdicts = row("chl_mg_m3 MAE %");
+    assert!(verdicts.contains("<td class=\"warn\">pass?</td>") && verdicts.contains("<td class=\"pass\">pass</td>"));
     // A program's own words are text, never markup.
     assert!(html.contains("<h2>Retrievals that returned nothing</h2>"));
     assert!(

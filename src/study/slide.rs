@@ -97,6 +97,8 @@ fn table<DB: DrawingBackend>(
             // A verdict alone ("pass", "FAIL: …") or at the end of a value ("10.6 / +5.5 pass").
             let colour = match cell.as_str() {
                 s if s.starts_with("FAIL") || s.ends_with(" FAIL") => RGBColor(190, 30, 30),
+                // A pass under a plausibility warning, amber as in the app.
+                "pass?" => RGBColor(180, 110, 0),
                 s if s == "pass" || s.ends_with(" pass") => RGBColor(30, 130, 30),
                 _ => RGBColor(25, 25, 25),
             };
