@@ -137,7 +137,7 @@ impl ShoalApp {
         let of = budget.map_or(String::new(), |b| format!(" of the {b:.1} GB budget (SHOAL_MEMORY_BUDGET)"));
         format!(
             "Memory at full resolution, planned: {gb:.2} GB{of}. Each design keeps its products and a view \
-             of its cubes (every n-th pixel, at most {} MB); the engine's cache keeps what lets a change \
+             of its cubes (every n-th pixel, at most {} MiB); the engine's cache keeps what lets a change \
              restart mid-chain.",
             crate::engine::VIEW_BYTES >> 20
         )

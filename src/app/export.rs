@@ -146,8 +146,9 @@ pub fn existing(what: What, path: &Path, designs: usize) -> Vec<PathBuf> {
 /// configuration. Written whole: a new or empty folder, or one Shoal wrote, which is replaced.
 ///
 /// The app's runs keep views of their cubes, not the cubes ([`crate::engine::Engine::for_app`]):
-/// each design is run again here, one at a time, by an engine that keeps them (the same
-/// configuration and seed make the same cubes), and its cubes are let go once written.
+/// each design is run again here up to its Rrs, one at a time, by an engine that keeps them (the
+/// same configuration and seed make the same cubes), with the retrievals the app ran, and its
+/// cubes are let go once written.
 pub fn write_data(snap: &Snapshot, dir: &Path) -> Result<usize, String> {
     let result = study_of(snap)?;
     let out = crate::study::OutputDir::create(dir, "Shoal app: data export").map_err(|e| e.to_string())?;
@@ -160,8 +161,15 @@ pub fn write_data(snap: &Snapshot, dir: &Path) -> Result<usize, String> {
         let run = if run.cubes.is_some() {
             &**run
         } else {
+            // The configuration the run flew (binning folded in, so flying it again changes
+            // nothing); its retrievals are the run's, not run again.
+            let mut config = run.config.clone();
+            config.retrievals.clear();
             let control = crate::control::RunControl::default();
-            rerun = crate::engine::Engine::new().run(&run.config, &control).map_err(|e| e.to_string())?;
+            let mut out = crate::engine::Engine::new().run(&config, &control).map_err(|e| e.to_string())?;
+            out.retrievals.clone_from(&run.retrievals);
+            out.config.retrievals.clone_from(&run.config.retrievals);
+            rerun = out;
             &rerun
         };
         outputs.files.extend(write_run(run, &sub).map_err(|e| e.to_string())?.files);

@@ -302,7 +302,7 @@ impl Cache {
         }
     }
 
-    /// Products kept, over all stages (at most the sum of [`Stage::capacity`]).
+    /// Products kept, over all stages (at most the sum of the stages' capacities).
     #[must_use]
     pub fn len(&self) -> usize {
         self.entries.values().map(VecDeque::len).sum()

@@ -67,7 +67,7 @@ pub use lut_axes::lut_axes_covering;
 pub use probe::{Probe, Probed};
 pub use products::{CorrectionProduct, Cubes, RetrievalOutput, RunOutput};
 pub use report::{AerosolSummary, RunReport, StageReport, StageStatus};
-pub use run::{Engine, LEAN_CACHE_BYTES};
+pub use run::{APP_LEVELS, Engine, LEAN_CACHE_BYTES};
 pub use views::{CubeViews, VIEW_BYTES, ViewOf};
 
 /// An engine failure: the stage and what went wrong (the message names the field).

@@ -25,11 +25,20 @@ pub struct Engine {
     keep_cubes: bool,
     /// Whether a run hands back every n-th pixel of its cubes ([`RunOutput::views`]).
     keep_views: bool,
+    /// The most a run's views may hold, bytes.
+    view_bytes: usize,
 }
 
 impl Default for Engine {
     fn default() -> Self {
-        Self { cache: Cache::default(), executions: HashMap::new(), fault: None, keep_cubes: true, keep_views: false }
+        Self {
+            cache: Cache::default(),
+            executions: HashMap::new(),
+            fault: None,
+            keep_cubes: true,
+            keep_views: false,
+            view_bytes: super::views::VIEW_BYTES,
+        }
     }
 }
 
@@ -37,6 +46,10 @@ impl Default for Engine {
 /// a run's retrieval products, not a cube of a full-resolution image (a 1024 × 2000 × 19 f32
 /// cube is 156 MB; its Level-0 counts and flags 117 MB).
 pub const LEAN_CACHE_BYTES: usize = 64 << 20;
+
+/// The decimations the app's cache keeps a large product of per design: its default levels are
+/// a coarse preview, a finer one and full resolution (`app::model`), and one more for a user's.
+pub const APP_LEVELS: usize = 4;
 
 /// Stages whose per-pixel loops report the pixel they fail at (an injected panic fires there).
 const PIXEL_STAGES: [Stage; 6] =
@@ -59,14 +72,23 @@ impl Engine {
     }
 
     /// An engine for the app: runs keep products and views of their cubes at a bounded size
-    /// ([`super::views::VIEW_BYTES`]), not the cubes; the cache keeps at most `cache_bytes` (so
-    /// a change to the retrieval restarts from the Rrs while the cache still holds it) and up to
-    /// `designs` cubes per stage at each of two decimations.
+    /// ([`super::views::VIEW_BYTES`]), not the cubes; the cache keeps at most `cache_bytes` and up
+    /// to `designs` cubes per stage at each of [`APP_LEVELS`] decimations. A change restarts
+    /// mid-chain where the cache still holds every product before it (a retrieval change needs
+    /// the run's pupil radiance, Level-0, Level-1 and Rrs: ~0.8 GB for the CubeSat).
     #[must_use]
     pub fn for_app(cache_bytes: usize, designs: usize) -> Self {
         let mut engine = Self { keep_cubes: false, keep_views: true, ..Self::default() };
-        engine.cache = Cache::with_budget(cache_bytes).with_large_capacity(2 * designs.max(2));
+        engine.cache = Cache::with_budget(cache_bytes).with_large_capacity(APP_LEVELS * designs.max(1));
         engine
+    }
+
+    /// Views of the cubes kept under `bytes` per run instead of [`super::views::VIEW_BYTES`]
+    /// (tests use it to see a stride above 1 on a small image).
+    #[must_use]
+    pub fn with_view_bytes(mut self, bytes: usize) -> Self {
+        self.view_bytes = bytes;
+        self
     }
 
     /// The same engine, its cache emptied and bounded to `bytes` (products past it are dropped,
@@ -220,7 +242,7 @@ impl Engine {
         let truth_rrs = radiance.truth_rrs.clone();
         let mut views = self.keep_views.then(|| {
             let (rows, cols, bands) = radiance.radiance.dim();
-            CubeViews::of_radiance(&radiance, super::views::stride_for(rows, cols, bands, super::views::VIEW_BYTES))
+            CubeViews::of_radiance(&radiance, super::views::stride_for(rows, cols, bands, self.view_bytes))
         });
         let mut inst = self.instrument_side(config, &side, radiance, radiance_key, control, &mut report)?;
         let kept_radiance = inst.radiance.take();

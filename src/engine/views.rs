@@ -15,7 +15,7 @@ use crate::correction::Reflectance;
 use crate::instrument::RadianceCube;
 
 /// The most a run's views may hold, bytes: the stride is the smallest that keeps them under it.
-/// At 2 (every other line and detector) for the paper's 19-band, 1024 × 2000 CubeSat (176 MB);
+/// At 2 (every other line and detector) for the paper's 19-band, 1024 × 2000 CubeSat (175 MB);
 /// at 4 for the 101-band spectrograph (170 MB).
 pub const VIEW_BYTES: usize = 192 << 20;
 

@@ -310,13 +310,15 @@ fn pause_after_preview(pause: &PreviewPause, latest: &AtomicU64, generation: u64
 /// The designs the app holds at most.
 pub const MAX_DESIGNS: usize = 8;
 
-/// The most the app engine's cache keeps: what lets a change restart mid-chain (the Rrs for a
-/// retrieval change, Level-1 for a correction change, the pupil radiance for a change to the
-/// detector), least recently used first, so the designs being edited keep theirs.
-pub const APP_CACHE_MAX_BYTES: usize = 1 << 30;
+/// The most the app engine's cache keeps: what lets a change restart mid-chain (a change to
+/// the retrieval needs every product up to the Rrs, ~0.8 GB a full-resolution CubeSat, so the
+/// default study's two designs keep theirs), least recently used first.
+pub const APP_CACHE_MAX_BYTES: usize = 2 << 30;
 
 /// The most a run's working set and the app engine's cache hold together: before a run whose
-/// working set would take the cache past it, the cache lets its least recently used products go.
+/// working set would take the cache past it, the cache lets its least recently used products go
+/// (the 101-band spectrograph's or a 10 m imager's full-resolution run, ~2.5 GiB and more,
+/// empties it: a later change reruns the other designs from the start).
 pub const APP_RUN_ENVELOPE_BYTES: usize = 5 << 29;
 
 /// The app engine's cache: a quarter of the memory budget (`SHOAL_MEMORY_BUDGET`, default 60 %
@@ -359,8 +361,8 @@ fn worker(requests: &Mailbox<Request>, link: &Link<'_>, pause: &PreviewPause, po
                 let mut config = base.clone();
                 config.fidelity.decimation = decimation;
                 // Room for a large run: the run's working set and the cache together stay within
-                // [`APP_RUN_ENVELOPE_BYTES`] (a 10 m imager's run empties the cache; a CubeSat's
-                // leaves it whole).
+                // [`APP_RUN_ENVELOPE_BYTES`] (the spectrograph's or a 10 m imager's run empties the
+                // cache; a CubeSat's leaves it 1.9 GiB).
                 let working = super::resources::run_demand_keeping(&config, false).bytes() as usize;
                 engine.set_cache_budget(cache_bytes.min(APP_RUN_ENVELOPE_BYTES.saturating_sub(working)));
                 let control = Arc::new(RunControl::for_generation(latest.clone(), request.generation));

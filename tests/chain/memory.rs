@@ -164,3 +164,31 @@ fn the_app_engine_restarts_a_retrieval_change_from_the_rrs_it_kept() {
     assert_eq!(engine.executions(Stage::Correction), corrections, "nor the correction");
     assert_eq!(engine.executions(Stage::Retrieval), 4);
 }
+
+#[test]
+fn views_at_a_stride_hold_the_cubes_bits_at_every_kept_pixel() {
+    use shoal::control::RunControl;
+    use shoal::engine::{Engine, RunConfig, ViewOf};
+    let config = RunConfig::new(super::small_lake(), super::small("cubesat", 96, 64));
+    let keeping = Engine::new().run(&config, &RunControl::new()).unwrap();
+    let cubes = keeping.cubes.as_ref().unwrap();
+    let (rows, cols, bands) = cubes.rrs.rrs.dim();
+    // A budget a third of the full views': every other line and detector.
+    let full = rows * cols * bands * shoal::engine::views::VIEW_BYTES_PER_PIXEL_BAND;
+    let app = Engine::for_app(64 << 20, 8).with_view_bytes(full / 3).run(&config, &RunControl::new()).unwrap();
+    let views = app.views.as_ref().unwrap();
+    assert_eq!(views.stride, 2);
+    assert_eq!(views.rrs.dim(), (rows.div_ceil(2), cols.div_ceil(2), bands));
+    let b = bands / 2;
+    let (rrs, flags) = views.band(ViewOf::Rrs, b).unwrap();
+    let (l1, _) = views.band(ViewOf::Level1, b).unwrap();
+    for r in 0..rows {
+        for c in 0..cols {
+            let (kr, kc) = views.kept((r, c));
+            assert_eq!((kr % 2, kc % 2, r - kr < 2, c - kc < 2), (0, 0, true, true));
+            assert_eq!(rrs[[r, c]].to_bits(), cubes.rrs.rrs[[kr, kc, b]].to_bits());
+            assert_eq!(flags[[r, c]], cubes.rrs.flags[[kr, kc, b]]);
+            assert_eq!(l1[[r, c]].to_bits(), cubes.level1.radiance[[kr, kc, b]].to_bits());
+        }
+    }
+}

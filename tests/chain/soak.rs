@@ -191,7 +191,7 @@ fn soak() -> Soak {
     // as stale by the handle — none lost, none shown twice.
     assert_eq!(stats.results_sent, displayed as u64 + stats.stale_results_dropped, "{stats:?}, {displayed} displayed");
     // The app engine keeps one large cube per design and decimation (`Engine::for_app`).
-    let large = 2 * shoal::engine::worker::MAX_DESIGNS;
+    let large = shoal::engine::APP_LEVELS * shoal::engine::worker::MAX_DESIGNS;
     let capacity: usize =
         Stage::ALL.iter().map(|s| if s.capacity() < Stage::Scene.capacity() { large } else { s.capacity() }).sum();
     assert!(load.max_cached_products <= capacity as u64, "{} cached products > {capacity}", load.max_cached_products);
