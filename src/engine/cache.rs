@@ -267,24 +267,12 @@ impl Cache {
         let stage = key.stage;
         self.remove(key);
         // What may go to make room: products the current run has not used, oldest first.
-        let mut evictable: Vec<(u64, Key, usize)> = self
-            .entries
-            .values()
-            .flatten()
-            .filter(|e| e.used < self.run_start && e.bytes > 0)
-            .map(|e| (e.used, e.key, e.bytes))
-            .collect();
-        let room = self.budget.saturating_add(evictable.iter().map(|e| e.2).sum());
+        let run_start = self.run_start;
+        let room = self.budget.saturating_add(self.bytes_where(|e| e.used < run_start));
         if self.held + bytes > room {
             return;
         }
-        evictable.sort_unstable_by_key(|e| e.0);
-        for (_, old, _) in evictable {
-            if self.held + bytes <= self.budget {
-                break;
-            }
-            self.remove(old);
-        }
+        self.evict_to(self.budget.saturating_sub(bytes), |e| e.used < run_start);
         let keep = self.capacity(stage);
         let list = self.entries.entry(stage).or_default();
         list.push_front(Entry { key, product, bytes, used: self.clock });
@@ -324,11 +312,22 @@ impl Cache {
     /// whichever run used them (called between runs, to make room for a large one).
     pub fn set_budget(&mut self, budget: usize) {
         self.budget = budget;
-        let mut held: Vec<(u64, Key)> =
-            self.entries.values().flatten().filter(|e| e.bytes > 0).map(|e| (e.used, e.key)).collect();
-        held.sort_unstable_by_key(|e| e.0);
-        for (_, key) in held {
-            if self.held <= self.budget {
+        self.evict_to(budget, |_| true);
+    }
+
+    /// Bytes of the products `may_go` admits.
+    fn bytes_where(&self, may_go: impl Fn(&Entry) -> bool) -> usize {
+        self.entries.values().flatten().filter(|e| may_go(e)).map(|e| e.bytes).sum()
+    }
+
+    /// Drop the least recently used products `may_go` admits until at most `target` bytes are
+    /// held (or none of them is left).
+    fn evict_to(&mut self, target: usize, may_go: impl Fn(&Entry) -> bool) {
+        let mut candidates: Vec<(u64, Key)> =
+            self.entries.values().flatten().filter(|e| e.bytes > 0 && may_go(e)).map(|e| (e.used, e.key)).collect();
+        candidates.sort_unstable_by_key(|e| e.0);
+        for (_, key) in candidates {
+            if self.held <= target {
                 break;
             }
             self.remove(key);
