@@ -110,6 +110,8 @@ pub const PRESETS: &[Asset] = embed_presets![
     "studies/paper_heron_island.ron",
     "studies/paper_lake_hume.ron",
     "studies/reef_survey_depth.ron",
+    "seasons/lake_hume_year.ron",
+    "seasons/heron_island_year.ron",
     "sweeps/aperture_lake_hume.ron",
     "sweeps/nir_snr_sweep.ron",
     "sweeps/nir_snr_sweep_clear.ron",

@@ -17,6 +17,7 @@
 //! |---|---|
 //! | [`colormap`] | viridis, diverging and class colours, value scales (figures and app) |
 //! | [`units`] | constants, unit conversions, angle helpers |
+//! | [`orbit`] | sun-synchronous orbits (J2), the sun's position, accesses to a site with their geometry |
 //! | [`markup`] | the one escaping rule for text inside HTML, SVG and XML |
 //! | [`csvtext`] | CSV text: the one writer every table goes through (quoted per RFC 4180) and its reader |
 //! | [`infile`] | reading a file someone else made: regular files only, sized before reading, never blocking |
@@ -42,6 +43,7 @@
 //! | [`engine`] | the chain as cached stages; the worker thread the app talks to |
 //! | [`study`] | studies: runs per instrument and seed, metrics tables, figures (PNG/SVG), cubes; the paper reproduced |
 //! | [`sweep`] | sweeps: a study over one parameter or a grid of two, with seeds; shards and merge |
+//! | [`season`] | seasons: a design's looks at a site over a period (orbit, glint, clouds), revisit and the product error over the valid looks |
 //! | [`design`] | design search: the cheapest design meeting every requirement, and the cost–error front |
 //! | [`report`] | the review pack: a study's verdict, figures and provenance as one self-contained HTML page |
 //! | [`library`] | the preset library: built-ins and the user's own; atomic saves |
@@ -72,12 +74,14 @@ pub mod library;
 pub mod markup;
 pub mod metrics;
 pub mod netcdf;
+pub mod orbit;
 pub mod parse;
 pub mod ranges;
 pub mod report;
 pub mod retrieval;
 pub mod scene;
 pub mod schema;
+pub mod season;
 pub mod simd;
 pub mod spectral;
 pub mod study;

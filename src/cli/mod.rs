@@ -28,6 +28,7 @@ mod output;
 mod report;
 mod reproduce;
 mod score;
+mod season;
 pub mod simulate;
 mod study;
 mod sweep;
@@ -122,6 +123,10 @@ enum Command {
     /// Run a sweep: a study repeated over one parameter (or a grid of two) with several noise
     /// seeds per point; writes the table and the curves with the requirement's crossing.
     Sweep(sweep::SweepArgs),
+    /// Run a season: a study's designs flown in a sun-synchronous orbit over a site for a
+    /// period; each pass's sun, view, glint and clouds; how often a look is valid (per month,
+    /// gaps, the revisit requirement); and each product's error over the valid looks.
+    Season(season::SeasonArgs),
     /// The image-based atmospheric correction on TOA radiance spectra from a CSV (geometry and
     /// band radiances per row): Rrs per band, AOT and Ångström exponent per row.
     Correct(correct::CorrectArgs),
@@ -269,6 +274,7 @@ pub fn main(app: impl FnOnce(&AppArgs) -> ExitCode) -> ExitCode {
         Command::Simulate(args) => simulate::run(&args),
         Command::Study(args) => study::run(&args),
         Command::Sweep(args) => sweep::run(&args),
+        Command::Season(args) => season::run(&args),
         Command::Reproduce(args) => reproduce::run(&args),
         Command::Merge(args) => sweep::merge_run(&args),
         Command::Budget(args) => budget::run(&args),

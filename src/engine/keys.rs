@@ -119,6 +119,7 @@ pub(super) struct Orbit {
     pub detectors: usize,
     pub lines: usize,
     pub forward_tilt_deg: f64,
+    pub across_track_tilt_deg: f64,
     pub decimation: usize,
 }
 
@@ -207,6 +208,7 @@ impl<'a> Inputs<'a> {
             exposure_s,
             lines,
             forward_tilt_deg,
+            across_track_tilt_deg,
             read_noise_e,
             well_depth_e,
             gain_e_per_dn,
@@ -264,6 +266,7 @@ impl<'a> Inputs<'a> {
                 detectors: *detectors,
                 lines: *lines,
                 forward_tilt_deg: *forward_tilt_deg,
+                across_track_tilt_deg: *across_track_tilt_deg,
                 decimation,
             },
             photon: PhotonSide {

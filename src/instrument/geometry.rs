@@ -3,11 +3,11 @@
 //!
 //! The instrument flies a straight ground track through the scene centre along `heading_deg`
 //! (clockwise from north). Detector j of N looks at the across-track angle
-//! α_j = atan((j − (N−1)/2)·p/f); a geometry group (a filter row of a linear-variable-filter
-//! imager) adds an along-track angle to the forward tilt β. The look direction (tan β, tan α, 1)
-//! makes the off-nadir angle γ with the nadir; on a spherical Earth of radius R seen from
-//! altitude h the view zenith at the ground is sin θ_v = (R + h)/R · sin γ and the ground point
-//! lies R·(θ_v − γ) from the sub-satellite point (Schowengerdt 2007, §3.4). Lines are one nadir
+//! α_j = atan((j − (N−1)/2)·p/f), plus the across-track pointing (roll); a geometry group (a
+//! filter row of a linear-variable-filter imager) adds an along-track angle to the forward tilt
+//! β. The look direction (tan β, tan α, 1) makes the off-nadir angle γ with the nadir; on a
+//! spherical Earth of radius R seen from altitude h the view zenith at the ground is
+//! sin θ_v = (R + h)/R · sin γ and the ground point lies R·(θ_v − γ) from the sub-satellite point (Schowengerdt 2007, §3.4). Lines are one nadir
 //! GSD apart (GSD = h·p/f): the line period is GSD / ground speed, and the exposure must fit in it.
 //!
 //! The scene is small next to the Earth, so the track is straight in the scene frame, the sun is
@@ -95,6 +95,7 @@ impl Viewing {
         let heading = spec.heading_deg.to_radians();
         let (along, right) = ((heading.sin(), heading.cos()), (heading.cos(), -heading.sin()));
         let tilt = spec.forward_tilt_deg.to_radians();
+        let roll = spec.across_track_tilt_deg.to_radians();
         let n = spec.detectors;
         let detector_index: Vec<usize> = (0..n).step_by(decimation).collect();
         let line_index: Vec<usize> = (0..spec.lines).step_by(decimation).collect();
@@ -132,13 +133,13 @@ impl Viewing {
         // The image centre (central detector of the mean group offset) lands on the scene centre.
         let mean_offset =
             response.groups.iter().map(|g| g.offset_rad.0).sum::<f64>() / response.groups.len().max(1) as f64;
-        let (cx, cy, ..) = look(tilt + mean_offset, 0.0)?;
+        let (cx, cy, ..) = look(tilt + mean_offset, roll)?;
         let mut looks = Vec::with_capacity(response.groups.len());
         for g in &response.groups {
             let row = detector_index
                 .iter()
                 .map(|&j| {
-                    let alpha = ((j as f64 - 0.5 * (n as f64 - 1.0)) * pitch_over_f).atan() + g.offset_rad.1;
+                    let alpha = ((j as f64 - 0.5 * (n as f64 - 1.0)) * pitch_over_f).atan() + g.offset_rad.1 + roll;
                     let (dx, dy, geometry, view_azimuth_rad) = look(tilt + g.offset_rad.0, alpha)?;
                     max_vza = max_vza.max(geometry.view_zenith_rad.to_degrees());
                     Ok(Look { dx_m: dx - cx, dy_m: dy - cy, geometry, view_azimuth_rad })
@@ -158,7 +159,7 @@ impl Viewing {
             let reference = detector_index
                 .iter()
                 .map(|&j| {
-                    let alpha = ((j as f64 - 0.5 * (n as f64 - 1.0)) * pitch_over_f).atan();
+                    let alpha = ((j as f64 - 0.5 * (n as f64 - 1.0)) * pitch_over_f).atan() + roll;
                     look(tilt + mean_offset, alpha).map(|(dx, dy, ..)| (dx - cx, dy - cy))
                 })
                 .collect::<Result<Vec<_>, InstrumentError>>()?;
@@ -372,5 +373,26 @@ mod tests {
         assert!(edge.geometry.view_zenith_rad > alpha);
         let sin_vza = (EARTH_RADIUS_M + 560e3) / EARTH_RADIUS_M * alpha.sin();
         assert!((edge.geometry.view_zenith_rad - sin_vza.asin()).abs() < 1e-9);
+    }
+
+    /// A roll of r to the right puts the image centre at off-nadir r, seen at sin θ_v = (R+h)/R
+    /// sin r from the left of the track (heading north: the sensor to the west, azimuth 270°);
+    /// the image stays centred on the scene.
+    #[test]
+    fn across_track_tilt_views_the_scene_from_the_side() {
+        let mut spec = nominal();
+        spec.across_track_tilt_deg = 20.0;
+        let r = Response::new(&spec, 1.0).unwrap();
+        let v = Viewing::new(&spec, &r, 0.5, 0.0, 1, None).unwrap();
+        let centre = (v.looks[0][511], v.looks[0][512]);
+        let vza = ((EARTH_RADIUS_M + spec.altitude_km * 1e3) / EARTH_RADIUS_M * 20f64.to_radians().sin()).asin();
+        let mid = 0.5 * (centre.0.geometry.view_zenith_rad + centre.1.geometry.view_zenith_rad);
+        assert!((mid - vza).abs() < 1e-3, "{} vs {}", mid.to_degrees(), vza.to_degrees());
+        assert!((centre.0.view_azimuth_rad.to_degrees() - 270.0).abs() < 0.1);
+        assert!((0.5 * (centre.0.dx_m + centre.1.dx_m)).abs() < spec.gsd_m());
+        // Left of the track looks the other way.
+        spec.across_track_tilt_deg = -20.0;
+        let v = Viewing::new(&spec, &r, 0.5, 0.0, 1, None).unwrap();
+        assert!((v.looks[0][512].view_azimuth_rad.to_degrees() - 90.0).abs() < 0.1);
     }
 }

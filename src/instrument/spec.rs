@@ -97,6 +97,11 @@ pub struct InstrumentSpec {
     /// Forward tilt of the line of sight, degrees (−60 to 60).
     #[serde(default)]
     pub forward_tilt_deg: f64,
+    /// Across-track pointing of the line of sight (roll), degrees (−60 to 60, positive: right
+    /// of the ground track); a fixed shift of the swath away from the sun's glint (as OLCI's
+    /// 12.6° west), or where a season's pass sees the site.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub across_track_tilt_deg: f64,
     /// Read noise, electrons rms.
     pub read_noise_e: f64,
     /// Full-well capacity, electrons.
@@ -151,6 +156,11 @@ pub fn ground_speed_m_s(altitude_km: f64) -> f64 {
     (EARTH_GM_M3_S2 / a).sqrt() * EARTH_RADIUS_M / a
 }
 
+/// Serde: leave a zero out of written files (files from before the field stay byte-identical).
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
+}
+
 impl InstrumentSpec {
     /// Parse RON; `origin` names the file in errors.
     pub fn from_ron(text: &str, origin: &str) -> Result<Self, InstrumentError> {
@@ -188,6 +198,7 @@ impl InstrumentSpec {
         check(&r::INSTRUMENT_EXPOSURE_S, self.exposure_s)?;
         check(&r::INSTRUMENT_LINES, count(self.lines))?;
         check(&r::INSTRUMENT_FORWARD_TILT_DEG, self.forward_tilt_deg)?;
+        check(&r::INSTRUMENT_ACROSS_TRACK_TILT_DEG, self.across_track_tilt_deg)?;
         check(&r::INSTRUMENT_READ_NOISE_E, self.read_noise_e)?;
         check(&r::INSTRUMENT_WELL_DEPTH_E, self.well_depth_e)?;
         check(&r::INSTRUMENT_GAIN_E_PER_DN, self.gain_e_per_dn)?;

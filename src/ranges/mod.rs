@@ -63,6 +63,8 @@ ranges! {
         .edited(Editor { label: "Lines", unit: "", scale: 1.0, slider: (16.0, 4_000.0), log: true, tip: "Exposures along track" });
     /// Forward tilt.
     INSTRUMENT_FORWARD_TILT_DEG = Range::closed("instrument.forward_tilt_deg", -60.0, 60.0, "degrees", "pointing along track (positive: forward)");
+    /// Across-track tilt (roll).
+    INSTRUMENT_ACROSS_TRACK_TILT_DEG = Range::closed("instrument.across_track_tilt_deg", -60.0, 60.0, "degrees", "pointing across track (positive: right of the ground track)");
     /// Read noise.
     INSTRUMENT_READ_NOISE_E = Range::closed("instrument.read_noise_e", 0.0, 1e5, "e-", "read noise, rms")
         .edited(Editor { label: "Read noise", unit: "e⁻", scale: 1.0, slider: (0.0, 100.0), log: false, tip: "Readout noise, electrons rms" });

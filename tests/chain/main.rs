@@ -29,6 +29,7 @@ mod rasters;
 mod report;
 mod reproduction;
 mod retrieval;
+mod season;
 mod soak;
 mod spatial;
 mod spectral_knowledge;

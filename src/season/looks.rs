@@ -1,0 +1,256 @@
+//! A season's looks: each access of a design's orbit to the site, with the geometry the design
+//! sees it from, its glint and cloud cover, and whether a processor would keep it.
+
+use rand::SeedableRng;
+use rand::rngs::Xoshiro256PlusPlus;
+use rand_distr::{Beta, Distribution};
+
+use super::SeasonSpec;
+use crate::atmosphere::{Geometry, glint_reflectance};
+use crate::instrument::InstrumentSpec;
+use crate::orbit::{Access, Site, SunSynchronous, accesses};
+use crate::units::EARTH_RADIUS_M;
+
+/// Refractive index of water for the glint's Fresnel reflectance (the scene's default).
+const WATER_INDEX: f64 = 1.34;
+
+/// Why a look is kept or not, in the order the checks are made.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Verdict {
+    /// Kept: sun high enough, glint low, clear enough.
+    Valid,
+    /// The sun too low (or set).
+    SunLow,
+    /// High glint at the site.
+    Glint,
+    /// Too cloudy.
+    Cloud,
+}
+
+impl Verdict {
+    /// Short name for tables.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Valid => "valid",
+            Self::SunLow => "sun low",
+            Self::Glint => "glint",
+            Self::Cloud => "cloud",
+        }
+    }
+}
+
+/// One pass of one design over the site.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Look {
+    /// The pass.
+    pub access: Access,
+    /// Fore/aft tilt chosen for the look, degrees (0 without a glint tilt).
+    pub forward_tilt_deg: f64,
+    /// Sun and view geometry at the site, with the tilt.
+    pub geometry: Geometry,
+    /// Normalised glint radiance L_GN = ρ_g μ₀/π at the site, sr⁻¹.
+    pub glint_per_sr: f64,
+    /// Cloud cover drawn for the look (0–1).
+    pub cloud_cover: f64,
+    /// Kept or why not.
+    pub verdict: Verdict,
+}
+
+/// Half the design's across-track field of view, rad: atan(N·p / 2f).
+#[must_use]
+pub fn half_field_of_view_rad(instrument: &InstrumentSpec) -> f64 {
+    let half_width_m = instrument.detectors as f64 * instrument.pixel_pitch_um * 1e-6 / 2.0;
+    (half_width_m / (instrument.focal_length_mm * 1e-3)).atan()
+}
+
+/// The sun and view geometry at the site for a line of sight tilted `forward_rad` along track
+/// and `across_rad` across (positive right) from a platform at `altitude_m` flying `heading_rad`
+/// with the sun at (`sun_zenith_rad`, `sun_azimuth_rad`), as the pushbroom geometry computes it
+/// ([`crate::instrument::Viewing`]): the look direction (tan β, tan α, 1) makes the off-nadir
+/// angle γ, sin θ_v = (R + h)/R sin γ, and the sensor is seen from the ground opposite the look's
+/// azimuth. Also returns the sensor's azimuth from the ground, rad clockwise from north.
+#[must_use]
+pub fn look_geometry(
+    altitude_m: f64,
+    heading_rad: f64,
+    forward_rad: f64,
+    across_rad: f64,
+    sun_zenith_rad: f64,
+    sun_azimuth_rad: f64,
+) -> (Geometry, f64) {
+    let (tb, ta) = (forward_rad.tan(), across_rad.tan());
+    let gamma = (1.0 / (1.0 + tb * tb + ta * ta).sqrt()).acos();
+    let sin_vza = ((EARTH_RADIUS_M + altitude_m) / EARTH_RADIUS_M * gamma.sin()).min(1.0);
+    let sensor_azimuth = if gamma > 1e-12 {
+        (heading_rad + ta.atan2(tb) + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
+    } else {
+        sun_azimuth_rad
+    };
+    let rel = (sensor_azimuth - sun_azimuth_rad).rem_euclid(std::f64::consts::TAU);
+    let rel = if rel > std::f64::consts::PI { std::f64::consts::TAU - rel } else { rel };
+    (Geometry { sun_zenith_rad, view_zenith_rad: sin_vza.asin(), relative_azimuth_rad: rel }, sensor_azimuth)
+}
+
+/// Normalised glint radiance L_GN = ρ_g μ₀/π (sr⁻¹; Wang & Bailey 2001) at `g` for `wind_m_s`,
+/// with ρ_g the Cox–Munk glint reflectance ([`glint_reflectance`]).
+#[must_use]
+pub fn normalised_glint_per_sr(g: &Geometry, wind_m_s: f64) -> f64 {
+    if g.sun_zenith_rad >= std::f64::consts::FRAC_PI_2 {
+        return 0.0;
+    }
+    glint_reflectance(g.sun_zenith_rad, g.view_zenith_rad, g.relative_azimuth_rad, wind_m_s, WATER_INDEX)
+        * g.sun_zenith_rad.cos()
+        / std::f64::consts::PI
+}
+
+/// A look's cloud cover: a draw from the beta distribution with mean `fraction` and α + β =
+/// `concentration` (Falls 1974); exactly `fraction` when it is 0 or 1.
+pub fn cloud_cover(fraction: f64, concentration: f64, rng: &mut Xoshiro256PlusPlus) -> f64 {
+    if fraction <= 0.0 || fraction >= 1.0 {
+        return fraction.clamp(0.0, 1.0);
+    }
+    match Beta::new(concentration * fraction, concentration * (1.0 - fraction)) {
+        Ok(beta) => beta.sample(rng),
+        Err(_) => fraction,
+    }
+}
+
+/// The looks of `instrument` (flying the season's orbit at its own altitude) at the season's
+/// site over its period, in time order; the site must lie in its swath (at a roll the season
+/// allows). `design` seeds the
+/// cloud draws, so designs see different weather (they fly different orbits).
+pub fn looks(season: &SeasonSpec, instrument: &InstrumentSpec, design: usize, wind_m_s: f64) -> Vec<Look> {
+    let (Ok((from, to)), Ok(epoch_days)) = (season.period_days(), season.epoch_days()) else { return Vec::new() };
+    let orbit = SunSynchronous {
+        altitude_m: instrument.altitude_km * 1e3,
+        descending_node_h: season.orbit.descending_node_h,
+        phase_rad: season.orbit.phase_deg.to_radians(),
+        epoch_days,
+    };
+    let site = Site::from_degrees(season.site.0, season.site.1);
+    let half = half_field_of_view_rad(instrument);
+    let pointing = instrument.across_track_tilt_deg.to_radians();
+    let roll = season.max_roll_deg.to_radians();
+    let found = accesses(&orbit, &site, from, to, pointing.abs() + roll + half);
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(season.seed ^ (design as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
+    let max_sun = season.max_sun_zenith_deg.to_radians();
+    let tilts: &[f64] = if season.glint_tilt_deg > 0.0 { &[1.0, -1.0] } else { &[0.0] };
+    found
+        .into_iter()
+        // Inside the swath at some roll in [pointing − roll, pointing + roll].
+        .filter(|a| ((a.off_nadir_rad - pointing).abs() - roll).max(0.0) <= half)
+        .map(|access| {
+            // The line of sight: the fore/aft tilt that glints less, the site's own off-nadir
+            // angle across track.
+            let (forward_tilt_deg, geometry, glint_per_sr) = tilts
+                .iter()
+                .map(|sign| {
+                    let forward = sign * season.glint_tilt_deg;
+                    let (g, _) = look_geometry(
+                        orbit.altitude_m,
+                        access.heading_rad,
+                        forward.to_radians(),
+                        access.off_nadir_rad,
+                        access.sun.zenith_rad,
+                        access.sun.azimuth_rad,
+                    );
+                    (forward, g, normalised_glint_per_sr(&g, wind_m_s))
+                })
+                .fold(None, |best: Option<(f64, Geometry, f64)>, c| match best {
+                    Some(b) if b.2 <= c.2 => Some(b),
+                    _ => Some(c),
+                })
+                .expect("at least one tilt");
+            // Every look draws its cover (night ones too), so a look's cover does not depend on
+            // which earlier looks were kept.
+            let month = crate::orbit::sun::calendar_date(access.days).1 as usize - 1;
+            let cloud_cover = season
+                .clouds
+                .as_ref()
+                .map_or(0.0, |c| cloud_cover(c.monthly_fraction[month], c.concentration, &mut rng));
+            let verdict = if access.sun.zenith_rad > max_sun {
+                Verdict::SunLow
+            } else if glint_per_sr > season.glint_threshold_per_sr {
+                Verdict::Glint
+            } else if 100.0 * (1.0 - cloud_cover) < season.min_clear_pct {
+                Verdict::Cloud
+            } else {
+                Verdict::Valid
+            };
+            Look { access, forward_tilt_deg, geometry, glint_per_sr, cloud_cover, verdict }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Untilted, the look geometry is the access's own (the orbit's spherical geometry and the
+    /// pushbroom formula agree to the two radii's difference in the altitude, 7 km in 700).
+    #[test]
+    fn untilted_look_geometry_is_the_access_geometry() {
+        let orbit = SunSynchronous {
+            altitude_m: 700e3,
+            descending_node_h: 10.5,
+            phase_rad: 0.0,
+            epoch_days: crate::orbit::days_since_j2000("2023-01-01").unwrap(),
+        };
+        let site = Site::from_degrees(-36.1, 147.0);
+        for a in accesses(&orbit, &site, orbit.epoch_days, orbit.epoch_days + 20.0, 0.5) {
+            let (g, sensor_az) = look_geometry(
+                orbit.altitude_m,
+                a.heading_rad,
+                0.0,
+                a.off_nadir_rad,
+                a.sun.zenith_rad,
+                a.sun.azimuth_rad,
+            );
+            assert!(
+                (g.view_zenith_rad - a.view_zenith_rad).abs() < 2e-3,
+                "{} {}",
+                g.view_zenith_rad,
+                a.view_zenith_rad
+            );
+            if a.off_nadir_rad.abs() > 0.01 {
+                let d = (sensor_az - a.view_azimuth_rad + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
+                    - std::f64::consts::PI;
+                assert!(d.abs() < 0.02, "azimuth off by {d}");
+            }
+        }
+    }
+
+    /// At the specular point L_GN is Cox–Munk's own: R_F(θ) p(0)/(4 cos θ_v) with p(0) = 1/(πσ²)
+    /// (Wang & Bailey 2001, eq. 2 with β = 0).
+    #[test]
+    fn glint_at_the_specular_point_is_cox_munk() {
+        let theta = 25f64.to_radians();
+        let g = Geometry { sun_zenith_rad: theta, view_zenith_rad: theta, relative_azimuth_rad: std::f64::consts::PI };
+        let wind = 7.0;
+        let sigma2 = 0.003 + 0.005_12 * wind;
+        let rf = crate::atmosphere::fresnel_reflectance(theta.cos(), WATER_INDEX);
+        let expected = rf / (std::f64::consts::PI * sigma2) / (4.0 * theta.cos());
+        let got = normalised_glint_per_sr(&g, wind);
+        assert!((got / expected - 1.0).abs() < 1e-12, "{got} vs {expected}");
+        // Far from it, nothing.
+        let away = Geometry { relative_azimuth_rad: 0.0, ..g };
+        assert!(normalised_glint_per_sr(&away, wind) < 1e-6);
+    }
+
+    /// Over many draws the cover's mean is the month's fraction (beta mean α/(α+β)) to 0.01,
+    /// and with concentration 1 most skies are nearly clear or nearly overcast (U shape).
+    #[test]
+    fn cloud_draws_follow_the_climatology() {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(7);
+        for f in [0.2, 0.5, 0.7] {
+            let draws: Vec<f64> = (0..20_000).map(|_| cloud_cover(f, 1.0, &mut rng)).collect();
+            let mean = draws.iter().sum::<f64>() / draws.len() as f64;
+            assert!((mean - f).abs() < 0.01, "{f}: {mean}");
+            let extreme = draws.iter().filter(|c| **c < 0.1 || **c > 0.9).count() as f64 / draws.len() as f64;
+            assert!(extreme > 0.4, "{f}: {extreme}");
+        }
+        assert_eq!(cloud_cover(0.0, 1.0, &mut rng), 0.0);
+        assert_eq!(cloud_cover(1.0, 1.0, &mut rng), 1.0);
+    }
+}

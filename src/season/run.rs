@@ -1,0 +1,270 @@
+//! Running a season: each design's valid looks through the chain at their geometry, and what
+//! the season reports per design.
+
+use std::path::Path;
+
+use rayon::prelude::*;
+
+use super::looks::{Look, Verdict, half_field_of_view_rad, looks};
+use super::{SeasonSpec, stats};
+use crate::control::RunControl;
+use crate::engine::{Engine, EngineError, RunConfig};
+use crate::study::{StudyError, StudySpec};
+
+/// One product variable's error in one look's run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LookError {
+    /// Retrieval (aLMI, SAMBUCA, …).
+    pub product: String,
+    /// Variable (`chl_mg_m3`).
+    pub variable: String,
+    /// Log-space MAE, %.
+    pub mae_pct: f64,
+    /// Log-space bias, %.
+    pub bias_pct: f64,
+    /// Share returned, %.
+    pub returned_pct: f64,
+}
+
+/// One valid look run through the chain.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LookRun {
+    /// Index of the look in its design's [`DesignSeason::looks`].
+    pub look: usize,
+    /// Every retrieval variable's error (empty when the run failed).
+    pub errors: Vec<LookError>,
+    /// Why the run failed (a geometry the chain refuses, say), if it did.
+    pub failure: Option<String>,
+}
+
+/// One design over the season.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DesignSeason {
+    /// The design's label in the study.
+    pub label: String,
+    /// Altitude, km.
+    pub altitude_km: f64,
+    /// Half the across-track field of view, degrees.
+    pub half_fov_deg: f64,
+    /// Every pass over the site, in time order.
+    pub looks: Vec<Look>,
+    /// The valid looks run through the chain.
+    pub runs: Vec<LookRun>,
+    /// The same season at other orbit phases (which months a near-repeating orbit sees the
+    /// site depends on where it was at the start, unknown before launch): per phase, degrees,
+    /// the valid looks and the revisit share (% of days within the requirement's wait, or the
+    /// 90th-percentile gap in days without a requirement).
+    pub phases: Vec<PhaseSample>,
+}
+
+/// One orbit phase's looks.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PhaseSample {
+    /// Argument of latitude at the start, degrees.
+    pub phase_deg: f64,
+    /// Valid looks.
+    pub valid: usize,
+    /// Share of days within the revisit requirement's wait, % (`None` without a requirement).
+    pub revisit_pct: Option<f64>,
+}
+
+/// Phases the spread is taken over.
+pub const PHASE_SAMPLES: usize = 12;
+
+impl DesignSeason {
+    /// Times of the valid looks, days since J2000.0.
+    #[must_use]
+    pub fn valid_days(&self) -> Vec<f64> {
+        self.looks.iter().filter(|l| l.verdict == Verdict::Valid).map(|l| l.access.days).collect()
+    }
+
+    /// Looks with `verdict` in each calendar month of the period, (year, month, count).
+    #[must_use]
+    pub fn per_month(&self, verdict: Option<Verdict>, from: f64, to: f64) -> Vec<((i64, u32), usize)> {
+        let mut months: Vec<((i64, u32), usize)> = Vec::new();
+        let mut d = from;
+        while d < to {
+            let (y, m, _) = crate::orbit::sun::calendar_date(d + 0.5);
+            if months.last().is_none_or(|(k, _)| *k != (y, m)) {
+                months.push(((y, m), 0));
+            }
+            d += 1.0;
+        }
+        for l in &self.looks {
+            if verdict.is_none_or(|v| v == l.verdict) {
+                let (y, m, _) = crate::orbit::sun::calendar_date(l.access.days);
+                if let Some(slot) = months.iter_mut().find(|(k, _)| *k == (y, m)) {
+                    slot.1 += 1;
+                }
+            }
+        }
+        months
+    }
+
+    /// The error of `variable` of `product` over the runs that returned it.
+    #[must_use]
+    pub fn errors_of(&self, product: &str, variable: &str) -> Vec<&LookError> {
+        self.runs.iter().flat_map(|r| &r.errors).filter(|e| e.product == product && e.variable == variable).collect()
+    }
+
+    /// Median and 90th-percentile gap between valid looks, days.
+    #[must_use]
+    pub fn gap_percentiles(&self) -> (Option<f64>, Option<f64>) {
+        let gaps = stats::gaps_days(&self.valid_days());
+        (stats::percentile(&gaps, 50.0), stats::percentile(&gaps, 90.0))
+    }
+}
+
+/// A season's result.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SeasonResult {
+    /// The season as written.
+    pub spec: SeasonSpec,
+    /// The study's name.
+    pub study: String,
+    /// The period, days since J2000.0 (start, end).
+    pub period: (f64, f64),
+    /// Per design.
+    pub designs: Vec<DesignSeason>,
+}
+
+/// The run configuration of `look` from a design's study configuration: the scene's sun and
+/// date at the pass, the ground track's heading, the line of sight pointed across track at the
+/// site's off-nadir angle and tilted as the look chose, at the season's decimation.
+#[must_use]
+pub fn look_config(base: &RunConfig, look: &Look, decimation: usize) -> RunConfig {
+    let mut config = base.clone();
+    let a = &look.access;
+    config.scene.sun.zenith_deg = a.sun.zenith_rad.to_degrees();
+    config.scene.sun.azimuth_deg = a.sun.azimuth_rad.to_degrees();
+    let (y, m, d) = crate::orbit::sun::calendar_date(a.days);
+    config.scene.date = format!("{y:04}-{m:02}-{d:02}");
+    let minutes = ((a.days + 0.5).rem_euclid(1.0) * 1440.0).round() as u32 % 1440;
+    config.scene.time = format!("{:02}:{:02} UT", minutes / 60, minutes % 60);
+    config.instrument.heading_deg = a.heading_rad.to_degrees();
+    config.instrument.across_track_tilt_deg = a.off_nadir_rad.to_degrees();
+    config.instrument.forward_tilt_deg = look.forward_tilt_deg;
+    config.fidelity.decimation = decimation;
+    config
+}
+
+/// Up to `n` of `items`, evenly spaced (all when there are no more than `n`).
+fn evenly<T: Copy>(items: &[T], n: usize) -> Vec<T> {
+    if items.len() <= n {
+        return items.to_vec();
+    }
+    (0..n).map(|k| items[(k * items.len() + items.len() / 2) / n.max(1)]).collect()
+}
+
+/// The study a season names, resolved: its name and one configuration per design (its first
+/// seed), labelled as the study labels them.
+pub fn designs(season: &SeasonSpec, dir: Option<&Path>) -> Result<(String, Vec<(String, RunConfig)>), StudyError> {
+    let (study, study_dir) =
+        crate::study::load(&season.study, dir, |n| StudySpec::preset(n).map_err(|e| e.to_string()), "study")?;
+    let resolved = study.resolve(study_dir.as_deref().or(dir))?;
+    let mut designs: Vec<(String, RunConfig)> = Vec::new();
+    for (label, _, config) in &resolved.runs {
+        if !designs.iter().any(|(l, _)| l == label) {
+            designs.push((label.clone(), config.clone()));
+        }
+    }
+    Ok((study.name, designs))
+}
+
+/// Run `season` over `designs` (from [`designs`]; `study` names them): find each design's
+/// looks, then run up to `max_runs` of its valid ones through the chain. `progress(done, total)`
+/// after each run.
+pub fn run_season(
+    season: &SeasonSpec,
+    study: &str,
+    designs: &[(String, RunConfig)],
+    control: &RunControl,
+    mut progress: impl FnMut(usize, usize),
+) -> Result<SeasonResult, StudyError> {
+    season.validate().map_err(StudyError::Invalid)?;
+    let period = season.period_days().map_err(StudyError::Invalid)?;
+    let mut seasons: Vec<DesignSeason> = designs
+        .iter()
+        .enumerate()
+        .map(|(i, (label, config))| {
+            let wind = match config.scene.atmosphere.surface {
+                crate::atmosphere::Surface::Wind { speed_m_s } => speed_m_s,
+                crate::atmosphere::Surface::Flat => season.wind_m_s,
+            };
+            DesignSeason {
+                label: label.clone(),
+                altitude_km: config.instrument.altitude_km,
+                half_fov_deg: half_field_of_view_rad(&config.instrument).to_degrees(),
+                looks: looks(season, &config.instrument, i, wind),
+                runs: Vec::new(),
+                phases: (0..PHASE_SAMPLES)
+                    .into_par_iter()
+                    .map(|k| {
+                        let mut other = season.clone();
+                        other.orbit.phase_deg = season.orbit.phase_deg + 360.0 * k as f64 / PHASE_SAMPLES as f64;
+                        let valid: Vec<f64> = looks(&other, &config.instrument, i, wind)
+                            .iter()
+                            .filter(|l| l.verdict == Verdict::Valid)
+                            .map(|l| l.access.days)
+                            .collect();
+                        PhaseSample {
+                            phase_deg: other.orbit.phase_deg,
+                            valid: valid.len(),
+                            revisit_pct: season.revisit.map(|q| stats::revisit_pct(&valid, period.0, period.1, q.days)),
+                        }
+                    })
+                    .collect(),
+            }
+        })
+        .collect();
+    let chosen: Vec<Vec<usize>> = seasons
+        .iter()
+        .map(|d| {
+            let valid: Vec<usize> = (0..d.looks.len()).filter(|&k| d.looks[k].verdict == Verdict::Valid).collect();
+            evenly(&valid, season.max_runs)
+        })
+        .collect();
+    let total: usize = chosen.iter().map(Vec::len).sum();
+    let mut engine = Engine::lean();
+    let mut done = 0;
+    for ((design, (_, base)), picks) in seasons.iter_mut().zip(designs).zip(&chosen) {
+        for &k in picks {
+            let config = look_config(base, &design.looks[k], season.decimation);
+            let run = match engine.run_with(&config, control, &[]) {
+                Ok(out) => LookRun {
+                    look: k,
+                    errors: out
+                        .retrievals
+                        .iter()
+                        .flat_map(|r| {
+                            r.metrics.variables.iter().map(|v| LookError {
+                                product: r.metrics.product.clone(),
+                                variable: v.variable.clone(),
+                                mae_pct: v.metrics.mae_pct(),
+                                bias_pct: v.metrics.bias_pct(),
+                                returned_pct: v.metrics.returned_pct,
+                            })
+                        })
+                        .collect(),
+                    failure: None,
+                },
+                Err(EngineError::Cancelled) => return Err(StudyError::Cancelled),
+                Err(e) => LookRun { look: k, errors: Vec::new(), failure: Some(e.to_string()) },
+            };
+            design.runs.push(run);
+            done += 1;
+            progress(done, total);
+        }
+    }
+    Ok(SeasonResult { spec: season.clone(), study: study.to_string(), period, designs: seasons })
+}
+
+impl SeasonResult {
+    /// Whether `design` meets the revisit requirement, with its share of days, %.
+    #[must_use]
+    pub fn revisit(&self, design: &DesignSeason) -> Option<(f64, bool)> {
+        let q = self.spec.revisit?;
+        let pct = stats::revisit_pct(&design.valid_days(), self.period.0, self.period.1, q.days);
+        Some((pct, pct >= q.pct))
+    }
+}

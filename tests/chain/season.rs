@@ -1,0 +1,171 @@
+//! Seasons: the valid looks against an independent count, a look's chain run at its geometry,
+//! the command line, and bad season files.
+
+use shoal::control::RunControl;
+use shoal::orbit::{Site, SunSynchronous, accesses, days_since_j2000};
+use shoal::season::SeasonSpec;
+use shoal::season::looks::{Verdict, half_field_of_view_rad};
+use shoal::season::run::{designs, look_config, run_season};
+
+fn spring(max_runs: usize) -> SeasonSpec {
+    let mut s = SeasonSpec::preset("heron_island_year").unwrap();
+    s.from = "2023-04-01".into();
+    s.to = "2023-06-30".into();
+    s.max_runs = max_runs;
+    s.decimation = 16;
+    s
+}
+
+/// Cox–Munk glint written out here from the slope statistics (not through the crate's glint
+/// code): facet normal h = s + v, tan²β = (h_x² + h_y²)/h_z², p = exp(−tan²β/σ²)/(πσ²),
+/// L_GN = R_F p / (4 cos θ_v cos⁴β) with the Fresnel reflectance of unpolarised light.
+fn glint_lgn(sun_zenith: f64, view_zenith: f64, relative_azimuth: f64, wind: f64) -> f64 {
+    let s = [sun_zenith.sin(), 0.0, sun_zenith.cos()];
+    let v = [view_zenith.sin() * relative_azimuth.cos(), view_zenith.sin() * relative_azimuth.sin(), view_zenith.cos()];
+    let h = [s[0] + v[0], s[1] + v[1], s[2] + v[2]];
+    let norm = (h[0] * h[0] + h[1] * h[1] + h[2] * h[2]).sqrt();
+    let cos_beta = h[2] / norm;
+    let tan2 = (h[0] * h[0] + h[1] * h[1]) / (h[2] * h[2]);
+    let sigma2 = 0.003 + 0.005_12 * wind;
+    let p = (-tan2 / sigma2).exp() / (std::f64::consts::PI * sigma2);
+    let ci = (s[0] * h[0] + s[1] * h[1] + s[2] * h[2]) / norm;
+    let n = 1.34;
+    let ct = (1.0 - (1.0 - ci * ci) / (n * n)).sqrt();
+    let rs = ((ci - n * ct) / (ci + n * ct)).powi(2);
+    let rp = ((n * ci - ct) / (n * ci + ct)).powi(2);
+    0.5 * (rs + rp) * p / (4.0 * view_zenith.cos() * cos_beta.powi(4))
+}
+
+/// Each design's looks are the accesses inside its swath (at any allowed roll), and a look is
+/// valid exactly when the sun is high enough, the glint (computed here) below the threshold and
+/// the cover leaves enough of the site clear.
+#[test]
+fn valid_looks_match_an_independent_count() {
+    let season = spring(0);
+    let (study, ds) = designs(&season, None).unwrap();
+    let result = run_season(&season, &study, &ds, &RunControl::new(), |_, _| {}).unwrap();
+    assert_eq!(result.designs.len(), 2);
+    let from = days_since_j2000(&season.from).unwrap();
+    let to = days_since_j2000(&season.to).unwrap() + 1.0;
+    let site = Site::from_degrees(season.site.0, season.site.1);
+    let mut any_valid = false;
+    for (d, (_, config)) in result.designs.iter().zip(&ds) {
+        let orbit = SunSynchronous {
+            altitude_m: config.instrument.altitude_km * 1e3,
+            descending_node_h: season.orbit.descending_node_h,
+            phase_rad: 0.0,
+            epoch_days: days_since_j2000("2023-01-01").unwrap(),
+        };
+        let half = half_field_of_view_rad(&config.instrument);
+        let reach = season.max_roll_deg.to_radians() + half;
+        let passes: Vec<_> =
+            accesses(&orbit, &site, from, to, reach).into_iter().filter(|a| a.off_nadir_rad.abs() <= reach).collect();
+        assert_eq!(d.looks.len(), passes.len(), "{}", d.label);
+        let mut valid = 0;
+        for (look, pass) in d.looks.iter().zip(&passes) {
+            assert_eq!(look.access, *pass);
+            let g = &look.geometry;
+            let glint = glint_lgn(g.sun_zenith_rad, g.view_zenith_rad, g.relative_azimuth_rad, season.wind_m_s);
+            let sun_ok = pass.sun.zenith_rad <= season.max_sun_zenith_deg.to_radians();
+            if sun_ok {
+                // Relative 1e-9: the same formula in another order.
+                assert!(
+                    (glint - look.glint_per_sr).abs() <= 1e-9 * glint.max(1e-12),
+                    "{glint} vs {}",
+                    look.glint_per_sr
+                );
+            }
+            let clear = 100.0 * (1.0 - look.cloud_cover) >= season.min_clear_pct;
+            let expected = if !sun_ok {
+                Verdict::SunLow
+            } else if glint > season.glint_threshold_per_sr {
+                Verdict::Glint
+            } else if !clear {
+                Verdict::Cloud
+            } else {
+                Verdict::Valid
+            };
+            assert_eq!(look.verdict, expected);
+            valid += usize::from(expected == Verdict::Valid);
+        }
+        assert_eq!(d.valid_days().len(), valid);
+        any_valid |= valid > 0;
+        // Months of the period, April to June, each counted.
+        assert_eq!(d.per_month(None, from, to).len(), 3);
+        assert_eq!(d.per_month(None, from, to).iter().map(|m| m.1).sum::<usize>(), d.looks.len());
+        assert_eq!(d.phases.len(), shoal::season::run::PHASE_SAMPLES);
+    }
+    assert!(any_valid, "autumn 2023 over Heron Island has valid looks at phase 0");
+}
+
+/// A look's run is the study's configuration at the look's sun, date, heading and pointing, and
+/// its products are scored (decimation 16: the test checks the wiring, not the numbers).
+#[test]
+fn a_valid_look_runs_the_chain_at_its_geometry() {
+    let season = spring(1);
+    let (study, ds) = designs(&season, None).unwrap();
+    let result = run_season(&season, &study, &ds[..1], &RunControl::new(), |_, _| {}).unwrap();
+    let d = &result.designs[0];
+    assert_eq!(d.runs.len(), 1);
+    let run = &d.runs[0];
+    assert!(run.failure.is_none(), "{:?}", run.failure);
+    let look = &d.looks[run.look];
+    assert_eq!(look.verdict, Verdict::Valid);
+    let config = look_config(&ds[0].1, look, 16);
+    assert!((config.scene.sun.zenith_deg - look.access.sun.zenith_rad.to_degrees()).abs() < 1e-12);
+    assert!((config.instrument.across_track_tilt_deg - look.access.off_nadir_rad.to_degrees()).abs() < 1e-12);
+    assert!(config.scene.date.starts_with("2023-0"));
+    let depth = run.errors.iter().find(|e| e.variable == "depth_m").expect("SAMBUCA's depth");
+    assert!(depth.mae_pct.is_finite() && depth.returned_pct > 50.0, "{depth:?}");
+}
+
+#[test]
+fn bad_seasons_are_refused_by_field() {
+    let base = spring(0);
+    let refused = |edit: &dyn Fn(&mut SeasonSpec), field: &str| {
+        let mut s = base.clone();
+        edit(&mut s);
+        let e = s.validate().unwrap_err();
+        assert!(e.field.contains(field), "{field}: {e}");
+    };
+    refused(&|s| s.site.0 = 95.0, "latitude");
+    refused(&|s| s.to = "2023-02-30".into(), "to");
+    refused(&|s| s.to = "2022-12-01".into(), "to");
+    refused(&|s| s.from = "yesterday".into(), "from");
+    refused(&|s| s.max_roll_deg = 80.0, "max_roll_deg");
+    refused(&|s| s.decimation = 0, "decimation");
+    refused(
+        &|s| s.clouds.as_mut().unwrap().monthly_fraction.pop().map(|_| ()).unwrap_or(()),
+        "clouds.monthly_fraction",
+    );
+    refused(&|s| s.clouds.as_mut().unwrap().monthly_fraction[3] = 1.5, "clouds.monthly_fraction");
+    refused(&|s| s.revisit = Some(shoal::season::RevisitRequirement { days: 0.0, pct: 80.0 }), "revisit.days");
+    assert!(SeasonSpec::from_ron("SeasonSpec(name: \"x\")", "x.ron").is_err());
+}
+
+#[test]
+fn season_command_writes_looks_and_months() {
+    let dir = std::env::temp_dir().join(format!("shoal-season-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_shoal"))
+        .args(["season", "lake_hume_year", "--from", "2023-03-01", "--to", "2023-03-31", "--max-runs", "0", "--out"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("valid looks per month: 2023-03"), "{stdout}");
+    assert!(stdout.contains("over 12 orbit phases"), "{stdout}");
+    let looks = std::fs::read_to_string(dir.join("looks.csv")).unwrap();
+    assert!(looks.starts_with("design,date,time_ut,descending,sun_zenith_deg"));
+    let months = std::fs::read_to_string(dir.join("months.csv")).unwrap();
+    assert_eq!(months.lines().count(), 3, "{months}");
+    let bad = std::process::Command::new(env!("CARGO_BIN_EXE_shoal"))
+        .args(["season", "lake_hume_year", "--to", "2023-13-01", "--out"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(!bad.status.success());
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("month 13"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
