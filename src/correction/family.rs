@@ -29,6 +29,24 @@ pub struct AerosolFamily {
     /// Two-way gas transmittance of every column and band: (T·Ed) of the Rayleigh atmosphere
     /// with its gases over the same without them (1 where the scene has no gases).
     pub gas_two_way: Vec<f64>,
+    /// Per column: the normalised glint radiance L_GN = ρ_g μ₀/π expected at its geometry from
+    /// the scene's wind (Cox–Munk; Wang & Bailey 2001), sr⁻¹; zeros unless the scene has glint.
+    pub glint_lgn: Vec<f64>,
+}
+
+impl AerosolFamily {
+    /// The family with each member's glint added to its path radiance: what a processor that
+    /// takes the expected glint away fits against.
+    #[must_use]
+    pub fn with_glint_in_path(&self) -> Self {
+        let mut out = self.clone();
+        for t in out.terms.iter_mut().flatten() {
+            for (l, g) in t.l_path.iter_mut().zip(&t.glint) {
+                *l += g;
+            }
+        }
+        out
+    }
 }
 
 /// The family's atmospheres: one LUT per model and AOT node (the τ = 0 Rayleigh atmosphere
@@ -143,7 +161,31 @@ impl AerosolFamily {
             }
             None => vec![1.0; rayleigh.t_ed.len()],
         };
+        let glint_lgn = match scene.spec.atmosphere.surface {
+            crate::atmosphere::Surface::Wind { speed_m_s } if scene.wants(crate::scene::Effect::SunGlint) => viewing
+                .looks
+                .first()
+                .map(|looks| {
+                    looks
+                        .iter()
+                        .map(|l| {
+                            let g = &l.geometry;
+                            crate::atmosphere::glint_reflectance(
+                                g.sun_zenith_rad,
+                                g.view_zenith_rad,
+                                g.relative_azimuth_rad,
+                                speed_m_s,
+                                scene.spec.atmosphere.water_refractive_index,
+                            ) * g.sun_zenith_rad.cos()
+                                / std::f64::consts::PI
+                        })
+                        .collect()
+                })
+                .unwrap_or_default(),
+            _ => Vec::new(),
+        };
         Ok(Self {
+            glint_lgn,
             gas_two_way,
             models: luts.models.clone(),
             aot550: luts.aot550.clone(),

@@ -26,6 +26,13 @@
 //! Noise and calibration error at the pair's bands enter every band's Rrs through A: this is
 //! how a design's NIR/SWIR SNR reaches the products (Wang & Gordon 2018).
 //!
+//! **Sun glint** (Wang & Bailey 2001, l2gen's `glint_opt`): where the scene has glint, the
+//! processor knows the wind and each pixel's geometry, and takes the glint it expects away
+//! before the fit: each family member's band glint (Cox–Munk through that member's own direct
+//! transmittances) is added to its path radiance, so the fit and the inversion see
+//! L1 − L_path − G. Pixels whose normalised glint L_GN = ρ_g μ₀/π exceeds 0.005 sr⁻¹ are left
+//! out (l2gen's HIGLINT). Off (`glint: false`), the glint is read as aerosol.
+//!
 //! ## References
 //! - Gordon, H. R. & Wang, M. (1994) Appl. Opt. 33, 443–452.
 //! - Ahmad, Z. et al. (2010) New aerosol models for the retrieval of aerosol optical thickness
@@ -44,6 +51,7 @@ use serde::{Deserialize, Serialize};
 use super::family::AerosolFamily;
 pub(super) use super::mixture::Mixture;
 use super::mixture::invert;
+pub(super) use super::nodes::{locate, weighted};
 use super::{CorrectionError, Reflectance, RrsFlags, assemble, flag_for, slice};
 use crate::atmosphere::AerosolType;
 use crate::calibration::Level1;
@@ -116,6 +124,15 @@ pub struct ImageCorrection {
     pub models: Vec<AerosolType>,
     /// AOT(550) nodes of the family's tables (0 is always added).
     pub aot_nodes: Vec<f64>,
+    /// Take away the sun glint expected from the wind and each pixel's geometry before the
+    /// aerosol fit (Cox–Munk through each family member's own direct transmittances: l2gen's
+    /// `glint_opt`, Wang & Bailey 2001), and leave out pixels whose normalised glint L_GN
+    /// exceeds `glint_threshold_per_sr` (l2gen's HIGLINT). Only where the scene has glint: the
+    /// processor knows the wind, as l2gen reads it from ancillary data.
+    pub glint: bool,
+    /// Largest normalised glint radiance L_GN = ρ_g μ₀/π a retrieved pixel may have, sr⁻¹
+    /// (l2gen's `glint_thresh`, 0.005).
+    pub glint_threshold_per_sr: f64,
 }
 
 impl Default for ImageCorrection {
@@ -127,6 +144,8 @@ impl Default for ImageCorrection {
             dark: DarkSpectrumSettings::default(),
             models: vec![AerosolType::Maritime, AerosolType::Continental, AerosolType::Urban],
             aot_nodes: vec![0.05, 0.1, 0.2, 0.4, 0.8],
+            glint: true,
+            glint_threshold_per_sr: 0.005,
         }
     }
 }
@@ -204,6 +223,8 @@ impl ImageCorrection {
                 format!("{} nodes (allowed: 1 to {MAX_AOT_NODES}, increasing)", self.aot_nodes.len()),
             ));
         }
+        let g = &crate::ranges::CORRECTION_GLINT_THRESHOLD;
+        g.check(self.glint_threshold_per_sr).map_err(|m| invalid(g.path, m))?;
         let d = &self.dark;
         let tile = &crate::ranges::CORRECTION_DARK_TILE_PX;
         tile.check(d.tile_px as f64).map_err(|m| invalid(tile.path, m))?;
@@ -273,54 +294,6 @@ impl ImageCorrection {
     }
 }
 
-/// Where the measured long-band aerosol signal lies in a model's table: up to three nodes and
-/// their weights, so that any tabulated quantity at the model's τ is Σ wᵢ·vᵢ. `a_long[k]` is the
-/// model's aerosol signal at the long band at node k (increasing with τ). Inside the table the
-/// weights are the quadratic Lagrange basis in the signal itself over the three nearest nodes
-/// (path radiance is close to, but not, linear in τ: a linear interpolation between AOT nodes
-/// 0.1 and 0.2 left 3 % at 400 nm and 10 % at 665 nm in Rrs); beyond the last node the last
-/// segment is extended; a signal at or below zero is τ = 0.
-pub(super) fn locate(a_long: &[f64], measured: f64) -> [(usize, f64); 3] {
-    let n = a_long.len();
-    if measured <= 0.0 || n < 2 {
-        return [(0, 1.0), (0, 0.0), (0, 0.0)];
-    }
-    if measured >= a_long[n - 1] || n == 2 {
-        let (k0, k1) = (n - 2, n - 1);
-        let span = a_long[k1] - a_long[k0];
-        let f = if span > 0.0 { (measured - a_long[k0]) / span } else { 0.0 };
-        return [(k0, 1.0 - f), (k1, f), (k1, 0.0)];
-    }
-    // The segment holding the signal, and its nearer neighbour as the third node.
-    let k = (0..n - 1).find(|&k| measured <= a_long[k + 1]).unwrap_or(n - 2);
-    let first = if k == 0 {
-        0
-    } else if k + 2 >= n {
-        n - 3
-    } else if measured - a_long[k] < a_long[k + 1] - measured {
-        k - 1
-    } else {
-        k
-    };
-    let x = [a_long[first], a_long[first + 1], a_long[first + 2]];
-    let basis = |i: usize| {
-        let (j, l) = ((i + 1) % 3, (i + 2) % 3);
-        (measured - x[j]) * (measured - x[l]) / ((x[i] - x[j]) * (x[i] - x[l]))
-    };
-    if (x[1] - x[0]) * (x[2] - x[1]) * (x[2] - x[0]) <= 0.0 {
-        // Nodes not strictly increasing (a degenerate table): linear in the segment.
-        let span = a_long[k + 1] - a_long[k];
-        let f = if span > 0.0 { (measured - a_long[k]) / span } else { 0.0 };
-        return [(k, 1.0 - f), (k + 1, f), (k + 1, 0.0)];
-    }
-    [(first, basis(0)), (first + 1, basis(1)), (first + 2, basis(2))]
-}
-
-/// Σ wᵢ·vᵢ of `value(k)` over the located nodes.
-pub(super) fn weighted(nodes: &[(usize, f64); 3], value: impl Fn(usize) -> f64) -> f64 {
-    nodes.iter().map(|&(k, w)| if w == 0.0 { 0.0 } else { w * value(k) }).sum()
-}
-
 /// What the correction found in each pixel.
 #[derive(Debug, Clone)]
 pub struct AerosolRetrieval {
@@ -334,6 +307,10 @@ pub struct AerosolRetrieval {
     pub passes_mean: f64,
     /// Dark-spectrum fitting's tiles (empty for the band-pair fit).
     pub tiles: Vec<super::dark::TileFit>,
+    /// Pixels left out for high glint (L_GN above the threshold).
+    pub high_glint: usize,
+    /// The expected glint was taken away (the scene has glint and the correction's `glint` is on).
+    pub glint_removed: bool,
 }
 
 /// One pixel of Level-1 as a fit sees it.
@@ -372,10 +349,39 @@ pub fn correct_image(
     if nb != family.n_bands || family.terms.is_empty() || bands.len() != nb {
         return Err(invalid("correction.image", format!("the family has {} bands, Level-1 {nb}", family.n_bands)));
     }
+    // The expected glint taken away: folded into every member's path radiance, so the fit and
+    // the inversion see L1 − L_path − G (the family's glint is zero unless the scene has glint).
+    let folded;
+    let glint_removed = settings.glint && family.terms.iter().flatten().any(|t| t.glint.iter().any(|g| *g != 0.0));
+    let family = if glint_removed {
+        folded = family.with_glint_in_path();
+        &folded
+    } else {
+        family
+    };
+    let high_glint =
+        |col: usize| settings.glint && family.glint_lgn.get(col).is_some_and(|g| *g > settings.glint_threshold_per_sr);
+    let (rrs, mut retrieval) = correct_with(level1, family, settings, bands, surface, control, &high_glint)?;
+    retrieval.high_glint = (0..level1.radiance.dim().1).filter(|&c| high_glint(c)).count() * level1.radiance.dim().0;
+    retrieval.glint_removed = glint_removed;
+    Ok((rrs, retrieval))
+}
+
+/// [`correct_image`] with the family as the fit uses it; `high_glint(col)`: the column's pixels
+/// are left out (flagged invalid).
+fn correct_with(
+    level1: &Level1,
+    family: &AerosolFamily,
+    settings: &ImageCorrection,
+    bands: &crate::spectral::BandSet,
+    surface: &SurfaceMap,
+    control: &RunControl,
+    high_glint: &(dyn Fn(usize) -> bool + Sync),
+) -> Result<(Reflectance, AerosolRetrieval), CorrectionError> {
     match settings.fit {
         AerosolFit::BandPair => {
             let fit = super::pair::PairFit::new(family, settings, bands)?;
-            apply(level1, surface, control, |p, mix, scratch| fit.fit(p, mix, scratch))
+            apply(level1, surface, control, |p, mix, scratch| !high_glint(p.col) && fit.fit(p, mix, scratch))
         }
         AerosolFit::DarkSpectrum => {
             let tiles = super::dark::fit_tiles(level1, family, &settings.dark, bands, control)?;
@@ -383,7 +389,7 @@ pub fn correct_image(
             let (rrs, mut retrieval) = if let Some(smooth) = super::dark::smoothed(&tiles, &settings.dark, rows, cols) {
                 apply(level1, surface, control, |p, mix, _: &mut ()| {
                     smooth.fill(family, p.row * cols + p.col, mix);
-                    true
+                    !high_glint(p.col)
                 })?
             } else {
                 let index = super::dark::tile_index(&tiles, rows, cols);
@@ -392,7 +398,7 @@ pub fn correct_image(
                     let m = &mixtures[index[p.row * cols + p.col]];
                     mix.entries.extend_from_slice(&m.entries);
                     (mix.aot550, mix.angstrom, mix.passes) = (m.aot550, m.angstrom, 1);
-                    true
+                    !high_glint(p.col)
                 })?
             };
             retrieval.tiles = tiles;
@@ -468,6 +474,8 @@ fn apply<'f, S: Default>(
         outside_family: outside,
         passes_mean: if retrieved == 0 { 0.0 } else { passes as f64 / retrieved as f64 },
         tiles: Vec::new(),
+        high_glint: 0,
+        glint_removed: false,
     };
     Ok((assemble(rows, cols, nb, rrs, flags)?, retrieval))
 }

@@ -27,6 +27,7 @@ pub mod family;
 pub mod image;
 mod mixture;
 pub mod nir_water;
+mod nodes;
 mod pair;
 mod rrs_metrics;
 

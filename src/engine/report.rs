@@ -210,8 +210,16 @@ fn fit_words(
     settings: &crate::correction::ImageCorrection,
     centres_nm: &[f64],
 ) -> String {
+    let glint = if a.glint_removed {
+        format!(
+            "; expected glint taken away, {} pixels left out for high glint (L_GN > {} sr⁻¹)",
+            a.high_glint, settings.glint_threshold_per_sr
+        )
+    } else {
+        String::new()
+    };
     if a.tiles.is_empty() {
-        return settings.label();
+        return format!("{}{glint}", settings.label());
     }
     let mut models: Vec<(crate::atmosphere::AerosolType, usize)> = Vec::new();
     for t in &a.tiles {
@@ -232,5 +240,5 @@ fn fit_words(
         }
         _ => String::new(),
     };
-    format!("{}; {} tile{}: {}{bands}", settings.label(), n, if n == 1 { "" } else { "s" }, chosen.join(", "))
+    format!("{}; {} tile{}: {}{bands}{glint}", settings.label(), n, if n == 1 { "" } else { "s" }, chosen.join(", "))
 }

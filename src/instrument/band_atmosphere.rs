@@ -237,6 +237,8 @@ pub struct BandTerms {
     pub t_ed: Vec<f64>,
     /// Spherical albedo.
     pub spherical_albedo: Vec<f64>,
+    /// Sun-glint radiance, W m⁻² sr⁻¹ nm⁻¹ (zeros unless the scene has glint).
+    pub glint: Vec<f64>,
 }
 
 /// The band terms of every column for one atmosphere (the photon-weighted means of
@@ -265,9 +267,10 @@ pub fn band_terms(
         l_path: vec![0.0; sampled.len() * nb],
         t_ed: vec![0.0; sampled.len() * nb],
         spherical_albedo: vec![0.0; sampled.len() * nb],
+        glint: vec![0.0; sampled.len() * nb],
     };
     for (gi, group) in response.groups.iter().enumerate() {
-        let columns: Vec<Vec<(usize, f64, f64, f64)>> = sampled
+        let columns: Vec<Vec<(usize, [f64; 4])>> = sampled
             .par_iter()
             .enumerate()
             .map(|(si, &c)| {
@@ -281,20 +284,25 @@ pub fn band_terms(
                     .map(|(k, &b)| {
                         let (first, w) = response.weights(gi, k, j);
                         let m = band_means(&path, first, w);
-                        (si * nb + b, m.l_path, m.t_ed, m.spherical_albedo)
+                        (si * nb + b, [m.l_path, m.t_ed, m.spherical_albedo, m.glint])
                     })
                     .collect())
             })
             .collect::<Result<_, InstrumentError>>()?;
-        for (i, l, te, s) in columns.into_iter().flatten() {
-            (at_sampled.l_path[i], at_sampled.t_ed[i], at_sampled.spherical_albedo[i]) = (l, te, s);
+        for (i, [l, te, s, g]) in columns.into_iter().flatten() {
+            (at_sampled.l_path[i], at_sampled.t_ed[i], at_sampled.spherical_albedo[i], at_sampled.glint[i]) =
+                (l, te, s, g);
         }
     }
     if sampled.len() == nc {
         return Ok(at_sampled);
     }
-    let mut out =
-        BandTerms { l_path: vec![0.0; nc * nb], t_ed: vec![0.0; nc * nb], spherical_albedo: vec![0.0; nc * nb] };
+    let mut out = BandTerms {
+        l_path: vec![0.0; nc * nb],
+        t_ed: vec![0.0; nc * nb],
+        spherical_albedo: vec![0.0; nc * nb],
+        glint: vec![0.0; nc * nb],
+    };
     for c in 0..nc {
         let s1 = sampled.partition_point(|&x| x < c).clamp(1, sampled.len() - 1);
         let (a, z) = (sampled[s1 - 1], sampled[s1]);
@@ -305,6 +313,7 @@ pub fn band_terms(
             out.t_ed[o] = at_sampled.t_ed[i0] + t * (at_sampled.t_ed[i1] - at_sampled.t_ed[i0]);
             out.spherical_albedo[o] = at_sampled.spherical_albedo[i0]
                 + t * (at_sampled.spherical_albedo[i1] - at_sampled.spherical_albedo[i0]);
+            out.glint[o] = at_sampled.glint[i0] + t * (at_sampled.glint[i1] - at_sampled.glint[i0]);
         }
     }
     Ok(out)

@@ -352,6 +352,8 @@ ranges! {
     CORRECTION_PAIR_NM = Range::closed("correction.image.pair_nm", 600.0, 2500.0, "nm", "centres of the short and long band of the aerosol pair, short first (the instrument's nearest bands, within 30 nm)");
     /// Image-based correction: AOT nodes of the family's tables.
     CORRECTION_AOT_NODE = Range::above("correction.image.aot_nodes", 0.0, 5.0, "", "AOT(550) nodes of the aerosol family's tables, increasing (0 is always added)");
+    /// Glint threshold of the image-based correction.
+    CORRECTION_GLINT_THRESHOLD = Range::above("correction.image.glint_threshold_per_sr", 0.0, 1.0, "sr-1", "largest normalised glint radiance L_GN of a retrieved pixel (l2gen's glint_thresh)");
     /// Dark-spectrum fitting: tile side.
     CORRECTION_DARK_TILE_PX = Range::count("correction.image.dark.tile_px", 0.0, 100_000.0, "pixels", "tile side of dark-spectrum fitting (0: the whole scene)");
     /// Dark-spectrum fitting: darkest pixels.
