@@ -5,9 +5,9 @@
 //! 0.01° between 1950 and 2050): with n the days from J2000.0 (2000-01-01 12:00 UT),
 //! mean longitude L = 280.460° + 0.985 647 4° n, mean anomaly g = 357.528° + 0.985 600 3° n,
 //! ecliptic longitude λ = L + 1.915° sin g + 0.020° sin 2g, obliquity ε = 23.439° − 4·10⁻⁷° n,
-//! α = atan2(cos ε sin λ, cos λ), δ = asin(sin ε sin λ). GMST = 18.697 374 558 h
-//! + 24.065 709 824 419 08 h · n (USNO). UT is taken for TT (the ~70 s between them moves the sun
-//! by 0.0008°).
+//! α = atan2(cos ε sin λ, cos λ), δ = asin(sin ε sin λ). Greenwich mean sidereal time
+//! GMST = 18.697 374 558 h + 24.065 709 824 419 08 h · n (USNO). UT is taken for TT (the ~70 s
+//! between them moves the sun by 0.0008°).
 //!
 //! ## References
 //! - U.S. Naval Observatory & HM Nautical Almanac Office, *The Astronomical Almanac* (2020),
@@ -176,7 +176,7 @@ mod tests {
             .map(|p| (p.zenith_rad.to_degrees(), p.azimuth_rad.to_degrees()))
             .fold((f64::MAX, 0.0), |best, p| if p.0 < best.0 { p } else { best });
         assert!((zmin - (36.1 + 23.44)).abs() < 0.05, "noon zenith {zmin}");
-        assert!(az < 1.0 || az > 359.0, "noon azimuth {az}");
+        assert!(!(1.0..=359.0).contains(&az), "noon azimuth {az}");
     }
 
     #[test]

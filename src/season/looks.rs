@@ -143,25 +143,22 @@ pub fn looks(season: &SeasonSpec, instrument: &InstrumentSpec, design: usize, wi
         .map(|access| {
             // The line of sight: the fore/aft tilt that glints less, the site's own off-nadir
             // angle across track.
-            let (forward_tilt_deg, geometry, glint_per_sr) = tilts
+            let candidate = |sign: f64| {
+                let forward = sign * season.glint_tilt_deg;
+                let (g, _) = look_geometry(
+                    orbit.altitude_m,
+                    access.heading_rad,
+                    forward.to_radians(),
+                    access.off_nadir_rad,
+                    access.sun.zenith_rad,
+                    access.sun.azimuth_rad,
+                );
+                (forward, g, normalised_glint_per_sr(&g, wind_m_s))
+            };
+            let (forward_tilt_deg, geometry, glint_per_sr) = tilts[1..]
                 .iter()
-                .map(|sign| {
-                    let forward = sign * season.glint_tilt_deg;
-                    let (g, _) = look_geometry(
-                        orbit.altitude_m,
-                        access.heading_rad,
-                        forward.to_radians(),
-                        access.off_nadir_rad,
-                        access.sun.zenith_rad,
-                        access.sun.azimuth_rad,
-                    );
-                    (forward, g, normalised_glint_per_sr(&g, wind_m_s))
-                })
-                .fold(None, |best: Option<(f64, Geometry, f64)>, c| match best {
-                    Some(b) if b.2 <= c.2 => Some(b),
-                    _ => Some(c),
-                })
-                .expect("at least one tilt");
+                .map(|s| candidate(*s))
+                .fold(candidate(tilts[0]), |best, c| if c.2 < best.2 { c } else { best });
             // Every look draws its cover (night ones too), so a look's cover does not depend on
             // which earlier looks were kept.
             let month = crate::orbit::sun::calendar_date(access.days).1 as usize - 1;
