@@ -118,9 +118,9 @@ pub fn cloud_cover(fraction: f64, concentration: f64, rng: &mut Xoshiro256PlusPl
 
 /// The looks of `instrument` (flying the season's orbit at its own altitude) at the season's
 /// site over its period, in time order; the site must lie in its swath (at a roll the season
-/// allows). `design` seeds the
-/// cloud draws, so designs see different weather (they fly different orbits).
-pub fn looks(season: &SeasonSpec, instrument: &InstrumentSpec, design: usize, wind_m_s: f64) -> Vec<Look> {
+/// allows). The cloud cover is drawn for the hour of each pass, so designs in the same orbit see
+/// the same weather.
+pub fn looks(season: &SeasonSpec, instrument: &InstrumentSpec, wind_m_s: f64) -> Vec<Look> {
     let (Ok((from, to)), Ok(epoch_days)) = (season.period_days(), season.epoch_days()) else { return Vec::new() };
     let orbit = SunSynchronous {
         altitude_m: instrument.altitude_km * 1e3,
@@ -133,7 +133,6 @@ pub fn looks(season: &SeasonSpec, instrument: &InstrumentSpec, design: usize, wi
     let pointing = instrument.across_track_tilt_deg.to_radians();
     let roll = season.max_roll_deg.to_radians();
     let found = accesses(&orbit, &site, from, to, pointing.abs() + roll + half);
-    let mut rng = Xoshiro256PlusPlus::seed_from_u64(season.seed ^ (design as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
     let max_sun = season.max_sun_zenith_deg.to_radians();
     let tilts: &[f64] = if season.glint_tilt_deg > 0.0 { &[1.0, -1.0] } else { &[0.0] };
     found
@@ -159,8 +158,11 @@ pub fn looks(season: &SeasonSpec, instrument: &InstrumentSpec, design: usize, wi
                 .iter()
                 .map(|s| candidate(*s))
                 .fold(candidate(tilts[0]), |best, c| if c.2 < best.2 { c } else { best });
-            // Every look draws its cover (night ones too), so a look's cover does not depend on
-            // which earlier looks were kept.
+            // The weather of the hour of the pass: two designs that pass within the same hour
+            // (the same orbit) see the same cover, and a look's cover does not depend on which
+            // other looks there are.
+            let hour = (access.days * 24.0).floor() as i64 as u64;
+            let mut rng = Xoshiro256PlusPlus::seed_from_u64(season.seed ^ hour.wrapping_mul(0x9E37_79B9_7F4A_7C15));
             let month = crate::orbit::sun::calendar_date(access.days).1 as usize - 1;
             let cloud_cover = season
                 .clouds

@@ -185,8 +185,7 @@ pub fn run_season(
     let period = season.period_days().map_err(StudyError::Invalid)?;
     let mut seasons: Vec<DesignSeason> = designs
         .iter()
-        .enumerate()
-        .map(|(i, (label, config))| {
+        .map(|(label, config)| {
             let wind = match config.scene.atmosphere.surface {
                 crate::atmosphere::Surface::Wind { speed_m_s } => speed_m_s,
                 crate::atmosphere::Surface::Flat => season.wind_m_s,
@@ -195,14 +194,14 @@ pub fn run_season(
                 label: label.clone(),
                 altitude_km: config.instrument.altitude_km,
                 half_fov_deg: half_field_of_view_rad(&config.instrument).to_degrees(),
-                looks: looks(season, &config.instrument, i, wind),
+                looks: looks(season, &config.instrument, wind),
                 runs: Vec::new(),
                 phases: (0..PHASE_SAMPLES)
                     .into_par_iter()
                     .map(|k| {
                         let mut other = season.clone();
                         other.orbit.phase_deg = season.orbit.phase_deg + 360.0 * k as f64 / PHASE_SAMPLES as f64;
-                        let valid: Vec<f64> = looks(&other, &config.instrument, i, wind)
+                        let valid: Vec<f64> = looks(&other, &config.instrument, wind)
                             .iter()
                             .filter(|l| l.verdict == Verdict::Valid)
                             .map(|l| l.access.days)
@@ -224,37 +223,43 @@ pub fn run_season(
             evenly(&valid, season.max_runs)
         })
         .collect();
-    let total: usize = chosen.iter().map(Vec::len).sum();
+    // Runs in time order across designs: designs in the same orbit pass together, and the
+    // second reuses the first's scene and atmosphere tables from the engine's cache.
+    let mut jobs: Vec<(usize, usize)> =
+        chosen.iter().enumerate().flat_map(|(d, picks)| picks.iter().map(move |&k| (d, k))).collect();
+    jobs.sort_by(|a, b| {
+        seasons[a.0].looks[a.1].access.days.total_cmp(&seasons[b.0].looks[b.1].access.days).then(a.0.cmp(&b.0))
+    });
+    let total = jobs.len();
     let mut engine = Engine::lean();
-    let mut done = 0;
-    for ((design, (_, base)), picks) in seasons.iter_mut().zip(designs).zip(&chosen) {
-        for &k in picks {
-            let config = look_config(base, &design.looks[k], season.decimation);
-            let run = match engine.run_with(&config, control, &[]) {
-                Ok(out) => LookRun {
-                    look: k,
-                    errors: out
-                        .retrievals
-                        .iter()
-                        .flat_map(|r| {
-                            r.metrics.variables.iter().map(|v| LookError {
-                                product: r.metrics.product.clone(),
-                                variable: v.variable.clone(),
-                                mae_pct: v.metrics.mae_pct(),
-                                bias_pct: v.metrics.bias_pct(),
-                                returned_pct: v.metrics.returned_pct,
-                            })
+    for (done, &(d, k)) in jobs.iter().enumerate() {
+        let config = look_config(&designs[d].1, &seasons[d].looks[k], season.decimation);
+        let run = match engine.run_with(&config, control, &[]) {
+            Ok(out) => LookRun {
+                look: k,
+                errors: out
+                    .retrievals
+                    .iter()
+                    .flat_map(|r| {
+                        r.metrics.variables.iter().map(|v| LookError {
+                            product: r.metrics.product.clone(),
+                            variable: v.variable.clone(),
+                            mae_pct: v.metrics.mae_pct(),
+                            bias_pct: v.metrics.bias_pct(),
+                            returned_pct: v.metrics.returned_pct,
                         })
-                        .collect(),
-                    failure: None,
-                },
-                Err(EngineError::Cancelled) => return Err(StudyError::Cancelled),
-                Err(e) => LookRun { look: k, errors: Vec::new(), failure: Some(e.to_string()) },
-            };
-            design.runs.push(run);
-            done += 1;
-            progress(done, total);
-        }
+                    })
+                    .collect(),
+                failure: None,
+            },
+            Err(EngineError::Cancelled) => return Err(StudyError::Cancelled),
+            Err(e) => LookRun { look: k, errors: Vec::new(), failure: Some(e.to_string()) },
+        };
+        seasons[d].runs.push(run);
+        progress(done + 1, total);
+    }
+    for d in &mut seasons {
+        d.runs.sort_by_key(|r| r.look);
     }
     Ok(SeasonResult { spec: season.clone(), study: study.to_string(), period, designs: seasons })
 }

@@ -96,6 +96,9 @@ fn valid_looks_match_an_independent_count() {
         assert_eq!(d.phases.len(), shoal::season::run::PHASE_SAMPLES);
     }
     assert!(any_valid, "autumn 2023 over Heron Island has valid looks at phase 0");
+    // Both designs fly 560 km: the same passes under the same weather.
+    let cover = |d: &shoal::season::run::DesignSeason| d.looks.iter().map(|l| l.cloud_cover).collect::<Vec<_>>();
+    assert_eq!(cover(&result.designs[0]), cover(&result.designs[1]));
 }
 
 /// A look's run is the study's configuration at the look's sun, date, heading and pointing, and
@@ -168,4 +171,19 @@ fn season_command_writes_looks_and_months() {
     assert!(!bad.status.success());
     assert!(String::from_utf8_lossy(&bad.stderr).contains("month 13"));
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The looks, their cloud draws and the phase spread do not depend on the threads.
+#[test]
+fn a_season_does_not_depend_on_the_threads() {
+    let season = spring(0);
+    let (study, ds) = designs(&season, None).unwrap();
+    let on = |n: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .unwrap()
+            .install(|| run_season(&season, &study, &ds, &RunControl::new(), |_, _| {}).unwrap())
+    };
+    assert_eq!(on(1).designs, on(2).designs);
 }
