@@ -100,7 +100,7 @@ pub struct InstrumentSpec {
     /// Across-track pointing of the line of sight (roll), degrees (−60 to 60, positive: right
     /// of the ground track); a fixed shift of the swath away from the sun's glint (as OLCI's
     /// 12.6° west), or where a season's pass sees the site.
-    #[serde(default, skip_serializing_if = "is_zero")]
+    #[serde(default)]
     pub across_track_tilt_deg: f64,
     /// Read noise, electrons rms.
     pub read_noise_e: f64,
@@ -154,11 +154,6 @@ pub fn ground_speed_m_s(altitude_km: f64) -> f64 {
     use crate::units::{EARTH_GM_M3_S2, EARTH_RADIUS_M};
     let a = EARTH_RADIUS_M + altitude_km * 1e3;
     (EARTH_GM_M3_S2 / a).sqrt() * EARTH_RADIUS_M / a
-}
-
-/// Serde: leave a zero out of written files (files from before the field stay byte-identical).
-fn is_zero(x: &f64) -> bool {
-    *x == 0.0
 }
 
 impl InstrumentSpec {

@@ -232,8 +232,8 @@ mod tests {
         let expected = rf / (std::f64::consts::PI * sigma2) / (4.0 * theta.cos());
         let got = normalised_glint_per_sr(&g, wind);
         assert!((got / expected - 1.0).abs() < 1e-12, "{got} vs {expected}");
-        // Far from it, nothing.
-        let away = Geometry { relative_azimuth_rad: 0.0, ..g };
+        // Far from it (the sensor at 60° on the sun's side: facets would tilt 42.5°), nothing.
+        let away = Geometry { relative_azimuth_rad: 0.0, view_zenith_rad: 60f64.to_radians(), ..g };
         assert!(normalised_glint_per_sr(&away, wind) < 1e-6);
     }
 

@@ -99,11 +99,21 @@ fn base(path: &str) -> RunConfig {
     c.fidelity.lut_wavelength_step_nm = 40.0;
     c.fidelity.lut_view_step_deg = 10.0;
     if path.starts_with("correction.image.dark") {
-        // Dark-spectrum fitting's settings act only when it is the fit.
-        c.correction.image = Some(shoal::correction::ImageCorrection::dark_spectrum());
+        // Dark-spectrum fitting's settings act only when it is the fit. The base's glint (~0.02
+        // sr⁻¹ at nadir) is left in, as ACOLITE's fit reads it: taken away, none of the four
+        // dark-spectrum settings changed this small reef's output any more.
+        c.correction.image = Some(shoal::correction::ImageCorrection {
+            glint: false,
+            ..shoal::correction::ImageCorrection::dark_spectrum()
+        });
     } else if path.starts_with("correction.image") {
-        // The image-based correction's settings act only when it is on.
-        c.correction.image = Some(shoal::correction::ImageCorrection::default());
+        // The image-based correction's settings act only when it is on. The base looks near the
+        // sun's glint (normalised glint ~0.02 sr⁻¹ at nadir): the glint is taken away but no
+        // pixel left out, so that every other setting reaches the Rrs.
+        c.correction.image = Some(shoal::correction::ImageCorrection {
+            glint_threshold_per_sr: 1.0,
+            ..shoal::correction::ImageCorrection::default()
+        });
     }
     c.validate().unwrap();
     c
@@ -200,6 +210,8 @@ fn chosen_value(path: &str) -> Option<f64> {
         "correction.image.pair_nm" => 900.0,
         // An AOT node (its `aot_nodes.2`, 0.2) moved within its neighbours 0.1 and 0.4.
         "correction.image.aot_nodes" => 0.15,
+        // l2gen's 0.005 sr⁻¹ against the base's 1: every pixel of the base is above it.
+        "correction.image.glint_threshold_per_sr" => 0.005,
         // Dark-spectrum fitting over the 16 × 12 image: 8-pixel tiles (2 × 2 where the default
         // is one scene-wide tile); 20 darkest pixels where the default's 200 take them all; a
         // gas threshold of 0.99 and a band range starting at 770 nm, each leaving out bands the

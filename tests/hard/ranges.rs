@@ -127,6 +127,7 @@ fn refusal(range: &Range, value: f64) -> Option<String> {
             "correction.image.dark.tile_px" => dark.tile_px = value as usize,
             "correction.image.dark.pixels" => dark.pixels = value as usize,
             "correction.image.dark.min_gas_transmittance" => dark.min_gas_transmittance = value,
+            "correction.image.glint_threshold_per_sr" => image.glint_threshold_per_sr = value,
             "correction.image.dark.wave_range_nm" => {
                 dark.wave_range_nm = if value < 1500.0 { [value, 2500.0] } else { [350.0, value] };
             }
