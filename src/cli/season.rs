@@ -41,6 +41,9 @@ pub struct SeasonArgs {
     /// Worker threads (default: all cores).
     #[arg(long)]
     threads: Option<usize>,
+    /// Do not draw the figures.
+    #[arg(long)]
+    no_figures: bool,
 }
 
 fn load(arg: &str) -> Result<(SeasonSpec, Option<PathBuf>), CliError> {
@@ -99,6 +102,13 @@ pub fn run(args: &SeasonArgs) -> Result<(), CliError> {
     print!("{}", summary(&result, seconds));
     write_bytes(&out.path().join("looks.csv"), looks_csv(&result).as_bytes())?;
     write_bytes(&out.path().join("months.csv"), months_csv(&result).as_bytes())?;
+    if !args.no_figures {
+        let limits = crate::season::run::mae_limits(&spec, dir.as_deref());
+        for fig in crate::season::figure::figures(&result, &limits)? {
+            write_bytes(&out.path().join(format!("{}.png", fig.name)), &fig.png)?;
+            write_bytes(&out.path().join(format!("{}.svg", fig.name)), fig.svg.as_bytes())?;
+        }
+    }
     write_bytes(
         &out.path().join("season.ron"),
         ron::ser::to_string_pretty(&spec, ron::ser::PrettyConfig::default()).unwrap_or_default().as_bytes(),

@@ -29,6 +29,7 @@
 //! - Falls, L. W. (1974) The beta distribution: a statistical model for world cloud cover.
 //!   J. Geophys. Res. 79, 1261–1264.
 
+pub mod figure;
 pub mod looks;
 pub mod run;
 pub mod stats;

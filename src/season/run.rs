@@ -171,6 +171,15 @@ pub fn designs(season: &SeasonSpec, dir: Option<&Path>) -> Result<(String, Vec<(
     Ok((study.name, designs))
 }
 
+/// The study's product requirements as (variable, largest MAE %), for the figures.
+pub fn mae_limits(season: &SeasonSpec, dir: Option<&Path>) -> Vec<(String, f64)> {
+    crate::study::load(&season.study, dir, |n| StudySpec::preset(n).map_err(|e| e.to_string()), "study")
+        .ok()
+        .and_then(|(s, _)| s.requirements)
+        .map(|r| r.products.iter().filter_map(|p| Some((p.variable.clone(), p.mae_pct?))).collect())
+        .unwrap_or_default()
+}
+
 /// Run `season` over `designs` (from [`designs`]; `study` names them): find each design's
 /// looks, then run up to `max_runs` of its valid ones through the chain. `progress(done, total)`
 /// after each run.

@@ -163,6 +163,7 @@ fn season_command_writes_looks_and_months() {
     assert!(looks.starts_with("design,date,time_ut,descending,sun_zenith_deg"));
     let months = std::fs::read_to_string(dir.join("months.csv")).unwrap();
     assert_eq!(months.lines().count(), 3, "{months}");
+    assert!(dir.join("season_valid_looks.svg").exists() && dir.join("season_valid_looks.png").exists());
     let bad = std::process::Command::new(env!("CARGO_BIN_EXE_shoal"))
         .args(["season", "lake_hume_year", "--to", "2023-13-01", "--out"])
         .arg(&dir)
