@@ -45,7 +45,7 @@ impl Verdict {
 pub struct Look {
     /// The pass.
     pub access: Access,
-    /// Fore/aft tilt chosen for the look, degrees (0 without a glint tilt).
+    /// Fore/aft tilt of the look, degrees (the design's own without a glint tilt).
     pub forward_tilt_deg: f64,
     /// Sun and view geometry at the site, with the tilt.
     pub geometry: Geometry,
@@ -134,7 +134,9 @@ pub fn looks(season: &SeasonSpec, instrument: &InstrumentSpec, wind_m_s: f64) ->
     let roll = season.max_roll_deg.to_radians();
     let found = accesses(&orbit, &site, from, to, pointing.abs() + roll + half);
     let max_sun = season.max_sun_zenith_deg.to_radians();
-    let tilts: &[f64] = if season.glint_tilt_deg > 0.0 { &[1.0, -1.0] } else { &[0.0] };
+    // Fore/aft candidates, degrees: the glint tilt either way, or the design's own forward tilt.
+    let t = season.glint_tilt_deg;
+    let tilts: Vec<f64> = if t > 0.0 { vec![t, -t] } else { vec![instrument.forward_tilt_deg] };
     found
         .into_iter()
         // Inside the swath at some roll in [pointing − roll, pointing + roll].
@@ -142,8 +144,7 @@ pub fn looks(season: &SeasonSpec, instrument: &InstrumentSpec, wind_m_s: f64) ->
         .map(|access| {
             // The line of sight: the fore/aft tilt that glints less, the site's own off-nadir
             // angle across track.
-            let candidate = |sign: f64| {
-                let forward = sign * season.glint_tilt_deg;
+            let candidate = |forward: f64| {
                 let (g, _) = look_geometry(
                     orbit.altitude_m,
                     access.heading_rad,
