@@ -157,13 +157,14 @@ pub fn summary(result: &SeasonResult, seconds: f64) -> String {
     for d in &result.designs {
         let count = |v: Verdict| d.looks.iter().filter(|l| l.verdict == v).count();
         t += &format!(
-            "\n{} ({} km, half field of view {:.2}°): {} passes; valid {}, sun low {}, glint {}, cloud {}\n",
+            "\n{} ({} km, half field of view {:.2}°): {} passes; valid {}, sun low {}, view oblique {}, glint {}, cloud {}\n",
             d.label,
             d.altitude_km,
             d.half_fov_deg,
             d.looks.len(),
             count(Verdict::Valid),
             count(Verdict::SunLow),
+            count(Verdict::ViewOblique),
             count(Verdict::Glint),
             count(Verdict::Cloud)
         );
@@ -225,8 +226,7 @@ pub fn summary(result: &SeasonResult, seconds: f64) -> String {
 }
 
 fn date_time(days: f64) -> (String, String) {
-    let (y, m, d) = crate::orbit::sun::calendar_date(days);
-    let minutes = ((days + 0.5).rem_euclid(1.0) * 1440.0).round() as u32 % 1440;
+    let ((y, m, d), minutes) = crate::orbit::sun::date_and_minute(days);
     (format!("{y:04}-{m:02}-{d:02}"), format!("{:02}:{:02}", minutes / 60, minutes % 60))
 }
 
@@ -293,12 +293,12 @@ pub fn looks_csv(result: &SeasonResult) -> String {
 /// Looks per calendar month and verdict, per design.
 #[must_use]
 pub fn months_csv(result: &SeasonResult) -> String {
-    let mut csv = Csv::new(&["design", "month", "passes", "valid", "sun_low", "glint", "cloud"]);
+    let mut csv = Csv::new(&["design", "month", "passes", "valid", "sun_low", "view_oblique", "glint", "cloud"]);
     for d in &result.designs {
         let all = d.per_month(None, result.period.0, result.period.1);
         let by = |v: Verdict| d.per_month(Some(v), result.period.0, result.period.1);
-        let (valid, sun, glint, cloud) =
-            (by(Verdict::Valid), by(Verdict::SunLow), by(Verdict::Glint), by(Verdict::Cloud));
+        let (valid, sun, view) = (by(Verdict::Valid), by(Verdict::SunLow), by(Verdict::ViewOblique));
+        let (glint, cloud) = (by(Verdict::Glint), by(Verdict::Cloud));
         for (i, ((y, m), n)) in all.iter().enumerate() {
             csv.row([
                 d.label.clone(),
@@ -306,6 +306,7 @@ pub fn months_csv(result: &SeasonResult) -> String {
                 n.to_string(),
                 valid[i].1.to_string(),
                 sun[i].1.to_string(),
+                view[i].1.to_string(),
                 glint[i].1.to_string(),
                 cloud[i].1.to_string(),
             ]);

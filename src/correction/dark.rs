@@ -144,6 +144,7 @@ pub fn fit_tiles(
     settings: &DarkSpectrumSettings,
     bands: &BandSet,
     control: &RunControl,
+    skip_column: &(dyn Fn(usize) -> bool + Sync),
 ) -> Result<Vec<TileFit>, CorrectionError> {
     let (rows, cols, nb) = level1.radiance.dim();
     let centres = bands.centres_nm();
@@ -173,7 +174,7 @@ pub fn fit_tiles(
         for &b in &fitted {
             values.clear();
             for r in rr[0]..rr[1] {
-                for c in cc[0]..cc[1] {
+                for c in (cc[0]..cc[1]).filter(|&c| !skip_column(c)) {
                     let i = (r * cols + c) * nb + b;
                     let v = f64::from(l1[i]);
                     if flags[i] == 0 && v.is_finite() && v > 0.0 {
@@ -232,7 +233,9 @@ pub fn fit_tiles(
     let scene = fit([0, rows], [0, cols]).ok_or_else(|| {
         invalid(
             "correction.image.dark",
-            "fewer than 10 % of the scene's pixels have valid Level-1 in a fitted band".into(),
+            "fewer than 10 % of the scene's pixels have valid Level-1 in a fitted band (pixels left out \
+             for high glint do not count)"
+                .into(),
         )
     })?;
     if settings.tile_px == 0 || (settings.tile_px >= rows && settings.tile_px >= cols) {

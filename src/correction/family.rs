@@ -161,27 +161,26 @@ impl AerosolFamily {
             }
             None => vec![1.0; rayleigh.t_ed.len()],
         };
+        // Per column, the largest over the geometry groups (a filter imager's rows see the ground
+        // from different angles).
         let glint_lgn = match scene.spec.atmosphere.surface {
-            crate::atmosphere::Surface::Wind { speed_m_s } if scene.wants(crate::scene::Effect::SunGlint) => viewing
-                .looks
-                .first()
-                .map(|looks| {
-                    looks
-                        .iter()
-                        .map(|l| {
-                            let g = &l.geometry;
-                            crate::atmosphere::glint_reflectance(
-                                g.sun_zenith_rad,
-                                g.view_zenith_rad,
-                                g.relative_azimuth_rad,
-                                speed_m_s,
-                                scene.spec.atmosphere.water_refractive_index,
-                            ) * g.sun_zenith_rad.cos()
-                                / std::f64::consts::PI
-                        })
-                        .collect()
-                })
-                .unwrap_or_default(),
+            crate::atmosphere::Surface::Wind { speed_m_s } if scene.wants(crate::scene::Effect::SunGlint) => {
+                let lgn = |g: &crate::atmosphere::Geometry| {
+                    crate::atmosphere::glint_reflectance(
+                        g.sun_zenith_rad,
+                        g.view_zenith_rad,
+                        g.relative_azimuth_rad,
+                        speed_m_s,
+                        scene.spec.atmosphere.water_refractive_index,
+                    ) * g.sun_zenith_rad.cos()
+                        / std::f64::consts::PI
+                };
+                (0..viewing.columns())
+                    .map(|c| {
+                        viewing.looks.iter().filter_map(|g| g.get(c)).map(|l| lgn(&l.geometry)).fold(0.0, f64::max)
+                    })
+                    .collect()
+            }
             _ => Vec::new(),
         };
         Ok(Self {

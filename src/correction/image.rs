@@ -384,7 +384,11 @@ fn correct_with(
             apply(level1, surface, control, |p, mix, scratch| !high_glint(p.col) && fit.fit(p, mix, scratch))
         }
         AerosolFit::DarkSpectrum => {
-            let tiles = super::dark::fit_tiles(level1, family, &settings.dark, bands, control)?;
+            if (0..level1.radiance.dim().1).all(high_glint) {
+                // Nothing to fit: every pixel is left out for glint.
+                return apply(level1, surface, control, |_, _, _: &mut ()| false);
+            }
+            let tiles = super::dark::fit_tiles(level1, family, &settings.dark, bands, control, high_glint)?;
             let (rows, cols) = (level1.radiance.dim().0, level1.radiance.dim().1);
             let (rrs, mut retrieval) = if let Some(smooth) = super::dark::smoothed(&tiles, &settings.dark, rows, cols) {
                 apply(level1, surface, control, |p, mix, _: &mut ()| {

@@ -111,7 +111,7 @@ impl Viewing {
                     field: "detectors".into(),
                     message: format!(
                         "the swath edge is seen at a view zenith above {MAX_VIEW_ZENITH_DEG}° (off-nadir {:.1}°); reduce detectors, \
-                         pixel pitch or forward tilt, or lengthen the focal length",
+                         pixel pitch, forward or across-track tilt, or lengthen the focal length",
                         gamma.to_degrees()
                     ),
                 }));

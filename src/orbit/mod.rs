@@ -43,7 +43,8 @@ pub const MEAN_SUN_RATE_RAD_S: f64 = TAU / (365.242_19 * sun::DAY_S);
 /// A circular sun-synchronous orbit.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SunSynchronous {
-    /// Altitude above the mean Earth radius, m.
+    /// Altitude above the equatorial radius, m (as missions quote it; the ground is a sphere of
+    /// the mean radius).
     pub altitude_m: f64,
     /// Local mean solar time of the descending node, hours (10.5: a 10:30 morning orbit).
     pub descending_node_h: f64,

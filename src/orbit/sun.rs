@@ -72,6 +72,15 @@ pub fn calendar_date(days: f64) -> (i64, u32, u32) {
     (year, month as u32, day as u32)
 }
 
+/// The UT calendar date and minute of the day of `days` since J2000.0, rounded to the minute
+/// (a time in the last half-minute before midnight is 00:00 of the next day).
+#[must_use]
+pub fn date_and_minute(days: f64) -> ((i64, u32, u32), u32) {
+    let minutes = ((days + 0.5) * 1440.0).round() as i64;
+    let (day, minute) = (minutes.div_euclid(1440), minutes.rem_euclid(1440));
+    (calendar_date(day as f64 - 0.25), minute as u32)
+}
+
 /// The sun's equatorial coordinates and mean longitude at `days` since J2000.0 (radians).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SunCoordinates {
@@ -147,6 +156,9 @@ mod tests {
             let (y, m, dd) = calendar_date(d + 0.3);
             assert_eq!(format!("{y:04}-{m:02}-{dd:02}"), date);
         }
+        let d = days_since_j2000("2023-06-21").unwrap();
+        assert_eq!(date_and_minute(d + 0.5), ((2023, 6, 21), 720));
+        assert_eq!(date_and_minute(d + 1.0 - 10.0 / 86_400.0), ((2023, 6, 22), 0));
         assert!(days_since_j2000("2023-02-29").unwrap_err().contains("day 29"));
         assert!(days_since_j2000("2023-13-01").unwrap_err().contains("month 13"));
         assert!(days_since_j2000("June").is_err());

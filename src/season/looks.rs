@@ -11,9 +11,6 @@ use crate::instrument::InstrumentSpec;
 use crate::orbit::{Access, Site, SunSynchronous, accesses};
 use crate::units::EARTH_RADIUS_M;
 
-/// Refractive index of water for the glint's Fresnel reflectance (the scene's default).
-const WATER_INDEX: f64 = 1.34;
-
 /// Why a look is kept or not, in the order the checks are made.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Verdict {
@@ -21,6 +18,8 @@ pub enum Verdict {
     Valid,
     /// The sun too low (or set).
     SunLow,
+    /// The site seen too obliquely (l2gen's HISATZEN).
+    ViewOblique,
     /// High glint at the site.
     Glint,
     /// Too cloudy.
@@ -34,6 +33,7 @@ impl Verdict {
         match self {
             Self::Valid => "valid",
             Self::SunLow => "sun low",
+            Self::ViewOblique => "view oblique",
             Self::Glint => "glint",
             Self::Cloud => "cloud",
         }
@@ -92,15 +92,15 @@ pub fn look_geometry(
     (Geometry { sun_zenith_rad, view_zenith_rad: sin_vza.asin(), relative_azimuth_rad: rel }, sensor_azimuth)
 }
 
-/// Normalised glint radiance L_GN = ρ_g μ₀/π (sr⁻¹; Wang & Bailey 2001) at `g` for `wind_m_s`,
-/// with ρ_g the Cox–Munk glint reflectance ([`glint_reflectance`]).
+/// Normalised glint radiance L_GN = ρ_g μ₀/π (sr⁻¹; Wang & Bailey 2001) at `g` for `wind_m_s`
+/// over water of refractive index `n`, with ρ_g the Cox–Munk glint reflectance
+/// ([`glint_reflectance`]).
 #[must_use]
-pub fn normalised_glint_per_sr(g: &Geometry, wind_m_s: f64) -> f64 {
+pub fn normalised_glint_per_sr(g: &Geometry, wind_m_s: f64, n: f64) -> f64 {
     if g.sun_zenith_rad >= std::f64::consts::FRAC_PI_2 {
         return 0.0;
     }
-    glint_reflectance(g.sun_zenith_rad, g.view_zenith_rad, g.relative_azimuth_rad, wind_m_s, WATER_INDEX)
-        * g.sun_zenith_rad.cos()
+    glint_reflectance(g.sun_zenith_rad, g.view_zenith_rad, g.relative_azimuth_rad, wind_m_s, n) * g.sun_zenith_rad.cos()
         / std::f64::consts::PI
 }
 
@@ -119,8 +119,8 @@ pub fn cloud_cover(fraction: f64, concentration: f64, rng: &mut Xoshiro256PlusPl
 /// The looks of `instrument` (flying the season's orbit at its own altitude) at the season's
 /// site over its period, in time order; the site must lie in its swath (at a roll the season
 /// allows). The cloud cover is drawn for the hour of each pass, so designs in the same orbit see
-/// the same weather.
-pub fn looks(season: &SeasonSpec, instrument: &InstrumentSpec, wind_m_s: f64) -> Vec<Look> {
+/// the same weather. `n`: the water's refractive index (the scene's).
+pub fn looks(season: &SeasonSpec, instrument: &InstrumentSpec, wind_m_s: f64, n: f64) -> Vec<Look> {
     let (Ok((from, to)), Ok(epoch_days)) = (season.period_days(), season.epoch_days()) else { return Vec::new() };
     let orbit = SunSynchronous {
         altitude_m: instrument.altitude_km * 1e3,
@@ -134,6 +134,7 @@ pub fn looks(season: &SeasonSpec, instrument: &InstrumentSpec, wind_m_s: f64) ->
     let roll = season.max_roll_deg.to_radians();
     let found = accesses(&orbit, &site, from, to, pointing.abs() + roll + half);
     let max_sun = season.max_sun_zenith_deg.to_radians();
+    let max_view = season.max_view_zenith_deg.to_radians();
     // Fore/aft candidates, degrees: the glint tilt either way, or the design's own forward tilt.
     let t = season.glint_tilt_deg;
     let tilts: Vec<f64> = if t > 0.0 { vec![t, -t] } else { vec![instrument.forward_tilt_deg] };
@@ -153,7 +154,7 @@ pub fn looks(season: &SeasonSpec, instrument: &InstrumentSpec, wind_m_s: f64) ->
                     access.sun.zenith_rad,
                     access.sun.azimuth_rad,
                 );
-                (forward, g, normalised_glint_per_sr(&g, wind_m_s))
+                (forward, g, normalised_glint_per_sr(&g, wind_m_s, n))
             };
             let (forward_tilt_deg, geometry, glint_per_sr) = tilts[1..]
                 .iter()
@@ -165,12 +166,13 @@ pub fn looks(season: &SeasonSpec, instrument: &InstrumentSpec, wind_m_s: f64) ->
             let hour = (access.days * 24.0).floor() as i64 as u64;
             let mut rng = Xoshiro256PlusPlus::seed_from_u64(season.seed ^ hour.wrapping_mul(0x9E37_79B9_7F4A_7C15));
             let month = crate::orbit::sun::calendar_date(access.days).1 as usize - 1;
-            let cloud_cover = season
-                .clouds
-                .as_ref()
-                .map_or(0.0, |c| cloud_cover(c.monthly_fraction[month], c.concentration, &mut rng));
+            let cloud_cover = season.clouds.as_ref().map_or(0.0, |c| {
+                cloud_cover(c.monthly_fraction.get(month).copied().unwrap_or(0.0), c.concentration, &mut rng)
+            });
             let verdict = if access.sun.zenith_rad > max_sun {
                 Verdict::SunLow
+            } else if geometry.view_zenith_rad > max_view {
+                Verdict::ViewOblique
             } else if glint_per_sr > season.glint_threshold_per_sr {
                 Verdict::Glint
             } else if 100.0 * (1.0 - cloud_cover) < season.min_clear_pct {
@@ -229,13 +231,13 @@ mod tests {
         let g = Geometry { sun_zenith_rad: theta, view_zenith_rad: theta, relative_azimuth_rad: std::f64::consts::PI };
         let wind = 7.0;
         let sigma2 = 0.003 + 0.005_12 * wind;
-        let rf = crate::atmosphere::fresnel_reflectance(theta.cos(), WATER_INDEX);
+        let rf = crate::atmosphere::fresnel_reflectance(theta.cos(), 1.34);
         let expected = rf / (std::f64::consts::PI * sigma2) / (4.0 * theta.cos());
-        let got = normalised_glint_per_sr(&g, wind);
+        let got = normalised_glint_per_sr(&g, wind, 1.34);
         assert!((got / expected - 1.0).abs() < 1e-12, "{got} vs {expected}");
         // Far from it (the sensor at 60° on the sun's side: facets would tilt 42.5°), nothing.
         let away = Geometry { relative_azimuth_rad: 0.0, view_zenith_rad: 60f64.to_radians(), ..g };
-        assert!(normalised_glint_per_sr(&away, wind) < 1e-6);
+        assert!(normalised_glint_per_sr(&away, wind, 1.34) < 1e-6);
     }
 
     /// Over many draws the cover's mean is the month's fraction (beta mean α/(α+β)) to 0.01,

@@ -6,7 +6,8 @@
 //! sun-synchronous orbit (its own altitude, [`crate::orbit`]) to the site are found over the
 //! period; each becomes a [`looks::Look`] with the sun and view geometry of that pass, judged
 //! valid or not the way a processor would:
-//! - the sun at most `max_sun_zenith_deg` from the zenith (l2gen's HISOLZEN, 75°);
+//! - the sun at most `max_sun_zenith_deg` from the zenith (l2gen's HISOLZEN, 75°), and the site
+//!   seen at most `max_view_zenith_deg` from it (HISATZEN, 60°);
 //! - the site inside the swath: the design's field of view about its across-track pointing, or
 //!   about any roll up to `max_roll_deg` for an agile platform;
 //! - no high glint: the Cox–Munk normalised glint radiance L_GN = ρ_g μ₀/π at the site at most
@@ -114,6 +115,9 @@ pub struct SeasonSpec {
     /// Largest sun zenith a look may have, degrees.
     #[serde(default = "default_max_sun")]
     pub max_sun_zenith_deg: f64,
+    /// Largest view zenith a look may have, degrees (l2gen's HISATZEN, 60°).
+    #[serde(default = "default_max_view")]
+    pub max_view_zenith_deg: f64,
     /// Wind speed for the glint, m/s (the scene's own when its surface is wind-roughened).
     #[serde(default = "default_wind")]
     pub wind_m_s: f64,
@@ -152,6 +156,9 @@ pub struct SeasonSpec {
 fn default_max_sun() -> f64 {
     75.0
 }
+fn default_max_view() -> f64 {
+    60.0
+}
 fn default_wind() -> f64 {
     5.0
 }
@@ -187,6 +194,9 @@ pub mod ranges {
     /// Sun limit.
     pub const MAX_SUN: Range =
         Range::closed("max_sun_zenith_deg", 10.0, 85.0, "degrees", "largest sun zenith of a look");
+    /// View limit.
+    pub const MAX_VIEW: Range =
+        Range::closed("max_view_zenith_deg", 10.0, 80.0, "degrees", "largest view zenith of a look");
     /// Wind.
     pub const WIND: Range = Range::closed("wind_m_s", 0.0, 30.0, "m/s", "wind speed for the glint");
     /// Glint threshold.
@@ -262,6 +272,7 @@ impl SeasonSpec {
         check(&r::NODE, self.orbit.descending_node_h)?;
         check(&r::PHASE, self.orbit.phase_deg)?;
         check(&r::MAX_SUN, self.max_sun_zenith_deg)?;
+        check(&r::MAX_VIEW, self.max_view_zenith_deg)?;
         check(&r::WIND, self.wind_m_s)?;
         check(&r::GLINT, self.glint_threshold_per_sr)?;
         check(&r::ROLL, self.max_roll_deg)?;

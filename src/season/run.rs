@@ -52,8 +52,8 @@ pub struct DesignSeason {
     pub runs: Vec<LookRun>,
     /// The same season at other orbit phases (which months a near-repeating orbit sees the
     /// site depends on where it was at the start, unknown before launch): per phase, degrees,
-    /// the valid looks and the revisit share (% of days within the requirement's wait, or the
-    /// 90th-percentile gap in days without a requirement).
+    /// the valid looks and the revisit share (% of days within the requirement's wait; `None`
+    /// without a requirement).
     pub phases: Vec<PhaseSample>,
 }
 
@@ -137,9 +137,8 @@ pub fn look_config(base: &RunConfig, look: &Look, decimation: usize) -> RunConfi
     let a = &look.access;
     config.scene.sun.zenith_deg = a.sun.zenith_rad.to_degrees();
     config.scene.sun.azimuth_deg = a.sun.azimuth_rad.to_degrees();
-    let (y, m, d) = crate::orbit::sun::calendar_date(a.days);
+    let ((y, m, d), minutes) = crate::orbit::sun::date_and_minute(a.days);
     config.scene.date = format!("{y:04}-{m:02}-{d:02}");
-    let minutes = ((a.days + 0.5).rem_euclid(1.0) * 1440.0).round() as u32 % 1440;
     config.scene.time = format!("{:02}:{:02} UT", minutes / 60, minutes % 60);
     config.instrument.heading_deg = a.heading_rad.to_degrees();
     config.instrument.across_track_tilt_deg = a.off_nadir_rad.to_degrees();
@@ -203,18 +202,19 @@ pub fn run_season(
                 label: label.clone(),
                 altitude_km: config.instrument.altitude_km,
                 half_fov_deg: half_field_of_view_rad(&config.instrument).to_degrees(),
-                looks: looks(season, &config.instrument, wind),
+                looks: looks(season, &config.instrument, wind, config.scene.atmosphere.water_refractive_index),
                 runs: Vec::new(),
                 phases: (0..PHASE_SAMPLES)
                     .into_par_iter()
                     .map(|k| {
                         let mut other = season.clone();
                         other.orbit.phase_deg = season.orbit.phase_deg + 360.0 * k as f64 / PHASE_SAMPLES as f64;
-                        let valid: Vec<f64> = looks(&other, &config.instrument, wind)
-                            .iter()
-                            .filter(|l| l.verdict == Verdict::Valid)
-                            .map(|l| l.access.days)
-                            .collect();
+                        let valid: Vec<f64> =
+                            looks(&other, &config.instrument, wind, config.scene.atmosphere.water_refractive_index)
+                                .iter()
+                                .filter(|l| l.verdict == Verdict::Valid)
+                                .map(|l| l.access.days)
+                                .collect();
                         PhaseSample {
                             phase_deg: other.orbit.phase_deg,
                             valid: valid.len(),

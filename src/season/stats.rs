@@ -22,8 +22,8 @@ pub fn gaps_days(times: &[f64]) -> Vec<f64> {
 }
 
 /// Share of the period's days (`from`..`to`, days) on which the last valid look (`times`,
-/// sorted) was at most `max_days` before, %: each day is judged at its end, and a day before
-/// the first valid look counts as waiting since the period began.
+/// sorted) was at most `max_days` before, %: each day is judged at its end; days before the
+/// first valid look are not within (what came before the period is not known).
 #[must_use]
 pub fn revisit_pct(times: &[f64], from: f64, to: f64, max_days: f64) -> f64 {
     let days = (to - from).round().max(1.0) as usize;

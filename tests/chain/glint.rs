@@ -95,4 +95,10 @@ fn high_glint_is_left_out() {
     assert_eq!(a.high_glint, rows * cols);
     assert!(out.kept().rrs.flags.iter().all(|f| f & RrsFlags::INVALID != 0));
     assert!(a.aot550.iter().all(|x| x.is_nan()));
+    // Dark-spectrum fitting leaves them out too (its tiles never see them).
+    let mut c = glinting(30.0, true);
+    c.correction.image = Some(ImageCorrection::dark_spectrum());
+    let out = run(&c);
+    assert_eq!(out.correction.aerosol.as_ref().unwrap().high_glint, rows * cols);
+    assert!(out.kept().rrs.flags.iter().all(|f| f & RrsFlags::INVALID != 0));
 }

@@ -78,6 +78,8 @@ fn valid_looks_match_an_independent_count() {
             let clear = 100.0 * (1.0 - look.cloud_cover) >= season.min_clear_pct;
             let expected = if !sun_ok {
                 Verdict::SunLow
+            } else if g.view_zenith_rad > season.max_view_zenith_deg.to_radians() {
+                Verdict::ViewOblique
             } else if glint > season.glint_threshold_per_sr {
                 Verdict::Glint
             } else if !clear {
