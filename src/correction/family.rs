@@ -165,15 +165,16 @@ impl AerosolFamily {
         // from different angles).
         let glint_lgn = match scene.spec.atmosphere.surface {
             crate::atmosphere::Surface::Wind { speed_m_s } if scene.wants(crate::scene::Effect::SunGlint) => {
+                // L_GN is the glint per unit solar flux without the path's attenuation (τ = 0).
                 let lgn = |g: &crate::atmosphere::Geometry| {
-                    crate::atmosphere::glint_reflectance(
+                    crate::atmosphere::glint_radiance_norm(
                         g.sun_zenith_rad,
                         g.view_zenith_rad,
                         g.relative_azimuth_rad,
                         speed_m_s,
                         scene.spec.atmosphere.water_refractive_index,
-                    ) * g.sun_zenith_rad.cos()
-                        / std::f64::consts::PI
+                        0.0,
+                    )
                 };
                 (0..viewing.columns())
                     .map(|c| {

@@ -350,9 +350,10 @@ pub fn correct_image(
         return Err(invalid("correction.image", format!("the family has {} bands, Level-1 {nb}", family.n_bands)));
     }
     // The expected glint taken away: folded into every member's path radiance, so the fit and
-    // the inversion see L1 − L_path − G (the family's glint is zero unless the scene has glint).
+    // the inversion see L1 − L_path − G (only where the scene has glint: `glint_lgn` is empty
+    // otherwise, as the family's glint is zero).
     let folded;
-    let glint_removed = settings.glint && family.terms.iter().flatten().any(|t| t.glint.iter().any(|g| *g != 0.0));
+    let glint_removed = settings.glint && !family.glint_lgn.is_empty();
     let family = if glint_removed {
         folded = family.with_glint_in_path();
         &folded

@@ -7,7 +7,8 @@
 //! filter row of a linear-variable-filter imager) adds an along-track angle to the forward tilt
 //! β. The look direction (tan β, tan α, 1) makes the off-nadir angle γ with the nadir; on a
 //! spherical Earth of radius R seen from altitude h the view zenith at the ground is
-//! sin θ_v = (R + h)/R · sin γ and the ground point lies R·(θ_v − γ) from the sub-satellite point (Schowengerdt 2007, §3.4). Lines are one nadir
+//! sin θ_v = (R + h)/R · sin γ and the ground point lies R·(θ_v − γ) from the sub-satellite
+//! point (Schowengerdt 2007, §3.4; [`line_of_sight`], which seasons use too). Lines are one nadir
 //! GSD apart (GSD = h·p/f): the line period is GSD / ground speed, and the exposure must fit in it.
 //!
 //! The scene is small next to the Earth, so the track is straight in the scene frame, the sun is
@@ -67,6 +68,55 @@ pub struct Viewing {
 /// View zenith above which the plane-parallel atmosphere is not trusted (matches the LUT limit).
 pub const MAX_VIEW_ZENITH_DEG: f64 = 80.0;
 
+/// One line of sight: where it meets the ground and from which direction.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LineOfSight {
+    /// Ground offset from the sub-satellite point, east, m.
+    pub dx_m: f64,
+    /// Ground offset from the sub-satellite point, north, m.
+    pub dy_m: f64,
+    /// Sun and view geometry at the ground point.
+    pub geometry: Geometry,
+    /// Azimuth of the sensor seen from the ground point, rad clockwise from north (the sun's at
+    /// nadir).
+    pub sensor_azimuth_rad: f64,
+}
+
+/// The line of sight tilted `forward_rad` (β) along track and `across_rad` (α, positive right)
+/// from a platform at `altitude_m` flying `heading_rad` (clockwise from north), with the sun at
+/// (`sun_zenith_rad`, `sun_azimuth_rad`): see the module docs. `Err` holds the off-nadir angle
+/// where the view zenith would reach [`MAX_VIEW_ZENITH_DEG`].
+pub fn line_of_sight(
+    altitude_m: f64,
+    heading_rad: f64,
+    forward_rad: f64,
+    across_rad: f64,
+    sun_zenith_rad: f64,
+    sun_azimuth_rad: f64,
+) -> Result<LineOfSight, f64> {
+    let (along, right) = ((heading_rad.sin(), heading_rad.cos()), (heading_rad.cos(), -heading_rad.sin()));
+    let (tb, ta) = (forward_rad.tan(), across_rad.tan());
+    let norm = (1.0 + tb * tb + ta * ta).sqrt();
+    let gamma = (1.0 / norm).acos();
+    let sin_vza = (EARTH_RADIUS_M + altitude_m) / EARTH_RADIUS_M * gamma.sin();
+    if !(sin_vza < MAX_VIEW_ZENITH_DEG.to_radians().sin()) {
+        return Err(gamma);
+    }
+    let vza = sin_vza.asin();
+    let s = EARTH_RADIUS_M * (vza - gamma);
+    let psi = ta.atan2(tb); // azimuth of the look in the instrument frame, from along-track
+    let (d_along, d_across) = (s * psi.cos(), s * psi.sin());
+    // Scene frame offset; the sensor is seen from the ground in the opposite direction.
+    let (dx, dy) = (d_along * along.0 + d_across * right.0, d_along * along.1 + d_across * right.1);
+    let sensor_azimuth = if s > 0.0 { (-dx).atan2(-dy) } else { sun_azimuth_rad };
+    let mut rel = (sensor_azimuth - sun_azimuth_rad).rem_euclid(2.0 * std::f64::consts::PI);
+    if rel > std::f64::consts::PI {
+        rel = 2.0 * std::f64::consts::PI - rel;
+    }
+    let geometry = Geometry { sun_zenith_rad, view_zenith_rad: vza, relative_azimuth_rad: rel };
+    Ok(LineOfSight { dx_m: dx, dy_m: dy, geometry, sensor_azimuth_rad: sensor_azimuth })
+}
+
 impl Viewing {
     /// The geometry of `spec` over a scene lit from (`sun_zenith_rad`, `sun_azimuth_rad`),
     /// keeping every `decimation`-th line and detector. With `scene_half_m` = the scene's half
@@ -93,42 +143,27 @@ impl Viewing {
         let speed = ground_speed_m_s(spec.altitude_km);
         let line_period_s = gsd / speed;
         let heading = spec.heading_deg.to_radians();
-        let (along, right) = ((heading.sin(), heading.cos()), (heading.cos(), -heading.sin()));
+        let along = (heading.sin(), heading.cos());
         let tilt = spec.forward_tilt_deg.to_radians();
         let roll = spec.across_track_tilt_deg.to_radians();
         let n = spec.detectors;
         let detector_index: Vec<usize> = (0..n).step_by(decimation).collect();
         let line_index: Vec<usize> = (0..spec.lines).step_by(decimation).collect();
         let mut max_vza: f64 = 0.0;
-        // Ground offset (along, across) and geometry of a look at angles (β, α).
+        // Ground offset (east, north) and geometry of a look at angles (β, α).
         let look = |beta: f64, alpha: f64| -> Result<(f64, f64, Geometry, f64), InstrumentError> {
-            let (tb, ta) = (beta.tan(), alpha.tan());
-            let norm = (1.0 + tb * tb + ta * ta).sqrt();
-            let gamma = (1.0 / norm).acos();
-            let sin_vza = (EARTH_RADIUS_M + h) / EARTH_RADIUS_M * gamma.sin();
-            if !(sin_vza < MAX_VIEW_ZENITH_DEG.to_radians().sin()) {
-                return Err(InstrumentError::Invalid(FieldError {
-                    field: "detectors".into(),
-                    message: format!(
-                        "the swath edge is seen at a view zenith above {MAX_VIEW_ZENITH_DEG}° (off-nadir {:.1}°); reduce detectors, \
-                         pixel pitch, forward or across-track tilt, or lengthen the focal length",
-                        gamma.to_degrees()
-                    ),
-                }));
-            }
-            let vza = sin_vza.asin();
-            let s = EARTH_RADIUS_M * (vza - gamma);
-            let psi = ta.atan2(tb); // azimuth of the look in the instrument frame, from along-track
-            let (d_along, d_across) = (s * psi.cos(), s * psi.sin());
-            // Scene frame offset; the sensor is seen from the ground in the opposite direction.
-            let (dx, dy) = (d_along * along.0 + d_across * right.0, d_along * along.1 + d_across * right.1);
-            let sensor_azimuth = if s > 0.0 { (-dx).atan2(-dy) } else { sun_azimuth_rad };
-            let mut rel = (sensor_azimuth - sun_azimuth_rad).rem_euclid(2.0 * std::f64::consts::PI);
-            if rel > std::f64::consts::PI {
-                rel = 2.0 * std::f64::consts::PI - rel;
-            }
-            let geometry = Geometry { sun_zenith_rad, view_zenith_rad: vza, relative_azimuth_rad: rel };
-            Ok((dx, dy, geometry, sensor_azimuth))
+            line_of_sight(h, heading, beta, alpha, sun_zenith_rad, sun_azimuth_rad)
+                .map(|l| (l.dx_m, l.dy_m, l.geometry, l.sensor_azimuth_rad))
+                .map_err(|gamma| {
+                    InstrumentError::Invalid(FieldError {
+                        field: "detectors".into(),
+                        message: format!(
+                            "the swath edge is seen at a view zenith above {MAX_VIEW_ZENITH_DEG}° (off-nadir {:.1}°); reduce detectors, \
+                             pixel pitch, forward or across-track tilt, or lengthen the focal length",
+                            gamma.to_degrees()
+                        ),
+                    })
+                })
         };
         // The image centre (central detector of the mean group offset) lands on the scene centre.
         let mean_offset =

@@ -55,7 +55,7 @@ pub mod truth;
 pub use detector::{Detector, DetectorMode, Flags};
 pub use effects::InstrumentEffect;
 pub use focal::{BandSelection, DarkLaw, DarkTemperature, DetectorMaterial, FocalPlane, Sampling};
-pub use geometry::{Look, Viewing};
+pub use geometry::{LineOfSight, Look, Viewing, line_of_sight};
 pub use level0::{Level0, digitise_cube, expose_and_digitise, expose_cube};
 pub use response::{GeometryGroup, Response};
 pub use sample::{AotNodes, BandAtmosphere, RadianceCube, SampleOptions, sample_radiance};

@@ -6,10 +6,9 @@ use rand::rngs::Xoshiro256PlusPlus;
 use rand_distr::{Beta, Distribution};
 
 use super::SeasonSpec;
-use crate::atmosphere::{Geometry, glint_reflectance};
-use crate::instrument::InstrumentSpec;
+use crate::atmosphere::{Geometry, glint_radiance_norm};
+use crate::instrument::{InstrumentSpec, line_of_sight};
 use crate::orbit::{Access, Site, SunSynchronous, accesses};
-use crate::units::EARTH_RADIUS_M;
 
 /// Why a look is kept or not, in the order the checks are made.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -64,44 +63,15 @@ pub fn half_field_of_view_rad(instrument: &InstrumentSpec) -> f64 {
     (half_width_m / (instrument.focal_length_mm * 1e-3)).atan()
 }
 
-/// The sun and view geometry at the site for a line of sight tilted `forward_rad` along track
-/// and `across_rad` across (positive right) from a platform at `altitude_m` flying `heading_rad`
-/// with the sun at (`sun_zenith_rad`, `sun_azimuth_rad`), as the pushbroom geometry computes it
-/// ([`crate::instrument::Viewing`]): the look direction (tan β, tan α, 1) makes the off-nadir
-/// angle γ, sin θ_v = (R + h)/R sin γ, and the sensor is seen from the ground opposite the look's
-/// azimuth. Also returns the sensor's azimuth from the ground, rad clockwise from north.
-#[must_use]
-pub fn look_geometry(
-    altitude_m: f64,
-    heading_rad: f64,
-    forward_rad: f64,
-    across_rad: f64,
-    sun_zenith_rad: f64,
-    sun_azimuth_rad: f64,
-) -> (Geometry, f64) {
-    let (tb, ta) = (forward_rad.tan(), across_rad.tan());
-    let gamma = (1.0 / (1.0 + tb * tb + ta * ta).sqrt()).acos();
-    let sin_vza = ((EARTH_RADIUS_M + altitude_m) / EARTH_RADIUS_M * gamma.sin()).min(1.0);
-    let sensor_azimuth = if gamma > 1e-12 {
-        (heading_rad + ta.atan2(tb) + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
-    } else {
-        sun_azimuth_rad
-    };
-    let rel = (sensor_azimuth - sun_azimuth_rad).rem_euclid(std::f64::consts::TAU);
-    let rel = if rel > std::f64::consts::PI { std::f64::consts::TAU - rel } else { rel };
-    (Geometry { sun_zenith_rad, view_zenith_rad: sin_vza.asin(), relative_azimuth_rad: rel }, sensor_azimuth)
-}
-
 /// Normalised glint radiance L_GN = ρ_g μ₀/π (sr⁻¹; Wang & Bailey 2001) at `g` for `wind_m_s`
-/// over water of refractive index `n`, with ρ_g the Cox–Munk glint reflectance
-/// ([`glint_reflectance`]).
+/// over water of refractive index `n`, with ρ_g the Cox–Munk glint reflectance: the crate's
+/// glint per unit solar flux ([`glint_radiance_norm`]) through a path of no optical depth.
 #[must_use]
 pub fn normalised_glint_per_sr(g: &Geometry, wind_m_s: f64, n: f64) -> f64 {
     if g.sun_zenith_rad >= std::f64::consts::FRAC_PI_2 {
         return 0.0;
     }
-    glint_reflectance(g.sun_zenith_rad, g.view_zenith_rad, g.relative_azimuth_rad, wind_m_s, n) * g.sun_zenith_rad.cos()
-        / std::f64::consts::PI
+    glint_radiance_norm(g.sun_zenith_rad, g.view_zenith_rad, g.relative_azimuth_rad, wind_m_s, n, 0.0)
 }
 
 /// A look's cloud cover: a draw from the beta distribution with mean `fraction` and α + β =
@@ -143,23 +113,36 @@ pub fn looks(season: &SeasonSpec, instrument: &InstrumentSpec, wind_m_s: f64, n:
         // Inside the swath at some roll in [pointing − roll, pointing + roll].
         .filter(|a| ((a.off_nadir_rad - pointing).abs() - roll).max(0.0) <= half)
         .map(|access| {
-            // The line of sight: the fore/aft tilt that glints less, the site's own off-nadir
-            // angle across track.
+            // The line of sight as the pushbroom geometry computes it: the fore/aft tilt that
+            // glints less, the site's own off-nadir angle across track. `None`: seen beyond the
+            // chain's largest view zenith.
             let candidate = |forward: f64| {
-                let (g, _) = look_geometry(
+                let sight = line_of_sight(
                     orbit.altitude_m,
                     access.heading_rad,
                     forward.to_radians(),
                     access.off_nadir_rad,
                     access.sun.zenith_rad,
                     access.sun.azimuth_rad,
-                );
-                (forward, g, normalised_glint_per_sr(&g, wind_m_s, n))
+                )
+                .ok()
+                .map(|l| l.geometry);
+                let glint = sight.map_or(f64::INFINITY, |g| normalised_glint_per_sr(&g, wind_m_s, n));
+                (forward, sight, glint)
             };
-            let (forward_tilt_deg, geometry, glint_per_sr) = tilts[1..]
+            let (forward_tilt_deg, sight, glint_per_sr) = tilts[1..]
                 .iter()
                 .map(|s| candidate(*s))
                 .fold(candidate(tilts[0]), |best, c| if c.2 < best.2 { c } else { best });
+            // Too oblique for the chain: the pass's own geometry, for the record.
+            let geometry = sight.unwrap_or_else(|| {
+                let rel = (access.view_azimuth_rad - access.sun.azimuth_rad).rem_euclid(std::f64::consts::TAU);
+                Geometry {
+                    sun_zenith_rad: access.sun.zenith_rad,
+                    view_zenith_rad: access.view_zenith_rad,
+                    relative_azimuth_rad: rel.min(std::f64::consts::TAU - rel),
+                }
+            });
             // The weather of the hour of the pass: two designs that pass within the same hour
             // (the same orbit) see the same cover, and a look's cover does not depend on which
             // other looks there are.
@@ -171,7 +154,7 @@ pub fn looks(season: &SeasonSpec, instrument: &InstrumentSpec, wind_m_s: f64, n:
             });
             let verdict = if access.sun.zenith_rad > max_sun {
                 Verdict::SunLow
-            } else if geometry.view_zenith_rad > max_view {
+            } else if sight.is_none() || geometry.view_zenith_rad > max_view {
                 Verdict::ViewOblique
             } else if glint_per_sr > season.glint_threshold_per_sr {
                 Verdict::Glint
@@ -189,7 +172,7 @@ pub fn looks(season: &SeasonSpec, instrument: &InstrumentSpec, wind_m_s: f64, n:
 mod tests {
     use super::*;
 
-    /// Untilted, the look geometry is the access's own (the orbit's spherical geometry and the
+    /// Untilted, the pushbroom line of sight at the site is the access's own geometry (the orbit's spherical geometry and the
     /// pushbroom formula agree to the two radii's difference in the altitude, 7 km in 700).
     #[test]
     fn untilted_look_geometry_is_the_access_geometry() {
@@ -201,14 +184,16 @@ mod tests {
         };
         let site = Site::from_degrees(-36.1, 147.0);
         for a in accesses(&orbit, &site, orbit.epoch_days, orbit.epoch_days + 20.0, 0.5) {
-            let (g, sensor_az) = look_geometry(
+            let l = line_of_sight(
                 orbit.altitude_m,
                 a.heading_rad,
                 0.0,
                 a.off_nadir_rad,
                 a.sun.zenith_rad,
                 a.sun.azimuth_rad,
-            );
+            )
+            .unwrap();
+            let (g, sensor_az) = (l.geometry, l.sensor_azimuth_rad);
             assert!(
                 (g.view_zenith_rad - a.view_zenith_rad).abs() < 2e-3,
                 "{} {}",
