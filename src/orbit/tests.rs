@@ -135,7 +135,7 @@ fn off_nadir_sign_and_view_azimuth_agree() {
 }
 
 #[test]
-fn a_year_of_accesses_takes_well_under_a_second() {
+fn a_year_of_accesses_finds_a_plausible_number_of_passes() {
     // Not a timing assertion (tests are not benchmarks): a year's search must finish and find
     // a plausible number of passes (a 700 km orbit with a ±20° swath sees a site at 23° S about
     // every 4–5 days by day and as often by night).
