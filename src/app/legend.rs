@@ -7,7 +7,7 @@ use super::raster::Palette;
 use crate::colormap::{categorical, diverging, viridis};
 
 /// The colour bar of `palette`, `height` tall, titled `label` (classes by their names).
-pub(super) fn colour_bar(ui: &mut egui::Ui, palette: Palette, height: f32, label: &str, classes: &[String]) {
+pub(super) fn colour_bar(ui: &mut egui::Ui, palette: Palette, height: f32, label: &str, classes: &[String]) -> Rect {
     let (rect, _) = ui.allocate_exact_size(Vec2::new(86.0, height), Sense::hover());
     let painter = ui.painter_at(rect);
     let bar = Rect::from_min_size(rect.min + Vec2::new(4.0, 16.0), Vec2::new(16.0, height - 40.0));
@@ -36,7 +36,7 @@ pub(super) fn colour_bar(ui: &mut egui::Ui, palette: Palette, height: f32, label
                 text,
             );
         }
-        return;
+        return rect;
     }
     for k in 0..steps {
         let t = (k as f64 + 0.5) / steps as f64;
@@ -82,6 +82,7 @@ pub(super) fn colour_bar(ui: &mut egui::Ui, palette: Palette, height: f32, label
             text,
         );
     }
+    rect
 }
 
 /// A scale bar under a map `width_px` wide showing `ground_m` across: the longest round length

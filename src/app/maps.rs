@@ -150,7 +150,8 @@ impl Images {
 
 fn product_menu(app: &mut ShoalApp, ui: &mut egui::Ui) {
     let state = &mut app.state;
-    ui.horizontal(|ui| {
+    // Wrapped: with eight designs the layout buttons and pair selectors outgrow a narrow panel.
+    ui.horizontal_wrapped(|ui| {
         egui::ComboBox::from_label("Product").selected_text(state.product.label()).show_ui(ui, |ui| {
             for kind in ProductKind::ALL {
                 ui.selectable_value(&mut state.product, kind, kind.label());
@@ -286,10 +287,13 @@ fn map_panel(
         _ => panel.title.clone(),
     };
     let earlier = earlier || superseded;
-    match panel.role {
-        Role::Design(i) => ui.colored_label(super::theme::design(i), title),
-        _ => ui.label(title),
+    // The title never wider than the map (a long one widened the row past the colour bar).
+    ui.set_max_width(room.x);
+    let title = match panel.role {
+        Role::Design(i) => egui::RichText::new(title).color(super::theme::design(i)),
+        _ => egui::RichText::new(title),
     };
+    ui.add(egui::Label::new(title).truncate());
     let img = &panel.image;
     let aspect = img.width as f32 / img.height.max(1) as f32;
     let height = (room.x / aspect).min(room.y).max(40.0);
@@ -397,14 +401,15 @@ pub fn central(app: &mut ShoalApp, ui: &mut egui::Ui) {
         let label_text = app.state.product.label().split(" (").next().unwrap_or("").to_string();
         let classes = class_names(app);
         ui.vertical(|ui| {
+            app.ui.map_rects.clear();
             if let Some(p) = palette {
-                colour_bar(ui, p, 220.0, &label_text, &classes);
+                app.ui.map_rects.push(colour_bar(ui, p, 220.0, &label_text, &classes));
             }
             if let Some(p) = app.images.difference_palette {
                 // The difference in the product's own unit ("A − B (mg m⁻³)").
                 let unit = app.state.product.label().split_once(" (").map_or(String::new(), |(_, u)| format!(" ({u}"));
                 let [a, b] = app.state.pair.map(label);
-                colour_bar(ui, p, 160.0, &format!("{a} − {b}{unit}"), &classes);
+                app.ui.map_rects.push(colour_bar(ui, p, 160.0, &format!("{a} − {b}{unit}"), &classes));
             }
         });
     });

@@ -117,6 +117,8 @@ struct UiState {
     history: history::History,
     /// Where the histogram, scatter and SNR plots were last drawn (for the layout test).
     plot_rects: Vec<egui::Rect>,
+    /// Where the maps and their colour bars were last drawn (for the layout test).
+    map_rects: Vec<egui::Rect>,
     /// The metrics table's width as last drawn (the bottom panel lays its plots out by it).
     metrics_width: Option<f32>,
     zoom: maps::View,
@@ -298,9 +300,17 @@ impl ShoalApp {
                 },
             );
         });
-        egui::Panel::left("left").resizable(true).default_size(380.0).show(ui, |ui| {
-            egui::ScrollArea::vertical().show(ui, |ui| panels::left(self, ui));
-        });
+        // At most 45 % of the window (and 560 px): a panel that grew with its content (a row of
+        // eight designs' buttons) pushed the maps' controls off a 1280-pixel screen, and egui
+        // remembers a panel's width across restarts. What is wider scrolls inside it.
+        let left_max = (0.45 * ctx.content_rect().width()).clamp(320.0, 560.0);
+        egui::Panel::left("left")
+            .resizable(true)
+            .default_size(380.0_f32.min(left_max))
+            .size_range(240.0..=left_max)
+            .show(ui, |ui| {
+                egui::ScrollArea::both().show(ui, |ui| panels::left(self, ui));
+            });
         egui::Panel::bottom("bottom")
             .resizable(true)
             .default_size(plots::panel_height(ui.ctx()))

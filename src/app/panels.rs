@@ -180,7 +180,8 @@ fn fine_step(value: f64, fraction: f32, range: (f64, f64), log: bool) -> f64 {
 }
 
 fn editor(app: &mut ShoalApp, ui: &mut egui::Ui) {
-    ui.horizontal(|ui| {
+    // Wrapped: eight designs' buttons on one row widened the panel past a 1280-pixel screen.
+    ui.horizontal_wrapped(|ui| {
         ui.heading("Instrument");
         for i in 0..app.state.designs.len() {
             ui.selectable_value(&mut app.state.editing, i, format!("Edit {}", label(i)));
@@ -330,7 +331,7 @@ fn settings(app: &mut ShoalApp, ui: &mut egui::Ui) {
     egui::CollapsingHeader::new("Retrieval, seeds, preview").default_open(true).show(ui, |ui| {
         let s = &mut app.state;
         // The retrievals offered: aLMI, SAMBUCA and the study's own, each by its title.
-        ui.horizontal(|ui| {
+        ui.horizontal_wrapped(|ui| {
             for i in 0..s.retrievals.len() {
                 let title = s.retrievals[i].algorithm().title();
                 ui.selectable_value(&mut s.selected_retrieval, i, title);

@@ -56,6 +56,12 @@ impl ShoalApp {
         &self.ui.plot_rects
     }
 
+    /// Where the maps and their colour bars were drawn in the last frame.
+    #[must_use]
+    pub fn map_rects(&self) -> &[egui::Rect] {
+        &self.ui.map_rects
+    }
+
     /// Median time the UI thread spent drawing each of the last frames, ms.
     #[must_use]
     pub fn median_frame_ms(&self) -> Option<f32> {

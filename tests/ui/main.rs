@@ -23,6 +23,7 @@ mod designs;
 mod editing;
 mod external;
 mod files;
+mod layout;
 mod review;
 mod session;
 mod spectrum;
