@@ -185,7 +185,14 @@ impl Explore {
             name: "app".into(),
             description: String::new(),
             scene: Source::Inline(Box::new(state.seeded_scene())),
-            instruments: state.designs.iter().map(|d| Source::Inline(Box::new(d.spec.clone()))).collect(),
+            // Each named as the design list names it ("C: cubesat"), as in the slide and the pack.
+            instruments: (0..state.designs.len())
+                .map(|i| {
+                    let mut spec = state.designs[i].spec.clone();
+                    spec.name = state.design_name(i);
+                    Source::Inline(Box::new(spec))
+                })
+                .collect(),
             retrievals: vec![state.retrieval_spec()],
             seeds: vec![1],
             detector: None,

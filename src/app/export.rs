@@ -83,11 +83,8 @@ impl Snapshot {
 fn study_of(snap: &Snapshot) -> Result<crate::study::StudyResult, String> {
     let all = snap.all()?;
     let state = &snap.state;
-    let runs: Vec<(String, &RunOutput)> = all
-        .iter()
-        .enumerate()
-        .map(|(i, r)| (format!("{} ({})", r.config.instrument.name, super::model::label(i)), r.as_ref()))
-        .collect();
+    let runs: Vec<(String, &RunOutput)> =
+        all.iter().enumerate().map(|(i, r)| (state.design_name(i), r.as_ref())).collect();
     let changes = state.changes();
     let letters: Vec<String> = (0..runs.len()).map(super::model::label).collect();
     let description = format!(
@@ -108,8 +105,15 @@ pub fn write_review_pack(snap: &Snapshot, dir: &Path) -> Result<PathBuf, String>
     let result = study_of(snap)?;
     let figures = crate::study::figure_set(&result).map_err(|e| e.to_string())?;
     let out = crate::study::OutputDir::create(dir, "Shoal app: review pack").map_err(|e| e.to_string())?;
-    crate::report::write_pack(&crate::report::review_data(&result, &[], &[]), &figures, out.path())
-        .map_err(|e| e.to_string())?;
+    let mut data = crate::report::review_data(&result, &[], &[]);
+    // An edited design is described by what it is now, and from which preset, never by the
+    // preset's words alone.
+    for (summary, slot) in data.instruments.iter_mut().zip(&snap.state.designs) {
+        if slot.modified() {
+            summary.description = format!("{}. Edited from the preset `{}`.", slot.spec.summary(), slot.preset);
+        }
+    }
+    crate::report::write_pack(&data, &figures, out.path()).map_err(|e| e.to_string())?;
     out.commit().map_err(|e| e.to_string())?;
     Ok(dir.join("index.html"))
 }

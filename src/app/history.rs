@@ -7,6 +7,7 @@
 //! Ctrl+Z / Ctrl+Shift+Z (and Ctrl+Y) reach it when no text field has the keyboard, which then
 //! keeps its own text undo.
 
+use super::designs::Moved;
 use super::model::{AppState, Slot, label};
 use crate::scene::SceneSpec;
 
@@ -17,6 +18,10 @@ struct Design {
     scene: SceneSpec,
     scene_name: String,
     scene_seed: u64,
+    /// How the designs were shown: on the maps, the pair, the reference, the one edited. Not a
+    /// step of its own (a tick on "map" is not undone), but restored with the designs, so an
+    /// undone removal brings its design back on the maps.
+    view: (Vec<usize>, [usize; 2], usize, usize),
 }
 
 impl Design {
@@ -26,6 +31,7 @@ impl Design {
             scene: state.scene.clone(),
             scene_name: state.scene_name.clone(),
             scene_seed: state.scene_seed,
+            view: (state.on_maps.clone(), state.pair, state.reference, state.editing),
         }
     }
 
@@ -43,6 +49,7 @@ impl Design {
         state.scene = self.scene;
         state.scene_name = self.scene_name;
         state.scene_seed = self.scene_seed;
+        (state.on_maps, state.pair, state.reference, state.editing) = self.view;
         // The design edited, the maps' list and the pair may name a design no longer there.
         state.settle();
     }
@@ -93,7 +100,15 @@ impl History {
         if pointer_down {
             return;
         }
-        if !settled.matches(state) {
+        if settled.matches(state) {
+            // The view moves without making a step; the step remembers it as it was last.
+            if let Some(s) = self.settled.as_mut()
+                && (s.view.0 != state.on_maps
+                    || (s.view.1, s.view.2, s.view.3) != (state.pair, state.reference, state.editing))
+            {
+                s.view = (state.on_maps.clone(), state.pair, state.reference, state.editing);
+            }
+        } else {
             let before = self.settled.replace(Design::of(state));
             self.undo.extend(before);
             if self.undo.len() > Self::DEPTH {
@@ -103,25 +118,28 @@ impl History {
         }
     }
 
-    /// Go back one step; false when there is none.
-    pub fn undo(&mut self, state: &mut AppState) -> bool {
+    /// Go back one step: where each design went (for the engine link to move its results with
+    /// it, [`moved`]), or `None` when there is no step.
+    pub fn undo(&mut self, state: &mut AppState) -> Option<Moved> {
         // An unsettled change (mid-drag) is a step of its own first.
         self.observe(state, false);
-        let Some(previous) = self.undo.pop() else { return false };
+        let previous = self.undo.pop()?;
         self.redo.push(Design::of(state));
         self.settled = Some(previous.clone());
+        let moved = moved(&state.designs, &previous.designs);
         previous.restore(state);
-        true
+        Some(moved)
     }
 
-    /// Go forward one step; false when there is none.
-    pub fn redo(&mut self, state: &mut AppState) -> bool {
+    /// Go forward one step, as [`Self::undo`].
+    pub fn redo(&mut self, state: &mut AppState) -> Option<Moved> {
         self.observe(state, false);
-        let Some(next) = self.redo.pop() else { return false };
+        let next = self.redo.pop()?;
         self.undo.push(Design::of(state));
         self.settled = Some(next.clone());
+        let moved = moved(&state.designs, &next.designs);
         next.restore(state);
-        true
+        Some(moved)
     }
 
     /// What undo would take back, if anything ("A's parameters").
@@ -135,6 +153,29 @@ impl History {
     pub fn redo_text(&self) -> Option<String> {
         Some(self.settled.as_ref()?.describe_change(self.redo.last()?))
     }
+}
+
+/// Where each of the designs `before` is among `after`: the same design (equal slot) wherever it
+/// went, else the same place if that holds a changed design; `None` for one that is gone. An
+/// undone removal so moves the designs after it back without running them again.
+#[must_use]
+pub fn moved(before: &[Slot], after: &[Slot]) -> Moved {
+    let mut taken = vec![false; after.len()];
+    let mut out: Moved = before
+        .iter()
+        .map(|slot| {
+            let k = (0..after.len()).find(|&k| !taken[k] && after[k] == *slot)?;
+            taken[k] = true;
+            Some(k)
+        })
+        .collect();
+    for (i, m) in out.iter_mut().enumerate() {
+        if m.is_none() && i < after.len() && !taken[i] && !after.iter().any(|s| *s == before[i]) {
+            taken[i] = true;
+            *m = Some(i);
+        }
+    }
+    out
 }
 
 #[cfg(test)]
@@ -158,17 +199,17 @@ mod tests {
         state.designs[1].spec.read_noise_e += 5.0;
         h.observe(&state, false);
 
-        assert!(h.undo(&mut state));
+        assert!(h.undo(&mut state).is_some());
         assert_eq!(state.designs[0].spec.aperture_mm, 90.0, "the last step (B's read noise) went first");
-        assert!(h.undo(&mut state));
+        assert!(h.undo(&mut state).is_some());
         assert_eq!(state.designs[0].spec.aperture_mm, start, "the drag undoes as one step");
-        assert!(!h.undo(&mut state), "nothing older");
-        assert!(h.redo(&mut state));
+        assert!(h.undo(&mut state).is_none(), "nothing older");
+        assert!(h.redo(&mut state).is_some());
         assert_eq!(state.designs[0].spec.aperture_mm, 90.0);
         // A new edit drops what could be redone.
         state.designs[0].spec.aperture_mm = 100.0;
         h.observe(&state, false);
-        assert!(!h.redo(&mut state));
+        assert!(h.redo(&mut state).is_none());
         assert_eq!(state.designs[0].spec.aperture_mm, 100.0);
     }
 
@@ -180,7 +221,32 @@ mod tests {
         let start = state.designs[0].spec.exposure_s;
         state.designs[0].spec.exposure_s *= 2.0;
         h.observe(&state, true);
-        assert!(h.undo(&mut state));
+        assert!(h.undo(&mut state).is_some());
         assert_eq!(state.designs[0].spec.exposure_s, start);
+    }
+
+    #[test]
+    fn an_undone_removal_moves_the_others_back_and_restores_the_map_tick() {
+        let mut state = AppState::default();
+        for name in ["nominal", "hyperspectral"] {
+            let spec = crate::instrument::InstrumentSpec::preset(name).unwrap_or_else(|e| panic!("{e}"));
+            assert!(state.add_design(Slot::new(name, spec)).is_some());
+        }
+        state.on_maps = vec![0, 2, 3];
+        let mut h = History::default();
+        h.observe(&state, false);
+        assert!(state.remove_design(1).is_some());
+        h.observe(&state, false);
+        assert_eq!(state.on_maps, [0, 1, 2]);
+        // Back: B returns to its place, C and D move from 1 and 2 back to 2 and 3 (their results
+        // with them), and the maps are as they were.
+        assert_eq!(h.undo(&mut state), Some(vec![Some(0), Some(2), Some(3)]));
+        assert_eq!(state.designs[1].preset, "smallsat");
+        assert_eq!(state.on_maps, [0, 2, 3], "B was not on the maps; C and D were");
+        assert_eq!(h.redo(&mut state), Some(vec![Some(0), None, Some(1), Some(2)]));
+        // A changed design keeps its place (its result shown, greyed, until the new one).
+        let before = state.designs.clone();
+        state.designs[1].spec.aperture_mm *= 2.0;
+        assert_eq!(moved(&before, &state.designs), vec![Some(0), Some(1), Some(2)]);
     }
 }

@@ -74,7 +74,7 @@ impl<'a> Standing<'a> {
 pub struct EngineLink {
     handle: EngineHandle,
     generation: u64,
-    submitted: Vec<RunConfig>,
+    submitted: Vec<Option<RunConfig>>,
     decimations: Vec<usize>,
     submitted_at: Instant,
     /// Per design: the result shown.
@@ -177,7 +177,10 @@ impl EngineLink {
     /// already shown is not run again: its result is carried over to the new generation (moving
     /// one slider of A re-runs only A).
     pub fn submit_if_changed(&mut self, configs: Vec<RunConfig>, decimations: Vec<usize>) -> bool {
-        if !self.moved && configs == self.submitted && decimations == self.decimations {
+        if !self.moved
+            && self.submitted.iter().map(Option::as_ref).eq(configs.iter().map(Some))
+            && decimations == self.decimations
+        {
             return false;
         }
         self.moved = false;
@@ -185,7 +188,7 @@ impl EngineLink {
         let keep: Vec<bool> = (0..configs.len())
             .map(|i| {
                 decimations == self.decimations
-                    && self.submitted.get(i) == configs.get(i)
+                    && self.submitted.get(i).and_then(Option::as_ref) == configs.get(i)
                     && self.finished.get(i).copied().unwrap_or(false)
                     && self.errors.get(i).is_some_and(Option::is_none)
                     && self
@@ -197,7 +200,7 @@ impl EngineLink {
             .collect();
         self.generation += 1;
         self.cancelled = false;
-        self.submitted.clone_from(&configs);
+        self.submitted = configs.iter().cloned().map(Some).collect();
         self.decimations.clone_from(&decimations);
         let n = configs.len();
         self.errors = vec![None; n];
@@ -315,7 +318,7 @@ impl EngineLink {
                     shown[*k] = taken;
                     errors[*k] = self.errors.get_mut(old).and_then(Option::take);
                     finished[*k] = self.finished.get(old).copied().unwrap_or(false);
-                    submitted[*k] = self.submitted.get(old).cloned();
+                    submitted[*k] = self.submitted.get(old).cloned().flatten();
                 }
                 None => {
                     if let Some(old) = taken {
@@ -325,8 +328,9 @@ impl EngineLink {
             }
         }
         (self.shown, self.errors, self.finished) = (shown, errors, finished);
-        // A design with no submitted configuration (none was moved into its place) runs anew.
-        self.submitted = submitted.into_iter().map_while(|c| c).collect();
+        // A design with no submitted configuration (none was moved into its place) runs anew;
+        // the others keep theirs (an undone removal runs the design that came back, only).
+        self.submitted = submitted;
         self.progress = None;
         self.moved = true;
     }

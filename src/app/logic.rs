@@ -102,10 +102,17 @@ impl ShoalApp {
                 || i.consume_shortcut(&KeyboardShortcut::new(Modifiers::COMMAND, Key::Y));
             (redo, i.consume_shortcut(&KeyboardShortcut::new(Modifiers::COMMAND, Key::Z)))
         });
-        if redo {
-            self.ui.history.redo(&mut self.state);
-        } else if undo {
-            self.ui.history.undo(&mut self.state);
+        if redo || undo {
+            self.step_history(redo);
+        }
+    }
+
+    /// Undo (or redo) one step; the engine link moves each design's result with its design, so
+    /// only a design that comes back or changed runs again.
+    pub(super) fn step_history(&mut self, redo: bool) {
+        let moved = if redo { self.ui.history.redo(&mut self.state) } else { self.ui.history.undo(&mut self.state) };
+        if let Some(moved) = moved {
+            self.link.remap(&moved);
         }
     }
 

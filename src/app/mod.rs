@@ -354,7 +354,7 @@ impl ShoalApp {
                 .on_hover_text(undo.map_or_else(|| "Nothing to undo".into(), |t| format!("Undo: {t} (Ctrl+Z)")))
                 .clicked();
             if clicked {
-                self.ui.history.undo(&mut self.state);
+                self.step_history(false);
             }
             let redo = self.ui.history.redo_text();
             let clicked = ui
@@ -362,7 +362,7 @@ impl ShoalApp {
                 .on_hover_text(redo.map_or_else(|| "Nothing to redo".into(), |t| format!("Redo: {t} (Ctrl+Shift+Z)")))
                 .clicked();
             if clicked {
-                self.ui.history.redo(&mut self.state);
+                self.step_history(true);
             }
             ui.separator();
             // One menu for the three exports keeps the top bar within 1280 px.

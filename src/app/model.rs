@@ -6,6 +6,7 @@ use serde::{Deserialize, Serialize};
 pub use super::designs::{MAPS_AT_OPEN, MAX_DESIGNS, label};
 pub use super::view::{Layout, ProductKind};
 
+use crate::colormap::significant;
 use crate::engine::{Fidelity, RunConfig};
 use crate::instrument::InstrumentSpec;
 use crate::retrieval::{AlmiSettings, RetrievalSpec, SambucaSettings};
@@ -366,56 +367,39 @@ impl AppState {
         l
     }
 
-    /// The parameters edited away from each design's preset, for captions ("A aperture_mm 60 → 80").
+    /// The parameters edited away from each design's preset, for captions ("A aperture_mm 60 →
+    /// 105.8"): numbers to four significant digits (never a float's raw digits), a list by its
+    /// length, anything else as "edited".
     #[must_use]
     pub fn changes(&self) -> Vec<String> {
         let mut out = Vec::new();
         for (i, slot) in self.designs.iter().enumerate() {
-            let name = label(i);
-            let (Ok(now), Ok(then)) = (ron::to_string(&slot.spec), ron::to_string(&slot.original)) else { continue };
-            if now == then {
+            let (Ok(serde_json::Value::Object(now)), Ok(serde_json::Value::Object(then))) =
+                (serde_json::to_value(&slot.spec), serde_json::to_value(&slot.original))
+            else {
                 continue;
-            }
-            let fields = |s: &str| -> Vec<(String, String)> {
-                let body = s.trim_start_matches("(").trim_end_matches(')');
-                split_top_level(body)
-                    .into_iter()
-                    .filter_map(|f| f.split_once(':').map(|(k, v)| (k.trim().to_string(), v.trim().to_string())))
-                    .collect()
             };
-            let (n, t) = (fields(&now), fields(&then));
-            for (k, v) in &n {
-                if let Some((_, old)) = t.iter().find(|(kk, _)| kk == k)
-                    && old != v
-                {
-                    out.push(format!("{name} {k} {old} → {v}"));
+            for (k, v) in &now {
+                let old = then.get(k).unwrap_or(&serde_json::Value::Null);
+                if old == v || k == "name" || k == "description" {
+                    continue;
                 }
+                let what = match (old, v) {
+                    (serde_json::Value::Number(a), serde_json::Value::Number(b)) => {
+                        let sig =
+                            |n: &serde_json::Number| n.as_f64().map_or_else(|| n.to_string(), |x| significant(x, 4));
+                        format!("{} → {}", sig(a), sig(b))
+                    }
+                    (serde_json::Value::Array(a), serde_json::Value::Array(b)) if a.len() != b.len() => {
+                        format!("{} → {} entries", a.len(), b.len())
+                    }
+                    _ => "edited".to_string(),
+                };
+                out.push(format!("{} {k} {what}", label(i)));
             }
         }
         out
     }
-}
-
-/// Split `a:1,b:(c,d),e:[f,g]` at top-level commas.
-fn split_top_level(s: &str) -> Vec<&str> {
-    let mut out = Vec::new();
-    let (mut depth, mut start, mut in_str) = (0i32, 0usize, false);
-    for (i, ch) in s.char_indices() {
-        match ch {
-            '"' => in_str = !in_str,
-            '(' | '[' | '{' if !in_str => depth += 1,
-            ')' | ']' | '}' if !in_str => depth -= 1,
-            ',' if depth == 0 && !in_str => {
-                out.push(&s[start..i]);
-                start = i + 1;
-            }
-            _ => {}
-        }
-    }
-    if start < s.len() {
-        out.push(&s[start..]);
-    }
-    out
 }
 
 /// The image-based correction `image` as design `spec` runs it: the default pair (779/865 nm),
@@ -459,7 +443,10 @@ mod tests {
         let mut s = AppState::default();
         s.designs[0].spec.aperture_mm = 80.0;
         assert!(s.designs[0].modified());
-        assert_eq!(s.changes(), vec!["A aperture_mm 60.0 → 80.0".to_string()]);
+        assert_eq!(s.changes(), vec!["A aperture_mm 60 → 80".to_string()]);
+        // A float's raw digits never reach a caption.
+        s.designs[0].spec.aperture_mm = 105.800_000_000_000_01;
+        assert_eq!(s.changes(), vec!["A aperture_mm 60 → 105.8".to_string()]);
     }
 
     #[test]

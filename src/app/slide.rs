@@ -58,24 +58,34 @@ pub fn write_figure(snap: &Snapshot, stem: &Path) -> Result<Vec<PathBuf>, String
         "Shoal: one colour scale for all panels; grey: land or not returned; metrics after Seegers et al. (2018)."
             .into(),
     ];
+    // What "pass?" means, and why, on the slide itself (the app says it on hover).
+    let mut caption = caption;
+    let warned: Vec<String> = runs
+        .iter()
+        .enumerate()
+        .filter_map(|(i, out)| {
+            let w = &out.report.warnings;
+            let first = w.first()?.message.split(['.', ';']).next().unwrap_or_default().to_string();
+            Some(format!("{}: {first}{}", super::model::label(i), if w.len() > 1 { " …" } else { "" }))
+        })
+        .collect();
+    if !warned.is_empty() {
+        caption.push(format!("pass?: the numbers pass but the design is implausible here ({})", warned.join("; ")));
+    }
     // What is compared, as set now (a study's name would outlive a change of scene).
     let title = format!("{} — {}", snap.title(), kind.label());
     let variable = kind.variable().unwrap_or("chl_mg_m3");
     // One series per design, in the designs' colours.
-    let series = |i: usize, out: &RunOutput, points: Vec<(f64, f64)>| {
+    let series = |i: usize, points: Vec<(f64, f64)>| {
         let [r, g, b, _] = super::theme::design(i).to_array();
-        SlideSeries {
-            name: format!("{}: {}", super::model::label(i), out.config.instrument.name),
-            colour: [r, g, b],
-            points,
-        }
+        SlideSeries { name: state.design_name(i), colour: [r, g, b], points }
     };
     let plot = super::plot_data::plot_data(&snap.runs, variable);
     let (mut snr, mut scatter) = (Vec::new(), Vec::new());
     for (i, out) in runs.iter().enumerate() {
         let analytic = out.snr.iter().filter(|r| r.snr_analytic.is_finite()).map(|r| (r.centre_nm, r.snr_analytic));
-        snr.push(series(i, out, analytic.collect()));
-        scatter.push(series(i, out, plot.scatter[i].iter().map(|p| (p[0], p[1])).collect()));
+        snr.push(series(i, analytic.collect()));
+        scatter.push(series(i, plot.scatter[i].iter().map(|p| (p[0], p[1])).collect()));
     }
     let slide = ReviewSlide {
         title,

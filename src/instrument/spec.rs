@@ -364,6 +364,36 @@ impl InstrumentSpec {
         std::f64::consts::PI * d * d / 4.0 * ifov * ifov
     }
 
+    /// What the design is, from its parameters (never from its preset's text, which an edit
+    /// leaves behind): "60.0 mm aperture, f/2.75, 5.86 µm pixels, 1024 × 30.0 m (30.7 km swath),
+    /// 1.50 ms exposure, 12-bit, 8 bands 443–865 nm".
+    ///
+    /// ```
+    /// let mut i = shoal::instrument::InstrumentSpec::preset("cubesat").unwrap();
+    /// i.aperture_mm = 105.8;
+    /// assert!(i.summary().starts_with("105.8 mm aperture, f/1.56"), "{}", i.summary());
+    /// ```
+    #[must_use]
+    pub fn summary(&self) -> String {
+        let sig = |v: f64| crate::colormap::significant(v, 3);
+        let bands = self.kind.model().band_set().map(|b| b.centres_nm()).unwrap_or_default();
+        let range = match (bands.iter().copied().reduce(f64::min), bands.iter().copied().reduce(f64::max)) {
+            (Some(lo), Some(hi)) => format!(", {} bands {lo:.0}–{hi:.0} nm", bands.len()),
+            _ => String::new(),
+        };
+        format!(
+            "{:.1} mm aperture, f/{:.2}, {:.2} µm pixels, {} × {} m ({} km swath), {:.2} ms exposure, {}-bit{range}",
+            self.aperture_mm,
+            self.f_number(),
+            self.pixel_pitch_um,
+            self.detectors,
+            sig(self.gsd_m()),
+            sig(self.swath_m() / 1e3),
+            self.exposure_s * 1e3,
+            self.adc_bits,
+        )
+    }
+
     /// Largest DN the ADC produces, 2^bits − 1.
     #[must_use]
     pub fn dn_max(&self) -> f64 {

@@ -62,7 +62,7 @@ nav ol { columns: 2; font-size: 14px; } .note { color: #555; font-size: 13px; }
 @media print { h2 { break-before: auto; } figure, table { break-inside: avoid; } pre { max-height: none; } }
 ";
 
-pub(super) fn num(v: f64, decimals: usize) -> String {
+pub(crate) fn num(v: f64, decimals: usize) -> String {
     if v.is_finite() { format!("{v:.decimals$}") } else { "–".into() }
 }
 
@@ -178,45 +178,8 @@ fn verdict(h: &mut String, d: &ReviewData) {
         h,
         "</div>\n<p class=\"note\">Margin: how far inside the limit (negative: outside), in the value's unit. A product with no pixel returned has no value and fails. <span class=\"warn\">pass?</span>: the numbers pass, but the design is implausible over this scene (it saturates, smears or has no buildable f-number; its warnings are under the instruments).{judged}</p>"
     );
-    // One row per requirement (and seed), the instruments side by side.
-    let labels: Vec<&str> = d.instruments.iter().map(|i| i.label.as_str()).collect();
-    let warned: Vec<bool> = d.instruments.iter().map(|i| !i.warnings.is_empty()).collect();
-    let mut keys: Vec<(u64, &str, f64)> = Vec::new();
-    for c in &d.checks {
-        if !keys.iter().any(|k| k.0 == c.seed && k.1 == c.what) {
-            keys.push((c.seed, &c.what, c.limit));
-        }
-    }
-    let several_seeds = keys.iter().any(|k| k.0 != keys[0].0);
-    h.push_str("<table>\n<tr><th>requirement</th><th>limit</th>");
-    for l in &labels {
-        let _ = write!(h, "<th colspan=\"3\">{}: value, margin, verdict</th>", escape(l));
-    }
-    h.push_str("</tr>\n");
-    for (seed, what, limit) in keys {
-        let name = if several_seeds { format!("{what} (seed {seed})") } else { what.to_string() };
-        let _ = write!(h, "<tr><td>{}</td><td class=\"num\">{}</td>", escape(&name), num(limit, 1));
-        for (l, warned) in labels.iter().zip(&warned) {
-            match d.checks.iter().find(|c| c.instrument == *l && c.seed == seed && c.what == what) {
-                Some(c) => {
-                    let (class, word) = match (c.pass, *warned) {
-                        (true, false) => ("pass", "pass"),
-                        (true, true) => ("warn", "pass?"),
-                        (false, _) => ("fail", "FAIL"),
-                    };
-                    let _ = write!(
-                        h,
-                        "<td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"{class}\">{word}</td>",
-                        c.value.map_or_else(|| "none".into(), |v| num(v, 1)),
-                        c.margin.map_or_else(|| "no pixel".into(), |m| format!("{m:+.1}")),
-                    );
-                }
-                None => h.push_str("<td colspan=\"3\">–</td>"),
-            }
-        }
-        h.push_str("</tr>\n");
-    }
-    h.push_str("</table>\n</section>\n");
+    super::verdicts::tables(h, d);
+    h.push_str("</section>\n");
 }
 
 fn instruments(h: &mut String, d: &ReviewData) {

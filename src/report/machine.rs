@@ -5,7 +5,7 @@
 use serde::{Deserialize, Serialize};
 
 /// What the machine is.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct Machine {
     /// CPU model name.
     pub cpu: String,

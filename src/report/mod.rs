@@ -15,6 +15,7 @@ mod pack;
 mod sections;
 pub mod substrate;
 pub mod svg;
+mod verdicts;
 
 use serde::{Deserialize, Serialize};
 
@@ -53,7 +54,7 @@ pub struct Derived {
 }
 
 /// One instrument as the review sees it.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct InstrumentSummary {
     /// Label in the study.
     pub label: String,
@@ -150,7 +151,7 @@ pub type CostTableRow = (String, usize, f64, (f64, f64), Option<f64>, String, Op
 pub type DataSource = (String, String, String, String);
 
 /// Everything the review pack states.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct ReviewData {
     /// Study name.
     pub study: String,
@@ -309,10 +310,18 @@ fn derived_rows(runs: &[&StudyRun], configs: &[&RunConfig]) -> Vec<Derived> {
     rows
 }
 
+/// A design as the pack describes it: its parameters (true whatever was edited), then its file's
+/// own words.
+#[must_use]
+pub fn describe(instrument: &crate::instrument::InstrumentSpec) -> String {
+    let text = instrument.description.trim();
+    if text.is_empty() { instrument.summary() } else { format!("{}. {text}", instrument.summary()) }
+}
+
 fn instrument_summary(run: &StudyRun, config: &RunConfig) -> InstrumentSummary {
     InstrumentSummary {
         label: run.label.clone(),
-        description: config.instrument.description.clone(),
+        description: describe(&config.instrument),
         config_ron: config.to_ron().unwrap_or_else(|e| format!("// cannot write the configuration: {e}")),
         stages: run
             .report

@@ -123,7 +123,11 @@ fn the_review_pack_states_each_cost_row_with_its_range_and_95th_percentile() {
     assert!(html.contains("<b class=\"warn\">MEETS ALL?</b> — 1 of 1 checks met; but implausible here: saturates"));
     assert!(html.contains("cubesat<br><b class=\"pass\">MEETS ALL</b>"));
     let verdicts = row("chl_mg_m3 MAE %");
-    assert!(verdicts.contains("<td class=\"warn\">pass?</td>") && verdicts.contains("<td class=\"pass\">pass</td>"));
+    assert!(
+        verdicts.contains("10.0 (+10.0) <span class=\"warn\">pass?</span>")
+            && verdicts.contains("10.0 (+10.0) <span class=\"pass\">pass</span>"),
+        "{verdicts}"
+    );
     // A program's own words are text, never markup.
     assert!(html.contains("<h2>Retrievals that returned nothing</h2>"));
     assert!(

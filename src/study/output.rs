@@ -276,7 +276,9 @@ pub fn write_study(result: &StudyResult, dir: &Path, figures: bool) -> Result<Ou
     text(dir, "metrics.csv", &metrics_csv(result), &mut o)?;
     text(dir, "seed_spread.csv", &super::seed_spread_csv(&super::seed_spread(result)), &mut o)?;
     if let Some(r) = &result.study.spec.requirements {
-        text(dir, "requirements.csv", &super::checks_csv(&r.check(result)), &mut o)?;
+        let warned: Vec<&str> =
+            result.runs.iter().filter(|r| !r.report.warnings.is_empty()).map(|r| r.label.as_str()).collect();
+        text(dir, "requirements.csv", &super::checks_csv(&r.check(result), &warned), &mut o)?;
     }
     let mut rows = Vec::new();
     let mut extra = Vec::new();

@@ -468,9 +468,10 @@ impl Requirements {
     }
 }
 
-/// The checks as CSV.
+/// The checks as CSV; a pass of an instrument in `warned` (one with a plausibility warning:
+/// saturation, smear, no buildable f-number) reads "pass?", as in the app and the pack.
 #[must_use]
-pub fn checks_csv(checks: &[Check]) -> String {
+pub fn checks_csv(checks: &[Check], warned: &[&str]) -> String {
     let mut csv = crate::csvtext::Csv::new(&["instrument", "seed", "requirement", "value", "limit", "pass", "margin"]);
     for c in checks {
         csv.row([
@@ -479,7 +480,12 @@ pub fn checks_csv(checks: &[Check]) -> String {
             c.what.clone(),
             c.value.map_or_else(String::new, |v| format!("{v:.4}")),
             c.limit.to_string(),
-            (if c.pass { "pass" } else { "FAIL" }).to_string(),
+            (match (c.pass, warned.contains(&c.instrument.as_str())) {
+                (true, false) => "pass",
+                (true, true) => "pass?",
+                (false, _) => "FAIL",
+            })
+            .to_string(),
             c.margin.map_or_else(String::new, |m| format!("{m:.4}")),
         ]);
     }

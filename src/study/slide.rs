@@ -78,41 +78,71 @@ fn text_style(size: u32, colour: RGBColor) -> TextStyle<'static> {
     (FONT, size).into_font().color(&colour)
 }
 
-/// A table at (x, y), first row bold-ruled; columns as wide as their longest cell.
+/// A table at (x, y) within `max_width`, first row bold-ruled; columns as wide as their longest
+/// cell. The font shrinks from 16 px to 11 px until the table fits; columns that still do not are
+/// left out and the last line says how many (eight designs' parameters ran off the slide).
 fn table<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     rows: &[Vec<String>],
     (x, y): (i32, i32),
     max_rows: usize,
+    max_width: i32,
 ) -> Result<(), String> {
     let columns = rows.first().map_or(0, Vec::len);
-    // DejaVu Sans at 16 px: about 9 px per character.
-    let widths: Vec<i32> = (0..columns)
-        .map(|c| rows.iter().map(|r| r.get(c).map_or(0, |s| s.chars().count())).max().unwrap_or(0) as i32 * 9 + 22)
-        .collect();
-    for (r, row) in rows.iter().take(max_rows).enumerate() {
-        let ty = y + ROW_H * r as i32;
+    // DejaVu Sans: about 0.56 em per character, plus a gap between columns.
+    let widths_at = |size: i32| -> Vec<i32> {
+        (0..columns)
+            .map(|c| {
+                let chars = rows.iter().map(|r| r.get(c).map_or(0, |s| s.chars().count())).max().unwrap_or(0);
+                (chars as f64 * 0.5625 * f64::from(size)).ceil() as i32 + size + 6
+            })
+            .collect()
+    };
+    let size = (11..=16).rev().find(|&s| widths_at(s).iter().sum::<i32>() <= max_width).unwrap_or(11);
+    let widths = widths_at(size);
+    // The columns that fit (always the first, the row names).
+    let mut shown = 0;
+    let mut used = 0;
+    for w in &widths {
+        if shown > 0 && used + w > max_width {
+            break;
+        }
+        used += w;
+        shown += 1;
+    }
+    let row_h = size + 8;
+    let size = u32::try_from(size).unwrap_or(16);
+    let rows_fit = max_rows.max(1);
+    for (r, row) in rows.iter().take(rows_fit).enumerate() {
+        let ty = y + row_h * r as i32;
         let mut tx = x;
-        for (c, cell) in row.iter().enumerate() {
+        for (c, cell) in row.iter().take(shown).enumerate() {
             // A verdict alone ("pass", "FAIL: …") or at the end of a value ("10.6 / +5.5 pass").
             let colour = match cell.as_str() {
                 s if s.starts_with("FAIL") || s.ends_with(" FAIL") => RGBColor(190, 30, 30),
                 // A pass under a plausibility warning, amber as in the app.
-                "pass?" => RGBColor(180, 110, 0),
+                s if s == "pass?" || s.ends_with(" pass?") => RGBColor(180, 110, 0),
                 s if s == "pass" || s.ends_with(" pass") => RGBColor(30, 130, 30),
                 _ => RGBColor(25, 25, 25),
             };
-            root.draw_text(cell, &text_style(16, colour), (tx, ty)).map_err(err)?;
+            root.draw_text(cell, &text_style(size, colour), (tx, ty)).map_err(err)?;
             tx += widths.get(c).copied().unwrap_or(90);
         }
         if r == 0 {
-            let ly = ty + ROW_H - 4;
+            let ly = ty + row_h - 4;
             root.draw(&PathElement::new(vec![(x, ly), (tx, ly)], BLACK)).map_err(err)?;
         }
     }
-    if rows.len() > max_rows {
-        let ty = y + ROW_H * max_rows as i32;
-        let more = format!("… {} more rows in the exported data", rows.len() - max_rows);
+    let mut notes = Vec::new();
+    if rows.len() > rows_fit {
+        notes.push(format!("{} more rows", rows.len() - rows_fit));
+    }
+    if shown < columns {
+        notes.push(format!("{} more columns", columns - shown));
+    }
+    if !notes.is_empty() {
+        let ty = y + row_h * rows_fit.min(rows.len()) as i32;
+        let more = format!("… {} in the review pack", notes.join(" and "));
         root.draw_text(&more, &text_style(14, RGBColor(90, 90, 90)), (x, ty)).map_err(err)?;
     }
     Ok(())
@@ -215,7 +245,19 @@ impl Draw for ReviewSlide {
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<Vec<Placed>, String> {
         root.fill(&WHITE).map_err(err)?;
-        root.draw_text(&self.title, &text_style(30, BLACK), (MARGIN, 16)).map_err(err)?;
+        // The title at 30 px, smaller where it would run off the slide (eight designs' names).
+        let room = 1920 - 2 * MARGIN;
+        let fits = |size: u32| {
+            root.estimate_text_size(&self.title, &text_style(size, BLACK)).is_ok_and(|(w, _)| w as i32 <= room)
+        };
+        let size = (16..=30).rev().find(|&s| fits(s)).unwrap_or(16);
+        let title = if fits(size) {
+            self.title.clone()
+        } else {
+            let keep = (f64::from(room) / (0.56 * f64::from(size))) as usize;
+            format!("{}…", self.title.chars().take(keep.saturating_sub(1)).collect::<String>())
+        };
+        root.draw_text(&title, &text_style(size, BLACK), (MARGIN, 16 + (30 - size as i32) / 2)).map_err(err)?;
         // The maps, on the study figures' renderer at slide size.
         let n = self.panels.len().max(1) as u32;
         let maps = Maps {
@@ -257,7 +299,7 @@ impl Draw for ReviewSlide {
         // As many rows as fit above the caption (the products of either retrieval and the SNR
         // row fit at three caption lines).
         let rows = usize::try_from((caption_y - table_y - 30) / ROW_H).unwrap_or(1).max(2);
-        table(root, &self.verdicts, (MARGIN, table_y + 30), rows)?;
+        table(root, &self.verdicts, (MARGIN, table_y + 30), rows, PLOTS_X - MARGIN - 16)?;
         // "A and B differ in" for a pair; with more designs, against the first column's.
         let names: Vec<&str> =
             self.parameters.first().map(|h| h.iter().skip(1).map(String::as_str).collect()).unwrap_or_default();
@@ -267,7 +309,7 @@ impl Draw for ReviewSlide {
             [] => "Parameters".to_string(),
         };
         root.draw_text(&heading, &text_style(20, BLACK), (PLOTS_X, table_y)).map_err(err)?;
-        table(root, &self.parameters, (PLOTS_X, table_y + 30), rows)?;
+        table(root, &self.parameters, (PLOTS_X, table_y + 30), rows, 1920 - PLOTS_X - 16)?;
         for (i, line) in self.caption.iter().enumerate() {
             root.draw_text(line, &text_style(15, RGBColor(60, 60, 60)), (MARGIN, caption_y + 24 * i as i32))
                 .map_err(err)?;

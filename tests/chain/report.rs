@@ -108,7 +108,8 @@ fn the_review_pack_renders_in_chromium_with_every_image_and_nothing_external() {
     }
     // What a reviewer looks for: the verdict (the CubeSat misses the chl-a MAE requirement),
     // both instruments, the commit, the configurations, the machine.
-    assert!(html.contains("cubesat: value, margin, verdict") && html.contains("smallsat: value, margin, verdict"));
+    assert!(html.contains("<th>cubesat</th>") && html.contains("<th>smallsat</th>"));
+    assert!(html.contains("<td>SNR, every band ≥</td>"), "one SNR row, not one per band");
     assert!(html.contains("<b class=\"fail\">FAILS</b> — "), "a verdict card");
     assert!(html.contains(&format!("commit {}", shoal::report::commit())));
     assert!(html.contains("download=\"cubesat.ron\""));

@@ -77,6 +77,24 @@ fn a_third_and_fourth_design_are_added_reordered_and_removed_and_results_move_wi
     assert!(h.query_by_label("D MAE").is_none(), "the table has no fourth design now");
     assert_eq!(h.state().state.editing, 2, "the design being edited is still filter_imager");
 
+    // Undo the removal: A comes back (and runs), the others move back a letter with their
+    // results, not run again, and the maps show what they showed.
+    let maps_before = h.state().state.on_maps.clone();
+    h.get_by_label("Undo").click();
+    h.step();
+    h.step();
+    assert_eq!(presets(&h), ["cubesat", "nominal", "smallsat", "filter_imager"]);
+    assert_eq!(h.state().state.on_maps, [0, 1, 2, 3], "A's map tick came back ({maps_before:?} before)");
+    wait_for_engine(&mut h);
+    let undone = runs(&h);
+    assert!(undone[1..].iter().zip(&left).all(|(a, b)| Arc::ptr_eq(a, b)), "B, C and D were run again");
+    assert_eq!(undone[0].config.instrument.name, "cubesat");
+    h.get_by_label("Redo").click();
+    h.step();
+    h.step();
+    wait_for_engine(&mut h);
+    assert!(runs(&h).iter().zip(&left).all(|(a, b)| Arc::ptr_eq(a, b)), "redo ran a design again");
+
     // The session round trip keeps the list, the design edited and the maps' choice.
     let mut state = h.state().state.clone();
     state.on_maps = vec![0, 2];

@@ -153,8 +153,7 @@ fn the_review_pack_exports_from_the_app_to_a_typed_folder() {
     }
     let html = std::fs::read_to_string(&index).unwrap();
     // A and B as the app labels them, the app's requirements judged, figures inline.
-    for part in
-        ["cubesat (A)", "smallsat (B)", "Verdict against the requirements", "<svg role=\"img\"", "id=\"fig-snr\""]
+    for part in ["A: cubesat", "B: smallsat", "Verdict against the requirements", "<svg role=\"img\"", "id=\"fig-snr\""]
     {
         assert!(html.contains(part), "the pack has no `{part}`");
     }

@@ -241,7 +241,13 @@ pub fn design_window(app: &mut super::super::ShoalApp, ctx: &egui::Context) {
             match (crate::design::space::configure(base, &d.searched, &e.x), to) {
                 (Ok(config), Put::IntoA) => app.state.designs[0].spec = config.instrument,
                 (Ok(config), Put::New) => {
-                    let slot = Slot::new(&format!("search #{}", i + 1), config.instrument);
+                    // Named as the list will show it, everywhere; described by its parameters
+                    // (the pack), never by the preset's text it was searched from.
+                    let name = format!("search #{}", i + 1);
+                    let mut spec = config.instrument;
+                    spec.name.clone_from(&name);
+                    spec.description = format!("found by the design search from {}", base.instrument.name);
+                    let slot = Slot::new(&name, spec);
                     if app.state.add_design(slot).is_none() {
                         app.ui.explore.design.status = "the app already holds as many designs as it can".into();
                     }

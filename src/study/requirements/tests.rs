@@ -42,8 +42,11 @@ fn a_product_with_no_pixel_returned_fails_every_check_even_without_a_returned_li
         assert!(c.describe().contains("no pixel returned"), "{}", c.describe());
     }
     assert_eq!(verdict(&checks), Some(false));
-    let csv = checks_csv(&checks);
-    assert!(csv.lines().nth(1).unwrap().starts_with("A,1,chl_mg_m3 MAE %,,20,FAIL,"), "{csv}");
+    let csv = checks_csv(&checks, &["A"]);
+    assert!(
+        csv.lines().nth(1).unwrap().starts_with("A,1,chl_mg_m3 MAE %,,20,FAIL,"),
+        "a warning never makes a FAIL pass: {csv}"
+    );
 }
 
 #[test]
@@ -57,6 +60,10 @@ fn a_returned_product_is_judged_by_mae_bias_and_share_with_margins() {
     assert!((values[1].1 - 5.0).abs() < 1e-9 && values[1].0, "|bias| 5 % under 10 %: {values:?}");
     assert!((values[2].1 - 5.0).abs() < 1e-9 && values[2].0, "75 % returned over 70 %: {values:?}");
     assert_eq!(verdict(&checks), Some(true));
+    // A design with a plausibility warning passes with a question mark in the CSV too.
+    let csv = checks_csv(&checks, &["A"]);
+    assert!(csv.lines().skip(1).all(|l| l.contains(",pass?,")), "{csv}");
+    assert!(checks_csv(&checks, &[]).lines().skip(1).all(|l| l.contains(",pass,")));
     let checks = chl_limits(Some(80.0)).check_run("A", 1, Some(&p), &[], &[]);
     assert_eq!(verdict(&checks), Some(false), "75 % returned under an 80 % floor fails");
     assert_eq!(verdict(&[]), None, "nothing checked: no verdict");
