@@ -13,18 +13,32 @@ impl ShoalApp {
             let l = ui.label("Export to");
             ui.add(egui::TextEdit::singleline(&mut self.ui.export_path).desired_width(420.0)).labelled_by(l.id);
             let path = PathBuf::from(self.ui.export_path.trim());
-            if ui.button("Write figure").on_hover_text("NAME.png, NAME.svg and NAME_config_A/B.ron").clicked() {
-                self.export_to(export::What::Figure, path.clone());
+            let target = |what| export::typed_target(what, &path);
+            if ui
+                .button("Write figure")
+                .on_hover_text("NAME.png, NAME.svg and NAME_config_A.ron, … per design")
+                .clicked()
+            {
+                self.export_to(export::What::Figure, target(export::What::Figure));
             }
-            if ui.button("Write data").on_hover_text("A folder NAME with one sub-folder per instrument").clicked() {
-                self.export_to(export::What::Data, path.clone());
+            if ui.button("Write data").on_hover_text("A folder NAME_data with one sub-folder per design").clicked() {
+                self.export_to(export::What::Data, target(export::What::Data));
             }
             if ui
                 .button("Write review pack")
-                .on_hover_text("A folder NAME with index.html (self-contained, opens in any browser) and its figures")
+                .on_hover_text(
+                    "A folder NAME_review with index.html (self-contained, opens in any browser) and its figures",
+                )
                 .clicked()
             {
-                self.export_to(export::What::ReviewPack, path);
+                self.export_to(export::What::ReviewPack, target(export::What::ReviewPack));
+            }
+            // What was written (or is being), in the row the buttons are in: the message row is
+            // this one while it is open.
+            if self.ui.exports.running > 0 {
+                ui.spinner();
+            } else if let Some(m) = &self.ui.message {
+                ui.add(egui::Label::new(egui::RichText::new(m.as_str()).small()).truncate());
             }
         });
     }

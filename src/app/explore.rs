@@ -46,6 +46,8 @@ pub struct Explore {
     table: Option<Table>,
     sweep_total: usize,
     sweep_status: String,
+    /// The sweep's instrument names (file-safe: "C search 2") and the design list's ("C: search 2").
+    sweep_names: Vec<(String, String)>,
     cost_decimation: usize,
     cost_task: Option<Task<(usize, CostRow)>>,
     /// Rounds of the cost measurement (each setting timed once per round, interleaved).
@@ -82,6 +84,7 @@ impl Default for Explore {
             table: None,
             sweep_total: 0,
             sweep_status: String::new(),
+            sweep_names: Vec::new(),
             cost_decimation: 4,
             cost_task: None,
             cost_rounds: 5,
@@ -105,6 +108,27 @@ impl Explore {
     #[must_use]
     pub fn sweep_rows(&self) -> usize {
         self.table.as_ref().map_or(0, |t| t.rows.len())
+    }
+
+    /// A sweep series' label as the design list names its design ("C search 2, …" → "C: search
+    /// 2, …").
+    #[must_use]
+    pub fn shown_label(&self, label: &str) -> String {
+        self.sweep_names
+            .iter()
+            .find_map(|(safe, shown)| {
+                label
+                    .strip_prefix(safe.as_str())
+                    .filter(|r| r.is_empty() || r.starts_with(", "))
+                    .map(|r| format!("{shown}{r}"))
+            })
+            .unwrap_or_else(|| label.to_string())
+    }
+
+    /// The sweep's last status line ("running 12 runs at 1/24", or why it stopped).
+    #[must_use]
+    pub fn sweep_status(&self) -> &str {
+        &self.sweep_status
     }
 
     /// Take what the helper threads sent.
@@ -181,15 +205,17 @@ impl Explore {
             parameters.push(Parameter { path: path.clone(), values: values(path, *a, *b, 3, false) });
         }
         let key = self.param.rsplit('.').next().unwrap_or("parameter").to_string();
+        self.sweep_names = (0..state.designs.len()).map(|i| (sweep_name(state, i), state.design_name(i))).collect();
         let study = StudySpec {
             name: "app".into(),
             description: String::new(),
             scene: Source::Inline(Box::new(state.seeded_scene())),
-            // Each named as the design list names it ("C: cubesat"), as in the slide and the pack.
+            // Each named by its letter and preset ("C cubesat": an instrument's name must be
+            // file-safe); the plot shows the design list's name ("C: cubesat").
             instruments: (0..state.designs.len())
                 .map(|i| {
                     let mut spec = state.designs[i].spec.clone();
-                    spec.name = state.design_name(i);
+                    spec.name = sweep_name(state, i);
                     Source::Inline(Box::new(spec))
                 })
                 .collect(),
@@ -318,6 +344,13 @@ fn fidelity_text(f: &Fidelity) -> String {
     } else {
         parts.join(", ")
     }
+}
+
+/// Design `i`'s instrument name in a sweep: its letter and preset ("C cubesat"), within the 64
+/// characters an instrument's (file-safe) name may have.
+fn sweep_name(state: &AppState, i: usize) -> String {
+    let preset: String = state.designs[i].preset.chars().take(60).collect();
+    format!("{} {}", super::model::label(i), preset.trim())
 }
 
 mod cost;

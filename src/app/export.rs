@@ -118,6 +118,21 @@ pub fn write_review_pack(snap: &Snapshot, dir: &Path) -> Result<PathBuf, String>
     Ok(dir.join("index.html"))
 }
 
+/// Where the typed path `name` writes `what`: the figure at NAME.png and NAME.svg, the data in
+/// the folder NAME_data and the review pack in NAME_review (one name no longer sends the data
+/// and the pack to the same folder, each replacing the other).
+#[must_use]
+pub fn typed_target(what: What, name: &Path) -> PathBuf {
+    let suffix = match what {
+        What::Figure => return name.to_path_buf(),
+        What::Data => "_data",
+        What::ReviewPack => "_review",
+    };
+    let mut s = name.as_os_str().to_os_string();
+    s.push(suffix);
+    PathBuf::from(s)
+}
+
 /// The configuration file of design `i` beside the figure at `stem` (`…_config_A.ron`).
 #[must_use]
 pub fn config_path(stem: &Path, i: usize) -> PathBuf {

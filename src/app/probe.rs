@@ -56,6 +56,12 @@ impl ShoalApp {
         &self.ui.plot_rects
     }
 
+    /// Is an export being written?
+    #[must_use]
+    pub fn exporting(&self) -> bool {
+        self.ui.exports.running > 0
+    }
+
     /// Where the maps and their colour bars were drawn in the last frame.
     #[must_use]
     pub fn map_rects(&self) -> &[egui::Rect] {

@@ -65,8 +65,8 @@ pub fn write_figure(snap: &Snapshot, stem: &Path) -> Result<Vec<PathBuf>, String
         .enumerate()
         .filter_map(|(i, out)| {
             let w = &out.report.warnings;
-            let first = w.first()?.message.split(['.', ';']).next().unwrap_or_default().to_string();
-            Some(format!("{}: {first}{}", super::model::label(i), if w.len() > 1 { " …" } else { "" }))
+            let words: Vec<String> = w.iter().map(crate::instrument::plausibility::Warning::short).collect();
+            (!words.is_empty()).then(|| format!("{}: {}", super::model::label(i), words.join(", ")))
         })
         .collect();
     if !warned.is_empty() {

@@ -28,6 +28,20 @@ pub enum Guard {
     FNumber,
 }
 
+impl Warning {
+    /// A few words for a caption ("smears 5.3 px", "saturates 7 bands", "f/0.80").
+    #[must_use]
+    pub fn short(&self) -> String {
+        match self.guard {
+            Guard::Saturation => {
+                format!("saturates at {:.0} % of full scale", 100.0 * self.value)
+            }
+            Guard::Smear => format!("smears {:.1} px", self.value),
+            Guard::FNumber => format!("f/{:.2}, faster than f/1", self.value),
+        }
+    }
+}
+
 /// One warning: what, how far, and the limit.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Warning {

@@ -298,7 +298,7 @@ fn the_papers_study_checks_its_requirements_with_margins() {
     let bands: usize = result.runs.iter().map(|r| r.snr.len()).sum();
     assert!(bands >= 2 * 16);
     assert_eq!(checks.iter().filter(|c| c.what.starts_with("SNR")).count(), bands);
-    let csv = shoal::study::checks_csv(&checks);
+    let csv = shoal::study::checks_csv(&checks, &[]);
     assert!(csv.contains("cubesat,1,chl_mg_m3 MAE %") && csv.contains("FAIL"));
 
     // Bad requirements are refused by name.

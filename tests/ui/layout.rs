@@ -17,7 +17,7 @@ fn controls_inside(h: &mut Harness<'static, ShoalApp>, size: egui::Vec2, n: usiz
     let mapped: Vec<String> = (0..n.min(4)).map(shoal::app::model::label).collect();
     let truth = format!("truth | {}", mapped.join(" | "));
     let pair = "A | B | A − B";
-    let mut check = |h: &Harness<'static, ShoalApp>, names: &[String]| {
+    let check = |h: &Harness<'static, ShoalApp>, names: &[String]| {
         for name in names {
             let r = h.get_by_label(name).rect();
             assert!(window.contains_rect(r), "`{name}` at {r:?} is outside the {size:?} window");

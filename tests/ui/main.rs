@@ -21,6 +21,7 @@ use shoal::library::Library;
 mod design;
 mod designs;
 mod editing;
+mod exports;
 mod external;
 mod files;
 mod layout;

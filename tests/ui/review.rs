@@ -138,8 +138,14 @@ fn the_sweep_takes_any_product_and_any_number_of_the_run() {
     }
     h.step();
     h.step();
-    assert_eq!(h.state().explore().sweep_rows(), 12);
+    assert_eq!(h.state().explore().sweep_rows(), 12, "{}", h.state().explore().sweep_status());
     assert!(h.query_all_by_label_contains("NAP MAE ≤").count() >= 2, "the lines judge NAP, not chl-a");
+    // Its series are named as the design list names the designs.
+    let e = h.state().explore();
+    assert_eq!(
+        (e.shown_label("A cubesat"), e.shown_label("B smallsat, x = 2")),
+        ("A: cubesat".into(), "B: smallsat, x = 2".into())
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 

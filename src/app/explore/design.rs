@@ -243,7 +243,8 @@ pub fn design_window(app: &mut super::super::ShoalApp, ctx: &egui::Context) {
                 (Ok(config), Put::New) => {
                     // Named as the list will show it, everywhere; described by its parameters
                     // (the pack), never by the preset's text it was searched from.
-                    let name = format!("search #{}", i + 1);
+                    // (A file-safe name, as every instrument's: `#` is not one.)
+                    let name = format!("search {}", i + 1);
                     let mut spec = config.instrument;
                     spec.name.clone_from(&name);
                     spec.description = format!("found by the design search from {}", base.instrument.name);

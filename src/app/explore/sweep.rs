@@ -124,19 +124,19 @@ fn sweep_plot(ui: &mut egui::Ui, e: &Explore, table: &Table, curves: &crate::stu
     plot.show(ui, |p| {
         for (k, s) in curves.series.iter().enumerate() {
             let colour = colour_of(k);
+            // The design list's name ("C: search 2"), the sweep's own kept for finding its rows.
+            let name = e.shown_label(&s.label);
             // B dashed over A: identical instruments stay visible as two curves.
             let style = if k % 2 == 0 { egui_plot::LineStyle::Solid } else { egui_plot::LineStyle::dashed_loose() };
             let pts = |f: fn(&crate::study::CurvePoint) -> f64| {
                 PlotPoints::from_iter(s.points.iter().map(|q| [x_of(q.x), y_of(f(q))]))
             };
-            p.line(Line::new(s.label.clone(), pts(|q| q.mean)).color(colour).style(style).width(2.0));
-            p.line(Line::new(format!("{} lowest seed", s.label), pts(|q| q.lo)).color(colour.gamma_multiply(0.4)));
-            p.line(Line::new(format!("{} highest seed", s.label), pts(|q| q.hi)).color(colour.gamma_multiply(0.4)));
+            p.line(Line::new(name.clone(), pts(|q| q.mean)).color(colour).style(style).width(2.0));
+            p.line(Line::new(format!("{name} lowest seed"), pts(|q| q.lo)).color(colour.gamma_multiply(0.4)));
+            p.line(Line::new(format!("{name} highest seed"), pts(|q| q.hi)).color(colour.gamma_multiply(0.4)));
             if let (Some(r), Some(x)) = (&requirement, s.crossing) {
                 p.points(
-                    Points::new(format!("{} meets", s.label), vec![[x_of(x), y_of(r.mae_pct)]])
-                        .radius(6.0)
-                        .color(colour),
+                    Points::new(format!("{name} meets"), vec![[x_of(x), y_of(r.mae_pct)]]).radius(6.0).color(colour),
                 );
             }
             // Which run the series is: its instrument, and the second parameter's value.
@@ -147,7 +147,7 @@ fn sweep_plot(ui: &mut egui::Ui, e: &Explore, table: &Table, curves: &crate::stu
                 .collect();
             if !rings.is_empty() {
                 p.points(
-                    Points::new(format!("{} saturates", s.label), rings)
+                    Points::new(format!("{name} saturates"), rings)
                         .radius(7.0)
                         .filled(false)
                         .color(super::super::theme::FAIL),
