@@ -29,6 +29,10 @@ pub struct Blocks {
     count: Vec<u32>,
     /// The first valid value of each block (row-major inside it): its class, for class maps.
     first: Vec<f32>,
+    /// Map pixels per block side, and the map's rows and columns (a block at the edge is smaller).
+    step: usize,
+    rows: usize,
+    cols: usize,
 }
 
 impl Blocks {
@@ -39,8 +43,17 @@ impl Blocks {
         let step = rows.max(cols).div_ceil(max_side.max(1)).max(1);
         let (height, width) = (rows.div_ceil(step).max(1), cols.div_ceil(step).max(1));
         let n = width * height;
-        let mut b =
-            Self { width, height, sum: vec![0.0; n], sum_ln: vec![0.0; n], count: vec![0; n], first: vec![0.0; n] };
+        let mut b = Self {
+            width,
+            height,
+            sum: vec![0.0; n],
+            sum_ln: vec![0.0; n],
+            count: vec![0; n],
+            first: vec![0.0; n],
+            step,
+            rows,
+            cols,
+        };
         for ((r, c), v) in map.values.indexed_iter() {
             if !map.valid[[r, c]] {
                 continue;
@@ -57,9 +70,21 @@ impl Blocks {
         b
     }
 
+    /// Is block (y, x) drawn in colour? Where only some of its pixels were returned, in
+    /// proportion: its returned share against an ordered-dither threshold
+    /// ([`crate::colormap::dithered`]), so the
+    /// grey share of any part of the image is the share not returned there, at any zoom. (A
+    /// block coloured by any returned pixel showed a product with 22 % returned as ~90 % coloured.)
+    fn lit(&self, y: usize, x: usize) -> bool {
+        let count = self.count[y * self.width + x];
+        let pixels = (self.step.min(self.rows - y * self.step) * self.step.min(self.cols - x * self.step)).max(1);
+        crate::colormap::dithered(f64::from(count) / pixels as f64, x, y)
+    }
+
     /// The image in `palette`: each block's mean position on the scale (sequential), mean value
     /// (diverging), first class (classes) or any disagreement (agreement); the first map row at
-    /// the bottom (flight direction up); blocks with no valid pixel transparent grey.
+    /// the bottom (flight direction up); blocks not returned, and partly returned ones in
+    /// proportion ([`Self::lit`]), transparent grey.
     #[must_use]
     pub fn colorize(&self, palette: Palette) -> Image {
         let (w, h) = (self.width, self.height);
@@ -68,7 +93,7 @@ impl Blocks {
             for x in 0..w {
                 let k = y * w + x;
                 let n = f64::from(self.count[k]);
-                let colour = if self.count[k] == 0 {
+                let colour = if self.count[k] == 0 || !self.lit(y, x) {
                     super::theme::NOT_RETURNED
                 } else {
                     let c = match palette {
@@ -171,6 +196,12 @@ mod tests {
             let want = per_pixel(&map, scale, 10);
             for (k, px) in image.rgba.chunks(4).enumerate() {
                 let (got, want) = (&px[..3], want[k]);
+                // A partly returned block drawn grey by the dither is grey, whatever its mean.
+                let (x, y) = (k % blocks.width, blocks.height - 1 - k / blocks.width);
+                if !blocks.lit(y, x) {
+                    assert_eq!(got, &crate::app::theme::NOT_RETURNED[..3], "block {k}");
+                    continue;
+                }
                 // Σ position / n and the position of Σ v / n differ by rounding only: at most
                 // one step of a colour channel where a value falls on a step's edge.
                 assert!(
@@ -179,5 +210,49 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// A product returned at scattered pixels (22 %, as QAA over Lake Hume) shows as much grey
+    /// as it did not return, whole and zoomed in: within 10 points at zooms 1, 4 and 16.
+    #[test]
+    fn a_scattered_return_is_grey_in_proportion_at_every_zoom() {
+        let (rows, cols) = (2000, 1024);
+        // A deterministic scatter: a pixel is returned when its hash falls under 0.22.
+        let hash = |r: usize, c: usize| {
+            let mut z = (r as u64) << 32 | c as u64;
+            z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let valid = Array2::from_shape_fn((rows, cols), |(r, c)| hash(r, c) < 0.22);
+        let map = MapData { values: Array2::from_elem((rows, cols), 5.0), valid: valid.clone() };
+        let blocks = Blocks::of(&map, 720);
+        let image = blocks.colorize(Palette::Sequential(Scale { lo: 1.0, hi: 10.0, log: true }));
+        let grey = crate::app::theme::NOT_RETURNED;
+        let (w, h) = (image.width, image.height);
+        let is_grey = |x: usize, y: usize| image.rgba[(y * w + x) * 4..][..3] == grey[..3];
+        for zoom in [1usize, 4, 16] {
+            // The centre window of 1/zoom of each side, in image cells and in map pixels (the
+            // image's first row is the map's last).
+            let (iw, ih) = (w / zoom, h / zoom);
+            let (x0, y0) = ((w - iw) / 2, (h - ih) / 2);
+            let cells = iw * ih;
+            let grey_cells =
+                (y0..y0 + ih).flat_map(|y| (x0..x0 + iw).map(move |x| (x, y))).filter(|&(x, y)| is_grey(x, y));
+            let grey_pct = 100.0 * grey_cells.count() as f64 / cells as f64;
+            let step = blocks.step;
+            let (r0, r1) = ((h - y0 - ih) * step, ((h - y0) * step).min(rows));
+            let (c0, c1) = (x0 * step, ((x0 + iw) * step).min(cols));
+            let window = valid.slice(ndarray::s![r0..r1, c0..c1]);
+            let returned_pct = 100.0 * window.iter().filter(|v| **v).count() as f64 / window.len() as f64;
+            assert!(
+                (grey_pct - (100.0 - returned_pct)).abs() < 10.0,
+                "zoom {zoom}: {grey_pct:.1} % grey where {returned_pct:.1} % was returned"
+            );
+        }
+        // Whole blocks returned stay coloured, blocks of nothing stay grey.
+        let full = MapData { values: Array2::from_elem((40, 40), 5.0), valid: Array2::from_elem((40, 40), true) };
+        let b = Blocks::of(&full, 7);
+        assert!((0..b.height).all(|y| (0..b.width).all(|x| b.lit(y, x))), "an edge block is its own size");
     }
 }

@@ -146,7 +146,8 @@ pub(super) fn colour(t: f64, diverging: bool) -> [u8; 3] {
     if diverging { crate::colormap::diverging(2.0 * t - 1.0) } else { viridis(t) }
 }
 
-/// Rasterise `panel` into `w × h` pixels (block means in scale space; grey where invalid).
+/// Rasterise `panel` into `w × h` pixels (block means in scale space; grey where invalid, and
+/// where partly invalid in proportion).
 pub(super) fn raster(panel: &Panel, scale: &Scale, w: u32, h: u32, diverging: bool) -> Vec<u8> {
     let (rows, cols) = panel.values.dim();
     let mut rgb = vec![0u8; (w * h * 3) as usize];
@@ -171,7 +172,10 @@ pub(super) fn raster(panel: &Panel, scale: &Scale, w: u32, h: u32, diverging: bo
                     }
                 }
             }
-            let colour = if n > 0 { colour(sum / n as f64, diverging) } else { [200, 200, 200] };
+            // Partly returned cells grey in proportion (`colormap::dithered`).
+            let cell = (r1.min(rows) - r0) * (c1.min(cols) - c0);
+            let lit = n > 0 && crate::colormap::dithered(n as f64 / cell.max(1) as f64, x as usize, yf as usize);
+            let colour = if lit { colour(sum / n as f64, diverging) } else { [200, 200, 200] };
             let i = ((y * w + x) * 3) as usize;
             rgb[i..i + 3].copy_from_slice(&colour);
         }
