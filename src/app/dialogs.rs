@@ -115,6 +115,13 @@ impl ShoalApp {
                     .on_hover_text(
                         "The run of the configuration set failed; its reason is shown where its maps would be.",
                     );
+            } else if let Some((i, why)) = (0..self.state.designs.len()).find_map(|i| {
+                let run = self.link.current(i)?;
+                run.output.retrievals.first()?.failure.clone().map(|w| (i, w))
+            }) {
+                // A retrieval that returned nothing is not "up to date": its banner says why.
+                ui.colored_label(super::theme::FAIL, format!("{}: retrieval returned nothing", super::model::label(i)))
+                    .on_hover_text(why);
             } else if self.state.preview_only {
                 ui.label("preview only (settings)");
             } else {

@@ -158,8 +158,23 @@ fn score_map(
     crate::metrics::VariableMetrics { variable: key, metrics: crate::metrics::compare(&got, &want) }
 }
 
-/// The product of a retrieval that returned nothing: every water pixel failed, no maps.
+/// The product of a retrieval that returned nothing: every water pixel failed, and a map of
+/// nothing (NaN) for each variable it promised, so each is scored as 0 % returned and its
+/// requirement fails (without maps its rows and FAIL verdicts vanished from the tables).
 fn failed_product(spec: &RetrievalSpec, inputs: &RetrievalInputs<'_>) -> Product {
+    use crate::variable::key;
     let flags = inputs.surface.water_mask().mapv(|w| if w { ProductFlags::FAILED } else { ProductFlags::LAND });
-    Product::bare(spec.name().to_string(), flags)
+    let nothing = ndarray::Array2::from_elem(flags.dim(), f32::NAN);
+    let mut p = Product::bare(spec.name().to_string(), flags);
+    for variable in spec.algorithm().variables() {
+        let map = Some(nothing.clone());
+        match variable.as_str() {
+            key::CHL => p.chl_mg_m3 = map,
+            key::NAP => p.nap_g_m3 = map,
+            key::CDOM => p.cdom_per_m = map,
+            key::DEPTH => p.depth_m = map,
+            _ => p.extras.push((variable, nothing.clone())),
+        }
+    }
+    p
 }

@@ -82,6 +82,20 @@ fn a_program_s_products_are_read_back_and_scored_like_any_retrieval() {
     let why = nothing.failure.as_deref().unwrap();
     assert!(why.contains("without writing its output"), "{why}");
     assert_eq!(nothing.metrics.failed, reference.truth.surface.codes().iter().filter(|l| **l == 0).count());
+    // Its promised product keeps its row, returned nowhere, so its requirement fails.
+    let chl = nothing.metrics.get("chl_mg_m3").expect("the promised chl-a is scored");
+    assert_eq!((chl.n, chl.returned_pct), (0, 0.0));
+    let limits = shoal::study::Requirements {
+        products: vec![shoal::study::ProductRequirement {
+            variable: "chl_mg_m3".into(),
+            mae_pct: Some(1000.0),
+            bias_pct: None,
+            returned_pct: None,
+        }],
+        ..Default::default()
+    };
+    let checks = limits.check_run("A", 1, Some(&nothing.metrics), &[], &[]);
+    assert_eq!(shoal::study::verdict(&checks), Some(false), "{checks:?}");
 }
 
 #[test]

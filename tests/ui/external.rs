@@ -32,6 +32,11 @@ fn the_app_asks_before_a_program_runs_and_shows_why_it_returned_nothing() {
     assert!(h.query_by_label_contains(ask).is_none(), "the prompt stays after allowing");
     assert!(h.query_by_label_contains("`mine` returned nothing").is_some(), "no failure box");
     assert!(h.query_all_by_label_contains("no model for 865 nm").next().is_some(), "its standard error is not shown");
+    // The top bar does not call it up to date, and chl-a keeps its row and fails it.
+    assert!(h.query_by_label("up to date").is_none(), "up to date while the retrieval returned nothing");
+    assert!(h.query_by_label("A: retrieval returned nothing").is_some());
+    assert!(h.query_by_label("chl-a (mg m⁻³)").is_some(), "the chl-a row is gone");
+    assert!(h.query_all_by_label_contains("FAIL").next().is_some(), "no FAIL verdict");
     // The rest of the run is there: the Rrs and the SNR of A.
     let shown = &h.state().link.shown[0].as_ref().unwrap().output;
     assert!(shown.views.as_ref().is_some_and(|v| v.rrs.iter().any(|v| *v > 0.0)));
