@@ -34,6 +34,10 @@ pub struct Evaluation {
     pub seconds: f64,
     /// Why it has no result (invalid parameters, a failed run).
     pub error: Option<String>,
+    /// Why it is implausible even where its numbers pass (it smears, saturates or has no
+    /// buildable f-number), in a few words each ([`crate::instrument::plausibility`]).
+    #[serde(default)]
+    pub warnings: Vec<String>,
 }
 
 impl Evaluation {
@@ -161,6 +165,7 @@ impl Evaluator<'_> {
             decimation: self.decimation,
             seconds: 0.0,
             error: None,
+            warnings: Vec::new(),
         };
         let mut config = match configure(self.base, self.vars, x) {
             Ok(c) => c,
@@ -209,6 +214,11 @@ impl Evaluator<'_> {
                 match mae.iter_mut().find(|(name, _)| *name == v.variable) {
                     Some(m) => m.1 += value / self.seeds.len() as f64,
                     None => mae.push((v.variable.clone(), value / self.seeds.len() as f64)),
+                }
+            }
+            for w in &out.report.warnings {
+                if !e.warnings.contains(&w.short()) {
+                    e.warnings.push(w.short());
                 }
             }
             e.cost = budget.cost.ota;

@@ -45,6 +45,7 @@ mod tests {
             decimation: 1,
             seconds: 0.0,
             error: None,
+            warnings: Vec::new(),
         }
     }
 

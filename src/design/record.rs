@@ -250,6 +250,7 @@ mod tests {
             decimation: 8,
             seconds: 1.5,
             error: None,
+            warnings: Vec::new(),
         };
         let r = Record {
             study: "s".into(),

@@ -191,6 +191,7 @@ mod tests {
             decimation: 4,
             seconds: 0.5,
             error: None,
+            warnings: Vec::new(),
         }
     }
 

@@ -45,5 +45,27 @@ fn the_design_window_searches_and_puts_a_design_into_a() {
         (h.state().state.designs[0].spec.aperture_mm - cheapest.x[0]).abs() < 1e-9,
         "A takes the design's aperture"
     );
+    // "+ design" adds it under a file-safe name the list, the slide and the pack share, and a
+    // description that says where it came from (not the CubeSat preset's words).
+    h.get_all_by_label("+ design").next().expect("a row per design").click();
+    h.step();
+    h.step();
+    let added = h.state().state.designs.last().unwrap().clone();
+    assert!(added.preset.starts_with("search ") && added.spec.name == added.preset, "{}", added.preset);
+    assert!(added.spec.validate().is_ok(), "the added design's name is refused");
+    assert!(added.spec.description.starts_with("found by the design search from"));
+    // Stop ends a search at once and keeps what it found.
+    h.get_by_label("Search").click();
+    h.step();
+    assert!(h.state().explore().busy());
+    h.get_by_label("Stop").click();
+    let start = Instant::now();
+    while h.state().explore().busy() {
+        assert!(start.elapsed() < Duration::from_secs(30), "Stop did not stop the search");
+        std::thread::sleep(Duration::from_millis(20));
+        h.step();
+    }
+    h.step();
+    assert!(h.query_by_label_contains("stopped after").is_some(), "the status does not say it stopped");
     let _ = std::fs::remove_dir_all(&dir);
 }

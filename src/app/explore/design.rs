@@ -217,6 +217,11 @@ pub fn design_window(app: &mut super::super::ShoalApp, ctx: &egui::Context) {
             if ui.add_enabled(!d.busy(), egui::Button::new("Search")).clicked() {
                 start = true;
             }
+            // Stop keeps the designs evaluated so far (closing the window also stops it).
+            if ui.add_enabled(d.busy(), egui::Button::new("Stop")).on_hover_text("Stop the search; the designs evaluated so far stay").clicked() {
+                d.cancel();
+                d.status = format!("stopped after {} designs", d.results.len());
+            }
         });
         ui.label(&d.status);
         let now = (current.as_ref(), &app.state.requirements);
@@ -323,7 +328,11 @@ fn table(ui: &mut egui::Ui, d: &DesignState, put: &mut Option<(Put, usize)>) {
                 ui.label(e.cost.map_or_else(|| "–".into(), |c| format!("{c:.3}")));
                 let chl = e.mae_pct.iter().find(|(v, _)| v == "chl_mg_m3").map(|m| m.1);
                 ui.label(chl.map_or_else(|| "–".into(), |m| format!("{m:.1}")));
-                if e.feasible() {
+                if e.feasible() && !e.warnings.is_empty() {
+                    // Its numbers pass, but no one could build it as set (as the metrics table's "pass?").
+                    ui.colored_label(super::super::theme::WARN, "yes?")
+                        .on_hover_text(format!("Meets every requirement, but: {}", e.warnings.join("; ")));
+                } else if e.feasible() {
                     ui.colored_label(super::super::theme::PASS, "yes");
                 } else {
                     ui.label(e.error.as_deref().map_or("no", |_| "error"))
