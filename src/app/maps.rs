@@ -349,6 +349,7 @@ fn map_panel(
 pub fn central(app: &mut ShoalApp, ui: &mut egui::Ui) {
     use super::banners::{external_banner, failure_box, product_note, retrieval_banner};
     retrieval_banner(app, ui);
+    super::banners::domain_banner(app, ui);
     external_banner(app, ui);
     product_menu(app, ui);
     if let Some(note) = product_note(app) {

@@ -108,3 +108,23 @@ fn an_implausible_designs_pass_is_a_question_in_the_slide_and_the_pack() {
     assert!(html.contains("<span class=\"pass\">pass</span>"), "a plausible design passes plainly");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// aLMI over clear water misses chl-a by thousands of percent at full resolution (NAP by 380–490 %
+/// for both designs at this 1/16 preview): the app says it is the retrieval's error over this
+/// scene, not the instruments'; over Lake Hume (NAP 150 % and 122 % at 1/16) it says nothing.
+#[test]
+fn a_retrieval_out_of_its_domain_is_said_so() {
+    let dir = temp_library("domain");
+    let state = AppState { decimations: vec![16], ..AppState::default() };
+    let mut h = with_state(state, &dir);
+    wait_for_engine(&mut h);
+    assert!(h.query_by_label_contains("for every design here").is_none(), "a banner over Lake Hume");
+    pick(&mut h, "Scene", "clear_water");
+    wait_for_engine(&mut h);
+    let nap = |k: usize| {
+        h.state().link.shown[k].as_ref().unwrap().output.retrievals[0].metrics.get("nap_g_m3").unwrap().mae_pct()
+    };
+    assert!(nap(0) > 200.0 && nap(1) > 200.0, "aLMI over clear water: NAP MAE {:.0} %, {:.0} %", nap(0), nap(1));
+    assert!(h.query_by_label_contains("aLMI is off by more than 200 % for every design here (NAP A ").is_some());
+    let _ = std::fs::remove_dir_all(&dir);
+}
