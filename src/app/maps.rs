@@ -407,10 +407,10 @@ pub fn central(app: &mut ShoalApp, ui: &mut egui::Ui) {
                 app.ui.map_rects.push(colour_bar(ui, p, 220.0, &label_text, &classes));
             }
             if let Some(p) = app.images.difference_palette {
-                // The difference in the product's own unit ("A − B (mg m⁻³)").
-                let unit = app.state.product.label().split_once(" (").map_or(String::new(), |(_, u)| format!(" ({u}"));
+                // The difference in the product's own unit ("A − B (mg m⁻³)"), as the study figures.
+                let unit = app.state.product.label().split_once(" (").map_or("", |(_, u)| u.trim_end_matches(')'));
                 let [a, b] = app.state.pair.map(label);
-                app.ui.map_rects.push(colour_bar(ui, p, 160.0, &format!("{a} − {b}{unit}"), &classes));
+                app.ui.map_rects.push(colour_bar(ui, p, 160.0, &crate::study::difference_bar(&a, &b, unit), &classes));
             }
         });
     });

@@ -38,7 +38,7 @@ impl ShoalApp {
         self.images.panel_count()
     }
 
-    /// The map panels' titles, in display order ("truth", "A", "C − A").
+    /// The map panels' titles, in display order ("truth", "A", "C − A (A at C's ground points)").
     #[must_use]
     pub fn panel_titles(&self) -> Vec<String> {
         self.images.titles()

@@ -111,7 +111,7 @@ pub enum Role {
 /// One map panel, ready to show.
 #[derive(Debug, Clone)]
 pub struct PanelImage {
-    /// Title ("truth", "A", "B", "A − B").
+    /// Title ("truth", "A", "B", "A − B (B at A's ground points)").
     pub title: String,
     /// What it shows.
     pub role: Role,
@@ -290,7 +290,7 @@ pub fn panels(job: &Job, cache: &mut MapCache) -> Done {
         })
         .collect();
     if let (Some((d, role)), Some(p)) = (diff, difference_palette) {
-        let title = format!("{} − {}", label(job.pair[0]), label(job.pair[1]));
+        let title = crate::study::difference_title(&label(job.pair[0]), &label(job.pair[1]), job.kind.categorical());
         let made_from = role.designs().into_iter().map(|i| (i, address(&job.runs, i))).collect();
         panels.push(PanelImage { title, role, image: d.blocks.colorize(p), data: d.data, made_from });
     }

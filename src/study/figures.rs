@@ -266,6 +266,23 @@ fn spacing_m(run: &StudyRun) -> f64 {
     run.viewing.gsd_m * run.viewing.decimation as f64
 }
 
+/// The heading of a difference map, the same in the app and the study figures: "A − B (B at A's
+/// ground points)", or for classes "A vs B: same class (at A's ground points)".
+#[must_use]
+pub fn difference_title(a: &str, b: &str, classes: bool) -> String {
+    if classes {
+        format!("{a} vs {b}: same class (at {a}'s ground points)")
+    } else {
+        format!("{a} − {b} ({b} at {a}'s ground points)")
+    }
+}
+
+/// The colour bar of a difference map in the product's unit: "A − B (mg m⁻³)".
+#[must_use]
+pub fn difference_bar(a: &str, b: &str, unit: &str) -> String {
+    if unit.is_empty() { format!("{a} − {b}") } else { format!("{a} − {b} ({unit})") }
+}
+
 /// A − B of two instruments' retrievals on A's pixels, B sampled at the pixel nearest each of A's
 /// ground points (the instruments' grids differ), on a diverging scale symmetric about zero.
 fn difference_figure(ctx: &Context<'_>) -> Option<Maps> {
@@ -294,11 +311,11 @@ fn difference_figure(ctx: &Context<'_>) -> Option<Maps> {
     let bound = *magnitudes.select_nth_unstable_by(k, f64::total_cmp).1;
     let bound = if bound > 0.0 { bound } else { 1.0 };
     Some(Maps {
-        title: format!("{}: A − B", ctx.title),
-        label: "A − B".into(),
+        title: format!("{}: {} − {}", ctx.title, a.label, b.label),
+        label: difference_bar(&a.label, &b.label, crate::metrics::unit(ctx.var)),
         scale: Scale { lo: -bound, hi: bound, log: false },
         panels: vec![Panel {
-            title: format!("{} − {} (B at A's ground points)", a.label, b.label),
+            title: difference_title(&a.label, &b.label, false),
             values,
             valid,
             spacing_m: spacing_m(a),

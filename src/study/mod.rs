@@ -45,7 +45,7 @@ mod substrate_figure;
 
 pub use budget::{Budget, BudgetLine, Stage, budget_table, error_budget};
 pub use curves::{CurvePoint, CurveSeries, Curves, curve_figure, first_crossing};
-pub use figures::figure_set;
+pub use figures::{difference_bar, difference_title, figure_set};
 pub use geotiff_out::{NODATA, swath_geotransform, write_run_geotiff};
 pub use optics_checks::{
     MTF_MAX_WHAT, MTF_MIN_WHAT, NONLINEARITY_WHAT, POLARISATION_WHAT, REGISTRATION_WHAT, StrayLightRequirement,

@@ -127,7 +127,7 @@ fn the_difference_layout_shows_the_chosen_pair() {
     h.state_mut().state.pair = [2, 0];
     h.step();
     h.get_by_label("C | A | C − A").click();
-    maps_become(&mut h, &["C", "A", "C − A"]);
+    maps_become(&mut h, &["C", "A", "C − A (A at C's ground points)"]);
     // Design C alone on the small multiples: the truth and C.
     h.state_mut().state.layout = shoal::app::model::Layout::TruthAB;
     h.state_mut().state.on_maps = vec![2];
