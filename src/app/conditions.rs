@@ -43,14 +43,20 @@ fn checked(
 /// The scene and atmosphere controls.
 pub(super) fn conditions(app: &mut ShoalApp, ui: &mut egui::Ui) {
     use crate::ranges as r;
-    // Each design's band centres, from its latest result (a pair the bands lack is not offered).
-    let bands: Vec<(String, Vec<f64>)> = (0..app.state.designs.len())
-        .filter_map(|i| {
-            let shown = app.link.current(i)?;
-            Some((super::designs::label(i), shown.output.response.bands.centres_nm()))
-        })
-        .collect();
     egui::CollapsingHeader::new("Scene and atmosphere").default_open(false).show(ui, |ui| {
+        // (Only while open: a design's bands from its instrument are not free to find each frame.)
+        // Each design's band centres (a pair the bands lack is not offered): from its latest result,
+        // or, while it waits or has failed, from its instrument (a design without a result was
+        // offered any pair).
+        let bands: Vec<(String, Vec<f64>)> = (0..app.state.designs.len())
+            .filter_map(|i| {
+                let centres = match app.link.current(i) {
+                    Some(shown) => shown.output.response.bands.centres_nm(),
+                    None => app.state.designs[i].spec.kind.model().band_set().ok()?.centres_nm(),
+                };
+                Some((super::designs::label(i), centres))
+            })
+            .collect();
         let s = &mut app.state;
         let mut refused = None;
         let atm = &mut s.scene.atmosphere;
