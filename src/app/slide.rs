@@ -69,7 +69,8 @@ pub fn write_figure(snap: &Snapshot, stem: &Path) -> Result<Vec<PathBuf>, String
             (!words.is_empty()).then(|| format!("{}: {}", super::model::label(i), words.join(", ")))
         })
         .collect();
-    if !warned.is_empty() {
+    // (Only when a "pass?" is on the slide: a design that fails anyway needs no footnote.)
+    if !warned.is_empty() && table.iter().flatten().any(|c| c.ends_with("pass?")) {
         caption.push(format!("pass?: the numbers pass but the design is implausible here ({})", warned.join("; ")));
     }
     // What is compared, as set now (a study's name would outlive a change of scene).

@@ -59,7 +59,7 @@ nav ol { columns: 2; font-size: 14px; } .note { color: #555; font-size: 13px; }
 .summary { display: flex; gap: 14px; flex-wrap: wrap; margin: 8px 0 6px; }
 .card { border: 1px solid #c9ced6; border-radius: 6px; padding: 8px 14px; min-width: 180px; }
 .card b { font-size: 18px; }
-@media print { h2 { break-before: auto; } figure, table { break-inside: avoid; } pre { max-height: none; } }
+@media print { body { font-size: 11px; padding: 0; } table { font-size: 9.5px; } th, td { padding: 1px 4px; } h2 { break-before: auto; } figure, table { break-inside: avoid; } pre { max-height: none; } }
 ";
 
 pub(crate) fn num(v: f64, decimals: usize) -> String {

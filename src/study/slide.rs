@@ -68,7 +68,6 @@ pub struct ReviewSlide {
 }
 
 const MARGIN: i32 = 24;
-const ROW_H: i32 = 24;
 const MAPS_TOP: i32 = 64;
 const MAPS_H: u32 = 620;
 const MAPS_W: u32 = 1230;
@@ -78,28 +77,39 @@ fn text_style(size: u32, colour: RGBColor) -> TextStyle<'static> {
     (FONT, size).into_font().color(&colour)
 }
 
-/// A table at (x, y) within `max_width`, first row bold-ruled; columns as wide as their longest
-/// cell. The font shrinks from 16 px to 11 px until the table fits; columns that still do not are
-/// left out and the last line says how many (eight designs' parameters ran off the slide).
+/// The largest font size (11–16 px) at which `rows` fit `max_width` and, a row being the size
+/// plus 8 px, `max_height`; `None` when none does (the table is then cut at 11 px).
+fn table_fit(rows: &[Vec<String>], (max_width, max_height): (i32, i32)) -> Option<i32> {
+    (11..=16)
+        .rev()
+        .find(|&s| table_widths(rows, s).iter().sum::<i32>() <= max_width && rows.len() as i32 * (s + 8) <= max_height)
+}
+
+/// Column widths of `rows` at font size `size`: DejaVu Sans is about 0.56 em per character, plus
+/// a gap between columns.
+fn table_widths(rows: &[Vec<String>], size: i32) -> Vec<i32> {
+    let columns = rows.first().map_or(0, Vec::len);
+    (0..columns)
+        .map(|c| {
+            let chars = rows.iter().map(|r| r.get(c).map_or(0, |s| s.chars().count())).max().unwrap_or(0);
+            (chars as f64 * 0.5625 * f64::from(size)).ceil() as i32 + size + 6
+        })
+        .collect()
+}
+
+/// A table at (x, y) within `room` (width, height), first row bold-ruled; columns as wide as
+/// their longest cell. The font shrinks from 16 px to 11 px until the table fits
+/// ([`table_fit`]); rows and columns that still do not are left out and the last line says how
+/// many (eight designs' parameters ran off the slide). Returns the height drawn.
 fn table<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     rows: &[Vec<String>],
     (x, y): (i32, i32),
-    max_rows: usize,
-    max_width: i32,
-) -> Result<(), String> {
+    (max_width, max_height): (i32, i32),
+) -> Result<i32, String> {
     let columns = rows.first().map_or(0, Vec::len);
-    // DejaVu Sans: about 0.56 em per character, plus a gap between columns.
-    let widths_at = |size: i32| -> Vec<i32> {
-        (0..columns)
-            .map(|c| {
-                let chars = rows.iter().map(|r| r.get(c).map_or(0, |s| s.chars().count())).max().unwrap_or(0);
-                (chars as f64 * 0.5625 * f64::from(size)).ceil() as i32 + size + 6
-            })
-            .collect()
-    };
-    let size = (11..=16).rev().find(|&s| widths_at(s).iter().sum::<i32>() <= max_width).unwrap_or(11);
-    let widths = widths_at(size);
+    let size = table_fit(rows, (max_width, max_height)).unwrap_or(11);
+    let widths = table_widths(rows, size);
     // The columns that fit (always the first, the row names).
     let mut shown = 0;
     let mut used = 0;
@@ -112,7 +122,9 @@ fn table<DB: DrawingBackend>(
     }
     let row_h = size + 8;
     let size = u32::try_from(size).unwrap_or(16);
-    let rows_fit = max_rows.max(1);
+    // The rows that fit, one line kept for the note when some do not.
+    let fit = usize::try_from(max_height / row_h).unwrap_or(1).max(2);
+    let rows_fit = if rows.len() > fit { fit - 1 } else { rows.len() };
     for (r, row) in rows.iter().take(rows_fit).enumerate() {
         let ty = y + row_h * r as i32;
         let mut tx = x;
@@ -140,12 +152,13 @@ fn table<DB: DrawingBackend>(
     if shown < columns {
         notes.push(format!("{} more columns", columns - shown));
     }
+    let mut height = row_h * rows_fit as i32;
     if !notes.is_empty() {
-        let ty = y + row_h * rows_fit.min(rows.len()) as i32;
         let more = format!("… {} in the review pack", notes.join(" and "));
-        root.draw_text(&more, &text_style(14, RGBColor(90, 90, 90)), (x, ty)).map_err(err)?;
+        root.draw_text(&more, &text_style(14, RGBColor(90, 90, 90)), (x, y + height)).map_err(err)?;
+        height += row_h;
     }
-    Ok(())
+    Ok(height)
 }
 
 /// An x–y chart of `series` in `area` (lines for the SNR, dots for the scatter).
@@ -258,8 +271,13 @@ impl Draw for ReviewSlide {
             format!("{}…", self.title.chars().take(keep.saturating_sub(1)).collect::<String>())
         };
         root.draw_text(&title, &text_style(size, BLACK), (MARGIN, 16 + (30 - size as i32) / 2)).map_err(err)?;
-        // The maps, on the study figures' renderer at slide size.
+        // The maps, on the study figures' renderer at slide size: in one row, as tall as their
+        // aspect needs at that width (at most MAPS_H), so many designs' narrow maps leave their
+        // room below to the tables.
         let n = self.panels.len().max(1) as u32;
+        let panel_w = (MAPS_W - 110) / n;
+        let aspect = self.panels.first().map_or(1.0, |p| p.values.ncols() as f64 / p.values.nrows().max(1) as f64);
+        let panel_h = ((f64::from(panel_w.saturating_sub(20)) / aspect.max(1e-3)).ceil() as u32 + 56).min(MAPS_H - 60);
         let maps = Maps {
             title: String::new(),
             label: self.label.clone(),
@@ -275,7 +293,7 @@ impl Draw for ReviewSlide {
                 })
                 .collect(),
             diverging: self.diverging,
-            panel: ((MAPS_W - 110) / n, MAPS_H - 60),
+            panel: (panel_w, panel_h),
         };
         let (mw, mh) = maps.size();
         let area = root.clone().shrink((MARGIN / 2, MAPS_TOP), (mw, mh));
@@ -292,14 +310,31 @@ impl Draw for ReviewSlide {
         let x = format!("log10 true {}", self.scatter_label);
         let y = format!("log10 retrieved {}", self.scatter_label);
         chart(&scatter_area, "Retrieved against true", (&x, &y), &self.scatter, false, None)?;
-        // Tables along the bottom.
-        let table_y = MAPS_TOP + MAPS_H as i32 + 24;
-        root.draw_text("Verdicts", &text_style(20, BLACK), (MARGIN, table_y)).map_err(err)?;
+        // The verdicts under the maps, the parameters under the charts; both above the caption.
         let caption_y = 1080 - 24 * self.caption.len() as i32 - 10;
-        // As many rows as fit above the caption (the products of either retrieval and the SNR
-        // row fit at three caption lines).
-        let rows = usize::try_from((caption_y - table_y - 30) / ROW_H).unwrap_or(1).max(2);
-        table(root, &self.verdicts, (MARGIN, table_y + 30), rows, PLOTS_X - MARGIN - 16)?;
+        let left_w = PLOTS_X - MARGIN - 16;
+        let right_w = 1920 - PLOTS_X - 16;
+        let table_y = (MAPS_TOP + mh as i32 + 24).max(MAPS_TOP + 280);
+        let charts_end = MAPS_TOP + MAPS_H as i32 + 24;
+        root.draw_text("Verdicts", &text_style(20, BLACK), (MARGIN, table_y)).map_err(err)?;
+        // The parameters beside the verdicts, under the charts, when they fit there; else under
+        // the verdicts on the left's full width, both tables at one font that fits them together.
+        let right_fits = table_fit(&self.parameters, (right_w, caption_y - charts_end - 30)).is_some();
+        let left_h = caption_y - table_y - 30;
+        let verdict_h = if right_fits {
+            left_h
+        } else {
+            let rows = (self.verdicts.len() + self.parameters.len()) as i32;
+            let size = ((left_h - 50) / rows.max(1) - 8).clamp(11, 16);
+            self.verdicts.len() as i32 * (size + 8)
+        };
+        let drawn = table(root, &self.verdicts, (MARGIN, table_y + 30), (left_w, verdict_h))?;
+        let below_y = table_y + 30 + drawn + 20;
+        let (px, py, room) = if right_fits {
+            (PLOTS_X, charts_end, (right_w, caption_y - charts_end - 30))
+        } else {
+            (MARGIN, below_y, (left_w, caption_y - below_y - 30))
+        };
         // "A and B differ in" for a pair; with more designs, against the first column's.
         let names: Vec<&str> =
             self.parameters.first().map(|h| h.iter().skip(1).map(String::as_str).collect()).unwrap_or_default();
@@ -308,8 +343,8 @@ impl Draw for ReviewSlide {
             [a, ..] => format!("The designs against {a}"),
             [] => "Parameters".to_string(),
         };
-        root.draw_text(&heading, &text_style(20, BLACK), (PLOTS_X, table_y)).map_err(err)?;
-        table(root, &self.parameters, (PLOTS_X, table_y + 30), rows, 1920 - PLOTS_X - 16)?;
+        root.draw_text(&heading, &text_style(20, BLACK), (px, py)).map_err(err)?;
+        table(root, &self.parameters, (px, py + 30), room)?;
         for (i, line) in self.caption.iter().enumerate() {
             root.draw_text(line, &text_style(15, RGBColor(60, 60, 60)), (MARGIN, caption_y + 24 * i as i32))
                 .map_err(err)?;

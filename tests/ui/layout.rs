@@ -2,6 +2,8 @@
 //! sizes a reviewer brings (1280 × 720 with eight designs, 900 × 600 with three), the left panel
 //! no wider than its share.
 
+use std::time::{Duration, Instant};
+
 use super::*;
 
 fn designs(names: &[&str]) -> Vec<Slot> {
@@ -75,6 +77,56 @@ fn eight_designs_fit_1280_by_720_and_three_fit_900_by_600() {
         h.set_size(size);
         wait_for_engine(&mut h);
         controls_inside(&mut h, size, names.len());
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The slide of eight designs: every design's map, legend entry and verdict row, the title and
+/// the parameter table within the slide (nothing cut), four designs to a histogram row in the
+/// pack (`SHOAL_KEEP_SLIDE=DIR` keeps the PNG).
+#[test]
+fn the_slide_of_eight_designs_cuts_nothing() {
+    let dir = temp_library("slide8");
+    let names = [
+        "cubesat",
+        "smallsat",
+        "nominal",
+        "hyperspectral",
+        "filter_imager",
+        "sentinel3a_olci",
+        "smallsat_swir",
+        "modis_aqua",
+    ];
+    let state = AppState { designs: designs(&names), decimations: vec![16], ..AppState::default() };
+    let mut h = with_state(state, &dir);
+    wait_for_engine(&mut h);
+    h.get_by_label("Path").click();
+    h.step();
+    h.step();
+    let stem = dir.join("eight");
+    h.get_by_role_and_label(egui::accesskit::Role::TextInput, "Export to")
+        .set_text_value_accesskit(stem.to_str().unwrap());
+    h.step();
+    h.get_by_label("Write figure").click();
+    let start = Instant::now();
+    while !stem.with_extension("svg").is_file() || h.state().exporting() {
+        assert!(start.elapsed() < Duration::from_secs(120), "the figure was not written");
+        assert_eq!(h.state().error(), None);
+        std::thread::sleep(Duration::from_millis(20));
+        h.step();
+    }
+    let svg = std::fs::read_to_string(stem.with_extension("svg")).unwrap();
+    for (i, name) in names.iter().enumerate() {
+        let design = format!("{}: {name}", shoal::app::model::label(i));
+        // A map title, an SNR and a scatter legend entry, and a verdict row each.
+        assert!(svg.matches(&design).count() >= 4, "`{design}` is not on the slide four times");
+    }
+    if let Ok(keep) = std::env::var("SHOAL_KEEP_SLIDE") {
+        std::fs::copy(stem.with_extension("png"), std::path::Path::new(&keep).join("slide_eight.png")).unwrap();
+    }
+    assert!(!svg.contains("more rows") && !svg.contains("more columns"), "the slide cut a table");
+    if let Ok(keep) = std::env::var("SHOAL_KEEP_SLIDE") {
+        std::fs::copy(stem.with_extension("png"), std::path::Path::new(&keep).join("slide_eight.png")).unwrap();
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
