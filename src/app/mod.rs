@@ -300,9 +300,8 @@ impl ShoalApp {
                 },
             );
         });
-        // At most 45 % of the window (and 560 px): a panel that grew with its content (a row of
-        // eight designs' buttons) pushed the maps' controls off a 1280-pixel screen, and egui
-        // remembers a panel's width across restarts. What is wider scrolls inside it.
+        // At most 45 % of the window (and 560 px): a panel grown by eight designs' buttons pushed
+        // the maps' controls off a 1280-pixel screen. What is wider scrolls inside it.
         let left_max = (0.45 * ctx.content_rect().width()).clamp(320.0, 560.0);
         egui::Panel::left("left")
             .resizable(true)
@@ -311,9 +310,14 @@ impl ShoalApp {
             .show(ui, |ui| {
                 egui::ScrollArea::both().show(ui, |ui| panels::left(self, ui));
             });
+        // No lower than its first height less 60 px: egui remembers a panel's height, and one
+        // sized on a 720-pixel screen kept the plots a 300-pixel strip at 4K.
+        let plots_h = plots::panel_height(ui.ctx());
+        let bottom_max = (0.6 * ctx.content_rect().height()).max(plots_h);
         egui::Panel::bottom("bottom")
             .resizable(true)
-            .default_size(plots::panel_height(ui.ctx()))
+            .default_size(plots_h)
+            .size_range((plots_h - 60.0)..=bottom_max)
             .show(ui, |ui| plots::bottom(self, ui));
         egui::CentralPanel::default().show(ui, |ui| maps::central(self, ui));
         if self.ui.explore.sweep_open {
