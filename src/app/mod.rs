@@ -37,6 +37,7 @@ mod editors;
 pub mod explore;
 mod export;
 mod history;
+mod hover;
 mod legend;
 pub mod link;
 mod listing;
@@ -119,8 +120,8 @@ struct UiState {
     plot_rects: Vec<egui::Rect>,
     /// Where the maps and their colour bars were last drawn (for the layout test).
     map_rects: Vec<egui::Rect>,
-    /// The metrics table's width as last drawn (the bottom panel lays its plots out by it).
-    metrics_width: Option<f32>,
+    /// The metrics table's width as last drawn stacked, and for how many designs.
+    metrics_width: Option<(usize, f32)>,
     zoom: maps::View,
     hover: Option<(usize, usize)>,
     /// A fault injected into A's runs (tests; `SHOAL_FAULT` at start).

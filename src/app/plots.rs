@@ -280,9 +280,14 @@ const GAP: f32 = 8.0;
 pub fn bottom(app: &mut ShoalApp, ui: &mut egui::Ui) {
     egui::ScrollArea::vertical().show(ui, |ui| {
         let total = ui.available_width();
-        // The table's width as last drawn (it depends on the products shown).
-        let table = app.ui.metrics_width.unwrap_or(560.0);
-        let beside = total - table - GAP >= 3.0 * MIN_PLOT_WIDTH + 2.0 * GAP;
+        // The table's width as last drawn stacked, for these designs (it depends on the designs
+        // and products shown). Beside the plots the table's grid came out wider than stacked
+        // (egui lays it out again in a horizontal row), so a width measured one way and used the
+        // other flipped the layout every frame and pushed the plots past the window: the width
+        // is measured stacked only, and beside the table is held to it (it scrolls sideways).
+        let designs = app.state.designs.len();
+        let table = app.ui.metrics_width.filter(|(n, _)| *n == designs).map(|(_, w)| w);
+        let beside = table.is_some_and(|t| total - t - GAP >= 3.0 * MIN_PLOT_WIDTH + 2.0 * GAP);
         let plots = |app: &ShoalApp, ui: &mut egui::Ui, room: f32| -> Vec<egui::Rect> {
             // No axes without data: a failed or pending configuration has nothing to plot.
             if (0..app.state.designs.len()).all(|i| {
@@ -323,17 +328,24 @@ pub fn bottom(app: &mut ShoalApp, ui: &mut egui::Ui) {
                     }
                 }
             });
-            app.ui.metrics_width = Some(r.response.rect.width());
+            r.response.rect.width()
         };
-        let rects = if beside {
-            ui.horizontal_top(|ui| {
-                metrics(app, ui);
-                plots(app, ui, total - table - GAP)
-            })
-            .inner
-        } else {
-            metrics(app, ui);
-            plots(app, ui, total)
+        let rects = match table {
+            Some(t) if beside => {
+                ui.horizontal_top(|ui| {
+                    ui.vertical(|ui| {
+                        ui.set_max_width(t);
+                        metrics(app, ui);
+                    });
+                    plots(app, ui, total - t - GAP)
+                })
+                .inner
+            }
+            _ => {
+                let width = metrics(app, ui);
+                app.ui.metrics_width = Some((designs, width));
+                plots(app, ui, total)
+            }
         };
         app.ui.plot_rects = rects;
         super::snr_table::snr_section(app, ui);

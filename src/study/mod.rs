@@ -26,6 +26,7 @@ mod budget;
 mod curves;
 mod figures;
 mod geotiff_out;
+mod histogram_figure;
 mod maps_figure;
 pub mod netcdf_out;
 mod optics_checks;
