@@ -23,15 +23,19 @@
 //! | [`infile`] | reading a file someone else made: regular files only, sized before reading, never blocking |
 //! | [`variable`] | the product variables (chl-a, NAP, CDOM, depth): keys, names, units, CF names |
 //! | [`assets`] | cited spectra embedded in the binary |
+//! | [`schema`] | the file formats' version, and files of older versions brought up to date |
+//! | [`parse`] | RON parse errors described with line, column and field |
+//! | [`ranges`] | the documented range of every number a user sets: one table the validators use |
+//! | [`metrics`] | log-space MAE and bias (Seegers et al. 2018), RMSE, R², histograms |
 //! | [`control`] | cancellation and progress shared by a run and its watcher |
 //! | [`budget`] | what a run may use of the machine (memory, the atmosphere's time), checked before it starts |
 //! | [`jobs`] | background work: the newest-request-wins mailbox and the one rayon pool builder |
+//! | [`timing`] | timing that can be believed on a noisy machine: wall and CPU time, interleaved repeats paired by round |
 //! | [`simd`] | hot loops compiled per instruction-set level (AVX-512, AVX2 + FMA), chosen at run time |
 //! | [`geotiff`] | GeoTIFF in and out: rasters with geotransform, CRS, nodata, band names and units |
 //! | [`netcdf`] | NetCDF-3 with CF metadata: the variables, writing atomically, reading (line, pixel) maps |
 //! | [`spectral`] | wavelength grid, spectra, band sets, `band_from_fine` |
 //! | [`water`] | SIOP sets, IOPs, deep/shallow reflectance (Lee et al. 1998/1999, SAMBUCA) |
-//! | [`ranges`] | the documented range of every number a user sets: one table the validators use |
 //! | [`atmosphere`] | Rayleigh, aerosols (Mie, WMO models), gases, SOS radiative transfer, LUT |
 //! | [`scene`] | scene files composing water, bottom, land, atmosphere and effects; maps |
 //! | [`toa`] | a scene's TOA radiance at any point and view: L_path + T_up·Lw (+ glint, adjacency) |
@@ -39,7 +43,6 @@
 //! | [`calibration`] | diffuser and dark frames → per-detector gain and offset; Level-0 → Level-1 |
 //! | [`correction`] | Level-1 → Rrs: exact per pixel, and the paper's per-scene approximation |
 //! | [`retrieval`] | aLMI and SAMBUCA inversions of band Rrs, improved and as the published codes run |
-//! | [`metrics`] | log-space MAE and bias (Seegers et al. 2018), RMSE, R², histograms |
 //! | [`engine`] | the chain as cached stages; the worker thread the app talks to |
 //! | [`study`] | studies: runs per instrument and seed, metrics tables, figures (PNG/SVG), cubes; the paper reproduced |
 //! | [`sweep`] | sweeps: a study over one parameter or a grid of two, with seeds; shards and merge |
@@ -47,8 +50,6 @@
 //! | [`design`] | design search: the cheapest design meeting every requirement, and the cost–error front |
 //! | [`report`] | the review pack: a study's verdict, figures and provenance as one self-contained HTML page |
 //! | [`library`] | the preset library: built-ins and the user's own; atomic saves |
-//! | [`parse`] | RON parse errors described with line, column and field |
-//! | [`schema`] | the file formats' version, and files of older versions brought up to date |
 //! | [`validation`] | comparisons with reference codes (OSOAA), shared by tests and `shoal bench` |
 //! | `app` | the desktop app (the `gui` feature; the only module that uses egui) |
 //! | [`cli`] | the headless command line (`shoal water`, `atmosphere`, `simulate`, `study`, `report`, `reproduce`, `sweep`, `merge`, `budget`, `bench`, `ranges`) |

@@ -10,7 +10,7 @@ use super::{EngineError, RunConfig};
 use crate::control::RunControl;
 use crate::correction::Reflectance;
 use crate::instrument::{Detector, DetectorMode, Truth};
-use crate::metrics::evaluate;
+use crate::retrieval::evaluate;
 use crate::retrieval::run::band_responses;
 use crate::retrieval::{Product, ProductFlags, RetrievalError, RetrievalInputs, RetrievalSpec, invert, prepare};
 use crate::water::WaterGeometry;

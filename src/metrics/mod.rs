@@ -17,10 +17,6 @@
 
 use serde::Serialize;
 
-mod evaluate;
-
-pub use evaluate::{dominant, evaluate};
-
 /// The metrics of one product.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Metrics {

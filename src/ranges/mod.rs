@@ -12,10 +12,9 @@
 //! thresholds of a study file.
 
 mod editor;
+pub mod limits;
 
 pub use editor::{Editor, INSTRUMENT_EDITOR};
-
-use crate::water::limits;
 
 /// Shortest wavelength Shoal simulates, nm.
 pub const MIN_SIMULATED_NM: f64 = 325.0;

@@ -19,6 +19,7 @@ pub mod almi;
 pub mod almi_lanes;
 pub mod almi_reference;
 pub mod band_model;
+mod evaluate;
 pub mod external;
 mod external_io;
 pub mod nnls;
@@ -36,6 +37,7 @@ mod slsqp_qp;
 pub use algorithm::{Algorithm, Model};
 pub use almi::{AlmiFlags, AlmiSettings};
 pub use band_model::{BandModel, BandResponse, ModelScratch, Parameters};
+pub use evaluate::{dominant, evaluate};
 pub use run::{Product, ProductFlags, RetrievalInputs, RetrievalSpec};
 pub use sambuca::{Objective, SambucaSettings, Starts};
 

@@ -392,7 +392,7 @@ impl Scene {
         Ok(scene)
     }
 
-    /// Every map within the water model's documented ranges (see `water::limits`).
+    /// Every map within the water model's documented ranges (see `ranges::limits`).
     /// Every value of every map within its range ([`crate::ranges`]).
     fn check_ranges(&self) -> Result<(), SceneError> {
         use crate::ranges as r;

@@ -29,8 +29,9 @@
 //!   data. Remote Sens. Environ. 113, 755–770 (SAMBUCA).
 
 mod fastmath;
+/// The water inputs' documented ranges (kept with every other range in [`crate::ranges`]).
+pub use crate::ranges::limits;
 mod kernel;
-pub mod limits;
 mod model;
 mod single;
 mod siop;

@@ -2,7 +2,8 @@
 //! SAMBUCA (`sambuca_core.forward_model`), with every intermediate returned.
 
 use super::kernel::{self, Spectra};
-use super::{Siop, WaterError, limits};
+use super::{Siop, WaterError};
+use crate::ranges::limits;
 use crate::simd::Baseline;
 use crate::units::PI;
 

@@ -103,7 +103,7 @@ impl PerPixel {
                     }
                     if let Some((fa, fb)) = bottoms {
                         let n = a.substrate_names.len().min(b.substrate_names.len());
-                        let dominant = |f| crate::metrics::dominant(f, n, r, c);
+                        let dominant = |f| crate::retrieval::dominant(f, n, r, c);
                         bottom_pixels += 1;
                         bottom_changed += usize::from(dominant(fa) != dominant(fb));
                     }

@@ -4,19 +4,17 @@
 //! is cut into fixed blocks of rows, each block's sums are taken on whichever thread is free, and
 //! the blocks are merged in row order. The blocks do not depend on the number of threads, so the
 //! result does not either (the determinism tests run 1 and 2 threads). The sums are those of
-//! [`super::compare`], added in another order: the metrics agree with a one-pixel-at-a-time pass
+//! [`crate::metrics::compare`], added in another order: the metrics agree with a one-pixel-at-a-time pass
 //! to the last few bits of a double.
-//!
-//! (The pass used to gather each variable's pixels into vectors first, single-threaded: six
-//! fresh 25 MB vectors and 14 % of the default study's page faults, on one core, after each
-//! retrieval.)
+//! (It lives with the retrievals, not in `metrics`: it reads their products, and `metrics` sits
+//! above the correction, which uses its statistics.)
 
 use ndarray::Array2;
 use rayon::prelude::*;
 
-use super::{Confusion, ProductMetrics, Sums, VariableMetrics};
+use super::{Product, ProductFlags};
 use crate::instrument::Truth;
-use crate::retrieval::{Product, ProductFlags};
+use crate::metrics::{Confusion, ProductMetrics, Sums, VariableMetrics};
 
 /// Rows per block (about 50 k pixels at full resolution: enough work to hide the hand-over).
 const ROWS_PER_BLOCK: usize = 32;

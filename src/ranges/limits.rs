@@ -1,4 +1,5 @@
-//! The documented ranges of water-stage inputs. Values outside are refused with a message that
+//! The documented ranges of the water model's inputs (`crate::water`; here, above it, so that
+//! the table of ranges needs nothing of the water model). Values outside are refused with a message that
 //! names the field and the range; inside, the model stays finite (see `tests/`).
 
 /// Largest chlorophyll-a accepted, mg m⁻³ (hypertrophic blooms reach ~10³).
