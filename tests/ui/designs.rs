@@ -205,16 +205,7 @@ fn eight_designs_complete_at_preview_and_the_app_says_what_they_plan_to_hold() {
     use shoal::app::model::Slot;
     use shoal::instrument::InstrumentSpec;
     let dir = temp_library("eight");
-    let names = [
-        "cubesat",
-        "smallsat",
-        "nominal",
-        "hyperspectral",
-        "filter_imager",
-        "sentinel3a_olci",
-        "smallsat_swir",
-        "modis_aqua",
-    ];
+    let names = super::EIGHT;
     let designs = names.iter().map(|n| Slot::new(n, InstrumentSpec::preset(n).unwrap())).collect();
     let mut h = with_state(AppState { designs, decimations: vec![16], ..AppState::default() }, &dir);
     wait_for_engine(&mut h);

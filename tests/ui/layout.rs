@@ -56,19 +56,7 @@ fn controls_inside(h: &mut Harness<'static, ShoalApp>, size: egui::Vec2, n: usiz
 fn eight_designs_fit_1280_by_720_and_three_fit_900_by_600() {
     let dir = temp_library("layout");
     for (names, size) in [
-        (
-            &[
-                "cubesat",
-                "smallsat",
-                "nominal",
-                "hyperspectral",
-                "filter_imager",
-                "sentinel3a_olci",
-                "smallsat_swir",
-                "modis_aqua",
-            ][..],
-            egui::vec2(1280.0, 720.0),
-        ),
+        (&super::EIGHT[..], egui::vec2(1280.0, 720.0)),
         (&["cubesat", "smallsat", "nominal"][..], egui::vec2(900.0, 600.0)),
     ] {
         let on_maps = (0..names.len().min(4)).collect();
@@ -87,16 +75,7 @@ fn eight_designs_fit_1280_by_720_and_three_fit_900_by_600() {
 #[test]
 fn the_slide_of_eight_designs_cuts_nothing() {
     let dir = temp_library("slide8");
-    let names = [
-        "cubesat",
-        "smallsat",
-        "nominal",
-        "hyperspectral",
-        "filter_imager",
-        "sentinel3a_olci",
-        "smallsat_swir",
-        "modis_aqua",
-    ];
+    let names = super::EIGHT;
     let state = AppState { designs: designs(&names), decimations: vec![16], ..AppState::default() };
     let mut h = with_state(state, &dir);
     wait_for_engine(&mut h);

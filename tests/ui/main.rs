@@ -29,6 +29,18 @@ mod review;
 mod session;
 mod spectrum;
 
+/// Eight designs of the library, every kind of instrument among them (the app's most).
+const EIGHT: [&str; 8] = [
+    "cubesat",
+    "smallsat",
+    "nominal",
+    "hyperspectral",
+    "filter_imager",
+    "sentinel3a_olci",
+    "smallsat_swir",
+    "modis_aqua",
+];
+
 /// A fresh, empty user library in the system temporary directory.
 fn temp_library(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("shoal-ui-{}-{name}", std::process::id()));
