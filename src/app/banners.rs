@@ -65,7 +65,7 @@ pub(super) fn domain_banner(app: &ShoalApp, ui: &mut egui::Ui) {
     ui.add(
         egui::Label::new(
             egui::RichText::new(format!(
-                "{retrieval} is off by more than {OUT_OF_DOMAIN_MAE_PCT:.0} % for every design here ({}): over `{}` \
+                "{retrieval} is off by more than {OUT_OF_DOMAIN_MAE_PCT:.0} % for every design that returned it ({}): over `{}` \
                  the retrieval, not the instruments, sets this error (its model does not fit the scene's water). \
                  Compare designs on what it retrieves well, or choose a retrieval made for this water.",
                 missed.join("; "),

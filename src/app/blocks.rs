@@ -93,7 +93,9 @@ impl Blocks {
             for x in 0..w {
                 let k = y * w + x;
                 let n = f64::from(self.count[k]);
-                let colour = if self.count[k] == 0 || !self.lit(y, x) {
+                // (A disagreement anywhere in the block shows, however little was returned.)
+                let shown = self.lit(y, x) || (palette == Palette::Agreement && self.sum[k] > 0.0);
+                let colour = if self.count[k] == 0 || !shown {
                     super::theme::NOT_RETURNED
                 } else {
                     let c = match palette {

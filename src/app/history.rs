@@ -44,12 +44,17 @@ impl Design {
             && self.scene_seed == state.scene_seed
     }
 
-    fn restore(self, state: &mut AppState) {
+    /// Put this design back; its view too when the designs were added, removed or moved
+    /// (`regrouped`), else the view stays as it is now (a map tick is not undone by undoing an
+    /// aperture).
+    fn restore(self, state: &mut AppState, regrouped: bool) {
         state.designs = self.designs;
         state.scene = self.scene;
         state.scene_name = self.scene_name;
         state.scene_seed = self.scene_seed;
-        (state.on_maps, state.pair, state.reference, state.editing) = self.view;
+        if regrouped {
+            (state.on_maps, state.pair, state.reference, state.editing) = self.view;
+        }
         // The design edited, the maps' list and the pair may name a design no longer there.
         state.settle();
     }
@@ -127,7 +132,7 @@ impl History {
         self.redo.push(Design::of(state));
         self.settled = Some(previous.clone());
         let moved = moved(&state.designs, &previous.designs);
-        previous.restore(state);
+        previous.restore(state, !identity(&moved));
         Some(moved)
     }
 
@@ -138,7 +143,7 @@ impl History {
         self.undo.push(Design::of(state));
         self.settled = Some(next.clone());
         let moved = moved(&state.designs, &next.designs);
-        next.restore(state);
+        next.restore(state, !identity(&moved));
         Some(moved)
     }
 
@@ -176,6 +181,11 @@ pub fn moved(before: &[Slot], after: &[Slot]) -> Moved {
         }
     }
     out
+}
+
+/// Did every design stay where it was (none added, removed or moved)?
+fn identity(moved: &Moved) -> bool {
+    moved.iter().enumerate().all(|(i, m)| *m == Some(i))
 }
 
 #[cfg(test)]
@@ -244,6 +254,12 @@ mod tests {
         assert_eq!(state.designs[1].preset, "smallsat");
         assert_eq!(state.on_maps, [0, 2, 3], "B was not on the maps; C and D were");
         assert_eq!(h.redo(&mut state), Some(vec![Some(0), None, Some(1), Some(2)]));
+        // An edit undone leaves the view as it is now: a tick made since is not taken back.
+        state.designs[0].spec.aperture_mm = 90.0;
+        h.observe(&state, false);
+        state.on_maps = vec![0];
+        assert_eq!(h.undo(&mut state), Some(vec![Some(0), Some(1), Some(2)]));
+        assert_eq!(state.on_maps, [0], "the map tick was undone with the aperture");
         // A changed design keeps its place (its result shown, greyed, until the new one).
         let before = state.designs.clone();
         state.designs[1].spec.aperture_mm *= 2.0;

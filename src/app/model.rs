@@ -379,20 +379,24 @@ impl AppState {
             else {
                 continue;
             };
-            for (k, v) in &now {
+            // Both files' keys: a list cleared to nothing is left out of the edited one.
+            let keys: Vec<&String> = now.keys().chain(then.keys().filter(|k| !now.contains_key(*k))).collect();
+            for k in keys {
+                let v = now.get(k).unwrap_or(&serde_json::Value::Null);
                 let old = then.get(k).unwrap_or(&serde_json::Value::Null);
                 if old == v || k == "name" || k == "description" {
                     continue;
                 }
                 let what = match (old, v) {
                     (serde_json::Value::Number(a), serde_json::Value::Number(b)) => {
-                        let sig =
-                            |n: &serde_json::Number| n.as_f64().map_or_else(|| n.to_string(), |x| significant(x, 4));
+                        let sig = |n: &serde_json::Number| n.as_f64().map_or_else(|| n.to_string(), four_digits);
                         format!("{} → {}", sig(a), sig(b))
                     }
                     (serde_json::Value::Array(a), serde_json::Value::Array(b)) if a.len() != b.len() => {
                         format!("{} → {} entries", a.len(), b.len())
                     }
+                    (serde_json::Value::Array(a), serde_json::Value::Null) => format!("{} → 0 entries", a.len()),
+                    (serde_json::Value::Null, serde_json::Value::Array(b)) => format!("0 → {} entries", b.len()),
                     _ => "edited".to_string(),
                 };
                 out.push(format!("{} {k} {what}", label(i)));
@@ -400,6 +404,12 @@ impl AppState {
         }
         out
     }
+}
+
+/// `x` to four significant digits: as people write it inside 0.001–10⁶ ("105.8"), else in
+/// e-notation with its four digits ("3.330e-4", where `significant` would say "3e-4").
+fn four_digits(x: f64) -> String {
+    if x == 0.0 || (1e-3..1e6).contains(&x.abs()) { significant(x, 4) } else { format!("{x:.3e}") }
 }
 
 /// The image-based correction `image` as design `spec` runs it: the default pair (779/865 nm),
@@ -447,6 +457,8 @@ mod tests {
         // A float's raw digits never reach a caption.
         s.designs[0].spec.aperture_mm = 105.800_000_000_000_01;
         assert_eq!(s.changes(), vec!["A aperture_mm 60 → 105.8".to_string()]);
+        s.designs[0].spec.exposure_s = 3.33e-4;
+        assert!(s.changes().contains(&"A exposure_s 0.0015 → 3.330e-4".to_string()), "{:?}", s.changes());
     }
 
     #[test]

@@ -60,17 +60,27 @@ pub fn write_figure(snap: &Snapshot, stem: &Path) -> Result<Vec<PathBuf>, String
     ];
     // What "pass?" means, and why, on the slide itself (the app says it on hover).
     let mut caption = caption;
+    // The designs whose row or column holds a "pass?" (a design that fails anyway needs none).
+    let questioned = |i: usize| {
+        let letter = super::model::label(i);
+        if runs.len() > 2 {
+            table.get(i + 1).is_some_and(|row| row.iter().any(|c| c.ends_with("pass?")))
+        } else {
+            let at = table.first().and_then(|h| h.iter().position(|c| *c == letter));
+            at.is_some_and(|k| table.iter().skip(1).any(|row| row.get(k).is_some_and(|c| c == "pass?")))
+        }
+    };
     let warned: Vec<String> = runs
         .iter()
         .enumerate()
+        .filter(|(i, _)| questioned(*i))
         .filter_map(|(i, out)| {
             let w = &out.report.warnings;
             let words: Vec<String> = w.iter().map(crate::instrument::plausibility::Warning::short).collect();
             (!words.is_empty()).then(|| format!("{}: {}", super::model::label(i), words.join(", ")))
         })
         .collect();
-    // (Only when a "pass?" is on the slide: a design that fails anyway needs no footnote.)
-    if !warned.is_empty() && table.iter().flatten().any(|c| c.ends_with("pass?")) {
+    if !warned.is_empty() {
         caption.push(format!("pass?: the numbers pass but the design is implausible here ({})", warned.join("; ")));
     }
     // What is compared, as set now (a study's name would outlive a change of scene).

@@ -29,7 +29,8 @@ pub enum Guard {
 }
 
 impl Warning {
-    /// A few words for a caption ("smears 5.3 px", "saturates 7 bands", "f/0.80").
+    /// A few words for a caption ("smears 5.3 px", "saturates at 191 % of full scale", "f/0.80,
+    /// faster than f/1").
     #[must_use]
     pub fn short(&self) -> String {
         match self.guard {

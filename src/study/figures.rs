@@ -77,6 +77,10 @@ impl Draw for Scatter {
 
 fn metric_line(m: Option<&Metrics>) -> String {
     m.map_or_else(String::new, |m| {
+        // Nothing returned has no error to state (its sums would read MAE 0 %).
+        if m.n == 0 {
+            return "no pixel returned".to_string();
+        }
         format!("MAE {:.0} %, bias {:+.0} %, {:.1} % returned", m.mae_pct(), m.bias_pct(), m.returned_pct)
     })
 }
@@ -233,6 +237,7 @@ fn scatter_and_histograms(ctx: &Context<'_>) -> Option<(Scatter, Histograms)> {
     };
     let mut scatter_panels = Vec::new();
     let mut hist_panels = Vec::new();
+    let mut hist_water = Vec::new();
     for run in ctx.runs {
         let (Some(ret), Some(truth)) = (run.retrievals.get(ctx.index), run.truth.map(ctx.var)) else { continue };
         let Some(map) = ret.product.map(ctx.var) else { continue };
@@ -249,10 +254,12 @@ fn scatter_and_histograms(ctx: &Context<'_>) -> Option<(Scatter, Histograms)> {
         let nb = hist_edges.len() - 1;
         let mut counts = vec![vec![0usize; nb]; categories.len().max(1)];
         let mut truth_counts = vec![0usize; nb];
+        let mut water = 0;
         for ((r, c), v) in map.indexed_iter() {
             if !run.truth.surface.is_water(r, c) {
                 continue;
             }
+            water += 1;
             if let Some(b) = bin_of(&hist_edges, f64::from(truth[[r, c]])) {
                 truth_counts[b] += 1;
             }
@@ -264,6 +271,7 @@ fn scatter_and_histograms(ctx: &Context<'_>) -> Option<(Scatter, Histograms)> {
         }
         let note = if p.flags.iter().any(|f| f & ProductFlags::FAILED != 0) { " (failures excluded)" } else { "" };
         hist_panels.push((format!("{}{note}", run.label), counts, truth_counts));
+        hist_water.push(water);
     }
     Some((
         Scatter { title: ctx.title.clone(), label: crate::metrics::label(ctx.var), edges, panels: scatter_panels },
@@ -273,6 +281,7 @@ fn scatter_and_histograms(ctx: &Context<'_>) -> Option<(Scatter, Histograms)> {
             edges: hist_edges,
             categories,
             panels: hist_panels,
+            water: hist_water,
         },
     ))
 }

@@ -17,6 +17,9 @@ pub(super) struct Histograms {
     pub(super) categories: Vec<String>,
     /// Per panel: title, counts[category][bin], truth counts[bin].
     pub(super) panels: Vec<(String, Vec<Vec<usize>>, Vec<usize>)>,
+    /// Per panel, the run's water pixels: what its bars are shares of (the bins hold only the
+    /// values inside the plotted range).
+    pub(super) water: Vec<usize>,
 }
 
 /// The factor on the tallest bar that leaves room above it for a legend of `entries` lines, so
@@ -50,20 +53,25 @@ impl Draw for Histograms {
         top.draw_text(&self.title, &(FONT, 17).into_font().color(&BLACK), (10, 8)).map_err(err)?;
         let (lo, hi) = (self.edges[0], self.edges[self.edges.len() - 1]);
         let nb = self.edges.len() - 1;
-        // Shares of each run's own water pixels (its truth's count), so a 10 m imager's millions
-        // of pixels do not flatten a 300 m one's bars; one axis for all panels.
-        let pct = |n: usize, truth: &[usize]| 100.0 * n as f64 / truth.iter().sum::<usize>().max(1) as f64;
+        // Shares of each run's own water pixels, so a 10 m imager's millions of pixels do not
+        // flatten a 300 m one's bars; one axis for all panels.
+        let water = |k: usize| self.water.get(k).copied().unwrap_or(0).max(1) as f64;
         let ymax = self
             .panels
             .iter()
-            .map(|(_, c, t)| {
-                (0..nb).map(|b| pct(c.iter().map(|row| row[b]).sum::<usize>().max(t[b]), t)).fold(0.0, f64::max)
+            .enumerate()
+            .map(|(k, (_, c, t))| {
+                (0..nb)
+                    .map(|b| 100.0 * c.iter().map(|row| row[b]).sum::<usize>().max(t[b]) as f64 / water(k))
+                    .fold(0.0, f64::max)
             })
             .fold(0.0, f64::max)
             .max(1e-9)
             * legend_headroom(self.panels.iter().map(|(_, c, _)| c.len()).max().unwrap_or(0) + 1);
         let (cols, rows) = self.grid();
-        for (area, (title, counts, truth)) in rest.split_evenly((rows, cols)).iter().zip(&self.panels) {
+        for (k, (area, (title, counts, truth))) in rest.split_evenly((rows, cols)).iter().zip(&self.panels).enumerate()
+        {
+            let pct = |n: usize| 100.0 * n as f64 / water(k);
             let mut chart = ChartBuilder::on(area)
                 .caption(title, (FONT, 16))
                 .margin(8)
@@ -93,7 +101,7 @@ impl Draw for Histograms {
                     .filter(|&b| row[b] > 0)
                     .map(|b| {
                         Rectangle::new(
-                            [(self.edges[b], pct(base[b], truth)), (self.edges[b + 1], pct(base[b] + row[b], truth))],
+                            [(self.edges[b], pct(base[b])), (self.edges[b + 1], pct(base[b] + row[b]))],
                             colour.filled(),
                         )
                     })
@@ -107,9 +115,8 @@ impl Draw for Histograms {
                     base[b] += row[b];
                 }
             }
-            let outline: Vec<(f64, f64)> = (0..nb)
-                .flat_map(|b| [(self.edges[b], pct(truth[b], truth)), (self.edges[b + 1], pct(truth[b], truth))])
-                .collect();
+            let outline: Vec<(f64, f64)> =
+                (0..nb).flat_map(|b| [(self.edges[b], pct(truth[b])), (self.edges[b + 1], pct(truth[b]))]).collect();
             chart
                 .draw_series(LineSeries::new(outline, BLACK.stroke_width(2)))
                 .map_err(err)?
@@ -152,6 +159,7 @@ mod tests {
             edges,
             categories: vec!["returned".into()],
             panels: (0..8).map(panel).collect(),
+            water: (0..8).map(|k| if k == 7 { 10_000 } else { 100 }).collect(),
         };
         assert_eq!(h.size(), (2080, 500 + 466));
         let f = render("h", &h).unwrap();

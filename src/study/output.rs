@@ -73,6 +73,11 @@ fn json<T: Serialize>(value: &T) -> Result<String, StudyError> {
     serde_json::to_string_pretty(value).map_err(|e| StudyError::Io(format!("JSON: {e}")))
 }
 
+/// [`number`] of `v` where `known`, else an empty field.
+fn some(known: bool, v: f64) -> String {
+    if known { number(v) } else { String::new() }
+}
+
 fn number(v: f64) -> String {
     if !v.is_finite() {
         "inf".into()
@@ -250,10 +255,11 @@ pub fn metrics_csv(result: &StudyResult) -> String {
                     run.seed.to_string(),
                     ret.metrics.product.to_string(),
                     v.variable.to_string(),
-                    number(m.mae),
-                    number(m.bias),
-                    number(m.mae_pct()),
-                    number(m.bias_pct()),
+                    // Nothing returned: no error (its sums would read MAE 0 %), an empty field.
+                    some(m.n > 0, m.mae),
+                    some(m.n > 0, m.bias),
+                    some(m.n > 0, m.mae_pct()),
+                    some(m.n > 0, m.bias_pct()),
                     m.n.to_string(),
                     m.candidates.to_string(),
                     number(m.returned_pct),

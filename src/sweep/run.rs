@@ -110,7 +110,9 @@ pub fn run_job(
     for ret in &out.retrievals {
         for v in &ret.metrics.variables {
             let m = &v.metrics;
-            rows.push(row(&ret.metrics.product, &v.variable, m.mae_pct(), m.bias_pct(), m.returned_pct, m.n));
+            // Nothing returned has no error: NaN, never the 0 % its empty sums would give.
+            let (mae, bias) = if m.n > 0 { (m.mae_pct(), m.bias_pct()) } else { (f64::NAN, f64::NAN) };
+            rows.push(row(&ret.metrics.product, &v.variable, mae, bias, m.returned_pct, m.n));
         }
     }
     Ok((rows, secs))

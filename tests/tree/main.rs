@@ -63,7 +63,8 @@ fn module_order() -> Vec<String> {
 /// The text of `file` a dependency can be in: neither comments nor the tests at its end.
 fn code(file: &Path) -> String {
     let text = std::fs::read_to_string(file).unwrap();
-    let body = text.split("#[cfg(test)]").next().unwrap_or_default();
+    // Cut at the test module (`#[cfg(test)]` on a helper function mid-file is not the end).
+    let body = text.split("#[cfg(test)]\nmod ").next().unwrap_or_default();
     body.lines().filter(|l| !l.trim_start().starts_with("//")).collect::<Vec<_>>().join("\n")
 }
 
