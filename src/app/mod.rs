@@ -120,7 +120,7 @@ struct UiState {
     plot_rects: Vec<egui::Rect>,
     /// Where the maps and their colour bars were last drawn (for the layout test).
     map_rects: Vec<egui::Rect>,
-    /// The metrics table's width as last drawn stacked, and for how many designs.
+    /// The widest the metrics table has been drawn, and for how many designs.
     metrics_width: Option<(usize, f32)>,
     zoom: maps::View,
     hover: Option<(usize, usize)>,

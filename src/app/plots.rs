@@ -280,11 +280,10 @@ const GAP: f32 = 8.0;
 pub fn bottom(app: &mut ShoalApp, ui: &mut egui::Ui) {
     egui::ScrollArea::vertical().show(ui, |ui| {
         let total = ui.available_width();
-        // The table's width as last drawn stacked, for these designs (it depends on the designs
-        // and products shown). Beside the plots the table's grid came out wider than stacked
-        // (egui lays it out again in a horizontal row), so a width measured one way and used the
-        // other flipped the layout every frame and pushed the plots past the window: the width
-        // is measured stacked only, and beside the table is held to it (it scrolls sideways).
+        // The widest the table has been drawn for these designs, stacked or beside the plots.
+        // Beside them its grid comes out wider than stacked (egui lays it out again in a row), so
+        // a width measured one way and used the other flipped the layout every frame and pushed
+        // the plots past the window; the widest of both settles on a layout that holds.
         let designs = app.state.designs.len();
         let table = app.ui.metrics_width.filter(|(n, _)| *n == designs).map(|(_, w)| w);
         let beside = table.is_some_and(|t| total - t - GAP >= 3.0 * MIN_PLOT_WIDTH + 2.0 * GAP);
@@ -330,20 +329,21 @@ pub fn bottom(app: &mut ShoalApp, ui: &mut egui::Ui) {
             });
             r.response.rect.width()
         };
+        let widest = |app: &mut ShoalApp, width: f32| {
+            app.ui.metrics_width = Some((designs, table.map_or(width, |t| t.max(width))));
+        };
         let rects = match table {
             Some(t) if beside => {
                 ui.horizontal_top(|ui| {
-                    ui.vertical(|ui| {
-                        ui.set_max_width(t);
-                        metrics(app, ui);
-                    });
+                    let width = metrics(app, ui);
+                    widest(app, width);
                     plots(app, ui, total - t - GAP)
                 })
                 .inner
             }
             _ => {
                 let width = metrics(app, ui);
-                app.ui.metrics_width = Some((designs, width));
+                widest(app, width);
                 plots(app, ui, total)
             }
         };
