@@ -4,11 +4,12 @@
 
 use super::ShoalApp;
 use super::model::ProductKind;
+use crate::retrieval::algorithm::{ALMI, SAMBUCA};
 
 /// The scene ↔ retrieval banner: a scene whose bottom shows needs a retrieval that models one.
 pub(super) fn retrieval_banner(app: &mut ShoalApp, ui: &mut egui::Ui) {
     use super::logic::UiCommand;
-    if app.state.runs("alm") && app.state.scene.needs_bottom_model() {
+    if app.state.runs(ALMI.name) && app.state.scene.needs_bottom_model() {
         ui.horizontal_wrapped(|ui| {
             ui.colored_label(
                 super::theme::NOTICE,
@@ -18,8 +19,12 @@ pub(super) fn retrieval_banner(app: &mut ShoalApp, ui: &mut egui::Ui) {
                     app.state.scene_name
                 ),
             );
-            if ui.button("Use SAMBUCA").on_hover_text("Retrieve depth, substrate and water together").clicked() {
-                app.ui.commands.push(UiCommand::UseRetrieval("sambuca"));
+            if ui
+                .button(format!("Use {}", SAMBUCA.title))
+                .on_hover_text("Retrieve depth, substrate and water together")
+                .clicked()
+            {
+                app.ui.commands.push(UiCommand::UseRetrieval(SAMBUCA.name));
             }
         });
     }
@@ -79,14 +84,14 @@ pub(super) fn domain_banner(app: &ShoalApp, ui: &mut egui::Ui) {
 
 /// The retrieval's name as tables and captions show it.
 pub(super) fn retrieval_name(state: &super::model::AppState) -> String {
-    state.retrieval_spec().algorithm().title()
+    state.retrieval_spec().title().to_string()
 }
 
 /// What the shown product is when the retrieval does not make it.
 pub(super) fn product_note(app: &ShoalApp) -> Option<String> {
     use crate::retrieval::RetrievalSpec;
     let spec = app.state.retrieval_spec();
-    let retrieval = spec.algorithm().title();
+    let retrieval = spec.title();
     let missing = match app.state.product {
         ProductKind::Depth | ProductKind::Chl | ProductKind::Nap | ProductKind::Cdom => {
             app.state.product.variable().is_some_and(|v| !spec.algorithm().variables().iter().any(|p| p == v))
@@ -115,14 +120,18 @@ pub(super) fn failure_box(app: &mut ShoalApp, ui: &mut egui::Ui, index: usize, m
         );
         ui.add(egui::Label::new(message).wrap());
         let deep = !app.state.scene.needs_bottom_model();
-        if app.state.runs("sambuca") && deep {
+        if app.state.runs(SAMBUCA.name) && deep {
             ui.horizontal_wrapped(|ui| {
                 ui.label(format!(
                     "`{}` is optically deep: SAMBUCA fits a bottom it does not have.",
                     app.state.scene_name
                 ));
-                if ui.button("Use aLMI").on_hover_text("Retrieve chl-a, NAP and CDOM for deep water").clicked() {
-                    app.ui.commands.push(UiCommand::UseRetrieval("alm"));
+                if ui
+                    .button(format!("Use {}", ALMI.title))
+                    .on_hover_text("Retrieve chl-a, NAP and CDOM for deep water")
+                    .clicked()
+                {
+                    app.ui.commands.push(UiCommand::UseRetrieval(ALMI.name));
                 }
             });
         }

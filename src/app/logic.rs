@@ -180,7 +180,11 @@ impl ShoalApp {
             }
             UiCommand::UseRetrieval(name) => {
                 if self.state.select_retrieval(name) {
-                    self.state.product = if name == "sambuca" { ProductKind::Depth } else { ProductKind::Chl };
+                    self.state.product = if name == crate::retrieval::algorithm::SAMBUCA.name {
+                        ProductKind::Depth
+                    } else {
+                        ProductKind::Chl
+                    };
                 }
             }
             UiCommand::SaveStudy { name } => {

@@ -333,7 +333,7 @@ fn settings(app: &mut ShoalApp, ui: &mut egui::Ui) {
         // The retrievals offered: aLMI, SAMBUCA and the study's own, each by its title.
         ui.horizontal_wrapped(|ui| {
             for i in 0..s.retrievals.len() {
-                let title = s.retrievals[i].algorithm().title();
+                let title = s.retrievals[i].title();
                 ui.selectable_value(&mut s.selected_retrieval, i, title);
             }
         });
@@ -395,26 +395,23 @@ fn retrieval_settings(spec: &mut crate::retrieval::RetrievalSpec, ui: &mut egui:
     use crate::retrieval::RetrievalSpec;
     // Reference: the published code's behaviour, to reproduce published numbers; Improved:
     // Shoal's inversion, the design default (QAA: the v6 document against the IOCCG sheet).
-    let (mode, names) = match spec {
-        RetrievalSpec::Almi { settings, .. } => (&mut settings.mode, ("Improved", "Reference")),
-        RetrievalSpec::Sambuca { settings, .. } => (&mut settings.mode, ("Improved", "Reference")),
-        RetrievalSpec::Qaa { settings } => (&mut settings.mode, ("Document", "IOCCG sheet")),
-        RetrievalSpec::External(e) => {
+    let Some((mode, names)) = spec.mode_mut() else {
+        if let RetrievalSpec::External(e) = spec {
             ui.small(format!(
                 "Runs `{}` on the Rrs (NetCDF) and scores its {} (time limit {} s).",
                 e.command.join(" "),
                 e.products.join(", "),
                 e.time_limit_s
             ));
-            return;
         }
+        return;
     };
     ui.horizontal(|ui| {
         ui.label("Mode");
-        ui.selectable_value(mode, Mode::Improved, names.0).on_hover_text(
+        ui.selectable_value(mode, Mode::Improved, names[0]).on_hover_text(
             "Shoal's inversion (QAA: the v6 document's equations, as NASA's l2gen): what a design study should use",
         );
-        ui.selectable_value(mode, Mode::Reference, names.1).on_hover_text(
+        ui.selectable_value(mode, Mode::Reference, names[1]).on_hover_text(
             "The published code step for step (DEA aLMI; CSIRO SAMBUCA with SLSQP from one start; the IOCCG QAA_v6 \
              spreadsheet), to reproduce published numbers",
         );

@@ -134,7 +134,7 @@ pub fn repair(state: &mut AppState) -> Vec<String> {
     let (mut kept, mut selected) = (Vec::new(), 0);
     for (i, mut r) in std::mem::take(&mut state.retrievals).into_iter().enumerate() {
         if let Err(e) = r.validate() {
-            reset.push(format!("retrieval {} settings ({e}): back to the defaults", r.algorithm().title()));
+            reset.push(format!("retrieval {} settings ({e}): back to the defaults", r.title()));
             let builtin = super::retrievals::built_in(Default::default(), Default::default());
             match builtin.into_iter().find(|b| b.name() == r.name()) {
                 Some(b) => r = b,

@@ -111,14 +111,14 @@ impl Engine {
                 .stage(model_key, report, control, || prepare(spec, &inputs).map_err(fail_in(Stage::RetrievalModel)))?;
             let result = self.stage(key, report, control, || {
                 // A user's program that fails costs its own product, not the run's others.
-                let (product, failure) = match invert(spec, &model, &inputs, control) {
+                let (product, failure) = match invert(&model, &inputs, control) {
                     Ok(p) => (p, None),
                     Err(e @ RetrievalError::External { .. }) => (failed_product(spec, &inputs), Some(e.to_string())),
                     Err(e) => return Err(fail(e)),
                 };
                 let mut metrics = evaluate(&product, truth);
                 // Extra products scored where the algorithm says what their truth is.
-                for (key, want) in spec.algorithm().extra_truths(&model, truth) {
+                for (key, want) in model.extra_truths(truth) {
                     if let Some(m) = product.map(&key) {
                         metrics.variables.push(score_map(&product, m, &want, &truth.surface, key));
                     }

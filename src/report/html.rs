@@ -273,11 +273,7 @@ fn metrics(h: &mut String, d: &ReviewData) {
 /// "aLMI chl-a" for the key `alm_chl_mg_m3` of a figure's file stem.
 fn describe_key(key: &str) -> String {
     let (retrieval, variable) = key.split_once('_').unwrap_or((key, ""));
-    let retrieval = match retrieval {
-        "alm" | "almi" => "aLMI",
-        "sambuca" => "SAMBUCA",
-        other => other,
-    };
+    let retrieval = crate::retrieval::title_of(if retrieval == "almi" { "alm" } else { retrieval });
     let variable = match variable {
         "chl_mg_m3" => "chlorophyll-a",
         "nap_g_m3" => "NAP",

@@ -11,7 +11,7 @@
 //! | solvers | [`nnls`], [`optimise`], [`slsqp`] | exact small NNLS; bounded Levenberg–Marquardt and BFGS; SciPy's SLSQP for bounds |
 //! | external | [`external`] | a user's own program, run on a NetCDF file of the Rrs, its products read back |
 //! | QAA v6 | [`qaa`] | the Quasi-Analytical Algorithm (Lee et al. 2002; v6 2014): IOPs, chl from a_ph(443) |
-//! | the seam | [`algorithm`] | the [`Algorithm`] trait every retrieval implements, and which spec runs which |
+//! | the seam | [`algorithm`] | the [`Algorithm`] and [`Prepared`] traits every retrieval implements, its names, and which spec runs which |
 //! | images | [`run`] | a retrieval over a whole Rrs cube, the products and their flags |
 
 pub mod algorithm;
@@ -34,7 +34,7 @@ pub mod sets;
 pub mod slsqp;
 mod slsqp_qp;
 
-pub use algorithm::{Algorithm, Model};
+pub use algorithm::{Algorithm, Identity, Model, Prepared, title_of};
 pub use almi::{AlmiFlags, AlmiSettings};
 pub use band_model::{BandModel, BandResponse, ModelScratch, Parameters};
 pub use evaluate::{dominant, evaluate};
@@ -103,14 +103,13 @@ pub fn prepare(spec: &RetrievalSpec, inputs: &RetrievalInputs<'_>) -> Result<Mod
     algorithm.prepare(inputs)
 }
 
-/// Run `spec` over the image with `model`, prepared by [`prepare`] from the same spec and bands.
+/// Run the retrieval `model` was prepared for ([`prepare`]) over the image at the same bands.
 pub fn invert(
-    spec: &RetrievalSpec,
     model: &Model,
     inputs: &RetrievalInputs<'_>,
     control: &crate::control::RunControl,
 ) -> Result<Product, RetrievalError> {
-    spec.algorithm().invert(model, inputs, control)
+    model.invert(inputs, control)
 }
 
 /// Run `spec` over the image: [`prepare`], then [`invert`].
@@ -119,6 +118,5 @@ pub fn retrieve(
     inputs: &RetrievalInputs<'_>,
     control: &crate::control::RunControl,
 ) -> Result<Product, RetrievalError> {
-    let model = prepare(spec, inputs)?;
-    invert(spec, &model, inputs, control)
+    prepare(spec, inputs)?.invert(inputs, control)
 }

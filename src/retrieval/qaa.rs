@@ -287,7 +287,7 @@ pub fn retrieve_qaa(
     let plane = |k: usize| out.mapv(|v| v[k]);
     // a_dg(443), a_ph(443), b_bp(555): the order of `crate::variable::EXTRAS`.
     let extras = crate::variable::EXTRAS.iter().enumerate().map(|(k, v)| (v.key.to_string(), plane(k + 1))).collect();
-    Ok(Product { chl_mg_m3: Some(plane(0)), extras, ..Product::bare("QAA".into(), flags) })
+    Ok(Product { chl_mg_m3: Some(plane(0)), extras, ..Product::bare(super::algorithm::QAA.title.into(), flags) })
 }
 
 #[cfg(test)]

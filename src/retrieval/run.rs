@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 
 use super::Mode;
 use super::RetrievalError;
+use super::algorithm::{ALMI, BUILT_IN};
 use super::almi::{AlmiFlags, AlmiSet, AlmiSettings};
 use super::almi_lanes::{PackedSets, Scratch, invert_packed};
 use super::almi_reference::invert_reference;
@@ -59,20 +60,9 @@ pub enum RetrievalSpec {
 
 /// The built-in retrievals' names ([`RetrievalSpec::name`]): a retrieval of the user's may
 /// not take one (its files and variables would overwrite the built-in's), in any case.
-pub const BUILT_IN_NAMES: [&str; 3] = ["alm", "sambuca", "qaa"];
+pub const BUILT_IN_NAMES: [&str; 3] = [BUILT_IN[0].name, BUILT_IN[1].name, BUILT_IN[2].name];
 
 impl RetrievalSpec {
-    /// Short name for reports and file names.
-    #[must_use]
-    pub fn name(&self) -> &str {
-        match self {
-            Self::Almi { .. } => "alm",
-            Self::Sambuca { .. } => "sambuca",
-            Self::External(e) => &e.name,
-            Self::Qaa { .. } => "qaa",
-        }
-    }
-
     /// The spec with an external command's `{dir}` replaced by `dir`, the study file's directory
     /// (the other retrievals take their relative paths from the scene's directory as they run).
     pub fn with_dir(&self, dir: Option<&Path>) -> Result<Self, RetrievalError> {
@@ -116,7 +106,7 @@ impl ProductFlags {
 /// A retrieval's products over the image.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Product {
-    /// "aLMI", "SAMBUCA", or an external retrieval's name.
+    /// The retrieval's title ([`super::algorithm::Identity::title`]), or an external retrieval's name.
     pub name: String,
     /// Chlorophyll-a, mg m⁻³ (0 where not returned; `None`: an external retrieval that does not
     /// return it).
@@ -381,7 +371,7 @@ pub(super) fn retrieve_almi(
     })?;
     let plane = |k: fn(&AlmiRow) -> f32| Array2::from_shape_fn((rows, cols), |(r, c)| k(&results[r][c]));
     Ok(Product {
-        name: "aLMI".into(),
+        name: ALMI.title.into(),
         chl_mg_m3: Some(plane(|p| p.0)),
         cdom_per_m: Some(plane(|p| p.1)),
         nap_g_m3: Some(plane(|p| p.2)),

@@ -178,7 +178,7 @@ fn sambuca_product(results: &[Vec<SambucaRow>], names: Vec<String>, siop_name: &
     let fractions = substrate_fractions(results, names.len());
     let plane = |k: fn(&SambucaRow) -> f32| Array2::from_shape_fn((rows, cols), |(r, c)| k(&results[r][c]));
     Product {
-        name: "SAMBUCA".into(),
+        name: super::algorithm::SAMBUCA.title.into(),
         chl_mg_m3: Some(plane(|p| p.0)),
         cdom_per_m: Some(plane(|p| p.1)),
         nap_g_m3: Some(plane(|p| p.2)),

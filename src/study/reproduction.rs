@@ -37,12 +37,9 @@ pub fn both_modes(name: &str) -> Result<StudySpec, StudyError> {
     })?;
     let with_mode = |mode: Mode| {
         let mut r = first.clone();
-        match &mut r {
-            RetrievalSpec::Almi { settings, .. } => settings.mode = mode,
-            RetrievalSpec::Sambuca { settings, .. } => settings.mode = mode,
-            RetrievalSpec::Qaa { settings } => settings.mode = mode,
-            // A user's program has one behaviour.
-            RetrievalSpec::External(_) => {}
+        // A user's program has one behaviour.
+        if let Some((m, _)) = r.mode_mut() {
+            *m = mode;
         }
         r
     };

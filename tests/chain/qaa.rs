@@ -26,7 +26,7 @@ fn qaa_returns_chl_and_its_iops_on_every_pixel_it_can_and_flags_the_rest() {
     let c = config();
     let (one, two) = (run_on(1, &c), run_on(2, &c));
     let p = &one.retrievals[0].product;
-    assert_eq!(p.name, "QAA");
+    assert_eq!(p.name, "QAA v6");
     let chl = p.chl_mg_m3.as_ref().unwrap();
     let keys: Vec<&str> = p.extras.iter().map(|(k, _)| k.as_str()).collect();
     assert_eq!(keys, ["adg443_per_m", "aph443_per_m", "bbp555_per_m"]);

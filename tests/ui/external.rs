@@ -89,7 +89,7 @@ fn a_study_with_qaa_offers_it_and_runs_it() {
     assert!(h.state().state.runs("qaa"));
     super::wait_for_engine(&mut h);
     let product = &h.state().link.shown[0].as_ref().unwrap().output.retrievals[0].product;
-    assert_eq!((product.name.as_str(), product.extras.len()), ("QAA", 3));
+    assert_eq!((product.name.as_str(), product.extras.len()), ("QAA v6", 3));
     h.state_mut().state.product = shoal::app::model::ProductKind::Nap;
     h.step();
     h.step();

@@ -38,22 +38,26 @@ pub struct Setting {
     /// Numeric fields set, by path ([`apply`]).
     pub set: Vec<(&'static str, f64)>,
     /// Any other change (switches, lists), made after `set`.
-    pub edit: Option<fn(&mut RunConfig)>,
+    pub edit: Option<Edit>,
 }
 
-/// aLMI's settings and sets in the first retrieval, if it is aLMI.
-fn almi(config: &mut RunConfig) -> Option<(&mut Vec<crate::water::SiopSource>, &mut crate::retrieval::AlmiSettings)> {
-    match config.retrievals.first_mut() {
-        Some(crate::retrieval::RetrievalSpec::Almi { siop_sets, settings }) => Some((siop_sets, settings)),
-        _ => None,
-    }
+/// A change a [`Setting`] makes beyond its numeric fields.
+#[derive(Clone, Copy)]
+pub enum Edit {
+    /// Of the configuration.
+    Config(fn(&mut RunConfig)),
+    /// Of its first retrieval ([`crate::retrieval::Algorithm::cheaper`]).
+    Retrieval(fn(&mut crate::retrieval::RetrievalSpec)),
 }
 
-/// The first retrieval's SAMBUCA settings, if it is SAMBUCA.
-fn sambuca(config: &mut RunConfig) -> Option<&mut crate::retrieval::SambucaSettings> {
-    match config.retrievals.first_mut() {
-        Some(crate::retrieval::RetrievalSpec::Sambuca { settings, .. }) => Some(settings),
-        _ => None,
+impl Setting {
+    /// `config` with this setting's edit made (after its numeric fields, [`apply`]).
+    pub fn edit(&self, config: &mut RunConfig) {
+        match self.edit {
+            Some(Edit::Config(edit)) => edit(config),
+            Some(Edit::Retrieval(edit)) => config.retrievals.first_mut().into_iter().for_each(edit),
+            None => {}
+        }
     }
 }
 
@@ -71,7 +75,11 @@ pub fn settings_for(base: &RunConfig) -> Vec<Setting> {
     use crate::scene::Effect;
     let base_decimation = base.fidelity.decimation;
     let s = |label: &str, set: Vec<(&'static str, f64)>| Setting { label: label.into(), set, edit: None };
-    let e = |label: &str, edit: fn(&mut RunConfig)| Setting { label: label.into(), set: Vec::new(), edit: Some(edit) };
+    let e = |label: &str, edit: fn(&mut RunConfig)| Setting {
+        label: label.into(),
+        set: Vec::new(),
+        edit: Some(Edit::Config(edit)),
+    };
     let effects = &base.scene.effects;
     let mut out = vec![
         s("reference (full fidelity)", vec![]),
@@ -118,37 +126,13 @@ pub fn settings_for(base: &RunConfig) -> Vec<Setting> {
             s("spatial response 3 points per GSD", vec![("fidelity.spatial_samples_per_gsd", 3.0)]),
         ]);
     }
-    match base.retrievals.first() {
-        Some(crate::retrieval::RetrievalSpec::Almi { .. }) => out.extend([
-            e("aLMI unweighted (one solve per set)", |c| {
-                if let Some((_, settings)) = almi(c) {
-                    settings.noise_weighting = false;
-                }
-            }),
-            e("aLMI 4 of 8 SIOP sets", |c| {
-                if let Some((sets, _)) = almi(c) {
-                    sets.truncate(4);
-                }
-            }),
-        ]),
-        // The defaults: 3 Gauss nodes per band, 100 iterations, adaptive starts, noise-weighted.
-        Some(crate::retrieval::RetrievalSpec::Sambuca { .. }) => out.extend([
-            e("SAMBUCA 1 Gauss node per band", |c| sambuca(c).into_iter().for_each(|s| s.nodes_per_band = 1)),
-            e("SAMBUCA 2 Gauss nodes per band", |c| sambuca(c).into_iter().for_each(|s| s.nodes_per_band = 2)),
-            e("SAMBUCA 5 Gauss nodes per band", |c| sambuca(c).into_iter().for_each(|s| s.nodes_per_band = 5)),
-            e("SAMBUCA 25 iterations per start", |c| sambuca(c).into_iter().for_each(|s| s.max_iterations = 25)),
-            e("SAMBUCA 50 iterations per start", |c| sambuca(c).into_iter().for_each(|s| s.max_iterations = 50)),
-            e("SAMBUCA shallow start only", |c| {
-                sambuca(c).into_iter().for_each(|s| s.starts = crate::retrieval::Starts::Shallow);
-            }),
-            e("SAMBUCA shallow and deep starts, every pixel", |c| {
-                sambuca(c).into_iter().for_each(|s| s.starts = crate::retrieval::Starts::ShallowAndDeep);
-            }),
-            e("SAMBUCA unweighted", |c| sambuca(c).into_iter().for_each(|s| s.noise_weighting = false)),
-        ]),
-        // A user's program has no settings Shoal could vary, nor has QAA (closed-form per pixel):
-        // their time is measured as it is.
-        Some(crate::retrieval::RetrievalSpec::External(_) | crate::retrieval::RetrievalSpec::Qaa { .. }) | None => {}
+    // The first retrieval's own rows.
+    if let Some(first) = base.retrievals.first() {
+        out.extend(first.algorithm().cheaper().into_iter().map(|(label, edit)| Setting {
+            label: label.into(),
+            set: Vec::new(),
+            edit: Some(Edit::Retrieval(edit)),
+        }));
     }
     // The image-based corrections priced beside the exact one: the 779/865 nm pair where the
     // design has it, and dark-spectrum fitting.
@@ -186,9 +170,7 @@ pub fn fidelity_of(label: &str, base: &RunConfig) -> Option<crate::engine::Fidel
     // The row's configuration; the reference (nothing set) is `base` itself, so applying it
     // goes back to `base`'s fidelity.
     let mut config = apply(base, &setting.set).ok()?;
-    if let Some(edit) = setting.edit {
-        edit(&mut config);
-    }
+    setting.edit(&mut config);
     // A fidelity setting alone: nothing but the fidelity differs, and not its resolution.
     let fidelity = config.fidelity.clone();
     config.fidelity = base.fidelity.clone();
@@ -222,9 +204,7 @@ pub fn cost_of_accuracy(
         .map(|setting| {
             let mut config = apply(base, &setting.set)
                 .map_err(|m| StudyError::Invalid(FieldError { field: setting.label.clone(), message: m }))?;
-            if let Some(edit) = setting.edit {
-                edit(&mut config);
-            }
+            setting.edit(&mut config);
             Ok::<_, StudyError>(config)
         })
         .collect::<Result<Vec<_>, _>>()?;
@@ -281,9 +261,7 @@ mod tests {
             .into_iter()
             .map(|setting| {
                 let mut c = apply(base, &setting.set).unwrap_or_else(|e| panic!("{}: {e}", setting.label));
-                if let Some(edit) = setting.edit {
-                    edit(&mut c);
-                }
+                setting.edit(&mut c);
                 (setting.label, c)
             })
             .collect()
