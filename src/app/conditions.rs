@@ -158,67 +158,33 @@ pub(super) fn conditions(app: &mut ShoalApp, ui: &mut egui::Ui) {
 /// (`bands`: each design's letter and band centres) lack is shown greyed, with which design and
 /// why.
 fn correction_choice(ui: &mut egui::Ui, spec: &mut crate::correction::CorrectionSpec, bands: &[(String, Vec<f64>)]) {
-    use crate::correction::{AerosolFit, ImageCorrection};
-    let pair = |p: [f64; 2]| Some(ImageCorrection { pair_nm: p, ..ImageCorrection::default() });
-    let choices: [(&str, &str, Option<ImageCorrection>, bool); 5] = [
-        (
-            "perfect processor (exact)",
-            "The forward model's own atmosphere, per pixel: the paper's perfect correction (no mission \
-             knows its atmosphere this well; the default corrects from the design's own bands)",
-            None,
-            false,
-        ),
-        ("per-scene (paper)", "Matthews et al. 2023, Appendix A: one set of terms from 20 water pixels", None, true),
-        (
-            "image: 779/865 nm",
-            "Aerosol from the design's 779 and 865 nm bands (Gordon & Wang 1994; l2gen's OLCI pair), \
-             the water's NIR signal estimated from the red band (Bailey et al. 2010); a design \
-             without them uses its own mission pair (MODIS 748/869 nm, or a SWIR pair)",
-            pair([779.0, 865.0]),
-            false,
-        ),
-        (
-            "image: 1610/2200 nm",
-            "Aerosol from a SWIR pair, black even over turbid water (Wang & Shi 2007)",
-            pair([1610.0, 2200.0]),
-            false,
-        ),
-        (
-            "image: dark spectrum",
-            "One atmosphere for the scene from its darkest pixels in every band (ACOLITE; \
-             Vanhellemont & Ruddick 2018)",
-            Some(ImageCorrection::dark_spectrum()),
-            false,
-        ),
-    ];
-    let current = choices
-        .iter()
-        .position(|(_, _, image, approx)| match (&spec.image, image) {
-            (Some(i), Some(c)) => i.fit == c.fit && (c.fit == AerosolFit::DarkSpectrum || i.pair_nm == c.pair_nm),
-            (None, None) => spec.use_approximation == *approx,
-            _ => false,
-        })
-        .map_or("image: custom", |i| choices[i].0);
+    use crate::correction::{AerosolFit, ImageCorrection, Method, PRESETS};
+    let current = PRESETS.iter().find(|p| p.matches(&spec.method)).map_or("image: custom", |p| p.label);
     egui::ComboBox::from_label("Atmospheric correction").selected_text(current).show_ui(ui, |ui| {
-        for (name, hover, image, approx) in choices {
+        for preset in &PRESETS {
+            let method = (preset.make)();
             // The first design whose bands cannot make the pair, and why.
             // The default pair falls back to each design's own ([`super::model::design_pair`]).
             let default_pair = ImageCorrection::default().pair_nm;
-            let lacking = image.as_ref().filter(|i| i.fit != AerosolFit::DarkSpectrum).and_then(|i| {
+            let image = match &method {
+                Method::Image(i) if i.fit != AerosolFit::DarkSpectrum => Some(i),
+                _ => None,
+            };
+            let lacking = image.and_then(|i| {
                 bands.iter().find_map(|(design, centres)| {
                     let usable = if i.pair_nm == default_pair { i.for_bands(centres) } else { Some(i.clone()) };
                     let err = usable.map_or_else(|| i.pair(centres).err(), |u| u.pair(centres).err());
                     err.map(|e| format!("{design}: {e}"))
                 })
             });
-            let label = ui.add_enabled(lacking.is_none(), egui::Button::selectable(current == name, name));
+            let label =
+                ui.add_enabled(lacking.is_none(), egui::Button::selectable(current == preset.label, preset.label));
             let label = match &lacking {
-                Some(why) => label.on_disabled_hover_text(format!("{hover}\n\nNot offered: design {why}")),
-                None => label.on_hover_text(hover),
+                Some(why) => label.on_disabled_hover_text(format!("{}\n\nNot offered: design {why}", preset.about)),
+                None => label.on_hover_text(preset.about),
             };
             if label.clicked() {
-                spec.use_approximation = approx;
-                spec.image = image;
+                spec.method = method;
             }
         }
     });

@@ -341,7 +341,9 @@ impl AppState {
                 c.calibration = self.calibration.clone();
                 c.snr_reference.clone_from(&self.snr_reference);
                 c.correction = self.correction.clone();
-                c.correction.image = c.correction.image.take().map(|i| design_pair(i, &slot.spec));
+                if let crate::correction::Method::Image(i) = &mut c.correction.method {
+                    *i = design_pair(i.clone(), &slot.spec);
+                }
                 c
             })
             .collect()
@@ -436,7 +438,7 @@ mod tests {
     fn default_is_the_cubesat_vs_smallsat_study_with_a_missions_correction() {
         let s = AppState::default();
         // The realistic processor: the aerosol from the designs' own 779/865 nm bands.
-        let image = s.correction.image.as_ref().expect("the default corrects from the image");
+        let image = s.correction.image().expect("the default corrects from the image");
         assert_eq!(image.pair_nm, [779.0, 865.0]);
         assert_eq!(s.study_name, crate::study::DEFAULT_STUDY);
         assert_eq!(

@@ -37,7 +37,8 @@ pub struct CorrectArgs {
     #[arg(long, default_value = "lake_hume_bloom")]
     scene: String,
     /// The correction: `pair` (779/865 nm band pair with the NIR iteration), `pair-black`
-    /// (without it), `dark` (dark-spectrum fitting over all rows), or a RON `ImageCorrection`.
+    /// (without it), `swir` (1610/2200 nm), `dark` (dark-spectrum fitting over all rows) — the
+    /// app's image-based choices — or a RON `ImageCorrection`.
     #[arg(long, default_value = "pair")]
     correction: String,
     /// Output directory (rrs.csv).
@@ -50,14 +51,26 @@ pub struct CorrectArgs {
 /// hold 730 MB: refused before any work).
 const MAX_ROWS: usize = 10_000;
 
+/// The correction `text` names: an image-based preset of [`crate::correction::PRESETS`] (the
+/// app's menu offers the same), or a RON `ImageCorrection`. The exact and per-scene corrections
+/// need the truth a spectrum file does not carry.
 fn settings(text: &str) -> Result<ImageCorrection, CliError> {
-    Ok(match text {
-        "pair" => ImageCorrection::default(),
-        "pair-black" => ImageCorrection { nir_iteration: false, ..ImageCorrection::default() },
-        "dark" => ImageCorrection::dark_spectrum(),
-        ron_text => ron::from_str::<ImageCorrection>(ron_text)
-            .map_err(|e| CliError::Input(format!("--correction: {e} (or one of pair, pair-black, dark)")))?,
-    })
+    use crate::correction::{Method, PRESETS, Preset};
+    let image_keys = || {
+        PRESETS.iter().filter(|p| matches!((p.make)(), Method::Image(_))).map(|p| p.key).collect::<Vec<_>>().join(", ")
+    };
+    match Preset::of(text).map(|p| (p, (p.make)())) {
+        Ok((_, Method::Image(image))) => Ok(image),
+        Ok((p, _)) => Err(CliError::Input(format!(
+            "--correction {}: the {} correction needs the simulation's own atmosphere; spectra are corrected \
+             from their bands: one of {}",
+            p.key,
+            p.label,
+            image_keys()
+        ))),
+        Err(_) => ron::from_str::<ImageCorrection>(text)
+            .map_err(|e| CliError::Input(format!("--correction: {e} (or one of {})", image_keys()))),
+    }
 }
 
 /// `shoal correct`.

@@ -131,7 +131,7 @@ pub fn config_from(args: &SimulateArgs) -> Result<RunConfig, CliError> {
         config.calibration.gain_drift_pct = g;
     }
     if args.approximate_correction {
-        config.correction.use_approximation = true;
+        config.correction.method = crate::correction::Method::PerScene;
     }
     // Scene paths in the resolved configuration are absolute, so it runs from anywhere.
     if let Some(dir) = &config.scene_dir

@@ -25,6 +25,7 @@ pub mod dark;
 mod difference;
 pub mod family;
 pub mod image;
+mod method;
 mod mixture;
 pub mod nir_water;
 mod nodes;
@@ -35,12 +36,13 @@ pub use dark::TileFit;
 pub use difference::{BandDifference, compare};
 pub use family::{AerosolFamily, FamilyLuts};
 pub use image::{AerosolFit, AerosolRetrieval, DarkSpectrumSettings, ImageCorrection, MISSION_PAIRS_NM, correct_image};
+pub use method::{CorrectionSpec, Method, PRESETS, Preset};
 pub use rrs_metrics::{BandRrsMetrics, RRS_SAMPLES, band_rrs_metrics, pooled_rrs_error};
 
 use ndarray::{Array2, Array3};
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 
 use crate::calibration::Level1;
 use crate::control::RunControl;
@@ -81,25 +83,6 @@ impl RrsFlags {
     pub const INVALID: u8 = 4;
 }
 
-/// Correction settings.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct CorrectionSpec {
-    /// Random water pixels for the paper's per-scene approximation (Appendix A: 20).
-    pub approx_points: usize,
-    /// Deliver the per-scene approximation as the Rrs product instead of the exact correction.
-    pub use_approximation: bool,
-    /// Deliver the image-based correction ([`image`]): the aerosol from the instrument's own
-    /// long bands, the scene's true atmosphere unknown to it. `None`: the exact correction.
-    pub image: Option<ImageCorrection>,
-}
-
-impl Default for CorrectionSpec {
-    fn default() -> Self {
-        Self { approx_points: 20, use_approximation: false, image: None }
-    }
-}
-
 impl CorrectionSpec {
     /// Check `approx_points` against [`crate::ranges::CORRECTION_APPROX_POINTS`].
     pub fn validate(&self) -> Result<(), CorrectionError> {
@@ -107,13 +90,7 @@ impl CorrectionSpec {
         range
             .check(self.approx_points as f64)
             .map_err(|message| CorrectionError::Invalid(FieldError { field: range.path.into(), message }))?;
-        if let Some(image) = &self.image {
-            if self.use_approximation {
-                return Err(CorrectionError::Invalid(FieldError {
-                    field: "correction.image".into(),
-                    message: "choose one: the image-based correction or use_approximation".into(),
-                }));
-            }
+        if let Some(image) = self.image() {
             image.validate()?;
         }
         Ok(())

@@ -55,7 +55,7 @@ impl Engine {
             // A preview computes only the product it shows; the diagnostics (the approximation
             // against the exact correction, and both against the truth) come with full resolution.
             let diagnostics = fid.decimation == 1;
-            let image = match (&family, &config.correction.image) {
+            let image = match (&family, config.correction.image()) {
                 (Some((fam, _)), Some(settings)) => Some(
                     correct_image(level1, fam, settings, &side.response.bands, &truth.surface, control)
                         .map_err(&fail)?,
@@ -66,7 +66,7 @@ impl Engine {
             // corrections are not run beside it (`shoal budget` prices the difference).
             let against_truth = diagnostics;
             let diagnostics = diagnostics && image.is_none();
-            let exact = if diagnostics || (!config.correction.use_approximation && image.is_none()) {
+            let exact = if diagnostics || (!config.correction.per_scene() && image.is_none()) {
                 let aerosol_map = side.aerosol_map.as_deref().zip(truth.aot550.as_ref());
                 Some(correct_exact(level1, band_atmosphere, aerosol_map, &truth.surface, control).map_err(&fail)?)
             } else {
@@ -74,11 +74,11 @@ impl Engine {
             };
             // The approximation is held whole only when it is the product; as a diagnostic it is
             // compared with the exact correction pixel by pixel.
-            let streamed = match (&exact, diagnostics && !config.correction.use_approximation) {
+            let streamed = match (&exact, diagnostics && !config.correction.per_scene()) {
                 (Some(e), true) => approximation.compare_with(level1, &truth.surface, e),
                 _ => None,
             };
-            let approx = if (diagnostics && streamed.is_none()) || config.correction.use_approximation {
+            let approx = if (diagnostics && streamed.is_none()) || config.correction.per_scene() {
                 Some(approximation.correct(level1, &truth.surface, control).map_err(&fail)?)
             } else {
                 None
@@ -91,7 +91,7 @@ impl Engine {
             let (image, aerosol) = image.map_or((None, None), |(r, a)| (Some(r), Some(a)));
             let rrs = match (image, exact, approx) {
                 (Some(i), _, _) => i,
-                (None, _, Some(a)) if config.correction.use_approximation => a,
+                (None, _, Some(a)) if config.correction.per_scene() => a,
                 (None, Some(e), _) => e,
                 (None, None, Some(a)) => a,
                 (None, None, None) => {
@@ -116,7 +116,7 @@ impl Engine {
         report.approximation = Some(product.approximation.clone());
         report.approximation_vs_exact = product.approximation_vs_exact.clone();
         report.rrs_vs_truth = product.rrs_vs_truth.clone();
-        report.aerosol = match (&product.aerosol, &config.correction.image) {
+        report.aerosol = match (&product.aerosol, config.correction.image()) {
             (Some(a), Some(settings)) => Some(super::report::aerosol_summary(
                 a,
                 settings,
@@ -140,7 +140,7 @@ impl Engine {
         control: &RunControl,
         report: &mut RunReport,
     ) -> Result<Option<(Arc<AerosolFamily>, Key)>, EngineError> {
-        let Some(image) = &config.correction.image else { return Ok(None) };
+        let Some(image) = config.correction.image() else { return Ok(None) };
         let fid = &config.fidelity;
         let axes = lut_axes(&side.response, &side.viewing, config.scene.sun.zenith_deg, fid);
         let mut atmosphere = config.scene.atmosphere.clone();

@@ -147,8 +147,7 @@ fn rt_seconds(acc: &RtAccuracy, aot550: f64) -> f64 {
 #[must_use]
 pub fn atmosphere_seconds(config: &RunConfig) -> f64 {
     let acc = &config.scene.atmosphere.accuracy;
-    rt_seconds(acc, config.scene.atmosphere.aot550)
-        + config.correction.image.as_ref().map_or(0.0, |i| family_seconds(acc, i))
+    rt_seconds(acc, config.scene.atmosphere.aot550) + config.correction.image().map_or(0.0, |i| family_seconds(acc, i))
 }
 
 /// The image-based correction's family: one more atmosphere per model and AOT node, and the

@@ -86,8 +86,7 @@ impl Stage {
             Self::Calibration => config.calibration.perfect = true,
             Self::Correction => {
                 // The perfect correction: the exact inversion with the forward model's atmosphere.
-                config.correction.use_approximation = false;
-                config.correction.image = None;
+                config.correction.method = crate::correction::Method::Exact;
             }
             Self::SiopChoice => {
                 let truth = config.scene.siop.clone();

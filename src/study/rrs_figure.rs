@@ -26,7 +26,7 @@ impl RrsFigure {
     /// The figure of `result` (first seed of each instrument), where it applies.
     pub(super) fn of(result: &StudyResult) -> Option<Self> {
         let spec = &result.study.spec;
-        let image = spec.correction.as_ref().and_then(|c| c.image.as_ref());
+        let image = spec.correction.as_ref().and_then(|c| c.image());
         let requirement =
             spec.requirements.as_ref().and_then(|r| r.rrs.as_ref()).map(|r| (r.mae_pct, r.from_nm, r.to_nm));
         if image.is_none() && requirement.is_none() {

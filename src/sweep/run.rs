@@ -73,7 +73,7 @@ pub fn run_job(
     let (r, c, b) = out.report.shape;
     let saturated_pct = 100.0 * out.report.saturated as f64 / (r * c * b).max(1) as f64;
     // The measured SNR at the band-pair correction's two bands.
-    let snr_pair = match &config.correction.image {
+    let snr_pair = match config.correction.image() {
         Some(image) if image.fit == crate::correction::image::AerosolFit::BandPair => {
             image.pair(&out.response.bands.centres_nm()).ok().map(|(s, l)| {
                 let at = |i: usize| out.snr.get(i).map_or(f64::NAN, |row| row.snr_measured);

@@ -106,7 +106,7 @@ fn smoothed_dark_spectrum_tiles_follow_a_haze_front_the_scene_fit_cannot() {
         let mut c = hazy(Some(front()), 0.1);
         let mut settings = ImageCorrection::dark_spectrum();
         (settings.dark.tile_px, settings.dark.smooth_tiles) = (tile_px, smooth);
-        c.correction.image = Some(settings);
+        c.correction.method = shoal::correction::Method::Image(settings);
         let out = run(&c);
         out.report.aerosol.as_ref().expect("the image-based correction ran").aot550_abs_error
     };

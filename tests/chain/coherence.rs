@@ -102,7 +102,7 @@ fn base(path: &str) -> RunConfig {
         // Dark-spectrum fitting's settings act only when it is the fit. The base's glint (~0.02
         // sr⁻¹ at nadir) is left in, as ACOLITE's fit reads it: taken away, none of the four
         // dark-spectrum settings changed this small reef's output any more.
-        c.correction.image = Some(shoal::correction::ImageCorrection {
+        c.correction.method = shoal::correction::Method::Image(shoal::correction::ImageCorrection {
             glint: false,
             ..shoal::correction::ImageCorrection::dark_spectrum()
         });
@@ -110,7 +110,7 @@ fn base(path: &str) -> RunConfig {
         // The image-based correction's settings act only when it is on. The base looks near the
         // sun's glint (normalised glint ~0.02 sr⁻¹ at nadir): the glint is taken away but no
         // pixel left out, so that every other setting reaches the Rrs.
-        c.correction.image = Some(shoal::correction::ImageCorrection {
+        c.correction.method = shoal::correction::Method::Image(shoal::correction::ImageCorrection {
             glint_threshold_per_sr: 1.0,
             ..shoal::correction::ImageCorrection::default()
         });
@@ -301,8 +301,7 @@ fn every_range_field_changes_the_output_or_is_documented_and_the_cache_follows()
         let config = base(range.path);
         // One cached engine per base instrument, warmed on its base run.
         let adjacency = if config.scene.effects.contains(&Effect::Adjacency) { "" } else { " without adjacency" };
-        let image =
-            config.correction.image.as_ref().map_or(String::new(), |i| format!(" image-corrected, {}", i.label()));
+        let image = config.correction.image().map_or(String::new(), |i| format!(" image-corrected, {}", i.label()));
         let aerosol = config.scene.atmosphere.aerosol.name();
         let effects = if config.instrument.effects.is_empty() { "" } else { " with optical effects" };
         let key = format!(

@@ -29,7 +29,7 @@ fn glinting(roll_deg: f64, glint: bool) -> RunConfig {
     let mut c = RunConfig::new(scene, instrument);
     c.detector = DetectorMode::IDEAL;
     c.calibration.dark_exposure_s = c.instrument.exposure_s;
-    c.correction.image = Some(ImageCorrection { glint, ..ImageCorrection::default() });
+    c.correction.method = shoal::correction::Method::Image(ImageCorrection { glint, ..ImageCorrection::default() });
     c
 }
 
@@ -97,7 +97,7 @@ fn high_glint_is_left_out() {
     assert!(a.aot550.iter().all(|x| x.is_nan()));
     // Dark-spectrum fitting leaves them out too (its tiles never see them).
     let mut c = glinting(30.0, true);
-    c.correction.image = Some(ImageCorrection::dark_spectrum());
+    c.correction.method = shoal::correction::Method::Image(ImageCorrection::dark_spectrum());
     let out = run(&c);
     assert_eq!(out.correction.aerosol.as_ref().unwrap().high_glint, rows * cols);
     assert!(out.kept().rrs.flags.iter().all(|f| f & RrsFlags::INVALID != 0));

@@ -24,7 +24,7 @@ fn clear_water(aerosol: AerosolType, aot550: f64) -> RunConfig {
     let mut c = RunConfig::new(scene, small("cubesat", 48, 32));
     c.detector = DetectorMode::IDEAL;
     c.calibration.dark_exposure_s = c.instrument.exposure_s;
-    c.correction.image = Some(ImageCorrection::default());
+    c.correction.method = shoal::correction::Method::Image(ImageCorrection::default());
     c
 }
 
@@ -94,7 +94,7 @@ fn an_aerosol_free_scene_gives_an_optical_depth_near_zero() {
 #[test]
 fn the_exact_correction_is_unchanged_without_the_image_setting() {
     let mut c = clear_water(AerosolType::Continental, 0.15);
-    c.correction.image = None;
+    c.correction.method = shoal::correction::Method::Exact;
     let out = run(&c);
     assert!(out.correction.aerosol.is_none());
     assert!(median_error(&out).iter().all(|(d, t)| (d / t).abs() < 1e-4), "the exact correction closes");
@@ -103,7 +103,8 @@ fn the_exact_correction_is_unchanged_without_the_image_setting() {
 #[test]
 fn a_pair_the_instrument_lacks_is_refused_naming_the_field() {
     let mut c = clear_water(AerosolType::Continental, 0.15);
-    c.correction.image = Some(ImageCorrection { pair_nm: [1240.0, 2130.0], ..ImageCorrection::default() });
+    c.correction.method =
+        shoal::correction::Method::Image(ImageCorrection { pair_nm: [1240.0, 2130.0], ..ImageCorrection::default() });
     let e = shoal::engine::Engine::new().run(&c, &shoal::control::RunControl::new()).unwrap_err().to_string();
     assert!(e.contains("correction.image.pair_nm") && e.contains("1240"), "{e}");
 }
@@ -114,7 +115,7 @@ fn a_gain_error_at_865_nm_reaches_443_nm_as_the_extrapolation_predicts() {
     // One model: the extrapolation is then the model's own, ε fixed; no NIR iteration.
     let settings =
         ImageCorrection { models: vec![AerosolType::Continental], nir_iteration: false, ..ImageCorrection::default() };
-    c.correction.image = Some(settings.clone());
+    c.correction.method = shoal::correction::Method::Image(settings.clone());
     let out = run(&c);
     let family = out.correction.family.clone().expect("the family");
     let l = settings.pair(&out.response.bands.centres_nm()).unwrap().1;
@@ -179,7 +180,7 @@ fn an_rrs_requirement_judges_each_band_of_its_range() {
 fn dark_spectrum_fitting_finds_the_family_aerosol_over_black_nir_water() {
     for aerosol in [AerosolType::Maritime, AerosolType::Continental] {
         let mut c = clear_water(aerosol, 0.15);
-        c.correction.image = Some(ImageCorrection::dark_spectrum());
+        c.correction.method = shoal::correction::Method::Image(ImageCorrection::dark_spectrum());
         let out = run(&c);
         let retrieved = out.correction.aerosol.as_ref().expect("the image-based correction ran");
         let tile = &retrieved.tiles[0];
@@ -207,7 +208,7 @@ fn dark_spectrum_fitting_finds_the_family_aerosol_over_black_nir_water() {
 #[test]
 fn dark_spectrum_fitting_without_aerosol_gives_an_optical_depth_near_zero() {
     let mut c = clear_water(AerosolType::None, 0.0);
-    c.correction.image = Some(ImageCorrection::dark_spectrum());
+    c.correction.method = shoal::correction::Method::Image(ImageCorrection::dark_spectrum());
     let out = run(&c);
     let aot = out.correction.aerosol.as_ref().unwrap().tiles[0].aot550;
     assert!(aot < 0.005, "AOT {aot}");
@@ -218,7 +219,7 @@ fn dark_spectrum_tiles_cover_the_image_and_each_fits_its_own() {
     let mut c = clear_water(AerosolType::Continental, 0.15);
     let mut settings = ImageCorrection::dark_spectrum();
     settings.dark.tile_px = 16;
-    c.correction.image = Some(settings);
+    c.correction.method = shoal::correction::Method::Image(settings);
     let out = run(&c);
     let a = out.correction.aerosol.as_ref().unwrap();
     // 48 detectors × 32 lines in 16-pixel tiles: 3 × 2 (the scene may crop a few edge pixels).
@@ -234,7 +235,7 @@ fn a_dark_spectrum_setting_out_of_range_names_its_field() {
     let mut c = clear_water(AerosolType::Continental, 0.15);
     let mut settings = ImageCorrection::dark_spectrum();
     settings.dark.min_gas_transmittance = 1.5;
-    c.correction.image = Some(settings);
+    c.correction.method = shoal::correction::Method::Image(settings);
     let e = shoal::engine::Engine::new().run(&c, &shoal::control::RunControl::new()).unwrap_err().to_string();
     assert!(e.contains("correction.image.dark.min_gas_transmittance"), "{e}");
 }
@@ -245,7 +246,8 @@ fn turbid_water(nir_iteration: bool) -> RunConfig {
     c.scene.chl_mg_m3 = MapSpec::Constant(10.0);
     c.scene.nap_g_m3 = MapSpec::Constant(10.0);
     c.scene.cdom_per_m = MapSpec::Constant(0.5);
-    c.correction.image = Some(ImageCorrection { nir_iteration, ..ImageCorrection::default() });
+    c.correction.method =
+        shoal::correction::Method::Image(ImageCorrection { nir_iteration, ..ImageCorrection::default() });
     c
 }
 
@@ -281,7 +283,8 @@ fn the_nir_iteration_takes_turbid_water_out_of_the_aerosol_pair() {
 #[test]
 fn correct_on_csv_spectra_matches_the_runs_own_correction() {
     let mut c = clear_water(AerosolType::Continental, 0.15);
-    c.correction.image = Some(ImageCorrection { nir_iteration: false, ..ImageCorrection::default() });
+    c.correction.method =
+        shoal::correction::Method::Image(ImageCorrection { nir_iteration: false, ..ImageCorrection::default() });
     let out = run(&c);
     let names: Vec<String> = out.response.bands.bands.iter().map(|b| b.name.clone()).collect();
     let pixels = [(3usize, 5usize), (10, 20), (20, 40), (30, 47)];

@@ -226,7 +226,7 @@ fn after_a_change_of_any_one_field_a_warm_engine_returns_what_a_fresh_one_does()
 fn the_image_based_correction_keeps_its_family_across_gain_and_true_aerosol_changes() {
     let mut engine = Engine::new();
     let mut config = RunConfig::new(small_lake(), small("cubesat", 48, 32));
-    config.correction.image = Some(shoal::correction::ImageCorrection::default());
+    config.correction.method = shoal::correction::Method::Image(shoal::correction::ImageCorrection::default());
     engine.run(&config, &RunControl::new()).unwrap();
     // A gain change reruns the correction, not its family.
     config.instrument.gain_e_per_dn = 2.0;

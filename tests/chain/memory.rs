@@ -78,7 +78,7 @@ fn a_lean_run_makes_the_same_products_as_one_that_keeps_its_cubes() {
     let mut config = RunConfig::new(super::small_lake(), super::small("cubesat", 96, 64));
     config.retrievals = vec![ron::from_str("Almi()").unwrap()];
     for image in [Some(shoal::correction::ImageCorrection::default()), None] {
-        config.correction.image = image;
+        config.correction.method = image.map_or(shoal::correction::Method::Exact, shoal::correction::Method::Image);
         let keeping = Engine::new().run(&config, &RunControl::new()).unwrap();
         let mut lean = Engine::lean();
         let probes = [Probe::TypicalWater];

@@ -192,7 +192,7 @@ fn the_cubesat_error_budget_matches_runs_with_each_stage_made_perfect() {
     let perfect = |c: &mut RunConfig, stage: usize| match stage {
         0 => c.detector = DetectorMode { noise: false, quantise: false },
         1 => c.calibration.perfect = true,
-        2 => c.correction.use_approximation = false,
+        2 => c.correction.method = shoal::correction::Method::Exact,
         _ => {
             let own = c.scene.siop.clone();
             for r in &mut c.retrievals {

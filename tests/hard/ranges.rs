@@ -134,7 +134,7 @@ fn refusal(range: &Range, value: f64) -> Option<String> {
             _ => image.aot_nodes = vec![value],
         }
         let mut config = base("scene.chl_mg_m3");
-        config.correction.image = Some(image);
+        config.correction.method = shoal::correction::Method::Image(image);
         return match config.validate() {
             Ok(()) => None,
             Err(EngineError::Failed { message, .. }) => Some(message),

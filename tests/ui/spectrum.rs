@@ -69,7 +69,7 @@ fn the_image_based_correction_is_the_default_and_the_perfect_processor_one_choic
         let out = &h.state().link.shown[i].as_ref().unwrap().output;
         let aerosol = out.correction.aerosol.as_ref().expect("the image-based correction ran");
         assert!(aerosol.aot550.iter().any(|v| v.is_finite() && *v > 0.0));
-        assert_eq!(out.config.correction.image.as_ref().unwrap().pair_nm, [779.0, 865.0]);
+        assert_eq!(out.config.correction.image().unwrap().pair_nm, [779.0, 865.0]);
     }
     // The metrics table tells what the correction found and what it left in Rrs.
     h.step();
@@ -78,12 +78,12 @@ fn the_image_based_correction_is_the_default_and_the_perfect_processor_one_choic
     assert!(h.query_by_label_contains("Rrs 400–560 nm").is_some(), "the Rrs row is shown");
     assert!(h.query_by_label_contains("aerosol found (image-based correction)").is_some(), "said on screen");
     // The scene panel's "Atmospheric correction" choice "perfect processor (exact)".
-    h.state_mut().state.correction.image = None;
+    h.state_mut().state.correction.method = shoal::correction::Method::Exact;
     h.step();
     wait_for_engine(&mut h);
     for i in 0..2 {
         let out = &h.state().link.shown[i].as_ref().unwrap().output;
-        assert!(out.correction.aerosol.is_none() && out.config.correction.image.is_none(), "the exact correction");
+        assert!(out.correction.aerosol.is_none() && out.config.correction.image().is_none(), "the exact correction");
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -109,11 +109,11 @@ fn a_swir_pair_the_designs_lack_is_not_offered() {
     assert!(!h.get_by_label("image: dark spectrum").accesskit_node().is_disabled());
     h.get_by_label("image: 1610/2200 nm").click_accesskit();
     settle(&mut h);
-    let image = h.state().state.correction.image.clone().expect("the default image-based correction");
+    let image = h.state().state.correction.image().cloned().expect("the default image-based correction");
     assert_eq!(image.pair_nm, [779.0, 865.0], "a pair the design lacks was taken");
     h.get_by_label("image: dark spectrum").click_accesskit();
     settle(&mut h);
-    let image = h.state().state.correction.image.clone().unwrap();
+    let image = h.state().state.correction.image().cloned().unwrap();
     assert_eq!(image.fit, shoal::correction::AerosolFit::DarkSpectrum);
     let _ = std::fs::remove_dir_all(&dir);
 }

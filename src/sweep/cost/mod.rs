@@ -139,14 +139,14 @@ pub fn settings_for(base: &RunConfig) -> Vec<Setting> {
     let centres = crate::instrument::Response::new(&base.instrument, base.fidelity.spectral_step_nm)
         .map(|r| r.bands.centres_nm())
         .unwrap_or_default();
-    if base.correction.image.is_none() {
+    if base.correction.image().is_none() {
         if crate::correction::ImageCorrection::default().pair(&centres).is_ok() {
             out.push(e("image-based correction (779/865 nm, NIR iteration)", |c| {
-                c.correction.image = Some(crate::correction::ImageCorrection::default());
+                c.correction.method = crate::correction::Method::Image(crate::correction::ImageCorrection::default());
             }));
         }
         out.push(e("image-based correction (dark spectrum, scene)", |c| {
-            c.correction.image = Some(crate::correction::ImageCorrection::dark_spectrum());
+            c.correction.method = crate::correction::Method::Image(crate::correction::ImageCorrection::dark_spectrum());
         }));
     }
     out.push(s(

@@ -26,7 +26,7 @@ pub(super) fn structural_edits() -> Vec<Edit> {
         ("detector noise off", |c| c.detector.noise = false),
         ("quantisation off", |c| c.detector.quantise = false),
         ("calibration perfect", |c| c.calibration.perfect = true),
-        ("correction uses the approximation", |c| c.correction.use_approximation = true),
+        ("correction uses the approximation", |c| c.correction.method = shoal::correction::Method::PerScene),
         ("aerosol continental", |c| c.scene.atmosphere.aerosol = shoal::atmosphere::AerosolType::Continental),
         ("flat surface (and so no glint)", |c| {
             c.scene.atmosphere.surface = shoal::atmosphere::Surface::Flat;
