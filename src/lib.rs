@@ -24,6 +24,7 @@
 //! | [`variable`] | the product variables (chl-a, NAP, CDOM, depth): keys, names, units, CF names |
 //! | [`assets`] | cited spectra embedded in the binary |
 //! | [`schema`] | the file formats' version, and files of older versions brought up to date |
+//! | [`fields`] | a configuration's fields by path, through serde: numbers read and set, every leaf, what changed, the texts it holds |
 //! | [`parse`] | RON parse errors described with line, column and field |
 //! | [`ranges`] | the documented range of every number a user sets: one table the validators use |
 //! | [`metrics`] | log-space MAE and bias (Seegers et al. 2018), RMSE, R², histograms |
@@ -67,6 +68,7 @@ pub mod correction;
 pub mod csvtext;
 pub mod design;
 pub mod engine;
+pub mod fields;
 pub mod geotiff;
 pub mod infile;
 pub mod instrument;

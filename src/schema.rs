@@ -15,7 +15,7 @@
 use std::borrow::Cow;
 
 /// The format this Shoal writes.
-pub const VERSION: u32 = 3;
+pub const VERSION: u32 = 4;
 
 /// The version of a file that does not say (written before `schema_version` existed).
 pub const UNVERSIONED: u32 = 1;
@@ -34,11 +34,18 @@ pub const RENAMES: &[(u32, &str, &str, &str)] = &[
 
 /// Changes of shape since version 1 that are not renames: (the version, what changed, where it is
 /// read).
-pub const RESHAPES: &[(u32, &str, &str)] = &[(
-    3,
-    "the app's session: instruments `a` and `b` (and `editing_instrument: A|B`) became the list `designs` (and `editing_design`)",
-    "AppState::settle (src/app/designs.rs), tests/ui/session.rs",
-)];
+pub const RESHAPES: &[(u32, &str, &str)] = &[
+    (
+        3,
+        "the app's session: instruments `a` and `b` (and `editing_instrument: A|B`) became the list `designs` (and `editing_design`)",
+        "src/app/migrate.rs, tests/ui/session.rs",
+    ),
+    (
+        4,
+        "the app's session: `retrieval: Almi|Sambuca|External` with the settings `almi`, `sambuca` and `external` became the list `retrievals` (and `selected_retrieval`); sessions of version 3 may hold either",
+        "src/app/migrate.rs, tests/ui/session.rs",
+    ),
+];
 
 /// The `schema_version: N` a RON text states at its outermost level, if it does.
 fn stated_version(text: &str) -> Result<Option<u32>, String> {
@@ -175,13 +182,14 @@ mod tests {
 
     #[test]
     fn a_current_file_is_left_alone_and_a_newer_one_is_refused() {
-        let current = "(schema_version: 3, lines: 10, exposures_s: 0.1)";
+        let current = format!("(schema_version: {VERSION}, lines: 10, exposures_s: 0.1)");
+        let current = current.as_str();
         assert!(matches!(migrate(current).unwrap(), Cow::Borrowed(_)));
         // A version-2 file with a field that happens to be called as an old one is not renamed.
         let v2 = "(schema_version: 2, nested: (levels: 3))";
         assert_eq!(migrate(v2).unwrap(), v2);
         let newer = migrate("(schema_version: 9, lines: 10)").unwrap_err();
-        assert!(newer.contains("schema_version 9") && newer.contains("up to 3"), "{newer}");
+        assert!(newer.contains("schema_version 9") && newer.contains(&format!("up to {VERSION}")), "{newer}");
         // Only the outermost level states the version.
         assert_eq!(stated_version("(inner: (schema_version: 7))").unwrap(), None);
         assert!(migrate("(schema_version: two)").unwrap_err().contains("whole number"));

@@ -157,7 +157,7 @@ pub fn rows(quick: bool) -> Result<String, String> {
     out.push_str("\n## App (headless egui frames, default study: CubeSat vs SmallSat over Lake Hume)\n\n");
     out.push_str(&format!(
         "Engine threads {}. From start: first preview (1/{preview}) on screen {cold_preview_s:.2} s, final (1/{finest}) {cold_final_s:.1} s.\n\n",
-        super::engine_threads(0)
+        super::link::engine_threads(0)
     ));
     out.push_str("| change to A | preview | changes | slider → preview on screen, median (min–max) ms | of which engine, median ms | target median / max | frame ms while engine runs, median / p95 / max | frames |\n|---|---|---|---|---|---|---|---|\n");
     let previews: &[usize] = if quick { &[24] } else { &[24, 16] };

@@ -4,7 +4,7 @@
 //! change returns where each old design went ([`Moved`]), so the engine link can move its results
 //! with them instead of running them again.
 
-use super::model::{AppState, LegacyAb, Slot};
+use super::model::{AppState, Slot};
 
 /// The designs the app holds at most: one colour each (`theme::DESIGN`), and a metrics table
 /// that still fits a 1920-pixel window (the engine sizes its cache for them).
@@ -23,17 +23,9 @@ pub fn label(i: usize) -> String {
 pub type Moved = Vec<Option<usize>>;
 
 impl AppState {
-    /// Bring the state to its invariants: a session saved before designs were a list gets its
-    /// A and B as the first two; at least one design and at most [`MAX_DESIGNS`]; every index in
-    /// range, the maps' list without repeats, the pair two different designs when there are two.
+    /// Bring the state to its invariants (an older session's fields were moved in by
+    /// `migrate`): at least one design and at most [`MAX_DESIGNS`]; every index in range, the maps' list without repeats, the pair two different designs when there are two.
     pub fn settle(&mut self) {
-        if let Some(a) = self.legacy_a.take() {
-            let b = self.legacy_b.take().unwrap_or_else(|| a.clone());
-            self.designs = vec![a, b];
-            self.editing = usize::from(self.legacy_editing == Some(LegacyAb::B));
-            (self.reference, self.on_maps, self.pair) = (0, vec![0, 1], [0, 1]);
-        }
-        (self.legacy_b, self.legacy_editing) = (None, None);
         self.settle_retrievals();
         if self.designs.is_empty() {
             self.designs = AppState::default().designs;
@@ -190,24 +182,5 @@ mod tests {
         s.designs.truncate(3);
         s.settle();
         assert_eq!((s.editing, s.on_maps.as_slice(), s.pair), (2, &[1, 0][..], [2, 0]));
-    }
-
-    #[test]
-    fn a_session_from_before_the_list_reads_as_a_and_b() {
-        // The session as the app saved it with fields `a`, `b` and `editing_instrument`.
-        let mut old = AppState::default();
-        old.designs[1].spec.aperture_mm = 123.0;
-        let text = ron::to_string(&old).unwrap_or_else(|e| panic!("{e}"));
-        let designs = text.find("designs:").unwrap_or_else(|| panic!("{text}"));
-        let a = ron::to_string(&old.designs[0]).unwrap_or_else(|e| panic!("{e}"));
-        let b = ron::to_string(&old.designs[1]).unwrap_or_else(|e| panic!("{e}"));
-        let end = designs + text[designs..].find("],linked").unwrap_or_else(|| panic!("{text}")) + 2;
-        let legacy = format!("{}a:{a},b:{b},editing_instrument:B,{}", &text[..designs], &text[end..]);
-        let mut read: AppState = ron::from_str(&legacy).unwrap_or_else(|e| panic!("{e}: {legacy}"));
-        read.settle();
-        assert_eq!(read.designs.len(), 2);
-        assert_eq!(read.designs[1].spec.aperture_mm, 123.0);
-        assert_eq!((read.editing, read.legacy_a.is_none()), (1, true));
-        assert!(!ron::to_string(&read).unwrap_or_default().contains("editing_instrument"));
     }
 }

@@ -354,3 +354,11 @@ impl EngineLink {
         }
     }
 }
+
+/// The engine's threads: `requested`, or every core the machine offers when 0.
+pub(super) fn engine_threads(requested: usize) -> usize {
+    if requested > 0 {
+        return requested;
+    }
+    std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
+}

@@ -8,6 +8,7 @@
 //! | part | file |
 //! |---|---|
 //! | persisted state, the designs' configurations | [`model`] |
+//! | sessions of older formats brought up to date | `migrate` |
 //! | the list of designs: add, remove, reorder | `designs` |
 //! | the retrievals offered, as specs | `retrievals` |
 //! | the engine thread's results | [`link`] |
@@ -44,6 +45,7 @@ mod listing;
 mod logic;
 mod maps;
 mod metrics_table;
+mod migrate;
 pub mod model;
 mod optics;
 mod panels;
@@ -171,25 +173,20 @@ pub struct ShoalApp {
 /// Storage key of the session.
 const STATE_KEY: &str = "shoal-session";
 
-fn engine_threads(requested: usize) -> usize {
-    if requested > 0 {
-        return requested;
-    }
-    std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
-}
-
 impl ShoalApp {
     /// The app with `state` (tests and the eframe creator).
     pub fn with_state(state: AppState, ctx: &egui::Context, options: AppOptions) -> Self {
         window::install_fonts(ctx);
         let engine_wake = ctx.clone();
-        let link =
-            EngineLink::new(engine_threads(options.engine_threads), Arc::new(move || engine_wake.request_repaint()))
-                .unwrap_or_else(|e| {
-                    // Without an engine thread (the OS refused a thread) nothing can run: say why and stop.
-                    eprintln!("error: cannot start the engine thread: {e}");
-                    std::process::exit(1);
-                });
+        let link = EngineLink::new(
+            link::engine_threads(options.engine_threads),
+            Arc::new(move || engine_wake.request_repaint()),
+        )
+        .unwrap_or_else(|e| {
+            // Without an engine thread (the OS refused a thread) nothing can run: say why and stop.
+            eprintln!("error: cannot start the engine thread: {e}");
+            std::process::exit(1);
+        });
         let wake = ctx.clone();
         let raster = raster::spawn_raster_thread(move || wake.request_repaint()).ok();
         let export_path = crate::library::export_dir().join("comparison").display().to_string();
@@ -232,7 +229,8 @@ impl ShoalApp {
             ),
             // A session saved by an earlier Shoal in eframe's own storage (outside SHOAL_HOME).
             (false, session::SavedSession::None) => {
-                let mut old = cc.storage.and_then(|s| eframe::get_value::<AppState>(s, STATE_KEY));
+                let stored = cc.storage.and_then(|s| s.get_string(STATE_KEY));
+                let mut old = stored.and_then(|t| AppState::from_session_text(&t).ok());
                 let reset = old.as_mut().map(session::repair).unwrap_or_default();
                 (
                     old,

@@ -63,34 +63,6 @@ pub fn fallback_requirements() -> Requirements {
     }
 }
 
-/// Sessions saved before the app held a list of designs named the instrument being edited
-/// `editing_instrument: A` or `B`; read, then moved to [`AppState::editing`] by
-/// [`AppState::settle`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-pub enum LegacyAb {
-    /// Instrument A (design 0).
-    A,
-    /// Instrument B (design 1).
-    B,
-}
-
-/// `Some` of a value stored bare (`a: (preset: …)`, not `a: Some((…))`), for the legacy fields.
-fn bare_some<'de, D: serde::Deserializer<'de>, T: Deserialize<'de>>(d: D) -> Result<Option<T>, D::Error> {
-    T::deserialize(d).map(Some)
-}
-
-/// The retrieval a session saved before [`AppState::retrievals`] ran (`retrieval: Almi`):
-/// read, then turned into the selection by [`AppState::settle`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-pub enum LegacyRetrieval {
-    /// aLMI.
-    Almi,
-    /// SAMBUCA.
-    Sambuca,
-    /// The study's external program.
-    External,
-}
-
 /// The whole persisted state of the app.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
@@ -99,19 +71,10 @@ pub struct AppState {
     pub schema_version: u32,
     /// The designs compared, in order: A, B, C, … (at least one, at most [`MAX_DESIGNS`]).
     pub designs: Vec<Slot>,
-    /// Instrument A of a session saved before `designs` (moved there by [`Self::settle`]).
-    #[serde(rename = "a", default, deserialize_with = "bare_some", skip_serializing)]
-    pub legacy_a: Option<Slot>,
-    /// Instrument B of such a session.
-    #[serde(rename = "b", default, deserialize_with = "bare_some", skip_serializing)]
-    pub legacy_b: Option<Slot>,
-    /// The instrument such a session was editing.
-    #[serde(rename = "editing_instrument", default, deserialize_with = "bare_some", skip_serializing)]
-    pub legacy_editing: Option<LegacyAb>,
     /// Parameters linked across the designs (field names): an edit of one sets it in all.
     pub linked: Vec<String>,
     /// The design the editor shows (an index into `designs`). (Saved as `editing_design`:
-    /// sessions from before [`LegacyAb`] saved a number under `editing`, which is ignored.)
+    /// sessions from before the designs' list saved a number under `editing`, which is ignored.)
     #[serde(rename = "editing_design")]
     pub editing: usize,
     /// The design the others are compared with in the parameter table ("Parameters against A").
@@ -134,19 +97,6 @@ pub struct AppState {
     pub retrievals: Vec<RetrievalSpec>,
     /// The one that runs (an index into `retrievals`).
     pub selected_retrieval: usize,
-    /// A session saved before `retrievals`: the retrieval it ran, its aLMI and SAMBUCA settings
-    /// and its study's program (moved into `retrievals` by [`Self::settle`]; never written).
-    #[serde(rename = "retrieval", default, deserialize_with = "bare_some", skip_serializing)]
-    pub legacy_retrieval: Option<LegacyRetrieval>,
-    /// (See `legacy_retrieval`.)
-    #[serde(rename = "almi", default, deserialize_with = "bare_some", skip_serializing)]
-    pub legacy_almi: Option<AlmiSettings>,
-    /// (See `legacy_retrieval`.)
-    #[serde(rename = "sambuca", default, deserialize_with = "bare_some", skip_serializing)]
-    pub legacy_sambuca: Option<SambucaSettings>,
-    /// (See `legacy_retrieval`.)
-    #[serde(rename = "external", default, skip_serializing)]
-    pub legacy_external: Option<crate::retrieval::external::ExternalSpec>,
     /// Preview decimations, coarsest first; the last is the final resolution (saved states
     /// before the rename call it `levels`: [`crate::schema::RENAMES`]).
     pub decimations: Vec<usize>,
@@ -219,9 +169,6 @@ impl AppState {
         let shown = designs.len().clamp(1, MAPS_AT_OPEN);
         Self {
             designs,
-            legacy_a: None,
-            legacy_b: None,
-            legacy_editing: None,
             linked: Vec::new(),
             editing: 0,
             reference: 0,
@@ -233,10 +180,6 @@ impl AppState {
             noise_seed: 1,
             retrievals: super::retrievals::built_in(AlmiSettings::default(), SambucaSettings::default()),
             selected_retrieval: 0,
-            legacy_retrieval: None,
-            legacy_almi: None,
-            legacy_sambuca: None,
-            legacy_external: None,
             schema_version: crate::schema::VERSION,
             decimations: vec![24, 4, 1],
             product: ProductKind::Chl,
@@ -370,35 +313,29 @@ impl AppState {
     }
 
     /// The parameters edited away from each design's preset, for captions ("A aperture_mm 60 →
-    /// 105.8"): numbers to four significant digits (never a float's raw digits), a list by its
-    /// length, anything else as "edited".
+    /// 105.8"), each by its path ([`crate::fields::diff`]: `effects.0.StrayLight.halo_fraction`):
+    /// numbers to four significant digits (never a float's raw digits), a list whose length changed
+    /// by its lengths, text and switches as they were and are, anything else as "edited".
     #[must_use]
     pub fn changes(&self) -> Vec<String> {
         let mut out = Vec::new();
         for (i, slot) in self.designs.iter().enumerate() {
-            let (Ok(serde_json::Value::Object(now)), Ok(serde_json::Value::Object(then))) =
-                (serde_json::to_value(&slot.spec), serde_json::to_value(&slot.original))
-            else {
-                continue;
-            };
-            // Both files' keys: a list cleared to nothing is left out of the edited one.
-            let keys: Vec<&String> = now.keys().chain(then.keys().filter(|k| !now.contains_key(*k))).collect();
-            for k in keys {
-                let v = now.get(k).unwrap_or(&serde_json::Value::Null);
-                let old = then.get(k).unwrap_or(&serde_json::Value::Null);
-                if old == v || k == "name" || k == "description" {
+            for change in crate::fields::diff(&slot.spec, &slot.original) {
+                use serde_json::Value;
+                let k = &change.path;
+                if k == "name" || k == "description" {
                     continue;
                 }
-                let what = match (old, v) {
-                    (serde_json::Value::Number(a), serde_json::Value::Number(b)) => {
+                let what = match (&change.before, &change.after) {
+                    (Value::Number(a), Value::Number(b)) => {
                         let sig = |n: &serde_json::Number| n.as_f64().map_or_else(|| n.to_string(), four_digits);
                         format!("{} → {}", sig(a), sig(b))
                     }
-                    (serde_json::Value::Array(a), serde_json::Value::Array(b)) if a.len() != b.len() => {
-                        format!("{} → {} entries", a.len(), b.len())
-                    }
-                    (serde_json::Value::Array(a), serde_json::Value::Null) => format!("{} → 0 entries", a.len()),
-                    (serde_json::Value::Null, serde_json::Value::Array(b)) => format!("0 → {} entries", b.len()),
+                    (Value::Array(a), Value::Array(b)) => format!("{} → {} entries", a.len(), b.len()),
+                    (Value::Array(a), Value::Null) => format!("{} → 0 entries", a.len()),
+                    (Value::Null, Value::Array(b)) => format!("0 → {} entries", b.len()),
+                    (Value::String(a), Value::String(b)) => format!("{a} → {b}"),
+                    (Value::Bool(a), Value::Bool(b)) => format!("{a} → {b}"),
                     _ => "edited".to_string(),
                 };
                 out.push(format!("{} {k} {what}", label(i)));

@@ -3,8 +3,6 @@
 //! typed value must meet), and how each reads and writes an instrument — through the
 //! instrument's serde form, as sweeps set any field by its path (`crate::sweep::apply`).
 
-use serde_json::Value;
-
 use crate::instrument::InstrumentSpec;
 use crate::ranges::{Editor, INSTRUMENT_EDITOR, Range};
 
@@ -49,27 +47,13 @@ pub fn param(key: &str) -> Option<Param> {
 /// form; NaN for a field it does not hold).
 #[must_use]
 pub fn values(spec: &InstrumentSpec) -> Vec<f64> {
-    let tree = serde_json::to_value(spec).unwrap_or(Value::Null);
-    params().map(|p| tree.get(p.key).and_then(Value::as_f64).unwrap_or(f64::NAN)).collect()
+    crate::fields::numbers(spec, params().map(|p| p.key))
 }
 
 /// `spec` with field `key` set to `value` (stored units), or why not (not a field, a whole number
 /// given a fraction). Not validated: the caller checks the instrument.
 pub fn with_value(spec: &InstrumentSpec, key: &str, value: f64) -> Result<InstrumentSpec, String> {
-    let mut tree = serde_json::to_value(spec).map_err(|e| e.to_string())?;
-    let slot = tree.get_mut(key).ok_or_else(|| format!("no instrument field `{key}`"))?;
-    *slot = match slot {
-        Value::Number(n) if !n.is_f64() => {
-            if value.fract() != 0.0 || !(0.0..=9.0e15).contains(&value) {
-                return Err(format!("`{key}` is a whole number; {value} is not"));
-            }
-            Value::from(value as u64)
-        }
-        _ => serde_json::Number::from_f64(value)
-            .map(Value::Number)
-            .ok_or_else(|| format!("`{key}`: {value} is not finite"))?,
-    };
-    serde_json::from_value(tree).map_err(|e| e.to_string())
+    crate::fields::with_numbers(spec, &[(key, value)])
 }
 
 /// The parameters in which the designs differ from the first (the reference), as rows

@@ -2,7 +2,7 @@
 //! aLMI and SAMBUCA always, then a study's own (a program, QAA). The app selects one by index,
 //! edits its settings in place, and switches by the retrieval's name (`alm`, `sambuca`).
 
-use super::model::{AppState, LegacyRetrieval};
+use super::model::AppState;
 use crate::retrieval::{AlmiSettings, RetrievalSpec, SambucaSettings};
 
 /// aLMI with the eight built-in SIOP sets and SAMBUCA with the scene's set and substrates.
@@ -63,22 +63,9 @@ impl AppState {
         self.retrievals = offered;
     }
 
-    /// The retrievals' part of [`AppState::settle`]: a session saved before `retrievals` gets its
-    /// aLMI and SAMBUCA settings and its program as specs, and the retrieval it ran selected; a
-    /// list without aLMI or SAMBUCA gets them back; the selection in range.
+    /// The retrievals' part of [`AppState::settle`]: a list without aLMI or SAMBUCA gets them
+    /// back; the selection in range.
     pub(super) fn settle_retrievals(&mut self) {
-        let legacy = self.legacy_retrieval.take();
-        let (almi, sambuca, external) =
-            (self.legacy_almi.take(), self.legacy_sambuca.take(), self.legacy_external.take());
-        if legacy.is_some() || almi.is_some() || sambuca.is_some() || external.is_some() {
-            self.retrievals = built_in(almi.unwrap_or_default(), sambuca.unwrap_or_default());
-            self.retrievals.extend(external.map(RetrievalSpec::External));
-            self.selected_retrieval = match legacy {
-                Some(LegacyRetrieval::Sambuca) => 1,
-                Some(LegacyRetrieval::External) if self.retrievals.len() > 2 => 2,
-                _ => 0,
-            };
-        }
         if !matches!(self.retrievals.first(), Some(RetrievalSpec::Almi { .. }))
             || !matches!(self.retrievals.get(1), Some(RetrievalSpec::Sambuca { .. }))
         {

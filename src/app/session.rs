@@ -55,11 +55,7 @@ pub fn load_session(path: &Path) -> SavedSession {
         Err(e) => Err(e.message),
     };
     let parsed = bytes.and_then(|bytes| match String::from_utf8(bytes) {
-        Ok(text) => crate::schema::migrate(&text).and_then(|text| {
-            let mut state = ron::from_str::<AppState>(&text).map_err(|e| crate::parse::describe(&text, &e))?;
-            state.schema_version = crate::schema::VERSION;
-            Ok(state)
-        }),
+        Ok(text) => AppState::from_session_text(&text),
         Err(e) => Err(format!("byte {} is not UTF-8 text", e.utf8_error().valid_up_to())),
     });
     match parsed {
@@ -229,7 +225,8 @@ mod tests {
         let today = AppState { decimations: vec![16, 2], ..AppState::default() };
         let text = ron::to_string(&today).unwrap_or_else(|e| panic!("{e}"));
         // As an older app saved it: no version, the decimations called `levels`.
-        let old = text.replace("schema_version:3,", "").replace("decimations:", "levels:");
+        let old =
+            text.replace(&format!("schema_version:{},", crate::schema::VERSION), "").replace("decimations:", "levels:");
         assert!(!old.contains("schema_version") && old.contains("levels:[16,2]"), "{old}");
         std::fs::write(&path, old).unwrap_or_else(|e| panic!("{e}"));
         match load_session(&path) {

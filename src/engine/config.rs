@@ -271,12 +271,13 @@ mod tests {
         let instrument = crate::instrument::InstrumentSpec::preset("cubesat").unwrap_or_else(|e| panic!("{e}"));
         let today = RunConfig::new(scene, instrument);
         let text = today.to_ron().unwrap_or_else(|e| panic!("{e}"));
-        assert!(text.contains("schema_version: 3"), "written with its version");
+        let version = format!("schema_version: {}", crate::schema::VERSION);
+        assert!(text.contains(&version), "written with its version");
         // As an older Shoal wrote it: no version, the instrument's `lines` called `exposures`.
-        let old = text.replace("    schema_version: 3,\n", "").replace("lines: 2000", "exposures: 2000");
+        let old = text.replace(&format!("    {version},\n"), "").replace("lines: 2000", "exposures: 2000");
         assert!(!old.contains("schema_version") && old.contains("exposures: 2000"));
         assert_eq!(RunConfig::from_ron(&old, "old.ron").unwrap_or_else(|e| panic!("{e}")), today);
-        let newer = text.replace("schema_version: 3", "schema_version: 4");
+        let newer = text.replace(&version, &format!("schema_version: {}", crate::schema::VERSION + 1));
         let e = RunConfig::from_ron(&newer, "new.ron").unwrap_err().to_string();
         assert!(e.contains("new.ron") && e.contains("newer Shoal"), "{e}");
     }

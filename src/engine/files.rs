@@ -34,14 +34,12 @@ pub const HASHED_BYTES: u64 = 1 << 20;
 /// `base_dir` (see the module docs); 0 when it refers to none.
 #[must_use]
 pub fn fingerprint(part: &impl Serialize, base_dir: Option<&Path>) -> u64 {
-    // The same text the keys hash; if `part` cannot be written as RON the key building fails
-    // the same way, so nothing is lost by finding no file here.
-    let Ok(text) = ron::to_string(part) else { return 0 };
     let mut bases: Vec<PathBuf> = base_dir.iter().map(|d| d.to_path_buf()).collect();
     bases.push(PathBuf::new());
     let mut files = BTreeMap::new();
-    for quoted in quoted_strings(&text) {
-        add_file(quoted, &bases, &mut files, DEPTH);
+    // Every text the configuration holds is tried as a file name ([`crate::fields::strings`]).
+    for text in crate::fields::strings(part) {
+        add_file(&text, &bases, &mut files, DEPTH);
     }
     if files.is_empty() {
         return 0;
@@ -51,8 +49,8 @@ pub fn fingerprint(part: &impl Serialize, base_dir: Option<&Path>) -> u64 {
     h.finish()
 }
 
-/// The pieces of `text` between double quotes (every other piece: paths hold no escaped
-/// quotes, and a wrong piece names no file and adds nothing).
+/// The pieces of a referenced file's `text` between double quotes (every other piece: paths hold
+/// no escaped quotes, and a wrong piece names no file and adds nothing).
 fn quoted_strings(text: &str) -> impl Iterator<Item = &str> {
     text.split('"').skip(1).step_by(2)
 }

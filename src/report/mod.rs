@@ -211,46 +211,12 @@ pub struct ReviewData {
     pub failures: Vec<(String, String, String)>,
 }
 
-/// Flatten a JSON value into dotted (name, text) pairs; long arrays are summarised.
-fn flatten(prefix: &str, v: &serde_json::Value, out: &mut Vec<(String, String)>) {
-    use serde_json::Value;
-    match v {
-        Value::Object(map) => {
-            for (k, v) in map {
-                let name = if prefix.is_empty() { k.clone() } else { format!("{prefix}.{k}") };
-                flatten(&name, v, out);
-            }
-        }
-        Value::Array(items) if items.iter().any(|i| i.is_object() || i.is_array()) || items.len() > 6 => {
-            // The digest makes two lists of the same length but other contents differ here too
-            // (their entries are listed only up to 40).
-            let digest = v
-                .to_string()
-                .bytes()
-                .fold(0xcbf2_9ce4_8422_2325u64, |h, b| (h ^ u64::from(b)).wrapping_mul(0x100_0000_01b3));
-            out.push((prefix.to_string(), format!("{} entries (digest {:08x})", items.len(), digest >> 32)));
-            if items.len() <= 40 {
-                for (i, item) in items.iter().enumerate() {
-                    flatten(&format!("{prefix}[{i}]"), item, out);
-                }
-            }
-        }
-        Value::String(s) => out.push((prefix.to_string(), s.clone())),
-        other => out.push((prefix.to_string(), other.to_string())),
-    }
-}
-
 /// The instruments' parameters side by side: every field of each spec, in the first one's order.
 fn parameter_rows(configs: &[&RunConfig]) -> Vec<ParameterRow> {
+    // Each leaf by the path a sweep sets it by ([`crate::fields`]).
     let flat: Vec<Vec<(String, String)>> = configs
         .iter()
-        .map(|c| {
-            let mut out = Vec::new();
-            if let Ok(v) = serde_json::to_value(&c.instrument) {
-                flatten("", &v, &mut out);
-            }
-            out
-        })
+        .map(|c| crate::fields::flatten(&c.instrument).into_iter().map(|l| (l.path, l.text)).collect())
         .collect();
     let mut names: Vec<String> = Vec::new();
     for f in &flat {

@@ -1,70 +1,24 @@
-//! Setting a numeric field of a run configuration by its path (`instrument.aperture_mm`).
-//!
-//! The configuration goes through its serde form (JSON values): the path walks object keys and
-//! array indices, the field must already hold a number, and the result is read back and
-//! validated like any configuration — so every field the files can set can be swept.
-
-use serde_json::Value;
+//! Setting a numeric field of a run configuration by its path (`instrument.aperture_mm`): the
+//! configuration layer's [`crate::fields::with_numbers`] on a [`RunConfig`] — the path walks the
+//! fields' names and list indices of its serde form, the field must already hold a number, and the
+//! result is read back and validated like any configuration, so every field the files can set can
+//! be swept.
 
 use crate::engine::RunConfig;
 
 /// `base` with each `(path, value)` set. Integer fields take integral values only.
+///
+/// # Errors
+/// A path that names no number, or a value its field cannot hold (the message names the path).
 pub fn apply(base: &RunConfig, settings: &[(&str, f64)]) -> Result<RunConfig, String> {
-    let mut tree = serde_json::to_value(base).map_err(|e| format!("cannot represent the configuration: {e}"))?;
-    for &(path, value) in settings {
-        set(&mut tree, path, value)?;
-    }
-    let config: RunConfig = serde_json::from_value(tree).map_err(|e| format!("`{settings:?}`: {e}"))?;
-    Ok(config)
+    crate::fields::with_numbers(base, settings)
 }
 
 /// The number at `path` of `config` (`None`: no such field, or not a number there — a field of
 /// another instrument kind, a map).
 #[must_use]
 pub fn value(config: &RunConfig, path: &str) -> Option<f64> {
-    let tree = serde_json::to_value(config).ok()?;
-    let mut node = &tree;
-    for key in path.split('.') {
-        node = match node {
-            Value::Object(map) => map.get(key)?,
-            Value::Array(items) => items.get(key.parse::<usize>().ok()?)?,
-            _ => return None,
-        };
-    }
-    node.as_f64()
-}
-
-fn set(tree: &mut Value, path: &str, value: f64) -> Result<(), String> {
-    let mut node = tree;
-    for key in path.split('.') {
-        node = match node {
-            Value::Object(map) => {
-                let known: Vec<String> = map.keys().cloned().collect();
-                map.get_mut(key)
-                    .ok_or_else(|| format!("`{path}`: no field `{key}` here (fields: {})", known.join(", ")))?
-            }
-            Value::Array(items) => {
-                let n = items.len();
-                let i: usize = key.parse().map_err(|_| format!("`{path}`: `{key}` must be an index 0..{n} here"))?;
-                items.get_mut(i).ok_or_else(|| format!("`{path}`: index {i} out of 0..{n}"))?
-            }
-            other => return Err(format!("`{path}`: `{key}` is inside a value that has no fields ({other})")),
-        };
-    }
-    let Value::Number(n) = node else {
-        return Err(format!("`{path}` is not a number (it holds {node})"));
-    };
-    *node = if n.is_f64() {
-        serde_json::Number::from_f64(value)
-            .map(Value::Number)
-            .ok_or_else(|| format!("`{path}`: {value} is not finite"))?
-    } else {
-        if value.fract() != 0.0 || !(0.0..=9.0e15).contains(&value) {
-            return Err(format!("`{path}` is a whole number; {value} is not (use a list of whole values)"));
-        }
-        Value::from(value as u64)
-    };
-    Ok(())
+    crate::fields::number(config, path)
 }
 
 #[cfg(test)]

@@ -65,11 +65,10 @@ fn a_study_with_a_program_opens_with_it_selectable_and_sessions_keep_it() {
     assert_eq!(ron::from_str::<AppState>(&text).unwrap(), state);
     // A session saved before the list (`retrieval: Almi`, `almi`, `sambuca`, `external`) reads
     // as the list with its selection.
-    let mut legacy = ron::from_str::<AppState>(
+    let legacy = AppState::from_session_text(
         &ron::to_string(&AppState::default()).unwrap().replace("selected_retrieval:0,", "retrieval:Sambuca,"),
     )
     .unwrap();
-    legacy.settle();
     assert!(legacy.runs("sambuca"));
 }
 
