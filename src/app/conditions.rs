@@ -5,7 +5,7 @@
 //! refused value keeps the last valid one and says why.
 
 use super::ShoalApp;
-use crate::atmosphere::{AerosolType, Surface};
+use crate::atmosphere::{AerosolType, SeaSurface};
 use crate::ranges::Range;
 use crate::scene::Effect;
 
@@ -100,15 +100,15 @@ pub(super) fn conditions(app: &mut ShoalApp, ui: &mut egui::Ui) {
         let mut glint = s.scene.effects.contains(&Effect::SunGlint);
         if ui.checkbox(&mut glint, "Sun glint (Cox–Munk, wind-roughened sea)").changed() {
             if glint {
-                if matches!(s.scene.atmosphere.surface, Surface::Flat) {
-                    s.scene.atmosphere.surface = Surface::Wind { speed_m_s: 5.0 };
+                if matches!(s.scene.atmosphere.surface, SeaSurface::Flat) {
+                    s.scene.atmosphere.surface = SeaSurface::Wind { speed_m_s: 5.0 };
                 }
                 s.scene.effects.push(Effect::SunGlint);
             } else {
                 s.scene.effects.retain(|e| *e != Effect::SunGlint);
             }
         }
-        if let Surface::Wind { speed_m_s } = &mut s.scene.atmosphere.surface {
+        if let SeaSurface::Wind { speed_m_s } = &mut s.scene.atmosphere.surface {
             refused =
                 refused.or(checked(ui, speed_m_s, (0.0, 15.0), &r::ATMOSPHERE_WIND_SPEED_M_S, "Wind speed", " m/s"));
         }

@@ -21,7 +21,7 @@ use crate::spectral::{Extrapolation, Spectrum};
 /// The sea surface.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
-pub enum Surface {
+pub enum SeaSurface {
     /// A flat Fresnel interface (no glint).
     #[default]
     Flat,
@@ -33,7 +33,7 @@ pub enum Surface {
     },
 }
 
-impl Surface {
+impl SeaSurface {
     /// Parse `flat` or `wind:5`.
     pub fn parse(text: &str) -> Result<Self, AtmosphereError> {
         let t = text.trim().to_ascii_lowercase();
@@ -65,8 +65,8 @@ pub struct AtmosphereSpec {
     pub gases: bool,
     /// Gas column amounts when `gases` is on.
     pub gas_amounts: GasAmounts,
-    /// Surface state.
-    pub surface: Surface,
+    /// Sea surface state.
+    pub surface: SeaSurface,
     /// Rayleigh optical-depth formula.
     pub rayleigh: RayleighDepth,
     /// Latitude of the scene, degrees (gravity in the Rayleigh depth).
@@ -91,7 +91,7 @@ impl Default for AtmosphereSpec {
             pressure_hpa: STANDARD_PRESSURE_HPA,
             gases: false,
             gas_amounts: GasAmounts::default(),
-            surface: Surface::Flat,
+            surface: SeaSurface::Flat,
             rayleigh: RayleighDepth::Bodhaine,
             latitude_deg: 45.0,
             rayleigh_scale_height_km: 8.0,
@@ -119,7 +119,7 @@ impl AtmosphereSpec {
         check(&r::ATMOSPHERE_PRESSURE_HPA, self.pressure_hpa)?;
         check(&r::ATMOSPHERE_OZONE_ATM_CM, self.gas_amounts.ozone_atm_cm)?;
         check(&r::ATMOSPHERE_WATER_VAPOUR_CM, self.gas_amounts.water_vapour_cm)?;
-        if let Surface::Wind { speed_m_s } = self.surface {
+        if let SeaSurface::Wind { speed_m_s } = self.surface {
             check(&r::ATMOSPHERE_WIND_SPEED_M_S, speed_m_s)?;
         }
         if let super::wmo::AerosolType::Mixture(f) = self.aerosol {
@@ -362,8 +362,8 @@ impl Atmosphere {
     /// flat surface).
     pub fn glint(&self, g: &Geometry, tau: f64) -> f64 {
         match self.spec.surface {
-            Surface::Flat => 0.0,
-            Surface::Wind { speed_m_s } => glint_radiance_norm(
+            SeaSurface::Flat => 0.0,
+            SeaSurface::Wind { speed_m_s } => glint_radiance_norm(
                 g.sun_zenith_rad,
                 g.view_zenith_rad,
                 g.relative_azimuth_rad,

@@ -14,7 +14,9 @@ use serde::{Deserialize, Serialize};
 use super::CliError;
 use super::grid::{GridArgs, GridSpec};
 use super::output::{Csv, emit};
-use crate::atmosphere::{AerosolType, AtmosphereSpec, AtmosphereTerms, Geometry, RayleighDepth, RtAccuracy, Surface};
+use crate::atmosphere::{
+    AerosolType, AtmosphereSpec, AtmosphereTerms, Geometry, RayleighDepth, RtAccuracy, SeaSurface,
+};
 use crate::spectral::{BandAverager, BandSetSpec};
 
 /// A `shoal atmosphere` run as a RON file (`presets/examples/atmosphere_lake_hume.ron`).
@@ -61,7 +63,7 @@ pub struct AtmosphereArgs {
     /// Aerosol optical thickness at 550 nm (0 to 5).
     #[arg(long, value_name = "AOT", allow_negative_numbers = true)]
     pub aot550: Option<f64>,
-    /// Surface: flat, or wind:SPEED (m/s, 0 to 30) to add Cox-Munk sun glint.
+    /// Sea surface: flat, or wind:SPEED (m/s, 0 to 30) to add Cox-Munk sun glint.
     #[arg(long, value_name = "flat|wind:SPEED")]
     pub surface: Option<String>,
     /// Gas absorption (ozone, oxygen, water vapour): on or off.
@@ -129,7 +131,7 @@ fn merged(args: &AtmosphereArgs) -> Result<AtmosphereRun, CliError> {
     }
     a.aot550 = args.aot550.unwrap_or(a.aot550);
     if let Some(s) = &args.surface {
-        a.surface = Surface::parse(s)?;
+        a.surface = SeaSurface::parse(s)?;
     }
     if let Some(g) = &args.gases {
         a.gases = match g.as_str() {

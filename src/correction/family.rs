@@ -164,7 +164,7 @@ impl AerosolFamily {
         // Per column, the largest over the geometry groups (a filter imager's rows see the ground
         // from different angles).
         let glint_lgn = match scene.spec.atmosphere.surface {
-            crate::atmosphere::Surface::Wind { speed_m_s } if scene.wants(crate::scene::Effect::SunGlint) => {
+            crate::atmosphere::SeaSurface::Wind { speed_m_s } if scene.wants(crate::scene::Effect::SunGlint) => {
                 // L_GN is the glint per unit solar flux without the path's attenuation (τ = 0).
                 let lgn = |g: &crate::atmosphere::Geometry| {
                     crate::atmosphere::glint_radiance_norm(

@@ -19,7 +19,7 @@ use super::cache::{Key, KeyBuilder};
 use super::{EngineError, RunOutput, Stage};
 use crate::atmosphere::{AtmosphereLut, LutAxes};
 use crate::spectral::WavelengthGrid;
-use crate::toa::{SceneOptics, Scratch, Surface};
+use crate::toa::{SceneOptics, Scratch, Target};
 
 /// First wavelength of the spectrum, nm.
 pub const SPECTRUM_START_NM: f64 = 350.0;
@@ -123,7 +123,7 @@ impl SpectrumMaker {
             pixel: (row, column),
             sun_zenith_deg: g.sun_zenith_rad.to_degrees(),
             view_zenith_deg: g.view_zenith_rad.to_degrees(),
-            water: surface == Surface::Water,
+            water: surface == Target::Water,
             gases: out.config.scene.atmosphere.gases,
             wavelengths_nm: optics.grid().wavelengths_nm().to_vec(),
             l_toa_w_m2_sr_um: per_um(&l_toa),

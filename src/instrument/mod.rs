@@ -62,7 +62,7 @@ pub use sample::{AotNodes, BandAtmosphere, RadianceCube, SampleOptions, sample_r
 pub use snr::{SnrRow, analytic_snr, measured_snr};
 pub use spatial::SpatialKernel;
 pub use spec::{InstrumentKind, InstrumentSpec, ground_speed_m_s};
-pub use truth::{Surface, SurfaceMap, Truth};
+pub use truth::{SurfaceClass, SurfaceMap, Truth};
 
 use crate::parse::{FieldError, ParseError};
 use crate::scene::SceneError;

@@ -30,7 +30,7 @@ use super::truth::{SurfaceMap, Truth};
 use crate::control::RunControl;
 use crate::parse::FieldError;
 use crate::scene::Scene;
-use crate::toa::{SceneOptics, Scratch, Surface};
+use crate::toa::{SceneOptics, Scratch, Target};
 
 pub use super::aerosol_map::AotNodes;
 pub use super::band_atmosphere::{BandAtmosphere, BandWeights, NodeWeights};
@@ -279,7 +279,7 @@ impl PixelSampler<'_> {
                         .fold((0.0, 0.0), |(n, d), (wi, v)| (n + wi * v, d + wi));
                     let weight = kernel.weights[b][k];
                     out[b] += (weight * num / den) as f32;
-                    if surface == Surface::Water {
+                    if surface == Target::Water {
                         let (tf, tw) = &self.truth_atmosphere.truth_weights[gi][c][kb];
                         let t: f64 = tw.iter().zip(&rrs[*tf..*tf + tw.len()]).map(|(a, v)| a * v).sum();
                         truth[b] += (weight * t) as f32;

@@ -33,7 +33,7 @@ pub struct Truth {
 /// What covers a pixel centre.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[repr(u8)]
-pub enum Surface {
+pub enum SurfaceClass {
     /// Open water: simulated, corrected and retrieved.
     Water = 0,
     /// Land (the scene's land mask).
@@ -44,7 +44,7 @@ pub enum Surface {
     CloudShadow = 3,
 }
 
-impl Surface {
+impl SurfaceClass {
     /// The class of a code as stored (an unknown code reads as land: never retrieved).
     #[must_use]
     pub const fn of_code(code: u8) -> Self {
@@ -64,15 +64,16 @@ impl Surface {
 }
 
 /// The surface class of every pixel, (row, column): the one place that says which pixels are
-/// water. Stored as the [`Surface`] codes, which the writers write as they are (`land_mask.npy`,
-/// NetCDF `land`, GeoTIFF: 0 water, 1 land).
+/// water. Stored as the [`SurfaceClass`] codes, which the writers write as they are
+/// (`surface_class.npy`, NetCDF `surface_class`, a GeoTIFF plane: 0 water, 1 land, 2 cloud, 3
+/// cloud shadow).
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct SurfaceMap {
     codes: Array2<u8>,
 }
 
 impl SurfaceMap {
-    /// The map of `codes` ([`Surface`] as `u8`).
+    /// The map of `codes` ([`SurfaceClass`] as `u8`).
     #[must_use]
     pub fn from_codes(codes: Array2<u8>) -> Self {
         Self { codes }
@@ -92,8 +93,8 @@ impl SurfaceMap {
 
     /// The class at (row, column).
     #[must_use]
-    pub fn at(&self, row: usize, column: usize) -> Surface {
-        Surface::of_code(self.codes[[row, column]])
+    pub fn at(&self, row: usize, column: usize) -> SurfaceClass {
+        SurfaceClass::of_code(self.codes[[row, column]])
     }
 
     /// Is (row, column) water the chain retrieves from?
@@ -105,19 +106,19 @@ impl SurfaceMap {
     /// Is the pixel at `index` (row-major) water?
     #[must_use]
     pub fn is_water_at(&self, index: usize) -> bool {
-        self.codes.as_slice().is_some_and(|c| c.get(index).is_some_and(|&v| Surface::of_code(v).is_water()))
+        self.codes.as_slice().is_some_and(|c| c.get(index).is_some_and(|&v| SurfaceClass::of_code(v).is_water()))
     }
 
     /// The water pixels.
     #[must_use]
     pub fn water_count(&self) -> usize {
-        self.codes.iter().filter(|&&c| Surface::of_code(c).is_water()).count()
+        self.codes.iter().filter(|&&c| SurfaceClass::of_code(c).is_water()).count()
     }
 
     /// True where water.
     #[must_use]
     pub fn water_mask(&self) -> Array2<bool> {
-        self.codes.mapv(|c| Surface::of_code(c).is_water())
+        self.codes.mapv(|c| SurfaceClass::of_code(c).is_water())
     }
 
     /// The codes as stored, for writers.

@@ -109,9 +109,11 @@ pub(super) fn write_input(
     let total = rows * cols * used.len();
     let bad = RrsFlags::INVALID | RrsFlags::SATURATED;
     let mut rrs_attrs = attrs("remote-sensing reflectance above the surface, corrected", "sr-1", standard_name("rrs"));
-    rrs_attrs.push(("ancillary_variables", "land".into()));
-    rrs_attrs
-        .push(("comment", "_FillValue where the correction flagged the band invalid or saturated, and on land".into()));
+    rrs_attrs.push(("ancillary_variables", "surface_class".into()));
+    rrs_attrs.push((
+        "comment",
+        "_FillValue where the correction flagged the band invalid or saturated, and off water".into(),
+    ));
     floats.push(FloatVar {
         name: "rrs".into(),
         dims: CUBE.to_vec(),
@@ -124,10 +126,10 @@ pub(super) fn write_input(
         }),
     });
     let flags = vec![FlagVar {
-        name: "land".into(),
+        name: "surface_class".into(),
         dims: MAP.to_vec(),
-        long_name: "land under the pixel centre (not retrieved)".into(),
-        flags: vec![(1, "land")],
+        long_name: "what covers the pixel centre (only water is retrieved)".into(),
+        flags: vec![(0, "water"), (1, "land"), (2, "cloud"), (3, "cloud_shadow")],
         values: Values::ready(inputs.surface.codes().iter().map(|&v| i32::from(v)).collect()),
         coordinates: "",
     }];

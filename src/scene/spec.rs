@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 use super::SceneError;
 use super::map::{Extent, Map, MapContext, MapSpec};
 use super::raster::{GeoFrame, Georeference, RasterCache, fill_nodata, resolve_frame};
-use crate::atmosphere::{AtmosphereSpec, Surface};
+use crate::atmosphere::{AtmosphereSpec, SeaSurface};
 use crate::parse::{FieldError, ParseError};
 use crate::spectral::SpectrumSource;
 use crate::water::SiopSource;
@@ -228,7 +228,7 @@ impl SceneSpec {
         if has(Effect::ShallowBottom) && self.substrates.is_empty() {
             return bad("substrates", "ShallowBottom needs at least one substrate".into());
         }
-        if has(Effect::SunGlint) && matches!(self.atmosphere.surface, Surface::Flat) {
+        if has(Effect::SunGlint) && matches!(self.atmosphere.surface, SeaSurface::Flat) {
             return bad(
                 "effects",
                 "SunGlint needs a wind-roughened surface: atmosphere.surface: Wind(speed_m_s: ..)".into(),

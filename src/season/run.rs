@@ -195,8 +195,8 @@ pub fn run_season(
         .iter()
         .map(|(label, config)| {
             let wind = match config.scene.atmosphere.surface {
-                crate::atmosphere::Surface::Wind { speed_m_s } => speed_m_s,
-                crate::atmosphere::Surface::Flat => season.wind_m_s,
+                crate::atmosphere::SeaSurface::Wind { speed_m_s } => speed_m_s,
+                crate::atmosphere::SeaSurface::Flat => season.wind_m_s,
             };
             DesignSeason {
                 label: label.clone(),

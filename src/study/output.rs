@@ -138,7 +138,7 @@ pub fn write_run(out: &RunOutput, dir: &Path) -> Result<Outputs, StudyError> {
     npy(dir, "truth_chl_mg_m3.npy", &r.chl_mg_m3, &mut o)?;
     npy(dir, "truth_nap_g_m3.npy", &r.nap_g_m3, &mut o)?;
     npy(dir, "truth_cdom_per_m.npy", &r.cdom_per_m, &mut o)?;
-    npy(dir, "land_mask.npy", r.surface.codes(), &mut o)?;
+    npy(dir, "surface_class.npy", r.surface.codes(), &mut o)?;
     if let Some(d) = &r.depth_m {
         npy(dir, "truth_depth_m.npy", d, &mut o)?;
     }

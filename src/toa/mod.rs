@@ -97,7 +97,7 @@ pub struct Scratch {
 
 /// What [`SceneOptics::radiance`] found at a point.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Surface {
+pub enum Target {
     /// Water: `rrs` holds its above-surface remote-sensing reflectance.
     Water,
     /// Land: `rrs` holds zeros.
@@ -316,7 +316,7 @@ impl SceneOptics {
         scratch: &mut Scratch,
         l_toa: &mut [f64],
         rrs: &mut [f64],
-    ) -> Result<Surface, SceneError> {
+    ) -> Result<Target, SceneError> {
         let n = self.grid.len();
         let surface = if scene.is_land(x_m, y_m) {
             let Some(rho) = &self.land else {
@@ -330,7 +330,7 @@ impl SceneOptics {
                 l_toa[i] = path.l_path[i] + path.t_up[i] * lw;
                 rrs[i] = 0.0;
             }
-            Surface::Land
+            Target::Land
         } else {
             let column = water_column(scene, x_m, y_m, &self.substrates, n, scratch);
             let geometry = WaterGeometry { sun_zenith_rad: g.sun_zenith_rad, view_zenith_rad: g.view_zenith_rad };
@@ -339,14 +339,14 @@ impl SceneOptics {
                 let lw = rrs[i] * path.ed[i] / (1.0 - path.spherical_albedo[i] * std::f64::consts::PI * rrs[i]);
                 l_toa[i] = path.l_path[i] + path.t_up[i] * lw + path.glint[i];
             }
-            Surface::Water
+            Target::Water
         };
         if let Some(adj) = &self.adjacency {
             let land = self.land.as_deref().unwrap_or(&[]);
             scratch.rho_target.clear();
             match surface {
-                Surface::Water => scratch.rho_target.extend(rrs.iter().map(|r| std::f64::consts::PI * r)),
-                Surface::Land => scratch.rho_target.extend_from_slice(land),
+                Target::Water => scratch.rho_target.extend(rrs.iter().map(|r| std::f64::consts::PI * r)),
+                Target::Land => scratch.rho_target.extend_from_slice(land),
             }
             adj.add(x_m, y_m, g, path, land, &scratch.rho_target, l_toa);
         }

@@ -74,7 +74,7 @@ fn base(path: &str) -> RunConfig {
         // Band nodes act only without adjacency (whose environment term needs whole spectra).
         scene.effects.retain(|e| *e != Effect::Adjacency);
     }
-    scene.atmosphere.surface = shoal::atmosphere::Surface::Wind { speed_m_s: 5.0 };
+    scene.atmosphere.surface = shoal::atmosphere::SeaSurface::Wind { speed_m_s: 5.0 };
     if path.starts_with("scene.atmosphere.aerosol.Mixture") {
         // A user's mixture (continental's fractions; the oceanic one 0 until changed).
         scene.atmosphere.aerosol = shoal::atmosphere::AerosolType::Mixture(Default::default());

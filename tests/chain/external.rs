@@ -110,7 +110,7 @@ fn the_program_sees_the_rrs_bands_and_geometry_but_never_the_truth() {
     let sza = reader.read_var_f32("solar_zenith_angle").unwrap();
     let (ds, _) = reader.close();
     let names = ds.get_var_names();
-    for v in ["rrs", "land", "wavelength", "bandwidth", "nedr", "solar_zenith_angle", "sensor_zenith_angle"] {
+    for v in ["rrs", "surface_class", "wavelength", "bandwidth", "nedr", "solar_zenith_angle", "sensor_zenith_angle"] {
         assert!(names.iter().any(|n| n == v), "{v} in {names:?}");
     }
     assert!(!names.iter().any(|n| n.starts_with("true")), "no truth: {names:?}");

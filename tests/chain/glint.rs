@@ -2,7 +2,7 @@
 //! scene with glint), read as aerosol when it is not, and high-glint pixels left out.
 
 use crate::common::Kept;
-use shoal::atmosphere::{AerosolType, Surface};
+use shoal::atmosphere::{AerosolType, SeaSurface};
 use shoal::correction::{ImageCorrection, RrsFlags};
 use shoal::engine::RunConfig;
 use shoal::instrument::DetectorMode;
@@ -21,7 +21,7 @@ fn glinting(roll_deg: f64, glint: bool) -> RunConfig {
     scene.cdom_per_m = MapSpec::Constant(0.02);
     scene.atmosphere.aerosol = AerosolType::Continental;
     scene.atmosphere.aot550 = 0.15;
-    scene.atmosphere.surface = Surface::Wind { speed_m_s: 5.0 };
+    scene.atmosphere.surface = SeaSurface::Wind { speed_m_s: 5.0 };
     scene.effects = vec![Effect::SunGlint];
     let mut instrument = small("cubesat", 48, 32);
     instrument.heading_deg = 290.0;

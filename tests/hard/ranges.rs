@@ -29,7 +29,7 @@ fn base(path: &str) -> RunConfig {
         c.retrievals.push(crate::common::external_retrieval(&["true"]));
     }
     c.calibration.sun_incidence_deg = Some(30.0);
-    c.scene.atmosphere.surface = shoal::atmosphere::Surface::Wind { speed_m_s: 5.0 };
+    c.scene.atmosphere.surface = shoal::atmosphere::SeaSurface::Wind { speed_m_s: 5.0 };
     if path.starts_with("scene.atmosphere.aerosol.Mixture") {
         c.scene.atmosphere.aerosol = shoal::atmosphere::AerosolType::Mixture(Default::default());
     }

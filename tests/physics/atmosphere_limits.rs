@@ -1,6 +1,6 @@
 //! Limits, determinism and bad input for the atmosphere.
 
-use shoal::atmosphere::{AerosolType, AtmosphereLut, AtmosphereSpec, Geometry, LutAxes, RtAccuracy, Surface};
+use shoal::atmosphere::{AerosolType, AtmosphereLut, AtmosphereSpec, Geometry, LutAxes, RtAccuracy, SeaSurface};
 
 fn spec(aerosol: AerosolType, aot550: f64) -> AtmosphereSpec {
     AtmosphereSpec { aerosol, aot550, ..Default::default() }
@@ -181,7 +181,7 @@ fn glint_matches_osoaa_rough_surface() {
     let aer = t.column_str("aer").unwrap();
     let diff = t.column_f64("glint_plus_rough_ws5_minus_flat").unwrap();
     let atm = AtmosphereSpec {
-        surface: Surface::Wind { speed_m_s: 5.0 },
+        surface: SeaSurface::Wind { speed_m_s: 5.0 },
         rayleigh: shoal::atmosphere::RayleighDepth::OsoaaHansenTravis,
         ..spec(AerosolType::None, 0.0)
     }
@@ -218,7 +218,10 @@ fn bad_inputs_name_the_field_and_range() {
         (spec(AerosolType::Maritime, -0.1), "aot550"),
         (spec(AerosolType::Maritime, f64::NAN), "aot550"),
         (AtmosphereSpec { pressure_hpa: 20.0, ..Default::default() }, "pressure_hpa"),
-        (AtmosphereSpec { surface: Surface::Wind { speed_m_s: 80.0 }, ..Default::default() }, "surface.Wind.speed_m_s"),
+        (
+            AtmosphereSpec { surface: SeaSurface::Wind { speed_m_s: 80.0 }, ..Default::default() },
+            "surface.Wind.speed_m_s",
+        ),
         (AtmosphereSpec { accuracy: RtAccuracy { streams: 0, ..Default::default() }, ..Default::default() }, "streams"),
         (AtmosphereSpec { day_of_year: 0, ..Default::default() }, "day_of_year"),
     ];

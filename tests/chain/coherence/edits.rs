@@ -29,7 +29,7 @@ pub(super) fn structural_edits() -> Vec<Edit> {
         ("correction uses the approximation", |c| c.correction.method = shoal::correction::Method::PerScene),
         ("aerosol continental", |c| c.scene.atmosphere.aerosol = shoal::atmosphere::AerosolType::Continental),
         ("flat surface (and so no glint)", |c| {
-            c.scene.atmosphere.surface = shoal::atmosphere::Surface::Flat;
+            c.scene.atmosphere.surface = shoal::atmosphere::SeaSurface::Flat;
             c.scene.effects.retain(|e| *e != Effect::SunGlint);
         }),
         ("gases off", |c| c.scene.atmosphere.gases = false),
