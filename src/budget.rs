@@ -99,7 +99,7 @@ impl Demand {
 
 /// How much a run may plan to use.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Budget {
+pub struct MachineBudget {
     /// Bytes of memory.
     pub memory_bytes: f64,
     /// Seconds of radiative transfer.
@@ -151,7 +151,7 @@ pub fn machine_memory_bytes() -> Option<f64> {
     }
 }
 
-impl Budget {
+impl MachineBudget {
     /// The budget from `SHOAL_MEMORY_BUDGET` and `SHOAL_TIME_BUDGET_S`, or the defaults; a value
     /// that does not read is an error naming the variable.
     pub fn from_env() -> Result<Self, String> {

@@ -16,7 +16,7 @@ use crate::study::{StudySpec, write_bytes};
 
 /// What a preset holds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Kind {
+pub enum PresetKind {
     /// An instrument.
     Instrument,
     /// A scene.
@@ -25,15 +25,15 @@ pub enum Kind {
     Study,
 }
 
-fn builtin_names(kind: Kind) -> Vec<String> {
+fn builtin_names(kind: PresetKind) -> Vec<String> {
     match kind {
-        Kind::Instrument => InstrumentSpec::preset_names(),
-        Kind::Scene => SceneSpec::preset_names(),
-        Kind::Study => StudySpec::preset_names(),
+        PresetKind::Instrument => InstrumentSpec::preset_names(),
+        PresetKind::Scene => SceneSpec::preset_names(),
+        PresetKind::Study => StudySpec::preset_names(),
     }
 }
 
-impl Kind {
+impl PresetKind {
     fn noun(self) -> &'static str {
         match self {
             Self::Instrument => "instrument",
@@ -162,7 +162,7 @@ impl Library {
     /// file called like a built-in preset (left by an older Shoal, or copied in by hand) takes
     /// the built-in's place in the list, so a name always means one preset.
     #[must_use]
-    pub fn list(&self, kind: Kind) -> Vec<Entry> {
+    pub fn list(&self, kind: PresetKind) -> Vec<Entry> {
         let builtin = builtin_names(kind);
         let mut out: Vec<Entry> = builtin
             .into_iter()
@@ -201,7 +201,7 @@ impl Library {
 
     /// The entry `name` of `kind` as [`Self::list`] resolves it (the user's file first).
     #[must_use]
-    pub fn find(&self, kind: Kind, name: &str) -> Option<Entry> {
+    pub fn find(&self, kind: PresetKind, name: &str) -> Option<Entry> {
         self.list(kind).into_iter().find(|e| e.name == name)
     }
 
@@ -246,7 +246,13 @@ impl Library {
         }
     }
 
-    fn save<T: Serialize>(&self, kind: Kind, name: &str, value: &T, overwrite: bool) -> Result<PathBuf, LibraryError> {
+    fn save<T: Serialize>(
+        &self,
+        kind: PresetKind,
+        name: &str,
+        value: &T,
+        overwrite: bool,
+    ) -> Result<PathBuf, LibraryError> {
         if !valid_name(name) {
             return Err(LibraryError::BadName(name.to_string()));
         }
@@ -266,12 +272,12 @@ impl Library {
 
     /// Save an instrument as the user's preset `name` (refuses to overwrite unless asked).
     pub fn save_instrument(&self, name: &str, spec: &InstrumentSpec, overwrite: bool) -> Result<PathBuf, LibraryError> {
-        self.save(Kind::Instrument, name, spec, overwrite)
+        self.save(PresetKind::Instrument, name, spec, overwrite)
     }
 
     /// Save a study as the user's preset `name`.
     pub fn save_study(&self, name: &str, spec: &StudySpec, overwrite: bool) -> Result<PathBuf, LibraryError> {
-        self.save(Kind::Study, name, spec, overwrite)
+        self.save(PresetKind::Study, name, spec, overwrite)
     }
 }
 
@@ -306,7 +312,7 @@ mod tests {
         assert!(matches!(lib.save_instrument("my_cube", &spec, false), Err(LibraryError::Exists(_))));
         assert!(lib.save_instrument("my_cube", &spec, true).is_ok());
         assert!(matches!(lib.save_instrument("../evil", &spec, false), Err(LibraryError::BadName(_))));
-        let entries = lib.list(Kind::Instrument);
+        let entries = lib.list(PresetKind::Instrument);
         assert!(entries.iter().any(|e| e.name == "nominal" && e.builtin));
         let mine = entries.iter().find(|e| e.name == "my_cube").unwrap();
         assert_eq!(lib.load_instrument(mine).unwrap(), spec);
@@ -319,7 +325,7 @@ mod tests {
         let dir = lib.dir.join("instruments");
         std::fs::create_dir_all(&dir).unwrap();
         std::fs::write(dir.join("broken.ron"), "InstrumentSpec(\n  name: \"b\",\n  apertur_mm: 3.0,\n)").unwrap();
-        let entry = lib.list(Kind::Instrument).into_iter().find(|e| e.name == "broken").unwrap();
+        let entry = lib.list(PresetKind::Instrument).into_iter().find(|e| e.name == "broken").unwrap();
         let e = lib.load_instrument(&entry).unwrap_err().to_string();
         assert!(e.contains("broken.ron") && e.contains("3:") && e.contains("apertur_mm"), "{e}");
         let _ = std::fs::remove_dir_all(&lib.dir);

@@ -153,7 +153,7 @@ impl ShoalApp {
             &configs.iter().collect::<Vec<_>>(),
             crate::engine::worker::app_cache_bytes(),
         );
-        let budget = crate::budget::Budget::from_env().map(|b| b.memory_bytes / 1e9);
+        let budget = crate::budget::MachineBudget::from_env().map(|b| b.memory_bytes / 1e9);
         let gb = demand.bytes() / 1e9;
         let of = budget.map_or(String::new(), |b| format!(" of the {b:.1} GB budget (SHOAL_MEMORY_BUDGET)"));
         format!(

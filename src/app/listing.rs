@@ -7,7 +7,7 @@
 use std::time::{Duration, Instant};
 
 use crate::jobs::Worker;
-use crate::library::{Entry, Kind, Library};
+use crate::library::{Entry, Library, PresetKind};
 
 /// How often the library folder is listed again in the background.
 const RESCAN: Duration = Duration::from_secs(3);
@@ -16,14 +16,14 @@ const RESCAN: Duration = Duration::from_secs(3);
 type Lists = [Vec<Entry>; 3];
 
 fn read(library: &Library) -> Lists {
-    [library.list(Kind::Instrument), library.list(Kind::Scene), library.list(Kind::Study)]
+    [library.list(PresetKind::Instrument), library.list(PresetKind::Scene), library.list(PresetKind::Study)]
 }
 
-const fn slot(kind: Kind) -> usize {
+const fn slot(kind: PresetKind) -> usize {
     match kind {
-        Kind::Instrument => 0,
-        Kind::Scene => 1,
-        Kind::Study => 2,
+        PresetKind::Instrument => 0,
+        PresetKind::Scene => 1,
+        PresetKind::Study => 2,
     }
 }
 
@@ -75,7 +75,7 @@ impl Listing {
 
     /// The entries of `kind`.
     #[must_use]
-    pub fn get(&self, kind: Kind) -> &[Entry] {
+    pub fn get(&self, kind: PresetKind) -> &[Entry] {
         &self.lists[slot(kind)]
     }
 }

@@ -251,7 +251,7 @@ impl ShoalApp {
         let mut app = Self::with_state(state.unwrap_or_default(), &cc.egui_ctx, options);
         app.ui.error = problem;
         if let Some(name) = study {
-            match app.library.find(crate::library::Kind::Study, &name) {
+            match app.library.find(crate::library::PresetKind::Study, &name) {
                 Some(entry) => app.apply_confirmed(logic::UiCommand::LoadStudy(entry)),
                 None => {
                     app.ui.error = Some(format!("No study `{name}` in the library: the app opens the session instead."))

@@ -7,7 +7,7 @@ use super::ShoalApp;
 use super::logic::UiCommand;
 use super::model::{MAX_DESIGNS, label};
 use super::params::{param, params};
-use crate::library::{Entry, Kind};
+use crate::library::{Entry, PresetKind};
 use crate::retrieval::{Mode, Objective, Starts};
 
 /// A preset picker: each entry with its description on hover, the chosen one's on the box.
@@ -50,7 +50,7 @@ fn library_combo_sized(
 /// maps, and buttons to move it up or down or remove it; then a menu to add one.
 fn designs(app: &mut ShoalApp, ui: &mut egui::Ui) {
     ui.heading("Designs");
-    let instruments = app.listing.get(Kind::Instrument).to_vec();
+    let instruments = app.listing.get(PresetKind::Instrument).to_vec();
     let n = app.state.designs.len();
     egui::Grid::new("designs").num_columns(5).spacing([6.0, 4.0]).show(ui, |ui| {
         for i in 0..n {
@@ -123,7 +123,7 @@ fn designs(app: &mut ShoalApp, ui: &mut egui::Ui) {
 fn presets(app: &mut ShoalApp, ui: &mut egui::Ui) {
     designs(app, ui);
     ui.heading("Presets");
-    let scenes = app.listing.get(Kind::Scene).to_vec();
+    let scenes = app.listing.get(PresetKind::Scene).to_vec();
     if let Some(entry) = library_combo(ui, "Scene", &app.state.scene_name.clone(), &scenes) {
         app.ui.commands.push(UiCommand::LoadScene(entry));
     }
@@ -131,7 +131,7 @@ fn presets(app: &mut ShoalApp, ui: &mut egui::Ui) {
     if !app.state.scene.description.is_empty() {
         ui.add(egui::Label::new(egui::RichText::new(&app.state.scene.description).small().weak()).wrap());
     }
-    let studies = app.listing.get(Kind::Study).to_vec();
+    let studies = app.listing.get(PresetKind::Study).to_vec();
     if let Some(entry) = library_combo(ui, "Study", &app.state.study_name.clone(), &studies) {
         app.ui.commands.push(UiCommand::LoadStudy(entry));
     }

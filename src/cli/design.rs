@@ -9,7 +9,7 @@ use clap::Args;
 
 use super::CliError;
 use crate::design::record::{self, Record};
-use crate::design::{Evaluation, Evaluator, Search, Settings, Variable, pareto_front, pass_probability_lower_bound};
+use crate::design::{Dimension, Evaluation, Evaluator, Search, Settings, pareto_front, pass_probability_lower_bound};
 use crate::study::{CurvePoint, CurveSeries, Curves, curve_figure, write_bytes};
 
 /// Arguments of `shoal design`.
@@ -71,7 +71,7 @@ pub fn run(args: &DesignArgs) -> Result<(), CliError> {
             return Err(CliError::Input(format!("{flag} {d} (allowed: 1 to 64; 0 skips confirmation)")));
         }
     }
-    let vars = args.vary.iter().map(|v| Variable::parse(v)).collect::<Result<Vec<_>, _>>().map_err(CliError::Input)?;
+    let vars = args.vary.iter().map(|v| Dimension::parse(v)).collect::<Result<Vec<_>, _>>().map_err(CliError::Input)?;
     let (spec, dir) = super::study::load(Some(&args.study))?;
     let resolved = spec.resolve(dir.as_deref())?;
     super::refuse_unallowed_external(resolved.runs.iter().map(|r| &r.2))?;
@@ -217,7 +217,7 @@ fn evaluations_csv(search: &Search) -> String {
     let excess: Vec<String> = keys.iter().map(|k| format!("excess {}", k.replace(',', ";"))).collect();
     let header: Vec<&str> = ["step", "phase"]
         .into_iter()
-        .chain(search.vars.iter().map(Variable::name))
+        .chain(search.vars.iter().map(Dimension::name))
         .chain(["cost", "feasible", "decimation", "seeds_passed", "seconds"])
         .chain(excess.iter().map(String::as_str))
         .chain(["error"])
@@ -241,7 +241,7 @@ fn evaluations_csv(search: &Search) -> String {
 
 fn front_csv(search: &Search, front: &[usize], variable: &str) -> String {
     let mae = format!("{variable}_mae_pct");
-    let header: Vec<&str> = search.vars.iter().map(Variable::name).chain(["cost", mae.as_str(), "feasible"]).collect();
+    let header: Vec<&str> = search.vars.iter().map(Dimension::name).chain(["cost", mae.as_str(), "feasible"]).collect();
     let mut csv = crate::csvtext::Csv::new(&header);
     for &i in front {
         let e = &search.evaluations[i];
@@ -280,7 +280,7 @@ fn front_curves(search: &Search, front: &[usize], variable: &str, limit: Option<
     Curves {
         title: format!(
             "{}: cost against {} error",
-            search.vars.iter().map(Variable::name).collect::<Vec<_>>().join(", "),
+            search.vars.iter().map(Dimension::name).collect::<Vec<_>>().join(", "),
             crate::metrics::name(variable)
         ),
         x_label: format!("telescope cost, {currency}"),

@@ -5,12 +5,12 @@
 use std::path::{Path, PathBuf};
 
 use super::CliError;
-use crate::library::{Entry, Kind, Library, LibraryError};
+use crate::library::{Entry, Library, LibraryError, PresetKind};
 
 /// How to read one kind of preset.
 pub(super) struct Lookup<T> {
     /// Which library folder.
-    pub(super) kind: Kind,
+    pub(super) kind: PresetKind,
     /// The flag or argument the name came from, for messages.
     pub(super) flag: &'static str,
     /// Parse a RON text (`origin` names it in errors).

@@ -229,9 +229,9 @@ fn pool(threads: usize, name: &'static str) -> Result<rayon::ThreadPool, CliErro
 }
 
 /// Refuse, before it starts, work that would not fit the machine's budget
-/// ([`crate::budget::Budget::from_env`]): the one resource plan every heavy command passes.
+/// ([`crate::budget::MachineBudget::from_env`]): the one resource plan every heavy command passes.
 pub(crate) fn within_budget(demand: &crate::budget::Demand) -> Result<(), CliError> {
-    let budget = crate::budget::Budget::from_env().map_err(CliError::Input)?;
+    let budget = crate::budget::MachineBudget::from_env().map_err(CliError::Input)?;
     budget.check(demand).map_err(|e| CliError::Input(e.to_string()))
 }
 
@@ -263,7 +263,7 @@ pub fn main(app: impl FnOnce(&AppArgs) -> ExitCode) -> ExitCode {
     }
     // The budget's environment variables are read by every command alike: one that does not
     // read is refused here, whatever the command.
-    if let Err(m) = crate::budget::Budget::from_env() {
+    if let Err(m) = crate::budget::MachineBudget::from_env() {
         eprintln!("error: {m}");
         return ExitCode::from(2);
     }

@@ -12,7 +12,7 @@ use super::CliError;
 use super::lookup::Lookup;
 use crate::engine::{Engine, EngineError, RunConfig, RunOutput};
 use crate::instrument::{InstrumentError, InstrumentSpec};
-use crate::library::{Kind, Library};
+use crate::library::{Library, PresetKind};
 use crate::scene::{SceneError, SceneSpec};
 
 /// Arguments of `shoal simulate`.
@@ -79,7 +79,7 @@ impl From<SceneError> for CliError {
 /// `SHOAL_HOME/presets` first, then the built-in): the parsed spec and the file's directory.
 /// `--scene`: a file, the user's library, or a built-in.
 pub(super) const SCENES: Lookup<SceneSpec> = Lookup {
-    kind: Kind::Scene,
+    kind: PresetKind::Scene,
     flag: "--scene",
     from_ron: |text, origin| Ok(SceneSpec::from_ron(text, origin)?),
     from_library: Library::load_scene,
@@ -88,7 +88,7 @@ pub(super) const SCENES: Lookup<SceneSpec> = Lookup {
 
 /// `--instrument`: a file, the user's library, or a built-in.
 pub(super) const INSTRUMENTS: Lookup<InstrumentSpec> = Lookup {
-    kind: Kind::Instrument,
+    kind: PresetKind::Instrument,
     flag: "--instrument",
     from_ron: |text, origin| Ok(InstrumentSpec::from_ron(text, origin)?),
     from_library: Library::load_instrument,

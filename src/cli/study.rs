@@ -58,7 +58,7 @@ impl From<StudyError> for CliError {
 /// A study argument: a file, the user's library, or a built-in; none: the default study.
 pub(super) fn load(arg: Option<&str>) -> Result<(StudySpec, Option<PathBuf>), CliError> {
     const STUDIES: Lookup<StudySpec> = Lookup {
-        kind: crate::library::Kind::Study,
+        kind: crate::library::PresetKind::Study,
         flag: "study",
         from_ron: |text, origin| Ok(StudySpec::from_ron(text, origin)?),
         from_library: crate::library::Library::load_study,

@@ -4,7 +4,7 @@
 
 use std::time::Instant;
 
-use super::space::{Variable, configure};
+use super::space::{Dimension, configure};
 use crate::control::RunControl;
 use crate::engine::{Engine, EngineError, RunConfig};
 use crate::instrument::budgets::{BudgetModels, DesignBudget};
@@ -59,7 +59,7 @@ pub struct Evaluator<'a> {
     /// The configuration every design starts from (the study's first instrument).
     pub base: &'a RunConfig,
     /// The varied fields.
-    pub vars: &'a [Variable],
+    pub vars: &'a [Dimension],
     /// Noise seeds each design runs with.
     pub seeds: &'a [u64],
     /// What the products and the design must meet.

@@ -40,7 +40,7 @@ pub mod space;
 
 pub use evaluate::{Evaluation, Evaluator};
 pub use front::pareto_front;
-pub use space::{Kind, Variable, latin_hypercube};
+pub use space::{Dimension, Domain, latin_hypercube};
 
 use crate::control::RunControl;
 use crate::engine::Engine;
@@ -110,7 +110,7 @@ impl Stall {
 #[derive(Debug, Clone)]
 pub struct Search {
     /// The varied fields.
-    pub vars: Vec<Variable>,
+    pub vars: Vec<Dimension>,
     /// Every design evaluated, in order.
     pub evaluations: Vec<Evaluation>,
     /// The cheapest feasible design found during the search (index into `evaluations`).
@@ -191,7 +191,7 @@ pub fn check(evaluator: &Evaluator<'_>, settings: &Settings) -> Result<(), Study
 /// machine's budget, so that a search whose largest designs would not fit is refused before its
 /// first run rather than recording every evaluation as failed.
 fn within_budget(evaluator: &Evaluator<'_>) -> Result<(), StudyError> {
-    let budget = crate::budget::Budget::from_env()
+    let budget = crate::budget::MachineBudget::from_env()
         .map_err(|m| StudyError::Invalid(FieldError { field: "budget".into(), message: m }))?;
     let n = evaluator.vars.len();
     for corner in 0..1u32 << n {
@@ -273,7 +273,7 @@ pub fn search_from(
         run(&x, &mut evaluations)?;
     }
     let keys = constraint_keys(&evaluations);
-    let xtypes: Vec<egobox_ego::XType> = evaluator.vars.iter().map(Variable::xtype).collect();
+    let xtypes: Vec<egobox_ego::XType> = evaluator.vars.iter().map(Dimension::xtype).collect();
     let mut step = 0u64;
     let mut stall = Stall { best: None, run: 0 };
     for e in &evaluations {

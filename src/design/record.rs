@@ -9,7 +9,7 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use super::{Evaluation, Variable};
+use super::{Dimension, Evaluation};
 use crate::parse::FieldError;
 use crate::study::StudyError;
 
@@ -38,7 +38,7 @@ pub struct Record {
 
 /// The varied fields as a record holds them.
 #[must_use]
-pub fn vars_of(vars: &[Variable]) -> Vec<(String, f64, f64)> {
+pub fn vars_of(vars: &[Dimension]) -> Vec<(String, f64, f64)> {
     vars.iter()
         .map(|v| {
             let (lo, hi) = v.bounds();
@@ -104,7 +104,7 @@ impl Record {
     /// is refused, naming its field.
     pub fn check_evaluations(
         &self,
-        vars: &[super::Variable],
+        vars: &[super::Dimension],
         plan: &(Vec<String>, Vec<String>),
         currency: &str,
         origin: &str,
@@ -128,7 +128,7 @@ const MAX_SECONDS: f64 = 1e7;
 fn check_one(
     e: &Evaluation,
     record: &Record,
-    vars: &[super::Variable],
+    vars: &[super::Dimension],
     (possible, required): &(Vec<String>, Vec<String>),
     currency: &str,
 ) -> Result<(), (String, String)> {
@@ -139,9 +139,9 @@ fn check_one(
     for (j, (x, v)) in e.x.iter().zip(vars).enumerate() {
         let (lo, hi) = v.bounds();
         let inside = match &v.kind {
-            super::Kind::Continuous(..) => x.is_finite() && (lo..=hi).contains(x),
-            super::Kind::Integer(..) => x.is_finite() && (lo..=hi).contains(x) && x.fract() == 0.0,
-            super::Kind::Choice(list) => list.contains(x),
+            super::Domain::Continuous(..) => x.is_finite() && (lo..=hi).contains(x),
+            super::Domain::Integer(..) => x.is_finite() && (lo..=hi).contains(x) && x.fract() == 0.0,
+            super::Domain::Choice(list) => list.contains(x),
         };
         if !inside {
             return bad(&format!("x[{j}]"), format!("{x} is outside --vary {} ({lo} to {hi})", v.path));
@@ -237,8 +237,8 @@ mod tests {
     #![allow(clippy::unwrap_used)]
     use super::*;
 
-    fn record() -> (Record, Vec<Variable>) {
-        let vars = vec![Variable::parse("aperture_mm=40:200").unwrap()];
+    fn record() -> (Record, Vec<Dimension>) {
+        let vars = vec![Dimension::parse("aperture_mm=40:200").unwrap()];
         let e = Evaluation {
             x: vec![100.0],
             cost: Some(2.5),

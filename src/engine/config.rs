@@ -221,7 +221,7 @@ impl RunConfig {
             }
         }
         // What the run will ask of the machine, against its budget (`engine::resources`).
-        let budget = crate::budget::Budget::from_env().map_err(at(Stage::Scene))?;
+        let budget = crate::budget::MachineBudget::from_env().map_err(at(Stage::Scene))?;
         let demand = super::resources::run_demand_keeping(self, keep_cubes);
         budget.check(&demand).map_err(at(if demand.atmosphere_s > budget.atmosphere_s {
             Stage::Lut

@@ -7,7 +7,7 @@
 //! chain holds radiance, the truth's Rrs, Level-0 counts and flags, Level-1, Rrs and their flags)
 //! and the scene's stored maps; `shoal bench` and the tests hold it against measured peaks.
 //!
-//! The budget it is held to is [`crate::budget::Budget`].
+//! The budget it is held to is [`crate::budget::MachineBudget`].
 
 use crate::atmosphere::{AtmosphereSpec, RtAccuracy};
 use crate::budget::{Demand, Lever, Part};
@@ -390,7 +390,7 @@ pub fn app_demand(configs: &[&RunConfig], cache_bytes: usize) -> Demand {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::budget::{Budget, DEFAULT_ATMOSPHERE_S};
+    use crate::budget::{DEFAULT_ATMOSPHERE_S, MachineBudget};
 
     fn default_runs() -> Vec<RunConfig> {
         let study = crate::study::StudySpec::default_study().unwrap_or_else(|e| panic!("{e}"));
@@ -408,7 +408,7 @@ mod tests {
         assert!((0.83..0.83 * 1.6).contains(&gb), "{gb} GB: {demand:?}");
         assert!(gb < 1.0, "the default study is planned within 1 GiB: {gb}");
         assert!(demand.atmosphere_s < 60.0, "{}", demand.atmosphere_s);
-        let budget = Budget { memory_bytes: 14e9, atmosphere_s: DEFAULT_ATMOSPHERE_S };
+        let budget = MachineBudget { memory_bytes: 14e9, atmosphere_s: DEFAULT_ATMOSPHERE_S };
         assert!(budget.check(&demand).is_ok());
     }
 
@@ -437,7 +437,7 @@ mod tests {
         let mut c = default_runs().remove(0);
         (c.instrument.lines, c.instrument.detectors) = (100_000, 20_000);
         (c.scene.width, c.scene.height) = (20_000, 20_000);
-        let budget = Budget { memory_bytes: 14e9, atmosphere_s: DEFAULT_ATMOSPHERE_S };
+        let budget = MachineBudget { memory_bytes: 14e9, atmosphere_s: DEFAULT_ATMOSPHERE_S };
         let e = budget.check(&run_demand(&c)).unwrap_err();
         assert!(e.field.contains("instrument.lines") && e.message.contains("fidelity.decimation"), "{e}");
         c.fidelity.decimation = 64;
@@ -447,7 +447,7 @@ mod tests {
     #[test]
     fn thin_layers_are_refused_for_their_memory_and_many_terms_for_their_time() {
         let mut c = default_runs().remove(0);
-        let budget = Budget { memory_bytes: 14e9, atmosphere_s: DEFAULT_ATMOSPHERE_S };
+        let budget = MachineBudget { memory_bytes: 14e9, atmosphere_s: DEFAULT_ATMOSPHERE_S };
         // The thinnest layers and the most streams: each level holds (2 · 48)² Stokes blocks.
         let acc = &mut c.scene.atmosphere.accuracy;
         (acc.max_layer_depth, acc.streams) = (1e-4, 48);
@@ -459,7 +459,7 @@ mod tests {
         // 900 s, memory binds first: the work per byte of kernel is bounded by terms × orders.)
         let acc = &mut c.scene.atmosphere.accuracy;
         (acc.max_layer_depth, acc.streams, acc.fourier_terms, acc.max_orders) = (0.002, 24, 96, 500);
-        let short = Budget { atmosphere_s: 10.0, ..budget };
+        let short = MachineBudget { atmosphere_s: 10.0, ..budget };
         assert!(budget.check(&run_demand(&c)).is_ok());
         let e = short.check(&run_demand(&c)).unwrap_err();
         assert_eq!(e.field, "scene.atmosphere.accuracy", "{e}");

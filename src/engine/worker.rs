@@ -328,7 +328,7 @@ pub const APP_RUN_ENVELOPE_BYTES: usize = 5 << 29;
 pub fn app_cache_bytes() -> usize {
     const SHARE: f64 = 0.25;
     // A budget that cannot be read (a malformed variable: the CLI refuses it) gets the most.
-    crate::budget::Budget::from_env()
+    crate::budget::MachineBudget::from_env()
         .map_or(APP_CACHE_MAX_BYTES, |b| ((b.memory_bytes * SHARE) as usize).min(APP_CACHE_MAX_BYTES))
 }
 

@@ -177,7 +177,7 @@ fn describe(search: &Search, x: &[f64]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::design::{Evaluation, Variable};
+    use crate::design::{Dimension, Evaluation};
 
     fn evaluation(x: f64, cost: f64, g: f64) -> Evaluation {
         Evaluation {
@@ -209,7 +209,7 @@ mod tests {
     #[test]
     fn the_page_states_the_answer_its_margins_and_escapes_what_it_was_given() {
         let search = Search {
-            vars: vec![Variable::parse("aperture_mm=40:200").unwrap()],
+            vars: vec![Dimension::parse("aperture_mm=40:200").unwrap()],
             evaluations: vec![evaluation(60.0, 0.27, 0.2), evaluation(75.0, 0.4, -0.05)],
             cheapest: Some(1),
             closest: None,
@@ -228,7 +228,7 @@ mod tests {
     #[test]
     fn no_feasible_design_names_the_closest_and_what_it_misses() {
         let search = Search {
-            vars: vec![Variable::parse("aperture_mm=40:200").unwrap()],
+            vars: vec![Dimension::parse("aperture_mm=40:200").unwrap()],
             evaluations: vec![evaluation(60.0, 0.27, 0.2)],
             cheapest: None,
             closest: Some(0),

@@ -24,7 +24,7 @@ pub use optics_rows::focal_plane_summary;
 pub use pack::{REVIEW_JSON, is_results_dir, load_results, review_json, write_pack};
 
 use crate::engine::RunConfig;
-use crate::study::{Budget, Check, StudyResult, StudyRun};
+use crate::study::{Check, ErrorBudget, StudyResult, StudyRun};
 use crate::sweep::CostRow;
 
 /// One row of the instruments' parameter table.
@@ -339,7 +339,7 @@ fn metric_rows(result: &StudyResult) -> Vec<MetricRow> {
         .collect()
 }
 
-fn budget_rows(budget: &[Budget]) -> Vec<BudgetRow> {
+fn budget_rows(budget: &[ErrorBudget]) -> Vec<BudgetRow> {
     budget
         .iter()
         .flat_map(|b| {
@@ -393,7 +393,7 @@ fn data_sources() -> Vec<DataSource> {
 
 /// The review data of `result` (budget and cost rows when they were run).
 #[must_use]
-pub fn review_data(result: &StudyResult, budget: &[Budget], cost: &[CostRow]) -> ReviewData {
+pub fn review_data(result: &StudyResult, budget: &[ErrorBudget], cost: &[CostRow]) -> ReviewData {
     let study = &result.study;
     // First seed of each instrument, in study order.
     let mut firsts: Vec<usize> = Vec::new();

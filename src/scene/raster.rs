@@ -136,7 +136,7 @@ impl RasterCache {
         }
         let embedded = base_dir.is_none().then(|| crate::assets::raster(&path.to_string_lossy())).flatten();
         // A quarter of the run's memory budget for one file's samples.
-        let limit = crate::budget::Budget::from_env().map_err(|m| invalid(field, m))?.raster_limit_samples();
+        let limit = crate::budget::MachineBudget::from_env().map_err(|m| invalid(field, m))?.raster_limit_samples();
         let raster = match embedded {
             Some(bytes) if !full.exists() => {
                 crate::geotiff::read_bytes_limited(bytes, &path.display().to_string(), limit)

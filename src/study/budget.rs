@@ -28,7 +28,7 @@ use super::StudyError;
 
 /// The stages with a perfect switch, in chain order.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Stage {
+pub enum ErrorSource {
     /// The instrument's optical effects, as the processor leaves them (`instrument::effects`).
     Optics,
     /// The focal plane's and electronics' effects, as the calibration and the ground leave them.
@@ -43,7 +43,7 @@ pub enum Stage {
     SiopChoice,
 }
 
-impl Stage {
+impl ErrorSource {
     /// All, in chain order.
     pub const ALL: [Self; 6] =
         [Self::Optics, Self::FocalPlane, Self::Noise, Self::Calibration, Self::Correction, Self::SiopChoice];
@@ -104,7 +104,7 @@ impl Stage {
 #[derive(Debug, Clone, PartialEq)]
 pub struct BudgetLine {
     /// The stage.
-    pub stage: Stage,
+    pub stage: ErrorSource,
     /// Sequential share: MAE drop when this stage is made perfect after those before it, points of %.
     pub sequential_pct: f64,
     /// One-at-a-time share: MAE with only this stage imperfect, minus the floor, points of %.
@@ -113,7 +113,7 @@ pub struct BudgetLine {
 
 /// The budget of one variable of one instrument.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Budget {
+pub struct ErrorBudget {
     /// Instrument label.
     pub instrument: String,
     /// Variable.
@@ -174,12 +174,12 @@ pub fn error_budget(
     config: &RunConfig,
     seeds: &[u64],
     control: &RunControl,
-) -> Result<Vec<Budget>, StudyError> {
+) -> Result<Vec<ErrorBudget>, StudyError> {
     if seeds.is_empty() {
         return Err(StudyError::Invalid(FieldError { field: "seeds".into(), message: "at least one seed".into() }));
     }
     let mut engine = Engine::new();
-    let stages: Vec<Stage> = Stage::ALL.into_iter().filter(|s| s.applies(config)).collect();
+    let stages: Vec<ErrorSource> = ErrorSource::ALL.into_iter().filter(|s| s.applies(config)).collect();
     let full = mae(&mut engine, config, seeds, control)?;
     // Sequential: perfect stages cumulatively in chain order.
     let mut cumulative = config.clone();
@@ -217,7 +217,7 @@ pub fn error_budget(
                     }
                 })
                 .collect();
-            Budget {
+            ErrorBudget {
                 instrument: label.to_string(),
                 variable: variable.clone(),
                 full_pct,
@@ -231,7 +231,7 @@ pub fn error_budget(
 
 /// The budgets as a Markdown table.
 #[must_use]
-pub fn budget_table(budgets: &[Budget]) -> String {
+pub fn budget_table(budgets: &[ErrorBudget]) -> String {
     let mut s = String::from(
         "| instrument | variable | full MAE % (± seeds' sd) | stage | sequential share | alone share | floor MAE % |\n|---|---|---|---|---|---|---|\n",
     );

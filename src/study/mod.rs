@@ -44,7 +44,7 @@ pub mod spectrum_figure;
 mod spread;
 mod substrate_figure;
 
-pub use budget::{Budget, BudgetLine, Stage, budget_table, error_budget};
+pub use budget::{BudgetLine, ErrorBudget, ErrorSource, budget_table, error_budget};
 pub use curves::{CurvePoint, CurveSeries, Curves, curve_figure, first_crossing};
 pub use figures::{difference_bar, difference_title, figure_set};
 pub use geotiff_out::{NODATA, swath_geotransform, write_run_geotiff};

@@ -71,7 +71,7 @@ pub fn run_study(
 ) -> Result<StudyResult, StudyError> {
     // The runs together against the machine's budget, before any runs (each run checks itself
     // alone when the engine validates it).
-    let budget = crate::budget::Budget::from_env()
+    let budget = crate::budget::MachineBudget::from_env()
         .map_err(|m| StudyError::Invalid(crate::parse::FieldError { field: "budget".into(), message: m }))?;
     let (demand, cache_bytes) = study_plan(study, keep_cubes);
     budget.check(&demand)?;

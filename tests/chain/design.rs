@@ -3,7 +3,7 @@
 //! grid's runs; a requirement no design meets is answered with the closest design.
 
 use shoal::control::RunControl;
-use shoal::design::{Evaluator, Settings, Variable, cheapest_feasible, search, search_from};
+use shoal::design::{Dimension, Evaluator, Settings, cheapest_feasible, search, search_from};
 use shoal::engine::Engine;
 use shoal::study::{Requirements, ResolvedStudy, StudySpec};
 
@@ -29,7 +29,7 @@ impl Fixture {
     }
 
     /// The evaluator over `vars` at decimation 8, from the study's instrument.
-    fn evaluator<'a>(&'a self, vars: &'a [Variable]) -> Evaluator<'a> {
+    fn evaluator<'a>(&'a self, vars: &'a [Dimension]) -> Evaluator<'a> {
         Evaluator {
             base: &self.resolved.runs[0].2,
             vars,
@@ -49,7 +49,7 @@ fn settings(evaluations: usize, seed: u64) -> Settings {
 #[test]
 fn the_search_finds_the_grids_cheapest_feasible_design_with_a_tenth_of_the_runs() {
     let fixture = Fixture::new(|_| {});
-    let vars = [Variable::parse("aperture_mm=40:200").unwrap(), Variable::parse("exposure_s=0.0005:0.003").unwrap()];
+    let vars = [Dimension::parse("aperture_mm=40:200").unwrap(), Dimension::parse("exposure_s=0.0005:0.003").unwrap()];
     let evaluator = fixture.evaluator(&vars);
     let control = RunControl::default();
     // The grid: every combination of 25 apertures and 8 exposures, 200 runs.
@@ -88,7 +88,7 @@ fn the_search_finds_the_grids_cheapest_feasible_design_with_a_tenth_of_the_runs(
 #[test]
 fn a_requirement_no_design_meets_names_the_closest() {
     let fixture = Fixture::new(|spec| spec.requirements.as_mut().unwrap().products[0].mae_pct = Some(0.5));
-    let vars = [Variable::parse("aperture_mm=40:120").unwrap()];
+    let vars = [Dimension::parse("aperture_mm=40:120").unwrap()];
     let evaluator = fixture.evaluator(&vars);
     let settings = settings(5, 2);
     let found = search(&evaluator, &settings, &RunControl::default(), |_, _, _| {}).unwrap();
@@ -105,7 +105,7 @@ fn a_requirement_no_design_meets_names_the_closest() {
 #[test]
 fn a_cost_model_that_refuses_the_range_is_refused_before_any_run() {
     let fixture = Fixture::new(|spec| spec.budgets = Some(shoal::study::Source::Preset("default".into())));
-    let vars = [Variable::parse("aperture_mm=40:200").unwrap()];
+    let vars = [Dimension::parse("aperture_mm=40:200").unwrap()];
     let evaluator = fixture.evaluator(&vars);
     let settings = settings(5, 1);
     let e = shoal::design::check(&evaluator, &settings).unwrap_err().to_string();
@@ -115,7 +115,7 @@ fn a_cost_model_that_refuses_the_range_is_refused_before_any_run() {
 #[test]
 fn a_search_resumed_from_two_shards_of_its_start_is_the_search_run_whole() {
     let fixture = Fixture::new(|_| {});
-    let vars = [Variable::parse("aperture_mm=40:200").unwrap(), Variable::parse("exposure_s=0.0005:0.003").unwrap()];
+    let vars = [Dimension::parse("aperture_mm=40:200").unwrap(), Dimension::parse("exposure_s=0.0005:0.003").unwrap()];
     let evaluator = fixture.evaluator(&vars);
     let control = RunControl::default();
     let whole = settings(9, 1);

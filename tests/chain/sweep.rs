@@ -7,7 +7,7 @@ use shoal::control::RunControl;
 use shoal::engine::{Engine, RunConfig};
 use shoal::instrument::DetectorMode;
 use shoal::retrieval::RetrievalSpec;
-use shoal::study::Stage;
+use shoal::study::ErrorSource;
 use shoal::sweep::{Parameter, Shard, SweepSpec, Table, Values, merge, run_sweep};
 
 use super::noise::Table1;
@@ -231,7 +231,7 @@ fn the_cubesat_error_budget_matches_runs_with_each_stage_made_perfect() {
     let close = |a: f64, b: f64| (a - b).abs() < 1e-9;
     assert!(close(chl.full_pct, steps[0]), "full {} vs {}", chl.full_pct, steps[0]);
     assert!(close(chl.floor_pct, steps[4]), "floor {} vs {}", chl.floor_pct, steps[4]);
-    let stages = [Stage::Noise, Stage::Calibration, Stage::Correction, Stage::SiopChoice];
+    let stages = [ErrorSource::Noise, ErrorSource::Calibration, ErrorSource::Correction, ErrorSource::SiopChoice];
     assert_eq!(chl.lines.iter().map(|l| l.stage).collect::<Vec<_>>(), stages);
     for (k, line) in chl.lines.iter().enumerate() {
         let want = steps[k] - steps[k + 1];

@@ -7,7 +7,7 @@ use std::process::Command;
 
 use shoal::engine::RunConfig;
 use shoal::instrument::InstrumentSpec;
-use shoal::library::{Kind, Library, LibraryError};
+use shoal::library::{Library, LibraryError, PresetKind};
 use shoal::retrieval::RetrievalSpec;
 use shoal::scene::SceneSpec;
 use shoal::spectral::Extrapolation::Clamp;
@@ -146,9 +146,9 @@ fn the_preset_library_refuses_a_built_in_name_and_lets_a_users_file_win() {
     let dir = home.join("presets").join("instruments");
     std::fs::create_dir_all(&dir).unwrap();
     std::fs::write(dir.join("cubesat.ron"), ron::ser::to_string(&spec).unwrap()).unwrap();
-    let entries = lib.list(Kind::Instrument);
+    let entries = lib.list(PresetKind::Instrument);
     assert_eq!(entries.iter().filter(|e| e.name == "cubesat").count(), 1);
-    let entry = lib.find(Kind::Instrument, "cubesat").unwrap();
+    let entry = lib.find(PresetKind::Instrument, "cubesat").unwrap();
     assert!(!entry.builtin);
     assert_eq!(lib.load_instrument(&entry).unwrap().aperture_mm, 95.0);
 }

@@ -62,11 +62,11 @@ pub fn netcdf(data: &[u8]) {
 /// A design search's shard record (`evaluations.ron`), checked whole against the search it
 /// would join: an aperture search of the default study at decimation 8, seed 1.
 pub fn shard_record(data: &[u8]) {
-    use shoal::design::Variable;
+    use shoal::design::Dimension;
     use shoal::design::record::{Record, vars_of};
     let Ok(text) = std::str::from_utf8(data) else { return };
     let Ok(record) = Record::parse(text, "fuzz", "--resume fuzz") else { return };
-    let Ok(aperture) = Variable::parse("aperture_mm=40:200") else { return };
+    let Ok(aperture) = Dimension::parse("aperture_mm=40:200") else { return };
     let vars = vec![aperture];
     let expected = Record {
         study: "cubesat_vs_smallsat".into(),

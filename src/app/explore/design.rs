@@ -8,7 +8,7 @@
 use egui_plot::{HLine, Legend, Line, Plot, PlotPoints, Points};
 
 use super::super::model::Slot;
-use crate::design::{Evaluation, Evaluator, Settings, Variable, cheapest_feasible, pareto_front};
+use crate::design::{Dimension, Evaluation, Evaluator, Settings, cheapest_feasible, pareto_front};
 use crate::instrument::budgets::BudgetModels;
 use crate::jobs::{Task, TaskNews};
 
@@ -22,7 +22,7 @@ pub struct DesignState {
     models: String,
     task: Option<Task<Evaluation>>,
     /// The search's variables and designs so far.
-    searched: Vec<Variable>,
+    searched: Vec<Dimension>,
     results: Vec<Evaluation>,
     status: String,
     /// Currency of the costs shown (the budget models' of the last search).
@@ -107,8 +107,8 @@ impl DesignState {
 
     /// Start a search from A's configuration against the app's requirements.
     pub fn start(&mut self, ctx: &egui::Context, state: &super::super::model::AppState) {
-        let vars: Result<Vec<Variable>, String> =
-            self.vars.iter().map(|(p, lo, hi)| Variable::parse(&format!("{p}={lo}:{hi}"))).collect();
+        let vars: Result<Vec<Dimension>, String> =
+            self.vars.iter().map(|(p, lo, hi)| Dimension::parse(&format!("{p}={lo}:{hi}"))).collect();
         let vars = match vars {
             Ok(v) => v,
             Err(e) => {
