@@ -93,7 +93,7 @@ pub(super) fn product_note(app: &ShoalApp) -> Option<String> {
     let spec = app.state.retrieval_spec();
     let retrieval = spec.title();
     let missing = match app.state.product {
-        ProductKind::Depth | ProductKind::Chl | ProductKind::Nap | ProductKind::Cdom => {
+        ProductKind::Depth | ProductKind::Chl | ProductKind::Nap | ProductKind::Cdom | ProductKind::Extra(_) => {
             app.state.product.variable().is_some_and(|v| !spec.algorithm().variables().iter().any(|p| p == v))
         }
         // Classes only the retrievals that choose them make.
@@ -102,7 +102,8 @@ pub(super) fn product_note(app: &ShoalApp) -> Option<String> {
         ProductKind::Rrs | ProductKind::Level1 | ProductKind::Snr => false,
     };
     missing.then(|| {
-        let product = app.state.product.label().split(" (").next().unwrap_or_default();
+        let label = app.state.product.label();
+        let product = label.split(" (").next().unwrap_or_default();
         format!("{retrieval} does not retrieve the {product}: no design has a map of it.")
     })
 }

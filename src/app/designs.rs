@@ -48,6 +48,10 @@ impl AppState {
         if self.pair[0] == self.pair[1] && last > 0 {
             self.pair[1] = usize::from(self.pair[0] == 0);
         }
+        // A retrieval's own product that no variable is (a damaged session).
+        if !self.product.exists() {
+            self.product = super::model::ProductKind::Chl;
+        }
     }
 
     /// Add `slot` as the last design, on the maps and in the editor; `None` at [`MAX_DESIGNS`].

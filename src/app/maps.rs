@@ -153,7 +153,9 @@ fn product_menu(app: &mut ShoalApp, ui: &mut egui::Ui) {
     // Wrapped: with eight designs the layout buttons and pair selectors outgrow a narrow panel.
     ui.horizontal_wrapped(|ui| {
         egui::ComboBox::from_label("Product").selected_text(state.product.label()).show_ui(ui, |ui| {
-            for kind in ProductKind::ALL {
+            // The retrieval's own products (QAA's IOPs) after the core ones.
+            let variables = state.retrieval_spec().algorithm().variables();
+            for kind in ProductKind::ALL.into_iter().chain(ProductKind::extras(&variables)) {
                 ui.selectable_value(&mut state.product, kind, kind.label());
             }
         });
@@ -408,7 +410,8 @@ pub fn central(app: &mut ShoalApp, ui: &mut egui::Ui) {
             }
             if let Some(p) = app.images.difference_palette {
                 // The difference in the product's own unit ("A − B (mg m⁻³)"), as the study figures.
-                let unit = app.state.product.label().split_once(" (").map_or("", |(_, u)| u.trim_end_matches(')'));
+                let product = app.state.product.label();
+                let unit = product.split_once(" (").map_or("", |(_, u)| u.trim_end_matches(')'));
                 let [a, b] = app.state.pair.map(label);
                 app.ui.map_rects.push(colour_bar(ui, p, 160.0, &crate::study::difference_bar(&a, &b, unit), &classes));
             }

@@ -45,6 +45,19 @@ pub fn product_map(out: &RunOutput, kind: ProductKind, band: usize, truth: bool)
         ProductKind::Nap => product_or_truth(&truth_maps.nap_g_m3, |p| p.nap_g_m3.as_ref()),
         ProductKind::Cdom => product_or_truth(&truth_maps.cdom_per_m, |p| p.cdom_per_m.as_ref()),
         ProductKind::Depth => product_or_truth(truth_maps.depth_m.as_ref()?, |p| p.depth_m.as_ref()),
+        ProductKind::Extra(_) => {
+            // A retrieval's own product; its truth where the retrieval says what it is.
+            let key = kind.variable()?;
+            let ret = ret?;
+            let values = if truth {
+                ret.extra_truths.iter().find(|(k, _)| k == key).map(|(_, m)| m)?
+            } else {
+                ret.product.map(key)?
+            };
+            let ok = if truth { water } else { returned(&ret.product) };
+            let valid = Array2::from_shape_fn(values.dim(), |(i, j)| ok[[i, j]] && values[[i, j]] > 0.0);
+            Some(MapData { values: values.clone(), valid })
+        }
         ProductKind::Substrate => {
             let (f, names) = if truth {
                 (truth_maps.substrate_fractions.as_ref()?, &truth_maps.substrate_names)

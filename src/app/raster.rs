@@ -65,7 +65,7 @@ pub fn palette_of_samples(samples: &[&[f64]], kind: ProductKind, difference: boo
         let bound = abs.get(abs.len().saturating_sub(1) * 99 / 100).copied().unwrap_or(1.0);
         return Palette::Diverging(if bound > 0.0 { bound } else { 1.0 });
     }
-    let concentration = matches!(kind, ProductKind::Chl | ProductKind::Nap | ProductKind::Cdom);
+    let concentration = matches!(kind, ProductKind::Chl | ProductKind::Nap | ProductKind::Cdom | ProductKind::Extra(_));
     // Concentrations are scaled over their positive values only.
     let kept: Vec<&[f64]> =
         samples.iter().map(|s| if concentration { &s[s.partition_point(|v| *v <= 0.0)..] } else { *s }).collect();

@@ -23,10 +23,13 @@ pub enum ProductKind {
     Level1,
     /// Per-pixel SNR of the selected band (analytic, at the pixel's radiance).
     Snr,
+    /// A retrieval's own product: [`crate::variable::EXTRAS`]`[i]` (QAA's IOPs, or what a user's
+    /// program returns of them).
+    Extra(u8),
 }
 
 impl ProductKind {
-    /// Every product, in menu order.
+    /// Every product every run may have, in menu order (then [`Self::extras`]).
     pub const ALL: [Self; 9] = [
         Self::Chl,
         Self::Nap,
@@ -39,9 +42,19 @@ impl ProductKind {
         Self::Snr,
     ];
 
-    /// Menu text.
+    /// The retrievals' own products among `variables` (a retrieval's
+    /// [`crate::retrieval::Algorithm::variables`]), in [`crate::variable::EXTRAS`] order.
+    pub fn extras(variables: &[String]) -> impl Iterator<Item = Self> + '_ {
+        crate::variable::EXTRAS
+            .iter()
+            .enumerate()
+            .filter(|(_, v)| variables.iter().any(|k| k == v.key))
+            .filter_map(|(i, _)| u8::try_from(i).ok().map(Self::Extra))
+    }
+
+    /// Menu text: the name, then the unit in brackets.
     #[must_use]
-    pub fn label(self) -> &'static str {
+    pub fn label(self) -> String {
         match self {
             Self::Chl => "chl-a (mg m⁻³)",
             Self::Nap => "NAP (g m⁻³)",
@@ -52,6 +65,21 @@ impl ProductKind {
             Self::Rrs => "Rrs (sr⁻¹)",
             Self::Level1 => "Level-1 radiance (W m⁻² sr⁻¹ nm⁻¹)",
             Self::Snr => "SNR",
+            Self::Extra(i) => {
+                return crate::variable::EXTRAS
+                    .get(usize::from(i))
+                    .map_or_else(|| "(no such product)".into(), |v| format!("{} ({})", v.name, v.unit));
+            }
+        }
+        .to_string()
+    }
+
+    /// It names a product (an [`Self::Extra`] index within [`crate::variable::EXTRAS`]).
+    #[must_use]
+    pub fn exists(self) -> bool {
+        match self {
+            Self::Extra(i) => usize::from(i) < crate::variable::EXTRAS.len(),
+            _ => true,
         }
     }
 
@@ -76,6 +104,7 @@ impl ProductKind {
             Self::Nap => Some(key::NAP),
             Self::Cdom => Some(key::CDOM),
             Self::Depth => Some(key::DEPTH),
+            Self::Extra(i) => crate::variable::EXTRAS.get(usize::from(i)).map(|v| v.key),
             _ => None,
         }
     }

@@ -114,6 +114,10 @@ pub struct RetrievalOutput {
     /// Why the retrieval returned nothing, when its program failed (an external retrieval:
     /// the rest of the run is kept, and this says what went wrong).
     pub failure: Option<String>,
+    /// The true maps of the extra products the retrieval says the truth of, by key
+    /// ([`crate::retrieval::Prepared::extra_truths`]: QAA's IOPs); scored in `metrics`, kept for
+    /// the maps.
+    pub extra_truths: Vec<(String, ndarray::Array2<f32>)>,
 }
 
 /// Products of the scene side of the chain and their keys.

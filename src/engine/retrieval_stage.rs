@@ -118,9 +118,10 @@ impl Engine {
                 };
                 let mut metrics = evaluate(&product, truth);
                 // Extra products scored where the algorithm says what their truth is.
-                for (key, want) in model.extra_truths(truth) {
-                    if let Some(m) = product.map(&key) {
-                        metrics.variables.push(score_map(&product, m, &want, &truth.surface, key));
+                let extra_truths = model.extra_truths(truth);
+                for (key, want) in &extra_truths {
+                    if let Some(m) = product.map(key) {
+                        metrics.variables.push(score_map(&product, m, want, &truth.surface, key.clone()));
                     }
                 }
                 Ok(RetrievalOutput {
@@ -130,6 +131,7 @@ impl Engine {
                     bands: inputs.bands.clone(),
                     nedr: inputs.nedr.clone(),
                     failure,
+                    extra_truths,
                 })
             })?;
             out.push(result);
