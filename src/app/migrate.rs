@@ -38,7 +38,7 @@ fn bare_some<'de, D: serde::Deserializer<'de>, T: Deserialize<'de>>(d: D) -> Res
 
 /// The fields of older session formats (every other field of the text is skipped).
 #[derive(Default, Deserialize)]
-#[serde(default)]
+#[serde(rename = "AppState", default)]
 pub(super) struct Legacy {
     /// Version 3 made `designs` a list: instrument A was the field `a`.
     #[serde(deserialize_with = "bare_some")]

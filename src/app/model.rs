@@ -315,15 +315,28 @@ impl AppState {
     /// The parameters edited away from each design's preset, for captions ("A aperture_mm 60 →
     /// 105.8"), each by its path ([`crate::fields::diff`]: `effects.0.StrayLight.halo_fraction`):
     /// numbers to four significant digits (never a float's raw digits), a list whose length changed
-    /// by its lengths, text and switches as they were and are, anything else as "edited".
+    /// by its lengths, text and switches as they were and are, anything else as "edited"; a field
+    /// with more than [`MAX_CHANGES_PER_FIELD`] changes inside it as their count.
     #[must_use]
     pub fn changes(&self) -> Vec<String> {
         let mut out = Vec::new();
         for (i, slot) in self.designs.iter().enumerate() {
-            for change in crate::fields::diff(&slot.spec, &slot.original) {
+            let changes = crate::fields::diff(&slot.spec, &slot.original);
+            // A field with more than a few changes inside it (a QE table, a band list edited
+            // entry by entry) is one line: "A quantum_efficiency: 40 values edited".
+            let top = |c: &crate::fields::Change| c.path.split('.').next().unwrap_or_default().to_string();
+            let mut summarised: Vec<String> = Vec::new();
+            for change in &changes {
                 use serde_json::Value;
                 let k = &change.path;
-                if k == "name" || k == "description" {
+                let field = top(change);
+                if field == "name" || field == "description" || summarised.contains(&field) {
+                    continue;
+                }
+                let inside = changes.iter().filter(|c| top(c) == field).count();
+                if inside > MAX_CHANGES_PER_FIELD {
+                    out.push(format!("{} {field}: {inside} values edited", label(i)));
+                    summarised.push(field);
                     continue;
                 }
                 let what = match (&change.before, &change.after) {
@@ -344,6 +357,10 @@ impl AppState {
         out
     }
 }
+
+/// Changes inside one top-level field of an instrument listed one by one in a caption; more are
+/// counted ([`AppState::changes`]).
+const MAX_CHANGES_PER_FIELD: usize = 3;
 
 /// `x` to four significant digits: as people write it inside 0.001–10⁶ ("105.8"), else in
 /// e-notation with its four digits ("3.330e-4", where `significant` would say "3e-4").

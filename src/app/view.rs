@@ -24,8 +24,8 @@ pub enum ProductKind {
     /// Per-pixel SNR of the selected band (analytic, at the pixel's radiance).
     Snr,
     /// A retrieval's own product: [`crate::variable::EXTRAS`]`[i]` (QAA's IOPs, or what a user's
-    /// program returns of them).
-    Extra(u8),
+    /// program returns of them); saved by its key, so a session outlives a reordered table.
+    Extra(#[serde(with = "extra_key")] u8),
 }
 
 impl ProductKind {
@@ -107,6 +107,38 @@ impl ProductKind {
             Self::Extra(i) => crate::variable::EXTRAS.get(usize::from(i)).map(|v| v.key),
             _ => None,
         }
+    }
+}
+
+/// [`ProductKind::Extra`]'s index saved as the variable's key; a key this Shoal does not know
+/// reads as an index past the table ([`ProductKind::exists`] false: the session's repair shows
+/// chl-a instead).
+mod extra_key {
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    use crate::variable::EXTRAS;
+
+    pub fn serialize<S: Serializer>(i: &u8, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(EXTRAS.get(usize::from(*i)).map_or("", |v| v.key))
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<u8, D::Error> {
+        let key = String::deserialize(d)?;
+        Ok(EXTRAS.iter().position(|v| v.key == key).and_then(|i| u8::try_from(i).ok()).unwrap_or(u8::MAX))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::ProductKind;
+
+    #[test]
+    fn a_retrieval_s_own_product_is_saved_by_its_key() {
+        let text = ron::to_string(&ProductKind::Extra(1)).unwrap_or_default();
+        assert_eq!(text, "Extra(\"aph443_per_m\")");
+        assert_eq!(ron::from_str::<ProductKind>(&text).ok(), Some(ProductKind::Extra(1)));
+        let unknown = ron::from_str::<ProductKind>("Extra(\"gone\")").ok();
+        assert!(unknown.is_some_and(|k| !k.exists()), "{unknown:?}");
     }
 }
 

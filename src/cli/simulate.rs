@@ -131,6 +131,13 @@ pub fn config_from(args: &SimulateArgs) -> Result<RunConfig, CliError> {
         config.calibration.gain_drift_pct = g;
     }
     if args.approximate_correction {
+        if config.correction.image().is_some() {
+            return Err(CliError::Input(
+                "--approximate-correction: the configuration asks for the image-based correction \
+                 (correction.image); choose one"
+                    .into(),
+            ));
+        }
         config.correction.method = crate::correction::Method::PerScene;
     }
     // Scene paths in the resolved configuration are absolute, so it runs from anywhere.

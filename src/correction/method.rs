@@ -52,18 +52,13 @@ impl CorrectionSpec {
             _ => None,
         }
     }
-
-    /// The paper's per-scene approximation is delivered.
-    #[must_use]
-    pub fn per_scene(&self) -> bool {
-        self.method == Method::PerScene
-    }
 }
 
 /// [`CorrectionSpec`] as a file writes it: `(approx_points: 20, use_approximation: false, image:
-/// Some((…)))`, the two choices as a switch and an option.
+/// Some((…)))`, the two choices as a switch and an option (under the spec's own name, which a
+/// file written with struct names states).
 #[derive(Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
+#[serde(rename = "CorrectionSpec", deny_unknown_fields, default)]
 struct CorrectionFile {
     approx_points: usize,
     use_approximation: bool,
@@ -178,7 +173,14 @@ pub const PRESETS: [Preset; 6] = [
         key: "swir",
         label: "image: 1610/2200 nm",
         about: "Aerosol from a SWIR pair, black even over turbid water (Wang & Shi 2007)",
-        make: || Method::Image(ImageCorrection { pair_nm: [1610.0, 2200.0], ..ImageCorrection::default() }),
+        // Water is black at 1610 and 2200 nm: no NIR iteration (MANUAL, the image-based correction).
+        make: || {
+            Method::Image(ImageCorrection {
+                pair_nm: [1610.0, 2200.0],
+                nir_iteration: false,
+                ..ImageCorrection::default()
+            })
+        },
     },
     Preset {
         key: "dark",
@@ -207,6 +209,16 @@ mod tests {
         }
         let written = ron::to_string(&CorrectionSpec::default()).unwrap();
         assert_eq!(written, "(approx_points:20,use_approximation:false,image:None)");
+        // With struct names (config.ron, study.ron, the library's studies), as an older Shoal
+        // wrote them.
+        let named = ron::ser::to_string_pretty(
+            &CorrectionSpec::default(),
+            ron::ser::PrettyConfig::default().struct_names(true),
+        )
+        .unwrap();
+        assert!(named.starts_with("CorrectionSpec("), "{named}");
+        let old: CorrectionSpec = ron::from_str("CorrectionSpec(approx_points: 20, use_approximation: true)").unwrap();
+        assert_eq!(old.method, Method::PerScene);
     }
 
     #[test]

@@ -55,6 +55,12 @@ impl Engine {
             // A preview computes only the product it shows; the diagnostics (the approximation
             // against the exact correction, and both against the truth) come with full resolution.
             let diagnostics = fid.decimation == 1;
+            // The product each method delivers (the image-based one through the family above); a
+            // new method is an arm here.
+            let per_scene = match &config.correction.method {
+                crate::correction::Method::Exact | crate::correction::Method::Image(_) => false,
+                crate::correction::Method::PerScene => true,
+            };
             let image = match (&family, config.correction.image()) {
                 (Some((fam, _)), Some(settings)) => Some(
                     correct_image(level1, fam, settings, &side.response.bands, &truth.surface, control)
@@ -66,7 +72,7 @@ impl Engine {
             // corrections are not run beside it (`shoal budget` prices the difference).
             let against_truth = diagnostics;
             let diagnostics = diagnostics && image.is_none();
-            let exact = if diagnostics || (!config.correction.per_scene() && image.is_none()) {
+            let exact = if diagnostics || (!per_scene && image.is_none()) {
                 let aerosol_map = side.aerosol_map.as_deref().zip(truth.aot550.as_ref());
                 Some(correct_exact(level1, band_atmosphere, aerosol_map, &truth.surface, control).map_err(&fail)?)
             } else {
@@ -74,11 +80,11 @@ impl Engine {
             };
             // The approximation is held whole only when it is the product; as a diagnostic it is
             // compared with the exact correction pixel by pixel.
-            let streamed = match (&exact, diagnostics && !config.correction.per_scene()) {
+            let streamed = match (&exact, diagnostics && !per_scene) {
                 (Some(e), true) => approximation.compare_with(level1, &truth.surface, e),
                 _ => None,
             };
-            let approx = if (diagnostics && streamed.is_none()) || config.correction.per_scene() {
+            let approx = if (diagnostics && streamed.is_none()) || per_scene {
                 Some(approximation.correct(level1, &truth.surface, control).map_err(&fail)?)
             } else {
                 None
@@ -91,7 +97,7 @@ impl Engine {
             let (image, aerosol) = image.map_or((None, None), |(r, a)| (Some(r), Some(a)));
             let rrs = match (image, exact, approx) {
                 (Some(i), _, _) => i,
-                (None, _, Some(a)) if config.correction.per_scene() => a,
+                (None, _, Some(a)) if per_scene => a,
                 (None, Some(e), _) => e,
                 (None, None, Some(a)) => a,
                 (None, None, None) => {

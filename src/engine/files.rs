@@ -7,8 +7,8 @@
 //! engine lives for the whole session.
 //!
 //! [`fingerprint`] finds the files without a list of the fields that hold paths (a list a new
-//! field could miss): every quoted string in the configuration's RON text (the text the keys
-//! hash) that names an existing file — as given, or relative to the scene's directory — counts,
+//! field could miss): every text value of the configuration ([`crate::fields::strings`]) that
+//! names an existing file — as given, or relative to the scene's directory — counts,
 //! and so does every quoted string inside such a file when it is small text (a SIOP file names
 //! its CSV columns relative to itself, whatever its extension). A file up to [`HASHED_BYTES`]
 //! enters the fingerprint with its contents; a larger one (a raster) with its length,

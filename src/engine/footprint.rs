@@ -99,7 +99,7 @@ impl Footprint for Product {
 
 impl Footprint for RetrievalOutput {
     fn bytes(&self) -> usize {
-        self.product.bytes()
+        self.product.bytes() + self.extra_truths.iter().map(|(_, m)| array_bytes(m)).sum::<usize>()
     }
 }
 

@@ -45,6 +45,26 @@ pub enum SurfaceClass {
 }
 
 impl SurfaceClass {
+    /// Every class, by code.
+    pub const ALL: [Self; 4] = [Self::Water, Self::Land, Self::Cloud, Self::CloudShadow];
+
+    /// Its name in the files (CF `flag_meanings`, the GeoTIFF plane's description).
+    #[must_use]
+    pub const fn name(self) -> &'static str {
+        match self {
+            Self::Water => "water",
+            Self::Land => "land",
+            Self::Cloud => "cloud",
+            Self::CloudShadow => "cloud_shadow",
+        }
+    }
+
+    /// (code, name) of every class: the flags every writer gives the surface-class map.
+    #[must_use]
+    pub fn flags() -> Vec<(i32, &'static str)> {
+        Self::ALL.iter().map(|c| (*c as i32, c.name())).collect()
+    }
+
     /// The class of a code as stored (an unknown code reads as land: never retrieved).
     #[must_use]
     pub const fn of_code(code: u8) -> Self {

@@ -129,7 +129,7 @@ pub(super) fn write_input(
         name: "surface_class".into(),
         dims: MAP.to_vec(),
         long_name: "what covers the pixel centre (only water is retrieved)".into(),
-        flags: vec![(0, "water"), (1, "land"), (2, "cloud"), (3, "cloud_shadow")],
+        flags: crate::instrument::SurfaceClass::flags(),
         values: Values::ready(inputs.surface.codes().iter().map(|&v| i32::from(v)).collect()),
         coordinates: "",
     }];

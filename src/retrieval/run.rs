@@ -60,7 +60,15 @@ pub enum RetrievalSpec {
 
 /// The built-in retrievals' names ([`RetrievalSpec::name`]): a retrieval of the user's may
 /// not take one (its files and variables would overwrite the built-in's), in any case.
-pub const BUILT_IN_NAMES: [&str; 3] = [BUILT_IN[0].name, BUILT_IN[1].name, BUILT_IN[2].name];
+pub const BUILT_IN_NAMES: [&str; BUILT_IN.len()] = {
+    let mut out = [""; BUILT_IN.len()];
+    let mut i = 0;
+    while i < BUILT_IN.len() {
+        out[i] = BUILT_IN[i].name;
+        i += 1;
+    }
+    out
+};
 
 impl RetrievalSpec {
     /// The spec with an external command's `{dir}` replaced by `dir`, the study file's directory

@@ -174,12 +174,10 @@ pub fn write_run_geotiff(out: &RunOutput, dir: &Path) -> Result<Outputs, StudyEr
             push(&mut t, cube_plane(f, k, &water), &format!("true {name} fraction"), "1");
         }
     }
-    push(
-        &mut t,
-        truth.surface.codes().iter().map(|v| f64::from(*v)).collect(),
-        "surface class: 0 water, 1 land, 2 cloud, 3 cloud shadow",
-        "1",
-    );
+    let classes: Vec<String> =
+        crate::instrument::SurfaceClass::flags().iter().map(|(code, name)| format!("{code} {name}")).collect();
+    let description = format!("surface class: {}", classes.join(", "));
+    push(&mut t, truth.surface.codes().iter().map(|v| f64::from(*v)).collect(), &description, "1");
     t.nodata = Some(NODATA);
     file(dir, "truth.tif", &t, &mut o)?;
 

@@ -193,7 +193,7 @@ fn truth_vars<'a>(out: &'a RunOutput, cubes: &'a Cubes, floats: &mut Vec<FloatVa
         name: "surface_class".into(),
         dims: MAP.to_vec(),
         long_name: "what covers the pixel centre".into(),
-        flags: vec![(0, "water"), (1, "land"), (2, "cloud"), (3, "cloud_shadow")],
+        flags: crate::instrument::SurfaceClass::flags(),
         values: Values::ready(truth.surface.codes().iter().map(|&v| i32::from(v)).collect()),
         coordinates: MAP_COORDINATES,
     });

@@ -69,12 +69,15 @@ fn a_built_in_retrieval_s_name_is_reserved_in_any_case() {
         let e = spec.validate().unwrap_err().to_string();
         assert!(e.contains("External.name") && e.contains("qaa"), "{name}: {e}");
     }
-    // Every built-in's name is in the reserved list.
+    // Every built-in's name is in the reserved list, and each spec is called by its identity.
     let builtins = [
         RetrievalSpec::Almi { siop_sets: shoal::retrieval::sets::default_almi_sets(), settings: Default::default() },
+        RetrievalSpec::Sambuca { siop: None, substrates: None, settings: Default::default() },
         RetrievalSpec::Qaa { settings: Default::default() },
     ];
-    for b in builtins {
+    assert_eq!(builtins.len(), shoal::retrieval::algorithm::BUILT_IN.len(), "a built-in missing from this list");
+    for (b, identity) in builtins.iter().zip(shoal::retrieval::algorithm::BUILT_IN) {
+        assert_eq!((b.name(), b.title()), (identity.name, identity.title));
         assert!(shoal::retrieval::run::BUILT_IN_NAMES.contains(&b.name()), "{}", b.name());
     }
 }

@@ -142,3 +142,35 @@ fn a_group_import_names_each_module() {
         ["colormap", "engine", "units"]
     );
 }
+
+/// The modules of ARCHITECTURE.md's table, in its order (a row may name several).
+fn architecture_order() -> Vec<String> {
+    let text = std::fs::read_to_string(root().join("docs/ARCHITECTURE.md")).unwrap();
+    let table = text.split("| module | what it holds |").nth(1).expect("ARCHITECTURE.md has its module table");
+    let mut out = Vec::new();
+    for line in table.lines().skip(2).take_while(|l| l.starts_with("| ")) {
+        let cell = line.split('|').nth(1).unwrap_or_default();
+        out.extend(cell.split(',').map(|m| m.trim().trim_matches('`').to_string()));
+    }
+    out
+}
+
+#[test]
+fn architecture_md_lists_the_modules_in_lib_rs_order() {
+    let order = module_order();
+    let rank: BTreeMap<&str, usize> = order.iter().enumerate().map(|(i, m)| (m.as_str(), i)).collect();
+    let listed = architecture_order();
+    assert!(listed.len() > 30, "ARCHITECTURE.md's table: {listed:?}");
+    let ranks: Vec<(String, usize)> = listed
+        .iter()
+        .map(|m| {
+            (
+                m.clone(),
+                *rank.get(m.as_str()).unwrap_or_else(|| panic!("ARCHITECTURE.md names `{m}`, not in src/lib.rs")),
+            )
+        })
+        .collect();
+    let out_of_order: Vec<String> =
+        ranks.windows(2).filter(|w| w[1].1 < w[0].1).map(|w| format!("`{}` after `{}`", w[1].0, w[0].0)).collect();
+    assert!(out_of_order.is_empty(), "ARCHITECTURE.md's table is not in src/lib.rs's order: {out_of_order:?}");
+}

@@ -194,7 +194,7 @@ fn gdal_reads_the_products_we_write_with_their_crs_transform_nodata_and_values()
     assert!((gdal_stat(s, "MINIMUM") - lo).abs() < 1e-9 && (gdal_stat(s, "MAXIMUM") - hi).abs() < 1e-9);
     let land_pixels = truth.surface.codes().iter().filter(|v| **v != 0).count();
     assert!(land_pixels > 0, "the cay is in the image");
-    assert_eq!(bands[7]["description"], "land (1) or water (0)");
+    assert_eq!(bands[7]["description"], "surface class: 0 water, 1 land, 2 cloud, 3 cloud_shadow");
     let land_mean = land_pixels as f64 / truth.surface.codes().len() as f64;
     assert!((gdal_stat(&bands[7], "MEAN") - land_mean).abs() < 1e-9);
 
