@@ -89,7 +89,6 @@ pub(super) fn retrieval_name(state: &super::model::AppState) -> String {
 
 /// What the shown product is when the retrieval does not make it.
 pub(super) fn product_note(app: &ShoalApp) -> Option<String> {
-    use crate::retrieval::RetrievalSpec;
     let spec = app.state.retrieval_spec();
     let retrieval = spec.title();
     let missing = match app.state.product {
@@ -97,8 +96,8 @@ pub(super) fn product_note(app: &ShoalApp) -> Option<String> {
             app.state.product.variable().is_some_and(|v| !spec.algorithm().variables().iter().any(|p| p == v))
         }
         // Classes only the retrievals that choose them make.
-        ProductKind::Substrate => !matches!(spec, RetrievalSpec::Sambuca { .. }),
-        ProductKind::SiopSet => !matches!(spec, RetrievalSpec::Almi { .. }),
+        ProductKind::Substrate => !spec.algorithm().classes().substrates,
+        ProductKind::SiopSet => !spec.algorithm().classes().siop_sets,
         ProductKind::Rrs | ProductKind::Level1 | ProductKind::Snr => false,
     };
     missing.then(|| {

@@ -180,11 +180,8 @@ impl ShoalApp {
             }
             UiCommand::UseRetrieval(name) => {
                 if self.state.select_retrieval(name) {
-                    self.state.product = if name == crate::retrieval::algorithm::SAMBUCA.name {
-                        ProductKind::Depth
-                    } else {
-                        ProductKind::Chl
-                    };
+                    let headline = self.state.retrieval_spec().algorithm().headline();
+                    self.state.product = ProductKind::of_variable(headline).unwrap_or(ProductKind::Chl);
                 }
             }
             UiCommand::SaveStudy { name } => {

@@ -224,9 +224,7 @@ impl AppState {
         // The study's retrievals as they run (`{dir}` in a program's command is the study file's
         // directory by now), its first selected.
         s.offer_study_retrievals(&first.2.retrievals);
-        if matches!(s.retrievals.get(s.selected_retrieval), Some(RetrievalSpec::Sambuca { .. })) {
-            s.product = ProductKind::Depth;
-        }
+        s.product = ProductKind::of_variable(s.retrieval_spec().algorithm().headline()).unwrap_or(ProductKind::Chl);
         if let Some(r) = &study.requirements {
             s.requirements = r.clone();
         }

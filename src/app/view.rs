@@ -74,6 +74,20 @@ impl ProductKind {
         .to_string()
     }
 
+    /// The map of the variable called `key` (of [`crate::variable::PRODUCTS`] or
+    /// [`crate::variable::EXTRAS`]).
+    #[must_use]
+    pub fn of_variable(key: &str) -> Option<Self> {
+        use crate::variable::{EXTRAS, key as k};
+        match key {
+            k::CHL => Some(Self::Chl),
+            k::NAP => Some(Self::Nap),
+            k::CDOM => Some(Self::Cdom),
+            k::DEPTH => Some(Self::Depth),
+            other => EXTRAS.iter().position(|v| v.key == other).and_then(|i| u8::try_from(i).ok()).map(Self::Extra),
+        }
+    }
+
     /// It names a product (an [`Self::Extra`] index within [`crate::variable::EXTRAS`]).
     #[must_use]
     pub fn exists(self) -> bool {

@@ -74,6 +74,16 @@ pub trait Algorithm {
     /// `base_dir`; never the Rrs).
     fn prepare(&self, inputs: &RetrievalInputs<'_>) -> Result<Model, RetrievalError>;
 
+    /// The variable people look at first (the app's map when it is chosen): chl-a by default.
+    fn headline(&self) -> &'static str {
+        crate::variable::key::CHL
+    }
+
+    /// The class maps it makes besides its variables.
+    fn classes(&self) -> Classes {
+        Classes::default()
+    }
+
     /// Its settings that trade accuracy for time, for the cost-of-accuracy table
     /// ([`crate::sweep::cost`]): each a label and an edit of the spec, one change from the spec as
     /// given. None by default (a user's program, or QAA, closed-form per pixel, is measured as it
@@ -81,6 +91,15 @@ pub trait Algorithm {
     fn cheaper(&self) -> Vec<Cheaper> {
         Vec::new()
     }
+}
+
+/// The class maps a retrieval makes ([`Algorithm::classes`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Classes {
+    /// The substrates it unmixed, and so the dominant one per pixel.
+    pub substrates: bool,
+    /// The SIOP set it chose per pixel.
+    pub siop_sets: bool,
 }
 
 /// A label and an edit of a [`RetrievalSpec`] ([`Algorithm::cheaper`]).
@@ -125,6 +144,9 @@ impl Algorithm for Almi<'_> {
     fn prepare(&self, inputs: &RetrievalInputs<'_>) -> Result<Model, RetrievalError> {
         Ok(Box::new(PreparedAlmi(run::almi_model(self.0, self.1, inputs)?, self.1.clone())))
     }
+    fn classes(&self) -> Classes {
+        Classes { siop_sets: true, ..Classes::default() }
+    }
     fn cheaper(&self) -> Vec<Cheaper> {
         vec![
             ("aLMI unweighted (one solve per set)", |r| {
@@ -163,6 +185,12 @@ impl Algorithm for Sambuca<'_> {
     fn prepare(&self, inputs: &RetrievalInputs<'_>) -> Result<Model, RetrievalError> {
         let model = run_sambuca::sambuca_model(self.0, self.1, self.2, inputs)?;
         Ok(Box::new(PreparedSambuca(model, self.2.clone())))
+    }
+    fn headline(&self) -> &'static str {
+        crate::variable::key::DEPTH
+    }
+    fn classes(&self) -> Classes {
+        Classes { substrates: true, ..Classes::default() }
     }
     // The defaults: 3 Gauss nodes per band, 100 iterations, adaptive starts, noise-weighted.
     fn cheaper(&self) -> Vec<Cheaper> {

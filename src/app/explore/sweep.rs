@@ -38,13 +38,10 @@ pub fn default_span(range: &Range, now: f64) -> (f64, f64) {
     if a < b { (a, b) } else { (range.lo, range.hi) }
 }
 
-/// The variables the retrieval of `config` makes.
+/// The core variables ([`crate::variable::KEYS`]) the retrievals of `config` make, in that order.
 fn variables(config: &RunConfig) -> Vec<&'static str> {
-    let mut v = vec!["chl_mg_m3", "nap_g_m3", "cdom_per_m"];
-    if config.retrievals.iter().any(|r| matches!(r, crate::retrieval::RetrievalSpec::Sambuca { .. })) {
-        v.push("depth_m");
-    }
-    v
+    let made: Vec<String> = config.retrievals.iter().flat_map(|r| r.algorithm().variables()).collect();
+    crate::variable::KEYS.into_iter().filter(|k| made.iter().any(|m| m == k)).collect()
 }
 
 /// The requirement the curves of `variable` are judged against, when the app has one.
