@@ -137,6 +137,10 @@ impl Effect for Binning {
         "Binning"
     }
 
+    fn role(&self) -> super::Role {
+        super::Role::Design
+    }
+
     fn validate(&self, at: &str) -> Result<(), InstrumentError> {
         check(&r::BINNING_FACTOR, f64::from(self.factor), &format!("{at}.factor"))?;
         check(&r::BINNING_SPECTRAL, f64::from(self.spectral), &format!("{at}.spectral"))

@@ -29,6 +29,10 @@ impl Effect for Compression {
         "Compression"
     }
 
+    fn role(&self) -> super::Role {
+        super::Role::FocalPlane
+    }
+
     fn validate(&self, at: &str) -> Result<(), InstrumentError> {
         check(&r::COMPRESSION_MAX_ERROR_DN, f64::from(self.max_error_dn), &format!("{at}.max_error_dn"))?;
         check(&r::COMPRESSION_BITS_PER_SAMPLE, self.bits_per_sample, &format!("{at}.bits_per_sample"))

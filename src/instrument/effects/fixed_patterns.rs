@@ -68,6 +68,10 @@ impl Effect for FixedPatterns {
         "FixedPatterns"
     }
 
+    fn role(&self) -> super::Role {
+        super::Role::Detector
+    }
+
     fn validate(&self, at: &str) -> Result<(), InstrumentError> {
         check(&r::PATTERN_GAIN_DRIFT, self.gain_drift, &format!("{at}.gain_drift"))?;
         check(&r::PATTERN_OFFSET_DRIFT_E, self.offset_drift_e, &format!("{at}.offset_drift_e"))?;

@@ -155,6 +155,10 @@ impl Effect for Misregistration {
         "Misregistration"
     }
 
+    fn role(&self) -> super::Role {
+        super::Role::FocalPlane
+    }
+
     fn validate(&self, at: &str) -> Result<(), InstrumentError> {
         check(&r::MISREGISTRATION_SIGMA_PX, self.sigma_px, &format!("{at}.sigma_px"))?;
         for (i, &(a, c)) in self.per_band.iter().enumerate() {

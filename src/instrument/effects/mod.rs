@@ -115,23 +115,14 @@ impl InstrumentEffect {
     /// misregistration, compression, TDI, the bands' spectral knowledge), rather than the optics?
     #[must_use]
     pub fn on_the_focal_plane(&self) -> bool {
-        matches!(
-            self,
-            Self::NonLinearity(_)
-                | Self::FixedPatterns(_)
-                | Self::Misregistration(_)
-                | Self::Compression(_)
-                | Self::Tdi(_)
-                | Self::SpectralKnowledge(_)
-                | Self::Binning(_)
-        )
+        self.effect().role() != Role::Optics
     }
 
     /// Is it an error source (which `shoal budget`'s perfect switches remove), rather than a
     /// design choice (binning)?
     #[must_use]
     pub fn makes_error(&self) -> bool {
-        !matches!(self, Self::Binning(_))
+        self.effect().role() != Role::Design
     }
 
     /// The entry as the optics apply it, the processor's knowledge left out: the key of the
@@ -204,10 +195,28 @@ pub struct Context<'a> {
     pub stokes: Option<&'a StokesColumns>,
 }
 
+/// Where an effect arises, which decides who carries it and what removes it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Role {
+    /// The optics make it (stray light, polarisation, the MTF budget).
+    Optics,
+    /// The focal plane's readout or the electronics downstream of the detector make it
+    /// (misregistration, compression, spectral knowledge).
+    FocalPlane,
+    /// The detector itself carries it, and its key and the calibration's include it
+    /// (non-linearity, fixed patterns, TDI).
+    Detector,
+    /// A design choice on the focal plane, not an error (`shoal budget`'s perfect switches keep
+    /// it): on-board binning.
+    Design,
+}
+
 /// One instrument effect.
 pub trait Effect: Sync {
     /// Its name in messages and tables.
     fn name(&self) -> &'static str;
+    /// Where it arises (no default: a new effect says).
+    fn role(&self) -> Role;
     /// Check the fields (`at` names the entry: `effects[0].StrayLight`).
     fn validate(&self, at: &str) -> Result<(), InstrumentError>;
     /// What it reads besides the cube.
@@ -244,9 +253,7 @@ pub fn validate(effects: &[InstrumentEffect]) -> Result<(), InstrumentError> {
 /// detector's key (as applied) and of the calibration's (with what the processor knows).
 #[must_use]
 pub fn on_the_detector(effects: &[InstrumentEffect]) -> Vec<InstrumentEffect> {
-    let carried = |e: &&InstrumentEffect| {
-        matches!(e, InstrumentEffect::NonLinearity(_) | InstrumentEffect::FixedPatterns(_) | InstrumentEffect::Tdi(_))
-    };
+    let carried = |e: &&InstrumentEffect| e.effect().role() == Role::Detector;
     effects.iter().filter(carried).cloned().collect()
 }
 

@@ -268,6 +268,10 @@ impl super::Effect for MtfBudget {
         "SpatialResponse"
     }
 
+    fn role(&self) -> super::Role {
+        super::Role::Optics
+    }
+
     fn validate(&self, at: &str) -> Result<(), InstrumentError> {
         MtfBudget::validate(self, at)
     }

@@ -144,6 +144,10 @@ impl Effect for NonLinearity {
         "NonLinearity"
     }
 
+    fn role(&self) -> super::Role {
+        super::Role::Detector
+    }
+
     fn validate(&self, at: &str) -> Result<(), InstrumentError> {
         let terms = std::iter::once((self.quadratic, self.cubic, at.to_string()))
             .chain(self.per_band.iter().enumerate().map(|(i, &(q, c))| (q, c, format!("{at}.per_band[{i}]"))));

@@ -90,6 +90,10 @@ impl Effect for Polarisation {
         "Polarisation"
     }
 
+    fn role(&self) -> super::Role {
+        super::Role::Optics
+    }
+
     fn validate(&self, at: &str) -> Result<(), InstrumentError> {
         check(&r::POLARISATION_SENSITIVITY, self.sensitivity, &format!("{at}.sensitivity"))?;
         for (i, &s) in self.per_band.iter().enumerate() {

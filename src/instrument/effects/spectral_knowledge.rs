@@ -142,6 +142,10 @@ impl Effect for SpectralKnowledge {
         "SpectralKnowledge"
     }
 
+    fn role(&self) -> super::Role {
+        super::Role::FocalPlane
+    }
+
     fn validate(&self, at: &str) -> Result<(), InstrumentError> {
         check(&r::SPECTRAL_CENTRE_NM, self.centre_nm, &format!("{at}.centre_nm"))?;
         check(&r::SPECTRAL_SIGMA_NM, self.sigma_nm, &format!("{at}.sigma_nm"))?;

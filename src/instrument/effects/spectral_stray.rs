@@ -127,6 +127,10 @@ impl Effect for SpectralStrayLight {
         "SpectralStrayLight"
     }
 
+    fn role(&self) -> super::Role {
+        super::Role::Optics
+    }
+
     fn validate(&self, at: &str) -> Result<(), InstrumentError> {
         check(&r::SPECTRAL_STRAY_FRACTION, self.fraction, &format!("{at}.fraction"))?;
         check(&r::SPECTRAL_STRAY_WIDTH_NM, self.width_nm, &format!("{at}.width_nm"))?;

@@ -179,6 +179,10 @@ impl Effect for StrayLight {
         "StrayLight"
     }
 
+    fn role(&self) -> super::Role {
+        super::Role::Optics
+    }
+
     fn validate(&self, at: &str) -> Result<(), InstrumentError> {
         check(&r::STRAY_HALO_FRACTION, self.halo_fraction, &format!("{at}.halo_fraction"))?;
         check(&r::STRAY_KNEE_M, self.knee_m, &format!("{at}.knee_m"))?;

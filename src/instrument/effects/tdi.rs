@@ -82,6 +82,10 @@ impl Effect for Tdi {
         "Tdi"
     }
 
+    fn role(&self) -> super::Role {
+        super::Role::Detector
+    }
+
     fn validate(&self, at: &str) -> Result<(), InstrumentError> {
         check(&r::TDI_STAGES, f64::from(self.stages), &format!("{at}.stages"))?;
         check(&r::TDI_LINE_RATE_ERROR, self.line_rate_error, &format!("{at}.line_rate_error"))?;
