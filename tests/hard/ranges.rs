@@ -270,3 +270,64 @@ fn a_spectrograph_reaching_past_the_data_is_refused_by_name() {
     let e = with_end(last + 0.5).validate().unwrap_err().to_string();
     assert!(e.contains("kind.Spectrograph.end_nm") && e.contains("≤ 2500 nm"), "{e}");
 }
+
+/// An instrument field's path as the ranges table writes it: list indices as `[]`
+/// (`instrument.effects.0.Tdi.stages` → `instrument.effects[].Tdi.stages`).
+fn table_path(leaf: &str) -> String {
+    let mut out = String::new();
+    for part in leaf.split('.') {
+        if part.parse::<usize>().is_ok() {
+            out.push_str("[]");
+        } else {
+            if !out.is_empty() {
+                out.push('.');
+            }
+            out.push_str(part);
+        }
+    }
+    out
+}
+
+/// Numbers of an instrument that are data, not settings a range could bound, with why.
+const NOT_SETTINGS: &[(&str, &str)] = &[
+    ("instrument.kind.Multispectral.bands", "a band set's own centres and widths: checked by the band set"),
+    ("instrument.kind.FilterImager.bands", "as a multispectral band set (`spectral::bands`: fwhm 0.1 to 300 nm)"),
+    ("instrument.quantum_efficiency", "a QE curve: each value checked as a fraction by the response"),
+    ("instrument.focal_planes[].quantum_efficiency", "as the instrument's QE curve"),
+    (
+        "instrument.focal_planes[].dark_temperature",
+        "checked with the instrument's `dark_temperature` ranges, the message naming the plane's field",
+    ),
+    ("instrument.effects[].Misregistration.draw", "a seed: any whole number"),
+    ("instrument.effects[].SpectralKnowledge.draw", "a seed: any whole number"),
+];
+
+/// Every number of every instrument preset (with each optical and focal-plane effect, every
+/// dark-current law and focal planes of its own where the preset has them) is a field of the
+/// ranges table, so a new instrument parameter cannot slip in without a documented range, a
+/// validator and the MANUAL's row (`manual_shows_the_table`).
+#[test]
+fn every_number_of_an_instrument_has_a_range() {
+    let ranged: Vec<&str> = ranges::ALL.iter().map(|r| r.path).collect();
+    let mut missing = std::collections::BTreeSet::new();
+    for name in InstrumentSpec::preset_names() {
+        let mut instrument = InstrumentSpec::preset(&name).unwrap();
+        crate::common::with_dark_laws(&mut instrument);
+        crate::common::with_optical_effects(&mut instrument);
+        let config = RunConfig::new(SceneSpec::preset("lake_hume_bloom").unwrap(), instrument);
+        for leaf in shoal::fields::flatten(&config) {
+            let path = table_path(&leaf.path);
+            // A number, or a short list of numbers (written as one leaf).
+            let list = serde_json::from_str::<Vec<f64>>(&leaf.text).is_ok_and(|v| !v.is_empty());
+            let numeric = leaf.text.parse::<f64>().is_ok() || list;
+            if !path.starts_with("instrument.") || !numeric || path.ends_with("schema_version") {
+                continue;
+            }
+            let exempt = NOT_SETTINGS.iter().any(|(p, _)| path.starts_with(p));
+            if !exempt && !ranged.contains(&path.as_str()) {
+                missing.insert(format!("{path} ({name})"));
+            }
+        }
+    }
+    assert!(missing.is_empty(), "instrument numbers without a range in shoal::ranges: {missing:#?}");
+}
