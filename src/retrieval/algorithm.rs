@@ -293,21 +293,33 @@ impl RetrievalSpec {
         }
     }
 
+    /// The built-in's names (`None`: a user's program, called by its own name). A new retrieval
+    /// gets an arm here and its [`Identity`] in [`BUILT_IN`] (`tests/chain/external_hostile.rs`
+    /// checks both).
+    #[must_use]
+    pub const fn identity(&self) -> Option<Identity> {
+        match self {
+            Self::Almi { .. } => Some(ALMI),
+            Self::Sambuca { .. } => Some(SAMBUCA),
+            Self::Qaa { .. } => Some(QAA),
+            Self::External(_) => None,
+        }
+    }
+
     /// Short name for reports and file names ([`Algorithm::name`]).
     #[must_use]
     pub fn name(&self) -> &str {
-        match self {
-            Self::Almi { .. } => ALMI.name,
-            Self::Sambuca { .. } => SAMBUCA.name,
-            Self::External(e) => &e.name,
-            Self::Qaa { .. } => QAA.name,
+        match (self.identity(), self) {
+            (Some(i), _) => i.name,
+            (None, Self::External(e)) => &e.name,
+            (None, _) => "",
         }
     }
 
     /// Its name for people ([`Algorithm::title`]).
     #[must_use]
     pub fn title(&self) -> &str {
-        title_of(self.name())
+        self.identity().map_or_else(|| self.name(), |i| i.title)
     }
 
     /// The retrieval's inversion mode and what its two modes are called for people (Shoal's

@@ -77,6 +77,7 @@ fn a_built_in_retrieval_s_name_is_reserved_in_any_case() {
     ];
     assert_eq!(builtins.len(), shoal::retrieval::algorithm::BUILT_IN.len(), "a built-in missing from this list");
     for (b, identity) in builtins.iter().zip(shoal::retrieval::algorithm::BUILT_IN) {
+        assert_eq!(b.identity(), Some(identity));
         assert_eq!((b.name(), b.title()), (identity.name, identity.title));
         assert!(shoal::retrieval::run::BUILT_IN_NAMES.contains(&b.name()), "{}", b.name());
     }
