@@ -175,6 +175,17 @@ impl Sums {
     }
 }
 
+/// The value at index round((n − 1)·`p`) of `v` sorted (nearest rank), NaN when `v` is empty;
+/// found in linear time (`select_nth_unstable`: the element a sort would put there, so the same
+/// value as sorting), `v` reordered.
+pub fn nearest_rank(v: &mut [f64], p: f64) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    let k = ((v.len() - 1) as f64 * p).round() as usize;
+    *v.select_nth_unstable_by(k.min(v.len() - 1), f64::total_cmp).1
+}
+
 /// A histogram over fixed bins (log10 or linear edges).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Histogram {
@@ -298,6 +309,18 @@ impl ProductMetrics {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn nearest_rank_is_the_sorted_value_at_that_rank() {
+        let mut v: Vec<f64> = (0..1001).map(|i| f64::from((i * 7919) % 1001) * 0.5).collect();
+        let mut sorted = v.clone();
+        sorted.sort_by(f64::total_cmp);
+        for p in [0.0, 0.05, 0.5, 0.95, 1.0] {
+            let want = sorted[((sorted.len() - 1) as f64 * p).round() as usize];
+            assert_eq!(nearest_rank(&mut v, p).to_bits(), want.to_bits(), "p = {p}");
+        }
+        assert!(nearest_rank(&mut [], 0.5).is_nan());
+    }
 
     #[test]
     fn a_confusion_table_gives_accuracy_and_recall() {
