@@ -139,14 +139,17 @@ fn variables(result: &SeasonResult) -> Vec<(String, String)> {
 pub fn summary(result: &SeasonResult, seconds: f64) -> String {
     let s = &result.spec;
     let mut t = format!(
-        "{}: study {}, site {:.2}°, {:.2}°, {} to {}, descending node {:.2} h, roll up to {}°, glint tilt {}°, {} in {seconds:.1} s\n",
+        "{}: study {}, site {:.2}°, {:.2}°, {} to {}, {}, roll up to {}°, glint tilt {}°, {} in {seconds:.1} s\n",
         s.name,
         result.study,
         s.site.0,
         s.site.1,
         s.from,
         s.to,
-        s.orbit.descending_node_h,
+        match &s.orbit.tle {
+            Some((line1, _)) => format!("two-line elements of {} (SGP4)", line1.get(2..7).unwrap_or("?").trim()),
+            None => format!("descending node {:.2} h", s.orbit.descending_node_h),
+        },
         s.max_roll_deg,
         s.glint_tilt_deg,
         match &s.clouds {

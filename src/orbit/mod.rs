@@ -27,11 +27,34 @@
 //!   EGM96/WGS-84).
 
 pub mod sun;
+pub mod tle;
 
 use std::f64::consts::TAU;
 
 use crate::units::{EARTH_GM_M3_S2, EARTH_RADIUS_M};
 pub use sun::{SunPosition, days_since_j2000, sun_position};
+pub use tle::TleOrbit;
+
+/// Where a spacecraft is: what the pass finder ([`accesses`]) asks of an orbit.
+pub trait Track {
+    /// The unit vector to the spacecraft in Earth-fixed axes and its distance from the Earth's
+    /// centre, m, at `days` since J2000.0; `None` where the orbit has no position (a decayed
+    /// TLE).
+    fn at(&self, days: f64) -> Option<([f64; 3], f64)>;
+
+    /// Its angular rate about the Earth, rad/s (the pass finder's step in ground track).
+    fn angular_rate_rad_s(&self) -> f64;
+}
+
+impl Track for SunSynchronous {
+    fn at(&self, days: f64) -> Option<([f64; 3], f64)> {
+        Some((self.direction_ecef(days), self.radius_m()))
+    }
+
+    fn angular_rate_rad_s(&self) -> f64 {
+        self.latitude_rate_rad_s()
+    }
+}
 
 /// The Earth's second zonal harmonic (EGM96; Montenbruck & Gill 2000, Table 3.1).
 pub const J2: f64 = 1.082_626_68e-3;
@@ -172,6 +195,8 @@ pub struct Access {
     pub sun: SunPosition,
     /// Whether the satellite was flying south (on the descending half of its orbit).
     pub descending: bool,
+    /// The spacecraft's distance from the Earth's centre at the pass, m.
+    pub radius_m: f64,
 }
 
 fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
@@ -186,25 +211,20 @@ fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 /// `max_off_nadir_rad` of nadir (either side), in time order. Each pass's closest approach is
 /// bracketed on a 20 s grid and refined by golden-section search to well under a second.
 #[must_use]
-pub fn accesses(
-    orbit: &SunSynchronous,
-    site: &Site,
-    from_days: f64,
-    to_days: f64,
-    max_off_nadir_rad: f64,
-) -> Vec<Access> {
-    let a = orbit.radius_m();
+pub fn accesses(orbit: &impl Track, site: &Site, from_days: f64, to_days: f64, max_off_nadir_rad: f64) -> Vec<Access> {
     let r = EARTH_RADIUS_M;
     // The central angle at which the site is seen at the largest off-nadir angle: sin(γ + c) =
-    // (a/R) sin γ.
+    // (a/R) sin γ (at the orbit's radius where the search starts; an eccentric orbit's is
+    // checked again at each pass).
+    let a = orbit.at(from_days).map_or(r, |(_, a)| a);
     let gamma = max_off_nadir_rad.clamp(0.0, 1.5);
     let c_max = ((a / r) * gamma.sin()).min(1.0).asin() - gamma;
     let step_days = 20.0 / sun::DAY_S;
     // A grid point next to the minimum is at most one step of ground track away.
-    let step_arc = orbit.latitude_rate_rad_s() * 20.0 + 7.3e-5 * 20.0;
+    let step_arc = orbit.angular_rate_rad_s() * 20.0 + 7.3e-5 * 20.0;
     let cos_limit = (c_max + step_arc).min(std::f64::consts::PI).cos();
     let s = site.unit();
-    let closeness = |d: f64| dot(orbit.direction_ecef(d), s);
+    let closeness = |d: f64| orbit.at(d).map_or(-1.0, |(p, _)| dot(p, s));
     let n = ((to_days - from_days) / step_days).ceil().max(0.0) as usize;
     let mut out = Vec::new();
     let (mut prev, mut here) = (closeness(from_days - step_days), closeness(from_days));
@@ -214,7 +234,7 @@ pub fn accesses(
         if here >= cos_limit && here >= prev && here > next {
             let best = golden_max(&closeness, t - step_days, t + step_days);
             if (from_days..=to_days).contains(&best)
-                && let Some(access) = access_at(orbit, site, best, c_max)
+                && let Some(access) = access_at(orbit, site, best, gamma)
             {
                 out.push(access);
             }
@@ -245,20 +265,21 @@ fn golden_max(f: &impl Fn(f64) -> f64, mut lo: f64, mut hi: f64) -> f64 {
     0.5 * (lo + hi)
 }
 
-/// The geometry of the pass closest to `site` at `days`, if the site is within central angle
-/// `c_max` of the ground track.
-fn access_at(orbit: &SunSynchronous, site: &Site, days: f64, c_max: f64) -> Option<Access> {
-    let p = orbit.direction_ecef(days);
+/// The geometry of the pass closest to `site` at `days`, if the site is within off-nadir angle
+/// `max_gamma` of the ground track.
+fn access_at(orbit: &impl Track, site: &Site, days: f64, max_gamma: f64) -> Option<Access> {
+    let (p, a) = orbit.at(days)?;
     let s = site.unit();
+    let r = EARTH_RADIUS_M;
+    let c_max = ((a / r) * max_gamma.sin()).min(1.0).asin() - max_gamma;
     let c = dot(p, s).clamp(-1.0, 1.0).acos();
     if c > c_max {
         return None;
     }
-    let (a, r) = (orbit.radius_m(), EARTH_RADIUS_M);
     let gamma = (r * c.sin()).atan2(a - r * c.cos());
     // Ground-track direction from a centred difference of one second.
     let ds = 1.0 / sun::DAY_S;
-    let (p0, p1) = (orbit.direction_ecef(days - ds), orbit.direction_ecef(days + ds));
+    let (p0, p1) = (orbit.at(days - ds)?.0, orbit.at(days + ds)?.0);
     let v = [p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]];
     let (north, east) = site.north_east();
     let heading = dot(v, east).atan2(dot(v, north)).rem_euclid(TAU);
@@ -279,8 +300,11 @@ fn access_at(orbit: &SunSynchronous, site: &Site, days: f64, c_max: f64) -> Opti
         heading_rad: heading,
         sun: sun_position(site.latitude_rad, site.longitude_rad, days),
         descending: dot(v, north) < 0.0,
+        radius_m: a,
     })
 }
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tle_tests;

@@ -8,7 +8,7 @@ use rand_distr::{Beta, Distribution};
 use super::SeasonSpec;
 use crate::atmosphere::{Geometry, glint_radiance_norm};
 use crate::instrument::{InstrumentSpec, line_of_sight};
-use crate::orbit::{Access, Site, SunSynchronous, accesses};
+use crate::orbit::{Access, EARTH_EQUATORIAL_RADIUS_M, Site, SunSynchronous, TleOrbit, accesses};
 
 /// Why a look is kept or not, in the order the checks are made.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -46,6 +46,9 @@ pub struct Look {
     pub access: Access,
     /// Fore/aft tilt of the look, degrees (the design's own without a glint tilt).
     pub forward_tilt_deg: f64,
+    /// The spacecraft's altitude at the pass over the equatorial radius, m, when it flies an
+    /// element set (`None`: the design's own altitude).
+    pub altitude_m: Option<f64>,
     /// Sun and view geometry at the site, with the tilt.
     pub geometry: Geometry,
     /// Normalised glint radiance L_GN = ρ_g μ₀/π at the site, sr⁻¹.
@@ -102,7 +105,13 @@ pub fn looks(season: &SeasonSpec, instrument: &InstrumentSpec, wind_m_s: f64, n:
     let half = half_field_of_view_rad(instrument);
     let pointing = instrument.across_track_tilt_deg.to_radians();
     let roll = season.max_roll_deg.to_radians();
-    let found = accesses(&orbit, &site, from, to, pointing.abs() + roll + half);
+    let tle = season.orbit.tle.as_ref().and_then(|(l1, l2)| TleOrbit::from_lines(l1, l2).ok());
+    let reach = pointing.abs() + roll + half;
+    let found = match &tle {
+        Some(t) => accesses(t, &site, from, to, reach),
+        None => accesses(&orbit, &site, from, to, reach),
+    };
+    let altitude_of = |a: &Access| tle.as_ref().map(|_| a.radius_m - EARTH_EQUATORIAL_RADIUS_M);
     let max_sun = season.max_sun_zenith_deg.to_radians();
     let max_view = season.max_view_zenith_deg.to_radians();
     // Fore/aft candidates, degrees: the glint tilt either way, or the design's own forward tilt.
@@ -118,7 +127,7 @@ pub fn looks(season: &SeasonSpec, instrument: &InstrumentSpec, wind_m_s: f64, n:
             // chain's largest view zenith.
             let candidate = |forward: f64| {
                 let sight = line_of_sight(
-                    orbit.altitude_m,
+                    altitude_of(&access).unwrap_or(orbit.altitude_m),
                     access.heading_rad,
                     forward.to_radians(),
                     access.off_nadir_rad,
@@ -163,7 +172,8 @@ pub fn looks(season: &SeasonSpec, instrument: &InstrumentSpec, wind_m_s: f64, n:
             } else {
                 Verdict::Valid
             };
-            Look { access, forward_tilt_deg, geometry, glint_per_sr, cloud_cover, verdict }
+            let altitude_m = altitude_of(&access);
+            Look { access, forward_tilt_deg, altitude_m, geometry, glint_per_sr, cloud_cover, verdict }
         })
         .collect()
 }

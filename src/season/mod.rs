@@ -3,8 +3,9 @@
 //!
 //! A season file names a study (the scene, the designs, the retrievals and the correction), the
 //! site on Earth, a period and the orbit's local time. For each design, the accesses of its
-//! sun-synchronous orbit (its own altitude, [`crate::orbit`]) to the site are found over the
-//! period; each becomes a [`looks::Look`] with the sun and view geometry of that pass, judged
+//! sun-synchronous orbit (its own altitude, [`crate::orbit`]) — or of a real spacecraft's
+//! two-line elements propagated with SGP4 (`orbit.tle`), which every design then flies — to the
+//! site are found over the period; each becomes a [`looks::Look`] with the sun and view geometry of that pass, judged
 //! valid or not the way a processor would:
 //! - the sun at most `max_sun_zenith_deg` from the zenith (l2gen's HISOLZEN, 75°), and the site
 //!   seen at most `max_view_zenith_deg` from it (HISATZEN, 60°);
@@ -52,7 +53,19 @@ pub struct OrbitSpec {
     /// days the passes fall on; a shorter period within the year keeps the same orbit).
     #[serde(default)]
     pub phase_deg: f64,
+    /// A real spacecraft's two-line elements (line 1, line 2): every design flies this orbit,
+    /// propagated with SGP4 ([`crate::orbit::TleOrbit`]), and each look runs at the spacecraft's
+    /// altitude at the pass; the node time and phase above are then unused. The period must lie
+    /// within [`TLE_REACH_DAYS`] of the elements' epoch.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tle: Option<(String, String)>,
 }
+
+/// How far a season may reach from its element set's epoch, days: an element set predicts which
+/// passes see a site for days to weeks around its epoch (SGP4's along-track error grows with
+/// time from the epoch, mostly with the unmodelled drag: Vallado et al. 2006); beyond that the
+/// passes are no longer the spacecraft's, so a newer element set is needed.
+pub const TLE_REACH_DAYS: f64 = 30.0;
 
 fn default_node() -> f64 {
     10.5
@@ -60,7 +73,7 @@ fn default_node() -> f64 {
 
 impl Default for OrbitSpec {
     fn default() -> Self {
-        Self { descending_node_h: default_node(), phase_deg: 0.0 }
+        Self { descending_node_h: default_node(), phase_deg: 0.0, tle: None }
     }
 }
 
@@ -296,7 +309,24 @@ impl SeasonSpec {
             check(&r::REVISIT_DAYS, q.days)?;
             check(&r::REVISIT_PCT, q.pct)?;
         }
-        self.period_days().map(|_| ())
+        let (from, to) = self.period_days()?;
+        if let Some((line1, line2)) = &self.orbit.tle {
+            let tle = crate::orbit::TleOrbit::from_lines(line1, line2)
+                .map_err(|message| FieldError { field: "orbit.tle".into(), message })?;
+            let (early, late) = (tle.epoch_days - from, to - tle.epoch_days);
+            if early > TLE_REACH_DAYS || late > TLE_REACH_DAYS {
+                let ((y, m, d), _) = crate::orbit::sun::date_and_minute(tle.epoch_days);
+                return Err(FieldError {
+                    field: "orbit.tle".into(),
+                    message: format!(
+                        "the elements' epoch is {y:04}-{m:02}-{d:02}; the period ({} to {}) must lie within {TLE_REACH_DAYS} \
+                         days of it (use the element set nearest the period)",
+                        self.from, self.to
+                    ),
+                });
+            }
+        }
+        Ok(())
     }
 }
 

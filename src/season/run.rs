@@ -143,6 +143,9 @@ pub fn look_config(base: &RunConfig, look: &Look, decimation: usize) -> RunConfi
     config.instrument.heading_deg = a.heading_rad.to_degrees();
     config.instrument.across_track_tilt_deg = a.off_nadir_rad.to_degrees();
     config.instrument.forward_tilt_deg = look.forward_tilt_deg;
+    if let Some(h) = look.altitude_m {
+        config.instrument.altitude_km = h / 1e3;
+    }
     config.fidelity.decimation = decimation;
     config
 }

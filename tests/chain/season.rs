@@ -190,3 +190,63 @@ fn a_season_does_not_depend_on_the_threads() {
     };
     assert_eq!(on(1).designs, on(2).designs);
 }
+
+/// `line` (68 characters) with its modulo-10 checksum.
+fn with_checksum(line: &str) -> String {
+    let sum: u32 = line.chars().map(|c| if c == '-' { 1 } else { c.to_digit(10).unwrap_or(0) }).sum();
+    format!("{line}{}", sum % 10)
+}
+
+/// A Landsat-8-like element set (705 km, 98.2°, no drag) with its epoch on 2023-04-10.
+fn element_set() -> (String, String) {
+    (
+        with_checksum("1 39084U 13008A   23100.00000000  .00000000  00000-0  00000-0 0  999"),
+        with_checksum("2 39084  98.2000 100.0000 0001000  90.0000 270.0000 14.57107000 5000"),
+    )
+}
+
+/// Every design flies the element set: its looks are the SGP4 orbit's passes over the site (found
+/// here again through `shoal::orbit`), each run at the spacecraft's altitude at the pass, the
+/// same for both designs whatever their own altitude.
+#[test]
+fn a_season_on_two_line_elements_flies_the_spacecraft() {
+    let mut season = spring(0);
+    (season.from, season.to) = ("2023-04-01".into(), "2023-04-30".into());
+    season.orbit.tle = Some(element_set());
+    season.validate().unwrap();
+    let (study, ds) = designs(&season, None).unwrap();
+    let result = run_season(&season, &study, &ds, &RunControl::new(), |_, _| {}).unwrap();
+    let tle = shoal::orbit::TleOrbit::from_lines(&element_set().0, &element_set().1).unwrap();
+    let site = Site::from_degrees(season.site.0, season.site.1);
+    let (from, to) = season.period_days().unwrap();
+    let times: Vec<Vec<f64>> = result.designs.iter().map(|d| d.looks.iter().map(|l| l.access.days).collect()).collect();
+    assert!(!times[0].is_empty(), "no pass of the element set over the site in April");
+    for (d, (_, config)) in result.designs.iter().zip(&ds) {
+        let reach = season.max_roll_deg.to_radians() + half_field_of_view_rad(&config.instrument);
+        let passes = accesses(&tle, &site, from, to, reach);
+        let want: Vec<f64> = passes.iter().map(|a| a.days).collect();
+        let got: Vec<f64> = d.looks.iter().map(|l| l.access.days).collect();
+        assert_eq!(got, want, "{}", config.instrument.name);
+        for look in &d.looks {
+            let h = look.altitude_m.expect("a look on elements has the spacecraft's altitude");
+            assert!((h - 705e3).abs() < 20e3, "{h}");
+            let run = look_config(config, look, 16);
+            assert_eq!(run.instrument.altitude_km, h / 1e3);
+        }
+    }
+    // One spacecraft: where the designs' fields of view are alike, so are their passes.
+    assert_eq!(times[0].first(), times[1].first());
+}
+
+#[test]
+fn element_sets_far_from_the_period_or_malformed_are_refused() {
+    let mut season = spring(0);
+    season.orbit.tle = Some(element_set());
+    // The spring season runs to the end of June, 81 days after the epoch.
+    let e = season.validate().unwrap_err();
+    assert!(e.field == "orbit.tle" && e.message.contains("2023-04-10") && e.message.contains("30"), "{e}");
+    season.to = "2023-04-20".into();
+    season.orbit.tle = Some((element_set().0.replace("23100.", "23101."), element_set().1));
+    let e = season.validate().unwrap_err();
+    assert!(e.field == "orbit.tle" && e.message.contains("checksum"), "{e}");
+}
