@@ -194,12 +194,14 @@ pub fn summary(result: &SeasonResult, seconds: f64) -> String {
                 fmt(stats::percentile(v, 100.0), digits)
             )
         };
-        t += &format!(
-            "  over {} orbit phases (min–median–max): valid looks {}{}\n",
-            d.phases.len(),
-            spread(&valid, 0),
-            if revisit.is_empty() { String::new() } else { format!(", revisit {} % of days", spread(&revisit, 1)) }
-        );
+        if !d.phases.is_empty() {
+            t += &format!(
+                "  over {} orbit phases (min–median–max): valid looks {}{}\n",
+                d.phases.len(),
+                spread(&valid, 0),
+                if revisit.is_empty() { String::new() } else { format!(", revisit {} % of days", spread(&revisit, 1)) }
+            );
+        }
         let failed = d.runs.iter().filter(|r| r.failure.is_some()).count();
         t += &format!(
             "  chain runs: {} of the valid looks{}\n",

@@ -42,7 +42,7 @@ pub struct LookRun {
 pub struct DesignSeason {
     /// The design's label in the study.
     pub label: String,
-    /// Altitude, km.
+    /// Altitude, km (on an element set, the spacecraft's at its first pass, to 0.1 km).
     pub altitude_km: f64,
     /// Half the across-track field of view, degrees.
     pub half_fov_deg: f64,
@@ -53,7 +53,7 @@ pub struct DesignSeason {
     /// The same season at other orbit phases (which months a near-repeating orbit sees the
     /// site depends on where it was at the start, unknown before launch): per phase, degrees,
     /// the valid looks and the revisit share (% of days within the requirement's wait; `None`
-    /// without a requirement).
+    /// without a requirement). Empty on an element set, whose phase is known.
     pub phases: Vec<PhaseSample>,
 }
 
@@ -201,13 +201,20 @@ pub fn run_season(
                 crate::atmosphere::SeaSurface::Wind { speed_m_s } => speed_m_s,
                 crate::atmosphere::SeaSurface::Flat => season.wind_m_s,
             };
+            let found = looks(season, &config.instrument, wind, config.scene.atmosphere.water_refractive_index);
+            // On an element set the spacecraft's altitude at its first pass, and no other phase
+            // to try: the elements say where it is.
+            let tle = season.orbit.tle.is_some();
             DesignSeason {
                 label: label.clone(),
-                altitude_km: config.instrument.altitude_km,
+                altitude_km: found
+                    .first()
+                    .and_then(|l| l.altitude_m)
+                    .map_or(config.instrument.altitude_km, |h| (h / 1e3 * 10.0).round() / 10.0),
                 half_fov_deg: half_field_of_view_rad(&config.instrument).to_degrees(),
-                looks: looks(season, &config.instrument, wind, config.scene.atmosphere.water_refractive_index),
+                looks: found,
                 runs: Vec::new(),
-                phases: (0..PHASE_SAMPLES)
+                phases: (0..if tle { 0 } else { PHASE_SAMPLES })
                     .into_par_iter()
                     .map(|k| {
                         let mut other = season.clone();
