@@ -249,6 +249,7 @@ pub fn run_season(
     jobs.sort_by(|a, b| {
         seasons[a.0].looks[a.1].access.days.total_cmp(&seasons[b.0].looks[b.1].access.days).then(a.0.cmp(&b.0))
     });
+    within_budget(&jobs, designs, &seasons, season.decimation)?;
     let total = jobs.len();
     let mut engine = Engine::lean();
     for (done, &(d, k)) in jobs.iter().enumerate() {
@@ -281,6 +282,42 @@ pub fn run_season(
         d.runs.sort_by_key(|r| r.look);
     }
     Ok(SeasonResult { spec: season.clone(), study: study.to_string(), period, designs: seasons })
+}
+
+/// Refuse a season whose chain runs would not fit the machine's budget
+/// ([`crate::budget::MachineBudget`]) before any runs: each look's memory as one run's, and the
+/// radiative transfer of every look together (each look has its own sun, so its own tables; a
+/// second design in the same orbit may reuse the first's, so this is an upper bound).
+fn within_budget(
+    jobs: &[(usize, usize)],
+    designs: &[(String, RunConfig)],
+    seasons: &[DesignSeason],
+    decimation: usize,
+) -> Result<(), StudyError> {
+    let budget = crate::budget::MachineBudget::from_env()
+        .map_err(|message| StudyError::Invalid(crate::parse::FieldError { field: "budget".into(), message }))?;
+    let mut seconds = 0.0;
+    for &(d, k) in jobs {
+        let demand =
+            crate::engine::resources::run_demand(&look_config(&designs[d].1, &seasons[d].looks[k], decimation));
+        seconds += demand.atmosphere_s;
+        budget
+            .check(&crate::budget::Demand { atmosphere_s: 0.0, ..demand })
+            .map_err(|e| StudyError::Invalid(crate::parse::FieldError { field: e.field, message: e.message }))?;
+    }
+    if seconds > budget.atmosphere_s {
+        return Err(StudyError::Invalid(crate::parse::FieldError {
+            field: "max_runs".into(),
+            message: format!(
+                "the season's {} chain runs would spend about {seconds:.0} s in radiative transfer (each look has its \
+                 own sun) but may take {:.0} s (SHOAL_TIME_BUDGET_S); lower max_runs or shorten the period, or raise \
+                 the budget",
+                jobs.len(),
+                budget.atmosphere_s
+            ),
+        }));
+    }
+    Ok(())
 }
 
 impl SeasonResult {

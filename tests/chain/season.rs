@@ -250,3 +250,27 @@ fn element_sets_far_from_the_period_or_malformed_are_refused() {
     let e = season.validate().unwrap_err();
     assert!(e.field == "orbit.tle" && e.message.contains("checksum"), "{e}");
 }
+
+/// A season whose looks would spend longer in radiative transfer than the machine's budget is
+/// refused before any run, naming `max_runs` and the budget; within the budget it runs.
+#[test]
+fn a_season_past_the_time_budget_is_refused_before_it_runs() {
+    let dir = std::env::temp_dir().join(format!("shoal-season-budget-{}", std::process::id()));
+    let run = |budget: &str| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_shoal"))
+            .args(["season", "lake_hume_year", "--max-runs", "400", "--decimation", "16", "--no-figures", "--out"])
+            .arg(&dir)
+            .env("SHOAL_TIME_BUDGET_S", budget)
+            .output()
+            .unwrap()
+    };
+    let started = std::time::Instant::now();
+    let out = run("30");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("max_runs") && stderr.contains("SHOAL_TIME_BUDGET_S"), "{stderr}");
+    // Refused from the plan, not after running looks (a year's looks take minutes).
+    assert!(started.elapsed().as_secs_f64() < 60.0, "{:?}", started.elapsed());
+    assert!(!dir.join("looks.csv").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
