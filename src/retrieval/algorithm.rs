@@ -309,10 +309,9 @@ impl RetrievalSpec {
     /// Short name for reports and file names ([`Algorithm::name`]).
     #[must_use]
     pub fn name(&self) -> &str {
-        match (self.identity(), self) {
-            (Some(i), _) => i.name,
-            (None, Self::External(e)) => &e.name,
-            (None, _) => "",
+        match self {
+            Self::External(e) => &e.name,
+            built_in => built_in.identity().map_or("", |i| i.name),
         }
     }
 
