@@ -55,6 +55,9 @@ pub struct Look {
     pub glint_per_sr: f64,
     /// Cloud cover drawn for the look (0–1).
     pub cloud_cover: f64,
+    /// Wind speed over the site, m/s: the glint the look was judged on, and the sea surface its
+    /// chain run sees.
+    pub wind_m_s: f64,
     /// Kept or why not.
     pub verdict: Verdict,
 }
@@ -173,7 +176,7 @@ pub fn looks(season: &SeasonSpec, instrument: &InstrumentSpec, wind_m_s: f64, n:
                 Verdict::Valid
             };
             let altitude_m = altitude_of(&access);
-            Look { access, forward_tilt_deg, altitude_m, geometry, glint_per_sr, cloud_cover, verdict }
+            Look { access, forward_tilt_deg, altitude_m, geometry, glint_per_sr, cloud_cover, wind_m_s, verdict }
         })
         .collect()
 }

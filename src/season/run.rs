@@ -130,7 +130,10 @@ pub struct SeasonResult {
 
 /// The run configuration of `look` from a design's study configuration: the scene's sun and
 /// date at the pass, the ground track's heading, the line of sight pointed across track at the
-/// site's off-nadir angle and tilted as the look chose, at the season's decimation.
+/// site's off-nadir angle and tilted as the look chose, at the season's decimation; the sea
+/// wind-roughened at the look's wind with its sun glint on, the glint the look was judged on (a
+/// valid look's glint is below the threshold, not zero: the correction takes away what it
+/// expects, as a processor does).
 #[must_use]
 pub fn look_config(base: &RunConfig, look: &Look, decimation: usize) -> RunConfig {
     let mut config = base.clone();
@@ -143,6 +146,10 @@ pub fn look_config(base: &RunConfig, look: &Look, decimation: usize) -> RunConfi
     config.instrument.heading_deg = a.heading_rad.to_degrees();
     config.instrument.across_track_tilt_deg = a.off_nadir_rad.to_degrees();
     config.instrument.forward_tilt_deg = look.forward_tilt_deg;
+    config.scene.atmosphere.surface = crate::atmosphere::SeaSurface::Wind { speed_m_s: look.wind_m_s };
+    if !config.scene.effects.contains(&crate::scene::Effect::SunGlint) {
+        config.scene.effects.push(crate::scene::Effect::SunGlint);
+    }
     if let Some(h) = look.altitude_m {
         config.instrument.altitude_km = h / 1e3;
     }

@@ -120,6 +120,9 @@ fn a_valid_look_runs_the_chain_at_its_geometry() {
     assert!((config.scene.sun.zenith_deg - look.access.sun.zenith_rad.to_degrees()).abs() < 1e-12);
     assert!((config.instrument.across_track_tilt_deg - look.access.off_nadir_rad.to_degrees()).abs() < 1e-12);
     assert!(config.scene.date.starts_with("2023-0"));
+    // The surface the look's glint was judged on, with its glint in the chain.
+    assert!(config.scene.effects.contains(&shoal::scene::Effect::SunGlint));
+    assert_eq!(config.scene.atmosphere.surface, shoal::atmosphere::SeaSurface::Wind { speed_m_s: look.wind_m_s });
     let depth = run.errors.iter().find(|e| e.variable == "depth_m").expect("SAMBUCA's depth");
     assert!(depth.mae_pct.is_finite() && depth.returned_pct > 50.0, "{depth:?}");
 }
