@@ -23,7 +23,7 @@ use serde_json::Value;
 ///
 /// # Errors
 /// serde cannot represent `value` as JSON.
-pub fn tree(value: &impl Serialize) -> Result<Value, String> {
+fn tree(value: &impl Serialize) -> Result<Value, String> {
     serde_json::to_value(value).map_err(|e| format!("cannot represent the configuration: {e}"))
 }
 

@@ -44,14 +44,6 @@ impl CorrectionSpec {
             _ => None,
         }
     }
-
-    /// As [`Self::image`], to edit.
-    pub fn image_mut(&mut self) -> Option<&mut ImageCorrection> {
-        match &mut self.method {
-            Method::Image(i) => Some(i),
-            _ => None,
-        }
-    }
 }
 
 /// [`CorrectionSpec`] as a file writes it: `(approx_points: 20, use_approximation: false, image:
