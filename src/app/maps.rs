@@ -152,7 +152,10 @@ fn product_menu(app: &mut ShoalApp, ui: &mut egui::Ui) {
     let state = &mut app.state;
     // Wrapped: with eight designs the layout buttons and pair selectors outgrow a narrow panel.
     ui.horizontal_wrapped(|ui| {
-        egui::ComboBox::from_label("Product").selected_text(state.product.label()).show_ui(ui, |ui| {
+        // Tall enough for every entry: a retrieval's own products come last and would scroll out of
+        // sight in the default height.
+        let menu = egui::ComboBox::from_label("Product").selected_text(state.product.label()).height(480.0);
+        menu.show_ui(ui, |ui| {
             // The retrieval's own products (QAA's IOPs) after the core ones.
             let variables = state.retrieval_spec().algorithm().variables();
             for kind in ProductKind::ALL.into_iter().chain(ProductKind::extras(&variables)) {

@@ -52,7 +52,7 @@ impl PlotData {
 /// (truth, retrieved or `None`) per pixel, visiting every `step`-th pixel.
 fn values(out: &RunOutput, variable: &str, step: usize) -> Vec<(f64, Option<f64>)> {
     let truth = &out.truth;
-    let Some(t) = truth.map(variable) else { return Vec::new() };
+    let Some(t) = out.truth_map(variable) else { return Vec::new() };
     let product = out.retrievals.first().map(|r| &r.product);
     let got = product.and_then(|p| p.map(variable));
     let cols = t.ncols().max(1);

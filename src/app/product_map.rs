@@ -49,11 +49,7 @@ pub fn product_map(out: &RunOutput, kind: ProductKind, band: usize, truth: bool)
             // A retrieval's own product; its truth where the retrieval says what it is.
             let key = kind.variable()?;
             let ret = ret?;
-            let values = if truth {
-                ret.extra_truths.iter().find(|(k, _)| k == key).map(|(_, m)| m)?
-            } else {
-                ret.product.map(key)?
-            };
+            let values = if truth { out.truth_map(key)? } else { ret.product.map(key)? };
             let ok = if truth { water } else { returned(&ret.product) };
             let valid = Array2::from_shape_fn(values.dim(), |(i, j)| ok[[i, j]] && values[[i, j]] > 0.0);
             Some(MapData { values: values.clone(), valid })

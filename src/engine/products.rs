@@ -98,6 +98,19 @@ pub struct RunOutput {
     pub report: RunReport,
 }
 
+impl RunOutput {
+    /// The true map of `variable` (a key of [`crate::variable`]): the scene's chl, NAP, CDOM or
+    /// depth, or what the first retrieval says the truth of its own product is
+    /// ([`RetrievalOutput::extra_truths`]: QAA's IOPs); `None` where there is none.
+    #[must_use]
+    pub fn truth_map(&self, variable: &str) -> Option<&ndarray::Array2<f32>> {
+        self.truth.map(variable).or_else(|| {
+            let extras = &self.retrievals.first()?.extra_truths;
+            extras.iter().find(|(k, _)| k == variable).map(|(_, m)| m)
+        })
+    }
+}
+
 /// One retrieval's product and its metrics.
 #[derive(Debug, Clone)]
 pub struct RetrievalOutput {

@@ -120,6 +120,12 @@ fn a_study_with_qaa_offers_it_and_runs_it() {
     // in turbid water; scored in the metrics). The bound only checks that the two maps are the same
     // quantity: chl-a is ~50 times a_ph(443) here, a_dg(443) ~5 times and b_bp ~0.5 times.
     assert!((1.5..3.5).contains(&median), "median retrieved/true a_ph(443) {median}");
+    // Its histograms and scatter have the same pixels as its maps.
+    let plotted = shoal::app::plot_data::RunValues::of(out, "aph443_per_m");
+    let shown = truth.valid.iter().zip(&truth.values).filter(|(ok, v)| **ok && **v > 0.0).count();
+    assert_eq!(plotted.truth_log10.len(), shown, "the truth's histogram");
+    assert_eq!(plotted.retrieved_log10.len(), both, "the retrieval's histogram");
+    assert!(!plotted.scatter.is_empty(), "the scatter");
     h.state_mut().state.product = shoal::app::model::ProductKind::Nap;
     h.step();
     h.step();
