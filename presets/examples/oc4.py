@@ -12,6 +12,9 @@ x = log10(max(Rrs443, Rrs490, Rrs510) / Rrs555). The product's bands nearest 443
 555 nm are used (within 15 nm). OC4 is an open-ocean algorithm: over a turbid reservoir it is
 expected to fail, which is what scoring it shows.
 
+The same function, `chlorophyll(ds)`, runs in-process as a Python retrieval (the `shoal` Python
+package: python/examples/sweep_and_oc4.py).
+
 Reads `rrs` and its `wavelength` coordinate; writes `chl_mg_m3` (line, pixel) with a fill value
 where a ratio is not positive or a band is missing. Needs xarray with a NetCDF backend
 (Debian: python3-xarray python3-netcdf4).
@@ -32,8 +35,9 @@ def nearest(wavelengths, target, tolerance=15.0):
     return i
 
 
-def main(src, dst):
-    ds = xr.open_dataset(src)
+def chlorophyll(ds):
+    """OC4v6 chlorophyll-a (mg m-3) of a dataset with `rrs` (line, pixel, band) and its
+    `wavelength`; FILL where a ratio is not positive or not finite."""
     wl = ds.wavelength.values
     rrs = ds.rrs
     blue = np.stack([rrs.isel(band=nearest(wl, w)).values for w in (443.0, 490.0, 510.0)])
@@ -42,7 +46,12 @@ def main(src, dst):
         ratio = np.nanmax(blue, axis=0) / green
         x = np.log10(ratio)
         chl = 10.0 ** np.polyval(OC4V6[::-1], x)
-    chl = np.where(np.isfinite(chl) & (ratio > 0), chl, FILL).astype("float32")
+    return np.where(np.isfinite(chl) & (ratio > 0), chl, FILL).astype("float32")
+
+
+def main(src, dst):
+    ds = xr.open_dataset(src)
+    chl = chlorophyll(ds)
     out = xr.Dataset(
         {"chl_mg_m3": (("line", "pixel"), chl, {"units": "mg m-3", "long_name": "OC4v6 chlorophyll-a"})},
         attrs={"source": "presets/examples/oc4.py (OC4v6, O'Reilly et al. 1998)", "input": str(src)},

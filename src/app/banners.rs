@@ -143,7 +143,7 @@ pub(super) fn failure_box(app: &mut ShoalApp, ui: &mut egui::Ui, index: usize, m
 pub(super) fn external_banner(app: &mut ShoalApp, ui: &mut egui::Ui) {
     use crate::retrieval::external;
     let crate::retrieval::RetrievalSpec::External(spec) = app.state.retrieval_spec() else { return };
-    if !external::allowed(&spec.command) {
+    if !spec.may_run() {
         ui.horizontal_wrapped(|ui| {
             ui.colored_label(
                 super::theme::NOTICE,

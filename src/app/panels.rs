@@ -398,8 +398,8 @@ fn retrieval_settings(spec: &mut crate::retrieval::RetrievalSpec, ui: &mut egui:
     let Some((mode, names)) = spec.mode_mut() else {
         if let RetrievalSpec::External(e) = spec {
             ui.small(format!(
-                "Runs `{}` on the Rrs (NetCDF) and scores its {} (time limit {} s).",
-                e.command.join(" "),
+                "Runs {} on the Rrs (NetCDF) and scores its {} (time limit {} s).",
+                e.what_runs(),
                 e.products.join(", "),
                 e.time_limit_s
             ));

@@ -30,7 +30,7 @@ mod reproduce;
 mod score;
 mod season;
 pub mod simulate;
-mod study;
+pub mod study;
 mod sweep;
 mod water;
 
@@ -59,12 +59,12 @@ pub(crate) fn refuse_unallowed_external<'a>(
     for c in configs {
         for r in &c.retrievals {
             if let crate::retrieval::RetrievalSpec::External(e) = r
-                && !crate::retrieval::external::allowed(&e.command)
+                && !e.may_run()
             {
                 return Err(CliError::Input(format!(
-                    "the retrieval `{}` runs a program (`{}`); read the study, then pass --allow-external to run it",
+                    "the retrieval `{}` runs a program ({}); read the study, then pass --allow-external to run it",
                     e.name,
-                    e.command.join(" ")
+                    e.what_runs()
                 )));
             }
         }

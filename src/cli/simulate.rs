@@ -95,6 +95,17 @@ pub(super) const INSTRUMENTS: Lookup<InstrumentSpec> = Lookup {
     preset: |name| Ok(InstrumentSpec::preset(name)?),
 };
 
+/// A scene as `--scene` resolves `arg` (a file, the user's library, or a built-in), with the
+/// directory its own paths are read from.
+pub fn scene(arg: &str) -> Result<(SceneSpec, Option<std::path::PathBuf>), CliError> {
+    SCENES.resolve(arg)
+}
+
+/// An instrument as `--instrument` resolves `arg`.
+pub fn instrument(arg: &str) -> Result<(InstrumentSpec, Option<std::path::PathBuf>), CliError> {
+    INSTRUMENTS.resolve(arg)
+}
+
 /// The run configuration the arguments describe.
 pub fn config_from(args: &SimulateArgs) -> Result<RunConfig, CliError> {
     let mut config = match &args.config {

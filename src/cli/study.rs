@@ -56,7 +56,7 @@ impl From<StudyError> for CliError {
 }
 
 /// A study argument: a file, the user's library, or a built-in; none: the default study.
-pub(super) fn load(arg: Option<&str>) -> Result<(StudySpec, Option<PathBuf>), CliError> {
+pub fn load(arg: Option<&str>) -> Result<(StudySpec, Option<PathBuf>), CliError> {
     const STUDIES: Lookup<StudySpec> = Lookup {
         kind: crate::library::PresetKind::Study,
         flag: "study",

@@ -74,10 +74,12 @@ impl Engine {
             // A SIOP or substrate file the retrieval names, edited on disk, is a new retrieval.
             let files = super::files::fingerprint(spec, config.scene_dir.as_deref());
             // An external program the user has since allowed is a new retrieval (its refusal is
-            // not kept).
+            // not kept), and so is a function registered again (new code under the same name).
             let allowed = match spec {
-                RetrievalSpec::External(e) => crate::retrieval::external::allowed(&e.command),
-                _ => true,
+                RetrievalSpec::External(e) => {
+                    (e.may_run(), e.function.as_deref().and_then(crate::retrieval::function::registration))
+                }
+                _ => (true, None),
             };
             let key = KeyBuilder::new(Stage::Retrieval)
                 .after(correction_key)

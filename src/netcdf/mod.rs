@@ -199,6 +199,101 @@ pub fn write_file(
     }
 }
 
+/// One variable's values, as [`write_file`] writes them.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Column {
+    /// A float variable ([`FloatVar`]), [`FILL`] where a value has no meaning.
+    Float(Vec<f32>),
+    /// A flag variable ([`FlagVar`]).
+    Int(Vec<i32>),
+    /// A text variable ([`TextVar`]): NUL-padded characters.
+    Text(Vec<u8>),
+}
+
+/// An attribute's value, in the type the file stores it in.
+#[derive(Debug, Clone, PartialEq)]
+pub enum AttrValue {
+    /// Text (NC_CHAR).
+    Text(String),
+    /// 32-bit floats (`_FillValue`).
+    Float(Vec<f32>),
+    /// 32-bit integers (`flag_masks`, `flag_values`).
+    Int(Vec<i32>),
+}
+
+/// A variable held in memory: its dimensions (slowest first), attributes and values.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MemoryVar {
+    /// Variable name.
+    pub name: String,
+    /// Its dimensions' names, slowest first.
+    pub dims: Vec<String>,
+    /// Its attributes, in the file's order.
+    pub attrs: Vec<(String, AttrValue)>,
+    /// Its values, in the dimensions' order.
+    pub values: Column,
+}
+
+/// A data set and its values made: exactly what [`write_file`] would write, held in memory. The
+/// Python package builds its xarray datasets from it, so a dataset and the file hold the same
+/// dimensions, variables, attributes and values by construction.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InMemory {
+    /// Dimensions and their sizes, in the file's order.
+    pub dims: Vec<(String, usize)>,
+    /// Global attributes.
+    pub attrs: Vec<(String, AttrValue)>,
+    /// Variables, in the file's order.
+    pub variables: Vec<MemoryVar>,
+}
+
+/// The attributes' values in the types the file stores.
+fn attr_values(attrs: &[&netcdf3::Attribute]) -> Vec<(String, AttrValue)> {
+    attrs
+        .iter()
+        .filter_map(|a| {
+            let value = match a.data_type() {
+                netcdf3::DataType::U8 => AttrValue::Text(a.get_as_string()?),
+                netcdf3::DataType::F32 => AttrValue::Float(a.get_f32()?.to_vec()),
+                netcdf3::DataType::I32 => AttrValue::Int(a.get_i32()?.to_vec()),
+                // Shoal writes no other attribute type.
+                _ => return None,
+            };
+            Some((a.name().to_string(), value))
+        })
+        .collect()
+}
+
+/// The data set of `ds` with the values of `floats`, `flags` and `texts` made.
+#[must_use]
+pub fn in_memory(ds: &DataSet, (floats, flags, texts): (&[FloatVar<'_>], &[FlagVar<'_>], &[TextVar])) -> InMemory {
+    let mut columns: Vec<(String, Column)> = floats
+        .iter()
+        .map(|v| (v.name.clone(), Column::Float(v.values.make())))
+        .chain(flags.iter().map(|f| (f.name.clone(), Column::Int(f.values.make()))))
+        .chain(texts.iter().map(|(name, bytes)| ((*name).to_string(), Column::Text(bytes.clone()))))
+        .collect();
+    let variables = ds
+        .get_vars()
+        .into_iter()
+        .filter_map(|v| {
+            let at = columns.iter().position(|(n, _)| n == v.name())?;
+            let values = columns.swap_remove(at).1;
+            Some(MemoryVar {
+                name: v.name().to_string(),
+                dims: v.dim_names(),
+                attrs: attr_values(&v.get_attrs()),
+                values,
+            })
+        })
+        .collect();
+    InMemory {
+        dims: ds.get_dims().iter().map(|d| (d.name(), d.size())).collect(),
+        attrs: attr_values(&ds.get_global_attrs()),
+        variables,
+    }
+}
+
 /// Add `floats` and `flags` to `ds` with their attributes: `_FillValue` on every float variable
 /// of more than one dimension, `flag_values`/`flag_masks` and `flag_meanings` on the flags.
 pub fn define_vars(ds: &mut DataSet, floats: &[FloatVar<'_>], flags: &[FlagVar<'_>]) -> Result<(), String> {

@@ -54,8 +54,13 @@ pub struct ExternalSpec {
     /// letter (not a built-in retrieval's name: [`super::run::BUILT_IN_NAMES`]).
     pub name: String,
     /// The program and its arguments (see the module documentation for `{input}`, `{output}`,
-    /// `{dir}` and `{example:NAME}`).
+    /// `{dir}` and `{example:NAME}`). Empty when `function` is given.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub command: Vec<String>,
+    /// Instead of a program: a function this process registered ([`super::function`]), given
+    /// the program's input in memory.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub function: Option<String>,
     /// The variables the program writes: one or more of `chl_mg_m3`, `nap_g_m3`, `cdom_per_m`,
     /// `depth_m`.
     pub products: Vec<String>,
@@ -68,7 +73,7 @@ pub struct ExternalSpec {
 }
 
 const fn default_time_limit_s() -> f64 {
-    300.0
+    ExternalSpec::DEFAULT_TIME_LIMIT_S
 }
 
 /// Built-in example scripts an argument may name as `{example:NAME}`.
@@ -104,6 +109,9 @@ pub fn allowed(command: &[String]) -> bool {
 }
 
 impl ExternalSpec {
+    /// `time_limit_s` when a file leaves it out, s.
+    pub const DEFAULT_TIME_LIMIT_S: f64 = 300.0;
+
     /// Check the spec's fields (not whether the program exists: that shows when it runs).
     pub fn validate(&self) -> Result<(), RetrievalError> {
         let invalid = |field: &str, message: String| {
@@ -123,8 +131,21 @@ impl ExternalSpec {
                 ),
             ));
         }
-        if self.command.is_empty() || self.command[0].trim().is_empty() {
-            return Err(invalid("command", "is empty (allowed: a program and its arguments)".into()));
+        match (&self.function, self.command.is_empty()) {
+            (Some(_), false) => {
+                return Err(invalid("function", "and `command` are both given (allowed: one of them)".into()));
+            }
+            (Some(f), true) if f.trim().is_empty() => {
+                return Err(invalid("function", "is empty (allowed: the name a function was registered under)".into()));
+            }
+            (Some(_), true) => {}
+            (None, _) if self.command.is_empty() || self.command[0].trim().is_empty() => {
+                return Err(invalid(
+                    "command",
+                    "is empty (allowed: a program and its arguments, or `function` instead)".into(),
+                ));
+            }
+            (None, _) => {}
         }
         if self.command.len() > 64 || self.command.iter().any(|a| a.len() > 4096) {
             return Err(invalid("command", "is over 64 arguments or an argument over 4096 bytes".into()));
@@ -189,6 +210,25 @@ impl ExternalSpec {
         Ok(out)
     }
 
+    /// May this retrieval run now? A function registered by this process may; a program only once
+    /// the user has allowed it ([`allowed`]).
+    #[must_use]
+    pub fn may_run(&self) -> bool {
+        match &self.function {
+            Some(_) => true,
+            None => allowed(&self.command),
+        }
+    }
+
+    /// What it runs, for messages: the program's command line, or the function's name.
+    #[must_use]
+    pub fn what_runs(&self) -> String {
+        match &self.function {
+            Some(f) => format!("the function `{f}`"),
+            None => format!("`{}`", self.command.join(" ")),
+        }
+    }
+
     fn error(&self, message: impl Into<String>) -> RetrievalError {
         RetrievalError::External { name: self.name.clone(), message: message.into() }
     }
@@ -222,6 +262,9 @@ pub fn retrieve_external(
     control: &RunControl,
 ) -> Result<Product, RetrievalError> {
     spec.validate()?;
+    if let Some(name) = &spec.function {
+        return super::function::retrieve(spec, name, inputs, control);
+    }
     if !allowed(&spec.command) {
         return Err(spec.error(format!(
             "runs a program (`{}`); allow it first (`--allow-external` on the command line, or \"Allow\" in the app)",

@@ -11,7 +11,8 @@ use super::external::ExternalSpec;
 use super::run::{Product, ProductFlags, RetrievalInputs};
 use crate::correction::RrsFlags;
 use crate::netcdf::{
-    CUBE, FlagVar, FloatVar, MAP, Maps, Values, attrs, define_vars, masked, standard_name, write_file,
+    CUBE, FlagVar, FloatVar, InMemory, MAP, Maps, TextVar, Values, attrs, define_vars, in_memory, masked,
+    standard_name, write_file,
 };
 use crate::parse::FieldError;
 use crate::variable::key;
@@ -53,15 +54,34 @@ fn equivalent_width_nm(b: &super::BandResponse) -> f64 {
     if peak > 0.0 { b.weights.iter().sum::<f64>() * step / peak } else { 0.0 }
 }
 
-/// Write the program's input: the Rrs of `used` bands (fill where invalid, saturated or land),
-/// the land mask, the bands, their noise and the geometry. No truth. (No Rrs flags: the fill
-/// value carries the ones that matter, and 32-bit flags would double the file.)
+/// Write the program's input file (see [`with_input`]).
 pub(super) fn write_input(
     spec: &ExternalSpec,
     inputs: &RetrievalInputs<'_>,
     used: &[usize],
     path: &Path,
 ) -> Result<(), String> {
+    with_input(spec, inputs, used, |ds, parts| write_file(path, ds, parts, false))?
+}
+
+/// The input an in-process function is given: the program's input file, held in memory.
+pub(super) fn input_in_memory(
+    spec: &ExternalSpec,
+    inputs: &RetrievalInputs<'_>,
+    used: &[usize],
+) -> Result<InMemory, String> {
+    with_input(spec, inputs, used, |ds, parts| in_memory(ds, parts))
+}
+
+/// The program's input, handed to `use_it`: the Rrs of `used` bands (fill where invalid,
+/// saturated or land), the land mask, the bands, their noise and the geometry. No truth. (No Rrs
+/// flags: the fill value carries the ones that matter, and 32-bit flags would double the file.)
+fn with_input<R>(
+    spec: &ExternalSpec,
+    inputs: &RetrievalInputs<'_>,
+    used: &[usize],
+    use_it: impl FnOnce(&DataSet, (&[FloatVar<'_>], &[FlagVar<'_>], &[TextVar])) -> R,
+) -> Result<R, String> {
     let (rows, cols, nb) = inputs.rrs.dim();
     let bands: Vec<&super::BandResponse> = used.iter().map(|&b| &inputs.bands[b]).collect();
     let mut floats = vec![
@@ -155,7 +175,7 @@ pub(super) fn write_input(
     ] {
         ds.add_global_attr_string(k, v).map_err(bad_def)?;
     }
-    write_file(path, &ds, (&floats, &flags, &[names]), false)
+    Ok(use_it(&ds, (&floats, &flags, &[names])))
 }
 
 /// The program's output as a [`Product`]: each wanted map (0 where missing), returned where every

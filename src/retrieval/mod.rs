@@ -22,6 +22,7 @@ pub mod band_model;
 mod evaluate;
 pub mod external;
 mod external_io;
+pub mod function;
 pub mod nnls;
 pub mod optimise;
 pub mod qaa;

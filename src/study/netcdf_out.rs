@@ -23,7 +23,8 @@ use super::output::Outputs;
 use crate::correction::RrsFlags;
 use crate::engine::{Cubes, RunOutput};
 use crate::netcdf::{
-    CUBE, FlagVar, FloatVar, MAP, Values, attrs, define_vars, masked, meaning, standard_name, write_file,
+    CUBE, FlagVar, FloatVar, InMemory, MAP, TextVar, Values, attrs, define_vars, in_memory, masked, meaning,
+    standard_name, write_file,
 };
 use crate::retrieval::ProductFlags;
 
@@ -40,6 +41,24 @@ const CUBE_COORDINATES: &str = "y x wavelength bandwidth band_name";
 /// Write `out`'s products into `dir/products.nc` (atomically: a temporary file, synced, then
 /// renamed).
 pub fn write_netcdf(out: &RunOutput, dir: &Path, o: &mut Outputs) -> Result<(), StudyError> {
+    let path = dir.join(FILE);
+    with_products(out, |data_set, parts| write_file(&path, data_set, parts, true).map_err(StudyError::Io))??;
+    o.files.push(FILE.to_string());
+    Ok(())
+}
+
+/// `out`'s products as [`write_netcdf`] writes them, held in memory (the Python package's
+/// datasets: the same variables, attributes and values as the file).
+pub fn products_in_memory(out: &RunOutput) -> Result<InMemory, StudyError> {
+    with_products(out, |data_set, parts| in_memory(data_set, parts))
+}
+
+/// The file's variables and data set, handed to `use_them`: one description for the file and the
+/// data set in memory.
+fn with_products<R>(
+    out: &RunOutput,
+    use_them: impl FnOnce(&DataSet, (&[FloatVar<'_>], &[FlagVar<'_>], &[TextVar])) -> R,
+) -> Result<R, StudyError> {
     let cubes = super::output::kept_cubes(out)?;
     let (rows, cols, nb) = cubes.level1.radiance.dim();
     let mut floats: Vec<FloatVar> = Vec::new();
@@ -49,10 +68,7 @@ pub fn write_netcdf(out: &RunOutput, dir: &Path, o: &mut Outputs) -> Result<(), 
     truth_vars(out, cubes, &mut floats, &mut flags);
     retrieval_vars(out, &mut floats, &mut flags);
     let (data_set, names) = define(out, (rows, cols, nb), &floats, &flags)?;
-    let path = dir.join(FILE);
-    write_file(&path, &data_set, (&floats, &flags, &[names]), true).map_err(StudyError::Io)?;
-    o.files.push(FILE.to_string());
-    Ok(())
+    Ok(use_them(&data_set, (&floats, &flags, &[names])))
 }
 
 /// The bands, and every pixel's ground position.

@@ -23,6 +23,7 @@ pub(super) fn external(name: &str, command: &[&str], products: &[&str]) -> Retri
         command,
         products: products.iter().map(|s| (*s).to_string()).collect(),
         bands: None,
+        function: None,
         time_limit_s: 60.0,
     })
 }
@@ -227,6 +228,7 @@ fn nothing_runs_until_the_program_is_allowed() {
         command: vec!["sh".into(), "-c".into(), "echo never > /dev/null".into()],
         products: vec!["chl_mg_m3".into()],
         bands: None,
+        function: None,
         time_limit_s: 10.0,
     });
     let out = run_with(spec);
@@ -242,6 +244,7 @@ fn a_bad_external_spec_names_its_field() {
         command: vec!["python3".into(), "{example:oc4.py}".into()],
         products: vec!["chl_mg_m3".into()],
         bands: None,
+        function: None,
         time_limit_s: 60.0,
     };
     assert!(base.validate().is_ok());

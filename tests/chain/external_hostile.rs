@@ -64,6 +64,7 @@ fn a_built_in_retrieval_s_name_is_reserved_in_any_case() {
             command: vec!["true".into()],
             products: vec!["chl_mg_m3".into()],
             bands: None,
+            function: None,
             time_limit_s: 10.0,
         };
         let e = spec.validate().unwrap_err().to_string();
@@ -90,6 +91,7 @@ fn dir_is_the_study_s_folder_even_for_a_bare_file_name() {
         command: vec!["{dir}/prog.py".into()],
         products: vec!["chl_mg_m3".into()],
         bands: None,
+        function: None,
         time_limit_s: 10.0,
     };
     // `Path::new("s.ron").parent()` is the empty path: the current directory.

@@ -18,6 +18,7 @@ mod effects;
 mod external;
 mod external_hostile;
 mod focal_plane;
+mod function;
 mod glint;
 mod image_correction;
 mod incremental;

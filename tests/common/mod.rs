@@ -39,6 +39,7 @@ pub fn external_retrieval(command: &[&str]) -> RetrievalSpec {
         command,
         products: vec!["chl_mg_m3".into()],
         bands: None,
+        function: None,
         time_limit_s: 300.0,
     })
 }

@@ -17,6 +17,7 @@ fn the_app_asks_before_a_program_runs_and_shows_why_it_returned_nothing() {
         command: vec!["sh".into(), "-c".into(), "echo 'mine.py: no model for 865 nm' >&2; exit 2".into()],
         products: vec!["chl_mg_m3".into()],
         bands: None,
+        function: None,
         time_limit_s: 30.0,
     })]);
     assert!(state.runs("mine"), "the study's first retrieval runs");
