@@ -70,7 +70,7 @@ pub(super) fn input_in_memory(
     inputs: &RetrievalInputs<'_>,
     used: &[usize],
 ) -> Result<InMemory, String> {
-    with_input(spec, inputs, used, |ds, parts| in_memory(ds, parts))
+    with_input(spec, inputs, used, in_memory)
 }
 
 /// The program's input, handed to `use_it`: the Rrs of `used` bands (fill where invalid,

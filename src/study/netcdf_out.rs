@@ -50,7 +50,7 @@ pub fn write_netcdf(out: &RunOutput, dir: &Path, o: &mut Outputs) -> Result<(), 
 /// `out`'s products as [`write_netcdf`] writes them, held in memory (the Python package's
 /// datasets: the same variables, attributes and values as the file).
 pub fn products_in_memory(out: &RunOutput) -> Result<InMemory, StudyError> {
-    with_products(out, |data_set, parts| in_memory(data_set, parts))
+    with_products(out, in_memory)
 }
 
 /// The file's variables and data set, handed to `use_them`: one description for the file and the
