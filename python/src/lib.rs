@@ -43,16 +43,15 @@ fn presets(py: Python<'_>) -> PyResult<Bound<'_, pyo3::types::PyDict>> {
 #[pyfunction]
 fn preset(kind: &str, name: &str) -> PyResult<String> {
     let json = match kind {
-        "study" => shoal::cli::study::load(Some(name)).map_err(errors::from_cli).map(|(s, _)| serde_json::to_string(&s)),
+        "study" => {
+            shoal::cli::study::load(Some(name)).map_err(errors::from_cli).map(|(s, _)| serde_json::to_string(&s))
+        }
         "scene" => shoal::cli::simulate::scene(name).map_err(errors::from_cli).map(|(s, _)| serde_json::to_string(&s)),
         "instrument" => {
             shoal::cli::simulate::instrument(name).map_err(errors::from_cli).map(|(s, _)| serde_json::to_string(&s))
         }
         other => {
-            return Err(errors::input(
-                format!("kind `{other}` (allowed: study, scene, instrument)"),
-                Some("kind"),
-            ));
+            return Err(errors::input(format!("kind `{other}` (allowed: study, scene, instrument)"), Some("kind")));
         }
     }?;
     json.map_err(|e| errors::RunError::new_err(e.to_string()))
