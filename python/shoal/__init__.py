@@ -95,6 +95,14 @@ def _dataset(raw):
     return xr.decode_cf(_raw_dataset(raw))
 
 
+def _products(raw):
+    """A run's products. The bands stay coordinates without the cubes (``cubes=False``), whose
+    ``coordinates`` attributes made them so in the file."""
+    ds = _dataset(raw)
+    bands = [name for name in ("wavelength", "bandwidth", "band_name") if name in ds.data_vars]
+    return ds.set_coords(bands) if bands else ds
+
+
 # --- retrievals written in Python ---------------------------------------------------------------
 
 
@@ -222,6 +230,7 @@ def study(
     threads: int = 0,
     allow_external: bool = False,
     progress: Callable[[float], Any] | None = None,
+    cubes: bool = True,
 ) -> Study:
     """Run a study: a built-in name, a preset of your library, or a RON file (``None``: the
     default study, as ``shoal study``).
@@ -232,6 +241,9 @@ def study(
     - ``retrievals``: `Retrieval` functions added to the study's retrievals.
     - ``allow_external``: run the external programs the study names (nothing runs otherwise).
     - ``progress(fraction)``: called about ten times a second while the study runs.
+    - ``cubes=False``: leave out the four (line, pixel, band) variables (Level-1, Rrs, its flags,
+      the true Rrs); the engine then streams them instead of keeping them, which for a
+      full-resolution study is several times faster and smaller (for sweeps).
     """
     import pandas as pd
 
@@ -246,6 +258,7 @@ def study(
             functions=extra,
             allow_external=bool(allow_external),
             progress=progress,
+            cubes=bool(cubes),
         )
     finally:
         _unregister(extra)
@@ -253,7 +266,7 @@ def study(
     datasets, configs, failures = {}, {}, {}
     for label, seed, raw, failed, config in out["runs"]:
         key = f"{label}_seed{seed}" if several_seeds else label
-        datasets[key] = _dataset(raw)
+        datasets[key] = _products(raw)
         configs[key] = config
         failures[key] = failed
         _warn_failures(key, failed)
@@ -278,11 +291,12 @@ def simulate(
     threads: int = 0,
     allow_external: bool = False,
     progress: Callable[[float], Any] | None = None,
+    cubes: bool = True,
 ):
     """Fly ``instrument`` over ``scene`` (preset names or RON files; ``config``: a whole run
     configuration) as ``shoal simulate`` does, and return the products as an xarray Dataset:
-    the file ``shoal simulate --format netcdf`` writes. ``settings`` and ``retrievals`` as in
-    `study` (a simulation runs no retrieval unless given one)."""
+    the file ``shoal simulate --format netcdf`` writes. ``settings``, ``retrievals`` and
+    ``cubes`` as in `study` (a simulation runs no retrieval unless given one)."""
     argv = ["--scene", str(scene), "--instrument", str(instrument)]
     if config is not None:
         argv += ["--config", str(config)]
@@ -309,9 +323,9 @@ def simulate(
             threads=int(threads),
             allow_external=bool(allow_external),
             progress=progress,
+            cubes=bool(cubes),
         )
     finally:
         _unregister(extra)
     _warn_failures(f"{instrument} over {scene}", out["failures"])
-    ds = _dataset(out["dataset"])
-    return ds
+    return _products(out["dataset"])

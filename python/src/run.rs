@@ -109,9 +109,12 @@ fn pool(threads: usize) -> PyResult<rayon::ThreadPool> {
     shoal::jobs::pool(threads, "shoal-python").map_err(|e| errors::RunError::new_err(e.to_string()))
 }
 
-/// One run's products, and its retrievals' failures.
-fn run_data(out: &RunOutput) -> Result<(shoal::netcdf::InMemory, Vec<(String, String)>), shoal::study::StudyError> {
-    let set = shoal::study::netcdf_out::products_in_memory(out)?;
+/// One run's products (with its cubes or not), and its retrievals' failures.
+fn run_data(
+    out: &RunOutput,
+    cubes: bool,
+) -> Result<(shoal::netcdf::InMemory, Vec<(String, String)>), shoal::study::StudyError> {
+    let set = shoal::study::netcdf_out::products_in_memory(out, cubes)?;
     let failures =
         out.retrievals.iter().filter_map(|r| r.failure.clone().map(|f| (r.spec.name().to_string(), f))).collect();
     Ok((set, failures))
@@ -136,7 +139,7 @@ fn function_retrieval((name, function, products, bands): FunctionRetrieval) -> R
 /// Run a study (a built-in name, a preset of the user's library or a RON file; `None`: the
 /// default study) and return its runs' products and metrics table.
 #[pyfunction]
-#[pyo3(signature = (study=None, *, decimation=None, seeds=None, threads=0, settings=None, functions=None, allow_external=false, progress=None))]
+#[pyo3(signature = (study=None, *, decimation=None, seeds=None, threads=0, settings=None, functions=None, allow_external=false, progress=None, cubes=true))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn study<'py>(
     py: Python<'py>,
@@ -148,6 +151,7 @@ pub(crate) fn study<'py>(
     functions: Option<Vec<FunctionRetrieval>>,
     allow_external: bool,
     progress: Option<Bound<'py, PyAny>>,
+    cubes: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (mut spec, dir) = shoal::cli::study::load(study.as_deref()).map_err(errors::from_cli)?;
     if let Some(s) = seeds {
@@ -178,8 +182,8 @@ pub(crate) fn study<'py>(
     let work = || {
         pool.install(|| {
             let mut sets = Vec::new();
-            let result = shoal::study::run_study(&resolved, &control, true, |i, out| {
-                sets.push((i, run_data(out)?));
+            let result = shoal::study::run_study(&resolved, &control, cubes, |i, out| {
+                sets.push((i, run_data(out, cubes)?));
                 let (d, t) = control.progress();
                 done_at.store(d, Ordering::Relaxed);
                 total_at.store(t, Ordering::Relaxed);
@@ -213,7 +217,7 @@ struct Simulate {
 
 /// Fly one instrument over one scene (`shoal simulate`'s options) and return its products.
 #[pyfunction]
-#[pyo3(signature = (argv, *, settings=None, functions=None, threads=0, allow_external=false, progress=None))]
+#[pyo3(signature = (argv, *, settings=None, functions=None, threads=0, allow_external=false, progress=None, cubes=true))]
 pub(crate) fn simulate<'py>(
     py: Python<'py>,
     argv: Vec<String>,
@@ -222,6 +226,7 @@ pub(crate) fn simulate<'py>(
     threads: usize,
     allow_external: bool,
     progress: Option<Bound<'py, PyAny>>,
+    cubes: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     // `--out` is the command line's; nothing is written here.
     let argv = ["simulate".to_string()].into_iter().chain(argv).chain(["--out".into(), "-".into()]);
@@ -238,9 +243,10 @@ pub(crate) fn simulate<'py>(
         let (done, total) = control.progress();
         if total > 0 { (done as f64 / total as f64).min(1.0) } else { 0.0 }
     };
-    let work = || pool.install(|| Engine::new().run(&config, &control));
+    // Without cubes, the engine that streams them instead of keeping them (less time and memory).
+    let work = || pool.install(|| if cubes { Engine::new() } else { Engine::lean() }.run(&config, &control));
     let out = released(py, progress.as_ref(), &control, fraction, work)?.map_err(errors::from_engine)?;
-    let (set, failures) = run_data(&out).map_err(errors::from_study)?;
+    let (set, failures) = run_data(&out, cubes).map_err(errors::from_study)?;
     let dict = PyDict::new(py);
     dict.set_item("dataset", crate::data::to_python(py, &set)?)?;
     dict.set_item("failures", failures)?;

@@ -55,6 +55,13 @@ def test_study_is_the_netcdf_files_and_the_metrics_table(tmp_path):
     assert np.array_equal(np.isnan(study.datasets["cubesat"].alm_chl_mg_m3.values), filled)
     chl = study.metrics[(study.metrics["variable"] == "chl_mg_m3")]
     assert len(chl) == 2 and (chl["mae_pct"] > 0).all()
+    # Without cubes: the lean engine, the same file less its four cubes, the same metrics.
+    lean = shoal.study("cubesat_vs_smallsat", decimation=DECIMATION, cubes=False)
+    cubes = ["level1_radiance", "rrs", "rrs_flags", "true_rrs"]
+    for label, ds in lean.datasets.items():
+        with xr.open_dataset(out / label / "products.nc") as file:
+            assert_same_bits(ds, file.load().drop_vars(cubes))
+    pd.testing.assert_frame_equal(lean.metrics, study.metrics)
     assert "StudySpec" not in study.configs["cubesat"] and study.configs["cubesat"].startswith("RunConfig(")
 
 

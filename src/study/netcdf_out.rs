@@ -42,29 +42,34 @@ const CUBE_COORDINATES: &str = "y x wavelength bandwidth band_name";
 /// renamed).
 pub fn write_netcdf(out: &RunOutput, dir: &Path, o: &mut Outputs) -> Result<(), StudyError> {
     let path = dir.join(FILE);
-    with_products(out, |data_set, parts| write_file(&path, data_set, parts, true).map_err(StudyError::Io))??;
+    with_products(out, true, |data_set, parts| write_file(&path, data_set, parts, true).map_err(StudyError::Io))??;
     o.files.push(FILE.to_string());
     Ok(())
 }
 
 /// `out`'s products as [`write_netcdf`] writes them, held in memory (the Python package's
-/// datasets: the same variables, attributes and values as the file).
-pub fn products_in_memory(out: &RunOutput) -> Result<InMemory, StudyError> {
-    with_products(out, in_memory)
+/// datasets: the same variables, attributes and values as the file). Without `cubes`, the file
+/// less its four (line, pixel, band) variables (Level-1, Rrs, its flags, the true Rrs): what a
+/// run of an engine that keeps no cubes ([`crate::engine::Engine::lean`]) can give.
+pub fn products_in_memory(out: &RunOutput, cubes: bool) -> Result<InMemory, StudyError> {
+    with_products(out, cubes, in_memory)
 }
 
 /// The file's variables and data set, handed to `use_them`: one description for the file and the
 /// data set in memory.
 fn with_products<R>(
     out: &RunOutput,
+    with_cubes: bool,
     use_them: impl FnOnce(&DataSet, (&[FloatVar<'_>], &[FlagVar<'_>], &[TextVar])) -> R,
 ) -> Result<R, StudyError> {
-    let cubes = super::output::kept_cubes(out)?;
-    let (rows, cols, nb) = cubes.level1.radiance.dim();
+    let cubes = if with_cubes { Some(super::output::kept_cubes(out)?) } else { None };
+    let (rows, cols, nb) = cubes.map_or(out.report.shape, |c| c.level1.radiance.dim());
     let mut floats: Vec<FloatVar> = Vec::new();
     let mut flags: Vec<FlagVar> = Vec::new();
     coordinate_vars(out, &mut floats);
-    radiometry_vars(cubes, &mut floats, &mut flags);
+    if let Some(c) = cubes {
+        radiometry_vars(c, &mut floats, &mut flags);
+    }
     truth_vars(out, cubes, &mut floats, &mut flags);
     retrieval_vars(out, &mut floats, &mut flags);
     let (data_set, names) = define(out, (rows, cols, nb), &floats, &flags)?;
@@ -158,23 +163,29 @@ fn radiometry_vars<'a>(cubes: &'a Cubes, floats: &mut Vec<FloatVar<'a>>, flags: 
 }
 
 /// The truth, and the aerosol an image-based correction found.
-fn truth_vars<'a>(out: &'a RunOutput, cubes: &'a Cubes, floats: &mut Vec<FloatVar<'a>>, flags: &mut Vec<FlagVar<'a>>) {
+fn truth_vars<'a>(
+    out: &'a RunOutput,
+    cubes: Option<&'a Cubes>,
+    floats: &mut Vec<FloatVar<'a>>,
+    flags: &mut Vec<FlagVar<'a>>,
+) {
     let truth = &out.truth;
-    let true_rrs = &*cubes.radiance.truth_rrs;
-    let nb = cubes.level1.radiance.dim().2;
     let water = |i: usize| truth.surface.is_water_at(i);
     let coordinates = ("coordinates", MAP_COORDINATES.to_string());
-    let cube_coordinates = ("coordinates", CUBE_COORDINATES.to_string());
-    let mut a =
-        attrs("true remote-sensing reflectance above the surface (band-weighted)", "sr-1", standard_name("rrs"));
-    a.push(cube_coordinates.clone());
-    let nbw = nb.max(1);
-    floats.push(FloatVar {
-        name: "true_rrs".into(),
-        dims: CUBE.to_vec(),
-        attrs: a,
-        values: Values::lazy(move || masked(true_rrs.iter().copied(), |i| water(i / nbw))),
-    });
+    if let Some(cubes) = cubes {
+        let true_rrs = &*cubes.radiance.truth_rrs;
+        let nb = cubes.level1.radiance.dim().2;
+        let mut a =
+            attrs("true remote-sensing reflectance above the surface (band-weighted)", "sr-1", standard_name("rrs"));
+        a.push(("coordinates", CUBE_COORDINATES.to_string()));
+        let nbw = nb.max(1);
+        floats.push(FloatVar {
+            name: "true_rrs".into(),
+            dims: CUBE.to_vec(),
+            attrs: a,
+            values: Values::lazy(move || masked(true_rrs.iter().copied(), |i| water(i / nbw))),
+        });
+    }
     let mut truth_maps: Vec<(&str, &ndarray::Array2<f32>)> =
         vec![("chl_mg_m3", &truth.chl_mg_m3), ("nap_g_m3", &truth.nap_g_m3), ("cdom_per_m", &truth.cdom_per_m)];
     if let Some(d) = &truth.depth_m {
