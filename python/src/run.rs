@@ -218,6 +218,7 @@ struct Simulate {
 /// Fly one instrument over one scene (`shoal simulate`'s options) and return its products.
 #[pyfunction]
 #[pyo3(signature = (argv, *, settings=None, functions=None, threads=0, allow_external=false, progress=None, cubes=true))]
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn simulate<'py>(
     py: Python<'py>,
     argv: Vec<String>,
