@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import io
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
@@ -122,7 +122,6 @@ class Retrieval:
     function: Callable[[Any], Any]
     products: Sequence[str]
     bands: Sequence[str] | None = None
-    _key: str = field(default="", init=False, repr=False)
 
 
 def _values(item):
@@ -146,8 +145,7 @@ def _bridge(function):
         if hasattr(result, "data_vars"):
             result = {name: result[name] for name in result.data_vars}
         elif not isinstance(result, Mapping):
-            products = raw["attrs"]
-            wanted = dict(products).get("products_wanted", "").split()
+            wanted = dict(raw["attrs"]).get("products_wanted", "").split()
             if len(wanted) != 1:
                 raise TypeError("return a dict of products (this retrieval makes several)")
             result = {wanted[0]: result}

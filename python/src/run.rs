@@ -3,7 +3,6 @@
 //! takes the GIL to call the progress callback and to check for signals, so Ctrl-C (a
 //! `KeyboardInterrupt`) cancels the run at its next row, and other Python threads run meanwhile.
 
-use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc;
 use std::time::Duration;
@@ -239,7 +238,7 @@ pub(crate) fn simulate<'py>(
     config.retrievals.extend(functions.unwrap_or_default().into_iter().map(function_retrieval));
     consent(&config, allow_external)?;
     let pool = pool(threads)?;
-    let control = Arc::new(RunControl::new());
+    let control = RunControl::new();
     let fraction = || {
         let (done, total) = control.progress();
         if total > 0 { (done as f64 / total as f64).min(1.0) } else { 0.0 }

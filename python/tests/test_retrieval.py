@@ -34,7 +34,12 @@ def test_a_function_scores_as_the_same_program(tmp_path):
     start = text.index('command: ["python3"')
     end = text.index("\n", start)
     (tmp_path / "oc4_function.ron").write_text(text[:start] + 'function: Some("oc4_here"),' + text[end:])
-    shoal.register_retrieval("oc4_here", lambda ds: np.where(*(lambda c: (c == oc4.FILL, np.nan, c))(oc4.chlorophyll(ds))))
+
+    def chlorophyll(ds):
+        chl = oc4.chlorophyll(ds)
+        return np.where(chl == oc4.FILL, np.nan, chl)
+
+    shoal.register_retrieval("oc4_here", chlorophyll)
     try:
         here = shoal.study(str(tmp_path / "oc4_function.ron"), decimation=DECIMATION)
     finally:
@@ -62,10 +67,26 @@ def test_a_function_gets_what_a_program_reads():
     assert not any(name.startswith("true") for name in given.variables)
     water = ds.surface_class.values == 0
     assert np.array_equal(np.isnan(given.rrs.values).all(axis=2), ~water | np.isnan(ds.rrs.values).all(axis=2))
-    # Returned on water, 1.0 exactly; changing the function's arrays now changes nothing of Shoal's.
     assert np.all(ds.keep_chl_mg_m3.values[water] == 1.0)
-    given.rrs.values[...] = 0.0
-    assert np.nanmax(ds.rrs.values) > 0.0
+
+
+def test_an_array_a_function_returned_is_copied_not_lent():
+    kept = []
+
+    def reuses(ds):
+        # The second run's call overwrites the array the first run's call returned: were it lent
+        # to Shoal instead of copied, the first run's product would change with it.
+        for earlier in kept:
+            earlier[...] = 5.0
+        kept.append(np.full(ds.rrs.shape[:2], 1.0))
+        return kept[-1]
+
+    study = shoal.study("cubesat_vs_smallsat", decimation=16, retrievals=[shoal.Retrieval("reuses", reuses, ["chl_mg_m3"])])
+    assert len(kept) == 2 and np.all(kept[0] == 5.0)
+    for label in ("cubesat", "smallsat"):
+        product = study.datasets[label].reuses_chl_mg_m3.values
+        returned = np.isfinite(product)
+        assert returned.any() and np.all(product[returned] == 1.0), label
 
 
 def test_a_failing_function_is_reported_and_the_run_kept():
