@@ -141,10 +141,12 @@ pub(super) fn backscattering<T: Lane, L: Level>(k: &Spectra<'_, T>, i: usize) ->
     mad::<L, T>(k.nap, k.bb_nap[i], mad::<L, T>(k.chl, k.bb_ph[i], k.bb_w[i]))
 }
 
-/// Rrs(0⁺) from rrs(0⁻) (Lee et al. 2002), as [`super::rrs_above_from_below`].
+/// Rrs(0⁺) = 0.52·rrs/(1 − 1.7·rrs) (Lee et al. 2002, as [`super::rrs_above_from_below`]) from
+/// rrs(0⁻) given as a ratio `p`/κ²: 0.52·p/(κ² − 1.7·p), one division for the whole pixel's
+/// chain (u = bb/κ is never divided out; see [`deep`]).
 #[inline(always)]
-fn above<T: Lane, L: Level>(rrs: T) -> T {
-    T::c(0.52) * rrs / mad::<L, T>(T::c(-1.7), rrs, T::c(1.0))
+fn above<T: Lane, L: Level>(p: T, kappa2: T) -> T {
+    T::c(0.52) * p / mad::<L, T>(T::c(-1.7), p, kappa2)
 }
 
 /// Both positive (false for NaN).
@@ -154,6 +156,10 @@ fn positive<T: Lane>(a: T, bb: T) -> bool {
 }
 
 /// Optically deep Rrs into `out` (one per wavelength); whether every a and bb was positive.
+///
+/// rrs_dp = (0.084 + 0.17u)·u with u = bb/κ (Lee et al. 1999 eq. 4) is carried as
+/// κ²·rrs_dp = (0.084κ + 0.17bb)·bb, so that a wavelength costs one division (in [`above`])
+/// instead of two: perf put this loop's time on its divisions' latency.
 #[inline(always)]
 fn deep<T: Lane, L: Level>(k: &Spectra<'_, T>, out: &mut [T]) -> bool {
     let n = out.len();
@@ -163,14 +169,21 @@ fn deep<T: Lane, L: Level>(k: &Spectra<'_, T>, out: &mut [T]) -> bool {
     for i in 0..n {
         let (a, bb) = (absorption::<T, L>(&k, i), backscattering::<T, L>(&k, i));
         ok &= positive(a, bb);
-        let u = bb / (a + bb);
-        out[i] = above::<T, L>(mad(T::c(0.17), u, T::c(0.084)) * u);
+        let kappa = a + bb;
+        let p = mad(T::c(0.084), kappa, T::c(0.17) * bb) * bb;
+        out[i] = above::<T, L>(p, kappa * kappa);
     }
     ok
 }
 
 /// Shallow-water Rrs into `out` (Lee et al. 1999 eq. 5 with the SAMBUCA attenuation factors);
 /// whether every a and bb was positive and every ρ_b in [0, 1].
+///
+/// With u = bb/κ, the attenuation exponents (D_C/μo + 1/μw)·κH, D_C = 1.03·√(1 + 2.4u), are
+/// carried as (1.03·√(κ(κ + 2.4bb))/μo + κ/μw)·H (and D_B's alike), and rrs as p/κ² with
+/// p = κ²·rrs_dp·(1 − e_C) + κ²·ρ_b/π·e_B: the same quantities with no division until [`above`]
+/// (one per wavelength instead of two; the same formulas as [`super::WaterModel::evaluate`],
+/// rounded otherwise: the test below bounds the difference).
 #[inline(always)]
 fn shallow<T: Lane, L: Level>(
     k: &Spectra<'_, T>,
@@ -184,21 +197,26 @@ fn shallow<T: Lane, L: Level>(
     let k = k.first(n);
     let rb = &rb[..n];
     let inv_pi = T::c(1.0 / std::f64::consts::PI);
+    // The constants of D_C and D_B folded into the view path and the depth: −1.03·H/μo, −H/μw.
+    let (c_view, b_view, sun) =
+        (T::c(-1.03) * inv_cos_o * depth_m, T::c(-1.04) * inv_cos_o * depth_m, -(inv_cos_w * depth_m));
     let mad = mad::<L, T>;
     let mut ok = true;
     for i in 0..n {
         let (a, bb) = (absorption::<T, L>(&k, i), backscattering::<T, L>(&k, i));
         ok &= positive(a, bb) & (rb[i] >= T::c(0.0)) & (rb[i] <= T::c(1.0));
         let kappa = a + bb;
-        let u = bb / kappa;
-        let kh = kappa * depth_m;
-        let du_c = T::c(1.03) * mad(T::c(2.4), u, T::c(1.0)).sqrt();
-        let du_b = T::c(1.04) * mad(T::c(5.4), u, T::c(1.0)).sqrt();
-        let rrs_dp = mad(T::c(0.17), u, T::c(0.084)) * u;
-        // rrs_dp·(1 − e_c) + ρ_b/π·e_b
-        let e_c = (-mad(du_c, inv_cos_o, inv_cos_w) * kh).exp::<L>();
-        let e_b = (-mad(du_b, inv_cos_o, inv_cos_w) * kh).exp::<L>();
-        out[i] = above::<T, L>(mad(rb[i] * inv_pi, e_b, mad(-rrs_dp, e_c, rrs_dp)));
+        let kappa2 = kappa * kappa;
+        // κ·√(1 + 2.4u) = √(κ² + 2.4·κ·bb), and 5.4 alike.
+        let kbb = kappa * bb;
+        let root_c = mad(T::c(2.4), kbb, kappa2).sqrt();
+        let root_b = mad(T::c(5.4), kbb, kappa2).sqrt();
+        let p_dp = mad(T::c(0.084), kappa, T::c(0.17) * bb) * bb;
+        let e_c = mad(c_view, root_c, sun * kappa).exp::<L>();
+        let e_b = mad(b_view, root_b, sun * kappa).exp::<L>();
+        // κ²·(rrs_dp·(1 − e_c) + ρ_b/π·e_b)
+        let p = mad(rb[i] * inv_pi * kappa2, e_b, mad(-p_dp, e_c, p_dp));
+        out[i] = above::<T, L>(p, kappa2);
     }
     ok
 }
