@@ -30,29 +30,12 @@ Reference workloads: the same calls, pixels and configuration every round (count
 - slsqp4: the same for set-up ALOS4_MB_notebook (ALOS bands 1-4, one pair: Moreton Bay white
   sand / brown mud, the notebook's NEDR and bounds): its 40 stored pixels, twice (80 fits).
 
-What Shoal's rows time instead (src/cli/bench.rs, bench_retrieval.rs):
-- forward: the same grid, SIOPs, waters and bottom, but `rrs_above_into` writes only the
-  above-surface Rrs (Lee 2002 conversion included) into a reused buffer, SIOPs resolved once;
-  forward_model recomputes bb_w, a*_CDOM, a*_NAP and the bb* power laws each call, allocates ~22
-  arrays and returns sub-surface rrs. Shoal reports the median of 7 runs of 0.4 s (3 x 0.1 s with
-  --quick). Its deep row is a dedicated optically deep path.
-- aLMI: 8 MODIS-like Gaussian bands (411.5-746.5 nm, FWHM 10 nm; SIOPs band-averaged, 3 Gauss
-  nodes) instead of 8 monochromatic OLCI centres; 100 000 synthetic pixels (20 000 with --quick)
-  all from set almi_5 (chl 10^U(0,2), cdom 1, nap 10, uniform +-1 % noise); f64, sets packed in
-  lanes. DEA: numpy lstsq per pixel and set, float32 outputs, unweighted. The reviewer's figure
-  is paired with Shoal's noise-weighted row (NEDR 1e-4); the unweighted row is printed too.
-- SLSQP: 28 Gaussian bands (FWHM 10 nm, centres 430-835 nm every 15 nm) or 4 ALOS-like ones
-  (460/70, 560/70, 650/60, 825/120 nm), not CASI04/ALOS filters cut at 800 nm; the
-  `heron_island` SIOPs (WASI6 a_w, seawater bb_w, HI open-water a*_ph, CDOM at 440 nm, n_w 1.34)
-  instead of SAMBUCA's; the same HI_3 substrates, or HI_3 sand / NCC Cymodocea for the 4 bands
-  (not Moreton Bay); 1000 synthetic pixels (200 with --quick; depth 0.5-8 m, 1 % Gaussian noise,
-  NEDR = 1 % of Rrs, 1/mu 1/0.95 and 1/0.999) instead of the stored pixels (depth to 15 or 7 m, 5e-4
-  additive noise on a third). The default row is Shoal's own fit (bounded Levenberg-Marquardt,
-  analytic Jacobian, log space, a 2 m start plus an adaptive deep start, 100 iterations, 3 Gauss
-  nodes per band: 84 or 12 wavelengths). The "reference mode" row is SLSQP from (max - min)/2
-  with forward differences, bounds of CASI28_HI3_wide for both rows (ALOS4 uses the notebook's),
-  on 250 pixels (50 with --quick), summing every 0.5 nm band sample: 863 wavelengths (417-848 nm)
-  or 1215 (371-978 nm) against SAMBUCA's 451.
+What Shoal's rows time instead, and how the workloads differ: tests/bench/README.md ("The
+workloads") and the footnote `shoal bench` prints under each table.
+
+With --shoal-before OLD, an earlier build runs right after --shoal in every round: each table then
+also pairs OLD's rows with the same round's reference and gives new / old per round (a kernel
+change measured against the reference codes and against its own past in the same rounds).
 """
 from __future__ import annotations
 
@@ -97,7 +80,7 @@ REF_MODE = ", reference mode (SLSQP from (max − min)/2)"
 #  constant in src/cli/bench_reference.rs that `shoal bench` divides that row by).
 PAIRS = [
     ("forward_shallow", "shallow, Rrs only (per-pixel path)", "SAMBUCA_FORWARD"),
-    ("forward_deep", "optically deep, Rrs only", "none (bench.rs divides by SAMBUCA_FORWARD)"),
+    ("forward_deep", "optically deep, Rrs only", "SAMBUCA_FORWARD_DEEP"),
     ("almi", "aLMI, 8 SIOP sets, noise-weighted", "DEA_ALMI"),
     ("almi", "aLMI, 8 SIOP sets, unweighted (as DEA)", "DEA_ALMI"),
     ("slsqp28", "SAMBUCA-style, 3 substrate pairs", "SAMBUCA_FIT_28"),
@@ -351,10 +334,11 @@ def machine_lines(shoal: str, paths: dict[str, str | None], load: str) -> list[s
     return out
 
 
-def run_rounds(args, shoal: str, paths: dict, active: list[str], pin: str):
-    """Every round: each section's reference workloads (one process each), then its Shoal run."""
+def run_rounds(args, shoals: list[str], paths: dict, active: list[str], pin: str):
+    """Every round: each section's reference workloads (one process each), then each Shoal binary's
+    run of that section (the one measured first, then --shoal-before's)."""
     rates = {k: [] for k in active}
-    shoal_rates = {label: [] for key, label, _ in PAIRS if key in active}
+    shoal_rates = [{label: [] for key, label, _ in PAIRS if key in active} for _ in shoals]
     checks, stubbed, loads = {}, set(), []
     given = [a for name, p in paths.items() if p for a in (f"--{name.replace('_', '-')}", str(Path(p).resolve()))]
     for rnd in range(1, args.rounds + 1):
@@ -368,19 +352,20 @@ def run_rounds(args, shoal: str, paths: dict, active: list[str], pin: str):
                 rates[key].append(res["rate"])
                 checks.setdefault(key, res["check"])
                 stubbed.update(res["stubbed"])
-            if keys:
-                print(f"[round {rnd}/{args.rounds}] shoal bench --only {section} ...", file=sys.stderr, flush=True)
+            for shoal, into in zip(shoals, shoal_rates) if keys else []:
+                print(f"[round {rnd}/{args.rounds}] {shoal} bench --only {section} ...", file=sys.stderr, flush=True)
                 cmd = [shoal, "bench", "--only", section] + (["--quick"] if args.shoal_quick else [])
                 rows = parse_shoal(run(cmd, args.core, pin))
                 for key, label, _ in PAIRS:
                     if key in keys:
-                        shoal_rates[label].append(rows.get(label))
+                        into[label].append(rows.get(label))
     loads.append(load1())
     return rates, shoal_rates, checks, stubbed, loads
 
 
-def report(rates: dict, shoal_rates: dict, loads: list[float]) -> None:
-    """A table per (reference workload, Shoal row), then a summary and the warnings."""
+def report(rates: dict, shoal_rates: dict, loads: list[float], before: dict | None = None) -> None:
+    """A table per (reference workload, Shoal row), then a summary and the warnings; with `before`
+    (--shoal-before's rows), its ratio and new / old per round beside each."""
     warnings, summary = [], []
     if max(loads) > LOAD_LIMIT:
         warnings.append(f"1-minute load average reached {max(loads):.2f} (> {LOAD_LIMIT}): not an idle machine")
@@ -389,12 +374,21 @@ def report(rates: dict, shoal_rates: dict, loads: list[float]) -> None:
             continue
         _, _, what, unit, _, reviewer = WORKLOADS[key]
         print(f"\n## {what} — Shoal row `{label}`\n")
-        print(f"| round | reference, {unit} | Shoal, {unit.replace('deep ', '')} | ratio |\n|---|---|---|---|")
-        ratios = []
+        old = before.get(label, []) if before else None
+        extra = " Shoal before | its ratio | new / old |" if old is not None else ""
+        print(f"| round | reference, {unit} | Shoal, {unit.replace('deep ', '')} | ratio |{extra}\n"
+              f"|---|---|---|---|{'---|---|---|' if extra else ''}")
+        ratios, gains = [], []
         for i, (ref, sh) in enumerate(zip(rates[key], shoal_rates[label]), 1):
             ratios += [sh / ref] if sh is not None else []
-            print(f"| {i} | {fmt(ref)} | {fmt(sh) if sh is not None else 'row missing'} | "
-                  f"{fmt_ratio(sh / ref) if sh is not None else '–'} |")
+            row = (f"| {i} | {fmt(ref)} | {fmt(sh) if sh is not None else 'row missing'} | "
+                   f"{fmt_ratio(sh / ref) if sh is not None else '–'} |")
+            if old is not None:
+                o = old[i - 1] if i <= len(old) else None
+                gains += [sh / o] if sh is not None and o else []
+                row += (f" {fmt(o) if o else 'row missing'} | {fmt_ratio(o / ref) if o else '–'} | "
+                        f"{f'{sh / o:.3f}' if sh is not None and o else '–'} |")
+            print(row)
         if not ratios:
             warnings.append(f"`{label}`: no such row in Shoal's output (labels changed?)")
             continue
@@ -403,6 +397,8 @@ def report(rates: dict, shoal_rates: dict, loads: list[float]) -> None:
         print(f"\nMedian ratio **{fmt_ratio(med)}** (min–max {fmt_ratio(lo)}–{fmt_ratio(hi)}: "
               f"{100 * (lo / med - 1):+.1f} % / {100 * (hi / med - 1):+.1f} % of the median). Median reference "
               f"{fmt(ref_med)} {unit} (reviewer: {fmt(reviewer)}); median Shoal {fmt(shoal_med)}.")
+        if gains:
+            print(f"New / old: median **{statistics.median(gains):.3f}** (min–max {min(gains):.3f}–{max(gains):.3f}).")
         off = sum(abs(r / med - 1) > SPREAD_LIMIT for r in ratios)
         if off:
             warnings.append(f"`{label}`: {off} of {len(ratios)} paired ratios more than ±{SPREAD_LIMIT:.0%} "
@@ -423,6 +419,7 @@ def main() -> int:
     ap.add_argument("--sambuca", help="checkout of sambuca (stevesagar/sambuca d153684)")
     ap.add_argument("--dea", help="checkout of GeoscienceAustralia/DEA-Water-Quality (dd794b0)")
     ap.add_argument("--shoal", default=str(REPO / "target" / "release" / "shoal"))
+    ap.add_argument("--shoal-before", help="an earlier build, run after --shoal in every round (new / old)")
     ap.add_argument("--rounds", type=int, default=8)
     ap.add_argument("--core", type=int, default=1, help="the one core every measurement runs on")
     ap.add_argument("--shoal-quick", action="store_true", help="pass --quick to shoal bench (same rows, noisier)")
@@ -439,9 +436,11 @@ def main() -> int:
     for name, p in paths.items():
         if p and not (Path(p) / MARKER[name]).is_file():
             ap.error(f"--{name.replace('_', '-')} {p}: not a checkout of {name} (no {MARKER[name]})")
-    if not (os.access(args.shoal, os.X_OK) and Path(args.shoal).is_file()):
-        ap.error(f"--shoal {args.shoal}: not an executable (build it with `cargo build --release`)")
+    for flag, binary in (("--shoal", args.shoal), ("--shoal-before", args.shoal_before)):
+        if binary is not None and not (os.access(binary, os.X_OK) and Path(binary).is_file()):
+            ap.error(f"{flag} {binary}: not an executable (build it with `cargo build --release`)")
     shoal = str(Path(args.shoal).resolve())
+    shoals = [shoal] + ([str(Path(args.shoal_before).resolve())] if args.shoal_before else [])
     pin = "taskset" if shutil.which("taskset") else "affinity" if hasattr(os, "sched_setaffinity") else "none"
     if pin != "none" and args.core not in os.sched_getaffinity(0):
         ap.error(f"--core {args.core}: not among this process's cores {sorted(os.sched_getaffinity(0))}")
@@ -469,7 +468,10 @@ def main() -> int:
         print("\n" + "\n".join(skipped))
     sys.stdout.flush()
 
-    rates, shoal_rates, checks, stubbed, loads = run_rounds(args, shoal, paths, active, pin)
+    if args.shoal_before:
+        print(f"- Shoal before: {shoals[1]} (run after the Shoal above in every round)")
+    rates, all_shoal, checks, stubbed, loads = run_rounds(args, shoals, paths, active, pin)
+    shoal_rates, before = all_shoal[0], all_shoal[1] if len(all_shoal) > 1 else None
     print(f"\n- Load average at end: {loadavg()}; 1-minute load before each round and at the end: "
           f"{', '.join(f'{x:.2f}' for x in loads)}")
     if stubbed:
@@ -477,9 +479,10 @@ def main() -> int:
               f"{', '.join(sorted(stubbed))}")
     print("\n## Checks (first round: the workload is the reference configuration)\n")
     print("\n".join(f"- {key}: {text}" for key, text in checks.items()))
-    report(rates, shoal_rates, loads)
+    report(rates, shoal_rates, loads, before)
     if args.json:
-        Path(args.json).write_text(json.dumps({"reference": rates, "shoal": shoal_rates, "loads": loads,
+        Path(args.json).write_text(json.dumps({"reference": rates, "shoal": shoal_rates, "shoal_before": before,
+                                               "loads": loads,
                                                "checks": checks, "args": vars(args)}, indent=1))
     return 0
 
