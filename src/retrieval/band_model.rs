@@ -105,14 +105,7 @@ pub struct ModelScratch {
 
 impl ModelScratch {
     fn resize(&mut self, n: usize) {
-        for v in [
-            &mut self.rb,
-            &mut self.drb,
-            &mut self.above,
-        ]
-        .into_iter()
-        .chain(&mut self.grad)
-        {
+        for v in [&mut self.rb, &mut self.drb, &mut self.above].into_iter().chain(&mut self.grad) {
             v.resize(n, 0.0);
         }
     }
@@ -390,7 +383,11 @@ impl Nodes<'_> {
             // ∂κ/∂C = ∂a + ∂bb, for chl, CDOM (no bb) and NAP; then depth and fraction.
             let w = weight[i];
             let inv_k2 = 1.0 / ((a + bb) * (a + bb));
-            let du = [(a * bb_ph[i] - bb * a_ph[i]) * inv_k2, -bb * a_cdom[i] * inv_k2, (a * bb_nap[i] - bb * a_nap[i]) * inv_k2];
+            let du = [
+                (a * bb_ph[i] - bb * a_ph[i]) * inv_k2,
+                -bb * a_cdom[i] * inv_k2,
+                (a * bb_nap[i] - bb * a_nap[i]) * inv_k2,
+            ];
             let dk = [a_ph[i] + bb_ph[i], a_cdom[i], a_nap[i] + bb_nap[i]];
             g0[i] = w * (d_u * du[0] + d_k * dk[0]);
             g1[i] = w * (d_u * du[1] + d_k * dk[1]);
