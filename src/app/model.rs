@@ -260,9 +260,12 @@ impl AppState {
             for (k, layer) in scene.substrates.iter_mut().enumerate() {
                 bump(&mut layer.fraction, 5 + k as u64);
             }
-            // The aerosol's map and the land mask are drawn from the seed too.
+            // The aerosol's map, the land mask and the clouds are drawn from the seed too.
             scene.aot550_map.iter_mut().for_each(|m| bump(m, 1000));
             scene.land.iter_mut().for_each(|l| bump(&mut l.mask, 1001));
+            scene.clouds.iter_mut().for_each(|c| {
+                c.seed = c.seed.wrapping_add(self.scene_seed.wrapping_mul(1_000_003).wrapping_add(1002));
+            });
         }
         scene
     }

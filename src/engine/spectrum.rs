@@ -114,8 +114,9 @@ impl SpectrumMaker {
         let path = optics.path_spectrum(&g).map_err(|e| fail(e.to_string()))?;
         let n = optics.grid().len();
         let (mut l_toa, mut rrs) = (vec![0.0; n], vec![0.0; n]);
+        let sky = out.scene.sky_at(ground_m.0, ground_m.1, g.view_zenith_rad, look.view_azimuth_rad);
         let surface = optics
-            .radiance(&out.scene, ground_m.0, ground_m.1, &g, &path, &mut Scratch::default(), &mut l_toa, &mut rrs)
+            .radiance(&out.scene, ground_m.0, ground_m.1, &g, sky, &path, &mut Scratch::default(), &mut l_toa, &mut rrs)
             .map_err(|e| fail(e.to_string()))?;
         let per_um = |v: &[f64]| v.iter().map(|x| x * 1000.0).collect::<Vec<_>>();
         Ok(PointSpectrum {

@@ -26,10 +26,10 @@ use super::InstrumentError;
 use super::geometry::Viewing;
 use super::response::Response;
 use super::spatial::SpatialKernel;
-use super::truth::{SurfaceMap, Truth};
+use super::truth::{SurfaceClass, SurfaceMap, Truth};
 use crate::control::RunControl;
 use crate::parse::FieldError;
-use crate::scene::Scene;
+use crate::scene::{Scene, Sky};
 use crate::toa::{SceneOptics, Scratch, Target};
 
 pub use super::aerosol_map::AotNodes;
@@ -165,7 +165,9 @@ pub fn sample_radiance(
                     } else {
                         None
                     };
-                    truth_at(scene, x, y, &mut map_block[at * 4..at * 4 + 4], &mut land_block[at], fractions);
+                    let look = &viewing.looks[0][c];
+                    let sky = scene.sky_at(x, y, look.geometry.view_zenith_rad, look.view_azimuth_rad);
+                    truth_at(scene, x, y, sky, &mut map_block[at * 4..at * 4 + 4], &mut land_block[at], fractions);
                 }
                 if control.cancelled() {
                     return Err(InstrumentError::Cancelled);
@@ -249,9 +251,10 @@ impl PixelSampler<'_> {
             let (x0, y0) = self.viewing.ground_m(gi, r, c);
             for (k, &(dx, dy)) in self.offsets.iter().enumerate() {
                 let (x, y) = (x0 + dx, y0 + dy);
+                let sky = self.scene.sky_at(x, y, look.geometry.view_zenith_rad, look.view_azimuth_rad);
                 let (node_rrs, node_f) = &mut work.at_nodes[gi];
                 if atmosphere.has_nodes(gi)
-                    && optics.water_at_nodes(self.scene, x, y, &look.geometry, &mut work.scratch, node_rrs)?
+                    && optics.water_at_nodes(self.scene, x, y, &look.geometry, sky, &mut work.scratch, node_rrs)?
                 {
                     for ((f, rrs), s_pi) in node_f.iter_mut().zip(node_rrs.iter()).zip(&atmosphere.node_s_pi[gi][c]) {
                         *f = rrs / (1.0 - s_pi * rrs);
@@ -270,7 +273,8 @@ impl PixelSampler<'_> {
                     continue;
                 }
                 let (l_toa, rrs) = &mut work.spectra[gi];
-                let surface = optics.radiance(self.scene, x, y, &look.geometry, path, &mut work.scratch, l_toa, rrs)?;
+                let surface =
+                    optics.radiance(self.scene, x, y, &look.geometry, sky, path, &mut work.scratch, l_toa, rrs)?;
                 for (kb, &b) in group.bands.iter().enumerate() {
                     let (first, w) = self.response.weights(gi, kb, j);
                     let (num, den) = w
@@ -337,14 +341,20 @@ impl TruthBuffers {
     }
 }
 
-/// The truth maps at scene point (x, y): chl, NAP, CDOM, depth into `maps`, the land flag, and
-/// the normalised substrate fractions.
-fn truth_at(scene: &Scene, x: f64, y: f64, maps: &mut [f32], land: &mut u8, fractions: Option<&mut [f32]>) {
+/// The truth maps at scene point (x, y): chl, NAP, CDOM, depth into `maps`, the surface class
+/// as the sensor sees it under `sky` (cloud over anything; water in a cloud's shadow), and the
+/// normalised substrate fractions.
+fn truth_at(scene: &Scene, x: f64, y: f64, sky: Sky, maps: &mut [f32], class: &mut u8, fractions: Option<&mut [f32]>) {
     maps[0] = scene.chl.value_at(x, y) as f32;
     maps[1] = scene.nap.value_at(x, y) as f32;
     maps[2] = scene.cdom.value_at(x, y) as f32;
     maps[3] = scene.depth.as_ref().map_or(0.0, |d| d.value_at(x, y)) as f32;
-    *land = u8::from(scene.is_land(x, y));
+    *class = match (sky, scene.is_land(x, y)) {
+        (Sky::Cloud, _) => SurfaceClass::Cloud,
+        (_, true) => SurfaceClass::Land,
+        (Sky::Shadow, false) => SurfaceClass::CloudShadow,
+        (Sky::Clear, false) => SurfaceClass::Water,
+    } as u8;
     if let Some(f) = fractions {
         let n = f.len();
         let values: Vec<f64> = scene.substrates.iter().map(|(_, m)| m.value_at(x, y).max(0.0)).collect();

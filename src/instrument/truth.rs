@@ -38,9 +38,10 @@ pub enum SurfaceClass {
     Water = 0,
     /// Land (the scene's land mask).
     Land = 1,
-    /// Cloud over the pixel (code reserved: no scene makes clouds yet).
+    /// Cloud between the pixel and the sensor (`scene.clouds`).
     Cloud = 2,
-    /// Water in a cloud's shadow (code reserved, as `Cloud`).
+    /// Water in a cloud's shadow: still water, with its own truth, that the processor must
+    /// screen out or retrieve from darker light.
     CloudShadow = 3,
 }
 
@@ -76,10 +77,11 @@ impl SurfaceClass {
         }
     }
 
-    /// Is it water the chain retrieves from?
+    /// Is it water the chain retrieves from (and scores), unless the processor's cloud screen
+    /// leaves it out?
     #[must_use]
     pub const fn is_water(self) -> bool {
-        matches!(self, Self::Water)
+        matches!(self, Self::Water | Self::CloudShadow)
     }
 }
 
@@ -139,6 +141,36 @@ impl SurfaceMap {
     #[must_use]
     pub fn water_mask(&self) -> Array2<bool> {
         self.codes.mapv(|c| SurfaceClass::of_code(c).is_water())
+    }
+
+    /// Does any pixel see cloud or a cloud's shadow?
+    #[must_use]
+    pub fn has_clouds(&self) -> bool {
+        self.codes.iter().any(|&c| matches!(SurfaceClass::of_code(c), SurfaceClass::Cloud | SurfaceClass::CloudShadow))
+    }
+
+    /// The screen of a processor that knows every cloud and shadow exactly (the perfect
+    /// processor's): true on cloud and cloud shadow.
+    #[must_use]
+    pub fn exact_screen(&self) -> Array2<bool> {
+        self.codes.mapv(|c| matches!(SurfaceClass::of_code(c), SurfaceClass::Cloud | SurfaceClass::CloudShadow))
+    }
+
+    /// The map a processor corrects over, given its cloud screen (`screened`: true where it
+    /// flags cloud or shadow): land as here (a land mask is static and known), every screened
+    /// pixel `Cloud` (not corrected), the rest water, a cloud it missed included.
+    #[must_use]
+    pub fn as_screened(&self, screened: &Array2<bool>) -> Self {
+        let codes = ndarray::Zip::from(&self.codes).and(screened).map_collect(|&c, &s| {
+            if SurfaceClass::of_code(c) == SurfaceClass::Land {
+                SurfaceClass::Land as u8
+            } else if s {
+                SurfaceClass::Cloud as u8
+            } else {
+                SurfaceClass::Water as u8
+            }
+        });
+        Self { codes }
     }
 
     /// The codes as stored, for writers.

@@ -242,6 +242,14 @@ ranges! {
     SCENE_SUBSTRATE_FRACTION = Range::closed("scene.substrates[i].fraction", 0.0, 1.0, "", "areal fraction of a substrate (every value)");
     /// Aerosol optical thickness map.
     SCENE_AOT550_MAP = Range::closed("scene.aot550_map", 0.0, 5.0, "", "aerosol optical thickness at 550 nm (every value of the map)");
+    /// Cloud cover.
+    SCENE_CLOUDS_COVER = Range::closed("scene.clouds.cover", 0.0, 1.0, "", "fraction of the scene under cloud");
+    /// Cloud size.
+    SCENE_CLOUDS_SIZE_M = Range::closed("scene.clouds.size_m", 50.0, 100_000.0, "m", "typical cloud size (the field's correlation length)");
+    /// Cloud layer height.
+    SCENE_CLOUDS_HEIGHT_M = Range::closed("scene.clouds.height_m", 0.0, 15_000.0, "m", "height of the cloud layer above the water (shadow and parallax)");
+    /// Cloud optical thickness.
+    SCENE_CLOUDS_OPTICAL_THICKNESS = Range::above("scene.clouds.optical_thickness", 0.0, 200.0, "", "cloud optical thickness at 550 nm (sets its albedo)");
 
     // Spectra written as formulas (SpectrumSource::PowerLaw and Exponential, wherever one is
     // given: SIOP sets, land reflectance, QE).
@@ -353,6 +361,10 @@ ranges! {
     CORRECTION_AOT_NODE = Range::above("correction.image.aot_nodes", 0.0, 5.0, "", "AOT(550) nodes of the aerosol family's tables, increasing (0 is always added)");
     /// Glint threshold of the image-based correction.
     CORRECTION_GLINT_THRESHOLD = Range::above("correction.image.glint_threshold_per_sr", 0.0, 1.0, "sr-1", "largest normalised glint radiance L_GN of a retrieved pixel (l2gen's glint_thresh)");
+    /// The cloud screen's threshold.
+    CORRECTION_CLOUD_THRESHOLD = Range::above("correction.image.clouds.threshold", 0.0, 1.0, "", "Rayleigh-corrected reflectance at 865 nm above which a pixel is cloud");
+    /// The cloud height the shadow screen assumes.
+    CORRECTION_CLOUD_HEIGHT_M = Range::closed("correction.image.clouds.height_m", 0.0, 15_000.0, "m", "cloud height the shadow projection assumes (0: no shadow screen)");
     /// Dark-spectrum fitting: tile side.
     CORRECTION_DARK_TILE_PX = Range::count("correction.image.dark.tile_px", 0.0, 100_000.0, "pixels", "tile side of dark-spectrum fitting (0: the whole scene)");
     /// Dark-spectrum fitting: darkest pixels.

@@ -10,11 +10,13 @@
 //!   aquatic remote sensing applications. Sensors 23, 7824 (scenes built from 2-D maps and 1-D
 //!   radiative transfer; Appendix B).
 
+pub mod clouds;
 mod grf;
 mod map;
 pub mod raster;
 mod spec;
 
+pub use clouds::{CloudField, CloudSpec, Sky};
 pub use grf::gaussian_random_field;
 pub use map::{Distribution, Extent, Map, MapContext, MapSpec, Shape};
 pub use raster::{GeoFrame, Georeference, Resampling};

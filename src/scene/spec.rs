@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use super::SceneError;
+use super::clouds::{CloudField, CloudSpec, Sky};
 use super::map::{Extent, Map, MapContext, MapSpec};
 use super::raster::{GeoFrame, Georeference, RasterCache, fill_nodata, resolve_frame};
 use crate::atmosphere::{AtmosphereSpec, SeaSurface};
@@ -120,6 +121,9 @@ pub struct SceneSpec {
     /// map and `atmosphere.aot550` is unused. Absent: `atmosphere.aot550` everywhere.
     #[serde(default)]
     pub aot550_map: Option<MapSpec>,
+    /// A broken cloud layer and its shadows (absent: a clear sky).
+    #[serde(default)]
+    pub clouds: Option<CloudSpec>,
 }
 
 /// Day of year of `YYYY-MM-DD`.
@@ -243,7 +247,7 @@ impl SceneSpec {
         if has(Effect::Adjacency) && self.land.is_none() {
             return bad("effects", "Adjacency needs `land` (a mask and a reflectance)".into());
         }
-        Ok(())
+        self.clouds.as_ref().map_or(Ok(()), CloudSpec::validate)
     }
 }
 
@@ -268,6 +272,8 @@ pub struct Scene {
     pub land: Option<Map>,
     /// Aerosol optical thickness at 550 nm, when the scene gives it as a map.
     pub aot550: Option<Map>,
+    /// The cloud layer, when the scene has clouds.
+    pub clouds: Option<CloudField>,
     /// Directory of the scene file (for relative paths), if any.
     pub base_dir: Option<PathBuf>,
     /// Day of year.
@@ -284,6 +290,7 @@ impl Scene {
         [&self.chl, &self.nap, &self.cdom].iter().map(|m| m.bytes()).sum::<usize>()
             + optional.iter().filter_map(|m| m.as_ref()).map(Map::bytes).sum::<usize>()
             + self.substrates.iter().map(|(_, m)| m.bytes()).sum::<usize>()
+            + self.clouds.as_ref().map_or(0, CloudField::bytes)
     }
 
     /// Validate `spec` and build its maps; `base_dir` is the scene file's directory.
@@ -374,7 +381,14 @@ impl Scene {
                 fill_nodata(cells, extent, &field, frame.as_ref(), &land_at)?;
             }
         }
+        let clouds = match &spec.clouds {
+            Some(c) => {
+                Some(CloudField::build(c, extent, spec.sun.zenith_deg.to_radians(), spec.sun.azimuth_deg.to_radians())?)
+            }
+            None => None,
+        };
         let scene = Self {
+            clouds,
             spec,
             extent,
             chl,
@@ -392,7 +406,6 @@ impl Scene {
         Ok(scene)
     }
 
-    /// Every map within the water model's documented ranges (see `ranges::limits`).
     /// Every value of every map within its range ([`crate::ranges`]).
     fn check_ranges(&self) -> Result<(), SceneError> {
         use crate::ranges as r;
@@ -430,6 +443,14 @@ impl Scene {
     #[must_use]
     pub fn is_land(&self, x_m: f64, y_m: f64) -> bool {
         self.land.as_ref().is_some_and(|m| m.value_at(x_m, y_m) >= 0.5)
+    }
+
+    /// What a sensor at (`view_zenith_rad`, `view_azimuth_rad`, the sensor's azimuth seen from
+    /// the ground) sees at ground point (x, y): cloud, the surface in a cloud's shadow, or the
+    /// surface in the sun (always, without clouds).
+    #[must_use]
+    pub fn sky_at(&self, x_m: f64, y_m: f64, view_zenith_rad: f64, view_azimuth_rad: f64) -> Sky {
+        self.clouds.as_ref().map_or(Sky::Clear, |c| c.sky_at(x_m, y_m, view_zenith_rad, view_azimuth_rad))
     }
 
     /// Aerosol optical thickness at 550 nm at (x, y): the map's value, or the atmosphere's.

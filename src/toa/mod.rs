@@ -25,7 +25,7 @@ use std::sync::Arc;
 
 use crate::atmosphere::{AtmosphereError, AtmosphereLut, Geometry};
 use crate::parse::FieldError;
-use crate::scene::{Effect, Scene, SceneError};
+use crate::scene::{Effect, Scene, SceneError, Sky};
 use crate::spectral::{Extrapolation, WavelengthGrid};
 use crate::water::{
     Bottom, SingleScratch, SingleWater, SubstrateLibrary, SubstrateMix, WaterColumn, WaterGeometry, WaterModel,
@@ -41,6 +41,8 @@ pub struct PathSpectrum {
     pub l_path: Vec<f64>,
     /// Downwelling irradiance just above the surface (black water).
     pub ed: Vec<f64>,
+    /// Its direct-beam part, μ₀·e^(−τ/μ₀)·E₀·T_gas: what a cloud's shadow takes away.
+    pub ed_direct: Vec<f64>,
     /// Upward transmittance (direct + diffuse).
     pub t_up: Vec<f64>,
     /// Diffuse part of the upward transmittance.
@@ -87,6 +89,8 @@ struct NodeWater {
 pub struct Scratch {
     mix: Vec<f64>,
     rho_target: Vec<f64>,
+    /// Ed in a cloud's shadow (the diffuse sky only).
+    ed_shadow: Vec<f64>,
     /// Water evaluations with a bottom term (shallow), counted for tests and run reports.
     pub bottom_evaluations: u64,
     /// Water evaluations in all.
@@ -102,6 +106,8 @@ pub enum Target {
     Water,
     /// Land: `rrs` holds zeros.
     Land,
+    /// Cloud between the surface and the sensor: `rrs` holds zeros.
+    Cloud,
 }
 
 /// The LUT wavelength nodes either side of `wavelength_nm` and the weight of the upper one,
@@ -198,18 +204,20 @@ impl SceneOptics {
     }
 
     /// Rrs above the surface at the band nodes (`rrs`, one per node) at scene point (x, y):
-    /// `Ok(false)` on land or without band nodes (the caller then takes [`Self::radiance`]).
+    /// `Ok(false)` on land, under cloud or in its shadow, or without band nodes (the caller then
+    /// takes [`Self::radiance`]).
     pub fn water_at_nodes(
         &self,
         scene: &Scene,
         x_m: f64,
         y_m: f64,
         g: &Geometry,
+        sky: Sky,
         scratch: &mut Scratch,
         rrs: &mut [f64],
     ) -> Result<bool, SceneError> {
         let Some(nodes) = &self.nodes_water else { return Ok(false) };
-        if scene.is_land(x_m, y_m) {
+        if scene.is_land(x_m, y_m) || sky != Sky::Clear {
             return Ok(false);
         }
         // The single-precision kernel's work buffer, out of `scratch` while the column borrows it.
@@ -265,6 +273,7 @@ impl SceneOptics {
         let mut p = PathSpectrum {
             l_path: vec![0.0; n],
             ed: vec![0.0; n],
+            ed_direct: vec![0.0; n],
             t_up: vec![0.0; n],
             t_up_diffuse: vec![0.0; n],
             spherical_albedo: vec![0.0; n],
@@ -285,6 +294,8 @@ impl SceneOptics {
             let e0 = self.e0[i];
             p.l_path[i] = loglin(a.radiance, b.radiance, t) * e0 * tg0 * tgv;
             p.ed[i] = loglin(a.ed, b.ed, t) * e0 * tg0;
+            let tau = loglin(a.tau_rayleigh + a.tau_aerosol, b.tau_rayleigh + b.tau_aerosol, t);
+            p.ed_direct[i] = (mu0 * (-tau / mu0).exp() * e0 * tg0).min(p.ed[i]);
             let t_up = lin(a.t_up, b.t_up, t);
             let t_dir = lin(a.t_up_direct, b.t_up_direct, t);
             p.t_up[i] = t_up * tgv;
@@ -304,7 +315,11 @@ impl SceneOptics {
     }
 
     /// TOA radiance (`l_toa`, W m⁻² sr⁻¹ nm⁻¹) and, over water, Rrs (`rrs`, sr⁻¹) at scene point
-    /// (x, y) m, seen along `g` through `path`.
+    /// (x, y) m, seen along `g` through `path` under `sky` ([`Scene::sky_at`]).
+    ///
+    /// A cloud reflects as a Lambertian layer of its albedo (as land does, with R for ρ); in a
+    /// cloud's shadow the surface is lit by the diffuse sky alone, Ed − Ed_direct, and shows no
+    /// glint (the sun is hidden). Rrs is a property of the water, the same in shadow.
     #[allow(clippy::too_many_arguments)]
     pub fn radiance(
         &self,
@@ -312,13 +327,30 @@ impl SceneOptics {
         x_m: f64,
         y_m: f64,
         g: &Geometry,
+        sky: Sky,
         path: &PathSpectrum,
         scratch: &mut Scratch,
         l_toa: &mut [f64],
         rrs: &mut [f64],
     ) -> Result<Target, SceneError> {
         let n = self.grid.len();
-        let surface = if scene.is_land(x_m, y_m) {
+        let shadow = sky == Sky::Shadow;
+        let mut ed_shadow = std::mem::take(&mut scratch.ed_shadow);
+        if shadow {
+            ed_shadow.clear();
+            ed_shadow.extend(path.ed.iter().zip(&path.ed_direct).map(|(e, d)| (e - d).max(0.0)));
+        }
+        let ed: &[f64] = if shadow { &ed_shadow } else { &path.ed };
+        let cloud_albedo = scene.clouds.as_ref().map_or(0.0, |c| c.spec().albedo());
+        let surface = if sky == Sky::Cloud {
+            for i in 0..n {
+                let lw =
+                    cloud_albedo * ed[i] / (std::f64::consts::PI * (1.0 - path.spherical_albedo[i] * cloud_albedo));
+                l_toa[i] = path.l_path[i] + path.t_up[i] * lw;
+                rrs[i] = 0.0;
+            }
+            Target::Cloud
+        } else if scene.is_land(x_m, y_m) {
             let Some(rho) = &self.land else {
                 return Err(SceneError::Invalid(FieldError {
                     field: "land".into(),
@@ -326,7 +358,7 @@ impl SceneOptics {
                 }));
             };
             for i in 0..n {
-                let lw = rho[i] * path.ed[i] / (std::f64::consts::PI * (1.0 - path.spherical_albedo[i] * rho[i]));
+                let lw = rho[i] * ed[i] / (std::f64::consts::PI * (1.0 - path.spherical_albedo[i] * rho[i]));
                 l_toa[i] = path.l_path[i] + path.t_up[i] * lw;
                 rrs[i] = 0.0;
             }
@@ -335,9 +367,10 @@ impl SceneOptics {
             let column = water_column(scene, x_m, y_m, &self.substrates, n, scratch);
             let geometry = WaterGeometry { sun_zenith_rad: g.sun_zenith_rad, view_zenith_rad: g.view_zenith_rad };
             self.water.rrs_above_into(&column, &geometry, rrs)?;
+            let glint = if shadow { 0.0 } else { 1.0 };
             for i in 0..n {
-                let lw = rrs[i] * path.ed[i] / (1.0 - path.spherical_albedo[i] * std::f64::consts::PI * rrs[i]);
-                l_toa[i] = path.l_path[i] + path.t_up[i] * lw + path.glint[i];
+                let lw = rrs[i] * ed[i] / (1.0 - path.spherical_albedo[i] * std::f64::consts::PI * rrs[i]);
+                l_toa[i] = path.l_path[i] + path.t_up[i] * lw + glint * path.glint[i];
             }
             Target::Water
         };
@@ -347,9 +380,11 @@ impl SceneOptics {
             match surface {
                 Target::Water => scratch.rho_target.extend(rrs.iter().map(|r| std::f64::consts::PI * r)),
                 Target::Land => scratch.rho_target.extend_from_slice(land),
+                Target::Cloud => scratch.rho_target.resize(n, cloud_albedo),
             }
             adj.add(x_m, y_m, g, path, land, &scratch.rho_target, l_toa);
         }
+        scratch.ed_shadow = ed_shadow;
         Ok(surface)
     }
 }
