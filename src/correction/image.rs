@@ -133,6 +133,8 @@ pub struct ImageCorrection {
     /// Largest normalised glint radiance L_GN = ρ_g μ₀/π a retrieved pixel may have, sr⁻¹
     /// (l2gen's `glint_thresh`, 0.005).
     pub glint_threshold_per_sr: f64,
+    /// The cloud and shadow screen, where the scene has clouds ([`super::clouds`]).
+    pub clouds: super::clouds::CloudScreen,
 }
 
 impl Default for ImageCorrection {
@@ -146,6 +148,7 @@ impl Default for ImageCorrection {
             aot_nodes: vec![0.05, 0.1, 0.2, 0.4, 0.8],
             glint: true,
             glint_threshold_per_sr: 0.005,
+            clouds: super::clouds::CloudScreen::default(),
         }
     }
 }
@@ -225,6 +228,7 @@ impl ImageCorrection {
         }
         let g = &crate::ranges::CORRECTION_GLINT_THRESHOLD;
         g.check(self.glint_threshold_per_sr).map_err(|m| invalid(g.path, m))?;
+        self.clouds.validate()?;
         let d = &self.dark;
         let tile = &crate::ranges::CORRECTION_DARK_TILE_PX;
         tile.check(d.tile_px as f64).map_err(|m| invalid(tile.path, m))?;

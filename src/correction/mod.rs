@@ -21,6 +21,7 @@
 //! - Matthews, M. W. et al. (2023) Sensors 23, 7824, Appendix A (equations A1–A3).
 //! - Vermote, E. F. et al. (1997) 6S: an overview. IEEE TGRS 35, 675–686.
 
+pub mod clouds;
 pub mod dark;
 mod difference;
 pub mod family;
@@ -32,6 +33,7 @@ mod nodes;
 mod pair;
 mod rrs_metrics;
 
+pub use clouds::{CloudScreen, Sun, screen_image};
 pub use dark::TileFit;
 pub use difference::{BandDifference, compare};
 pub use family::{AerosolFamily, FamilyLuts};
@@ -81,6 +83,8 @@ impl RrsFlags {
     pub const SATURATED: u8 = 2;
     /// No valid Rrs: land, zero counts or a non-finite value.
     pub const INVALID: u8 = 4;
+    /// Left out by the processor's cloud screen (cloud or cloud shadow; with `INVALID`).
+    pub const CLOUD: u8 = 8;
 }
 
 impl CorrectionSpec {

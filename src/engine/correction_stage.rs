@@ -13,7 +13,9 @@ use super::run::Engine;
 use super::stages::failed;
 use super::{EngineError, RunConfig};
 use crate::control::RunControl;
-use crate::correction::{AerosolFamily, FamilyLuts, SceneApproximation, compare, correct_exact, correct_image};
+use crate::correction::{
+    AerosolFamily, FamilyLuts, RrsFlags, SceneApproximation, compare, correct_exact, correct_image, screen_image,
+};
 use crate::instrument::Truth;
 use ndarray::Array3;
 
@@ -61,11 +63,31 @@ impl Engine {
                 crate::correction::Method::Exact | crate::correction::Method::Image(_) => false,
                 crate::correction::Method::PerScene => true,
             };
+            // Where the scene has clouds, the processor screens them and their shadows out: the
+            // image-based correction with its own test, the exact one knowing them exactly.
+            let screen = match (&family, config.correction.image()) {
+                _ if config.scene.clouds.is_none() => None,
+                (Some((fam, _)), Some(settings)) => {
+                    let sun = crate::correction::Sun {
+                        zenith_rad: config.scene.sun.zenith_deg.to_radians(),
+                        azimuth_rad: config.scene.sun.azimuth_deg.to_radians(),
+                    };
+                    let rayleigh = fam.terms.first().and_then(|m| m.first()).ok_or_else(|| EngineError::Failed {
+                        stage: Stage::Correction,
+                        message: "the family has no members".into(),
+                    })?;
+                    let bands = &side.response.bands;
+                    let (viewing, clouds) = (&side.viewing, &settings.clouds);
+                    Some(screen_image(level1, rayleigh, bands, viewing, sun, clouds, &truth.surface).map_err(&fail)?)
+                }
+                _ => Some(truth.surface.exact_screen()),
+            };
+            let screened = screen.as_ref().map(|s| truth.surface.as_screened(s));
+            let surface = screened.as_ref().unwrap_or(&truth.surface);
             let image = match (&family, config.correction.image()) {
-                (Some((fam, _)), Some(settings)) => Some(
-                    correct_image(level1, fam, settings, &side.response.bands, &truth.surface, control)
-                        .map_err(&fail)?,
-                ),
+                (Some((fam, _)), Some(settings)) => {
+                    Some(correct_image(level1, fam, settings, &side.response.bands, surface, control).map_err(&fail)?)
+                }
                 _ => None,
             };
             // The image-based product is compared with the truth; the exact and approximate
@@ -74,18 +96,18 @@ impl Engine {
             let diagnostics = diagnostics && image.is_none();
             let exact = if diagnostics || (!per_scene && image.is_none()) {
                 let aerosol_map = side.aerosol_map.as_deref().zip(truth.aot550.as_ref());
-                Some(correct_exact(level1, band_atmosphere, aerosol_map, &truth.surface, control).map_err(&fail)?)
+                Some(correct_exact(level1, band_atmosphere, aerosol_map, surface, control).map_err(&fail)?)
             } else {
                 None
             };
             // The approximation is held whole only when it is the product; as a diagnostic it is
             // compared with the exact correction pixel by pixel.
             let streamed = match (&exact, diagnostics && !per_scene) {
-                (Some(e), true) => approximation.compare_with(level1, &truth.surface, e),
+                (Some(e), true) => approximation.compare_with(level1, surface, e),
                 _ => None,
             };
             let approx = if (diagnostics && streamed.is_none()) || per_scene {
-                Some(approximation.correct(level1, &truth.surface, control).map_err(&fail)?)
+                Some(approximation.correct(level1, surface, control).map_err(&fail)?)
             } else {
                 None
             };
@@ -95,7 +117,7 @@ impl Engine {
                 _ => Vec::new(),
             };
             let (image, aerosol) = image.map_or((None, None), |(r, a)| (Some(r), Some(a)));
-            let rrs = match (image, exact, approx) {
+            let mut rrs = match (image, exact, approx) {
                 (Some(i), _, _) => i,
                 (None, _, Some(a)) if per_scene => a,
                 (None, Some(e), _) => e,
@@ -104,6 +126,9 @@ impl Engine {
                     return Err(EngineError::Failed { stage: Stage::Correction, message: "no correction ran".into() });
                 }
             };
+            if let Some(screen) = &screen {
+                mark_screened(&mut rrs, screen);
+            }
             let rrs_vs_truth = if against_truth { compare(&rrs, truth_rrs, None) } else { Vec::new() };
             let family = family.as_ref().map(|(f, _)| f.clone());
             let names: Vec<String> = side.response.bands.bands.iter().map(|b| b.name.clone()).collect();
@@ -171,5 +196,15 @@ impl Engine {
                 .map_err(failed(Stage::AerosolFamily))
         })?;
         Ok(Some((fam, key)))
+    }
+}
+
+/// Flag every band of the pixels the cloud screen left out (`screen` true) as cloud.
+fn mark_screened(rrs: &mut crate::correction::Reflectance, screen: &ndarray::Array2<bool>) {
+    for ((r, c), _) in screen.indexed_iter().filter(|(_, s)| **s) {
+        for b in 0..rrs.flags.dim().2 {
+            rrs.flags[[r, c, b]] |= RrsFlags::CLOUD | RrsFlags::INVALID;
+            rrs.rrs[[r, c, b]] = 0.0;
+        }
     }
 }

@@ -156,6 +156,7 @@ fn radiometry_vars<'a>(cubes: &'a Cubes, floats: &mut Vec<FloatVar<'a>>, flags: 
             (i32::from(RrsFlags::NEGATIVE), "negative"),
             (i32::from(RrsFlags::SATURATED), "saturated"),
             (i32::from(RrsFlags::INVALID), "invalid"),
+            (i32::from(RrsFlags::CLOUD), "cloud"),
         ],
         values: Values::lazy(move || rrs_flags.iter().map(|&f| i32::from(f)).collect()),
         coordinates: CUBE_COORDINATES,
