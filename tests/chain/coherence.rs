@@ -83,6 +83,11 @@ fn base(path: &str) -> RunConfig {
         // A user's size distribution: the bushfire-smoke scene's two modes.
         scene.atmosphere.aerosol = SceneSpec::preset("lake_hume_smoke").unwrap().atmosphere.aerosol;
     }
+    if path.contains("clouds.") {
+        // Clouds and their shadows over the 2.4 × 1.6 km reef: 40 % of 300 m clouds at 300 m.
+        scene.clouds =
+            Some(shoal::scene::CloudSpec { cover: 0.4, size_m: 300.0, height_m: 300.0, ..Default::default() });
+    }
     for e in [Effect::SunGlint, Effect::SpatialResponse] {
         if !scene.effects.contains(&e) {
             scene.effects.push(e);
@@ -212,6 +217,11 @@ fn chosen_value(path: &str) -> Option<f64> {
         "correction.image.aot_nodes" => 0.15,
         // l2gen's 0.005 sr⁻¹ against the base's 1: every pixel of the base is above it.
         "correction.image.glint_threshold_per_sr" => 0.005,
+        // Above the clouds' albedo (0.72): no cloud is screened.
+        "correction.image.clouds.threshold" => 0.9,
+        // Shadows projected from the base clouds' own 300 m, where the default 1500 m puts every
+        // projected shadow off the 16 × 12 image.
+        "correction.image.clouds.height_m" => 300.0,
         // Dark-spectrum fitting over the 16 × 12 image: 8-pixel tiles (2 × 2 where the default
         // is one scene-wide tile); 20 darkest pixels where the default's 200 take them all; a
         // gas threshold of 0.99 and a band range starting at 770 nm, each leaving out bands the
@@ -304,8 +314,9 @@ fn every_range_field_changes_the_output_or_is_documented_and_the_cache_follows()
         let image = config.correction.image().map_or(String::new(), |i| format!(" image-corrected, {}", i.label()));
         let aerosol = config.scene.atmosphere.aerosol.name();
         let effects = if config.instrument.effects.is_empty() { "" } else { " with optical effects" };
+        let clouds = if config.scene.clouds.is_some() { " under clouds" } else { "" };
         let key = format!(
-            "{}{adjacency}{image}{effects}, {aerosol}, {} retrievals",
+            "{}{adjacency}{image}{effects}{clouds}, {aerosol}, {} retrievals",
             config.instrument.name,
             config.retrievals.len()
         );

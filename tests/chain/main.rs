@@ -9,6 +9,7 @@ mod band_nodes;
 mod binning;
 mod cli;
 mod closure;
+mod clouds;
 mod coherence;
 #[path = "../common/mod.rs"]
 mod common;

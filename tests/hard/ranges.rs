@@ -33,6 +33,9 @@ fn base(path: &str) -> RunConfig {
     if path.starts_with("scene.atmosphere.aerosol.Mixture") {
         c.scene.atmosphere.aerosol = shoal::atmosphere::AerosolType::Mixture(Default::default());
     }
+    if path.starts_with("scene.clouds.") {
+        c.scene.clouds = Some(shoal::scene::CloudSpec::default());
+    }
     if path.starts_with("scene.atmosphere.aerosol.LogNormal") {
         // The bushfire-smoke scene's two modes.
         c.scene.atmosphere.aerosol = SceneSpec::preset("lake_hume_smoke").unwrap().atmosphere.aerosol;
@@ -128,6 +131,8 @@ fn refusal(range: &Range, value: f64) -> Option<String> {
             "correction.image.dark.pixels" => dark.pixels = value as usize,
             "correction.image.dark.min_gas_transmittance" => dark.min_gas_transmittance = value,
             "correction.image.glint_threshold_per_sr" => image.glint_threshold_per_sr = value,
+            "correction.image.clouds.threshold" => image.clouds.threshold = value,
+            "correction.image.clouds.height_m" => image.clouds.height_m = value,
             "correction.image.dark.wave_range_nm" => {
                 dark.wave_range_nm = if value < 1500.0 { [value, 2500.0] } else { [350.0, value] };
             }
