@@ -214,13 +214,17 @@ pub fn summary(result: &SeasonResult, seconds: f64) -> String {
                 continue;
             }
             let p = |q: f64| fmt(stats::percentile(&errs, q), 1);
+            // The water each look returned: clouds, their shadows and glint take their share.
+            let returned: Vec<f64> = d.errors_of(&product, &variable).iter().map(|e| e.returned_pct).collect();
             t += &format!(
-                "  {product} {variable} MAE %: median {}, 10th–90th percentile {}–{}, worst {} ({} looks)\n",
+                "  {product} {variable} MAE %: median {}, 10th–90th percentile {}–{}, worst {} ({} looks); returned % median {}, least {}\n",
                 p(50.0),
                 p(10.0),
                 p(90.0),
                 p(100.0),
-                errs.len()
+                errs.len(),
+                fmt(stats::percentile(&returned, 50.0), 1),
+                fmt(stats::percentile(&returned, 0.0), 1),
             );
         }
         for r in d.runs.iter().filter(|r| r.failure.is_some()).take(3) {
@@ -258,7 +262,7 @@ pub fn looks_csv(result: &SeasonResult) -> String {
     .iter()
     .map(ToString::to_string)
     .collect();
-    header.extend(vars.iter().map(|(p, v)| format!("{p}_{v}_mae_pct")));
+    header.extend(vars.iter().flat_map(|(p, v)| [format!("{p}_{v}_mae_pct"), format!("{p}_{v}_returned_pct")]));
     let refs: Vec<&str> = header.iter().map(String::as_str).collect();
     let mut csv = Csv::new(&refs);
     for d in &result.designs {
@@ -288,6 +292,7 @@ pub fn looks_csv(result: &SeasonResult) -> String {
             for (p, v) in &vars {
                 let e = run.and_then(|r| r.errors.iter().find(|e| e.product == *p && e.variable == *v));
                 row.push(e.map_or_else(String::new, |e| format!("{:.2}", e.mae_pct)));
+                row.push(e.map_or_else(String::new, |e| format!("{:.2}", e.returned_pct)));
             }
             csv.row(row);
         }

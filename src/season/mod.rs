@@ -19,9 +19,10 @@
 //!
 //! Valid looks are then run through the whole chain at the look's geometry (sun, date, heading,
 //! pointing), at the season's decimation, and their product errors collected
-//! ([`run::run_season`]). What this does not model yet: clouds and shadows inside the scene (a
-//! look is clear or not as a whole), glint inside the chain unless the scene asks for it (the
-//! valid looks' residual glint is left out), TLE orbits.
+//! ([`run::run_season`]). A valid look's cloud cover is in its scene as a cloud field with its
+//! shadows (`scene::clouds`), which the processor screens out with its own cloud test and shadow
+//! projection, so a valid look's product error counts the water it loses to them and the shadow
+//! it misses.
 //!
 //! ## References
 //! - Wang, M. & Bailey, S. W. (2001) Correction of sun glint contamination on the SeaWiFS ocean

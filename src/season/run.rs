@@ -153,6 +153,14 @@ pub fn look_config(base: &RunConfig, look: &Look, decimation: usize) -> RunConfi
     if let Some(h) = look.altitude_m {
         config.instrument.altitude_km = h / 1e3;
     }
+    // The look's cloud cover as a cloud field in the scene (the scene's own layer's size, height
+    // and thickness where it has one), seeded by the hour of the pass as the cover was, so
+    // designs in one orbit see the same clouds.
+    config.scene.clouds = (look.cloud_cover > 0.0).then(|| crate::scene::CloudSpec {
+        cover: look.cloud_cover,
+        seed: (a.days * 24.0).floor() as u64,
+        ..base.scene.clouds.clone().unwrap_or_default()
+    });
     config.fidelity.decimation = decimation;
     config
 }

@@ -127,6 +127,29 @@ fn a_valid_look_runs_the_chain_at_its_geometry() {
     assert!(depth.mae_pct.is_finite() && depth.returned_pct > 50.0, "{depth:?}");
 }
 
+/// A look's drawn cloud cover is in its scene, seeded by the hour of the pass: the same field for
+/// every design flying that pass, another for the next pass, none for a clear look.
+#[test]
+fn a_look_s_clouds_are_in_its_scene() {
+    let season = spring(0);
+    let (study, ds) = designs(&season, None).unwrap();
+    let result = run_season(&season, &study, &ds, &RunControl::new(), |_, _| {}).unwrap();
+    let (a, b) = (&result.designs[0], &result.designs[1]);
+    let cloudy: Vec<usize> =
+        (0..a.looks.len()).filter(|&k| a.looks[k].cloud_cover > 0.0 && a.looks[k].verdict == Verdict::Valid).collect();
+    assert!(cloudy.len() >= 2, "{} partly cloudy valid looks", cloudy.len());
+    let clouds = |d: &shoal::season::run::DesignSeason, k: usize| look_config(&ds[0].1, &d.looks[k], 16).scene.clouds;
+    let first = clouds(a, cloudy[0]).expect("a cloud layer");
+    assert_eq!(first.cover, a.looks[cloudy[0]].cloud_cover);
+    // The same pass seen by the second design: the same field.
+    let same = b.looks.iter().position(|l| (l.access.days - a.looks[cloudy[0]].access.days).abs() < 1e-9).unwrap();
+    assert_eq!(clouds(b, same), Some(first.clone()));
+    assert_ne!(clouds(a, cloudy[1]).unwrap().seed, first.seed);
+    if let Some(clear) = a.looks.iter().position(|l| l.cloud_cover == 0.0) {
+        assert!(clouds(a, clear).is_none());
+    }
+}
+
 #[test]
 fn bad_seasons_are_refused_by_field() {
     let base = spring(0);
