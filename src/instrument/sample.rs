@@ -253,8 +253,9 @@ impl PixelSampler<'_> {
                 let (x, y) = (x0 + dx, y0 + dy);
                 let sky = self.scene.sky_at(x, y, look.geometry.view_zenith_rad, look.view_azimuth_rad);
                 let (node_rrs, node_f) = &mut work.at_nodes[gi];
-                if atmosphere.has_nodes(gi)
-                    && optics.water_at_nodes(self.scene, x, y, &look.geometry, sky, &mut work.scratch, node_rrs)?
+                if sky == Sky::Clear
+                    && atmosphere.has_nodes(gi)
+                    && optics.water_at_nodes(self.scene, x, y, &look.geometry, &mut work.scratch, node_rrs)?
                 {
                     for ((f, rrs), s_pi) in node_f.iter_mut().zip(node_rrs.iter()).zip(&atmosphere.node_s_pi[gi][c]) {
                         *f = rrs / (1.0 - s_pi * rrs);

@@ -204,20 +204,19 @@ impl SceneOptics {
     }
 
     /// Rrs above the surface at the band nodes (`rrs`, one per node) at scene point (x, y):
-    /// `Ok(false)` on land, under cloud or in its shadow, or without band nodes (the caller then
-    /// takes [`Self::radiance`]).
+    /// `Ok(false)` on land or without band nodes (the caller then takes [`Self::radiance`], as it
+    /// does under a cloud or in its shadow).
     pub fn water_at_nodes(
         &self,
         scene: &Scene,
         x_m: f64,
         y_m: f64,
         g: &Geometry,
-        sky: Sky,
         scratch: &mut Scratch,
         rrs: &mut [f64],
     ) -> Result<bool, SceneError> {
         let Some(nodes) = &self.nodes_water else { return Ok(false) };
-        if scene.is_land(x_m, y_m) || sky != Sky::Clear {
+        if scene.is_land(x_m, y_m) {
             return Ok(false);
         }
         // The single-precision kernel's work buffer, out of `scratch` while the column borrows it.
