@@ -83,6 +83,12 @@ impl SurfaceClass {
     pub const fn is_water(self) -> bool {
         matches!(self, Self::Water | Self::CloudShadow)
     }
+
+    /// Cloud or a cloud's shadow: what a perfect cloud screen leaves out.
+    #[must_use]
+    pub const fn is_cloudy(self) -> bool {
+        matches!(self, Self::Cloud | Self::CloudShadow)
+    }
 }
 
 /// The surface class of every pixel, (row, column): the one place that says which pixels are
@@ -146,14 +152,14 @@ impl SurfaceMap {
     /// Does any pixel see cloud or a cloud's shadow?
     #[must_use]
     pub fn has_clouds(&self) -> bool {
-        self.codes.iter().any(|&c| matches!(SurfaceClass::of_code(c), SurfaceClass::Cloud | SurfaceClass::CloudShadow))
+        self.codes.iter().any(|&c| SurfaceClass::of_code(c).is_cloudy())
     }
 
     /// The screen of a processor that knows every cloud and shadow exactly (the perfect
     /// processor's): true on cloud and cloud shadow.
     #[must_use]
     pub fn exact_screen(&self) -> Array2<bool> {
-        self.codes.mapv(|c| matches!(SurfaceClass::of_code(c), SurfaceClass::Cloud | SurfaceClass::CloudShadow))
+        self.codes.mapv(|c| SurfaceClass::of_code(c).is_cloudy())
     }
 
     /// The map a processor corrects over, given its cloud screen (`screened`: true where it

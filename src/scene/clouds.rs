@@ -53,7 +53,7 @@ const MAX_CELLS: usize = 1 << 24;
 /// A broken cloud layer over the scene.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct CloudSpec {
+pub struct CloudLayer {
     /// Fraction of the scene under cloud, 0–1.
     pub cover: f64,
     /// Typical cloud size: the correlation length of the field, m.
@@ -80,7 +80,7 @@ fn default_optical_thickness() -> f64 {
     20.0
 }
 
-impl Default for CloudSpec {
+impl Default for CloudLayer {
     fn default() -> Self {
         Self {
             cover: 0.3,
@@ -92,7 +92,7 @@ impl Default for CloudSpec {
     }
 }
 
-impl CloudSpec {
+impl CloudLayer {
     /// Check every number against its range.
     pub fn validate(&self) -> Result<(), SceneError> {
         use crate::ranges as r;
@@ -132,7 +132,7 @@ pub enum Sky {
 /// The cloud layer, rasterised.
 #[derive(Debug, Clone)]
 pub struct CloudField {
-    spec: CloudSpec,
+    spec: CloudLayer,
     /// Field values, row-major, row 0 at the south edge.
     values: Vec<f32>,
     width: usize,
@@ -148,7 +148,7 @@ impl CloudField {
     /// The layer of `spec` over a scene of `extent` with the sun at (`sun_zenith_rad`,
     /// `sun_azimuth_rad`).
     pub fn build(
-        spec: &CloudSpec,
+        spec: &CloudLayer,
         extent: Extent,
         sun_zenith_rad: f64,
         sun_azimuth_rad: f64,
@@ -185,7 +185,7 @@ impl CloudField {
 
     /// The spec it was built from.
     #[must_use]
-    pub fn spec(&self) -> &CloudSpec {
+    pub fn spec(&self) -> &CloudLayer {
         &self.spec
     }
 
@@ -265,7 +265,7 @@ mod tests {
     #[test]
     fn the_field_covers_the_fraction_asked_for() {
         for cover in [0.0, 0.1, 0.35, 0.8, 1.0] {
-            let spec = CloudSpec { cover, ..CloudSpec::default() };
+            let spec = CloudLayer { cover, ..CloudLayer::default() };
             let f = CloudField::build(&spec, extent(), 0.5, 0.0).unwrap();
             // Exactly, on the raster's cells (to one cell in 3 750).
             assert!((f.cell_cover() - cover).abs() < 1.0 / 3000.0, "{cover}: {}", f.cell_cover());
@@ -287,7 +287,7 @@ mod tests {
     fn the_shadow_falls_away_from_the_sun_by_height_times_tan_zenith() {
         // Sun at 45° zenith in the east (azimuth 90°): a point is shadowed by the cloud
         // height_m east of it, and sees at nadir the cloud above it.
-        let spec = CloudSpec { cover: 0.3, height_m: 1200.0, ..CloudSpec::default() };
+        let spec = CloudLayer { cover: 0.3, height_m: 1200.0, ..CloudLayer::default() };
         let f = CloudField::build(&spec, extent(), 45f64.to_radians(), 90f64.to_radians()).unwrap();
         let (mut shadows, mut clouds) = (0, 0);
         for i in 0..4000 {
@@ -312,26 +312,26 @@ mod tests {
     #[test]
     fn albedo_follows_lacis_and_hansen() {
         // τ = 20, g = 0.85: x = √3·0.15·20 = 5.196, R = 5.196/7.196 = 0.7221.
-        let spec = CloudSpec { optical_thickness: 20.0, ..CloudSpec::default() };
+        let spec = CloudLayer { optical_thickness: 20.0, ..CloudLayer::default() };
         assert!((spec.albedo() - 0.722_08).abs() < 1e-4, "{}", spec.albedo());
-        let thin = CloudSpec { optical_thickness: 1.0, ..CloudSpec::default() };
+        let thin = CloudLayer { optical_thickness: 1.0, ..CloudLayer::default() };
         assert!((thin.albedo() - 0.115_0).abs() < 1e-3, "{}", thin.albedo());
     }
 
     #[test]
     fn bad_numbers_are_refused_naming_the_field() {
         for (spec, field) in [
-            (CloudSpec { cover: 1.5, ..CloudSpec::default() }, "cover"),
-            (CloudSpec { cover: f64::NAN, ..CloudSpec::default() }, "cover"),
-            (CloudSpec { size_m: 0.0, ..CloudSpec::default() }, "size_m"),
-            (CloudSpec { height_m: -1.0, ..CloudSpec::default() }, "height_m"),
-            (CloudSpec { optical_thickness: 0.0, ..CloudSpec::default() }, "optical_thickness"),
+            (CloudLayer { cover: 1.5, ..CloudLayer::default() }, "cover"),
+            (CloudLayer { cover: f64::NAN, ..CloudLayer::default() }, "cover"),
+            (CloudLayer { size_m: 0.0, ..CloudLayer::default() }, "size_m"),
+            (CloudLayer { height_m: -1.0, ..CloudLayer::default() }, "height_m"),
+            (CloudLayer { optical_thickness: 0.0, ..CloudLayer::default() }, "optical_thickness"),
         ] {
             let e = CloudField::build(&spec, extent(), 0.5, 0.0).unwrap_err().to_string();
             assert!(e.contains(field), "{e}");
         }
         // Clouds too small for a large scene: refused before the raster is made.
-        let tiny = CloudSpec { size_m: 10.0, ..CloudSpec::default() };
+        let tiny = CloudLayer { size_m: 10.0, ..CloudLayer::default() };
         let big = Extent { width: 20_000, height: 20_000, cell_m: 10.0 };
         assert!(CloudField::build(&tiny, big, 0.5, 0.0).unwrap_err().to_string().contains("size_m"));
     }

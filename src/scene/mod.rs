@@ -16,7 +16,7 @@ mod map;
 pub mod raster;
 mod spec;
 
-pub use clouds::{CloudField, CloudSpec, Sky};
+pub use clouds::{CloudField, CloudLayer, Sky};
 pub use grf::gaussian_random_field;
 pub use map::{Distribution, Extent, Map, MapContext, MapSpec, Shape};
 pub use raster::{GeoFrame, Georeference, Resampling};

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use super::SceneError;
-use super::clouds::{CloudField, CloudSpec, Sky};
+use super::clouds::{CloudField, CloudLayer, Sky};
 use super::map::{Extent, Map, MapContext, MapSpec};
 use super::raster::{GeoFrame, Georeference, RasterCache, fill_nodata, resolve_frame};
 use crate::atmosphere::{AtmosphereSpec, SeaSurface};
@@ -123,7 +123,7 @@ pub struct SceneSpec {
     pub aot550_map: Option<MapSpec>,
     /// A broken cloud layer and its shadows (absent: a clear sky).
     #[serde(default)]
-    pub clouds: Option<CloudSpec>,
+    pub clouds: Option<CloudLayer>,
 }
 
 /// Day of year of `YYYY-MM-DD`.
@@ -247,7 +247,7 @@ impl SceneSpec {
         if has(Effect::Adjacency) && self.land.is_none() {
             return bad("effects", "Adjacency needs `land` (a mask and a reflectance)".into());
         }
-        self.clouds.as_ref().map_or(Ok(()), CloudSpec::validate)
+        self.clouds.as_ref().map_or(Ok(()), CloudLayer::validate)
     }
 }
 

@@ -55,6 +55,9 @@ pub struct Look {
     pub glint_per_sr: f64,
     /// Cloud cover drawn for the look (0–1).
     pub cloud_cover: f64,
+    /// The seed of the look's weather (the season's seed and the hour of the pass): its cover
+    /// was drawn from it, and its scene's cloud field is made from it.
+    pub weather_seed: u64,
     /// Wind speed over the site, m/s: the glint the look was judged on, and the sea surface its
     /// chain run sees.
     pub wind_m_s: f64,
@@ -159,7 +162,8 @@ pub fn looks(season: &SeasonSpec, instrument: &InstrumentSpec, wind_m_s: f64, n:
             // (the same orbit) see the same cover, and a look's cover does not depend on which
             // other looks there are.
             let hour = (access.days * 24.0).floor() as i64 as u64;
-            let mut rng = Xoshiro256PlusPlus::seed_from_u64(season.seed ^ hour.wrapping_mul(0x9E37_79B9_7F4A_7C15));
+            let weather_seed = season.seed ^ hour.wrapping_mul(0x9E37_79B9_7F4A_7C15);
+            let mut rng = Xoshiro256PlusPlus::seed_from_u64(weather_seed);
             let month = crate::orbit::sun::calendar_date(access.days).1 as usize - 1;
             let cloud_cover = season.clouds.as_ref().map_or(0.0, |c| {
                 cloud_cover(c.monthly_fraction.get(month).copied().unwrap_or(0.0), c.concentration, &mut rng)
@@ -176,7 +180,17 @@ pub fn looks(season: &SeasonSpec, instrument: &InstrumentSpec, wind_m_s: f64, n:
                 Verdict::Valid
             };
             let altitude_m = altitude_of(&access);
-            Look { access, forward_tilt_deg, altitude_m, geometry, glint_per_sr, cloud_cover, wind_m_s, verdict }
+            Look {
+                access,
+                forward_tilt_deg,
+                altitude_m,
+                geometry,
+                glint_per_sr,
+                cloud_cover,
+                weather_seed,
+                wind_m_s,
+                verdict,
+            }
         })
         .collect()
 }

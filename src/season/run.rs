@@ -154,11 +154,11 @@ pub fn look_config(base: &RunConfig, look: &Look, decimation: usize) -> RunConfi
         config.instrument.altitude_km = h / 1e3;
     }
     // The look's cloud cover as a cloud field in the scene (the scene's own layer's size, height
-    // and thickness where it has one), seeded by the hour of the pass as the cover was, so
+    // and thickness where it has one), made from the weather its cover was drawn from, so
     // designs in one orbit see the same clouds.
-    config.scene.clouds = (look.cloud_cover > 0.0).then(|| crate::scene::CloudSpec {
+    config.scene.clouds = (look.cloud_cover > 0.0).then(|| crate::scene::CloudLayer {
         cover: look.cloud_cover,
-        seed: (a.days * 24.0).floor() as u64,
+        seed: look.weather_seed,
         ..base.scene.clouds.clone().unwrap_or_default()
     });
     config.fidelity.decimation = decimation;

@@ -8,20 +8,20 @@ use shoal::atmosphere::AerosolType;
 use shoal::correction::{CloudScreen, ImageCorrection, RrsFlags};
 use shoal::engine::{RunConfig, RunOutput};
 use shoal::instrument::{DetectorMode, SurfaceClass};
-use shoal::scene::{CloudSpec, MapSpec};
+use shoal::scene::{CloudLayer, MapSpec};
 
 use super::{run, small, small_lake};
 
 /// The cloud layer of these tests: 30 % cover of 300 m clouds at 200 m, whose shadows fall 350
 /// m from them under the scene's 60° sun (17 of the image's 20 m pixels).
-fn layer() -> CloudSpec {
-    CloudSpec { cover: 0.3, size_m: 300.0, height_m: 200.0, optical_thickness: 20.0, seed: 3 }
+fn layer() -> CloudLayer {
+    CloudLayer { cover: 0.3, size_m: 300.0, height_m: 200.0, optical_thickness: 20.0, seed: 3 }
 }
 
 /// A uniform turbid lake (chl 5 mg m⁻³, NAP 2 g m⁻³, CDOM 0.3 m⁻¹) under a continental
 /// aerosol of AOT 0.1 and `clouds`, seen by a noise-free 160 × 120 CubeSat (3.2 × 2.4 km),
 /// corrected by the image-based correction with `screen`.
-fn cloudy(clouds: Option<CloudSpec>, screen: CloudScreen) -> RunConfig {
+fn cloudy(clouds: Option<CloudLayer>, screen: CloudScreen) -> RunConfig {
     let mut scene = small_lake();
     scene.chl_mg_m3 = MapSpec::Constant(5.0);
     scene.nap_g_m3 = MapSpec::Constant(2.0);
@@ -135,9 +135,9 @@ fn a_missed_shadow_costs_chl_error_and_the_perfect_processor_screens_exactly() {
 #[test]
 fn a_cloud_layer_out_of_range_is_refused_naming_the_field() {
     for (clouds, field) in [
-        (CloudSpec { cover: 1.2, ..layer() }, "clouds.cover"),
-        (CloudSpec { height_m: 20_000.0, ..layer() }, "clouds.height_m"),
-        (CloudSpec { optical_thickness: -1.0, ..layer() }, "clouds.optical_thickness"),
+        (CloudLayer { cover: 1.2, ..layer() }, "clouds.cover"),
+        (CloudLayer { height_m: 20_000.0, ..layer() }, "clouds.height_m"),
+        (CloudLayer { optical_thickness: -1.0, ..layer() }, "clouds.optical_thickness"),
     ] {
         let e = cloudy(Some(clouds), CloudScreen::default()).validate().unwrap_err().to_string();
         assert!(e.contains(field), "{e}");

@@ -86,7 +86,7 @@ fn base(path: &str) -> RunConfig {
     if path.contains("clouds.") {
         // Clouds and their shadows over the 2.4 × 1.6 km reef: 40 % of 300 m clouds at 300 m.
         scene.clouds =
-            Some(shoal::scene::CloudSpec { cover: 0.4, size_m: 300.0, height_m: 300.0, ..Default::default() });
+            Some(shoal::scene::CloudLayer { cover: 0.4, size_m: 300.0, height_m: 300.0, ..Default::default() });
     }
     for e in [Effect::SunGlint, Effect::SpatialResponse] {
         if !scene.effects.contains(&e) {

@@ -34,7 +34,7 @@ fn base(path: &str) -> RunConfig {
         c.scene.atmosphere.aerosol = shoal::atmosphere::AerosolType::Mixture(Default::default());
     }
     if path.starts_with("scene.clouds.") {
-        c.scene.clouds = Some(shoal::scene::CloudSpec::default());
+        c.scene.clouds = Some(shoal::scene::CloudLayer::default());
     }
     if path.starts_with("scene.atmosphere.aerosol.LogNormal") {
         // The bushfire-smoke scene's two modes.
