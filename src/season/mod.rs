@@ -35,7 +35,9 @@
 pub mod figure;
 pub mod looks;
 pub mod run;
+pub mod shard;
 pub mod stats;
+pub mod summary;
 
 use serde::{Deserialize, Serialize};
 

@@ -10,9 +10,10 @@ use super::{SeasonSpec, stats};
 use crate::control::RunControl;
 use crate::engine::{Engine, EngineError, RunConfig};
 use crate::study::{StudyError, StudySpec};
+use crate::sweep::Shard;
 
 /// One product variable's error in one look's run.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct LookError {
     /// Retrieval (aLMI, SAMBUCA, …).
     pub product: String,
@@ -27,7 +28,7 @@ pub struct LookError {
 }
 
 /// One valid look run through the chain.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct LookRun {
     /// Index of the look in its design's [`DesignSeason::looks`].
     pub look: usize,
@@ -197,19 +198,28 @@ pub fn mae_limits(season: &SeasonSpec, dir: Option<&Path>) -> Vec<(String, f64)>
         .unwrap_or_default()
 }
 
-/// Run `season` over `designs` (from [`designs`]; `study` names them): find each design's
-/// looks, then run up to `max_runs` of its valid ones through the chain. `progress(done, total)`
-/// after each run.
-pub fn run_season(
+/// A season before its chain runs: every design's looks (and orbit phases), and the chain runs
+/// to make, as (design, look) in the order they run.
+#[derive(Debug, Clone)]
+pub struct SeasonPlan {
+    /// The result with no runs yet.
+    pub result: SeasonResult,
+    /// The chain runs: (index in `result.designs`, index in that design's looks), in time order
+    /// across designs. A shard `i/n` makes the runs whose index here is `i` modulo `n`.
+    pub jobs: Vec<(usize, usize)>,
+}
+
+/// Find each design's looks over `season` (from [`designs`]; `study` names them) and choose up
+/// to `max_runs` of its valid ones, evenly spaced, for the chain. Cheap (the orbit and the
+/// looks, no chain run), so a shard and a merge each make the same plan for themselves.
+pub fn plan_season(
     season: &SeasonSpec,
     study: &str,
     designs: &[(String, RunConfig)],
-    control: &RunControl,
-    mut progress: impl FnMut(usize, usize),
-) -> Result<SeasonResult, StudyError> {
+) -> Result<SeasonPlan, StudyError> {
     season.validate().map_err(StudyError::Invalid)?;
     let period = season.period_days().map_err(StudyError::Invalid)?;
-    let mut seasons: Vec<DesignSeason> = designs
+    let seasons: Vec<DesignSeason> = designs
         .iter()
         .map(|(label, config)| {
             let wind = match config.scene.atmosphere.surface {
@@ -264,32 +274,31 @@ pub fn run_season(
     jobs.sort_by(|a, b| {
         seasons[a.0].looks[a.1].access.days.total_cmp(&seasons[b.0].looks[b.1].access.days).then(a.0.cmp(&b.0))
     });
+    let result = SeasonResult { spec: season.clone(), study: study.to_string(), period, designs: seasons };
+    Ok(SeasonPlan { result, jobs })
+}
+
+/// Run `season` over `designs` (from [`designs`]; `study` names them): plan it
+/// ([`plan_season`]), then make the chain runs `shard` owns (all of them for
+/// [`Shard::ALL`]). `progress(done, total)` after each run. A shard's result holds its own runs
+/// only; [`super::shard::merge`] joins the shards' into the result one whole run gives.
+pub fn run_season(
+    season: &SeasonSpec,
+    study: &str,
+    designs: &[(String, RunConfig)],
+    shard: Shard,
+    control: &RunControl,
+    mut progress: impl FnMut(usize, usize),
+) -> Result<SeasonResult, StudyError> {
+    let SeasonPlan { result, jobs } = plan_season(season, study, designs)?;
+    let SeasonResult { period, designs: mut seasons, .. } = result;
+    let jobs: Vec<(usize, usize)> =
+        jobs.iter().enumerate().filter(|(j, _)| shard.owns(*j)).map(|(_, &job)| job).collect();
     within_budget(&jobs, designs, &seasons, season.decimation)?;
     let total = jobs.len();
     let mut engine = Engine::lean();
     for (done, &(d, k)) in jobs.iter().enumerate() {
-        let config = look_config(&designs[d].1, &seasons[d].looks[k], season.decimation);
-        let run = match engine.run_with(&config, control, &[]) {
-            Ok(out) => LookRun {
-                look: k,
-                errors: out
-                    .retrievals
-                    .iter()
-                    .flat_map(|r| {
-                        r.metrics.variables.iter().map(|v| LookError {
-                            product: r.metrics.product.clone(),
-                            variable: v.variable.clone(),
-                            mae_pct: v.metrics.mae_pct(),
-                            bias_pct: v.metrics.bias_pct(),
-                            returned_pct: v.metrics.returned_pct,
-                        })
-                    })
-                    .collect(),
-                failure: None,
-            },
-            Err(EngineError::Cancelled) => return Err(StudyError::Cancelled),
-            Err(e) => LookRun { look: k, errors: Vec::new(), failure: Some(e.to_string()) },
-        };
+        let run = run_look(&mut engine, &designs[d].1, &seasons[d].looks[k], k, season.decimation, control)?;
         seasons[d].runs.push(run);
         progress(done + 1, total);
     }
@@ -299,11 +308,46 @@ pub fn run_season(
     Ok(SeasonResult { spec: season.clone(), study: study.to_string(), period, designs: seasons })
 }
 
+/// Run look `k` of a design (its configuration `base`) through the chain on `engine` at the
+/// look's geometry ([`look_config`]): every retrieval variable's error, or why the run failed.
+/// Only a cancel is an error.
+pub fn run_look(
+    engine: &mut Engine,
+    base: &RunConfig,
+    look: &Look,
+    k: usize,
+    decimation: usize,
+    control: &RunControl,
+) -> Result<LookRun, StudyError> {
+    let config = look_config(base, look, decimation);
+    Ok(match engine.run_with(&config, control, &[]) {
+        Ok(out) => LookRun {
+            look: k,
+            errors: out
+                .retrievals
+                .iter()
+                .flat_map(|r| {
+                    r.metrics.variables.iter().map(|v| LookError {
+                        product: r.metrics.product.clone(),
+                        variable: v.variable.clone(),
+                        mae_pct: v.metrics.mae_pct(),
+                        bias_pct: v.metrics.bias_pct(),
+                        returned_pct: v.metrics.returned_pct,
+                    })
+                })
+                .collect(),
+            failure: None,
+        },
+        Err(EngineError::Cancelled) => return Err(StudyError::Cancelled),
+        Err(e) => LookRun { look: k, errors: Vec::new(), failure: Some(e.to_string()) },
+    })
+}
+
 /// Refuse a season whose chain runs would not fit the machine's budget
 /// ([`crate::budget::MachineBudget`]) before any runs: each look's memory as one run's, and the
 /// radiative transfer of every look together (each look has its own sun, so its own tables; a
 /// second design in the same orbit may reuse the first's, so this is an upper bound).
-fn within_budget(
+pub fn within_budget(
     jobs: &[(usize, usize)],
     designs: &[(String, RunConfig)],
     seasons: &[DesignSeason],

@@ -31,7 +31,7 @@ pub use cost::{
     settings_for,
 };
 pub use figure::sweep_figure;
-pub use run::{Job, SweepResult, empty_table, run_job, run_sweep};
+pub use run::{Job, SweepResult, empty_table, fnv1a, run_job, run_sweep};
 pub use table::{Row, Table, merge};
 
 use std::path::Path;

@@ -34,7 +34,7 @@ pub struct SweepResult {
 }
 
 /// FNV-1a, 64 bit: a fingerprint that is the same on every machine and toolchain.
-fn fnv1a(text: &str) -> u64 {
+pub fn fnv1a(text: &str) -> u64 {
     text.bytes().fold(0xcbf2_9ce4_8422_2325, |h, b| (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3))
 }
 

@@ -33,6 +33,7 @@ mod report;
 mod reproduction;
 mod retrieval;
 mod season;
+mod season_shards;
 mod soak;
 mod spatial;
 mod spectral_knowledge;

@@ -6,6 +6,7 @@ use shoal::orbit::{Site, SunSynchronous, accesses, days_since_j2000};
 use shoal::season::SeasonSpec;
 use shoal::season::looks::{Verdict, half_field_of_view_rad};
 use shoal::season::run::{designs, look_config, run_season};
+use shoal::sweep::Shard;
 
 fn spring(max_runs: usize) -> SeasonSpec {
     let mut s = SeasonSpec::preset("heron_island_year").unwrap();
@@ -43,7 +44,7 @@ fn glint_lgn(sun_zenith: f64, view_zenith: f64, relative_azimuth: f64, wind: f64
 fn valid_looks_match_an_independent_count() {
     let season = spring(0);
     let (study, ds) = designs(&season, None).unwrap();
-    let result = run_season(&season, &study, &ds, &RunControl::new(), |_, _| {}).unwrap();
+    let result = run_season(&season, &study, &ds, Shard::ALL, &RunControl::new(), |_, _| {}).unwrap();
     assert_eq!(result.designs.len(), 2);
     let from = days_since_j2000(&season.from).unwrap();
     let to = days_since_j2000(&season.to).unwrap() + 1.0;
@@ -109,7 +110,7 @@ fn valid_looks_match_an_independent_count() {
 fn a_valid_look_runs_the_chain_at_its_geometry() {
     let season = spring(1);
     let (study, ds) = designs(&season, None).unwrap();
-    let result = run_season(&season, &study, &ds[..1], &RunControl::new(), |_, _| {}).unwrap();
+    let result = run_season(&season, &study, &ds[..1], Shard::ALL, &RunControl::new(), |_, _| {}).unwrap();
     let d = &result.designs[0];
     assert_eq!(d.runs.len(), 1);
     let run = &d.runs[0];
@@ -133,7 +134,7 @@ fn a_valid_look_runs_the_chain_at_its_geometry() {
 fn a_look_s_clouds_are_in_its_scene() {
     let season = spring(0);
     let (study, ds) = designs(&season, None).unwrap();
-    let result = run_season(&season, &study, &ds, &RunControl::new(), |_, _| {}).unwrap();
+    let result = run_season(&season, &study, &ds, Shard::ALL, &RunControl::new(), |_, _| {}).unwrap();
     let (a, b) = (&result.designs[0], &result.designs[1]);
     let cloudy: Vec<usize> =
         (0..a.looks.len()).filter(|&k| a.looks[k].cloud_cover > 0.0 && a.looks[k].verdict == Verdict::Valid).collect();
@@ -212,7 +213,7 @@ fn a_season_does_not_depend_on_the_threads() {
             .num_threads(n)
             .build()
             .unwrap()
-            .install(|| run_season(&season, &study, &ds, &RunControl::new(), |_, _| {}).unwrap())
+            .install(|| run_season(&season, &study, &ds, Shard::ALL, &RunControl::new(), |_, _| {}).unwrap())
     };
     assert_eq!(on(1).designs, on(2).designs);
 }
@@ -241,7 +242,7 @@ fn a_season_on_two_line_elements_flies_the_spacecraft() {
     season.orbit.tle = Some(element_set());
     season.validate().unwrap();
     let (study, ds) = designs(&season, None).unwrap();
-    let result = run_season(&season, &study, &ds, &RunControl::new(), |_, _| {}).unwrap();
+    let result = run_season(&season, &study, &ds, Shard::ALL, &RunControl::new(), |_, _| {}).unwrap();
     let tle = shoal::orbit::TleOrbit::from_lines(&element_set().0, &element_set().1).unwrap();
     let site = Site::from_degrees(season.site.0, season.site.1);
     let (from, to) = season.period_days().unwrap();
