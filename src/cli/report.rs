@@ -33,26 +33,58 @@ pub struct ReportArgs {
     /// repeat for several sweeps.
     #[arg(long, value_name = "DIR")]
     sweep: Vec<PathBuf>,
+    /// A season's output directory (`shoal season --out DIR`, or its `--merge`) whose summary and
+    /// figures go into the pack; repeat for several seasons.
+    #[arg(long, value_name = "DIR")]
+    season: Vec<PathBuf>,
     /// Worker threads (default: all cores).
     #[arg(long)]
     threads: Option<usize>,
 }
 
+/// The largest season summary read (eight designs, twenty variables and ten years of months
+/// are well under 1 MB).
+const SEASON_JSON_MAX_BYTES: u64 = 16 << 20;
+
+/// The summary and figures a season wrote into `dir`: `season.json` (the season's numbers,
+/// checked against its schema; every text is escaped on the page) and its `season_*.svg`.
+fn season_dir(dir: &Path) -> Result<(crate::season::summary::SeasonSummary, Vec<crate::study::Figure>), CliError> {
+    use crate::season::summary::{SUMMARY_JSON, SeasonSummary};
+    let path = dir.join(SUMMARY_JSON);
+    let text = crate::infile::read_text(&path, SEASON_JSON_MAX_BYTES).map_err(|e| {
+        CliError::Input(format!(
+            "--season {}: {e} (write one with `shoal season … --out {}`, or its --merge)",
+            dir.display(),
+            dir.display()
+        ))
+    })?;
+    let summary: SeasonSummary = serde_json::from_str(&text)
+        .map_err(|e| CliError::Input(format!("--season {}: not a season summary: {e}", path.display())))?;
+    Ok((summary, prefixed_figures(dir, "season_", "--season")?))
+}
+
 /// The curves (`sweep_*.svg`, and their PNGs) a sweep wrote into `dir`.
 fn sweep_figures(dir: &Path) -> Result<Vec<crate::study::Figure>, CliError> {
-    let entries = std::fs::read_dir(dir).map_err(|e| CliError::Input(format!("--sweep {}: {e}", dir.display())))?;
+    prefixed_figures(dir, "sweep_", "--sweep")
+}
+
+/// The figures (`PREFIX*.svg`, and their PNGs) a command wrote into `dir`, named with the
+/// folder's name so that two folders' figures do not collide; `flag` names the option in errors.
+fn prefixed_figures(dir: &Path, prefix: &str, flag: &str) -> Result<Vec<crate::study::Figure>, CliError> {
+    let entries = std::fs::read_dir(dir).map_err(|e| CliError::Input(format!("{flag} {}: {e}", dir.display())))?;
     let mut svgs: Vec<PathBuf> = entries
         .filter_map(Result::ok)
         .map(|e| e.path())
         .filter(|p| {
             p.extension().is_some_and(|x| x == "svg")
-                && p.file_name().is_some_and(|n| n.to_string_lossy().starts_with("sweep_"))
+                && p.file_name().is_some_and(|n| n.to_string_lossy().starts_with(prefix))
         })
         .collect();
     if svgs.is_empty() {
         return Err(CliError::Input(format!(
-            "--sweep {}: no sweep curves (sweep_*.svg) there; run `shoal sweep … --out {}` without --no-figures",
+            "{flag} {}: no figures ({prefix}*.svg) there; run `shoal {} … --out {}` without --no-figures",
             dir.display(),
+            flag.trim_start_matches('-'),
             dir.display()
         )));
     }
@@ -61,7 +93,7 @@ fn sweep_figures(dir: &Path) -> Result<Vec<crate::study::Figure>, CliError> {
     svgs.into_iter()
         .map(|p| {
             let svg = crate::infile::read_text(&p, crate::report::svg::MAX_SVG_BYTES as u64)
-                .map_err(|e| CliError::Input(format!("--sweep {e}")))?;
+                .map_err(|e| CliError::Input(format!("{flag} {e}")))?;
             // Optional: anything but a regular file within the limit is left out.
             let png = crate::infile::read(&p.with_extension("png"), 64 << 20).unwrap_or_default();
             let stem = p.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
@@ -74,6 +106,7 @@ fn sweep_figures(dir: &Path) -> Result<Vec<crate::study::Figure>, CliError> {
 pub fn run(args: &ReportArgs) -> Result<(), CliError> {
     let start = std::time::Instant::now();
     let sweeps = args.sweep.iter().map(|d| sweep_figures(d)).collect::<Result<Vec<_>, _>>()?;
+    let seasons = args.season.iter().map(|d| season_dir(d)).collect::<Result<Vec<_>, _>>()?;
     let results_dir = args.target.as_deref().map(Path::new).filter(|p| p.is_dir());
     if let Some(dir) = results_dir
         && let (Ok(d), Ok(o)) = (dir.canonicalize(), args.out.canonicalize())
@@ -86,7 +119,7 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
         )));
     }
     let out = crate::study::OutputDir::create(&args.out, "shoal report")?;
-    let (data, mut figures) = match results_dir {
+    let (mut data, mut figures) = match results_dir {
         Some(dir) => {
             if !is_results_dir(dir) {
                 return Err(CliError::Input(format!(
@@ -105,6 +138,10 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
         None => run_for_report(args)?,
     };
     figures.extend(sweeps.into_iter().flatten());
+    for (summary, season_figures) in seasons {
+        data.seasons.push(summary);
+        figures.extend(season_figures);
+    }
     write_pack(&data, &figures, out.path())?;
     out.commit()?;
     let index = args.out.join("index.html");

@@ -8,8 +8,9 @@ use clap::Args;
 use super::CliError;
 use crate::csvtext::Csv;
 use crate::season::looks::Verdict;
-use crate::season::run::{SeasonResult, run_season};
-use crate::season::{SeasonSpec, stats};
+use crate::season::run::{SeasonPlan, SeasonResult, plan_season, run_season};
+use crate::season::summary::{SUMMARY_JSON, SeasonSummary, variables};
+use crate::season::{SeasonSpec, shard};
 use crate::study::write_bytes;
 
 /// Arguments of `shoal season`.
@@ -44,6 +45,14 @@ pub struct SeasonArgs {
     /// Do not draw the figures.
     #[arg(long)]
     no_figures: bool,
+    /// Make one slice of the chain runs: `i/n` makes every n-th run starting at i (0-based) and
+    /// writes them to `runs.ron`; join the slices with `--merge`.
+    #[arg(long, conflicts_with = "merge")]
+    shard: Option<String>,
+    /// Join shards' output directories (each holds `runs.ron`) into the tables and figures one
+    /// whole run writes; give the season and options the shards ran with.
+    #[arg(long, num_args = 1..)]
+    merge: Vec<PathBuf>,
 }
 
 fn load(arg: &str) -> Result<(SeasonSpec, Option<PathBuf>), CliError> {
@@ -78,8 +87,26 @@ pub fn run(args: &SeasonArgs) -> Result<(), CliError> {
         spec.max_roll_deg = r;
     }
     spec.validate().map_err(|e| CliError::Input(e.to_string()))?;
+    let shard = match &args.shard {
+        Some(text) => crate::sweep::Shard::parse(text).map_err(CliError::Input)?,
+        None => crate::sweep::Shard::ALL,
+    };
     let (study, designs) = crate::season::run::designs(&spec, dir.as_deref())?;
     super::refuse_unallowed_external(designs.iter().map(|d| &d.1))?;
+    let plan = plan_season(&spec, &study, &designs)?;
+    let key = shard::key(&plan, &designs);
+    if !args.merge.is_empty() {
+        let mut parts = Vec::with_capacity(args.merge.len());
+        for d in &args.merge {
+            parts.push((d.display().to_string(), shard::read(d)?));
+        }
+        let result = shard::merge(&plan, &key, &parts)?;
+        let out = crate::study::OutputDir::create(&args.out, "shoal season --merge")?;
+        eprintln!("{}: merged {} shards, {} chain runs", spec.name, parts.len(), plan.jobs.len());
+        print!("{}", SeasonSummary::of(&result).text(None));
+        write_outputs(&result, &plan, &key, crate::sweep::Shard::ALL, &out, args, dir.as_deref())?;
+        return Ok(out.commit()?);
+    }
     let out = crate::study::OutputDir::create(&args.out, "shoal season")?;
     let pool = super::pool(args.threads.unwrap_or(0), "shoal-season")?;
     let bar = indicatif::ProgressBar::new(0);
@@ -92,146 +119,65 @@ pub fn run(args: &SeasonArgs) -> Result<(), CliError> {
     let control = super::interrupt::control();
     let start = std::time::Instant::now();
     let result = pool.install(|| {
-        run_season(&spec, &study, &designs, &control, |done, total| {
+        run_season(&spec, &study, &designs, shard, &control, |done, total| {
             bar.set_length(total as u64);
             bar.set_position(done as u64);
         })
     })?;
     bar.finish_and_clear();
     let seconds = start.elapsed().as_secs_f64();
-    print!("{}", summary(&result, seconds));
-    write_bytes(&out.path().join("looks.csv"), looks_csv(&result).as_bytes())?;
-    write_bytes(&out.path().join("months.csv"), months_csv(&result).as_bytes())?;
+    if shard.count > 1 {
+        // A slice: its runs only; the tables and figures come from the merge.
+        let mine = plan.jobs.iter().enumerate().filter(|(j, _)| shard.owns(*j)).count();
+        eprintln!(
+            "{}: shard {}/{}, {mine} of {} chain runs in {seconds:.1} s; join with `shoal season {} --merge DIR…`",
+            spec.name,
+            shard.index,
+            shard.count,
+            plan.jobs.len(),
+            args.season
+        );
+    } else {
+        print!("{}", SeasonSummary::of(&result).text(Some(seconds)));
+    }
+    write_outputs(&result, &plan, &key, shard, &out, args, dir.as_deref())?;
+    Ok(out.commit()?)
+}
+
+/// Write a season's outputs into `out`: its runs (`runs.ron`, which `--merge` reads) and the
+/// season as run; for a whole season (or a merge) also the tables and, unless turned off, the
+/// figures.
+fn write_outputs(
+    result: &SeasonResult,
+    plan: &SeasonPlan,
+    key: &str,
+    shard: crate::sweep::Shard,
+    out: &crate::study::OutputDir,
+    args: &SeasonArgs,
+    dir: Option<&Path>,
+) -> Result<(), CliError> {
+    let runs = shard::shard_runs(plan, key.to_string(), shard, result);
+    write_bytes(&out.path().join(shard::RUNS_FILE), shard::to_ron(&runs).as_bytes())?;
+    write_bytes(
+        &out.path().join("season.ron"),
+        ron::ser::to_string_pretty(&result.spec, ron::ser::PrettyConfig::default()).unwrap_or_default().as_bytes(),
+    )?;
+    if shard.count > 1 {
+        return Ok(());
+    }
+    let summary = serde_json::to_string_pretty(&SeasonSummary::of(result))
+        .map_err(|e| CliError::Input(format!("{SUMMARY_JSON}: {e}")))?;
+    write_bytes(&out.path().join(SUMMARY_JSON), summary.as_bytes())?;
+    write_bytes(&out.path().join("looks.csv"), looks_csv(result).as_bytes())?;
+    write_bytes(&out.path().join("months.csv"), months_csv(result).as_bytes())?;
     if !args.no_figures {
-        let limits = crate::season::run::mae_limits(&spec, dir.as_deref());
-        for fig in crate::season::figure::figures(&result, &limits)? {
+        let limits = crate::season::run::mae_limits(&result.spec, dir);
+        for fig in crate::season::figure::figures(result, &limits)? {
             write_bytes(&out.path().join(format!("{}.png", fig.name)), &fig.png)?;
             write_bytes(&out.path().join(format!("{}.svg", fig.name)), fig.svg.as_bytes())?;
         }
     }
-    write_bytes(
-        &out.path().join("season.ron"),
-        ron::ser::to_string_pretty(&spec, ron::ser::PrettyConfig::default()).unwrap_or_default().as_bytes(),
-    )?;
-    Ok(out.commit()?)
-}
-
-fn fmt(v: Option<f64>, digits: usize) -> String {
-    v.map_or_else(|| "–".to_string(), |v| format!("{v:.digits$}"))
-}
-
-/// The variables every design's runs returned, as (product, variable), in first-seen order.
-fn variables(result: &SeasonResult) -> Vec<(String, String)> {
-    let mut out: Vec<(String, String)> = Vec::new();
-    for d in &result.designs {
-        for e in d.runs.iter().flat_map(|r| &r.errors) {
-            if !out.iter().any(|(p, v)| *p == e.product && *v == e.variable) {
-                out.push((e.product.clone(), e.variable.clone()));
-            }
-        }
-    }
-    out
-}
-
-/// The printed summary: per design, looks by verdict, valid looks per month, gaps, the revisit
-/// requirement, and each product's error over the valid looks run.
-#[must_use]
-pub fn summary(result: &SeasonResult, seconds: f64) -> String {
-    let s = &result.spec;
-    let mut t = format!(
-        "{}: study {}, site {:.2}°, {:.2}°, {} to {}, {}, roll up to {}°, glint tilt {}°, {} in {seconds:.1} s\n",
-        s.name,
-        result.study,
-        s.site.0,
-        s.site.1,
-        s.from,
-        s.to,
-        match &s.orbit.tle {
-            Some((line1, _)) => format!("two-line elements of {} (SGP4)", line1.get(2..7).unwrap_or("?").trim()),
-            None => format!("descending node {:.2} h", s.orbit.descending_node_h),
-        },
-        s.max_roll_deg,
-        s.glint_tilt_deg,
-        match &s.clouds {
-            Some(c) => format!("clouds from {}", c.source),
-            None => "no clouds".to_string(),
-        },
-    );
-    for d in &result.designs {
-        let count = |v: Verdict| d.looks.iter().filter(|l| l.verdict == v).count();
-        t += &format!(
-            "\n{} ({} km, half field of view {:.2}°): {} passes; valid {}, sun low {}, view oblique {}, glint {}, cloud {}\n",
-            d.label,
-            d.altitude_km,
-            d.half_fov_deg,
-            d.looks.len(),
-            count(Verdict::Valid),
-            count(Verdict::SunLow),
-            count(Verdict::ViewOblique),
-            count(Verdict::Glint),
-            count(Verdict::Cloud)
-        );
-        let months = d.per_month(Some(Verdict::Valid), result.period.0, result.period.1);
-        let row: Vec<String> = months.iter().map(|((y, m), n)| format!("{y}-{m:02} {n}")).collect();
-        t += &format!("  valid looks per month: {}\n", row.join(", "));
-        let (median, p90) = d.gap_percentiles();
-        t += &format!("  gap between valid looks: median {} d, 90th percentile {} d\n", fmt(median, 1), fmt(p90, 1));
-        if let (Some(q), Some((pct, ok))) = (s.revisit, result.revisit(d)) {
-            t += &format!(
-                "  revisit: a valid look within {} d on {pct:.1} % of days (required {} %): {}\n",
-                q.days,
-                q.pct,
-                if ok { "pass" } else { "FAIL" }
-            );
-        }
-        let valid: Vec<f64> = d.phases.iter().map(|p| p.valid as f64).collect();
-        let revisit: Vec<f64> = d.phases.iter().filter_map(|p| p.revisit_pct).collect();
-        let spread = |v: &[f64], digits: usize| {
-            format!(
-                "{}–{}–{}",
-                fmt(stats::percentile(v, 0.0), digits),
-                fmt(stats::percentile(v, 50.0), digits),
-                fmt(stats::percentile(v, 100.0), digits)
-            )
-        };
-        if !d.phases.is_empty() {
-            t += &format!(
-                "  over {} orbit phases (min–median–max): valid looks {}{}\n",
-                d.phases.len(),
-                spread(&valid, 0),
-                if revisit.is_empty() { String::new() } else { format!(", revisit {} % of days", spread(&revisit, 1)) }
-            );
-        }
-        let failed = d.runs.iter().filter(|r| r.failure.is_some()).count();
-        t += &format!(
-            "  chain runs: {} of the valid looks{}\n",
-            d.runs.len(),
-            if failed > 0 { format!(", {failed} failed") } else { String::new() }
-        );
-        for (product, variable) in variables(result) {
-            let errs: Vec<f64> = d.errors_of(&product, &variable).iter().map(|e| e.mae_pct).collect();
-            if errs.is_empty() {
-                continue;
-            }
-            let p = |q: f64| fmt(stats::percentile(&errs, q), 1);
-            // The water each look returned: clouds, their shadows and glint take their share.
-            let returned: Vec<f64> = d.errors_of(&product, &variable).iter().map(|e| e.returned_pct).collect();
-            t += &format!(
-                "  {product} {variable} MAE %: median {}, 10th–90th percentile {}–{}, worst {} ({} looks); returned % median {}, least {}\n",
-                p(50.0),
-                p(10.0),
-                p(90.0),
-                p(100.0),
-                errs.len(),
-                fmt(stats::percentile(&returned, 50.0), 1),
-                fmt(stats::percentile(&returned, 0.0), 1),
-            );
-        }
-        for r in d.runs.iter().filter(|r| r.failure.is_some()).take(3) {
-            t += &format!("  a run failed: {}\n", r.failure.as_deref().unwrap_or_default());
-        }
-    }
-    t
+    Ok(())
 }
 
 fn date_time(days: f64) -> (String, String) {

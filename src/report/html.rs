@@ -80,6 +80,7 @@ pub fn page(d: &ReviewData, figures: &[PageFigure]) -> String {
     instruments(&mut h, d);
     metrics(&mut h, d);
     figures_section(&mut h, figures);
+    super::seasons::section(&mut h, d);
     super::substrate::section(&mut h, d);
     super::sections::aerosol(&mut h, d);
     super::sections::failures(&mut h, d);
@@ -119,6 +120,9 @@ fn header(h: &mut String, d: &ReviewData) {
         );
     }
     h.push_str("</header>\n<nav><ol>\n<li><a href=\"#verdict\">Verdict against the requirements</a></li>\n<li><a href=\"#instruments\">The instruments side by side</a></li>\n<li><a href=\"#metrics\">Product errors</a></li>\n<li><a href=\"#figures\">Figures</a></li>\n");
+    if !d.seasons.is_empty() {
+        h.push_str("<li><a href=\"#seasons\">Seasons</a></li>\n");
+    }
     if !d.substrates.is_empty() {
         h.push_str("<li><a href=\"#substrate\">Bottom type</a></li>\n");
     }
@@ -300,6 +304,8 @@ fn caption(name: &str) -> String {
         "difference" => format!("A − B ({what}): B sampled at the pixel nearest each of A's ground points; diverging scale symmetric about zero."),
         "scatter" => format!("Retrieved against true ({what}), pixel density on log axes; the line is 1:1."),
         "histogram" => format!("Distribution of retrieved values ({what}) by SIOP set or dominant substrate; the outline is the truth."),
+        "season" if rest == "valid_looks" => "Valid looks per month of the season per design: passes with the sun high enough, the site in the swath, no high glint and clear enough.".into(),
+        "season" => "A product's error look by look through the season, per design: each point one valid look run through the chain at its own sun, view, date and clouds; a dashed line, when drawn, is the study's requirement.".into(),
         "sweep" => "Trade-off curve from `shoal sweep`: the MAE against the swept parameter for each instrument, with the noise seeds' range and the requirement.".into(),
         _ => what,
     }

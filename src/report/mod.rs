@@ -12,6 +12,7 @@ pub mod html;
 mod machine;
 mod optics_rows;
 mod pack;
+mod seasons;
 mod sections;
 pub mod substrate;
 pub mod svg;
@@ -209,6 +210,10 @@ pub struct ReviewData {
     /// Retrievals whose program returned nothing: (instrument, retrieval, why), first seed.
     #[serde(default)]
     pub failures: Vec<(String, String, String)>,
+    /// Seasons carried into the pack (`shoal report … --season DIR`): how often each design
+    /// sees the site and its products' error over those looks.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub seasons: Vec<crate::season::summary::SeasonSummary>,
 }
 
 /// The instruments' parameters side by side: every field of each spec, in the first one's order.
@@ -449,6 +454,7 @@ pub fn review_data(result: &StudyResult, budget: &[ErrorBudget], cost: &[CostRow
             .flat_map(|r| r.retrievals.iter().map(move |x| (r, x)))
             .filter_map(|(r, x)| x.failure.clone().map(|f| (r.label.clone(), x.metrics.product.clone(), f)))
             .collect(),
+        seasons: Vec::new(),
     }
 }
 

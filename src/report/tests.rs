@@ -97,6 +97,7 @@ fn the_review_pack_states_each_cost_row_with_its_range_and_95th_percentile() {
             },
         }],
         failures: vec![("cubesat".into(), "mine".into(), "exited with 2; <script>alert(1)</script>".into())],
+        seasons: Vec::new(),
     };
     let html = html::page(&data, &[]);
     // The aerosol the correction found, its text escaped.

@@ -211,7 +211,7 @@ fn a_report_straight_from_a_study_carries_its_error_budget_and_bad_targets_are_r
     let out =
         shoal().arg("report").arg(&from_dir).arg("--sweep").arg(&from_dir).arg("--out").arg(&again).output().unwrap();
     assert_eq!(out.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("no sweep curves"));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no figures (sweep_*.svg)"));
 
     let empty = tempdir("empty");
     let out = shoal().arg("report").arg(&empty).output().unwrap();
@@ -221,6 +221,51 @@ fn a_report_straight_from_a_study_carries_its_error_budget_and_bad_targets_are_r
     assert_eq!(out.status.code(), Some(2));
     let _ = std::fs::remove_dir_all(&dir);
     let _ = std::fs::remove_dir_all(&empty);
+}
+
+/// A season's summary and figures go into the pack; what its folder holds is escaped, and a
+/// folder without a season, or with a summary that is not one, is refused naming it.
+#[test]
+fn a_season_goes_into_the_pack_escaped() {
+    let dir = tempdir("season");
+    let season = dir.join("season");
+    ok(shoal()
+        .args(["season", "lake_hume_year", "--from", "2023-03-01", "--to", "2023-03-31", "--max-runs", "1"])
+        .args(["--decimation", "32", "--out"])
+        .arg(&season));
+    // What another person's folder could hold: markup in the season's description.
+    let json = season.join("season.json");
+    let text = std::fs::read_to_string(&json).unwrap();
+    let planted = text.replacen("\"description\": \"", "\"description\": \"<script>alert(1)</script>", 1);
+    assert_ne!(planted, text);
+    std::fs::write(&json, planted).unwrap();
+    let pack = dir.join("pack");
+    ok(shoal()
+        .args(["report", "cubesat_vs_smallsat_image", "--decimation", "32", "--season"])
+        .arg(&season)
+        .arg("--out")
+        .arg(&pack));
+    let html = std::fs::read_to_string(pack.join("index.html")).unwrap();
+    for part in [
+        "id=\"seasons\"",
+        "<h3>lake_hume_year</h3>",
+        "&lt;script&gt;alert(1)&lt;/script&gt;",
+        "id=\"fig-season_valid_looks_season\"",
+        "MAE % median",
+        "returned % median",
+    ] {
+        assert!(html.contains(part), "the pack has no `{part}`");
+    }
+    assert!(!html.contains("<script>"), "a planted script reached the page raw");
+    assert_eq!(external_references(&html), Vec::<String>::new());
+    std::fs::write(&json, "{\"name\": 3}").unwrap();
+    let out = shoal().args(["report", "cubesat_vs_smallsat_image", "--season"]).arg(&season).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("not a season summary"), "{out:?}");
+    let out = shoal().args(["report", "cubesat_vs_smallsat_image", "--season"]).arg(&dir).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("season.json"), "{out:?}");
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// A figure planted in a results folder with a script, an event handler and an image from a
