@@ -5,7 +5,10 @@
 //! acceptable. **Design**: the cheapest design from A that meets the requirements
 //! (`crate::design`), with its cost–error plot and a click to put a design into A or beside the others.
 //!
-//! Both run on a helper thread (not the engine thread, whose pool serves the maps) and stream
+//! **Season**: the designs flown over a site for a period (`crate::season`), how often they
+//! see it and their products' error over those looks.
+//!
+//! All run on a helper thread (not the engine thread, whose pool serves the maps) and stream
 //! their results; a new run or closing the window cancels the old one.
 
 use super::model::AppState;
@@ -26,6 +29,8 @@ pub struct Explore {
     pub design_open: bool,
     /// The design search's settings and results.
     pub design: design::DesignState,
+    /// The season's settings and results (its window's open flag inside).
+    pub season: season::SeasonState,
     /// The swept field's path in the run configuration (`instrument.aperture_mm`).
     param: String,
     /// A second parameter and its span (a curve per value), if any.
@@ -69,6 +74,7 @@ impl Default for Explore {
             cost_open: false,
             design_open: false,
             design: design::DesignState::default(),
+            season: season::SeasonState::default(),
             param: "instrument.aperture_mm".into(),
             second: None,
             variable: "chl_mg_m3".into(),
@@ -101,7 +107,7 @@ impl Explore {
     /// Is a helper thread working?
     #[must_use]
     pub fn busy(&self) -> bool {
-        self.sweep_task.is_some() || self.cost_task.is_some() || self.design.busy()
+        self.sweep_task.is_some() || self.cost_task.is_some() || self.design.busy() || self.season.busy()
     }
 
     /// Rows of the sweep so far.
@@ -138,6 +144,7 @@ impl Explore {
             self.design.cancel();
         }
         self.design.poll();
+        self.season.poll();
         if let Some(task) = &self.sweep_task {
             let mut finished = None;
             while let Some(msg) = task.poll() {
@@ -297,6 +304,22 @@ impl Explore {
     }
 }
 
+/// The trade-off windows that are open.
+pub fn windows(app: &mut super::ShoalApp, ctx: &egui::Context) {
+    if app.ui.explore.sweep_open {
+        sweep_window(app, ctx);
+    }
+    if app.ui.explore.cost_open {
+        cost_window(app, ctx);
+    }
+    if app.ui.explore.design_open {
+        design_window(app, ctx);
+    }
+    if app.ui.explore.season.open {
+        season_window(app, ctx);
+    }
+}
+
 /// `config` at full fidelity (its decimation kept).
 fn at_full_fidelity(mut config: RunConfig) -> RunConfig {
     config.fidelity = Fidelity { decimation: config.fidelity.decimation, ..Fidelity::full() };
@@ -357,6 +380,8 @@ mod cost;
 pub use cost::cost_window;
 mod design;
 pub use design::design_window;
+mod season;
+pub use season::season_window;
 mod sweep;
 pub use sweep::sweep_window;
 

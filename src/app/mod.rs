@@ -319,15 +319,7 @@ impl ShoalApp {
             .size_range((plots_h - 60.0)..=bottom_max)
             .show(ui, |ui| plots::bottom(self, ui));
         egui::CentralPanel::default().show(ui, |ui| maps::central(self, ui));
-        if self.ui.explore.sweep_open {
-            explore::sweep_window(self, &ctx);
-        }
-        if self.ui.explore.cost_open {
-            explore::cost_window(self, &ctx);
-        }
-        if self.ui.explore.design_open {
-            explore::design_window(self, &ctx);
-        }
+        explore::windows(self, &ctx);
         if self.ui.spectrum.open {
             spectrum::spectrum_window(self, &ctx);
         }
@@ -395,6 +387,8 @@ impl ShoalApp {
                 .on_hover_text("Time against error for each fidelity setting");
             ui.toggle_value(&mut self.ui.explore.design_open, "Design")
                 .on_hover_text("The cheapest design from A that meets the requirements, and its cost against error");
+            ui.toggle_value(&mut self.ui.explore.season.open, "Season")
+                .on_hover_text("The designs over a season at a site: valid looks (orbit, glint, clouds) and the error over them");
             ui.separator();
             ui.toggle_value(&mut self.ui.typed_export, "Path")
                 .on_hover_text("Export to a typed path (for desktops without a file-chooser portal)");

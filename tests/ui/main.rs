@@ -26,6 +26,7 @@ mod external;
 mod files;
 mod layout;
 mod review;
+mod season;
 mod session;
 mod spectrum;
 
