@@ -30,7 +30,7 @@ pub struct AerosolFamily {
     /// with its gases over the same without them (1 where the scene has no gases).
     pub gas_two_way: Vec<f64>,
     /// Per column: the normalised glint radiance L_GN = ρ_g μ₀/π expected at its geometry from
-    /// the scene's wind (Cox–Munk; Wang & Bailey 2001), sr⁻¹; zeros unless the scene has glint.
+    /// the wind the processor assumes (Cox–Munk; Wang & Bailey 2001), sr⁻¹; zeros unless the scene has glint.
     pub glint_lgn: Vec<f64>,
 }
 
@@ -65,11 +65,31 @@ pub struct FamilyLuts {
     /// The Rayleigh atmosphere without gases, where the scene has them (for the bands'
     /// gas transmittance).
     pub gas_free: Option<std::sync::Arc<AtmosphereLut>>,
+    /// The sea surface the processor assumes: the scene's, its wind off by
+    /// `glint_wind_error_m_s`. Its glint is what the family expects.
+    pub surface: crate::atmosphere::SeaSurface,
+}
+
+/// The sea surface a processor with `settings` assumes over a scene with `surface`: the wind
+/// off by the settings' error, at least 0 (a flat sea stays flat: no glint is expected).
+#[must_use]
+pub fn assumed_surface(
+    surface: crate::atmosphere::SeaSurface,
+    settings: &ImageCorrection,
+) -> crate::atmosphere::SeaSurface {
+    match surface {
+        crate::atmosphere::SeaSurface::Wind { speed_m_s } => {
+            crate::atmosphere::SeaSurface::Wind { speed_m_s: (speed_m_s + settings.glint_wind_error_m_s).max(0.0) }
+        }
+        flat => flat,
+    }
 }
 
 impl FamilyLuts {
     /// Build the family's LUTs: `atmosphere` is the scene's (its aerosol and AOT replaced by
-    /// each member's), `axes` the run's LUT axes.
+    /// each member's, its wind by the one the processor assumes: [`assumed_surface`]), `axes`
+    /// the run's LUT axes. The sea's wind enters only the glint, not the radiative transfer
+    /// (a flat Fresnel surface), so a wind error costs no other solve.
     pub fn build(
         settings: &ImageCorrection,
         atmosphere: &AtmosphereSpec,
@@ -77,6 +97,8 @@ impl FamilyLuts {
         control: &RunControl,
     ) -> Result<Self, CorrectionError> {
         settings.validate()?;
+        let atmosphere =
+            &AtmosphereSpec { surface: assumed_surface(atmosphere.surface, settings), ..atmosphere.clone() };
         let fail = |e: String| invalid("correction.image", e);
         let lut_with = |spec: AtmosphereSpec| -> Result<std::sync::Arc<AtmosphereLut>, CorrectionError> {
             if control.cancelled() {
@@ -118,7 +140,7 @@ impl FamilyLuts {
         } else {
             None
         };
-        Ok(Self { models: settings.models.clone(), aot550, angstrom, luts, gas_free })
+        Ok(Self { models: settings.models.clone(), aot550, angstrom, luts, gas_free, surface: atmosphere.surface })
     }
 }
 
@@ -163,7 +185,7 @@ impl AerosolFamily {
         };
         // Per column, the largest over the geometry groups (a filter imager's rows see the ground
         // from different angles).
-        let glint_lgn = match scene.spec.atmosphere.surface {
+        let glint_lgn = match luts.surface {
             crate::atmosphere::SeaSurface::Wind { speed_m_s } if scene.wants(crate::scene::Effect::SunGlint) => {
                 // L_GN is the glint per unit solar flux without the path's attenuation (τ = 0).
                 let lgn = |g: &crate::atmosphere::Geometry| {

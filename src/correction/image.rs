@@ -133,6 +133,13 @@ pub struct ImageCorrection {
     /// Largest normalised glint radiance L_GN = ρ_g μ₀/π a retrieved pixel may have, sr⁻¹
     /// (l2gen's `glint_thresh`, 0.005).
     pub glint_threshold_per_sr: f64,
+    /// The error of the wind the processor assumes for the glint, m/s: its wind is the
+    /// scene's plus this (at least 0). l2gen takes the wind from ancillary meteorological
+    /// fields (NCEP), which over a lake or a reef are not the wind on the water; the glint
+    /// it expects, and so what it takes away and which pixels it leaves out, follow the wind it
+    /// assumes (Cox–Munk's slope variance grows with the wind: Cox & Munk 1954). 0: the
+    /// processor knows the wind.
+    pub glint_wind_error_m_s: f64,
     /// The cloud and shadow screen, where the scene has clouds ([`super::clouds`]).
     pub clouds: super::clouds::CloudScreen,
 }
@@ -148,6 +155,7 @@ impl Default for ImageCorrection {
             aot_nodes: vec![0.05, 0.1, 0.2, 0.4, 0.8],
             glint: true,
             glint_threshold_per_sr: 0.005,
+            glint_wind_error_m_s: 0.0,
             clouds: super::clouds::CloudScreen::default(),
         }
     }
@@ -228,6 +236,8 @@ impl ImageCorrection {
         }
         let g = &crate::ranges::CORRECTION_GLINT_THRESHOLD;
         g.check(self.glint_threshold_per_sr).map_err(|m| invalid(g.path, m))?;
+        let w = &crate::ranges::CORRECTION_GLINT_WIND_ERROR;
+        w.check(self.glint_wind_error_m_s).map_err(|m| invalid(w.path, m))?;
         self.clouds.validate()?;
         let d = &self.dark;
         let tile = &crate::ranges::CORRECTION_DARK_TILE_PX;

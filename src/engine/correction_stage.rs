@@ -182,6 +182,7 @@ impl Engine {
             .with(&axes)
             .with(&image.models)
             .with(&image.aot_nodes)
+            .with(&image.glint_wind_error_m_s)
             .finish();
         let luts = self.stage(luts_key, report, control, || {
             FamilyLuts::build(image, &atmosphere, &axes, control).map_err(failed(Stage::AerosolLuts))

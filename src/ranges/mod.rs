@@ -361,6 +361,8 @@ ranges! {
     CORRECTION_AOT_NODE = Range::above("correction.image.aot_nodes", 0.0, 5.0, "", "AOT(550) nodes of the aerosol family's tables, increasing (0 is always added)");
     /// Glint threshold of the image-based correction.
     CORRECTION_GLINT_THRESHOLD = Range::above("correction.image.glint_threshold_per_sr", 0.0, 1.0, "sr-1", "largest normalised glint radiance L_GN of a retrieved pixel (l2gen's glint_thresh)");
+    /// Error of the wind the image-based correction assumes for the glint.
+    CORRECTION_GLINT_WIND_ERROR = Range::closed("correction.image.glint_wind_error_m_s", -20.0, 20.0, "m/s", "error of the wind the processor assumes for the glint (its wind: the scene's plus this, at least 0)");
     /// The cloud screen's threshold.
     CORRECTION_CLOUD_THRESHOLD = Range::above("correction.image.clouds.threshold", 0.0, 1.0, "", "Rayleigh-corrected reflectance at 865 nm above which a pixel is cloud");
     /// The cloud height the shadow screen assumes.

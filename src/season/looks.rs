@@ -61,6 +61,9 @@ pub struct Look {
     /// Wind speed over the site, m/s: the glint the look was judged on, and the sea surface its
     /// chain run sees.
     pub wind_m_s: f64,
+    /// The error of the wind the processor assumes for the look's glint, m/s (drawn from the
+    /// season's `processor_wind_rms_m_s`; 0 without).
+    pub processor_wind_error_m_s: f64,
     /// Kept or why not.
     pub verdict: Verdict,
 }
@@ -168,6 +171,14 @@ pub fn looks(season: &SeasonSpec, instrument: &InstrumentSpec, wind_m_s: f64, n:
             let cloud_cover = season.clouds.as_ref().map_or(0.0, |c| {
                 cloud_cover(c.monthly_fraction.get(month).copied().unwrap_or(0.0), c.concentration, &mut rng)
             });
+            // Drawn after the cover, from the same weather, so that a wind error leaves every
+            // look's cover as it was; within the range the correction accepts.
+            let processor_wind_error_m_s = if season.processor_wind_rms_m_s > 0.0 {
+                let z: f64 = rand_distr::StandardNormal.sample(&mut rng);
+                (season.processor_wind_rms_m_s * z).clamp(-20.0, 20.0)
+            } else {
+                0.0
+            };
             let verdict = if access.sun.zenith_rad > max_sun {
                 Verdict::SunLow
             } else if sight.is_none() || geometry.view_zenith_rad > max_view {
@@ -189,6 +200,7 @@ pub fn looks(season: &SeasonSpec, instrument: &InstrumentSpec, wind_m_s: f64, n:
                 cloud_cover,
                 weather_seed,
                 wind_m_s,
+                processor_wind_error_m_s,
                 verdict,
             }
         })

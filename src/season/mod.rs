@@ -137,6 +137,11 @@ pub struct SeasonSpec {
     /// Wind speed for the glint, m/s (the scene's own when its surface is wind-roughened).
     #[serde(default = "default_wind")]
     pub wind_m_s: f64,
+    /// RMS error of the wind the processor assumes for the glint, m/s: each look's error is
+    /// drawn from a normal distribution of this spread with its weather (an ancillary wind is
+    /// not the wind on the water). 0: the processor knows the wind.
+    #[serde(default)]
+    pub processor_wind_rms_m_s: f64,
     /// Largest normalised glint radiance L_GN a valid look may have, sr⁻¹.
     #[serde(default = "default_glint_threshold")]
     pub glint_threshold_per_sr: f64,
@@ -215,6 +220,14 @@ pub mod ranges {
         Range::closed("max_view_zenith_deg", 10.0, 80.0, "degrees", "largest view zenith of a look");
     /// Wind.
     pub const WIND: Range = Range::closed("wind_m_s", 0.0, 30.0, "m/s", "wind speed for the glint");
+    /// The processor's wind error.
+    pub const WIND_ERROR: Range = Range::closed(
+        "processor_wind_rms_m_s",
+        0.0,
+        10.0,
+        "m/s",
+        "RMS error of the wind the processor assumes for the glint",
+    );
     /// Glint threshold.
     pub const GLINT: Range =
         Range::above("glint_threshold_per_sr", 0.0, 1.0, "sr-1", "largest normalised glint of a valid look");
@@ -290,6 +303,7 @@ impl SeasonSpec {
         check(&r::MAX_SUN, self.max_sun_zenith_deg)?;
         check(&r::MAX_VIEW, self.max_view_zenith_deg)?;
         check(&r::WIND, self.wind_m_s)?;
+        check(&r::WIND_ERROR, self.processor_wind_rms_m_s)?;
         check(&r::GLINT, self.glint_threshold_per_sr)?;
         check(&r::ROLL, self.max_roll_deg)?;
         check(&r::TILT, self.glint_tilt_deg)?;

@@ -151,6 +151,10 @@ pub fn look_config(base: &RunConfig, look: &Look, decimation: usize) -> RunConfi
     if !config.scene.effects.contains(&crate::scene::Effect::SunGlint) {
         config.scene.effects.push(crate::scene::Effect::SunGlint);
     }
+    // The processor's glint from the wind it assumes (the look's draw of its error).
+    if let crate::correction::Method::Image(image) = &mut config.correction.method {
+        image.glint_wind_error_m_s = look.processor_wind_error_m_s;
+    }
     if let Some(h) = look.altitude_m {
         config.instrument.altitude_km = h / 1e3;
     }

@@ -102,3 +102,38 @@ fn high_glint_is_left_out() {
     assert_eq!(out.correction.aerosol.as_ref().unwrap().high_glint, rows * cols);
     assert!(out.kept().rrs.flags.iter().all(|f| f & RrsFlags::INVALID != 0));
 }
+
+/// The processor's wind off at the 15° roll (true wind 5 m/s). Far from the specular direction
+/// the glint a processor expects grows steeply with the wind it assumes (Cox–Munk: the slope
+/// variance σ² = 0.003 + 0.00512·W sets exp(−tan²β/σ²)). Off by +1 m/s it takes away more glint
+/// than there is and finds less aerosol; off by −1 m/s it expects almost none and reads the
+/// glint as aerosol, as a correction without glint handling does; at ±2 m/s the Rrs is wrong by
+/// more than ten times the closure bound either way. Measured (AOT, Rrs(443) error): −2 m/s
+/// 0.243, +6.1·10⁻³; −1 m/s 0.241, +6.3·10⁻³; +1 m/s 0.133, +1.0·10⁻³; +2 m/s 0.171,
+/// +7.1·10⁻³ (the known wind: 0.150 and under 2·10⁻⁵; the glint ignored: 0.244, +6.0·10⁻³).
+#[test]
+fn a_wrong_wind_leaves_the_glint_it_misjudges_in_the_aerosol() {
+    let with_error = |e: f64| {
+        let mut c = glinting(15.0, true);
+        if let shoal::correction::Method::Image(i) = &mut c.correction.method {
+            i.glint_wind_error_m_s = e;
+        }
+        medians(&c)
+    };
+    let mut aot = Vec::new();
+    for e in [-2.0, -1.0, 1.0, 2.0] {
+        let (a, errors, _) = with_error(e);
+        println!("wind error {e:+} m/s: AOT {a:.4} (true 0.15), Rrs(443) error {:+.2e}", errors[2].0);
+        aot.push((a, errors[2].0));
+    }
+    assert!(aot[2].0 < 0.15 * 0.97, "a stronger assumed wind takes away too much glint: AOT {}", aot[2].0);
+    assert!(aot[1].0 > 0.15 * 1.03, "a weaker assumed wind leaves glint as aerosol: AOT {}", aot[1].0);
+    assert!(aot[0].1.abs() > 2e-4 && aot[3].1.abs() > 2e-4, "{aot:?}");
+    // A wind error is refused outside its range, naming the field.
+    let mut c = glinting(15.0, true);
+    if let shoal::correction::Method::Image(i) = &mut c.correction.method {
+        i.glint_wind_error_m_s = 25.0;
+    }
+    let e = c.validate().unwrap_err().to_string();
+    assert!(e.contains("correction.image.glint_wind_error_m_s"), "{e}");
+}

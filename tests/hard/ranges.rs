@@ -131,6 +131,7 @@ fn refusal(range: &Range, value: f64) -> Option<String> {
             "correction.image.dark.pixels" => dark.pixels = value as usize,
             "correction.image.dark.min_gas_transmittance" => dark.min_gas_transmittance = value,
             "correction.image.glint_threshold_per_sr" => image.glint_threshold_per_sr = value,
+            "correction.image.glint_wind_error_m_s" => image.glint_wind_error_m_s = value,
             "correction.image.clouds.threshold" => image.clouds.threshold = value,
             "correction.image.clouds.height_m" => image.clouds.height_m = value,
             "correction.image.dark.wave_range_nm" => {
