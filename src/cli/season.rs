@@ -128,7 +128,7 @@ pub fn run(args: &SeasonArgs) -> Result<(), CliError> {
     let seconds = start.elapsed().as_secs_f64();
     if shard.count > 1 {
         // A slice: its runs only; the tables and figures come from the merge.
-        let mine = plan.jobs.iter().enumerate().filter(|(j, _)| shard.owns(*j)).count();
+        let mine = plan.owned(shard).len();
         eprintln!(
             "{}: shard {}/{}, {mine} of {} chain runs in {seconds:.1} s; join with `shoal season {} --merge DIR…`",
             spec.name,

@@ -209,8 +209,39 @@ pub struct SeasonPlan {
     /// The result with no runs yet.
     pub result: SeasonResult,
     /// The chain runs: (index in `result.designs`, index in that design's looks), in time order
-    /// across designs. A shard `i/n` makes the runs whose index here is `i` modulo `n`.
+    /// across designs.
     pub jobs: Vec<(usize, usize)>,
+}
+
+impl SeasonPlan {
+    /// Does `shard` make run `job`? Runs are dealt to shards by the hour of their pass, so the
+    /// designs in one orbit pass in the same shard, where the second reuses the first's scene
+    /// and atmosphere tables: a shard `i/n` makes the passes whose count, in time order, is `i`
+    /// modulo `n`.
+    #[must_use]
+    pub fn owns(&self, shard: Shard, job: usize) -> bool {
+        self.passes().get(job).is_some_and(|&pass| shard.owns(pass))
+    }
+
+    /// The runs `shard` makes, as indices into [`Self::jobs`].
+    #[must_use]
+    pub fn owned(&self, shard: Shard) -> Vec<usize> {
+        self.passes().iter().enumerate().filter(|(_, pass)| shard.owns(**pass)).map(|(j, _)| j).collect()
+    }
+
+    /// Each run's pass: runs in the same hour share one, counted in time order from 0.
+    fn passes(&self) -> Vec<usize> {
+        let hour = |&(d, k): &(usize, usize)| (self.result.designs[d].looks[k].access.days * 24.0).floor();
+        let mut pass = 0;
+        let mut out = Vec::with_capacity(self.jobs.len());
+        for (j, job) in self.jobs.iter().enumerate() {
+            if j > 0 && hour(job) != hour(&self.jobs[j - 1]) {
+                pass += 1;
+            }
+            out.push(pass);
+        }
+        out
+    }
 }
 
 /// Find each design's looks over `season` (from [`designs`]; `study` names them) and choose up
@@ -294,10 +325,9 @@ pub fn run_season(
     control: &RunControl,
     mut progress: impl FnMut(usize, usize),
 ) -> Result<SeasonResult, StudyError> {
-    let SeasonPlan { result, jobs } = plan_season(season, study, designs)?;
-    let SeasonResult { period, designs: mut seasons, .. } = result;
-    let jobs: Vec<(usize, usize)> =
-        jobs.iter().enumerate().filter(|(j, _)| shard.owns(*j)).map(|(_, &job)| job).collect();
+    let plan = plan_season(season, study, designs)?;
+    let jobs: Vec<(usize, usize)> = plan.owned(shard).into_iter().map(|j| plan.jobs[j]).collect();
+    let SeasonResult { period, designs: mut seasons, .. } = plan.result;
     within_budget(&jobs, designs, &seasons, season.decimation)?;
     let total = jobs.len();
     let mut engine = Engine::lean();

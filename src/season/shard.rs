@@ -88,11 +88,10 @@ pub fn key(plan: &SeasonPlan, designs: &[(String, RunConfig)]) -> String {
 #[must_use]
 pub fn shard_runs(plan: &SeasonPlan, key: String, shard: Shard, result: &SeasonResult) -> ShardRuns {
     let mut runs: Vec<JobRun> = plan
-        .jobs
-        .iter()
-        .enumerate()
-        .filter(|(j, _)| shard.owns(*j))
-        .filter_map(|(job, &(d, k))| {
+        .owned(shard)
+        .into_iter()
+        .filter_map(|job| {
+            let (d, k) = plan.jobs[job];
             let design = &result.designs[d];
             let run = design.runs.iter().find(|r| r.look == k)?;
             Some(JobRun {
@@ -154,7 +153,7 @@ fn check_run(plan: &SeasonPlan, name: &str, shard: Shard, run: &JobRun) -> Resul
         .jobs
         .get(run.job)
         .ok_or_else(|| invalid(format!("{name}: run {} is outside the season's {} runs", run.job, plan.jobs.len())))?;
-    if !shard.owns(run.job) {
+    if !plan.owns(shard, run.job) {
         return Err(invalid(format!("{name}: run {} is not shard {}/{}'s", run.job, shard.index, shard.count)));
     }
     let design = &plan.result.designs[d];
@@ -241,7 +240,7 @@ pub fn merge(plan: &SeasonPlan, key: &str, parts: &[(String, ShardRuns)]) -> Res
         return Err(invalid(format!(
             "run {j} (`{}`'s look of {y:04}-{m:02}-{day:02}) is in no shard: shard {}/{count} did not finish it",
             plan.result.designs[d].label,
-            j % count
+            (0..count).find(|&i| plan.owns(Shard { index: i, count }, j)).unwrap_or(0)
         )));
     }
     for d in &mut result.designs {
