@@ -30,6 +30,8 @@ pub struct Snapshot {
     pub decimation: usize,
     /// Per design, why it has no result to export (failed, still running), if it has none.
     pub missing: Vec<Option<String>>,
+    /// The Season window's season, when it has finished for the designs and scene set now.
+    pub season: Option<crate::season::run::SeasonResult>,
 }
 
 impl Snapshot {
@@ -56,6 +58,7 @@ impl Snapshot {
             runs: (0..n).map(|i| app.link.current(i).map(|s| s.output.clone())).collect(),
             decimation: app.link.current(0).map_or(1, |s| s.decimation),
             missing,
+            season: app.ui.explore.season.finished_for(&app.state.configs()).cloned(),
         }
     }
 
@@ -112,6 +115,17 @@ pub fn write_review_pack(snap: &Snapshot, dir: &Path) -> Result<PathBuf, String>
         if slot.modified() {
             summary.description = format!("{}. Edited from the preset `{}`.", slot.spec.summary(), slot.preset);
         }
+    }
+    // The season the Season window ran for these designs, with its figures, as `shoal report
+    // --season` carries one.
+    let mut figures = figures;
+    if let Some(season) = &snap.season {
+        data.seasons.push(crate::season::summary::SeasonSummary::of(season));
+        let limits: Vec<(String, f64)> = crate::season::summary::variables(season)
+            .into_iter()
+            .filter_map(|(_, v)| Some((v.clone(), snap.state.requirements.for_variable(&v)?.mae_pct?)))
+            .collect();
+        figures.extend(crate::season::figure::figures(season, &limits).map_err(|e| e.to_string())?);
     }
     crate::report::write_pack(&data, &figures, out.path()).map_err(|e| e.to_string())?;
     out.commit().map_err(|e| e.to_string())?;

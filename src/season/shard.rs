@@ -1,10 +1,12 @@
-//! A season split over machines: `shoal season S --shard i/n` makes every n-th of the plan's
-//! chain runs and writes them to `runs.ron`; `shoal season S --merge DIR…` joins the shards'
+//! A season split over machines: `shoal season S --shard i/n` makes the chain runs of every n-th
+//! pass (the designs in one orbit pass together, sharing their tables) and writes them to
+//! `runs.ron`; `shoal season S --merge DIR…` joins the shards'
 //! runs into the result one whole run gives, so its tables and figures are the same, byte for
 //! byte.
 //!
 //! The looks themselves are not shipped: a shard and the merge each plan the season
-//! ([`super::run::plan_season`], the orbit and the looks, well under a second for a year), and
+//! ([`super::run::plan_season`]: the orbit, the looks and their spread over orbit phases, no
+//! chain run; seconds for a year), and
 //! a fingerprint of everything that decides the runs (the season and each design's
 //! configuration) ties a shard's runs to that plan. What a shard file holds comes from another
 //! machine and is checked before it is used: the fingerprint, each shard once, each run once and

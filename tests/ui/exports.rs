@@ -10,7 +10,7 @@ use super::*;
 
 /// Type `name` into the Path row and press `button`; wait until `done` exists and the export
 /// has finished.
-fn export(h: &mut Harness<'static, ShoalApp>, name: &std::path::Path, button: &str, done: &std::path::Path) {
+pub(super) fn export(h: &mut Harness<'static, ShoalApp>, name: &std::path::Path, button: &str, done: &std::path::Path) {
     if h.query_by_role_and_label(Role::TextInput, "Export to").is_none() {
         h.get_by_label("Path").click();
         h.step();

@@ -47,5 +47,17 @@ fn the_season_window_runs_the_designs_on_screen_over_a_month() {
         assert!(d.products.iter().any(|p| p.variable == "chl_mg_m3" && p.looks == 6 && p.mae_median_pct > 0.0));
     }
     assert!(h.query_by_label("MAE % median").is_some(), "the error table is shown");
+    // The review pack written now carries the season, as `shoal report --season` does (the
+    // window closed: its finished season stays).
+    h.get_by_label("Close window").click();
+    h.step();
+    h.step();
+    super::wait_for_engine(&mut h);
+    let stem = dir.join("season");
+    super::exports::export(&mut h, &stem, "Write review pack", &dir.join("season_review").join("index.html"));
+    let html = std::fs::read_to_string(dir.join("season_review").join("index.html")).unwrap();
+    for part in ["id=\"seasons\"", "<h3>lake_hume_year</h3>", "id=\"fig-season_valid_looks\"", "A: cubesat"] {
+        assert!(html.contains(part), "the pack has no `{part}`");
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -81,6 +81,14 @@ impl SeasonState {
         self.summary.as_ref()
     }
 
+    /// The season, when it has finished (every run made) for exactly `configs`, the designs
+    /// and scene set now: what the review pack may carry.
+    #[must_use]
+    pub fn finished_for(&self, configs: &[RunConfig]) -> Option<&SeasonResult> {
+        let done = !self.busy() && self.done == self.total && self.ran_with == configs;
+        self.result.as_ref().filter(|_| done)
+    }
+
     /// Stop the season being run (its looks and the runs made so far stay).
     pub fn cancel(&mut self) {
         if self.task.take().is_some() {
