@@ -48,6 +48,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use ndarray::Array2;
 use serde::{Deserialize, Serialize};
 
+use super::dark::DarkSpectrumSettings;
 use super::family::AerosolFamily;
 pub(super) use super::mixture::Mixture;
 use super::mixture::invert;
@@ -68,40 +69,6 @@ pub enum AerosolFit {
     BandPair,
     /// Dark-spectrum fitting, one atmosphere per tile (Vanhellemont & Ruddick 2018; [`super::dark`]).
     DarkSpectrum,
-}
-
-/// Settings of dark-spectrum fitting ([`super::dark`]).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct DarkSpectrumSettings {
-    /// Tile side, pixels; 0: one atmosphere for the whole scene (ACOLITE's `fixed`, as
-    /// published).
-    pub tile_px: usize,
-    /// Darkest pixels per band whose linear fit against rank gives the dark value at rank 0
-    /// (ACOLITE's `intercept` option; 200 in its MSI, OLI and OLCI settings).
-    pub pixels: usize,
-    /// Bands whose two-way gas transmittance is below this are not fitted (ACOLITE's
-    /// `min_tgas_aot`, 0.85).
-    pub min_gas_transmittance: f64,
-    /// Bands fitted, nm (ACOLITE's `dsf_wave_range`).
-    pub wave_range_nm: [f64; 2],
-    /// With tiles: one model for the scene (the tiles' most common), its tile AOTs smoothed
-    /// with a 3 × 3 box and interpolated between tile centres to every pixel (ACOLITE's
-    /// defaults `dsf_aot_most_common_model`, `dsf_tile_smoothing`, kernel 3, linear). Off:
-    /// blocks, each tile its own model and AOT.
-    pub smooth_tiles: bool,
-}
-
-impl Default for DarkSpectrumSettings {
-    fn default() -> Self {
-        Self {
-            tile_px: 0,
-            pixels: 200,
-            min_gas_transmittance: 0.85,
-            wave_range_nm: [400.0, 2500.0],
-            smooth_tiles: true,
-        }
-    }
 }
 
 /// Settings of the image-based correction.

@@ -34,10 +34,11 @@ mod pair;
 mod rrs_metrics;
 
 pub use clouds::{CloudScreen, Sun, screen_image};
+pub use dark::DarkSpectrumSettings;
 pub use dark::TileFit;
 pub use difference::{BandDifference, compare};
 pub use family::{AerosolFamily, FamilyLuts};
-pub use image::{AerosolFit, AerosolRetrieval, DarkSpectrumSettings, ImageCorrection, MISSION_PAIRS_NM, correct_image};
+pub use image::{AerosolFit, AerosolRetrieval, ImageCorrection, MISSION_PAIRS_NM, correct_image};
 pub use method::{CorrectionSpec, Method, PRESETS, Preset};
 pub use rrs_metrics::{BandRrsMetrics, RRS_SAMPLES, band_rrs_metrics, pooled_rrs_error};
 

@@ -5,7 +5,7 @@
 //! climatology and the orbit come from a season preset; the period, tilt, roll and the number of
 //! chain runs are set here. The looks appear at once; the runs stream in on a helper thread.
 
-use egui_plot::{Legend, Line, Plot, PlotPoints, Points};
+use egui_plot::{Legend, Line, LineStyle, Plot, PlotPoints, Points};
 
 use crate::engine::RunConfig;
 use crate::jobs::{Task, TaskNews};
@@ -263,7 +263,10 @@ fn plots(ui: &mut egui::Ui, r: &SeasonResult, shown: Option<&(String, String)>) 
                     let months = d.per_month(Some(Verdict::Valid), r.period.0, r.period.1);
                     let pts: Vec<[f64; 2]> =
                         months.iter().enumerate().map(|(i, (_, n))| [i as f64 + 1.0, *n as f64]).collect();
-                    p.line(Line::new(d.label.clone(), PlotPoints::from(pts)).color(colour(k)).width(2.0));
+                    // Designs in one orbit have the same looks: every other one dashed, so
+                    // neither hides the other.
+                    let style = if k % 2 == 0 { LineStyle::Solid } else { LineStyle::dashed_loose() };
+                    p.line(Line::new(d.label.clone(), PlotPoints::from(pts)).color(colour(k)).width(2.0).style(style));
                 }
             });
         let Some((product, variable)) = shown else { return };
