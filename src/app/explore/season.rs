@@ -270,11 +270,21 @@ fn plots(ui: &mut egui::Ui, r: &SeasonResult, shown: Option<&(String, String)>) 
                 }
             });
         let Some((product, variable)) = shown else { return };
+        // Headroom above the worst look for the legend, which sits at the top right.
+        let worst = r
+            .designs
+            .iter()
+            .flat_map(|d| &d.runs)
+            .flat_map(|run| &run.errors)
+            .filter(|e| e.product == *product && e.variable == *variable)
+            .map(|e| e.mae_pct)
+            .fold(0.0, f64::max);
         Plot::new("season-errors-plot")
             .legend(Legend::default())
             .x_axis_label(format!("days from {}", r.spec.from))
             .y_axis_label(format!("{} MAE %", crate::metrics::name(variable)))
             .include_y(0.0)
+            .include_y(worst * 1.35)
             .width(width)
             .height(height)
             .show(ui, |p| {
