@@ -8,7 +8,7 @@ use clap::Args;
 use super::CliError;
 use crate::csvtext::Csv;
 use crate::season::looks::Verdict;
-use crate::season::run::{SeasonPlan, SeasonResult, plan_season, run_season};
+use crate::season::run::{SeasonPlan, SeasonResult, plan_season, run_plan};
 use crate::season::summary::{SUMMARY_JSON, SeasonSummary, variables};
 use crate::season::{SeasonSpec, shard};
 use crate::study::write_bytes;
@@ -45,8 +45,8 @@ pub struct SeasonArgs {
     /// Do not draw the figures.
     #[arg(long)]
     no_figures: bool,
-    /// Make one slice of the chain runs: `i/n` makes every n-th run starting at i (0-based) and
-    /// writes them to `runs.ron`; join the slices with `--merge`.
+    /// Make one slice of the chain runs: `i/n` makes the runs of every n-th pass starting at i
+    /// (0-based) and writes them to `runs.ron`; join the slices with `--merge`.
     #[arg(long, conflicts_with = "merge")]
     shard: Option<String>,
     /// Join shards' output directories (each holds `runs.ron`) into the tables and figures one
@@ -93,7 +93,10 @@ pub fn run(args: &SeasonArgs) -> Result<(), CliError> {
     };
     let (study, designs) = crate::season::run::designs(&spec, dir.as_deref())?;
     super::refuse_unallowed_external(designs.iter().map(|d| &d.1))?;
-    let plan = plan_season(&spec, &study, &designs)?;
+    let pool = super::pool(args.threads.unwrap_or(0), "shoal-season")?;
+    // Planned once, on the season's threads: the runs, the shard's share and the merge all
+    // work from this plan.
+    let plan = pool.install(|| plan_season(&spec, &study, &designs))?;
     let key = shard::key(&plan, &designs);
     if !args.merge.is_empty() {
         let mut parts = Vec::with_capacity(args.merge.len());
@@ -108,7 +111,6 @@ pub fn run(args: &SeasonArgs) -> Result<(), CliError> {
         return Ok(out.commit()?);
     }
     let out = crate::study::OutputDir::create(&args.out, "shoal season")?;
-    let pool = super::pool(args.threads.unwrap_or(0), "shoal-season")?;
     let bar = indicatif::ProgressBar::new(0);
     bar.set_style(
         indicatif::ProgressStyle::with_template("{prefix} [{bar:30}] look {pos}/{len}, {elapsed} (eta {eta})")
@@ -119,7 +121,7 @@ pub fn run(args: &SeasonArgs) -> Result<(), CliError> {
     let control = super::interrupt::control();
     let start = std::time::Instant::now();
     let result = pool.install(|| {
-        run_season(&spec, &study, &designs, shard, &control, |done, total| {
+        run_plan(&plan, &designs, shard, &control, |done, total, _, _| {
             bar.set_length(total as u64);
             bar.set_position(done as u64);
         })

@@ -175,7 +175,8 @@ pub fn looks(season: &SeasonSpec, instrument: &InstrumentSpec, wind_m_s: f64, n:
             // look's cover as it was; within the range the correction accepts.
             let processor_wind_error_m_s = if season.processor_wind_rms_m_s > 0.0 {
                 let z: f64 = rand_distr::StandardNormal.sample(&mut rng);
-                (season.processor_wind_rms_m_s * z).clamp(-20.0, 20.0)
+                let allowed = &crate::ranges::CORRECTION_GLINT_WIND_ERROR;
+                (season.processor_wind_rms_m_s * z).clamp(allowed.lo, allowed.hi)
             } else {
                 0.0
             };

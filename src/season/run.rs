@@ -214,23 +214,19 @@ pub struct SeasonPlan {
 }
 
 impl SeasonPlan {
-    /// Does `shard` make run `job`? Runs are dealt to shards by the hour of their pass, so the
-    /// designs in one orbit pass in the same shard, where the second reuses the first's scene
-    /// and atmosphere tables: a shard `i/n` makes the passes whose count, in time order, is `i`
-    /// modulo `n`.
-    #[must_use]
-    pub fn owns(&self, shard: Shard, job: usize) -> bool {
-        self.passes().get(job).is_some_and(|&pass| shard.owns(pass))
-    }
-
-    /// The runs `shard` makes, as indices into [`Self::jobs`].
+    /// The runs `shard` makes, as indices into [`Self::jobs`]. Runs are dealt to shards by the
+    /// hour of their pass ([`Self::passes`]), so the designs in one orbit pass in the same
+    /// shard, where the second reuses the first's scene and atmosphere tables: a shard `i/n`
+    /// makes the passes whose count, in time order, is `i` modulo `n`.
     #[must_use]
     pub fn owned(&self, shard: Shard) -> Vec<usize> {
         self.passes().iter().enumerate().filter(|(_, pass)| shard.owns(**pass)).map(|(j, _)| j).collect()
     }
 
-    /// Each run's pass: runs in the same hour share one, counted in time order from 0.
-    fn passes(&self) -> Vec<usize> {
+    /// Each run's pass, by which runs are dealt to shards: runs in the same hour share one,
+    /// counted in time order from 0.
+    #[must_use]
+    pub fn passes(&self) -> Vec<usize> {
         let hour = |&(d, k): &(usize, usize)| (self.result.designs[d].looks[k].access.days * 24.0).floor();
         let mut pass = 0;
         let mut out = Vec::with_capacity(self.jobs.len());
@@ -313,10 +309,8 @@ pub fn plan_season(
     Ok(SeasonPlan { result, jobs })
 }
 
-/// Run `season` over `designs` (from [`designs`]; `study` names them): plan it
-/// ([`plan_season`]), then make the chain runs `shard` owns (all of them for
-/// [`Shard::ALL`]). `progress(done, total)` after each run. A shard's result holds its own runs
-/// only; [`super::shard::merge`] joins the shards' into the result one whole run gives.
+/// Plan `season` over `designs` ([`plan_season`]) and make every chain run ([`run_plan`]);
+/// `progress(done, total)` after each run.
 pub fn run_season(
     season: &SeasonSpec,
     study: &str,
@@ -326,26 +320,41 @@ pub fn run_season(
     mut progress: impl FnMut(usize, usize),
 ) -> Result<SeasonResult, StudyError> {
     let plan = plan_season(season, study, designs)?;
+    run_plan(&plan, designs, shard, control, |done, total, _, _| progress(done, total))
+}
+
+/// Make the chain runs of `plan` (over the `designs` it was planned for) that `shard` owns (all
+/// of them for [`Shard::ALL`]), refused first if they would not fit the machine's budget.
+/// `on_run(done, total, design, run)` after each run. A shard's result holds its own runs only;
+/// [`super::shard::merge`] joins the shards' into the result one whole run gives.
+pub fn run_plan(
+    plan: &SeasonPlan,
+    designs: &[(String, RunConfig)],
+    shard: Shard,
+    control: &RunControl,
+    mut on_run: impl FnMut(usize, usize, usize, &LookRun),
+) -> Result<SeasonResult, StudyError> {
     let jobs: Vec<(usize, usize)> = plan.owned(shard).into_iter().map(|j| plan.jobs[j]).collect();
-    let SeasonResult { period, designs: mut seasons, .. } = plan.result;
-    within_budget(&jobs, designs, &seasons, season.decimation)?;
+    let mut result = plan.result.clone();
+    let decimation = result.spec.decimation;
+    within_budget(&jobs, designs, &result.designs, decimation)?;
     let total = jobs.len();
     let mut engine = Engine::lean();
     for (done, &(d, k)) in jobs.iter().enumerate() {
-        let run = run_look(&mut engine, &designs[d].1, &seasons[d].looks[k], k, season.decimation, control)?;
-        seasons[d].runs.push(run);
-        progress(done + 1, total);
+        let run = run_look(&mut engine, &designs[d].1, &result.designs[d].looks[k], k, decimation, control)?;
+        on_run(done + 1, total, d, &run);
+        result.designs[d].runs.push(run);
     }
-    for d in &mut seasons {
+    for d in &mut result.designs {
         d.runs.sort_by_key(|r| r.look);
     }
-    Ok(SeasonResult { spec: season.clone(), study: study.to_string(), period, designs: seasons })
+    Ok(result)
 }
 
 /// Run look `k` of a design (its configuration `base`) through the chain on `engine` at the
 /// look's geometry ([`look_config`]): every retrieval variable's error, or why the run failed.
 /// Only a cancel is an error.
-pub fn run_look(
+fn run_look(
     engine: &mut Engine,
     base: &RunConfig,
     look: &Look,
@@ -381,7 +390,7 @@ pub fn run_look(
 /// ([`crate::budget::MachineBudget`]) before any runs: each look's memory as one run's, and the
 /// radiative transfer of every look together (each look has its own sun, so its own tables; a
 /// second design in the same orbit may reuse the first's, so this is an upper bound).
-pub fn within_budget(
+fn within_budget(
     jobs: &[(usize, usize)],
     designs: &[(String, RunConfig)],
     seasons: &[DesignSeason],

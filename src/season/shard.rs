@@ -149,13 +149,20 @@ fn plain_message(text: &str) -> bool {
     text.chars().count() <= MAX_MESSAGE_CHARS && !text.chars().any(char::is_control)
 }
 
-/// Check one run of shard `part` (named `name` in messages) against the plan.
-fn check_run(plan: &SeasonPlan, name: &str, shard: Shard, run: &JobRun) -> Result<(usize, usize), StudyError> {
+/// Check one run of shard `part` (named `name` in messages) against the plan, whose runs'
+/// passes are `passes` ([`SeasonPlan::passes`]).
+fn check_run(
+    plan: &SeasonPlan,
+    passes: &[usize],
+    name: &str,
+    shard: Shard,
+    run: &JobRun,
+) -> Result<(usize, usize), StudyError> {
     let &(d, k) = plan
         .jobs
         .get(run.job)
         .ok_or_else(|| invalid(format!("{name}: run {} is outside the season's {} runs", run.job, plan.jobs.len())))?;
-    if !plan.owns(shard, run.job) {
+    if !shard.owns(passes[run.job]) {
         return Err(invalid(format!("{name}: run {} is not shard {}/{}'s", run.job, shard.index, shard.count)));
     }
     let design = &plan.result.designs[d];
@@ -225,11 +232,12 @@ pub fn merge(plan: &SeasonPlan, key: &str, parts: &[(String, ShardRuns)]) -> Res
         return Err(invalid(format!("shard {} not given (every shard of {count} is needed)", missing.join(", "))));
     }
     let mut result = plan.result.clone();
+    let passes = plan.passes();
     let mut done = vec![false; plan.jobs.len()];
     for (name, p) in parts {
         let shard = Shard { index: p.index, count };
         for run in &p.runs {
-            let (d, k) = check_run(plan, name, shard, run)?;
+            let (d, k) = check_run(plan, &passes, name, shard, run)?;
             if std::mem::replace(&mut done[run.job], true) {
                 return Err(invalid(format!("{name}: run {} is given twice", run.job)));
             }
@@ -242,7 +250,7 @@ pub fn merge(plan: &SeasonPlan, key: &str, parts: &[(String, ShardRuns)]) -> Res
         return Err(invalid(format!(
             "run {j} (`{}`'s look of {y:04}-{m:02}-{day:02}) is in no shard: shard {}/{count} did not finish it",
             plan.result.designs[d].label,
-            (0..count).find(|&i| plan.owns(Shard { index: i, count }, j)).unwrap_or(0)
+            passes[j] % count
         )));
     }
     for d in &mut result.designs {

@@ -65,7 +65,7 @@ fn merged_shards_equal_the_whole_run_and_bad_ones_are_refused() {
     refused(&nan, "allowed: MAE ≥ 0");
     let mut named = parts.clone();
     named[1].1.runs[0].errors[0].variable = "../chl".into();
-    refused(&named, "run 0");
+    refused(&named, "holds '/'");
     let mut message = parts.clone();
     message[1].1.runs[0].failure = Some("\u{1b}[2Jcleared".into());
     refused(&message, "control characters");

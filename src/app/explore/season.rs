@@ -9,9 +9,10 @@ use egui_plot::{Legend, Line, LineStyle, Plot, PlotPoints, Points};
 
 use crate::engine::RunConfig;
 use crate::jobs::{Task, TaskNews};
-use crate::season::run::{LookRun, SeasonResult, plan_season, run_look, within_budget};
+use crate::season::run::{LookRun, SeasonResult, plan_season, run_plan};
 use crate::season::summary::SeasonSummary;
 use crate::season::{SeasonSpec, looks::Verdict};
+use crate::sweep::Shard;
 
 /// What the helper thread sends.
 pub enum SeasonNews {
@@ -122,7 +123,7 @@ impl SeasonState {
         self.ran_with = designs.iter().map(|d| d.1.clone()).collect();
         self.result = None;
         self.summary = None;
-        self.done = 0;
+        (self.done, self.total) = (0, 0);
         self.status = format!("finding the passes of {} designs …", designs.len());
         let wake = ctx.clone();
         let task = Task::spawn(
@@ -130,17 +131,11 @@ impl SeasonState {
             move || wake.request_repaint(),
             move |control, send| {
                 let plan = plan_season(&spec, "the designs on screen", &designs).map_err(|e| e.to_string())?;
-                within_budget(&plan.jobs, &designs, &plan.result.designs, spec.decimation)
-                    .map_err(|e| e.to_string())?;
+                // The looks at once; the runs (held to the machine's budget first) as they come.
                 send(SeasonNews::Plan(Box::new(plan.result.clone()), plan.jobs.len()));
-                let mut engine = crate::engine::Engine::lean();
-                for &(d, k) in &plan.jobs {
-                    let look = &plan.result.designs[d].looks[k];
-                    let run = run_look(&mut engine, &designs[d].1, look, k, spec.decimation, control)
-                        .map_err(|e| e.to_string())?;
-                    send(SeasonNews::Run(d, run));
-                }
-                Ok(())
+                run_plan(&plan, &designs, Shard::ALL, control, |_, _, d, run| send(SeasonNews::Run(d, run.clone())))
+                    .map(|_| ())
+                    .map_err(|e| e.to_string())
             },
         );
         match task {
@@ -341,7 +336,8 @@ pub fn season_window(app: &mut super::super::ShoalApp, ctx: &egui::Context) {
             }
         });
         ui.label(&s.status);
-        let stale = s.result.is_some() && s.ran_with != designs.iter().map(|d| d.1.clone()).collect::<Vec<_>>();
+        let stale = s.result.is_some()
+            && (s.ran_with.len() != designs.len() || s.ran_with.iter().zip(&designs).any(|(a, (_, b))| a != b));
         if stale {
             ui.colored_label(super::super::theme::FAIL, "The designs or the scene changed since this season ran: Run again to update it.");
         }
