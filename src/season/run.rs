@@ -240,29 +240,79 @@ impl SeasonPlan {
     }
 }
 
-/// Find each design's looks over `season` (from [`designs`]; `study` names them) and choose up
-/// to `max_runs` of its valid ones, evenly spaced, for the chain. Cheap (the orbit and the
-/// looks, no chain run), so a shard and a merge each make the same plan for themselves.
+/// Find each design's looks over `season` (from [`designs`]; `study` names them), their spread
+/// over orbit phases ([`phase_spread`]), and choose up to `max_runs` of each design's valid
+/// looks, evenly spaced, for the chain. No chain run, so a shard and a merge each make the same
+/// plan for themselves.
 pub fn plan_season(
     season: &SeasonSpec,
     study: &str,
     designs: &[(String, RunConfig)],
 ) -> Result<SeasonPlan, StudyError> {
+    let mut plan = plan_looks(season, study, designs)?;
+    for (d, phases) in plan.result.designs.iter_mut().zip(phase_spread(season, designs, plan.result.period)) {
+        d.phases = phases;
+    }
+    Ok(plan)
+}
+
+/// The wind a design's looks are judged on: its scene's where the sea is wind-roughened, else
+/// the season's.
+fn wind_of(season: &SeasonSpec, config: &RunConfig) -> f64 {
+    match config.scene.atmosphere.surface {
+        crate::atmosphere::SeaSurface::Wind { speed_m_s } => speed_m_s,
+        crate::atmosphere::SeaSurface::Flat => season.wind_m_s,
+    }
+}
+
+/// Each design's valid looks and revisit at [`PHASE_SAMPLES`] orbit phases (none on an element
+/// set: the elements say where the spacecraft is). Thirteen times the looks' work: the app
+/// shows the looks first and adds this after.
+#[must_use]
+pub fn phase_spread(season: &SeasonSpec, designs: &[(String, RunConfig)], period: (f64, f64)) -> Vec<Vec<PhaseSample>> {
+    let phases = if season.orbit.tle.is_some() { 0 } else { PHASE_SAMPLES };
+    designs
+        .iter()
+        .map(|(_, config)| {
+            let wind = wind_of(season, config);
+            (0..phases)
+                .into_par_iter()
+                .map(|k| {
+                    let mut other = season.clone();
+                    other.orbit.phase_deg = season.orbit.phase_deg + 360.0 * k as f64 / PHASE_SAMPLES as f64;
+                    let valid: Vec<f64> =
+                        looks(&other, &config.instrument, wind, config.scene.atmosphere.water_refractive_index)
+                            .iter()
+                            .filter(|l| l.verdict == Verdict::Valid)
+                            .map(|l| l.access.days)
+                            .collect();
+                    PhaseSample {
+                        phase_deg: other.orbit.phase_deg,
+                        valid: valid.len(),
+                        revisit_pct: season.revisit.map(|q| stats::revisit_pct(&valid, period.0, period.1, q.days)),
+                    }
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// [`plan_season`] without the phase spread (each design's `phases` empty).
+pub fn plan_looks(season: &SeasonSpec, study: &str, designs: &[(String, RunConfig)]) -> Result<SeasonPlan, StudyError> {
     season.validate().map_err(StudyError::Invalid)?;
     let period = season.period_days().map_err(StudyError::Invalid)?;
     let seasons: Vec<DesignSeason> = designs
         .iter()
         .map(|(label, config)| {
-            let wind = match config.scene.atmosphere.surface {
-                crate::atmosphere::SeaSurface::Wind { speed_m_s } => speed_m_s,
-                crate::atmosphere::SeaSurface::Flat => season.wind_m_s,
-            };
-            let found = looks(season, &config.instrument, wind, config.scene.atmosphere.water_refractive_index);
-            // On an element set the spacecraft's altitude at its first pass, and no other phase
-            // to try: the elements say where it is.
-            let tle = season.orbit.tle.is_some();
+            let found = looks(
+                season,
+                &config.instrument,
+                wind_of(season, config),
+                config.scene.atmosphere.water_refractive_index,
+            );
             DesignSeason {
                 label: label.clone(),
+                // On an element set, the spacecraft's altitude at its first pass.
                 altitude_km: found
                     .first()
                     .and_then(|l| l.altitude_m)
@@ -270,24 +320,7 @@ pub fn plan_season(
                 half_fov_deg: half_field_of_view_rad(&config.instrument).to_degrees(),
                 looks: found,
                 runs: Vec::new(),
-                phases: (0..if tle { 0 } else { PHASE_SAMPLES })
-                    .into_par_iter()
-                    .map(|k| {
-                        let mut other = season.clone();
-                        other.orbit.phase_deg = season.orbit.phase_deg + 360.0 * k as f64 / PHASE_SAMPLES as f64;
-                        let valid: Vec<f64> =
-                            looks(&other, &config.instrument, wind, config.scene.atmosphere.water_refractive_index)
-                                .iter()
-                                .filter(|l| l.verdict == Verdict::Valid)
-                                .map(|l| l.access.days)
-                                .collect();
-                        PhaseSample {
-                            phase_deg: other.orbit.phase_deg,
-                            valid: valid.len(),
-                            revisit_pct: season.revisit.map(|q| stats::revisit_pct(&valid, period.0, period.1, q.days)),
-                        }
-                    })
-                    .collect(),
+                phases: Vec::new(),
             }
         })
         .collect();

@@ -44,6 +44,7 @@ fn the_season_window_runs_the_designs_on_screen_over_a_month() {
     for d in &s.designs {
         assert!(d.by_verdict[0] > 0, "{}: no valid look in March", d.label);
         assert_eq!(d.runs, 6, "{}: six runs", d.label);
+        assert!(d.phases == 12 && d.phase_valid.is_some(), "{}: the orbit phases come after the runs", d.label);
         assert!(d.products.iter().any(|p| p.variable == "chl_mg_m3" && p.looks == 6 && p.mae_median_pct > 0.0));
     }
     assert!(h.query_by_label("MAE % median").is_some(), "the error table is shown");

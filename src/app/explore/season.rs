@@ -9,7 +9,7 @@ use egui_plot::{Legend, Line, LineStyle, Plot, PlotPoints, Points};
 
 use crate::engine::RunConfig;
 use crate::jobs::{Task, TaskNews};
-use crate::season::run::{LookRun, SeasonResult, plan_season, run_plan};
+use crate::season::run::{LookRun, PhaseSample, SeasonResult, phase_spread, plan_looks, run_plan};
 use crate::season::summary::SeasonSummary;
 use crate::season::{SeasonSpec, looks::Verdict};
 use crate::sweep::Shard;
@@ -20,6 +20,8 @@ pub enum SeasonNews {
     Plan(Box<SeasonResult>, usize),
     /// One chain run: (design, run).
     Run(usize, LookRun),
+    /// Each design's spread over orbit phases, made after the runs.
+    Phases(Vec<Vec<PhaseSample>>),
 }
 
 /// The window's settings and results (not persisted: results belong to the session).
@@ -130,12 +132,15 @@ impl SeasonState {
             "shoal-season",
             move || wake.request_repaint(),
             move |control, send| {
-                let plan = plan_season(&spec, "the designs on screen", &designs).map_err(|e| e.to_string())?;
-                // The looks at once; the runs (held to the machine's budget first) as they come.
+                // The looks at once (a fraction of a second); the runs (held to the machine's
+                // budget first) as they come; the spread over orbit phases, which costs twelve
+                // times the looks, last.
+                let plan = plan_looks(&spec, "the designs on screen", &designs).map_err(|e| e.to_string())?;
                 send(SeasonNews::Plan(Box::new(plan.result.clone()), plan.jobs.len()));
                 run_plan(&plan, &designs, Shard::ALL, control, |_, _, d, run| send(SeasonNews::Run(d, run.clone())))
-                    .map(|_| ())
-                    .map_err(|e| e.to_string())
+                    .map_err(|e| e.to_string())?;
+                send(SeasonNews::Phases(phase_spread(&spec, &designs, plan.result.period)));
+                Ok(())
             },
         );
         match task {
@@ -167,12 +172,24 @@ impl SeasonState {
                     self.done += 1;
                     changed = true;
                 }
+                TaskNews::Item(SeasonNews::Phases(phases)) => {
+                    if let Some(r) = &mut self.result {
+                        for (d, p) in r.designs.iter_mut().zip(phases) {
+                            d.phases = p;
+                        }
+                    }
+                    changed = true;
+                }
                 TaskNews::Done(r) => finished = Some(r),
             }
         }
         if changed {
             self.summary = self.result.as_ref().map(SeasonSummary::of);
-            self.status = format!("{} of {} chain runs", self.done, self.total);
+            self.status = if self.done == self.total {
+                format!("{} chain runs; the spread over orbit phases …", self.total)
+            } else {
+                format!("{} of {} chain runs", self.done, self.total)
+            };
         }
         if let Some(r) = finished {
             self.status = match r {
