@@ -42,7 +42,7 @@
 use rayon::prelude::*;
 
 use super::family::AerosolFamily;
-use super::image::{Mixture, invalid, locate, weighted};
+use super::image::{Mixture, PackedFamily, invalid, locate, weighted};
 use super::{CorrectionError, slice};
 use crate::atmosphere::AerosolType;
 use crate::calibration::Level1;
@@ -110,12 +110,12 @@ pub struct TileFit {
 }
 
 impl TileFit {
-    /// The tile's atmosphere as table entries of the family.
-    pub(super) fn mixture<'f>(&self, family: &'f AerosolFamily) -> Mixture<'f> {
+    /// The tile's atmosphere as table entries of the family (`packed`: its terms).
+    pub(super) fn mixture<'f>(&self, family: &AerosolFamily, packed: &'f PackedFamily) -> Mixture<'f> {
         let nodes = locate(&family.aot550, self.aot550);
         let m = self.model_index;
         Mixture {
-            entries: nodes.iter().filter(|n| n.1 != 0.0).map(|&(k, w)| (&family.terms[m][k], w)).collect(),
+            entries: nodes.iter().filter(|n| n.1 != 0.0).map(|&(k, w)| (&packed.terms[m][k][..], w)).collect(),
             aot550: self.aot550,
             angstrom: family.angstrom[m],
             outside: false,
@@ -299,11 +299,11 @@ pub(super) struct Smoothed {
 }
 
 impl Smoothed {
-    /// Pixel `i`'s atmosphere as table entries of the family.
-    pub(super) fn fill<'f>(&self, family: &'f AerosolFamily, i: usize, mix: &mut Mixture<'f>) {
+    /// Pixel `i`'s atmosphere as table entries of the family (`packed`: its terms).
+    pub(super) fn fill<'f>(&self, family: &AerosolFamily, packed: &'f PackedFamily, i: usize, mix: &mut Mixture<'f>) {
         let (m, tau) = (self.model_index, self.aot550[i]);
         let nodes = locate(&family.aot550, tau);
-        mix.entries.extend(nodes.iter().filter(|n| n.1 != 0.0).map(|&(k, w)| (&family.terms[m][k], w)));
+        mix.entries.extend(nodes.iter().filter(|n| n.1 != 0.0).map(|&(k, w)| (&packed.terms[m][k][..], w)));
         (mix.aot550, mix.angstrom, mix.passes) = (tau, family.angstrom[m], 1);
     }
 }

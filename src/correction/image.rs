@@ -50,7 +50,7 @@ use serde::{Deserialize, Serialize};
 
 use super::dark::DarkSpectrumSettings;
 use super::family::AerosolFamily;
-pub(super) use super::mixture::Mixture;
+pub(super) use super::mixture::{Mixture, PackedFamily};
 use super::mixture::invert;
 pub(super) use super::nodes::{locate, weighted};
 use super::{CorrectionError, Reflectance, RrsFlags, assemble, flag_for, slice};
@@ -360,9 +360,10 @@ fn correct_with(
     control: &RunControl,
     high_glint: &(dyn Fn(usize) -> bool + Sync),
 ) -> Result<(Reflectance, AerosolRetrieval), CorrectionError> {
+    let packed = PackedFamily::new(family);
     match settings.fit {
         AerosolFit::BandPair => {
-            let fit = super::pair::PairFit::new(family, settings, bands)?;
+            let fit = super::pair::PairFit::new(family, &packed, settings, bands)?;
             apply(level1, surface, control, |p, mix, scratch| !high_glint(p.col) && fit.fit(p, mix, scratch))
         }
         AerosolFit::DarkSpectrum => {
@@ -374,12 +375,12 @@ fn correct_with(
             let (rows, cols) = (level1.radiance.dim().0, level1.radiance.dim().1);
             let (rrs, mut retrieval) = if let Some(smooth) = super::dark::smoothed(&tiles, &settings.dark, rows, cols) {
                 apply(level1, surface, control, |p, mix, _: &mut ()| {
-                    smooth.fill(family, p.row * cols + p.col, mix);
+                    smooth.fill(family, &packed, p.row * cols + p.col, mix);
                     !high_glint(p.col)
                 })?
             } else {
                 let index = super::dark::tile_index(&tiles, rows, cols);
-                let mixtures: Vec<Mixture<'_>> = tiles.iter().map(|t| t.mixture(family)).collect();
+                let mixtures: Vec<Mixture<'_>> = tiles.iter().map(|t| t.mixture(family, &packed)).collect();
                 apply(level1, surface, control, |p, mix, _: &mut ()| {
                     let m = &mixtures[index[p.row * cols + p.col]];
                     mix.entries.extend_from_slice(&m.entries);

@@ -1,14 +1,39 @@
 //! A pixel's atmosphere as the image-based correction finds it: weighted entries of the aerosol
 //! family's tables ([`super::family`]), and the exact inversion through them.
 
-use super::family::BandTerms;
+use super::family::AerosolFamily;
+
+/// One family member's band terms with the three a pixel's inversion reads side by side:
+/// `[L_path, T·Ed, S]` at index column·bands + band.
+pub(super) type Packed = [[f64; 3]];
+
+/// The family's members as [`Packed`] tables, `terms[m][k]` as in [`AerosolFamily::terms`].
+///
+/// A pixel's mixture reads up to six members at a few bands each. Held as the family holds them
+/// (three arrays per member), those reads went to eighteen places in memory per band, too many
+/// streams for the CPU's prefetcher: perf put a third of the band-pair fit's time on them. Side
+/// by side, one member's terms at a column are one contiguous block.
+pub(super) struct PackedFamily {
+    /// `terms[m][k]`: model m at AOT node k.
+    pub terms: Vec<Vec<Vec<[f64; 3]>>>,
+}
+
+impl PackedFamily {
+    /// The family's terms side by side (the same values: the inversion's bits do not change).
+    pub fn new(family: &AerosolFamily) -> Self {
+        let pack = |t: &super::family::BandTerms| -> Vec<[f64; 3]> {
+            t.l_path.iter().zip(&t.t_ed).zip(&t.spherical_albedo).map(|((l, e), s)| [*l, *e, *s]).collect()
+        };
+        Self { terms: family.terms.iter().map(|row| row.iter().map(pack).collect()).collect() }
+    }
+}
 
 /// A pixel's atmosphere: up to six weighted table entries (two models, three AOT nodes each),
 /// its AOT(550) and Ångström exponent.
 #[derive(Default)]
 pub(super) struct Mixture<'f> {
-    /// (band terms, weight).
-    pub entries: Vec<(&'f BandTerms, f64)>,
+    /// (a member's packed terms, weight).
+    pub entries: Vec<(&'f Packed, f64)>,
     /// AOT(550).
     pub aot550: f64,
     /// Ångström exponent 443–865 nm.
@@ -25,9 +50,10 @@ impl Mixture<'_> {
     pub fn terms(&self, i: usize) -> (f64, f64, f64) {
         let (mut lp, mut te, mut s) = (0.0, 0.0, 0.0);
         for &(t, w) in &self.entries {
-            lp += w * t.l_path[i];
-            te += w * t.t_ed[i];
-            s += w * t.spherical_albedo[i];
+            let [l, e, a] = t[i];
+            lp += w * l;
+            te += w * e;
+            s += w * a;
         }
         (lp, te, s)
     }
@@ -40,11 +66,10 @@ impl Mixture<'_> {
         te.fill(0.0);
         sa.fill(0.0);
         for &(t, w) in &self.entries {
-            let (tl, tt, ts) = (&t.l_path[span.clone()], &t.t_ed[span.clone()], &t.spherical_albedo[span.clone()]);
-            for b in 0..lp.len() {
-                lp[b] += w * tl[b];
-                te[b] += w * tt[b];
-                sa[b] += w * ts[b];
+            for (b, [l, e, a]) in t[span.clone()].iter().enumerate().take(lp.len()) {
+                lp[b] += w * l;
+                te[b] += w * e;
+                sa[b] += w * a;
             }
         }
     }
