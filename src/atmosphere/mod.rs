@@ -21,6 +21,7 @@ mod fresnel;
 mod gas;
 mod gas_swir;
 mod glint;
+mod kernel_cache;
 mod kernels;
 mod lut;
 mod mie;

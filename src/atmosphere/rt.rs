@@ -36,7 +36,8 @@
 use serde::{Deserialize, Serialize};
 
 use super::fresnel::{fresnel_matrix, fresnel_reflectance};
-use super::kernels::{delta_m, scalar_kernel, vector_rayleigh_kernels};
+use super::kernel_cache::rayleigh_kernels;
+use super::kernels::{delta_m, scalar_kernel};
 use super::phase::PhaseFunction;
 use super::profile::{AltitudeQuadrature, ColumnOptics, Layering};
 use super::sos::{Drive, Kernel, OrderSettings, Streams, solve};
@@ -304,7 +305,6 @@ pub fn solve_sun(column: &WavelengthColumn, mu0: f64, user_mu: &[f64], acc: &RtA
     let streams = Streams::new(acc.streams, user_mu.to_vec());
     let (layering, beta_a) = column.scaled(acc);
     let rayleigh_phase = PhaseFunction::Rayleigh { depolarization: column.depolarization };
-    let beta_r = rayleigh_phase.moments(2);
     let n = column.water_index;
     let surf_q = fresnel_blocks(&streams.mu, n);
     let surf_u = fresnel_blocks(user_mu, n);
@@ -320,13 +320,16 @@ pub fn solve_sun(column: &WavelengthColumn, mu0: f64, user_mu: &[f64], acc: &RtA
         2.min(acc.fourier_terms - 1)
     };
     let polarize = acc.polarization_correction && acc.max_orders > 1;
-    let vector = if polarize { vector_rayleigh_kernels(&streams, column.depolarization, mu0, n) } else { Vec::new() };
+    // The molecular kernels depend on the streams, sun and surface alone: shared by the solves
+    // of every wavelength (and every LUT) at this sun.
+    let rayleigh = rayleigh_kernels(&streams, mu0, column.depolarization, n, m_max + 1);
+    let vector = if polarize { rayleigh.vector(&streams) } else { &[] };
     let (vq, vu) = (fresnel_blocks3(&streams.mu, n), fresnel_blocks3(user_mu, n));
     let mut ms_fourier = vec![Vec::new(); user_mu.len()];
     let mut qu_fourier = vec![[0.0; 5]; if polarize { user_mu.len() } else { 0 }];
     let (mut ed_diffuse, mut orders, mut small) = (0.0, 0, 0);
     for m in 0..=m_max {
-        let kr = scalar_kernel(&streams, &beta_r, m, mu0, n);
+        let kr = rayleigh.scalar(&streams, m);
         let ka = beta_a.as_ref().map(|b| scalar_kernel(&streams, b, m, mu0, n));
         let f = solve(&streams, &layering, &kr, ka.as_ref(), &surf_q, &surf_u, &Drive::Sun { mu0 }, acc.orders());
         if m == 0 {
@@ -450,13 +453,9 @@ pub fn solve_transmittance(column: &WavelengthColumn, user_mu: &[f64], acc: &RtA
     let streams = Streams::new(acc.streams, user_mu.to_vec());
     let (layering, beta_a) = column.scaled(acc);
     let n = column.water_index;
-    let kr = scalar_kernel(
-        &streams,
-        &PhaseFunction::Rayleigh { depolarization: column.depolarization }.moments(2),
-        0,
-        0.5,
-        n,
-    );
+    // (The sun's cosine does not enter these m = 0 problems: 0.5 is a placeholder.)
+    let rayleigh = rayleigh_kernels(&streams, 0.5, column.depolarization, n, 1);
+    let kr = rayleigh.scalar(&streams, 0);
     let ka = beta_a.as_ref().map(|b| scalar_kernel(&streams, b, 0, 0.5, n));
     let tau_scaled = layering.total();
     // Water-leaving radiance of an isotropic in-water field, normalised to 1 at nadir.

@@ -1,0 +1,125 @@
+//! The molecular (Rayleigh) scattering kernels of a solar solve, computed once and shared by
+//! every solve with the same streams, sun and surface.
+//!
+//! A solve's Rayleigh kernels — the scalar phase-function kernel of each Fourier term and the
+//! (I, Q, U) kernels of the polarisation correction (`kernels::vector_rayleigh_kernels`) — are
+//! functions of the quadrature streams, the view cosines, the sun's cosine, the air's
+//! depolarisation and the water's refractive index only: not of the wavelength's optical depths
+//! or its aerosol. A LUT solves every wavelength at each sun node, and the image-based
+//! correction's family builds sixteen LUTs on the same nodes; computed per solve, the vector
+//! kernels alone (16 azimuth steps of the Rayleigh phase matrix, with its rotations, for every
+//! pair of directions) took a quarter of `shoal correct`'s time in perf. The values are the same
+//! function of the same inputs whichever solve computes them first, so sharing them changes no
+//! result.
+
+use std::collections::HashMap;
+use std::sync::{Arc, LazyLock, Mutex, OnceLock, PoisonError};
+
+use super::kernels::{scalar_kernel, vector_rayleigh_kernels};
+use super::phase::PhaseFunction;
+use super::sos::{Kernel, Streams};
+
+/// The most kernel sets held (about 0.6 MB each at 12 streams and 19 view cosines; a LUT has
+/// a few sun nodes, so this holds every node of a family's builds). When full, the cache is
+/// emptied and refilled: a later solve recomputes what it needs.
+const MAX_SETS: usize = 32;
+
+/// The Rayleigh kernels of one (streams, view cosines, sun, depolarisation, water index), each
+/// computed the first time a solve asks for it.
+pub(super) struct RayleighKernels {
+    mu0: f64,
+    depolarization: f64,
+    water_index: f64,
+    /// The scalar kernel of Fourier term m.
+    scalar: Vec<OnceLock<Kernel<1>>>,
+    /// The (I, Q, U) kernels for m = 0, 1, 2.
+    vector: OnceLock<Vec<Kernel<3>>>,
+}
+
+impl RayleighKernels {
+    /// The scalar kernel of Fourier term `m` ([`scalar_kernel`] with the Rayleigh moments).
+    pub fn scalar(&self, streams: &Streams, m: usize) -> std::borrow::Cow<'_, Kernel<1>> {
+        let compute = || {
+            let beta = PhaseFunction::Rayleigh { depolarization: self.depolarization }.moments(2);
+            scalar_kernel(streams, &beta, m, self.mu0, self.water_index)
+        };
+        match self.scalar.get(m) {
+            Some(cell) => std::borrow::Cow::Borrowed(cell.get_or_init(compute)),
+            None => std::borrow::Cow::Owned(compute()),
+        }
+    }
+
+    /// The (I, Q, U) kernels for m = 0, 1, 2 ([`vector_rayleigh_kernels`]).
+    pub fn vector(&self, streams: &Streams) -> &[Kernel<3>] {
+        self.vector
+            .get_or_init(|| vector_rayleigh_kernels(streams, self.depolarization, self.mu0, self.water_index))
+    }
+}
+
+/// What the kernels depend on, bit for bit.
+#[derive(PartialEq, Eq, Hash)]
+struct Key {
+    streams: usize,
+    user_mu: Vec<u64>,
+    mu0: u64,
+    depolarization: u64,
+    water_index: u64,
+}
+
+static CACHE: LazyLock<Mutex<HashMap<Key, Arc<RayleighKernels>>>> = LazyLock::new(Mutex::default);
+
+/// The shared Rayleigh kernels for `streams` (built with `n_streams` per hemisphere), sun
+/// cosine `mu0`, depolarisation ratio and water refractive index; up to `fourier_terms` scalar
+/// terms are held.
+pub(super) fn rayleigh_kernels(
+    streams: &Streams,
+    mu0: f64,
+    depolarization: f64,
+    water_index: f64,
+    fourier_terms: usize,
+) -> Arc<RayleighKernels> {
+    let key = Key {
+        streams: streams.n(),
+        user_mu: streams.user_mu.iter().map(|m| m.to_bits()).collect(),
+        mu0: mu0.to_bits(),
+        depolarization: depolarization.to_bits(),
+        water_index: water_index.to_bits(),
+    };
+    let mut cache = CACHE.lock().unwrap_or_else(PoisonError::into_inner);
+    if let Some(found) = cache.get(&key) {
+        return found.clone();
+    }
+    if cache.len() >= MAX_SETS {
+        cache.clear();
+    }
+    let kernels = Arc::new(RayleighKernels {
+        mu0,
+        depolarization,
+        water_index,
+        scalar: (0..fourier_terms).map(|_| OnceLock::new()).collect(),
+        vector: OnceLock::new(),
+    });
+    cache.insert(key, kernels.clone());
+    kernels
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shared_kernels_equal_fresh_ones_bit_for_bit() {
+        let streams = Streams::new(8, vec![1.0, 0.9, 0.7]);
+        let (mu0, rho, n) = (0.6, 0.0279, 1.34);
+        let shared = rayleigh_kernels(&streams, mu0, rho, n, 16);
+        let again = rayleigh_kernels(&streams, mu0, rho, n, 16);
+        assert!(Arc::ptr_eq(&shared, &again), "the same inputs share one set");
+        let beta = PhaseFunction::Rayleigh { depolarization: rho }.moments(2);
+        for m in [0, 1, 2, 5, 20] {
+            assert_eq!(*shared.scalar(&streams, m), scalar_kernel(&streams, &beta, m, mu0, n), "m = {m}");
+        }
+        assert_eq!(shared.vector(&streams), vector_rayleigh_kernels(&streams, rho, mu0, n).as_slice());
+        let other = rayleigh_kernels(&streams, 0.5, rho, n, 16);
+        assert!(!Arc::ptr_eq(&shared, &other), "another sun, another set");
+    }
+}
