@@ -75,46 +75,54 @@ fn compare_source(source: Source<'_>, nb: usize, b: &Array3<f32>, b_flags: Optio
         values: vec![0.0; scratch],
         flags: vec![0; scratch],
     };
-    let acc = (0..pixels)
+    // Fixed blocks of pixels, summed in block order: the sums (of f64, whose rounding depends
+    // on the order) are the same whatever the threads and however rayon splits the work (a
+    // `fold` over the pixels split them where threads stole work, so the bias moved in its last
+    // digits from run to run).
+    let blocks: Vec<Acc> = (0..pixels.div_ceil(BLOCK_PIXELS))
         .into_par_iter()
-        .fold(empty, |mut acc, p| {
-            // One pixel's bands as slices (no per-value bounds checks), and whether it is a
-            // median sample decided once per pixel: the modulo per value was half the stage.
-            let span = p * nb..(p + 1) * nb;
-            let (a, a_flags) = match &source {
-                Source::Cube(ar, af) => (&ar[span.clone()], &af[span.clone()]),
-                Source::Pixels(f) => {
-                    f(p, &mut acc.values, &mut acc.flags);
-                    (&acc.values[..], &acc.flags[..])
-                }
-            };
-            let b = &br[span.clone()];
-            let b_flags = bf.map(|f| &f[span]);
-            let sampled = p % stride == 0;
-            for band in 0..nb {
-                let fb = b_flags.map_or(0, |f| f[band]);
-                let (x, y) = (f64::from(a[band]), f64::from(b[band]));
-                if a_flags[band] == 0 && fb == 0 && y > 0.0 && x.is_finite() {
-                    let rel = (x - y) / y;
-                    acc.n[band] += 1;
-                    acc.sum[band] += rel;
-                    acc.max[band] = acc.max[band].max(rel.abs());
-                    if sampled {
-                        acc.sample[band].push(rel.abs());
+        .map(|k| {
+            let mut acc = empty();
+            for p in k * BLOCK_PIXELS..((k + 1) * BLOCK_PIXELS).min(pixels) {
+                // One pixel's bands as slices (no per-value bounds checks), and whether it is a
+                // median sample decided once per pixel: the modulo per value was half the stage.
+                let span = p * nb..(p + 1) * nb;
+                let (a, a_flags) = match &source {
+                    Source::Cube(ar, af) => (&ar[span.clone()], &af[span.clone()]),
+                    Source::Pixels(f) => {
+                        f(p, &mut acc.values, &mut acc.flags);
+                        (&acc.values[..], &acc.flags[..])
+                    }
+                };
+                let b = &br[span.clone()];
+                let b_flags = bf.map(|f| &f[span]);
+                let sampled = p % stride == 0;
+                for band in 0..nb {
+                    let fb = b_flags.map_or(0, |f| f[band]);
+                    let (x, y) = (f64::from(a[band]), f64::from(b[band]));
+                    if a_flags[band] == 0 && fb == 0 && y > 0.0 && x.is_finite() {
+                        let rel = (x - y) / y;
+                        acc.n[band] += 1;
+                        acc.sum[band] += rel;
+                        acc.max[band] = acc.max[band].max(rel.abs());
+                        if sampled {
+                            acc.sample[band].push(rel.abs());
+                        }
                     }
                 }
             }
             acc
         })
-        .reduce(empty, |mut a, b| {
-            for band in 0..nb {
-                a.n[band] += b.n[band];
-                a.sum[band] += b.sum[band];
-                a.max[band] = a.max[band].max(b.max[band]);
-                a.sample[band].extend_from_slice(&b.sample[band]);
-            }
-            a
-        });
+        .collect();
+    let acc = blocks.into_iter().fold(empty(), |mut a, b| {
+        for band in 0..nb {
+            a.n[band] += b.n[band];
+            a.sum[band] += b.sum[band];
+            a.max[band] = a.max[band].max(b.max[band]);
+            a.sample[band].extend_from_slice(&b.sample[band]);
+        }
+        a
+    });
     (0..nb)
         .map(|band| {
             let n = acc.n[band];
@@ -131,5 +139,33 @@ fn compare_source(source: Source<'_>, nb: usize, b: &Array3<f32>, b_flags: Optio
         .collect()
 }
 
+/// Pixels per block of [`compare`]'s sums.
+const BLOCK_PIXELS: usize = 4096;
+
 /// Pixels per band the median of [`compare`] is taken from, at most.
 const MEDIAN_SAMPLES: usize = 200_000;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The sums are taken in fixed blocks: one thread and three give the same bits.
+    #[test]
+    fn the_comparison_does_not_depend_on_the_threads() {
+        let (rows, cols, nb) = (97, 113, 3);
+        let value = |i: usize| 0.001 + 1e-5 * ((i * 7919) % 1013) as f32;
+        let truth = Array3::from_shape_fn((rows, cols, nb), |(r, c, b)| value(r * 31 + c * 7 + b));
+        let rrs = Array3::from_shape_fn((rows, cols, nb), |(r, c, b)| value(r * 17 + c * 13 + b * 5));
+        let mut flags = Array3::zeros((rows, cols, nb));
+        flags[[5, 6, 1]] = 1;
+        let a = Reflectance { rrs, flags };
+        let on = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| compare(&a, &truth, None))
+        };
+        let (one, three) = (on(1), on(3));
+        assert_eq!(one, three);
+        assert_eq!(one[1].n, rows * cols - 1, "the flagged value is left out");
+        assert!(one.iter().all(|d| d.mean_rel.is_finite() && d.median_abs_rel > 0.0));
+    }
+}
