@@ -250,7 +250,8 @@ pub fn plan_season(
     designs: &[(String, RunConfig)],
 ) -> Result<SeasonPlan, StudyError> {
     let mut plan = plan_looks(season, study, designs)?;
-    for (d, phases) in plan.result.designs.iter_mut().zip(phase_spread(season, designs, plan.result.period)) {
+    let spread = phase_spread(season, designs, plan.result.period, &RunControl::new())?;
+    for (d, phases) in plan.result.designs.iter_mut().zip(spread) {
         d.phases = phases;
     }
     Ok(plan)
@@ -269,7 +270,12 @@ fn wind_of(season: &SeasonSpec, config: &RunConfig) -> f64 {
 /// set: the elements say where the spacecraft is). Thirteen times the looks' work: the app
 /// shows the looks first and adds this after.
 #[must_use]
-pub fn phase_spread(season: &SeasonSpec, designs: &[(String, RunConfig)], period: (f64, f64)) -> Vec<Vec<PhaseSample>> {
+pub fn phase_spread(
+    season: &SeasonSpec,
+    designs: &[(String, RunConfig)],
+    period: (f64, f64),
+    control: &RunControl,
+) -> Result<Vec<Vec<PhaseSample>>, StudyError> {
     let phases = if season.orbit.tle.is_some() { 0 } else { PHASE_SAMPLES };
     designs
         .iter()
@@ -278,6 +284,11 @@ pub fn phase_spread(season: &SeasonSpec, designs: &[(String, RunConfig)], period
             (0..phases)
                 .into_par_iter()
                 .map(|k| {
+                    // Each phase is a season's looks (a second on a year): a stop is heard
+                    // between them.
+                    if control.cancelled() {
+                        return Err(StudyError::Cancelled);
+                    }
                     let mut other = season.clone();
                     other.orbit.phase_deg = season.orbit.phase_deg + 360.0 * k as f64 / PHASE_SAMPLES as f64;
                     let valid: Vec<f64> =
@@ -286,11 +297,11 @@ pub fn phase_spread(season: &SeasonSpec, designs: &[(String, RunConfig)], period
                             .filter(|l| l.verdict == Verdict::Valid)
                             .map(|l| l.access.days)
                             .collect();
-                    PhaseSample {
+                    Ok(PhaseSample {
                         phase_deg: other.orbit.phase_deg,
                         valid: valid.len(),
                         revisit_pct: season.revisit.map(|q| stats::revisit_pct(&valid, period.0, period.1, q.days)),
-                    }
+                    })
                 })
                 .collect()
         })

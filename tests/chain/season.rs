@@ -5,7 +5,7 @@ use shoal::control::RunControl;
 use shoal::orbit::{Site, SunSynchronous, accesses, days_since_j2000};
 use shoal::season::SeasonSpec;
 use shoal::season::looks::{Verdict, half_field_of_view_rad};
-use shoal::season::run::{designs, look_config, run_season};
+use shoal::season::run::{designs, look_config, phase_spread, run_season};
 use shoal::sweep::Shard;
 
 fn spring(max_runs: usize) -> SeasonSpec {
@@ -216,6 +216,21 @@ fn a_season_does_not_depend_on_the_threads() {
             .install(|| run_season(&season, &study, &ds, Shard::ALL, &RunControl::new(), |_, _| {}).unwrap())
     };
     assert_eq!(on(1).designs, on(2).designs);
+}
+
+/// The spread over orbit phases (twelve seasons' looks) stops when its run is cancelled, as
+/// the app's Stop does; uncancelled, it samples every phase.
+#[test]
+fn the_phase_spread_stops_when_cancelled() {
+    let season = spring(0);
+    let (_, ds) = designs(&season, None).unwrap();
+    let period = season.period_days().unwrap();
+    let stopped = RunControl::new();
+    stopped.cancel();
+    assert!(matches!(phase_spread(&season, &ds, period, &stopped), Err(shoal::study::StudyError::Cancelled)));
+    let spread = phase_spread(&season, &ds, period, &RunControl::new()).unwrap();
+    assert_eq!(spread.len(), ds.len());
+    assert!(spread.iter().all(|d| d.len() == shoal::season::run::PHASE_SAMPLES), "{spread:?}");
 }
 
 /// `line` (68 characters) with its modulo-10 checksum.

@@ -139,7 +139,8 @@ impl SeasonState {
                 send(SeasonNews::Plan(Box::new(plan.result.clone()), plan.jobs.len()));
                 run_plan(&plan, &designs, Shard::ALL, control, |_, _, d, run| send(SeasonNews::Run(d, run.clone())))
                     .map_err(|e| e.to_string())?;
-                send(SeasonNews::Phases(phase_spread(&spec, &designs, plan.result.period)));
+                let phases = phase_spread(&spec, &designs, plan.result.period, control).map_err(|e| e.to_string())?;
+                send(SeasonNews::Phases(phases));
                 Ok(())
             },
         );
