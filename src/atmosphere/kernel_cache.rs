@@ -51,8 +51,7 @@ impl RayleighKernels {
 
     /// The (I, Q, U) kernels for m = 0, 1, 2 ([`vector_rayleigh_kernels`]).
     pub fn vector(&self, streams: &Streams) -> &[Kernel<3>] {
-        self.vector
-            .get_or_init(|| vector_rayleigh_kernels(streams, self.depolarization, self.mu0, self.water_index))
+        self.vector.get_or_init(|| vector_rayleigh_kernels(streams, self.depolarization, self.mu0, self.water_index))
     }
 }
 

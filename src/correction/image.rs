@@ -50,8 +50,8 @@ use serde::{Deserialize, Serialize};
 
 use super::dark::DarkSpectrumSettings;
 use super::family::AerosolFamily;
-pub(super) use super::mixture::{Mixture, PackedFamily};
 use super::mixture::invert;
+pub(super) use super::mixture::{Mixture, PackedFamily};
 pub(super) use super::nodes::{locate, weighted};
 use super::{CorrectionError, Reflectance, RrsFlags, assemble, flag_for, slice};
 use crate::atmosphere::AerosolType;

@@ -44,7 +44,8 @@ impl Signals {
         let (models, nodes, nb) = (family.models.len(), family.aot550.len(), family.n_bands.max(1));
         let rayleigh_terms = &family.terms[0][0];
         let cols = rayleigh_terms.l_path.len() / nb;
-        let (mut long, mut short) = (Vec::with_capacity(cols * models * nodes), Vec::with_capacity(cols * models * nodes));
+        let (mut long, mut short) =
+            (Vec::with_capacity(cols * models * nodes), Vec::with_capacity(cols * models * nodes));
         for c in 0..cols {
             let (il, is) = (c * nb + l, c * nb + s);
             for row in &family.terms {
@@ -54,7 +55,8 @@ impl Signals {
                 }
             }
         }
-        let rayleigh = (0..cols).map(|c| [rayleigh_terms.l_path[c * nb + s], rayleigh_terms.l_path[c * nb + l]]).collect();
+        let rayleigh =
+            (0..cols).map(|c| [rayleigh_terms.l_path[c * nb + s], rayleigh_terms.l_path[c * nb + l]]).collect();
         Self { models, nodes, long, short, rayleigh }
     }
 

@@ -268,8 +268,7 @@ fn wind_of(season: &SeasonSpec, config: &RunConfig) -> f64 {
 
 /// Each design's valid looks and revisit at [`PHASE_SAMPLES`] orbit phases (none on an element
 /// set: the elements say where the spacecraft is). Thirteen times the looks' work: the app
-/// shows the looks first and adds this after.
-#[must_use]
+/// shows the looks first and adds this after. Cancelled through `control` between phases.
 pub fn phase_spread(
     season: &SeasonSpec,
     designs: &[(String, RunConfig)],
