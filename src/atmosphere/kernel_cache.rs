@@ -67,15 +67,15 @@ struct Key {
 
 static CACHE: LazyLock<Mutex<HashMap<Key, Arc<RayleighKernels>>>> = LazyLock::new(Mutex::default);
 
-/// The shared Rayleigh kernels for `streams` (built with `n_streams` per hemisphere), sun
-/// cosine `mu0`, depolarisation ratio and water refractive index; up to `fourier_terms` scalar
-/// terms are held.
+/// The shared Rayleigh kernels for `streams`, sun cosine `mu0`, depolarisation ratio and water
+/// refractive index. Every Fourier term a solve with these streams can ask for has its cell
+/// (m < 2n: `solve_sun` stops at `min(fourier_terms, 2n) − 1`), whichever solve comes first: a
+/// Rayleigh atmosphere's solve (three terms) makes the set the aerosol solves after it fill.
 pub(super) fn rayleigh_kernels(
     streams: &Streams,
     mu0: f64,
     depolarization: f64,
     water_index: f64,
-    fourier_terms: usize,
 ) -> Arc<RayleighKernels> {
     let key = Key {
         streams: streams.n(),
@@ -95,7 +95,7 @@ pub(super) fn rayleigh_kernels(
         mu0,
         depolarization,
         water_index,
-        scalar: (0..fourier_terms).map(|_| OnceLock::new()).collect(),
+        scalar: (0..(2 * streams.n()).max(3)).map(|_| OnceLock::new()).collect(),
         vector: OnceLock::new(),
     });
     cache.insert(key, kernels.clone());
@@ -110,15 +110,19 @@ mod tests {
     fn shared_kernels_equal_fresh_ones_bit_for_bit() {
         let streams = Streams::new(8, vec![1.0, 0.9, 0.7]);
         let (mu0, rho, n) = (0.6, 0.0279, 1.34);
-        let shared = rayleigh_kernels(&streams, mu0, rho, n, 16);
-        let again = rayleigh_kernels(&streams, mu0, rho, n, 16);
+        let shared = rayleigh_kernels(&streams, mu0, rho, n);
+        let again = rayleigh_kernels(&streams, mu0, rho, n);
         assert!(Arc::ptr_eq(&shared, &again), "the same inputs share one set");
         let beta = PhaseFunction::Rayleigh { depolarization: rho }.moments(2);
-        for m in [0, 1, 2, 5, 20] {
+        for m in [0, 1, 2, 5, 15, 20] {
             assert_eq!(*shared.scalar(&streams, m), scalar_kernel(&streams, &beta, m, mu0, n), "m = {m}");
         }
+        // Every term a solve with 8 streams can reach (m ≤ 15) is held, so a later solve reads
+        // it; beyond, a kernel is made for the caller alone.
+        assert!(matches!(shared.scalar(&streams, 15), std::borrow::Cow::Borrowed(_)));
+        assert!(matches!(shared.scalar(&streams, 16), std::borrow::Cow::Owned(_)));
         assert_eq!(shared.vector(&streams), vector_rayleigh_kernels(&streams, rho, mu0, n).as_slice());
-        let other = rayleigh_kernels(&streams, 0.5, rho, n, 16);
+        let other = rayleigh_kernels(&streams, 0.5, rho, n);
         assert!(!Arc::ptr_eq(&shared, &other), "another sun, another set");
     }
 }

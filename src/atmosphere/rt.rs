@@ -322,7 +322,7 @@ pub fn solve_sun(column: &WavelengthColumn, mu0: f64, user_mu: &[f64], acc: &RtA
     let polarize = acc.polarization_correction && acc.max_orders > 1;
     // The molecular kernels depend on the streams, sun and surface alone: shared by the solves
     // of every wavelength (and every LUT) at this sun.
-    let rayleigh = rayleigh_kernels(&streams, mu0, column.depolarization, n, m_max + 1);
+    let rayleigh = rayleigh_kernels(&streams, mu0, column.depolarization, n);
     let vector = if polarize { rayleigh.vector(&streams) } else { &[] };
     let (vq, vu) = (fresnel_blocks3(&streams.mu, n), fresnel_blocks3(user_mu, n));
     let mut ms_fourier = vec![Vec::new(); user_mu.len()];
@@ -454,7 +454,7 @@ pub fn solve_transmittance(column: &WavelengthColumn, user_mu: &[f64], acc: &RtA
     let (layering, beta_a) = column.scaled(acc);
     let n = column.water_index;
     // (The sun's cosine does not enter these m = 0 problems: 0.5 is a placeholder.)
-    let rayleigh = rayleigh_kernels(&streams, 0.5, column.depolarization, n, 1);
+    let rayleigh = rayleigh_kernels(&streams, 0.5, column.depolarization, n);
     let kr = rayleigh.scalar(&streams, 0);
     let ka = beta_a.as_ref().map(|b| scalar_kernel(&streams, b, 0, 0.5, n));
     let tau_scaled = layering.total();
