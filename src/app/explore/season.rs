@@ -95,7 +95,13 @@ impl SeasonState {
     /// Stop the season being run (its looks and the runs made so far stay).
     pub fn cancel(&mut self) {
         if self.task.take().is_some() {
-            self.status = format!("stopped after {} of {} chain runs", self.done, self.total);
+            self.status = match self.result {
+                // Every run made: what was stopped is the spread over orbit phases.
+                Some(_) if self.done == self.total => {
+                    format!("stopped in the spread over orbit phases ({} of {} chain runs made)", self.done, self.total)
+                }
+                _ => format!("stopped after {} of {} chain runs", self.done, self.total),
+            };
         }
     }
 
