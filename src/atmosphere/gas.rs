@@ -83,19 +83,65 @@ fn ozone_air_mass(mu: f64) -> f64 {
 /// Gas transmittance along a path of relative air mass `m` (ozone's `m_oz`): the path's amounts
 /// enter each band model whole, not as a product of legs.
 fn along(wavelength_nm: f64, m: f64, m_oz: f64, gases: &GasAmounts, pressure_hpa: f64) -> Result<f64, AtmosphereError> {
+    let mut t = [0.0];
+    along_paths(wavelength_nm, &[AirMasses { m, m_oz }], gases, pressure_hpa, &mut t)?;
+    Ok(t[0])
+}
+
+/// The relative air masses of one path: for the band models (Kasten & Young 1989) and for ozone
+/// (Paltridge & Platt 1976). They depend on the geometry alone, so a spectrum computes them once.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct AirMasses {
+    m: f64,
+    m_oz: f64,
+}
+
+impl AirMasses {
+    /// The path down (or up) at zenith cosine `mu`.
+    #[must_use]
+    pub(super) fn one_way(mu: f64) -> Self {
+        Self { m: air_mass(mu), m_oz: ozone_air_mass(mu) }
+    }
+
+    /// The sun–surface–sensor path: the legs' air masses summed ([`two_way_transmittance`]).
+    #[must_use]
+    pub(super) fn two_way(mu0: f64, muv: f64) -> Self {
+        Self { m: air_mass(mu0) + air_mass(muv), m_oz: ozone_air_mass(mu0) + ozone_air_mass(muv) }
+    }
+}
+
+/// The transmittance along each of `paths` at `wavelength_nm` into `out` (one per path): the
+/// formulas of the module docs, the absorption coefficients looked up once for all the paths.
+pub(super) fn along_paths(
+    wavelength_nm: f64,
+    paths: &[AirMasses],
+    gases: &GasAmounts,
+    pressure_hpa: f64,
+    out: &mut [f64],
+) -> Result<(), AtmosphereError> {
     if wavelength_nm > super::gas_swir::FROM_NM {
-        return super::gas_swir::transmittance(wavelength_nm, gases.water_vapour_cm * m, m * pressure_hpa / 1013.25);
+        for (t, p) in out.iter_mut().zip(paths) {
+            *t = super::gas_swir::transmittance(
+                wavelength_nm,
+                gases.water_vapour_cm * p.m,
+                p.m * pressure_hpa / 1013.25,
+            )?;
+        }
+        return Ok(());
     }
     let c = coefficients()?;
     let a_oz = c.a_oz.value_at(wavelength_nm, Extrapolation::Error)?;
     let a_ox = c.a_ox.value_at(wavelength_nm, Extrapolation::Error)?;
     let a_wv = c.a_wv.value_at(wavelength_nm, Extrapolation::Error)?;
-    let m_p = m * pressure_hpa / 1013.25;
-    let t_oz = (-a_oz * gases.ozone_atm_cm * m_oz).exp();
-    let t_ox = (-1.41 * a_ox * m_p / (1.0 + 118.3 * a_ox * m_p).powf(0.45)).exp();
-    let w = gases.water_vapour_cm;
-    let t_wv = (-0.2385 * a_wv * w * m / (1.0 + 20.07 * a_wv * w * m).powf(0.45)).exp();
-    Ok(t_oz * t_ox * t_wv)
+    for (t, &AirMasses { m, m_oz }) in out.iter_mut().zip(paths) {
+        let m_p = m * pressure_hpa / 1013.25;
+        let t_oz = (-a_oz * gases.ozone_atm_cm * m_oz).exp();
+        let t_ox = (-1.41 * a_ox * m_p / (1.0 + 118.3 * a_ox * m_p).powf(0.45)).exp();
+        let w = gases.water_vapour_cm;
+        let t_wv = (-0.2385 * a_wv * w * m / (1.0 + 20.07 * a_wv * w * m).powf(0.45)).exp();
+        *t = t_oz * t_ox * t_wv;
+    }
+    Ok(())
 }
 
 /// One-way gas transmittance at `wavelength_nm` along a path of zenith cosine `mu`.

@@ -62,7 +62,7 @@ pub use rt::{
 pub use rustfft::num_complex::Complex64 as Complex;
 pub use solar::{e0_on_grid, sun_distance_factor, tsis1};
 pub use sos::Streams;
-pub use spec::{Atmosphere, AtmosphereSpec, AtmosphereTerms, Geometry, Normalised, SeaSurface};
+pub use spec::{Atmosphere, AtmosphereSpec, AtmosphereTerms, GasLegs, Geometry, Normalised, SeaSurface};
 pub use user_aerosol::{AerosolMode, R_MAX_UM, SizeDistribution};
 pub use wmo::{AerosolType, Component, WmoFractions};
 

@@ -10,13 +10,30 @@ use serde::{Deserialize, Serialize};
 use super::aerosol::mixture_optics;
 use super::check;
 use super::fresnel::SEA_REFRACTIVE_INDEX;
-use super::gas::{GasAmounts, transmittance as gas_transmittance, two_way_transmittance};
+use super::gas::{AirMasses, GasAmounts, along_paths, transmittance as gas_transmittance, two_way_transmittance};
 use super::glint::glint_radiance_norm;
 use super::rayleigh::{AIR_DEPOLARIZATION, RayleighColumn, RayleighDepth, STANDARD_PRESSURE_HPA};
 use super::rt::{RtAccuracy, WavelengthColumn, solve_sun, solve_transmittance};
 use super::wmo::AerosolType;
 use super::{AtmosphereError, solar};
 use crate::spectral::{Extrapolation, Spectrum};
+
+/// Gas factors along one geometry, one per wavelength ([`Atmosphere::gas_legs`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct GasLegs {
+    /// The sun's leg, T(m₀).
+    pub down: Vec<f64>,
+    /// The upward factor T(m₀ + m_v)/T(m₀), at most 1.
+    pub up_after_down: Vec<f64>,
+    /// The wavelengths, nm.
+    pub wavelengths_nm: Vec<f64>,
+    /// The geometry's cos θ₀.
+    pub mu0: f64,
+    /// The geometry's cos θ_v.
+    pub muv: f64,
+    /// The atmosphere's [`Atmosphere::gas_key`].
+    pub key: Option<(GasAmounts, f64)>,
+}
 
 /// The sea surface.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
@@ -328,6 +345,41 @@ impl Atmosphere {
         let down = self.gas(wavelength_nm, mu0)?;
         let both = self.gas_two_way(wavelength_nm, mu0, muv)?;
         Ok(if down > 0.0 { (both / down).min(1.0) } else { 0.0 })
+    }
+
+    /// The gas factors of a spectrum seen along one geometry: at each of `wavelengths_nm`, the
+    /// sun's leg T(m₀) ([`Self::gas`]) and the upward factor ([`Self::gas_up_after_down`]) — the
+    /// same values, with the air masses computed once and each wavelength's absorption
+    /// coefficients looked up once for both paths.
+    pub fn gas_legs(&self, wavelengths_nm: &[f64], mu0: f64, muv: f64) -> Result<GasLegs, AtmosphereError> {
+        let n = wavelengths_nm.len();
+        if !self.spec.gases {
+            return Ok(GasLegs {
+                down: vec![1.0; n],
+                up_after_down: vec![1.0; n],
+                wavelengths_nm: wavelengths_nm.to_vec(),
+                mu0,
+                muv,
+                key: None,
+            });
+        }
+        let paths = [AirMasses::one_way(mu0), AirMasses::two_way(mu0, muv)];
+        let (mut down, mut up_after_down) = (Vec::with_capacity(n), Vec::with_capacity(n));
+        let mut t = [0.0; 2];
+        for &w in wavelengths_nm {
+            along_paths(w, &paths, &self.spec.gas_amounts, self.spec.pressure_hpa, &mut t)?;
+            let [d, both] = t;
+            down.push(d);
+            up_after_down.push(if d > 0.0 { (both / d).min(1.0) } else { 0.0 });
+        }
+        Ok(GasLegs { down, up_after_down, wavelengths_nm: wavelengths_nm.to_vec(), mu0, muv, key: self.gas_key() })
+    }
+
+    /// What the gas factors depend on besides the geometry and the wavelength: `None` when the
+    /// gases are off. Two atmospheres with the same key have the same [`Self::gas_legs`].
+    #[must_use]
+    pub fn gas_key(&self) -> Option<(GasAmounts, f64)> {
+        self.spec.gases.then_some((self.spec.gas_amounts, self.spec.pressure_hpa))
     }
 
     /// All terms at one wavelength and geometry, by a direct RT solve (what `shoal atmosphere`

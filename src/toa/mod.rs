@@ -20,6 +20,7 @@
 //!   thickness over the oceans with SeaWiFS: a preliminary algorithm. Appl. Opt. 33, 443–452.
 
 pub mod adjacency;
+mod path;
 
 use std::sync::Arc;
 
@@ -32,6 +33,7 @@ use crate::water::{
 };
 
 pub use adjacency::Adjacency;
+pub use path::PathOptics;
 
 /// The atmosphere on the simulation grid for one sun/view geometry (physical units:
 /// W m⁻² sr⁻¹ nm⁻¹ for radiances, W m⁻² nm⁻¹ for irradiances; gases included).
@@ -58,16 +60,12 @@ pub struct PathSpectrum {
 /// Everything needed to turn a ground point into TOA radiance, built once per scene and grid.
 #[derive(Debug, Clone)]
 pub struct SceneOptics {
-    grid: WavelengthGrid,
+    /// The atmosphere on the grid.
+    path: PathOptics,
     water: WaterModel,
     substrates: Vec<Vec<f64>>,
     land: Option<Vec<f64>>,
-    e0: Vec<f64>,
-    lut: Arc<AtmosphereLut>,
-    /// Per grid wavelength: bracketing LUT nodes and the weight in ln λ.
-    nodes: Vec<(usize, usize, f64)>,
     adjacency: Option<Adjacency>,
-    glint: bool,
     /// The water model at band nodes only (`Fidelity::band_nodes`), if asked for.
     nodes_water: Option<NodeWater>,
 }
@@ -110,17 +108,6 @@ pub enum Target {
     Cloud,
 }
 
-/// The LUT wavelength nodes either side of `wavelength_nm` and the weight of the upper one,
-/// linear in ln λ; constant beyond the first and last node.
-fn ln_bracket(node_wl: &[f64], wavelength_nm: f64) -> (usize, usize, f64) {
-    if node_wl.len() == 1 {
-        return (0, 0, 0.0);
-    }
-    let j = node_wl.partition_point(|&v| v <= wavelength_nm).clamp(1, node_wl.len() - 1);
-    let t = (wavelength_nm / node_wl[j - 1]).ln() / (node_wl[j] / node_wl[j - 1]).ln();
-    (j - 1, j, t.clamp(0.0, 1.0))
-}
-
 impl SceneOptics {
     /// Bind a scene to a simulation grid and an atmosphere LUT built for that scene (its
     /// wavelength nodes must bracket the grid).
@@ -148,37 +135,8 @@ impl SceneOptics {
             }
             None => None,
         };
-        let atmosphere = lut.atmosphere();
-        let e0 = grid.wavelengths_nm().iter().map(|&w| atmosphere.e0(w)).collect::<Result<Vec<_>, _>>()?;
-        let node_wl = &lut.axes().wavelengths_nm;
-        let nodes = grid
-            .wavelengths_nm()
-            .iter()
-            .map(|&w| {
-                let (first, last) = (node_wl[0], node_wl[node_wl.len() - 1]);
-                if w < first - 1e-9 || w > last + 1e-9 {
-                    return Err(SceneError::Atmosphere(AtmosphereError::OutOfRange {
-                        field: "wavelength_nm (LUT nodes)".into(),
-                        value: w,
-                        allowed: format!("{first} to {last} nm"),
-                    }));
-                }
-                Ok(ln_bracket(node_wl, w))
-            })
-            .collect::<Result<Vec<_>, SceneError>>()?;
         let adjacency = if scene.wants(Effect::Adjacency) { Some(Adjacency::new(scene)) } else { None };
-        Ok(Self {
-            grid: grid.clone(),
-            water,
-            substrates,
-            land,
-            e0,
-            lut,
-            nodes,
-            adjacency,
-            glint: scene.wants(Effect::SunGlint),
-            nodes_water: None,
-        })
+        Ok(Self { path: PathOptics::new(scene, grid, lut)?, water, substrates, land, adjacency, nodes_water: None })
     }
 
     /// Evaluate water spectra per pixel only at the grid indices `indices` (increasing; see
@@ -235,7 +193,13 @@ impl SceneOptics {
     /// The simulation grid.
     #[must_use]
     pub fn grid(&self) -> &WavelengthGrid {
-        &self.grid
+        self.path.grid()
+    }
+
+    /// The atmosphere on the grid (what [`Self::path_spectrum`] reads).
+    #[must_use]
+    pub fn path(&self) -> &PathOptics {
+        &self.path
     }
 
     /// The water model (SIOP set on the grid).
@@ -247,15 +211,16 @@ impl SceneOptics {
     /// Extraterrestrial irradiance on the grid at the scene's date, W m⁻² nm⁻¹.
     #[must_use]
     pub fn e0(&self) -> &[f64] {
-        &self.e0
+        self.path.e0()
     }
 
     /// The path radiance's (Q/I, U/I) at `wavelength_nm` (linear in ln λ between the table's
     /// wavelength nodes, constant beyond its ends) in the view's meridian frame; `None` when the
     /// table holds no vector solution ([`AtmosphereLut::path_polarisation`]).
     pub fn path_polarisation(&self, g: &Geometry, wavelength_nm: f64) -> Result<Option<(f64, f64)>, AtmosphereError> {
-        let (j0, j1, t) = ln_bracket(&self.lut.axes().wavelengths_nm, wavelength_nm);
-        let (Some(a), Some(b)) = (self.lut.path_polarisation(j0, g)?, self.lut.path_polarisation(j1, g)?) else {
+        let lut = self.path.lut();
+        let (j0, j1, t) = path::ln_bracket(&lut.axes().wavelengths_nm, wavelength_nm);
+        let (Some(a), Some(b)) = (lut.path_polarisation(j0, g)?, lut.path_polarisation(j1, g)?) else {
             return Ok(None);
         };
         Ok(Some((a.0 + t * (b.0 - a.0), a.1 + t * (b.1 - a.1))))
@@ -264,53 +229,7 @@ impl SceneOptics {
     /// The atmosphere on the grid for geometry `g` (LUT nodes interpolated log–log in λ, then
     /// the 1-nm solar spectrum and the gases applied).
     pub fn path_spectrum(&self, g: &Geometry) -> Result<PathSpectrum, AtmosphereError> {
-        let n_nodes = self.lut.axes().wavelengths_nm.len();
-        let norm = (0..n_nodes).map(|w| self.lut.normalised_with(w, g, self.glint)).collect::<Result<Vec<_>, _>>()?;
-        let atmosphere = self.lut.atmosphere();
-        let (mu0, muv) = (g.sun_zenith_rad.cos(), g.view_zenith_rad.cos());
-        let n = self.grid.len();
-        let mut p = PathSpectrum {
-            l_path: vec![0.0; n],
-            ed: vec![0.0; n],
-            ed_direct: vec![0.0; n],
-            t_up: vec![0.0; n],
-            t_up_diffuse: vec![0.0; n],
-            spherical_albedo: vec![0.0; n],
-            glint: vec![0.0; n],
-            rayleigh_share: vec![0.0; n],
-        };
-        let loglin = |a: f64, b: f64, t: f64| {
-            if a > 0.0 && b > 0.0 { (a.ln() + t * (b.ln() - a.ln())).exp() } else { a + t * (b - a) }
-        };
-        let lin = |a: f64, b: f64, t: f64| a + t * (b - a);
-        for (i, &wl) in self.grid.wavelengths_nm().iter().enumerate() {
-            let (j0, j1, t) = self.nodes[i];
-            let (a, b) = (&norm[j0], &norm[j1]);
-            // Ed carries the sun's leg; the upward factor the rest of the two-way transmittance
-            // (band-model gases are not a product of legs: see `gas::two_way_transmittance`).
-            let tg0 = atmosphere.gas(wl, mu0)?;
-            let tgv = atmosphere.gas_up_after_down(wl, mu0, muv)?;
-            let e0 = self.e0[i];
-            p.l_path[i] = loglin(a.radiance, b.radiance, t) * e0 * tg0 * tgv;
-            p.ed[i] = loglin(a.ed, b.ed, t) * e0 * tg0;
-            let tau = loglin(a.tau_rayleigh + a.tau_aerosol, b.tau_rayleigh + b.tau_aerosol, t);
-            p.ed_direct[i] = (mu0 * (-tau / mu0).exp() * e0 * tg0).min(p.ed[i]);
-            let t_up = lin(a.t_up, b.t_up, t);
-            let t_dir = lin(a.t_up_direct, b.t_up_direct, t);
-            p.t_up[i] = t_up * tgv;
-            p.t_up_diffuse[i] = (t_up - t_dir).max(0.0) * tgv;
-            p.spherical_albedo[i] = loglin(a.spherical_albedo, b.spherical_albedo, t);
-            if self.glint {
-                p.glint[i] = loglin(a.glint, b.glint, t) * e0 * tg0 * tgv;
-            }
-            // Diffuse transmission by molecules vs aerosols, in proportion to their forward-
-            // scattering depths ω·η·τ (η from each phase function: ½ for molecules, the Mie
-            // table's forward share for the aerosol; see WavelengthColumn::forward_scattering).
-            let dr = lin(a.forward_scattering.0, b.forward_scattering.0, t);
-            let da = lin(a.forward_scattering.1, b.forward_scattering.1, t);
-            p.rayleigh_share[i] = if dr + da > 0.0 { dr / (dr + da) } else { 1.0 };
-        }
-        Ok(p)
+        self.path.path_spectrum(g)
     }
 
     /// TOA radiance (`l_toa`, W m⁻² sr⁻¹ nm⁻¹) and, over water, Rrs (`rrs`, sr⁻¹) at scene point
@@ -332,7 +251,7 @@ impl SceneOptics {
         l_toa: &mut [f64],
         rrs: &mut [f64],
     ) -> Result<Target, SceneError> {
-        let n = self.grid.len();
+        let n = self.path.grid().len();
         let shadow = sky == Sky::Shadow;
         let mut ed_shadow = std::mem::take(&mut scratch.ed_shadow);
         if shadow {

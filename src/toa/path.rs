@@ -1,0 +1,198 @@
+//! The atmosphere on the simulation grid for one geometry ([`PathOptics::path_spectrum`]): the
+//! LUT's normalised terms at its wavelength nodes, interpolated log–log in λ onto the grid, times
+//! the 1-nm solar spectrum and the gas transmittances (the formulas of [`super`]'s docs).
+//!
+//! It is what the forward model, the band-effective atmosphere and the image-based correction's
+//! aerosol family all read, so it is built apart from the water ([`super::SceneOptics`] holds
+//! one): the family binds twenty atmospheres to one grid and needs no water model for them.
+//! Two things a spectrum repeats are computed once: the logarithms of each LUT node's terms
+//! (two per grid wavelength and term otherwise), and the gas factors, which depend on the
+//! geometry and the gases but not on the aerosol ([`PathOptics::gas_legs`], shared by the
+//! family's members through [`PathOptics::path_spectrum_with`]).
+
+use std::sync::Arc;
+
+use super::PathSpectrum;
+use crate::atmosphere::{AtmosphereError, AtmosphereLut, GasAmounts, GasLegs, Geometry, Normalised};
+use crate::scene::{Effect, Scene, SceneError};
+use crate::spectral::WavelengthGrid;
+
+/// A LUT bound to a simulation grid: what [`Self::path_spectrum`] needs.
+#[derive(Debug, Clone)]
+pub struct PathOptics {
+    grid: WavelengthGrid,
+    e0: Vec<f64>,
+    lut: Arc<AtmosphereLut>,
+    /// Per grid wavelength: bracketing LUT nodes and the weight in ln λ.
+    nodes: Vec<(usize, usize, f64)>,
+    glint: bool,
+}
+
+/// The LUT wavelength nodes either side of `wavelength_nm` and the weight of the upper one,
+/// linear in ln λ; constant beyond the first and last node.
+pub(super) fn ln_bracket(node_wl: &[f64], wavelength_nm: f64) -> (usize, usize, f64) {
+    if node_wl.len() == 1 {
+        return (0, 0, 0.0);
+    }
+    let j = node_wl.partition_point(|&v| v <= wavelength_nm).clamp(1, node_wl.len() - 1);
+    let t = (wavelength_nm / node_wl[j - 1]).ln() / (node_wl[j] / node_wl[j - 1]).ln();
+    (j - 1, j, t.clamp(0.0, 1.0))
+}
+
+/// One LUT node's terms and the logarithms of those interpolated log–log.
+struct Node {
+    at: Normalised,
+    /// τ_Rayleigh + τ_aerosol.
+    tau: f64,
+    ln_radiance: f64,
+    ln_ed: f64,
+    ln_tau: f64,
+    ln_spherical_albedo: f64,
+    ln_glint: f64,
+}
+
+impl Node {
+    fn new(at: Normalised) -> Self {
+        let tau = at.tau_rayleigh + at.tau_aerosol;
+        Self {
+            tau,
+            ln_radiance: at.radiance.ln(),
+            ln_ed: at.ed.ln(),
+            ln_tau: tau.ln(),
+            ln_spherical_albedo: at.spherical_albedo.ln(),
+            ln_glint: at.glint.ln(),
+            at,
+        }
+    }
+}
+
+/// Between `a` and `b` at weight `t`: linear in the logarithms (`la`, `lb`: theirs) where both
+/// are positive, else linear.
+#[inline]
+fn loglin(a: f64, b: f64, la: f64, lb: f64, t: f64) -> f64 {
+    if a > 0.0 && b > 0.0 { (la + t * (lb - la)).exp() } else { a + t * (b - a) }
+}
+
+impl PathOptics {
+    /// Bind `lut` (built for `scene`; its wavelength nodes must bracket the grid) to `grid`.
+    pub fn new(scene: &Scene, grid: &WavelengthGrid, lut: Arc<AtmosphereLut>) -> Result<Self, SceneError> {
+        let atmosphere = lut.atmosphere();
+        let e0 = grid.wavelengths_nm().iter().map(|&w| atmosphere.e0(w)).collect::<Result<Vec<_>, _>>()?;
+        let node_wl = &lut.axes().wavelengths_nm;
+        let nodes = grid
+            .wavelengths_nm()
+            .iter()
+            .map(|&w| {
+                let (first, last) = (node_wl[0], node_wl[node_wl.len() - 1]);
+                if w < first - 1e-9 || w > last + 1e-9 {
+                    return Err(SceneError::Atmosphere(AtmosphereError::OutOfRange {
+                        field: "wavelength_nm (LUT nodes)".into(),
+                        value: w,
+                        allowed: format!("{first} to {last} nm"),
+                    }));
+                }
+                Ok(ln_bracket(node_wl, w))
+            })
+            .collect::<Result<Vec<_>, SceneError>>()?;
+        Ok(Self { grid: grid.clone(), e0, lut, nodes, glint: scene.wants(Effect::SunGlint) })
+    }
+
+    /// The simulation grid.
+    #[must_use]
+    pub fn grid(&self) -> &WavelengthGrid {
+        &self.grid
+    }
+
+    /// Extraterrestrial irradiance on the grid at the scene's date, W m⁻² nm⁻¹.
+    #[must_use]
+    pub fn e0(&self) -> &[f64] {
+        &self.e0
+    }
+
+    /// The atmosphere LUT.
+    #[must_use]
+    pub fn lut(&self) -> &Arc<AtmosphereLut> {
+        &self.lut
+    }
+
+    /// What the gas factors depend on besides the geometry: paths with the same key and grid
+    /// have the same [`Self::gas_legs`] at a geometry.
+    #[must_use]
+    pub fn gas_key(&self) -> Option<(GasAmounts, f64)> {
+        self.lut.atmosphere().gas_key()
+    }
+
+    /// The gas factors on the grid along `g` ([`crate::atmosphere::Atmosphere::gas_legs`]).
+    pub fn gas_legs(&self, g: &Geometry) -> Result<GasLegs, AtmosphereError> {
+        self.lut.atmosphere().gas_legs(self.grid.wavelengths_nm(), g.sun_zenith_rad.cos(), g.view_zenith_rad.cos())
+    }
+
+    /// The atmosphere on the grid for geometry `g` (LUT nodes interpolated log–log in λ, then
+    /// the 1-nm solar spectrum and the gases applied).
+    pub fn path_spectrum(&self, g: &Geometry) -> Result<PathSpectrum, AtmosphereError> {
+        self.path_spectrum_with(g, &self.gas_legs(g)?)
+    }
+
+    /// [`Self::path_spectrum`] with the gas factors `legs` given: [`Self::gas_legs`] of this
+    /// path or of one with the same [`Self::gas_key`] and grid at the same geometry (legs that
+    /// do not fit, checked, are not used: the path's own are computed instead).
+    pub fn path_spectrum_with(&self, g: &Geometry, legs: &GasLegs) -> Result<PathSpectrum, AtmosphereError> {
+        let n = self.grid.len();
+        let mu0 = g.sun_zenith_rad.cos();
+        let fits = legs.wavelengths_nm == self.grid.wavelengths_nm()
+            && legs.mu0 == mu0
+            && legs.muv == g.view_zenith_rad.cos()
+            && legs.key == self.gas_key();
+        let own;
+        let legs = if fits {
+            legs
+        } else {
+            own = self.gas_legs(g)?;
+            &own
+        };
+        let n_nodes = self.lut.axes().wavelengths_nm.len();
+        let nodes = (0..n_nodes)
+            .map(|w| self.lut.normalised_with(w, g, self.glint).map(Node::new))
+            .collect::<Result<Vec<_>, _>>()?;
+        let mut p = PathSpectrum {
+            l_path: vec![0.0; n],
+            ed: vec![0.0; n],
+            ed_direct: vec![0.0; n],
+            t_up: vec![0.0; n],
+            t_up_diffuse: vec![0.0; n],
+            spherical_albedo: vec![0.0; n],
+            glint: vec![0.0; n],
+            rayleigh_share: vec![0.0; n],
+        };
+        let lin = |a: f64, b: f64, t: f64| a + t * (b - a);
+        for i in 0..n {
+            let (j0, j1, t) = self.nodes[i];
+            let (na, nb) = (&nodes[j0], &nodes[j1]);
+            let (a, b) = (&na.at, &nb.at);
+            // Ed carries the sun's leg; the upward factor the rest of the two-way transmittance
+            // (band-model gases are not a product of legs: see `gas::two_way_transmittance`).
+            let (tg0, tgv) = (legs.down[i], legs.up_after_down[i]);
+            let e0 = self.e0[i];
+            p.l_path[i] = loglin(a.radiance, b.radiance, na.ln_radiance, nb.ln_radiance, t) * e0 * tg0 * tgv;
+            p.ed[i] = loglin(a.ed, b.ed, na.ln_ed, nb.ln_ed, t) * e0 * tg0;
+            let tau = loglin(na.tau, nb.tau, na.ln_tau, nb.ln_tau, t);
+            p.ed_direct[i] = (mu0 * (-tau / mu0).exp() * e0 * tg0).min(p.ed[i]);
+            let t_up = lin(a.t_up, b.t_up, t);
+            let t_dir = lin(a.t_up_direct, b.t_up_direct, t);
+            p.t_up[i] = t_up * tgv;
+            p.t_up_diffuse[i] = (t_up - t_dir).max(0.0) * tgv;
+            p.spherical_albedo[i] =
+                loglin(a.spherical_albedo, b.spherical_albedo, na.ln_spherical_albedo, nb.ln_spherical_albedo, t);
+            if self.glint {
+                p.glint[i] = loglin(a.glint, b.glint, na.ln_glint, nb.ln_glint, t) * e0 * tg0 * tgv;
+            }
+            // Diffuse transmission by molecules vs aerosols, in proportion to their forward-
+            // scattering depths ω·η·τ (η from each phase function: ½ for molecules, the Mie
+            // table's forward share for the aerosol; see WavelengthColumn::forward_scattering).
+            let dr = lin(a.forward_scattering.0, b.forward_scattering.0, t);
+            let da = lin(a.forward_scattering.1, b.forward_scattering.1, t);
+            p.rayleigh_share[i] = if dr + da > 0.0 { dr / (dr + da) } else { 1.0 };
+        }
+        Ok(p)
+    }
+}
