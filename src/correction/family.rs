@@ -7,11 +7,11 @@ use super::CorrectionError;
 use super::image::{ImageCorrection, invalid};
 use crate::atmosphere::{AerosolType, AtmosphereLut, AtmosphereSpec, LutAxes};
 use crate::control::RunControl;
-use crate::instrument::band_atmosphere::band_terms;
+use crate::instrument::band_atmosphere::band_terms_of_each;
 pub use crate::instrument::band_atmosphere::{BandTerms, TERM_COLUMNS};
 use crate::instrument::{Response, Viewing};
 use crate::scene::Scene;
-use crate::toa::SceneOptics;
+use crate::toa::PathOptics;
 
 /// The family's tables: per model, per AOT node, per column and band.
 #[derive(Debug, Clone)]
@@ -155,30 +155,45 @@ impl AerosolFamily {
         across_track: bool,
         control: &RunControl,
     ) -> Result<Self, CorrectionError> {
-        let terms_of = |lut: &std::sync::Arc<AtmosphereLut>| -> Result<BandTerms, CorrectionError> {
-            if control.cancelled() {
-                return Err(CorrectionError::Cancelled);
-            }
-            let optics = response
+        if control.cancelled() {
+            return Err(CorrectionError::Cancelled);
+        }
+        // Every LUT bound to each geometry group's grid: the Rayleigh atmosphere (shared by the
+        // models' first node), each model's other nodes, and the gas-free one where there is one.
+        let bind = |lut: &std::sync::Arc<AtmosphereLut>| -> Result<Vec<PathOptics>, CorrectionError> {
+            response
                 .groups
                 .iter()
-                .map(|g| SceneOptics::new(scene, &g.grid, lut.clone()))
+                .map(|g| PathOptics::new(scene, &g.grid, lut.clone()))
                 .collect::<Result<Vec<_>, _>>()
-                .map_err(|e| invalid("correction.image", e.to_string()))?;
-            band_terms(&optics, viewing, response, across_track).map_err(|e| invalid("correction.image", e.to_string()))
+                .map_err(|e| invalid("correction.image", e.to_string()))
         };
-        let rayleigh = terms_of(&luts.luts[0][0])?;
+        let mut bound = vec![bind(&luts.luts[0][0])?];
+        for row in &luts.luts {
+            for lut in &row[1..] {
+                bound.push(bind(lut)?);
+            }
+        }
+        if let Some(lut) = &luts.gas_free {
+            bound.push(bind(lut)?);
+        }
+        let atmospheres: Vec<Vec<&PathOptics>> = bound.iter().map(|b| b.iter().collect()).collect();
+        let mut all = band_terms_of_each(&atmospheres, viewing, response, across_track)
+            .map_err(|e| invalid("correction.image", e.to_string()))?
+            .into_iter();
+        let mut next = || all.next().ok_or_else(|| invalid("correction.image", "a member's terms are missing".into()));
+        let rayleigh = next()?;
         let mut terms = Vec::with_capacity(luts.models.len());
         for row in &luts.luts {
             let mut out = vec![rayleigh.clone()];
-            for lut in &row[1..] {
-                out.push(terms_of(lut)?);
+            for _ in &row[1..] {
+                out.push(next()?);
             }
             terms.push(out);
         }
         let gas_two_way = match &luts.gas_free {
-            Some(lut) => {
-                let free = terms_of(lut)?;
+            Some(_) => {
+                let free = next()?;
                 rayleigh.t_ed.iter().zip(&free.t_ed).map(|(a, b)| if *b > 0.0 { a / b } else { 1.0 }).collect()
             }
             None => vec![1.0; rayleigh.t_ed.len()],

@@ -7,7 +7,7 @@ use rayon::prelude::*;
 use super::InstrumentError;
 use super::geometry::Viewing;
 use super::response::Response;
-use crate::toa::{PathSpectrum, SceneOptics};
+use crate::toa::{PathOptics, PathSpectrum, SceneOptics};
 
 /// Per band of a group: first grid index and weights on the grid from there.
 pub type BandWeights = Vec<(usize, Vec<f64>)>;
@@ -242,17 +242,32 @@ pub struct BandTerms {
 }
 
 /// The band terms of every column for one atmosphere (the photon-weighted means of
-/// `BandAtmosphere`, without what only the forward model needs). Where every detector has the
-/// same response (no smile) and the columns are a swath (`across_track`), the terms are computed
-/// at [`TERM_COLUMNS`] columns spread over it and interpolated linearly between them: they follow
-/// the view zenith, which changes smoothly across track. Otherwise (a user's spectra, one per
-/// column, `shoal correct`) every column is computed.
+/// `BandAtmosphere`, without what only the forward model needs): [`band_terms_of_each`] of one.
 pub fn band_terms(
     optics: &[SceneOptics],
     viewing: &Viewing,
     response: &Response,
     across_track: bool,
 ) -> Result<BandTerms, InstrumentError> {
+    let paths: Vec<&PathOptics> = optics.iter().map(SceneOptics::path).collect();
+    let mut terms = band_terms_of_each(&[paths], viewing, response, across_track)?;
+    Ok(terms.remove(0))
+}
+
+/// The band terms of every column for each of several atmospheres (`atmospheres[a][g]`: the
+/// atmosphere `a` bound to geometry group `g`'s grid). Where every detector has the same
+/// response (no smile) and the columns are a swath (`across_track`), the terms are computed at
+/// [`TERM_COLUMNS`] columns spread over it and interpolated linearly between them: they follow
+/// the view zenith, which changes smoothly across track. Otherwise (a user's spectra, one per
+/// column, `shoal correct`) every column is computed. The gas factors of a column's geometry are
+/// computed once for all the atmospheres that share the first's gases (the image-based
+/// correction's family: one atmosphere per aerosol model and AOT node, the same gases).
+pub fn band_terms_of_each(
+    atmospheres: &[Vec<&PathOptics>],
+    viewing: &Viewing,
+    response: &Response,
+    across_track: bool,
+) -> Result<Vec<BandTerms>, InstrumentError> {
     let nb = response.n_bands();
     let nc = viewing.columns();
     let one_response = response.smile_class.iter().all(|&c| c == response.smile_class.first().copied().unwrap_or(0));
@@ -263,40 +278,65 @@ pub fn band_terms(
     } else {
         (0..nc).collect()
     };
-    let mut at_sampled = BandTerms {
-        l_path: vec![0.0; sampled.len() * nb],
-        t_ed: vec![0.0; sampled.len() * nb],
-        spherical_albedo: vec![0.0; sampled.len() * nb],
-        glint: vec![0.0; sampled.len() * nb],
+    let empty = |n: usize| BandTerms {
+        l_path: vec![0.0; n * nb],
+        t_ed: vec![0.0; n * nb],
+        spherical_albedo: vec![0.0; n * nb],
+        glint: vec![0.0; n * nb],
     };
+    let mut at_sampled: Vec<BandTerms> = atmospheres.iter().map(|_| empty(sampled.len())).collect();
+    let scene_error = |e: crate::atmosphere::AtmosphereError| InstrumentError::Scene(e.into());
     for (gi, group) in response.groups.iter().enumerate() {
-        let columns: Vec<Vec<(usize, [f64; 4])>> = sampled
+        // Per sampled column, per atmosphere: (entry, [L_path, T·Ed, S, glint]) of each band.
+        type Means = Vec<(usize, [f64; 4])>;
+        let columns: Vec<Vec<Means>> = sampled
             .par_iter()
             .enumerate()
             .map(|(si, &c)| {
                 let look = &viewing.looks[gi][c];
-                let path = optics[gi].path_spectrum(&look.geometry).map_err(|e| InstrumentError::Scene(e.into()))?;
                 let j = viewing.detector_index[c];
-                Ok(group
-                    .bands
+                let legs = match atmospheres.first() {
+                    Some(first) => Some(first[gi].gas_legs(&look.geometry).map_err(scene_error)?),
+                    None => None,
+                };
+                atmospheres
                     .iter()
-                    .enumerate()
-                    .map(|(k, &b)| {
-                        let (first, w) = response.weights(gi, k, j);
-                        let m = band_means(&path, first, w);
-                        (si * nb + b, [m.l_path, m.t_ed, m.spherical_albedo, m.glint])
+                    .map(|paths| {
+                        let path = match &legs {
+                            Some(legs) => paths[gi].path_spectrum_with(&look.geometry, legs),
+                            None => paths[gi].path_spectrum(&look.geometry),
+                        }
+                        .map_err(scene_error)?;
+                        Ok(group
+                            .bands
+                            .iter()
+                            .enumerate()
+                            .map(|(k, &b)| {
+                                let (first, w) = response.weights(gi, k, j);
+                                let m = band_means(&path, first, w);
+                                (si * nb + b, [m.l_path, m.t_ed, m.spherical_albedo, m.glint])
+                            })
+                            .collect())
                     })
-                    .collect())
+                    .collect::<Result<Vec<Means>, InstrumentError>>()
             })
             .collect::<Result<_, InstrumentError>>()?;
-        for (i, [l, te, s, g]) in columns.into_iter().flatten() {
-            (at_sampled.l_path[i], at_sampled.t_ed[i], at_sampled.spherical_albedo[i], at_sampled.glint[i]) =
-                (l, te, s, g);
+        for per_atmosphere in columns {
+            for (terms, means) in at_sampled.iter_mut().zip(per_atmosphere) {
+                for (i, [l, te, s, g]) in means {
+                    (terms.l_path[i], terms.t_ed[i], terms.spherical_albedo[i], terms.glint[i]) = (l, te, s, g);
+                }
+            }
         }
     }
     if sampled.len() == nc {
         return Ok(at_sampled);
     }
+    Ok(at_sampled.iter().map(|at| across_columns(at, &sampled, nc, nb)).collect())
+}
+
+/// The terms at every one of `nc` columns, linear between the `sampled` columns' `at`.
+fn across_columns(at: &BandTerms, sampled: &[usize], nc: usize, nb: usize) -> BandTerms {
     let mut out = BandTerms {
         l_path: vec![0.0; nc * nb],
         t_ed: vec![0.0; nc * nb],
@@ -309,14 +349,13 @@ pub fn band_terms(
         let t = if z > a { (c - a) as f64 / (z - a) as f64 } else { 0.0 };
         for b in 0..nb {
             let (i0, i1, o) = ((s1 - 1) * nb + b, s1 * nb + b, c * nb + b);
-            out.l_path[o] = at_sampled.l_path[i0] + t * (at_sampled.l_path[i1] - at_sampled.l_path[i0]);
-            out.t_ed[o] = at_sampled.t_ed[i0] + t * (at_sampled.t_ed[i1] - at_sampled.t_ed[i0]);
-            out.spherical_albedo[o] = at_sampled.spherical_albedo[i0]
-                + t * (at_sampled.spherical_albedo[i1] - at_sampled.spherical_albedo[i0]);
-            out.glint[o] = at_sampled.glint[i0] + t * (at_sampled.glint[i1] - at_sampled.glint[i0]);
+            out.l_path[o] = at.l_path[i0] + t * (at.l_path[i1] - at.l_path[i0]);
+            out.t_ed[o] = at.t_ed[i0] + t * (at.t_ed[i1] - at.t_ed[i0]);
+            out.spherical_albedo[o] = at.spherical_albedo[i0] + t * (at.spherical_albedo[i1] - at.spherical_albedo[i0]);
+            out.glint[o] = at.glint[i0] + t * (at.glint[i1] - at.glint[i0]);
         }
     }
-    Ok(out)
+    out
 }
 
 /// Columns at which [`band_terms`] computes the family's terms when it may interpolate.

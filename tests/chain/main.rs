@@ -26,6 +26,7 @@ mod incremental;
 mod memory;
 mod netcdf;
 mod noise;
+mod path_sharing;
 mod plausibility;
 mod qaa;
 mod rasters;
