@@ -161,13 +161,20 @@ impl Detector {
             (0..nb).map(|b| response.plane_of_band.get(b).copied().unwrap_or(0).min(planes.len() - 1)).collect();
         let mut responsivity = vec![0.0; nd * nb];
         let mut dark_e = vec![0.0; nd * nb];
+        // Σw of each band of each smile class: the detectors of a class share one weight slice
+        // (`Response::weights`), so each sum is taken once, not once per detector.
+        let photon_sums: Vec<Vec<Vec<f64>>> = response
+            .groups
+            .iter()
+            .map(|g| g.weights.iter().map(|class| class.iter().map(|(_, w)| w.iter().sum()).collect()).collect())
+            .collect();
         for j in 0..nd {
             let mut rng = pixel_rng(seed, Stream::FixedPattern, 0, j);
             for (gi, g) in response.groups.iter().enumerate() {
                 for (k, &b) in g.bands.iter().enumerate() {
                     let p = plane_of_band[b];
                     let plane = &planes[p];
-                    let photons: f64 = response.weights(gi, k, j).1.iter().sum();
+                    let photons = photon_sums[gi][response.smile_class_of(gi, j)][k];
                     let (z1, z2) = if p == 0 {
                         (normal(&mut rng), normal(&mut rng))
                     } else {

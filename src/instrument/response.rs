@@ -194,10 +194,14 @@ impl Response {
     /// The band-`k` weights of group `g` for detector `detector` (its smile class).
     #[must_use]
     pub fn weights(&self, g: usize, k: usize, detector: usize) -> (usize, &[f64]) {
-        let group = &self.groups[g];
-        let class = self.smile_class.get(detector).copied().unwrap_or(0).min(group.weights.len() - 1);
-        let (first, w) = &group.weights[class][k];
+        let (first, w) = &self.groups[g].weights[self.smile_class_of(g, detector)][k];
         (*first, w)
+    }
+
+    /// The index of detector `detector`'s weights in group `g` (its smile class).
+    #[must_use]
+    pub fn smile_class_of(&self, g: usize, detector: usize) -> usize {
+        self.smile_class.get(detector).copied().unwrap_or(0).min(self.groups[g].weights.len() - 1)
     }
 
     /// Photon response ∫w_b dλ of band `b` (photons J⁻¹), at the swath centre.
