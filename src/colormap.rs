@@ -159,13 +159,23 @@ impl Scale {
     /// its pixels.
     #[must_use]
     pub fn position_of_mean(&self, mean_value: f64, mean_ln: f64) -> f64 {
-        if self.log {
-            let (a, b) = (self.lo.max(f64::MIN_POSITIVE).ln(), self.hi.max(f64::MIN_POSITIVE).ln());
-            if b > a { (mean_ln - a) / (b - a) } else { 0.5 }
-        } else if self.hi > self.lo {
-            (mean_value - self.lo) / (self.hi - self.lo)
-        } else {
-            0.5
+        self.position_of_mean_fn()(mean_value, mean_ln)
+    }
+
+    /// [`Self::position_of_mean`] with the scale's logarithms taken once, for a whole image (the
+    /// same values: a map of 720 × 480 blocks took two logarithms per block).
+    #[must_use]
+    pub fn position_of_mean_fn(&self) -> impl Fn(f64, f64) -> f64 + Copy + use<> {
+        let (log, lo, hi) = (self.log, self.lo, self.hi);
+        let (a, b) = if log { (lo.max(f64::MIN_POSITIVE).ln(), hi.max(f64::MIN_POSITIVE).ln()) } else { (lo, hi) };
+        move |mean_value: f64, mean_ln: f64| {
+            if log {
+                if b > a { (mean_ln - a) / (b - a) } else { 0.5 }
+            } else if hi > lo {
+                (mean_value - lo) / (hi - lo)
+            } else {
+                0.5
+            }
         }
     }
 

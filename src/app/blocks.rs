@@ -89,7 +89,12 @@ impl Blocks {
     pub fn colorize(&self, palette: Palette) -> Image {
         let (w, h) = (self.width, self.height);
         let mut rgba = vec![0u8; w * h * 4];
-        for y in 0..h {
+        let position = match palette {
+            Palette::Sequential(s) => s.position_of_mean_fn(),
+            _ => crate::colormap::Scale { lo: 0.0, hi: 1.0, log: false }.position_of_mean_fn(),
+        };
+        for (row, out) in rgba.chunks_mut((w * 4).max(1)).enumerate() {
+            let y = h - 1 - row;
             for x in 0..w {
                 let k = y * w + x;
                 let n = f64::from(self.count[k]);
@@ -99,7 +104,7 @@ impl Blocks {
                     super::theme::NOT_RETURNED
                 } else {
                     let c = match palette {
-                        Palette::Sequential(s) => viridis(s.position_of_mean(self.sum[k] / n, self.sum_ln[k] / n)),
+                        Palette::Sequential(_) => viridis(position(self.sum[k] / n, self.sum_ln[k] / n)),
                         Palette::Diverging(bound) => diverging((self.sum[k] / n) / bound.max(f64::MIN_POSITIVE)),
                         Palette::Classes => categorical(f64::from(self.first[k]).max(0.0) as usize),
                         // Any disagreement in the block shows (a mean above 0).
@@ -107,8 +112,7 @@ impl Blocks {
                     };
                     [c[0], c[1], c[2], 255]
                 };
-                let i = ((h - 1 - y) * w + x) * 4;
-                rgba[i..i + 4].copy_from_slice(&colour);
+                out[x * 4..x * 4 + 4].copy_from_slice(&colour);
             }
         }
         Image { width: w, height: h, rgba }
