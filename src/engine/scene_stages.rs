@@ -17,7 +17,7 @@ use crate::instrument::effects;
 use crate::instrument::sample::BandAtmosphere;
 use crate::instrument::{AotNodes, Response, Viewing};
 use crate::scene::Scene;
-use crate::toa::SceneOptics;
+use crate::toa::{PathOptics, SceneOptics};
 
 impl Engine {
     /// The bands the instrument really has, where the processor's knowledge of them is wrong
@@ -109,18 +109,20 @@ impl Engine {
         }
         let nodes_key = nodes_key.finish();
         let at_nodes = self.stage(nodes_key, report, control, || {
-            let optics = luts
+            // Each node's atmosphere on the grids, without the water (the band terms read only
+            // the path).
+            let paths = luts
                 .iter()
                 .map(|lut| {
                     response
                         .groups
                         .iter()
-                        .map(|g| SceneOptics::new(scene, &g.grid, lut.clone()))
+                        .map(|g| PathOptics::new(scene, &g.grid, lut.clone()))
                         .collect::<Result<Vec<_>, _>>()
                 })
                 .collect::<Result<Vec<_>, _>>()
                 .map_err(failed_any(Stage::BandAtmosphere))?;
-            AotNodes::build(nodes.clone(), &optics, viewing, response).map_err(failed(Stage::BandAtmosphere))
+            AotNodes::build(nodes.clone(), &paths, viewing, response).map_err(failed(Stage::BandAtmosphere))
         })?;
         Ok((Some(at_nodes), nodes_key))
     }

@@ -29,10 +29,10 @@
 //!   675–686.
 
 use super::InstrumentError;
-use super::band_atmosphere::{BandAtmosphere, BandTerms, band_terms};
+use super::band_atmosphere::{BandAtmosphere, BandTerms, band_terms_of_each};
 use super::geometry::Viewing;
 use super::response::Response;
-use crate::toa::SceneOptics;
+use crate::toa::PathOptics;
 
 /// Largest spacing of the AOT nodes. Quadratic interpolation over nodes 0.05 apart leaves
 /// below 10⁻⁴ relative error in path radiance (the closure test's measure).
@@ -92,16 +92,17 @@ pub fn weights(nodes: &[f64], tau: f64) -> [(usize, f64); 3] {
 }
 
 impl AotNodes {
-    /// The band terms at each node: `optics[k]` is the scene bound to each geometry group's grid
-    /// with the atmosphere at `aot550[k]`. Every column is computed (no across-track
-    /// interpolation: this is the forward model).
+    /// The band terms at each node: `paths[k]` is the atmosphere at `aot550[k]` bound to each
+    /// geometry group's grid. Every column is computed (no across-track interpolation: this is
+    /// the forward model); the gas factors of a column's geometry once for all the nodes.
     pub fn build(
         aot550: Vec<f64>,
-        optics: &[Vec<SceneOptics>],
+        paths: &[Vec<PathOptics>],
         viewing: &Viewing,
         response: &Response,
     ) -> Result<Self, InstrumentError> {
-        let terms = optics.iter().map(|o| band_terms(o, viewing, response, false)).collect::<Result<Vec<_>, _>>()?;
+        let paths: Vec<Vec<&PathOptics>> = paths.iter().map(|p| p.iter().collect()).collect();
+        let terms = band_terms_of_each(&paths, viewing, response, false)?;
         Ok(Self { aot550, terms, n_bands: response.n_bands() })
     }
 
