@@ -164,7 +164,6 @@ impl Scale {
 
     /// [`Self::position_of_mean`] with the scale's logarithms taken once, for a whole image (the
     /// same values: a map of 720 × 480 blocks took two logarithms per block).
-    #[must_use]
     pub fn position_of_mean_fn(&self) -> impl Fn(f64, f64) -> f64 + Copy + use<> {
         let (log, lo, hi) = (self.log, self.lo, self.hi);
         let (a, b) = if log { (lo.max(f64::MIN_POSITIVE).ln(), hi.max(f64::MIN_POSITIVE).ln()) } else { (lo, hi) };
