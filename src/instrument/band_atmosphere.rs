@@ -287,6 +287,13 @@ pub fn band_terms_of_each(
     let mut at_sampled: Vec<BandTerms> = atmospheres.iter().map(|_| empty(sampled.len())).collect();
     let scene_error = |e: crate::atmosphere::AtmosphereError| InstrumentError::Scene(e.into());
     for (gi, group) in response.groups.iter().enumerate() {
+        // The grid points some band of the group weighs (in any smile class): all the terms read.
+        let mut needed = vec![false; group.grid.len()];
+        for (first, w) in group.weights.iter().flatten() {
+            for m in needed.iter_mut().skip(*first).take(w.len()) {
+                *m = true;
+            }
+        }
         // Per sampled column, per atmosphere: (entry, [L_path, T·Ed, S, glint]) of each band.
         type Means = Vec<(usize, [f64; 4])>;
         let columns: Vec<Vec<Means>> = sampled
@@ -303,7 +310,7 @@ pub fn band_terms_of_each(
                     .iter()
                     .map(|paths| {
                         let path = match &legs {
-                            Some(legs) => paths[gi].path_spectrum_with(&look.geometry, legs),
+                            Some(legs) => paths[gi].band_path_with(&look.geometry, legs, &needed),
                             None => paths[gi].path_spectrum(&look.geometry),
                         }
                         .map_err(scene_error)?;

@@ -137,6 +137,26 @@ impl PathOptics {
     /// path or of one with the same [`Self::gas_key`] and grid at the same geometry (legs that
     /// do not fit, checked, are not used: the path's own are computed instead).
     pub fn path_spectrum_with(&self, g: &Geometry, legs: &GasLegs) -> Result<PathSpectrum, AtmosphereError> {
+        self.fill(g, legs, None)
+    }
+
+    /// What band-effective terms read of [`Self::path_spectrum_with`] — L_path, Ed, T_up, S
+    /// and the glint — at the grid indices `needed` marks (a band's span of weights); every other
+    /// entry, and `ed_direct`, `t_up_diffuse` and `rayleigh_share`, are left 0. The entries
+    /// computed are the full spectrum's, bit for bit (the same formulas); the image-based
+    /// correction's family reads twenty atmospheres this way, and its bands cover part of the grid.
+    pub fn band_path_with(
+        &self,
+        g: &Geometry,
+        legs: &GasLegs,
+        needed: &[bool],
+    ) -> Result<PathSpectrum, AtmosphereError> {
+        self.fill(g, legs, Some(needed))
+    }
+
+    /// The spectrum along `g` with the gas factors `legs`: every entry, or (`needed`) only the
+    /// band terms' at the marked indices.
+    fn fill(&self, g: &Geometry, legs: &GasLegs, needed: Option<&[bool]>) -> Result<PathSpectrum, AtmosphereError> {
         let n = self.grid.len();
         let mu0 = g.sun_zenith_rad.cos();
         let fits = legs.wavelengths_nm == self.grid.wavelengths_nm()
@@ -166,6 +186,11 @@ impl PathOptics {
         };
         let lin = |a: f64, b: f64, t: f64| a + t * (b - a);
         for i in 0..n {
+            let full = match needed {
+                None => true,
+                Some(m) if m.get(i).copied().unwrap_or(false) => false,
+                Some(_) => continue,
+            };
             let (j0, j1, t) = self.nodes[i];
             let (na, nb) = (&nodes[j0], &nodes[j1]);
             let (a, b) = (&na.at, &nb.at);
@@ -175,17 +200,20 @@ impl PathOptics {
             let e0 = self.e0[i];
             p.l_path[i] = loglin(a.radiance, b.radiance, na.ln_radiance, nb.ln_radiance, t) * e0 * tg0 * tgv;
             p.ed[i] = loglin(a.ed, b.ed, na.ln_ed, nb.ln_ed, t) * e0 * tg0;
-            let tau = loglin(na.tau, nb.tau, na.ln_tau, nb.ln_tau, t);
-            p.ed_direct[i] = (mu0 * (-tau / mu0).exp() * e0 * tg0).min(p.ed[i]);
             let t_up = lin(a.t_up, b.t_up, t);
-            let t_dir = lin(a.t_up_direct, b.t_up_direct, t);
             p.t_up[i] = t_up * tgv;
-            p.t_up_diffuse[i] = (t_up - t_dir).max(0.0) * tgv;
             p.spherical_albedo[i] =
                 loglin(a.spherical_albedo, b.spherical_albedo, na.ln_spherical_albedo, nb.ln_spherical_albedo, t);
             if self.glint {
                 p.glint[i] = loglin(a.glint, b.glint, na.ln_glint, nb.ln_glint, t) * e0 * tg0 * tgv;
             }
+            if !full {
+                continue;
+            }
+            let tau = loglin(na.tau, nb.tau, na.ln_tau, nb.ln_tau, t);
+            p.ed_direct[i] = (mu0 * (-tau / mu0).exp() * e0 * tg0).min(p.ed[i]);
+            let t_dir = lin(a.t_up_direct, b.t_up_direct, t);
+            p.t_up_diffuse[i] = (t_up - t_dir).max(0.0) * tgv;
             // Diffuse transmission by molecules vs aerosols, in proportion to their forward-
             // scattering depths ω·η·τ (η from each phase function: ½ for molecules, the Mie
             // table's forward share for the aerosol; see WavelengthColumn::forward_scattering).

@@ -54,6 +54,22 @@ fn shared_gas_factors_give_each_atmosphere_its_own_spectrum_bit_for_bit() {
         PathOptics::new(&scene, &WavelengthGrid::uniform(400.0, 900.0, 2.0).unwrap(), lut(&atmospheres(&scene)[0]))
             .unwrap();
     assert_eq!(coarse.path_spectrum_with(&g, &legs).unwrap(), coarse.path_spectrum(&g).unwrap());
+    // The band terms' entries alone, at the indices a band weighs, are the full spectrum's.
+    let needed: Vec<bool> = (0..grid.len()).map(|i| (100..160).contains(&i) || i % 7 == 0).collect();
+    let (part, full) = (b.band_path_with(&g, &legs, &needed).unwrap(), b.path_spectrum(&g).unwrap());
+    for i in 0..grid.len() {
+        let pairs = [
+            (part.l_path[i], full.l_path[i]),
+            (part.ed[i], full.ed[i]),
+            (part.t_up[i], full.t_up[i]),
+            (part.spherical_albedo[i], full.spherical_albedo[i]),
+            (part.glint[i], full.glint[i]),
+        ];
+        for (k, (x, y)) in pairs.into_iter().enumerate() {
+            assert_eq!(x, if needed[i] { y } else { 0.0 }, "term {k} at index {i}");
+        }
+        assert!(full.ed[i] > 0.0 && part.ed_direct[i] == 0.0 && part.rayleigh_share[i] == 0.0);
+    }
     // The scene's optics read the same path.
     let optics = SceneOptics::new(&scene, &grid, lut(&atmospheres(&scene)[0])).unwrap();
     assert_eq!(optics.path_spectrum(&g).unwrap(), a.path_spectrum(&g).unwrap());
