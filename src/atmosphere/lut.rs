@@ -15,7 +15,7 @@
 use rayon::prelude::*;
 
 use super::AtmosphereError;
-use super::rt::{Scatterers, SsCoefficients, WavelengthColumn, fourier_sum, solve_sun, solve_transmittance};
+use super::rt::{Scatterers, SsCoefficients, WavelengthColumn, fourier_sum_with, solve_sun, solve_transmittance};
 use super::spec::{Atmosphere, AtmosphereTerms, Geometry, Normalised};
 use super::stokes;
 
@@ -94,6 +94,8 @@ pub struct AtmosphereLut {
     t_up_direct: Vec<f64>,
     spherical_albedo: Vec<f64>,
     tau_total: Vec<f64>,
+    /// The direct beam μ₀·e^(−τ/μ₀) at each (wavelength, sun) node, `[w * ns + s]`.
+    direct_at_nodes: Vec<f64>,
     tau_rayleigh: Vec<f64>,
     forward_scattering: Vec<(f64, f64)>,
     /// Per node, the path's `[Q₀, Q₁, Q₂, U₁, U₂]` ([`super::stokes`]); empty when the table was
@@ -137,6 +139,17 @@ fn corners(a: &LutAxes, g: &Geometry) -> Result<Corners, AtmosphereError> {
     Ok((corners, (s0, s1, ts), (v0, v1, tv)))
 }
 
+/// A geometry's table corners, brackets and cosines, shared by every wavelength node.
+struct AtGeometry {
+    corners: [(usize, usize, f64); 4],
+    sun: (usize, usize, f64),
+    view: (usize, usize, f64),
+    mu0: f64,
+    muv: f64,
+    /// cos(mψ), ψ = π − Δφ, for each Fourier term m ([`fourier_sum_with`]).
+    cos_m_psi: Vec<f64>,
+}
+
 impl AtmosphereLut {
     /// Build the table (parallel over wavelength × sun zenith in the caller's rayon pool).
     pub fn build(atmosphere: &Atmosphere, axes: LutAxes) -> Result<Self, AtmosphereError> {
@@ -174,8 +187,16 @@ impl AtmosphereLut {
         let t_up = up.iter().flat_map(|t| t.t_up.iter().copied()).collect();
         let t_up_direct = up.iter().flat_map(|t| t.t_up_direct.iter().copied()).collect();
         let spherical_albedo = up.iter().map(|t| t.spherical_albedo).collect();
+        let tau_total: Vec<f64> = columns.iter().map(|c| c.total_tau()).collect();
+        let direct_at_nodes = tau_total
+            .iter()
+            .flat_map(|&tau| {
+                axes.sun_zenith_deg.iter().map(move |s| s.to_radians().cos() * (-tau / s.to_radians().cos()).exp())
+            })
+            .collect();
         Ok(Self {
-            tau_total: columns.iter().map(|c| c.total_tau()).collect(),
+            tau_total,
+            direct_at_nodes,
             tau_rayleigh: columns.iter().map(|c| c.tau_rayleigh).collect(),
             forward_scattering: columns.iter().map(WavelengthColumn::forward_scattering).collect(),
             axes,
@@ -239,10 +260,8 @@ impl AtmosphereLut {
     /// As [`Self::normalised`]; the Cox–Munk glint term is computed only when `glint` is true
     /// (a scene that does not ask for `SunGlint` gets 0 without the cost).
     pub fn normalised_with(&self, w: usize, g: &Geometry, glint: bool) -> Result<Normalised, AtmosphereError> {
-        g.validate()?;
+        let at = self.at_geometry(g)?;
         let a = &self.axes;
-        let (ns, nv, nf) = (a.sun_zenith_deg.len(), a.view_zenith_deg.len(), self.n_fourier);
-        let (corners, (s0, s1, ts), (v0, v1, tv)) = corners(a, g)?;
         if w >= a.wavelengths_nm.len() {
             return Err(AtmosphereError::OutOfRange {
                 field: "wavelength index".into(),
@@ -250,8 +269,39 @@ impl AtmosphereLut {
                 allowed: format!("0 to {}", a.wavelengths_nm.len() - 1),
             });
         }
+        Ok(self.normalised_at(w, g, glint, &at))
+    }
+
+    /// [`Self::normalised_with`] at every wavelength node, the geometry's part (its check, the
+    /// table's corners, the cosines, the azimuth's Fourier cosines) computed once: the same
+    /// values, for a spectrum along one geometry.
+    pub fn normalised_all(&self, g: &Geometry, glint: bool) -> Result<Vec<Normalised>, AtmosphereError> {
+        let at = self.at_geometry(g)?;
+        Ok((0..self.axes.wavelengths_nm.len()).map(|w| self.normalised_at(w, g, glint, &at)).collect())
+    }
+
+    /// What [`Self::normalised_at`] needs of geometry `g` alone.
+    fn at_geometry(&self, g: &Geometry) -> Result<AtGeometry, AtmosphereError> {
+        g.validate()?;
+        let (corners, sun, view) = corners(&self.axes, g)?;
+        let psi = std::f64::consts::PI - g.relative_azimuth_rad;
+        Ok(AtGeometry {
+            corners,
+            sun,
+            view,
+            mu0: g.sun_zenith_rad.cos(),
+            muv: g.view_zenith_rad.cos(),
+            cos_m_psi: (0..self.n_fourier).map(|m| (m as f64 * psi).cos()).collect(),
+        })
+    }
+
+    /// The terms at wavelength node `w` (checked by the caller) and geometry `g` ([`Self::at_geometry`]).
+    fn normalised_at(&self, w: usize, g: &Geometry, glint: bool, at: &AtGeometry) -> Normalised {
+        let a = &self.axes;
+        let (ns, nv, nf) = (a.sun_zenith_deg.len(), a.view_zenith_deg.len(), self.n_fourier);
+        let AtGeometry { ref corners, sun: (s0, s1, ts), view: (v0, v1, tv), mu0, muv, ref cos_m_psi } = *at;
         let mut fourier = vec![0.0; nf];
-        for &(s, v, weight) in &corners {
+        for &(s, v, weight) in corners {
             let node = (w * ns + s) * nv + v;
             for (f, c) in fourier.iter_mut().zip(&self.ms[node * nf..(node + 1) * nf]) {
                 *f += weight * c;
@@ -260,8 +310,7 @@ impl AtmosphereLut {
         let parts: Vec<(f64, &SsCoefficients)> =
             corners.iter().map(|&(s, v, weight)| (weight, &self.ss[(w * ns + s) * nv + v])).collect();
         let ss = SsCoefficients::weighted(&parts);
-        let (mu0, muv) = (g.sun_zenith_rad.cos(), g.view_zenith_rad.cos());
-        let radiance = fourier_sum(&fourier, g.relative_azimuth_rad)
+        let radiance = fourier_sum_with(&fourier, cos_m_psi)
             + self.scatterers[w].single_scattering(&ss, mu0, muv, g.relative_azimuth_rad);
         let lerp = |x: f64, y: f64, t: f64| x + t * (y - x);
         let ed = lerp(self.ed[w * ns + s0], self.ed[w * ns + s1], ts);
@@ -270,14 +319,10 @@ impl AtmosphereLut {
         // Normalised quantities scale smoothly with μ₀ where the direct beam dominates; the
         // interpolated Ed is rescaled by the exact direct-beam ratio at this sun angle.
         let tau = self.tau_total[w];
-        let direct_nodes = lerp(
-            a.sun_zenith_deg[s0].to_radians().cos() * (-tau / a.sun_zenith_deg[s0].to_radians().cos()).exp(),
-            a.sun_zenith_deg[s1].to_radians().cos() * (-tau / a.sun_zenith_deg[s1].to_radians().cos()).exp(),
-            ts,
-        );
+        let direct_nodes = lerp(self.direct_at_nodes[w * ns + s0], self.direct_at_nodes[w * ns + s1], ts);
         let ed = ed * (mu0 * (-tau / mu0).exp()) / direct_nodes;
         let glint = if glint { self.atmosphere.glint(g, tau) } else { 0.0 };
-        Ok(Normalised {
+        Normalised {
             wavelength_nm: a.wavelengths_nm[w],
             tau_rayleigh: self.tau_rayleigh[w],
             tau_aerosol: tau - self.tau_rayleigh[w],
@@ -290,6 +335,6 @@ impl AtmosphereLut {
             spherical_albedo: self.spherical_albedo[w],
             glint,
             forward_scattering: self.forward_scattering[w],
-        })
+        }
     }
 }

@@ -53,8 +53,8 @@ pub use profile::{AltitudeQuadrature, ColumnOptics, Layering};
 pub use quadrature::{gauss_half, gauss_legendre, legendre_polynomials, normalized_legendre};
 pub use rayleigh::{AIR_DEPOLARIZATION, RayleighColumn, RayleighDepth, STANDARD_PRESSURE_HPA, bodhaine_tau};
 pub use rt::{
-    RtAccuracy, Scatterers, SsCoefficients, SunSolution, Transmittance, WavelengthColumn, fourier_sum, solve_sun,
-    solve_transmittance,
+    RtAccuracy, Scatterers, SsCoefficients, SunSolution, Transmittance, WavelengthColumn, fourier_sum,
+    fourier_sum_with, solve_sun, solve_transmittance,
 };
 /// Complex numbers of the Mie series: num-complex's (through rustfft, already a dependency).
 /// Divisions use [`Complex::fdiv`], which scales by |z| and cannot overflow where the textbook

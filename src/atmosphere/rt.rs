@@ -226,12 +226,16 @@ impl Scatterers {
         let horizontal = s0 * sv * relative_azimuth_rad.cos();
         let cos_opposite = -mu0 * muv - horizontal;
         let cos_same = mu0 * muv - horizontal;
+        // Two scattering angles between the four terms: each phase function read once at each.
+        let rayleigh = [self.rayleigh.value(cos_opposite), self.rayleigh.value(cos_same)];
+        let aerosol =
+            self.aerosol.as_ref().map(|(ssa, phase)| (*ssa, [phase.value(cos_opposite), phase.value(cos_same)]));
         let mut total = 0.0;
         for (k, [c_r, c_a]) in c.0.iter().enumerate() {
-            let cos_t = if k == 0 || k == 3 { cos_opposite } else { cos_same };
-            total += self.rayleigh.value(cos_t) * c_r;
-            if let Some((ssa, phase)) = &self.aerosol {
-                total += ssa * phase.value(cos_t) * c_a;
+            let at = usize::from(!(k == 0 || k == 3));
+            total += rayleigh[at] * c_r;
+            if let Some((ssa, p)) = &aerosol {
+                total += ssa * p[at] * c_a;
             }
         }
         total / (4.0 * std::f64::consts::PI * muv)
@@ -243,6 +247,13 @@ impl Scatterers {
 pub fn fourier_sum(coefficients: &[f64], relative_azimuth_rad: f64) -> f64 {
     let psi = std::f64::consts::PI - relative_azimuth_rad;
     coefficients.iter().enumerate().map(|(m, c)| if m == 0 { *c } else { 2.0 * c * (m as f64 * psi).cos() }).sum()
+}
+
+/// [`fourier_sum`] with cos mψ given (`cos_m_psi[m]`, at least as many as the coefficients): the
+/// same sum, the cosines taken once for many sums at one azimuth.
+#[must_use]
+pub fn fourier_sum_with(coefficients: &[f64], cos_m_psi: &[f64]) -> f64 {
+    coefficients.iter().zip(cos_m_psi).enumerate().map(|(m, (c, cos))| if m == 0 { *c } else { 2.0 * c * cos }).sum()
 }
 
 /// Path radiance and irradiance for one sun position over a set of view cosines.

@@ -170,10 +170,7 @@ impl PathOptics {
             own = self.gas_legs(g)?;
             &own
         };
-        let n_nodes = self.lut.axes().wavelengths_nm.len();
-        let nodes = (0..n_nodes)
-            .map(|w| self.lut.normalised_with(w, g, self.glint).map(Node::new))
-            .collect::<Result<Vec<_>, _>>()?;
+        let nodes: Vec<Node> = self.lut.normalised_all(g, self.glint)?.into_iter().map(Node::new).collect();
         let mut p = PathSpectrum {
             l_path: vec![0.0; n],
             ed: vec![0.0; n],
