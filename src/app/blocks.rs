@@ -90,11 +90,10 @@ impl Blocks {
         let (w, h) = (self.width, self.height);
         let mut rgba = vec![0u8; w * h * 4];
         let position = match palette {
-            Palette::Sequential(s) => s.position_of_mean_fn(),
-            _ => crate::colormap::Scale { lo: 0.0, hi: 1.0, log: false }.position_of_mean_fn(),
+            Palette::Sequential(s) => Some(s.position_of_mean_fn()),
+            _ => None,
         };
-        for (row, out) in rgba.chunks_mut((w * 4).max(1)).enumerate() {
-            let y = h - 1 - row;
+        for y in 0..h {
             for x in 0..w {
                 let k = y * w + x;
                 let n = f64::from(self.count[k]);
@@ -104,7 +103,9 @@ impl Blocks {
                     super::theme::NOT_RETURNED
                 } else {
                     let c = match palette {
-                        Palette::Sequential(_) => viridis(position(self.sum[k] / n, self.sum_ln[k] / n)),
+                        Palette::Sequential(_) => {
+                            viridis(position.map_or(f64::NAN, |p| p(self.sum[k] / n, self.sum_ln[k] / n)))
+                        }
                         Palette::Diverging(bound) => diverging((self.sum[k] / n) / bound.max(f64::MIN_POSITIVE)),
                         Palette::Classes => categorical(f64::from(self.first[k]).max(0.0) as usize),
                         // Any disagreement in the block shows (a mean above 0).
@@ -112,7 +113,8 @@ impl Blocks {
                     };
                     [c[0], c[1], c[2], 255]
                 };
-                out[x * 4..x * 4 + 4].copy_from_slice(&colour);
+                let i = ((h - 1 - y) * w + x) * 4;
+                rgba[i..i + 4].copy_from_slice(&colour);
             }
         }
         Image { width: w, height: h, rgba }

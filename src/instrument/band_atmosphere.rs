@@ -268,6 +268,7 @@ pub fn band_terms_of_each(
     response: &Response,
     across_track: bool,
 ) -> Result<Vec<BandTerms>, InstrumentError> {
+    let Some(first_atmosphere) = atmospheres.first() else { return Ok(Vec::new()) };
     let nb = response.n_bands();
     let nc = viewing.columns();
     let one_response = response.smile_class.iter().all(|&c| c == response.smile_class.first().copied().unwrap_or(0));
@@ -302,18 +303,11 @@ pub fn band_terms_of_each(
             .map(|(si, &c)| {
                 let look = &viewing.looks[gi][c];
                 let j = viewing.detector_index[c];
-                let legs = match atmospheres.first() {
-                    Some(first) => Some(first[gi].gas_legs(&look.geometry).map_err(scene_error)?),
-                    None => None,
-                };
+                let legs = first_atmosphere[gi].gas_legs(&look.geometry).map_err(scene_error)?;
                 atmospheres
                     .iter()
                     .map(|paths| {
-                        let path = match &legs {
-                            Some(legs) => paths[gi].band_path_with(&look.geometry, legs, &needed),
-                            None => paths[gi].path_spectrum(&look.geometry),
-                        }
-                        .map_err(scene_error)?;
+                        let path = paths[gi].band_path_with(&look.geometry, &legs, &needed).map_err(scene_error)?;
                         Ok(group
                             .bands
                             .iter()
