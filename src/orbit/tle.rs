@@ -26,6 +26,8 @@ pub struct TleOrbit {
     pub epoch_days: f64,
     /// Mean motion, rad/s (the elements' revolutions per day).
     mean_motion_rad_s: f64,
+    /// The elements' eccentricity.
+    eccentricity: f64,
 }
 
 impl TleOrbit {
@@ -41,7 +43,12 @@ impl TleOrbit {
             sgp4::Constants::from_elements_afspc_compatibility_mode(&elements).map_err(|e| e.to_string())?;
         // Julian years of 365.25 days since J2000.0, as SGP4 counts them.
         let epoch_days = elements.epoch_afspc_compatibility_mode() * 365.25;
-        Ok(Self { constants, epoch_days, mean_motion_rad_s: elements.mean_motion * std::f64::consts::TAU / sun::DAY_S })
+        Ok(Self {
+            constants,
+            epoch_days,
+            mean_motion_rad_s: elements.mean_motion * std::f64::consts::TAU / sun::DAY_S,
+            eccentricity: elements.eccentricity,
+        })
     }
 
     /// Position in the TEME frame at `days` since J2000.0, m, or `None` where SGP4 stops (the
@@ -71,5 +78,13 @@ impl Track for TleOrbit {
 
     fn angular_rate_rad_s(&self) -> f64 {
         self.mean_motion_rad_s
+    }
+
+    /// The rate at perigee, n·(1 + e)²/(1 − e²)^{3/2} (Kepler's second law: r²·dν/dt =
+    /// n·a²·√(1 − e²) at r = a(1 − e); Vallado 2013, §2.3), with e 0.02 above the elements' for
+    /// SGP4's perturbations of it over the period.
+    fn max_angular_rate_rad_s(&self) -> f64 {
+        let e = (self.eccentricity + 0.02).min(0.95);
+        self.mean_motion_rad_s * (1.0 + e).powi(2) / (1.0 - e * e).powf(1.5)
     }
 }

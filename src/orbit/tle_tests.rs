@@ -3,7 +3,7 @@
 use super::*;
 
 /// `line` (68 characters) with its modulo-10 checksum: digits count their value, a minus sign 1.
-fn with_checksum(line: &str) -> String {
+pub(super) fn with_checksum(line: &str) -> String {
     let sum: u32 = line.chars().map(|c| if c == '-' { 1 } else { c.to_digit(10).unwrap_or(0) }).sum();
     format!("{line}{}", sum % 10)
 }
