@@ -67,17 +67,19 @@ impl PackedSets {
     }
 }
 
-/// Per-thread work space of [`invert_packed`]: the rows and weights of every band (20 kB, so
-/// reused from pixel to pixel rather than zeroed for each).
+/// Per-thread work space of [`invert_packed`]: the rows and weights of every band and the
+/// pixel's per-band quantities (23 kB, so reused from pixel to pixel rather than zeroed for
+/// each).
 #[derive(Clone)]
 pub struct Scratch {
     rows: Vec<Rows>,
     w2: Vec<[f64; LANES]>,
+    pixel: Box<Prepared>,
 }
 
 impl Default for Scratch {
     fn default() -> Self {
-        Self { rows: vec![Rows::default(); MAX_BANDS], w2: vec![[1.0; LANES]; MAX_BANDS] }
+        Self { rows: vec![Rows::default(); MAX_BANDS], w2: vec![[1.0; LANES]; MAX_BANDS], pixel: Box::default() }
     }
 }
 
@@ -385,14 +387,13 @@ fn invert_lanes(
     nedr: &[f64],
 ) -> AlmiPixel {
     let (g0, g1) = (settings.g0, settings.g1);
-    let mut p = Prepared::default();
-    if !p.prepare(settings, rrs_above, valid, nedr) {
+    let Scratch { rows, w2, pixel } = scratch;
+    if !pixel.prepare(settings, rrs_above, valid, nedr) {
         return AlmiPixel::FAILED;
     }
-    let Prepared { ref used, m, ref rrs, ref u, ref sigma_u, ref inv_sigma_rrs, mean_rrs } = p;
+    let Prepared { ref used, m, ref rrs, ref u, ref sigma_u, ref inv_sigma_rrs, mean_rrs, .. } = **pixel;
     let used = &used[..m];
     let mut best = AlmiPixel::FAILED;
-    let Scratch { rows, w2 } = scratch;
     for (chunk, (bands, &lanes)) in sets.chunks.iter().zip(&sets.lanes).enumerate() {
         for (i, &k) in used.iter().enumerate() {
             let c = &bands[k];
