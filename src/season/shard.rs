@@ -6,7 +6,7 @@
 //!
 //! The looks themselves are not shipped: a shard and the merge each plan the season
 //! ([`super::run::plan_season`]: the orbit, the looks and their spread over orbit phases, no
-//! chain run; seconds for a year), and
+//! chain run; a third of a second for a year), and
 //! a fingerprint of everything that decides the runs (the season and each design's
 //! configuration) ties a shard's runs to that plan. What a shard file holds comes from another
 //! machine and is checked before it is used: the fingerprint, each shard once, each run once and
