@@ -52,6 +52,7 @@ pub mod probe;
 mod products;
 mod report;
 pub mod resources;
+mod restart;
 mod retrieval_stage;
 mod run;
 mod scene_stages;

@@ -104,6 +104,21 @@ impl Engine {
         self.cache.set_budget(bytes);
     }
 
+    /// Whether runs hand back views of their cubes, and their most bytes.
+    pub(super) fn views_setting(&self) -> (bool, usize) {
+        (self.keep_views, self.view_bytes)
+    }
+
+    /// The product kept under `key`, if any.
+    pub(super) fn cache_get<T: Send + Sync + 'static>(&mut self, key: Key) -> Option<Arc<T>> {
+        self.cache.get(key)
+    }
+
+    /// Keep `product` (of `bytes`) under `key`, within the cache's budget.
+    pub(super) fn cache_put<T: Send + Sync + 'static>(&mut self, key: Key, product: Arc<T>, bytes: usize) {
+        self.cache.put(key, product, bytes);
+    }
+
     /// Whether runs hand back their full-resolution cubes.
     #[must_use]
     pub fn keeps_cubes(&self) -> bool {
@@ -224,6 +239,14 @@ impl Engine {
             ..RunReport::default()
         };
         let side = self.scene_side(config, control, &mut report)?;
+        // A run that differs from a kept one only in its retrievals restarts at them.
+        let restart_key = self.restart_key(config, &side);
+        let scene_stages = report.stages.len();
+        if let Some(key) = restart_key.filter(|_| probes.is_empty())
+            && let Some(output) = self.run_from_rrs(key, config, &side, &report, control, start)
+        {
+            return output;
+        }
         let (radiance, radiance_key) = self.radiance_stage(config, &side, control, &mut report)?;
         let truth = radiance.truth.clone();
         let mut probed: Vec<Probed> = probes.iter().map(|p| Probed::locate(*p, &truth, &side.viewing)).collect();
@@ -270,6 +293,7 @@ impl Engine {
         }
         let kept_level1 = inst.level1.take().filter(|_| self.keep_cubes);
         let (snr, typical) = self.snr_stage(config, &side, typical, &inst, control, &mut report)?;
+        let before_retrievals = restart_key.map(|_| (report.clone(), typical.clone()));
         let retrievals = self.retrieval_stage(
             config,
             &side,
@@ -285,6 +309,21 @@ impl Engine {
             }
             _ => None,
         };
+        let views = views.map(Arc::new);
+        if let (Some(key), Some((report, typical))) = (restart_key, before_retrievals) {
+            let restart = super::restart::Restart {
+                truth: truth.clone(),
+                calibration: inst.calibration.clone(),
+                feasibility: inst.feasibility.clone(),
+                snr: snr.clone(),
+                typical,
+                views: views.clone(),
+                correction_key,
+                report,
+                scene_stages,
+            };
+            self.keep_restart(key, restart);
+        }
         report.total_seconds = start.elapsed().as_secs_f64();
         Ok(RunOutput {
             config: config.clone(),
@@ -294,7 +333,7 @@ impl Engine {
             band_atmosphere: side.band_atmosphere.clone(),
             truth,
             cubes,
-            views: views.map(Arc::new),
+            views,
             calibration: inst.calibration,
             correction: corrected.product.clone(),
             snr,

@@ -32,6 +32,7 @@ mod qaa;
 mod rasters;
 mod report;
 mod reproduction;
+mod restart;
 mod retrieval;
 mod season;
 mod season_shards;
