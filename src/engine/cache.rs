@@ -97,6 +97,13 @@ impl Stage {
 }
 
 impl Stage {
+    /// The large cubes a run makes on its way to the Rrs (pupil radiance, the radiance after
+    /// the optics, electrons, Level-0, Level-1): what the cache lets go first.
+    #[must_use]
+    pub const fn is_upstream_cube(self) -> bool {
+        matches!(self, Self::Radiance | Self::Effects | Self::Electrons | Self::Level0 | Self::Level1)
+    }
+
     /// The stage's name in messages and progress ("atmosphere LUT", "retrieval").
     #[must_use]
     pub const fn name(self) -> &'static str {
@@ -259,20 +266,32 @@ impl Cache {
 
     /// Keep `product` (of `bytes`) under `key`, then drop what is over the stage's capacity.
     /// Within the budget, room is made by dropping the least recently used products the current
-    /// run has not used ([`Self::begin_run`]); a product there is no such room for is not kept
-    /// (a run's pupil radiance, kept for the next noise seed, is not pushed out by the run's own
+    /// run has not used ([`Self::begin_run`]), the upstream cubes first
+    /// ([`Stage::is_upstream_cube`]). A cube may push out only other cubes; a product that is
+    /// not one (an Rrs, a run's restart) pushes out the current run's own cubes before any other
+    /// product: a design's Rrs lets a retrieval change skip the instrument, and is smaller than
+    /// the cubes it was made from. A product there is no such room for is not kept (a run's
+    /// pupil radiance, kept for the next noise seed, is not pushed out by the run's own
     /// Level-0).
     pub fn put<T: Send + Sync + 'static>(&mut self, key: Key, product: Arc<T>, bytes: usize) {
         self.clock += 1;
         let stage = key.stage;
         self.remove(key);
-        // What may go to make room: products the current run has not used, oldest first.
         let run_start = self.run_start;
-        let room = self.budget.saturating_add(self.bytes_where(|e| e.used < run_start));
+        let cube = stage.is_upstream_cube();
+        // In this order: cubes the run has not used, the run's own cubes (not for a cube), then
+        // other products the run has not used (not for a cube).
+        let unused_cube = |e: &Entry| e.used < run_start && e.key.stage.is_upstream_cube();
+        let own_cube = |e: &Entry| !cube && e.key.stage.is_upstream_cube();
+        let unused_other = |e: &Entry| !cube && e.used < run_start && !e.key.stage.is_upstream_cube();
+        let room = self.budget.saturating_add(self.bytes_where(|e| unused_cube(e) || own_cube(e) || unused_other(e)));
         if self.held + bytes > room {
             return;
         }
-        self.evict_to(self.budget.saturating_sub(bytes), |e| e.used < run_start);
+        let target = self.budget.saturating_sub(bytes);
+        self.evict_to(target, unused_cube);
+        self.evict_to(target, own_cube);
+        self.evict_to(target, unused_other);
         let keep = self.capacity(stage);
         let list = self.entries.entry(stage).or_default();
         list.push_front(Entry { key, product, bytes, used: self.clock });
@@ -320,13 +339,18 @@ impl Cache {
         self.entries.values().flatten().filter(|e| may_go(e)).map(|e| e.bytes).sum()
     }
 
-    /// Drop the least recently used products `may_go` admits until at most `target` bytes are
-    /// held (or none of them is left).
+    /// Drop the products `may_go` admits, the upstream cubes first and least recently used
+    /// first among them, until at most `target` bytes are held (or none of them is left).
     fn evict_to(&mut self, target: usize, may_go: impl Fn(&Entry) -> bool) {
-        let mut candidates: Vec<(u64, Key)> =
-            self.entries.values().flatten().filter(|e| e.bytes > 0 && may_go(e)).map(|e| (e.used, e.key)).collect();
-        candidates.sort_unstable_by_key(|e| e.0);
-        for (_, key) in candidates {
+        let mut candidates: Vec<(bool, u64, Key)> = self
+            .entries
+            .values()
+            .flatten()
+            .filter(|e| e.bytes > 0 && may_go(e))
+            .map(|e| (!e.key.stage.is_upstream_cube(), e.used, e.key))
+            .collect();
+        candidates.sort_unstable_by_key(|e| (e.0, e.1));
+        for (_, _, key) in candidates {
             if self.held <= target {
                 break;
             }
@@ -366,14 +390,14 @@ mod tests {
     fn the_budget_drops_the_least_recently_used_bytes_first() {
         let mut cache = Cache::with_budget(100);
         cache.begin_run();
-        cache.put(key(Stage::Radiance, 1), Arc::new(1u8), 60);
+        cache.put(key(Stage::Retrieval, 1), Arc::new(1u8), 60);
         cache.put(key(Stage::Scene, 1), Arc::new(2u8), 30);
         cache.begin_run();
-        // The next run uses the radiance: the scene is now the older one, and not used by it.
-        assert!(cache.get::<u8>(key(Stage::Radiance, 1)).is_some());
-        cache.put(key(Stage::Level0, 1), Arc::new(3u8), 30);
+        // The next run uses the retrieval's product: the scene is now the older one, and not used by it.
+        assert!(cache.get::<u8>(key(Stage::Retrieval, 1)).is_some());
+        cache.put(key(Stage::Correction, 1), Arc::new(3u8), 30);
         assert!(cache.get::<u8>(key(Stage::Scene, 1)).is_none(), "the least recently used goes first");
-        assert!(cache.get::<u8>(key(Stage::Radiance, 1)).is_some());
+        assert!(cache.get::<u8>(key(Stage::Retrieval, 1)).is_some());
         assert_eq!(cache.bytes(), 90);
         // A product over the whole budget is not kept, and pushes nothing out.
         cache.put(key(Stage::Level1, 1), Arc::new(4u8), 101);
@@ -384,6 +408,38 @@ mod tests {
             cache.put(key(Stage::Response, n), Arc::new(0u8), 0);
         }
         assert_eq!(cache.len(), 2 + Stage::Response.capacity());
+    }
+
+    #[test]
+    fn cubes_go_first_and_an_rrs_may_push_out_its_own_runs_cubes() {
+        let mut cache = Cache::with_budget(100);
+        cache.begin_run();
+        cache.put(key(Stage::Radiance, 1), Arc::new(1u8), 40);
+        cache.put(key(Stage::Correction, 1), Arc::new(1u8), 40);
+        // Another run's cube pushes out the older cube, not the newer Rrs.
+        cache.begin_run();
+        cache.put(key(Stage::Level0, 2), Arc::new(2u8), 40);
+        assert!(cache.get::<u8>(key(Stage::Radiance, 1)).is_none());
+        assert!(cache.get::<u8>(key(Stage::Correction, 1)).is_some());
+        // A run's Rrs with no other room pushes out that run's own cubes, oldest first.
+        cache.begin_run();
+        cache.put(key(Stage::Radiance, 3), Arc::new(3u8), 30);
+        cache.put(key(Stage::Level1, 3), Arc::new(3u8), 20);
+        assert!(cache.get::<u8>(key(Stage::Level0, 2)).is_none(), "the other run's cube went for this run's");
+        assert_eq!(cache.bytes(), 90);
+        cache.put(key(Stage::Correction, 3), Arc::new(3u8), 30);
+        assert!(cache.get::<u8>(key(Stage::Correction, 3)).is_some());
+        assert!(cache.get::<u8>(key(Stage::Radiance, 3)).is_none(), "its own oldest cube went");
+        assert!(cache.get::<u8>(key(Stage::Level1, 3)).is_some());
+        assert_eq!(cache.bytes(), 90);
+        // A cube never pushes out an Rrs: with only Rrs to push out, it is not kept.
+        cache.begin_run();
+        cache.put(key(Stage::Radiance, 4), Arc::new(4u8), 80);
+        assert!(cache.get::<u8>(key(Stage::Radiance, 4)).is_none());
+        assert!(
+            cache.get::<u8>(key(Stage::Correction, 1)).is_some()
+                && cache.get::<u8>(key(Stage::Correction, 3)).is_some()
+        );
     }
 
     #[test]
