@@ -3,13 +3,13 @@
 //! A change to the retrievals (a mode, a SIOP set, a band choice) changes nothing before the Rrs.
 //! The stage cache restarts a run at its first changed stage only while it holds every product
 //! before it — for a full-resolution CubeSat the pupil radiance, Level-0 and Level-1 beside the
-//! Rrs, ~0.8 GB — and those large cubes are the first to go when several designs share the
-//! cache (least recently used first). So besides the Rrs (the correction stage's product) each
+//! Rrs, ~0.8 GB — and those large cubes are the first the cache lets go when several designs
+//! share it (`Cache::put`). So besides the Rrs (the correction stage's product) each
 //! run leaves a [`Restart`]: what the run's output carries from the stages between the scene
 //! and the retrievals — the truth maps, the calibration, SNR and feasibility figures, the views
 //! of the cubes and the report — a few tens of megabytes beside the Rrs. A later run whose
 //! configuration differs only in its retrievals finds both and runs the retrievals alone; its
-//! output is the one a full run gives (`tests/chain/incremental.rs`).
+//! output is the one a full run gives, report included (`tests/chain/restart.rs`).
 //!
 //! Not taken: by an engine that hands back its cubes (those are not kept), for a run asking for
 //! probes (they read the Level-1), or one injecting a fault.

@@ -74,8 +74,8 @@ impl Engine {
     /// An engine for the app: runs keep products and views of their cubes at a bounded size
     /// ([`super::views::VIEW_BYTES`]), not the cubes; the cache keeps at most `cache_bytes` and up
     /// to `designs` cubes per stage at each of [`APP_LEVELS`] decimations. A change restarts
-    /// mid-chain where the cache still holds every product before it (a retrieval change needs
-    /// the run's pupil radiance, Level-0, Level-1 and Rrs: ~0.8 GB for the CubeSat).
+    /// mid-chain where the cache still holds every product before it; a change to the
+    /// retrievals alone restarts from the run's kept Rrs ([`super::restart`]).
     #[must_use]
     pub fn for_app(cache_bytes: usize, designs: usize) -> Self {
         let mut engine = Self { keep_cubes: false, keep_views: true, ..Self::default() };

@@ -310,9 +310,10 @@ fn pause_after_preview(pause: &PreviewPause, latest: &AtomicU64, generation: u64
 /// The designs the app holds at most.
 pub const MAX_DESIGNS: usize = 8;
 
-/// The most the app engine's cache keeps: what lets a change restart mid-chain (a change to
-/// the retrieval needs every product up to the Rrs, ~0.8 GB a full-resolution CubeSat, so the
-/// default study's two designs keep theirs), least recently used first.
+/// The most the app engine's cache keeps: what lets a change restart mid-chain (an instrument
+/// change needs the cubes before it, ~0.8 GB up to the Rrs for a full-resolution CubeSat, so the
+/// default study's two designs keep theirs; a retrieval change needs only each design's Rrs, which
+/// outlasts the cubes).
 pub const APP_CACHE_MAX_BYTES: usize = 2 << 30;
 
 /// The most a run's working set and the app engine's cache hold together: before a run whose
