@@ -11,8 +11,9 @@
 //! configuration differs only in its retrievals finds both and runs the retrievals alone; its
 //! output is the one a full run gives, report included (`tests/chain/restart.rs`).
 //!
-//! Not taken: by an engine that hands back its cubes (those are not kept), for a run asking for
-//! probes (they read the Level-1), or one injecting a fault.
+//! Only the app's engine ([`Engine::for_app`]) restarts so. Not taken: by an engine that hands
+//! back its cubes (those are not kept) or a lean one, for a run asking for probes (they read the
+//! Level-1), or one injecting a fault.
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -60,7 +61,10 @@ impl Engine {
     /// the files it names, the scene side's keys and what the engine hands back), or `None`
     /// where a run may not restart at its retrievals (see the module docs).
     pub(super) fn restart_key(&self, config: &RunConfig, side: &SceneSide) -> Option<Key> {
-        if self.keeps_cubes() || config.fault.is_some() {
+        // Only the app's engine (views, no cubes) restarts: a lean engine's small cache keeps no
+        // full-resolution Rrs, and its runs would build the key and copy the report for nothing.
+        let (keeps_views, _) = self.views_setting();
+        if self.keeps_cubes() || !keeps_views || config.fault.is_some() {
             return None;
         }
         let mut upstream = config.clone();
