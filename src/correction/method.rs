@@ -27,11 +27,18 @@ pub struct CorrectionSpec {
     pub approx_points: usize,
     /// The correction delivered as the Rrs product.
     pub method: Method,
+    /// The error of the wind the exact correction assumes for the glint it takes away, m/s: its
+    /// wind is the scene's plus this (at least 0). The exact correction knows the atmosphere; a
+    /// processor knows the wind only from ancillary fields, as l2gen does, so over a glinting
+    /// scene this prices the wind alone ([`super::expected_glint`]). 0: the wind is known. The
+    /// image-based correction states its own (`image.glint_wind_error_m_s`); the per-scene
+    /// approximation, whose terms come from the scene's own pixels, takes none.
+    pub glint_wind_error_m_s: f64,
 }
 
 impl Default for CorrectionSpec {
     fn default() -> Self {
-        Self { approx_points: 20, method: Method::Exact }
+        Self { approx_points: 20, method: Method::Exact, glint_wind_error_m_s: 0.0 }
     }
 }
 
@@ -55,6 +62,7 @@ struct CorrectionFile {
     approx_points: usize,
     use_approximation: bool,
     image: Option<ImageCorrection>,
+    glint_wind_error_m_s: f64,
 }
 
 impl Default for CorrectionFile {
@@ -67,6 +75,12 @@ impl TryFrom<CorrectionFile> for CorrectionSpec {
     type Error = String;
 
     fn try_from(f: CorrectionFile) -> Result<Self, String> {
+        if f.glint_wind_error_m_s != 0.0 && (f.use_approximation || f.image.is_some()) {
+            return Err("correction.glint_wind_error_m_s: the exact correction's wind error; the image-based \
+                        correction states its own (correction.image.glint_wind_error_m_s), the per-scene \
+                        approximation none"
+                .into());
+        }
         let method = match (f.use_approximation, f.image) {
             (false, None) => Method::Exact,
             (true, None) => Method::PerScene,
@@ -77,7 +91,7 @@ impl TryFrom<CorrectionFile> for CorrectionSpec {
                     .into());
             }
         };
-        Ok(Self { approx_points: f.approx_points, method })
+        Ok(Self { approx_points: f.approx_points, method, glint_wind_error_m_s: f.glint_wind_error_m_s })
     }
 }
 
@@ -88,7 +102,7 @@ impl From<CorrectionSpec> for CorrectionFile {
             Method::PerScene => (true, None),
             Method::Image(i) => (false, Some(i)),
         };
-        Self { approx_points: s.approx_points, use_approximation, image }
+        Self { approx_points: s.approx_points, use_approximation, image, glint_wind_error_m_s: s.glint_wind_error_m_s }
     }
 }
 
@@ -200,7 +214,7 @@ mod tests {
             assert_eq!(back, spec);
         }
         let written = ron::to_string(&CorrectionSpec::default()).unwrap();
-        assert_eq!(written, "(approx_points:20,use_approximation:false,image:None)");
+        assert_eq!(written, "(approx_points:20,use_approximation:false,image:None,glint_wind_error_m_s:0.0)");
         // With struct names (config.ron, study.ron, the library's studies), as an older Shoal
         // wrote them.
         let named = ron::ser::to_string_pretty(
@@ -220,6 +234,22 @@ mod tests {
         assert!(e.contains("choose one") && e.contains("use_approximation"), "{e}");
         let e = ron::from_str::<CorrectionSpec>("(image: None, exact: true)").unwrap_err().to_string();
         assert!(e.contains("exact"), "{e}");
+        // The exact correction's wind error beside another method: refused, naming the field.
+        for text in
+            ["(use_approximation: true, glint_wind_error_m_s: 1.0)", "(image: Some(()), glint_wind_error_m_s: 1.0)"]
+        {
+            let e = ron::from_str::<CorrectionSpec>(text).unwrap_err().to_string();
+            assert!(e.contains("correction.glint_wind_error_m_s") && e.contains("correction.image"), "{e}");
+        }
+    }
+
+    #[test]
+    fn the_exact_correction_s_wind_error_reads_and_writes() {
+        let spec: CorrectionSpec = ron::from_str("(glint_wind_error_m_s: -1.5)").unwrap();
+        assert_eq!((spec.method.clone(), spec.glint_wind_error_m_s), (Method::Exact, -1.5));
+        let text = ron::to_string(&spec).unwrap();
+        assert_eq!(text, "(approx_points:20,use_approximation:false,image:None,glint_wind_error_m_s:-1.5)");
+        assert_eq!(ron::from_str::<CorrectionSpec>(&text).unwrap(), spec);
     }
 
     #[test]

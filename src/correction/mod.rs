@@ -24,6 +24,7 @@
 pub mod clouds;
 pub mod dark;
 mod difference;
+pub mod expected_glint;
 pub mod family;
 pub mod image;
 mod method;
@@ -37,6 +38,7 @@ pub use clouds::{CloudScreen, Sun, screen_image};
 pub use dark::DarkSpectrumSettings;
 pub use dark::TileFit;
 pub use difference::{BandDifference, compare};
+pub use expected_glint::expected_glint;
 pub use family::{AerosolFamily, FamilyLuts};
 pub use image::{AerosolFit, AerosolRetrieval, ImageCorrection, MISSION_PAIRS_NM, correct_image};
 pub use method::{CorrectionSpec, Method, PRESETS, Preset};
@@ -89,12 +91,18 @@ impl RrsFlags {
 }
 
 impl CorrectionSpec {
-    /// Check `approx_points` against [`crate::ranges::CORRECTION_APPROX_POINTS`].
+    /// Check `approx_points` against [`crate::ranges::CORRECTION_APPROX_POINTS`], the exact
+    /// correction's wind error against [`crate::ranges::CORRECTION_EXACT_GLINT_WIND_ERROR`] and
+    /// the image-based correction's settings.
     pub fn validate(&self) -> Result<(), CorrectionError> {
-        let range = &crate::ranges::CORRECTION_APPROX_POINTS;
-        range
-            .check(self.approx_points as f64)
-            .map_err(|message| CorrectionError::Invalid(FieldError { field: range.path.into(), message }))?;
+        for (range, value) in [
+            (&crate::ranges::CORRECTION_APPROX_POINTS, self.approx_points as f64),
+            (&crate::ranges::CORRECTION_EXACT_GLINT_WIND_ERROR, self.glint_wind_error_m_s),
+        ] {
+            range
+                .check(value)
+                .map_err(|message| CorrectionError::Invalid(FieldError { field: range.path.into(), message }))?;
+        }
         if let Some(image) = self.image() {
             image.validate()?;
         }
@@ -160,14 +168,17 @@ pub(crate) fn assemble(
 
 /// Exact per-pixel correction of `level1` with the band-effective atmosphere of each column;
 /// where the scene's AOT is a map, `aerosol_map` holds the terms at its AOT nodes and the map
-/// under each pixel, and each pixel is corrected with the atmosphere at its own AOT.
+/// under each pixel, and each pixel is corrected with the atmosphere at its own AOT. `glint` is
+/// the glint taken away, per column × band: the scene's own (`None`) or what a processor
+/// expects from the wind it assumes ([`expected_glint`]).
 pub fn correct_exact(
     level1: &Level1,
-    atmosphere: &BandAtmosphere,
+    (atmosphere, glint): (&BandAtmosphere, Option<&[f64]>),
     aerosol_map: Option<(&AotNodes, &Array2<f32>)>,
     surface: &SurfaceMap,
     control: &RunControl,
 ) -> Result<Reflectance, CorrectionError> {
+    let glint_taken = glint.unwrap_or(&atmosphere.glint);
     let (rows, cols, nb) = level1.radiance.dim();
     let (l1, l0_flags) = (slice(&level1.radiance)?, slice(&level1.flags)?);
     let aot = aerosol_map.map(|(_, a)| slice(a)).transpose()?;
@@ -189,7 +200,7 @@ pub fn correct_exact(
             // The column's slices, all of length nb, so the band loop runs without index
             // checks and the compiler can compute neighbouring bands together.
             let a = atmosphere.at(c, 0)..atmosphere.at(c, 0) + nb;
-            let glint = &atmosphere.glint[a.clone()];
+            let glint = &glint_taken[a.clone()];
             let (l_path, t_ed, s_albedo) = match (aerosol_map, aot) {
                 (Some((nodes, _)), Some(aot)) => {
                     nodes.column_terms(c, f64::from(aot[r * cols + c]), &mut lp, &mut te, &mut sa);

@@ -96,7 +96,9 @@ impl Engine {
             let diagnostics = diagnostics && image.is_none();
             let exact = if diagnostics || (!per_scene && image.is_none()) {
                 let aerosol_map = side.aerosol_map.as_deref().zip(truth.aot550.as_ref());
-                Some(correct_exact(level1, band_atmosphere, aerosol_map, surface, control).map_err(&fail)?)
+                let expected = exact_glint(config, side);
+                let atmosphere = (band_atmosphere.as_ref(), expected.as_deref());
+                Some(correct_exact(level1, atmosphere, aerosol_map, surface, control).map_err(&fail)?)
             } else {
                 None
             };
@@ -198,6 +200,20 @@ impl Engine {
         })?;
         Ok(Some((fam, key)))
     }
+}
+
+/// The glint the exact correction takes away when its wind is not the scene's
+/// (`correction.glint_wind_error_m_s`) over a scene with glint: the scene's glint carried to the
+/// wind it assumes ([`crate::correction::expected_glint`]). `None`: the scene's own glint.
+fn exact_glint(config: &RunConfig, side: &SceneSide) -> Option<Vec<f64>> {
+    let error = config.correction.glint_wind_error_m_s;
+    let crate::atmosphere::SeaSurface::Wind { speed_m_s } = config.scene.atmosphere.surface else { return None };
+    if error == 0.0 || !side.scene.wants(crate::scene::Effect::SunGlint) {
+        return None;
+    }
+    let winds = (speed_m_s, (speed_m_s + error).max(0.0));
+    let n = config.scene.atmosphere.water_refractive_index;
+    Some(crate::correction::expected_glint(&side.band_atmosphere, &side.viewing, &side.response, winds, n))
 }
 
 /// Flag every band of the pixels the cloud screen left out (`screen` true) as cloud.
