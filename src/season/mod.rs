@@ -139,7 +139,8 @@ pub struct SeasonSpec {
     pub wind_m_s: f64,
     /// RMS error of the wind the processor assumes for the glint, m/s: each look's error is
     /// drawn from a normal distribution of this spread with its weather (an ancillary wind is
-    /// not the wind on the water). 0: the processor knows the wind.
+    /// not the wind on the water) and given to the image-based correction or the exact one
+    /// (which then knows the atmosphere but not the wind). 0: the processor knows the wind.
     #[serde(default)]
     pub processor_wind_rms_m_s: f64,
     /// Largest normalised glint radiance L_GN a valid look may have, sr⁻¹.

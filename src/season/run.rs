@@ -151,9 +151,13 @@ pub fn look_config(base: &RunConfig, look: &Look, decimation: usize) -> RunConfi
     if !config.scene.effects.contains(&crate::scene::Effect::SunGlint) {
         config.scene.effects.push(crate::scene::Effect::SunGlint);
     }
-    // The processor's glint from the wind it assumes (the look's draw of its error).
-    if let crate::correction::Method::Image(image) = &mut config.correction.method {
-        image.glint_wind_error_m_s = look.processor_wind_error_m_s;
+    // The processor's glint from the wind it assumes (the look's draw of its error): the
+    // image-based correction's own setting, or the exact correction's (the per-scene
+    // approximation's terms come from the scene's pixels, glint and all).
+    match &mut config.correction.method {
+        crate::correction::Method::Image(image) => image.glint_wind_error_m_s = look.processor_wind_error_m_s,
+        crate::correction::Method::Exact => config.correction.glint_wind_error_m_s = look.processor_wind_error_m_s,
+        crate::correction::Method::PerScene => {}
     }
     if let Some(h) = look.altitude_m {
         config.instrument.altitude_km = h / 1e3;

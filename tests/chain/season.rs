@@ -339,6 +339,13 @@ fn a_look_s_processor_wind_error_is_drawn_from_its_weather() {
     let config = look_config(&ds[0].1, look, 16);
     let shoal::correction::Method::Image(image) = &config.correction.method else { panic!("an image correction") };
     assert_eq!(image.glint_wind_error_m_s, look.processor_wind_error_m_s);
+    // With the exact correction, the look's error is the exact correction's own.
+    let mut exact = ds[0].1.clone();
+    exact.correction.method = shoal::correction::Method::Exact;
+    let config = look_config(&exact, look, 16);
+    assert_eq!(config.correction.method, shoal::correction::Method::Exact);
+    assert_eq!(config.correction.glint_wind_error_m_s, look.processor_wind_error_m_s);
+    config.validate().unwrap();
     season.processor_wind_rms_m_s = 11.0;
     assert!(season.validate().unwrap_err().to_string().contains("processor_wind_rms_m_s"));
 }
