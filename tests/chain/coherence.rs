@@ -219,6 +219,8 @@ fn chosen_value(path: &str) -> Option<f64> {
         "correction.image.glint_threshold_per_sr" => 0.005,
         // The processor's wind 2 m/s stronger than the base's 5 m/s: it takes away more glint.
         "correction.image.glint_wind_error_m_s" => 2.0,
+        // The same for the base's exact correction.
+        "correction.glint_wind_error_m_s" => 2.0,
         // Above the clouds' albedo (0.72): no cloud is screened.
         "correction.image.clouds.threshold" => 0.9,
         // Shadows projected from the base clouds' own 300 m, where the default 1500 m puts every
