@@ -158,9 +158,10 @@ impl ShoalApp {
         let of = budget.map_or(String::new(), |b| format!(" of the {b:.1} GB budget (SHOAL_MEMORY_BUDGET)"));
         format!(
             "Memory at full resolution, planned: {gb:.2} GB{of}. Each design keeps its products and a view \
-             of its cubes (every n-th pixel, at most {} MiB); the engine's cache keeps what lets a change \
-             restart mid-chain.",
-            crate::engine::VIEW_BYTES >> 20
+             of its cubes (every n-th pixel, at most {} MiB with {} designs); the engine's cache keeps what \
+             lets a change restart mid-chain.",
+            crate::engine::views::view_bytes_per_run(configs.len()) >> 20,
+            configs.len()
         )
     }
 

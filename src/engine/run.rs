@@ -72,7 +72,7 @@ impl Engine {
     }
 
     /// An engine for the app: runs keep products and views of their cubes at a bounded size
-    /// ([`super::views::VIEW_BYTES`]), not the cubes; the cache keeps at most `cache_bytes` and up
+    /// ([`super::views::VIEW_BYTES`], or less: [`Self::set_view_bytes`]), not the cubes; the cache keeps at most `cache_bytes` and up
     /// to `designs` cubes per stage at each of [`APP_LEVELS`] decimations. A change restarts
     /// mid-chain where the cache still holds every product before it; a change to the
     /// retrievals alone restarts from the run's kept Rrs ([`super::restart`]).
@@ -89,6 +89,12 @@ impl Engine {
     pub fn with_view_bytes(mut self, bytes: usize) -> Self {
         self.view_bytes = bytes;
         self
+    }
+
+    /// Keep the views of later runs under `bytes` per run (the app: its designs' share of
+    /// [`super::views::ALL_VIEW_BYTES`]).
+    pub fn set_view_bytes(&mut self, bytes: usize) {
+        self.view_bytes = bytes;
     }
 
     /// The same engine, its cache emptied and bounded to `bytes` (products past it are dropped,

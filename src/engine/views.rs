@@ -1,8 +1,9 @@
 //! What the app shows of a run's cubes, at a bounded size: the pupil radiance, the true Rrs, the
 //! Level-1 radiance and the corrected Rrs of every band at every `stride`-th line and detector,
 //! their values unchanged. An engine that keeps views ([`super::Engine::for_app`]) takes them
-//! while each cube is at hand and lets the cube go, so a design costs its products and
-//! [`VIEW_BYTES`], not its cubes (a 101-band spectrograph's full cubes are 3.2 GB).
+//! while each cube is at hand and lets the cube go, so a design costs its products and at most
+//! [`VIEW_BYTES`] (its share of [`ALL_VIEW_BYTES`] beyond four designs), not its cubes (a
+//! 101-band spectrograph's full cubes are 3.2 GB).
 //!
 //! A map is read back at full resolution with each kept pixel standing for the `stride × stride`
 //! block it starts (nearest neighbour), and a spectrum is read at the kept pixel of the block.
@@ -18,6 +19,20 @@ use crate::instrument::RadianceCube;
 /// At 2 (every other line and detector) for the paper's 19-band, 1024 × 2000 CubeSat (175 MB);
 /// at 4 for the 101-band spectrograph (170 MB).
 pub const VIEW_BYTES: usize = 192 << 20;
+
+/// The most the views of all the designs the app holds may take together, bytes: each run's
+/// views get an equal share, at most [`VIEW_BYTES`] ([`view_bytes_per_run`]). Up to four designs
+/// keep [`VIEW_BYTES`] each; eight keep half of it (every third pixel of the paper's CubeSat,
+/// 78 MB), as each design's maps on screen shrink with their number: eight designs' four map
+/// panels at 1920 pixels are ~370 pixels wide, the CubeSat's third-pixel view 341.
+pub const ALL_VIEW_BYTES: usize = 4 * VIEW_BYTES;
+
+/// Each run's share of [`ALL_VIEW_BYTES`] when the app holds `designs` designs, at most
+/// [`VIEW_BYTES`].
+#[must_use]
+pub fn view_bytes_per_run(designs: usize) -> usize {
+    VIEW_BYTES.min(ALL_VIEW_BYTES / designs.max(1))
+}
 
 /// Bytes of the views per kept pixel and band: four f32 cubes and two u8 flag cubes.
 pub const VIEW_BYTES_PER_PIXEL_BAND: usize = 4 * 4 + 2;
@@ -177,6 +192,18 @@ mod tests {
         // A budget nothing fits: one pixel.
         assert_eq!(stride_for(10, 10, 3, 0), 10);
         assert_eq!(stride_for(0, 0, 3, 0), 1);
+    }
+
+    #[test]
+    fn eight_designs_share_what_four_keep() {
+        assert_eq!(view_bytes_per_run(0), VIEW_BYTES);
+        assert_eq!(view_bytes_per_run(2), VIEW_BYTES);
+        assert_eq!(view_bytes_per_run(4), VIEW_BYTES);
+        assert_eq!(view_bytes_per_run(8), VIEW_BYTES / 2);
+        // The paper's CubeSat among eight: every third pixel (78 MB).
+        assert_eq!(stride_for(2000, 1024, 19, view_bytes_per_run(8)), 3);
+        // From five designs on, all of them together stay within the whole budget.
+        assert!((5..=8).all(|d| d * view_bytes_per_run(d) <= ALL_VIEW_BYTES));
     }
 
     #[test]

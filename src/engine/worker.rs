@@ -339,6 +339,8 @@ fn worker(requests: &Mailbox<Request>, link: &Link<'_>, pause: &PreviewPause, po
     let mut engine = Engine::for_app(cache_bytes, MAX_DESIGNS);
     // The mailbox holds only the newest request: an older one was replaced (and counted) there.
     while let Some(request) = requests.take() {
+        // Each design's share of the views: the more designs, the smaller each one's maps.
+        engine.set_view_bytes(super::views::view_bytes_per_run(request.configs.len()));
         // A configuration that failed is not run at finer levels; the others go on (one
         // broken instrument does not hide the other's results).
         let mut failed = vec![false; request.configs.len()];
