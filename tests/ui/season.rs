@@ -62,3 +62,45 @@ fn the_season_window_runs_the_designs_on_screen_over_a_month() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Stop while the spread over orbit phases is being made: the looks and the runs stay, the
+/// status says where it stopped, and the window is free to run again. Ten years of looks, so the
+/// spread (12 phases of ten years' passes, ~0.3 s a year) is still running seconds after the
+/// runs end, while the click comes a frame or two after them.
+#[test]
+fn stop_in_the_spread_over_orbit_phases_keeps_the_looks() {
+    let dir = temp_library("season-stop");
+    let mut h = harness("cubesat", 24, &dir);
+    h.get_by_label("Season").click();
+    h.step();
+    h.step();
+    h.get_by_role_and_label(Role::TextInput, "from").set_text_value_accesskit("2023-01-01");
+    h.get_by_role_and_label(Role::TextInput, "to").set_text_value_accesskit("2032-12-31");
+    h.step();
+    pick(&mut h, "resolution", "1/32");
+    h.get_by_label("Run").click();
+    h.step();
+    let start = Instant::now();
+    while h.query_by_label_contains("the spread over orbit phases …").is_none() {
+        assert!(h.state().explore().busy(), "the season ended before its spread could be stopped");
+        assert!(start.elapsed() < Duration::from_secs(300), "the runs did not end");
+        std::thread::sleep(Duration::from_millis(5));
+        h.step();
+    }
+    h.get_by_label("Stop").click();
+    h.step();
+    h.step();
+    assert!(!h.state().explore().busy(), "Stop ends the season's task");
+    assert!(
+        h.query_by_label_contains("stopped in the spread over orbit phases (12 of 12 chain runs made)").is_some(),
+        "the status says where it stopped"
+    );
+    let s = h.state().explore().season.summary().expect("the looks stay").clone();
+    for d in &s.designs {
+        assert!(d.passes > 1000 && d.by_verdict[0] > 0, "{}: ten years of looks", d.label);
+        assert_eq!(d.runs, 6, "{}: the runs made stay", d.label);
+        assert_eq!(d.phases, 0, "{}: no spread was kept", d.label);
+    }
+    assert!(h.query_by_label("Run").is_some(), "the window can run again");
+    let _ = std::fs::remove_dir_all(&dir);
+}
