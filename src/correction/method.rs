@@ -32,7 +32,10 @@ pub struct CorrectionSpec {
     /// processor knows the wind only from ancillary fields, as l2gen does, so over a glinting
     /// scene this prices the wind alone ([`super::expected_glint`]). 0: the wind is known. The
     /// image-based correction states its own (`image.glint_wind_error_m_s`); the per-scene
-    /// approximation, whose terms come from the scene's own pixels, takes none.
+    /// approximation, whose terms come from the scene's own pixels, takes none. Read only while
+    /// the method is [`Method::Exact`] (the app's menu keeps it through a switch to another
+    /// method and back) and written only then, so a file never holds it beside another method,
+    /// which reading refuses.
     pub glint_wind_error_m_s: f64,
 }
 
@@ -43,6 +46,13 @@ impl Default for CorrectionSpec {
 }
 
 impl CorrectionSpec {
+    /// The wind error the exact correction works with: [`Self::glint_wind_error_m_s`] when the
+    /// method is exact, else 0.
+    #[must_use]
+    pub fn exact_wind_error_m_s(&self) -> f64 {
+        if self.method == Method::Exact { self.glint_wind_error_m_s } else { 0.0 }
+    }
+
     /// The image-based correction's settings, when that is the method.
     #[must_use]
     pub fn image(&self) -> Option<&ImageCorrection> {
@@ -97,12 +107,13 @@ impl TryFrom<CorrectionFile> for CorrectionSpec {
 
 impl From<CorrectionSpec> for CorrectionFile {
     fn from(s: CorrectionSpec) -> Self {
+        let glint_wind_error_m_s = s.exact_wind_error_m_s();
         let (use_approximation, image) = match s.method {
             Method::Exact => (false, None),
             Method::PerScene => (true, None),
             Method::Image(i) => (false, Some(i)),
         };
-        Self { approx_points: s.approx_points, use_approximation, image, glint_wind_error_m_s: s.glint_wind_error_m_s }
+        Self { approx_points: s.approx_points, use_approximation, image, glint_wind_error_m_s }
     }
 }
 
@@ -250,6 +261,12 @@ mod tests {
         let text = ron::to_string(&spec).unwrap();
         assert_eq!(text, "(approx_points:20,use_approximation:false,image:None,glint_wind_error_m_s:-1.5)");
         assert_eq!(ron::from_str::<CorrectionSpec>(&text).unwrap(), spec);
+        // Switched to another method (as the app's menu does), it is neither read nor written:
+        // the file reads back.
+        let image = CorrectionSpec { method: Method::Image(ImageCorrection::default()), ..spec };
+        assert_eq!(image.exact_wind_error_m_s(), 0.0);
+        let back: CorrectionSpec = ron::from_str(&ron::to_string(&image).unwrap()).unwrap();
+        assert_eq!((back.method, back.glint_wind_error_m_s), (image.method, 0.0));
     }
 
     #[test]

@@ -94,17 +94,27 @@ impl Engine {
             // corrections are not run beside it (`shoal budget` prices the difference).
             let against_truth = diagnostics;
             let diagnostics = diagnostics && image.is_none();
+            let aerosol_map = side.aerosol_map.as_deref().zip(truth.aot550.as_ref());
+            let expected = exact_glint(config, side);
             let exact = if diagnostics || (!per_scene && image.is_none()) {
-                let aerosol_map = side.aerosol_map.as_deref().zip(truth.aot550.as_ref());
-                let expected = exact_glint(config, side);
                 let atmosphere = (band_atmosphere.as_ref(), expected.as_deref());
                 Some(correct_exact(level1, atmosphere, aerosol_map, surface, control).map_err(&fail)?)
             } else {
                 None
             };
+            // The approximation's diagnostic is against the exact inversion with the scene's own
+            // glint: where the exact correction works from another wind, that one is made apart.
+            let reference = match (&expected, &exact, diagnostics && !per_scene) {
+                (Some(_), Some(_), true) => Some(
+                    correct_exact(level1, (band_atmosphere.as_ref(), None), aerosol_map, surface, control)
+                        .map_err(&fail)?,
+                ),
+                _ => None,
+            };
+            let exact_reference = reference.as_ref().or(exact.as_ref());
             // The approximation is held whole only when it is the product; as a diagnostic it is
             // compared with the exact correction pixel by pixel.
-            let streamed = match (&exact, diagnostics && !per_scene) {
+            let streamed = match (exact_reference, diagnostics && !per_scene) {
                 (Some(e), true) => approximation.compare_with(level1, surface, e),
                 _ => None,
             };
@@ -113,7 +123,7 @@ impl Engine {
             } else {
                 None
             };
-            let approximation_vs_exact = match (streamed, &approx, &exact, diagnostics) {
+            let approximation_vs_exact = match (streamed, &approx, exact_reference, diagnostics) {
                 (Some(d), ..) => d,
                 (None, Some(a), Some(e), true) => compare(a, &e.rrs, Some(&e.flags)),
                 _ => Vec::new(),
@@ -206,7 +216,7 @@ impl Engine {
 /// (`correction.glint_wind_error_m_s`) over a scene with glint: the scene's glint carried to the
 /// wind it assumes ([`crate::correction::expected_glint`]). `None`: the scene's own glint.
 fn exact_glint(config: &RunConfig, side: &SceneSide) -> Option<Vec<f64>> {
-    let error = config.correction.glint_wind_error_m_s;
+    let error = config.correction.exact_wind_error_m_s();
     let crate::atmosphere::SeaSurface::Wind { speed_m_s } = config.scene.atmosphere.surface else { return None };
     if error == 0.0 || !side.scene.wants(crate::scene::Effect::SunGlint) {
         return None;

@@ -85,8 +85,10 @@ impl ErrorSource {
             }
             Self::Calibration => config.calibration.perfect = true,
             Self::Correction => {
-                // The perfect correction: the exact inversion with the forward model's atmosphere.
+                // The perfect correction: the exact inversion with the forward model's atmosphere
+                // and its wind.
                 config.correction.method = crate::correction::Method::Exact;
+                config.correction.glint_wind_error_m_s = 0.0;
             }
             Self::SiopChoice => {
                 let truth = config.scene.siop.clone();

@@ -65,8 +65,9 @@ fn the_season_window_runs_the_designs_on_screen_over_a_month() {
 
 /// Stop while the spread over orbit phases is being made: the looks and the runs stay, the
 /// status says where it stopped, and the window is free to run again. Ten years of looks, so the
-/// spread (12 phases of ten years' passes, ~0.3 s a year) is still running seconds after the
-/// runs end, while the click comes a frame or two after them.
+/// spread (12 phases of ten years' passes, ~0.3 s a year and phase on one core) is still running
+/// after the runs end: seconds on two cores, and on any number of cores at least one phase's ten
+/// years (~3 s), while the click comes a frame or two (milliseconds) after them.
 #[test]
 fn stop_in_the_spread_over_orbit_phases_keeps_the_looks() {
     let dir = temp_library("season-stop");
