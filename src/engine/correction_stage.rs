@@ -95,22 +95,16 @@ impl Engine {
             let against_truth = diagnostics;
             let diagnostics = diagnostics && image.is_none();
             let aerosol_map = side.aerosol_map.as_deref().zip(truth.aot550.as_ref());
+            let run_exact = |glint| {
+                correct_exact(level1, (band_atmosphere.as_ref(), glint), aerosol_map, surface, control).map_err(&fail)
+            };
+            // The exact correction takes away the glint of the wind it assumes (`None`: the
+            // scene's own); the approximation's diagnostic stays against the scene's own glint.
             let expected = exact_glint(config, side);
-            let exact = if diagnostics || (!per_scene && image.is_none()) {
-                let atmosphere = (band_atmosphere.as_ref(), expected.as_deref());
-                Some(correct_exact(level1, atmosphere, aerosol_map, surface, control).map_err(&fail)?)
-            } else {
-                None
-            };
-            // The approximation's diagnostic is against the exact inversion with the scene's own
-            // glint: where the exact correction works from another wind, that one is made apart.
-            let reference = match (&expected, &exact, diagnostics && !per_scene) {
-                (Some(_), Some(_), true) => Some(
-                    correct_exact(level1, (band_atmosphere.as_ref(), None), aerosol_map, surface, control)
-                        .map_err(&fail)?,
-                ),
-                _ => None,
-            };
+            let exact = (diagnostics || (!per_scene && image.is_none())).then(|| run_exact(expected.as_deref()));
+            let exact = exact.transpose()?;
+            let apart = expected.is_some() && exact.is_some() && diagnostics && !per_scene;
+            let reference = apart.then(|| run_exact(None)).transpose()?;
             let exact_reference = reference.as_ref().or(exact.as_ref());
             // The approximation is held whole only when it is the product; as a diagnostic it is
             // compared with the exact correction pixel by pixel.
