@@ -103,8 +103,8 @@ impl Engine {
             let expected = exact_glint(config, side);
             let exact = (diagnostics || (!per_scene && image.is_none())).then(|| run_exact(expected.as_deref()));
             let exact = exact.transpose()?;
-            let apart = expected.is_some() && exact.is_some() && diagnostics && !per_scene;
-            let reference = apart.then(|| run_exact(None)).transpose()?;
+            // (A wind error is the exact method's, so `diagnostics` here means the exact ran.)
+            let reference = (expected.is_some() && diagnostics).then(|| run_exact(None)).transpose()?;
             let exact_reference = reference.as_ref().or(exact.as_ref());
             // The approximation is held whole only when it is the product; as a diagnostic it is
             // compared with the exact correction pixel by pixel.

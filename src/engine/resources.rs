@@ -345,8 +345,8 @@ pub fn study_demand(configs: &[&RunConfig], keep_cubes: bool, cache_bytes: usize
 const APP_WINDOW_BYTES: f64 = 0.35 * 1024.0 * 1024.0 * 1024.0;
 
 /// What the app holds for `configs` at full resolution ([`super::Engine::for_app`]): each design's
-/// views of its cubes (its share of [`super::views::ALL_VIEW_BYTES`]) and its products and truth maps, the
-/// largest run at work, and the cache (`cache_bytes`, less what a run takes of
+/// views of its cubes (its share of [`super::views::ALL_VIEW_BYTES`]) and its products and truth
+/// maps, the largest run at work, and the cache (`cache_bytes`, less what a run takes of
 /// [`super::worker::APP_RUN_ENVELOPE_BYTES`]: the most a run and the cache hold together).
 #[must_use]
 pub fn app_demand(configs: &[&RunConfig], cache_bytes: usize) -> Demand {
@@ -372,11 +372,11 @@ pub fn app_demand(configs: &[&RunConfig], cache_bytes: usize) -> Demand {
     if let Some(p) = demand.parts.iter_mut().find(|p| p.what == "the engine's cache") {
         p.bytes = cache;
     }
+    let share = super::views::view_bytes_per_run(configs.len());
     for c in configs {
         let flown = c.flown();
         let (rows, cols) = image_size(&flown);
         let bands = band_count(&flown.instrument.kind);
-        let share = super::views::view_bytes_per_run(configs.len());
         let stride = super::views::stride_for(rows, cols, bands, share);
         let kept = rows.div_ceil(stride) * cols.div_ceil(stride) * bands * super::views::VIEW_BYTES_PER_PIXEL_BAND;
         demand.parts.push(Part {

@@ -72,8 +72,9 @@ impl Engine {
     }
 
     /// An engine for the app: runs keep products and views of their cubes at a bounded size
-    /// ([`super::views::VIEW_BYTES`], or less: [`Self::set_view_bytes`]), not the cubes; the cache keeps at most `cache_bytes` and up
-    /// to `designs` cubes per stage at each of [`APP_LEVELS`] decimations. A change restarts
+    /// ([`super::views::VIEW_BYTES`], or less: [`Self::set_view_bytes`]), not the cubes; the
+    /// cache keeps at most `cache_bytes` and up to `designs` cubes per stage at each of
+    /// [`APP_LEVELS`] decimations. A change restarts
     /// mid-chain where the cache still holds every product before it; a change to the
     /// retrievals alone restarts from the run's kept Rrs ([`super::restart`]).
     #[must_use]

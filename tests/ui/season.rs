@@ -8,13 +8,19 @@ use egui_kittest::kittest::Queryable;
 
 use super::{harness, pick, temp_library};
 
-#[test]
-fn the_season_window_runs_the_designs_on_screen_over_a_month() {
-    let dir = temp_library("season");
+/// The app on the CubeSat at 1/24 in a library of its own (`name`), its Season window open.
+fn season_window(name: &str) -> (std::path::PathBuf, egui_kittest::Harness<'static, shoal::app::ShoalApp>) {
+    let dir = temp_library(name);
     let mut h = harness("cubesat", 24, &dir);
     h.get_by_label("Season").click();
     h.step();
     h.step();
+    (dir, h)
+}
+
+#[test]
+fn the_season_window_runs_the_designs_on_screen_over_a_month() {
+    let (dir, mut h) = season_window("season");
     // A bad date is refused naming the field, and nothing runs.
     h.get_by_role_and_label(Role::TextInput, "to").set_text_value_accesskit("2023-13-01");
     h.step();
@@ -70,11 +76,7 @@ fn the_season_window_runs_the_designs_on_screen_over_a_month() {
 /// years (~3 s), while the click comes a frame or two (milliseconds) after them.
 #[test]
 fn stop_in_the_spread_over_orbit_phases_keeps_the_looks() {
-    let dir = temp_library("season-stop");
-    let mut h = harness("cubesat", 24, &dir);
-    h.get_by_label("Season").click();
-    h.step();
-    h.step();
+    let (dir, mut h) = season_window("season-stop");
     h.get_by_role_and_label(Role::TextInput, "from").set_text_value_accesskit("2023-01-01");
     h.get_by_role_and_label(Role::TextInput, "to").set_text_value_accesskit("2032-12-31");
     h.step();
