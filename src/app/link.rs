@@ -18,6 +18,12 @@ use crate::engine::{EngineError, RunConfig, RunOutput};
 /// (minimised), refinement is late by this much at most.
 const PREVIEW_PAUSE: Duration = Duration::from_millis(25);
 
+/// Bytes of a run's views of its cubes (0 without views).
+fn views_bytes(output: &RunOutput) -> usize {
+    use crate::engine::footprint::Footprint;
+    output.views.as_ref().map_or(0, |v| v.bytes())
+}
+
 /// A result on display.
 #[derive(Debug, Clone)]
 pub struct Shown {
@@ -216,10 +222,28 @@ impl EngineLink {
                 self.finished[i] = true;
             }
         }
+        // A kept design whose views are larger than its share among the designs now held (a
+        // design was added) runs again at the finest level only: restarted from its kept Rrs, it
+        // comes back with its views cut to the share, while its maps stay on screen.
+        let share = crate::engine::views::view_bytes_per_run(n);
+        let finest_only: Vec<bool> = keep
+            .iter()
+            .zip(&self.shown)
+            .map(|(kept, shown)| *kept && shown.as_ref().is_some_and(|s| views_bytes(&s.output) > share))
+            .collect();
+        for (i, recut) in finest_only.iter().enumerate() {
+            if *recut {
+                self.finished[i] = false;
+            }
+        }
         self.submitted_at = Instant::now();
         self.latency_pending = true;
-        let configs = configs.into_iter().zip(&keep).map(|(c, kept)| (!kept).then_some(c)).collect();
-        self.handle.submit(Request { generation: self.generation, configs, decimations })
+        let configs = configs
+            .into_iter()
+            .zip(keep.iter().zip(&finest_only))
+            .map(|(c, (kept, recut))| (!kept || *recut).then_some(c))
+            .collect();
+        self.handle.submit(Request { generation: self.generation, configs, finest_only, decimations })
     }
 
     /// Take the engine's events; true if anything shown changed.

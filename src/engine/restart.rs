@@ -32,6 +32,7 @@ use crate::instrument::{SnrRow, Truth};
 
 /// What a run carries from its stages between the scene and the retrievals, kept to restart at
 /// the retrievals.
+#[derive(Clone)]
 pub(super) struct Restart {
     pub(super) truth: Arc<Truth>,
     pub(super) calibration: Arc<Calibration>,
@@ -74,7 +75,6 @@ impl Engine {
             .with("restart at the retrievals")
             .with(&upstream)
             .with(&files)
-            .with(&self.views_setting())
             .after(side.band_key);
         if let Some(sensed) = &side.sensed {
             key = key.after(sensed.band_key);
@@ -103,8 +103,17 @@ impl Engine {
         control: &RunControl,
         start: Instant,
     ) -> Option<Result<RunOutput, EngineError>> {
-        let kept = self.cache_get::<Restart>(key)?;
+        let mut kept = self.cache_get::<Restart>(key)?;
         let corrected = self.cache_get::<Corrected>(kept.correction_key)?;
+        // Views kept under a larger share than this run's (the app holds more designs than when
+        // the run was made) are cut to it, here and in the cache, so the larger ones go.
+        let (_, view_bytes) = self.views_setting();
+        if let Some(cut) = kept.views.as_ref().and_then(|v| v.within(view_bytes)) {
+            let smaller = Restart { views: Some(Arc::new(cut)), ..kept.as_ref().clone() };
+            let bytes = smaller.bytes();
+            kept = Arc::new(smaller);
+            self.cache_put(key, kept.clone(), bytes);
+        }
         let mut restored = kept.report.clone();
         // This run's scene side, then the stages the kept products stand for, served from them.
         restored.stages.clone_from(&report.stages);

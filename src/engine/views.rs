@@ -116,6 +116,34 @@ impl CubeViews {
         self.rrs_flags = every(&rrs.flags.view(), self.stride);
     }
 
+    /// The same views cut to fit `budget` bytes, or `None` when they already fit: every k-th
+    /// kept line and detector for the smallest k that fits, so that the result is exactly the
+    /// views a run at stride `k · stride` takes (a design among more designs than when it ran
+    /// gets a smaller share without running again, [`super::Engine::set_view_bytes`]). The
+    /// stride may come out coarser than [`stride_for`] would give a new run (every 4th pixel
+    /// from every 2nd where every 3rd would fit), never finer.
+    #[must_use]
+    pub fn within(&self, budget: usize) -> Option<Self> {
+        if self.bytes() <= budget {
+            return None;
+        }
+        let (rows, cols, _) = self.toa.dim();
+        let per_pixel = self.bytes() / (rows * cols).max(1);
+        let bytes = |k: usize| rows.div_ceil(k) * cols.div_ceil(k) * per_pixel;
+        let most = rows.max(cols).max(1);
+        let k = (2..=most).find(|&k| bytes(k) <= budget).unwrap_or(most);
+        Some(Self {
+            stride: self.stride * k,
+            full: self.full,
+            toa: every(&self.toa.view(), k),
+            truth_rrs: every(&self.truth_rrs.view(), k),
+            level1: every(&self.level1.view(), k),
+            level1_flags: every(&self.level1_flags.view(), k),
+            rrs: every(&self.rrs.view(), k),
+            rrs_flags: every(&self.rrs_flags.view(), k),
+        })
+    }
+
     /// The kept pixel standing for full-resolution pixel `(r, c)`.
     #[must_use]
     pub fn kept(&self, (r, c): (usize, usize)) -> (usize, usize) {
@@ -204,6 +232,37 @@ mod tests {
         assert_eq!(stride_for(2000, 1024, 19, view_bytes_per_run(8)), 3);
         // From five designs on, all of them together stay within the whole budget.
         assert!((5..=8).all(|d| d * view_bytes_per_run(d) <= ALL_VIEW_BYTES));
+    }
+
+    #[test]
+    fn views_cut_to_a_smaller_share_are_the_views_of_a_coarser_run() {
+        let (rows, cols, bands) = (20, 11, 3);
+        let cube =
+            |seed: f32| Array3::from_shape_fn((rows, cols, bands), |(r, c, b)| seed + (100 * r + 10 * c + b) as f32);
+        let flags = Array3::from_shape_fn((rows, cols, bands), |(r, c, b)| ((r + c + b) % 3) as u8);
+        let at = |stride: usize| CubeViews {
+            stride,
+            full: (rows, cols),
+            toa: every(&cube(0.0).view(), stride),
+            truth_rrs: every(&cube(0.5).view(), stride),
+            level1: every(&cube(0.25).view(), stride),
+            level1_flags: every(&flags.view(), stride),
+            rrs: every(&cube(0.75).view(), stride),
+            rrs_flags: every(&flags.view(), stride),
+        };
+        let two = at(2);
+        // Fits: kept as it is.
+        assert_eq!(two.within(two.bytes()), None);
+        // Every 3rd pixel of the full cubes would fit 1 byte less than every 2nd's; from the
+        // kept every-2nd pixels the next that can be cut is every 4th, the run's own at 4.
+        let cut = two.within(two.bytes() - 1).unwrap();
+        assert_eq!(cut, at(4));
+        assert!(cut.bytes() < two.bytes());
+        // A budget nothing fits: one pixel per band, still the run's own.
+        let one = two.within(0).unwrap();
+        assert_eq!(one.stride, 2 * 10);
+        assert_eq!(one.toa.dim(), (1, 1, bands));
+        assert_eq!(one.toa[[0, 0, 2]], 2.0);
     }
 
     #[test]

@@ -28,6 +28,11 @@ pub struct Request {
     /// The configurations; `None` at an index the caller already holds a final result for
     /// (unchanged since its previous request): nothing is run or reported for it.
     pub configs: Vec<Option<RunConfig>>,
+    /// Per configuration (missing: false): run it at the finest decimation only. The app asks so
+    /// for a design whose final result is shown but whose views are larger than its share of
+    /// the request's designs: the run restarts from the kept Rrs and hands back the views cut to
+    /// the share ([`super::views::CubeViews::within`]), while its maps stay on screen.
+    pub finest_only: Vec<bool>,
     /// Decimation factors, e.g. `[4, 1]` for a preview then full resolution.
     pub decimations: Vec<usize>,
 }
@@ -351,7 +356,8 @@ fn worker(requests: &Mailbox<Request>, link: &Link<'_>, pause: &PreviewPause, po
             }
             for (index, base) in request.configs.iter().enumerate() {
                 let Some(base) = base else { continue };
-                if failed[index] {
+                let finest = level + 1 == request.decimations.len();
+                if failed[index] || (!finest && request.finest_only.get(index).copied().unwrap_or(false)) {
                     continue;
                 }
                 if latest.load(Ordering::SeqCst) != request.generation {

@@ -80,3 +80,42 @@ fn an_engine_that_keeps_cubes_hands_them_back_after_a_retrieval_change() {
     assert!(out.cubes.is_some(), "the cubes are handed back");
     assert_eq!(engine.executions(Stage::Radiance), 1);
 }
+
+#[test]
+fn a_smaller_share_of_the_views_restarts_at_the_retrievals_and_cuts_the_views() {
+    use shoal::engine::footprint::Footprint;
+    let mut config = RunConfig::new(small_lake(), small("nominal", 48, 40));
+    config.retrievals = vec![ron::from_str("Almi()").unwrap()];
+    // The views of 40 × 48 pixels and 19 bands take 18 bytes per kept pixel and band: every
+    // other pixel is 164,160 bytes, every third 76,608, every fourth 41,040.
+    let mut engine = Engine::for_app(usize::MAX, 2).with_view_bytes(170 << 10);
+    let first = engine.run(&config, &RunControl::new()).unwrap();
+    let wide = first.views.clone().unwrap();
+    assert_eq!((wide.stride, wide.bytes()), (2, 164_160));
+    let ran = |e: &Engine| {
+        [Stage::Radiance, Stage::Level0, Stage::Level1, Stage::Correction, Stage::Retrieval].map(|s| e.executions(s))
+    };
+    let before = ran(&engine);
+    // More designs in the app: a smaller share, in which a new run would keep every third
+    // pixel. The same configuration restarts from its kept Rrs; nothing runs (its retrieval
+    // comes from the cache), and its views are cut from every other pixel to every fourth.
+    let share = 80 << 10;
+    engine.set_view_bytes(share);
+    let cut = engine.run(&config, &RunControl::new()).unwrap();
+    assert_eq!(ran(&engine), before, "nothing ran again");
+    let views = cut.views.clone().unwrap();
+    assert_eq!((views.stride, views.bytes()), (4, 41_040));
+    assert_eq!(Some(&*views), wide.within(share).as_ref());
+    // They are the views a run at every fourth pixel keeps, value for value.
+    let own = Engine::for_app(usize::MAX, 2).with_view_bytes(48 << 10).run(&config, &RunControl::new()).unwrap();
+    assert_eq!(own.views.as_deref(), Some(&*views));
+    same(&cut, &first, "the restart under a smaller share", &["views"]);
+    // The engine keeps the cut views, not the wide ones: the next restart hands back the same.
+    let again = engine.run(&config, &RunControl::new()).unwrap();
+    assert!(std::sync::Arc::ptr_eq(again.views.as_ref().unwrap(), cut.views.as_ref().unwrap()));
+    // A larger share again keeps the cut views (a run made again would take finer ones).
+    engine.set_view_bytes(170 << 10);
+    let wider = engine.run(&config, &RunControl::new()).unwrap();
+    assert_eq!(wider.views.as_ref().unwrap().stride, 4);
+    assert_eq!(ran(&engine), before);
+}

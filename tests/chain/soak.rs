@@ -150,6 +150,7 @@ fn soak() -> Soak {
         assert!(handle.submit(Request {
             generation,
             configs: configs.iter().cloned().map(Some).collect(),
+            finest_only: Vec::new(),
             decimations: decimations.clone(),
         }));
         // Random intervals: mostly shorter than a preview (edits pile up and cancel runs

@@ -44,10 +44,20 @@ fn preview_then_full_for_the_newest_generation() {
     let handle = EngineHandle::spawn(1).unwrap();
     let config = RunConfig::new(small_lake(), small("nominal", 64, 64));
     // Generation 1 is superseded at once by generation 2 (another gain).
-    assert!(handle.submit(Request { generation: 1, configs: vec![Some(config.clone())], decimations: vec![4, 1] }));
+    assert!(handle.submit(Request {
+        generation: 1,
+        configs: vec![Some(config.clone())],
+        finest_only: vec![],
+        decimations: vec![4, 1]
+    }));
     let mut newer = config;
     newer.instrument.gain_e_per_dn = 2.5;
-    assert!(handle.submit(Request { generation: 2, configs: vec![Some(newer)], decimations: vec![4, 1] }));
+    assert!(handle.submit(Request {
+        generation: 2,
+        configs: vec![Some(newer)],
+        finest_only: vec![],
+        decimations: vec![4, 1]
+    }));
     let events = finished(&handle, Duration::from_secs(120));
     assert_eq!(events, vec![(2, 4, true), (2, 1, true)], "preview first, then full, of generation 2 only");
     // Generation 1 went one of three ways, and the counters say which: skipped before it ran,
@@ -67,12 +77,22 @@ fn a_stale_result_is_dropped_not_cancelled() {
     // event queue, stale, and `wait` must drop it (counted), while no run was cancelled.
     let handle = EngineHandle::spawn(1).unwrap();
     let config = RunConfig::new(small_lake(), small("nominal", 16, 16));
-    assert!(handle.submit(Request { generation: 1, configs: vec![Some(config.clone())], decimations: vec![1] }));
+    assert!(handle.submit(Request {
+        generation: 1,
+        configs: vec![Some(config.clone())],
+        finest_only: vec![],
+        decimations: vec![1]
+    }));
     let s = until(&handle, Duration::from_secs(120), |s| s.results_sent == 1);
     assert_eq!(s, WorkerStats { results_sent: 1, ..WorkerStats::default() });
     let mut newer = config;
     newer.instrument.gain_e_per_dn = 2.5;
-    assert!(handle.submit(Request { generation: 2, configs: vec![Some(newer)], decimations: vec![1] }));
+    assert!(handle.submit(Request {
+        generation: 2,
+        configs: vec![Some(newer)],
+        finest_only: vec![],
+        decimations: vec![1]
+    }));
     assert_eq!(finished(&handle, Duration::from_secs(120)), vec![(2, 1, true)]);
     assert_eq!(
         handle.stats(),
@@ -88,7 +108,12 @@ fn a_newer_request_cancels_the_running_one_which_reports_nothing() {
     // done, reported every 50 ms). Generation 1 must be cancelled: no result sent, none dropped.
     let handle = EngineHandle::spawn(1).unwrap();
     let big = RunConfig::new(small_lake(), small("nominal", 1024, 512));
-    assert!(handle.submit(Request { generation: 1, configs: vec![Some(big)], decimations: vec![1] }));
+    assert!(handle.submit(Request {
+        generation: 1,
+        configs: vec![Some(big)],
+        finest_only: vec![],
+        decimations: vec![1]
+    }));
     let deadline = Instant::now() + Duration::from_secs(120);
     loop {
         assert!(Instant::now() < deadline, "generation 1 never reported progress");
@@ -100,7 +125,12 @@ fn a_newer_request_cancels_the_running_one_which_reports_nothing() {
     }
     assert_eq!(handle.stats(), WorkerStats::default(), "generation 1 finished before it could be cancelled");
     let light = RunConfig::new(small_lake(), small("nominal", 16, 16));
-    assert!(handle.submit(Request { generation: 2, configs: vec![Some(light)], decimations: vec![1] }));
+    assert!(handle.submit(Request {
+        generation: 2,
+        configs: vec![Some(light)],
+        finest_only: vec![],
+        decimations: vec![1]
+    }));
     assert_eq!(finished(&handle, Duration::from_secs(120)), vec![(2, 1, true)]);
     assert_eq!(
         handle.stats(),
@@ -113,7 +143,12 @@ fn a_failed_run_is_reported_and_the_worker_survives() {
     let handle = EngineHandle::spawn(1).unwrap();
     let mut bad = RunConfig::new(small_lake(), small("nominal", 16, 16));
     bad.instrument.aperture_mm = 0.0;
-    assert!(handle.submit(Request { generation: 1, configs: vec![Some(bad)], decimations: vec![1] }));
+    assert!(handle.submit(Request {
+        generation: 1,
+        configs: vec![Some(bad)],
+        finest_only: vec![],
+        decimations: vec![1]
+    }));
     let deadline = Instant::now() + Duration::from_secs(60);
     loop {
         match handle.wait(Duration::from_millis(100)) {
@@ -126,7 +161,12 @@ fn a_failed_run_is_reported_and_the_worker_survives() {
         }
     }
     let good = RunConfig::new(small_lake(), small("nominal", 16, 16));
-    assert!(handle.submit(Request { generation: 2, configs: vec![Some(good)], decimations: vec![1] }));
+    assert!(handle.submit(Request {
+        generation: 2,
+        configs: vec![Some(good)],
+        finest_only: vec![],
+        decimations: vec![1]
+    }));
     let events = finished(&handle, Duration::from_secs(60));
     assert_eq!(events, vec![(2, 1, true)]);
 }
@@ -136,7 +176,12 @@ fn a_and_b_run_at_each_level_before_the_next() {
     let handle = EngineHandle::spawn(1).unwrap();
     let a = RunConfig::new(small_lake(), small("cubesat", 32, 32));
     let b = RunConfig::new(small_lake(), small("smallsat", 32, 32));
-    assert!(handle.submit(Request { generation: 1, configs: vec![Some(a), Some(b)], decimations: vec![4, 1] }));
+    assert!(handle.submit(Request {
+        generation: 1,
+        configs: vec![Some(a), Some(b)],
+        finest_only: vec![],
+        decimations: vec![4, 1]
+    }));
     let mut order = Vec::new();
     let deadline = Instant::now() + Duration::from_secs(120);
     while order.len() < 4 && Instant::now() < deadline {
@@ -169,7 +214,7 @@ fn after_a_preview_the_engine_waits_until_it_is_on_screen() {
     let request = |generation, gain| {
         let mut c = config.clone();
         c.instrument.gain_e_per_dn = gain;
-        Request { generation, configs: vec![Some(c)], decimations: vec![4, 1] }
+        Request { generation, configs: vec![Some(c)], finest_only: vec![], decimations: vec![4, 1] }
     };
     assert!(handle.submit(request(1, 3.0)));
     assert_eq!(next_finished(&handle, Duration::from_secs(60)), Some((1, 4)));
@@ -187,4 +232,32 @@ fn after_a_preview_the_engine_waits_until_it_is_on_screen() {
     assert_eq!(next_finished(&handle, Duration::from_secs(60)), Some((3, 4)), "the newer preview");
     handle.preview_shown(3);
     assert_eq!(next_finished(&handle, Duration::from_secs(60)), Some((3, 1)));
+}
+
+#[test]
+fn a_design_asked_at_the_finest_level_only_skips_the_previews() {
+    let handle = EngineHandle::spawn(1).unwrap();
+    let a = RunConfig::new(small_lake(), small("nominal", 24, 24));
+    let mut b = a.clone();
+    b.instrument.gain_e_per_dn = 2.5;
+    let request = |generation, finest_only| Request {
+        generation,
+        configs: vec![Some(a.clone()), Some(b.clone())],
+        finest_only,
+        decimations: vec![4, 2, 1],
+    };
+    assert!(handle.submit(request(1, vec![true, false])));
+    let mut seen = Vec::new();
+    let deadline = Instant::now() + Duration::from_secs(120);
+    while seen.len() < 4 && Instant::now() < deadline {
+        if let Some(Event::Finished { index, decimation, result, .. }) = handle.wait(Duration::from_millis(100)) {
+            assert!(result.is_ok());
+            seen.push((index, decimation));
+        }
+    }
+    // A runs once, at full resolution, in its place among the finest runs; B at every level.
+    assert_eq!(seen, vec![(1, 4), (1, 2), (0, 1), (1, 1)]);
+    // And nothing else: the worker is idle after them.
+    std::thread::sleep(Duration::from_millis(200));
+    assert_eq!(handle.stats().results_sent, 4);
 }

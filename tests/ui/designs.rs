@@ -224,3 +224,51 @@ fn eight_designs_complete_at_preview_and_the_app_says_what_they_plan_to_hold() {
     assert!((3.92..3.92 * 1.2).contains(&gb), "{plan}");
     assert!(plan.contains("at most 96 MiB with 8 designs"), "each design's share of the views: {plan}");
 }
+
+#[test]
+fn a_fifth_design_cuts_the_views_of_those_already_shown_without_running_them_again() {
+    use shoal::app::model::Slot;
+    use shoal::engine::StageStatus;
+    use shoal::engine::footprint::Footprint;
+    use shoal::engine::views::{ALL_VIEW_BYTES, view_bytes_per_run};
+    use shoal::instrument::InstrumentSpec;
+    let dir = temp_library("fifth");
+    // The default study at full resolution: the CubeSat's views keep every other pixel of its
+    // 2000 lines × 1024 detectors × 19 bands, 175 MB, within the 192 MiB of up to four designs.
+    let mut h = with_state(AppState { decimations: vec![1], ..AppState::default() }, &dir);
+    wait_for_engine(&mut h);
+    let before = runs(&h);
+    let views = |r: &RunOutput| r.views.as_ref().expect("views").clone();
+    assert_eq!((views(&before[0]).stride, views(&before[0]).bytes()), (2, 175_104_000));
+    // Three small designs more: five share the views' budget, 153.6 MiB each.
+    for k in 0..3 {
+        let mut spec = InstrumentSpec::preset("nominal").unwrap();
+        (spec.detectors, spec.lines) = (48, 40 + k);
+        let app = h.state_mut();
+        let moved = app.state.add_design(Slot::new("nominal", spec)).expect("room for a design");
+        app.link.remap(&moved);
+    }
+    wait_for_engine(&mut h);
+    let after = runs(&h);
+    assert_eq!(after.len(), 5);
+    let share = view_bytes_per_run(5);
+    // A and B (the SmallSat's views are 174 MB) keep every 4th pixel now (every 3rd cannot be
+    // cut from every 2nd), their products the very ones they had: restarted from their kept
+    // Rrs, nothing before ran again, and their retrievals came from the cache.
+    for (i, bytes) in [(0, 43_776_000), (1, 43_600_896)] {
+        let cut = views(&after[i]);
+        assert_eq!((cut.stride, cut.bytes()), (4, bytes));
+        assert_eq!(Some(&*cut), views(&before[i]).within(share).as_ref());
+        for (old, new) in before[i].retrievals.iter().zip(&after[i].retrievals) {
+            assert!(Arc::ptr_eq(old, new), "design {i}'s retrieval was served from the cache");
+        }
+        let stages = &after[i].report.stages;
+        assert!(stages.iter().all(|s| s.status == StageStatus::Cached), "{stages:?}");
+    }
+    // The small designs keep every pixel.
+    assert!(after[2..].iter().all(|r| views(r).stride == 1));
+    let held: usize = after.iter().map(|r| views(r).bytes()).sum();
+    assert!(after.iter().all(|r| views(r).bytes() <= share));
+    assert!(held <= ALL_VIEW_BYTES, "{held} bytes of views");
+    let _ = std::fs::remove_dir_all(&dir);
+}
