@@ -49,6 +49,7 @@ pub const ALL: &[Asset] = embed![
     "atmosphere/atmosphere_gas_absorption_wasi6.csv",
     "atmosphere/rayleigh_optical_depth_bodhaine1999.csv",
     "atmosphere/wmo_aerosol_mie.csv",
+    "atmosphere/aerosol_6sv_components.csv",
     "atmosphere/gas_transmittance_6sv.csv",
 ];
 

@@ -65,6 +65,9 @@ pub(super) fn conditions(app: &mut ShoalApp, ui: &mut egui::Ui) {
             (AerosolType::Maritime, "maritime"),
             (AerosolType::Continental, "continental"),
             (AerosolType::Urban, "urban"),
+            (AerosolType::Maritime6sv, "maritime (6SV's components)"),
+            (AerosolType::Continental6sv, "continental (6SV's components)"),
+            (AerosolType::Urban6sv, "urban (6SV's components)"),
         ];
         // A user's mixture (set in a scene file) shows its fractions; the menu offers the models.
         let current =

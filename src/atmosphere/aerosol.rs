@@ -212,6 +212,9 @@ pub fn mixture_optics(kind: AerosolType, wavelength_nm: f64) -> Result<Option<Ae
     if kind == AerosolType::None {
         return Ok(None);
     }
+    if let Some(wmo) = kind.sixs() {
+        return super::aerosol_6sv::SixsTable::embedded()?.mixture(&wmo.volume_fractions(), wavelength_nm).map(Some);
+    }
     let table = ComponentTable::embedded()?;
     // Every part's table and number fraction: the WMO components, or a user's modes.
     let user: Vec<(std::sync::Arc<Vec<ComponentOptics>>, f64)> = match kind {

@@ -17,6 +17,7 @@
 //! | Ed(0⁺) | `ed_0plus` | downwelling irradiance just above the surface | W m⁻² nm⁻¹ |
 
 mod aerosol;
+pub mod aerosol_6sv;
 mod fresnel;
 mod gas;
 mod gas_swir;

@@ -1,0 +1,188 @@
+//! The basic aerosol models as 6SV builds them: its own component tables
+//! (`assets/atmosphere/aerosol_6sv_components.csv`, copied from 6SV 1.0B's DUST.f, WATE.f,
+//! OCEA.f and SOOT.f) mixed by its rule (AEROSO.f; Vermote et al. 1997, Kotchenova et al. 2006).
+//!
+//! 6SV's four components are the WMO ones with the size distributions and refractive indices of
+//! d'Almeida, Koepke & Shettle (1991), not WCP-55's, which OSOAA and [`super::aerosol`] use: its
+//! continental model puts 0.012 % of its particles in the dust-like mode and 51 % in soot, where
+//! WCP-55's has 2.3·10⁻⁴ % and 6 %, so that its extinction keeps 22 % of its 550 nm value at
+//! 2250 nm, WCP-55's 15 %. With the models computed from these tables, Shoal's aerosol is 6SV's
+//! (its extinction, single-scattering albedo and phase function), so that a comparison with 6SV or
+//! with a processor whose tables come from 6SV (ACOLITE's dark-spectrum fitting) is a comparison
+//! of the radiative transfer alone.
+//!
+//! The mixture of volume fractions cᵢ: c_ij = (cᵢ/vᵢ)/Σⱼ(cⱼ/vⱼ) with 6SV's volume per particle
+//! vᵢ, K_ext = Σ c_ij ext_i, K_sca = Σ c_ij sca_i, P = Σ c_ij sca_i P_i / K_sca (AEROSO.f);
+//! between 6SV's 20 wavelengths the coefficients are interpolated log–log in λ and the phase
+//! function linearly, as [`super::aerosol`] does with its own table. The phase functions are
+//! tabulated at 6SV's 83 quadrature cosines (−1, the 80-point Gauss–Legendre nodes, 0 and 1).
+
+use std::sync::OnceLock;
+
+use super::AtmosphereError;
+use super::aerosol::AerosolOptics;
+use super::phase::PhaseFunction;
+use super::wmo::Component;
+use crate::spectral::Table;
+
+/// Path of the 6SV component table below `assets/`.
+pub const SIXS_ASSET: &str = "atmosphere/aerosol_6sv_components.csv";
+
+/// 6SV's wavelengths, nm (its `wldis`).
+pub const SIXS_WAVELENGTHS_NM: [f64; 20] = [
+    350.0, 400.0, 412.0, 443.0, 470.0, 488.0, 515.0, 550.0, 590.0, 633.0, 670.0, 694.0, 760.0, 860.0, 1240.0, 1536.0,
+    1650.0, 1950.0, 2250.0, 3750.0,
+];
+
+/// Points of 6SV's phase-function quadrature (`nqdef_p`).
+const ANGLES: usize = 83;
+
+/// One component at one of 6SV's wavelengths.
+#[derive(Debug, Clone, PartialEq)]
+struct Row {
+    /// Extinction coefficient, 6SV's units (only ratios enter a mixture).
+    ext: f64,
+    /// Scattering coefficient, the same units.
+    sca: f64,
+    /// P at the table's angles, rising from 0 to 180°.
+    p: Vec<f64>,
+}
+
+/// The parsed table: per component, its rows at [`SIXS_WAVELENGTHS_NM`] and 6SV's volume per
+/// particle vᵢ.
+#[derive(Debug)]
+pub struct SixsTable {
+    angles_deg: Vec<f64>,
+    components: Vec<(Component, Vec<Row>, f64)>,
+}
+
+/// 6SV's quadrature angles, degrees, rising from 0 to 180 (the table's `p_83` down to `p_1`).
+fn angles_deg() -> Vec<f64> {
+    let (x, _) = super::quadrature::gauss_legendre(ANGLES - 3);
+    let half = x.len() / 2;
+    let mut mu = vec![-1.0];
+    mu.extend_from_slice(&x[..half]);
+    mu.push(0.0);
+    mu.extend_from_slice(&x[half..]);
+    mu.push(1.0);
+    mu.iter().rev().map(|m: &f64| m.clamp(-1.0, 1.0).acos().to_degrees()).collect()
+}
+
+impl SixsTable {
+    /// The embedded table, parsed once.
+    pub fn embedded() -> Result<&'static Self, AtmosphereError> {
+        static TABLE: OnceLock<Result<SixsTable, AtmosphereError>> = OnceLock::new();
+        TABLE.get_or_init(|| Self::parse(&Table::from_asset(SIXS_ASSET)?)).as_ref().map_err(Clone::clone)
+    }
+
+    fn parse(t: &Table) -> Result<Self, AtmosphereError> {
+        let keys = t.column_str("component")?;
+        let (wl, ext, sca, vi) =
+            (t.column_f64("wavelength_nm")?, t.column_f64("ext")?, t.column_f64("sca")?, t.column_f64("vi")?);
+        let p: Vec<Vec<f64>> = (1..=ANGLES).map(|k| t.column_f64(&format!("p_{k}"))).collect::<Result<_, _>>()?;
+        let mut components = Vec::new();
+        for c in Component::ALL {
+            let mut rows = Vec::new();
+            let mut volume = f64::NAN;
+            for w in SIXS_WAVELENGTHS_NM {
+                let i = (0..t.len())
+                    .find(|&i| keys[i] == c.key() && (wl[i] - w).abs() < 1e-9)
+                    .ok_or_else(|| AtmosphereError::Data(format!("{SIXS_ASSET}: no row for {} at {w} nm", c.key())))?;
+                volume = vi[i];
+                // The file runs from μ = −1 (180°) to μ = 1 (0°); the rows rise in angle.
+                rows.push(Row { ext: ext[i], sca: sca[i], p: p.iter().rev().map(|col| col[i]).collect() });
+            }
+            components.push((c, rows, volume));
+        }
+        Ok(Self { angles_deg: angles_deg(), components })
+    }
+
+    /// 6SV's volume per particle of `c` (its mixing weight cᵢ/vᵢ).
+    #[must_use]
+    pub fn volume(&self, c: Component) -> f64 {
+        self.components.iter().find(|(k, ..)| *k == c).map_or(f64::NAN, |(_, _, v)| *v)
+    }
+
+    /// The optics of the mixture of `volume_fractions` at `wavelength_nm` (350–3750 nm), by
+    /// 6SV's rule (see the module docs).
+    pub fn mixture(
+        &self,
+        volume_fractions: &[(Component, f64)],
+        wavelength_nm: f64,
+    ) -> Result<AerosolOptics, AtmosphereError> {
+        let (lo, hi) = (SIXS_WAVELENGTHS_NM[0], SIXS_WAVELENGTHS_NM[SIXS_WAVELENGTHS_NM.len() - 1]);
+        if !(lo..=hi).contains(&wavelength_nm) {
+            return Err(AtmosphereError::OutOfRange {
+                field: "wavelength_nm (6SV aerosol)".into(),
+                value: wavelength_nm,
+                allowed: format!("{lo} to {hi} nm"),
+            });
+        }
+        let total: f64 = volume_fractions.iter().map(|(c, f)| f / self.volume(*c)).sum();
+        let parts: Vec<(&[Row], f64)> = volume_fractions
+            .iter()
+            .filter_map(|(c, f)| {
+                self.components.iter().find(|(k, ..)| k == c).map(|(_, rows, v)| (rows.as_slice(), f / v / total))
+            })
+            .collect();
+        let k_ext = |w: f64| -> f64 { parts.iter().map(|(rows, n)| n * interpolate(rows, w).ext).sum() };
+        let (mut k_sca, mut p) = (0.0, vec![0.0; ANGLES]);
+        for (rows, n) in &parts {
+            let o = interpolate(rows, wavelength_nm);
+            k_sca += n * o.sca;
+            for (pi, v) in p.iter_mut().zip(&o.p) {
+                *pi += n * o.sca * v;
+            }
+        }
+        if !(k_sca > 0.0) {
+            return Err(AtmosphereError::Data("6SV aerosol: a mixture with no scattering".into()));
+        }
+        for v in &mut p {
+            *v /= k_sca;
+        }
+        let ext = k_ext(wavelength_nm);
+        Ok(AerosolOptics {
+            extinction_ratio: ext / k_ext(550.0),
+            ssa: k_sca / ext,
+            phase: PhaseFunction::from_table(&self.angles_deg, &p)?,
+        })
+    }
+}
+
+/// A component's row at `wavelength_nm` within the table: coefficients log–log in λ, the phase
+/// function linearly.
+fn interpolate(rows: &[Row], wavelength_nm: f64) -> Row {
+    let j = SIXS_WAVELENGTHS_NM.partition_point(|&w| w <= wavelength_nm).clamp(1, SIXS_WAVELENGTHS_NM.len() - 1);
+    let (w0, w1) = (SIXS_WAVELENGTHS_NM[j - 1], SIXS_WAVELENGTHS_NM[j]);
+    let (a, b) = (&rows[j - 1], &rows[j]);
+    let t_log = (wavelength_nm / w0).ln() / (w1 / w0).ln();
+    let t = (wavelength_nm - w0) / (w1 - w0);
+    let loglog = |x: f64, y: f64| (x.ln() + t_log * (y.ln() - x.ln())).exp();
+    Row {
+        ext: loglog(a.ext, b.ext),
+        sca: loglog(a.sca, b.sca),
+        p: a.p.iter().zip(&b.p).map(|(x, y)| x + t * (y - x)).collect(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_angles_are_6svs_quadrature_and_the_table_reads() {
+        let a = angles_deg();
+        assert_eq!(a.len(), 83);
+        assert_eq!((a[0], a[41], a[82]), (0.0, 90.0, 180.0));
+        // The 80-point rule's node nearest the forward direction: 1.7116°.
+        assert!((a[1] - 1.7116207).abs() < 1e-6, "{}", a[1]);
+        let t = SixsTable::embedded().unwrap();
+        // DUST.f's vi_m and its 550 nm coefficients.
+        assert_eq!(t.volume(Component::DustLike), 18.2859898);
+        assert_eq!(t.volume(Component::Soot), 6.05630412e-5);
+        let dust = &t.components[0].1[7];
+        assert_eq!((dust.ext, dust.sca), (8.519962, 6.215003));
+        // P(180°) of the water-soluble component at 350 nm (WATE.f's first entry).
+        assert_eq!(t.components[1].1[0].p[82], 0.4078);
+    }
+}
