@@ -91,6 +91,10 @@ pub struct EngineLink {
     pub progress: Option<Progress>,
     /// Per design: has the current generation's finest level finished?
     finished: Vec<bool>,
+    /// Per design: its shown result is being run again at the finest level only, to cut its
+    /// views to a smaller share (a design was added); it counts as kept until that run comes
+    /// back, so a later submission asks for the cut again rather than for a new preview.
+    recut: Vec<bool>,
     /// The designs moved since the last submission: submit even if the configurations read the
     /// same (the runs in flight report by their old positions).
     moved: bool,
@@ -117,6 +121,7 @@ impl EngineLink {
             errors: Vec::new(),
             progress: None,
             finished: Vec::new(),
+            recut: Vec::new(),
             moved: false,
             last_latency_s: None,
             latency_pending: false,
@@ -195,7 +200,7 @@ impl EngineLink {
             .map(|i| {
                 decimations == self.decimations
                     && self.submitted.get(i).and_then(Option::as_ref) == configs.get(i)
-                    && self.finished.get(i).copied().unwrap_or(false)
+                    && (self.finished.get(i).copied().unwrap_or(false) || self.recut.get(i).copied().unwrap_or(false))
                     && self.errors.get(i).is_some_and(Option::is_none)
                     && self
                         .shown
@@ -236,6 +241,7 @@ impl EngineLink {
                 self.finished[i] = false;
             }
         }
+        self.recut.clone_from(&finest_only);
         self.submitted_at = Instant::now();
         self.latency_pending = true;
         let configs = configs
@@ -257,8 +263,9 @@ impl EngineLink {
                 Event::Finished { generation, index, decimation, result } => {
                     let finest = self.decimations.last().copied().unwrap_or(1);
                     let known = index < self.shown.len();
-                    if known && decimation == finest {
+                    if known && decimation == finest && !matches!(result, Err(EngineError::Cancelled)) {
                         self.finished[index] = true;
+                        self.recut[index] = false;
                     }
                     match result {
                         Ok(output) if known => {
@@ -334,6 +341,7 @@ impl EngineLink {
         let mut shown = vec![None; n];
         let mut errors = vec![None; n];
         let mut finished = vec![false; n];
+        let mut recut = vec![false; n];
         let mut submitted: Vec<Option<RunConfig>> = vec![None; n];
         for (old, new) in moved.iter().enumerate() {
             let taken = self.shown.get_mut(old).and_then(Option::take);
@@ -342,6 +350,7 @@ impl EngineLink {
                     shown[*k] = taken;
                     errors[*k] = self.errors.get_mut(old).and_then(Option::take);
                     finished[*k] = self.finished.get(old).copied().unwrap_or(false);
+                    recut[*k] = self.recut.get(old).copied().unwrap_or(false);
                     submitted[*k] = self.submitted.get(old).cloned().flatten();
                 }
                 None => {
@@ -351,7 +360,7 @@ impl EngineLink {
                 }
             }
         }
-        (self.shown, self.errors, self.finished) = (shown, errors, finished);
+        (self.shown, self.errors, self.finished, self.recut) = (shown, errors, finished, recut);
         // A design with no submitted configuration (none was moved into its place) runs anew;
         // the others keep theirs (an undone removal runs the design that came back, only).
         self.submitted = submitted;
@@ -367,6 +376,7 @@ impl EngineLink {
             self.poll();
             let ready = (0..self.shown.len()).all(|i| {
                 self.shown[i].as_ref().is_some_and(|s| s.generation == self.generation && s.decimation <= decimation)
+                    && !self.recut.get(i).copied().unwrap_or(false)
             }) || self.errors.iter().any(Option::is_some);
             if ready {
                 return self.errors.iter().all(Option::is_none);

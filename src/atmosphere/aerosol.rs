@@ -212,8 +212,8 @@ pub fn mixture_optics(kind: AerosolType, wavelength_nm: f64) -> Result<Option<Ae
     if kind == AerosolType::None {
         return Ok(None);
     }
-    if let Some(wmo) = kind.sixs() {
-        return super::aerosol_6sv::SixsTable::embedded()?.mixture(&wmo.volume_fractions(), wavelength_nm).map(Some);
+    if kind.sixs().is_some() {
+        return super::aerosol_6sv::SixsTable::embedded()?.mixture(&kind.number_fractions(), wavelength_nm).map(Some);
     }
     let table = ComponentTable::embedded()?;
     // Every part's table and number fraction: the WMO components, or a user's modes.

@@ -34,6 +34,23 @@ pub const SIXS_WAVELENGTHS_NM: [f64; 20] = [
     1650.0, 1950.0, 2250.0, 3750.0,
 ];
 
+/// The shortest wavelength the models are given at, nm: below 6SV's first (350 nm) the first
+/// interval's power law is extended, as 6SV's INTERP.f extends its end intervals; Shoal
+/// simulates from 325 nm ([`crate::ranges::MIN_SIMULATED_NM`]).
+pub const SIXS_MIN_NM: f64 = 325.0;
+
+/// 6SV's volume per particle of each component (`vi_m` of DUST.f, WATE.f, OCEA.f, SOOT.f): the
+/// mixing weight cᵢ/vᵢ. The table carries the same values (a test checks them).
+#[must_use]
+pub fn sixs_volume(c: Component) -> f64 {
+    match c {
+        Component::DustLike => 18.285_989_8,
+        Component::WaterSoluble => 0.001_827_373_05,
+        Component::Oceanic => 4.998_090_27,
+        Component::Soot => 6.056_304_12e-5,
+    }
+}
+
 /// Points of 6SV's phase-function quadrature (`nqdef_p`).
 const ANGLES: usize = 83;
 
@@ -103,14 +120,14 @@ impl SixsTable {
         self.components.iter().find(|(k, ..)| *k == c).map_or(f64::NAN, |(_, _, v)| *v)
     }
 
-    /// The optics of the mixture of `volume_fractions` at `wavelength_nm` (350–3750 nm), by
-    /// 6SV's rule (see the module docs).
+    /// The optics of the mixture of `number_fractions` (c_ij, [`crate::atmosphere::AerosolType::number_fractions`])
+    /// at `wavelength_nm` ([`SIXS_MIN_NM`]–3750 nm), by 6SV's rule (see the module docs).
     pub fn mixture(
         &self,
-        volume_fractions: &[(Component, f64)],
+        number_fractions: &[(Component, f64)],
         wavelength_nm: f64,
     ) -> Result<AerosolOptics, AtmosphereError> {
-        let (lo, hi) = (SIXS_WAVELENGTHS_NM[0], SIXS_WAVELENGTHS_NM[SIXS_WAVELENGTHS_NM.len() - 1]);
+        let (lo, hi) = (SIXS_MIN_NM, SIXS_WAVELENGTHS_NM[SIXS_WAVELENGTHS_NM.len() - 1]);
         if !(lo..=hi).contains(&wavelength_nm) {
             return Err(AtmosphereError::OutOfRange {
                 field: "wavelength_nm (6SV aerosol)".into(),
@@ -118,11 +135,10 @@ impl SixsTable {
                 allowed: format!("{lo} to {hi} nm"),
             });
         }
-        let total: f64 = volume_fractions.iter().map(|(c, f)| f / self.volume(*c)).sum();
-        let parts: Vec<(&[Row], f64)> = volume_fractions
+        let parts: Vec<(&[Row], f64)> = number_fractions
             .iter()
-            .filter_map(|(c, f)| {
-                self.components.iter().find(|(k, ..)| k == c).map(|(_, rows, v)| (rows.as_slice(), f / v / total))
+            .filter_map(|(c, n)| {
+                self.components.iter().find(|(k, ..)| k == c).map(|(_, rows, _)| (rows.as_slice(), *n))
             })
             .collect();
         let k_ext = |w: f64| -> f64 { parts.iter().map(|(rows, n)| n * interpolate(rows, w).ext).sum() };
@@ -149,14 +165,14 @@ impl SixsTable {
     }
 }
 
-/// A component's row at `wavelength_nm` within the table: coefficients log–log in λ, the phase
-/// function linearly.
+/// A component's row at `wavelength_nm`: coefficients log–log in λ (extended below the first
+/// wavelength), the phase function linearly (the first row's below it).
 fn interpolate(rows: &[Row], wavelength_nm: f64) -> Row {
     let j = SIXS_WAVELENGTHS_NM.partition_point(|&w| w <= wavelength_nm).clamp(1, SIXS_WAVELENGTHS_NM.len() - 1);
     let (w0, w1) = (SIXS_WAVELENGTHS_NM[j - 1], SIXS_WAVELENGTHS_NM[j]);
     let (a, b) = (&rows[j - 1], &rows[j]);
     let t_log = (wavelength_nm / w0).ln() / (w1 / w0).ln();
-    let t = (wavelength_nm - w0) / (w1 - w0);
+    let t = ((wavelength_nm - w0) / (w1 - w0)).clamp(0.0, 1.0);
     let loglog = |x: f64, y: f64| (x.ln() + t_log * (y.ln() - x.ln())).exp();
     Row {
         ext: loglog(a.ext, b.ext),
@@ -177,12 +193,42 @@ mod tests {
         // The 80-point rule's node nearest the forward direction: 1.7116°.
         assert!((a[1] - 1.7116207).abs() < 1e-6, "{}", a[1]);
         let t = SixsTable::embedded().unwrap();
-        // DUST.f's vi_m and its 550 nm coefficients.
-        assert_eq!(t.volume(Component::DustLike), 18.2859898);
-        assert_eq!(t.volume(Component::Soot), 6.05630412e-5);
+        // DUST.f's vi_m and its 550 nm coefficients; the constants are the table's.
+        for c in Component::ALL {
+            assert_eq!(t.volume(c), sixs_volume(c), "{c:?}");
+        }
         let dust = &t.components[0].1[7];
         assert_eq!((dust.ext, dust.sca), (8.519962, 6.215003));
         // P(180°) of the water-soluble component at 350 nm (WATE.f's first entry).
         assert_eq!(t.components[1].1[0].p[82], 0.4078);
+    }
+}
+
+#[cfg(test)]
+mod range_tests {
+    use super::*;
+    use crate::atmosphere::AerosolType;
+
+    #[test]
+    fn between_and_beyond_6svs_wavelengths() {
+        let t = SixsTable::embedded().unwrap();
+        let n = AerosolType::Continental6sv.number_fractions();
+        let at = |w: f64| t.mixture(&n, w).unwrap();
+        // At its own wavelengths the ratio is 6SV's (aerosol_6sv_models.csv: 1.4977 at 350 nm,
+        // 0.2172 at 2250 nm); between 1240 and 1536 nm it lies between them.
+        assert!((at(350.0).extinction_ratio - 1.4977).abs() < 1e-4);
+        assert!((at(2250.0).extinction_ratio - 0.2172).abs() < 1e-4);
+        let mid = at(1400.0).extinction_ratio;
+        assert!(mid < at(1240.0).extinction_ratio && mid > at(1536.0).extinction_ratio, "{mid}");
+        // Below 350 nm the first interval's power law goes on (continental: Ångström 0.79 between 350 and 400 nm).
+        let below = at(325.0).extinction_ratio;
+        let alpha = (1.4977_f64 / 1.3479).ln() / (400.0_f64 / 350.0).ln();
+        assert!((below / (1.4977 * (325.0_f64 / 350.0).powf(-alpha)) - 1.0).abs() < 1e-3, "{below}");
+        assert!((0.0..1.0).contains(&at(325.0).ssa));
+        // Outside: an error naming the field and the range, never a NaN.
+        for w in [300.0, 4000.0, f64::NAN] {
+            let e = t.mixture(&n, w).unwrap_err().to_string();
+            assert!(e.contains("6SV aerosol") && e.contains("325 to 3750"), "{e}");
+        }
     }
 }

@@ -241,7 +241,7 @@ impl WmoFractions {
 }
 
 impl AerosolType {
-    /// Parse `none|maritime|continental|urban|mixture:DL,WS,OC,SO` (volume fractions of
+    /// Parse `none|maritime|continental|urban|maritime-6sv|continental-6sv|urban-6sv|mixture:DL,WS,OC,SO` (volume fractions of
     /// dust-like, water-soluble, oceanic and soot) or `lognormal:R,SG,N,K` (one mode: modal
     /// radius µm, geometric standard deviation, refractive index) with, for two modes,
     /// `,R,SG,N,K,F` for the coarse mode and its volume fraction.
@@ -355,12 +355,14 @@ impl AerosolType {
         }
     }
 
-    /// Number fractions Nᵢ = (Cᵢ/Vᵢ)/Σⱼ(Cⱼ/Vⱼ) of the WCP-55 components (a 6SV model's are
-    /// [`super::aerosol_6sv::SixsTable::volume`]'s).
+    /// Number fractions Nᵢ = (Cᵢ/Vᵢ)/Σⱼ(Cⱼ/Vⱼ), with WCP-55's volumes per particle Vᵢ or, for
+    /// a 6SV model, 6SV's ([`super::aerosol_6sv::sixs_volume`]).
     #[must_use]
     pub fn number_fractions(self) -> Vec<(Component, f64)> {
+        let volume =
+            |c: Component| if self.sixs().is_some() { super::aerosol_6sv::sixs_volume(c) } else { c.volume_um3() };
         let v = self.volume_fractions();
-        let total: f64 = v.iter().map(|(c, f)| f / c.volume_um3()).sum();
-        v.iter().map(|(c, f)| (*c, f / c.volume_um3() / total)).collect()
+        let total: f64 = v.iter().map(|(c, f)| f / volume(*c)).sum();
+        v.iter().map(|(c, f)| (*c, f / volume(*c) / total)).collect()
     }
 }

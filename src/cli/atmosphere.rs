@@ -57,7 +57,8 @@ pub struct AtmosphereArgs {
     /// A RON run file (see presets/examples/); flags below override its values.
     #[arg(long, value_name = "FILE")]
     pub spec: Option<PathBuf>,
-    /// Aerosol model: none, maritime, continental or urban.
+    /// Aerosol model: none, maritime, continental, urban (WCP-55 components), maritime-6sv,
+    /// continental-6sv, urban-6sv (6SV's components), mixture:DL,WS,OC,SO or lognormal:R,SG,N,K.
     #[arg(long, value_name = "MODEL")]
     pub aerosol: Option<String>,
     /// Aerosol optical thickness at 550 nm (0 to 5).

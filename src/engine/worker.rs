@@ -28,10 +28,12 @@ pub struct Request {
     /// The configurations; `None` at an index the caller already holds a final result for
     /// (unchanged since its previous request): nothing is run or reported for it.
     pub configs: Vec<Option<RunConfig>>,
-    /// Per configuration (missing: false): run it at the finest decimation only. The app asks so
-    /// for a design whose final result is shown but whose views are larger than its share of
-    /// the request's designs: the run restarts from the kept Rrs and hands back the views cut to
-    /// the share ([`super::views::CubeViews::within`]), while its maps stay on screen.
+    /// Per configuration (missing: false): run it at the finest decimation only, after the
+    /// others there. The app asks so for a design whose final result is shown but whose views
+    /// are larger than its share of the request's designs: where the cache still holds its Rrs
+    /// the run restarts from it and hands back the views cut to the share
+    /// ([`super::views::CubeViews::within`]); where it does not, the design runs again in full at
+    /// the finest level. Its maps stay on screen meanwhile.
     pub finest_only: Vec<bool>,
     /// Decimation factors, e.g. `[4, 1]` for a preview then full resolution.
     pub decimations: Vec<usize>,
@@ -354,10 +356,17 @@ fn worker(requests: &Mailbox<Request>, link: &Link<'_>, pause: &PreviewPause, po
             if level == 1 && started {
                 pause_after_preview(pause, latest, request.generation);
             }
-            for (index, base) in request.configs.iter().enumerate() {
-                let Some(base) = base else { continue };
-                let finest = level + 1 == request.decimations.len();
-                if failed[index] || (!finest && request.finest_only.get(index).copied().unwrap_or(false)) {
+            // The designs asked at the finest level only come after the others there: a new
+            // design's result is not kept waiting behind the cuts of the ones on screen.
+            let finest = level + 1 == request.decimations.len();
+            let only_finest = |i: &usize| request.finest_only.get(*i).copied().unwrap_or(false);
+            let order: Vec<usize> = (0..request.configs.len())
+                .filter(|i| !only_finest(i))
+                .chain((0..request.configs.len()).filter(|i| finest && only_finest(i)))
+                .collect();
+            for index in order {
+                let Some(base) = &request.configs[index] else { continue };
+                if failed[index] {
                     continue;
                 }
                 if latest.load(Ordering::SeqCst) != request.generation {

@@ -255,8 +255,8 @@ fn a_design_asked_at_the_finest_level_only_skips_the_previews() {
             seen.push((index, decimation));
         }
     }
-    // A runs once, at full resolution, in its place among the finest runs; B at every level.
-    assert_eq!(seen, vec![(1, 4), (1, 2), (0, 1), (1, 1)]);
+    // A runs once, at full resolution, after B's; B at every level.
+    assert_eq!(seen, vec![(1, 4), (1, 2), (1, 1), (0, 1)]);
     // And nothing else: the worker is idle after them.
     std::thread::sleep(Duration::from_millis(200));
     assert_eq!(handle.stats().results_sent, 4);

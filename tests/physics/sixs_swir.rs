@@ -233,9 +233,9 @@ fn swir_atmosphere_with_6svs_aerosol_tables_matches_6sv() {
     };
     let nm = |r: &Compared| r.label.split(' ').nth(1).and_then(|w| w.strip_suffix("nm")).and_then(|w| w.parse().ok());
     let at = |w: f64| move |r: &Compared| nm(r) == Some(w);
-    // Aerosol depth at 6SV's own wavelengths (1240, 1650, 2250 nm): the same tables, measured
-    // within 0.01 %; the bound is the table's 7 significant digits and our log-log
-    // interpolation at 865 nm (6SV's node is 860 nm).
+    // Aerosol depth at 6SV's own wavelengths (1240, 1650, 2250 nm): the same tables, so this
+    // checks the wiring (the model reaches the column, AOT(550) scales it); measured within
+    // 0.01 %, the bound the tables' 7 significant digits.
     for w in [1240.0, 1650.0, 2250.0] {
         let (e, at) = worst("tau_aerosol", &at(w));
         assert!(e < 0.05, "aerosol depth at 6SV's {w} nm: {e:.3} % at {at}");

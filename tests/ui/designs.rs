@@ -226,7 +226,7 @@ fn eight_designs_complete_at_preview_and_the_app_says_what_they_plan_to_hold() {
 }
 
 #[test]
-fn a_fifth_design_cuts_the_views_of_those_already_shown_without_running_them_again() {
+fn more_designs_cut_the_views_of_those_already_shown_without_running_them_again() {
     use shoal::app::model::Slot;
     use shoal::engine::StageStatus;
     use shoal::engine::footprint::Footprint;
@@ -240,18 +240,39 @@ fn a_fifth_design_cuts_the_views_of_those_already_shown_without_running_them_aga
     let before = runs(&h);
     let views = |r: &RunOutput| r.views.as_ref().expect("views").clone();
     assert_eq!((views(&before[0]).stride, views(&before[0]).bytes()), (2, 175_104_000));
-    // Three small designs more: five share the views' budget, 153.6 MiB each.
-    for k in 0..3 {
+    let add = |h: &mut Harness<'static, ShoalApp>, k: usize| {
         let mut spec = InstrumentSpec::preset("nominal").unwrap();
         (spec.detectors, spec.lines) = (48, 40 + k);
         let app = h.state_mut();
         let moved = app.state.add_design(Slot::new("nominal", spec)).expect("room for a design");
         app.link.remap(&moved);
+    };
+    // Two small designs: four share the views' budget, 192 MiB each, as two did.
+    add(&mut h, 0);
+    add(&mut h, 1);
+    wait_for_engine(&mut h);
+    let four = runs(&h);
+    assert!(Arc::ptr_eq(&four[0], &before[0]) && Arc::ptr_eq(&four[1], &before[1]), "A and B kept as they were");
+    // A fifth (153.6 MiB each), and at once a sixth (128 MiB each), likely before A's and B's
+    // cuts for five have come back: they stay on screen, current, throughout.
+    add(&mut h, 2);
+    h.step();
+    add(&mut h, 3);
+    let start = std::time::Instant::now();
+    loop {
+        h.step();
+        let link = &h.state().link;
+        assert!(!link.stale(0) && !link.stale(1), "A or B went stale while its views were cut");
+        if !link.busy() && (0..6).all(|i| !link.stale(i)) {
+            break;
+        }
+        assert!(start.elapsed() < std::time::Duration::from_secs(600), "the engine did not finish");
+        std::thread::sleep(std::time::Duration::from_millis(20));
     }
     wait_for_engine(&mut h);
     let after = runs(&h);
-    assert_eq!(after.len(), 5);
-    let share = view_bytes_per_run(5);
+    assert_eq!(after.len(), 6);
+    let share = view_bytes_per_run(6);
     // A and B (the SmallSat's views are 174 MB) keep every 4th pixel now (every 3rd cannot be
     // cut from every 2nd), their products the very ones they had: restarted from their kept
     // Rrs, nothing before ran again, and their retrievals came from the cache.
@@ -267,6 +288,7 @@ fn a_fifth_design_cuts_the_views_of_those_already_shown_without_running_them_aga
     }
     // The small designs keep every pixel.
     assert!(after[2..].iter().all(|r| views(r).stride == 1));
+    assert!(Arc::ptr_eq(&after[2], &four[2]) && Arc::ptr_eq(&after[3], &four[3]), "C and D were not run again");
     let held: usize = after.iter().map(|r| views(r).bytes()).sum();
     assert!(after.iter().all(|r| views(r).bytes() <= share));
     assert!(held <= ALL_VIEW_BYTES, "{held} bytes of views");
