@@ -95,6 +95,9 @@ pub struct EngineLink {
     /// views to a smaller share (a design was added); it counts as kept until that run comes
     /// back, so a later submission asks for the cut again rather than for a new preview.
     recut: Vec<bool>,
+    /// Per design: the engine kept no Rrs to cut its views from ([`Event::Kept`]): it keeps its
+    /// larger views until its configuration changes, rather than running again in full.
+    recut_declined: Vec<bool>,
     /// The designs moved since the last submission: submit even if the configurations read the
     /// same (the runs in flight report by their old positions).
     moved: bool,
@@ -122,6 +125,7 @@ impl EngineLink {
             progress: None,
             finished: Vec::new(),
             recut: Vec::new(),
+            recut_declined: Vec::new(),
             moved: false,
             last_latency_s: None,
             latency_pending: false,
@@ -234,8 +238,14 @@ impl EngineLink {
         let finest_only: Vec<bool> = keep
             .iter()
             .zip(&self.shown)
-            .map(|(kept, shown)| *kept && shown.as_ref().is_some_and(|s| views_bytes(&s.output) > share))
+            .enumerate()
+            .map(|(i, (kept, shown))| {
+                *kept
+                    && !self.recut_declined.get(i).copied().unwrap_or(false)
+                    && shown.as_ref().is_some_and(|s| views_bytes(&s.output) > share)
+            })
             .collect();
+        self.recut_declined = (0..n).map(|i| keep[i] && self.recut_declined.get(i).copied().unwrap_or(false)).collect();
         for (i, recut) in finest_only.iter().enumerate() {
             if *recut {
                 self.finished[i] = false;
@@ -259,6 +269,14 @@ impl EngineLink {
             match event {
                 Event::Progress { index, decimation, done, total, stage, .. } => {
                     self.progress = Some(Progress { index, decimation, done, total, stage });
+                }
+                Event::Kept { index, .. } => {
+                    if index < self.shown.len() {
+                        (self.finished[index], self.recut[index], self.recut_declined[index]) = (true, false, true);
+                    }
+                    if self.finished.iter().all(|f| *f) {
+                        self.progress = None;
+                    }
                 }
                 Event::Finished { generation, index, decimation, result } => {
                     let finest = self.decimations.last().copied().unwrap_or(1);
@@ -342,6 +360,7 @@ impl EngineLink {
         let mut errors = vec![None; n];
         let mut finished = vec![false; n];
         let mut recut = vec![false; n];
+        let mut declined = vec![false; n];
         let mut submitted: Vec<Option<RunConfig>> = vec![None; n];
         for (old, new) in moved.iter().enumerate() {
             let taken = self.shown.get_mut(old).and_then(Option::take);
@@ -351,6 +370,7 @@ impl EngineLink {
                     errors[*k] = self.errors.get_mut(old).and_then(Option::take);
                     finished[*k] = self.finished.get(old).copied().unwrap_or(false);
                     recut[*k] = self.recut.get(old).copied().unwrap_or(false);
+                    declined[*k] = self.recut_declined.get(old).copied().unwrap_or(false);
                     submitted[*k] = self.submitted.get(old).cloned().flatten();
                 }
                 None => {
@@ -360,7 +380,8 @@ impl EngineLink {
                 }
             }
         }
-        (self.shown, self.errors, self.finished, self.recut) = (shown, errors, finished, recut);
+        (self.shown, self.errors, self.finished, self.recut, self.recut_declined) =
+            (shown, errors, finished, recut, declined);
         // A design with no submitted configuration (none was moved into its place) runs anew;
         // the others keep theirs (an undone removal runs the design that came back, only).
         self.submitted = submitted;

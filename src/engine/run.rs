@@ -223,6 +223,25 @@ impl Engine {
         self.run_with(config, control, &[])
     }
 
+    /// The run of `config` from its kept Rrs and [`super::restart`]'s record alone, or `None`
+    /// where this engine keeps none for it (nothing before the retrievals is computed: what the
+    /// app asks for a design on screen whose views it cuts to a smaller share).
+    pub fn run_restart_only(
+        &mut self,
+        config: &RunConfig,
+        control: &RunControl,
+    ) -> Result<Option<RunOutput>, EngineError> {
+        let start = Instant::now();
+        self.cache.begin_run();
+        self.fault = config.fault;
+        config.validate_keeping(self.keep_cubes)?;
+        let flown = config.flown();
+        let mut report = report_for(&flown);
+        let side = self.scene_side(&flown, control, &mut report)?;
+        let Some(key) = self.restart_key(&flown, &side) else { return Ok(None) };
+        self.run_from_rrs(key, &flown, &side, &report, control, start).transpose()
+    }
+
     /// [`Self::run`], keeping the Level-1 radiance and the corrected Rrs of the pixels `probes`
     /// name ([`RunOutput::probes`]), whether or not the run keeps its cubes.
     pub fn run_with(
@@ -239,12 +258,7 @@ impl Engine {
         // simulates and the output reports.
         let flown = config.flown();
         let config: &RunConfig = &flown;
-        let mut report = RunReport {
-            scene: config.scene.name.clone(),
-            instrument: config.instrument.name.clone(),
-            decimation: config.fidelity.decimation,
-            ..RunReport::default()
-        };
+        let mut report = report_for(config);
         let side = self.scene_side(config, control, &mut report)?;
         // A run that differs from a kept one only in its retrievals restarts at them.
         let restart_key = self.restart_key(config, &side);
@@ -349,5 +363,15 @@ impl Engine {
             probes: probed,
             report,
         })
+    }
+}
+
+/// A run's report before its stages: what it runs.
+fn report_for(config: &RunConfig) -> RunReport {
+    RunReport {
+        scene: config.scene.name.clone(),
+        instrument: config.instrument.name.clone(),
+        decimation: config.fidelity.decimation,
+        ..RunReport::default()
     }
 }

@@ -28,12 +28,12 @@ pub struct Request {
     /// The configurations; `None` at an index the caller already holds a final result for
     /// (unchanged since its previous request): nothing is run or reported for it.
     pub configs: Vec<Option<RunConfig>>,
-    /// Per configuration (missing: false): run it at the finest decimation only, after the
+    /// Per configuration (missing: false): restart it at the finest decimation only, after the
     /// others there. The app asks so for a design whose final result is shown but whose views
     /// are larger than its share of the request's designs: where the cache still holds its Rrs
     /// the run restarts from it and hands back the views cut to the share
-    /// ([`super::views::CubeViews::within`]); where it does not, the design runs again in full at
-    /// the finest level. Its maps stay on screen meanwhile.
+    /// ([`super::views::CubeViews::within`]); where it does not, the design is not run
+    /// ([`Event::Kept`]). Its maps stay on screen meanwhile.
     pub finest_only: Vec<bool>,
     /// Decimation factors, e.g. `[4, 1]` for a preview then full resolution.
     pub decimations: Vec<usize>,
@@ -56,6 +56,15 @@ pub enum Event {
         total: u64,
         /// The stage computing now and its own rows.
         stage: Option<crate::control::StageProgress>,
+    },
+    /// A design asked at the finest level only ([`Request::finest_only`]) was not run: the
+    /// engine keeps no Rrs to restart it from, and running it again in full would cost more than
+    /// its larger views do. Its result on screen stays as it is.
+    Kept {
+        /// Generation.
+        generation: u64,
+        /// Which configuration of the request.
+        index: usize,
     },
     /// A run finished (or failed).
     Finished {
@@ -233,7 +242,7 @@ impl EngineHandle {
     fn current(&self, event: Event) -> Option<Event> {
         let (generation, finished) = match &event {
             Event::Progress { generation, .. } => (*generation, false),
-            Event::Finished { generation, .. } => (*generation, true),
+            Event::Finished { generation, .. } | Event::Kept { generation, .. } => (*generation, true),
         };
         if generation == self.latest_generation() {
             return Some(event);
@@ -381,8 +390,13 @@ fn worker(requests: &Mailbox<Request>, link: &Link<'_>, pause: &PreviewPause, po
                 // Room for a large run: the run's working set and the cache together stay within
                 // [`APP_RUN_ENVELOPE_BYTES`] (the spectrograph's or a 10 m imager's run empties the
                 // cache; a CubeSat's leaves it 1.9 GiB).
-                let working = super::resources::run_demand_keeping(&config, false).bytes() as usize;
-                engine.set_cache_budget(cache_bytes.min(APP_RUN_ENVELOPE_BYTES.saturating_sub(working)));
+                // A design asked at the finest level only restarts from what the cache keeps, or
+                // is not run: the cache is left as it is for it.
+                let only_restart = only_finest(&index);
+                if !only_restart {
+                    let working = super::resources::run_demand_keeping(&config, false).bytes() as usize;
+                    engine.set_cache_budget(cache_bytes.min(APP_RUN_ENVELOPE_BYTES.saturating_sub(working)));
+                }
                 let control = Arc::new(RunControl::for_generation(latest.clone(), request.generation));
                 let generation = request.generation;
                 let report = |c: &RunControl| {
@@ -396,7 +410,13 @@ fn worker(requests: &Mailbox<Request>, link: &Link<'_>, pause: &PreviewPause, po
                     }
                 };
                 let result = crate::control::observed(&control, Duration::from_millis(50), report, || {
-                    pool.install(|| engine.run(&config, &control))
+                    pool.install(|| {
+                        if only_restart {
+                            engine.run_restart_only(&config, &control)
+                        } else {
+                            engine.run(&config, &control).map(Some)
+                        }
+                    })
                 });
                 counters.max_cached_products.fetch_max(engine.cached_products() as u64, Ordering::SeqCst);
                 if matches!(result, Err(EngineError::Cancelled)) {
@@ -405,10 +425,14 @@ fn worker(requests: &Mailbox<Request>, link: &Link<'_>, pause: &PreviewPause, po
                     break 'decimations;
                 }
                 failed[index] = result.is_err();
+                let event = match result {
+                    Ok(None) => Event::Kept { generation, index },
+                    Ok(Some(output)) => Event::Finished { generation, index, decimation, result: Ok(Arc::new(output)) },
+                    Err(e) => Event::Finished { generation, index, decimation, result: Err(e) },
+                };
                 // Counted before it is sent, so a reader that has the event sees it counted.
                 counters.results_sent.fetch_add(1, Ordering::SeqCst);
-                if events.send(Event::Finished { generation, index, decimation, result: result.map(Arc::new) }).is_err()
-                {
+                if events.send(event).is_err() {
                     return;
                 }
                 wake();

@@ -20,7 +20,7 @@ fn finished(handle: &EngineHandle, timeout: Duration) -> Vec<(u64, usize, bool)>
                     break;
                 }
             }
-            Some(Event::Progress { .. }) | None => {}
+            Some(Event::Progress { .. } | Event::Kept { .. }) | None => {}
         }
     }
     out
@@ -157,7 +157,9 @@ fn a_failed_run_is_reported_and_the_worker_survives() {
                 break;
             }
             Some(Event::Finished { result: Ok(_), .. }) => panic!("a zero aperture was accepted"),
-            Some(Event::Progress { .. }) | None => assert!(Instant::now() < deadline, "no answer from the worker"),
+            Some(Event::Progress { .. } | Event::Kept { .. }) | None => {
+                assert!(Instant::now() < deadline, "no answer from the worker")
+            }
         }
     }
     let good = RunConfig::new(small_lake(), small("nominal", 16, 16));
@@ -235,29 +237,42 @@ fn after_a_preview_the_engine_waits_until_it_is_on_screen() {
 }
 
 #[test]
-fn a_design_asked_at_the_finest_level_only_skips_the_previews() {
+fn a_design_asked_at_the_finest_level_only_restarts_from_its_rrs_or_is_kept() {
     let handle = EngineHandle::spawn(1).unwrap();
     let a = RunConfig::new(small_lake(), small("nominal", 24, 24));
     let mut b = a.clone();
     b.instrument.gain_e_per_dn = 2.5;
-    let request = |generation, finest_only| Request {
+    let mut c = a.clone();
+    c.instrument.read_noise_e = 20.0;
+    let request = |generation, configs: Vec<&RunConfig>, finest_only| Request {
         generation,
-        configs: vec![Some(a.clone()), Some(b.clone())],
+        configs: configs.into_iter().cloned().map(Some).collect(),
         finest_only,
         decimations: vec![4, 2, 1],
     };
-    assert!(handle.submit(request(1, vec![true, false])));
-    let mut seen = Vec::new();
-    let deadline = Instant::now() + Duration::from_secs(120);
-    while seen.len() < 4 && Instant::now() < deadline {
-        if let Some(Event::Finished { index, decimation, result, .. }) = handle.wait(Duration::from_millis(100)) {
-            assert!(result.is_ok());
-            seen.push((index, decimation));
+    // What the worker reports, (index, decimation) or (index, 0) for a design kept as it is.
+    let events = |n: usize| {
+        let mut seen = Vec::new();
+        let deadline = Instant::now() + Duration::from_secs(120);
+        while seen.len() < n && Instant::now() < deadline {
+            match handle.wait(Duration::from_millis(100)) {
+                Some(Event::Finished { index, decimation, result, .. }) => {
+                    assert!(result.is_ok());
+                    seen.push((index, decimation));
+                }
+                Some(Event::Kept { index, .. }) => seen.push((index, 0)),
+                Some(Event::Progress { .. }) | None => {}
+            }
         }
-    }
-    // A runs once, at full resolution, after B's; B at every level.
-    assert_eq!(seen, vec![(1, 4), (1, 2), (1, 1), (0, 1)]);
+        seen
+    };
+    assert!(handle.submit(request(1, vec![&a], vec![])));
+    assert_eq!(events(3), vec![(0, 4), (0, 2), (0, 1)]);
+    // A again at the finest level only, beside a new B: B at every level, then A, restarted
+    // from the Rrs its first run left; C, never run, is not run but kept as it is.
+    assert!(handle.submit(request(2, vec![&a, &b, &c], vec![true, false, true])));
+    assert_eq!(events(5), vec![(1, 4), (1, 2), (1, 1), (0, 1), (2, 0)]);
     // And nothing else: the worker is idle after them.
     std::thread::sleep(Duration::from_millis(200));
-    assert_eq!(handle.stats().results_sent, 4);
+    assert_eq!(handle.stats().results_sent, 3 + 5);
 }

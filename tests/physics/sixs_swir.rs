@@ -110,18 +110,26 @@ fn compare(sixs_tables: bool) -> Vec<Compared> {
     out
 }
 
+/// The largest |error| in % of `quantity` over the rows `keep` accepts, and where.
+fn worst_of(rows: &[Compared], quantity: &str, keep: &dyn Fn(&Compared) -> bool) -> (f64, String) {
+    rows.iter()
+        .filter(|r| r.quantity == quantity && keep(r))
+        .map(|r| (r.error_pct().abs(), format!("{}: shoal {:.5} 6SV {:.5}", r.label, r.shoal, r.sixs)))
+        .fold((0.0, String::new()), |a, b| if b.0 > a.0 { b } else { a })
+}
+
+/// The rows of `quantities` as a Markdown table body (stderr, for the record).
+fn print_rows(rows: &[Compared], quantities: &[&str]) {
+    for r in rows.iter().filter(|r| quantities.is_empty() || quantities.contains(&r.quantity)) {
+        eprintln!("| {} | {} | {:.5} | {:.5} | {:+.2} % |", r.label, r.quantity, r.shoal, r.sixs, r.error_pct());
+    }
+}
+
 #[test]
 fn swir_atmosphere_matches_6sv() {
     let rows = compare(false);
-    for r in &rows {
-        eprintln!("| {} | {} | {:.5} | {:.5} | {:+.2} % |", r.label, r.quantity, r.shoal, r.sixs, r.error_pct());
-    }
-    let worst = |quantity: &str, keep: &dyn Fn(&Compared) -> bool| {
-        rows.iter()
-            .filter(|r| r.quantity == quantity && keep(r))
-            .map(|r| (r.error_pct().abs(), format!("{}: shoal {:.5} 6SV {:.5}", r.label, r.shoal, r.sixs)))
-            .fold((0.0, String::new()), |a, b| if b.0 > a.0 { b } else { a })
-    };
+    print_rows(&rows, &[]);
+    let worst = |quantity: &str, keep: &dyn Fn(&Compared) -> bool| worst_of(&rows, quantity, keep);
     let sea_level = |r: &Compared| !r.label.starts_with('C');
     let swir_nm =
         |r: &Compared| r.label.split(' ').nth(1).and_then(|w| w.strip_suffix("nm")).and_then(|w| w.parse::<f64>().ok());
@@ -222,15 +230,8 @@ fn aerosol_models_in_the_swir_against_6sv_models() {
 #[test]
 fn swir_atmosphere_with_6svs_aerosol_tables_matches_6sv() {
     let rows = compare(true);
-    for r in rows.iter().filter(|r| r.quantity == "tau_aerosol" || r.quantity == "rho_path") {
-        eprintln!("| {} | {} | {:.5} | {:.5} | {:+.2} % |", r.label, r.quantity, r.shoal, r.sixs, r.error_pct());
-    }
-    let worst = |quantity: &str, keep: &dyn Fn(&Compared) -> bool| {
-        rows.iter()
-            .filter(|r| r.quantity == quantity && keep(r))
-            .map(|r| (r.error_pct().abs(), format!("{}: shoal {:.5} 6SV {:.5}", r.label, r.shoal, r.sixs)))
-            .fold((0.0, String::new()), |a, b| if b.0 > a.0 { b } else { a })
-    };
+    print_rows(&rows, &["tau_aerosol", "rho_path"]);
+    let worst = |quantity: &str, keep: &dyn Fn(&Compared) -> bool| worst_of(&rows, quantity, keep);
     let nm = |r: &Compared| r.label.split(' ').nth(1).and_then(|w| w.strip_suffix("nm")).and_then(|w| w.parse().ok());
     let at = |w: f64| move |r: &Compared| nm(r) == Some(w);
     // Aerosol depth at 6SV's own wavelengths (1240, 1650, 2250 nm): the same tables, so this
