@@ -180,14 +180,20 @@ fn within_table(wavelength_nm: f64) -> Result<(), AtmosphereError> {
     })
 }
 
-/// Optics tabulated at [`TABLE_WAVELENGTHS_NM`] (`rows`), at `wavelength_nm` within the table:
-/// cross-sections log–log in λ, phase functions linearly.
+/// Optics tabulated at [`TABLE_WAVELENGTHS_NM`] (`rows`), at `wavelength_nm` within the table.
 fn interpolate(rows: &[ComponentOptics], wavelength_nm: f64) -> ComponentOptics {
-    let j = TABLE_WAVELENGTHS_NM.partition_point(|&w| w <= wavelength_nm).clamp(1, TABLE_WAVELENGTHS_NM.len() - 1);
-    let (w0, w1) = (TABLE_WAVELENGTHS_NM[j - 1], TABLE_WAVELENGTHS_NM[j]);
+    interpolate_on(&TABLE_WAVELENGTHS_NM, rows, wavelength_nm)
+}
+
+/// Optics tabulated at the rising wavelengths `grid` (`rows`), at `wavelength_nm`:
+/// cross-sections log–log in λ (the end interval's power law beyond the grid), phase functions
+/// linearly (the end row's beyond it).
+pub(super) fn interpolate_on(grid: &[f64], rows: &[ComponentOptics], wavelength_nm: f64) -> ComponentOptics {
+    let j = grid.partition_point(|&w| w <= wavelength_nm).clamp(1, grid.len() - 1);
+    let (w0, w1) = (grid[j - 1], grid[j]);
     let (a, b) = (&rows[j - 1], &rows[j]);
     let t_log = (wavelength_nm / w0).ln() / (w1 / w0).ln();
-    let t = (wavelength_nm - w0) / (w1 - w0);
+    let t = ((wavelength_nm - w0) / (w1 - w0)).clamp(0.0, 1.0);
     let loglog = |x: f64, y: f64| (x.ln() + t_log * (y.ln() - x.ln())).exp();
     ComponentOptics {
         c_ext_um2: loglog(a.c_ext_um2, b.c_ext_um2),
@@ -234,22 +240,38 @@ pub fn mixture_optics(kind: AerosolType, wavelength_nm: f64) -> Result<Option<Ae
             .collect::<Result<_, AtmosphereError>>()?,
     };
     within_table(wavelength_nm)?;
-    let k_ext = |w: f64| -> f64 { parts.iter().map(|(rows, n)| n * interpolate(rows, w).c_ext_um2).sum() };
-    let (mut k_sca, mut p) = (0.0, vec![0.0; table.angles_deg().len()]);
-    for (rows, n) in &parts {
-        let o = interpolate(rows, wavelength_nm);
+    mix(&parts, &TABLE_WAVELENGTHS_NM, table.angles_deg(), wavelength_nm).map(Some)
+}
+
+/// The optics of a mixture at `wavelength_nm`: `parts` are each component's optics at the
+/// wavelengths `grid` (P at `angles_deg`) and its number fraction Nᵢ; K = Σ Nᵢ Cᵢ,
+/// P = Σ Nᵢ C_sca,ᵢ Pᵢ / K_sca, and the extinction relative to 550 nm (OSOAA_MAIN.F; 6SV's
+/// AEROSO.f mixes the same way).
+pub(super) fn mix(
+    parts: &[(&[ComponentOptics], f64)],
+    grid: &[f64],
+    angles_deg: &[f64],
+    wavelength_nm: f64,
+) -> Result<AerosolOptics, AtmosphereError> {
+    let k_ext = |w: f64| -> f64 { parts.iter().map(|(rows, n)| n * interpolate_on(grid, rows, w).c_ext_um2).sum() };
+    let (mut k_sca, mut p) = (0.0, vec![0.0; angles_deg.len()]);
+    for (rows, n) in parts {
+        let o = interpolate_on(grid, rows, wavelength_nm);
         k_sca += n * o.c_sca_um2;
         for (pi, v) in p.iter_mut().zip(&o.p11) {
             *pi += n * o.c_sca_um2 * v;
         }
     }
+    if !(k_sca > 0.0) {
+        return Err(AtmosphereError::Data("aerosol: a mixture with no scattering".into()));
+    }
     for v in &mut p {
         *v /= k_sca;
     }
     let ext = k_ext(wavelength_nm);
-    Ok(Some(AerosolOptics {
+    Ok(AerosolOptics {
         extinction_ratio: ext / k_ext(550.0),
         ssa: k_sca / ext,
-        phase: PhaseFunction::from_table(table.angles_deg(), &p)?,
-    }))
+        phase: PhaseFunction::from_table(angles_deg, &p)?,
+    })
 }

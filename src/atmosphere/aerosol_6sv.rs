@@ -20,8 +20,7 @@
 use std::sync::OnceLock;
 
 use super::AtmosphereError;
-use super::aerosol::AerosolOptics;
-use super::phase::PhaseFunction;
+use super::aerosol::{AerosolOptics, ComponentOptics, mix};
 use super::wmo::Component;
 use crate::spectral::Table;
 
@@ -54,23 +53,14 @@ pub fn sixs_volume(c: Component) -> f64 {
 /// Points of 6SV's phase-function quadrature (`nqdef_p`).
 const ANGLES: usize = 83;
 
-/// One component at one of 6SV's wavelengths.
-#[derive(Debug, Clone, PartialEq)]
-struct Row {
-    /// Extinction coefficient, 6SV's units (only ratios enter a mixture).
-    ext: f64,
-    /// Scattering coefficient, the same units.
-    sca: f64,
-    /// P at the table's angles, rising from 0 to 180°.
-    p: Vec<f64>,
-}
-
 /// The parsed table: per component, its rows at [`SIXS_WAVELENGTHS_NM`] and 6SV's volume per
-/// particle vᵢ.
+/// particle vᵢ. A row's "cross-sections" are 6SV's extinction and scattering coefficients:
+/// proportional to the component's per-particle cross-sections by one factor for all four, the
+/// only thing a mixture's ratios read.
 #[derive(Debug)]
 pub struct SixsTable {
     angles_deg: Vec<f64>,
-    components: Vec<(Component, Vec<Row>, f64)>,
+    components: Vec<(Component, Vec<ComponentOptics>, f64)>,
 }
 
 /// 6SV's quadrature angles, degrees, rising from 0 to 180 (the table's `p_83` down to `p_1`).
@@ -107,7 +97,11 @@ impl SixsTable {
                     .ok_or_else(|| AtmosphereError::Data(format!("{SIXS_ASSET}: no row for {} at {w} nm", c.key())))?;
                 volume = vi[i];
                 // The file runs from μ = −1 (180°) to μ = 1 (0°); the rows rise in angle.
-                rows.push(Row { ext: ext[i], sca: sca[i], p: p.iter().rev().map(|col| col[i]).collect() });
+                rows.push(ComponentOptics {
+                    c_ext_um2: ext[i],
+                    c_sca_um2: sca[i],
+                    p11: p.iter().rev().map(|col| col[i]).collect(),
+                });
             }
             components.push((c, rows, volume));
         }
@@ -135,49 +129,13 @@ impl SixsTable {
                 allowed: format!("{lo} to {hi} nm"),
             });
         }
-        let parts: Vec<(&[Row], f64)> = number_fractions
+        let parts: Vec<(&[ComponentOptics], f64)> = number_fractions
             .iter()
             .filter_map(|(c, n)| {
                 self.components.iter().find(|(k, ..)| k == c).map(|(_, rows, _)| (rows.as_slice(), *n))
             })
             .collect();
-        let k_ext = |w: f64| -> f64 { parts.iter().map(|(rows, n)| n * interpolate(rows, w).ext).sum() };
-        let (mut k_sca, mut p) = (0.0, vec![0.0; ANGLES]);
-        for (rows, n) in &parts {
-            let o = interpolate(rows, wavelength_nm);
-            k_sca += n * o.sca;
-            for (pi, v) in p.iter_mut().zip(&o.p) {
-                *pi += n * o.sca * v;
-            }
-        }
-        if !(k_sca > 0.0) {
-            return Err(AtmosphereError::Data("6SV aerosol: a mixture with no scattering".into()));
-        }
-        for v in &mut p {
-            *v /= k_sca;
-        }
-        let ext = k_ext(wavelength_nm);
-        Ok(AerosolOptics {
-            extinction_ratio: ext / k_ext(550.0),
-            ssa: k_sca / ext,
-            phase: PhaseFunction::from_table(&self.angles_deg, &p)?,
-        })
-    }
-}
-
-/// A component's row at `wavelength_nm`: coefficients log–log in λ (extended below the first
-/// wavelength), the phase function linearly (the first row's below it).
-fn interpolate(rows: &[Row], wavelength_nm: f64) -> Row {
-    let j = SIXS_WAVELENGTHS_NM.partition_point(|&w| w <= wavelength_nm).clamp(1, SIXS_WAVELENGTHS_NM.len() - 1);
-    let (w0, w1) = (SIXS_WAVELENGTHS_NM[j - 1], SIXS_WAVELENGTHS_NM[j]);
-    let (a, b) = (&rows[j - 1], &rows[j]);
-    let t_log = (wavelength_nm / w0).ln() / (w1 / w0).ln();
-    let t = ((wavelength_nm - w0) / (w1 - w0)).clamp(0.0, 1.0);
-    let loglog = |x: f64, y: f64| (x.ln() + t_log * (y.ln() - x.ln())).exp();
-    Row {
-        ext: loglog(a.ext, b.ext),
-        sca: loglog(a.sca, b.sca),
-        p: a.p.iter().zip(&b.p).map(|(x, y)| x + t * (y - x)).collect(),
+        mix(&parts, &SIXS_WAVELENGTHS_NM, &self.angles_deg, wavelength_nm)
     }
 }
 
@@ -198,9 +156,9 @@ mod tests {
             assert_eq!(t.volume(c), sixs_volume(c), "{c:?}");
         }
         let dust = &t.components[0].1[7];
-        assert_eq!((dust.ext, dust.sca), (8.519962, 6.215003));
+        assert_eq!((dust.c_ext_um2, dust.c_sca_um2), (8.519962, 6.215003));
         // P(180°) of the water-soluble component at 350 nm (WATE.f's first entry).
-        assert_eq!(t.components[1].1[0].p[82], 0.4078);
+        assert_eq!(t.components[1].1[0].p11[82], 0.4078);
     }
 }
 

@@ -223,6 +223,23 @@ impl Engine {
         self.run_with(config, control, &[])
     }
 
+    /// A run's start: its clock, the configuration as flown (on-board binning folded into its
+    /// pixels: what every stage simulates and the output reports), its report and its scene side.
+    fn begin<'c>(
+        &mut self,
+        config: &'c RunConfig,
+        control: &RunControl,
+    ) -> Result<(Instant, std::borrow::Cow<'c, RunConfig>, RunReport, super::products::SceneSide), EngineError> {
+        let start = Instant::now();
+        self.cache.begin_run();
+        self.fault = config.fault;
+        config.validate_keeping(self.keep_cubes)?;
+        let flown = config.flown();
+        let mut report = report_for(&flown);
+        let side = self.scene_side(&flown, control, &mut report)?;
+        Ok((start, flown, report, side))
+    }
+
     /// The run of `config` from its kept Rrs and [`super::restart`]'s record alone, or `None`
     /// where this engine keeps none for it (nothing before the retrievals is computed: what the
     /// app asks for a design on screen whose views it cuts to a smaller share).
@@ -231,13 +248,7 @@ impl Engine {
         config: &RunConfig,
         control: &RunControl,
     ) -> Result<Option<RunOutput>, EngineError> {
-        let start = Instant::now();
-        self.cache.begin_run();
-        self.fault = config.fault;
-        config.validate_keeping(self.keep_cubes)?;
-        let flown = config.flown();
-        let mut report = report_for(&flown);
-        let side = self.scene_side(&flown, control, &mut report)?;
+        let (start, flown, report, side) = self.begin(config, control)?;
         let Some(key) = self.restart_key(&flown, &side) else { return Ok(None) };
         self.run_from_rrs(key, &flown, &side, &report, control, start).transpose()
     }
@@ -250,16 +261,8 @@ impl Engine {
         control: &RunControl,
         probes: &[Probe],
     ) -> Result<RunOutput, EngineError> {
-        let start = Instant::now();
-        self.cache.begin_run();
-        self.fault = config.fault;
-        config.validate_keeping(self.keep_cubes)?;
-        // The instrument as flown (on-board binning folded into its pixels): what every stage
-        // simulates and the output reports.
-        let flown = config.flown();
+        let (start, flown, mut report, side) = self.begin(config, control)?;
         let config: &RunConfig = &flown;
-        let mut report = report_for(config);
-        let side = self.scene_side(config, control, &mut report)?;
         // A run that differs from a kept one only in its retrievals restarts at them.
         let restart_key = self.restart_key(config, &side);
         let scene_stages = report.stages.len();
