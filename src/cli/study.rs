@@ -304,6 +304,13 @@ fn print_runs(out: &mut String, result: &crate::study::StudyResult) {
                 if a.passes_mean > 1.0 { format!(", {:.1} passes", a.passes_mean) } else { String::new() }
             );
         }
+        if let Some(g) = &run.report.exact_high_glint {
+            let _ = writeln!(
+                out,
+                "{:<12} glint    {} of {} water pixels left out for high glint (L_GN > {} sr⁻¹ at the assumed wind {:.1} m/s)",
+                run.label, g.pixels, g.water_pixels, g.threshold_per_sr, g.assumed_wind_m_s
+            );
+        }
     }
 }
 

@@ -28,8 +28,9 @@
 //!   and atmosphere products. Appl. Opt. 40, 4790–4798 (the glint a processor takes away, from
 //!   the wind of ancillary data).
 
+use super::{Reflectance, RrsFlags};
 use crate::atmosphere::{Geometry, glint_radiance_norm};
-use crate::instrument::{BandAtmosphere, Response, Viewing};
+use crate::instrument::{BandAtmosphere, Response, SurfaceMap, Viewing};
 
 /// The band glint per column × band (the index of [`BandAtmosphere::glint`]) that a processor
 /// assuming `assumed_wind_m_s` expects over a scene whose glint `atmosphere` holds at
@@ -55,6 +56,40 @@ pub fn expected_glint(
         }
     }
     out
+}
+
+/// Per column: the normalised glint radiance L_GN = ρ_g·μ₀/π (sr⁻¹; Wang & Bailey 2001: the
+/// glint per unit solar flux, without the path's attenuation) that a processor assuming
+/// `wind_m_s` expects at the column's geometry over water of refractive index `n`, the largest
+/// over the geometry groups (a filter imager's rows see the ground from different angles). What
+/// l2gen compares with `glint_thresh` to set HIGLINT.
+#[must_use]
+pub fn column_lgn(viewing: &Viewing, wind_m_s: f64, n: f64) -> Vec<f64> {
+    let lgn = |g: &Geometry| {
+        glint_radiance_norm(g.sun_zenith_rad, g.view_zenith_rad, g.relative_azimuth_rad, wind_m_s, n, 0.0)
+    };
+    (0..viewing.columns())
+        .map(|c| viewing.looks.iter().filter_map(|g| g.get(c)).map(|l| lgn(&l.geometry)).fold(0.0, f64::max))
+        .collect()
+}
+
+/// Leave out the water pixels of the columns `high_glint` names, as a processor masks HIGLINT:
+/// every band flagged [`RrsFlags::GLINT`] and [`RrsFlags::INVALID`], its Rrs 0. Pixels that are
+/// not water in `surface` (land, or screened out as cloud) keep their flags. Returns the pixels
+/// left out.
+pub fn mark_high_glint(rrs: &mut Reflectance, high_glint: &dyn Fn(usize) -> bool, surface: &SurfaceMap) -> usize {
+    let (rows, cols, nb) = rrs.rrs.dim();
+    let mut marked = 0;
+    for c in (0..cols).filter(|&c| high_glint(c)) {
+        for r in (0..rows).filter(|&r| surface.is_water(r, c)) {
+            for b in 0..nb {
+                rrs.flags[[r, c, b]] |= RrsFlags::GLINT | RrsFlags::INVALID;
+                rrs.rrs[[r, c, b]] = 0.0;
+            }
+            marked += 1;
+        }
+    }
+    marked
 }
 
 /// ρ_g(g, W′)/ρ_g(g, W) (see the module docs): 0 where the scene's glint is zero.

@@ -202,22 +202,7 @@ impl AerosolFamily {
         // from different angles).
         let glint_lgn = match luts.surface {
             crate::atmosphere::SeaSurface::Wind { speed_m_s } if scene.wants(crate::scene::Effect::SunGlint) => {
-                // L_GN is the glint per unit solar flux without the path's attenuation (τ = 0).
-                let lgn = |g: &crate::atmosphere::Geometry| {
-                    crate::atmosphere::glint_radiance_norm(
-                        g.sun_zenith_rad,
-                        g.view_zenith_rad,
-                        g.relative_azimuth_rad,
-                        speed_m_s,
-                        scene.spec.atmosphere.water_refractive_index,
-                        0.0,
-                    )
-                };
-                (0..viewing.columns())
-                    .map(|c| {
-                        viewing.looks.iter().filter_map(|g| g.get(c)).map(|l| lgn(&l.geometry)).fold(0.0, f64::max)
-                    })
-                    .collect()
+                super::column_lgn(viewing, speed_m_s, scene.spec.atmosphere.water_refractive_index)
             }
             _ => Vec::new(),
         };

@@ -288,7 +288,7 @@ pub struct AerosolRetrieval {
     pub passes_mean: f64,
     /// Dark-spectrum fitting's tiles (empty for the band-pair fit).
     pub tiles: Vec<super::dark::TileFit>,
-    /// Pixels left out for high glint (L_GN above the threshold).
+    /// Water pixels left out for high glint (L_GN above the threshold).
     pub high_glint: usize,
     /// The expected glint was taken away (the scene has glint and the correction's `glint` is on).
     pub glint_removed: bool,
@@ -343,8 +343,9 @@ pub fn correct_image(
     };
     let high_glint =
         |col: usize| settings.glint && family.glint_lgn.get(col).is_some_and(|g| *g > settings.glint_threshold_per_sr);
-    let (rrs, mut retrieval) = correct_with(level1, family, settings, bands, surface, control, &high_glint)?;
-    retrieval.high_glint = (0..level1.radiance.dim().1).filter(|&c| high_glint(c)).count() * level1.radiance.dim().0;
+    let (mut rrs, mut retrieval) = correct_with(level1, family, settings, bands, surface, control, &high_glint)?;
+    // Left out already (invalid); flagged as glint too, so the flags say why.
+    retrieval.high_glint = super::mark_high_glint(&mut rrs, &high_glint, surface);
     retrieval.glint_removed = glint_removed;
     Ok((rrs, retrieval))
 }

@@ -37,11 +37,18 @@ pub struct CorrectionSpec {
     /// method and back) and written only then, so a file never holds it beside another method,
     /// which reading refuses.
     pub glint_wind_error_m_s: f64,
+    /// The exact correction's high-glint mask: leave out the water pixels whose normalised glint
+    /// L_GN = ρ_g·μ₀/π, expected from the wind it assumes, exceeds this, sr⁻¹ (l2gen's HIGLINT
+    /// with its `glint_thresh`, 0.005; Wang & Bailey 2001). `None`, the default: the paper's
+    /// perfect processor keeps every pixel. A season sets its own threshold here for the exact
+    /// correction, as the image-based correction has its own (`image.glint_threshold_per_sr`).
+    /// Read and written only with the exact method, as the wind error is.
+    pub glint_threshold_per_sr: Option<f64>,
 }
 
 impl Default for CorrectionSpec {
     fn default() -> Self {
-        Self { approx_points: 20, method: Method::Exact, glint_wind_error_m_s: 0.0 }
+        Self { approx_points: 20, method: Method::Exact, glint_wind_error_m_s: 0.0, glint_threshold_per_sr: None }
     }
 }
 
@@ -51,6 +58,13 @@ impl CorrectionSpec {
     #[must_use]
     pub fn exact_wind_error_m_s(&self) -> f64 {
         if self.method == Method::Exact { self.glint_wind_error_m_s } else { 0.0 }
+    }
+
+    /// The exact correction's high-glint threshold: [`Self::glint_threshold_per_sr`] when the
+    /// method is exact, else `None`.
+    #[must_use]
+    pub fn exact_glint_threshold_per_sr(&self) -> Option<f64> {
+        if self.method == Method::Exact { self.glint_threshold_per_sr } else { None }
     }
 
     /// The image-based correction's settings, when that is the method.
@@ -73,6 +87,9 @@ struct CorrectionFile {
     use_approximation: bool,
     image: Option<ImageCorrection>,
     glint_wind_error_m_s: f64,
+    // Written only when set, so that every file written before reads and writes as it did.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    glint_threshold_per_sr: Option<f64>,
 }
 
 impl Default for CorrectionFile {
@@ -91,6 +108,12 @@ impl TryFrom<CorrectionFile> for CorrectionSpec {
                         approximation none"
                 .into());
         }
+        if f.glint_threshold_per_sr.is_some() && (f.use_approximation || f.image.is_some()) {
+            return Err("correction.glint_threshold_per_sr: the exact correction's high-glint mask; the image-based \
+                        correction states its own (correction.image.glint_threshold_per_sr), the per-scene \
+                        approximation none"
+                .into());
+        }
         let method = match (f.use_approximation, f.image) {
             (false, None) => Method::Exact,
             (true, None) => Method::PerScene,
@@ -101,19 +124,25 @@ impl TryFrom<CorrectionFile> for CorrectionSpec {
                     .into());
             }
         };
-        Ok(Self { approx_points: f.approx_points, method, glint_wind_error_m_s: f.glint_wind_error_m_s })
+        Ok(Self {
+            approx_points: f.approx_points,
+            method,
+            glint_wind_error_m_s: f.glint_wind_error_m_s,
+            glint_threshold_per_sr: f.glint_threshold_per_sr,
+        })
     }
 }
 
 impl From<CorrectionSpec> for CorrectionFile {
     fn from(s: CorrectionSpec) -> Self {
         let glint_wind_error_m_s = s.exact_wind_error_m_s();
+        let glint_threshold_per_sr = s.exact_glint_threshold_per_sr();
         let (use_approximation, image) = match s.method {
             Method::Exact => (false, None),
             Method::PerScene => (true, None),
             Method::Image(i) => (false, Some(i)),
         };
-        Self { approx_points: s.approx_points, use_approximation, image, glint_wind_error_m_s }
+        Self { approx_points: s.approx_points, use_approximation, image, glint_wind_error_m_s, glint_threshold_per_sr }
     }
 }
 

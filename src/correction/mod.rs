@@ -38,7 +38,7 @@ pub use clouds::{CloudScreen, Sun, screen_image};
 pub use dark::DarkSpectrumSettings;
 pub use dark::TileFit;
 pub use difference::{BandDifference, compare};
-pub use expected_glint::expected_glint;
+pub use expected_glint::{column_lgn, expected_glint, mark_high_glint};
 pub use family::{AerosolFamily, FamilyLuts};
 pub use image::{AerosolFit, AerosolRetrieval, ImageCorrection, MISSION_PAIRS_NM, correct_image};
 pub use method::{CorrectionSpec, Method, PRESETS, Preset};
@@ -88,12 +88,16 @@ impl RrsFlags {
     pub const INVALID: u8 = 4;
     /// Left out by the processor's cloud screen (cloud or cloud shadow; with `INVALID`).
     pub const CLOUD: u8 = 8;
+    /// Left out for high glint: the normalised glint L_GN the processor expects from the wind
+    /// it assumes exceeds its threshold (l2gen's HIGLINT; with `INVALID`).
+    pub const GLINT: u8 = 16;
 }
 
 impl CorrectionSpec {
     /// Check `approx_points` against [`crate::ranges::CORRECTION_APPROX_POINTS`], the exact
-    /// correction's wind error against [`crate::ranges::CORRECTION_EXACT_GLINT_WIND_ERROR`] and
-    /// the image-based correction's settings.
+    /// correction's wind error against [`crate::ranges::CORRECTION_EXACT_GLINT_WIND_ERROR`], its
+    /// high-glint threshold against [`crate::ranges::CORRECTION_EXACT_GLINT_THRESHOLD`] and the
+    /// image-based correction's settings.
     pub fn validate(&self) -> Result<(), CorrectionError> {
         for (range, value) in [
             (&crate::ranges::CORRECTION_APPROX_POINTS, self.approx_points as f64),
@@ -101,6 +105,12 @@ impl CorrectionSpec {
         ] {
             range
                 .check(value)
+                .map_err(|message| CorrectionError::Invalid(FieldError { field: range.path.into(), message }))?;
+        }
+        if let Some(threshold) = self.glint_threshold_per_sr {
+            let range = &crate::ranges::CORRECTION_EXACT_GLINT_THRESHOLD;
+            range
+                .check(threshold)
                 .map_err(|message| CorrectionError::Invalid(FieldError { field: range.path.into(), message }))?;
         }
         if let Some(image) = self.image() {

@@ -65,23 +65,7 @@ impl Engine {
             };
             // Where the scene has clouds, the processor screens them and their shadows out: the
             // image-based correction with its own test, the exact one knowing them exactly.
-            let screen = match (&family, config.correction.image()) {
-                _ if config.scene.clouds.is_none() => None,
-                (Some((fam, _)), Some(settings)) => {
-                    let sun = crate::correction::Sun {
-                        zenith_rad: config.scene.sun.zenith_deg.to_radians(),
-                        azimuth_rad: config.scene.sun.azimuth_deg.to_radians(),
-                    };
-                    let rayleigh = fam.terms.first().and_then(|m| m.first()).ok_or_else(|| EngineError::Failed {
-                        stage: Stage::Correction,
-                        message: "the family has no members".into(),
-                    })?;
-                    let bands = &side.response.bands;
-                    let (viewing, clouds) = (&side.viewing, &settings.clouds);
-                    Some(screen_image(level1, rayleigh, bands, viewing, sun, clouds, &truth.surface).map_err(&fail)?)
-                }
-                _ => Some(truth.surface.exact_screen()),
-            };
+            let screen = cloud_screen(config, side, family.as_ref().map(|(f, _)| &**f), level1, truth)?;
             let screened = screen.as_ref().map(|s| truth.surface.as_screened(s));
             let surface = screened.as_ref().unwrap_or(&truth.surface);
             let image = match (&family, config.correction.image()) {
@@ -122,6 +106,7 @@ impl Engine {
                 (None, Some(a), Some(e), true) => compare(a, &e.rrs, Some(&e.flags)),
                 _ => Vec::new(),
             };
+            let image_ran = image.is_some();
             let (image, aerosol) = image.map_or((None, None), |(r, a)| (Some(r), Some(a)));
             let mut rrs = match (image, exact, approx) {
                 (Some(i), _, _) => i,
@@ -132,6 +117,9 @@ impl Engine {
                     return Err(EngineError::Failed { stage: Stage::Correction, message: "no correction ran".into() });
                 }
             };
+            // The image-based correction masks high glint itself.
+            let exact_high_glint =
+                if image_ran { None } else { mask_exact_high_glint(config, side, &mut rrs, surface) };
             if let Some(screen) = &screen {
                 mark_screened(&mut rrs, screen);
             }
@@ -145,8 +133,15 @@ impl Engine {
                 &names,
                 &side.response.bands.centres_nm(),
             );
-            let product =
-                CorrectionProduct { approximation, approximation_vs_exact, rrs_vs_truth, rrs_metrics, aerosol, family };
+            let product = CorrectionProduct {
+                approximation,
+                approximation_vs_exact,
+                rrs_vs_truth,
+                rrs_metrics,
+                aerosol,
+                family,
+                exact_high_glint,
+            };
             Ok(Corrected { rrs: Arc::new(rrs), product: Arc::new(product) })
         })?;
         let product = &correction.product;
@@ -163,6 +158,7 @@ impl Engine {
             )),
             _ => None,
         };
+        report.exact_high_glint = product.exact_high_glint;
         Ok((correction, correction_key))
     }
 
@@ -218,6 +214,59 @@ fn exact_glint(config: &RunConfig, side: &SceneSide) -> Option<Vec<f64>> {
     let winds = (speed_m_s, (speed_m_s + error).max(0.0));
     let n = config.scene.atmosphere.water_refractive_index;
     Some(crate::correction::expected_glint(&side.band_atmosphere, &side.viewing, &side.response, winds, n))
+}
+
+/// Where the scene has clouds, the pixels the processor screens out (clouds and their shadows):
+/// the image-based correction's own test with its family's Rayleigh member, the exact correction
+/// knowing them exactly. `None` without clouds.
+fn cloud_screen(
+    config: &RunConfig,
+    side: &SceneSide,
+    family: Option<&AerosolFamily>,
+    level1: &crate::calibration::Level1,
+    truth: &Truth,
+) -> Result<Option<ndarray::Array2<bool>>, EngineError> {
+    if config.scene.clouds.is_none() {
+        return Ok(None);
+    }
+    let (Some(fam), Some(settings)) = (family, config.correction.image()) else {
+        return Ok(Some(truth.surface.exact_screen()));
+    };
+    let sun = crate::correction::Sun {
+        zenith_rad: config.scene.sun.zenith_deg.to_radians(),
+        azimuth_rad: config.scene.sun.azimuth_deg.to_radians(),
+    };
+    let rayleigh = fam
+        .terms
+        .first()
+        .and_then(|m| m.first())
+        .ok_or_else(|| EngineError::Failed { stage: Stage::Correction, message: "the family has no members".into() })?;
+    let (bands, viewing, clouds) = (&side.response.bands, &side.viewing, &settings.clouds);
+    let screen = screen_image(level1, rayleigh, bands, viewing, sun, clouds, &truth.surface)
+        .map_err(failed(Stage::Correction))?;
+    Ok(Some(screen))
+}
+
+/// The exact correction's high-glint mask, where its threshold is set and the scene glints: the
+/// water pixels of the columns whose normalised glint L_GN, expected from the wind it assumes
+/// (the scene's plus its error, at least 0), exceeds the threshold are left out of `rrs`.
+fn mask_exact_high_glint(
+    config: &RunConfig,
+    side: &SceneSide,
+    rrs: &mut crate::correction::Reflectance,
+    surface: &crate::instrument::SurfaceMap,
+) -> Option<super::HighGlint> {
+    let threshold_per_sr = config.correction.exact_glint_threshold_per_sr()?;
+    let crate::atmosphere::SeaSurface::Wind { speed_m_s } = config.scene.atmosphere.surface else { return None };
+    if !side.scene.wants(crate::scene::Effect::SunGlint) {
+        return None;
+    }
+    let assumed_wind_m_s = (speed_m_s + config.correction.exact_wind_error_m_s()).max(0.0);
+    let n = config.scene.atmosphere.water_refractive_index;
+    let lgn = crate::correction::column_lgn(&side.viewing, assumed_wind_m_s, n);
+    let high = |c: usize| lgn.get(c).is_some_and(|g| *g > threshold_per_sr);
+    let pixels = crate::correction::mark_high_glint(rrs, &high, surface);
+    Some(super::HighGlint { pixels, water_pixels: surface.water_count(), threshold_per_sr, assumed_wind_m_s })
 }
 
 /// Flag every band of the pixels the cloud screen left out (`screen` true) as cloud.

@@ -67,7 +67,7 @@ pub use fault::{Fault, FaultKind};
 pub use lut_axes::lut_axes_covering;
 pub use probe::{Probe, Probed};
 pub use products::{CorrectionProduct, Cubes, RetrievalOutput, RunOutput};
-pub use report::{AerosolSummary, RunReport, StageReport, StageStatus};
+pub use report::{AerosolSummary, HighGlint, RunReport, StageReport, StageStatus};
 pub use run::{APP_LEVELS, Engine, LEAN_CACHE_BYTES};
 pub use views::{CubeViews, VIEW_BYTES, ViewOf};
 

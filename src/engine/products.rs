@@ -45,6 +45,8 @@ pub struct CorrectionProduct {
     pub aerosol: Option<crate::correction::AerosolRetrieval>,
     /// The image-based correction's aerosol family, when it ran.
     pub family: Option<Arc<crate::correction::AerosolFamily>>,
+    /// The exact correction's high-glint mask, where it has a threshold and the scene glints.
+    pub exact_high_glint: Option<super::HighGlint>,
 }
 
 /// The full-resolution cubes of a run: what `shoal simulate` and a study with cubes write, and

@@ -77,6 +77,19 @@ pub struct AerosolSummary {
     pub fit: String,
 }
 
+/// Water pixels the exact correction left out for high glint (its `glint_threshold_per_sr`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct HighGlint {
+    /// Water pixels left out.
+    pub pixels: usize,
+    /// Water pixels corrected (left out or not).
+    pub water_pixels: usize,
+    /// The threshold, sr⁻¹.
+    pub threshold_per_sr: f64,
+    /// The wind the processor assumed, m/s.
+    pub assumed_wind_m_s: f64,
+}
+
 /// The report of one run.
 #[derive(Debug, Clone, PartialEq, Serialize, Default)]
 pub struct RunReport {
@@ -120,6 +133,9 @@ pub struct RunReport {
     pub rrs_vs_truth: Vec<BandDifference>,
     /// What the image-based correction retrieved of the aerosol, against the scene's.
     pub aerosol: Option<AerosolSummary>,
+    /// The exact correction's high-glint mask, where it has a threshold and the scene glints.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub exact_high_glint: Option<HighGlint>,
     /// Line period and exposure, s.
     pub line_period_s: f64,
     /// The truth's depth and substrate shares over the water pixels seen.

@@ -357,6 +357,8 @@ ranges! {
     CORRECTION_APPROX_POINTS = Range::count("correction.approx_points", 1.0, 10_000.0, "", "water pixels of the per-scene approximation (paper: 20)");
     /// Error of the wind the exact correction assumes for the glint.
     CORRECTION_EXACT_GLINT_WIND_ERROR = Range::closed("correction.glint_wind_error_m_s", -20.0, 20.0, "m/s", "error of the wind the exact correction assumes for the glint it takes away (its wind: the scene's plus this, at least 0)");
+    /// High-glint threshold of the exact correction.
+    CORRECTION_EXACT_GLINT_THRESHOLD = Range::above("correction.glint_threshold_per_sr", 0.0, 1.0, "sr-1", "largest normalised glint radiance L_GN, from the wind the exact correction assumes, of a pixel it keeps (l2gen's glint_thresh; unset: every pixel kept)");
     /// Image-based correction: the aerosol pair's band centres.
     CORRECTION_PAIR_NM = Range::closed("correction.image.pair_nm", 600.0, 2500.0, "nm", "centres of the short and long band of the aerosol pair, short first (the instrument's nearest bands, within 30 nm)");
     /// Image-based correction: AOT nodes of the family's tables.

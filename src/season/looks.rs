@@ -53,6 +53,9 @@ pub struct Look {
     pub geometry: Geometry,
     /// Normalised glint radiance L_GN = ρ_g μ₀/π at the site, sr⁻¹.
     pub glint_per_sr: f64,
+    /// The season's high-glint threshold, sr⁻¹: the look was judged against it at the site, and
+    /// the exact correction masks the pixels above it at the wind it assumes.
+    pub glint_threshold_per_sr: f64,
     /// Cloud cover drawn for the look (0–1).
     pub cloud_cover: f64,
     /// The seed of the look's weather (the season's seed and the hour of the pass): its cover
@@ -198,6 +201,7 @@ pub fn looks(season: &SeasonSpec, instrument: &InstrumentSpec, wind_m_s: f64, n:
                 altitude_m,
                 geometry,
                 glint_per_sr,
+                glint_threshold_per_sr: season.glint_threshold_per_sr,
                 cloud_cover,
                 weather_seed,
                 wind_m_s,

@@ -134,7 +134,8 @@ pub struct SeasonResult {
 /// site's off-nadir angle and tilted as the look chose, at the season's decimation; the sea
 /// wind-roughened at the look's wind with its sun glint on, the glint the look was judged on (a
 /// valid look's glint is below the threshold, not zero: the correction takes away what it
-/// expects, as a processor does).
+/// expects, as a processor does, and the exact correction masks the pixels above the season's
+/// threshold at the wind it assumes).
 #[must_use]
 pub fn look_config(base: &RunConfig, look: &Look, decimation: usize) -> RunConfig {
     let mut config = base.clone();
@@ -153,10 +154,15 @@ pub fn look_config(base: &RunConfig, look: &Look, decimation: usize) -> RunConfi
     }
     // The processor's glint from the wind it assumes (the look's draw of its error): the
     // image-based correction's own setting, or the exact correction's (the per-scene
-    // approximation's terms come from the scene's pixels, glint and all).
+    // approximation's terms come from the scene's pixels, glint and all). The exact correction
+    // masks high glint at the season's threshold, as the look was judged (the image-based one
+    // keeps its own threshold).
     match &mut config.correction.method {
         crate::correction::Method::Image(image) => image.glint_wind_error_m_s = look.processor_wind_error_m_s,
-        crate::correction::Method::Exact => config.correction.glint_wind_error_m_s = look.processor_wind_error_m_s,
+        crate::correction::Method::Exact => {
+            config.correction.glint_wind_error_m_s = look.processor_wind_error_m_s;
+            config.correction.glint_threshold_per_sr = Some(look.glint_threshold_per_sr);
+        }
         crate::correction::Method::PerScene => {}
     }
     if let Some(h) = look.altitude_m {

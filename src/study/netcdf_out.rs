@@ -157,6 +157,7 @@ fn radiometry_vars<'a>(cubes: &'a Cubes, floats: &mut Vec<FloatVar<'a>>, flags: 
             (i32::from(RrsFlags::SATURATED), "saturated"),
             (i32::from(RrsFlags::INVALID), "invalid"),
             (i32::from(RrsFlags::CLOUD), "cloud"),
+            (i32::from(RrsFlags::GLINT), "high_glint"),
         ],
         values: Values::lazy(move || rrs_flags.iter().map(|&f| i32::from(f)).collect()),
         coordinates: CUBE_COORDINATES,

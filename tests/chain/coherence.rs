@@ -221,6 +221,8 @@ fn chosen_value(path: &str) -> Option<f64> {
         "correction.image.glint_wind_error_m_s" => 2.0,
         // The same for the base's exact correction.
         "correction.glint_wind_error_m_s" => 2.0,
+        // l2gen's 0.005 sr⁻¹ where the base's exact correction masks nothing (unset).
+        "correction.glint_threshold_per_sr" => 0.005,
         // Above the clouds' albedo (0.72): no cloud is screened.
         "correction.image.clouds.threshold" => 0.9,
         // Shadows projected from the base clouds' own 300 m, where the default 1500 m puts every
@@ -260,6 +262,8 @@ fn try_set(config: &RunConfig, path: &str, value: f64) -> Result<RunConfig, Stri
         "scene.cdom_per_m" => c.scene.cdom_per_m = m,
         "scene.depth_m" => c.scene.depth_m = Some(m),
         "scene.aot550_map" => c.scene.aot550_map = Some(m),
+        // Unset in the base (the perfect processor masks nothing), so not a number to edit.
+        "correction.glint_threshold_per_sr" => c.correction.glint_threshold_per_sr = Some(value),
         "scene.substrates[i].fraction" => c.scene.substrates[0].fraction = m,
         // A spectrum's values: the land's reflectance, constant over wavelength.
         "scene.land.reflectance" => {

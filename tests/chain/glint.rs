@@ -93,7 +93,14 @@ fn high_glint_is_left_out() {
     let a = out.correction.aerosol.as_ref().unwrap();
     let (rows, cols, _) = out.kept().rrs.rrs.dim();
     assert_eq!(a.high_glint, rows * cols);
-    assert!(out.kept().rrs.flags.iter().all(|f| f & RrsFlags::INVALID != 0));
+    // Left out, and flagged as glint so the flags say why.
+    assert!(
+        out.kept()
+            .rrs
+            .flags
+            .iter()
+            .all(|f| f & (RrsFlags::INVALID | RrsFlags::GLINT) == RrsFlags::INVALID | RrsFlags::GLINT)
+    );
     assert!(a.aot550.iter().all(|x| x.is_nan()));
     // Dark-spectrum fitting leaves them out too (its tiles never see them).
     let mut c = glinting(30.0, true);
@@ -212,4 +219,72 @@ fn the_exact_correction_with_a_wrong_wind_misjudges_only_the_glint() {
     assert!(e.contains("correction.glint_wind_error_m_s") && e.contains("-20"), "{e}");
     c.correction.glint_wind_error_m_s = f64::NAN;
     assert!(c.validate().unwrap_err().to_string().contains("correction.glint_wind_error_m_s"));
+}
+
+/// The glinting scene corrected exactly with the wind off by `error_m_s` and the high-glint mask
+/// at `threshold` (sr⁻¹; `None`: the perfect processor, no mask): the pixels flagged glint, the
+/// report's count of them, and the water pixels.
+fn exact_mask(roll_deg: f64, error_m_s: f64, threshold: Option<f64>) -> (usize, Option<usize>, usize) {
+    let mut c = glinting(roll_deg, true);
+    c.correction.method = shoal::correction::Method::Exact;
+    c.correction.glint_wind_error_m_s = error_m_s;
+    c.correction.glint_threshold_per_sr = threshold;
+    let out = run(&c);
+    let k = out.kept();
+    let (rows, cols, _) = k.rrs.rrs.dim();
+    let mut flagged = 0;
+    for r in 0..rows {
+        for col in 0..cols {
+            let f = k.rrs.flags[[r, col, 0]];
+            if f & RrsFlags::GLINT != 0 {
+                assert!(f & RrsFlags::INVALID != 0, "a masked pixel is left out");
+                assert!(k.rrs.rrs.slice(ndarray::s![r, col, ..]).iter().all(|v| *v == 0.0));
+                flagged += 1;
+            }
+        }
+    }
+    (flagged, out.report.exact_high_glint.map(|g| g.pixels), out.truth.surface.water_count())
+}
+
+/// The exact correction masks high glint as l2gen's HIGLINT does, only when its threshold is set
+/// and at the wind it assumes. Rolled 30° (view 30° opposite a 60° sun: the facets tilt 15°,
+/// L_GN above 0.005 sr⁻¹ at 5 m/s, as `high_glint_is_left_out` finds) every water pixel is
+/// masked, flagged glint and invalid with its Rrs 0, and the report counts them; the perfect
+/// processor (no threshold) masks none. Assuming a calm sea there (wind error −5 m/s: Cox–Munk's
+/// slope variance 0.003, so exp(−tan²15°/0.003) ≈ 4·10⁻¹¹) it expects no glint and masks none.
+/// Rolled 20° (view about 21.5°, facets tilted about 19°) the true glint, L_GN ≈ 1.4·10⁻³ sr⁻¹
+/// by Cox–Munk's formula (bracketed with thresholds: masked at 1.2·10⁻³, not at 1.6·10⁻³), is
+/// below the threshold and nothing is masked; a processor assuming 20 m/s instead of 5 (σ² 0.105
+/// against 0.029) expects about six times more (masked at 7·10⁻³, not at 9·10⁻³) and masks
+/// every water pixel. (At 15° a 15 m/s wind would expect 4.6·10⁻³ sr⁻¹, too near the
+/// threshold to test on.)
+#[test]
+fn the_exact_correction_masks_high_glint_at_the_wind_it_assumes() {
+    let perfect = exact_mask(30.0, 0.0, None);
+    let water = perfect.2;
+    assert!(water > 0);
+    assert_eq!(perfect, (0, None, water), "the perfect processor masks nothing");
+    assert_eq!(exact_mask(30.0, 0.0, Some(0.005)), (water, Some(water), water));
+    assert_eq!(exact_mask(30.0, -5.0, Some(0.005)), (0, Some(0), water), "a calm sea assumed: no glint expected");
+    assert_eq!(exact_mask(20.0, 0.0, Some(0.005)), (0, Some(0), water));
+    assert_eq!(exact_mask(20.0, 15.0, Some(0.005)), (water, Some(water), water), "a stronger wind assumed");
+    // The threshold is the exact correction's: refused beside another method and out of range,
+    // naming the field.
+    let e =
+        ron::from_str::<shoal::correction::CorrectionSpec>("(image: Some(()), glint_threshold_per_sr: Some(0.005))")
+            .unwrap_err()
+            .to_string();
+    assert!(e.contains("correction.glint_threshold_per_sr") && e.contains("correction.image"), "{e}");
+    for bad in [0.0, -1.0, 2.0, f64::NAN] {
+        let mut c = exact_with_wind(5.0, 0.0);
+        c.correction.glint_threshold_per_sr = Some(bad);
+        let e = c.validate().unwrap_err().to_string();
+        assert!(e.contains("correction.glint_threshold_per_sr"), "{bad}: {e}");
+    }
+    // Written only when set: a file written before reads and writes as it did.
+    let plain = ron::to_string(&shoal::correction::CorrectionSpec::default()).unwrap();
+    assert!(!plain.contains("glint_threshold_per_sr"), "{plain}");
+    let spec = shoal::correction::CorrectionSpec { glint_threshold_per_sr: Some(0.005), ..Default::default() };
+    let back: shoal::correction::CorrectionSpec = ron::from_str(&ron::to_string(&spec).unwrap()).unwrap();
+    assert_eq!(back, spec);
 }

@@ -345,6 +345,8 @@ fn a_look_s_processor_wind_error_is_drawn_from_its_weather() {
     let config = look_config(&exact, look, 16);
     assert_eq!(config.correction.method, shoal::correction::Method::Exact);
     assert_eq!(config.correction.glint_wind_error_m_s, look.processor_wind_error_m_s);
+    // It masks high glint at the season's threshold, as the look was judged.
+    assert_eq!(config.correction.glint_threshold_per_sr, Some(look.glint_threshold_per_sr));
     config.validate().unwrap();
     season.processor_wind_rms_m_s = 11.0;
     assert!(season.validate().unwrap_err().to_string().contains("processor_wind_rms_m_s"));
