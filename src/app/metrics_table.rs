@@ -265,6 +265,7 @@ pub(super) fn metrics_table(app: &ShoalApp, ui: &mut egui::Ui, configs: &[crate:
                 ui.end_row();
             }
             correction_rows(ui, &columns);
+            glint_row(ui, &columns);
         });
     });
     if columns.iter().all(|c| c.run().is_none()) {
@@ -321,6 +322,37 @@ fn correction_rows(ui: &mut egui::Ui, columns: &[Column<'_>]) {
             }
         }
         ui.label("");
+    }
+    ui.end_row();
+}
+
+/// With the exact correction's high-glint mask (`correction.glint_threshold_per_sr`, a season's
+/// looks): the water pixels it left out, which the returned shares above no longer count.
+fn glint_row(ui: &mut egui::Ui, columns: &[Column<'_>]) {
+    let mask = |c: &Column<'_>| c.run().and_then(|o| o.report.exact_high_glint);
+    if !columns.iter().any(|c| mask(c).is_some()) {
+        return;
+    }
+    ui.label("left out for high glint").on_hover_text(
+        "water pixels the exact correction masked, as l2gen's HIGLINT: the normalised glint it expects from \
+         the wind it assumes above its threshold",
+    );
+    for column in columns {
+        match mask(column) {
+            Some(g) => {
+                let share = if g.water_pixels > 0 { 100.0 * g.pixels as f64 / g.water_pixels as f64 } else { 0.0 };
+                ui.label(column.text(format!("{share:.1} %"))).on_hover_text(format!(
+                    "{} of {} water pixels: L_GN above {} sr⁻¹ at the assumed wind {:.1} m/s",
+                    g.pixels, g.water_pixels, g.threshold_per_sr, g.assumed_wind_m_s
+                ));
+            }
+            None => {
+                ui.label("–");
+            }
+        }
+        for _ in 0..3 {
+            ui.label("");
+        }
     }
     ui.end_row();
 }
