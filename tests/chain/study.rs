@@ -134,3 +134,25 @@ fn the_seed_spread_is_the_mean_and_scatter_of_the_seeds() {
     assert!(csv.lines().any(|l| l.starts_with("cubesat,aLMI,chl_mg_m3,3,")), "{csv}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Every example study (presets/examples/study_*.ron, which docs/RESULTS.md's rows cite) reads
+/// and resolves, its scene files and presets included: a renamed preset or a changed field
+/// cannot leave a documented result that no longer runs.
+#[test]
+fn every_example_study_resolves() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("presets/examples");
+    let mut studies: Vec<std::path::PathBuf> = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(Result::ok)
+        .map(|e| e.path())
+        .filter(|p| p.file_name().is_some_and(|n| n.to_string_lossy().starts_with("study_")))
+        .collect();
+    studies.sort();
+    assert!(studies.len() >= 5, "{studies:?}");
+    for path in &studies {
+        let text = std::fs::read_to_string(path).unwrap();
+        let spec = StudySpec::from_ron(&text, &path.to_string_lossy()).unwrap_or_else(|e| panic!("{path:?}: {e}"));
+        let resolved = spec.resolve(Some(&dir)).unwrap_or_else(|e| panic!("{path:?}: {e}"));
+        assert!(!resolved.runs.is_empty(), "{path:?}");
+    }
+}
