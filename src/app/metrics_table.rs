@@ -289,8 +289,15 @@ fn correction_rows(ui: &mut egui::Ui, columns: &[Column<'_>]) {
             Some(a) => {
                 ui.label(column.text(format!("AOT {:.3} (true {:.3})", a.aot550.0, a.aot550_true))).on_hover_text(
                     format!(
-                        "5–95 %: {:.3}–{:.3}; per-pixel error (median) {:.3}; Ångström {:.2} (true {:.2}); outside the family: {:.1} %; {}",
-                        a.aot550.1, a.aot550.2, a.aot550_abs_error, a.angstrom, a.angstrom_true, a.outside_family_pct, a.fit
+                        "5–95 %: {:.3}–{:.3}; per-pixel error (median) {:.3}; Ångström {:.2} (true {:.2}); outside the family: {:.1} %; {}\n{}",
+                        a.aot550.1,
+                        a.aot550.2,
+                        a.aot550_abs_error,
+                        a.angstrom,
+                        a.angstrom_true,
+                        a.outside_family_pct,
+                        a.fit,
+                        a.epsilon_words()
                     ),
                 );
             }

@@ -303,6 +303,10 @@ fn print_runs(out: &mut String, result: &crate::study::StudyResult) {
                 a.fit,
                 if a.passes_mean > 1.0 { format!(", {:.1} passes", a.passes_mean) } else { String::new() }
             );
+            let eps = a.epsilon_words();
+            if !eps.is_empty() {
+                let _ = writeln!(out, "{:<12} aerosol  {eps}", run.label);
+            }
         }
         if let Some(g) = &run.report.exact_high_glint {
             let _ = writeln!(

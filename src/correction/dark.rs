@@ -120,6 +120,8 @@ impl TileFit {
             angstrom: family.angstrom[m],
             outside: false,
             passes: 1,
+            epsilon: f64::NAN,
+            long_signal: f64::NAN,
         }
     }
 }

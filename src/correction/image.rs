@@ -292,6 +292,15 @@ pub struct AerosolRetrieval {
     pub high_glint: usize,
     /// The expected glint was taken away (the scene has glint and the correction's `glint` is on).
     pub glint_removed: bool,
+    /// The measured ε at the pair per pixel (the band-pair fit; NaN elsewhere).
+    pub epsilon: Array2<f32>,
+    /// The measured long-band aerosol signal per pixel while the fit runs (emptied once the
+    /// members' ε are placed: not kept).
+    pub long_signal: Vec<f32>,
+    /// The band-pair fit: every member's ε for the median pixel (its long-band signal, the
+    /// centre column), as the fit places a measured ε among them (empty for dark-spectrum
+    /// fitting).
+    pub members_epsilon: Vec<f64>,
 }
 
 /// One pixel of Level-1 as a fit sees it.
@@ -346,6 +355,7 @@ pub fn correct_image(
     let (mut rrs, mut retrieval) = correct_with(level1, family, settings, bands, surface, control, &high_glint)?;
     // Left out already (invalid); flagged as glint too, so the flags say why.
     retrieval.high_glint = super::mark_high_glint(&mut rrs, &high_glint, surface);
+    retrieval.long_signal = Vec::new();
     retrieval.glint_removed = glint_removed;
     Ok((rrs, retrieval))
 }
@@ -365,7 +375,13 @@ fn correct_with(
     match settings.fit {
         AerosolFit::BandPair => {
             let fit = super::pair::PairFit::new(family, &packed, settings, bands)?;
-            apply(level1, surface, control, |p, mix, scratch| !high_glint(p.col) && fit.fit(p, mix, scratch))
+            let (rrs, mut retrieval) =
+                apply(level1, surface, control, |p, mix, scratch| !high_glint(p.col) && fit.fit(p, mix, scratch))?;
+            let long = std::mem::take(&mut retrieval.long_signal);
+            let mut long: Vec<f64> = long.into_iter().filter(|v| v.is_finite()).map(f64::from).collect();
+            let median = crate::metrics::nearest_rank(&mut long, 0.5);
+            retrieval.members_epsilon = fit.member_epsilon(level1.radiance.dim().1 / 2, median);
+            Ok((rrs, retrieval))
         }
         AerosolFit::DarkSpectrum => {
             if (0..level1.radiance.dim().1).all(high_glint) {
@@ -410,48 +426,57 @@ fn apply<'f, S: Default>(
     // Written in place, row by row (rows of per-row vectors joined at the end held the cube twice).
     let (mut rrs, mut flags) = (vec![0.0f32; rows * stride], vec![0u8; rows * stride]);
     let (mut aot, mut alpha) = (vec![f32::NAN; rows * cols], vec![f32::NAN; rows * cols]);
+    let (mut eps, mut long) = (vec![f32::NAN; rows * cols], vec![f32::NAN; rows * cols]);
     let (outside, passes) = (AtomicUsize::new(0), AtomicUsize::new(0));
-    let outputs =
-        ((rrs.as_mut_slice(), flags.as_mut_slice()), (OwnRows(aot.as_mut_slice()), OwnRows(alpha.as_mut_slice())));
-    control.fill_rows(outputs, rows, stride, |at, ((rrs_row, flag_row), (aot_row, alpha_row))| {
-        let r = at.index();
-        let base = r * stride;
-        let (mut row_outside, mut row_passes) = (0usize, 0usize);
-        let mut scratch = S::default();
-        let mut mix = Mixture::default();
-        let (mut lp, mut te, mut sa) = (vec![0.0f64; nb], vec![0.0f64; nb], vec![0.0f64; nb]);
-        for c in 0..cols {
-            at.column(c);
-            let span = c * nb..(c + 1) * nb;
-            let p = Pixel {
-                row: r,
-                col: c,
-                nb,
-                l1: &l1[base + span.start..base + span.end],
-                flags: &l0_flags[base + span.start..base + span.end],
-                land: !surface.is_water(r, c),
-            };
-            mix.entries.clear();
-            (mix.outside, mix.passes) = (false, 1);
-            let usable = fit(&p, &mut mix, &mut scratch) && !p.land;
-            mix.column_terms(span.clone(), &mut lp, &mut te, &mut sa);
-            for b in 0..nb {
-                let value = invert(f64::from(p.l1[b]), lp[b], te[b], sa[b]);
-                let f = flag_for(p.flags[b], !usable, value);
-                flag_row[span.start + b] = f;
-                rrs_row[span.start + b] = if f & RrsFlags::INVALID != 0 { 0.0 } else { value as f32 };
+    let maps = (OwnRows(aot.as_mut_slice()), OwnRows(alpha.as_mut_slice()));
+    let pair = (OwnRows(eps.as_mut_slice()), OwnRows(long.as_mut_slice()));
+    let outputs = ((rrs.as_mut_slice(), flags.as_mut_slice()), maps, pair);
+    control.fill_rows(
+        outputs,
+        rows,
+        stride,
+        |at, ((rrs_row, flag_row), (aot_row, alpha_row), (eps_row, long_row))| {
+            let r = at.index();
+            let base = r * stride;
+            let (mut row_outside, mut row_passes) = (0usize, 0usize);
+            let mut scratch = S::default();
+            let mut mix = Mixture::default();
+            let (mut lp, mut te, mut sa) = (vec![0.0f64; nb], vec![0.0f64; nb], vec![0.0f64; nb]);
+            for c in 0..cols {
+                at.column(c);
+                let span = c * nb..(c + 1) * nb;
+                let p = Pixel {
+                    row: r,
+                    col: c,
+                    nb,
+                    l1: &l1[base + span.start..base + span.end],
+                    flags: &l0_flags[base + span.start..base + span.end],
+                    land: !surface.is_water(r, c),
+                };
+                mix.entries.clear();
+                (mix.outside, mix.passes, mix.epsilon, mix.long_signal) = (false, 1, f64::NAN, f64::NAN);
+                let usable = fit(&p, &mut mix, &mut scratch) && !p.land;
+                mix.column_terms(span.clone(), &mut lp, &mut te, &mut sa);
+                for b in 0..nb {
+                    let value = invert(f64::from(p.l1[b]), lp[b], te[b], sa[b]);
+                    let f = flag_for(p.flags[b], !usable, value);
+                    flag_row[span.start + b] = f;
+                    rrs_row[span.start + b] = if f & RrsFlags::INVALID != 0 { 0.0 } else { value as f32 };
+                }
+                if usable {
+                    aot_row[c] = mix.aot550 as f32;
+                    alpha_row[c] = mix.angstrom as f32;
+                    eps_row[c] = mix.epsilon as f32;
+                    long_row[c] = mix.long_signal as f32;
+                    row_outside += usize::from(mix.outside);
+                    row_passes += mix.passes;
+                }
             }
-            if usable {
-                aot_row[c] = mix.aot550 as f32;
-                alpha_row[c] = mix.angstrom as f32;
-                row_outside += usize::from(mix.outside);
-                row_passes += mix.passes;
-            }
-        }
-        outside.fetch_add(row_outside, Ordering::Relaxed);
-        passes.fetch_add(row_passes, Ordering::Relaxed);
-        Ok::<_, CorrectionError>(())
-    })?;
+            outside.fetch_add(row_outside, Ordering::Relaxed);
+            passes.fetch_add(row_passes, Ordering::Relaxed);
+            Ok::<_, CorrectionError>(())
+        },
+    )?;
     let (outside, passes) = (outside.into_inner(), passes.into_inner());
     let retrieved = aot.iter().filter(|v| v.is_finite()).count();
     let shape = (rows, cols);
@@ -464,6 +489,9 @@ fn apply<'f, S: Default>(
         tiles: Vec::new(),
         high_glint: 0,
         glint_removed: false,
+        epsilon: Array2::from_shape_vec(shape, eps).map_err(bad)?,
+        long_signal: long,
+        members_epsilon: Vec::new(),
     };
     Ok((assemble(rows, cols, nb, rrs, flags)?, retrieval))
 }

@@ -42,6 +42,10 @@ pub(super) struct Mixture<'f> {
     pub outside: bool,
     /// Passes of the NIR iteration.
     pub passes: usize,
+    /// The measured ε at the pair (the band-pair fit; NaN otherwise or where not measured).
+    pub epsilon: f64,
+    /// The measured aerosol signal at the pair's long band, W m⁻² sr⁻¹ nm⁻¹ (with `epsilon`).
+    pub long_signal: f64,
 }
 
 impl Mixture<'_> {

@@ -91,6 +91,23 @@ impl<'f> PairFit<'f> {
         Ok(Self { family, packed, pair, nir, signals })
     }
 
+    /// Every member's ε at column `c` for a pixel whose aerosol signal at the long band is
+    /// `long_signal`, as [`Self::fit`] places a pixel's measured ε among them: each model at the
+    /// AOT that gives that signal. NaN where the signal is not positive.
+    pub fn member_epsilon(&self, c: usize, long_signal: f64) -> Vec<f64> {
+        let c = c.min(self.signals.rayleigh.len().saturating_sub(1));
+        (0..self.signals.models)
+            .map(|m| {
+                let (long, short) = self.signals.of(c, m);
+                if long_signal > 0.0 {
+                    weighted(&locate(long, long_signal), |k| short[k]) / long_signal
+                } else {
+                    f64::NAN
+                }
+            })
+            .collect()
+    }
+
     /// Fill `mix` with the pixel's atmosphere; false where the pair's bands are flagged.
     pub fn fit(&self, p: &Pixel<'_>, mix: &mut Mixture<'f>, scratch: &mut Scratch) -> bool {
         let (s, l) = self.pair;
@@ -145,6 +162,7 @@ impl<'f> PairFit<'f> {
             eps[m] = if a_l > 0.0 { short / a_l } else { 0.0 };
         }
         let measured = if a_l > 0.0 { a_s / a_l } else { 0.0 };
+        (mix.epsilon, mix.long_signal) = if a_l > 0.0 { (measured, a_l) } else { (f64::NAN, f64::NAN) };
         // The bracketing pair (by ε), or the nearest model outside the family's range.
         order.clear();
         order.extend(0..nm);

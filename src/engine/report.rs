@@ -75,6 +75,38 @@ pub struct AerosolSummary {
     /// What the correction did, in words (its fit; for dark-spectrum fitting the models the
     /// tiles chose).
     pub fit: String,
+    /// The band-pair fit: the measured ε at the pair (the ratio of the aerosol radiances at its
+    /// short and long band, as the fit forms it) over the retrieved pixels, median, 5th and 95th
+    /// percentiles (NaN for dark-spectrum fitting).
+    #[serde(default = "nan_triple", deserialize_with = "nan_triple_if_null")]
+    pub epsilon: (f64, f64, f64),
+    /// The band-pair fit: each member's ε at the pair as the fit places the median pixel's
+    /// measured ε among them (each model at the AOT that gives that pixel's long-band signal, at
+    /// the centre column). Two members closer than the measured ε's spread cannot be told apart.
+    #[serde(default)]
+    pub members_epsilon: Vec<(String, f64)>,
+}
+
+fn nan_triple() -> (f64, f64, f64) {
+    (f64::NAN, f64::NAN, f64::NAN)
+}
+
+impl AerosolSummary {
+    /// The measured ε against the members', in words ("" without a band-pair fit).
+    #[must_use]
+    pub fn epsilon_words(&self) -> String {
+        if self.members_epsilon.is_empty() || !self.epsilon.0.is_finite() {
+            return String::new();
+        }
+        let members: Vec<String> = self.members_epsilon.iter().map(|(m, e)| format!("{m} {e:.4}")).collect();
+        format!(
+            "ε at the pair {:.4} (5–95 %: {:.4}–{:.4}) against the members' {}",
+            self.epsilon.0,
+            self.epsilon.1,
+            self.epsilon.2,
+            members.join(", ")
+        )
+    }
 }
 
 /// Water pixels the exact correction left out for high glint (its `glint_threshold_per_sr`).
@@ -194,6 +226,7 @@ pub(super) fn aerosol_summary(
     let mut errors: Vec<f64> = retrieved.clone().map(|(i, v)| (f64::from(*v) - true_at(i)).abs()).collect();
     let mut true_values: Vec<f64> = retrieved.map(|(i, _)| true_at(i)).collect();
     let mut alpha: Vec<f64> = a.angstrom.iter().filter(|v| v.is_finite()).map(|&v| f64::from(v)).collect();
+    let mut eps: Vec<f64> = a.epsilon.iter().filter(|v| v.is_finite()).map(|&v| f64::from(v)).collect();
     // Quantiles by selection, not sorting: four sorts of a million pixels each took ~0.4 s of one
     // core per run, while the other core waited.
     let q = |v: &mut [f64], p: f64| crate::metrics::nearest_rank(v, p);
@@ -205,8 +238,10 @@ pub(super) fn aerosol_summary(
             Some(-(tau(865.0)? / tau(443.0)?).ln() / (865.0f64 / 443.0).ln())
         })
         .unwrap_or(f64::NAN);
+    let aot550 = (q(&mut aot, 0.5), q(&mut aot, 0.05), q(&mut aot, 0.95));
+    let members_epsilon = settings.models.iter().zip(&a.members_epsilon).map(|(m, e)| (m.name(), *e)).collect();
     AerosolSummary {
-        aot550: (q(&mut aot, 0.5), q(&mut aot, 0.05), q(&mut aot, 0.95)),
+        aot550,
         aot550_true: if truth_aot.is_some() { q(&mut true_values, 0.5) } else { truth.aot550 },
         aot550_abs_error: q(&mut errors, 0.5),
         angstrom: q(&mut alpha, 0.5),
@@ -214,6 +249,8 @@ pub(super) fn aerosol_summary(
         outside_family_pct: if aot.is_empty() { 0.0 } else { 100.0 * a.outside_family as f64 / aot.len() as f64 },
         passes_mean: a.passes_mean,
         fit: fit_words(a, settings, centres_nm),
+        epsilon: (q(&mut eps, 0.5), q(&mut eps, 0.05), q(&mut eps, 0.95)),
+        members_epsilon,
     }
 }
 

@@ -51,12 +51,12 @@ pub(super) fn aerosol(h: &mut String, d: &ReviewData) {
     if d.aerosol.is_empty() {
         return;
     }
-    h.push_str("<section id=\"aerosol\">\n<h2>Aerosol the correction found</h2>\n<p class=\"note\">The image-based correction knows nothing of the scene's atmosphere: it finds the aerosol from the design's own Level-1. AOT(550) over the water pixels (median, 5–95 %) against the scene's; the per-pixel error is the median |retrieved − true| with each pixel against the AOT under it; Ångström exponent 443–865 nm; the share of pixels whose band ratio lay outside the family of models.</p>\n<table>\n<tr><th>instrument</th><th>correction</th><th>AOT(550) found</th><th>5–95 %</th><th>true</th><th>per-pixel error</th><th>Ångström found</th><th>true</th><th>outside family %</th></tr>\n");
+    h.push_str("<section id=\"aerosol\">\n<h2>Aerosol the correction found</h2>\n<p class=\"note\">The image-based correction knows nothing of the scene's atmosphere: it finds the aerosol from the design's own Level-1. AOT(550) over the water pixels (median, 5–95 %) against the scene's; the per-pixel error is the median |retrieved − true| with each pixel against the AOT under it; Ångström exponent 443–865 nm; the share of pixels whose band ratio lay outside the family of models; the band ratio ε measured at the pair (median, 5–95 %) against each model's: two models closer than its spread cannot be told apart.</p>\n<table>\n<tr><th>instrument</th><th>correction</th><th>AOT(550) found</th><th>5–95 %</th><th>true</th><th>per-pixel error</th><th>Ångström found</th><th>true</th><th>outside family %</th><th>ε at the pair</th><th>the models' ε</th></tr>\n");
     for row in &d.aerosol {
         let a = &row.found;
         let _ = writeln!(
             h,
-            "<tr><td>{}</td><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}–{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td></tr>",
+            "<tr><td>{}</td><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}–{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{} ({}–{})</td><td>{}</td></tr>",
             escape(&row.instrument),
             escape(&a.fit),
             num(a.aot550.0, 3),
@@ -66,7 +66,11 @@ pub(super) fn aerosol(h: &mut String, d: &ReviewData) {
             num(a.aot550_abs_error, 3),
             num(a.angstrom, 2),
             num(a.angstrom_true, 2),
-            num(a.outside_family_pct, 1)
+            num(a.outside_family_pct, 1),
+            num(a.epsilon.0, 4),
+            num(a.epsilon.1, 4),
+            num(a.epsilon.2, 4),
+            escape(&a.members_epsilon.iter().map(|(m, e)| format!("{m} {e:.4}")).collect::<Vec<_>>().join(", "))
         );
     }
     h.push_str("</table>\n</section>\n");

@@ -5,9 +5,9 @@ use super::*;
 use crate::report::machine::utc_text;
 use crate::timing::{Comparison, Paired};
 
-#[test]
-fn the_review_pack_states_each_cost_row_with_its_range_and_95th_percentile() {
-    let rows = [
+/// Four timed cost rows: the reference, the defaults, a preview, one whose percentile failed.
+fn sample_cost_rows() -> [CostRow; 4] {
+    [
         CostRow::timed(
             "reference (full fidelity)",
             &[4.47, 4.32, 4.49],
@@ -30,7 +30,12 @@ fn the_review_pack_states_each_cost_row_with_its_range_and_95th_percentile() {
             Some(0.1),
             Some(f64::NAN),
         ),
-    ];
+    ]
+}
+
+#[test]
+fn the_review_pack_states_each_cost_row_with_its_range_and_95th_percentile() {
+    let rows = sample_cost_rows();
     let table = cost_rows(&rows);
     // Median of three, the range, the CPU median, the comparison's text, both errors.
     assert_eq!(
@@ -94,16 +99,19 @@ fn the_review_pack_states_each_cost_row_with_its_range_and_95th_percentile() {
                 outside_family_pct: 0.0,
                 passes_mean: 1.0,
                 fit: "dark spectrum <tiles>".into(),
+                epsilon: (1.21, 1.15, 1.26),
+                members_epsilon: vec![("maritime".into(), 1.0421), ("<urban>".into(), 1.1801)],
             },
         }],
         failures: vec![("cubesat".into(), "mine".into(), "exited with 2; <script>alert(1)</script>".into())],
         seasons: Vec::new(),
     };
     let html = html::page(&data, &[]);
-    // The aerosol the correction found, its text escaped.
+    // The aerosol the correction found, its text escaped; the ε at the pair against the models'.
     assert!(html.contains(
         "<tr><td>smallsat</td><td>dark spectrum &lt;tiles&gt;</td><td class=\"num\">0.121</td><td class=\"num\">0.083–0.170</td>\
-         <td class=\"num\">0.124</td><td class=\"num\">0.012</td>"
+         <td class=\"num\">0.124</td><td class=\"num\">0.012</td><td class=\"num\">0.22</td><td class=\"num\">1.18</td>\
+         <td class=\"num\">0.0</td><td class=\"num\">1.2100 (1.1500–1.2600)</td><td>maritime 1.0421, &lt;urban&gt; 1.1801</td></tr>"
     ));
     let row = |label: &str| {
         let at = html.find(&format!("<tr><td>{label}</td>")).unwrap_or_else(|| panic!("no row {label}"));

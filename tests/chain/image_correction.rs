@@ -396,27 +396,34 @@ fn correct_reads_each_rows_own_sun_node_whatever_the_other_rows() {
 /// clear water of [`clear_water`] (its true Rrs(443) 2.39·10⁻³ sr⁻¹) under `aerosol` at 0.15,
 /// corrected with a family of `models`.
 fn closure_with(aerosol: AerosolType, models: &[AerosolType]) -> (f64, f64) {
+    let (aot, d, _) = closure_and_summary(aerosol, models);
+    (aot, d)
+}
+
+/// [`closure_with`] and the run's aerosol summary.
+fn closure_and_summary(aerosol: AerosolType, models: &[AerosolType]) -> (f64, f64, shoal::engine::AerosolSummary) {
     let mut c = clear_water(aerosol, 0.15);
     c.correction.method =
         shoal::correction::Method::Image(ImageCorrection { models: models.to_vec(), ..ImageCorrection::default() });
     let out = run(&c);
-    (median(&out.correction.aerosol.as_ref().unwrap().aot550), median_error(&out)[2].0)
+    let summary = out.report.aerosol.clone().unwrap();
+    (median(&out.correction.aerosol.as_ref().unwrap().aot550), median_error(&out)[2].0, summary)
 }
 
 /// Two-band model selection (Gordon & Wang 1994) picks the pair of models whose ε at 779/865 nm
-/// brackets the measured one. WMO continental and urban have the same ε there to within 2·10⁻³
-/// (1.47304 and 1.47306 for this image at AOT 0.1, measured inside the fit), against ε(443/865)
-/// of 1.90 and 1.20 (`shoal atmosphere`, sun 60°, nadir): their absorption differs, their NIR
-/// colour does not (Gordon, Du & Zhang 1997). Over clear water the black-pixel assumption moves
-/// the measured ε by +1.7 to 2.2·10⁻³ (the water's Rrs of 7·10⁻⁶ and 3·10⁻⁶ sr⁻¹ at 779 and
-/// 865 nm read as aerosol), more than their difference, so which of the
-/// two a pixel gets is decided by that shift and the models' order, not by the aerosol: a
-/// noise-free urban scene under the default family comes out as continental (measured AOT
-/// 0.1349 for 0.15, Rrs(443) −1.21·10⁻³ sr⁻¹, half the water's), while the default family
+/// brackets the measured one. WMO continental and urban have nearly the same ε there (for this
+/// image's median pixel at AOT 0.15, 1.4716 and 1.4664; at 0.1, 1.47304 and 1.47306), against
+/// ε(443/865) of 1.90 and 1.20 (`shoal atmosphere`, sun 60°, nadir): their absorption differs,
+/// their NIR colour does not (Gordon, Du & Zhang 1997). Over clear water the black-pixel
+/// assumption moves the measured ε by +1.7 to 2.2·10⁻³ (the water's Rrs of 7·10⁻⁶ and 3·10⁻⁶
+/// sr⁻¹ at 779 and 865 nm read as aerosol), a third of their difference or more, so what a pixel
+/// gets is decided by that shift and the models' order, not by the aerosol: a noise-free urban
+/// scene under the default family comes out 35 % continental (measured AOT 0.1349 for 0.15,
+/// Rrs(443) −1.21·10⁻³ sr⁻¹, half the water's), while the default family
 /// recovers a continental scene (`an_aerosol_of_the_family_over_black_nir_water_is_removed`)
 /// only because the shift carries it past the edge of the family, to continental. With urban
 /// beside maritime alone, whose ε is far below, urban is recovered: the member is the scene's
-/// own. 6SV's continental and urban differ by 0.024 in ε; the same shift, inside that gap,
+/// own. 6SV's continental and urban differ by 0.024 in ε (at AOT 0.1); the same shift, inside that gap,
 /// mixes 7 % of urban into a continental scene (AOT 0.1541, Rrs(443) +2.45·10⁻⁴ sr⁻¹), and
 /// beside maritime alone it closes. Bounds: the failures are asserted at half their measured
 /// size; the closures at 0.5 % in AOT and 2·10⁻⁵ sr⁻¹ (the black-pixel bound of the test above).
@@ -427,9 +434,17 @@ fn the_nir_pair_cannot_tell_continental_from_urban() {
         println!("{what}: AOT {aot:.4}, Rrs(443) error {d:+.2e} sr-1");
         assert!((aot / 0.15 - 1.0).abs() < 0.005 && d.abs() < 2e-5, "{what}: AOT {aot}, Rrs(443) {d:+.2e}");
     };
-    let (aot, d) = closure_with(Urban, &[Maritime, Continental, Urban]);
-    println!("urban, default family: AOT {aot:.4}, Rrs(443) error {d:+.2e} sr-1");
+    let (aot, d, summary) = closure_and_summary(Urban, &[Maritime, Continental, Urban]);
+    println!("urban, default family: AOT {aot:.4}, Rrs(443) error {d:+.2e} sr-1; {}", summary.epsilon_words());
     assert!(aot < 0.15 * 0.95 && d < -6e-4, "urban read as continental: AOT {aot}, Rrs(443) {d:+.2e}");
+    // The report shows why: for the median pixel continental's and urban's ε lie 5·10⁻³ apart
+    // (measured 1.4716 and 1.4664), maritime's far below (1.3017), and the measured ε (1.4682)
+    // between them, the black-pixel shift above urban's taking it 35 % of the way to continental.
+    let member = |name: &str| summary.members_epsilon.iter().find(|m| m.0 == name).map(|m| m.1).unwrap();
+    let (c, u, m) = (member("continental"), member("urban"), member("maritime"));
+    let eps = summary.epsilon.0;
+    assert!(c - u > 0.0 && c - u < 6e-3 && m < u - 0.1, "members' ε: {:?}", summary.members_epsilon);
+    assert!(u < eps && eps < c && (eps - u) / (c - u) > 0.2, "ε {eps} between urban {u} and continental {c}");
     closes(closure_with(Urban, &[Maritime, Urban]), "urban beside maritime");
     let (aot, d) = closure_with(Continental6sv, &[Maritime6sv, Continental6sv, Urban6sv]);
     println!("continental (6SV), 6SV family: AOT {aot:.4}, Rrs(443) error {d:+.2e} sr-1");
