@@ -63,20 +63,52 @@ pub fn numbers<'p>(value: &impl Serialize, paths: impl IntoIterator<Item = &'p s
 /// As above, naming the path.
 pub fn with_numbers<T: Serialize + DeserializeOwned>(value: &T, settings: &[(&str, f64)]) -> Result<T, String> {
     let mut tree = tree(value)?;
+    // Optional numbers left unset (absent from the tree, or null), each with the error to give
+    // if it does not read back.
+    let mut unset = Vec::new();
     for &(path, v) in settings {
-        set(&mut tree, path, v)?;
+        if let Some(error) = set(&mut tree, path, v)? {
+            unset.push((path, v, error));
+        }
     }
-    serde_json::from_value(tree).map_err(|e| format!("`{settings:?}`: {e}"))
+    let out: T = match serde_json::from_value(tree) {
+        Ok(out) => out,
+        // A field the type does not have: say so, with the fields it has there.
+        Err(_) if !unset.is_empty() => return Err(unset.swap_remove(0).2),
+        Err(e) => return Err(format!("`{settings:?}`: {e}")),
+    };
+    // An unset field is set only where the type reads it there: a name it does not have (a
+    // misspelt path) is not silently dropped by a type that ignores unknown fields.
+    if !unset.is_empty() {
+        let back = self::tree(&out)?;
+        for (path, v, error) in unset {
+            if node(&back, path).and_then(Value::as_f64) != Some(v) {
+                return Err(error);
+            }
+        }
+    }
+    Ok(out)
 }
 
-fn set(tree: &mut Value, path: &str, value: f64) -> Result<(), String> {
+/// Set the number at `path` of `tree`. `Some(error)`: the path's last field was absent or null
+/// (an optional number left unset, which serde writes as nothing or null) and now holds the
+/// number; `error` is what to say if the type does not read it back.
+fn set(tree: &mut Value, path: &str, value: f64) -> Result<Option<String>, String> {
+    let finite = |v: f64| {
+        serde_json::Number::from_f64(v).map(Value::Number).ok_or_else(|| format!("`{path}`: {v} is not finite"))
+    };
+    let keys: Vec<&str> = path.split('.').collect();
     let mut node = tree;
-    for key in path.split('.') {
+    for (i, key) in keys.iter().enumerate() {
         node = match node {
             Value::Object(map) => {
                 let known: Vec<String> = map.keys().cloned().collect();
-                map.get_mut(key)
-                    .ok_or_else(|| format!("`{path}`: no field `{key}` here (fields: {})", known.join(", ")))?
+                let missing = format!("`{path}`: no field `{key}` here (fields: {})", known.join(", "));
+                if i + 1 == keys.len() && map.get(*key).is_none_or(Value::is_null) {
+                    map.insert((*key).to_string(), finite(value)?);
+                    return Ok(Some(missing));
+                }
+                map.get_mut(*key).ok_or(missing)?
             }
             Value::Array(items) => {
                 let n = items.len();
@@ -90,16 +122,14 @@ fn set(tree: &mut Value, path: &str, value: f64) -> Result<(), String> {
         return Err(format!("`{path}` is not a number (it holds {node})"));
     };
     *node = if n.is_f64() {
-        serde_json::Number::from_f64(value)
-            .map(Value::Number)
-            .ok_or_else(|| format!("`{path}`: {value} is not finite"))?
+        finite(value)?
     } else {
         if value.fract() != 0.0 || !(0.0..=9.0e15).contains(&value) {
             return Err(format!("`{path}` is a whole number; {value} is not (use a list of whole values)"));
         }
         Value::from(value as u64)
     };
-    Ok(())
+    Ok(None)
 }
 
 /// A leaf of [`flatten`]: its value as text, or a list summarised.
@@ -240,6 +270,30 @@ mod tests {
         inner: Inner,
         list: Vec<f64>,
         kinds: Vec<Kind>,
+    }
+
+    #[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
+    #[serde(deny_unknown_fields)]
+    struct Optional {
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        left_out: Option<f64>,
+        #[serde(default)]
+        null: Option<f64>,
+    }
+
+    /// Optional numbers left unset (not written, or written as null) are set by path; a name the
+    /// type does not have is refused with the fields it has, whether it denies unknown fields or
+    /// ignores them.
+    #[test]
+    fn unset_optional_numbers_are_set_and_unknown_names_refused() {
+        let none = Optional { left_out: None, null: None };
+        let set = with_numbers(&none, &[("left_out", 0.005), ("null", 2.0)]).unwrap();
+        assert_eq!(set, Optional { left_out: Some(0.005), null: Some(2.0) });
+        let e = with_numbers(&none, &[("left_uot", 1.0)]).unwrap_err();
+        assert!(e.contains("no field `left_uot`") && e.contains("null"), "{e}");
+        let e = with_numbers(&base(), &[("inner.g", 1.0)]).unwrap_err();
+        assert!(e.contains("no field `g`") && e.contains("f, n"), "{e}");
+        assert!(with_numbers(&none, &[("left_out", f64::NAN)]).unwrap_err().contains("not finite"));
     }
 
     fn base() -> Config {

@@ -262,8 +262,6 @@ fn try_set(config: &RunConfig, path: &str, value: f64) -> Result<RunConfig, Stri
         "scene.cdom_per_m" => c.scene.cdom_per_m = m,
         "scene.depth_m" => c.scene.depth_m = Some(m),
         "scene.aot550_map" => c.scene.aot550_map = Some(m),
-        // Unset in the base (the perfect processor masks nothing), so not a number to edit.
-        "correction.glint_threshold_per_sr" => c.correction.glint_threshold_per_sr = Some(value),
         "scene.substrates[i].fraction" => c.scene.substrates[0].fraction = m,
         // A spectrum's values: the land's reflectance, constant over wavelength.
         "scene.land.reflectance" => {
