@@ -239,7 +239,14 @@ pub(super) fn aerosol_summary(
         })
         .unwrap_or(f64::NAN);
     let aot550 = (q(&mut aot, 0.5), q(&mut aot, 0.05), q(&mut aot, 0.95));
-    let members_epsilon = settings.models.iter().zip(&a.members_epsilon).map(|(m, e)| (m.name(), *e)).collect();
+    // Only members with a finite ε (a JSON null would not read back as a number).
+    let members_epsilon = settings
+        .models
+        .iter()
+        .zip(&a.members_epsilon)
+        .filter(|(_, e)| e.is_finite())
+        .map(|(m, e)| (m.name(), *e))
+        .collect();
     AerosolSummary {
         aot550,
         aot550_true: if truth_aot.is_some() { q(&mut true_values, 0.5) } else { truth.aot550 },

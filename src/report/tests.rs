@@ -149,11 +149,18 @@ fn an_aerosol_summary_with_missing_values_round_trips_through_review_json() {
         aot550: (f64::NAN, 0.1, f64::NAN),
         angstrom_true: f64::NAN,
         fit: "pair".into(),
+        epsilon: (f64::NAN, f64::NAN, f64::NAN),
         ..Default::default()
     };
     let text = serde_json::to_string(&a).unwrap();
     let back: crate::engine::AerosolSummary = serde_json::from_str(&text).unwrap();
     assert!(back.aot550.0.is_nan() && back.aot550.2.is_nan() && back.angstrom_true.is_nan(), "{text}");
+    assert!(back.epsilon.0.is_nan() && back.members_epsilon.is_empty(), "{text}");
+    // A summary written before the ε fields reads with them missing.
+    let older = text.replace(",\"epsilon\":[null,null,null],\"members_epsilon\":[]", "");
+    assert!(!older.contains("epsilon"), "{older}");
+    let back: crate::engine::AerosolSummary = serde_json::from_str(&older).unwrap();
+    assert!(back.epsilon.1.is_nan() && back.members_epsilon.is_empty());
     assert_eq!((back.aot550.1, back.fit.as_str()), (0.1, "pair"));
 }
 
