@@ -406,10 +406,12 @@ fn review_pack_injection(tally: &mut Tally) {
     std::fs::write(results.join("figures/snr.svg"), original).unwrap();
     // review.json naming files outside the folder, or not parsing at all.
     let json = std::fs::read_to_string(results.join("review.json")).unwrap();
+    // Cut in half at a character boundary (the file holds units such as sr⁻¹).
+    let half = (0..=json.len() / 2).rev().find(|&i| json.is_char_boundary(i)).unwrap_or(0);
     let cases = [
         ("figure name ../../", json.replacen("\"snr\"", "\"../../../../etc/passwd\"", 1), "review.json"),
         ("figure name absolute", json.replacen("\"snr\"", "\"/etc/hostname\"", 1), "review.json"),
-        ("truncated review.json", json[..json.len() / 2].to_string(), "review.json"),
+        ("truncated review.json", json[..half].to_string(), "review.json"),
         ("review.json not JSON", "\u{FEFF}<html>".to_string(), "review.json"),
     ];
     for (what, text, said) in cases {
