@@ -292,11 +292,9 @@ pub struct AerosolRetrieval {
     pub high_glint: usize,
     /// The expected glint was taken away (the scene has glint and the correction's `glint` is on).
     pub glint_removed: bool,
-    /// The measured ε at the pair per pixel (the band-pair fit; NaN elsewhere).
-    pub epsilon: Array2<f32>,
-    /// The measured long-band aerosol signal per pixel while the fit runs (emptied once the
-    /// members' ε are placed: not kept).
-    pub long_signal: Vec<f32>,
+    /// The measured ε at the pair over the retrieved pixels: median, 5th and 95th percentiles
+    /// (the band-pair fit; NaN otherwise).
+    pub epsilon: (f64, f64, f64),
     /// The band-pair fit: every member's ε for the median pixel (its long-band signal, the
     /// centre column), as the fit places a measured ε among them (empty for dark-spectrum
     /// fitting).
@@ -355,7 +353,6 @@ pub fn correct_image(
     let (mut rrs, mut retrieval) = correct_with(level1, family, settings, bands, surface, control, &high_glint)?;
     // Left out already (invalid); flagged as glint too, so the flags say why.
     retrieval.high_glint = super::mark_high_glint(&mut rrs, &high_glint, surface);
-    retrieval.long_signal = Vec::new();
     retrieval.glint_removed = glint_removed;
     Ok((rrs, retrieval))
 }
@@ -375,9 +372,8 @@ fn correct_with(
     match settings.fit {
         AerosolFit::BandPair => {
             let fit = super::pair::PairFit::new(family, &packed, settings, bands)?;
-            let (rrs, mut retrieval) =
+            let (rrs, mut retrieval, long) =
                 apply(level1, surface, control, |p, mix, scratch| !high_glint(p.col) && fit.fit(p, mix, scratch))?;
-            let long = std::mem::take(&mut retrieval.long_signal);
             let mut long: Vec<f64> = long.into_iter().filter(|v| v.is_finite()).map(f64::from).collect();
             let median = crate::metrics::nearest_rank(&mut long, 0.5);
             retrieval.members_epsilon = fit.member_epsilon(level1.radiance.dim().1 / 2, median);
@@ -386,25 +382,26 @@ fn correct_with(
         AerosolFit::DarkSpectrum => {
             if (0..level1.radiance.dim().1).all(high_glint) {
                 // Nothing to fit: every pixel is left out for glint.
-                return apply(level1, surface, control, |_, _, _: &mut ()| false);
+                return apply(level1, surface, control, |_, _, _: &mut ()| false).map(|(r, a, _)| (r, a));
             }
             let tiles = super::dark::fit_tiles(level1, family, &settings.dark, bands, control, high_glint)?;
             let (rows, cols) = (level1.radiance.dim().0, level1.radiance.dim().1);
-            let (rrs, mut retrieval) = if let Some(smooth) = super::dark::smoothed(&tiles, &settings.dark, rows, cols) {
-                apply(level1, surface, control, |p, mix, _: &mut ()| {
-                    smooth.fill(family, &packed, p.row * cols + p.col, mix);
-                    !high_glint(p.col)
-                })?
-            } else {
-                let index = super::dark::tile_index(&tiles, rows, cols);
-                let mixtures: Vec<Mixture<'_>> = tiles.iter().map(|t| t.mixture(family, &packed)).collect();
-                apply(level1, surface, control, |p, mix, _: &mut ()| {
-                    let m = &mixtures[index[p.row * cols + p.col]];
-                    mix.entries.extend_from_slice(&m.entries);
-                    (mix.aot550, mix.angstrom, mix.passes) = (m.aot550, m.angstrom, 1);
-                    !high_glint(p.col)
-                })?
-            };
+            let (rrs, mut retrieval, _) =
+                if let Some(smooth) = super::dark::smoothed(&tiles, &settings.dark, rows, cols) {
+                    apply(level1, surface, control, |p, mix, _: &mut ()| {
+                        smooth.fill(family, &packed, p.row * cols + p.col, mix);
+                        !high_glint(p.col)
+                    })?
+                } else {
+                    let index = super::dark::tile_index(&tiles, rows, cols);
+                    let mixtures: Vec<Mixture<'_>> = tiles.iter().map(|t| t.mixture(family, &packed)).collect();
+                    apply(level1, surface, control, |p, mix, _: &mut ()| {
+                        let m = &mixtures[index[p.row * cols + p.col]];
+                        mix.entries.extend_from_slice(&m.entries);
+                        (mix.aot550, mix.angstrom, mix.passes) = (m.aot550, m.angstrom, 1);
+                        !high_glint(p.col)
+                    })?
+                };
             retrieval.tiles = tiles;
             Ok((rrs, retrieval))
         }
@@ -413,13 +410,15 @@ fn correct_with(
 
 /// Every pixel through `fit` (which fills the pixel's [`Mixture`] and says whether the pixel is
 /// usable), then every band inverted with that mixture; rows in parallel, each with its own
-/// scratch `S` (so the result does not depend on the threads).
+/// scratch `S` (so the result does not depend on the threads). Also returns each pixel's measured
+/// aerosol signal at the band pair's long band (NaN where none: not kept, only read to place the
+/// members' ε).
 fn apply<'f, S: Default>(
     level1: &Level1,
     surface: &SurfaceMap,
     control: &RunControl,
     fit: impl Fn(&Pixel<'_>, &mut Mixture<'f>, &mut S) -> bool + Sync,
-) -> Result<(Reflectance, AerosolRetrieval), CorrectionError> {
+) -> Result<(Reflectance, AerosolRetrieval, Vec<f32>), CorrectionError> {
     let (rows, cols, nb) = level1.radiance.dim();
     let (l1, l0_flags) = (slice(&level1.radiance)?, slice(&level1.flags)?);
     let stride = cols * nb;
@@ -481,6 +480,9 @@ fn apply<'f, S: Default>(
     let retrieved = aot.iter().filter(|v| v.is_finite()).count();
     let shape = (rows, cols);
     let bad = |e: ndarray::ShapeError| invalid("cube", e.to_string());
+    let mut eps: Vec<f64> = eps.into_iter().filter(|v| v.is_finite()).map(f64::from).collect();
+    let mut q = |p: f64| crate::metrics::nearest_rank(&mut eps, p);
+    let epsilon = (q(0.5), q(0.05), q(0.95));
     let retrieval = AerosolRetrieval {
         aot550: Array2::from_shape_vec(shape, aot).map_err(bad)?,
         angstrom: Array2::from_shape_vec(shape, alpha).map_err(bad)?,
@@ -489,9 +491,8 @@ fn apply<'f, S: Default>(
         tiles: Vec::new(),
         high_glint: 0,
         glint_removed: false,
-        epsilon: Array2::from_shape_vec(shape, eps).map_err(bad)?,
-        long_signal: long,
+        epsilon,
         members_epsilon: Vec::new(),
     };
-    Ok((assemble(rows, cols, nb, rrs, flags)?, retrieval))
+    Ok((assemble(rows, cols, nb, rrs, flags)?, retrieval, long))
 }

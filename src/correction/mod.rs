@@ -99,18 +99,16 @@ impl CorrectionSpec {
     /// high-glint threshold against [`crate::ranges::CORRECTION_EXACT_GLINT_THRESHOLD`] and the
     /// image-based correction's settings.
     pub fn validate(&self) -> Result<(), CorrectionError> {
+        let threshold = self.glint_threshold_per_sr.map(|t| (&crate::ranges::CORRECTION_EXACT_GLINT_THRESHOLD, t));
         for (range, value) in [
             (&crate::ranges::CORRECTION_APPROX_POINTS, self.approx_points as f64),
             (&crate::ranges::CORRECTION_EXACT_GLINT_WIND_ERROR, self.glint_wind_error_m_s),
-        ] {
+        ]
+        .into_iter()
+        .chain(threshold)
+        {
             range
                 .check(value)
-                .map_err(|message| CorrectionError::Invalid(FieldError { field: range.path.into(), message }))?;
-        }
-        if let Some(threshold) = self.glint_threshold_per_sr {
-            let range = &crate::ranges::CORRECTION_EXACT_GLINT_THRESHOLD;
-            range
-                .check(threshold)
                 .map_err(|message| CorrectionError::Invalid(FieldError { field: range.path.into(), message }))?;
         }
         if let Some(image) = self.image() {

@@ -206,14 +206,21 @@ impl Engine {
 /// (`correction.glint_wind_error_m_s`) over a scene with glint: the scene's glint carried to the
 /// wind it assumes ([`crate::correction::expected_glint`]). `None`: the scene's own glint.
 fn exact_glint(config: &RunConfig, side: &SceneSide) -> Option<Vec<f64>> {
-    let error = config.correction.exact_wind_error_m_s();
-    let crate::atmosphere::SeaSurface::Wind { speed_m_s } = config.scene.atmosphere.surface else { return None };
-    if error == 0.0 || !side.scene.wants(crate::scene::Effect::SunGlint) {
+    if config.correction.exact_wind_error_m_s() == 0.0 {
         return None;
     }
-    let winds = (speed_m_s, (speed_m_s + error).max(0.0));
+    let winds = exact_winds(config, side)?;
     let n = config.scene.atmosphere.water_refractive_index;
     Some(crate::correction::expected_glint(&side.band_atmosphere, &side.viewing, &side.response, winds, n))
+}
+
+/// Over a scene with glint (a wind-roughened sea and `SunGlint`): the scene's wind and the one
+/// the exact correction assumes (the scene's plus its error, at least 0), m/s.
+fn exact_winds(config: &RunConfig, side: &SceneSide) -> Option<(f64, f64)> {
+    let crate::atmosphere::SeaSurface::Wind { speed_m_s } = config.scene.atmosphere.surface else { return None };
+    side.scene
+        .wants(crate::scene::Effect::SunGlint)
+        .then(|| (speed_m_s, (speed_m_s + config.correction.exact_wind_error_m_s()).max(0.0)))
 }
 
 /// Where the scene has clouds, the pixels the processor screens out (clouds and their shadows):
@@ -257,11 +264,7 @@ fn mask_exact_high_glint(
     surface: &crate::instrument::SurfaceMap,
 ) -> Option<super::HighGlint> {
     let threshold_per_sr = config.correction.exact_glint_threshold_per_sr()?;
-    let crate::atmosphere::SeaSurface::Wind { speed_m_s } = config.scene.atmosphere.surface else { return None };
-    if !side.scene.wants(crate::scene::Effect::SunGlint) {
-        return None;
-    }
-    let assumed_wind_m_s = (speed_m_s + config.correction.exact_wind_error_m_s()).max(0.0);
+    let (_, assumed_wind_m_s) = exact_winds(config, side)?;
     let n = config.scene.atmosphere.water_refractive_index;
     let lgn = crate::correction::column_lgn(&side.viewing, assumed_wind_m_s, n);
     let high = |c: usize| lgn.get(c).is_some_and(|g| *g > threshold_per_sr);

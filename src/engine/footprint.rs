@@ -76,11 +76,7 @@ impl Footprint for Level1 {
 
 impl Footprint for Corrected {
     fn bytes(&self) -> usize {
-        let aerosol = self
-            .product
-            .aerosol
-            .as_ref()
-            .map_or(0, |a| array_bytes(&a.aot550) + array_bytes(&a.angstrom) + array_bytes(&a.epsilon));
+        let aerosol = self.product.aerosol.as_ref().map_or(0, |a| array_bytes(&a.aot550) + array_bytes(&a.angstrom));
         array_bytes(&self.rrs.rrs) + array_bytes(&self.rrs.flags) + aerosol
     }
 }

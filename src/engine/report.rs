@@ -226,7 +226,6 @@ pub(super) fn aerosol_summary(
     let mut errors: Vec<f64> = retrieved.clone().map(|(i, v)| (f64::from(*v) - true_at(i)).abs()).collect();
     let mut true_values: Vec<f64> = retrieved.map(|(i, _)| true_at(i)).collect();
     let mut alpha: Vec<f64> = a.angstrom.iter().filter(|v| v.is_finite()).map(|&v| f64::from(v)).collect();
-    let mut eps: Vec<f64> = a.epsilon.iter().filter(|v| v.is_finite()).map(|&v| f64::from(v)).collect();
     // Quantiles by selection, not sorting: four sorts of a million pixels each took ~0.4 s of one
     // core per run, while the other core waited.
     let q = |v: &mut [f64], p: f64| crate::metrics::nearest_rank(v, p);
@@ -256,7 +255,7 @@ pub(super) fn aerosol_summary(
         outside_family_pct: if aot.is_empty() { 0.0 } else { 100.0 * a.outside_family as f64 / aot.len() as f64 },
         passes_mean: a.passes_mean,
         fit: fit_words(a, settings, centres_nm),
-        epsilon: (q(&mut eps, 0.5), q(&mut eps, 0.05), q(&mut eps, 0.95)),
+        epsilon: a.epsilon,
         members_epsilon,
     }
 }

@@ -62,8 +62,8 @@ const LEAN_BYTES_PER_PIXEL_BAND: f64 = 16.0;
 const EFFECTS_BYTES_PER_PIXEL_BAND: f64 = 8.0;
 /// Bytes per pixel of a lean run beyond its bands: its truth maps (13), its products as they are
 /// made and the retrieval's rows before they are joined (about 45), an image-based correction's
-/// aerosol maps (AOT, Ångström and ε: 12, and the long band's signal while the fit runs: 4),
-/// rounded up.
+/// aerosol maps (AOT and Ångström: 8, and the band pair's ε and long-band signal while the fit
+/// runs: 8), rounded up.
 const LEAN_BYTES_PER_PIXEL: f64 = 80.0;
 /// Bytes per pixel a study keeps of each run until its tables and figures are written: the
 /// truth's maps (chl, NAP, CDOM, depth, three substrate fractions, surface: at most 29) and an
