@@ -102,9 +102,7 @@ fn f_number_and_smear_against_first_principles() {
 
 #[test]
 fn the_cli_prints_the_warnings_and_writes_them_into_report_json() {
-    let dir = std::env::temp_dir().join(format!("shoal-plausible-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = crate::common::TempDir::new("plausible", "cli");
     let mut instrument = small("cubesat", 12, 8);
     instrument.aperture_mm = 999.0;
     instrument.well_depth_e = 10.0;

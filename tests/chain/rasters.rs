@@ -213,11 +213,8 @@ fn resampling_matches_gdalwarp() {
 }
 
 /// A fresh temporary directory for one test.
-fn tempdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("shoal-rasters-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+fn tempdir(name: &str) -> crate::common::TempDir {
+    crate::common::TempDir::new("rasters", name)
 }
 
 /// Run a GDAL tool (Debian's gdal-bin, which `.ci/run` installs) and return its stdout.

@@ -2,18 +2,15 @@
 //! installs) renders it headless; the page must not be blank, every image must load, and the
 //! HTML must reference nothing outside itself.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
 fn shoal() -> Command {
     Command::new(env!("CARGO_BIN_EXE_shoal"))
 }
 
-fn tempdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("shoal-report-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+fn tempdir(name: &str) -> crate::common::TempDir {
+    crate::common::TempDir::new("report", name)
 }
 
 fn ok(cmd: &mut Command) -> String {

@@ -14,11 +14,8 @@ use shoal::spectral::Extrapolation::Clamp;
 use shoal::spectral::{BandSet, BandSetSpec, GaussianBand, Table};
 use shoal::water::{SiopSpec, SubstrateLibrary};
 
-fn temp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("shoal-user-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+fn temp(name: &str) -> crate::common::TempDir {
+    crate::common::TempDir::new("user", name)
 }
 
 fn shoal(home: &Path) -> Command {

@@ -198,3 +198,44 @@ impl Kept for shoal::engine::RunOutput {
         self.cubes.as_ref().expect("an engine made by Engine::new keeps its cubes")
     }
 }
+
+/// A directory of its own under the system's temporary directory, made empty when created and
+/// removed with everything in it when dropped, so a test run leaves nothing behind (it derefs to
+/// its path).
+pub struct TempDir(std::path::PathBuf);
+
+impl TempDir {
+    /// `shoal-{kind}-{name}-{process id}`, empty.
+    #[must_use]
+    pub fn new(kind: &str, name: &str) -> Self {
+        let dir = std::env::temp_dir().join(format!("shoal-{kind}-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        Self(dir)
+    }
+}
+
+impl std::ops::Deref for TempDir {
+    type Target = std::path::PathBuf;
+    fn deref(&self) -> &std::path::PathBuf {
+        &self.0
+    }
+}
+
+impl AsRef<std::path::Path> for TempDir {
+    fn as_ref(&self) -> &std::path::Path {
+        &self.0
+    }
+}
+
+impl AsRef<std::ffi::OsStr> for TempDir {
+    fn as_ref(&self) -> &std::ffi::OsStr {
+        self.0.as_os_str()
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}

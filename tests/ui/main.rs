@@ -7,7 +7,6 @@
 #![cfg(feature = "gui")]
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use egui::accesskit::Role;
@@ -18,6 +17,8 @@ use shoal::app::{AppOptions, ShoalApp};
 use shoal::instrument::InstrumentSpec;
 use shoal::library::Library;
 
+#[path = "../common/mod.rs"]
+mod common;
 mod design;
 mod designs;
 mod editing;
@@ -43,11 +44,8 @@ const EIGHT: [&str; 8] = [
 ];
 
 /// A fresh, empty user library in the system temporary directory.
-fn temp_library(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("shoal-ui-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+fn temp_library(name: &str) -> common::TempDir {
+    common::TempDir::new("ui", name)
 }
 
 /// The default study (CubeSat vs SmallSat over Lake Hume) with A set to `a`, run at 1/`level`.

@@ -9,7 +9,7 @@ use egui_kittest::kittest::Queryable;
 use super::{harness, pick, temp_library};
 
 /// The app on the CubeSat at 1/24 in a library of its own (`name`), its Season window open.
-fn season_window(name: &str) -> (std::path::PathBuf, egui_kittest::Harness<'static, shoal::app::ShoalApp>) {
+fn season_window(name: &str) -> (super::common::TempDir, egui_kittest::Harness<'static, shoal::app::ShoalApp>) {
     let dir = temp_library(name);
     let mut h = harness("cubesat", 24, &dir);
     h.get_by_label("Season").click();
