@@ -18,9 +18,13 @@
 //! l2gen relates rrs and u through Morel's tabulated f/Q; Shoal has no such table and uses
 //! rrs = g₀·u + g₁·u² with g₀ = 0.0949, g₁ = 0.0794 (Gordon et al. 1988, as QAA does, Lee et al.
 //! 2002) in both directions, so that the relation's form cancels where u is small. The pass's
-//! NIR Rrs enters the next as (1 − 0.33)·new + 0.33·previous, and not at all where chl ≤ 0.7
-//! mg m⁻³ (ramped in to 1.3): l2gen's damping and ramp. Passes stop when Rrs(670) changes by
-//! less than 2 % or after ten (l2gen's `nir_chg` and `aer_iter_max`).
+//! NIR water radiance enters the next as (1 − 0.33)·new + 0.33·previous, that damped value then
+//! scaled by the ramp: 0 where chl ≤ 0.7 mg m⁻³, 1 from 1.3 (l2gen's damping, then its ramp,
+//! in that order). Where OC4 fails (a blue or green Rrs not positive), the pass is reseeded as
+//! l2gen's `atmocor2.c` does for turbid water: chl 10 mg m⁻³ and the red band's whole
+//! Rayleigh-corrected radiance taken as the water's (once, and a second time as the last pass).
+//! Passes stop when Rrs(670) changes by less than 2 % or after ten (l2gen's `nir_chg` and
+//! `aer_iter_max`).
 //!
 //! a_w is WOPP v3 (Röttgers et al.; Mason et al. 2016), bb_w Zhang et al. (2009) seawater, both
 //! averaged over each band's response: the processor's own tables, not the scene's SIOPs.
@@ -51,6 +55,8 @@ pub const DAMPING: f64 = 0.33;
 pub const CONVERGED: f64 = 0.02;
 /// l2gen's `aer_iter_max`.
 pub const MAX_PASSES: usize = 10;
+/// The chlorophyll, mg m⁻³, l2gen reseeds a pass with where OC4 fails (`atmocor2.c`).
+pub const TURBID_SEED_CHL: f64 = 10.0;
 
 /// The band model and the bands it reads.
 #[derive(Debug, Clone)]

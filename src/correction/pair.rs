@@ -109,35 +109,62 @@ impl<'f> PairFit<'f> {
     }
 
     /// Fill `mix` with the pixel's atmosphere; false where the pair's bands are flagged.
+    ///
+    /// Each pass follows l2gen's `atmocor2.c`: the NIR water radiance the model gives is damped
+    /// against the previous pass's, and the ramp then scales the damped value, so that where
+    /// OC4 gives 0.7 mg m⁻³ or less the water is black whatever the previous pass held. A pass
+    /// whose OC4 fails (a blue or green Rrs not positive: the black-pixel fit over-corrected a
+    /// turbid pixel) is taken for turbid water, as l2gen reseeds it: chl 10 mg m⁻³ and the red
+    /// band's whole Rayleigh-corrected radiance the water's; a second failure reseeds once more
+    /// and ends the passes.
     pub fn fit(&self, p: &Pixel<'_>, mix: &mut Mixture<'f>, scratch: &mut Scratch) -> bool {
         let (s, l) = self.pair;
         let usable = !p.land && p.flags[l] == 0 && p.flags[s] == 0;
         // The water's part of the TOA radiance at the pair's bands, from the previous pass; the
         // first pass starts where the row's previous water pixel ended (l2gen starts every pixel
-        // black: the fixed point is the same, reached in fewer passes).
+        // black: the iteration contracts to the same fixed point, reached in fewer passes).
         let mut water = if usable && self.nir.is_some() { scratch.warm.unwrap_or([0.0; 2]) } else { [0.0; 2] };
         let mut previous_red = f64::INFINITY;
+        let mut reseeds = 0;
         for pass in 1..=nir_water::MAX_PASSES + 1 {
             self.select(p, water, mix, scratch);
             mix.passes = pass;
             let Some(nir) = self.nir.as_ref().filter(|_| usable) else { break };
             let rrs = |b: usize| mix.rrs(p.at(b), f64::from(p.l1[b]));
             let red = rrs(nir.red);
+            if red < 0.0 && pass == 1 && water != [0.0; 2] {
+                // The previous pixel's water leaves this one's red band negative: start again
+                // black, where l2gen starts every pixel.
+                water = [0.0; 2];
+                continue;
+            }
             if red < 0.0
                 || (red - previous_red).abs() < nir_water::CONVERGED * red.abs()
                 || pass > nir_water::MAX_PASSES
+                || reseeds > 1
             {
                 scratch.warm = Some(water);
                 break;
             }
             previous_red = red;
-            // No chlorophyll (a ratio not positive) or below the ramp: the water stays black.
-            let chl = nir.chl_oc4(rrs).unwrap_or(0.0);
+            let (chl, red_as_water) = match nir.chl_oc4(rrs) {
+                Some(chl) => (chl, None),
+                None if pass < nir_water::MAX_PASSES => {
+                    reseeds += 1;
+                    // The red band with the Rayleigh atmosphere alone: all its aerosol signal
+                    // counted as the water's.
+                    let [l_path, t_ed, albedo] = self.packed.terms[0][0][p.at(nir.red)];
+                    let all = super::mixture::invert(f64::from(p.l1[nir.red]), l_path, t_ed, albedo);
+                    (nir_water::TURBID_SEED_CHL, Some(all))
+                }
+                None => (0.0, None),
+            };
             let ramp = NirWater::ramp(chl);
-            let estimate = if ramp > 0.0 { nir.estimate(rrs, chl, [s, l]).unwrap_or([0.0; 2]) } else { [0.0; 2] };
+            let model_rrs = |b: usize| if b == nir.red { red_as_water.unwrap_or(red) } else { rrs(b) };
+            let estimate = if ramp > 0.0 { nir.estimate(model_rrs, chl, [s, l]).unwrap_or([0.0; 2]) } else { [0.0; 2] };
             for (j, b) in [s, l].into_iter().enumerate() {
-                let new = mix.water_radiance(p.at(b), ramp * estimate[j]);
-                water[j] = (1.0 - nir_water::DAMPING) * new + nir_water::DAMPING * water[j];
+                let new = mix.water_radiance(p.at(b), estimate[j]);
+                water[j] = ramp * ((1.0 - nir_water::DAMPING) * new + nir_water::DAMPING * water[j]);
             }
         }
         usable
