@@ -233,7 +233,7 @@ pub fn accesses(orbit: &impl Track, site: &Site, from_days: f64, to_days: f64, m
     // checked again at each pass).
     let a = orbit.at(from_days).map_or(r, |(_, a)| a);
     let gamma = max_off_nadir_rad.clamp(0.0, 1.5);
-    let c_max = ((a / r) * gamma.sin()).min(1.0).asin() - gamma;
+    let c_max = max_central_angle(a, gamma);
     let step_days = 20.0 / sun::DAY_S;
     // A grid point next to the minimum is at most one step of ground track away.
     let step_arc = orbit.angular_rate_rad_s() * 20.0 + 7.3e-5 * 20.0;
@@ -304,13 +304,24 @@ fn golden_max(f: &impl Fn(f64) -> f64, mut lo: f64, mut hi: f64) -> f64 {
     0.5 * (lo + hi)
 }
 
+/// The largest central angle (rad, between the sub-satellite point and a ground point) that a
+/// satellite at radius `a_m` sees within off-nadir angle `gamma_rad`: sin(γ + c) = (a/R)·sin γ
+/// on the near side of the Earth (the sine rule in the triangle of the Earth's centre, the
+/// satellite and the ground point; Wertz 2009, §8.3). Past the horizon's off-nadir angle
+/// asin(R/a) the ray misses the Earth, and the answer stays the horizon's, acos(R/a).
+fn max_central_angle(a_m: f64, gamma_rad: f64) -> f64 {
+    let r = EARTH_RADIUS_M;
+    let x = (a_m / r) * gamma_rad.sin();
+    if x >= 1.0 { (r / a_m).clamp(-1.0, 1.0).acos() } else { x.asin() - gamma_rad }
+}
+
 /// The geometry of the pass closest to `site` at `days`, if the site is within off-nadir angle
 /// `max_gamma` of the ground track.
 fn access_at(orbit: &impl Track, site: &Site, days: f64, max_gamma: f64) -> Option<Access> {
     let (p, a) = orbit.at(days)?;
     let s = site.unit();
     let r = EARTH_RADIUS_M;
-    let c_max = ((a / r) * max_gamma.sin()).min(1.0).asin() - max_gamma;
+    let c_max = max_central_angle(a, max_gamma);
     let c = dot(p, s).clamp(-1.0, 1.0).acos();
     if c > c_max {
         return None;

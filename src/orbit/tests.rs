@@ -230,3 +230,29 @@ fn a_year_asks_for_far_fewer_positions_than_grid_points() {
     assert!(counted.1.get() * 15 < grid, "{} positions for {grid} grid points", counted.1.get());
     assert!((120..220).contains(&year.len()), "{}", year.len());
 }
+
+/// Past the horizon's off-nadir angle (asin(R/a) = 64.2° at 700 km) a wider reach sees no
+/// further: the central angle stays the horizon's (25.8°), and every pass a 57° reach finds, a
+/// reach of 1.4 rad (80°) finds too, with the same geometry. (The search once took the
+/// central angle as π/2 − γ there, so that 80° kept passes only out to 10°.)
+#[test]
+fn a_reach_past_the_horizon_keeps_every_pass_a_smaller_one_finds() {
+    let o = orbit(700.0);
+    let horizon = (EARTH_RADIUS_M / o.radius_m()).acos();
+    assert!((horizon.to_degrees() - 25.8).abs() < 0.05, "{}", horizon.to_degrees());
+    assert_eq!(max_central_angle(o.radius_m(), 1.4), horizon);
+    assert!(max_central_angle(o.radius_m(), 1.0) < horizon);
+    let site = Site::from_degrees(-36.1, 147.0);
+    let narrow = accesses(&o, &site, o.epoch_days, o.epoch_days + 16.0, 1.0);
+    let wide = accesses(&o, &site, o.epoch_days, o.epoch_days + 16.0, 1.4);
+    assert!(narrow.len() >= 20, "{}", narrow.len());
+    for a in &narrow {
+        assert!(
+            wide.iter().any(|w| (w.days - a.days).abs() * sun::DAY_S < 1.0 && (w.off_nadir_rad - a.off_nadir_rad).abs() < 1e-9),
+            "the pass at off-nadir {:.1}° is lost",
+            a.off_nadir_rad.to_degrees()
+        );
+    }
+    assert!(wide.len() > narrow.len());
+    assert!(wide.iter().all(|w| w.off_nadir_rad.abs() < (EARTH_RADIUS_M / o.radius_m()).asin() + 1e-9));
+}
