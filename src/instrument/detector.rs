@@ -409,8 +409,12 @@ impl Detector {
             return None;
         }
         if !self.mode.noise {
-            // Every frame is the same value.
-            return Some(self.level0_value(&self.read_out_with(b, exposure.draw(rng), 0.0)));
+            // Every frame is the same value, read through the exposure's own detector's
+            // response curve. A value that clips is read frame by frame, which counts the
+            // saturated frames.
+            let adc = readout::Adc::of(self, 0, b).with_curve(exposure.curve);
+            let r = readout::value(adc, exposure.draw(rng), 0.0);
+            return (r.flags & Flags::SATURATED == 0).then(|| self.level0_value(&r));
         }
         let plane = self.plane(b);
         let q = exposure.binned;

@@ -66,12 +66,18 @@ pub fn registration_px(spec: &InstrumentSpec) -> f64 {
 }
 
 /// The largest departure from a straight line at full well the calibration leaves, %: the
-/// curve's |a₂ + a₃| (its largest band's; columns spread about it by `column_spread`) times
+/// curve's |a₂ + a₃| (its largest band's, the per-band list's where there is one; columns
+/// spread about it by `column_spread`) times
 /// |error| when it linearises, whole when not; 0 without non-linearity.
 #[must_use]
 pub fn nonlinearity_left_pct(spec: &InstrumentSpec) -> f64 {
     effects::non_linearity(&spec.effects).map_or(0.0, |n| {
-        let worst = n.per_band.iter().map(|&(q, c)| (q + c).abs()).fold((n.quadratic + n.cubic).abs(), f64::max);
+        // A per-band list sets every band (the stated curve then applies to none).
+        let worst = if n.per_band.is_empty() {
+            (n.quadratic + n.cubic).abs()
+        } else {
+            n.per_band.iter().map(|&(q, c)| (q + c).abs()).fold(0.0, f64::max)
+        };
         let left = if n.correction.corrected { n.correction.error.abs() } else { 1.0 };
         100.0 * worst * left
     })

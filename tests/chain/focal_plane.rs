@@ -73,6 +73,20 @@ fn a_straight_line_changes_nothing_and_a_known_curve_closes() {
     }
 }
 
+/// Each detector's own curve, known exactly, closes too: the calibration's noise-free frames
+/// are read through the element's curve, not detector 0's (which left every other column's
+/// gain and offset off by the curves' difference: a 5 % spread striped Level-1 by percents).
+#[test]
+fn a_curve_that_differs_by_column_closes_column_by_column() {
+    let base = residuals(&run(&config("[]")));
+    let spread = "[NonLinearity((quadratic: -0.025, cubic: 0.005, column_spread: 0.05, \
+                  correction: (corrected: true, error: 0.0)))]";
+    let exact = residuals(&run(&config(spread)));
+    for (e, b) in exact.iter().zip(&base) {
+        assert!((e - b).abs() < 2e-6, "known exactly, per column: {e} against {b}");
+    }
+}
+
 #[test]
 fn a_curve_that_falls_is_refused_by_name() {
     let mut c = config(&non_linearity(-0.2, -0.2, true, 0.0));
@@ -240,4 +254,18 @@ fn misregistration_moves_level1_and_co_registration_takes_most_of_it_back() {
     assert!((wrong / expected - 1.0).abs() < 0.1, "{wrong} against {expected}");
     // The pupil radiance is untouched: the shift is the instrument's.
     assert_eq!(shifted(false, 0.0).kept().radiance.radiance, ideal.kept().radiance.radiance);
+}
+
+/// A per-band curve sets every band: the non-linearity a study judges is the list's worst, the
+/// stated curve applying to none (it once counted too, and a requirement failed on a curve no
+/// band had).
+#[test]
+fn the_judged_non_linearity_is_the_per_band_lists_where_there_is_one() {
+    let mut spec = small("cubesat", 8, 8);
+    let list = ["(-0.004, 0.001)", "(-0.001, 0.0)", "(0.002, 0.0)"].join(", ");
+    spec.effects = ron::from_str(&format!(
+        "[NonLinearity((quadratic: -0.05, cubic: 0.0, per_band: [{list}], correction: (corrected: false)))]"
+    ))
+    .unwrap();
+    assert!((shoal::study::nonlinearity_left_pct(&spec) - 0.3).abs() < 1e-9);
 }

@@ -103,6 +103,12 @@ pub(super) struct Adc {
 }
 
 impl Adc {
+    /// The same converter with response curve `curve` (an exposure's: its detector's own).
+    #[inline(always)]
+    pub(super) fn with_curve(self, curve: Curve) -> Self {
+        Self { curve, ..self }
+    }
+
     /// The converter of detector `j`'s band `b` (its focal plane's, with the element's curve).
     #[inline(always)]
     pub(super) fn of(d: &Detector, j: usize, b: usize) -> Self {
