@@ -68,7 +68,11 @@ pub fn error_curves(result: &SeasonResult, product: &str, variable: &str, limit:
                 .runs
                 .iter()
                 .filter_map(|r| {
-                    let e = r.errors.iter().find(|e| e.product == product && e.variable == variable)?;
+                    // A look that returned none of the product has no error to plot.
+                    let e = r
+                        .errors
+                        .iter()
+                        .find(|e| e.product == product && e.variable == variable && e.returned_pct > 0.0)?;
                     Some(point(d.looks[r.look].access.days - result.period.0, e.mae_pct))
                 })
                 .collect();

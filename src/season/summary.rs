@@ -5,7 +5,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::looks::Verdict;
-use super::run::SeasonResult;
+use super::run::{LookError, SeasonResult};
 use super::stats;
 
 /// The file `shoal season` writes its summary to.
@@ -122,6 +122,27 @@ fn spread(values: &[f64]) -> Option<(f64, f64, f64)> {
     Some((stats::percentile(values, 0.0)?, stats::percentile(values, 50.0)?, stats::percentile(values, 100.0)?))
 }
 
+/// One product's error over a design's looks: the MAE percentiles over the looks that returned
+/// some of it (a look whose water was all screened out, masked or failed has no error: its
+/// metrics' MAE of 0 % would pull the median down), the share returned over every look run.
+/// `None` when no look returned it.
+fn product_season(product: &str, variable: &str, errs: &[&LookError]) -> Option<ProductSeason> {
+    let mae: Vec<f64> = errs.iter().filter(|e| e.returned_pct > 0.0).map(|e| e.mae_pct).collect();
+    let returned: Vec<f64> = errs.iter().map(|e| e.returned_pct).collect();
+    let p = |q: f64| stats::percentile(&mae, q);
+    Some(ProductSeason {
+        product: product.to_string(),
+        variable: variable.to_string(),
+        looks: mae.len(),
+        mae_median_pct: p(50.0)?,
+        mae_p10_pct: p(10.0)?,
+        mae_p90_pct: p(90.0)?,
+        mae_worst_pct: p(100.0)?,
+        returned_median_pct: stats::percentile(&returned, 50.0)?,
+        returned_least_pct: stats::percentile(&returned, 0.0)?,
+    })
+}
+
 impl SeasonSummary {
     /// The summary of `result`.
     #[must_use]
@@ -139,21 +160,7 @@ impl SeasonSummary {
                 let products = vars
                     .iter()
                     .filter_map(|(product, variable)| {
-                        let errs = d.errors_of(product, variable);
-                        let mae: Vec<f64> = errs.iter().map(|e| e.mae_pct).collect();
-                        let returned: Vec<f64> = errs.iter().map(|e| e.returned_pct).collect();
-                        let p = |q: f64| stats::percentile(&mae, q);
-                        Some(ProductSeason {
-                            product: product.clone(),
-                            variable: variable.clone(),
-                            looks: mae.len(),
-                            mae_median_pct: p(50.0)?,
-                            mae_p10_pct: p(10.0)?,
-                            mae_p90_pct: p(90.0)?,
-                            mae_worst_pct: p(100.0)?,
-                            returned_median_pct: stats::percentile(&returned, 50.0)?,
-                            returned_least_pct: stats::percentile(&returned, 0.0)?,
-                        })
+                        product_season(product, variable, &d.errors_of(product, variable))
                     })
                     .collect();
                 DesignSummary {
@@ -287,4 +294,27 @@ impl SeasonSummary {
 
 fn fmt(v: Option<f64>, digits: usize) -> String {
     v.map_or_else(|| "–".to_string(), |v| format!("{v:.digits$}"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn error(mae_pct: f64, returned_pct: f64) -> LookError {
+        LookError { product: "aLMI".into(), variable: "chl_mg_m3".into(), mae_pct, bias_pct: 0.0, returned_pct }
+    }
+
+    /// A look that returned no water has no error: it does not enter the MAE percentiles (its
+    /// metrics' MAE of 0 % would have made the median 20 % here), but it is the least returned.
+    #[test]
+    fn a_look_that_returned_nothing_has_no_error() {
+        let errs = [error(20.0, 90.0), error(0.0, 0.0), error(0.0, 0.0), error(30.0, 80.0)];
+        let refs: Vec<&LookError> = errs.iter().collect();
+        let p = product_season("aLMI", "chl_mg_m3", &refs).unwrap();
+        assert_eq!(p.looks, 2);
+        assert!((p.mae_median_pct - 25.0).abs() < 1e-12 && p.mae_p10_pct >= 20.0, "{p:?}");
+        assert_eq!(p.returned_least_pct, 0.0);
+        let none = [error(0.0, 0.0)];
+        assert!(product_season("aLMI", "chl_mg_m3", &none.iter().collect::<Vec<_>>()).is_none());
+    }
 }
