@@ -378,11 +378,13 @@ pub fn edge_ratio(effects: &[InstrumentEffect], distance_m: f64, centre_nm: f64)
     })
 }
 
-/// The largest polarisation sensitivity of any band; `None` without the effect.
+/// The largest polarisation sensitivity of any band (the per-band list's where there is one: it
+/// then sets every band); `None` without the effect.
 #[must_use]
 pub fn polarisation_sensitivity(effects: &[InstrumentEffect]) -> Option<f64> {
     effects.iter().find_map(|e| match e {
-        InstrumentEffect::Polarisation(p) => Some(p.per_band.iter().copied().fold(p.sensitivity, f64::max)),
+        InstrumentEffect::Polarisation(p) if p.per_band.is_empty() => Some(p.sensitivity),
+        InstrumentEffect::Polarisation(p) => Some(p.per_band.iter().copied().fold(f64::NEG_INFINITY, f64::max)),
         _ => None,
     })
 }

@@ -66,7 +66,7 @@ impl Polarisation {
             })
         })?;
         let (_, cols, nb) = cube.dim();
-        if self.per_band.len() > 1 && self.per_band.len() != nb {
+        if !self.per_band.is_empty() && self.per_band.len() != nb {
             return Err(InstrumentError::Invalid(FieldError {
                 field: "effects[].Polarisation.per_band".into(),
                 message: format!("{} values for {nb} bands (give one per band, or none)", self.per_band.len()),
@@ -171,6 +171,14 @@ mod tests {
         let mut cube = Array3::<f32>::from_elem((1, 1, 2), 1.0);
         let e = p.apply(&mut cube, &ctx(&stokes, &[443.0, 865.0]), &RunControl::new()).unwrap_err();
         assert!(e.to_string().contains("per_band"), "{e}");
+        // One value for two bands is refused too (it would have set band 0 alone).
+        let one = Polarisation { per_band: vec![0.01], ..p.clone() };
+        let e = one.apply(&mut cube, &ctx(&stokes, &[443.0, 865.0]), &RunControl::new()).unwrap_err();
+        assert!(e.to_string().contains("1 values for 2 bands"), "{e}");
+        // The worst band is the list's where there is one: `sensitivity` then applies to none.
+        let listed = Polarisation { sensitivity: 0.02, per_band: vec![0.005, 0.004], ..p.clone() };
+        let effects = [super::super::InstrumentEffect::Polarisation(listed)];
+        assert_eq!(super::super::polarisation_sensitivity(&effects), Some(0.005));
         assert!(p.validate("instrument.effects[0].Polarisation").is_ok());
         let bad = Polarisation { sensitivity: 0.5, ..p };
         let e = bad.validate("instrument.effects[0].Polarisation").unwrap_err().to_string();

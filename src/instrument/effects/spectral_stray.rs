@@ -49,7 +49,12 @@ impl SpectralStrayLight {
             if n < 2 {
                 continue;
             }
-            let k = |i: usize| (-(centres_nm[i] - centres_nm[j]).abs() / self.width_nm).exp();
+            // Each weight relative to the nearest other band's (the shares are the same): a
+            // width far below the bands' spacing would otherwise underflow every weight to 0 and
+            // make the shares 0/0. The nearest band then takes the whole share.
+            let distance = |i: usize| (centres_nm[i] - centres_nm[j]).abs();
+            let nearest = (0..n).filter(|&i| i != j).map(distance).fold(f64::INFINITY, f64::min);
+            let k = |i: usize| (-(distance(i) - nearest) / self.width_nm).exp();
             let total: f64 = (0..n).filter(|&i| i != j).map(k).sum();
             m[j * n + j] -= fraction;
             for i in (0..n).filter(|&i| i != j) {
@@ -203,6 +208,24 @@ mod tests {
         let stray = f64::from(cube[(0, 0, 0)] - truth[(0, 0, 0)]);
         let residual = f64::from(left[(0, 0, 0)] - truth[(0, 0, 0)]);
         assert!((residual / stray + 0.2).abs() < 0.02, "residual {residual} of stray {stray}");
+    }
+
+    /// A width far below the bands' spacing (Landsat 8's SWIR band is 592 nm from the next:
+    /// exp(−592/0.5) underflows to 0) sends each band's share to its nearest neighbour, and
+    /// every entry is finite; the columns still sum to 1 (light moved, not made).
+    #[test]
+    fn a_narrow_width_gives_the_share_to_the_nearest_band() {
+        let centres = [443.0, 482.0, 561.0, 655.0, 865.0, 1609.0, 2201.0];
+        let s = SpectralStrayLight { fraction: 0.02, width_nm: 0.5, correction: Knowledge::default() };
+        let m = s.matrix(&centres, s.fraction);
+        let n = centres.len();
+        assert!(m.iter().all(|v| v.is_finite()));
+        for j in 0..n {
+            let column: f64 = (0..n).map(|i| m[i * n + j]).sum();
+            assert!((column - 1.0).abs() < 1e-15, "column {j} sums to {column}");
+        }
+        // 2201 nm gives its 2 % to 1609 nm, the nearest.
+        assert!((m[5 * n + 6] - 0.02).abs() < 1e-15 && m[4 * n + 6] == 0.0);
     }
 
     #[test]
