@@ -342,7 +342,7 @@ ranges! {
     /// Dark frames.
     CALIBRATION_DARK_FRAMES = Range::count("calibration.dark_frames", 1.0, 10_000.0, "", "dark frames averaged");
     /// Dark exposure.
-    CALIBRATION_DARK_EXPOSURE_S = Range::closed("calibration.dark_exposure_s", 0.0, 10.0, "s", "exposure of the dark frames (0: the scene's)");
+    CALIBRATION_DARK_EXPOSURE_S = Range::closed("calibration.dark_exposure_s", 0.0, 10.0, "s", "exposure of the dark frames (0, the paper's: no dark current; the scene's to see it)");
     /// Diffuser reflectance.
     CALIBRATION_DIFFUSER_REFLECTANCE = Range::above("calibration.diffuser_reflectance", 0.0, 1.0, "", "diffuser reflectance");
     /// Sun incidence on the diffuser.
