@@ -276,7 +276,8 @@ impl crate::simd::Kernel for Correct<'_, '_> {
 
 impl SceneApproximation {
     /// The paper's per-scene terms from `points` random water pixels (seeded), using the
-    /// noise-free TOA radiance and the true Rrs of those pixels.
+    /// noise-free TOA radiance and the true Rrs of those pixels: open water, out of the clouds'
+    /// shadows, wherever the image has some.
     pub fn new(
         toa_radiance: &Array3<f32>,
         truth_rrs: &Array3<f32>,
@@ -286,7 +287,11 @@ impl SceneApproximation {
         seed: u64,
     ) -> Result<Self, CorrectionError> {
         let (rows, cols, nb) = toa_radiance.dim();
-        let n_water = surface.water_count();
+        // Open water only where there is some: in a cloud's shadow the direct sun is missing from
+        // the water's irradiance, and A1 would take the missing part for path radiance.
+        let open = (0..rows * cols).any(|i| surface.is_open_water_at(i));
+        let sampled = |i: usize| if open { surface.is_open_water_at(i) } else { surface.is_water_at(i) };
+        let n_water = (0..rows * cols).filter(|&i| sampled(i)).count();
         if n_water == 0 || points == 0 {
             return Err(CorrectionError::Invalid(FieldError {
                 field: "correction.approx_points".into(),
@@ -300,7 +305,7 @@ impl SceneApproximation {
         let mut chosen = Vec::with_capacity(picks.len());
         let mut k = 0;
         for i in 0..rows * cols {
-            if surface.is_water_at(i) {
+            if sampled(i) {
                 if picks.binary_search(&k).is_ok() {
                     chosen.push((i / cols, i % cols));
                 }

@@ -137,6 +137,13 @@ impl SurfaceMap {
         self.codes.as_slice().is_some_and(|c| c.get(index).is_some_and(|&v| SurfaceClass::of_code(v).is_water()))
     }
 
+    /// Is the pixel at `index` (row-major) open water: water out of any cloud's shadow, under
+    /// the full sun?
+    #[must_use]
+    pub fn is_open_water_at(&self, index: usize) -> bool {
+        self.codes.as_slice().is_some_and(|c| c.get(index).is_some_and(|&v| v == SurfaceClass::Water as u8))
+    }
+
     /// The water pixels.
     #[must_use]
     pub fn water_count(&self) -> usize {

@@ -145,3 +145,20 @@ fn a_cloud_layer_out_of_range_is_refused_naming_the_field() {
     let e = cloudy(None, CloudScreen { threshold: 0.0, ..CloudScreen::default() }).validate().unwrap_err().to_string();
     assert!(e.contains("clouds.threshold"), "{e}");
 }
+
+/// The paper's per-scene approximation samples open water only: in a cloud's shadow the water's
+/// irradiance lacks the direct sun, and A1 (L_path = L_TOA − T·Rrs·Ed with the full Ed) would
+/// read the missing part as negative path radiance. Under the cloud layer its path radiance is
+/// the cloud-free scene's to 1 % (the points differ, and with them the view angles).
+#[test]
+fn the_per_scene_approximation_samples_water_out_of_the_shadows() {
+    let (clear, clouded) =
+        (run(&cloudy(None, CloudScreen::default())), run(&cloudy(Some(layer()), CloudScreen::default())));
+    let shadow = clouded.truth.surface.codes().iter().filter(|&&c| c == SurfaceClass::CloudShadow as u8).count();
+    assert!(shadow > 100, "{shadow} shadow pixels");
+    let (a, b) = (clear.report.approximation.as_ref().unwrap(), clouded.report.approximation.as_ref().unwrap());
+    assert!(b.points.iter().all(|&(r, c)| clouded.truth.surface.at(r, c) == SurfaceClass::Water));
+    for (band, (x, y)) in a.l_path.iter().zip(&b.l_path).enumerate() {
+        assert!((y / x - 1.0).abs() < 0.01, "band {band}: L_path {y} under clouds, {x} without");
+    }
+}
