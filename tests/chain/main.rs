@@ -25,6 +25,7 @@ mod image_correction;
 mod incremental;
 mod memory;
 mod netcdf;
+mod nir_iteration;
 mod noise;
 mod path_sharing;
 mod plausibility;
