@@ -245,17 +245,21 @@ fn print_runs(out: &mut String, result: &crate::study::StudyResult) {
     for run in &result.runs {
         for ret in &run.retrievals {
             for v in ret.metrics.variables.iter().chain(&ret.metrics.depth_by_true_substrate) {
+                // Nothing returned: no error to print (the metrics' MAE of 0 % would read as perfect).
+                let m = &v.metrics;
+                let (mae, bias, error) = if m.n > 0 {
+                    (
+                        format!("{:.1}", m.mae_pct()),
+                        format!("{:+.1}", m.bias_pct()),
+                        format!("{:.3} {}", m.mean_abs_error, crate::metrics::unit(&v.variable)),
+                    )
+                } else {
+                    ("–".into(), "–".into(), "none returned".into())
+                };
                 let _ = writeln!(
                     out,
-                    "{:<12} {:<8} {:<24} {:>9.1} {:>+9.1} {:>10.2}  {:.3} {}",
-                    run.label,
-                    ret.metrics.product,
-                    v.variable,
-                    v.metrics.mae_pct(),
-                    v.metrics.bias_pct(),
-                    v.metrics.returned_pct,
-                    v.metrics.mean_abs_error,
-                    crate::metrics::unit(&v.variable)
+                    "{:<12} {:<8} {:<24} {:>9} {:>9} {:>10.2}  {error}",
+                    run.label, ret.metrics.product, v.variable, mae, bias, m.returned_pct,
                 );
             }
             if let Some(a) = ret.metrics.substrate_agreement_pct {
@@ -287,7 +291,13 @@ fn print_runs(out: &mut String, result: &crate::study::StudyResult) {
                 );
             }
         }
-        if let Some(a) = &run.report.aerosol {
+        if let Some(a) = run.report.aerosol.as_ref().filter(|a| !a.aot550.0.is_finite()) {
+            let _ = writeln!(
+                out,
+                "{:<12} aerosol  no pixel retrieved (true AOT(550) {:.3}, Ångström {:.2}); {}",
+                run.label, a.aot550_true, a.angstrom_true, a.fit
+            );
+        } else if let Some(a) = &run.report.aerosol {
             let _ = writeln!(
                 out,
                 "{:<12} aerosol  AOT(550) {:.3} (5–95 %: {:.3}–{:.3}; true {:.3}; per-pixel error {:.3}), Ångström {:.2} (true {:.2}); outside the family: {:.1} %; {}{}",

@@ -134,3 +134,25 @@ fn the_raster_study_runs_and_writes_geotiff_products() {
     assert!(String::from_utf8_lossy(&bad.stderr).contains("geotiff"));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A run that returns no water (the glint example at a 15° roll: every pixel above l2gen's
+/// glint threshold, left out) prints no error for its products and no aerosol numbers: the
+/// metrics' MAE of 0 % and the AOT of an empty set (NaN) would read as a perfect answer and as
+/// garbage.
+#[test]
+fn a_run_that_returns_nothing_prints_no_error_and_no_nan() {
+    let dir = crate::common::TempDir::new("cli", "nothing-returned");
+    let study = Path::new(env!("CARGO_MANIFEST_DIR")).join("presets/examples/study_glint_roll_15_on.ron");
+    let out = shoal()
+        .arg("study")
+        .arg(&study)
+        .args(["--decimation", "8", "--no-cubes", "--no-figures", "--out"])
+        .arg(dir.join("out"))
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("chl_mg_m3") && text.contains("none returned"), "{text}");
+    assert!(text.contains("aerosol  no pixel retrieved"), "{text}");
+    assert!(!text.contains("NaN"), "{text}");
+}
