@@ -289,9 +289,9 @@ impl SceneApproximation {
         let (rows, cols, nb) = toa_radiance.dim();
         // Open water only where there is some: in a cloud's shadow the direct sun is missing from
         // the water's irradiance, and A1 would take the missing part for path radiance.
-        let open = (0..rows * cols).any(|i| surface.is_open_water_at(i));
-        let sampled = |i: usize| if open { surface.is_open_water_at(i) } else { surface.is_water_at(i) };
-        let n_water = (0..rows * cols).filter(|&i| sampled(i)).count();
+        let n_open = (0..rows * cols).filter(|&i| surface.is_open_water_at(i)).count();
+        let sampled = |i: usize| if n_open > 0 { surface.is_open_water_at(i) } else { surface.is_water_at(i) };
+        let n_water = if n_open > 0 { n_open } else { surface.water_count() };
         if n_water == 0 || points == 0 {
             return Err(CorrectionError::Invalid(FieldError {
                 field: "correction.approx_points".into(),

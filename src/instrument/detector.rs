@@ -369,7 +369,9 @@ impl Detector {
         Exposure { shot, binned: q, ideal: self.ideal, well_e: plane.well_e, mean_e: mean, curve: self.curve(j, b) }
     }
 
-    /// Read out band `b`'s `electrons`: read noise, gain, bias and the ADC.
+    /// Read out band `b`'s `electrons`: read noise, gain, bias and the ADC, through detector 0's
+    /// response curve (one detector's own: [`Self::exposure`] carries it, Level-0 reads it per
+    /// element).
     #[inline(always)]
     pub fn read_out<R: rand::Rng + ?Sized>(&self, b: usize, electrons: f64, rng: &mut R) -> Readout {
         let z = if self.mode.noise { normal(rng) } else { 0.0 };
