@@ -174,6 +174,14 @@ pub(crate) fn assemble(
     })
 }
 
+/// The correction of an image with no water (an overcast look, a view of land): every pixel
+/// INVALID, and SATURATED too where Level-1 is, as any method flags a pixel that is not water.
+pub fn no_water(level1: &Level1) -> Result<Reflectance, CorrectionError> {
+    let (rows, cols, nb) = level1.radiance.dim();
+    let flags = slice(&level1.flags)?.iter().map(|&f| flag_for(f, true, 0.0)).collect();
+    assemble(rows, cols, nb, vec![0.0; rows * cols * nb], flags)
+}
+
 /// Exact per-pixel correction of `level1` with the band-effective atmosphere of each column;
 /// where the scene's AOT is a map, `aerosol_map` holds the terms at its AOT nodes and the map
 /// under each pixel, and each pixel is corrected with the atmosphere at its own AOT. `glint` is
@@ -277,7 +285,9 @@ impl crate::simd::Kernel for Correct<'_, '_> {
 impl SceneApproximation {
     /// The paper's per-scene terms from `points` random water pixels (seeded), using the
     /// noise-free TOA radiance and the true Rrs of those pixels: open water, out of the clouds'
-    /// shadows, wherever the image has some.
+    /// shadows, wherever the image has some. `None` when the image holds no water at all (an
+    /// overcast look, a view of land): there is nothing to estimate the terms from, and nothing
+    /// they would correct.
     pub fn new(
         toa_radiance: &Array3<f32>,
         truth_rrs: &Array3<f32>,
@@ -285,18 +295,21 @@ impl SceneApproximation {
         surface: &SurfaceMap,
         points: usize,
         seed: u64,
-    ) -> Result<Self, CorrectionError> {
+    ) -> Result<Option<Self>, CorrectionError> {
         let (rows, cols, nb) = toa_radiance.dim();
+        if points == 0 {
+            return Err(CorrectionError::Invalid(FieldError {
+                field: "correction.approx_points".into(),
+                message: "0 water pixels asked for: the approximation needs at least 1".into(),
+            }));
+        }
         // Open water only where there is some: in a cloud's shadow the direct sun is missing from
         // the water's irradiance, and A1 would take the missing part for path radiance.
         let n_open = (0..rows * cols).filter(|&i| surface.is_open_water_at(i)).count();
         let sampled = |i: usize| if n_open > 0 { surface.is_open_water_at(i) } else { surface.is_water_at(i) };
         let n_water = if n_open > 0 { n_open } else { surface.water_count() };
-        if n_water == 0 || points == 0 {
-            return Err(CorrectionError::Invalid(FieldError {
-                field: "correction.approx_points".into(),
-                message: "the image holds no water pixel to sample (or approx_points is 0)".into(),
-            }));
+        if n_water == 0 {
+            return Ok(None);
         }
         // Distinct water pixels drawn uniformly: indices among the water pixels, then located.
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed ^ 0xA7C0_11EC);
@@ -312,7 +325,6 @@ impl SceneApproximation {
                 k += 1;
             }
         }
-        let _ = rows;
         let n = chosen.len() as f64;
         let (mut l_path, mut t_up, mut ed) = (vec![0.0; nb], vec![0.0; nb], vec![0.0; nb]);
         for &(r, c) in &chosen {
@@ -328,7 +340,7 @@ impl SceneApproximation {
                 ed[b] += e / n;
             }
         }
-        Ok(Self { points: chosen, l_path, t_up, ed })
+        Ok(Some(Self { points: chosen, l_path, t_up, ed }))
     }
 
     /// Band `b`'s Rrs and flags from its Level-1 radiance and flags (A1–A3 inverted).

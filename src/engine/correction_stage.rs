@@ -27,7 +27,7 @@ impl Engine {
         config: &RunConfig,
         side: &SceneSide,
         (truth, truth_rrs, radiance_key): (&Truth, &Array3<f32>, Key),
-        approximation: SceneApproximation,
+        approximation: Option<SceneApproximation>,
         inst: &InstrumentSide,
         control: &RunControl,
         report: &mut RunReport,
@@ -92,14 +92,17 @@ impl Engine {
             let exact_reference = reference.as_ref().or(exact.as_ref());
             // The approximation is held whole only when it is the product; as a diagnostic it is
             // compared with the exact correction pixel by pixel.
-            let streamed = match (exact_reference, diagnostics && !per_scene) {
-                (Some(e), true) => approximation.compare_with(level1, surface, e),
+            // (No approximation: the image holds no water, and its correction is every pixel left out.)
+            let streamed = match (exact_reference, &approximation, diagnostics && !per_scene) {
+                (Some(e), Some(a), true) => a.compare_with(level1, surface, e),
                 _ => None,
             };
-            let approx = if (diagnostics && streamed.is_none()) || per_scene {
-                Some(approximation.correct(level1, surface, control).map_err(&fail)?)
-            } else {
-                None
+            let approx = match &approximation {
+                Some(a) if (diagnostics && streamed.is_none()) || per_scene => {
+                    Some(a.correct(level1, surface, control).map_err(&fail)?)
+                }
+                None if per_scene => Some(crate::correction::no_water(level1).map_err(&fail)?),
+                _ => None,
             };
             let approximation_vs_exact = match (streamed, &approx, exact_reference, diagnostics) {
                 (Some(d), ..) => d,
@@ -145,7 +148,7 @@ impl Engine {
             Ok(Corrected { rrs: Arc::new(rrs), product: Arc::new(product) })
         })?;
         let product = &correction.product;
-        report.approximation = Some(product.approximation.clone());
+        report.approximation = product.approximation.clone();
         report.approximation_vs_exact = product.approximation_vs_exact.clone();
         report.rrs_vs_truth = product.rrs_vs_truth.clone();
         report.aerosol = match (&product.aerosol, config.correction.image()) {

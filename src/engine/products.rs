@@ -33,8 +33,8 @@ pub(super) struct Corrected {
 /// The atmospheric correction's diagnostics (the Rrs cube itself is [`Cubes::rrs`]).
 #[derive(Debug, Clone)]
 pub struct CorrectionProduct {
-    /// The paper's per-scene approximation terms.
-    pub approximation: SceneApproximation,
+    /// The paper's per-scene approximation terms (none when the image holds no water).
+    pub approximation: Option<SceneApproximation>,
     /// Per band: approximation against exact correction.
     pub approximation_vs_exact: Vec<crate::correction::BandDifference>,
     /// Per band: delivered Rrs against the truth.

@@ -157,7 +157,7 @@ pub struct RunReport {
     pub diffuser_incidence_deg: f64,
     /// Calibration frames that saturated.
     pub diffuser_saturated_frames: usize,
-    /// The paper's per-scene approximation terms.
+    /// The paper's per-scene approximation terms (none when the image holds no water).
     pub approximation: Option<SceneApproximation>,
     /// Per band: the per-scene approximation against the exact correction (same Level-1).
     pub approximation_vs_exact: Vec<BandDifference>,

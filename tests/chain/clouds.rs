@@ -170,3 +170,32 @@ fn the_per_scene_approximation_samples_water_out_of_the_shadows() {
         assert!((y / x - 1.0).abs() < 0.01, "band {band}: L_path {y} under clouds, {x} without");
     }
 }
+
+/// An overcast look (cover 1: no water pixel in the image) is a look that returns nothing, not a
+/// failed run, whichever correction runs: the per-scene approximation has no water to estimate
+/// its terms from (and reports none), every pixel is left out, and the retrieval returns no
+/// pixel with no NaN in its metrics.
+#[test]
+fn an_overcast_look_returns_nothing_and_fails_no_stage() {
+    let overcast = CloudLayer { cover: 1.0, ..layer() };
+    for (name, method) in [
+        ("exact", shoal::correction::Method::Exact),
+        ("per-scene approximation", shoal::correction::Method::PerScene),
+        ("band pair", shoal::correction::Method::Image(ImageCorrection::default())),
+        ("dark spectrum", shoal::correction::Method::Image(ImageCorrection::dark_spectrum())),
+    ] {
+        let mut c = cloudy(Some(overcast.clone()), CloudScreen::default());
+        c.correction.method = method;
+        let out = shoal::engine::Engine::new()
+            .run(&c, &shoal::control::RunControl::new())
+            .unwrap_or_else(|e| panic!("{name}: the overcast run failed: {e}"));
+        assert_eq!(out.truth.surface.water_count(), 0, "{name}: the image still holds water");
+        assert!(out.report.approximation.is_none(), "{name}");
+        assert!(out.kept().rrs.flags.iter().all(|f| f & RrsFlags::INVALID != 0), "{name}: a pixel corrected");
+        let m = &out.retrievals[0].metrics;
+        for v in &m.variables {
+            assert_eq!(v.metrics.n, 0, "{name}: {}", v.variable);
+            assert!(v.metrics.returned_pct.is_finite(), "{name}: {} {:?}", v.variable, v.metrics);
+        }
+    }
+}
