@@ -21,7 +21,9 @@
 //! Bands are fitted only inside `wave_range_nm` and where the two-way gas transmittance at the
 //! tile's centre reaches `min_gas_transmittance` (ACOLITE's `min_tgas_aot`, which is what keeps
 //! the water-vapour and O₂ bands out). A tile with less than 10 % of its pixels valid in a
-//! fitted band takes the scene's fit (ACOLITE's `dsf_min_tile_cover`).
+//! fitted band takes the scene's fit (ACOLITE's `dsf_min_tile_cover`); pixels left out for high
+//! glint count neither as valid nor in the tile's size, so a scene mostly in glint is fitted
+//! from the part outside it.
 //!
 //! With tiles and `smooth_tiles` (ACOLITE's defaults, `tiles_interp` in its `shared` module),
 //! the scene takes the tiles' most common model; that model's tile AOTs are smoothed with a
@@ -204,7 +206,12 @@ pub fn fit_tiles(
     }
     let (l1, flags) = (slice(&level1.radiance)?, slice(&level1.flags)?);
     let fit = |rr: [usize; 2], cc: [usize; 2]| -> Option<TileFit> {
-        let area = (rr[1] - rr[0]) * (cc[1] - cc[0]);
+        // The pixels the processor looks at: those left out for high glint do not count, in the
+        // 10 % below as in the dark spectrum (a tile wholly in glint falls back to the scene's fit).
+        let area = (rr[1] - rr[0]) * (cc[0]..cc[1]).filter(|&c| !skip_column(c)).count();
+        if area == 0 {
+            return None;
+        }
         let centre = (cc[0] + cc[1]) / 2;
         let mut dark = vec![f64::NAN; nb];
         let mut values = Vec::with_capacity(area);
@@ -270,9 +277,7 @@ pub fn fit_tiles(
     let scene = fit([0, rows], [0, cols]).ok_or_else(|| {
         invalid(
             "correction.image.dark",
-            "fewer than 10 % of the scene's pixels have valid Level-1 in a fitted band (pixels left out \
-             for high glint do not count)"
-                .into(),
+            "fewer than 10 % of the scene's pixels outside high glint have valid Level-1 in a fitted band".into(),
         )
     })?;
     if settings.tile_px == 0 || (settings.tile_px >= rows && settings.tile_px >= cols) {

@@ -110,6 +110,47 @@ fn high_glint_is_left_out() {
     assert!(out.kept().rrs.flags.iter().all(|f| f & RrsFlags::INVALID != 0));
 }
 
+/// Dark-spectrum fitting with most of the swath, not all, in high glint: the threshold set so
+/// that 44 of the 48 columns exceed it (the family's L_GN falls monotonically across this swath).
+/// The dark spectrum is taken from the 4 columns outside the glint (8 % of the image, under the
+/// 10 % a tile needs of the whole image, but all of the part the processor looks at), and those
+/// columns are corrected; the others are left out and flagged as glint.
+#[test]
+fn dark_spectrum_fitting_corrects_the_part_of_a_scene_outside_its_glint() {
+    let mut c = glinting(30.0, true);
+    c.correction.method = shoal::correction::Method::Image(ImageCorrection {
+        glint_threshold_per_sr: 0.5,
+        ..ImageCorrection::dark_spectrum()
+    });
+    let out = run(&c);
+    let lgn = out.correction.family.as_ref().unwrap().glint_lgn.clone();
+    let mut sorted = lgn.clone();
+    sorted.sort_by(|a, b| b.total_cmp(a));
+    let threshold = 0.5 * (sorted[43] + sorted[44]);
+    let glinting_cols: Vec<usize> = (0..lgn.len()).filter(|&col| lgn[col] > threshold).collect();
+    assert_eq!(glinting_cols.len(), 44, "L_GN across the swath: {lgn:?}");
+    c.correction.method = shoal::correction::Method::Image(ImageCorrection {
+        glint_threshold_per_sr: threshold,
+        ..ImageCorrection::dark_spectrum()
+    });
+    let out = run(&c);
+    let a = out.correction.aerosol.as_ref().unwrap();
+    let (rows, cols, nb) = out.kept().rrs.rrs.dim();
+    assert_eq!(a.high_glint, rows * 44);
+    for col in 0..cols {
+        for r in 0..rows {
+            let f = out.kept().rrs.flags[[r, col, 0]];
+            if glinting_cols.contains(&col) {
+                assert_eq!(f & (RrsFlags::INVALID | RrsFlags::GLINT), RrsFlags::INVALID | RrsFlags::GLINT);
+            } else {
+                assert_eq!(f & RrsFlags::INVALID, 0, "pixel ({r}, {col}) outside the glint left out");
+                assert!((0..nb).all(|b| out.kept().rrs.rrs[[r, col, b]].is_finite()));
+                assert!(a.aot550[[r, col]].is_finite());
+            }
+        }
+    }
+}
+
 /// The processor's wind off at the 15° roll (true wind 5 m/s). Far from the specular direction
 /// the glint a processor expects grows steeply with the wind it assumes (Cox–Munk: the slope
 /// variance σ² = 0.003 + 0.00512·W sets exp(−tan²β/σ²)). Off by +1 m/s it takes away more glint
