@@ -253,8 +253,8 @@ pub fn looks_csv(result: &SeasonResult) -> String {
 pub fn months_csv(result: &SeasonResult) -> String {
     let mut csv = Csv::new(&["design", "month", "passes", "valid", "sun_low", "view_oblique", "glint", "cloud"]);
     for d in &result.designs {
-        let all = d.per_month(None, result.period.0, result.period.1);
-        let by = |v: Verdict| d.per_month(Some(v), result.period.0, result.period.1);
+        let all = d.per_month(None, result.period, result.spec.local_offset_days());
+        let by = |v: Verdict| d.per_month(Some(v), result.period, result.spec.local_offset_days());
         let (valid, sun, view) = (by(Verdict::Valid), by(Verdict::SunLow), by(Verdict::ViewOblique));
         let (glint, cloud) = (by(Verdict::Glint), by(Verdict::Cloud));
         for (i, ((y, m), n)) in all.iter().enumerate() {

@@ -17,7 +17,7 @@ pub fn valid_looks_curves(result: &SeasonResult) -> Curves {
         .designs
         .iter()
         .map(|d| {
-            let months = d.per_month(Some(Verdict::Valid), result.period.0, result.period.1);
+            let months = d.per_month(Some(Verdict::Valid), result.period, result.spec.local_offset_days());
             CurveSeries {
                 label: d.label.clone(),
                 points: months.iter().enumerate().map(|(i, (_, n))| point((i + 1) as f64, *n as f64)).collect(),
@@ -25,7 +25,7 @@ pub fn valid_looks_curves(result: &SeasonResult) -> Curves {
             }
         })
         .collect();
-    let first = result.designs.first().map(|d| d.per_month(None, result.period.0, result.period.1));
+    let first = result.designs.first().map(|d| d.per_month(None, result.period, result.spec.local_offset_days()));
     let span = first
         .as_ref()
         .and_then(|m| {

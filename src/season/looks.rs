@@ -124,6 +124,7 @@ pub fn looks(season: &SeasonSpec, instrument: &InstrumentSpec, wind_m_s: f64, n:
         None => accesses(&orbit, &site, from, to, reach),
     };
     let altitude_of = |a: &Access| tle.as_ref().map(|_| a.radius_m - EARTH_EQUATORIAL_RADIUS_M);
+    let local_offset_days = season.local_offset_days();
     let max_sun = season.max_sun_zenith_deg.to_radians();
     let max_view = season.max_view_zenith_deg.to_radians();
     // Fore/aft candidates, degrees: the glint tilt either way, or the design's own forward tilt.
@@ -170,7 +171,8 @@ pub fn looks(season: &SeasonSpec, instrument: &InstrumentSpec, wind_m_s: f64, n:
             let hour = (access.days * 24.0).floor() as i64 as u64;
             let weather_seed = season.seed ^ hour.wrapping_mul(0x9E37_79B9_7F4A_7C15);
             let mut rng = Xoshiro256PlusPlus::seed_from_u64(weather_seed);
-            let month = crate::orbit::sun::calendar_date(access.days).1 as usize - 1;
+            // The site's month (local mean solar date), as the climatology's.
+            let month = crate::orbit::sun::calendar_date(access.days + local_offset_days).1 as usize - 1;
             let cloud_cover = season.clouds.as_ref().map_or(0.0, |c| {
                 cloud_cover(c.monthly_fraction.get(month).copied().unwrap_or(0.0), c.concentration, &mut rng)
             });

@@ -283,14 +283,24 @@ impl SeasonSpec {
             .map_err(|message| FieldError { field: "from".into(), message })
     }
 
-    /// The period as days since J2000.0: (start of `from`, end of `to`).
+    /// The site's local mean solar time minus UT, days (longitude east / 360, the longitude taken
+    /// in −180…180°). A season's dates and months are the site's own, as a cloud climatology's
+    /// months are: a 09:30 pass over Heron Island (151.9° E) is at 23:22 UT the day before.
+    #[must_use]
+    pub fn local_offset_days(&self) -> f64 {
+        ((self.site.1 + 180.0).rem_euclid(360.0) - 180.0) / 360.0
+    }
+
+    /// The period as days since J2000.0 (UT): from the site's local mean midnight starting `from`
+    /// to the one ending `to`.
     pub fn period_days(&self) -> Result<(f64, f64), FieldError> {
         let day = |field: &str, text: &str| {
             crate::orbit::days_since_j2000(text).map_err(|message| FieldError { field: field.into(), message })
         };
         let (from, to) = (day("from", &self.from)?, day("to", &self.to)? + 1.0);
         check(&ranges::PERIOD_DAYS, to - from)?;
-        Ok((from, to))
+        let offset = self.local_offset_days();
+        Ok((from - offset, to - offset))
     }
 
     /// Check every number against its range, naming the field.

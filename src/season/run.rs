@@ -79,13 +79,20 @@ impl DesignSeason {
         self.looks.iter().filter(|l| l.verdict == Verdict::Valid).map(|l| l.access.days).collect()
     }
 
-    /// Looks with `verdict` in each calendar month of the period, (year, month, count).
+    /// Looks with `verdict` in each calendar month of the period `from`–`to` (days since J2000.0,
+    /// UT), (year, month, count); months and days are the site's, `local_offset_days` ahead of UT
+    /// ([`super::SeasonSpec::local_offset_days`]).
     #[must_use]
-    pub fn per_month(&self, verdict: Option<Verdict>, from: f64, to: f64) -> Vec<((i64, u32), usize)> {
+    pub fn per_month(
+        &self,
+        verdict: Option<Verdict>,
+        (from, to): (f64, f64),
+        local_offset_days: f64,
+    ) -> Vec<((i64, u32), usize)> {
         let mut months: Vec<((i64, u32), usize)> = Vec::new();
         let mut d = from;
         while d < to {
-            let (y, m, _) = crate::orbit::sun::calendar_date(d + 0.5);
+            let (y, m, _) = crate::orbit::sun::calendar_date(d + local_offset_days + 0.5);
             if months.last().is_none_or(|(k, _)| *k != (y, m)) {
                 months.push(((y, m), 0));
             }
@@ -93,7 +100,7 @@ impl DesignSeason {
         }
         for l in &self.looks {
             if verdict.is_none_or(|v| v == l.verdict) {
-                let (y, m, _) = crate::orbit::sun::calendar_date(l.access.days);
+                let (y, m, _) = crate::orbit::sun::calendar_date(l.access.days + local_offset_days);
                 if let Some(slot) = months.iter_mut().find(|(k, _)| *k == (y, m)) {
                     slot.1 += 1;
                 }

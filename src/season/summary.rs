@@ -176,7 +176,7 @@ impl SeasonSummary {
                         count(Verdict::Cloud),
                     ],
                     valid_per_month: d
-                        .per_month(Some(Verdict::Valid), result.period.0, result.period.1)
+                        .per_month(Some(Verdict::Valid), result.period, result.spec.local_offset_days())
                         .iter()
                         .map(|((y, m), n)| (format!("{y}-{m:02}"), *n))
                         .collect(),

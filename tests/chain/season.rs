@@ -17,6 +17,39 @@ fn spring(max_runs: usize) -> SeasonSpec {
     s
 }
 
+/// A season's months are the site's: over a site at 170° E (local mean time 11 h 20 min ahead of
+/// UT) a 09:30 descending pass is at about 22:10 UT the day before, so a look on the 1st of a
+/// month falls in the month before by UT's date. Each month's count is the count by the site's
+/// date (written out here: UT + 170/360 days), which differs from UT's in some month of the year.
+#[test]
+fn a_seasons_months_are_the_sites_local_dates() {
+    let mut season = spring(0);
+    season.site = (-23.44, 170.0);
+    season.orbit.descending_node_h = 9.5;
+    season.from = "2023-01-01".into();
+    season.to = "2023-12-31".into();
+    season.clouds = None;
+    let (study, ds) = designs(&season, None).unwrap();
+    let result = run_season(&season, &study, &ds, Shard::ALL, &RunControl::new(), |_, _| {}).unwrap();
+    let month_of = |days: f64| {
+        let (y, m, _) = shoal::orbit::sun::calendar_date(days);
+        (y, m)
+    };
+    for d in &result.designs {
+        let months = d.per_month(None, result.period, season.local_offset_days());
+        assert_eq!(months.len(), 12, "{}", d.label);
+        let by_local: Vec<usize> = months
+            .iter()
+            .map(|(k, _)| d.looks.iter().filter(|l| month_of(l.access.days + 170.0 / 360.0) == *k).count())
+            .collect();
+        let by_ut: Vec<usize> =
+            months.iter().map(|(k, _)| d.looks.iter().filter(|l| month_of(l.access.days) == *k).count()).collect();
+        assert_eq!(months.iter().map(|m| m.1).collect::<Vec<_>>(), by_local, "{}", d.label);
+        assert_ne!(by_local, by_ut, "{}: no look on a month's first day to tell the dates apart", d.label);
+        assert_eq!(by_local.iter().sum::<usize>(), d.looks.len(), "{}: a look outside the site's year", d.label);
+    }
+}
+
 /// Cox–Munk glint written out here from the slope statistics (not through the crate's glint
 /// code): facet normal h = s + v, tan²β = (h_x² + h_y²)/h_z², p = exp(−tan²β/σ²)/(πσ²),
 /// L_GN = R_F p / (4 cos θ_v cos⁴β) with the Fresnel reflectance of unpolarised light.
@@ -46,8 +79,10 @@ fn valid_looks_match_an_independent_count() {
     let (study, ds) = designs(&season, None).unwrap();
     let result = run_season(&season, &study, &ds, Shard::ALL, &RunControl::new(), |_, _| {}).unwrap();
     assert_eq!(result.designs.len(), 2);
-    let from = days_since_j2000(&season.from).unwrap();
-    let to = days_since_j2000(&season.to).unwrap() + 1.0;
+    // The site's dates: its local mean midnight is longitude / 360 days ahead of UT's.
+    let local = season.site.1 / 360.0;
+    let from = days_since_j2000(&season.from).unwrap() - local;
+    let to = days_since_j2000(&season.to).unwrap() + 1.0 - local;
     let site = Site::from_degrees(season.site.0, season.site.1);
     let mut any_valid = false;
     for (d, (_, config)) in result.designs.iter().zip(&ds) {
@@ -94,8 +129,9 @@ fn valid_looks_match_an_independent_count() {
         assert_eq!(d.valid_days().len(), valid);
         any_valid |= valid > 0;
         // Months of the period, April to June, each counted.
-        assert_eq!(d.per_month(None, from, to).len(), 3);
-        assert_eq!(d.per_month(None, from, to).iter().map(|m| m.1).sum::<usize>(), d.looks.len());
+        let months = d.per_month(None, (from, to), season.local_offset_days());
+        assert_eq!(months.len(), 3);
+        assert_eq!(months.iter().map(|m| m.1).sum::<usize>(), d.looks.len());
         assert_eq!(d.phases.len(), shoal::season::run::PHASE_SAMPLES);
     }
     assert!(any_valid, "autumn 2023 over Heron Island has valid looks at phase 0");

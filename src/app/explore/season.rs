@@ -279,7 +279,7 @@ fn plots(ui: &mut egui::Ui, r: &SeasonResult, shown: Option<&(String, String)>) 
             .height(height)
             .show(ui, |p| {
                 for (k, d) in r.designs.iter().enumerate() {
-                    let months = d.per_month(Some(Verdict::Valid), r.period.0, r.period.1);
+                    let months = d.per_month(Some(Verdict::Valid), r.period, r.spec.local_offset_days());
                     let pts: Vec<[f64; 2]> =
                         months.iter().enumerate().map(|(i, (_, n))| [i as f64 + 1.0, *n as f64]).collect();
                     // Designs in one orbit have the same looks: every other one dashed, so
