@@ -2,10 +2,13 @@
 //! because a cloud covers them or shades the water.
 //!
 //! - **Cloud**: the Rayleigh-corrected reflectance at the band nearest 865 nm above a threshold,
-//!   ρ_rc = π(L − L_r)/(T·Ed)_r with the family's τ = 0 member as the Rayleigh atmosphere, or
-//!   that band saturated. This is l2gen's cloud albedo test (`cloud_wave` 865/869 nm,
-//!   `cloud_thresh` 0.027; Wang & Shi 2006 for its use over turbid water, where bright water
-//!   can pass it: the threshold is a setting).
+//!   ρ_rc = π(L − L_r − G)/(T·Ed)_r with the family's τ = 0 member as the Rayleigh atmosphere,
+//!   or that band saturated. G is the glint the processor expects through that atmosphere,
+//!   where it takes glint away (0 otherwise): l2gen's cloud albedo subtracts it the same way
+//!   (`setflags.c`: ρ_s − π·TLg/(μ0·F0) at `cloud_wave`), so a glinting sea is not read as
+//!   cloud. This is l2gen's cloud albedo test (`cloud_wave` 865/869 nm, `cloud_thresh` 0.027;
+//!   Wang & Shi 2006 for its use over turbid water, where bright water can pass it: the
+//!   threshold is a setting).
 //! - **Shadow**: each cloud pixel's shadow projected on the image from an assumed cloud height
 //!   h: the cloud seen at ground point p lies at p + h·tan θv·(sin φv, cos φv) and shades the
 //!   ground at that point − h·tan θs·(sin φs, cos φs) (Fmask's geometric shadow projection,
@@ -75,11 +78,14 @@ pub struct Sun {
 }
 
 /// The screen of `level1`: true where the processor flags cloud or cloud shadow. `rayleigh` is
-/// the family's τ = 0 member's band terms (every column); pixels `surface` calls land are
-/// never flagged (the processor knows its land mask, nothing else of the truth).
+/// the family's τ = 0 member's band terms (every column); with `glint_expected` its glint is
+/// taken away with its path radiance (a processor that removes glint); pixels `surface` calls
+/// land are never flagged (the processor knows its land mask, nothing else of the truth).
+#[allow(clippy::too_many_arguments)]
 pub fn screen_image(
     level1: &Level1,
     rayleigh: &BandTerms,
+    glint_expected: bool,
     bands: &BandSet,
     viewing: &Viewing,
     sun: Sun,
@@ -104,8 +110,9 @@ pub fn screen_image(
             return false;
         }
         let i = c * nb + k;
-        let rho =
-            std::f64::consts::PI * (f64::from(level1.radiance[[r, c, k]]) - rayleigh.l_path[i]) / rayleigh.t_ed[i];
+        let glint = if glint_expected { rayleigh.glint.get(i).copied().unwrap_or(0.0) } else { 0.0 };
+        let rho = std::f64::consts::PI * (f64::from(level1.radiance[[r, c, k]]) - rayleigh.l_path[i] - glint)
+            / rayleigh.t_ed[i];
         rho > settings.threshold || level1.flags[[r, c, k]] & saturated != 0
     });
     let mut screened = cloud.clone();

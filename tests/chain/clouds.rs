@@ -199,3 +199,37 @@ fn an_overcast_look_returns_nothing_and_fails_no_stage() {
         }
     }
 }
+
+/// The cloud test takes away the glint the processor expects, as l2gen's cloud albedo does
+/// (setflags.c: ρ_s − π·TLg/(μ0·F0) at the cloud band). The cloud layer over a glinting sea (wind
+/// 5 m/s, the CubeSat rolled 30° on a 290° heading to look towards the specular direction of
+/// the 60° sun: a normalised glint above 0.005 sr⁻¹, a glint reflectance above 0.03 at 865 nm,
+/// over the 0.027 threshold), the high-glint mask set out of the way (0.5 sr⁻¹) so the screen
+/// alone decides. Taking the glint away, the screen flags hardly any sunlit water (under 1 %, as
+/// over the calm lake above); a processor that leaves the glint in reads most of it as cloud.
+#[test]
+fn the_cloud_test_takes_away_the_glint_the_processor_expects() {
+    let flagged_water = |glint: bool| {
+        let mut c = cloudy(Some(layer()), CloudScreen { height_m: 200.0, ..CloudScreen::default() });
+        c.scene.atmosphere.surface = shoal::atmosphere::SeaSurface::Wind { speed_m_s: 5.0 };
+        c.scene.effects = vec![shoal::scene::Effect::SunGlint];
+        c.instrument.heading_deg = 290.0;
+        c.instrument.across_track_tilt_deg = 30.0;
+        c.correction.method = shoal::correction::Method::Image(ImageCorrection {
+            clouds: CloudScreen { height_m: 200.0, ..CloudScreen::default() },
+            glint,
+            glint_threshold_per_sr: 0.5,
+            ..ImageCorrection::default()
+        });
+        let out = run(&c);
+        let lgn = &out.correction.family.as_ref().unwrap().glint_lgn;
+        if glint {
+            assert!(lgn.iter().all(|g| *g > 0.005), "normalised glint {lgn:?}");
+        }
+        screened_by_class(&out)[0].2
+    };
+    let (taken_away, left_in) = (flagged_water(true), flagged_water(false));
+    println!("sunlit water flagged as cloud: {taken_away:.4} with the glint taken away, {left_in:.4} without");
+    assert!(taken_away < 0.01, "{taken_away}");
+    assert!(left_in > 0.5, "{left_in}");
+}
