@@ -212,7 +212,10 @@ pub fn fit_tiles(
         if area == 0 {
             return None;
         }
-        let centre = (cc[0] + cc[1]) / 2;
+        // The terms the dark spectrum is compared with: the tile's centre column, or the column
+        // nearest it outside the glint (whose pixels alone make the dark spectrum).
+        let mid = (cc[0] + cc[1]) / 2;
+        let centre = (cc[0]..cc[1]).filter(|&c| !skip_column(c)).min_by_key(|&c| c.abs_diff(mid)).unwrap_or(mid);
         let mut dark = vec![f64::NAN; nb];
         let mut values = Vec::with_capacity(area);
         for &b in &fitted {
