@@ -193,8 +193,9 @@ pub fn looks_csv(result: &SeasonResult) -> String {
     let vars = variables(result);
     let mut header: Vec<String> = [
         "design",
-        "date",
+        "date_ut",
         "time_ut",
+        "date_local",
         "descending",
         "sun_zenith_deg",
         "sun_azimuth_deg",
@@ -213,14 +214,18 @@ pub fn looks_csv(result: &SeasonResult) -> String {
     header.extend(vars.iter().flat_map(|(p, v)| [format!("{p}_{v}_mae_pct"), format!("{p}_{v}_returned_pct")]));
     let refs: Vec<&str> = header.iter().map(String::as_str).collect();
     let mut csv = Csv::new(&refs);
+    // The site's date (local mean solar time), by which months.csv counts the look.
+    let local_offset_days = result.spec.local_offset_days();
     for d in &result.designs {
         for (k, l) in d.looks.iter().enumerate() {
             let run = d.runs.iter().find(|r| r.look == k);
             let (date, time) = date_time(l.access.days);
+            let (local_date, _) = date_time(l.access.days + local_offset_days);
             let mut row = vec![
                 d.label.clone(),
                 date,
                 time,
+                local_date,
                 l.access.descending.to_string(),
                 format!("{:.2}", l.geometry.sun_zenith_rad.to_degrees()),
                 format!("{:.2}", l.access.sun.azimuth_rad.to_degrees()),
@@ -239,7 +244,8 @@ pub fn looks_csv(result: &SeasonResult) -> String {
             ];
             for (p, v) in &vars {
                 let e = run.and_then(|r| r.errors.iter().find(|e| e.product == *p && e.variable == *v));
-                row.push(e.map_or_else(String::new, |e| format!("{:.2}", e.mae_pct)));
+                // A look that returned nothing has no error (its MAE of an empty set is not 0 %).
+                row.push(e.filter(|e| e.returned_pct > 0.0).map_or_else(String::new, |e| format!("{:.2}", e.mae_pct)));
                 row.push(e.map_or_else(String::new, |e| format!("{:.2}", e.returned_pct)));
             }
             csv.row(row);

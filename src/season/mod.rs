@@ -121,9 +121,9 @@ pub struct SeasonSpec {
     pub study: Source<StudySpec>,
     /// The site, degrees (latitude north, longitude east).
     pub site: (f64, f64),
-    /// First day, YYYY-MM-DD.
+    /// First day, YYYY-MM-DD, the site's local date (from its local mean midnight).
     pub from: String,
-    /// Last day, YYYY-MM-DD (inclusive).
+    /// Last day, YYYY-MM-DD (inclusive), the site's local date.
     pub to: String,
     /// The orbit.
     #[serde(default)]

@@ -130,7 +130,8 @@ pub struct SeasonResult {
     pub spec: SeasonSpec,
     /// The study's name.
     pub study: String,
-    /// The period, days since J2000.0 (start, end).
+    /// The period, days since J2000.0 in UT (start, end): the site's local mean midnights
+    /// ([`SeasonSpec::period_days`]).
     pub period: (f64, f64),
     /// Per design.
     pub designs: Vec<DesignSeason>,

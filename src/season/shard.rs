@@ -26,8 +26,10 @@ use crate::sweep::Shard;
 /// The file a season run writes its chain runs to (a whole run is shard 0/1).
 pub const RUNS_FILE: &str = "runs.ron";
 
-/// The format tag of [`RUNS_FILE`].
-const FORMAT: &str = "shoal season runs 1";
+/// The format tag of [`RUNS_FILE`]. Runs of another version are refused: version 2 draws each
+/// look's cloud cover from its local month, so a version-1 run of the same look may have seen
+/// other weather.
+const FORMAT: &str = "shoal season runs 2";
 
 /// The largest runs file read: a shard of 400 runs of 8 designs with 20 variables each is
 /// under 2 MB.

@@ -248,7 +248,19 @@ fn scatter_and_histograms(ctx: &Context<'_>) -> Option<(Scatter, Histograms)> {
             .filter(|((r, c), _)| water_returned(*r, *c))
             .map(|((r, c), v)| (f64::from(truth[[r, c]]), f64::from(*v)));
         let caption = ret.metrics.get(ctx.var).map_or_else(String::new, |m| {
-            format!("{}: N {}, MAE {:.0} %, bias {:+.0} %, R² {:.2}", run.label, m.n, m.mae_pct(), m.bias_pct(), m.r2)
+            if m.n == 0 {
+                // No pixel returned: no error to state (an empty set's MAE is not 0 %).
+                format!("{}: N 0, none returned", run.label)
+            } else {
+                format!(
+                    "{}: N {}, MAE {:.0} %, bias {:+.0} %, R² {:.2}",
+                    run.label,
+                    m.n,
+                    m.mae_pct(),
+                    m.bias_pct(),
+                    m.r2
+                )
+            }
         });
         scatter_panels.push((caption, histogram_2d(pairs, &edges)));
         let nb = hist_edges.len() - 1;

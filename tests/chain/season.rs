@@ -20,7 +20,9 @@ fn spring(max_runs: usize) -> SeasonSpec {
 /// A season's months are the site's: over a site at 170° E (local mean time 11 h 20 min ahead of
 /// UT) a 09:30 descending pass is at about 22:10 UT the day before, so a look on the 1st of a
 /// month falls in the month before by UT's date. Each month's count is the count by the site's
-/// date (written out here: UT + 170/360 days), which differs from UT's in some month of the year.
+/// date (written out here: UT + 170/360 days), which differs from UT's in some month of the year;
+/// and each look's cloud cover is its local month's (a climatology of alternately clear and
+/// overcast months: the draw of a fraction of 0 is 0, of 1 is 1).
 #[test]
 fn a_seasons_months_are_the_sites_local_dates() {
     let mut season = spring(0);
@@ -28,7 +30,12 @@ fn a_seasons_months_are_the_sites_local_dates() {
     season.orbit.descending_node_h = 9.5;
     season.from = "2023-01-01".into();
     season.to = "2023-12-31".into();
-    season.clouds = None;
+    let alternate: Vec<f64> = (0..12).map(|m| f64::from(m % 2)).collect();
+    season.clouds = Some(shoal::season::CloudSpec {
+        monthly_fraction: alternate.clone(),
+        source: "test".into(),
+        concentration: 1.0,
+    });
     let (study, ds) = designs(&season, None).unwrap();
     let result = run_season(&season, &study, &ds, Shard::ALL, &RunControl::new(), |_, _| {}).unwrap();
     let month_of = |days: f64| {
@@ -47,6 +54,10 @@ fn a_seasons_months_are_the_sites_local_dates() {
         assert_eq!(months.iter().map(|m| m.1).collect::<Vec<_>>(), by_local, "{}", d.label);
         assert_ne!(by_local, by_ut, "{}: no look on a month's first day to tell the dates apart", d.label);
         assert_eq!(by_local.iter().sum::<usize>(), d.looks.len(), "{}: a look outside the site's year", d.label);
+        for l in &d.looks {
+            let (_, month) = month_of(l.access.days + 170.0 / 360.0);
+            assert_eq!(l.cloud_cover, alternate[month as usize - 1], "{}: look at {}", d.label, l.access.days);
+        }
     }
 }
 
@@ -225,7 +236,7 @@ fn season_command_writes_looks_and_months() {
     assert!(stdout.contains("valid looks per month: 2023-03"), "{stdout}");
     assert!(stdout.contains("over 12 orbit phases"), "{stdout}");
     let looks = std::fs::read_to_string(dir.join("looks.csv")).unwrap();
-    assert!(looks.starts_with("design,date,time_ut,descending,sun_zenith_deg"));
+    assert!(looks.starts_with("design,date_ut,time_ut,date_local,descending,sun_zenith_deg"));
     let months = std::fs::read_to_string(dir.join("months.csv")).unwrap();
     assert_eq!(months.lines().count(), 3, "{months}");
     assert!(dir.join("season_valid_looks.svg").exists() && dir.join("season_valid_looks.png").exists());

@@ -313,7 +313,8 @@ fn plots(ui: &mut egui::Ui, r: &SeasonResult, shown: Option<&(String, String)>) 
                         .iter()
                         .filter_map(|run| {
                             let e = run.errors.iter().find(|e| e.product == *product && e.variable == *variable)?;
-                            Some([d.looks[run.look].access.days - r.period.0, e.mae_pct])
+                            // A look that returned nothing has no error to plot.
+                            (e.returned_pct > 0.0).then(|| [d.looks[run.look].access.days - r.period.0, e.mae_pct])
                         })
                         .collect();
                     p.points(Points::new(d.label.clone(), pts).radius(4.0).color(colour(k)));
