@@ -155,4 +155,19 @@ fn every_example_study_resolves() {
         let resolved = spec.resolve(Some(&dir)).unwrap_or_else(|e| panic!("{path:?}: {e}"));
         assert!(!resolved.runs.is_empty(), "{path:?}");
     }
+    // The seasons behind RESULTS rows load and check, and their studies resolve.
+    let seasons: Vec<std::path::PathBuf> = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(Result::ok)
+        .map(|e| e.path())
+        .filter(|p| p.file_name().is_some_and(|n| n.to_string_lossy().starts_with("season_")))
+        .collect();
+    assert!(seasons.len() >= 3, "{seasons:?}");
+    for path in &seasons {
+        let text = std::fs::read_to_string(path).unwrap();
+        let season = shoal::season::SeasonSpec::from_ron(&text, &path.to_string_lossy())
+            .unwrap_or_else(|e| panic!("{path:?}: {e}"));
+        season.validate().unwrap_or_else(|e| panic!("{path:?}: {e}"));
+        shoal::season::run::designs(&season, Some(&dir)).unwrap_or_else(|e| panic!("{path:?}: {e}"));
+    }
 }
