@@ -8,7 +8,7 @@ use clap::Args;
 use super::CliError;
 use crate::csvtext::Csv;
 use crate::season::looks::Verdict;
-use crate::season::run::{SeasonPlan, SeasonResult, plan_season, run_plan};
+use crate::season::run::{LookError, SeasonPlan, SeasonResult, plan_season, run_plan};
 use crate::season::summary::{SUMMARY_JSON, SeasonSummary, variables};
 use crate::season::{SeasonSpec, shard};
 use crate::study::write_bytes;
@@ -244,8 +244,7 @@ pub fn looks_csv(result: &SeasonResult) -> String {
             ];
             for (p, v) in &vars {
                 let e = run.and_then(|r| r.errors.iter().find(|e| e.product == *p && e.variable == *v));
-                // A look that returned nothing has no error (its MAE of an empty set is not 0 %).
-                row.push(e.filter(|e| e.returned_pct > 0.0).map_or_else(String::new, |e| format!("{:.2}", e.mae_pct)));
+                row.push(e.and_then(LookError::returned_mae_pct).map_or_else(String::new, |m| format!("{m:.2}")));
                 row.push(e.map_or_else(String::new, |e| format!("{:.2}", e.returned_pct)));
             }
             csv.row(row);
@@ -259,8 +258,8 @@ pub fn looks_csv(result: &SeasonResult) -> String {
 pub fn months_csv(result: &SeasonResult) -> String {
     let mut csv = Csv::new(&["design", "month", "passes", "valid", "sun_low", "view_oblique", "glint", "cloud"]);
     for d in &result.designs {
-        let all = d.per_month(None, result.period, result.spec.local_offset_days());
-        let by = |v: Verdict| d.per_month(Some(v), result.period, result.spec.local_offset_days());
+        let all = result.per_month(d, None);
+        let by = |v: Verdict| result.per_month(d, Some(v));
         let (valid, sun, view) = (by(Verdict::Valid), by(Verdict::SunLow), by(Verdict::ViewOblique));
         let (glint, cloud) = (by(Verdict::Glint), by(Verdict::Cloud));
         for (i, ((y, m), n)) in all.iter().enumerate() {

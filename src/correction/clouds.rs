@@ -78,14 +78,13 @@ pub struct Sun {
 }
 
 /// The screen of `level1`: true where the processor flags cloud or cloud shadow. `rayleigh` is
-/// the family's τ = 0 member's band terms (every column); with `glint_expected` its glint is
-/// taken away with its path radiance (a processor that removes glint); pixels `surface` calls
-/// land are never flagged (the processor knows its land mask, nothing else of the truth).
-#[allow(clippy::too_many_arguments)]
+/// the family's τ = 0 member's band terms (every column), with the expected glint folded into
+/// its path radiance where the processor takes glint away
+/// ([`BandTerms::fold_glint_into_path`]); pixels `surface` calls land are never flagged (the
+/// processor knows its land mask, nothing else of the truth).
 pub fn screen_image(
     level1: &Level1,
     rayleigh: &BandTerms,
-    glint_expected: bool,
     bands: &BandSet,
     viewing: &Viewing,
     sun: Sun,
@@ -110,9 +109,8 @@ pub fn screen_image(
             return false;
         }
         let i = c * nb + k;
-        let glint = if glint_expected { rayleigh.glint.get(i).copied().unwrap_or(0.0) } else { 0.0 };
-        let rho = std::f64::consts::PI * (f64::from(level1.radiance[[r, c, k]]) - rayleigh.l_path[i] - glint)
-            / rayleigh.t_ed[i];
+        let rho =
+            std::f64::consts::PI * (f64::from(level1.radiance[[r, c, k]]) - rayleigh.l_path[i]) / rayleigh.t_ed[i];
         rho > settings.threshold || level1.flags[[r, c, k]] & saturated != 0
     });
     let mut screened = cloud.clone();

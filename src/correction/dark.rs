@@ -208,20 +208,18 @@ pub fn fit_tiles(
     let fit = |rr: [usize; 2], cc: [usize; 2]| -> Option<TileFit> {
         // The pixels the processor looks at: those left out for high glint do not count, in the
         // 10 % below as in the dark spectrum (a tile wholly in glint falls back to the scene's fit).
-        let area = (rr[1] - rr[0]) * (cc[0]..cc[1]).filter(|&c| !skip_column(c)).count();
-        if area == 0 {
-            return None;
-        }
+        let kept: Vec<usize> = (cc[0]..cc[1]).filter(|&c| !skip_column(c)).collect();
+        let area = (rr[1] - rr[0]) * kept.len();
         // The terms the dark spectrum is compared with: the tile's centre column, or the column
         // nearest it outside the glint (whose pixels alone make the dark spectrum).
         let mid = (cc[0] + cc[1]) / 2;
-        let centre = (cc[0]..cc[1]).filter(|&c| !skip_column(c)).min_by_key(|&c| c.abs_diff(mid)).unwrap_or(mid);
+        let centre = *kept.iter().min_by_key(|&&c| c.abs_diff(mid))?;
         let mut dark = vec![f64::NAN; nb];
         let mut values = Vec::with_capacity(area);
         for &b in &fitted {
             values.clear();
             for r in rr[0]..rr[1] {
-                for c in (cc[0]..cc[1]).filter(|&c| !skip_column(c)) {
+                for &c in &kept {
                     let i = (r * cols + c) * nb + b;
                     let v = f64::from(l1[i]);
                     if flags[i] == 0 && v.is_finite() && v > 0.0 {

@@ -40,11 +40,7 @@ impl AerosolFamily {
     #[must_use]
     pub fn with_glint_in_path(&self) -> Self {
         let mut out = self.clone();
-        for t in out.terms.iter_mut().flatten() {
-            for (l, g) in t.l_path.iter_mut().zip(&t.glint) {
-                *l += g;
-            }
-        }
+        out.terms.iter_mut().flatten().for_each(crate::instrument::band_atmosphere::BandTerms::fold_glint_into_path);
         out
     }
 }

@@ -252,10 +252,19 @@ fn cloud_screen(
         .and_then(|m| m.first())
         .ok_or_else(|| EngineError::Failed { stage: Stage::Correction, message: "the family has no members".into() })?;
     let (bands, viewing, clouds) = (&side.response.bands, &side.viewing, &settings.clouds);
-    // The glint the correction takes away is taken away before the cloud test too (as
-    // `correction::correct_image` folds it into every member's path radiance).
-    let glint_expected = settings.glint && !fam.glint_lgn.is_empty();
-    let screen = screen_image(level1, rayleigh, glint_expected, bands, viewing, sun, clouds, &truth.surface)
+    // The glint the correction takes away is taken away before the cloud test too, folded into
+    // the Rayleigh member's path radiance as `correction::correct_image` folds it into every
+    // member's.
+    let folded;
+    let rayleigh = if settings.glint && !fam.glint_lgn.is_empty() {
+        let mut terms = rayleigh.clone();
+        terms.fold_glint_into_path();
+        folded = terms;
+        &folded
+    } else {
+        rayleigh
+    };
+    let screen = screen_image(level1, rayleigh, bands, viewing, sun, clouds, &truth.surface)
         .map_err(failed(Stage::Correction))?;
     Ok(Some(screen))
 }

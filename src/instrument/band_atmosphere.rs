@@ -241,6 +241,16 @@ pub struct BandTerms {
     pub glint: Vec<f64>,
 }
 
+impl BandTerms {
+    /// The glint added to the path radiance: the terms a processor that takes the expected glint
+    /// away inverts with (L − L_path − G).
+    pub fn fold_glint_into_path(&mut self) {
+        for (l, g) in self.l_path.iter_mut().zip(&self.glint) {
+            *l += g;
+        }
+    }
+}
+
 /// The band terms of every column for one atmosphere (the photon-weighted means of
 /// `BandAtmosphere`, without what only the forward model needs): [`band_terms_of_each`] of one.
 pub fn band_terms(

@@ -17,7 +17,7 @@ pub fn valid_looks_curves(result: &SeasonResult) -> Curves {
         .designs
         .iter()
         .map(|d| {
-            let months = d.per_month(Some(Verdict::Valid), result.period, result.spec.local_offset_days());
+            let months = result.per_month(d, Some(Verdict::Valid));
             CurveSeries {
                 label: d.label.clone(),
                 points: months.iter().enumerate().map(|(i, (_, n))| point((i + 1) as f64, *n as f64)).collect(),
@@ -25,7 +25,7 @@ pub fn valid_looks_curves(result: &SeasonResult) -> Curves {
             }
         })
         .collect();
-    let first = result.designs.first().map(|d| d.per_month(None, result.period, result.spec.local_offset_days()));
+    let first = result.designs.first().map(|d| result.per_month(d, None));
     let span = first
         .as_ref()
         .and_then(|m| {
@@ -69,11 +69,8 @@ pub fn error_curves(result: &SeasonResult, product: &str, variable: &str, limit:
                 .iter()
                 .filter_map(|r| {
                     // A look that returned none of the product has no error to plot.
-                    let e = r
-                        .errors
-                        .iter()
-                        .find(|e| e.product == product && e.variable == variable && e.returned_pct > 0.0)?;
-                    Some(point(d.looks[r.look].access.days - result.period.0, e.mae_pct))
+                    let e = r.errors.iter().find(|e| e.product == product && e.variable == variable)?;
+                    Some(point(d.looks[r.look].access.days - result.period.0, e.returned_mae_pct()?))
                 })
                 .collect();
             CurveSeries { label: d.label.clone(), points, crossing: None }

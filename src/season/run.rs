@@ -27,6 +27,14 @@ pub struct LookError {
     pub returned_pct: f64,
 }
 
+impl LookError {
+    /// The MAE, % — `None` where the look returned no pixel (an empty set's MAE is not 0 %).
+    #[must_use]
+    pub fn returned_mae_pct(&self) -> Option<f64> {
+        (self.returned_pct > 0.0).then_some(self.mae_pct)
+    }
+}
+
 /// One valid look run through the chain.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct LookRun {
@@ -135,6 +143,14 @@ pub struct SeasonResult {
     pub period: (f64, f64),
     /// Per design.
     pub designs: Vec<DesignSeason>,
+}
+
+impl SeasonResult {
+    /// [`DesignSeason::per_month`] of `design` over this season's period, in the site's months.
+    #[must_use]
+    pub fn per_month(&self, design: &DesignSeason, verdict: Option<Verdict>) -> Vec<((i64, u32), usize)> {
+        design.per_month(verdict, self.period, self.spec.local_offset_days())
+    }
 }
 
 /// The run configuration of `look` from a design's study configuration: the scene's sun and

@@ -127,7 +127,7 @@ fn spread(values: &[f64]) -> Option<(f64, f64, f64)> {
 /// metrics' MAE of 0 % would pull the median down), the share returned over every look run.
 /// `None` when no look returned it.
 fn product_season(product: &str, variable: &str, errs: &[&LookError]) -> Option<ProductSeason> {
-    let mae: Vec<f64> = errs.iter().filter(|e| e.returned_pct > 0.0).map(|e| e.mae_pct).collect();
+    let mae: Vec<f64> = errs.iter().filter_map(|e| e.returned_mae_pct()).collect();
     let returned: Vec<f64> = errs.iter().map(|e| e.returned_pct).collect();
     let p = |q: f64| stats::percentile(&mae, q);
     Some(ProductSeason {
@@ -175,8 +175,8 @@ impl SeasonSummary {
                         count(Verdict::Glint),
                         count(Verdict::Cloud),
                     ],
-                    valid_per_month: d
-                        .per_month(Some(Verdict::Valid), result.period, result.spec.local_offset_days())
+                    valid_per_month: result
+                        .per_month(d, Some(Verdict::Valid))
                         .iter()
                         .map(|((y, m), n)| (format!("{y}-{m:02}"), *n))
                         .collect(),

@@ -279,7 +279,7 @@ fn plots(ui: &mut egui::Ui, r: &SeasonResult, shown: Option<&(String, String)>) 
             .height(height)
             .show(ui, |p| {
                 for (k, d) in r.designs.iter().enumerate() {
-                    let months = d.per_month(Some(Verdict::Valid), r.period, r.spec.local_offset_days());
+                    let months = r.per_month(d, Some(Verdict::Valid));
                     let pts: Vec<[f64; 2]> =
                         months.iter().enumerate().map(|(i, (_, n))| [i as f64 + 1.0, *n as f64]).collect();
                     // Designs in one orbit have the same looks: every other one dashed, so
@@ -313,8 +313,7 @@ fn plots(ui: &mut egui::Ui, r: &SeasonResult, shown: Option<&(String, String)>) 
                         .iter()
                         .filter_map(|run| {
                             let e = run.errors.iter().find(|e| e.product == *product && e.variable == *variable)?;
-                            // A look that returned nothing has no error to plot.
-                            (e.returned_pct > 0.0).then(|| [d.looks[run.look].access.days - r.period.0, e.mae_pct])
+                            Some([d.looks[run.look].access.days - r.period.0, e.returned_mae_pct()?])
                         })
                         .collect();
                     p.points(Points::new(d.label.clone(), pts).radius(4.0).color(colour(k)));
