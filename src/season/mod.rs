@@ -34,6 +34,7 @@
 
 pub mod figure;
 pub mod looks;
+pub mod months;
 pub mod run;
 pub mod shard;
 pub mod stats;
