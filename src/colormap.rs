@@ -60,10 +60,19 @@ const CLASSES: [Rgb; 12] = [
 fn interpolate(anchors: &[Rgb], t: f64) -> Rgb {
     let t = if t.is_finite() { t.clamp(0.0, 1.0) } else { 0.0 };
     let x = t * (anchors.len() - 1) as f64;
-    let i = (x.floor() as usize).min(anchors.len() - 2);
+    // x ≥ 0, so truncation is its floor (no libm call: a map's every block comes through here).
+    let i = (x as usize).min(anchors.len() - 2);
     let f = x - i as f64;
     let (a, b) = (anchors[i], anchors[i + 1]);
-    std::array::from_fn(|k| (f64::from(a[k]) + f * (f64::from(b[k]) - f64::from(a[k]))).round() as u8)
+    std::array::from_fn(|k| round_channel(f64::from(a[k]) + f * (f64::from(b[k]) - f64::from(a[k]))))
+}
+
+/// `v.round() as u8` for `v` in 0–255, without a libm call: half up by truncation, less one where
+/// `v + 0.5` rounded up to the next integer in floating point (`v` just below ½).
+#[inline]
+fn round_channel(v: f64) -> u8 {
+    let r = (v + 0.5) as u8;
+    if f64::from(r) - v > 0.5 { r - 1 } else { r }
 }
 
 /// Viridis at t ∈ [0, 1] (clamped; NaN gives the low end).
