@@ -145,6 +145,13 @@ impl<Req: Send + 'static, Out: Send + 'static> Worker<Req, Out> {
         self.inbox.put(request)
     }
 
+    /// A handle that asks this worker from another thread (as [`Self::request`]); its answers
+    /// come back to the worker's owner.
+    #[must_use]
+    pub fn requester(&self) -> Requester<Req> {
+        Requester(self.inbox.clone())
+    }
+
     /// The oldest answer not yet taken.
     pub fn poll(&self) -> Option<Out> {
         self.answers.try_recv().ok()
@@ -167,6 +174,17 @@ impl<Req: Send + 'static, Out: Send + 'static> Worker<Req, Out> {
             last = Some(a);
         }
         last
+    }
+}
+
+/// Asks a [`Worker`] from another thread ([`Worker::requester`]).
+#[derive(Debug)]
+pub struct Requester<Req>(Arc<Mailbox<Req>>);
+
+impl<Req> Requester<Req> {
+    /// Ask, replacing a request not yet started. Never blocks.
+    pub fn request(&self, request: Req) -> Put<Req> {
+        self.0.put(request)
     }
 }
 

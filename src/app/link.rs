@@ -133,6 +133,11 @@ impl EngineLink {
         })
     }
 
+    /// Call `hook` with each result on the engine thread, before it reaches [`Self::poll`].
+    pub fn set_result_hook(&self, hook: crate::engine::worker::ResultHook) {
+        self.handle.set_result_hook(hook);
+    }
+
     /// What instrument `index` has to show for the configuration now set (see [`Standing`]).
     #[must_use]
     pub fn standing(&self, index: usize) -> Standing<'_> {

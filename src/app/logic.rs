@@ -247,6 +247,7 @@ impl ShoalApp {
             if self.images.ready() {
                 self.link.maps_on_screen();
             }
+            self.prefetch.update(&self.state, &self.link);
         }
         while let Some(news) = self.ui.exports.poll() {
             match news {

@@ -2,8 +2,6 @@
 //! or a pair of designs and their difference, A | B | A − B) on one colour scale with a colour
 //! bar, zoomed and panned together, with the values under the cursor.
 
-use std::hash::{DefaultHasher, Hash, Hasher};
-
 use egui::{Color32, Pos2, Rect, Sense, Vec2};
 
 use super::ShoalApp;
@@ -81,45 +79,18 @@ impl Images {
     /// Ask the raster thread for the images of the current state, if not already asked; true
     /// when this call asked.
     pub fn request(&mut self, state: &AppState, link: &EngineLink, raster: &RasterThread) -> bool {
-        let mut h = DefaultHasher::new();
-        state.product.hash(&mut h);
-        state.band.hash(&mut h);
-        state.layout.hash(&mut h);
-        state.on_maps.hash(&mut h);
-        state.pair.hash(&mut h);
-        // The results themselves, not their generation: a result carried over to a new
-        // generation (the instrument did not change) keeps its images. A run that failed shows
-        // no map (never the previous configuration's).
-        let runs: Vec<_> = (0..state.designs.len())
-            .map(|i| match link.standing(i) {
-                Standing::Current(s) | Standing::Earlier(s) => Some(s.output.clone()),
-                Standing::Failed(_) | Standing::Waiting => None,
-            })
-            .collect();
-        for r in &runs {
-            r.as_ref().map(std::sync::Arc::as_ptr).hash(&mut h);
-        }
-        let key = h.finish();
-        if self.requested == Some(key) {
+        let job = job_for(state, link);
+        if self.requested == Some(job.key) {
             return false;
         }
-        if runs.iter().all(Option::is_none) {
+        if job.runs.iter().all(Option::is_none) {
             // Nothing to show (every run failed): no map of an earlier configuration stays up.
             self.panels.clear();
             self.plot = None;
-            (self.requested, self.shown) = (Some(key), Some(key));
+            (self.requested, self.shown) = (Some(job.key), Some(job.key));
             return false;
         }
-        let job = Job {
-            key,
-            runs,
-            on_maps: state.on_maps.clone(),
-            pair: state.pair,
-            kind: state.product,
-            band: state.band,
-            layout: state.layout,
-            max_side: 720,
-        };
+        let key = job.key;
         if matches!(raster.request(job), crate::jobs::Put::Closed(_)) {
             return false;
         }
@@ -127,9 +98,11 @@ impl Images {
         true
     }
 
-    /// Upload the raster thread's answer if it is the newest.
+    /// Upload the raster thread's answer if it is the newest and not already on display (the
+    /// answer to a request the engine's result hook made early comes again when the frame that
+    /// takes the result asks: [`super::prefetch`]).
     pub fn receive(&mut self, ctx: &egui::Context, done: Done) {
-        if Some(done.key) != self.requested {
+        if Some(done.key) != self.requested || self.shown == Some(done.key) {
             return;
         }
         self.panels = done
@@ -146,6 +119,31 @@ impl Images {
         self.plot = Some(done.plot);
         self.shown = Some(done.key);
     }
+}
+
+/// What the raster thread is asked for the state and results now on display: each design's
+/// result of the current or an earlier configuration. Keyed by the results themselves, not their
+/// generation: a result carried over to a new generation (the instrument did not change) keeps
+/// its images. A run that failed shows no map (never the previous configuration's).
+#[must_use]
+pub fn job_for(state: &AppState, link: &EngineLink) -> Job {
+    let runs = (0..state.designs.len())
+        .map(|i| match link.standing(i) {
+            Standing::Current(s) | Standing::Earlier(s) => Some(s.output.clone()),
+            Standing::Failed(_) | Standing::Waiting => None,
+        })
+        .collect();
+    Job {
+        key: 0,
+        runs,
+        on_maps: state.on_maps.clone(),
+        pair: state.pair,
+        kind: state.product,
+        band: state.band,
+        layout: state.layout,
+        max_side: 720,
+    }
+    .keyed()
 }
 
 fn product_menu(app: &mut ShoalApp, ui: &mut egui::Ui) {

@@ -12,7 +12,7 @@
 //! | the list of designs: add, remove, reorder | `designs` |
 //! | the retrievals offered, as specs | `retrievals` |
 //! | the engine thread's results | [`link`] |
-//! | product maps, colours, differences | [`raster`] |
+//! | product maps, colours, differences (asked for as a result arrives: `prefetch`) | [`raster`] |
 //! | histogram and scatter data, off the UI thread | [`plot_data`] |
 //! | colours and what they mean | [`theme`] |
 //! | presets and instrument editor | `panels` |
@@ -53,6 +53,7 @@ mod params;
 mod planes;
 pub mod plot_data;
 pub mod plots;
+mod prefetch;
 mod probe;
 pub mod product_map;
 pub mod raster;
@@ -155,6 +156,8 @@ pub struct ShoalApp {
     listing: listing::Listing,
     images: maps::Images,
     raster: Option<raster::RasterThread>,
+    /// What the engine's result hook asks the raster thread for early.
+    prefetch: Arc<prefetch::Prefetch>,
     ui: UiState,
     options: AppOptions,
     screenshot_taken: Arc<std::sync::Mutex<Option<Arc<egui::ColorImage>>>>,
@@ -189,6 +192,10 @@ impl ShoalApp {
         });
         let wake = ctx.clone();
         let raster = raster::spawn_raster_thread(move || wake.request_repaint()).ok();
+        let prefetch = Arc::new(prefetch::Prefetch::default());
+        if let Some(r) = &raster {
+            link.set_result_hook(prefetch.hook(prefetch::asking(r.requester())));
+        }
         let export_path = crate::library::export_dir().join("comparison").display().to_string();
         Self {
             state,
@@ -197,6 +204,7 @@ impl ShoalApp {
             library: Library::user(),
             images: maps::Images::default(),
             raster,
+            prefetch,
             ui: UiState { preset_name: "my_instrument".into(), export_path, ..UiState::default() },
             options,
             screenshot_taken: Arc::default(),

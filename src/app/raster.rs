@@ -97,6 +97,28 @@ pub struct Job {
     pub max_side: usize,
 }
 
+impl Job {
+    /// The job with its key: what it shows and the results' identities (their addresses: the
+    /// raster thread keeps the runs it was last asked for alive, so an address is not reused
+    /// while its key may still be compared).
+    #[must_use]
+    pub fn keyed(mut self) -> Self {
+        use std::hash::{DefaultHasher, Hash, Hasher};
+        let mut h = DefaultHasher::new();
+        self.kind.hash(&mut h);
+        self.band.hash(&mut h);
+        self.layout.hash(&mut h);
+        self.on_maps.hash(&mut h);
+        self.pair.hash(&mut h);
+        self.max_side.hash(&mut h);
+        for r in &self.runs {
+            r.as_ref().map(Arc::as_ptr).hash(&mut h);
+        }
+        self.key = h.finish();
+        self
+    }
+}
+
 /// What a map panel shows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Role {
@@ -307,7 +329,14 @@ pub fn spawn_raster_thread(wake: impl Fn() + Send + 'static) -> std::io::Result<
     let mut maps = MapCache::default();
     // Each run's share of the plots, by variable.
     let mut values = ByRun::<&'static str, Arc<RunValues>>::default();
+    // The last answer and the runs it was made from (kept alive, so their addresses in its key
+    // stay theirs): a request asked again — made early by the engine's result hook, then by the
+    // frame that takes the result — is answered at once.
+    let mut last: Option<(Vec<Option<Arc<RunOutput>>>, Done)> = None;
     Worker::spawn("shoal-raster", wake, move |job: Job| {
+        if let Some((_, done)) = last.as_ref().filter(|(_, d)| d.key == job.key) {
+            return done.clone();
+        }
         let mut done = panels(&job, &mut maps);
         let variable = job.kind.variable().unwrap_or("chl_mg_m3");
         values.keep_only(&job.runs);
@@ -319,6 +348,7 @@ pub fn spawn_raster_thread(wake: impl Fn() + Send + 'static) -> std::io::Result<
             .collect();
         let refs: Vec<Option<&RunValues>> = runs.iter().map(Option::as_deref).collect();
         done.plot = Arc::new(combine(variable, &refs));
+        last = Some((job.runs, done.clone()));
         done
     })
 }

@@ -9,9 +9,9 @@
 //! then full resolution), through the same stage cache. The worker owns a rayon pool of its own,
 //! so the UI thread keeps a core.
 
-use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc::{Receiver, RecvTimeoutError, SyncSender, TryRecvError, sync_channel};
+use std::sync::{Arc, Mutex, PoisonError};
 use std::thread::JoinHandle;
 use std::time::Duration;
 
@@ -82,6 +82,30 @@ pub enum Event {
 /// Called by the worker after it sends an event.
 pub type Wake = Arc<dyn Fn() + Send + Sync>;
 
+/// Called by the worker with each result (generation, design, decimation, output) just before it
+/// sends it: an owner can start work on the result on its own threads without waiting for its
+/// next poll (the app starts colouring the result's maps while its UI thread waits for the
+/// display's next refresh).
+pub type ResultHook = Arc<dyn Fn(u64, usize, usize, &Arc<RunOutput>) + Send + Sync>;
+
+/// Where the owner's [`ResultHook`] is kept, shared by the handle and the worker.
+#[derive(Default)]
+struct HookSlot(Mutex<Option<ResultHook>>);
+
+impl std::fmt::Debug for HookSlot {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("HookSlot")
+    }
+}
+
+impl HookSlot {
+    fn call(&self, generation: u64, index: usize, decimation: usize, output: &Arc<RunOutput>) {
+        if let Some(hook) = self.0.lock().unwrap_or_else(PoisonError::into_inner).as_ref() {
+            hook(generation, index, decimation, output);
+        }
+    }
+}
+
 /// What became of the runs and results since the worker started (for tests and diagnostics):
 /// a stale result (a run that finished after a newer request was submitted, dropped by
 /// [`EngineHandle::poll`]) is told apart from a cancelled run (stopped before it finished,
@@ -129,6 +153,7 @@ pub struct EngineHandle {
     latest: Arc<AtomicU64>,
     counters: Arc<Counters>,
     pause: Arc<PreviewPause>,
+    hook: Arc<HookSlot>,
     thread: Option<JoinHandle<()>>,
 }
 
@@ -163,14 +188,27 @@ impl EngineHandle {
         let worker_counters = counters.clone();
         let pause = Arc::new(PreviewPause::default());
         let worker_pause = pause.clone();
+        let hook = Arc::new(HookSlot::default());
+        let worker_hook = hook.clone();
         let pool = crate::jobs::pool(threads.max(1), "shoal-engine")?;
         let thread = std::thread::Builder::new().name("shoal-engine".into()).spawn(move || {
-            let link = Link { events: &event_tx, latest: &worker_latest, counters: &worker_counters, wake: &wake };
+            let link = Link {
+                events: &event_tx,
+                latest: &worker_latest,
+                counters: &worker_counters,
+                wake: &wake,
+                hook: &worker_hook,
+            };
             worker(&worker_requests, &link, &worker_pause, &pool);
             // However the worker ended, later submissions are refused rather than left waiting.
             worker_requests.close();
         })?;
-        Ok(Self { requests, events: event_rx, latest, counters, pause, thread: Some(thread) })
+        Ok(Self { requests, events: event_rx, latest, counters, pause, hook, thread: Some(thread) })
+    }
+
+    /// Call `hook` with each result before it is sent (see [`ResultHook`]); replaces any hook set.
+    pub fn set_result_hook(&self, hook: ResultHook) {
+        *self.hook.0.lock().unwrap_or_else(PoisonError::into_inner) = Some(hook);
     }
 
     /// Pause up to `limit` between a request's coarsest level and its finer ones, until
@@ -308,6 +346,7 @@ struct Link<'a> {
     latest: &'a Arc<AtomicU64>,
     counters: &'a Counters,
     wake: &'a Wake,
+    hook: &'a HookSlot,
 }
 
 /// Wait, after `generation`'s preview, until it is on screen, a newer generation arrives or the
@@ -350,7 +389,7 @@ pub fn app_cache_bytes() -> usize {
 }
 
 fn worker(requests: &Mailbox<Request>, link: &Link<'_>, pause: &PreviewPause, pool: &rayon::ThreadPool) {
-    let Link { events, latest, counters, wake } = *link;
+    let Link { events, latest, counters, wake, hook } = *link;
     let cache_bytes = app_cache_bytes();
     let mut engine = Engine::for_app(cache_bytes, MAX_DESIGNS);
     // The mailbox holds only the newest request: an older one was replaced (and counted) there.
@@ -430,6 +469,9 @@ fn worker(requests: &Mailbox<Request>, link: &Link<'_>, pause: &PreviewPause, po
                     Ok(Some(output)) => Event::Finished { generation, index, decimation, result: Ok(Arc::new(output)) },
                     Err(e) => Event::Finished { generation, index, decimation, result: Err(e) },
                 };
+                if let Event::Finished { result: Ok(output), .. } = &event {
+                    hook.call(generation, index, decimation, output);
+                }
                 // Counted before it is sent, so a reader that has the event sees it counted.
                 counters.results_sent.fetch_add(1, Ordering::SeqCst);
                 if events.send(event).is_err() {
