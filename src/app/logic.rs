@@ -236,9 +236,10 @@ impl ShoalApp {
         if let Some(r) = &self.raster {
             // A new result's images are waited for briefly, so that they appear in the frame that
             // took the result rather than one refresh (16.7 ms) later: recolouring A's preview
-            // beside B at full resolution takes a few ms from the kept block sums (`blocks`).
-            // The wait is capped, so a slower answer (B's first full-resolution maps) only
-            // costs this frame the cap and arrives with a later frame.
+            // beside B at full resolution takes a few ms from the kept block sums (`blocks`),
+            // begun when the engine had the result (`prefetch`). The wait is capped, so a slower
+            // answer (B's first full-resolution maps) only costs this frame the cap and arrives
+            // with a later frame.
             let asked = self.images.request(&self.state, &self.link, r);
             let answer = if asked { r.latest_within(RASTER_WAIT) } else { r.latest() };
             if let Some(done) = answer {
