@@ -193,7 +193,15 @@ impl<'f> PairFit<'f> {
         // The bracketing pair (by ε), or the nearest model outside the family's range.
         order.clear();
         order.extend(0..nm);
-        order.sort_by(|&a, &b| eps[a].total_cmp(&eps[b]));
+        // Stable insertion sort, as `sort_by` orders them: a family has a handful of members,
+        // and per pass of every pixel the library sort's set-up cost more than the sorting.
+        for i in 1..nm {
+            let mut j = i;
+            while j > 0 && eps[order[j - 1]].total_cmp(&eps[order[j]]).is_gt() {
+                order.swap(j - 1, j);
+                j -= 1;
+            }
+        }
         let (m1, m2, w, out) = match order.windows(2).find(|q| eps[q[0]] <= measured && measured <= eps[q[1]]) {
             Some(q) => {
                 let d = eps[q[1]] - eps[q[0]];
