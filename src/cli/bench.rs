@@ -94,8 +94,9 @@ pub enum Section {
     App,
 }
 
-fn machine() -> String {
-    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+/// The CPU's model name (`/proc/cpuinfo`), or "unknown CPU".
+pub(super) fn cpu_model() -> String {
+    std::fs::read_to_string("/proc/cpuinfo")
         .ok()
         .and_then(|s| {
             s.lines()
@@ -103,7 +104,11 @@ fn machine() -> String {
                 .and_then(|l| l.split(':').nth(1))
                 .map(|s| s.trim().to_string())
         })
-        .unwrap_or_else(|| "unknown CPU".into());
+        .unwrap_or_else(|| "unknown CPU".into())
+}
+
+fn machine() -> String {
+    let cpu = cpu_model();
     let threads = std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get);
     format!(
         "{cpu}, {threads} logical cores, rayon pool {} threads, vector kernels at {}",
@@ -196,10 +201,14 @@ fn water_rows(out: &mut String, quick: bool) -> Result<(), CliError> {
         ("shallow, Rrs only, single precision (setting `water_single_precision`)", single_shallow, shallow_ref),
         ("optically deep, Rrs only, single precision", single_deep, deep_ref),
     ] {
-        say!(out, "| {label} | {:.0} | {} | {} |", r, reference.text(), reference.ratio(r));
+        say!(out, "| {label} | {:.0} | {} | {} |", r, reference.text(), reference.ratio_here(r));
     }
     say!(out);
     say!(out, "{}", super::bench_reference::SIDE_BY_SIDE);
+    if let Some(w) = super::bench_reference::other_machine(&cpu_model()) {
+        say!(out);
+        say!(out, "{w}");
+    }
     say!(out);
     Ok(())
 }

@@ -34,6 +34,28 @@ impl ReferenceFigure {
         let f = |v: f64| if v >= 10.0 { format!("{v:.0}") } else { format!("{v:.2}") };
         if self.range.0 == self.range.1 { format!("{}×", f(lo)) } else { format!("{}–{}×", f(lo), f(hi)) }
     }
+
+    /// [`Self::ratio`] of a `rate` measured on this machine, marked "(across CPUs)" where this
+    /// CPU is not the one the reference was measured on ([`other_machine`]).
+    #[must_use]
+    pub fn ratio_here(&self, rate: f64) -> String {
+        let ratio = self.ratio(rate);
+        if other_machine(&super::bench::cpu_model()).is_some() { format!("{ratio} (across CPUs)") } else { ratio }
+    }
+}
+
+/// The CPU note 1's figures were measured on: a `model name` that starts so is that class.
+pub const REFERENCE_CPU: &str = "AMD EPYC";
+
+/// Why the ratios printed on a machine whose CPU (`cpu`, its model name) is not of
+/// [`REFERENCE_CPU`]'s class are no paired ratios; `None` on that class.
+#[must_use]
+pub fn other_machine(cpu: &str) -> Option<String> {
+    (!cpu.starts_with(REFERENCE_CPU)).then(|| {
+        format!(
+            "This CPU ({cpu}) is not the one note 1's figures were measured on ({REFERENCE_CPU}): each × column divides this machine's speed by another machine's, so it is no paired ratio (marked \"across CPUs\"). To compare here, run the reference codes beside Shoal with tests/bench/reference_codes.py."
+        )
+    })
 }
 
 /// Where, when and how note 1's figures were measured.
@@ -75,5 +97,12 @@ mod tests {
         assert_eq!(DEA_ALMI.ratio(820_900.0), "100×");
         let range = ReferenceFigure { note: 1, what: "", range: (14.0, 17.0) };
         assert_eq!((range.text(), range.ratio(34.0)), ("14.0–17.0 [1]".to_string(), "2.00–2.43×".to_string()));
+    }
+
+    #[test]
+    fn a_ratio_across_cpus_says_so() {
+        assert!(other_machine("AMD EPYC 7B13").is_none());
+        let w = other_machine("Intel(R) Xeon(R) Processor").unwrap();
+        assert!(w.contains("Intel(R) Xeon(R) Processor") && w.contains("AMD EPYC") && w.contains("reference_codes.py"));
     }
 }

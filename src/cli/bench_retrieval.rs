@@ -300,7 +300,7 @@ pub fn retrieval_rows(out: &mut String, quick: bool) -> Result<(), CliError> {
             out,
             "| aLMI, 8 SIOP sets, {label} | {nb} | {rate:.0} | {} | {} | 1e-6 (test) |",
             dea.text(),
-            dea.ratio(rate)
+            dea.ratio_here(rate)
         );
     }
     let _ = writeln!(
@@ -330,7 +330,7 @@ pub fn retrieval_rows(out: &mut String, quick: bool) -> Result<(), CliError> {
             "| {label} | {} | {rate:.0} | {} | {} | {no_worse:.1} % no worse than truth; depth within 1 % in {depth_ok:.1} % |",
             bands.len(),
             reference.text(),
-            reference.ratio(rate)
+            reference.ratio_here(rate)
         );
         let (rate, no_worse, depth_ok) = sambuca_reference_rate(&bands, &subs, n / 4, quick)?;
         let _ = writeln!(
@@ -338,11 +338,15 @@ pub fn retrieval_rows(out: &mut String, quick: bool) -> Result<(), CliError> {
             "| {label}, reference mode (SLSQP from (max − min)/2) | {} | {rate:.0} | {} | {} | {no_worse:.1} % no worse than truth; depth within 1 % in {depth_ok:.1} % |",
             bands.len(),
             reference.text(),
-            reference.ratio(rate)
+            reference.ratio_here(rate)
         );
     }
     let _ = writeln!(out);
     let _ = writeln!(out, "{}", super::bench_reference::SIDE_BY_SIDE);
+    if let Some(w) = super::bench_reference::other_machine(&super::bench::cpu_model()) {
+        let _ = writeln!(out);
+        let _ = writeln!(out, "{w}");
+    }
     let _ = writeln!(out);
     let _ = writeln!(out, "{}", super::bench_reference::SUPERSEDED);
     let _ = writeln!(out);
