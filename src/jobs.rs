@@ -73,6 +73,19 @@ impl<T> Mailbox<T> {
         old.map_or(Put::Queued, Put::Replaced)
     }
 
+    /// Leave `value` only if no request is waiting (one waiting is newer or more wanted: it
+    /// stays); false if it was not left. Never blocks.
+    pub fn offer(&self, value: T) -> bool {
+        let mut slot = self.lock();
+        if slot.closed || slot.waiting.is_some() {
+            return false;
+        }
+        slot.waiting = Some(value);
+        drop(slot);
+        self.ready.notify_one();
+        true
+    }
+
     /// The waiting request, waiting for one if there is none; `None` once the mailbox is closed
     /// (a request left when it closed is dropped: nobody wants it any more).
     pub fn take(&self) -> Option<T> {
@@ -145,8 +158,8 @@ impl<Req: Send + 'static, Out: Send + 'static> Worker<Req, Out> {
         self.inbox.put(request)
     }
 
-    /// A handle that asks this worker from another thread (as [`Self::request`]); its answers
-    /// come back to the worker's owner.
+    /// A handle that offers this worker work from another thread (never replacing a request of
+    /// the owner's); its answers come back to the owner.
     #[must_use]
     pub fn requester(&self) -> Requester<Req> {
         Requester(self.inbox.clone())
@@ -157,14 +170,11 @@ impl<Req: Send + 'static, Out: Send + 'static> Worker<Req, Out> {
         self.answers.try_recv().ok()
     }
 
-    /// The newest answer, waiting at most `timeout` for one when none is there yet: for an
-    /// owner that has just asked and would rather draw the answer in this frame than one refresh
-    /// later. The wait is bounded, so a slow answer costs the frame `timeout` at most.
-    pub fn latest_within(&self, timeout: std::time::Duration) -> Option<Out> {
-        match self.latest() {
-            Some(a) => Some(a),
-            None => self.answers.recv_timeout(timeout).ok().map(|a| self.latest().unwrap_or(a)),
-        }
+    /// The oldest answer not yet taken, waiting until `deadline` for one when none is there: for
+    /// an owner that has just asked and would rather draw the answer in this frame than one
+    /// refresh later. The wait is bounded, so a slow answer costs the frame its deadline at most.
+    pub fn poll_until(&self, deadline: std::time::Instant) -> Option<Out> {
+        self.answers.recv_timeout(deadline.saturating_duration_since(std::time::Instant::now())).ok()
     }
 
     /// The newest answer, dropping older ones not yet taken.
@@ -177,14 +187,16 @@ impl<Req: Send + 'static, Out: Send + 'static> Worker<Req, Out> {
     }
 }
 
-/// Asks a [`Worker`] from another thread ([`Worker::requester`]).
+/// Offers a [`Worker`] work from another thread ([`Worker::requester`]): the owner's own
+/// requests come first.
 #[derive(Debug)]
 pub struct Requester<Req>(Arc<Mailbox<Req>>);
 
 impl<Req> Requester<Req> {
-    /// Ask, replacing a request not yet started. Never blocks.
-    pub fn request(&self, request: Req) -> Put<Req> {
-        self.0.put(request)
+    /// Ask, unless a request is waiting (the owner's, which is never replaced from here); true if
+    /// asked. Never blocks.
+    pub fn offer(&self, request: Req) -> bool {
+        self.0.offer(request)
     }
 }
 
@@ -286,6 +298,19 @@ mod tests {
         assert_eq!(m.put(3), Put::Replaced(2));
         assert_eq!(m.take(), Some(3));
         assert_eq!(m.try_take(), None);
+    }
+
+    #[test]
+    fn an_offer_never_replaces_a_waiting_request() {
+        let m = Mailbox::new();
+        assert!(m.offer(1));
+        assert!(!m.offer(2), "an offer replaced an offer");
+        assert_eq!(m.put(3), Put::Replaced(1));
+        assert!(!m.offer(4), "an offer replaced a request");
+        assert_eq!(m.take(), Some(3));
+        assert!(m.offer(5));
+        m.close();
+        assert!(!m.offer(6));
     }
 
     #[test]

@@ -241,8 +241,13 @@ impl ShoalApp {
             // answer (B's first full-resolution maps) only costs this frame the cap and arrives
             // with a later frame.
             let asked = self.images.request(&self.state, &self.link, r);
-            let answer = if asked { r.latest_within(RASTER_WAIT) } else { r.latest() };
-            if let Some(done) = answer {
+            // Every answer is looked at (one made early for a result may come after the one
+            // asked for); only the one asked for is shown.
+            let deadline = asked.then(|| std::time::Instant::now() + RASTER_WAIT);
+            while let Some(done) = match deadline {
+                Some(d) if !self.images.ready() => r.poll_until(d),
+                _ => r.poll(),
+            } {
                 self.images.receive(ctx, done);
             }
             if self.images.ready() {

@@ -2,6 +2,8 @@
 //! or a pair of designs and their difference, A | B | A − B) on one colour scale with a colour
 //! bar, zoomed and panned together, with the values under the cursor.
 
+use std::sync::Arc;
+
 use egui::{Color32, Pos2, Rect, Sense, Vec2};
 
 use super::ShoalApp;
@@ -10,6 +12,7 @@ use super::legend::{colour_bar, scale_bar};
 use super::link::{EngineLink, Standing};
 use super::model::{AppState, Layout, ProductKind, label};
 use super::raster::{Done, Job, Palette, PanelImage, RasterThread, Role};
+use crate::engine::RunOutput;
 
 /// Zoom and pan shared by every map: the visible part of the image in 0–1 coordinates.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -39,6 +42,10 @@ impl View {
 pub struct Images {
     requested: Option<u64>,
     shown: Option<u64>,
+    /// The runs of the requested and shown keys, kept alive: a key holds their addresses, which
+    /// a new run must not take while the key may be compared.
+    requested_runs: Vec<Option<Arc<RunOutput>>>,
+    shown_runs: Vec<Option<Arc<RunOutput>>>,
     pub(super) panels: Vec<(PanelImage, egui::TextureHandle)>,
     palette: Option<Palette>,
     difference_palette: Option<Palette>,
@@ -83,18 +90,27 @@ impl Images {
         if self.requested == Some(job.key) {
             return false;
         }
+        if self.shown == Some(job.key) {
+            // Asked again for what is on display (the runs changed and changed back): nothing to do.
+            self.requested = self.shown;
+            let_go(std::mem::replace(&mut self.requested_runs, self.shown_runs.clone()), &self.shown_runs);
+            return false;
+        }
         if job.runs.iter().all(Option::is_none) {
             // Nothing to show (every run failed): no map of an earlier configuration stays up.
             self.panels.clear();
             self.plot = None;
             (self.requested, self.shown) = (Some(job.key), Some(job.key));
+            let_go(std::mem::take(&mut self.requested_runs), &[]);
+            let_go(std::mem::take(&mut self.shown_runs), &[]);
             return false;
         }
-        let key = job.key;
+        let (key, runs) = (job.key, job.runs.clone());
         if matches!(raster.request(job), crate::jobs::Put::Closed(_)) {
             return false;
         }
         self.requested = Some(key);
+        let_go(std::mem::replace(&mut self.requested_runs, runs), &self.shown_runs);
         true
     }
 
@@ -118,6 +134,15 @@ impl Images {
         self.difference_palette = done.difference_palette;
         self.plot = Some(done.plot);
         self.shown = Some(done.key);
+        let_go(std::mem::replace(&mut self.shown_runs, self.requested_runs.clone()), &self.requested_runs);
+    }
+}
+
+/// Drop `old` runs, on a thread of their own if one of them is not in `kept` (it may be the last
+/// handle on a run at full resolution).
+fn let_go(old: Vec<Option<Arc<RunOutput>>>, kept: &[Option<Arc<RunOutput>>]) {
+    if old.iter().flatten().any(|r| !kept.iter().flatten().any(|k| Arc::ptr_eq(k, r))) {
+        crate::jobs::free_later(old);
     }
 }
 

@@ -47,7 +47,18 @@ impl Prefetch {
             job: super::maps::job_for(state, link),
             shown: link.shown.iter().map(|s| s.as_ref().map(|s| (s.generation, s.decimation))).collect(),
         };
-        *self.view.lock().unwrap_or_else(PoisonError::into_inner) = Some(view);
+        let old = self.view.lock().unwrap_or_else(PoisonError::into_inner).replace(view);
+        // The view replaced may hold the last handle on a run no longer shown (a design was
+        // removed): freed off the UI thread.
+        if let Some(old) = old.filter(|o| o.job.runs.iter().flatten().any(|r| !self.holds(r))) {
+            crate::jobs::free_later(old);
+        }
+    }
+
+    /// Does the view hold `run`?
+    fn holds(&self, run: &Arc<RunOutput>) -> bool {
+        let guard = self.view.lock().unwrap_or_else(PoisonError::into_inner);
+        guard.as_ref().is_some_and(|v| v.job.runs.iter().flatten().any(|r| Arc::ptr_eq(r, run)))
     }
 
     /// The job the UI will ask for once it takes `output` (design `index`, `generation`, at
@@ -81,10 +92,10 @@ impl Prefetch {
     }
 }
 
-/// The hook asking `raster`.
+/// The hook offering `raster` the job (never replacing a request of the UI's waiting there).
 pub fn asking(raster: Requester<Job>) -> impl Fn(Job) + Send + Sync + 'static {
     move |job| {
-        let _ = raster.request(job);
+        raster.offer(job);
     }
 }
 

@@ -319,6 +319,11 @@ pub fn panels(job: &Job, cache: &mut MapCache) -> Done {
     Done { key: job.key, panels, palette, difference_palette, plot: Arc::default() }
 }
 
+/// Does the last job (`last`) hold `run`?
+fn job_runs_hold(last: &Option<(Vec<Option<Arc<RunOutput>>>, Done)>, run: &Arc<RunOutput>) -> bool {
+    last.as_ref().is_some_and(|(runs, _)| runs.iter().flatten().any(|r| Arc::ptr_eq(r, run)))
+}
+
 /// The thread that prepares map panels (and the plots' data) off the UI thread, always on the
 /// newest request (a [`Worker`]: asking never blocks, and a request not yet started is replaced
 /// by a newer one).
@@ -348,7 +353,12 @@ pub fn spawn_raster_thread(wake: impl Fn() + Send + 'static) -> std::io::Result<
             .collect();
         let refs: Vec<Option<&RunValues>> = runs.iter().map(Option::as_deref).collect();
         done.plot = Arc::new(combine(variable, &refs));
-        last = Some((job.runs, done.clone()));
+        if let Some((old, _)) = last.replace((job.runs, done.clone()))
+            && old.iter().flatten().any(|r| !job_runs_hold(&last, r))
+        {
+            // Possibly the last handle on a run at full resolution: freed off this thread.
+            crate::jobs::free_later(old);
+        }
         done
     })
 }

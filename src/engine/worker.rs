@@ -469,7 +469,10 @@ fn worker(requests: &Mailbox<Request>, link: &Link<'_>, pause: &PreviewPause, po
                     Ok(Some(output)) => Event::Finished { generation, index, decimation, result: Ok(Arc::new(output)) },
                     Err(e) => Event::Finished { generation, index, decimation, result: Err(e) },
                 };
-                if let Event::Finished { result: Ok(output), .. } = &event {
+                // Not for a result the owner will drop as stale (a newer request, or a cancel).
+                if let Event::Finished { result: Ok(output), .. } = &event
+                    && latest.load(Ordering::SeqCst) == generation
+                {
                     hook.call(generation, index, decimation, output);
                 }
                 // Counted before it is sent, so a reader that has the event sees it counted.
