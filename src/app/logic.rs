@@ -240,7 +240,8 @@ impl ShoalApp {
             // begun when the engine had the result (`prefetch`). The wait is capped, so a slower
             // answer (B's first full-resolution maps) only costs this frame the cap and arrives
             // with a later frame.
-            let asked = self.images.request(&self.state, &self.link, r);
+            let job = super::maps::job_for(&self.state, &self.link);
+            let asked = self.images.request(job.clone(), r);
             // Every answer is looked at (one made early for a result may come after the one
             // asked for); only the one asked for is shown.
             let deadline = asked.then(|| std::time::Instant::now() + RASTER_WAIT);
@@ -253,7 +254,7 @@ impl ShoalApp {
             if self.images.ready() {
                 self.link.maps_on_screen();
             }
-            self.prefetch.update(&self.state, &self.link);
+            self.prefetch.update(job, &self.link);
         }
         while let Some(news) = self.ui.exports.poll() {
             match news {

@@ -11,7 +11,7 @@ pub(super) use super::legend::format_value;
 use super::legend::{colour_bar, scale_bar};
 use super::link::{EngineLink, Standing};
 use super::model::{AppState, Layout, ProductKind, label};
-use super::raster::{Done, Job, Palette, PanelImage, RasterThread, Role};
+use super::raster::{Done, Job, Palette, PanelImage, RasterThread, Role, let_go};
 use crate::engine::RunOutput;
 
 /// Zoom and pan shared by every map: the visible part of the image in 0–1 coordinates.
@@ -83,10 +83,9 @@ impl Images {
         self.requested.is_some() && self.requested == self.shown
     }
 
-    /// Ask the raster thread for the images of the current state, if not already asked; true
-    /// when this call asked.
-    pub fn request(&mut self, state: &AppState, link: &EngineLink, raster: &RasterThread) -> bool {
-        let job = job_for(state, link);
+    /// Ask the raster thread for `job`'s images (the current state's: [`job_for`]), if not
+    /// already asked; true when this call asked.
+    pub fn request(&mut self, job: Job, raster: &RasterThread) -> bool {
         if self.requested == Some(job.key) {
             return false;
         }
@@ -135,14 +134,6 @@ impl Images {
         self.plot = Some(done.plot);
         self.shown = Some(done.key);
         let_go(std::mem::replace(&mut self.shown_runs, self.requested_runs.clone()), &self.requested_runs);
-    }
-}
-
-/// Drop `old` runs, on a thread of their own if one of them is not in `kept` (it may be the last
-/// handle on a run at full resolution).
-fn let_go(old: Vec<Option<Arc<RunOutput>>>, kept: &[Option<Arc<RunOutput>>]) {
-    if old.iter().flatten().any(|r| !kept.iter().flatten().any(|k| Arc::ptr_eq(k, r))) {
-        crate::jobs::free_later(old);
     }
 }
 

@@ -16,7 +16,6 @@
 use std::sync::{Arc, Mutex, PoisonError};
 
 use super::link::EngineLink;
-use super::model::AppState;
 use super::raster::Job;
 use crate::engine::RunOutput;
 use crate::engine::worker::ResultHook;
@@ -40,25 +39,23 @@ pub struct Prefetch {
 }
 
 impl Prefetch {
-    /// Record the state and results on display (the UI thread, each frame).
-    pub fn update(&self, state: &AppState, link: &EngineLink) {
-        let view = View {
-            generation: link.generation(),
-            job: super::maps::job_for(state, link),
-            shown: link.shown.iter().map(|s| s.as_ref().map(|s| (s.generation, s.decimation))).collect(),
-        };
-        let old = self.view.lock().unwrap_or_else(PoisonError::into_inner).replace(view);
+    /// Record `job`, the raster job for what is on display, and the link's results (the UI
+    /// thread, each frame; nothing is rewritten while they stay the same).
+    pub fn update(&self, job: Job, link: &EngineLink) {
+        let generation = link.generation();
+        let shown: Vec<_> = link.shown.iter().map(|s| s.as_ref().map(|s| (s.generation, s.decimation))).collect();
+        let mut guard = self.view.lock().unwrap_or_else(PoisonError::into_inner);
+        if guard.as_ref().is_some_and(|v| v.generation == generation && v.job.key == job.key && v.shown == shown) {
+            return;
+        }
+        let kept = job.runs.clone();
+        let old = guard.replace(View { generation, job, shown });
+        drop(guard);
         // The view replaced may hold the last handle on a run no longer shown (a design was
         // removed): freed off the UI thread.
-        if let Some(old) = old.filter(|o| o.job.runs.iter().flatten().any(|r| !self.holds(r))) {
-            crate::jobs::free_later(old);
+        if let Some(old) = old {
+            super::raster::let_go(old.job.runs, &kept);
         }
-    }
-
-    /// Does the view hold `run`?
-    fn holds(&self, run: &Arc<RunOutput>) -> bool {
-        let guard = self.view.lock().unwrap_or_else(PoisonError::into_inner);
-        guard.as_ref().is_some_and(|v| v.job.runs.iter().flatten().any(|r| Arc::ptr_eq(r, run)))
     }
 
     /// The job the UI will ask for once it takes `output` (design `index`, `generation`, at
@@ -103,6 +100,7 @@ pub fn asking(raster: Requester<Job>) -> impl Fn(Job) + Send + Sync + 'static {
 mod tests {
     use std::time::{Duration, Instant};
 
+    use super::super::model::AppState;
     use super::*;
 
     /// The keys the hook asked for, in order, once the link shows both designs' results of the
@@ -115,7 +113,7 @@ mod tests {
         link.set_result_hook(prefetch.hook(move |job| sink.lock().unwrap().push(job.key)));
         assert!(link.submit_if_changed(state.configs(), state.decimations()));
         // Once, before any result: the UI's view of generation 1 with nothing shown yet.
-        prefetch.update(state, &link);
+        prefetch.update(super::super::maps::job_for(state, &link), &link);
         let start = Instant::now();
         while !link.shown.iter().all(|s| s.as_ref().is_some_and(|s| s.generation == link.generation())) {
             link.poll();

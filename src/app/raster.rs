@@ -319,9 +319,12 @@ pub fn panels(job: &Job, cache: &mut MapCache) -> Done {
     Done { key: job.key, panels, palette, difference_palette, plot: Arc::default() }
 }
 
-/// Does the last job (`last`) hold `run`?
-fn job_runs_hold(last: &Option<(Vec<Option<Arc<RunOutput>>>, Done)>, run: &Arc<RunOutput>) -> bool {
-    last.as_ref().is_some_and(|(runs, _)| runs.iter().flatten().any(|r| Arc::ptr_eq(r, run)))
+/// Drop the runs `old`, on a thread of their own if one of them is not in `kept` (it may be the
+/// last handle on a run at full resolution, whose freeing would stall the thread dropping it).
+pub fn let_go(old: Vec<Option<Arc<RunOutput>>>, kept: &[Option<Arc<RunOutput>>]) {
+    if old.iter().flatten().any(|r| !kept.iter().flatten().any(|k| Arc::ptr_eq(k, r))) {
+        crate::jobs::free_later(old);
+    }
 }
 
 /// The thread that prepares map panels (and the plots' data) off the UI thread, always on the
@@ -353,11 +356,8 @@ pub fn spawn_raster_thread(wake: impl Fn() + Send + 'static) -> std::io::Result<
             .collect();
         let refs: Vec<Option<&RunValues>> = runs.iter().map(Option::as_deref).collect();
         done.plot = Arc::new(combine(variable, &refs));
-        if let Some((old, _)) = last.replace((job.runs, done.clone()))
-            && old.iter().flatten().any(|r| !job_runs_hold(&last, r))
-        {
-            // Possibly the last handle on a run at full resolution: freed off this thread.
-            crate::jobs::free_later(old);
+        if let Some((old, _)) = last.replace((job.runs.clone(), done.clone())) {
+            let_go(old, &job.runs);
         }
         done
     })

@@ -94,17 +94,20 @@ pub enum Section {
     App,
 }
 
-/// The CPU's model name (`/proc/cpuinfo`), or "unknown CPU".
-pub(super) fn cpu_model() -> String {
-    std::fs::read_to_string("/proc/cpuinfo")
-        .ok()
-        .and_then(|s| {
-            s.lines()
-                .find(|l| l.starts_with("model name"))
-                .and_then(|l| l.split(':').nth(1))
-                .map(|s| s.trim().to_string())
-        })
-        .unwrap_or_else(|| "unknown CPU".into())
+/// The CPU's model name (`/proc/cpuinfo`, read once), or "unknown CPU".
+pub(super) fn cpu_model() -> &'static str {
+    static MODEL: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    MODEL.get_or_init(|| {
+        std::fs::read_to_string("/proc/cpuinfo")
+            .ok()
+            .and_then(|s| {
+                s.lines()
+                    .find(|l| l.starts_with("model name"))
+                    .and_then(|l| l.split(':').nth(1))
+                    .map(|s| s.trim().to_string())
+            })
+            .unwrap_or_else(|| "unknown CPU".into())
+    })
 }
 
 fn machine() -> String {
@@ -205,7 +208,7 @@ fn water_rows(out: &mut String, quick: bool) -> Result<(), CliError> {
     }
     say!(out);
     say!(out, "{}", super::bench_reference::SIDE_BY_SIDE);
-    if let Some(w) = super::bench_reference::other_machine(&cpu_model()) {
+    if let Some(w) = super::bench_reference::other_machine(cpu_model()) {
         say!(out);
         say!(out, "{w}");
     }

@@ -40,7 +40,7 @@ impl ReferenceFigure {
     #[must_use]
     pub fn ratio_here(&self, rate: f64) -> String {
         let ratio = self.ratio(rate);
-        if other_machine(&super::bench::cpu_model()).is_some() { format!("{ratio} (across CPUs)") } else { ratio }
+        if other_machine(super::bench::cpu_model()).is_some() { format!("{ratio} (across CPUs)") } else { ratio }
     }
 }
 

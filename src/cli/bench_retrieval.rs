@@ -343,7 +343,7 @@ pub fn retrieval_rows(out: &mut String, quick: bool) -> Result<(), CliError> {
     }
     let _ = writeln!(out);
     let _ = writeln!(out, "{}", super::bench_reference::SIDE_BY_SIDE);
-    if let Some(w) = super::bench_reference::other_machine(&super::bench::cpu_model()) {
+    if let Some(w) = super::bench_reference::other_machine(super::bench::cpu_model()) {
         let _ = writeln!(out);
         let _ = writeln!(out, "{w}");
     }
