@@ -311,11 +311,36 @@ pub fn calibrate(
     viewing: &Viewing,
     control: &RunControl,
 ) -> Result<Level1, CalibrationError> {
+    let out = calibrated_radiance(level0, calibration, viewing, control)?;
+    finish(out, level0.flags.clone(), calibration, viewing)
+}
+
+/// [`calibrate`], handing `level0`'s flags on to the Level-1 rather than copying them (the
+/// counts are let go once read).
+pub fn calibrate_owned(
+    level0: Level0,
+    calibration: &Calibration,
+    viewing: &Viewing,
+    control: &RunControl,
+) -> Result<Level1, CalibrationError> {
+    let out = calibrated_radiance(&level0, calibration, viewing, control)?;
+    let Level0 { flags, .. } = level0;
+    finish(out, flags, calibration, viewing)
+}
+
+fn not_standard() -> CalibrationError {
+    CalibrationError::Invalid(FieldError { field: "Level-0 cube".into(), message: "not in standard layout".into() })
+}
+
+/// The calibrated radiance of every pixel of `level0`, (row, column, band) in one vector.
+fn calibrated_radiance(
+    level0: &Level0,
+    calibration: &Calibration,
+    viewing: &Viewing,
+    control: &RunControl,
+) -> Result<Vec<f32>, CalibrationError> {
     let (rows, cols, nb) = level0.dn.dim();
     let mut out = vec![0.0f32; rows * cols * nb];
-    let not_standard = || {
-        CalibrationError::Invalid(FieldError { field: "Level-0 cube".into(), message: "not in standard layout".into() })
-    };
     // The values calibration reads: the analogue ones when quantisation is off, else the DN.
     let analog = level0.analog.as_ref().map(|a| a.as_slice().ok_or_else(not_standard)).transpose()?;
     let dn = level0.dn.as_slice().ok_or_else(not_standard)?;
@@ -354,12 +379,25 @@ pub fn calibrate(
         }
         Ok::<_, CalibrationError>(())
     })?;
-    let mut flags = level0.flags.clone();
+    Ok(out)
+}
+
+/// The Level-1 of the calibrated radiance `out` with the Level-0 `flags` (its shape), the
+/// detector's known defects repaired.
+fn finish(
+    mut out: Vec<f32>,
+    mut flags: Array3<u8>,
+    calibration: &Calibration,
+    viewing: &Viewing,
+) -> Result<Level1, CalibrationError> {
+    let (rows, cols, nb) = flags.dim();
     if let Some(defects) = &calibration.defects {
         let flag_rows = flags.as_slice_mut().ok_or_else(not_standard)?;
-        out.par_chunks_mut(cols * nb).zip(flag_rows.par_chunks_mut(cols * nb)).for_each(|(row, flags)| {
-            defects.repair_row(row, flags, &viewing.detector_index);
-        });
+        out.par_chunks_mut((cols * nb).max(1)).zip(flag_rows.par_chunks_mut((cols * nb).max(1))).for_each(
+            |(row, flags)| {
+                defects.repair_row(row, flags, &viewing.detector_index);
+            },
+        );
     }
     Ok(Level1 {
         radiance: Array3::from_shape_vec((rows, cols, nb), out)

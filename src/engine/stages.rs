@@ -13,7 +13,7 @@ use super::report::{RunReport, SkippedEffect};
 use super::run::Engine;
 use super::{EngineError, RunConfig};
 use crate::atmosphere::AtmosphereLut;
-use crate::calibration::{Calibration, FocalKnowledge, band_e0, calibrate};
+use crate::calibration::{Calibration, FocalKnowledge, band_e0, calibrate, calibrate_owned};
 use crate::control::Cancellable;
 use crate::control::RunControl;
 use crate::instrument::compression::compress_level0;
@@ -341,8 +341,15 @@ impl Engine {
         report.diffuser_saturated_frames = calibration.saturated_frames;
         let level1_key =
             KeyBuilder::new(Stage::Level1).after(level0_key).after(calibration_key).with(&inputs.effects).finish();
+        let kept_level0 = self.keeps_cubes().then(|| level0.clone());
         let level1 = self.stage(level1_key, report, control, || {
-            let mut level1 = calibrate(&level0, &calibration, viewing, control).map_err(failed(Stage::Level1))?;
+            // Where nothing else holds the Level-0 (a run that keeps no cubes, whose cache let it
+            // go), its flags become the Level-1's and its counts go as soon as they are read.
+            let level1 = match Arc::try_unwrap(level0) {
+                Ok(own) => calibrate_owned(own, &calibration, viewing, control),
+                Err(shared) => calibrate(&shared, &calibration, viewing, control),
+            };
+            let mut level1 = level1.map_err(failed(Stage::Level1))?;
             super::effects_stage::correct_level1(config, side, &mut level1.radiance, control)?;
             Ok(level1)
         })?;
@@ -352,7 +359,7 @@ impl Engine {
             detector,
             detector_key,
             feasibility,
-            level0: self.keeps_cubes().then_some(level0),
+            level0: kept_level0,
             calibration,
             level1: Some(level1),
             level1_key,
