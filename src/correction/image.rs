@@ -43,20 +43,17 @@
 //! - Wang, M. & Gordon, H. R. (2018) Sensor performance requirements for atmospheric correction
 //!   of satellite ocean color remote sensing. Opt. Express 26, 7390–7403.
 
-use std::sync::atomic::{AtomicUsize, Ordering};
-
 use ndarray::Array2;
 use serde::{Deserialize, Serialize};
 
+use super::apply::{Level1Input, apply};
 use super::dark::DarkSpectrumSettings;
 use super::family::AerosolFamily;
-use super::mixture::invert;
 pub(super) use super::mixture::{Mixture, PackedFamily};
 pub(super) use super::nodes::{locate, weighted};
-use super::{CorrectionError, Reflectance, RrsFlags, assemble, flag_for, slice};
+use super::{CorrectionError, Reflectance};
 use crate::atmosphere::AerosolType;
-use crate::calibration::Level1;
-use crate::control::{OwnRows, RunControl};
+use crate::control::RunControl;
 use crate::instrument::SurfaceMap;
 use crate::parse::FieldError;
 
@@ -324,16 +321,18 @@ impl Pixel<'_> {
     }
 }
 
-/// Correct `level1` with the family: see the module docs.
-pub fn correct_image(
-    level1: &Level1,
+/// Correct `level1` with the family: see the module docs. A Level-1 handed over
+/// ([`Level1Input::Owned`]) becomes the Rrs.
+pub fn correct_image<'a>(
+    level1: impl Into<Level1Input<'a>>,
     family: &AerosolFamily,
     settings: &ImageCorrection,
     bands: &crate::spectral::BandSet,
     surface: &SurfaceMap,
     control: &RunControl,
 ) -> Result<(Reflectance, AerosolRetrieval), CorrectionError> {
-    let nb = level1.radiance.dim().2;
+    let level1 = level1.into();
+    let nb = level1.level1().radiance.dim().2;
     if nb != family.n_bands || family.terms.is_empty() || bands.len() != nb {
         return Err(invalid("correction.image", format!("the family has {} bands, Level-1 {nb}", family.n_bands)));
     }
@@ -360,7 +359,7 @@ pub fn correct_image(
 /// [`correct_image`] with the family as the fit uses it; `high_glint(col)`: the column's pixels
 /// are left out (flagged invalid).
 fn correct_with(
-    level1: &Level1,
+    level1: Level1Input<'_>,
     family: &AerosolFamily,
     settings: &ImageCorrection,
     bands: &crate::spectral::BandSet,
@@ -372,20 +371,21 @@ fn correct_with(
     match settings.fit {
         AerosolFit::BandPair => {
             let fit = super::pair::PairFit::new(family, &packed, settings, bands)?;
+            let cols = level1.level1().radiance.dim().1;
             let (rrs, mut retrieval, long) =
                 apply(level1, surface, control, |p, mix, scratch| !high_glint(p.col) && fit.fit(p, mix, scratch))?;
             let mut long: Vec<f64> = long.into_iter().filter(|v| v.is_finite()).map(f64::from).collect();
             let median = crate::metrics::nearest_rank(&mut long, 0.5);
-            retrieval.members_epsilon = fit.member_epsilon(level1.radiance.dim().1 / 2, median);
+            retrieval.members_epsilon = fit.member_epsilon(cols / 2, median);
             Ok((rrs, retrieval))
         }
         AerosolFit::DarkSpectrum => {
-            if (0..level1.radiance.dim().1).all(high_glint) {
+            let (rows, cols) = (level1.level1().radiance.dim().0, level1.level1().radiance.dim().1);
+            if (0..cols).all(high_glint) {
                 // Nothing to fit: every pixel is left out for glint.
                 return apply(level1, surface, control, |_, _, _: &mut ()| false).map(|(r, a, _)| (r, a));
             }
-            let tiles = super::dark::fit_tiles(level1, family, &settings.dark, bands, control, high_glint)?;
-            let (rows, cols) = (level1.radiance.dim().0, level1.radiance.dim().1);
+            let tiles = super::dark::fit_tiles(level1.level1(), family, &settings.dark, bands, control, high_glint)?;
             let (rrs, mut retrieval, _) =
                 if let Some(smooth) = super::dark::smoothed(&tiles, &settings.dark, rows, cols) {
                     apply(level1, surface, control, |p, mix, _: &mut ()| {
@@ -406,93 +406,4 @@ fn correct_with(
             Ok((rrs, retrieval))
         }
     }
-}
-
-/// Every pixel through `fit` (which fills the pixel's [`Mixture`] and says whether the pixel is
-/// usable), then every band inverted with that mixture; rows in parallel, each with its own
-/// scratch `S` (so the result does not depend on the threads). Also returns each pixel's measured
-/// aerosol signal at the band pair's long band (NaN where none: not kept, only read to place the
-/// members' ε).
-fn apply<'f, S: Default>(
-    level1: &Level1,
-    surface: &SurfaceMap,
-    control: &RunControl,
-    fit: impl Fn(&Pixel<'_>, &mut Mixture<'f>, &mut S) -> bool + Sync,
-) -> Result<(Reflectance, AerosolRetrieval, Vec<f32>), CorrectionError> {
-    let (rows, cols, nb) = level1.radiance.dim();
-    let (l1, l0_flags) = (slice(&level1.radiance)?, slice(&level1.flags)?);
-    let stride = cols * nb;
-    // Written in place, row by row (rows of per-row vectors joined at the end held the cube twice).
-    let (mut rrs, mut flags) = (vec![0.0f32; rows * stride], vec![0u8; rows * stride]);
-    let (mut aot, mut alpha) = (vec![f32::NAN; rows * cols], vec![f32::NAN; rows * cols]);
-    let (mut eps, mut long) = (vec![f32::NAN; rows * cols], vec![f32::NAN; rows * cols]);
-    let (outside, passes) = (AtomicUsize::new(0), AtomicUsize::new(0));
-    let maps = (OwnRows(aot.as_mut_slice()), OwnRows(alpha.as_mut_slice()));
-    let pair = (OwnRows(eps.as_mut_slice()), OwnRows(long.as_mut_slice()));
-    let outputs = ((rrs.as_mut_slice(), flags.as_mut_slice()), maps, pair);
-    control.fill_rows(
-        outputs,
-        rows,
-        stride,
-        |at, ((rrs_row, flag_row), (aot_row, alpha_row), (eps_row, long_row))| {
-            let r = at.index();
-            let base = r * stride;
-            let (mut row_outside, mut row_passes) = (0usize, 0usize);
-            let mut scratch = S::default();
-            let mut mix = Mixture::default();
-            let (mut lp, mut te, mut sa) = (vec![0.0f64; nb], vec![0.0f64; nb], vec![0.0f64; nb]);
-            for c in 0..cols {
-                at.column(c);
-                let span = c * nb..(c + 1) * nb;
-                let p = Pixel {
-                    row: r,
-                    col: c,
-                    nb,
-                    l1: &l1[base + span.start..base + span.end],
-                    flags: &l0_flags[base + span.start..base + span.end],
-                    land: !surface.is_water(r, c),
-                };
-                mix.entries.clear();
-                (mix.outside, mix.passes, mix.epsilon, mix.long_signal) = (false, 1, f64::NAN, f64::NAN);
-                let usable = fit(&p, &mut mix, &mut scratch) && !p.land;
-                mix.column_terms(span.clone(), &mut lp, &mut te, &mut sa);
-                for b in 0..nb {
-                    let value = invert(f64::from(p.l1[b]), lp[b], te[b], sa[b]);
-                    let f = flag_for(p.flags[b], !usable, value);
-                    flag_row[span.start + b] = f;
-                    rrs_row[span.start + b] = if f & RrsFlags::INVALID != 0 { 0.0 } else { value as f32 };
-                }
-                if usable {
-                    aot_row[c] = mix.aot550 as f32;
-                    alpha_row[c] = mix.angstrom as f32;
-                    eps_row[c] = mix.epsilon as f32;
-                    long_row[c] = mix.long_signal as f32;
-                    row_outside += usize::from(mix.outside);
-                    row_passes += mix.passes;
-                }
-            }
-            outside.fetch_add(row_outside, Ordering::Relaxed);
-            passes.fetch_add(row_passes, Ordering::Relaxed);
-            Ok::<_, CorrectionError>(())
-        },
-    )?;
-    let (outside, passes) = (outside.into_inner(), passes.into_inner());
-    let retrieved = aot.iter().filter(|v| v.is_finite()).count();
-    let shape = (rows, cols);
-    let bad = |e: ndarray::ShapeError| invalid("cube", e.to_string());
-    let mut eps: Vec<f64> = eps.into_iter().filter(|v| v.is_finite()).map(f64::from).collect();
-    let mut q = |p: f64| crate::metrics::nearest_rank(&mut eps, p);
-    let epsilon = (q(0.5), q(0.05), q(0.95));
-    let retrieval = AerosolRetrieval {
-        aot550: Array2::from_shape_vec(shape, aot).map_err(bad)?,
-        angstrom: Array2::from_shape_vec(shape, alpha).map_err(bad)?,
-        outside_family: outside,
-        passes_mean: if retrieved == 0 { 0.0 } else { passes as f64 / retrieved as f64 },
-        tiles: Vec::new(),
-        high_glint: 0,
-        glint_removed: false,
-        epsilon,
-        members_epsilon: Vec::new(),
-    };
-    Ok((assemble(rows, cols, nb, rrs, flags)?, retrieval, long))
 }

@@ -21,6 +21,7 @@
 //! - Matthews, M. W. et al. (2023) Sensors 23, 7824, Appendix A (equations A1–A3).
 //! - Vermote, E. F. et al. (1997) 6S: an overview. IEEE TGRS 35, 675–686.
 
+mod apply;
 pub mod clouds;
 pub mod dark;
 mod difference;
@@ -34,6 +35,7 @@ mod nodes;
 mod pair;
 mod rrs_metrics;
 
+pub use apply::Level1Input;
 pub use clouds::{CloudScreen, Sun, screen_image};
 pub use dark::DarkSpectrumSettings;
 pub use dark::TileFit;

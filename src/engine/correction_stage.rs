@@ -7,11 +7,12 @@ use std::sync::Arc;
 use super::cache::{Key, KeyBuilder, Stage};
 use super::keys::Inputs;
 use super::lut_axes::lut_axes;
-use super::products::{Corrected, CorrectionProduct, InstrumentSide, SceneSide};
+use super::products::{Corrected, CorrectionProduct, SceneSide};
 use super::report::RunReport;
 use super::run::Engine;
 use super::stages::failed;
 use super::{EngineError, RunConfig};
+use crate::calibration::Level1;
 use crate::control::RunControl;
 use crate::correction::{
     AerosolFamily, FamilyLuts, RrsFlags, SceneApproximation, compare, correct_exact, correct_image, screen_image,
@@ -28,16 +29,16 @@ impl Engine {
         side: &SceneSide,
         (truth, truth_rrs, radiance_key): (&Truth, &Array3<f32>, Key),
         approximation: Option<SceneApproximation>,
-        inst: &InstrumentSide,
+        (level1, level1_key): (Option<Arc<Level1>>, Key),
         control: &RunControl,
         report: &mut RunReport,
     ) -> Result<(Arc<Corrected>, Key), EngineError> {
         let fid = &config.fidelity;
         let inputs = Inputs::of(config);
-        let Some(level1) = inst.level1.as_deref() else {
+        let Some(level1) = level1 else {
             return Err(EngineError::Failed { stage: Stage::Correction, message: "no Level-1 to correct".into() });
         };
-        let (band_atmosphere, band_key, level1_key) = (&side.band_atmosphere, side.band_key, inst.level1_key);
+        let (band_atmosphere, band_key) = (&side.band_atmosphere, side.band_key);
         // Atmospheric correction.
         let correction_key = KeyBuilder::new(Stage::Correction)
             .after(level1_key)
@@ -65,14 +66,25 @@ impl Engine {
             };
             // Where the scene has clouds, the processor screens them and their shadows out: the
             // image-based correction with its own test, the exact one knowing them exactly.
-            let screen = cloud_screen(config, side, family.as_ref().map(|(f, _)| &**f), level1, truth)?;
+            let screen = cloud_screen(config, side, family.as_ref().map(|(f, _)| &**f), &level1, truth)?;
             let screened = screen.as_ref().map(|s| truth.surface.as_screened(s));
             let surface = screened.as_ref().unwrap_or(&truth.surface);
-            let image = match (&family, config.correction.image()) {
+            // Nothing reads the Level-1 after the image-based correction: handed over where
+            // nothing else holds it, it becomes the Rrs (one cube where there were two).
+            let (image, level1) = match (&family, config.correction.image()) {
                 (Some((fam, _)), Some(settings)) => {
-                    Some(correct_image(level1, fam, settings, &side.response.bands, surface, control).map_err(&fail)?)
+                    let bands = &side.response.bands;
+                    (Some(correct_image(level1, fam, settings, bands, surface, control).map_err(&fail)?), None)
                 }
-                _ => None,
+                _ => (None, Some(level1)),
+            };
+            // The Level-1 the other methods read (there whenever they run: the image-based
+            // correction ran alone).
+            let l1 = || {
+                level1.as_deref().ok_or_else(|| EngineError::Failed {
+                    stage: Stage::Correction,
+                    message: "the Level-1 became the image-based correction's Rrs".into(),
+                })
             };
             // The image-based product is compared with the truth; the exact and approximate
             // corrections are not run beside it (`shoal budget` prices the difference).
@@ -80,7 +92,7 @@ impl Engine {
             let diagnostics = diagnostics && image.is_none();
             let aerosol_map = side.aerosol_map.as_deref().zip(truth.aot550.as_ref());
             let run_exact = |glint| {
-                correct_exact(level1, (band_atmosphere.as_ref(), glint), aerosol_map, surface, control).map_err(&fail)
+                correct_exact(l1()?, (band_atmosphere.as_ref(), glint), aerosol_map, surface, control).map_err(&fail)
             };
             // The exact correction takes away the glint of the wind it assumes (`None`: the
             // scene's own); the approximation's diagnostic stays against the scene's own glint.
@@ -94,14 +106,14 @@ impl Engine {
             // compared with the exact correction pixel by pixel.
             // (No approximation: the image holds no water, and its correction is every pixel left out.)
             let streamed = match (exact_reference, &approximation, diagnostics && !per_scene) {
-                (Some(e), Some(a), true) => a.compare_with(level1, surface, e),
+                (Some(e), Some(a), true) => a.compare_with(l1()?, surface, e),
                 _ => None,
             };
             let approx = match &approximation {
                 Some(a) if (diagnostics && streamed.is_none()) || per_scene => {
-                    Some(a.correct(level1, surface, control).map_err(&fail)?)
+                    Some(a.correct(l1()?, surface, control).map_err(&fail)?)
                 }
-                None if per_scene => Some(crate::correction::no_water(level1).map_err(&fail)?),
+                None if per_scene => Some(crate::correction::no_water(l1()?).map_err(&fail)?),
                 _ => None,
             };
             let approximation_vs_exact = match (streamed, &approx, exact_reference, diagnostics) {

@@ -301,12 +301,15 @@ impl Engine {
                 v.keep_level1(level1);
             }
         }
+        // The Level-1 goes to the correction, which writes the Rrs over it where nothing else
+        // holds it (a run that keeps no cubes, whose cache let it go).
+        let level1 = if self.keep_cubes { inst.level1.clone() } else { inst.level1.take() };
         let (corrected, correction_key) = self.correction_stage(
             config,
             &side,
             (&truth, &truth_rrs, radiance_key),
             approximation,
-            &inst,
+            (level1, inst.level1_key),
             control,
             &mut report,
         )?;
