@@ -107,12 +107,15 @@ struct Blocks {
 }
 
 impl BlockMeans {
-    /// The block means of `radiance` (rows of `cols` pixels of `nb` bands), or `None` without
-    /// coarse planes. Each block's sum runs over its rows, then its columns, in order (in
-    /// parallel over block rows, so the same sums whatever the threads).
-    fn new(detector: &Detector, radiance: &[f32], viewing: &Viewing, cols: usize, nb: usize) -> Option<Self> {
+    /// The block means of `radiance` (rows of `cols` pixels of `nb` bands; grid row r is line
+    /// `lines[r]`, grid column c detector `detectors[c]`), band b's blocks `block[b]` lines and
+    /// detectors wide; `None` without a block wider than 1. Each block's sum runs over its rows,
+    /// then its columns, in order (in parallel over block rows, so the same sums whatever the
+    /// threads).
+    fn new(block: &[usize], radiance: &[f32], (lines, detectors): (&[usize], &[usize]), cols: usize) -> Option<Self> {
         use rayon::prelude::*;
-        let mut sizes: Vec<usize> = (0..nb).map(|b| detector.plane(b).block()).filter(|&k| k > 1).collect();
+        let nb = block.len();
+        let mut sizes: Vec<usize> = block.iter().copied().filter(|&k| k > 1).collect();
         if sizes.is_empty() {
             return None;
         }
@@ -138,12 +141,12 @@ impl BlockMeans {
             .iter()
             .enumerate()
             .map(|(g, &k)| {
-                let bands: Vec<usize> = (0..nb).filter(|&b| detector.plane(b).block() == k).collect();
+                let bands: Vec<usize> = (0..nb).filter(|&b| block[b] == k).collect();
                 for (slot, &b) in bands.iter().enumerate() {
                     of_band[b] = Some((g, slot));
                 }
-                let (row_id, n_r) = dense(&viewing.line_index[..rows], k);
-                let (col_id, n_c) = dense(&viewing.detector_index[..cols], k);
+                let (row_id, n_r) = dense(&lines[..rows], k);
+                let (col_id, n_c) = dense(&detectors[..cols], k);
                 let mut first_row = vec![rows; n_r + 1];
                 for (r, &id) in row_id.iter().enumerate().rev() {
                     first_row[id] = r;
@@ -200,7 +203,9 @@ fn exposure_input<'a>(
     let input = radiance.as_slice().ok_or_else(|| {
         InstrumentError::Invalid(FieldError { field: "cube".into(), message: "not contiguous".into() })
     })?;
-    Ok((input, BlockMeans::new(detector, input, viewing, cols, nb)))
+    let block: Vec<usize> = (0..nb).map(|b| detector.plane(b).block()).collect();
+    let indices = (viewing.line_index.as_slice(), viewing.detector_index.as_slice());
+    Ok((input, BlockMeans::new(&block, input, indices, cols)))
 }
 
 /// Row `r`'s electrons from `input` (the row's radiance, column after column of `nb` bands;
@@ -393,3 +398,6 @@ fn count_flags(flags: &[u8]) -> (usize, usize) {
         })
         .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1))
 }
+
+#[cfg(test)]
+mod tests;
