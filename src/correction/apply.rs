@@ -77,6 +77,61 @@ fn into_flat<T: Clone>(a: Array3<T>) -> Vec<T> {
     a.iter().cloned().collect()
 }
 
+/// A Level-1 read in place: its radiance and flags, contiguous.
+pub(super) type Read<'a> = (&'a [f32], &'a [u8]);
+
+/// The Rrs and flag buffers of a per-pixel pass over `level1`, and the Level-1 to read each
+/// pixel from: a handed-over Level-1's own buffers (read `None`: each pixel is copied out before
+/// it is overwritten, [`PixelReader`]), else new ones, with the Level-1 kept in `held`.
+pub(super) fn out_buffers<'h, 'a: 'h>(
+    level1: Level1Input<'a>,
+    held: &'h mut Option<Level1Input<'a>>,
+) -> Result<(Vec<f32>, Vec<u8>, Option<Read<'h>>), CorrectionError> {
+    match level1 {
+        Level1Input::Owned(Level1 { radiance, flags }) => Ok((into_flat(radiance), into_flat(flags), None)),
+        other => {
+            let l = held.insert(other).level1();
+            let n = l.radiance.len();
+            Ok((vec![0.0; n], vec![0; n], Some((slice(&l.radiance)?, slice(&l.flags)?))))
+        }
+    }
+}
+
+/// One row's pixels as a per-pixel pass reads them: from the Level-1, or copied out of the row
+/// the pass is about to overwrite.
+pub(super) struct PixelReader<'h> {
+    read: Option<Read<'h>>,
+    l1: Vec<f32>,
+    flags: Vec<u8>,
+}
+
+impl<'h> PixelReader<'h> {
+    /// A reader of pixels of `nb` bands.
+    pub(super) fn new(read: Option<Read<'h>>, nb: usize) -> Self {
+        let own = if read.is_some() { 0 } else { nb };
+        Self { read, l1: vec![0.0; own], flags: vec![0; own] }
+    }
+
+    /// The Level-1 radiance and flags of the pixel at `span` of the row starting at `base`
+    /// (`rrs_row`, `flag_row`: the row's output, which holds the Level-1 in place).
+    #[inline]
+    pub(super) fn pixel(
+        &mut self,
+        base: usize,
+        span: std::ops::Range<usize>,
+        (rrs_row, flag_row): (&[f32], &[u8]),
+    ) -> (&[f32], &[u8]) {
+        match self.read {
+            Some((l1, flags)) => (&l1[base + span.start..base + span.end], &flags[base + span.start..base + span.end]),
+            None => {
+                self.l1.copy_from_slice(&rrs_row[span.clone()]);
+                self.flags.copy_from_slice(&flag_row[span]);
+                (&self.l1, &self.flags)
+            }
+        }
+    }
+}
+
 /// Every pixel through `fit` (which fills the pixel's [`Mixture`] and says whether the pixel is
 /// usable), then every band inverted with that mixture; rows in parallel, each with its own
 /// scratch `S` (so the result does not depend on the threads). Also returns each pixel's measured
@@ -92,16 +147,8 @@ pub(super) fn apply<'f, S: Default>(
     let stride = cols * nb;
     // Written in place, row by row (rows of per-row vectors joined at the end held the cube
     // twice); over the Level-1 itself when it is handed over.
-    let held;
-    let (mut rrs, mut flags, read) = match level1 {
-        Level1Input::Owned(Level1 { radiance, flags }) => (into_flat(radiance), into_flat(flags), None),
-        other => {
-            held = other;
-            let l = held.level1();
-            let read = (slice(&l.radiance)?, slice(&l.flags)?);
-            (vec![0.0f32; rows * stride], vec![0u8; rows * stride], Some(read))
-        }
-    };
+    let mut held = None;
+    let (mut rrs, mut flags, read) = out_buffers(level1, &mut held)?;
     let (mut aot, mut alpha) = (vec![f32::NAN; rows * cols], vec![f32::NAN; rows * cols]);
     let (mut eps, mut long) = (vec![f32::NAN; rows * cols], vec![f32::NAN; rows * cols]);
     let (outside, passes) = (AtomicUsize::new(0), AtomicUsize::new(0));
@@ -119,19 +166,11 @@ pub(super) fn apply<'f, S: Default>(
             let mut scratch = S::default();
             let mut mix = Mixture::default();
             let (mut lp, mut te, mut sa) = (vec![0.0f64; nb], vec![0.0f64; nb], vec![0.0f64; nb]);
-            // The pixel's Level-1 where the Rrs is written over it.
-            let (mut own_l1, mut own_flags) = (vec![0.0f32; nb], vec![0u8; nb]);
+            let mut reader = PixelReader::new(read, nb);
             for c in 0..cols {
                 at.column(c);
                 let span = c * nb..(c + 1) * nb;
-                let (l1, l0_flags): (&[f32], &[u8]) = match read {
-                    Some((l1, f)) => (&l1[base + span.start..base + span.end], &f[base + span.start..base + span.end]),
-                    None => {
-                        own_l1.copy_from_slice(&rrs_row[span.clone()]);
-                        own_flags.copy_from_slice(&flag_row[span.clone()]);
-                        (&own_l1, &own_flags)
-                    }
-                };
+                let (l1, l0_flags) = reader.pixel(base, span.clone(), (rrs_row, flag_row));
                 let p = Pixel { row: r, col: c, nb, l1, flags: l0_flags, land: !surface.is_water(r, c) };
                 mix.entries.clear();
                 (mix.outside, mix.passes, mix.epsilon, mix.long_signal) = (false, 1, f64::NAN, f64::NAN);

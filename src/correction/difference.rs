@@ -39,20 +39,43 @@ enum Source<'a> {
 #[must_use]
 pub fn compare(a: &Reflectance, b: &Array3<f32>, b_flags: Option<&Array3<u8>>) -> Vec<BandDifference> {
     let (Ok(ar), Ok(af)) = (slice(&a.rrs), slice(&a.flags)) else { return Vec::new() };
-    compare_source(Source::Cube(ar, af), a.rrs.dim().2, b, b_flags)
+    let Some(reference) = Reference::of(b, b_flags) else { return Vec::new() };
+    compare_source(Source::Cube(ar, af), a.rrs.dim().2, reference)
 }
 
 /// [`compare`] with `a`'s values and flags at each pixel (row-major, `b`'s bands) made by `a`.
 #[must_use]
 pub fn compare_pixels(a: PixelBands<'_>, b: &Array3<f32>, b_flags: Option<&Array3<u8>>) -> Vec<BandDifference> {
-    compare_source(Source::Pixels(a), b.dim().2, b, b_flags)
+    let Some(reference) = Reference::of(b, b_flags) else { return Vec::new() };
+    compare_source(Source::Pixels(a), b.dim().2, reference)
 }
 
-fn compare_source(source: Source<'_>, nb: usize, b: &Array3<f32>, b_flags: Option<&Array3<u8>>) -> Vec<BandDifference> {
-    let Ok(br) = slice(b) else { return Vec::new() };
-    let bf = b_flags.and_then(|f| slice(f).ok());
+/// [`compare`] with both `a` and the reference `b` made pixel by pixel (`pixels` of `nb` bands,
+/// row-major): neither product is held whole.
+#[must_use]
+pub fn compare_both_pixels(a: PixelBands<'_>, b: PixelBands<'_>, pixels: usize, nb: usize) -> Vec<BandDifference> {
+    compare_source(Source::Pixels(a), nb, Reference::Pixels(b, pixels))
+}
+
+/// The reference a comparison is against: a cube with its flags if any, or `pixels` pixels made
+/// on the fly (with flags).
+enum Reference<'a> {
+    Cube(&'a [f32], Option<&'a [u8]>),
+    Pixels(PixelBands<'a>, usize),
+}
+
+impl<'a> Reference<'a> {
+    fn of(b: &'a Array3<f32>, b_flags: Option<&'a Array3<u8>>) -> Option<Self> {
+        Some(Self::Cube(slice(b).ok()?, b_flags.and_then(|f| slice(f).ok())))
+    }
+}
+
+fn compare_source(source: Source<'_>, nb: usize, reference: Reference<'_>) -> Vec<BandDifference> {
     let nb = nb.max(1);
-    let pixels = br.len() / nb;
+    let pixels = match reference {
+        Reference::Cube(br, _) => br.len() / nb,
+        Reference::Pixels(_, pixels) => pixels,
+    };
     // Count, sum and maximum over every pixel; the median from at most ~200 000 evenly strided
     // pixels per band (its sampling error is far below the differences it reports).
     let stride = (pixels / MEDIAN_SAMPLES).max(1);
@@ -62,11 +85,15 @@ fn compare_source(source: Source<'_>, nb: usize, b: &Array3<f32>, b_flags: Optio
         sum: Vec<f64>,
         max: Vec<f64>,
         sample: Vec<Vec<f64>>,
-        /// A pixel's bands and flags as a [`Source::Pixels`] makes them (not combined).
+        /// A pixel's bands and flags as a [`Source::Pixels`] makes them (not combined), and as a
+        /// [`Reference::Pixels`] does.
         values: Vec<f32>,
         flags: Vec<u8>,
+        ref_values: Vec<f32>,
+        ref_flags: Vec<u8>,
     }
     let scratch = usize::from(matches!(source, Source::Pixels(_))) * nb;
+    let ref_scratch = usize::from(matches!(reference, Reference::Pixels(..))) * nb;
     let empty = || Acc {
         n: vec![0; nb],
         sum: vec![0.0; nb],
@@ -74,6 +101,8 @@ fn compare_source(source: Source<'_>, nb: usize, b: &Array3<f32>, b_flags: Optio
         sample: vec![Vec::new(); nb],
         values: vec![0.0; scratch],
         flags: vec![0; scratch],
+        ref_values: vec![0.0; ref_scratch],
+        ref_flags: vec![0; ref_scratch],
     };
     // Fixed blocks of pixels, summed in block order: the sums (of f64, whose rounding depends
     // on the order) are the same whatever the threads and however rayon splits the work (a
@@ -94,8 +123,13 @@ fn compare_source(source: Source<'_>, nb: usize, b: &Array3<f32>, b_flags: Optio
                         (&acc.values[..], &acc.flags[..])
                     }
                 };
-                let b = &br[span.clone()];
-                let b_flags = bf.map(|f| &f[span]);
+                let (b, b_flags) = match &reference {
+                    Reference::Cube(br, bf) => (&br[span.clone()], bf.map(|f| &f[span])),
+                    Reference::Pixels(f, _) => {
+                        f(p, &mut acc.ref_values, &mut acc.ref_flags);
+                        (&acc.ref_values[..], Some(&acc.ref_flags[..]))
+                    }
+                };
                 let sampled = p % stride == 0;
                 for band in 0..nb {
                     let fb = b_flags.map_or(0, |f| f[band]);

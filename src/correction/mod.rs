@@ -25,6 +25,7 @@ mod apply;
 pub mod clouds;
 pub mod dark;
 mod difference;
+mod exact;
 pub mod expected_glint;
 pub mod family;
 pub mod image;
@@ -40,20 +41,21 @@ pub use clouds::{CloudScreen, Sun, screen_image};
 pub use dark::DarkSpectrumSettings;
 pub use dark::TileFit;
 pub use difference::{BandDifference, compare};
+pub use exact::{ExactTerms, correct_exact};
 pub use expected_glint::{column_lgn, expected_glint, mark_high_glint};
 pub use family::{AerosolFamily, FamilyLuts};
 pub use image::{AerosolFit, AerosolRetrieval, ImageCorrection, MISSION_PAIRS_NM, correct_image};
 pub use method::{CorrectionSpec, Method, PRESETS, Preset};
 pub use rrs_metrics::{BandRrsMetrics, RRS_SAMPLES, band_rrs_metrics, pooled_rrs_error};
 
-use ndarray::{Array2, Array3};
+use ndarray::Array3;
 use rand::SeedableRng;
 use rand::rngs::Xoshiro256PlusPlus;
 use serde::Serialize;
 
 use crate::calibration::Level1;
 use crate::control::RunControl;
-use crate::instrument::{AotNodes, BandAtmosphere, Flags, SurfaceMap};
+use crate::instrument::{BandAtmosphere, Flags, SurfaceMap};
 use crate::parse::FieldError;
 
 /// Errors from the atmospheric correction stage; each names the field and what is allowed.
@@ -184,106 +186,6 @@ pub fn no_water(level1: &Level1) -> Result<Reflectance, CorrectionError> {
     assemble(rows, cols, nb, vec![0.0; rows * cols * nb], flags)
 }
 
-/// Exact per-pixel correction of `level1` with the band-effective atmosphere of each column;
-/// where the scene's AOT is a map, `aerosol_map` holds the terms at its AOT nodes and the map
-/// under each pixel, and each pixel is corrected with the atmosphere at its own AOT. `glint` is
-/// the glint taken away, per column × band: the scene's own (`None`) or what a processor
-/// expects from the wind it assumes ([`expected_glint`]).
-pub fn correct_exact(
-    level1: &Level1,
-    (atmosphere, glint): (&BandAtmosphere, Option<&[f64]>),
-    aerosol_map: Option<(&AotNodes, &Array2<f32>)>,
-    surface: &SurfaceMap,
-    control: &RunControl,
-) -> Result<Reflectance, CorrectionError> {
-    let glint_taken = glint.unwrap_or(&atmosphere.glint);
-    let (rows, cols, nb) = level1.radiance.dim();
-    let (l1, l0_flags) = (slice(&level1.radiance)?, slice(&level1.flags)?);
-    let aot = aerosol_map.map(|(_, a)| slice(a)).transpose()?;
-    let mut rrs = vec![0.0f32; rows * cols * nb];
-    let mut flags = vec![0u8; rows * cols * nb];
-    let stride = cols * nb;
-    control.fill_rows((rrs.as_mut_slice(), flags.as_mut_slice()), rows, stride, |at, (rrs_row, flag_row)| {
-        let r = at.index();
-        let base = r * stride;
-        // The pixel's own terms where the AOT is a map.
-        let (mut lp, mut te, mut sa) = if aerosol_map.is_some() {
-            (vec![0.0; nb], vec![0.0; nb], vec![0.0; nb])
-        } else {
-            (Vec::new(), Vec::new(), Vec::new())
-        };
-        for c in 0..cols {
-            at.column(c);
-            let is_land = !surface.is_water(r, c);
-            // The column's slices, all of length nb, so the band loop runs without index
-            // checks and the compiler can compute neighbouring bands together.
-            let a = atmosphere.at(c, 0)..atmosphere.at(c, 0) + nb;
-            let glint = &glint_taken[a.clone()];
-            let (l_path, t_ed, s_albedo) = match (aerosol_map, aot) {
-                (Some((nodes, _)), Some(aot)) => {
-                    nodes.column_terms(c, f64::from(aot[r * cols + c]), &mut lp, &mut te, &mut sa);
-                    (&lp[..], &te[..], &sa[..])
-                }
-                _ => (&atmosphere.l_path[a.clone()], &atmosphere.t_ed[a.clone()], &atmosphere.spherical_albedo[a]),
-            };
-            let k = c * nb..(c + 1) * nb;
-            let (l1, l0_flags) = (&l1[base + k.start..base + k.end], &l0_flags[base + k.start..base + k.end]);
-            let (rrs_out, flag_out) = (&mut rrs_row[k.clone()], &mut flag_row[k]);
-            let column = ExactColumn { l1, l0_flags, is_land, l_path, glint, t_ed, s_albedo };
-            crate::simd::avx2(Correct { column: &column, rrs_out, flag_out });
-        }
-        Ok::<_, CorrectionError>(())
-    })?;
-    assemble(rows, cols, nb, rrs, flags)
-}
-
-/// One column's inputs to [`correct_exact`], every slice one value per band.
-struct ExactColumn<'a> {
-    l1: &'a [f32],
-    l0_flags: &'a [u8],
-    is_land: bool,
-    l_path: &'a [f64],
-    glint: &'a [f64],
-    t_ed: &'a [f64],
-    s_albedo: &'a [f64],
-}
-
-impl ExactColumn<'_> {
-    /// The exact inversion band by band (see [`correct_exact`]).
-    #[inline(always)]
-    fn correct(&self, rrs_out: &mut [f32], flag_out: &mut [u8]) {
-        let nb = rrs_out.len();
-        let (l1, l0_flags) = (&self.l1[..nb], &self.l0_flags[..nb]);
-        let (l_path, glint, t_ed, s_albedo) =
-            (&self.l_path[..nb], &self.glint[..nb], &self.t_ed[..nb], &self.s_albedo[..nb]);
-        let flag_out = &mut flag_out[..nb];
-        for b in 0..nb {
-            let y = (f64::from(l1[b]) - l_path[b] - glint[b]) / t_ed[b];
-            let value = y / (1.0 + s_albedo[b] * std::f64::consts::PI * y);
-            let f = flag_for(l0_flags[b], self.is_land, value);
-            flag_out[b] = f;
-            rrs_out[b] = if f & RrsFlags::INVALID != 0 { 0.0 } else { value as f32 };
-        }
-    }
-}
-
-/// [`ExactColumn::correct`] as a [`crate::simd::Kernel`]: with AVX2, four divisions per
-/// instruction (the same operations at every level, so the same bits).
-struct Correct<'a, 'c> {
-    column: &'a ExactColumn<'c>,
-    rrs_out: &'a mut [f32],
-    flag_out: &'a mut [u8],
-}
-
-impl crate::simd::Kernel for Correct<'_, '_> {
-    type Output = ();
-
-    #[inline(always)]
-    fn run<L: crate::simd::Level>(self) {
-        self.column.correct(self.rrs_out, self.flag_out);
-    }
-}
-
 impl SceneApproximation {
     /// The paper's per-scene terms from `points` random water pixels (seeded), using the
     /// noise-free TOA radiance and the true Rrs of those pixels: open water, out of the clouds'
@@ -373,6 +275,28 @@ impl SceneApproximation {
             }
         };
         Some(difference::compare_pixels(&pixel, &exact.rrs, Some(&exact.flags)))
+    }
+
+    /// [`Self::compare_with`] the exact correction made pixel by pixel with `terms` (the same
+    /// values as [`correct_exact`]'s cube): neither product is held, so the exact correction
+    /// can then write its Rrs over the Level-1.
+    #[must_use]
+    pub fn compare_with_exact(
+        &self,
+        level1: &Level1,
+        surface: &SurfaceMap,
+        terms: &exact::ExactTerms<'_>,
+    ) -> Option<Vec<BandDifference>> {
+        let (rows, cols, nb) = level1.radiance.dim();
+        let (l1, l0_flags) = (slice(&level1.radiance).ok()?, slice(&level1.flags).ok()?);
+        let pixel = |p: usize, values: &mut [f32], flags: &mut [u8]| {
+            let land = !surface.is_water(p / cols.max(1), p % cols.max(1));
+            for b in 0..nb {
+                (values[b], flags[b]) = self.value(b, l1[p * nb + b], l0_flags[p * nb + b], land);
+            }
+        };
+        let exact = |p: usize, values: &mut [f32], flags: &mut [u8]| terms.pixel_of(p, (l1, l0_flags), values, flags);
+        Some(difference::compare_both_pixels(&pixel, &exact, rows * cols, nb))
     }
 
     /// Apply the per-scene terms to every pixel (A2, A3).

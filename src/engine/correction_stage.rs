@@ -15,7 +15,8 @@ use super::{EngineError, RunConfig};
 use crate::calibration::Level1;
 use crate::control::RunControl;
 use crate::correction::{
-    AerosolFamily, FamilyLuts, RrsFlags, SceneApproximation, compare, correct_exact, correct_image, screen_image,
+    AerosolFamily, ExactTerms, FamilyLuts, RrsFlags, SceneApproximation, compare, correct_exact, correct_image,
+    screen_image,
 };
 use crate::instrument::Truth;
 use ndarray::Array3;
@@ -78,44 +79,58 @@ impl Engine {
                 }
                 _ => (None, Some(level1)),
             };
-            // The Level-1 the other methods read (there whenever they run: the image-based
-            // correction ran alone).
-            let l1 = || {
-                level1.as_deref().ok_or_else(|| EngineError::Failed {
-                    stage: Stage::Correction,
-                    message: "the Level-1 became the image-based correction's Rrs".into(),
-                })
-            };
             // The image-based product is compared with the truth; the exact and approximate
             // corrections are not run beside it (`shoal budget` prices the difference).
             let against_truth = diagnostics;
             let diagnostics = diagnostics && image.is_none();
             let aerosol_map = side.aerosol_map.as_deref().zip(truth.aot550.as_ref());
-            let run_exact = |glint| {
-                correct_exact(l1()?, (band_atmosphere.as_ref(), glint), aerosol_map, surface, control).map_err(&fail)
-            };
+            let atmosphere = band_atmosphere.as_ref();
             // The exact correction takes away the glint of the wind it assumes (`None`: the
             // scene's own); the approximation's diagnostic stays against the scene's own glint.
             let expected = exact_glint(config, side);
-            let exact = (diagnostics || (!per_scene && image.is_none())).then(|| run_exact(expected.as_deref()));
-            let exact = exact.transpose()?;
-            // (A wind error is the exact method's, so `diagnostics` here means the exact ran.)
-            let reference = (expected.is_some() && diagnostics).then(|| run_exact(None)).transpose()?;
-            let exact_reference = reference.as_ref().or(exact.as_ref());
-            // The approximation is held whole only when it is the product; as a diagnostic it is
-            // compared with the exact correction pixel by pixel.
-            // (No approximation: the image holds no water, and its correction is every pixel left out.)
-            let streamed = match (exact_reference, &approximation, diagnostics && !per_scene) {
-                (Some(e), Some(a), true) => a.compare_with(l1()?, surface, e),
-                _ => None,
-            };
-            let approx = match &approximation {
-                Some(a) if (diagnostics && streamed.is_none()) || per_scene => {
-                    Some(a.correct(l1()?, surface, control).map_err(&fail)?)
+            // Every other reader of the Level-1 first; the exact correction last, handed the
+            // Level-1 (where nothing else holds it, it becomes the Rrs).
+            let (reference, streamed, approx) = match level1.as_deref() {
+                None => (None, None, None),
+                Some(l1) => {
+                    // (A wind error is the exact method's, so `diagnostics` here means the exact
+                    // correction runs.)
+                    let reference = (expected.is_some() && diagnostics)
+                        .then(|| correct_exact(l1, (atmosphere, None), aerosol_map, surface, control))
+                        .transpose()
+                        .map_err(&fail)?;
+                    // The approximation is held whole only when it is the product; as a
+                    // diagnostic it is compared pixel by pixel with the exact correction against
+                    // the scene's own glint: the reference above, or made pixel by pixel beside it.
+                    // (No approximation: the image holds no water, and its correction is every
+                    // pixel left out.)
+                    let streamed = match (&approximation, &reference, diagnostics && !per_scene) {
+                        (Some(a), Some(r), true) => a.compare_with(l1, surface, r),
+                        (Some(a), None, true) => {
+                            let dims = (l1.radiance.dim().1, l1.radiance.dim().2);
+                            let terms = ExactTerms::new((atmosphere, None), aerosol_map, surface, dims);
+                            a.compare_with_exact(l1, surface, &terms.map_err(&fail)?)
+                        }
+                        _ => None,
+                    };
+                    let approx = match &approximation {
+                        Some(a) if (diagnostics && streamed.is_none()) || per_scene => {
+                            Some(a.correct(l1, surface, control).map_err(&fail)?)
+                        }
+                        None if per_scene => Some(crate::correction::no_water(l1).map_err(&fail)?),
+                        _ => None,
+                    };
+                    (reference, streamed, approx)
                 }
-                None if per_scene => Some(crate::correction::no_water(l1()?).map_err(&fail)?),
+            };
+            let exact = match level1 {
+                Some(l1) if diagnostics || !per_scene => {
+                    let glint = expected.as_deref();
+                    Some(correct_exact(l1, (atmosphere, glint), aerosol_map, surface, control).map_err(&fail)?)
+                }
                 _ => None,
             };
+            let exact_reference = reference.as_ref().or(exact.as_ref());
             let approximation_vs_exact = match (streamed, &approx, exact_reference, diagnostics) {
                 (Some(d), ..) => d,
                 (None, Some(a), Some(e), true) => compare(a, &e.rrs, Some(&e.flags)),

@@ -22,6 +22,7 @@ mod focal_plane;
 mod function;
 mod glint;
 mod image_correction;
+mod in_place;
 mod incremental;
 mod memory;
 mod netcdf;
