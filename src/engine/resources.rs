@@ -49,13 +49,23 @@ const RT_OVERHEAD_S: f64 = 0.05;
 /// term: the level's mixed scattering kernel, one 3 × 3 Stokes block of f64 per stream pair
 /// (`atmosphere::sos::solve`); the fields per level and stream are smaller by a factor of streams.
 const RT_BYTES_PER_LEVEL_STREAM_PAIR: f64 = 72.0;
-/// Bytes per pixel and band of a run that does not keep its cubes, at its peak: the true Rrs,
-/// Level-1 and Rrs with their flags side by side while the correction runs (4 + 5 + 5), plus the
-/// stages' working copies (the exact correction's diagnostic is compared pixel by pixel, not
-/// held). Measured peaks (VmHWM, `shoal study --no-cubes`): the default study 0.83 GiB (plan
-/// 0.96), the paper's study with the exact correction 0.78 GiB, `four_designs_lake_hume` (the
-/// 101-band spectrograph the largest run) 2.74 GiB (plan 2.83).
-const LEAN_BYTES_PER_PIXEL_BAND: f64 = 16.0;
+/// Bytes per pixel and band of a run that does not keep its cubes, at its peak: the pupil
+/// radiance, the true Rrs and the Level-0 counts and flags side by side while the detector reads
+/// out (4 + 4 + 3), then the true Rrs, the counts and the Level-1 (which takes the Level-0's
+/// flags) while it is calibrated (4 + 2 + 5); the correction writes its Rrs over the Level-1
+/// (and the approximation's diagnostic makes the exact correction pixel by pixel), so it holds
+/// less. Rounded up for the stages' working copies. Measured peaks (VmHWM, `shoal study
+/// --no-cubes`): the default study 0.67 GiB (plan 0.82), `four_designs_lake_hume` 2.15 GiB (plan
+/// 2.28), Sentinel-2 MSI alone (16 million pixels) 2.75 GiB (plan 3.61).
+const LEAN_BYTES_PER_PIXEL_BAND: f64 = 12.0;
+/// What a lean run adds per pixel and band where Level-0 keeps the analogue signal beside the
+/// counts (quantisation off: the ideal-ADC closure setting), f32.
+const ANALOG_BYTES_PER_PIXEL_BAND: f64 = 4.0;
+/// What a lean run adds per pixel and band where its correction holds a second Rrs beside the
+/// product: the per-scene approximation as the product (the exact correction its diagnostic),
+/// or the exact correction assuming another wind than the scene's (the diagnostic's reference
+/// against the scene's own glint): the true Rrs and two Rrs with their flags (4 + 5 + 5).
+const SECOND_RRS_BYTES_PER_PIXEL_BAND: f64 = 2.0;
 /// Bytes per pixel and band an instrument's optical effects add (`instrument::effects`): the
 /// radiance at the detector, then the measured Level-1 and its stray part while the processor
 /// corrects it.
@@ -225,7 +235,7 @@ pub fn run_demand_keeping(config: &RunConfig, keep_cubes: bool) -> Demand {
     parts.push(if keep_cubes {
         cube_part(config, BYTES_PER_PIXEL_BAND)
     } else {
-        cube_part_with(config, LEAN_BYTES_PER_PIXEL_BAND, LEAN_BYTES_PER_PIXEL)
+        cube_part_with(config, lean_bytes_per_pixel_band(config), LEAN_BYTES_PER_PIXEL)
     });
     // The scene's synthesis is over before the cubes are made: the larger of the two counts.
     if let Some(i) = parts.iter().position(|p| p.what == SYNTHESIS) {
@@ -250,6 +260,19 @@ fn image_size(config: &RunConfig) -> (usize, usize) {
     let diagonal_m = (s.width as f64 * s.cell_m).hypot(s.height as f64 * s.cell_m);
     let across = if gsd_m > 0.0 && diagonal_m > 0.0 { (diagonal_m / gsd_m).ceil() as usize + 2 } else { usize::MAX };
     (i.lines.min(across).div_ceil(d), i.detectors.min(across).div_ceil(d))
+}
+
+/// Bytes per pixel and band of `config`'s run at its peak when it keeps no cubes.
+fn lean_bytes_per_pixel_band(config: &RunConfig) -> f64 {
+    let analog = if config.detector.quantise { 0.0 } else { ANALOG_BYTES_PER_PIXEL_BAND };
+    let second_rrs = match config.correction.method {
+        crate::correction::Method::PerScene => SECOND_RRS_BYTES_PER_PIXEL_BAND,
+        crate::correction::Method::Exact if config.correction.exact_wind_error_m_s() != 0.0 => {
+            SECOND_RRS_BYTES_PER_PIXEL_BAND
+        }
+        _ => 0.0,
+    };
+    LEAN_BYTES_PER_PIXEL_BAND + analog + second_rrs
 }
 
 fn cube_part(config: &RunConfig, bytes_per_pixel_band: f64) -> Part {
@@ -301,12 +324,13 @@ pub fn study_demand(configs: &[&RunConfig], keep_cubes: bool, cache_bytes: usize
     }
     // The largest run at work: its cubes as the stages hand them on (all of them when kept, to
     // be written) and its products as they are made.
-    let (per_band, per_pixel) = if keep_cubes {
-        (BYTES_PER_PIXEL_BAND, BYTES_PER_PIXEL)
-    } else {
-        (LEAN_BYTES_PER_PIXEL_BAND, LEAN_BYTES_PER_PIXEL)
+    let part = |c: &RunConfig| {
+        if keep_cubes {
+            cube_part_with(c, BYTES_PER_PIXEL_BAND, BYTES_PER_PIXEL)
+        } else {
+            cube_part_with(c, lean_bytes_per_pixel_band(c), LEAN_BYTES_PER_PIXEL)
+        }
     };
-    let part = |c: &RunConfig| cube_part_with(c, per_band, per_pixel);
     let largest = configs.iter().enumerate().max_by(|(_, a), (_, b)| part(a).bytes.total_cmp(&part(b).bytes));
     let largest = largest.map(|(i, c)| (i, part(c)));
     // The products and truth maps every other run leaves behind.
