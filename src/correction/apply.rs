@@ -80,13 +80,16 @@ fn into_flat<T: Clone>(a: Array3<T>) -> Vec<T> {
 /// A Level-1 read in place: its radiance and flags, contiguous.
 pub(super) type Read<'a> = (&'a [f32], &'a [u8]);
 
+/// A per-pixel pass's Rrs and flag buffers, and the Level-1 it reads (see [`out_buffers`]).
+pub(super) type OutBuffers<'h> = (Vec<f32>, Vec<u8>, Option<Read<'h>>);
+
 /// The Rrs and flag buffers of a per-pixel pass over `level1`, and the Level-1 to read each
 /// pixel from: a handed-over Level-1's own buffers (read `None`: each pixel is copied out before
 /// it is overwritten, [`PixelReader`]), else new ones, with the Level-1 kept in `held`.
 pub(super) fn out_buffers<'h, 'a: 'h>(
     level1: Level1Input<'a>,
     held: &'h mut Option<Level1Input<'a>>,
-) -> Result<(Vec<f32>, Vec<u8>, Option<Read<'h>>), CorrectionError> {
+) -> Result<OutBuffers<'h>, CorrectionError> {
     match level1 {
         Level1Input::Owned(Level1 { radiance, flags }) => Ok((into_flat(radiance), into_flat(flags), None)),
         other => {

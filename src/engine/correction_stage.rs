@@ -15,11 +15,11 @@ use super::{EngineError, RunConfig};
 use crate::calibration::Level1;
 use crate::control::RunControl;
 use crate::correction::{
-    AerosolFamily, ExactTerms, FamilyLuts, RrsFlags, SceneApproximation, compare, correct_exact, correct_image,
-    screen_image,
+    AerosolFamily, BandDifference, ExactTerms, FamilyLuts, Reflectance, RrsFlags, SceneApproximation, compare,
+    correct_exact, correct_image, screen_image,
 };
-use crate::instrument::Truth;
-use ndarray::Array3;
+use crate::instrument::{AotNodes, SurfaceMap, Truth};
+use ndarray::{Array2, Array3};
 
 impl Engine {
     /// Atmospheric correction: the delivered Rrs and the diagnostics.
@@ -39,7 +39,7 @@ impl Engine {
         let Some(level1) = level1 else {
             return Err(EngineError::Failed { stage: Stage::Correction, message: "no Level-1 to correct".into() });
         };
-        let (band_atmosphere, band_key) = (&side.band_atmosphere, side.band_key);
+        let band_key = side.band_key;
         // Atmospheric correction.
         let correction_key = KeyBuilder::new(Stage::Correction)
             .after(level1_key)
@@ -84,61 +84,13 @@ impl Engine {
             let against_truth = diagnostics;
             let diagnostics = diagnostics && image.is_none();
             let aerosol_map = side.aerosol_map.as_deref().zip(truth.aot550.as_ref());
-            let atmosphere = band_atmosphere.as_ref();
-            // The exact correction takes away the glint of the wind it assumes (`None`: the
-            // scene's own); the approximation's diagnostic stays against the scene's own glint.
-            let expected = exact_glint(config, side);
-            // Every other reader of the Level-1 first; the exact correction last, handed the
-            // Level-1 (where nothing else holds it, it becomes the Rrs).
-            let (reference, streamed, approx) = match level1.as_deref() {
-                None => (None, None, None),
-                Some(l1) => {
-                    // (A wind error is the exact method's, so `diagnostics` here means the exact
-                    // correction runs.)
-                    let reference = (expected.is_some() && diagnostics)
-                        .then(|| correct_exact(l1, (atmosphere, None), aerosol_map, surface, control))
-                        .transpose()
-                        .map_err(&fail)?;
-                    // The approximation is held whole only when it is the product; as a
-                    // diagnostic it is compared pixel by pixel with the exact correction against
-                    // the scene's own glint: the reference above, or made pixel by pixel beside it.
-                    // (No approximation: the image holds no water, and its correction is every
-                    // pixel left out.)
-                    let streamed = match (&approximation, &reference, diagnostics && !per_scene) {
-                        (Some(a), Some(r), true) => a.compare_with(l1, surface, r),
-                        (Some(a), None, true) => {
-                            let dims = (l1.radiance.dim().1, l1.radiance.dim().2);
-                            let terms = ExactTerms::new((atmosphere, None), aerosol_map, surface, dims);
-                            a.compare_with_exact(l1, surface, &terms.map_err(&fail)?)
-                        }
-                        _ => None,
-                    };
-                    let approx = match &approximation {
-                        Some(a) if (diagnostics && streamed.is_none()) || per_scene => {
-                            Some(a.correct(l1, surface, control).map_err(&fail)?)
-                        }
-                        None if per_scene => Some(crate::correction::no_water(l1).map_err(&fail)?),
-                        _ => None,
-                    };
-                    (reference, streamed, approx)
-                }
-            };
-            let exact = match level1 {
-                Some(l1) if diagnostics || !per_scene => {
-                    let glint = expected.as_deref();
-                    Some(correct_exact(l1, (atmosphere, glint), aerosol_map, surface, control).map_err(&fail)?)
-                }
-                _ => None,
-            };
-            let exact_reference = reference.as_ref().or(exact.as_ref());
-            let approximation_vs_exact = match (streamed, &approx, exact_reference, diagnostics) {
-                (Some(d), ..) => d,
-                (None, Some(a), Some(e), true) => compare(a, &e.rrs, Some(&e.flags)),
-                _ => Vec::new(),
-            };
+            let modes = (diagnostics, per_scene);
+            let model =
+                model_based(config, side, (level1, surface, aerosol_map), approximation.as_ref(), modes, control)?;
+            let approximation_vs_exact = model.approximation_vs_exact;
             let image_ran = image.is_some();
             let (image, aerosol) = image.map_or((None, None), |(r, a)| (Some(r), Some(a)));
-            let mut rrs = match (image, exact, approx) {
+            let mut rrs = match (image, model.exact, model.approx) {
                 (Some(i), _, _) => i,
                 (None, _, Some(a)) if per_scene => a,
                 (None, Some(e), _) => e,
@@ -230,6 +182,82 @@ impl Engine {
         })?;
         Ok(Some((fam, key)))
     }
+}
+
+/// The AOT nodes' terms and the AOT under each pixel, where the scene's AOT is a map.
+type AerosolMap<'a> = Option<(&'a AotNodes, &'a Array2<f32>)>;
+
+/// What the corrections that invert with the model's own atmosphere make: the exact correction,
+/// the per-scene approximation, and the approximation's diagnostic against the exact correction.
+struct ModelBased {
+    exact: Option<Reflectance>,
+    approx: Option<Reflectance>,
+    approximation_vs_exact: Vec<BandDifference>,
+}
+
+/// The exact and per-scene corrections of `level1` (`None`: the image-based correction took
+/// it, and none of them runs) as the run asks for them: the product, and at full resolution
+/// (`diagnostics`) the diagnostics. Every other reader of the Level-1 first; the exact
+/// correction last, handed the Level-1 (where nothing else holds it, it becomes the Rrs).
+fn model_based(
+    config: &RunConfig,
+    side: &SceneSide,
+    (level1, surface, aerosol_map): (Option<Arc<Level1>>, &SurfaceMap, AerosolMap<'_>),
+    approximation: Option<&SceneApproximation>,
+    (diagnostics, per_scene): (bool, bool),
+    control: &RunControl,
+) -> Result<ModelBased, EngineError> {
+    let fail = failed(Stage::Correction);
+    let atmosphere = side.band_atmosphere.as_ref();
+    // The exact correction takes away the glint of the wind it assumes (`None`: the scene's
+    // own); the approximation's diagnostic stays against the scene's own glint.
+    let expected = exact_glint(config, side);
+    let (reference, streamed, approx) = match level1.as_deref() {
+        None => (None, None, None),
+        Some(l1) => {
+            // (A wind error is the exact method's, so `diagnostics` here means the exact
+            // correction runs.)
+            let reference = (expected.is_some() && diagnostics)
+                .then(|| correct_exact(l1, (atmosphere, None), aerosol_map, surface, control))
+                .transpose()
+                .map_err(&fail)?;
+            // The approximation is held whole only when it is the product; as a diagnostic it is
+            // compared pixel by pixel with the exact correction against the scene's own glint:
+            // the reference above, or made pixel by pixel beside it. (No approximation: the
+            // image holds no water, and its correction is every pixel left out.)
+            let streamed = match (approximation, &reference, diagnostics && !per_scene) {
+                (Some(a), Some(r), true) => a.compare_with(l1, surface, r),
+                (Some(a), None, true) => {
+                    let dims = (l1.radiance.dim().1, l1.radiance.dim().2);
+                    let terms = ExactTerms::new((atmosphere, None), aerosol_map, surface, dims);
+                    a.compare_with_exact(l1, surface, &terms.map_err(&fail)?)
+                }
+                _ => None,
+            };
+            let approx = match approximation {
+                Some(a) if (diagnostics && streamed.is_none()) || per_scene => {
+                    Some(a.correct(l1, surface, control).map_err(&fail)?)
+                }
+                None if per_scene => Some(crate::correction::no_water(l1).map_err(&fail)?),
+                _ => None,
+            };
+            (reference, streamed, approx)
+        }
+    };
+    let exact = match level1 {
+        Some(l1) if diagnostics || !per_scene => {
+            let glint = expected.as_deref();
+            Some(correct_exact(l1, (atmosphere, glint), aerosol_map, surface, control).map_err(&fail)?)
+        }
+        _ => None,
+    };
+    let exact_reference = reference.as_ref().or(exact.as_ref());
+    let approximation_vs_exact = match (streamed, &approx, exact_reference, diagnostics) {
+        (Some(d), ..) => d,
+        (None, Some(a), Some(e), true) => compare(a, &e.rrs, Some(&e.flags)),
+        _ => Vec::new(),
+    };
+    Ok(ModelBased { exact, approx, approximation_vs_exact })
 }
 
 /// The glint the exact correction takes away when its wind is not the scene's
