@@ -37,7 +37,9 @@
 //! What a run holds: [`Engine::new`] hands back every cube ([`Cubes`]) and caches them within its
 //! byte budget; [`Engine::lean`] (studies) frees each cube once the next stage has read it, makes
 //! `Electrons` and `Level0` in one pass row by row (no electrons product), and hands back the truth
-//! maps, products, metrics and the pixels asked for ([`Probe`]).
+//! maps, products, metrics and the pixels asked for ([`Probe`]). A cube nothing else holds (not
+//! kept, not cached) is handed to the stage that reads it last: Level-1 takes Level-0's flags, and
+//! the correction writes its Rrs over the Level-1 (`correction::Level1Input`).
 
 mod cache;
 mod config;
