@@ -324,7 +324,8 @@ pub fn calibrate_owned(
     control: &RunControl,
 ) -> Result<Level1, CalibrationError> {
     let out = calibrated_radiance(&level0, calibration, viewing, control)?;
-    let Level0 { flags, .. } = level0;
+    let Level0 { flags, dn, analog, .. } = level0;
+    drop((dn, analog));
     finish(out, flags, calibration, viewing)
 }
 

@@ -2,7 +2,7 @@
 //! (the forward model's own terms), y = (L1 − L_path − G)/(T·Ed), Rrs = y/(1 + S·π·y) (the
 //! inversion of [`crate::instrument::sample`]'s L = L_path + G + T·Ed·Rrs/(1 − S·π·Rrs)).
 //!
-//! The inversion of one pixel ([`ExactTerms::pixel`]) serves the pass over the image and a
+//! The inversion of one pixel (`ExactTerms::pixel`) serves the pass over the image and a
 //! diagnostic that compares another product with it pixel by pixel without holding it
 //! ([`super::SceneApproximation::compare_with_exact`]).
 
@@ -30,6 +30,13 @@ struct PixelTerms {
     l_path: Vec<f64>,
     t_ed: Vec<f64>,
     s_albedo: Vec<f64>,
+}
+
+thread_local! {
+    /// [`ExactTerms::pixel_of`]'s work space, one per thread (a pixel at a time, from a
+    /// comparison's parallel blocks).
+    static WORK: std::cell::RefCell<PixelTerms> =
+        const { std::cell::RefCell::new(PixelTerms { l_path: Vec::new(), t_ed: Vec::new(), s_albedo: Vec::new() }) };
 }
 
 impl<'a> ExactTerms<'a> {
@@ -86,7 +93,13 @@ impl<'a> ExactTerms<'a> {
     pub fn pixel_of(&self, p: usize, (l1, l0_flags): (&[f32], &[u8]), values: &mut [f32], flags: &mut [u8]) {
         let span = p * self.nb..(p + 1) * self.nb;
         let at = (p / self.cols.max(1), p % self.cols.max(1));
-        self.pixel(at, (&l1[span.clone()], &l0_flags[span]), (values, flags), &mut self.work());
+        WORK.with_borrow_mut(|work| {
+            let n = if self.aerosol_map.is_some() { self.nb } else { 0 };
+            if work.l_path.len() != n {
+                *work = self.work();
+            }
+            self.pixel(at, (&l1[span.clone()], &l0_flags[span]), (values, flags), work);
+        });
     }
 }
 

@@ -266,15 +266,27 @@ impl SceneApproximation {
         surface: &SurfaceMap,
         exact: &Reflectance,
     ) -> Option<Vec<BandDifference>> {
-        let (_, cols, nb) = level1.radiance.dim();
         let (l1, l0_flags) = (slice(&level1.radiance).ok()?, slice(&level1.flags).ok()?);
         let pixel = |p: usize, values: &mut [f32], flags: &mut [u8]| {
-            let land = !surface.is_water(p / cols.max(1), p % cols.max(1));
-            for b in 0..nb {
-                (values[b], flags[b]) = self.value(b, l1[p * nb + b], l0_flags[p * nb + b], land);
-            }
+            self.pixel_of(p, (l1, l0_flags), level1.radiance.dim(), surface, (values, flags));
         };
         Some(difference::compare_pixels(&pixel, &exact.rrs, Some(&exact.flags)))
+    }
+
+    /// Pixel `p` (row-major) of the Level-1 `l1` (radiance and flags of an image of `dims`
+    /// (rows, columns, bands)) corrected with the per-scene terms, into `out`.
+    fn pixel_of(
+        &self,
+        p: usize,
+        (l1, l0_flags): (&[f32], &[u8]),
+        (_, cols, nb): (usize, usize, usize),
+        surface: &SurfaceMap,
+        (values, flags): (&mut [f32], &mut [u8]),
+    ) {
+        let land = !surface.is_water(p / cols.max(1), p % cols.max(1));
+        for b in 0..nb {
+            (values[b], flags[b]) = self.value(b, l1[p * nb + b], l0_flags[p * nb + b], land);
+        }
     }
 
     /// [`Self::compare_with`] the exact correction made pixel by pixel with `terms` (the same
@@ -290,10 +302,7 @@ impl SceneApproximation {
         let (rows, cols, nb) = level1.radiance.dim();
         let (l1, l0_flags) = (slice(&level1.radiance).ok()?, slice(&level1.flags).ok()?);
         let pixel = |p: usize, values: &mut [f32], flags: &mut [u8]| {
-            let land = !surface.is_water(p / cols.max(1), p % cols.max(1));
-            for b in 0..nb {
-                (values[b], flags[b]) = self.value(b, l1[p * nb + b], l0_flags[p * nb + b], land);
-            }
+            self.pixel_of(p, (l1, l0_flags), (rows, cols, nb), surface, (values, flags));
         };
         let exact = |p: usize, values: &mut [f32], flags: &mut [u8]| terms.pixel_of(p, (l1, l0_flags), values, flags);
         Some(difference::compare_both_pixels(&pixel, &exact, rows * cols, nb))

@@ -62,9 +62,8 @@ const LEAN_BYTES_PER_PIXEL_BAND: f64 = 12.0;
 /// counts (quantisation off: the ideal-ADC closure setting), f32.
 const ANALOG_BYTES_PER_PIXEL_BAND: f64 = 4.0;
 /// What a lean run adds per pixel and band where its correction holds a second Rrs beside the
-/// product: the per-scene approximation as the product (the exact correction its diagnostic),
-/// or the exact correction assuming another wind than the scene's (the diagnostic's reference
-/// against the scene's own glint): the true Rrs and two Rrs with their flags (4 + 5 + 5).
+/// product (the per-scene product beside the exact diagnostic, or a wind error's reference
+/// against the scene's own glint): the true Rrs and two Rrs make 14 (4 + 5 + 5), 2 above 12.
 const SECOND_RRS_BYTES_PER_PIXEL_BAND: f64 = 2.0;
 /// Bytes per pixel and band an instrument's optical effects add (`instrument::effects`): the
 /// radiance at the detector, then the measured Level-1 and its stray part while the processor

@@ -311,7 +311,9 @@ impl Engine {
                     .map_err(failed(Stage::Level0))
             })?
         };
-        // The pupil radiance is let go once the detector has seen it, unless the run keeps it.
+        // The pupil radiance is let go once the detector has seen it, unless the run keeps it, and
+        // the radiance at the detector with it (the cache may keep it, within its budget).
+        drop(at_detector);
         let radiance = self.keeps_cubes().then_some(radiance);
         (report.saturated, report.zero_counts) = (level0.saturated, level0.zero_counts);
         report.compression = level0.compression;
@@ -344,7 +346,7 @@ impl Engine {
         let kept_level0 = self.keeps_cubes().then(|| level0.clone());
         let level1 = self.stage(level1_key, report, control, || {
             // Where nothing else holds the Level-0 (a run that keeps no cubes, whose cache let it
-            // go), its flags become the Level-1's and its counts go as soon as they are read.
+            // go), its flags become the Level-1's and its counts go once they are read.
             let level1 = match Arc::try_unwrap(level0) {
                 Ok(own) => calibrate_owned(own, &calibration, viewing, control),
                 Err(shared) => calibrate(&shared, &calibration, viewing, control),

@@ -85,6 +85,22 @@ fn draw_bands(
     }
 }
 
+/// The block of each grid line (or detector) `index` for blocks `k` wide, numbered from 0 in
+/// the order they come, and their number: consecutive grid lines in one plane pixel share an
+/// id, so each block row is a run of grid rows.
+fn block_ids(index: &[usize], k: usize) -> (Vec<usize>, usize) {
+    let mut ids = Vec::with_capacity(index.len());
+    let (mut last, mut n) = (usize::MAX, 0);
+    for &v in index {
+        if v / k != last {
+            last = v / k;
+            n += 1;
+        }
+        ids.push(n - 1);
+    }
+    (ids, n)
+}
+
 /// Each coarse focal plane's pixel values: the mean radiance of the k × k block of grid pixels a
 /// plane pixel reads (as far as the grid is simulated), held once per block and band. (A copy of
 /// the cube with the means spread over its blocks held the cube twice: 0.8 GB for Sentinel-2
@@ -122,20 +138,6 @@ impl BlockMeans {
         sizes.sort_unstable();
         sizes.dedup();
         let rows = radiance.len() / (cols * nb).max(1);
-        // Consecutive grid lines (detectors) in one plane pixel share an id; the lines simulated
-        // are in order, so each block row is a run of grid rows.
-        let dense = |index: &[usize], k: usize| -> (Vec<usize>, usize) {
-            let mut ids = Vec::with_capacity(index.len());
-            let (mut last, mut n) = (usize::MAX, 0);
-            for &v in index {
-                if v / k != last {
-                    last = v / k;
-                    n += 1;
-                }
-                ids.push(n - 1);
-            }
-            (ids, n)
-        };
         let mut of_band = vec![None; nb];
         let groups = sizes
             .iter()
@@ -145,8 +147,8 @@ impl BlockMeans {
                 for (slot, &b) in bands.iter().enumerate() {
                     of_band[b] = Some((g, slot));
                 }
-                let (row_id, n_r) = dense(&lines[..rows], k);
-                let (col_id, n_c) = dense(&detectors[..cols], k);
+                let (row_id, n_r) = block_ids(&lines[..rows], k);
+                let (col_id, n_c) = block_ids(&detectors[..cols], k);
                 let mut first_row = vec![rows; n_r + 1];
                 for (r, &id) in row_id.iter().enumerate().rev() {
                     first_row[id] = r;

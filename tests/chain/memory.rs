@@ -77,8 +77,9 @@ fn a_lean_run_makes_the_same_products_as_one_that_keeps_its_cubes() {
     // approximation diagnostic a lean run compares pixel by pixel).
     let mut config = RunConfig::new(super::small_lake(), super::small("cubesat", 96, 64));
     config.retrievals = vec![ron::from_str("Almi()").unwrap()];
-    for image in [Some(shoal::correction::ImageCorrection::default()), None] {
-        config.correction.method = image.map_or(shoal::correction::Method::Exact, shoal::correction::Method::Image);
+    use shoal::correction::{ImageCorrection, Method};
+    for method in [Method::Image(ImageCorrection::default()), Method::Exact, Method::PerScene] {
+        config.correction.method = method;
         let keeping = Engine::new().run(&config, &RunControl::new()).unwrap();
         let mut lean = Engine::lean();
         let probes = [Probe::TypicalWater];
@@ -87,6 +88,13 @@ fn a_lean_run_makes_the_same_products_as_one_that_keeps_its_cubes() {
         let (a, b) = (&keeping.retrievals[0], &light.retrievals[0]);
         assert_eq!(a.product, b.product, "the same maps, bit for bit");
         assert_eq!(format!("{:?}", a.metrics), format!("{:?}", b.metrics));
+        // A lean engine whose cache keeps nothing hands each cube to the stage that reads it last
+        // (Level-0's flags to Level-1, Level-1 to the correction, which writes its Rrs over it):
+        // the same products and diagnostics, bit for bit, as the run that read them.
+        let bare = Engine::lean().with_cache_budget(0).run(&config, &RunControl::new()).unwrap();
+        assert_eq!(bare.retrievals[0].product, b.product, "{:?}: handed over", config.correction.method);
+        assert_eq!(format!("{:?}", bare.retrievals[0].metrics), format!("{:?}", b.metrics));
+        assert_eq!(format!("{:?}", bare.correction), format!("{:?}", light.correction));
         // The diagnostic's counts, medians and maxima are the same; its mean is a parallel sum
         // whose grouping follows rayon's work stealing, so it may differ in the last bits
         // (1e-12 relative, as between any two runs).

@@ -6,17 +6,8 @@ fn spread_means(block: &[usize], radiance: &[f32], (lines, detectors): (&[usize]
     let nb = block.len();
     let rows = radiance.len() / (cols * nb);
     let mut out = radiance.to_vec();
-    let dense = |index: &[usize], k: usize| -> (Vec<usize>, usize) {
-        let (mut ids, mut last, mut n) = (Vec::new(), usize::MAX, 0);
-        for &v in index {
-            if v / k != last {
-                last = v / k;
-                n += 1;
-            }
-            ids.push(n - 1);
-        }
-        (ids, n)
-    };
+    // The block ids as the table numbers them (what is tested is the sums and the lookup).
+    let dense = super::block_ids;
     for b in (0..nb).filter(|&b| block[b] > 1) {
         let k = block[b];
         let (row_id, _) = dense(&lines[..rows], k);
