@@ -186,6 +186,23 @@ pub fn no_water(level1: &Level1) -> Result<Reflectance, CorrectionError> {
     assemble(rows, cols, nb, vec![0.0; rows * cols * nb], flags)
 }
 
+/// [`no_water`] compared with the exact correction ([`compare`]), both made pixel by pixel as
+/// the comparison reads them: the per-scene method's diagnostic over an image with no water.
+/// `None` when a Level-1 array is not contiguous.
+#[must_use]
+pub fn no_water_compared_with_exact(level1: &Level1, terms: &ExactTerms<'_>) -> Option<Vec<BandDifference>> {
+    let (rows, cols, nb) = level1.radiance.dim();
+    let (l1, l0_flags) = (slice(&level1.radiance).ok()?, slice(&level1.flags).ok()?);
+    let pixel = |p: usize, values: &mut [f32], flags: &mut [u8]| {
+        values.fill(0.0);
+        for (f, &l0) in flags.iter_mut().zip(&l0_flags[p * nb..(p + 1) * nb]) {
+            *f = flag_for(l0, true, 0.0);
+        }
+    };
+    let exact = |p: usize, values: &mut [f32], flags: &mut [u8]| terms.pixel_of(p, (l1, l0_flags), values, flags);
+    Some(difference::compare_both_pixels(&pixel, &exact, rows * cols, nb))
+}
+
 impl SceneApproximation {
     /// The paper's per-scene terms from `points` random water pixels (seeded), using the
     /// noise-free TOA radiance and the true Rrs of those pixels: open water, out of the clouds'
@@ -308,17 +325,18 @@ impl SceneApproximation {
         Some(difference::compare_both_pixels(&pixel, &exact, rows * cols, nb))
     }
 
-    /// Apply the per-scene terms to every pixel (A2, A3).
-    pub fn correct(
+    /// Apply the per-scene terms to every pixel (A2, A3). A Level-1 handed over
+    /// ([`Level1Input::Owned`]) becomes the Rrs: each value is read before it is overwritten.
+    pub fn correct<'a>(
         &self,
-        level1: &Level1,
+        level1: impl Into<Level1Input<'a>>,
         surface: &SurfaceMap,
         control: &RunControl,
     ) -> Result<Reflectance, CorrectionError> {
-        let (rows, cols, nb) = level1.radiance.dim();
-        let (l1, l0_flags) = (slice(&level1.radiance)?, slice(&level1.flags)?);
-        let mut rrs = vec![0.0f32; rows * cols * nb];
-        let mut flags = vec![0u8; rows * cols * nb];
+        let level1 = level1.into();
+        let (rows, cols, nb) = level1.level1().radiance.dim();
+        let mut held = None;
+        let (mut rrs, mut flags, read) = apply::out_buffers(level1, &mut held)?;
         let stride = cols * nb;
         control.fill_rows((rrs.as_mut_slice(), flags.as_mut_slice()), rows, stride, |at, (rrs_row, flag_row)| {
             let r = at.index();
@@ -328,7 +346,11 @@ impl SceneApproximation {
                 let land = !surface.is_water(r, c);
                 for b in 0..nb {
                     let k = c * nb + b;
-                    (rrs_row[k], flag_row[k]) = self.value(b, l1[base + k], l0_flags[base + k], land);
+                    let (l1, l1_flags) = match read {
+                        Some((l1, l0_flags)) => (l1[base + k], l0_flags[base + k]),
+                        None => (rrs_row[k], flag_row[k]),
+                    };
+                    (rrs_row[k], flag_row[k]) = self.value(b, l1, l1_flags, land);
                 }
             }
             Ok::<_, CorrectionError>(())

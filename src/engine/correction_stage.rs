@@ -90,14 +90,8 @@ impl Engine {
             let approximation_vs_exact = model.approximation_vs_exact;
             let image_ran = image.is_some();
             let (image, aerosol) = image.map_or((None, None), |(r, a)| (Some(r), Some(a)));
-            let mut rrs = match (image, model.exact, model.approx) {
-                (Some(i), _, _) => i,
-                (None, _, Some(a)) if per_scene => a,
-                (None, Some(e), _) => e,
-                (None, None, Some(a)) => a,
-                (None, None, None) => {
-                    return Err(EngineError::Failed { stage: Stage::Correction, message: "no correction ran".into() });
-                }
+            let Some(mut rrs) = image.or(model.rrs) else {
+                return Err(EngineError::Failed { stage: Stage::Correction, message: "no correction ran".into() });
             };
             // The image-based correction masks high glint itself.
             let exact_high_glint =
@@ -187,18 +181,23 @@ impl Engine {
 /// The AOT nodes' terms and the AOT under each pixel, where the scene's AOT is a map.
 type AerosolMap<'a> = Option<(&'a AotNodes, &'a Array2<f32>)>;
 
-/// What the corrections that invert with the model's own atmosphere make: the exact correction,
-/// the per-scene approximation, and the approximation's diagnostic against the exact correction.
+/// What the corrections that invert with the model's own atmosphere make: the product (the
+/// exact correction or the per-scene approximation), and the approximation's diagnostic against
+/// the exact correction.
 struct ModelBased {
-    exact: Option<Reflectance>,
-    approx: Option<Reflectance>,
+    rrs: Option<Reflectance>,
     approximation_vs_exact: Vec<BandDifference>,
 }
 
-/// The exact and per-scene corrections of `level1` (`None`: the image-based correction took
-/// it, and none of them runs) as the run asks for them: the product, and at full resolution
-/// (`diagnostics`) the diagnostics. Every other reader of the Level-1 first; the exact
-/// correction last, handed the Level-1 (where nothing else holds it, it becomes the Rrs).
+/// The exact or per-scene correction of `level1` (`None`: the image-based correction took it,
+/// and neither runs) as the run asks for it, and at full resolution (`diagnostics`) the
+/// approximation against the exact correction.
+///
+/// The diagnostic is always against the exact correction with the scene's own glint (whatever
+/// wind the exact product assumes), and both sides are made pixel by pixel from the Level-1 as
+/// the comparison reads them ([`SceneApproximation::compare_with_exact`]), so neither is held
+/// whole for it. It runs first; the product then takes the Level-1 (where nothing else holds
+/// it, its Rrs is written over it).
 fn model_based(
     config: &RunConfig,
     side: &SceneSide,
@@ -208,56 +207,36 @@ fn model_based(
     control: &RunControl,
 ) -> Result<ModelBased, EngineError> {
     let fail = failed(Stage::Correction);
+    let Some(level1) = level1 else { return Ok(ModelBased { rrs: None, approximation_vs_exact: Vec::new() }) };
     let atmosphere = side.band_atmosphere.as_ref();
-    // The exact correction takes away the glint of the wind it assumes (`None`: the scene's
-    // own); the approximation's diagnostic stays against the scene's own glint.
-    let expected = exact_glint(config, side);
-    let (reference, streamed, approx) = match level1.as_deref() {
-        None => (None, None, None),
-        Some(l1) => {
-            // (A wind error is the exact method's, so `diagnostics` here means the exact
-            // correction runs.)
-            let reference = (expected.is_some() && diagnostics)
-                .then(|| correct_exact(l1, (atmosphere, None), aerosol_map, surface, control))
-                .transpose()
-                .map_err(&fail)?;
-            // The approximation is held whole only when it is the product; as a diagnostic it is
-            // compared pixel by pixel with the exact correction against the scene's own glint:
-            // the reference above, or made pixel by pixel beside it. (No approximation: the
-            // image holds no water, and its correction is every pixel left out.)
-            let streamed = match (approximation, &reference, diagnostics && !per_scene) {
-                (Some(a), Some(r), true) => a.compare_with(l1, surface, r),
-                (Some(a), None, true) => {
-                    let dims = (l1.radiance.dim().1, l1.radiance.dim().2);
-                    let terms = ExactTerms::new((atmosphere, None), aerosol_map, surface, dims);
-                    a.compare_with_exact(l1, surface, &terms.map_err(&fail)?)
-                }
-                _ => None,
-            };
-            let approx = match approximation {
-                Some(a) if (diagnostics && streamed.is_none()) || per_scene => {
-                    Some(a.correct(l1, surface, control).map_err(&fail)?)
-                }
-                None if per_scene => Some(crate::correction::no_water(l1).map_err(&fail)?),
-                _ => None,
-            };
-            (reference, streamed, approx)
+    let (rows, cols, nb) = level1.radiance.dim();
+    // With no approximation (the image holds no water) the per-scene product is every pixel left
+    // out, and the diagnostic compares that with the exact correction.
+    let approximation_vs_exact = if diagnostics && (approximation.is_some() || per_scene) {
+        let terms = ExactTerms::new((atmosphere, None), aerosol_map, surface, (cols, nb)).map_err(&fail)?;
+        let compared = match approximation {
+            Some(a) => a.compare_with_exact(&level1, surface, &terms),
+            None => crate::correction::no_water_compared_with_exact(&level1, &terms),
+        };
+        compared.ok_or_else(|| EngineError::Failed {
+            stage: Stage::Correction,
+            message: format!("the Level-1 ({rows} × {cols} × {nb}) is not in standard layout"),
+        })?
+    } else {
+        Vec::new()
+    };
+    let rrs = if per_scene {
+        match approximation {
+            Some(a) => a.correct(level1, surface, control),
+            None => crate::correction::no_water(&level1),
         }
+    } else {
+        // The exact correction takes away the glint of the wind it assumes (`None`: the scene's
+        // own).
+        let expected = exact_glint(config, side);
+        correct_exact(level1, (atmosphere, expected.as_deref()), aerosol_map, surface, control)
     };
-    let exact = match level1 {
-        Some(l1) if diagnostics || !per_scene => {
-            let glint = expected.as_deref();
-            Some(correct_exact(l1, (atmosphere, glint), aerosol_map, surface, control).map_err(&fail)?)
-        }
-        _ => None,
-    };
-    let exact_reference = reference.as_ref().or(exact.as_ref());
-    let approximation_vs_exact = match (streamed, &approx, exact_reference, diagnostics) {
-        (Some(d), ..) => d,
-        (None, Some(a), Some(e), true) => compare(a, &e.rrs, Some(&e.flags)),
-        _ => Vec::new(),
-    };
-    Ok(ModelBased { exact, approx, approximation_vs_exact })
+    Ok(ModelBased { rrs: Some(rrs.map_err(&fail)?), approximation_vs_exact })
 }
 
 /// The glint the exact correction takes away when its wind is not the scene's

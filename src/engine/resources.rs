@@ -52,8 +52,8 @@ const RT_BYTES_PER_LEVEL_STREAM_PAIR: f64 = 72.0;
 /// Bytes per pixel and band of a run that does not keep its cubes, at its peak: the pupil
 /// radiance, the true Rrs and the Level-0 counts and flags side by side while the detector reads
 /// out (4 + 4 + 3), then the true Rrs, the counts and the Level-1 (which takes the Level-0's
-/// flags) while it is calibrated (4 + 2 + 5); the correction writes its Rrs over the Level-1
-/// (and the approximation's diagnostic makes the exact correction pixel by pixel), so it holds
+/// flags) while it is calibrated (4 + 2 + 5); every correction writes its Rrs over the Level-1
+/// (and the approximation's diagnostic makes both corrections pixel by pixel), so it holds
 /// less. Rounded up for the stages' working copies. Measured peaks (VmHWM, `shoal study
 /// --no-cubes`): the default study 0.67 GiB (plan 0.82), `four_designs_lake_hume` 2.15 GiB (plan
 /// 2.28), Sentinel-2 MSI alone (16 million pixels) 2.75 GiB (plan 3.61).
@@ -61,10 +61,6 @@ const LEAN_BYTES_PER_PIXEL_BAND: f64 = 12.0;
 /// What a lean run adds per pixel and band where Level-0 keeps the analogue signal beside the
 /// counts (quantisation off: the ideal-ADC closure setting), f32.
 const ANALOG_BYTES_PER_PIXEL_BAND: f64 = 4.0;
-/// What a lean run adds per pixel and band where its correction holds a second Rrs beside the
-/// product (the per-scene product beside the exact diagnostic, or a wind error's reference
-/// against the scene's own glint): the true Rrs and two Rrs make 14 (4 + 5 + 5), 2 above 12.
-const SECOND_RRS_BYTES_PER_PIXEL_BAND: f64 = 2.0;
 /// Bytes per pixel and band an instrument's optical effects add (`instrument::effects`): the
 /// radiance at the detector, then the measured Level-1 and its stray part while the processor
 /// corrects it.
@@ -264,14 +260,7 @@ fn image_size(config: &RunConfig) -> (usize, usize) {
 /// Bytes per pixel and band of `config`'s run at its peak when it keeps no cubes.
 fn lean_bytes_per_pixel_band(config: &RunConfig) -> f64 {
     let analog = if config.detector.quantise { 0.0 } else { ANALOG_BYTES_PER_PIXEL_BAND };
-    let second_rrs = match config.correction.method {
-        crate::correction::Method::PerScene => SECOND_RRS_BYTES_PER_PIXEL_BAND,
-        crate::correction::Method::Exact if config.correction.exact_wind_error_m_s() != 0.0 => {
-            SECOND_RRS_BYTES_PER_PIXEL_BAND
-        }
-        _ => 0.0,
-    };
-    LEAN_BYTES_PER_PIXEL_BAND + analog + second_rrs
+    LEAN_BYTES_PER_PIXEL_BAND + analog
 }
 
 fn cube_part(config: &RunConfig, bytes_per_pixel_band: f64) -> Part {

@@ -1,14 +1,16 @@
 //! A correction handed its Level-1 (`correction::Level1Input::Owned`, what a run that keeps no
 //! cubes does) writes the Rrs over it: the same bits as a correction that reads it, for the
-//! image-based correction (band pair and dark-spectrum fitting) and the exact one. And the
-//! approximation's diagnostic against the exact correction made pixel by pixel (what lets the
-//! exact correction take the Level-1 last) equals the one against the exact cube.
+//! image-based correction (band pair and dark-spectrum fitting), the exact one and the paper's
+//! per-scene approximation. And the approximation's diagnostic against the exact correction made
+//! pixel by pixel (what lets either product take the Level-1 after it) equals the one between the
+//! two cubes.
 
 use crate::common::Kept;
 use shoal::atmosphere::AerosolType;
 use shoal::control::RunControl;
 use shoal::correction::{
-    AerosolFit, ExactTerms, ImageCorrection, Level1Input, Method, Reflectance, correct_exact, correct_image,
+    AerosolFit, ExactTerms, ImageCorrection, Level1Input, Method, Reflectance, compare, correct_exact, correct_image,
+    no_water, no_water_compared_with_exact,
 };
 use shoal::instrument::DetectorMode;
 
@@ -77,4 +79,34 @@ fn the_exact_correction_handed_its_level1_gives_the_same_bits_and_the_same_diagn
     assert_eq!(against_cube, on_the_fly);
     assert_eq!(against_cube, out.correction.approximation_vs_exact, "the run's diagnostic");
     assert!(against_cube.iter().all(|d| d.n > 0));
+}
+
+#[test]
+fn the_per_scene_product_handed_its_level1_gives_the_same_bits_and_the_same_diagnostic() {
+    let mut c = clear_water(AerosolType::Continental, 0.15);
+    c.detector = DetectorMode::default();
+    c.correction.method = Method::PerScene;
+    let out = run(&c);
+    let (surface, control) = (&out.truth.surface, RunControl::new());
+    let approximation = out.correction.approximation.as_ref().expect("a lake has water");
+    let level1 = (*out.kept().level1).clone();
+    let read = approximation.correct(&level1, surface, &control).unwrap();
+    let owned = approximation.correct(Level1Input::Owned(level1.clone()), surface, &control).unwrap();
+    assert_same(&read, &owned, "per-scene");
+    assert_same(&read, &out.kept().rrs, "per-scene, the run's product");
+    assert!(read.flags.iter().any(|f| *f == 0), "some pixels retrieved");
+    // The diagnostic between the two cubes, and with both made pixel by pixel (the run's).
+    let atmosphere = (out.band_atmosphere.as_ref(), None);
+    let exact = correct_exact(&level1, atmosphere, None, surface, &control).unwrap();
+    let between_cubes = compare(&read, &exact.rrs, Some(&exact.flags));
+    let (_, cols, nb) = level1.radiance.dim();
+    let terms = ExactTerms::new(atmosphere, None, surface, (cols, nb)).unwrap();
+    assert_eq!(between_cubes, approximation.compare_with_exact(&level1, surface, &terms).unwrap());
+    assert_eq!(between_cubes, out.correction.approximation_vs_exact, "the run's diagnostic");
+    assert!(between_cubes.iter().all(|d| d.n > 0));
+    // An image with no water: its product (every pixel left out) against the exact correction.
+    let none = no_water(&level1).unwrap();
+    let expected = compare(&none, &exact.rrs, Some(&exact.flags));
+    assert_eq!(expected, no_water_compared_with_exact(&level1, &terms).unwrap());
+    assert!(expected.iter().all(|d| d.n == 0), "nothing of it is valid");
 }
