@@ -107,6 +107,7 @@ fn sweep_row(
 ) -> Result<String, String> {
     let mut latencies = Vec::new();
     let mut engine = Vec::new();
+    let mut stages: std::collections::BTreeMap<String, Vec<f64>> = std::collections::BTreeMap::new();
     let mut busy_frames = Vec::new();
     for k in 0..steps {
         (sweep.set)(&mut app.state, k);
@@ -114,7 +115,13 @@ fn sweep_row(
         let first = frames_until(ctx, app, Duration::from_secs(120), |a| on_screen(a, preview))?;
         latencies.push(start.elapsed().as_secs_f64() * 1e3);
         // The engine's share: A's run (only A changed).
-        engine.extend(app.link.shown[0].as_ref().map(|s| s.output.report.total_seconds * 1e3));
+        if let Some(shown) = app.link.shown[0].as_ref() {
+            let report = &shown.output.report;
+            engine.push(report.total_seconds * 1e3);
+            for s in report.stages.iter().filter(|s| s.status == crate::engine::StageStatus::Ran) {
+                stages.entry(s.stage.to_string()).or_default().push(s.seconds * 1e3);
+            }
+        }
         busy_frames.extend(first);
         busy_frames.extend(frames_until(ctx, app, Duration::from_secs(600), |a| on_screen(a, settle))?);
     }
@@ -122,14 +129,30 @@ fn sweep_row(
     let lat_max = latencies.iter().copied().fold(0.0, f64::max);
     let n = busy_frames.len();
     Ok(format!(
-        "| {} | 1/{preview} | {steps} | {:.0} ({lat_min:.0}–{lat_max:.0}) | {:.0} | ≤ 40 / 60 | {:.1} / {:.1} / {:.1} | {n} |\n",
+        "| {} | 1/{preview} | {steps} | {:.0} ({lat_min:.0}–{lat_max:.0}) | {:.0}: {} | ≤ 40 / 60 | {:.1} / {:.1} / {:.1} | {n} |\n",
         sweep.label,
         percentile(latencies.clone(), 0.5),
         percentile(engine, 0.5),
+        largest_stages(stages, steps),
         percentile(busy_frames.clone(), 0.5),
         percentile(busy_frames.clone(), 0.95),
         percentile(busy_frames, 1.0),
     ))
+}
+
+/// The engine's three largest stages by median time, ms ("correction 2.8, retrieval 1.9, …"):
+/// what a change reruns and where its time goes. A stage that ran in only some of the `steps`
+/// runs counts as 0 in the others.
+fn largest_stages(stages: std::collections::BTreeMap<String, Vec<f64>>, steps: usize) -> String {
+    let mut by_time: Vec<(f64, String)> = stages
+        .into_iter()
+        .map(|(name, mut t)| {
+            t.resize(steps.max(t.len()), 0.0);
+            (percentile(t, 0.5), name)
+        })
+        .collect();
+    by_time.sort_by(|a, b| b.0.total_cmp(&a.0));
+    by_time.iter().take(3).map(|(t, name)| format!("{name} {t:.1}")).collect::<Vec<_>>().join(", ")
 }
 
 /// The app rows of `shoal bench` (Markdown, with a heading).
@@ -159,7 +182,7 @@ pub fn rows(quick: bool) -> Result<String, String> {
         "Engine threads {}. From start: first preview (1/{preview}) on screen {cold_preview_s:.2} s, final (1/{finest}) {cold_final_s:.1} s.\n\n",
         super::link::engine_threads(0)
     ));
-    out.push_str("| change to A | preview | changes | slider → preview on screen, median (min–max) ms | of which engine, median ms | target median / max | frame ms while engine runs, median / p95 / max | frames |\n|---|---|---|---|---|---|---|---|\n");
+    out.push_str("| change to A | preview | changes | slider → preview on screen, median (min–max) ms | of which engine, median ms: its largest stages | target median / max | frame ms while engine runs, median / p95 / max | frames |\n|---|---|---|---|---|---|---|---|\n");
     let previews: &[usize] = if quick { &[24] } else { &[24, 16] };
     for &p in previews {
         app.state.decimations = vec![p, 4, finest];
