@@ -43,13 +43,6 @@ pub fn compare(a: &Reflectance, b: &Array3<f32>, b_flags: Option<&Array3<u8>>) -
     compare_source(Source::Cube(ar, af), a.rrs.dim().2, reference)
 }
 
-/// [`compare`] with `a`'s values and flags at each pixel (row-major, `b`'s bands) made by `a`.
-#[must_use]
-pub fn compare_pixels(a: PixelBands<'_>, b: &Array3<f32>, b_flags: Option<&Array3<u8>>) -> Vec<BandDifference> {
-    let Some(reference) = Reference::of(b, b_flags) else { return Vec::new() };
-    compare_source(Source::Pixels(a), b.dim().2, reference)
-}
-
 /// [`compare`] with both `a` and the reference `b` made pixel by pixel (`pixels` of `nb` bands,
 /// row-major): neither product is held whole.
 #[must_use]

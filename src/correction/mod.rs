@@ -191,13 +191,27 @@ pub fn no_water(level1: &Level1) -> Result<Reflectance, CorrectionError> {
 /// `None` when a Level-1 array is not contiguous.
 #[must_use]
 pub fn no_water_compared_with_exact(level1: &Level1, terms: &ExactTerms<'_>) -> Option<Vec<BandDifference>> {
+    compared_with_exact(level1, terms, |_, (_, l0_flags), values, flags| {
+        values.fill(0.0);
+        for (f, &l0) in flags.iter_mut().zip(l0_flags) {
+            *f = flag_for(l0, true, 0.0);
+        }
+    })
+}
+
+/// A product made pixel by pixel by `product(p, pixel's Level-1 radiance and flags, values,
+/// flags)` compared with the exact correction made pixel by pixel with `terms` ([`compare`]'s
+/// figures; neither is held whole). `None` when a Level-1 array is not contiguous.
+fn compared_with_exact(
+    level1: &Level1,
+    terms: &ExactTerms<'_>,
+    product: impl Fn(usize, apply::Read<'_>, &mut [f32], &mut [u8]) + Sync,
+) -> Option<Vec<BandDifference>> {
     let (rows, cols, nb) = level1.radiance.dim();
     let (l1, l0_flags) = (slice(&level1.radiance).ok()?, slice(&level1.flags).ok()?);
     let pixel = |p: usize, values: &mut [f32], flags: &mut [u8]| {
-        values.fill(0.0);
-        for (f, &l0) in flags.iter_mut().zip(&l0_flags[p * nb..(p + 1) * nb]) {
-            *f = flag_for(l0, true, 0.0);
-        }
+        let span = p * nb..(p + 1) * nb;
+        product(p, (&l1[span.clone()], &l0_flags[span]), values, flags);
     };
     let exact = |p: usize, values: &mut [f32], flags: &mut [u8]| terms.pixel_of(p, (l1, l0_flags), values, flags);
     Some(difference::compare_both_pixels(&pixel, &exact, rows * cols, nb))
@@ -273,42 +287,19 @@ impl SceneApproximation {
         (if f & RrsFlags::INVALID != 0 { 0.0 } else { value as f32 }, f)
     }
 
-    /// [`Self::correct`] compared with `exact` ([`compare`]) without holding the approximation's
-    /// cube: each pixel is corrected as the comparison reads it (the same values). `None` when a
-    /// Level-1 array is not contiguous.
-    #[must_use]
-    pub fn compare_with(
-        &self,
-        level1: &Level1,
-        surface: &SurfaceMap,
-        exact: &Reflectance,
-    ) -> Option<Vec<BandDifference>> {
-        let (l1, l0_flags) = (slice(&level1.radiance).ok()?, slice(&level1.flags).ok()?);
-        let pixel = |p: usize, values: &mut [f32], flags: &mut [u8]| {
-            self.pixel_of(p, (l1, l0_flags), level1.radiance.dim(), surface, (values, flags));
-        };
-        Some(difference::compare_pixels(&pixel, &exact.rrs, Some(&exact.flags)))
-    }
-
-    /// Pixel `p` (row-major) of the Level-1 `l1` (radiance and flags of an image of `dims`
-    /// (rows, columns, bands)) corrected with the per-scene terms, into `out`.
-    fn pixel_of(
-        &self,
-        p: usize,
-        (l1, l0_flags): (&[f32], &[u8]),
-        (_, cols, nb): (usize, usize, usize),
-        surface: &SurfaceMap,
-        (values, flags): (&mut [f32], &mut [u8]),
-    ) {
-        let land = !surface.is_water(p / cols.max(1), p % cols.max(1));
-        for b in 0..nb {
-            (values[b], flags[b]) = self.value(b, l1[p * nb + b], l0_flags[p * nb + b], land);
+    /// One pixel's Rrs and flags into `out` from its Level-1 radiance and flags (`nb` values
+    /// each; `land`: the pixel is not water).
+    #[inline]
+    fn pixel(&self, (l1, l1_flags): apply::Read<'_>, land: bool, (values, flags): (&mut [f32], &mut [u8])) {
+        for b in 0..values.len() {
+            (values[b], flags[b]) = self.value(b, l1[b], l1_flags[b], land);
         }
     }
 
-    /// [`Self::compare_with`] the exact correction made pixel by pixel with `terms` (the same
-    /// values as [`correct_exact`]'s cube): neither product is held, so the exact correction
-    /// can then write its Rrs over the Level-1.
+    /// [`Self::correct`] compared with the exact correction made pixel by pixel with `terms` (the
+    /// same values as [`correct_exact`]'s cube; [`compare`]'s figures): neither product is held,
+    /// so either can then write its Rrs over the Level-1. `None` when a Level-1 array is not
+    /// contiguous.
     #[must_use]
     pub fn compare_with_exact(
         &self,
@@ -316,13 +307,10 @@ impl SceneApproximation {
         surface: &SurfaceMap,
         terms: &exact::ExactTerms<'_>,
     ) -> Option<Vec<BandDifference>> {
-        let (rows, cols, nb) = level1.radiance.dim();
-        let (l1, l0_flags) = (slice(&level1.radiance).ok()?, slice(&level1.flags).ok()?);
-        let pixel = |p: usize, values: &mut [f32], flags: &mut [u8]| {
-            self.pixel_of(p, (l1, l0_flags), (rows, cols, nb), surface, (values, flags));
-        };
-        let exact = |p: usize, values: &mut [f32], flags: &mut [u8]| terms.pixel_of(p, (l1, l0_flags), values, flags);
-        Some(difference::compare_both_pixels(&pixel, &exact, rows * cols, nb))
+        let cols = level1.radiance.dim().1.max(1);
+        compared_with_exact(level1, terms, |p, l1, values, flags| {
+            self.pixel(l1, !surface.is_water(p / cols, p % cols), (values, flags));
+        })
     }
 
     /// Apply the per-scene terms to every pixel (A2, A3). A Level-1 handed over
@@ -341,17 +329,12 @@ impl SceneApproximation {
         control.fill_rows((rrs.as_mut_slice(), flags.as_mut_slice()), rows, stride, |at, (rrs_row, flag_row)| {
             let r = at.index();
             let base = r * stride;
+            let mut reader = apply::PixelReader::new(read, nb);
             for c in 0..cols {
                 at.column(c);
-                let land = !surface.is_water(r, c);
-                for b in 0..nb {
-                    let k = c * nb + b;
-                    let (l1, l1_flags) = match read {
-                        Some((l1, l0_flags)) => (l1[base + k], l0_flags[base + k]),
-                        None => (rrs_row[k], flag_row[k]),
-                    };
-                    (rrs_row[k], flag_row[k]) = self.value(b, l1, l1_flags, land);
-                }
+                let k = c * nb..(c + 1) * nb;
+                let l1 = reader.pixel(base, k.clone(), (rrs_row, flag_row));
+                self.pixel(l1, !surface.is_water(r, c), (&mut rrs_row[k.clone()], &mut flag_row[k]));
             }
             Ok::<_, CorrectionError>(())
         })?;

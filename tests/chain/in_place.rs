@@ -56,6 +56,28 @@ fn an_image_correction_handed_its_level1_gives_the_bits_of_one_reading_it() {
     }
 }
 
+/// The approximation's diagnostic of `out` (a run at full resolution) between the two cubes
+/// (`compare`), with both made pixel by pixel, and as the run reported it: the same counts,
+/// medians, maxima and (summed in the same fixed blocks) means. Returns the terms of the exact
+/// correction and its cube.
+fn assert_the_diagnostic_is_the_cubes<'a>(
+    out: &'a shoal::engine::RunOutput,
+    level1: &'a shoal::calibration::Level1,
+) -> (ExactTerms<'a>, Reflectance) {
+    let (surface, control) = (&out.truth.surface, RunControl::new());
+    let approximation = out.correction.approximation.as_ref().expect("a lake has water");
+    let atmosphere = (out.band_atmosphere.as_ref(), None);
+    let exact = correct_exact(level1, atmosphere, None, surface, &control).unwrap();
+    let approximate = approximation.correct(level1, surface, &control).unwrap();
+    let between_cubes = compare(&approximate, &exact.rrs, Some(&exact.flags));
+    let (_, cols, nb) = level1.radiance.dim();
+    let terms = ExactTerms::new(atmosphere, None, surface, (cols, nb)).unwrap();
+    assert_eq!(between_cubes, approximation.compare_with_exact(level1, surface, &terms).unwrap());
+    assert_eq!(between_cubes, out.correction.approximation_vs_exact, "the run's diagnostic");
+    assert!(between_cubes.iter().all(|d| d.n > 0));
+    (terms, exact)
+}
+
 #[test]
 fn the_exact_correction_handed_its_level1_gives_the_same_bits_and_the_same_diagnostic() {
     let mut c = clear_water(AerosolType::Continental, 0.15);
@@ -69,16 +91,7 @@ fn the_exact_correction_handed_its_level1_gives_the_same_bits_and_the_same_diagn
     let owned = correct_exact(Level1Input::Owned(level1.clone()), atmosphere, None, surface, &control).unwrap();
     assert_same(&read, &owned, "exact");
     assert_same(&read, &out.kept().rrs, "exact, the run's product");
-    // The approximation against the exact cube, and against the exact correction made pixel by
-    // pixel: the same counts, medians, maxima and (summed in the same fixed blocks) means.
-    let approximation = out.correction.approximation.as_ref().expect("a lake has water");
-    let against_cube = approximation.compare_with(&level1, surface, &read).unwrap();
-    let (_, cols, nb) = level1.radiance.dim();
-    let terms = ExactTerms::new(atmosphere, None, surface, (cols, nb)).unwrap();
-    let on_the_fly = approximation.compare_with_exact(&level1, surface, &terms).unwrap();
-    assert_eq!(against_cube, on_the_fly);
-    assert_eq!(against_cube, out.correction.approximation_vs_exact, "the run's diagnostic");
-    assert!(against_cube.iter().all(|d| d.n > 0));
+    assert_the_diagnostic_is_the_cubes(&out, &level1);
 }
 
 #[test]
@@ -95,15 +108,7 @@ fn the_per_scene_product_handed_its_level1_gives_the_same_bits_and_the_same_diag
     assert_same(&read, &owned, "per-scene");
     assert_same(&read, &out.kept().rrs, "per-scene, the run's product");
     assert!(read.flags.iter().any(|f| *f == 0), "some pixels retrieved");
-    // The diagnostic between the two cubes, and with both made pixel by pixel (the run's).
-    let atmosphere = (out.band_atmosphere.as_ref(), None);
-    let exact = correct_exact(&level1, atmosphere, None, surface, &control).unwrap();
-    let between_cubes = compare(&read, &exact.rrs, Some(&exact.flags));
-    let (_, cols, nb) = level1.radiance.dim();
-    let terms = ExactTerms::new(atmosphere, None, surface, (cols, nb)).unwrap();
-    assert_eq!(between_cubes, approximation.compare_with_exact(&level1, surface, &terms).unwrap());
-    assert_eq!(between_cubes, out.correction.approximation_vs_exact, "the run's diagnostic");
-    assert!(between_cubes.iter().all(|d| d.n > 0));
+    let (terms, exact) = assert_the_diagnostic_is_the_cubes(&out, &level1);
     // An image with no water: its product (every pixel left out) against the exact correction.
     let none = no_water(&level1).unwrap();
     let expected = compare(&none, &exact.rrs, Some(&exact.flags));
