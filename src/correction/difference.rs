@@ -167,10 +167,10 @@ fn compare_source(source: Source<'_>, nb: usize, reference: Reference<'_>) -> Ve
 }
 
 /// Pixels per block of [`compare`]'s sums.
-const BLOCK_PIXELS: usize = 4096;
+pub(super) const BLOCK_PIXELS: usize = 4096;
 
 /// Pixels per band the median of [`compare`] is taken from, at most.
-const MEDIAN_SAMPLES: usize = 200_000;
+pub(super) const MEDIAN_SAMPLES: usize = 200_000;
 
 #[cfg(test)]
 mod tests {

@@ -46,7 +46,9 @@ pub use expected_glint::{column_lgn, expected_glint, mark_high_glint};
 pub use family::{AerosolFamily, FamilyLuts};
 pub use image::{AerosolFit, AerosolRetrieval, ImageCorrection, MISSION_PAIRS_NM, correct_image};
 pub use method::{CorrectionSpec, Method, PRESETS, Preset};
-pub use rrs_metrics::{BandRrsMetrics, RRS_SAMPLES, band_rrs_metrics, pooled_rrs_error};
+pub use rrs_metrics::{
+    BandRrsMetrics, RRS_SAMPLES, TruthRrsSample, band_rrs_metrics, compare_with_truth, pooled_rrs_error,
+};
 
 use ndarray::Array3;
 use rand::SeedableRng;

@@ -15,11 +15,11 @@ use super::{EngineError, RunConfig};
 use crate::calibration::Level1;
 use crate::control::RunControl;
 use crate::correction::{
-    AerosolFamily, BandDifference, ExactTerms, FamilyLuts, Reflectance, RrsFlags, SceneApproximation, compare,
-    correct_exact, correct_image, screen_image,
+    AerosolFamily, BandDifference, ExactTerms, FamilyLuts, Reflectance, RrsFlags, SceneApproximation, TruthRrsSample,
+    compare_with_truth, correct_exact, correct_image, screen_image,
 };
 use crate::instrument::{AotNodes, SurfaceMap, Truth};
-use ndarray::{Array2, Array3};
+use ndarray::Array2;
 
 impl Engine {
     /// Atmospheric correction: the delivered Rrs and the diagnostics.
@@ -28,7 +28,7 @@ impl Engine {
         &mut self,
         config: &RunConfig,
         side: &SceneSide,
-        (truth, truth_rrs, radiance_key): (&Truth, &Array3<f32>, Key),
+        (truth, truth_rrs, radiance_key): (&Truth, &TruthRrsSample, Key),
         approximation: Option<SceneApproximation>,
         (level1, level1_key): (Option<Arc<Level1>>, Key),
         control: &RunControl,
@@ -99,16 +99,11 @@ impl Engine {
             if let Some(screen) = &screen {
                 mark_screened(&mut rrs, screen);
             }
-            let rrs_vs_truth = if against_truth { compare(&rrs, truth_rrs, None) } else { Vec::new() };
+            let rrs_vs_truth = if against_truth { compare_with_truth(&rrs, truth_rrs) } else { Vec::new() };
             let family = family.as_ref().map(|(f, _)| f.clone());
             let names: Vec<String> = side.response.bands.bands.iter().map(|b| b.name.clone()).collect();
-            let rrs_metrics = crate::correction::band_rrs_metrics(
-                &rrs,
-                truth_rrs,
-                &truth.surface,
-                &names,
-                &side.response.bands.centres_nm(),
-            );
+            let rrs_metrics =
+                crate::correction::band_rrs_metrics(&rrs, truth_rrs, &names, &side.response.bands.centres_nm());
             let product = CorrectionProduct {
                 approximation,
                 approximation_vs_exact,

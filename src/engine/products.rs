@@ -37,7 +37,7 @@ pub struct CorrectionProduct {
     pub approximation: Option<SceneApproximation>,
     /// Per band: approximation against exact correction.
     pub approximation_vs_exact: Vec<crate::correction::BandDifference>,
-    /// Per band: delivered Rrs against the truth.
+    /// Per band: delivered Rrs against the truth ([`crate::correction::compare_with_truth`]).
     pub rrs_vs_truth: Vec<crate::correction::BandDifference>,
     /// Per band: the delivered Rrs against the truth, log-space metrics.
     pub rrs_metrics: Vec<crate::correction::BandRrsMetrics>,

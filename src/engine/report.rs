@@ -161,7 +161,8 @@ pub struct RunReport {
     pub approximation: Option<SceneApproximation>,
     /// Per band: the per-scene approximation against the exact correction (same Level-1).
     pub approximation_vs_exact: Vec<BandDifference>,
-    /// Per band: the delivered Rrs against the true band Rrs.
+    /// Per band: the delivered Rrs against the true band Rrs, over every ⌊N/200 000⌋-th of the
+    /// image's N pixels ([`crate::correction::compare_with_truth`]).
     pub rrs_vs_truth: Vec<BandDifference>,
     /// What the image-based correction retrieved of the aerosol, against the scene's.
     pub aerosol: Option<AerosolSummary>,

@@ -271,7 +271,7 @@ impl Engine {
         {
             return output;
         }
-        let (radiance, radiance_key) = self.radiance_stage(config, &side, control, &mut report)?;
+        let (mut radiance, radiance_key) = self.radiance_stage(config, &side, control, &mut report)?;
         let truth = radiance.truth.clone();
         let mut probed: Vec<Probed> = probes.iter().map(|p| Probed::locate(*p, &truth, &side.viewing)).collect();
         let typical = radiance.typical_water_w_m2_sr_nm.clone();
@@ -286,11 +286,19 @@ impl Engine {
             config.seed,
         )
         .map_err(super::stages::failed(Stage::Correction))?;
-        let truth_rrs = radiance.truth_rrs.clone();
         let mut views = self.keep_views.then(|| {
             let (rows, cols, bands) = radiance.radiance.dim();
             CubeViews::of_radiance(&radiance, super::views::stride_for(rows, cols, bands, self.view_bytes))
         });
+        // The pixels the correction compares with the truth, taken now: a run that keeps no cubes
+        // then lets the true Rrs cube go before the detector reads out (unless the cache keeps
+        // the radiance product: then it is the cache's to hold).
+        let truth_rrs = crate::correction::TruthRrsSample::of(&radiance.truth_rrs, &truth.surface);
+        if !self.keep_cubes
+            && let Some(product) = Arc::get_mut(&mut radiance)
+        {
+            product.truth_rrs = Arc::default();
+        }
         let mut inst = self.instrument_side(config, &side, radiance, radiance_key, control, &mut report)?;
         let kept_radiance = inst.radiance.take();
         // Each cube is let go once read (the cache may still keep it, within its budget).
