@@ -95,7 +95,12 @@ pub fn sample_radiance(
     let pixel = cols * nb;
     let mut radiance = vec![0.0f32; rows * pixel];
     let mut rrs_truth = vec![0.0f32; rows * pixel];
-    let mut maps = vec![0.0f32; rows * cols * 4];
+    // The truth's maps, each a plane (chl, NAP, CDOM, and depth where there is a bottom: one
+    // unused float per row without), written as the truth keeps them.
+    let depth_stride = if shallow { cols } else { 1 };
+    let (mut chl, mut nap, mut cdom) =
+        (vec![0.0f32; rows * cols], vec![0.0f32; rows * cols], vec![0.0f32; rows * cols]);
+    let mut depth = vec![0.0f32; rows * depth_stride];
     // Without a bottom the fraction rows are one unused float each (keeps the row zip simple).
     let frac_stride = if shallow { (cols * n_sub).max(1) } else { 1 };
     let mut fractions = vec![0.0f32; rows * frac_stride];
@@ -117,73 +122,83 @@ pub fn sample_radiance(
     let counters: Vec<(u64, u64)> = radiance
         .par_chunks_mut((pixel * block).max(1))
         .zip(rrs_truth.par_chunks_mut((pixel * block).max(1)))
-        .zip(maps.par_chunks_mut(cols * 4 * block))
+        .zip(chl.par_chunks_mut(cols * block).zip(nap.par_chunks_mut(cols * block)))
+        .zip(cdom.par_chunks_mut(cols * block).zip(depth.par_chunks_mut(depth_stride * block)))
         .zip(land.par_chunks_mut(cols * block))
         .zip(fractions.par_chunks_mut(frac_stride * block))
         .zip(aot.par_chunks_mut(aot_stride * block))
         .enumerate()
-        .map(|(bi, (((((rad_block, rrs_block), map_block), land_block), frac_block), aot_block))| {
-            if control.cancelled() {
-                return Err(InstrumentError::Cancelled);
-            }
-            // Written before it is read: the zeroed allocation is still unmapped, so this first
-            // touch maps fresh pages. Read first (the `+=` of `pixel`), each page would map the
-            // kernel's shared zero page and then be copied on the first write, with a TLB flush
-            // sent to every core (an inter-processor interrupt, a VM exit here): 8 % of the
-            // default study's CPU time, measured with perf.
-            rad_block.fill(0.0);
-            rrs_block.fill(0.0);
-            let first_row = bi * block;
-            let n_rows = land_block.len() / cols.max(1);
-            let sampler = PixelSampler {
-                scene,
-                optics,
-                viewing,
-                response,
-                atmosphere,
-                truth_atmosphere,
-                kernel,
-                offsets: &offsets,
-            };
-            let mut work = PixelWork::new(optics);
-            for c in 0..cols {
-                for rr in 0..n_rows {
-                    let r = first_row + rr;
-                    let mut at = control.row(r);
-                    at.column(c);
-                    let at = rr * pixel + c * nb;
-                    sampler.pixel(&mut work, r, c, &mut rad_block[at..at + nb], &mut rrs_block[at..at + nb])?;
-                    let (x, y) = viewing.ground_m(0, r, c);
-                    if let Some(nodes) = aerosol_map {
-                        let tau = scene.aot550_at(x, y);
-                        nodes.exchange(atmosphere, c, tau, &mut rad_block[at..at + nb]);
-                        aot_block[rr * cols + c] = tau as f32;
-                    }
-                    let at = rr * cols + c;
-                    let fractions = if shallow {
-                        Some(&mut frac_block[rr * frac_stride + c * n_sub..rr * frac_stride + (c + 1) * n_sub])
-                    } else {
-                        None
-                    };
-                    let look = &viewing.looks[0][c];
-                    let sky = scene.sky_at(x, y, look.geometry.view_zenith_rad, look.view_azimuth_rad);
-                    truth_at(scene, x, y, sky, &mut map_block[at * 4..at * 4 + 4], &mut land_block[at], fractions);
-                }
+        .map(
+            |(
+                bi,
+                ((((((rad_block, rrs_block), (chl_b, nap_b)), (cdom_b, depth_b)), land_block), frac_block), aot_block),
+            )| {
                 if control.cancelled() {
                     return Err(InstrumentError::Cancelled);
                 }
-            }
-            control.tick(n_rows as u64);
-            Ok((work.scratch.water_evaluations, work.scratch.bottom_evaluations))
-        })
+                // Written before it is read: the zeroed allocation is still unmapped, so this first
+                // touch maps fresh pages. Read first (the `+=` of `pixel`), each page would map the
+                // kernel's shared zero page and then be copied on the first write, with a TLB flush
+                // sent to every core (an inter-processor interrupt, a VM exit here): 8 % of the
+                // default study's CPU time, measured with perf.
+                rad_block.fill(0.0);
+                rrs_block.fill(0.0);
+                let first_row = bi * block;
+                let n_rows = land_block.len() / cols.max(1);
+                let sampler = PixelSampler {
+                    scene,
+                    optics,
+                    viewing,
+                    response,
+                    atmosphere,
+                    truth_atmosphere,
+                    kernel,
+                    offsets: &offsets,
+                };
+                let mut work = PixelWork::new(optics);
+                for c in 0..cols {
+                    for rr in 0..n_rows {
+                        let r = first_row + rr;
+                        let mut at = control.row(r);
+                        at.column(c);
+                        let at = rr * pixel + c * nb;
+                        sampler.pixel(&mut work, r, c, &mut rad_block[at..at + nb], &mut rrs_block[at..at + nb])?;
+                        let (x, y) = viewing.ground_m(0, r, c);
+                        if let Some(nodes) = aerosol_map {
+                            let tau = scene.aot550_at(x, y);
+                            nodes.exchange(atmosphere, c, tau, &mut rad_block[at..at + nb]);
+                            aot_block[rr * cols + c] = tau as f32;
+                        }
+                        let at = rr * cols + c;
+                        let fractions = if shallow {
+                            Some(&mut frac_block[rr * frac_stride + c * n_sub..rr * frac_stride + (c + 1) * n_sub])
+                        } else {
+                            None
+                        };
+                        let look = &viewing.looks[0][c];
+                        let sky = scene.sky_at(x, y, look.geometry.view_zenith_rad, look.view_azimuth_rad);
+                        let values = truth_at(scene, x, y, sky, &mut land_block[at], fractions);
+                        (chl_b[at], nap_b[at], cdom_b[at]) = (values[0], values[1], values[2]);
+                        if shallow {
+                            depth_b[at] = values[3];
+                        }
+                    }
+                    if control.cancelled() {
+                        return Err(InstrumentError::Cancelled);
+                    }
+                }
+                control.tick(n_rows as u64);
+                Ok((work.scratch.water_evaluations, work.scratch.bottom_evaluations))
+            },
+        )
         .collect::<Result<Vec<_>, InstrumentError>>()?;
     apply_keystone(&mut radiance, cols, nb, &response.keystone_px, viewing.decimation);
     let bad =
         |e: ndarray::ShapeError| InstrumentError::Invalid(FieldError { field: "cube".into(), message: e.to_string() });
     let radiance = Array3::from_shape_vec((rows, cols, nb), radiance).map_err(bad)?;
     let aot = aerosol_map.is_some().then_some(aot);
-    let (truth, truth_rrs) =
-        TruthBuffers { rrs: rrs_truth, maps, fractions, land, aot }.into_truth(scene, (rows, cols, nb))?;
+    let (truth, truth_rrs) = TruthBuffers { rrs: rrs_truth, maps: [chl, nap, cdom, depth], fractions, land, aot }
+        .into_truth(scene, (rows, cols, nb))?;
     Ok(RadianceCube {
         brightest_water_w_m2_sr_nm: super::plausibility::brightest_water(&radiance, &truth.surface),
         typical_water_w_m2_sr_nm: super::plausibility::typical_water(&radiance, &truth.surface),
@@ -300,8 +315,9 @@ impl PixelSampler<'_> {
 struct TruthBuffers {
     /// Band Rrs(0+), (row, column, band).
     rrs: Vec<f32>,
-    /// chl, NAP, CDOM, depth per pixel, (row, column, 4).
-    maps: Vec<f32>,
+    /// chl, NAP, CDOM and depth, each (row, column) (depth one unused float per row without a
+    /// bottom).
+    maps: [Vec<f32>; 4],
     /// Substrate fractions, (row, column, substrate) when the scene is shallow.
     fractions: Vec<f32>,
     /// Land flags, (row, column).
@@ -321,14 +337,14 @@ impl TruthBuffers {
             InstrumentError::Invalid(FieldError { field: "truth".into(), message: e.to_string() })
         };
         let shallow = scene.depth.is_some();
-        let maps = self.maps;
-        let plane = |k: usize| Array2::from_shape_fn((rows, cols), |(r, c)| maps[(r * cols + c) * 4 + k]);
+        let [chl, nap, cdom, depth] = self.maps;
+        let plane = |v: Vec<f32>| Array2::from_shape_vec((rows, cols), v).map_err(bad);
         let rrs = Array3::from_shape_vec((rows, cols, nb), self.rrs).map_err(bad)?;
         let truth = Truth {
-            chl_mg_m3: plane(0),
-            nap_g_m3: plane(1),
-            cdom_per_m: plane(2),
-            depth_m: shallow.then(|| plane(3)),
+            chl_mg_m3: plane(chl)?,
+            nap_g_m3: plane(nap)?,
+            cdom_per_m: plane(cdom)?,
+            depth_m: shallow.then(|| plane(depth)).transpose()?,
             substrate_fractions: if shallow {
                 Some(Array3::from_shape_vec((rows, cols, scene.substrates.len()), self.fractions).map_err(bad)?)
             } else {
@@ -342,14 +358,16 @@ impl TruthBuffers {
     }
 }
 
-/// The truth maps at scene point (x, y): chl, NAP, CDOM, depth into `maps`, the surface class
+/// The truth maps at scene point (x, y): chl, NAP, CDOM and depth (0 without a bottom), the surface class
 /// as the sensor sees it under `sky` (cloud over anything; water in a cloud's shadow), and the
 /// normalised substrate fractions.
-fn truth_at(scene: &Scene, x: f64, y: f64, sky: Sky, maps: &mut [f32], class: &mut u8, fractions: Option<&mut [f32]>) {
-    maps[0] = scene.chl.value_at(x, y) as f32;
-    maps[1] = scene.nap.value_at(x, y) as f32;
-    maps[2] = scene.cdom.value_at(x, y) as f32;
-    maps[3] = scene.depth.as_ref().map_or(0.0, |d| d.value_at(x, y)) as f32;
+fn truth_at(scene: &Scene, x: f64, y: f64, sky: Sky, class: &mut u8, fractions: Option<&mut [f32]>) -> [f32; 4] {
+    let maps = [
+        scene.chl.value_at(x, y) as f32,
+        scene.nap.value_at(x, y) as f32,
+        scene.cdom.value_at(x, y) as f32,
+        scene.depth.as_ref().map_or(0.0, |d| d.value_at(x, y)) as f32,
+    ];
     *class = match (sky, scene.is_land(x, y)) {
         (Sky::Cloud, _) => SurfaceClass::Cloud,
         (_, true) => SurfaceClass::Land,
@@ -364,6 +382,7 @@ fn truth_at(scene: &Scene, x: f64, y: f64, sky: Sky, maps: &mut [f32], class: &m
             f[s] = if total > 0.0 { (v / total) as f32 } else { 1.0 / n as f32 };
         }
     }
+    maps
 }
 
 /// Shift band b of every row by `keystone_px[b] / decimation` columns (linear interpolation,
