@@ -220,8 +220,8 @@ fn eight_designs_complete_at_preview_and_the_app_says_what_they_plan_to_hold() {
     println!("{plan}");
     let gb: f64 = plan.split("planned: ").nth(1).and_then(|s| s.split(" GB").next()).unwrap().parse().unwrap();
     // The plan at full resolution of these eight: an upper bound of the measured peak resident
-    // memory, 3.46 GB (3.22 GiB; src/engine/resources.rs holds the plan within 1.25× of it).
-    assert!((3.46..3.46 * 1.25).contains(&gb), "{plan}");
+    // memory, 3.76 GB (3.50 GiB; src/engine/resources.rs holds the plan within 1.2× of it).
+    assert!((3.76..3.76 * 1.2).contains(&gb), "{plan}");
     assert!(plan.contains("at most 96 MiB with 8 designs"), "each design's share of the views: {plan}");
 }
 
