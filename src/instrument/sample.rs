@@ -57,7 +57,9 @@ pub struct RadianceCube {
     /// True band remote-sensing reflectance above the surface, Rrs(0+), sr⁻¹ (0 on land),
     /// (row, column, band), weighted by each band's response as the radiance is (the water
     /// model's `rrs` is below the surface, rrs(0−)). A cube: kept apart from the truth's maps,
-    /// so that a run that does not keep its cubes keeps the maps alone.
+    /// so that a run that does not keep its cubes keeps the maps alone; such a run empties it once
+    /// it has taken the pixels its comparisons read (`correction::TruthRrsSample`), where nothing
+    /// else holds this product.
     pub truth_rrs: Arc<Array3<f32>>,
     /// Depth bins and substrate shares of the truth's water pixels, counted once per cube (runs
     /// that reuse the cube from the cache reuse them).
