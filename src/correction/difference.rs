@@ -167,7 +167,7 @@ fn compare_source(source: Source<'_>, nb: usize, reference: Reference<'_>) -> Ve
 }
 
 /// Pixels per block of [`compare`]'s sums.
-pub(super) const BLOCK_PIXELS: usize = 4096;
+const BLOCK_PIXELS: usize = 4096;
 
 /// Pixels per band the median of [`compare`] is taken from, at most.
 pub(super) const MEDIAN_SAMPLES: usize = 200_000;

@@ -6,7 +6,7 @@ use ndarray::Array3;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use super::difference::{BLOCK_PIXELS, BandDifference, MEDIAN_SAMPLES};
+use super::difference::{BandDifference, MEDIAN_SAMPLES};
 use super::{Reflectance, RrsFlags};
 use crate::instrument::SurfaceMap;
 
@@ -122,46 +122,26 @@ pub fn band_rrs_metrics(
 /// ⌊N/[`MEDIAN_SAMPLES`]⌋-th of the image's N pixels ([`TruthRrsSample`]): every pixel of an
 /// image of fewer than 2 × [`MEDIAN_SAMPLES`], where the two give the same numbers; over a larger
 /// one the same median (`compare` takes it from these pixels), and the mean and the largest
-/// difference of these pixels rather than of all. Each band's sums run in pixel order, so the
-/// threads do not change them.
+/// difference of these pixels rather than of all. `compare`'s own loop over those pixels (its
+/// fixed blocks: the threads do not change the sums); empty if `rrs` is not the sample's image.
 #[must_use]
 pub fn compare_with_truth(rrs: &Reflectance, truth: &TruthRrsSample) -> Vec<BandDifference> {
-    let (rows, cols, nb) = truth.dim;
+    let (Ok(values), Ok(flags)) = (super::slice(&rrs.rrs), super::slice(&rrs.flags)) else { return Vec::new() };
     if rrs.rrs.dim() != truth.dim {
         return Vec::new();
     }
-    (0..nb)
-        .into_par_iter()
-        .map(|band| {
-            let (mut n, mut sum, mut max, mut sample) = (0usize, 0.0f64, 0.0f64, Vec::new());
-            // Summed in `compare`'s blocks of pixels (so the same bits where every pixel is read).
-            let mut block = (0, 0.0f64);
-            for (k, i) in (0..rows * cols).step_by(truth.stride).enumerate() {
-                if i / BLOCK_PIXELS != block.0 {
-                    sum += block.1;
-                    block = (i / BLOCK_PIXELS, 0.0);
-                }
-                let (r, c) = (i / cols, i % cols);
-                let (x, y) = (f64::from(rrs.rrs[[r, c, band]]), f64::from(truth.strided_rrs[k * nb + band]));
-                if rrs.flags[[r, c, band]] == 0 && y > 0.0 && x.is_finite() {
-                    let rel = (x - y) / y;
-                    n += 1;
-                    block.1 += rel;
-                    max = max.max(rel.abs());
-                    sample.push(rel.abs());
-                }
-            }
-            sum += block.1;
-            let m = sample.len();
-            BandDifference {
-                band,
-                n,
-                median_abs_rel: if m > 0 { *sample.select_nth_unstable_by(m / 2, f64::total_cmp).1 } else { 0.0 },
-                mean_rel: if n > 0 { sum / n as f64 } else { 0.0 },
-                max_abs_rel: max,
-            }
-        })
-        .collect()
+    let nb = truth.dim.2.max(1);
+    // The k-th pixel compared is pixel k·stride of the image, the k-th of the sample.
+    let at = |k: usize| k * truth.stride * nb..(k * truth.stride + 1) * nb;
+    let product = |k: usize, v: &mut [f32], f: &mut [u8]| {
+        v.copy_from_slice(&values[at(k)]);
+        f.copy_from_slice(&flags[at(k)]);
+    };
+    let reference = |k: usize, v: &mut [f32], f: &mut [u8]| {
+        v.copy_from_slice(&truth.strided_rrs[k * nb..(k + 1) * nb]);
+        f.fill(0);
+    };
+    super::difference::compare_both_pixels(&product, &reference, truth.strided_rrs.len() / nb, nb)
 }
 
 /// Water pixels per band [`band_rrs_metrics`] judges: at least this many where there are as many,

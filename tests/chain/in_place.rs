@@ -7,11 +7,13 @@
 
 use crate::common::Kept;
 use shoal::atmosphere::AerosolType;
+use shoal::calibration::Level1;
 use shoal::control::RunControl;
 use shoal::correction::{
     AerosolFit, ExactTerms, ImageCorrection, Level1Input, Method, Reflectance, compare, correct_exact, correct_image,
     no_water, no_water_compared_with_exact,
 };
+use shoal::engine::RunOutput;
 use shoal::instrument::DetectorMode;
 
 use super::image_correction::clear_water;
@@ -78,15 +80,21 @@ fn assert_the_diagnostic_is_the_cubes<'a>(
     (terms, exact)
 }
 
-#[test]
-fn the_exact_correction_handed_its_level1_gives_the_same_bits_and_the_same_diagnostic() {
+/// A noisy run over clear water at full resolution with `method`, and a copy of its Level-1.
+fn run_with(method: Method) -> (RunOutput, Level1) {
     let mut c = clear_water(AerosolType::Continental, 0.15);
     c.detector = DetectorMode::default();
-    c.correction.method = Method::Exact;
+    c.correction.method = method;
     let out = run(&c);
+    let level1 = (*out.kept().level1).clone();
+    (out, level1)
+}
+
+#[test]
+fn the_exact_correction_handed_its_level1_gives_the_same_bits_and_the_same_diagnostic() {
+    let (out, level1) = run_with(Method::Exact);
     let (surface, control) = (&out.truth.surface, RunControl::new());
     let atmosphere = (out.band_atmosphere.as_ref(), None);
-    let level1 = (*out.kept().level1).clone();
     let read = correct_exact(&level1, atmosphere, None, surface, &control).unwrap();
     let owned = correct_exact(Level1Input::Owned(level1.clone()), atmosphere, None, surface, &control).unwrap();
     assert_same(&read, &owned, "exact");
@@ -96,13 +104,9 @@ fn the_exact_correction_handed_its_level1_gives_the_same_bits_and_the_same_diagn
 
 #[test]
 fn the_per_scene_product_handed_its_level1_gives_the_same_bits_and_the_same_diagnostic() {
-    let mut c = clear_water(AerosolType::Continental, 0.15);
-    c.detector = DetectorMode::default();
-    c.correction.method = Method::PerScene;
-    let out = run(&c);
+    let (out, level1) = run_with(Method::PerScene);
     let (surface, control) = (&out.truth.surface, RunControl::new());
     let approximation = out.correction.approximation.as_ref().expect("a lake has water");
-    let level1 = (*out.kept().level1).clone();
     let read = approximation.correct(&level1, surface, &control).unwrap();
     let owned = approximation.correct(Level1Input::Owned(level1.clone()), surface, &control).unwrap();
     assert_same(&read, &owned, "per-scene");
