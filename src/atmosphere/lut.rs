@@ -155,7 +155,10 @@ impl AtmosphereLut {
     pub fn build(atmosphere: &Atmosphere, axes: LutAxes) -> Result<Self, AtmosphereError> {
         axes.validate()?;
         let acc = atmosphere.spec().accuracy;
-        let columns = axes.wavelengths_nm.iter().map(|&w| atmosphere.column(w)).collect::<Result<Vec<_>, _>>()?;
+        // Each wavelength's column (its aerosol's phase function moments) in parallel too; the
+        // first failure in wavelength order, whichever thread met it first.
+        let columns: Vec<Result<_, _>> = axes.wavelengths_nm.par_iter().map(|&w| atmosphere.column(w)).collect();
+        let columns = columns.into_iter().collect::<Result<Vec<_>, _>>()?;
         let view_mu: Vec<f64> = axes.view_zenith_deg.iter().map(|v| v.to_radians().cos()).collect();
         let (nw, ns, nv) = (axes.wavelengths_nm.len(), axes.sun_zenith_deg.len(), axes.view_zenith_deg.len());
         let jobs: Vec<(usize, usize)> = (0..nw).flat_map(|w| (0..ns).map(move |s| (w, s))).collect();

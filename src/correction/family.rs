@@ -12,6 +12,7 @@ pub use crate::instrument::band_atmosphere::{BandTerms, TERM_COLUMNS};
 use crate::instrument::{Response, Viewing};
 use crate::scene::Scene;
 use crate::toa::PathOptics;
+use rayon::prelude::*;
 
 /// The family's tables: per model, per AOT node, per column and band.
 #[derive(Debug, Clone)]
@@ -103,19 +104,33 @@ impl FamilyLuts {
             let built = spec.build().map_err(|e| fail(e.to_string()))?;
             Ok(std::sync::Arc::new(AtmosphereLut::build(&built, axes.clone()).map_err(|e| fail(e.to_string()))?))
         };
-        let lut_of = |aerosol: AerosolType, aot: f64| -> Result<std::sync::Arc<AtmosphereLut>, CorrectionError> {
-            lut_with(AtmosphereSpec { aerosol, aot550: aot, ..atmosphere.clone() })
-        };
         let mut aot550 = vec![0.0];
         aot550.extend_from_slice(&settings.aot_nodes);
-        // τ = 0 is the same Rayleigh atmosphere for every model: built once.
-        let rayleigh = lut_of(AerosolType::None, 0.0)?;
+        // Every atmosphere of the family, built side by side (each LUT is parallel only over its
+        // wavelengths and sun zeniths, with a serial start: one at a time left a core idle for
+        // a third of the stage). τ = 0 is the same Rayleigh atmosphere for every model: built
+        // once, first; the gas-free Rayleigh atmosphere, where the scene has gases, last.
+        let mut specs = vec![AtmosphereSpec { aerosol: AerosolType::None, aot550: 0.0, ..atmosphere.clone() }];
+        for &m in &settings.models {
+            for &t in &settings.aot_nodes {
+                specs.push(AtmosphereSpec { aerosol: m, aot550: t, ..atmosphere.clone() });
+            }
+        }
+        if atmosphere.gases {
+            specs.push(AtmosphereSpec { aerosol: AerosolType::None, aot550: 0.0, gases: false, ..atmosphere.clone() });
+        }
+        let built: Vec<Result<std::sync::Arc<AtmosphereLut>, CorrectionError>> =
+            specs.into_par_iter().map(lut_with).collect();
+        // The first failure in the order above, whichever thread met it first.
+        let mut built = built.into_iter().collect::<Result<Vec<_>, _>>()?.into_iter();
+        let mut next = || built.next().ok_or_else(|| fail("a member's atmosphere is missing".into()));
+        let rayleigh = next()?;
         let mut luts = Vec::with_capacity(settings.models.len());
         let mut angstrom = Vec::with_capacity(settings.models.len());
         for &m in &settings.models {
             let mut row = vec![rayleigh.clone()];
-            for &t in &settings.aot_nodes {
-                row.push(lut_of(m, t)?);
+            for _ in &settings.aot_nodes {
+                row.push(next()?);
             }
             luts.push(row);
             let built = AtmosphereSpec { aerosol: m, aot550: 1.0, ..atmosphere.clone() }
@@ -126,16 +141,7 @@ impl FamilyLuts {
             };
             angstrom.push(-(tau(865.0)? / tau(443.0)?).ln() / (865.0f64 / 443.0).ln());
         }
-        let gas_free = if atmosphere.gases {
-            Some(lut_with(AtmosphereSpec {
-                aerosol: AerosolType::None,
-                aot550: 0.0,
-                gases: false,
-                ..atmosphere.clone()
-            })?)
-        } else {
-            None
-        };
+        let gas_free = if atmosphere.gases { Some(next()?) } else { None };
         Ok(Self { models: settings.models.clone(), aot550, angstrom, luts, gas_free, surface: atmosphere.surface })
     }
 }
