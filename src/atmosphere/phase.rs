@@ -151,9 +151,9 @@ impl PhaseFunction {
 /// The tabulated moments already computed, by table and order. Every solve of an aerosol
 /// atmosphere expands its phase function at each wavelength (per sun zenith of a LUT, for the
 /// transmittances again), and the image-based correction's family builds five atmospheres per
-/// aerosol model that differ only in optical depth: the same tables, expanded again and again
-/// (with the memo, the family's build takes a fifth less time). The memo returns the vector
-/// computed the first time, so the moments are the same bits either way.
+/// aerosol model that differ only in optical depth: the same tables, expanded again and again.
+/// The memo returns the vector computed the first time, so the moments are the same bits
+/// either way.
 mod moments_memo {
     use std::collections::HashMap;
     use std::sync::{LazyLock, Mutex};

@@ -106,10 +106,10 @@ impl FamilyLuts {
         };
         let mut aot550 = vec![0.0];
         aot550.extend_from_slice(&settings.aot_nodes);
-        // Every atmosphere of the family, built side by side (each LUT is parallel only over its
-        // wavelengths and sun zeniths, with a serial start: one at a time left a core idle for
-        // a third of the stage). τ = 0 is the same Rayleigh atmosphere for every model: built
-        // once, first; the gas-free Rayleigh atmosphere, where the scene has gases, last.
+        // Every atmosphere of the family, built side by side: each LUT is parallel only over its
+        // wavelengths and sun zeniths, too few jobs to keep the cores busy one LUT at a time.
+        // τ = 0 is the same Rayleigh atmosphere for every model: built once, first; the
+        // gas-free Rayleigh atmosphere, where the scene has gases, last.
         let mut specs = vec![AtmosphereSpec { aerosol: AerosolType::None, aot550: 0.0, ..atmosphere.clone() }];
         for &m in &settings.models {
             for &t in &settings.aot_nodes {
