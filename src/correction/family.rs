@@ -106,8 +106,8 @@ impl FamilyLuts {
         };
         let mut aot550 = vec![0.0];
         aot550.extend_from_slice(&settings.aot_nodes);
-        // Every atmosphere of the family, built side by side: each LUT is parallel only over its
-        // wavelengths and sun zeniths, too few jobs to keep the cores busy one LUT at a time.
+        // Every atmosphere of the family, built side by side: a LUT's solves are parallel, but
+        // its start and its assembly are not, and one LUT at a time left a core idle between.
         // τ = 0 is the same Rayleigh atmosphere for every model: built once, first; the
         // gas-free Rayleigh atmosphere, where the scene has gases, last.
         let mut specs = vec![AtmosphereSpec { aerosol: AerosolType::None, aot550: 0.0, ..atmosphere.clone() }];
