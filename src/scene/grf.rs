@@ -73,8 +73,7 @@ fn synthesise(
             *cell *= amplitude;
         }
     });
-    let mut field = inverse_fft_2d_real(&mut data, width, height, |row| skip_zero_rows && zero_row(row));
-    drop(data);
+    let mut field = inverse_fft_2d_real(data, width, height, |row| skip_zero_rows && zero_row(row));
     // The sums in order, one after the other (a parallel sum would add in another order and
     // change the field's last bits with the thread count); the rescaling in parallel.
     let mean = field.iter().map(|v| f64::from(*v)).sum::<f64>() / n as f64;
@@ -85,16 +84,16 @@ fn synthesise(
 }
 
 /// The real part of the 2-D inverse FFT (rows, then columns) of `data`, unnormalised (the
-/// caller rescales); `data` is used as work space. Rows are transformed in parallel; the
-/// columns too, as rows of the transpose (each transform is the same as one at a time, so the
-/// field does not depend on the thread count).
+/// caller rescales). Rows are transformed in parallel; the columns too, as rows of the
+/// transpose (each transform is the same as one at a time, so the field does not depend on the
+/// thread count). At most two complex arrays are held at once (16 bytes a cell).
 ///
 /// Rows for which `zero_row` holds are all zeros (of either sign) and are left as they are:
 /// their transform is zeros too, and a zero's sign cannot change a sum with a non-zero term, so
 /// the columns' transforms are the same bits but for the sign of exact zeros (and the field's
 /// rescaling takes those to the same value).
 fn inverse_fft_2d_real(
-    data: &mut [Complex32],
+    mut data: Vec<Complex32>,
     width: usize,
     height: usize,
     zero_row: impl Fn(usize) -> bool + Sync,
@@ -114,11 +113,12 @@ fn inverse_fft_2d_real(
             },
         );
     };
-    rows(data, width, &zero_row);
+    rows(&mut data, width, &zero_row);
     let mut transposed = vec![Complex32::new(0.0, 0.0); data.len()];
-    transpose_into(data, width, height, &mut transposed);
+    transpose_into(&data, width, height, &mut transposed);
+    drop(data);
     rows(&mut transposed, height, &|_| false);
-    let mut real = vec![0.0f32; data.len()];
+    let mut real = vec![0.0f32; transposed.len()];
     transpose_into_with(&transposed, height, width, &mut real, |c| c.re);
     real
 }
