@@ -11,6 +11,11 @@
 //! pair of directions) took a quarter of `shoal correct`'s time in perf. The values are the same
 //! function of the same inputs whichever solve computes them first, so sharing them changes no
 //! result.
+//!
+//! The same holds for an aerosol's phase-function moments ([`phase_moments`]): a function of
+//! its table alone, which every solve of a wavelength expands (per sun node of a LUT, and again
+//! for the transmittances), as does each of the family's five atmospheres per aerosol model,
+//! whose tables differ only in optical depth, not in phase function.
 
 use std::collections::HashMap;
 use std::sync::{Arc, LazyLock, Mutex, OnceLock, PoisonError};
@@ -102,6 +107,36 @@ pub(super) fn rayleigh_kernels(
     kernels
 }
 
+/// The most phase expansions held. An entry keeps its table's bits (the built-in tables' 128
+/// angles: 2 kB), so the cache stays under a few MB; the built-in models at a LUT's wavelengths
+/// take some tens of entries. When full, the cache is emptied and refilled.
+const MAX_EXPANSIONS: usize = 1024;
+
+/// A phase function's table and the expansion's order, bit for bit.
+type MomentsKey = (usize, Vec<u64>);
+
+static MOMENTS: LazyLock<Mutex<HashMap<MomentsKey, Arc<[f64]>>>> = LazyLock::new(Mutex::default);
+
+/// [`PhaseFunction::moments`] of `phase` to order `l_max`, expanded once per table and order
+/// (the Rayleigh function's, analytic, are not kept).
+pub(super) fn phase_moments(phase: &PhaseFunction, l_max: usize) -> Arc<[f64]> {
+    let PhaseFunction::Tabulated { angles_rad, ln_values } = phase else {
+        return phase.moments(l_max).into();
+    };
+    let key: MomentsKey = (l_max, angles_rad.iter().chain(ln_values).map(|v| v.to_bits()).collect());
+    if let Some(found) = MOMENTS.lock().unwrap_or_else(PoisonError::into_inner).get(&key) {
+        return found.clone();
+    }
+    // Expanded outside the lock, so that solves of other tables do not wait on it.
+    let beta: Arc<[f64]> = phase.moments(l_max).into();
+    let mut cache = MOMENTS.lock().unwrap_or_else(PoisonError::into_inner);
+    if cache.len() >= MAX_EXPANSIONS {
+        cache.clear();
+    }
+    cache.insert(key, beta.clone());
+    beta
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -124,5 +159,19 @@ mod tests {
         assert_eq!(shared.vector(&streams), vector_rayleigh_kernels(&streams, rho, mu0, n).as_slice());
         let other = rayleigh_kernels(&streams, 0.5, rho, n);
         assert!(!Arc::ptr_eq(&shared, &other), "another sun, another set");
+    }
+
+    #[test]
+    fn shared_phase_moments_equal_fresh_ones_bit_for_bit() {
+        let phase = PhaseFunction::from_table(&[0.0, 10.0, 45.0, 90.0, 180.0], &[40.0, 8.0, 1.0, 0.3, 0.5]).unwrap();
+        let shared = phase_moments(&phase, 24);
+        assert!(Arc::ptr_eq(&shared, &phase_moments(&phase, 24)), "the same table and order share one expansion");
+        let fresh = phase.moments(24);
+        assert!(shared.iter().zip(&fresh).all(|(a, b)| a.to_bits() == b.to_bits()) && shared.len() == fresh.len());
+        assert_eq!(phase_moments(&phase, 8).len(), 9, "another order, another expansion");
+        let other = PhaseFunction::from_table(&[0.0, 10.0, 45.0, 90.0, 180.0], &[30.0, 8.0, 1.0, 0.3, 0.5]).unwrap();
+        assert_ne!(&*phase_moments(&other, 24), &*shared, "another table, its own moments");
+        let rayleigh = PhaseFunction::Rayleigh { depolarization: 0.0279 };
+        assert_eq!(&*phase_moments(&rayleigh, 4), rayleigh.moments(4).as_slice());
     }
 }

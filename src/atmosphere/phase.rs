@@ -85,28 +85,23 @@ impl PhaseFunction {
                 }
                 b
             }
-            Self::Tabulated { angles_rad, ln_values } => {
-                moments_memo::get_or_insert(angles_rad, ln_values, l_max, || self.tabulated_moments(angles_rad, l_max))
+            Self::Tabulated { angles_rad, .. } => {
+                // βₗ = (2l+1)/2 ∫ P(μ) Pₗ(μ) dμ, Gauss–Legendre on every table interval (in angle).
+                let (gx, gw) = gauss_legendre(12);
+                let mut beta = vec![0.0; l_max + 1];
+                for w in angles_rad.windows(2) {
+                    let (a, b) = (w[0], w[1]);
+                    for (x, wt) in gx.iter().zip(&gw) {
+                        let theta = 0.5 * (a + b) + 0.5 * (b - a) * x;
+                        let mu = theta.cos();
+                        // dμ = sinθ dθ
+                        let weight = wt * 0.5 * (b - a) * theta.sin() * self.value(mu);
+                        add_legendre(&mut beta, weight, mu);
+                    }
+                }
+                beta.iter().enumerate().map(|(l, v)| (2 * l + 1) as f64 / 2.0 * v).collect()
             }
         }
-    }
-
-    /// [`Self::moments`] of a tabulated phase function at `angles_rad` (its own), computed:
-    /// βₗ = (2l+1)/2 ∫ P(μ) Pₗ(μ) dμ, Gauss–Legendre on every table interval (in angle).
-    fn tabulated_moments(&self, angles_rad: &[f64], l_max: usize) -> Vec<f64> {
-        let (gx, gw) = gauss_legendre(12);
-        let mut beta = vec![0.0; l_max + 1];
-        for w in angles_rad.windows(2) {
-            let (a, b) = (w[0], w[1]);
-            for (x, wt) in gx.iter().zip(&gw) {
-                let theta = 0.5 * (a + b) + 0.5 * (b - a) * x;
-                let mu = theta.cos();
-                // dμ = sinθ dθ
-                let weight = wt * 0.5 * (b - a) * theta.sin() * self.value(mu);
-                add_legendre(&mut beta, weight, mu);
-            }
-        }
-        beta.iter().enumerate().map(|(l, v)| (2 * l + 1) as f64 / 2.0 * v).collect()
     }
 
     /// The share of scattered light sent into the forward hemisphere, η = ½∫₀¹ P(μ) dμ
@@ -145,52 +140,6 @@ impl PhaseFunction {
     #[must_use]
     pub fn asymmetry(&self) -> f64 {
         self.moments(1).get(1).copied().unwrap_or(0.0) / 3.0
-    }
-}
-
-/// The tabulated moments already computed, by table and order. Every solve of an aerosol
-/// atmosphere expands its phase function at each wavelength (per sun zenith of a LUT, for the
-/// transmittances again), and the image-based correction's family builds five atmospheres per
-/// aerosol model that differ only in optical depth: the same tables, expanded again and again.
-/// The memo returns the vector computed the first time, so the moments are the same bits
-/// either way.
-mod moments_memo {
-    use std::collections::HashMap;
-    use std::sync::{LazyLock, Mutex};
-
-    /// Tables kept at most; beyond, the memo starts again. An entry holds its table's bits (the
-    /// built-in tables' 128 angles: 2 kB), so the memo stays under a few MB; the built-in models
-    /// at a LUT's wavelengths take some tens of entries.
-    const MAX_ENTRIES: usize = 1024;
-
-    /// A table and an order, by their bits (exact: two tables share moments only when equal).
-    type Key = (usize, Vec<u64>);
-
-    static MEMO: LazyLock<Mutex<HashMap<Key, Vec<f64>>>> = LazyLock::new(|| Mutex::new(HashMap::new()));
-
-    /// The memo's moments of (`angles_rad`, `ln_values`) to order `l_max`, or `compute`'s, kept.
-    pub(super) fn get_or_insert(
-        angles_rad: &[f64],
-        ln_values: &[f64],
-        l_max: usize,
-        compute: impl FnOnce() -> Vec<f64>,
-    ) -> Vec<f64> {
-        let key: Key = (l_max, angles_rad.iter().chain(ln_values).map(|v| v.to_bits()).collect());
-        // A poisoned lock (a panic elsewhere while holding it) only loses the memo: compute.
-        if let Ok(memo) = MEMO.lock()
-            && let Some(beta) = memo.get(&key)
-        {
-            return beta.clone();
-        }
-        // Computed outside the lock, so that threads expanding other tables do not wait.
-        let beta = compute();
-        if let Ok(mut memo) = MEMO.lock() {
-            if memo.len() >= MAX_ENTRIES {
-                memo.clear();
-            }
-            memo.insert(key, beta.clone());
-        }
-        beta
     }
 }
 

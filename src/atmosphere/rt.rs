@@ -36,7 +36,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::fresnel::{fresnel_matrix, fresnel_reflectance};
-use super::kernel_cache::rayleigh_kernels;
+use super::kernel_cache::{phase_moments, rayleigh_kernels};
 use super::kernels::{delta_m, scalar_kernel};
 use super::phase::PhaseFunction;
 use super::profile::{AltitudeQuadrature, ColumnOptics, Layering};
@@ -170,7 +170,7 @@ impl WavelengthColumn {
         let n_terms = 2 * acc.streams;
         match &self.aerosol {
             Some((_, _, phase)) => {
-                let (beta, f) = delta_m(&phase.moments(n_terms), n_terms);
+                let (beta, f) = delta_m(&phase_moments(phase, n_terms), n_terms);
                 (Layering::new(&self.optics(), f, acc.max_layer_depth, acc.min_layers), Some(beta))
             }
             None => (Layering::new(&self.optics(), 0.0, acc.max_layer_depth, acc.min_layers), None),
