@@ -180,8 +180,10 @@ impl Prepared {
         for (r, &a) in self.rrs[..m].iter_mut().zip(above) {
             *r = rrs_below_from_above(a);
         }
-        // (`abs() < ∞` is `is_finite()` as a comparison, which vectorises; NaN fails both.)
-        if !self.rrs[..m].iter().fold(true, |ok, r| ok & (r.abs() < f64::INFINITY) & (*r > 0.0)) {
+        // (r·0 = 0 is `is_finite()` as a comparison, which vectorises; NaN fails both. The
+        // compiler turns `is_finite()` or |r| < ∞ beside r > 0 into integer tests of the bits,
+        // one band at a time.)
+        if !self.rrs[..m].iter().fold(true, |ok, r| ok & (*r * 0.0 == 0.0) & (*r > 0.0)) {
             return false;
         }
         for (u, &r) in self.u[..m].iter_mut().zip(&self.rrs[..m]) {

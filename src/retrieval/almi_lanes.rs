@@ -100,7 +100,7 @@ type Lanes = [f64; LANES];
 
 mod ops;
 
-use ops::{INF, cramer, det3_lanes, feasible, finite, lanewise, mask, select};
+use ops::{cramer, det3_lanes, feasible, finite, lanewise, mask, select};
 
 /// Index of (i, j) among the six stored entries of a symmetric 3 × 3 matrix.
 const AT: [[usize; 3]; 3] = [[0, 1, 2], [1, 3, 4], [2, 4, 5]];
@@ -120,18 +120,12 @@ impl Scaled {
         &self.gs[AT[i][j]]
     }
 
-    /// The residual ‖A·x − y‖² of scaled x with its non-zeros in `support`, as `nnls3` writes
-    /// it but without the terms of the zeros outside the support. In a lane that can win (x
-    /// finite, G finite) each such term is ±0, and adding ±0 leaves r as it was (at most the
-    /// sign of a zero r changes, and r only enters comparisons), so the kept terms, added in
-    /// `nnls3`'s order, give its residual. A support of one or two columns then costs a third
-    /// of the full support's 12 terms, or less.
-    #[inline(always)]
-    fn residual(&self, x: &[Lanes; 3], support: &[usize]) -> Lanes {
-        lanewise(|s| self.residual_lane(&[x[0][s], x[1][s], x[2][s]], support, s))
-    }
-
-    /// [`Self::residual`] of lane `s`.
+    /// The residual ‖A·x − y‖² in lane `s` of scaled x with its non-zeros in `support`, as
+    /// `nnls3` writes it but without the terms of the zeros outside the support. In a lane that
+    /// can win (x finite, G finite) each such term is ±0, and adding ±0 leaves r as it was (at
+    /// most the sign of a zero r changes, and r only enters comparisons), so the kept terms,
+    /// added in `nnls3`'s order, give its residual. A support of one or two columns then costs
+    /// a third of the full support's 12 terms, or less.
     #[inline(always)]
     fn residual_lane(&self, x: &[f64; 3], support: &[usize], s: usize) -> f64 {
         let mut r = self.yy[s];
@@ -145,49 +139,67 @@ impl Scaled {
     }
 }
 
-/// The enumeration's best feasible solution so far, per lane. It starts from the empty support
-/// (x = 0, the residual yᵀy), the first support `nnls3` tries and always feasible, so a later
-/// support is kept exactly when it is feasible and strictly better, as in `nnls3`.
+/// The enumeration's best feasible solution, per lane. It starts from the empty support (x = 0,
+/// the residual yᵀy), the first support `nnls3` tries and always feasible, so a later support is
+/// kept exactly when it is feasible and strictly better, as in `nnls3`.
 struct Best {
     x: [Lanes; 3],
-    r: Lanes,
 }
 
 impl Best {
-    #[inline(always)]
-    fn empty(sc: &Scaled) -> Self {
-        Self { x: [[0.0; LANES]; 3], r: sc.residual(&[[0.0; LANES]; 3], &[]) }
+    /// No lane enumerated yet (x = 0: the empty support's answer).
+    fn empty() -> Self {
+        Self { x: [[0.0; LANES]; 3] }
     }
 
-    /// Solve on `support` (one or two columns) as [`nnls3`] does, and keep the solution in each
-    /// lane where it is feasible and strictly better. One loop over the lanes does it all, so
-    /// the masks stay in vector registers (stored as `bool` arrays between loops, they were
-    /// packed to bytes and back, and the enumeration took a third of aLMI's time).
+    /// Enumerate the supports of one or two columns in the lanes of `quad`, in `nnls3`'s order
+    /// (its masks 0 to 6: bit j, column j; the empty one is where each lane starts), and keep
+    /// each lane's first feasible solution of smallest residual. One pass over the lanes runs
+    /// all six supports, the lane's best so far held in registers and stored once: with a pass
+    /// per support, the compiler turned each conditional update of the stored best into masked
+    /// stores (`vmaskmovpd`), slow on AMD (perf put 14 % of aLMI's time on them and their
+    /// masks). Each support is spelled out so that its indices are constants once inlined.
     #[inline(always)]
-    fn consider(&mut self, sc: &Scaled, support: &[usize]) {
-        for s in 0..LANES {
-            let mut x = [0.0; 3];
-            let ok = match *support {
-                [j] => {
-                    x[j] = sc.bs[j][s] / sc.at(j, j)[s];
-                    true
-                }
-                [p, q, ..] => {
-                    let (gpp, gqq, gpq, gqp) = (sc.at(p, p)[s], sc.at(q, q)[s], sc.at(p, q)[s], sc.at(q, p)[s]);
-                    let det = gpp * gqq - gpq * gqp;
-                    let inv = 1.0 / det;
-                    x[p] = (sc.bs[p][s] * gqq - gpq * sc.bs[q][s]) * inv;
-                    x[q] = (gpp * sc.bs[q][s] - gqp * sc.bs[p][s]) * inv;
-                    det.abs() > MIN_DET * (gpp * gqq)
-                }
-                _ => unreachable!("the enumeration considers supports of one or two columns"),
-            };
-            let r = sc.residual_lane(&x, support, s);
-            let take = ok & feasible(&x) & (r < self.r[s]);
-            self.r[s] = if take { r } else { self.r[s] };
-            for (j, v) in x.iter().enumerate() {
-                self.x[j][s] = if take { *v } else { self.x[j][s] };
+    fn enumerate(&mut self, sc: &Scaled, quad: usize) {
+        for s in quad * QUAD..(quad + 1) * QUAD {
+            let mut best = ([0.0; 3], sc.residual_lane(&[0.0; 3], &[], s));
+            Self::consider(sc, &[0], s, &mut best);
+            Self::consider(sc, &[1], s, &mut best);
+            Self::consider(sc, &[0, 1], s, &mut best);
+            Self::consider(sc, &[2], s, &mut best);
+            Self::consider(sc, &[0, 2], s, &mut best);
+            Self::consider(sc, &[1, 2], s, &mut best);
+            for j in 0..3 {
+                self.x[j][s] = best.0[j];
             }
+        }
+    }
+
+    /// Solve lane `s` on `support` (one or two columns) as [`nnls3`] does, and take the solution
+    /// into `best` (x, residual) where it is feasible and strictly better.
+    #[inline(always)]
+    fn consider(sc: &Scaled, support: &[usize], s: usize, best: &mut ([f64; 3], f64)) {
+        let mut x = [0.0; 3];
+        let ok = match *support {
+            [j] => {
+                x[j] = sc.bs[j][s] / sc.at(j, j)[s];
+                true
+            }
+            [p, q, ..] => {
+                let (gpp, gqq, gpq, gqp) = (sc.at(p, p)[s], sc.at(q, q)[s], sc.at(p, q)[s], sc.at(q, p)[s]);
+                let det = gpp * gqq - gpq * gqp;
+                let inv = 1.0 / det;
+                x[p] = (sc.bs[p][s] * gqq - gpq * sc.bs[q][s]) * inv;
+                x[q] = (gpp * sc.bs[q][s] - gqp * sc.bs[p][s]) * inv;
+                det.abs() > MIN_DET * (gpp * gqq)
+            }
+            _ => unreachable!("the enumeration considers supports of one or two columns"),
+        };
+        let r = sc.residual_lane(&x, support, s);
+        let take = mask(ok & feasible(&x) & (r < best.1));
+        best.1 = select(take, r, best.1);
+        for (b, v) in best.0.iter_mut().zip(x) {
+            *b = select(take, v, *b);
         }
     }
 }
@@ -216,7 +228,7 @@ impl Normal {
         // lane, and the lanes are tested side by side.)
         let regular: [bool; LANES] = lanewise(|s| {
             (0..3)
-                .fold(finite(self.yy[s]), |ok, j| ok & (norm2(j)[s] > 0.0) & (norm2(j)[s] < INF) & finite(self.b[j][s]))
+                .fold(finite(self.yy[s]), |ok, j| ok & (norm2(j)[s] > 0.0) & finite(norm2(j)[s]) & finite(self.b[j][s]))
         });
         // The full support by Cramer's rule.
         let rows = [[at(0, 0), at(0, 1), at(0, 2)], [at(1, 0), at(1, 1), at(1, 2)], [at(2, 0), at(2, 1), at(2, 2)]];
@@ -232,18 +244,15 @@ impl Normal {
             lanewise(|s| regular[s] && solvable[s] && feasible(&[full[0][s], full[1][s], full[2][s]]));
         let unscale =
             |x: &[Lanes; 3], s: usize| -> [f64; 3] { [x[0][s] * sc[0][s], x[1][s] * sc[1][s], x[2][s] * sc[2][s]] };
-        let mut best = Best::empty(&scaled);
-        if (0..lanes).any(|s| regular[s] && !fast[s]) {
-            // The other supports, in `nnls3`'s order (its masks 0 to 6: bit j, column j; the
-            // empty one is where `best` starts), each spelled out so that its indices are
-            // constants once inlined (a loop over the supports left them as loads, and ran
-            // slower).
-            best.consider(&scaled, &[0]);
-            best.consider(&scaled, &[1]);
-            best.consider(&scaled, &[0, 1]);
-            best.consider(&scaled, &[2]);
-            best.consider(&scaled, &[0, 2]);
-            best.consider(&scaled, &[1, 2]);
+        // The other supports, in the quads (four lanes, one AVX2 vector) with a lane that needs
+        // them.
+        let mut best = Best::empty();
+        for quad in 0..LANES / QUAD {
+            let need =
+                (quad * QUAD..((quad + 1) * QUAD).min(lanes)).fold(false, |any, s| any | (regular[s] & !fast[s]));
+            if need {
+                best.enumerate(&scaled, quad);
+            }
         }
         let best = best.x;
         let mut out: [Solution; LANES] = [None; LANES];

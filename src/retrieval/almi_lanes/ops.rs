@@ -17,8 +17,6 @@ pub(super) fn lanewise<T: Copy + Default>(f: impl Fn(usize) -> T) -> [T; LANES] 
     out
 }
 
-pub(super) const INF: f64 = f64::INFINITY;
-
 /// The lane mask of `b`: all bits set when true.
 #[inline(always)]
 pub(super) fn mask(b: bool) -> u64 {
@@ -31,12 +29,14 @@ pub(super) fn select(mask: u64, a: f64, b: f64) -> f64 {
     f64::from_bits((a.to_bits() & mask) | (b.to_bits() & !mask))
 }
 
-/// `x.is_finite()` as a floating-point comparison: `is_finite` compiles to integer tests of the
-/// bits, one lane at a time, where a comparison runs four lanes per instruction. (NaN compares
-/// false, so the two agree on every input.)
+/// `x.is_finite()` as x·0 = 0, which runs four lanes per instruction: x·0 is ±0 for finite x
+/// and NaN for ±∞ and NaN, so the two agree on every input. The spellings the compiler
+/// recognises as a class test of x (`is_finite`, |x| < ∞, 0 ≤ x < ∞) it compiles to integer
+/// tests of the bits, one lane at a time: the lane masks' 16 % of aLMI's time (perf), against
+/// 2 % as comparisons.
 #[inline(always)]
 pub(super) fn finite(x: f64) -> bool {
-    x.abs() < INF
+    x * 0.0 == 0.0
 }
 
 /// The lane-wise [`det3`]: the same expression per lane, so the same bits.
@@ -67,5 +67,5 @@ pub(super) fn cramer(rows: &[[&Lanes; 3]; 3], bs: &[Lanes; 3], inv_det: &Lanes, 
 /// Whether `x` is feasible: every component finite and non-negative.
 #[inline(always)]
 pub(super) fn feasible(x: &[f64; 3]) -> bool {
-    x.iter().fold(true, |ok, v| ok & (*v >= 0.0) & (*v < INF))
+    x.iter().fold(true, |ok, v| ok & (*v >= 0.0) & finite(*v))
 }
