@@ -32,8 +32,8 @@ pub(super) fn select(mask: u64, a: f64, b: f64) -> f64 {
 /// `x.is_finite()` as x·0 = 0, which runs four lanes per instruction: x·0 is ±0 for finite x
 /// and NaN for ±∞ and NaN, so the two agree on every input. The spellings the compiler
 /// recognises as a class test of x (`is_finite`, |x| < ∞, 0 ≤ x < ∞) it compiles to integer
-/// tests of the bits, one lane at a time: the lane masks' 16 % of aLMI's time (perf), against
-/// 2 % as comparisons.
+/// tests of the bits, one lane at a time: for eight lanes of [`feasible`], 451 instructions
+/// against 54 (rustc 1.95, AVX2), and aLMI ran about 15 % faster with the comparisons.
 #[inline(always)]
 pub(super) fn finite(x: f64) -> bool {
     x * 0.0 == 0.0
