@@ -84,14 +84,20 @@ impl<'a, T: Copy> Spectra<'a, T> {
     /// carries no bounds checks and vectorises (panics if a spectrum is shorter).
     #[inline(always)]
     fn first(&self, n: usize) -> Self {
+        self.range(0..n)
+    }
+
+    /// The wavelengths in `range`, every slice re-sliced alike (panics if a spectrum is shorter).
+    #[inline(always)]
+    fn range(&self, range: std::ops::Range<usize>) -> Self {
         Spectra {
-            a_w: &self.a_w[..n],
-            bb_w: &self.bb_w[..n],
-            a_ph: &self.a_ph[..n],
-            a_cdom: &self.a_cdom[..n],
-            a_nap: &self.a_nap[..n],
-            bb_ph: &self.bb_ph[..n],
-            bb_nap: &self.bb_nap[..n],
+            a_w: &self.a_w[range.clone()],
+            bb_w: &self.bb_w[range.clone()],
+            a_ph: &self.a_ph[range.clone()],
+            a_cdom: &self.a_cdom[range.clone()],
+            a_nap: &self.a_nap[range.clone()],
+            bb_ph: &self.bb_ph[range.clone()],
+            bb_nap: &self.bb_nap[range],
             ..*self
         }
     }
@@ -176,6 +182,9 @@ fn deep<T: Lane, L: Level>(k: &Spectra<'_, T>, out: &mut [T]) -> bool {
     ok
 }
 
+/// Wavelengths per block of [`shallow`]'s passes (its four work arrays: 2 kB in `f64`).
+const BLOCK: usize = 64;
+
 /// Shallow-water Rrs into `out` (Lee et al. 1999 eq. 5 with the SAMBUCA attenuation factors);
 /// whether every a and bb was positive and every ρ_b in [0, 1].
 ///
@@ -184,6 +193,14 @@ fn deep<T: Lane, L: Level>(k: &Spectra<'_, T>, out: &mut [T]) -> bool {
 /// p = κ²·rrs_dp·(1 − e_C) + κ²·ρ_b/π·e_B: the same quantities with no division until [`above`]
 /// (one per wavelength instead of two; the same formulas as [`super::WaterModel::evaluate`],
 /// rounded otherwise: the test below bounds the difference).
+///
+/// A wavelength's operations form one long chain (IOPs → square roots → exponentials → the
+/// division, some 140 cycles of latency), and one loop over them all kept only about two
+/// wavelength vectors in flight: the loop ran at about half of what its instructions need of
+/// the CPU's units. So the work runs in blocks of [`BLOCK`] wavelengths, in three passes (the
+/// roots and the exponents' arguments; the exponentials; the combination and the division),
+/// each a short chain that the CPU overlaps across wavelengths. Each wavelength goes through
+/// the same operations in the same order as in one loop, so the result is the same bits.
 #[inline(always)]
 fn shallow<T: Lane, L: Level>(
     k: &Spectra<'_, T>,
@@ -194,7 +211,6 @@ fn shallow<T: Lane, L: Level>(
     out: &mut [T],
 ) -> bool {
     let n = out.len();
-    let k = k.first(n);
     let rb = &rb[..n];
     let inv_pi = T::c(1.0 / std::f64::consts::PI);
     // The constants of D_C and D_B folded into the view path and the depth: −1.03·H/μo, −H/μw.
@@ -202,21 +218,37 @@ fn shallow<T: Lane, L: Level>(
         (T::c(-1.03) * inv_cos_o * depth_m, T::c(-1.04) * inv_cos_o * depth_m, -(inv_cos_w * depth_m));
     let mad = mad::<L, T>;
     let mut ok = true;
-    for i in 0..n {
-        let (a, bb) = (absorption::<T, L>(&k, i), backscattering::<T, L>(&k, i));
-        ok &= positive(a, bb) & (rb[i] >= T::c(0.0)) & (rb[i] <= T::c(1.0));
-        let kappa = a + bb;
-        let kappa2 = kappa * kappa;
-        // κ·√(1 + 2.4u) = √(κ² + 2.4·κ·bb), and 5.4 alike.
-        let kbb = kappa * bb;
-        let root_c = mad(T::c(2.4), kbb, kappa2).sqrt();
-        let root_b = mad(T::c(5.4), kbb, kappa2).sqrt();
-        let p_dp = mad(T::c(0.084), kappa, T::c(0.17) * bb) * bb;
-        let e_c = mad(c_view, root_c, sun * kappa).exp::<L>();
-        let e_b = mad(b_view, root_b, sun * kappa).exp::<L>();
-        // κ²·(rrs_dp·(1 − e_c) + ρ_b/π·e_b)
-        let p = mad(rb[i] * inv_pi * kappa2, e_b, mad(-p_dp, e_c, p_dp));
-        out[i] = above::<T, L>(p, kappa2);
+    let zero = T::c(0.0);
+    let (mut e_c, mut e_b, mut p_dp, mut kappa2) = ([zero; BLOCK], [zero; BLOCK], [zero; BLOCK], [zero; BLOCK]);
+    for start in (0..n).step_by(BLOCK) {
+        let end = (start + BLOCK).min(n);
+        let len = end - start;
+        let k = k.range(start..end);
+        let (rb, out) = (&rb[start..end], &mut out[start..end]);
+        let (e_c, e_b, p_dp, kappa2) = (&mut e_c[..len], &mut e_b[..len], &mut p_dp[..len], &mut kappa2[..len]);
+        // The IOPs, the roots and the exponents' arguments.
+        for i in 0..len {
+            let (a, bb) = (absorption::<T, L>(&k, i), backscattering::<T, L>(&k, i));
+            ok &= positive(a, bb) & (rb[i] >= T::c(0.0)) & (rb[i] <= T::c(1.0));
+            let kappa = a + bb;
+            let k2 = kappa * kappa;
+            // κ·√(1 + 2.4u) = √(κ² + 2.4·κ·bb), and 5.4 alike.
+            let kbb = kappa * bb;
+            let root_c = mad(T::c(2.4), kbb, k2).sqrt();
+            let root_b = mad(T::c(5.4), kbb, k2).sqrt();
+            p_dp[i] = mad(T::c(0.084), kappa, T::c(0.17) * bb) * bb;
+            e_c[i] = mad(c_view, root_c, sun * kappa);
+            e_b[i] = mad(b_view, root_b, sun * kappa);
+            kappa2[i] = k2;
+        }
+        for i in 0..len {
+            (e_c[i], e_b[i]) = (e_c[i].exp::<L>(), e_b[i].exp::<L>());
+        }
+        // κ²·(rrs_dp·(1 − e_c) + ρ_b/π·e_b), and Rrs.
+        for i in 0..len {
+            let p = mad(rb[i] * inv_pi * kappa2[i], e_b[i], mad(-p_dp[i], e_c[i], p_dp[i]));
+            out[i] = above::<T, L>(p, kappa2[i]);
+        }
     }
     ok
 }
