@@ -27,7 +27,7 @@ use serde::{Deserialize, Serialize};
 
 pub use super::Mode;
 use super::band_model::BandIops;
-use super::nnls::nnls3;
+use super::nnls::{finite, nnls3};
 use crate::water::rrs_below_from_above;
 
 /// aLMI settings.
@@ -180,10 +180,8 @@ impl Prepared {
         for (r, &a) in self.rrs[..m].iter_mut().zip(above) {
             *r = rrs_below_from_above(a);
         }
-        // (r·0 = 0 is `is_finite()` as a comparison, which vectorises; NaN fails both. The
-        // compiler turns `is_finite()` or |r| < ∞ beside r > 0 into integer tests of the bits,
-        // one band at a time.)
-        if !self.rrs[..m].iter().fold(true, |ok, r| ok & (*r * 0.0 == 0.0) & (*r > 0.0)) {
+        // (`finite` is `is_finite()` as a comparison, which vectorises beside r > 0.)
+        if !self.rrs[..m].iter().fold(true, |ok, r| ok & finite(*r) & (*r > 0.0)) {
             return false;
         }
         for (u, &r) in self.u[..m].iter_mut().zip(&self.rrs[..m]) {

@@ -12,7 +12,7 @@
 //! below); the scalar one stays as the readable statement of the method.
 
 use super::almi::{AlmiFlags, AlmiPixel, AlmiSet, AlmiSettings, MAX_BANDS, Prepared};
-use super::nnls::{MIN_DET, column_scale, nnls3};
+use super::nnls::{MIN_DET, column_scale, finite, nnls3};
 
 /// Sets per chunk (one chunk of eight covers the built-in sets).
 pub const LANES: usize = 8;
@@ -100,7 +100,7 @@ type Lanes = [f64; LANES];
 
 mod ops;
 
-use ops::{cramer, det3_lanes, feasible, finite, lanewise, mask, select};
+use ops::{cramer, det3_lanes, feasible, lanewise, mask, select};
 
 /// Index of (i, j) among the six stored entries of a symmetric 3 × 3 matrix.
 const AT: [[usize; 3]; 3] = [[0, 1, 2], [1, 3, 4], [2, 4, 5]];
@@ -139,19 +139,8 @@ impl Scaled {
     }
 }
 
-/// The enumeration's best feasible solution, per lane. It starts from the empty support (x = 0,
-/// the residual yᵀy), the first support `nnls3` tries and always feasible, so a later support is
-/// kept exactly when it is feasible and strictly better, as in `nnls3`.
-struct Best {
-    x: [Lanes; 3],
-}
-
-impl Best {
-    /// No lane enumerated yet (x = 0: the empty support's answer).
-    fn empty() -> Self {
-        Self { x: [[0.0; LANES]; 3] }
-    }
-
+/// The enumeration of supports, on the scaled normal equations of every lane.
+impl Scaled {
     /// Enumerate the supports of one or two columns in the lanes of `quad`, in `nnls3`'s order
     /// (its masks 0 to 6: bit j, column j; the empty one is where each lane starts), and keep
     /// each lane's first feasible solution of smallest residual. One pass over the lanes runs
@@ -160,17 +149,19 @@ impl Best {
     /// stores (`vmaskmovpd`), slow on AMD (perf put 14 % of aLMI's time on them and their
     /// masks). Each support is spelled out so that its indices are constants once inlined.
     #[inline(always)]
-    fn enumerate(&mut self, sc: &Scaled, quad: usize) {
+    fn enumerate(&self, quad: usize, x: &mut [Lanes; 3]) {
         for s in quad * QUAD..(quad + 1) * QUAD {
-            let mut best = ([0.0; 3], sc.residual_lane(&[0.0; 3], &[], s));
-            Self::consider(sc, &[0], s, &mut best);
-            Self::consider(sc, &[1], s, &mut best);
-            Self::consider(sc, &[0, 1], s, &mut best);
-            Self::consider(sc, &[2], s, &mut best);
-            Self::consider(sc, &[0, 2], s, &mut best);
-            Self::consider(sc, &[1, 2], s, &mut best);
+            // The empty support first (x = 0, the residual yᵀy), always feasible: a later
+            // support is kept exactly when it is feasible and strictly better, as in `nnls3`.
+            let mut best = ([0.0; 3], self.residual_lane(&[0.0; 3], &[], s));
+            self.consider(&[0], s, &mut best);
+            self.consider(&[1], s, &mut best);
+            self.consider(&[0, 1], s, &mut best);
+            self.consider(&[2], s, &mut best);
+            self.consider(&[0, 2], s, &mut best);
+            self.consider(&[1, 2], s, &mut best);
             for j in 0..3 {
-                self.x[j][s] = best.0[j];
+                x[j][s] = best.0[j];
             }
         }
     }
@@ -178,24 +169,24 @@ impl Best {
     /// Solve lane `s` on `support` (one or two columns) as [`nnls3`] does, and take the solution
     /// into `best` (x, residual) where it is feasible and strictly better.
     #[inline(always)]
-    fn consider(sc: &Scaled, support: &[usize], s: usize, best: &mut ([f64; 3], f64)) {
+    fn consider(&self, support: &[usize], s: usize, best: &mut ([f64; 3], f64)) {
         let mut x = [0.0; 3];
         let ok = match *support {
             [j] => {
-                x[j] = sc.bs[j][s] / sc.at(j, j)[s];
+                x[j] = self.bs[j][s] / self.at(j, j)[s];
                 true
             }
             [p, q, ..] => {
-                let (gpp, gqq, gpq, gqp) = (sc.at(p, p)[s], sc.at(q, q)[s], sc.at(p, q)[s], sc.at(q, p)[s]);
+                let (gpp, gqq, gpq, gqp) = (self.at(p, p)[s], self.at(q, q)[s], self.at(p, q)[s], self.at(q, p)[s]);
                 let det = gpp * gqq - gpq * gqp;
                 let inv = 1.0 / det;
-                x[p] = (sc.bs[p][s] * gqq - gpq * sc.bs[q][s]) * inv;
-                x[q] = (gpp * sc.bs[q][s] - gqp * sc.bs[p][s]) * inv;
+                x[p] = (self.bs[p][s] * gqq - gpq * self.bs[q][s]) * inv;
+                x[q] = (gpp * self.bs[q][s] - gqp * self.bs[p][s]) * inv;
                 det.abs() > MIN_DET * (gpp * gqq)
             }
             _ => unreachable!("the enumeration considers supports of one or two columns"),
         };
-        let r = sc.residual_lane(&x, support, s);
+        let r = self.residual_lane(&x, support, s);
         let take = mask(ok & feasible(&x) & (r < best.1));
         best.1 = select(take, r, best.1);
         for (b, v) in best.0.iter_mut().zip(x) {
@@ -246,15 +237,14 @@ impl Normal {
             |x: &[Lanes; 3], s: usize| -> [f64; 3] { [x[0][s] * sc[0][s], x[1][s] * sc[1][s], x[2][s] * sc[2][s]] };
         // The other supports, in the quads (four lanes, one AVX2 vector) with a lane that needs
         // them.
-        let mut best = Best::empty();
+        let mut best = [[0.0; LANES]; 3];
         for quad in 0..LANES / QUAD {
             let need =
                 (quad * QUAD..((quad + 1) * QUAD).min(lanes)).fold(false, |any, s| any | (regular[s] & !fast[s]));
             if need {
-                best.enumerate(&scaled, quad);
+                scaled.enumerate(quad, &mut best);
             }
         }
-        let best = best.x;
         let mut out: [Solution; LANES] = [None; LANES];
         for (s, slot) in out.iter_mut().enumerate().take(lanes) {
             // Which of the full and the enumerated solution a lane takes is data, unpredictable

@@ -118,6 +118,17 @@ pub(crate) fn det3(c: &[[f64; 3]; 3]) -> f64 {
         + c[0][2] * (c[1][0] * c[2][1] - c[1][1] * c[2][0])
 }
 
+/// `x.is_finite()` as x·0 = 0, which runs four lanes per instruction: x·0 is ±0 for finite x
+/// and NaN for ±∞ and NaN, so the two agree on every input. The spellings the compiler
+/// recognises as a class test of x (`is_finite`, |x| < ∞, 0 ≤ x < ∞) it compiles to integer
+/// tests of the bits, one lane at a time: for eight lanes of `almi_lanes`' feasibility test,
+/// 451 instructions against 54 (rustc 1.95, AVX2), and aLMI ran about 15 % faster with the
+/// comparisons. Shared by aLMI's scalar and lane code, so both spell the test this way.
+#[inline(always)]
+pub(crate) fn finite(x: f64) -> bool {
+    x * 0.0 == 0.0
+}
+
 /// The smallest |det| of the scaled Gram matrix [`nnls3`] solves with, relative to the product
 /// of its diagonal (so the determinant of the columns' correlation matrix: below it the columns
 /// are taken as dependent).

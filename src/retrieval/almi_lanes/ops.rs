@@ -3,7 +3,7 @@
 //! scalar code it mirrors (so the same bits).
 
 use super::{LANES, Lanes};
-use crate::retrieval::nnls::det3;
+use crate::retrieval::nnls::{det3, finite};
 
 /// A value per lane from `f(lane)`. A plain loop rather than `std::array::from_fn`, which the
 /// compiler left as a call (compiled without AVX2) inside the AVX2 build: 6 % of the default
@@ -27,16 +27,6 @@ pub(super) fn mask(b: bool) -> u64 {
 #[inline(always)]
 pub(super) fn select(mask: u64, a: f64, b: f64) -> f64 {
     f64::from_bits((a.to_bits() & mask) | (b.to_bits() & !mask))
-}
-
-/// `x.is_finite()` as x·0 = 0, which runs four lanes per instruction: x·0 is ±0 for finite x
-/// and NaN for ±∞ and NaN, so the two agree on every input. The spellings the compiler
-/// recognises as a class test of x (`is_finite`, |x| < ∞, 0 ≤ x < ∞) it compiles to integer
-/// tests of the bits, one lane at a time: for eight lanes of [`feasible`], 451 instructions
-/// against 54 (rustc 1.95, AVX2), and aLMI ran about 15 % faster with the comparisons.
-#[inline(always)]
-pub(super) fn finite(x: f64) -> bool {
-    x * 0.0 == 0.0
 }
 
 /// The lane-wise [`det3`]: the same expression per lane, so the same bits.
