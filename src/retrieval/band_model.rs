@@ -263,9 +263,11 @@ impl BandModel {
         // Bottom reflectance of the pair (zero when there is none) and its q-derivative.
         match (self.substrates.get(s1), self.substrates.get(s2)) {
             (Some(a), Some(b)) => {
+                // Every slice cut to n: the loop carries no bounds checks and vectorises.
+                let (a, b, rb, drb) = (&a[..n], &b[..n], &mut s.rb[..n], &mut s.drb[..n]);
                 for i in 0..n {
-                    s.rb[i] = q * a[i] + (1.0 - q) * b[i];
-                    s.drb[i] = a[i] - b[i];
+                    rb[i] = q * a[i] + (1.0 - q) * b[i];
+                    drb[i] = a[i] - b[i];
                 }
             }
             (Some(a), None) => {
@@ -283,18 +285,33 @@ impl BandModel {
         };
         let with_jacobian = jacobian.is_some();
         crate::simd::avx2(Nodes { model: self, p, inv_cos, h, shallow, with_jacobian, n, s });
-        for (b, range) in self.ranges.iter().enumerate() {
-            out[b] = range.clone().map(|i| self.weight[i] * s.above[i]).sum();
-        }
-        let Some(j) = jacobian else { return };
-        for (b, range) in self.ranges.iter().enumerate() {
-            let mut grad = [0.0; 5];
-            for i in range.clone() {
-                for (k, g) in grad.iter_mut().enumerate() {
-                    *g += s.grad[k][i];
-                }
+        let Some(j) = jacobian else {
+            for (b, range) in self.ranges.iter().enumerate() {
+                out[b] = range.clone().map(|i| self.weight[i] * s.above[i]).sum();
             }
-            j[b] = grad;
+            return;
+        };
+        // A band's Rrs and its five gradient terms in one loop over its nodes: six independent
+        // sums (each in node order, as before) overlap, and the zipped slices carry no bounds
+        // checks.
+        let [g0, g1, g2, g3, g4] = &s.grad;
+        for ((b, range), j_b) in self.ranges.iter().enumerate().zip(j.iter_mut()) {
+            let r = range.clone();
+            let terms =
+                g0[r.clone()].iter().zip(&g1[r.clone()]).zip(&g2[r.clone()]).zip(&g3[r.clone()]).zip(&g4[r.clone()]);
+            let (mut rrs, mut grad) = (-0.0, [0.0; 5]);
+            for ((&w, &above), ((((&d0, &d1), &d2), &d3), &d4)) in
+                self.weight[r.clone()].iter().zip(&s.above[r]).zip(terms)
+            {
+                rrs += w * above;
+                grad[0] += d0;
+                grad[1] += d1;
+                grad[2] += d2;
+                grad[3] += d3;
+                grad[4] += d4;
+            }
+            out[b] = rrs;
+            *j_b = grad;
         }
     }
 
