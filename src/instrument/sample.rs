@@ -275,7 +275,17 @@ impl PixelSampler<'_> {
                     && optics.water_at_nodes(self.scene, x, y, &look.geometry, &mut work.scratch, node_rrs)?
                 {
                     let weight = |b: usize| kernel.weights[b][k];
-                    crate::simd::avx2(AtNodes { sampler: self, gi, c, bands: &group.bands, weight, node_rrs, node_f, out, truth });
+                    crate::simd::avx2(AtNodes {
+                        sampler: self,
+                        gi,
+                        c,
+                        bands: &group.bands,
+                        weight,
+                        node_rrs,
+                        node_f,
+                        out,
+                        truth,
+                    });
                     continue;
                 }
                 let (l_toa, rrs) = &mut work.spectra[gi];

@@ -295,7 +295,7 @@ impl BandModel {
         // sums (each in node order, as before) overlap, and the zipped slices carry no bounds
         // checks.
         let [g0, g1, g2, g3, g4] = &s.grad;
-        for ((b, range), j_b) in self.ranges.iter().enumerate().zip(j.iter_mut()) {
+        for (b, range) in self.ranges.iter().enumerate() {
             let r = range.clone();
             let terms =
                 g0[r.clone()].iter().zip(&g1[r.clone()]).zip(&g2[r.clone()]).zip(&g3[r.clone()]).zip(&g4[r.clone()]);
@@ -311,7 +311,7 @@ impl BandModel {
                 grad[4] += d4;
             }
             out[b] = rrs;
-            *j_b = grad;
+            j[b] = grad;
         }
     }
 

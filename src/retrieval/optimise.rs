@@ -332,6 +332,39 @@ pub fn projected_bfgs(
 mod tests {
     use super::*;
 
+    /// The one-pass sums are each sum added alone, bit for bit, for every parameter count
+    /// (including the fallback above [`MAX_PARAMETERS`] and a sum of −0.0 terms only, whose sign
+    /// the starting value decides).
+    #[test]
+    fn normal_equations_are_the_sums_one_at_a_time_to_the_bit() {
+        for n in 1..=MAX_PARAMETERS + 1 {
+            let m = 29;
+            let jac: Vec<Vec<f64>> = (0..m)
+                .map(|i| {
+                    (0..n)
+                        .map(|k| match k {
+                            // Column 0 times column 1 (positive) is −0.0 in every row.
+                            0 => -0.0,
+                            1 => 1e-3 * (1.5 + (i as f64).sin()),
+                            _ => ((i * 7 + k * 13) as f64 * 0.37).sin() * 1e-3,
+                        })
+                        .collect()
+                })
+                .collect();
+            let r: Vec<f64> = (0..m).map(|i| ((i as f64) * 1.3).cos() * 1e-4).collect();
+            let (mut g, mut a) = (vec![0.0; n], vec![vec![0.0; n]; n]);
+            normal_equations(&jac, &r, &mut g, &mut a);
+            for k in 0..n {
+                let g_k: f64 = (0..m).map(|i| jac[i][k] * r[i]).sum();
+                assert_eq!(g[k].to_bits(), g_k.to_bits(), "n {n}, g[{k}]");
+                for q in 0..n {
+                    let a_kq: f64 = (0..m).map(|i| jac[i][k.max(q)] * jac[i][k.min(q)]).sum();
+                    assert_eq!(a[k][q].to_bits(), a_kq.to_bits(), "n {n}, a[{k}][{q}]");
+                }
+            }
+        }
+    }
+
     #[test]
     fn lm_fits_an_exponential_and_respects_bounds() {
         // y = 2·exp(−0.7 t); with the rate bounded at 0.5, the fit sits on the bound.
