@@ -113,6 +113,8 @@ fn damped_step(a: &[Vec<f64>], g: &[f64], lambda: f64, free: &[bool], step: &mut
 /// own time waiting on them). The parameter count is a constant of each instance of
 /// [`sums`], so that its accumulators can live in registers.
 fn normal_equations(jac: &[Vec<f64>], r: &[f64], g: &mut [f64], a: &mut [Vec<f64>]) {
+    // The match below has an arm for every count up to the damped step's limit.
+    const _: () = assert!(MAX_PARAMETERS == 8);
     fn put<const N: usize>((g_sum, a_sum): ([f64; N], [[f64; N]; N]), g: &mut [f64], a: &mut [Vec<f64>]) {
         g[..N].copy_from_slice(&g_sum);
         for k in 0..N {
@@ -129,6 +131,8 @@ fn normal_equations(jac: &[Vec<f64>], r: &[f64], g: &mut [f64], a: &mut [Vec<f64
         5 => put(sums::<5>(jac, r), g, a),
         6 => put(sums::<6>(jac, r), g, a),
         7 => put(sums::<7>(jac, r), g, a),
+        8 => put(sums::<8>(jac, r), g, a),
+        // Above what the damped step solves: the sums one at a time.
         n => {
             for k in 0..n {
                 g[k] = jac.iter().zip(r).map(|(row, ri)| row[k] * ri).sum();
