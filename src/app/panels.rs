@@ -442,6 +442,9 @@ fn retrieval_settings(spec: &mut crate::retrieval::RetrievalSpec, ui: &mut egui:
                 ui.selectable_value(&mut settings.starts, Starts::Shallow, "Shallow");
                 ui.selectable_value(&mut settings.starts, Starts::ShallowAndDeep, "ShallowAndDeep");
             });
+            ui.checkbox(&mut settings.warm_pairs, "Warm pair starts").on_hover_text(
+                "Start each substrate pair from the best fit so far (off: every pair from the shallow start)",
+            );
         }
         RetrievalSpec::Qaa { .. } => {
             ui.small("IOPs from the Rrs with no SIOP assumed; chl from a_ph(443) (Bricaud et al. 1998).");

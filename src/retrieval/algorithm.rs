@@ -192,7 +192,8 @@ impl Algorithm for Sambuca<'_> {
     fn classes(&self) -> Classes {
         Classes { substrates: true, ..Classes::default() }
     }
-    // The defaults: 3 Gauss nodes per band, 100 iterations, adaptive starts, noise-weighted.
+    // The defaults: 3 Gauss nodes per band, 100 iterations, adaptive starts, warm pairs,
+    // noise-weighted.
     fn cheaper(&self) -> Vec<Cheaper> {
         use super::Starts;
         vec![
@@ -205,6 +206,7 @@ impl Algorithm for Sambuca<'_> {
             ("SAMBUCA shallow and deep starts, every pixel", |r| {
                 sambuca_mut(r).into_iter().for_each(|s| s.starts = Starts::ShallowAndDeep);
             }),
+            ("SAMBUCA cold start for every pair", |r| sambuca_mut(r).into_iter().for_each(|s| s.warm_pairs = false)),
             ("SAMBUCA unweighted", |r| sambuca_mut(r).into_iter().for_each(|s| s.noise_weighting = false)),
         ]
     }

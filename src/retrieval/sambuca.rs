@@ -22,6 +22,15 @@
 //! leaves the bottom undetectable (`Starts::Adaptive`, the default; `ShallowAndDeep` always does
 //! both). The closure test shows the fit ends no worse than the truth.
 //!
+//! **Warm pairs.** The pairs share the water column: only the bottom's composition differs. So
+//! each pair after the first starts from the best fit so far (its concentrations and depth, the
+//! fraction at 0.5), which lies near the next pair's minimum wherever the bottom term is a small
+//! change, unless one of those four sits on its bound: a fit pinned to a bound is where the
+//! optimiser got stuck, and started from there the next pair can stay in the same poor basin.
+//! The deep start stays cold (its purpose is the other basin). `warm_pairs: false` starts every
+//! pair shallow; `tests/physics/sambuca_starts.rs` shows both reach the same minima on the
+//! bench's pixels.
+//!
 //! **Substrate detectability index** (SAMBUCA; Sen2Coral): SDI = max_b |Rrs_b − Rrs_dp,b| / NEΔRrs_b
 //! at the solution, the bottom's contribution in units of the noise; below 1 the bottom is not
 //! detectable and the depth is unreliable.
@@ -98,12 +107,15 @@ pub struct SambucaSettings {
     pub nodes_per_band: usize,
     /// Which starts each pair gets.
     pub starts: Starts,
+    /// Start each pair after the first from the best fit so far where none of its
+    /// concentrations or depth sits on a bound (see the module's "Warm pairs").
+    pub warm_pairs: bool,
     /// Shoal's inversion (`Improved`, the design default) or the CSIRO package's
     /// (`Reference`: [`super::sambuca_reference`]). The reference mode fixes what the package
     /// fixes — objective `distance_f` with the noise-equivalent ΔRrs, one start at
     /// (p_max − p_min)/2, SLSQP with 500 iterations, the full band sum — so `objective`,
-    /// `noise_weighting`, `max_iterations`, `nodes_per_band` and `starts` are then ignored; the
-    /// bounds are used.
+    /// `noise_weighting`, `max_iterations`, `nodes_per_band`, `starts` and `warm_pairs` are then
+    /// ignored; the bounds are used.
     pub mode: super::Mode,
 }
 
@@ -116,6 +128,7 @@ impl Default for SambucaSettings {
             max_iterations: 100,
             nodes_per_band: 3,
             starts: Starts::Adaptive,
+            warm_pairs: true,
             mode: super::Mode::Improved,
         }
     }
@@ -366,7 +379,8 @@ pub fn invert(model: &BandModel, settings: &SambucaSettings, obs: &Observation<'
         }
     };
     for &pair in &pairs {
-        let fit = px.fit(pair, &shallow);
+        let from = if settings.warm_pairs { warm_start(&best, &lo, &hi).unwrap_or(shallow) } else { shallow };
+        let fit = px.fit(pair, &from);
         keep(fit, &mut best);
     }
     if best.ok {
@@ -391,6 +405,18 @@ pub fn invert(model: &BandModel, settings: &SambucaSettings, obs: &Observation<'
     }
     best.iterations = px.iterations;
     best
+}
+
+/// The start a pair takes from the best fit so far (module docs, "Warm pairs"): its
+/// concentrations and depth in log space and the fraction at 0.5, or `None` where there is no fit
+/// yet or one of the four sits on its bound (within 10⁻⁶ in log space, the round trip through
+/// `exp` and `ln`).
+fn warm_start(best: &SambucaPixel, lo: &[f64; 5], hi: &[f64; 5]) -> Option<[f64; 5]> {
+    if !best.ok {
+        return None;
+    }
+    let z = [best.chl.ln(), best.cdom.ln(), best.nap.ln(), best.depth_m.ln(), 0.5];
+    (0..4).all(|k| z[k] > lo[k] + 1e-6 && z[k] < hi[k] - 1e-6).then_some(z)
 }
 
 /// α·f and its gradient with respect to the optimisation variables (∂m/∂z = ∂m/∂p · dp/dz).

@@ -13,6 +13,7 @@ mod osoaa;
 mod qaa;
 mod sambuca;
 mod sambuca_reference;
+mod sambuca_starts;
 mod sixs_swir;
 mod user_aerosol;
 mod water_limits;
