@@ -17,8 +17,11 @@
 //! - The levels differ in vector width: AVX2 holds 4 doubles (8 floats), AVX-512 8 (16). On
 //!   AMD Zen 4 a 512-bit instruction takes two cycles, so AVX-512 pays where a loop is bound by
 //!   latency (more wavelengths in flight per instruction: the double-precision water kernel) and
-//!   not where it is bound by throughput (the aLMI lanes, the exact correction, which ask for
-//!   [`avx2`]). `SHOAL_SIMD=… shoal bench` measures each level (docs/RESULTS.md).
+//!   not where it is bound by throughput. AMD Zen 5 runs them in one, so the throughput-bound
+//!   kernels that gained from it there (the band model's nodes, the exact correction) ask for
+//!   [`throughput`]: AVX-512 on such a CPU, AVX2 elsewhere. Those that did not (the aLMI lanes,
+//!   25 % slower at AVX-512 on Zen 5; the radiance stage's node sums, no faster) ask for
+//!   [`avx2`]. `SHOAL_SIMD=… shoal bench` measures each level (docs/RESULTS.md).
 //!
 //! The one `unsafe` block of each level is here, with its safety argument.
 
@@ -144,10 +147,30 @@ impl Tier {
 /// the binary refuses at start, see [`check_env`], caps nothing).
 fn tier() -> Tier {
     static TIER: std::sync::OnceLock<Tier> = std::sync::OnceLock::new();
-    *TIER.get_or_init(|| {
+    let tier = *TIER.get_or_init(|| {
         let cap = Tier::parse_cap(std::env::var(CAP_ENV).ok().as_deref()).unwrap_or(Tier::Avx512);
         Tier::of_cpu().min(cap)
-    })
+    });
+    #[cfg(test)]
+    if let Some(cap) = TEST_CAP.get() {
+        return tier.min(cap);
+    }
+    tier
+}
+
+#[cfg(test)]
+thread_local! {
+    static TEST_CAP: std::cell::Cell<Option<Tier>> = const { std::cell::Cell::new(None) };
+}
+
+/// Run `f` with every kernel this thread runs capped at `cap` (tests compare the levels' bits
+/// within one process, where [`CAP_ENV`] is read once).
+#[cfg(test)]
+pub(crate) fn capped<R>(cap: Tier, f: impl FnOnce() -> R) -> R {
+    TEST_CAP.set(Some(cap));
+    let out = f();
+    TEST_CAP.set(None);
+    out
 }
 
 /// Check [`CAP_ENV`].
@@ -159,7 +182,8 @@ pub fn check_env() -> Result<(), String> {
 }
 
 /// The instruction-set level this CPU runs `widest` at: "AVX-512", "AVX2+FMA" or "portable"
-/// (for `shoal bench` to print), with "(capped by SHOAL_SIMD)" when [`CAP_ENV`] lowered it.
+/// (for `shoal bench` to print), saying at which the throughput-bound kernels run on an AVX-512
+/// CPU ([`throughput`]), with "(capped by SHOAL_SIMD)" when [`CAP_ENV`] lowered it.
 #[must_use]
 pub fn widest_level() -> String {
     let name = match tier() {
@@ -167,7 +191,12 @@ pub fn widest_level() -> String {
         Tier::Avx2 => "AVX2+FMA",
         Tier::Baseline => "portable",
     };
-    if tier() < Tier::of_cpu() { format!("{name} (capped by {CAP_ENV})") } else { name.into() }
+    let name = match tier() {
+        Tier::Avx512 if full_width_512() => format!("{name} (512 bits at full width)"),
+        Tier::Avx512 => format!("{name} (throughput-bound kernels at AVX2)"),
+        _ => name.into(),
+    };
+    if tier() < Tier::of_cpu() { format!("{name} (capped by {CAP_ENV})") } else { name }
 }
 
 /// Run `kernel` at the widest level the CPU has: AVX-512 (F and VL) with AVX2 and FMA, or AVX2
@@ -181,6 +210,55 @@ pub fn widest<K: Kernel>(kernel: K) -> K::Output {
         Tier::Avx2 => x86::avx2(kernel),
         _ => kernel.run::<Baseline>(),
     }
+}
+
+/// Run a throughput-bound `kernel` at AVX-512 where the CPU executes 512-bit instructions at
+/// full width (AMD Zen 5 and later: [`full_width_512`]), else as [`avx2`] runs it (at most the
+/// level [`CAP_ENV`] allows). On AMD Zen 4 a 512-bit instruction takes two cycles, so such a
+/// kernel gains nothing from it (the aLMI lanes measured 0–3 % slower); on Zen 5 each takes one
+/// (the SAMBUCA-style fit's node loop 1.37× as fast as at AVX2, the exact correction 1.1×).
+#[inline]
+pub fn throughput<K: Kernel>(kernel: K) -> K::Output {
+    match tier() {
+        #[cfg(target_arch = "x86_64")]
+        Tier::Avx512 if full_width_512() => x86::avx512(kernel),
+        _ => avx2(kernel),
+    }
+}
+
+/// Whether the CPU's 512-bit instructions run at full width: AMD family 1Ah (Zen 5) and later.
+/// Other CPUs with AVX-512 (AMD Zen 4, family 19h, whose units are 256 bits wide; Intel's, not
+/// measured here) answer no. Read once from CPUID (vendor, leaf 0; family, leaf 1, as AMD's
+/// "CPUID Specification" 25481 §E.3.2 composes it: base family, plus the extended family where
+/// the base is Fh).
+#[must_use]
+pub fn full_width_512() -> bool {
+    static FULL: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    *FULL.get_or_init(|| {
+        #[cfg(target_arch = "x86_64")]
+        {
+            let (vendor, signature) = x86::vendor_and_signature();
+            vendor == *b"AuthenticAMD" && family(signature) >= 0x1A
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        false
+    })
+}
+
+/// Doubles per vector instruction of a kernel run by [`throughput`]: 8 at AVX-512, 4 otherwise
+/// (what a kernel pads its loops to, so that they run whole vectors).
+#[must_use]
+pub fn throughput_f64_lanes() -> usize {
+    match tier() {
+        Tier::Avx512 if full_width_512() => 8,
+        _ => 4,
+    }
+}
+
+/// The family of a CPUID leaf 1 signature (EAX): bits 8–11, plus bits 20–27 where those are Fh.
+fn family(signature: u32) -> u32 {
+    let base = (signature >> 8) & 0xF;
+    if base == 0xF { base + ((signature >> 20) & 0xFF) } else { base }
 }
 
 /// Run `kernel` with AVX2 and FMA where the CPU has them (even if it has AVX-512), else at the
@@ -204,6 +282,18 @@ mod x86 {
 
     pub fn avx2_available() -> bool {
         std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma")
+    }
+
+    /// The vendor string (CPUID leaf 0: EBX, EDX, ECX) and the leaf 1 signature (EAX).
+    pub fn vendor_and_signature() -> ([u8; 12], u32) {
+        // SAFETY: CPUID leaves 0 and 1 exist on every x86-64 CPU and only read registers.
+        #[allow(unsafe_code, unused_unsafe)]
+        let (zero, one) = unsafe { (std::arch::x86_64::__cpuid(0), std::arch::x86_64::__cpuid(1)) };
+        let mut vendor = [0; 12];
+        for (chunk, word) in vendor.chunks_mut(4).zip([zero.ebx, zero.edx, zero.ecx]) {
+            chunk.copy_from_slice(&word.to_le_bytes());
+        }
+        (vendor, one.eax)
     }
 
     #[target_feature(enable = "avx512f,avx512vl,avx2,fma")]
@@ -262,6 +352,15 @@ mod tests {
         let want = if widest_level().starts_with("portable") { base } else { fused };
         assert_eq!(widest(Dot(&a, &b)).to_bits(), want.to_bits());
         assert_eq!(avx2(Dot(&a, &b)).to_bits(), want.to_bits());
+        assert_eq!(throughput(Dot(&a, &b)).to_bits(), want.to_bits());
+    }
+
+    #[test]
+    fn the_family_adds_the_extended_family_only_to_family_f() {
+        // Signatures of AMD Zen 3 (19h, model 01h), Zen 5 (1Ah) and an Intel Core (6, model 55h).
+        assert_eq!(family(0x00A0_0F11), 0x19);
+        assert_eq!(family(0x00B0_0F21), 0x1A);
+        assert_eq!(family(0x0005_0654), 6);
     }
 
     #[test]

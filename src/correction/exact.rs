@@ -84,7 +84,7 @@ impl<'a> ExactTerms<'a> {
         };
         let is_land = !self.surface.is_water(r, c);
         let column = ExactColumn { l1: l1.0, l0_flags: l1.1, is_land, l_path, glint, t_ed, s_albedo };
-        crate::simd::avx2(Correct { column: &column, rrs_out: out.0, flag_out: out.1 });
+        crate::simd::throughput(Correct { column: &column, rrs_out: out.0, flag_out: out.1 });
     }
 
     /// Pixel `p` (row-major) of the Level-1 `l1` (radiance and flags, every pixel's `nb`
@@ -166,7 +166,8 @@ impl ExactColumn<'_> {
 }
 
 /// [`ExactColumn::correct`] as a [`crate::simd::Kernel`]: with AVX2, four divisions per
-/// instruction (the same operations at every level, so the same bits).
+/// instruction, eight with AVX-512 where [`crate::simd::throughput`] takes it (the same
+/// operations at every level, so the same bits).
 struct Correct<'a, 'c> {
     column: &'a ExactColumn<'c>,
     rrs_out: &'a mut [f32],

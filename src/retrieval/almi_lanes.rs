@@ -344,7 +344,7 @@ fn kappa(c: &BandLanes, x: &[[f64; LANES]; 3], s: usize) -> (f64, f64) {
 
 /// [`super::almi::invert`] over packed sets: the same inputs, the same pixel, bit for bit.
 /// On a CPU with AVX2 the lanes run four sets per instruction (two otherwise); not AVX-512,
-/// which measured 0–3 % slower on AMD Zen 4 (see [`crate::simd`]).
+/// which measured 0–3 % slower on AMD Zen 4 and 25 % slower on Zen 5 (see [`crate::simd`]).
 #[must_use]
 pub fn invert_packed(
     scratch: &mut Scratch,

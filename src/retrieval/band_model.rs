@@ -120,7 +120,7 @@ pub struct BandModel {
     pub band_names: Vec<String>,
     /// Per band: node range.
     ranges: Vec<std::ops::Range<usize>>,
-    /// Per node: quadrature weight (normalised per band).
+    /// Per node: quadrature weight (normalised per band); zero on the padding nodes.
     weight: Vec<f64>,
     a_w: Vec<f64>,
     bb_w: Vec<f64>,
@@ -129,7 +129,10 @@ pub struct BandModel {
     a_nap: Vec<f64>,
     bb_ph: Vec<f64>,
     bb_nap: Vec<f64>,
-    /// Substrate names and reflectance per node.
+    /// Substrate names and reflectance per node. Every per-node vector holds the bands' nodes
+    /// and then copies of the last node up to a multiple of the node loop's vector width
+    /// ([`crate::simd::throughput_f64_lanes`]): the loop then runs whole vectors of nodes, never
+    /// a scalar remainder, and no band sum reads the padding (`ranges` end before it).
     substrate_names: Vec<String>,
     substrates: Vec<Vec<f64>>,
     /// Refractive index of water.
@@ -175,9 +178,14 @@ impl BandModel {
         unique.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
         let grid = WavelengthGrid::from_wavelengths(unique.clone())?;
         let s = siop.resolve(&grid, siop_dir)?;
+        let padded = nodes.len().next_multiple_of(crate::simd::throughput_f64_lanes());
         let at = |v: &[f64]| -> Vec<f64> {
-            nodes.iter().map(|x| v[unique.partition_point(|u| *u < x - 1e-9).min(unique.len() - 1)]).collect()
+            let mut at: Vec<f64> =
+                nodes.iter().map(|x| v[unique.partition_point(|u| *u < x - 1e-9).min(unique.len() - 1)]).collect();
+            at.resize(padded, at[at.len() - 1]);
+            at
         };
+        weight.resize(padded, 0.0);
         let substrate_spectra = substrates
             .iter()
             .map(|name| {
@@ -215,10 +223,10 @@ impl BandModel {
         &self.substrate_names
     }
 
-    /// Quadrature nodes in all.
+    /// Quadrature nodes in all (not counting the padding).
     #[must_use]
     pub fn n_nodes(&self) -> usize {
-        self.weight.len()
+        self.ranges.last().map_or(0, |r| r.end)
     }
 
     /// The band averages of the SIOP spectra.
@@ -257,6 +265,7 @@ impl BandModel {
         jacobian: Option<&mut [[f64; 5]]>,
         s: &mut ModelScratch,
     ) {
+        // Every node, the padding too (see `substrates`).
         let n = self.weight.len();
         s.resize(n);
         let (s1, s2, q) = p.substrates;
@@ -284,7 +293,7 @@ impl BandModel {
             None => (0.0, 0.0),
         };
         let with_jacobian = jacobian.is_some();
-        crate::simd::avx2(Nodes { model: self, p, inv_cos, h, shallow, with_jacobian, n, s });
+        crate::simd::throughput(Nodes { model: self, p, inv_cos, h, shallow, with_jacobian, n, s });
         let Some(j) = jacobian else {
             for (b, range) in self.ranges.iter().enumerate() {
                 out[b] = range.clone().map(|i| self.weight[i] * s.above[i]).sum();
@@ -323,9 +332,10 @@ impl BandModel {
     }
 }
 
-/// The per-node work of [`BandModel::evaluate_with`], as a [`crate::simd::Kernel`] run with AVX2
-/// where the CPU has it (four nodes per instruction; AVX-512 measured slower at the 12 to 84
-/// nodes of a retrieval's bands): Rrs at each node and, with the Jacobian, each node's weighted
+/// The per-node work of [`BandModel::evaluate_with`], as a [`crate::simd::Kernel`] run by
+/// [`crate::simd::throughput`] (four nodes per instruction with AVX2, eight with AVX-512 where
+/// its units are full width; on AMD Zen 4 AVX-512 measured slower at the 12 to 84 nodes of a
+/// retrieval's bands): Rrs at each node and, with the Jacobian, each node's weighted
 /// terms of the band gradients. Written with separate multiplies and adds (and the baseline
 /// [`fast_exp`]), so every level gives the same bits; the vector levels only take more nodes per
 /// instruction.

@@ -23,6 +23,8 @@ mod evaluate;
 pub mod external;
 mod external_io;
 pub mod function;
+#[cfg(test)]
+mod levels_test;
 pub mod nnls;
 pub mod optimise;
 pub mod qaa;
