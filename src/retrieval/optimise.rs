@@ -53,9 +53,15 @@ impl Default for Tolerances {
 /// Largest number of parameters the optimisers take (their working arrays live on the stack).
 pub const MAX_PARAMETERS: usize = 8;
 
+/// A row of a Jacobian (∂r_i/∂x_k for k < n; the rest unused), or of JᵀJ: fixed-size, so that a
+/// fit's m rows are one allocation rather than m.
+pub type Row = [f64; MAX_PARAMETERS];
+
 /// Solve the n × n system (A + λ·diag A)·δ = −g on the free variables by Gaussian elimination
 /// with partial pivoting into `step` (zero for fixed variables); false if singular.
-fn damped_step(a: &[Vec<f64>], g: &[f64], lambda: f64, free: &[bool], step: &mut [f64]) -> bool {
+fn damped_step(a: &[Row], g: &[f64], lambda: f64, free: &[bool], step: &mut [f64]) -> bool {
+    // The match below has an arm for every count up to the limit.
+    const _: () = assert!(MAX_PARAMETERS == 8);
     let n = g.len().min(MAX_PARAMETERS);
     let mut idx = [0usize; MAX_PARAMETERS];
     let mut m = 0;
@@ -73,9 +79,38 @@ fn damped_step(a: &[Vec<f64>], g: &[f64], lambda: f64, free: &[bool], step: &mut
         mat[r][r] += lambda * a[idx[r]][idx[r]].max(1e-30);
         mat[r][m] = -g[idx[r]];
     }
-    for col in 0..m {
+    let mut sol = [0.0f64; MAX_PARAMETERS];
+    let solved = match m {
+        0 => true,
+        1 => eliminate::<1>(&mut mat, &mut sol),
+        2 => eliminate::<2>(&mut mat, &mut sol),
+        3 => eliminate::<3>(&mut mat, &mut sol),
+        4 => eliminate::<4>(&mut mat, &mut sol),
+        5 => eliminate::<5>(&mut mat, &mut sol),
+        6 => eliminate::<6>(&mut mat, &mut sol),
+        7 => eliminate::<7>(&mut mat, &mut sol),
+        _ => eliminate::<8>(&mut mat, &mut sol),
+    };
+    if !solved {
+        return false;
+    }
+    step.fill(0.0);
+    for k in 0..m {
+        step[idx[k]] = sol[k];
+    }
+    step.iter().all(|v| v.is_finite())
+}
+
+/// Gaussian elimination with partial pivoting of the M × M system `mat` (its column M the
+/// right-hand side) into `sol`; false if a pivot is zero. M is a constant of each instance, so
+/// that its loops unroll: a Levenberg–Marquardt iteration of a SAMBUCA fit spent a sixth of its
+/// time here with M known only at run time. The same operations in the same order at every M,
+/// so the same bits.
+#[inline]
+fn eliminate<const M: usize>(mat: &mut [[f64; MAX_PARAMETERS + 1]; MAX_PARAMETERS], sol: &mut [f64]) -> bool {
+    for col in 0..M {
         let mut pivot = col;
-        for r in col + 1..m {
+        for r in col + 1..M {
             if mat[r][col].abs() > mat[pivot][col].abs() {
                 pivot = r;
             }
@@ -84,23 +119,18 @@ fn damped_step(a: &[Vec<f64>], g: &[f64], lambda: f64, free: &[bool], step: &mut
             return false;
         }
         mat.swap(col, pivot);
-        for row in col + 1..m {
+        for row in col + 1..M {
             let f = mat[row][col] / mat[col][col];
-            for c in col..=m {
+            for c in col..=M {
                 mat[row][c] -= f * mat[col][c];
             }
         }
     }
-    let mut sol = [0.0f64; MAX_PARAMETERS];
-    for row in (0..m).rev() {
-        let s: f64 = (row + 1..m).map(|c| mat[row][c] * sol[c]).sum();
-        sol[row] = (mat[row][m] - s) / mat[row][row];
+    for row in (0..M).rev() {
+        let s: f64 = (row + 1..M).map(|c| mat[row][c] * sol[c]).sum();
+        sol[row] = (mat[row][M] - s) / mat[row][row];
     }
-    step.fill(0.0);
-    for k in 0..m {
-        step[idx[k]] = sol[k];
-    }
-    step.iter().all(|v| v.is_finite())
+    true
 }
 
 /// Jᵀr into `g` and JᵀJ into `a` (both triangles) for the Jacobian rows `jac` and residuals `r`
@@ -112,10 +142,10 @@ fn damped_step(a: &[Vec<f64>], g: &[f64], lambda: f64, free: &[bool], step: &mut
 /// after another (a Levenberg–Marquardt iteration of a 28-band SAMBUCA fit spent most of its
 /// own time waiting on them). The parameter count is a constant of each instance of
 /// [`sums`], so that its accumulators can live in registers.
-fn normal_equations(jac: &[Vec<f64>], r: &[f64], g: &mut [f64], a: &mut [Vec<f64>]) {
+fn normal_equations(jac: &[Row], r: &[f64], g: &mut [f64], a: &mut [Row]) {
     // The match below has an arm for every count up to the damped step's limit.
     const _: () = assert!(MAX_PARAMETERS == 8);
-    fn put<const N: usize>((g_sum, a_sum): ([f64; N], [[f64; N]; N]), g: &mut [f64], a: &mut [Vec<f64>]) {
+    fn put<const N: usize>((g_sum, a_sum): ([f64; N], [[f64; N]; N]), g: &mut [f64], a: &mut [Row]) {
         g[..N].copy_from_slice(&g_sum);
         for k in 0..N {
             for q in 0..=k {
@@ -124,6 +154,7 @@ fn normal_equations(jac: &[Vec<f64>], r: &[f64], g: &mut [f64], a: &mut [Vec<f64
         }
     }
     match g.len() {
+        0 => {}
         1 => put(sums::<1>(jac, r), g, a),
         2 => put(sums::<2>(jac, r), g, a),
         3 => put(sums::<3>(jac, r), g, a),
@@ -131,23 +162,13 @@ fn normal_equations(jac: &[Vec<f64>], r: &[f64], g: &mut [f64], a: &mut [Vec<f64
         5 => put(sums::<5>(jac, r), g, a),
         6 => put(sums::<6>(jac, r), g, a),
         7 => put(sums::<7>(jac, r), g, a),
-        8 => put(sums::<8>(jac, r), g, a),
-        // Above what the damped step solves: the sums one at a time.
-        n => {
-            for k in 0..n {
-                g[k] = jac.iter().zip(r).map(|(row, ri)| row[k] * ri).sum();
-                for q in 0..=k {
-                    let v: f64 = jac.iter().map(|row| row[k] * row[q]).sum();
-                    (a[k][q], a[q][k]) = (v, v);
-                }
-            }
-        }
+        _ => put(sums::<8>(jac, r), g, a),
     }
 }
 
 /// Jᵀr and the lower triangle of JᵀJ for N parameters (see [`normal_equations`]).
 #[inline]
-fn sums<const N: usize>(jac: &[Vec<f64>], r: &[f64]) -> ([f64; N], [[f64; N]; N]) {
+fn sums<const N: usize>(jac: &[Row], r: &[f64]) -> ([f64; N], [[f64; N]; N]) {
     let mut g = [-0.0f64; N];
     let mut a = [[-0.0f64; N]; N];
     for (row, &ri) in jac.iter().zip(r) {
@@ -162,12 +183,13 @@ fn sums<const N: usize>(jac: &[Vec<f64>], r: &[f64]) -> ([f64; N], [[f64; N]; N]
     (g, a)
 }
 
-/// Bounded Levenberg–Marquardt. `residuals(x, r, j)` fills the residual vector `r` and the
-/// Jacobian rows `j[i][k]` = ∂r_i/∂x_k; it returns false if x is not admissible (the step is
-/// then rejected). The Jacobian is computed at every trial point, so an accepted step costs one
+/// Bounded Levenberg–Marquardt of n = `x0.len()` ≤ [`MAX_PARAMETERS`] parameters (panics
+/// above). `residuals(x, r, j)` fills the residual vector `r` and the Jacobian rows
+/// `j[i][k]` = ∂r_i/∂x_k (k < n); it returns false if x is not admissible (the step is then
+/// rejected). The Jacobian is computed at every trial point, so an accepted step costs one
 /// evaluation.
 pub fn levenberg_marquardt(
-    mut residuals: impl FnMut(&[f64], &mut [f64], &mut [Vec<f64>]) -> bool,
+    mut residuals: impl FnMut(&[f64], &mut [f64], &mut [Row]) -> bool,
     x0: &[f64],
     lo: &[f64],
     hi: &[f64],
@@ -175,6 +197,7 @@ pub fn levenberg_marquardt(
     tol: &Tolerances,
 ) -> Solution {
     let n = x0.len();
+    assert!(n <= MAX_PARAMETERS, "levenberg_marquardt takes at most {MAX_PARAMETERS} parameters, not {n}");
     let clamp = |x: &mut [f64]| {
         for i in 0..n {
             x[i] = x[i].clamp(lo[i], hi[i]);
@@ -183,7 +206,7 @@ pub fn levenberg_marquardt(
     let mut x = x0.to_vec();
     clamp(&mut x);
     let mut r = vec![0.0; m];
-    let mut jac = vec![vec![0.0; n]; m];
+    let mut jac = vec![[0.0; MAX_PARAMETERS]; m];
     if !residuals(&x, &mut r, &mut jac) {
         return Solution { x, value: f64::INFINITY, iterations: 0, converged: false };
     }
@@ -191,9 +214,9 @@ pub fn levenberg_marquardt(
     let mut lambda = 1e-3;
     let mut trial = vec![0.0; n];
     let mut trial_r = vec![0.0; m];
-    let mut trial_jac = vec![vec![0.0; n]; m];
+    let mut trial_jac = vec![[0.0; MAX_PARAMETERS]; m];
     let mut g = vec![0.0; n];
-    let mut a = vec![vec![0.0; n]; n];
+    let mut a = [[0.0; MAX_PARAMETERS]; MAX_PARAMETERS];
     let mut free = vec![true; n];
     let mut step = vec![0.0; n];
     let mut iterations = 0;
@@ -204,7 +227,7 @@ pub fn levenberg_marquardt(
             converged = true;
             break;
         }
-        normal_equations(&jac[..m], &r[..m], &mut g, &mut a);
+        normal_equations(&jac[..m], &r[..m], &mut g, &mut a[..n]);
         for k in 0..n {
             free[k] = !((x[k] <= lo[k] && g[k] > 0.0) || (x[k] >= hi[k] && g[k] < 0.0));
         }
@@ -337,26 +360,23 @@ mod tests {
     use super::*;
 
     /// The one-pass sums are each sum added alone, bit for bit, for every parameter count
-    /// (including the fallback above [`MAX_PARAMETERS`] and a sum of −0.0 terms only, whose sign
-    /// the starting value decides).
+    /// (and a sum of −0.0 terms only, whose sign the starting value decides).
     #[test]
     fn normal_equations_are_the_sums_one_at_a_time_to_the_bit() {
-        for n in 1..=MAX_PARAMETERS + 1 {
+        for n in 1..=MAX_PARAMETERS {
             let m = 29;
-            let jac: Vec<Vec<f64>> = (0..m)
+            let jac: Vec<Row> = (0..m)
                 .map(|i| {
-                    (0..n)
-                        .map(|k| match k {
-                            // Column 0 times column 1 (positive) is −0.0 in every row.
-                            0 => -0.0,
-                            1 => 1e-3 * (1.5 + (i as f64).sin()),
-                            _ => ((i * 7 + k * 13) as f64 * 0.37).sin() * 1e-3,
-                        })
-                        .collect()
+                    std::array::from_fn(|k| match k {
+                        // Column 0 times column 1 (positive) is −0.0 in every row.
+                        0 => -0.0,
+                        1 => 1e-3 * (1.5 + (i as f64).sin()),
+                        _ => ((i * 7 + k * 13) as f64 * 0.37).sin() * 1e-3,
+                    })
                 })
                 .collect();
             let r: Vec<f64> = (0..m).map(|i| ((i as f64) * 1.3).cos() * 1e-4).collect();
-            let (mut g, mut a) = (vec![0.0; n], vec![vec![0.0; n]; n]);
+            let (mut g, mut a) = (vec![0.0; n], vec![[0.0; MAX_PARAMETERS]; n]);
             normal_equations(&jac, &r, &mut g, &mut a);
             for k in 0..n {
                 let g_k: f64 = (0..m).map(|i| jac[i][k] * r[i]).sum();
@@ -369,12 +389,60 @@ mod tests {
         }
     }
 
+    /// The elimination with M a constant of each instance gives the bits of the same loops
+    /// with M known only at run time (pivots that swap, on systems of every size).
+    #[test]
+    fn elimination_at_a_constant_size_is_the_run_time_loop_to_the_bit() {
+        type Mat = [[f64; MAX_PARAMETERS + 1]; MAX_PARAMETERS];
+        fn at_run_time(mat: &mut Mat, m: usize) -> [f64; MAX_PARAMETERS] {
+            for col in 0..m {
+                let pivot = (col..m).fold(col, |p, r| if mat[r][col].abs() > mat[p][col].abs() { r } else { p });
+                mat.swap(col, pivot);
+                for row in col + 1..m {
+                    let f = mat[row][col] / mat[col][col];
+                    for c in col..=m {
+                        mat[row][c] -= f * mat[col][c];
+                    }
+                }
+            }
+            let mut sol = [0.0; MAX_PARAMETERS];
+            for row in (0..m).rev() {
+                let s: f64 = (row + 1..m).map(|c| mat[row][c] * sol[c]).sum();
+                sol[row] = (mat[row][m] - s) / mat[row][row];
+            }
+            sol
+        }
+        for m in 1..=MAX_PARAMETERS {
+            let mut mat: Mat = [[0.0; MAX_PARAMETERS + 1]; MAX_PARAMETERS];
+            for (r, row) in mat.iter_mut().enumerate().take(m) {
+                for (c, v) in row.iter_mut().enumerate().take(m + 1) {
+                    *v = ((r * 11 + c * 5 + m) as f64 * 0.73).sin() + if r == c { 0.1 } else { 0.0 };
+                }
+            }
+            let want = at_run_time(&mut mat.clone(), m);
+            let mut sol = [0.0; MAX_PARAMETERS];
+            let solved = match m {
+                1 => eliminate::<1>(&mut mat, &mut sol),
+                2 => eliminate::<2>(&mut mat, &mut sol),
+                3 => eliminate::<3>(&mut mat, &mut sol),
+                4 => eliminate::<4>(&mut mat, &mut sol),
+                5 => eliminate::<5>(&mut mat, &mut sol),
+                6 => eliminate::<6>(&mut mat, &mut sol),
+                7 => eliminate::<7>(&mut mat, &mut sol),
+                _ => eliminate::<8>(&mut mat, &mut sol),
+            };
+            assert!(solved);
+            assert!(sol[..m].iter().all(|v| v.is_finite() && *v != 0.0), "m {m}: {sol:?}");
+            assert_eq!(sol.map(f64::to_bits), want.map(f64::to_bits), "m {m}");
+        }
+    }
+
     #[test]
     fn lm_fits_an_exponential_and_respects_bounds() {
         // y = 2·exp(−0.7 t); with the rate bounded at 0.5, the fit sits on the bound.
         let t: Vec<f64> = (0..20).map(|i| f64::from(i) * 0.25).collect();
         let y: Vec<f64> = t.iter().map(|t| 2.0 * (-0.7 * t).exp()).collect();
-        let model = |x: &[f64], r: &mut [f64], j: &mut [Vec<f64>]| {
+        let model = |x: &[f64], r: &mut [f64], j: &mut [Row]| {
             for (i, (t, y)) in t.iter().zip(&y).enumerate() {
                 r[i] = x[0] * (-x[1] * t).exp() - y;
                 j[i][0] = (-x[1] * t).exp();

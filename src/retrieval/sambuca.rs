@@ -43,7 +43,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::band_model::{BandModel, ModelScratch, Parameters};
-use super::optimise::{Tolerances, levenberg_marquardt, projected_bfgs};
+use super::optimise::{Row, Tolerances, levenberg_marquardt, projected_bfgs};
 
 /// Which distance is minimised.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -248,7 +248,7 @@ impl Pixel<'_> {
         let tol = Tolerances { max_iterations: self.settings.max_iterations, ..Tolerances::default() };
         let (model, obs, weights, scale) = (self.model, self.obs, &self.weights, self.scale);
         let (m, jac, scratch) = (&mut self.m, &mut self.jac, &mut self.scratch);
-        let residuals = |z: &[f64], r: &mut [f64], jrows: &mut [Vec<f64>]| -> bool {
+        let residuals = |z: &[f64], r: &mut [f64], jrows: &mut [Row]| -> bool {
             let p = to_params(z, pair);
             model.evaluate_with(&p, obs.inv_cos, m, Some(jac), scratch);
             let dz = [p.chl, p.cdom, p.nap, p.depth_m.unwrap_or(1.0), 1.0];
