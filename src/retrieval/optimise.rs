@@ -80,18 +80,7 @@ fn damped_step(a: &[Row], g: &[f64], lambda: f64, free: &[bool], step: &mut [f64
         mat[r][m] = -g[idx[r]];
     }
     let mut sol = [0.0f64; MAX_PARAMETERS];
-    let solved = match m {
-        0 => true,
-        1 => eliminate::<1>(&mut mat, &mut sol),
-        2 => eliminate::<2>(&mut mat, &mut sol),
-        3 => eliminate::<3>(&mut mat, &mut sol),
-        4 => eliminate::<4>(&mut mat, &mut sol),
-        5 => eliminate::<5>(&mut mat, &mut sol),
-        6 => eliminate::<6>(&mut mat, &mut sol),
-        7 => eliminate::<7>(&mut mat, &mut sol),
-        _ => eliminate::<8>(&mut mat, &mut sol),
-    };
-    if !solved {
+    if !solve(&mut mat, m, &mut sol) {
         return false;
     }
     step.fill(0.0);
@@ -99,6 +88,22 @@ fn damped_step(a: &[Row], g: &[f64], lambda: f64, free: &[bool], step: &mut [f64
         step[idx[k]] = sol[k];
     }
     step.iter().all(|v| v.is_finite())
+}
+
+/// The m × m system `mat` (m ≤ [`MAX_PARAMETERS`], its column m the right-hand side) into
+/// `sol` by [`eliminate`] at that size; false if a pivot is zero.
+fn solve(mat: &mut [[f64; MAX_PARAMETERS + 1]; MAX_PARAMETERS], m: usize, sol: &mut [f64]) -> bool {
+    match m {
+        0 => true,
+        1 => eliminate::<1>(mat, sol),
+        2 => eliminate::<2>(mat, sol),
+        3 => eliminate::<3>(mat, sol),
+        4 => eliminate::<4>(mat, sol),
+        5 => eliminate::<5>(mat, sol),
+        6 => eliminate::<6>(mat, sol),
+        7 => eliminate::<7>(mat, sol),
+        _ => eliminate::<8>(mat, sol),
+    }
 }
 
 /// Gaussian elimination with partial pivoting of the M × M system `mat` (its column M the
@@ -421,17 +426,7 @@ mod tests {
             }
             let want = at_run_time(&mut mat.clone(), m);
             let mut sol = [0.0; MAX_PARAMETERS];
-            let solved = match m {
-                1 => eliminate::<1>(&mut mat, &mut sol),
-                2 => eliminate::<2>(&mut mat, &mut sol),
-                3 => eliminate::<3>(&mut mat, &mut sol),
-                4 => eliminate::<4>(&mut mat, &mut sol),
-                5 => eliminate::<5>(&mut mat, &mut sol),
-                6 => eliminate::<6>(&mut mat, &mut sol),
-                7 => eliminate::<7>(&mut mat, &mut sol),
-                _ => eliminate::<8>(&mut mat, &mut sol),
-            };
-            assert!(solved);
+            assert!(solve(&mut mat, m, &mut sol));
             assert!(sol[..m].iter().all(|v| v.is_finite() && *v != 0.0), "m {m}: {sol:?}");
             assert_eq!(sol.map(f64::to_bits), want.map(f64::to_bits), "m {m}");
         }
