@@ -216,7 +216,7 @@ pub fn widest<K: Kernel>(kernel: K) -> K::Output {
 /// full width (AMD Zen 5 and later: [`full_width_512`]), else as [`avx2`] runs it (at most the
 /// level [`CAP_ENV`] allows). On AMD Zen 4 a 512-bit instruction takes two cycles, so such a
 /// kernel gains nothing from it (the aLMI lanes measured 0–3 % slower); on Zen 5 each takes one
-/// (the SAMBUCA-style fit's node loop 1.37× as fast as at AVX2, the exact correction 1.1×).
+/// (the SAMBUCA-style fit of 28 bands 1.33× as fast as at AVX2, the exact correction 1.1×).
 #[inline]
 pub fn throughput<K: Kernel>(kernel: K) -> K::Output {
     match tier() {

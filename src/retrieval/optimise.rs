@@ -60,8 +60,6 @@ pub type Row = [f64; MAX_PARAMETERS];
 /// Solve the n × n system (A + λ·diag A)·δ = −g on the free variables by Gaussian elimination
 /// with partial pivoting into `step` (zero for fixed variables); false if singular.
 fn damped_step(a: &[Row], g: &[f64], lambda: f64, free: &[bool], step: &mut [f64]) -> bool {
-    // The match below has an arm for every count up to the limit.
-    const _: () = assert!(MAX_PARAMETERS == 8);
     let n = g.len().min(MAX_PARAMETERS);
     let mut idx = [0usize; MAX_PARAMETERS];
     let mut m = 0;
@@ -93,6 +91,8 @@ fn damped_step(a: &[Row], g: &[f64], lambda: f64, free: &[bool], step: &mut [f64
 /// The m × m system `mat` (m ≤ [`MAX_PARAMETERS`], its column m the right-hand side) into
 /// `sol` by [`eliminate`] at that size; false if a pivot is zero.
 fn solve(mat: &mut [[f64; MAX_PARAMETERS + 1]; MAX_PARAMETERS], m: usize, sol: &mut [f64]) -> bool {
+    // The match below has an arm for every size up to the limit.
+    const _: () = assert!(MAX_PARAMETERS == 8);
     match m {
         0 => true,
         1 => eliminate::<1>(mat, sol),
