@@ -345,6 +345,11 @@ fn kappa(c: &BandLanes, x: &[[f64; LANES]; 3], s: usize) -> (f64, f64) {
 /// [`super::almi::invert`] over packed sets: the same inputs, the same pixel, bit for bit.
 /// On a CPU with AVX2 the lanes run four sets per instruction (two otherwise); not AVX-512,
 /// which measured 0–3 % slower on AMD Zen 4 and 25 % slower on Zen 5 (see [`crate::simd`]).
+/// What was tried on Zen 5 before keeping AVX2: at AVX-512 the lane-by-lane selects of
+/// `Scaled::enumerate` compile to k-masked scalar moves (`vmovsd {k}`, the hottest
+/// instructions in perf); written support by support over a quad's lanes, that build recovered
+/// to about 5 % behind AVX2, and AVX2 itself moved within the noise; accumulating the sums of
+/// all eight lanes at once (one zmm per sum) left AVX-512 about 35 % behind AVX2.
 #[must_use]
 pub fn invert_packed(
     scratch: &mut Scratch,
