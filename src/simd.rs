@@ -187,16 +187,12 @@ pub fn check_env() -> Result<(), String> {
 #[must_use]
 pub fn widest_level() -> String {
     let name = match tier() {
-        Tier::Avx512 => "AVX-512",
+        Tier::Avx512 if throughput_at_512() => "AVX-512 (512 bits at full width)",
+        Tier::Avx512 => "AVX-512 (throughput-bound kernels at AVX2)",
         Tier::Avx2 => "AVX2+FMA",
         Tier::Baseline => "portable",
     };
-    let name = match tier() {
-        Tier::Avx512 if full_width_512() => format!("{name} (512 bits at full width)"),
-        Tier::Avx512 => format!("{name} (throughput-bound kernels at AVX2)"),
-        _ => name.into(),
-    };
-    if tier() < Tier::of_cpu() { format!("{name} (capped by {CAP_ENV})") } else { name }
+    if tier() < Tier::of_cpu() { format!("{name} (capped by {CAP_ENV})") } else { name.into() }
 }
 
 /// Run `kernel` at the widest level the CPU has: AVX-512 (F and VL) with AVX2 and FMA, or AVX2
@@ -219,11 +215,18 @@ pub fn widest<K: Kernel>(kernel: K) -> K::Output {
 /// (the SAMBUCA-style fit of 28 bands 1.33× as fast as at AVX2, the exact correction 1.1×).
 #[inline]
 pub fn throughput<K: Kernel>(kernel: K) -> K::Output {
-    match tier() {
-        #[cfg(target_arch = "x86_64")]
-        Tier::Avx512 if full_width_512() => x86::avx512(kernel),
-        _ => avx2(kernel),
+    #[cfg(target_arch = "x86_64")]
+    if throughput_at_512() {
+        return x86::avx512(kernel);
     }
+    avx2(kernel)
+}
+
+/// Whether [`throughput`] runs its kernels at AVX-512: the level allows it and the CPU runs
+/// 512-bit instructions at full width (what the dispatch, the padding of
+/// [`throughput_f64_lanes`] and [`widest_level`] all read).
+fn throughput_at_512() -> bool {
+    tier() == Tier::Avx512 && full_width_512()
 }
 
 /// Whether the CPU's 512-bit instructions run at full width: AMD family 1Ah (Zen 5) and later.
@@ -249,10 +252,7 @@ pub fn full_width_512() -> bool {
 /// (what a kernel pads its loops to, so that they run whole vectors).
 #[must_use]
 pub fn throughput_f64_lanes() -> usize {
-    match tier() {
-        Tier::Avx512 if full_width_512() => 8,
-        _ => 4,
-    }
+    if throughput_at_512() { 8 } else { 4 }
 }
 
 /// The family of a CPUID leaf 1 signature (EAX): bits 8–11, plus bits 20–27 where those are Fh.
