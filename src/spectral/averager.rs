@@ -52,27 +52,30 @@ impl BandAverager {
         xs.push(b);
         xs.sort_by(f64::total_cmp);
         xs.dedup_by(|p, q| (*p - *q).abs() < 1e-12);
+        // The SRF at every breakpoint, read once (each is an end of two intervals).
+        let at_breakpoints: Vec<f64> = xs.iter().map(|&x| srf(x)).collect();
         let mut weights = vec![0.0; g.len()];
         let mut inside = 0.0;
-        for w in xs.windows(2) {
-            let (x0, x1) = (w[0], w[1]);
+        for (w, s) in xs.windows(2).zip(at_breakpoints.windows(2)) {
+            let (x0, x1, s0, s1) = (w[0], w[1], s[0], s[1]);
             if x1 <= x0 {
                 continue;
             }
             let xm = 0.5 * (x0 + x1);
+            let sm = srf(xm);
+            let simpson = |f0: f64, fm: f64, f1: f64| (x1 - x0) / 6.0 * (f0 + 4.0 * fm + f1);
             // Grid interval [g[j-1], g[j]] that contains this sub-interval.
             let j = g.partition_point(|&v| v <= xm).clamp(1, g.len().max(2) - 1);
             if g.len() == 1 {
-                let seg = (x1 - x0) / 6.0 * (srf(x0) + 4.0 * srf(xm) + srf(x1));
+                let seg = simpson(s0, sm, s1);
                 weights[0] += seg;
                 inside += seg;
                 continue;
             }
             let (gl, gr) = (g[j - 1], g[j]);
             let hat_r = |x: f64| (x - gl) / (gr - gl);
-            let simpson = |f: &dyn Fn(f64) -> f64| (x1 - x0) / 6.0 * (f(x0) + 4.0 * f(xm) + f(x1));
-            let right = simpson(&|x| srf(x) * hat_r(x));
-            let left = simpson(&|x| srf(x) * (1.0 - hat_r(x)));
+            let right = simpson(s0 * hat_r(x0), sm * hat_r(xm), s1 * hat_r(x1));
+            let left = simpson(s0 * (1.0 - hat_r(x0)), sm * (1.0 - hat_r(xm)), s1 * (1.0 - hat_r(x1)));
             weights[j - 1] += left;
             weights[j] += right;
             inside += left + right;
