@@ -16,6 +16,7 @@ use rayon::prelude::*;
 
 use super::AtmosphereError;
 use super::rt::{Scatterers, SsCoefficients, WavelengthColumn, fourier_sum_with, solve_sun, solve_transmittance};
+use super::single_scattering::ScatteringGeometry;
 use super::spec::{Atmosphere, AtmosphereTerms, Geometry, Normalised};
 use super::stokes;
 
@@ -148,6 +149,8 @@ struct AtGeometry {
     muv: f64,
     /// cos(mψ), ψ = π − Δφ, for each Fourier term m ([`fourier_sum_with`]).
     cos_m_psi: Vec<f64>,
+    /// The scattering angles of the single-scattering paths.
+    scattering: ScatteringGeometry,
 }
 
 impl AtmosphereLut {
@@ -248,6 +251,12 @@ impl AtmosphereLut {
         self.atmosphere.assemble(&self.normalised(w, g)?)
     }
 
+    /// The spherical albedo S at each wavelength node (it depends on no geometry).
+    #[must_use]
+    pub fn spherical_albedo_at_nodes(&self) -> &[f64] {
+        &self.spherical_albedo
+    }
+
     /// The atmosphere this table was built for.
     #[must_use]
     pub fn atmosphere(&self) -> &Atmosphere {
@@ -272,7 +281,7 @@ impl AtmosphereLut {
                 allowed: format!("0 to {}", a.wavelengths_nm.len() - 1),
             });
         }
-        Ok(self.normalised_at(w, g, glint, &at))
+        Ok(self.normalised_at(w, g, glint, &at, &mut vec![0.0; self.n_fourier]))
     }
 
     /// [`Self::normalised_with`] at every wavelength node, the geometry's part (its check, the
@@ -280,7 +289,8 @@ impl AtmosphereLut {
     /// values, for a spectrum along one geometry.
     pub fn normalised_all(&self, g: &Geometry, glint: bool) -> Result<Vec<Normalised>, AtmosphereError> {
         let at = self.at_geometry(g)?;
-        Ok((0..self.axes.wavelengths_nm.len()).map(|w| self.normalised_at(w, g, glint, &at)).collect())
+        let mut fourier = vec![0.0; self.n_fourier];
+        Ok((0..self.axes.wavelengths_nm.len()).map(|w| self.normalised_at(w, g, glint, &at, &mut fourier)).collect())
     }
 
     /// What [`Self::normalised_at`] needs of geometry `g` alone.
@@ -295,26 +305,31 @@ impl AtmosphereLut {
             mu0: g.sun_zenith_rad.cos(),
             muv: g.view_zenith_rad.cos(),
             cos_m_psi: (0..self.n_fourier).map(|m| (m as f64 * psi).cos()).collect(),
+            scattering: ScatteringGeometry::new(
+                g.sun_zenith_rad.cos(),
+                g.view_zenith_rad.cos(),
+                g.relative_azimuth_rad,
+            ),
         })
     }
 
-    /// The terms at wavelength node `w` (checked by the caller) and geometry `g` ([`Self::at_geometry`]).
-    fn normalised_at(&self, w: usize, g: &Geometry, glint: bool, at: &AtGeometry) -> Normalised {
+    /// The terms at wavelength node `w` (checked by the caller) and geometry `g` ([`Self::at_geometry`]);
+    /// `fourier` is scratch space of `n_fourier` values.
+    fn normalised_at(&self, w: usize, g: &Geometry, glint: bool, at: &AtGeometry, fourier: &mut [f64]) -> Normalised {
         let a = &self.axes;
         let (ns, nv, nf) = (a.sun_zenith_deg.len(), a.view_zenith_deg.len(), self.n_fourier);
-        let AtGeometry { ref corners, sun: (s0, s1, ts), view: (v0, v1, tv), mu0, muv, ref cos_m_psi } = *at;
-        let mut fourier = vec![0.0; nf];
+        let AtGeometry { ref corners, sun: (s0, s1, ts), view: (v0, v1, tv), mu0, muv, ref cos_m_psi, ref scattering } =
+            *at;
+        fourier.fill(0.0);
         for &(s, v, weight) in corners {
             let node = (w * ns + s) * nv + v;
             for (f, c) in fourier.iter_mut().zip(&self.ms[node * nf..(node + 1) * nf]) {
                 *f += weight * c;
             }
         }
-        let parts: Vec<(f64, &SsCoefficients)> =
-            corners.iter().map(|&(s, v, weight)| (weight, &self.ss[(w * ns + s) * nv + v])).collect();
+        let parts = corners.map(|(s, v, weight)| (weight, &self.ss[(w * ns + s) * nv + v]));
         let ss = SsCoefficients::weighted(&parts);
-        let radiance = fourier_sum_with(&fourier, cos_m_psi)
-            + self.scatterers[w].single_scattering(&ss, mu0, muv, g.relative_azimuth_rad);
+        let radiance = fourier_sum_with(fourier, cos_m_psi) + self.scatterers[w].single_scattering_at(&ss, scattering);
         let lerp = |x: f64, y: f64, t: f64| x + t * (y - x);
         let ed = lerp(self.ed[w * ns + s0], self.ed[w * ns + s1], ts);
         let t_up = lerp(self.t_up[w * nv + v0], self.t_up[w * nv + v1], tv);

@@ -31,6 +31,7 @@ mod profile;
 mod quadrature;
 mod rayleigh;
 mod rt;
+mod single_scattering;
 mod solar;
 mod sos;
 mod sos_transfer;

@@ -28,6 +28,23 @@ pub enum PhaseFunction {
     },
 }
 
+/// A scattering angle Θ: its cosine and Θ itself (radians, the cosine clamped to [−1, 1]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ScatteringAngle {
+    /// cos Θ as given.
+    pub cos: f64,
+    /// Θ, radians.
+    pub theta_rad: f64,
+}
+
+impl ScatteringAngle {
+    /// The angle with cosine `cos_theta`.
+    #[must_use]
+    pub fn new(cos_theta: f64) -> Self {
+        Self { cos: cos_theta, theta_rad: cos_theta.clamp(-1.0, 1.0).acos() }
+    }
+}
+
 impl PhaseFunction {
     /// A tabulated phase function from angles in degrees (0…180) and values; renormalised so
     /// that ½∫P dcosΘ = 1 exactly under the interpolation used.
@@ -60,12 +77,24 @@ impl PhaseFunction {
     #[must_use]
     pub fn value(&self, cos_theta: f64) -> f64 {
         match self {
+            // No angle needed: the arccosine is left untaken.
+            Self::Rayleigh { .. } => self.value_at(&ScatteringAngle { cos: cos_theta, theta_rad: f64::NAN }),
+            Self::Tabulated { .. } => self.value_at(&ScatteringAngle::new(cos_theta)),
+        }
+    }
+
+    /// P at `angle`: [`Self::value`] with the angle's arccosine taken once for many phase
+    /// functions (a LUT's wavelength nodes all scatter through the same angles).
+    #[must_use]
+    pub fn value_at(&self, angle: &ScatteringAngle) -> f64 {
+        match self {
             Self::Rayleigh { depolarization } => {
                 let b2 = rayleigh_beta2(*depolarization);
+                let cos_theta = angle.cos;
                 1.0 + b2 * 0.5 * (3.0 * cos_theta * cos_theta - 1.0)
             }
             Self::Tabulated { angles_rad, ln_values } => {
-                let theta = cos_theta.clamp(-1.0, 1.0).acos();
+                let theta = angle.theta_rad;
                 let j = angles_rad.partition_point(|&a| a <= theta).clamp(1, angles_rad.len() - 1);
                 let t = (theta - angles_rad[j - 1]) / (angles_rad[j] - angles_rad[j - 1]);
                 (ln_values[j - 1] + t * (ln_values[j] - ln_values[j - 1])).exp()
