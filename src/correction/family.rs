@@ -162,15 +162,18 @@ impl AerosolFamily {
         }
         // Every LUT bound to each geometry group's grid: the Rayleigh atmosphere (shared by the
         // models' first node), each model's other nodes, and the gas-free one where there is one.
+        let fail = |e: crate::scene::SceneError| invalid("correction.image", e.to_string());
+        let first: Vec<PathOptics> = response
+            .groups
+            .iter()
+            .map(|g| PathOptics::new(scene, &g.grid, luts.luts[0][0].clone()))
+            .collect::<Result<_, _>>()
+            .map_err(fail)?;
+        // The others share the first's solar spectrum and node brackets on each grid.
         let bind = |lut: &std::sync::Arc<AtmosphereLut>| -> Result<Vec<PathOptics>, CorrectionError> {
-            response
-                .groups
-                .iter()
-                .map(|g| PathOptics::new(scene, &g.grid, lut.clone()))
-                .collect::<Result<Vec<_>, _>>()
-                .map_err(|e| invalid("correction.image", e.to_string()))
+            first.iter().map(|p| p.rebind(scene, lut.clone())).collect::<Result<Vec<_>, _>>().map_err(fail)
         };
-        let mut bound = vec![bind(&luts.luts[0][0])?];
+        let mut bound = vec![first.clone()];
         for row in &luts.luts {
             for lut in &row[1..] {
                 bound.push(bind(lut)?);

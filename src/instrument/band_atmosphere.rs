@@ -205,27 +205,43 @@ pub struct BandMeans {
 /// [`BandMeans`] of the band with weights `w` from grid index `first`, through `path`.
 #[must_use]
 pub fn band_means(path: &PathSpectrum, first: usize, w: &[f64]) -> BandMeans {
+    let te: Vec<f64> = te_of(path, first, w).collect();
+    let te_sum: f64 = te.iter().sum();
+    let [l_path, t_ed, spherical_albedo, glint] = means_with(path, first, w, (te.iter().copied(), te_sum));
+    let total: f64 = w.iter().sum();
+    let ed = w.iter().zip(&path.ed[first..first + w.len()]).map(|(a, x)| a * x).sum::<f64>() / total;
+    BandMeans { total, l_path, glint, ed, t_ed, spherical_albedo, te, te_sum }
+}
+
+/// [L_path, T·Ed, S, glint] of [`band_means`], the same values, without holding w·T_up·Ed: what
+/// the band terms read.
+#[must_use]
+fn band_terms_only(path: &PathSpectrum, first: usize, w: &[f64]) -> [f64; 4] {
+    means_with(path, first, w, (te_of(path, first, w), te_of(path, first, w).sum()))
+}
+
+/// w·T_up·Ed on the band's grid points.
+fn te_of<'a>(path: &'a PathSpectrum, first: usize, w: &'a [f64]) -> impl Iterator<Item = f64> + 'a {
+    let span = first..first + w.len();
+    w.iter().zip(&path.t_up[span.clone()]).zip(&path.ed[span]).map(|((a, t), e)| a * t * e)
+}
+
+/// [L_path, T·Ed, S, glint] from w·T_up·Ed (`te`) and its sum.
+fn means_with(
+    path: &PathSpectrum,
+    first: usize,
+    w: &[f64],
+    (te, te_sum): (impl Iterator<Item = f64>, f64),
+) -> [f64; 4] {
     let span = first..first + w.len();
     let total: f64 = w.iter().sum();
     let dot = |v: &[f64]| w.iter().zip(&v[span.clone()]).map(|(a, x)| a * x).sum::<f64>() / total;
-    let te: Vec<f64> =
-        w.iter().zip(&path.t_up[span.clone()]).zip(&path.ed[span.clone()]).map(|((a, t), e)| a * t * e).collect();
-    let te_sum: f64 = te.iter().sum();
     let spherical_albedo = if te_sum > 0.0 {
-        te.iter().zip(&path.spherical_albedo[span.clone()]).map(|(a, s)| a * s).sum::<f64>() / te_sum
+        te.zip(&path.spherical_albedo[span.clone()]).map(|(a, s)| a * s).sum::<f64>() / te_sum
     } else {
         0.0
     };
-    BandMeans {
-        total,
-        l_path: dot(&path.l_path),
-        glint: dot(&path.glint),
-        ed: dot(&path.ed),
-        t_ed: te_sum / total,
-        spherical_albedo,
-        te,
-        te_sum,
-    }
+    [dot(&path.l_path), te_sum / total, spherical_albedo, dot(&path.glint)]
 }
 
 /// Band-effective atmosphere of every column: index column·bands + band.
@@ -324,8 +340,7 @@ pub fn band_terms_of_each(
                             .enumerate()
                             .map(|(k, &b)| {
                                 let (first, w) = response.weights(gi, k, j);
-                                let m = band_means(&path, first, w);
-                                (si * nb + b, [m.l_path, m.t_ed, m.spherical_albedo, m.glint])
+                                (si * nb + b, band_terms_only(&path, first, w))
                             })
                             .collect())
                     })

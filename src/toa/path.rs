@@ -25,6 +25,8 @@ pub struct PathOptics {
     lut: Arc<AtmosphereLut>,
     /// Per grid wavelength: bracketing LUT nodes and the weight in ln λ.
     nodes: Vec<(usize, usize, f64)>,
+    /// The spherical albedo on the grid: it depends on no geometry, so it is interpolated once.
+    spherical_albedo: Vec<f64>,
     glint: bool,
 }
 
@@ -39,28 +41,36 @@ pub(super) fn ln_bracket(node_wl: &[f64], wavelength_nm: f64) -> (usize, usize, 
     (j - 1, j, t.clamp(0.0, 1.0))
 }
 
+/// The LUT's spherical albedo on the grid whose node brackets are `nodes` (log–log in λ).
+fn spherical_albedo_on(lut: &AtmosphereLut, nodes: &[(usize, usize, f64)]) -> Vec<f64> {
+    let albedo = lut.spherical_albedo_at_nodes();
+    let ln_albedo: Vec<f64> = albedo.iter().map(|s| s.ln()).collect();
+    nodes.iter().map(|&(j0, j1, t)| loglin(albedo[j0], albedo[j1], ln_albedo[j0], ln_albedo[j1], t)).collect()
+}
+
 /// One LUT node's terms and the logarithms of those interpolated log–log.
+/// (The spherical albedo's are [`PathOptics::new`]'s: it depends on no geometry.)
 struct Node {
     at: Normalised,
     /// τ_Rayleigh + τ_aerosol.
     tau: f64,
     ln_radiance: f64,
     ln_ed: f64,
+    /// ln τ where the whole spectrum is asked for (band terms do not read τ), else NaN.
     ln_tau: f64,
-    ln_spherical_albedo: f64,
+    /// ln of the glint where the path has glint (0 and so −∞ otherwise, never read).
     ln_glint: f64,
 }
 
 impl Node {
-    fn new(at: Normalised) -> Self {
+    fn new(at: Normalised, full: bool, glint: bool) -> Self {
         let tau = at.tau_rayleigh + at.tau_aerosol;
         Self {
             tau,
             ln_radiance: at.radiance.ln(),
             ln_ed: at.ed.ln(),
-            ln_tau: tau.ln(),
-            ln_spherical_albedo: at.spherical_albedo.ln(),
-            ln_glint: at.glint.ln(),
+            ln_tau: if full { tau.ln() } else { f64::NAN },
+            ln_glint: if glint { at.glint.ln() } else { f64::NEG_INFINITY },
             at,
         }
     }
@@ -94,7 +104,20 @@ impl PathOptics {
                 Ok(ln_bracket(node_wl, w))
             })
             .collect::<Result<Vec<_>, SceneError>>()?;
-        Ok(Self { grid: grid.clone(), e0, lut, nodes, glint: scene.wants(Effect::SunGlint) })
+        let spherical_albedo = spherical_albedo_on(&lut, &nodes);
+        Ok(Self { grid: grid.clone(), e0, lut, nodes, spherical_albedo, glint: scene.wants(Effect::SunGlint) })
+    }
+
+    /// [`Self::new`] of the same scene and grid with another `lut`: where that LUT has the same
+    /// wavelength nodes and day (the image-based correction's family: one LUT per aerosol model
+    /// and AOT), the solar spectrum and node brackets are this binding's, not computed again.
+    pub fn rebind(&self, scene: &Scene, lut: Arc<AtmosphereLut>) -> Result<Self, SceneError> {
+        let same_day = lut.atmosphere().spec().day_of_year == self.lut.atmosphere().spec().day_of_year;
+        if !(same_day && lut.axes().wavelengths_nm == self.lut.axes().wavelengths_nm) {
+            return Self::new(scene, &self.grid, lut);
+        }
+        let spherical_albedo = spherical_albedo_on(&lut, &self.nodes);
+        Ok(Self { lut, spherical_albedo, ..self.clone() })
     }
 
     /// The simulation grid.
@@ -142,7 +165,7 @@ impl PathOptics {
 
     /// What band-effective terms read of [`Self::path_spectrum_with`] — L_path, Ed, T_up, S
     /// and the glint — at the grid indices `needed` marks (a band's span of weights); every other
-    /// entry, and `ed_direct`, `t_up_diffuse` and `rayleigh_share`, are left 0. The entries
+    /// entry is left 0, and `ed_direct`, `t_up_diffuse` and `rayleigh_share` are empty. The entries
     /// computed are the full spectrum's, bit for bit (the same formulas); the image-based
     /// correction's family reads twenty atmospheres this way, and its bands cover part of the grid.
     pub fn band_path_with(
@@ -170,16 +193,19 @@ impl PathOptics {
             own = self.gas_legs(g)?;
             &own
         };
-        let nodes: Vec<Node> = self.lut.normalised_all(g, self.glint)?.into_iter().map(Node::new).collect();
+        let every = needed.is_none();
+        let nodes: Vec<Node> =
+            self.lut.normalised_all(g, self.glint)?.into_iter().map(|at| Node::new(at, every, self.glint)).collect();
+        let all = |on: bool| if on { vec![0.0; n] } else { Vec::new() };
         let mut p = PathSpectrum {
             l_path: vec![0.0; n],
             ed: vec![0.0; n],
-            ed_direct: vec![0.0; n],
+            ed_direct: all(every),
             t_up: vec![0.0; n],
-            t_up_diffuse: vec![0.0; n],
+            t_up_diffuse: all(every),
             spherical_albedo: vec![0.0; n],
             glint: vec![0.0; n],
-            rayleigh_share: vec![0.0; n],
+            rayleigh_share: all(every),
         };
         let lin = |a: f64, b: f64, t: f64| a + t * (b - a);
         for i in 0..n {
@@ -199,8 +225,7 @@ impl PathOptics {
             p.ed[i] = loglin(a.ed, b.ed, na.ln_ed, nb.ln_ed, t) * e0 * tg0;
             let t_up = lin(a.t_up, b.t_up, t);
             p.t_up[i] = t_up * tgv;
-            p.spherical_albedo[i] =
-                loglin(a.spherical_albedo, b.spherical_albedo, na.ln_spherical_albedo, nb.ln_spherical_albedo, t);
+            p.spherical_albedo[i] = self.spherical_albedo[i];
             if self.glint {
                 p.glint[i] = loglin(a.glint, b.glint, na.ln_glint, nb.ln_glint, t) * e0 * tg0 * tgv;
             }
