@@ -161,7 +161,7 @@ pub fn run(args: &CorrectArgs) -> Result<(), CliError> {
     (atmosphere.aerosol, atmosphere.aot550) = (AerosolType::None, 0.0);
     let fail = |e: crate::correction::CorrectionError| CliError::Input(e.to_string());
     let luts = FamilyLuts::build(&image, &atmosphere, &axes, &control).map_err(fail)?;
-    let family = AerosolFamily::tabulate(&luts, &scene, &response, &viewing, false, &control).map_err(fail)?;
+    let family = AerosolFamily::tabulate(&luts, &scene, &response, &viewing, None, &control).map_err(fail)?;
     let level1 = Level1 { radiance, flags: Array3::zeros((1, rows, nb)) };
     let water = crate::instrument::SurfaceMap::all_water((1, rows));
     let (rrs, aerosol) = correct_image(&level1, &family, &image, &response.bands, &water, &control).map_err(fail)?;

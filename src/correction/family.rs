@@ -148,13 +148,13 @@ impl FamilyLuts {
 
 impl AerosolFamily {
     /// The family's band terms over an instrument's geometry and bands; `across_track`: the
-    /// viewing's columns are a swath (see `band_terms`).
+    /// viewing's columns are a swath, computed at that many columns (see `band_terms_of_each`).
     pub fn tabulate(
         luts: &FamilyLuts,
         scene: &Scene,
         response: &Response,
         viewing: &Viewing,
-        across_track: bool,
+        across_track: Option<usize>,
         control: &RunControl,
     ) -> Result<Self, CorrectionError> {
         if control.cancelled() {

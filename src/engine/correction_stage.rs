@@ -165,8 +165,10 @@ impl Engine {
             .after(side.geometry_key)
             .with(&side.scene.spec.effects)
             .finish();
+        // A preview computes the terms at fewer columns across the swath (its own key: the geometry's).
+        let columns = crate::instrument::band_atmosphere::term_columns(fid.decimation);
         let fam = self.stage(key, report, control, || {
-            AerosolFamily::tabulate(&luts, &side.scene, &side.response, &side.viewing, true, control)
+            AerosolFamily::tabulate(&luts, &side.scene, &side.response, &side.viewing, Some(columns), control)
                 .map_err(failed(Stage::AerosolFamily))
         })?;
         Ok(Some((fam, key)))

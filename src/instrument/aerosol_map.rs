@@ -102,7 +102,7 @@ impl AotNodes {
         response: &Response,
     ) -> Result<Self, InstrumentError> {
         let paths: Vec<Vec<&PathOptics>> = paths.iter().map(|p| p.iter().collect()).collect();
-        let terms = band_terms_of_each(&paths, viewing, response, false)?;
+        let terms = band_terms_of_each(&paths, viewing, response, None)?;
         Ok(Self { aot550, terms, n_bands: response.n_bands() })
     }
 

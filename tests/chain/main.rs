@@ -44,6 +44,7 @@ mod spectral_knowledge;
 mod spectrum;
 mod study;
 mod sweep;
+mod term_columns;
 mod user_data;
 mod worker;
 

@@ -109,7 +109,7 @@ fn band_terms_of_several_atmospheres_are_each_ones_own_bit_for_bit() {
         })
         .collect();
     // Across track (33 sampled columns interpolated) and at every column.
-    for across_track in [true, false] {
+    for across_track in [Some(shoal::instrument::band_atmosphere::TERM_COLUMNS), None] {
         let paths: Vec<Vec<&PathOptics>> = bound.iter().map(|o| o.iter().map(SceneOptics::path).collect()).collect();
         let together = band_terms_of_each(&paths, &viewing, &response, across_track).unwrap();
         for (o, t) in bound.iter().zip(&together) {
