@@ -71,10 +71,18 @@ impl TruthRrsSample {
         // Counted, then walked again: the water pixels' indices are not held (8 bytes a pixel).
         let all = || (0..rows * cols).filter(|&i| surface.is_water(i / cols, i % cols));
         let water: Vec<usize> = all().step_by((all().count() / RRS_SAMPLES).max(1)).collect();
-        let bands_of = |i: usize| (0..nb).map(move |b| truth[[i / cols, i % cols, b]]);
-        let water_rrs = water.iter().flat_map(|&i| bands_of(i)).collect();
+        // A pixel's bands: a slice of the cube where it is laid out row-major (as every stage
+        // makes it), copied whole; element by element otherwise.
+        let flat = truth.as_slice();
+        let take = |out: &mut Vec<f32>, i: usize| match flat {
+            Some(f) => out.extend_from_slice(&f[i * nb..(i + 1) * nb]),
+            None => out.extend((0..nb).map(|b| truth[[i / cols, i % cols, b]])),
+        };
+        let mut water_rrs = Vec::with_capacity(water.len() * nb);
+        water.iter().for_each(|&i| take(&mut water_rrs, i));
         let stride = (rows * cols / MEDIAN_SAMPLES).max(1);
-        let strided_rrs = (0..rows * cols).step_by(stride).flat_map(bands_of).collect();
+        let mut strided_rrs = Vec::with_capacity((rows * cols).div_ceil(stride) * nb);
+        (0..rows * cols).step_by(stride).for_each(|i| take(&mut strided_rrs, i));
         Self { dim: (rows, cols, nb), water, water_rrs, stride, strided_rrs }
     }
 
