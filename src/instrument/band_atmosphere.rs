@@ -387,8 +387,8 @@ fn across_columns(at: &BandTerms, sampled: &[usize], nc: usize, nb: usize) -> Ba
 }
 
 /// Columns at which [`band_terms`] computes the family's terms when it may interpolate. Against
-/// every column's terms, Sentinel-3 OLCI's 7.8° half swath leaves 4·10⁻⁵ of the path radiance,
-/// most of it at nadir, where the view zenith turns back (test `term_columns`).
+/// every column's terms, Sentinel-3 OLCI's 7.8° half swath leaves 4·10⁻⁵ of the path radiance
+/// (test `term_columns`).
 pub const TERM_COLUMNS: usize = 33;
 
 /// Columns of the family's terms at a preview that keeps every `decimation`-th detector: 33 at
