@@ -110,7 +110,8 @@ impl PathOptics {
 
     /// [`Self::new`] of the same scene and grid with another `lut`: where that LUT has the same
     /// wavelength nodes and day (the image-based correction's family: one LUT per aerosol model
-    /// and AOT), the solar spectrum and node brackets are this binding's, not computed again.
+    /// and AOT), the solar spectrum and node brackets are this binding's, not computed again
+    /// (every atmosphere's E₀ is TSIS-1 scaled to its day: `AtmosphereSpec::build`).
     pub fn rebind(&self, scene: &Scene, lut: Arc<AtmosphereLut>) -> Result<Self, SceneError> {
         let same_day = lut.atmosphere().spec().day_of_year == self.lut.atmosphere().spec().day_of_year;
         if !(same_day && lut.axes().wavelengths_nm == self.lut.axes().wavelengths_nm) {
