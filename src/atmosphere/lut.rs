@@ -298,18 +298,15 @@ impl AtmosphereLut {
         g.validate()?;
         let (corners, sun, view) = corners(&self.axes, g)?;
         let psi = std::f64::consts::PI - g.relative_azimuth_rad;
+        let (mu0, muv) = (g.sun_zenith_rad.cos(), g.view_zenith_rad.cos());
         Ok(AtGeometry {
             corners,
             sun,
             view,
-            mu0: g.sun_zenith_rad.cos(),
-            muv: g.view_zenith_rad.cos(),
+            mu0,
+            muv,
             cos_m_psi: (0..self.n_fourier).map(|m| (m as f64 * psi).cos()).collect(),
-            scattering: ScatteringGeometry::new(
-                g.sun_zenith_rad.cos(),
-                g.view_zenith_rad.cos(),
-                g.relative_azimuth_rad,
-            ),
+            scattering: ScatteringGeometry::new(mu0, muv, g.relative_azimuth_rad),
         })
     }
 

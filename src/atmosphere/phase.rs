@@ -76,11 +76,7 @@ impl PhaseFunction {
     /// P at scattering angle with cosine `cos_theta`.
     #[must_use]
     pub fn value(&self, cos_theta: f64) -> f64 {
-        match self {
-            // No angle needed: the arccosine is left untaken.
-            Self::Rayleigh { .. } => self.value_at(&ScatteringAngle { cos: cos_theta, theta_rad: f64::NAN }),
-            Self::Tabulated { .. } => self.value_at(&ScatteringAngle::new(cos_theta)),
-        }
+        self.value_at(&ScatteringAngle::new(cos_theta))
     }
 
     /// P at `angle`: [`Self::value`] with the angle's arccosine taken once for many phase

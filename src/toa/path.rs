@@ -197,16 +197,17 @@ impl PathOptics {
         let every = needed.is_none();
         let nodes: Vec<Node> =
             self.lut.normalised_all(g, self.glint)?.into_iter().map(|at| Node::new(at, every, self.glint)).collect();
-        let all = |on: bool| if on { vec![0.0; n] } else { Vec::new() };
+        // What only the whole spectrum holds.
+        let if_every = || if every { vec![0.0; n] } else { Vec::new() };
         let mut p = PathSpectrum {
             l_path: vec![0.0; n],
             ed: vec![0.0; n],
-            ed_direct: all(every),
+            ed_direct: if_every(),
             t_up: vec![0.0; n],
-            t_up_diffuse: all(every),
+            t_up_diffuse: if_every(),
             spherical_albedo: vec![0.0; n],
             glint: vec![0.0; n],
-            rayleigh_share: all(every),
+            rayleigh_share: if_every(),
         };
         let lin = |a: f64, b: f64, t: f64| a + t * (b - a);
         for i in 0..n {
