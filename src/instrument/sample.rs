@@ -30,10 +30,12 @@ use super::truth::{SurfaceClass, SurfaceMap, Truth};
 use crate::control::RunControl;
 use crate::parse::FieldError;
 use crate::scene::{Scene, Sky};
-use crate::toa::{SceneOptics, Scratch, Target};
+use crate::toa::{SceneOptics, Scratch};
 
 pub use super::aerosol_map::AotNodes;
 pub use super::band_atmosphere::{BandAtmosphere, BandWeights, NodeWeights};
+
+mod lanes;
 
 /// Rows per work block of [`sample_radiance`].
 const BLOCK_ROWS: usize = 32;
@@ -139,7 +141,7 @@ pub fn sample_radiance(
                     return Err(InstrumentError::Cancelled);
                 }
                 // Written before it is read: the zeroed allocation is still unmapped, so this first
-                // touch maps fresh pages. Read first (the `+=` of `pixel`), each page would map the
+                // touch maps fresh pages. Read first (the band sums' `+=`), each page would map the
                 // kernel's shared zero page and then be copied on the first write, with a TLB flush
                 // sent to every core (an inter-processor interrupt, a VM exit here): 8 % of the
                 // default study's CPU time, measured with perf.
@@ -158,33 +160,18 @@ pub fn sample_radiance(
                     offsets: &offsets,
                 };
                 let mut work = PixelWork::new(optics);
+                let mut block = lanes::Block {
+                    first_row,
+                    rows: n_rows,
+                    radiance: rad_block,
+                    truth_rrs: rrs_block,
+                    maps: [chl_b, nap_b, cdom_b, depth_b],
+                    land: land_block,
+                    fractions: frac_block,
+                    aot: aot_block,
+                };
                 for c in 0..cols {
-                    for rr in 0..n_rows {
-                        let r = first_row + rr;
-                        let mut at = control.row(r);
-                        at.column(c);
-                        let at = rr * pixel + c * nb;
-                        sampler.pixel(&mut work, r, c, &mut rad_block[at..at + nb], &mut rrs_block[at..at + nb])?;
-                        let (x, y) = viewing.ground_m(0, r, c);
-                        if let Some(nodes) = aerosol_map {
-                            let tau = scene.aot550_at(x, y);
-                            nodes.exchange(atmosphere, c, tau, &mut rad_block[at..at + nb]);
-                            aot_block[rr * cols + c] = tau as f32;
-                        }
-                        let at = rr * cols + c;
-                        let fractions = if shallow {
-                            Some(&mut frac_block[rr * frac_stride + c * n_sub..rr * frac_stride + (c + 1) * n_sub])
-                        } else {
-                            None
-                        };
-                        let look = &viewing.looks[0][c];
-                        let sky = scene.sky_at(x, y, look.geometry.view_zenith_rad, look.view_azimuth_rad);
-                        let values = truth_at(scene, x, y, sky, &mut land_block[at], fractions);
-                        (chl_b[at], nap_b[at], cdom_b[at]) = (values[0], values[1], values[2]);
-                        if shallow {
-                            depth_b[at] = values[3];
-                        }
-                    }
+                    sampler.column(&mut work, &mut block, c, (aerosol_map, control))?;
                     if control.cancelled() {
                         return Err(InstrumentError::Cancelled);
                     }
@@ -234,6 +221,10 @@ struct PixelWork {
     spectra: Vec<(Vec<f64>, Vec<f64>)>,
     /// Per group: Rrs and f = Rrs/(1 − S·π·Rrs) at the band nodes (empty without them).
     at_nodes: Vec<(Vec<f64>, Vec<f64>)>,
+    /// Rrs at the band nodes of each water lane of a run ([`lanes::LANES`] × nodes).
+    lane_rrs: Vec<f64>,
+    /// f and Rrs at each node for the lanes ([`lanes`]'s kernel).
+    lane_f: Vec<[[f64; lanes::LANES]; 2]>,
 }
 
 impl PixelWork {
@@ -243,130 +234,8 @@ impl PixelWork {
             scratch: Scratch::default(),
             spectra: optics.iter().map(|o| pair(o.grid().len())).collect(),
             at_nodes: optics.iter().map(|o| pair(o.band_nodes().map_or(0, <[usize]>::len))).collect(),
-        }
-    }
-}
-
-impl PixelSampler<'_> {
-    /// Add pixel (r, c)'s band radiance to `out` and its true band Rrs to `truth` (both zero on
-    /// entry), over every group and spatial quadrature point: at the band nodes where the
-    /// optics has them and the point is water, on the full grid otherwise.
-    fn pixel(
-        &self,
-        work: &mut PixelWork,
-        r: usize,
-        c: usize,
-        out: &mut [f32],
-        truth: &mut [f32],
-    ) -> Result<(), InstrumentError> {
-        let (atmosphere, kernel) = (self.atmosphere, self.kernel);
-        let j = self.viewing.detector_index[c];
-        for (gi, group) in self.response.groups.iter().enumerate() {
-            let optics = &self.optics[gi];
-            let look = &self.viewing.looks[gi][c];
-            let path = &atmosphere.paths[gi][c];
-            let (x0, y0) = self.viewing.ground_m(gi, r, c);
-            for (k, &(dx, dy)) in self.offsets.iter().enumerate() {
-                let (x, y) = (x0 + dx, y0 + dy);
-                let sky = self.scene.sky_at(x, y, look.geometry.view_zenith_rad, look.view_azimuth_rad);
-                let (node_rrs, node_f) = &mut work.at_nodes[gi];
-                if sky == Sky::Clear
-                    && atmosphere.has_nodes(gi)
-                    && optics.water_at_nodes(self.scene, x, y, &look.geometry, &mut work.scratch, node_rrs)?
-                {
-                    let weight = |b: usize| kernel.weights[b][k];
-                    crate::simd::avx2(AtNodes {
-                        sampler: self,
-                        gi,
-                        c,
-                        bands: &group.bands,
-                        weight,
-                        node_rrs,
-                        node_f,
-                        out,
-                        truth,
-                    });
-                    continue;
-                }
-                let (l_toa, rrs) = &mut work.spectra[gi];
-                let surface =
-                    optics.radiance(self.scene, x, y, &look.geometry, sky, path, &mut work.scratch, l_toa, rrs)?;
-                for (kb, &b) in group.bands.iter().enumerate() {
-                    let (first, w) = self.response.weights(gi, kb, j);
-                    let (num, den) = w
-                        .iter()
-                        .zip(&l_toa[first..first + w.len()])
-                        .fold((0.0, 0.0), |(n, d), (wi, v)| (n + wi * v, d + wi));
-                    let weight = kernel.weights[b][k];
-                    out[b] += (weight * num / den) as f32;
-                    if surface == Target::Water {
-                        let (tf, tw) = &self.truth_atmosphere.truth_weights[gi][c][kb];
-                        let t: f64 = tw.iter().zip(&rrs[*tf..*tf + tw.len()]).map(|(a, v)| a * v).sum();
-                        truth[b] += (weight * t) as f32;
-                    }
-                }
-            }
-        }
-        Ok(())
-    }
-}
-
-/// One water point's band sums at the band nodes (see [`PixelSampler::pixel`]), as a
-/// [`crate::simd::Kernel`]: f = Rrs/(1 − S·π·Rrs) at every node, then per band
-/// L_b += ω·(L_path + G + Σ Cₙ fₙ) and Rrs_b += ω·Σ Dₙ Rrsₙ. Compiled with AVX2 where the CPU has
-/// it, the division takes four nodes an instruction; nothing is fused, and each sum adds its
-/// terms in node order, so every level gives the same bits.
-struct AtNodes<'s, 'b, W> {
-    sampler: &'s PixelSampler<'s>,
-    /// Group and column.
-    gi: usize,
-    c: usize,
-    bands: &'b [usize],
-    /// The point's spatial weight in band b.
-    weight: W,
-    /// Rrs at the nodes (in), and f (out).
-    node_rrs: &'b [f64],
-    node_f: &'b mut [f64],
-    out: &'b mut [f32],
-    truth: &'b mut [f32],
-}
-
-impl<W: Fn(usize) -> f64> crate::simd::Kernel for AtNodes<'_, '_, W> {
-    type Output = ();
-
-    #[inline(always)]
-    fn run<L: crate::simd::Level>(self) {
-        let AtNodes { sampler, gi, c, bands, weight, node_rrs, node_f, out, truth } = self;
-        let atmosphere = sampler.atmosphere;
-        let s_pi = &atmosphere.node_s_pi[gi][c];
-        let n = node_f.len().min(node_rrs.len()).min(s_pi.len());
-        let (f, rrs, s_pi) = (&mut node_f[..n], &node_rrs[..n], &s_pi[..n]);
-        for i in 0..n {
-            f[i] = rrs[i] / (1.0 - s_pi[i] * rrs[i]);
-        }
-        let (f, rrs) = (&*f, rrs);
-        for (kb, &b) in bands.iter().enumerate() {
-            let nw = &atmosphere.node_weights[gi][c][kb];
-            let tw = &sampler.truth_atmosphere.node_weights[gi][c][kb];
-            let span = nw.first..nw.first + nw.radiance.len();
-            let (water, t) = if tw.first == nw.first && tw.truth.len() == nw.radiance.len() {
-                // One loop, two independent sums (the truth's weights are usually the radiance's).
-                let (mut water, mut t) = (-0.0, -0.0);
-                let terms = nw.radiance.iter().zip(&f[span.clone()]).zip(&tw.truth).zip(&rrs[span]);
-                for (((&cn, &fn_), &dn), &rn) in terms {
-                    water += cn * fn_;
-                    t += dn * rn;
-                }
-                (water, t)
-            } else {
-                let water: f64 = nw.radiance.iter().zip(&f[span]).map(|(a, v)| a * v).sum();
-                let t: f64 = tw.truth.iter().zip(&rrs[tw.first..]).map(|(a, v)| a * v).sum();
-                (water, t)
-            };
-            let i = atmosphere.at(c, b);
-            let weight = weight(b);
-            out[b] += (weight * (atmosphere.l_path[i] + atmosphere.glint[i] + water)) as f32;
-            truth[b] += (weight * t) as f32;
+            lane_rrs: Vec::new(),
+            lane_f: Vec::new(),
         }
     }
 }

@@ -1,0 +1,286 @@
+//! A block of rows, column by column, a few pixels of a column at once: [`PixelSampler::column`],
+//! [`PixelSampler::pixels`] and its band-sum kernel.
+//!
+//! The band sums at the nodes (L_b += ω·(L_path + G + Σ Cₙ fₙ), Rrs_b += ω·Σ Dₙ Rrsₙ, see
+//! [`super::sample_radiance`]) add each pixel's terms in node order, so a pixel's sum is a chain
+//! of dependent additions that cannot be split across vector lanes without changing its bits.
+//! Pixels of one column share the weights, though: [`LANES`] pixels of consecutive rows, one per
+//! vector lane, each add the same terms in the same order as alone — the same bits, a vector
+//! instruction for what took one per pixel.
+
+use super::{AotNodes, InstrumentError, PixelSampler, PixelWork, truth_at};
+use crate::control::RunControl;
+use crate::scene::Sky;
+use crate::toa::Target;
+
+/// Pixels (consecutive rows of one column) sampled together.
+pub(super) const LANES: usize = 8;
+
+/// Where a run of up to [`LANES`] pixels of one column writes: pixel `l` of the run (row
+/// `first_row + l`) at `at + l·stride` in `radiance` and `truth`, `n_bands` values each.
+pub(super) struct Run<'o> {
+    pub first_row: usize,
+    pub lanes: usize,
+    pub column: usize,
+    pub at: usize,
+    pub stride: usize,
+    pub radiance: &'o mut [f32],
+    pub truth: &'o mut [f32],
+}
+
+impl Run<'_> {
+    /// Pixel `l`'s radiance and truth.
+    fn pixel(&mut self, l: usize, nb: usize) -> (&mut [f32], &mut [f32]) {
+        let at = self.at + l * self.stride;
+        (&mut self.radiance[at..at + nb], &mut self.truth[at..at + nb])
+    }
+}
+
+/// A block of rows' outputs, each row-major within the block (see [`super::sample_radiance`]).
+pub(super) struct Block<'o> {
+    /// The block's first row and its number of rows.
+    pub first_row: usize,
+    pub rows: usize,
+    /// Band radiance and true band Rrs, (row, column, band); zero on entry.
+    pub radiance: &'o mut [f32],
+    pub truth_rrs: &'o mut [f32],
+    /// chl, NAP, CDOM, (row, column), and depth ((row, column) with a bottom, one float a row
+    /// without).
+    pub maps: [&'o mut [f32]; 4],
+    /// Surface classes, (row, column).
+    pub land: &'o mut [u8],
+    /// Substrate fractions, (row, column, substrate) with a bottom (one float a row without).
+    pub fractions: &'o mut [f32],
+    /// AOT(550) under each pixel centre, (row, column) with an aerosol map (one float a row
+    /// without).
+    pub aot: &'o mut [f32],
+}
+
+impl PixelSampler<'_> {
+    /// Column `c` of `block`: every pixel's band radiance (its aerosol exchanged where the
+    /// scene's AOT is a map) and its truth. Checks `control` at every pixel (a fault injected
+    /// at a pixel fires there; a panic while a run of pixels is summed is placed at the run's
+    /// first pixel).
+    pub(super) fn column(
+        &self,
+        work: &mut PixelWork,
+        block: &mut Block<'_>,
+        c: usize,
+        (aerosol_map, control): (Option<&AotNodes>, &RunControl),
+    ) -> Result<(), InstrumentError> {
+        let (scene, viewing) = (self.scene, self.viewing);
+        let cols = viewing.columns();
+        let nb = self.response.n_bands();
+        let pixel = cols * nb;
+        let shallow = scene.depth.is_some();
+        let n_sub = scene.substrates.len();
+        let frac_stride = if shallow { (cols * n_sub).max(1) } else { 1 };
+        for rr0 in (0..block.rows).step_by(LANES) {
+            let n_lanes = LANES.min(block.rows - rr0);
+            for rr in rr0 + 1..rr0 + n_lanes {
+                control.row(block.first_row + rr).column(c);
+            }
+            let mut at = control.row(block.first_row + rr0);
+            at.column(c);
+            let mut run = Run {
+                first_row: block.first_row + rr0,
+                lanes: n_lanes,
+                column: c,
+                at: rr0 * pixel + c * nb,
+                stride: pixel,
+                radiance: block.radiance,
+                truth: block.truth_rrs,
+            };
+            self.pixels(work, &mut run)?;
+            drop(at);
+            for rr in rr0..rr0 + n_lanes {
+                let r = block.first_row + rr;
+                let mut at = control.row(r);
+                at.column(c);
+                let (x, y) = viewing.ground_m(0, r, c);
+                if let Some(nodes) = aerosol_map {
+                    let tau = scene.aot550_at(x, y);
+                    let at = rr * pixel + c * nb;
+                    nodes.exchange(self.atmosphere, c, tau, &mut block.radiance[at..at + nb]);
+                    block.aot[rr * cols + c] = tau as f32;
+                }
+                let at = rr * cols + c;
+                let fractions = shallow
+                    .then(|| &mut block.fractions[rr * frac_stride + c * n_sub..rr * frac_stride + (c + 1) * n_sub]);
+                let look = &viewing.looks[0][c];
+                let sky = scene.sky_at(x, y, look.geometry.view_zenith_rad, look.view_azimuth_rad);
+                let values = truth_at(scene, x, y, sky, &mut block.land[at], fractions);
+                let [chl, nap, cdom, depth] = &mut block.maps;
+                (chl[at], nap[at], cdom[at]) = (values[0], values[1], values[2]);
+                if shallow {
+                    depth[at] = values[3];
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Add the run's pixels' band radiance and true band Rrs (both zero on entry), over every
+    /// group and spatial quadrature point: at the band nodes where the optics has them and the
+    /// point is water ([`LANES`] pixels at once), on the full grid otherwise (pixel by pixel).
+    /// Each pixel receives its terms in the order it would alone: group by group, point by point.
+    pub(super) fn pixels(&self, work: &mut PixelWork, run: &mut Run<'_>) -> Result<(), InstrumentError> {
+        let (atmosphere, kernel, c) = (self.atmosphere, self.kernel, run.column);
+        let nb = self.response.n_bands();
+        for (gi, group) in self.response.groups.iter().enumerate() {
+            let optics = &self.optics[gi];
+            let look = &self.viewing.looks[gi][c];
+            let n_nodes = work.at_nodes[gi].0.len();
+            work.lane_rrs.resize(LANES * n_nodes, 0.0);
+            for (k, &(dx, dy)) in self.offsets.iter().enumerate() {
+                // The lanes whose point is water at the band nodes, their Rrs there one after another.
+                let mut water_lanes = [0usize; LANES];
+                let mut n_water = 0;
+                for l in 0..run.lanes {
+                    let (x0, y0) = self.viewing.ground_m(gi, run.first_row + l, c);
+                    let (x, y) = (x0 + dx, y0 + dy);
+                    let sky = self.scene.sky_at(x, y, look.geometry.view_zenith_rad, look.view_azimuth_rad);
+                    let rrs = &mut work.lane_rrs[n_water * n_nodes..(n_water + 1) * n_nodes];
+                    if sky == Sky::Clear
+                        && atmosphere.has_nodes(gi)
+                        && optics.water_at_nodes(self.scene, x, y, &look.geometry, &mut work.scratch, rrs)?
+                    {
+                        water_lanes[n_water] = l;
+                        n_water += 1;
+                        continue;
+                    }
+                    let (out, truth) = run.pixel(l, nb);
+                    self.on_grid(work, (gi, k), c, (x, y, sky), out, truth)?;
+                }
+                if n_water > 0 {
+                    let weight = |b: usize| kernel.weights[b][k];
+                    crate::simd::avx2(AtNodes {
+                        sampler: self,
+                        gi,
+                        c,
+                        bands: &group.bands,
+                        weight,
+                        node_rrs: &work.lane_rrs[..n_water * n_nodes],
+                        lanes: &water_lanes[..n_water],
+                        f: &mut work.lane_f,
+                        run,
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// One point's band radiance and truth on the full grid (land, cloud, shadow, or optics
+    /// without band nodes), added to `out` and `truth`.
+    fn on_grid(
+        &self,
+        work: &mut PixelWork,
+        (gi, k): (usize, usize),
+        c: usize,
+        (x, y, sky): (f64, f64, Sky),
+        out: &mut [f32],
+        truth: &mut [f32],
+    ) -> Result<(), InstrumentError> {
+        let optics = &self.optics[gi];
+        let look = &self.viewing.looks[gi][c];
+        let path = &self.atmosphere.paths[gi][c];
+        let j = self.viewing.detector_index[c];
+        let (l_toa, rrs) = &mut work.spectra[gi];
+        let surface = optics.radiance(self.scene, x, y, &look.geometry, sky, path, &mut work.scratch, l_toa, rrs)?;
+        for (kb, &b) in self.response.groups[gi].bands.iter().enumerate() {
+            let (first, w) = self.response.weights(gi, kb, j);
+            let (num, den) =
+                w.iter().zip(&l_toa[first..first + w.len()]).fold((0.0, 0.0), |(n, d), (wi, v)| (n + wi * v, d + wi));
+            let weight = self.kernel.weights[b][k];
+            out[b] += (weight * num / den) as f32;
+            if surface == Target::Water {
+                let (tf, tw) = &self.truth_atmosphere.truth_weights[gi][c][kb];
+                let t: f64 = tw.iter().zip(&rrs[*tf..*tf + tw.len()]).map(|(a, v)| a * v).sum();
+                truth[b] += (weight * t) as f32;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The water points' band sums at the band nodes, [`LANES`] pixels a vector, as a
+/// [`crate::simd::Kernel`]: f = Rrs/(1 − S·π·Rrs) at every node, then per band
+/// L_b += ω·(L_path + G + Σ Cₙ fₙ) and Rrs_b += ω·Σ Dₙ Rrsₙ. Nothing is fused and each lane adds
+/// its terms in node order, from −0.0 as `Iterator::sum` does: every level, and every lane, gives
+/// the bits of a pixel summed alone.
+struct AtNodes<'s, 'b, 'o, W> {
+    sampler: &'s PixelSampler<'s>,
+    /// Group and column.
+    gi: usize,
+    c: usize,
+    bands: &'b [usize],
+    /// The point's spatial weight in band b.
+    weight: W,
+    /// Rrs at the nodes of each water lane, one lane after another.
+    node_rrs: &'b [f64],
+    /// The run's pixel of each water lane.
+    lanes: &'b [usize],
+    /// Work space: f and Rrs, node by node, [`LANES`] values a node.
+    f: &'b mut Vec<[[f64; LANES]; 2]>,
+    run: &'b mut Run<'o>,
+}
+
+impl<W: Fn(usize) -> f64> crate::simd::Kernel for AtNodes<'_, '_, '_, W> {
+    type Output = ();
+
+    #[inline(always)]
+    fn run<L: crate::simd::Level>(self) {
+        let AtNodes { sampler, gi, c, bands, weight, node_rrs, lanes, f, run } = self;
+        let atmosphere = sampler.atmosphere;
+        let s_pi = &atmosphere.node_s_pi[gi][c];
+        let m = lanes.len().min(LANES);
+        let n = (node_rrs.len() / m.max(1)).min(s_pi.len());
+        f.resize(n, [[0.0; LANES]; 2]);
+        // Node-major: a node's lanes side by side (unused lanes 0, whose f is 0).
+        for (i, (fi, &s)) in f.iter_mut().zip(s_pi).enumerate() {
+            let mut rrs = [0.0; LANES];
+            for (l, v) in rrs.iter_mut().enumerate().take(m) {
+                *v = node_rrs[l * n + i];
+            }
+            for l in 0..LANES {
+                fi[0][l] = rrs[l] / (1.0 - s * rrs[l]);
+            }
+            fi[1] = rrs;
+        }
+        let nb = sampler.response.n_bands();
+        for (kb, &b) in bands.iter().enumerate() {
+            let nw = &atmosphere.node_weights[gi][c][kb];
+            let tw = &sampler.truth_atmosphere.node_weights[gi][c][kb];
+            let (mut water, mut t) = ([-0.0; LANES], [-0.0; LANES]);
+            if tw.first == nw.first && tw.truth.len() == nw.radiance.len() {
+                // One loop, two independent sums (the truth's weights are usually the radiance's).
+                let terms = nw.radiance.iter().zip(&tw.truth).zip(&f[nw.first..]);
+                for ((&cn, &dn), [fn_, rn]) in terms {
+                    for l in 0..LANES {
+                        water[l] += cn * fn_[l];
+                        t[l] += dn * rn[l];
+                    }
+                }
+            } else {
+                for (&cn, [fn_, _]) in nw.radiance.iter().zip(&f[nw.first..]) {
+                    for l in 0..LANES {
+                        water[l] += cn * fn_[l];
+                    }
+                }
+                for (&dn, [_, rn]) in tw.truth.iter().zip(&f[tw.first..]) {
+                    for l in 0..LANES {
+                        t[l] += dn * rn[l];
+                    }
+                }
+            }
+            let i = atmosphere.at(c, b);
+            let (weight, base) = (weight(b), atmosphere.l_path[i] + atmosphere.glint[i]);
+            for (&pixel, (water, t)) in lanes.iter().zip(water.iter().zip(&t)) {
+                let (out, truth) = run.pixel(pixel, nb);
+                out[b] += (weight * (base + water)) as f32;
+                truth[b] += (weight * t) as f32;
+            }
+        }
+    }
+}
