@@ -214,17 +214,19 @@ struct PixelSampler<'a> {
     offsets: &'a [(f64, f64)],
 }
 
-/// A worker's buffers for [`PixelSampler::pixel`].
+/// A worker's buffers for [`PixelSampler::pixels`].
 struct PixelWork {
     scratch: Scratch,
     /// Per group: TOA radiance and Rrs on the grid.
     spectra: Vec<(Vec<f64>, Vec<f64>)>,
-    /// Per group: Rrs and f = Rrs/(1 − S·π·Rrs) at the band nodes (empty without them).
-    at_nodes: Vec<(Vec<f64>, Vec<f64>)>,
-    /// Rrs at the band nodes of each water lane of a run ([`lanes::LANES`] × nodes).
+    /// Per group: the number of band nodes (0 without them).
+    nodes: Vec<usize>,
+    /// Rrs at the band nodes of each lane of a run ([`lanes::LANES`] × nodes).
     lane_rrs: Vec<f64>,
     /// f and Rrs at each node for the lanes ([`lanes`]'s kernel).
     lane_f: Vec<[[f64; lanes::LANES]; 2]>,
+    /// Per band: the lanes' radiance and truth sums.
+    sums: Vec<[[f32; lanes::LANES]; 2]>,
 }
 
 impl PixelWork {
@@ -233,9 +235,10 @@ impl PixelWork {
         Self {
             scratch: Scratch::default(),
             spectra: optics.iter().map(|o| pair(o.grid().len())).collect(),
-            at_nodes: optics.iter().map(|o| pair(o.band_nodes().map_or(0, <[usize]>::len))).collect(),
+            nodes: optics.iter().map(|o| o.band_nodes().map_or(0, <[usize]>::len)).collect(),
             lane_rrs: Vec::new(),
             lane_f: Vec::new(),
+            sums: Vec::new(),
         }
     }
 }

@@ -123,36 +123,36 @@ impl PixelSampler<'_> {
     /// Add the run's pixels' band radiance and true band Rrs (both zero on entry), over every
     /// group and spatial quadrature point: at the band nodes where the optics has them and the
     /// point is water ([`LANES`] pixels at once), on the full grid otherwise (pixel by pixel).
-    /// Each pixel receives its terms in the order it would alone: group by group, point by point.
+    /// Each pixel's sums take their terms in the order they would alone (group by group, point
+    /// by point, from +0.0), in `work.sums` (a band's lanes side by side), then go to the run.
     pub(super) fn pixels(&self, work: &mut PixelWork, run: &mut Run<'_>) -> Result<(), InstrumentError> {
         let (atmosphere, kernel, c) = (self.atmosphere, self.kernel, run.column);
         let nb = self.response.n_bands();
+        work.sums.clear();
+        work.sums.resize(nb, [[0.0; LANES]; 2]);
         for (gi, group) in self.response.groups.iter().enumerate() {
             let optics = &self.optics[gi];
             let look = &self.viewing.looks[gi][c];
-            let n_nodes = work.at_nodes[gi].0.len();
+            let n_nodes = work.nodes[gi];
             work.lane_rrs.resize(LANES * n_nodes, 0.0);
             for (k, &(dx, dy)) in self.offsets.iter().enumerate() {
-                // The lanes whose point is water at the band nodes, their Rrs there one after another.
-                let mut water_lanes = [0usize; LANES];
-                let mut n_water = 0;
+                // The lanes whose point is water at the band nodes, with their Rrs there (lane
+                // after lane; zero in the others).
+                let mut water = [false; LANES];
                 for l in 0..run.lanes {
                     let (x0, y0) = self.viewing.ground_m(gi, run.first_row + l, c);
                     let (x, y) = (x0 + dx, y0 + dy);
                     let sky = self.scene.sky_at(x, y, look.geometry.view_zenith_rad, look.view_azimuth_rad);
-                    let rrs = &mut work.lane_rrs[n_water * n_nodes..(n_water + 1) * n_nodes];
-                    if sky == Sky::Clear
+                    let rrs = &mut work.lane_rrs[l * n_nodes..(l + 1) * n_nodes];
+                    water[l] = sky == Sky::Clear
                         && atmosphere.has_nodes(gi)
-                        && optics.water_at_nodes(self.scene, x, y, &look.geometry, &mut work.scratch, rrs)?
-                    {
-                        water_lanes[n_water] = l;
-                        n_water += 1;
-                        continue;
+                        && optics.water_at_nodes(self.scene, x, y, &look.geometry, &mut work.scratch, rrs)?;
+                    if !water[l] {
+                        rrs.fill(0.0);
+                        self.on_grid(work, (gi, k), c, (x, y, sky), l)?;
                     }
-                    let (out, truth) = run.pixel(l, nb);
-                    self.on_grid(work, (gi, k), c, (x, y, sky), out, truth)?;
                 }
-                if n_water > 0 {
+                if water.contains(&true) {
                     let weight = |b: usize| kernel.weights[b][k];
                     crate::simd::avx2(AtNodes {
                         sampler: self,
@@ -160,27 +160,32 @@ impl PixelSampler<'_> {
                         c,
                         bands: &group.bands,
                         weight,
-                        node_rrs: &work.lane_rrs[..n_water * n_nodes],
-                        lanes: &water_lanes[..n_water],
+                        node_rrs: &work.lane_rrs[..LANES * n_nodes],
+                        water,
                         f: &mut work.lane_f,
-                        run,
+                        sums: &mut work.sums,
                     });
                 }
+            }
+        }
+        for l in 0..run.lanes {
+            let (out, truth) = run.pixel(l, nb);
+            for (b, [radiance, t]) in work.sums.iter().enumerate() {
+                (out[b], truth[b]) = (radiance[l], t[l]);
             }
         }
         Ok(())
     }
 
     /// One point's band radiance and truth on the full grid (land, cloud, shadow, or optics
-    /// without band nodes), added to `out` and `truth`.
+    /// without band nodes), added to lane `l` of `work.sums`.
     fn on_grid(
         &self,
         work: &mut PixelWork,
         (gi, k): (usize, usize),
         c: usize,
         (x, y, sky): (f64, f64, Sky),
-        out: &mut [f32],
-        truth: &mut [f32],
+        l: usize,
     ) -> Result<(), InstrumentError> {
         let optics = &self.optics[gi];
         let look = &self.viewing.looks[gi][c];
@@ -193,11 +198,11 @@ impl PixelSampler<'_> {
             let (num, den) =
                 w.iter().zip(&l_toa[first..first + w.len()]).fold((0.0, 0.0), |(n, d), (wi, v)| (n + wi * v, d + wi));
             let weight = self.kernel.weights[b][k];
-            out[b] += (weight * num / den) as f32;
+            work.sums[b][0][l] += (weight * num / den) as f32;
             if surface == Target::Water {
                 let (tf, tw) = &self.truth_atmosphere.truth_weights[gi][c][kb];
                 let t: f64 = tw.iter().zip(&rrs[*tf..*tf + tw.len()]).map(|(a, v)| a * v).sum();
-                truth[b] += (weight * t) as f32;
+                work.sums[b][1][l] += (weight * t) as f32;
             }
         }
         Ok(())
@@ -208,8 +213,9 @@ impl PixelSampler<'_> {
 /// [`crate::simd::Kernel`]: f = Rrs/(1 − S·π·Rrs) at every node, then per band
 /// L_b += ω·(L_path + G + Σ Cₙ fₙ) and Rrs_b += ω·Σ Dₙ Rrsₙ. Nothing is fused and each lane adds
 /// its terms in node order, from −0.0 as `Iterator::sum` does: every level, and every lane, gives
-/// the bits of a pixel summed alone.
-struct AtNodes<'s, 'b, 'o, W> {
+/// the bits of a pixel summed alone. Lanes that are not water add +0.0 (which changes no sum:
+/// one that starts at +0.0 is never −0.0).
+struct AtNodes<'s, 'b, W> {
     sampler: &'s PixelSampler<'s>,
     /// Group and column.
     gi: usize,
@@ -217,38 +223,34 @@ struct AtNodes<'s, 'b, 'o, W> {
     bands: &'b [usize],
     /// The point's spatial weight in band b.
     weight: W,
-    /// Rrs at the nodes of each water lane, one lane after another.
+    /// Rrs at the nodes of each lane, lane after lane (zero where not water).
     node_rrs: &'b [f64],
-    /// The run's pixel of each water lane.
-    lanes: &'b [usize],
+    /// Which lanes are water.
+    water: [bool; LANES],
     /// Work space: f and Rrs, node by node, [`LANES`] values a node.
     f: &'b mut Vec<[[f64; LANES]; 2]>,
-    run: &'b mut Run<'o>,
+    /// The lanes' band radiance and truth, band by band.
+    sums: &'b mut [[[f32; LANES]; 2]],
 }
 
-impl<W: Fn(usize) -> f64> crate::simd::Kernel for AtNodes<'_, '_, '_, W> {
+impl<W: Fn(usize) -> f64> crate::simd::Kernel for AtNodes<'_, '_, W> {
     type Output = ();
 
     #[inline(always)]
     fn run<L: crate::simd::Level>(self) {
-        let AtNodes { sampler, gi, c, bands, weight, node_rrs, lanes, f, run } = self;
+        let AtNodes { sampler, gi, c, bands, weight, node_rrs, water: is_water, f, sums } = self;
         let atmosphere = sampler.atmosphere;
         let s_pi = &atmosphere.node_s_pi[gi][c];
-        let m = lanes.len().min(LANES);
-        let n = (node_rrs.len() / m.max(1)).min(s_pi.len());
+        let n = (node_rrs.len() / LANES).min(s_pi.len());
         f.resize(n, [[0.0; LANES]; 2]);
-        // Node-major: a node's lanes side by side (unused lanes 0, whose f is 0).
+        // Node-major: a node's lanes side by side.
         for (i, (fi, &s)) in f.iter_mut().zip(s_pi).enumerate() {
-            let mut rrs = [0.0; LANES];
-            for (l, v) in rrs.iter_mut().enumerate().take(m) {
-                *v = node_rrs[l * n + i];
-            }
+            let rrs: [f64; LANES] = std::array::from_fn(|l| node_rrs[l * n + i]);
             for l in 0..LANES {
                 fi[0][l] = rrs[l] / (1.0 - s * rrs[l]);
             }
             fi[1] = rrs;
         }
-        let nb = sampler.response.n_bands();
         for (kb, &b) in bands.iter().enumerate() {
             let nw = &atmosphere.node_weights[gi][c][kb];
             let tw = &sampler.truth_atmosphere.node_weights[gi][c][kb];
@@ -276,10 +278,10 @@ impl<W: Fn(usize) -> f64> crate::simd::Kernel for AtNodes<'_, '_, '_, W> {
             }
             let i = atmosphere.at(c, b);
             let (weight, base) = (weight(b), atmosphere.l_path[i] + atmosphere.glint[i]);
-            for (&pixel, (water, t)) in lanes.iter().zip(water.iter().zip(&t)) {
-                let (out, truth) = run.pixel(pixel, nb);
-                out[b] += (weight * (base + water)) as f32;
-                truth[b] += (weight * t) as f32;
+            let [radiance, truth] = &mut sums[b];
+            for l in 0..LANES {
+                radiance[l] += if is_water[l] { (weight * (base + water[l])) as f32 } else { 0.0 };
+                truth[l] += if is_water[l] { (weight * t[l]) as f32 } else { 0.0 };
             }
         }
     }
