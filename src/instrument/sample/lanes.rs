@@ -18,14 +18,17 @@ pub(super) const LANES: usize = 8;
 
 /// Where a run of up to [`LANES`] pixels of one column writes: pixel `l` of the run (row
 /// `first_row + l`) at `at + l·stride` in `radiance` and `truth`, `n_bands` values each.
-pub(super) struct Run<'o> {
-    pub first_row: usize,
-    pub lanes: usize,
-    pub column: usize,
-    pub at: usize,
-    pub stride: usize,
-    pub radiance: &'o mut [f32],
-    pub truth: &'o mut [f32],
+struct Run<'o> {
+    /// The run's first row (of the image), its pixels and its column.
+    first_row: usize,
+    lanes: usize,
+    column: usize,
+    /// The first pixel's offset in the block's buffers, and a row's.
+    at: usize,
+    stride: usize,
+    /// The block's band radiance and true band Rrs.
+    radiance: &'o mut [f32],
+    truth: &'o mut [f32],
 }
 
 impl Run<'_> {
@@ -125,7 +128,7 @@ impl PixelSampler<'_> {
     /// point is water ([`LANES`] pixels at once), on the full grid otherwise (pixel by pixel).
     /// Each pixel's sums take their terms in the order they would alone (group by group, point
     /// by point, from +0.0), in `work.sums` (a band's lanes side by side), then go to the run.
-    pub(super) fn pixels(&self, work: &mut PixelWork, run: &mut Run<'_>) -> Result<(), InstrumentError> {
+    fn pixels(&self, work: &mut PixelWork, run: &mut Run<'_>) -> Result<(), InstrumentError> {
         let (atmosphere, kernel, c) = (self.atmosphere, self.kernel, run.column);
         let nb = self.response.n_bands();
         work.sums.clear();
