@@ -8,7 +8,7 @@
 //! vector lane, each add the same terms in the same order as alone — the same bits, a vector
 //! instruction for what took one per pixel.
 
-use super::{AotNodes, InstrumentError, PixelSampler, PixelWork, truth_at};
+use super::{AotNodes, BandAtmosphere, InstrumentError, PixelSampler, PixelWork, truth_at};
 use crate::control::RunControl;
 use crate::scene::Sky;
 use crate::toa::Target;
@@ -158,7 +158,8 @@ impl PixelSampler<'_> {
                 if water.contains(&true) {
                     let weight = |b: usize| kernel.weights[b][k];
                     crate::simd::avx2(AtNodes {
-                        sampler: self,
+                        atmosphere,
+                        truth_atmosphere: self.truth_atmosphere,
                         gi,
                         c,
                         bands: &group.bands,
@@ -219,7 +220,9 @@ impl PixelSampler<'_> {
 /// the bits of a pixel summed alone. Lanes that are not water add +0.0 (which changes no sum:
 /// one that starts at +0.0 is never −0.0).
 struct AtNodes<'s, 'b, W> {
-    sampler: &'s PixelSampler<'s>,
+    /// The atmosphere the radiance is summed with, and the one the truth's weights come from.
+    atmosphere: &'s BandAtmosphere,
+    truth_atmosphere: &'s BandAtmosphere,
     /// Group and column.
     gi: usize,
     c: usize,
@@ -241,8 +244,7 @@ impl<W: Fn(usize) -> f64> crate::simd::Kernel for AtNodes<'_, '_, W> {
 
     #[inline(always)]
     fn run<L: crate::simd::Level>(self) {
-        let AtNodes { sampler, gi, c, bands, weight, node_rrs, water: is_water, f, sums } = self;
-        let atmosphere = sampler.atmosphere;
+        let AtNodes { atmosphere, truth_atmosphere, gi, c, bands, weight, node_rrs, water: is_water, f, sums } = self;
         let s_pi = &atmosphere.node_s_pi[gi][c];
         let n = (node_rrs.len() / LANES).min(s_pi.len());
         f.resize(n, [[0.0; LANES]; 2]);
@@ -256,7 +258,7 @@ impl<W: Fn(usize) -> f64> crate::simd::Kernel for AtNodes<'_, '_, W> {
         }
         for (kb, &b) in bands.iter().enumerate() {
             let nw = &atmosphere.node_weights[gi][c][kb];
-            let tw = &sampler.truth_atmosphere.node_weights[gi][c][kb];
+            let tw = &truth_atmosphere.node_weights[gi][c][kb];
             let (mut water, mut t) = ([-0.0; LANES], [-0.0; LANES]);
             if tw.first == nw.first && tw.truth.len() == nw.radiance.len() {
                 // One loop, two independent sums (the truth's weights are usually the radiance's).
@@ -285,6 +287,85 @@ impl<W: Fn(usize) -> f64> crate::simd::Kernel for AtNodes<'_, '_, W> {
             for l in 0..LANES {
                 radiance[l] += if is_water[l] { (weight * (base + water[l])) as f32 } else { 0.0 };
                 truth[l] += if is_water[l] { (weight * t[l]) as f32 } else { 0.0 };
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::NodeWeights;
+    use super::*;
+
+    /// Every lane's sums are, to the bit, those of its pixel summed alone in node order (the
+    /// scalar loop the lanes replaced), whichever lanes are water, at every vector level; a lane
+    /// that is not water keeps its sums. Band 2's truth weights start at another node than its
+    /// radiance weights (the kernel's second branch).
+    #[test]
+    fn each_lane_sums_as_its_pixel_alone() {
+        let (n, nb, c) = (12, 3, 1);
+        let value = |i: usize| 0.5 + ((i * 7919) % 1013) as f64 / 997.0;
+        let weights = |first: usize, len: usize, shift: usize, scale: f64| NodeWeights {
+            first,
+            radiance: (0..len).map(|j| scale * value(j + shift)).collect(),
+            truth: (0..len).map(|j| value(j + shift + 5) / len as f64).collect(),
+        };
+        let radiance_weights = vec![weights(0, 5, 0, 80.0), weights(3, 6, 2, 95.0), weights(7, 5, 4, 60.0)];
+        let mut truth_weights = radiance_weights.clone();
+        truth_weights[2] = weights(6, 6, 9, 60.0);
+        let atmosphere = |node_weights: &Vec<NodeWeights>| BandAtmosphere {
+            n_bands: nb,
+            paths: Vec::new(),
+            l_path: (0..2 * nb).map(|i| 30.0 + value(i)).collect(),
+            glint: (0..2 * nb).map(|i| 0.1 * value(i + 3)).collect(),
+            ed: Vec::new(),
+            t_ed: Vec::new(),
+            spherical_albedo: Vec::new(),
+            truth_weights: Vec::new(),
+            node_weights: vec![vec![Vec::new(), node_weights.clone()]],
+            node_s_pi: vec![vec![Vec::new(), (0..n).map(|i| 0.3 + 0.01 * value(i)).collect()]],
+        };
+        let (radiance_atm, truth_atm) = (atmosphere(&radiance_weights), atmosphere(&truth_weights));
+        let rrs = |l: usize, i: usize| 0.002 + 1e-4 * value(l * 31 + i * 3);
+        let node_rrs: Vec<f64> = (0..LANES).flat_map(|l| (0..n).map(move |i| rrs(l, i))).collect();
+        let water: [bool; LANES] = std::array::from_fn(|l| l % 3 != 1);
+        let weight = |b: usize| 0.25 + 0.1 * b as f64;
+        for tier in [crate::simd::Tier::Avx512, crate::simd::Tier::Avx2, crate::simd::Tier::Baseline] {
+            let mut sums = vec![[[0.0f32; LANES]; 2]; nb];
+            sums[1][0][1] = 7.0;
+            let mut f = Vec::new();
+            crate::simd::capped(tier, || {
+                crate::simd::avx2(AtNodes {
+                    atmosphere: &radiance_atm,
+                    truth_atmosphere: &truth_atm,
+                    gi: 0,
+                    c,
+                    bands: &[0, 1, 2],
+                    weight,
+                    node_rrs: &node_rrs,
+                    water,
+                    f: &mut f,
+                    sums: &mut sums,
+                });
+            });
+            for l in 0..LANES {
+                let f_alone: Vec<f64> =
+                    (0..n).map(|i| rrs(l, i) / (1.0 - radiance_atm.node_s_pi[0][c][i] * rrs(l, i))).collect();
+                for b in 0..nb {
+                    let (nw, tw) = (&radiance_weights[b], &truth_weights[b]);
+                    let water_sum: f64 = nw.radiance.iter().zip(&f_alone[nw.first..]).map(|(a, v)| a * v).sum();
+                    let t: f64 = tw.truth.iter().zip((tw.first..).map(|i| rrs(l, i))).map(|(a, v)| a * v).sum();
+                    let i = radiance_atm.at(c, b);
+                    let start = if (b, l) == (1, 1) { 7.0f32 } else { 0.0 };
+                    let (want_l, want_t) = if water[l] {
+                        let l_b = weight(b) * (radiance_atm.l_path[i] + radiance_atm.glint[i] + water_sum);
+                        (start + l_b as f32, 0.0f32 + (weight(b) * t) as f32)
+                    } else {
+                        (start, 0.0)
+                    };
+                    assert_eq!(sums[b][0][l].to_bits(), want_l.to_bits(), "{tier:?}: lane {l}, band {b}, radiance");
+                    assert_eq!(sums[b][1][l].to_bits(), want_t.to_bits(), "{tier:?}: lane {l}, band {b}, truth");
+                }
             }
         }
     }
