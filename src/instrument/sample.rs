@@ -168,6 +168,7 @@ pub fn sample_radiance(
                     maps: [chl_b, nap_b, cdom_b, depth_b],
                     land: land_block,
                     fractions: frac_block,
+                    frac_stride,
                     aot: aot_block,
                 };
                 for c in 0..cols {

@@ -52,8 +52,10 @@ pub(super) struct Block<'o> {
     pub maps: [&'o mut [f32]; 4],
     /// Surface classes, (row, column).
     pub land: &'o mut [u8],
-    /// Substrate fractions, (row, column, substrate) with a bottom (one float a row without).
+    /// Substrate fractions, (row, column, substrate) with a bottom (one float a row without),
+    /// and a row's length there.
     pub fractions: &'o mut [f32],
+    pub frac_stride: usize,
     /// AOT(550) under each pixel centre, (row, column) with an aerosol map (one float a row
     /// without).
     pub aot: &'o mut [f32],
@@ -76,8 +78,7 @@ impl PixelSampler<'_> {
         let nb = self.response.n_bands();
         let pixel = cols * nb;
         let shallow = scene.depth.is_some();
-        let n_sub = scene.substrates.len();
-        let frac_stride = if shallow { (cols * n_sub).max(1) } else { 1 };
+        let (n_sub, frac_stride) = (scene.substrates.len(), block.frac_stride);
         for rr0 in (0..block.rows).step_by(LANES) {
             let n_lanes = LANES.min(block.rows - rr0);
             for rr in rr0 + 1..rr0 + n_lanes {
@@ -246,11 +247,13 @@ impl<W: Fn(usize) -> f64> crate::simd::Kernel for AtNodes<'_, '_, W> {
     fn run<L: crate::simd::Level>(self) {
         let AtNodes { atmosphere, truth_atmosphere, gi, c, bands, weight, node_rrs, water: is_water, f, sums } = self;
         let s_pi = &atmosphere.node_s_pi[gi][c];
-        let n = (node_rrs.len() / LANES).min(s_pi.len());
+        // A lane's nodes lie `stride` apart in `node_rrs`.
+        let stride = node_rrs.len() / LANES;
+        let n = stride.min(s_pi.len());
         f.resize(n, [[0.0; LANES]; 2]);
         // Node-major: a node's lanes side by side.
         for (i, (fi, &s)) in f.iter_mut().zip(s_pi).enumerate() {
-            let rrs: [f64; LANES] = std::array::from_fn(|l| node_rrs[l * n + i]);
+            let rrs: [f64; LANES] = std::array::from_fn(|l| node_rrs[l * stride + i]);
             for l in 0..LANES {
                 fi[0][l] = rrs[l] / (1.0 - s * rrs[l]);
             }
