@@ -120,6 +120,9 @@ pub struct BandModel {
     pub band_names: Vec<String>,
     /// Per band: node range.
     ranges: Vec<std::ops::Range<usize>>,
+    /// The node count of every band where they are all the same (a band's nodes are then
+    /// `uniform·b..uniform·(b + 1)`), else 0.
+    uniform: usize,
     /// Per node: quadrature weight (normalised per band); zero on the padding nodes.
     weight: Vec<f64>,
     a_w: Vec<f64>,
@@ -193,10 +196,13 @@ impl BandModel {
                 Ok(at(&library.mix_on_grid(&mix, &grid)?))
             })
             .collect::<Result<Vec<_>, RetrievalError>>()?;
+        let first = ranges[0].len();
+        let uniform = if ranges.iter().all(|r| r.len() == first) { first } else { 0 };
         Ok(Self {
             siop_name: siop.name.clone(),
             band_names: bands.iter().map(|b| b.name.clone()).collect(),
             ranges,
+            uniform,
             weight,
             a_w: at(&s.a_w),
             bb_w: at(&s.bb_w),
@@ -294,6 +300,13 @@ impl BandModel {
         };
         let with_jacobian = jacobian.is_some();
         crate::simd::throughput(Nodes { model: self, p, inv_cos, h, shallow, with_jacobian, n, s });
+        match self.uniform {
+            1 => return self.uniform_sums::<1>(out, jacobian, s),
+            2 => return self.uniform_sums::<2>(out, jacobian, s),
+            3 => return self.uniform_sums::<3>(out, jacobian, s),
+            4 => return self.uniform_sums::<4>(out, jacobian, s),
+            _ => {}
+        }
         let Some(j) = jacobian else {
             for (b, range) in self.ranges.iter().enumerate() {
                 out[b] = range.clone().map(|i| self.weight[i] * s.above[i]).sum();
@@ -321,6 +334,45 @@ impl BandModel {
             }
             out[b] = rrs;
             j[b] = grad;
+        }
+    }
+
+    /// The band sums of [`Self::evaluate_with`] where every band has `K` nodes: the same sums in
+    /// the same order, over fixed-size chunks, so that they carry no loop over ranges and no
+    /// bounds check (they took a sixth of a 28-band fit's time as ranges).
+    fn uniform_sums<const K: usize>(&self, out: &mut [f64], jacobian: Option<&mut [[f64; 5]]>, s: &ModelScratch) {
+        let nb = self.n_bands();
+        fn chunks<const K: usize>(v: &[f64], nb: usize) -> &[[f64; K]] {
+            &v[..nb * K].as_chunks::<K>().0[..nb]
+        }
+        let nodes = chunks::<K>(&self.weight, nb).iter().zip(chunks::<K>(&s.above, nb));
+        let Some(j) = jacobian else {
+            for (o, (w, above)) in out[..nb].iter_mut().zip(nodes) {
+                let mut rrs = -0.0;
+                for i in 0..K {
+                    rrs += w[i] * above[i];
+                }
+                *o = rrs;
+            }
+            return;
+        };
+        let [g0, g1, g2, g3, g4] = &s.grad;
+        let c = |g| chunks::<K>(g, nb);
+        let terms = c(g0).iter().zip(c(g1)).zip(c(g2)).zip(c(g3)).zip(c(g4));
+        for ((o, row), ((w, above), ((((d0, d1), d2), d3), d4))) in
+            out[..nb].iter_mut().zip(&mut j[..nb]).zip(nodes.zip(terms))
+        {
+            let (mut rrs, mut grad) = (-0.0, [0.0; 5]);
+            for i in 0..K {
+                rrs += w[i] * above[i];
+                grad[0] += d0[i];
+                grad[1] += d1[i];
+                grad[2] += d2[i];
+                grad[3] += d3[i];
+                grad[4] += d4[i];
+            }
+            *o = rrs;
+            *row = grad;
         }
     }
 
