@@ -22,7 +22,11 @@ use super::RetrievalError;
 use super::quadrature::gauss_rule;
 use crate::parse::FieldError;
 use crate::spectral::WavelengthGrid;
-use crate::water::{SiopSpec, SubstrateLibrary, SubstrateMix, fast_exp};
+use crate::water::{SiopSpec, SubstrateLibrary, SubstrateMix};
+
+mod nodes;
+
+use nodes::Nodes;
 
 /// A band's response on the simulation grid: the discrete measure its Rrs is averaged over.
 #[derive(Debug, Clone, PartialEq)]
@@ -381,99 +385,6 @@ impl BandModel {
     pub fn evaluate_deep(&self, p: &Parameters, out: &mut [f64]) {
         let deep = Parameters { depth_m: None, ..*p };
         self.evaluate(&deep, (1.0, 1.0), out, None);
-    }
-}
-
-/// The per-node work of [`BandModel::evaluate_with`], as a [`crate::simd::Kernel`] run by
-/// [`crate::simd::throughput`] (four nodes per instruction with AVX2, eight with AVX-512 where
-/// its units are full width; on AMD Zen 4 AVX-512 measured slower at the 12 to 84 nodes of a
-/// retrieval's bands): Rrs at each node and, with the Jacobian, each node's weighted
-/// terms of the band gradients. Written with separate multiplies and adds (and the baseline
-/// [`fast_exp`]), so every level gives the same bits; the vector levels only take more nodes per
-/// instruction.
-struct Nodes<'a> {
-    model: &'a BandModel,
-    p: &'a Parameters,
-    inv_cos: (f64, f64),
-    h: f64,
-    shallow: f64,
-    with_jacobian: bool,
-    n: usize,
-    s: &'a mut ModelScratch,
-}
-
-impl crate::simd::Kernel for Nodes<'_> {
-    type Output = ();
-
-    #[inline(always)]
-    fn run<L: crate::simd::Level>(self) {
-        // Two loops, so that the one without the Jacobian carries none of its work.
-        if self.with_jacobian { self.nodes::<true>() } else { self.nodes::<false>() }
-    }
-}
-
-impl Nodes<'_> {
-    #[inline(always)]
-    fn nodes<const JACOBIAN: bool>(self) {
-        let Nodes { model, p, inv_cos, h, shallow, n, s, .. } = self;
-        let (mu_w, mu_o) = inv_cos;
-        let inv_pi = 1.0 / std::f64::consts::PI;
-        let (chl, cdom, nap) = (p.chl, p.cdom, p.nap);
-        let (a_w, bb_w, a_ph, a_cdom, a_nap, bb_ph, bb_nap) = (
-            &model.a_w[..n],
-            &model.bb_w[..n],
-            &model.a_ph[..n],
-            &model.a_cdom[..n],
-            &model.a_nap[..n],
-            &model.bb_ph[..n],
-            &model.bb_nap[..n],
-        );
-        let (rb, drb, above) = (&s.rb[..n], &s.drb[..n], &mut s.above[..n]);
-        let [g0, g1, g2, g3, g4] = &mut s.grad;
-        let (g0, g1, g2, g3, g4) = (&mut g0[..n], &mut g1[..n], &mut g2[..n], &mut g3[..n], &mut g4[..n]);
-        let weight = &model.weight[..n];
-        for i in 0..n {
-            let a = a_w[i] + chl * a_ph[i] + cdom * a_cdom[i] + nap * a_nap[i];
-            let bb = bb_w[i] + chl * bb_ph[i] + nap * bb_nap[i];
-            let kappa = a + bb;
-            let u = bb / kappa;
-            let rrs_dp = (0.084 + 0.17 * u) * u;
-            let (sc, sb) = ((1.0 + 2.4 * u).sqrt(), (1.0 + 5.4 * u).sqrt());
-            let (kc, kb) = (mu_w + 1.03 * sc * mu_o, mu_w + 1.04 * sb * mu_o);
-            // Optically deep: the exponentials are replaced by (e_c, e_b) = (0, 0).
-            let ec = shallow * fast_exp(-kc * kappa * h);
-            let eb = shallow * fast_exp(-kb * kappa * h);
-            let rrs = rrs_dp * (1.0 - ec) + rb[i] * inv_pi * eb;
-            let denom = 1.0 - 1.7 * rrs;
-            above[i] = 0.52 * rrs / denom;
-            if !JACOBIAN {
-                continue;
-            }
-            let d_rrs_dp = 0.084 + 0.34 * u;
-            let d_above = 0.52 / (denom * denom);
-            let (d_dc, d_db) = (1.236 / sc, 2.808 / sb);
-            let d_ec_du = -ec * d_dc * mu_o * kappa * h;
-            let d_eb_du = -eb * d_db * mu_o * kappa * h;
-            let d_u = d_above * (d_rrs_dp * (1.0 - ec) - rrs_dp * d_ec_du + rb[i] * inv_pi * d_eb_du);
-            let d_k = d_above * (rrs_dp * ec * kc * h - rb[i] * inv_pi * eb * kb * h);
-            let d_h = d_above * (rrs_dp * ec * kc * kappa - rb[i] * inv_pi * eb * kb * kappa);
-            let d_q = d_above * drb[i] * inv_pi * eb;
-            // Each node's terms of the band gradients: ∂u/∂C = (a·∂bb − bb·∂a)/κ² and
-            // ∂κ/∂C = ∂a + ∂bb, for chl, CDOM (no bb) and NAP; then depth and fraction.
-            let w = weight[i];
-            let inv_k2 = 1.0 / ((a + bb) * (a + bb));
-            let du = [
-                (a * bb_ph[i] - bb * a_ph[i]) * inv_k2,
-                -bb * a_cdom[i] * inv_k2,
-                (a * bb_nap[i] - bb * a_nap[i]) * inv_k2,
-            ];
-            let dk = [a_ph[i] + bb_ph[i], a_cdom[i], a_nap[i] + bb_nap[i]];
-            g0[i] = w * (d_u * du[0] + d_k * dk[0]);
-            g1[i] = w * (d_u * du[1] + d_k * dk[1]);
-            g2[i] = w * (d_u * du[2] + d_k * dk[2]);
-            g3[i] = w * d_h * shallow;
-            g4[i] = w * d_q;
-        }
     }
 }
 
