@@ -448,4 +448,25 @@ mod tests {
             }
         }
     }
+
+    /// Where every band has the same node count the sums run over fixed-size chunks; they give
+    /// the bits of the general path over node ranges, with and without the Jacobian.
+    #[test]
+    fn uniform_band_sums_are_the_range_sums_to_the_bit() {
+        let uniform = model();
+        assert_eq!(uniform.uniform, 4);
+        let general = BandModel { uniform: 0, ..uniform.clone() };
+        let nb = uniform.n_bands();
+        for depth in [None, Some(2.5)] {
+            let p = Parameters { chl: 1.3, cdom: 0.02, nap: 0.7, depth_m: depth, substrates: (0, 1, 0.6) };
+            let run = |m: &BandModel| {
+                let (mut rrs, mut plain, mut jac) = (vec![0.0; nb], vec![0.0; nb], vec![[0.0; 5]; nb]);
+                m.evaluate(&p, (1.05, 1.01), &mut rrs, Some(&mut jac));
+                m.evaluate(&p, (1.05, 1.01), &mut plain, None);
+                let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                (bits(&rrs), bits(&plain), bits(&jac.concat()))
+            };
+            assert_eq!(run(&uniform), run(&general), "depth {depth:?}");
+        }
+    }
 }
