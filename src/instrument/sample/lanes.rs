@@ -63,9 +63,9 @@ pub(super) struct Block<'o> {
 
 impl PixelSampler<'_> {
     /// Column `c` of `block`: every pixel's band radiance (its aerosol exchanged where the
-    /// scene's AOT is a map) and its truth. Checks `control` at every pixel (a fault injected
-    /// at a pixel fires there; a panic while a run of pixels is summed is placed at the run's
-    /// first pixel).
+    /// scene's AOT is a map) and its truth. Checks `control` at every pixel, after its run's
+    /// sums (a fault injected at a pixel fires there; a panic while a run of pixels is summed
+    /// is placed at the run's first pixel).
     pub(super) fn column(
         &self,
         work: &mut PixelWork,
@@ -81,9 +81,7 @@ impl PixelSampler<'_> {
         let (n_sub, frac_stride) = (scene.substrates.len(), block.frac_stride);
         for rr0 in (0..block.rows).step_by(LANES) {
             let n_lanes = LANES.min(block.rows - rr0);
-            for rr in rr0 + 1..rr0 + n_lanes {
-                control.row(block.first_row + rr).column(c);
-            }
+            // The run's sums are placed at its first pixel; each pixel is visited after them.
             let mut at = control.row(block.first_row + rr0);
             at.column(c);
             let mut run = Run {
