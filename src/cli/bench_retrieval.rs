@@ -15,7 +15,9 @@ use super::CliError;
 use crate::control::RunControl;
 use crate::retrieval::almi::{AlmiSet, AlmiSettings};
 use crate::retrieval::almi_lanes::{PackedSets, Scratch, invert_packed};
-use crate::retrieval::sambuca::{Observation, SambucaSettings, invert as sambuca_invert, objective_value};
+use crate::retrieval::sambuca::{
+    self, Observation, SambucaSettings, invert as sambuca_invert, invert_in, objective_value,
+};
 use crate::retrieval::sets::ALMI_SETS;
 use crate::retrieval::{BandModel, BandResponse, Parameters};
 use crate::study::{StudySpec, run_study};
@@ -176,10 +178,12 @@ fn sambuca_rate(
     // Timed on noisy pixels (the noise the NEΔRrs describes), as the study's pixels are.
     let noisy = with_noise(&observed, &mut rng);
     let mut sink = 0.0;
+    // Working arrays kept from pixel to pixel, as the study's rows keep them.
+    let mut scratch = sambuca::Scratch::default();
     let rate = timed_rate(min_seconds(quick), n, |i| {
         let nedr = nedr_of(&noisy[i]);
         let obs = Observation { rrs: &noisy[i], valid: &valid, nedr: &nedr, inv_cos: inv };
-        sink += sambuca_invert(&model, &settings, &obs).depth_m;
+        sink += invert_in(&mut scratch, &model, &settings, &obs).depth_m;
     });
     std::hint::black_box(sink);
     let results: Vec<_> = observed

@@ -383,8 +383,13 @@ impl BandModel {
     /// Band Rrs of the optically deep water with the same constituents (for the substrate
     /// detectability index).
     pub fn evaluate_deep(&self, p: &Parameters, out: &mut [f64]) {
+        self.evaluate_deep_with(p, out, &mut ModelScratch::default());
+    }
+
+    /// [`Self::evaluate_deep`] with caller-owned working memory.
+    pub fn evaluate_deep_with(&self, p: &Parameters, out: &mut [f64], s: &mut ModelScratch) {
         let deep = Parameters { depth_m: None, ..*p };
-        self.evaluate(&deep, (1.0, 1.0), out, None);
+        self.evaluate_with(&deep, (1.0, 1.0), out, None, s);
     }
 }
 

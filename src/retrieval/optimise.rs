@@ -65,16 +65,47 @@ pub const MAX_PARAMETERS: usize = 8;
 /// fit's m rows are one allocation rather than m.
 pub type Row = [f64; MAX_PARAMETERS];
 
+/// The working arrays of [`levenberg_marquardt_in`] whose size follows the residual count m:
+/// kept between fits, so that a pixel's fits (one per substrate pair and start) allocate them
+/// once rather than at every fit.
+#[derive(Debug, Clone, Default)]
+pub struct Workspace {
+    r: Vec<f64>,
+    jac: Vec<Row>,
+    trial_r: Vec<f64>,
+    trial_jac: Vec<Row>,
+}
+
+impl Workspace {
+    fn resize(&mut self, m: usize) {
+        self.r.resize(m, 0.0);
+        self.trial_r.resize(m, 0.0);
+        self.jac.resize(m, [0.0; MAX_PARAMETERS]);
+        self.trial_jac.resize(m, [0.0; MAX_PARAMETERS]);
+    }
+}
+
 /// Bounded Levenberg–Marquardt of n = `x0.len()` ≤ [`MAX_PARAMETERS`] parameters (panics
 /// above). `residuals(x, r, j)` fills the residual vector `r` and the Jacobian rows
 /// `j[i][k]` = ∂r_i/∂x_k (k < n); it returns false if x is not admissible (the step is then
 /// rejected). The Jacobian is computed at every trial point, so an accepted step costs one
 /// evaluation.
 pub fn levenberg_marquardt(
-    mut residuals: impl FnMut(&[f64], &mut [f64], &mut [Row]) -> bool,
+    residuals: impl FnMut(&[f64], &mut [f64], &mut [Row]) -> bool,
     x0: &[f64],
     lo: &[f64],
     hi: &[f64],
+    m: usize,
+    tol: &Tolerances,
+) -> Solution {
+    levenberg_marquardt_in(&mut Workspace::default(), residuals, (x0, lo, hi), m, tol)
+}
+
+/// [`levenberg_marquardt`] in `work` (whatever it held: the same solution).
+pub fn levenberg_marquardt_in(
+    work: &mut Workspace,
+    mut residuals: impl FnMut(&[f64], &mut [f64], &mut [Row]) -> bool,
+    (x0, lo, hi): (&[f64], &[f64], &[f64]),
     m: usize,
     tol: &Tolerances,
 ) -> Solution {
@@ -85,22 +116,22 @@ pub fn levenberg_marquardt(
             x[i] = x[i].clamp(lo[i], hi[i]);
         }
     };
-    let mut x = x0.to_vec();
+    work.resize(m);
+    let Workspace { r, jac, trial_r, trial_jac } = work;
+    // The n-sized arrays live on the stack; only their first n entries are used.
+    let mut x = [0.0; MAX_PARAMETERS];
+    x[..n].copy_from_slice(x0);
     clamp(&mut x);
-    let mut r = vec![0.0; m];
-    let mut jac = vec![[0.0; MAX_PARAMETERS]; m];
-    if !residuals(&x, &mut r, &mut jac) {
-        return Solution { x, value: f64::INFINITY, iterations: 0, converged: false };
+    if !residuals(&x[..n], r, jac) {
+        return Solution { x: x[..n].to_vec(), value: f64::INFINITY, iterations: 0, converged: false };
     }
     let mut value = 0.5 * r.iter().map(|v| v * v).sum::<f64>();
     let mut lambda = 1e-3;
-    let mut trial = vec![0.0; n];
-    let mut trial_r = vec![0.0; m];
-    let mut trial_jac = vec![[0.0; MAX_PARAMETERS]; m];
-    let mut g = vec![0.0; n];
+    let mut trial = [0.0; MAX_PARAMETERS];
+    let mut g = [0.0; MAX_PARAMETERS];
     let mut a = [[0.0; MAX_PARAMETERS]; MAX_PARAMETERS];
-    let mut free = vec![true; n];
-    let mut step = vec![0.0; n];
+    let mut free = [true; MAX_PARAMETERS];
+    let mut step = [0.0; MAX_PARAMETERS];
     let mut iterations = 0;
     let mut converged = false;
     while iterations < tol.max_iterations {
@@ -109,33 +140,33 @@ pub fn levenberg_marquardt(
             converged = true;
             break;
         }
-        normal_equations(&jac[..m], &r[..m], &mut g, &mut a[..n]);
+        normal_equations(&jac[..m], &r[..m], &mut g[..n], &mut a[..n]);
         for k in 0..n {
             free[k] = !((x[k] <= lo[k] && g[k] > 0.0) || (x[k] >= hi[k] && g[k] < 0.0));
         }
-        if !free.iter().any(|f| *f) {
+        if !free[..n].iter().any(|f| *f) {
             converged = true;
             break;
         }
         let mut accepted = false;
         while lambda < 1e16 {
-            if !damped_step(&a, &g, lambda, &free, &mut step) {
+            if !damped_step(&a, &g[..n], lambda, &free[..n], &mut step[..n]) {
                 lambda *= 10.0;
                 continue;
             }
             for k in 0..n {
                 trial[k] = (x[k] + step[k]).clamp(lo[k], hi[k]);
             }
-            if trial == x {
+            if trial[..n] == x[..n] {
                 break;
             }
-            if residuals(&trial, &mut trial_r, &mut trial_jac) {
+            if residuals(&trial[..n], trial_r, trial_jac) {
                 let trial_value = 0.5 * trial_r.iter().map(|v| v * v).sum::<f64>();
                 if trial_value < value {
                     let decrease = (value - trial_value) / value;
                     std::mem::swap(&mut x, &mut trial);
-                    std::mem::swap(&mut r, &mut trial_r);
-                    std::mem::swap(&mut jac, &mut trial_jac);
+                    std::mem::swap(r, trial_r);
+                    std::mem::swap(jac, trial_jac);
                     value = trial_value;
                     lambda = (lambda / 3.0).max(1e-15);
                     accepted = true;
@@ -153,7 +184,7 @@ pub fn levenberg_marquardt(
             break;
         }
     }
-    Solution { x, value, iterations, converged }
+    Solution { x: x[..n].to_vec(), value, iterations, converged }
 }
 
 /// Bounded BFGS. `objective(x, grad)` returns f(x) and fills ∇f (or returns `None` if x is not

@@ -7,7 +7,7 @@ use super::Mode;
 use super::RetrievalError;
 use super::band_model::BandModel;
 use super::run::{Product, ProductFlags, RetrievalInputs};
-use super::sambuca::{Observation, SambucaSettings, invert as sambuca_invert};
+use super::sambuca::{Observation, SambucaSettings, Scratch, invert_in as sambuca_invert};
 use super::sambuca_reference::{self as reference, ReferenceModel};
 use crate::control::RunControl;
 use crate::correction::RrsFlags;
@@ -122,6 +122,7 @@ pub(super) fn retrieve_sambuca(
         let r = at.index();
         let mut obs = vec![0.0; nb];
         let mut valid = vec![false; nb];
+        let mut scratch = Scratch::default();
         let row = (0..cols)
             .map(|c| {
                 at.column(c);
@@ -134,7 +135,7 @@ pub(super) fn retrieve_sambuca(
                     valid[k] = inputs.flags[[r, c, k]] & (RrsFlags::INVALID | RrsFlags::SATURATED) == 0;
                 }
                 let o = Observation { rrs: &obs, valid: &valid, nedr: &inputs.nedr, inv_cos: inv_cos[c] };
-                let p = sambuca_invert(model, settings, &o);
+                let p = sambuca_invert(&mut scratch, model, settings, &o);
                 if !p.ok {
                     return failed;
                 }

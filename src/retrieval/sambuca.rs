@@ -43,7 +43,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::band_model::{BandModel, ModelScratch, Parameters};
-use super::optimise::{Row, Tolerances, levenberg_marquardt, projected_bfgs};
+use super::optimise::{Row, Tolerances, Workspace, levenberg_marquardt_in, projected_bfgs};
 
 /// Which distance is minimised.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -216,18 +216,31 @@ pub fn objective_value(objective: Objective, obs: &Observation<'_>, weights: &[f
     }
 }
 
+/// The working arrays of a pixel's inversion ([`invert_in`]), kept from pixel to pixel so that
+/// a row allocates them once.
+#[derive(Debug, Clone, Default)]
+pub struct Scratch {
+    /// Per band: the residual weight (0 for a band left out).
+    weights: Vec<f64>,
+    /// The model's Rrs and its Jacobian.
+    m: Vec<f64>,
+    jac: Vec<[f64; 5]>,
+    /// The optically deep Rrs (the SDI).
+    deep: Vec<f64>,
+    model: ModelScratch,
+    /// The optimiser's working arrays.
+    work: Workspace,
+}
+
 /// Working state of one pixel's inversion.
 struct Pixel<'a> {
     model: &'a BandModel,
     settings: &'a SambucaSettings,
     obs: &'a Observation<'a>,
-    weights: Vec<f64>,
+    s: &'a mut Scratch,
     scale: f64,
     lo: [f64; 5],
     hi: [f64; 5],
-    m: Vec<f64>,
-    jac: Vec<[f64; 5]>,
-    scratch: ModelScratch,
     iterations: u32,
 }
 
@@ -246,8 +259,9 @@ impl Pixel<'_> {
     fn fit(&mut self, pair: (usize, usize), start: &[f64; 5]) -> SambucaPixel {
         let nb = self.model.n_bands();
         let tol = Tolerances { max_iterations: self.settings.max_iterations, ..Tolerances::default() };
-        let (model, obs, weights, scale) = (self.model, self.obs, &self.weights, self.scale);
-        let (m, jac, scratch) = (&mut self.m, &mut self.jac, &mut self.scratch);
+        let (model, obs, scale) = (self.model, self.obs, self.scale);
+        let Scratch { weights, m, jac, model: scratch, work, .. } = &mut *self.s;
+        let weights = &*weights;
         let residuals = |z: &[f64], r: &mut [f64], jrows: &mut [Row]| -> bool {
             let p = to_params(z, pair);
             model.evaluate_with(&p, obs.inv_cos, m, Some(jac), scratch);
@@ -263,10 +277,9 @@ impl Pixel<'_> {
             }
             r.iter().all(|v| v.is_finite())
         };
-        let mut sol = levenberg_marquardt(residuals, start, &self.lo, &self.hi, nb, &tol);
+        let mut sol = levenberg_marquardt_in(work, residuals, (start, &self.lo, &self.hi), nb, &tol);
         self.iterations += sol.iterations;
         if self.settings.objective == Objective::AlphaF {
-            let (m, jac, scratch) = (&mut self.m, &mut self.jac, &mut self.scratch);
             let f = |z: &[f64], g: &mut [f64]| -> Option<f64> {
                 let p = to_params(z, pair);
                 model.evaluate_with(&p, obs.inv_cos, m, Some(jac), scratch);
@@ -279,8 +292,8 @@ impl Pixel<'_> {
             sol = polished;
         }
         let p = to_params(&sol.x, pair);
-        self.model.evaluate_with(&p, obs.inv_cos, &mut self.m, None, &mut self.scratch);
-        let value = objective_value(self.settings.objective, obs, weights, &self.m);
+        self.model.evaluate_with(&p, obs.inv_cos, m, None, scratch);
+        let value = objective_value(self.settings.objective, obs, weights, m);
         SambucaPixel {
             chl: p.chl,
             cdom: p.cdom,
@@ -310,12 +323,13 @@ impl Pixel<'_> {
                 best.fraction,
             ),
         };
-        let mut deep = vec![0.0; nb];
-        self.model.evaluate_with(&p, self.obs.inv_cos, &mut self.m, None, &mut self.scratch);
-        self.model.evaluate_deep(&p, &mut deep);
+        let Scratch { m, deep, model: scratch, .. } = &mut *self.s;
+        deep.resize(nb, 0.0);
+        self.model.evaluate_with(&p, self.obs.inv_cos, m, None, scratch);
+        self.model.evaluate_deep_with(&p, deep, scratch);
         (0..nb)
             .filter(|&b| self.obs.nedr[b] > 0.0)
-            .map(|b| (self.m[b] - deep[b]).abs() / self.obs.nedr[b])
+            .map(|b| (m[b] - deep[b]).abs() / self.obs.nedr[b])
             .fold(0.0, f64::max)
     }
 }
@@ -323,19 +337,30 @@ impl Pixel<'_> {
 /// Invert one pixel with `model`.
 #[must_use]
 pub fn invert(model: &BandModel, settings: &SambucaSettings, obs: &Observation<'_>) -> SambucaPixel {
+    invert_in(&mut Scratch::default(), model, settings, obs)
+}
+
+/// [`invert`] in `scratch` (whatever it held: the same pixel), for loops over pixels.
+#[must_use]
+pub fn invert_in(
+    scratch: &mut Scratch,
+    model: &BandModel,
+    settings: &SambucaSettings,
+    obs: &Observation<'_>,
+) -> SambucaPixel {
     let nb = model.n_bands();
-    let weights: Vec<f64> = (0..nb)
-        .map(|b| {
-            let ok = obs.valid[b] && obs.rrs[b].is_finite();
-            if !ok {
-                0.0
-            } else if settings.noise_weighting {
-                if obs.nedr[b] > 0.0 { 1.0 / obs.nedr[b] } else { 0.0 }
-            } else {
-                1.0
-            }
-        })
-        .collect();
+    scratch.weights.clear();
+    scratch.weights.extend((0..nb).map(|b| {
+        let ok = obs.valid[b] && obs.rrs[b].is_finite();
+        if !ok {
+            0.0
+        } else if settings.noise_weighting {
+            if obs.nedr[b] > 0.0 { 1.0 / obs.nedr[b] } else { 0.0 }
+        } else {
+            1.0
+        }
+    }));
+    let weights = &scratch.weights;
     let n_valid = weights.iter().filter(|w| **w > 0.0).count();
     let sum_o: f64 = (0..nb).map(|b| obs.rrs[b] * weights[b]).sum();
     if n_valid < MIN_BANDS || !(sum_o > 0.0) {
@@ -350,35 +375,25 @@ pub fn invert(model: &BandModel, settings: &SambucaSettings, obs: &Observation<'
     let lo = [bnd.chl_mg_m3.0.ln(), bnd.cdom_per_m.0.ln(), bnd.nap_g_m3.0.ln(), bnd.depth_m.0.ln(), 0.0];
     let hi = [bnd.chl_mg_m3.1.ln(), bnd.cdom_per_m.1.ln(), bnd.nap_g_m3.1.ln(), bnd.depth_m.1.ln(), 1.0];
     let n_sub = model.substrate_names().len();
-    let pairs: Vec<(usize, usize)> = if n_sub >= 2 {
-        (0..n_sub).flat_map(|i| (i + 1..n_sub).map(move |j| (i, j))).collect()
-    } else {
-        vec![(0, usize::MAX)]
+    // Every substrate pair (i < j), in order, or the one substrate alone.
+    let pairs = || {
+        let one = (n_sub < 2).then_some((0, usize::MAX));
+        one.into_iter().chain((0..n_sub).flat_map(move |i| (i + 1..n_sub).map(move |j| (i, j))))
     };
     let mid = |k: usize| 0.5 * (lo[k] + hi[k]);
     let start = |depth_ln: f64| [mid(0), mid(1), mid(2), depth_ln, 0.5];
     let shallow = start(2.0f64.clamp(bnd.depth_m.0, bnd.depth_m.1).ln());
     let deep = start(hi[3]);
-    let mut px = Pixel {
-        model,
-        settings,
-        obs,
-        weights,
-        scale,
-        lo,
-        hi,
-        m: vec![0.0; nb],
-        jac: vec![[0.0; 5]; nb],
-        scratch: ModelScratch::default(),
-        iterations: 0,
-    };
+    scratch.m.resize(nb, 0.0);
+    scratch.jac.resize(nb, [0.0; 5]);
+    let mut px = Pixel { model, settings, obs, s: scratch, scale, lo, hi, iterations: 0 };
     let mut best = SambucaPixel::FAILED;
     let keep = |candidate: SambucaPixel, best: &mut SambucaPixel| {
         if candidate.ok && candidate.objective < best.objective {
             *best = candidate;
         }
     };
-    for &pair in &pairs {
+    for pair in pairs() {
         let from = if settings.warm_pairs { warm_start(&best, &lo, &hi).unwrap_or(shallow) } else { shallow };
         let fit = px.fit(pair, &from);
         keep(fit, &mut best);
@@ -395,7 +410,7 @@ pub fn invert(model: &BandModel, settings: &SambucaSettings, obs: &Observation<'
     };
     if deep_too {
         let before = best.objective;
-        for &pair in &pairs {
+        for pair in pairs() {
             let fit = px.fit(pair, &deep);
             keep(fit, &mut best);
         }
