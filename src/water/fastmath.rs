@@ -52,7 +52,7 @@ fn fast_exp_fused(x: f64) -> f64 {
 
 /// e^x with a·b + c as level `L` computes it ([`crate::simd::mad`]).
 #[inline(always)]
-pub(super) fn exp<L: Level>(x: f64) -> f64 {
+pub(crate) fn exp<L: Level>(x: f64) -> f64 {
     let mad = mad::<L, f64>;
     let x = x.clamp(-708.0, 709.0);
     let t = mad(x, LOG2_E, SHIFT);

@@ -37,6 +37,7 @@ mod single;
 mod siop;
 mod substrate;
 
+pub(crate) use fastmath::exp as exp_at;
 pub use fastmath::fast_exp;
 pub use model::{
     Bottom, WaterColumn, WaterGeometry, WaterModel, WaterReflectance, rrs_above_from_below, rrs_below_from_above,
