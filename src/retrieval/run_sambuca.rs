@@ -7,7 +7,7 @@ use super::Mode;
 use super::RetrievalError;
 use super::band_model::BandModel;
 use super::run::{Product, ProductFlags, RetrievalInputs};
-use super::sambuca::{Observation, SambucaSettings, Scratch, invert_in as sambuca_invert};
+use super::sambuca::{Observation, SambucaSettings, Scratch, invert_in};
 use super::sambuca_reference::{self as reference, ReferenceModel};
 use crate::control::RunControl;
 use crate::correction::RrsFlags;
@@ -135,7 +135,7 @@ pub(super) fn retrieve_sambuca(
                     valid[k] = inputs.flags[[r, c, k]] & (RrsFlags::INVALID | RrsFlags::SATURATED) == 0;
                 }
                 let o = Observation { rrs: &obs, valid: &valid, nedr: &inputs.nedr, inv_cos: inv_cos[c] };
-                let p = sambuca_invert(&mut scratch, model, settings, &o);
+                let p = invert_in(&mut scratch, model, settings, &o);
                 if !p.ok {
                     return failed;
                 }

@@ -1,17 +1,23 @@
 //! The SAMBUCA-style fit's warm pair starts (`SambucaSettings::warm_pairs`) against a cold start
 //! for every pair, on the kind of pixels `shoal bench` times: 28 Gaussian bands (430–835 nm,
-//! 10 nm FWHM), three reef substrates (three pairs), the Heron Island SIOPs, 1 % noise.
+//! 10 nm FWHM), three reef substrates (three pairs), the Heron Island SIOPs, 1 % noise; and
+//! the working arrays a loop over pixels keeps (`invert_in`) against fresh ones.
 
 use rand::rngs::Xoshiro256PlusPlus;
 use rand::{RngExt, SeedableRng};
-use shoal::retrieval::sambuca::{Observation, SambucaPixel, invert, objective_value};
-use shoal::retrieval::{BandModel, BandResponse, Parameters, SambucaSettings};
+use shoal::retrieval::sambuca::{Observation, SambucaPixel, Scratch, invert, invert_in, objective_value};
+use shoal::retrieval::{BandModel, BandResponse, Objective, Parameters, SambucaSettings, Starts};
 use shoal::water::{SiopSpec, SubstrateLibrary};
 
 const INV_COS: (f64, f64) = (1.0 / 0.95, 1.0 / 0.999);
 
 fn model() -> BandModel {
-    let bands: Vec<BandResponse> = (0..28)
+    model_of(28)
+}
+
+/// The bench's model with its first `n_bands` bands.
+fn model_of(n_bands: i32) -> BandModel {
+    let bands: Vec<BandResponse> = (0..n_bands)
         .map(|i| {
             let (c, s): (f64, f64) = (430.0 + 15.0 * f64::from(i), 10.0 / 2.354_820_045);
             let x: Vec<f64> =
@@ -114,4 +120,35 @@ fn warm_pair_starts_keep_noise_free_closure() {
         worse += usize::from(got.objective > at_truth * (1.0 + 1e-9) + 1e-12);
     }
     assert_eq!(worse, 0, "{worse} of {n} noise-free pixels fitted worse than the truth");
+}
+
+/// `invert_in` keeps its working arrays from pixel to pixel: whatever the scratch held (another
+/// model's band count, another objective, a failed pixel), each pixel is the one a fresh
+/// `invert` returns, to the bit.
+#[test]
+fn a_reused_scratch_gives_each_pixel_as_a_fresh_one_does() {
+    let models = [model(), model_of(5)];
+    let settings = [
+        SambucaSettings::default(),
+        SambucaSettings { objective: Objective::AlphaF, ..SambucaSettings::default() },
+        SambucaSettings { noise_weighting: false, starts: Starts::ShallowAndDeep, ..SambucaSettings::default() },
+    ];
+    let mut scratch = Scratch::default();
+    let mut compared = 0;
+    for (k, (_, m)) in pixels(&models[0], 12, 23).into_iter().enumerate() {
+        for model in &models {
+            let rrs = &m[..model.n_bands()];
+            let nedr = nedr(rrs);
+            // Every third pixel with two valid bands only: refused, its arrays half written.
+            let valid: Vec<bool> = (0..rrs.len()).map(|b| k % 3 != 2 || b < 2).collect();
+            let obs = Observation { rrs, valid: &valid, nedr: &nedr, inv_cos: INV_COS };
+            for s in &settings {
+                let (fresh, reused) = (invert(model, s, &obs), invert_in(&mut scratch, model, s, &obs));
+                assert_eq!(format!("{reused:?}"), format!("{fresh:?}"), "pixel {k}, {} bands", model.n_bands());
+                compared += usize::from(fresh.ok);
+            }
+        }
+    }
+    // Most pixels are fitted (not only refused ones compared).
+    assert!(compared >= 40, "{compared}");
 }
