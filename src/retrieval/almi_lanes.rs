@@ -465,10 +465,15 @@ fn invert_lanes(
                 sq[s] += if weighting { (d * inv_sigma).powi(2) } else { d * d };
             }
         }
+        // Every lane's cost at once: the square roots and divisions run side by side (inside the
+        // loop below, after its `continue`, they ran lane by lane).
+        let costs: Lanes = lanewise(|s| {
+            let rms = (sq[s] / m as f64).sqrt();
+            if weighting { rms } else { rms / mean_rrs }
+        });
         for (s, p) in sol.iter().enumerate().take(lanes) {
             let Some((xs, unconstrained)) = p else { continue };
-            let cost =
-                if settings.noise_weighting { (sq[s] / m as f64).sqrt() } else { (sq[s] / m as f64).sqrt() / mean_rrs };
+            let cost = costs[s];
             if cost.is_finite() && cost < best.cost {
                 let physical = unconstrained.iter().all(|v| *v >= 0.0);
                 let at_bound = xs.contains(&0.0);
