@@ -141,26 +141,24 @@ fn compare_source(source: Source<'_>, nb: usize, reference: Reference<'_>) -> Ve
             acc
         })
         .collect();
-    let acc = blocks.into_iter().fold(empty(), |mut a, b| {
-        for band in 0..nb {
-            a.n[band] += b.n[band];
-            a.sum[band] += b.sum[band];
-            a.max[band] = a.max[band].max(b.max[band]);
-            a.sample[band].extend_from_slice(&b.sample[band]);
-        }
-        a
-    });
+    // Band by band, each band's blocks merged in block order (so the same sums as one fold over
+    // the blocks), the bands side by side: merged in one fold, then copied again for the
+    // medians, the samples were 0.1 s of one core per run while the other waited (perf).
     (0..nb)
+        .into_par_iter()
         .map(|band| {
-            let n = acc.n[band];
-            let mut sample = acc.sample[band].clone();
+            let n: usize = blocks.iter().map(|b| b.n[band]).sum();
+            let sum = blocks.iter().fold(0.0, |s, b| s + b.sum[band]);
+            let max_abs_rel = blocks.iter().fold(0.0f64, |m, b| m.max(b.max[band]));
+            let mut sample = Vec::with_capacity(blocks.iter().map(|b| b.sample[band].len()).sum());
+            blocks.iter().for_each(|b| sample.extend_from_slice(&b.sample[band]));
             let m = sample.len();
             BandDifference {
                 band,
                 n,
                 median_abs_rel: if m > 0 { *sample.select_nth_unstable_by(m / 2, f64::total_cmp).1 } else { 0.0 },
-                mean_rel: if n > 0 { acc.sum[band] / n as f64 } else { 0.0 },
-                max_abs_rel: acc.max[band],
+                mean_rel: if n > 0 { sum / n as f64 } else { 0.0 },
+                max_abs_rel,
             }
         })
         .collect()

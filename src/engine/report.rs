@@ -220,25 +220,48 @@ pub(super) fn aerosol_summary(
     truth_aot: Option<&ndarray::Array2<f32>>,
     centres_nm: &[f64],
 ) -> AerosolSummary {
-    let mut aot: Vec<f64> = a.aot550.iter().filter(|v| v.is_finite()).map(|&v| f64::from(v)).collect();
+    // Quantiles by selection, not sorting: four sorts of a million pixels each took ~0.4 s of one
+    // core per run, while the other core waited. The four selections (and the reading of the
+    // maps they select from) run side by side.
+    let q = |v: &mut [f64], p: f64| crate::metrics::nearest_rank(v, p);
     // Retrieved pixels (land is NaN in the retrieval) against the AOT under each.
     let true_at = |i: usize| truth_aot.and_then(|m| m.as_slice()).map_or(truth.aot550, |m| f64::from(m[i]));
-    let retrieved = a.aot550.iter().enumerate().filter(|(_, v)| v.is_finite());
-    let mut errors: Vec<f64> = retrieved.clone().map(|(i, v)| (f64::from(*v) - true_at(i)).abs()).collect();
-    let mut true_values: Vec<f64> = retrieved.map(|(i, _)| true_at(i)).collect();
-    let mut alpha: Vec<f64> = a.angstrom.iter().filter(|v| v.is_finite()).map(|&v| f64::from(v)).collect();
-    // Quantiles by selection, not sorting: four sorts of a million pixels each took ~0.4 s of one
-    // core per run, while the other core waited.
-    let q = |v: &mut [f64], p: f64| crate::metrics::nearest_rank(v, p);
-    let angstrom_true = crate::atmosphere::AtmosphereSpec { aot550: 1.0, ..truth.clone() }
-        .build()
-        .ok()
-        .and_then(|atm| {
-            let tau = |nm: f64| atm.column(nm).ok().and_then(|c| c.aerosol.map(|x| x.0));
-            Some(-(tau(865.0)? / tau(443.0)?).ln() / (865.0f64 / 443.0).ln())
-        })
-        .unwrap_or(f64::NAN);
-    let aot550 = (q(&mut aot, 0.5), q(&mut aot, 0.05), q(&mut aot, 0.95));
+    let retrieved = || a.aot550.iter().enumerate().filter(|(_, v)| v.is_finite());
+    let (((aot550, retrieved_n), aot550_true), (aot550_abs_error, (angstrom, angstrom_true))) = rayon::join(
+        || {
+            rayon::join(
+                || {
+                    let mut aot: Vec<f64> = a.aot550.iter().filter(|v| v.is_finite()).map(|&v| f64::from(v)).collect();
+                    ((q(&mut aot, 0.5), q(&mut aot, 0.05), q(&mut aot, 0.95)), aot.len())
+                },
+                || {
+                    if truth_aot.is_some() {
+                        q(&mut retrieved().map(|(i, _)| true_at(i)).collect::<Vec<f64>>(), 0.5)
+                    } else {
+                        truth.aot550
+                    }
+                },
+            )
+        },
+        || {
+            rayon::join(
+                || q(&mut retrieved().map(|(i, v)| (f64::from(*v) - true_at(i)).abs()).collect::<Vec<f64>>(), 0.5),
+                || {
+                    let mut alpha: Vec<f64> =
+                        a.angstrom.iter().filter(|v| v.is_finite()).map(|&v| f64::from(v)).collect();
+                    let angstrom_true = crate::atmosphere::AtmosphereSpec { aot550: 1.0, ..truth.clone() }
+                        .build()
+                        .ok()
+                        .and_then(|atm| {
+                            let tau = |nm: f64| atm.column(nm).ok().and_then(|c| c.aerosol.map(|x| x.0));
+                            Some(-(tau(865.0)? / tau(443.0)?).ln() / (865.0f64 / 443.0).ln())
+                        })
+                        .unwrap_or(f64::NAN);
+                    (q(&mut alpha, 0.5), angstrom_true)
+                },
+            )
+        },
+    );
     // Only members with a finite ε (a JSON null would not read back as a number).
     let members_epsilon = settings
         .models
@@ -249,11 +272,11 @@ pub(super) fn aerosol_summary(
         .collect();
     AerosolSummary {
         aot550,
-        aot550_true: if truth_aot.is_some() { q(&mut true_values, 0.5) } else { truth.aot550 },
-        aot550_abs_error: q(&mut errors, 0.5),
-        angstrom: q(&mut alpha, 0.5),
+        aot550_true,
+        aot550_abs_error,
+        angstrom,
         angstrom_true,
-        outside_family_pct: if aot.is_empty() { 0.0 } else { 100.0 * a.outside_family as f64 / aot.len() as f64 },
+        outside_family_pct: if retrieved_n == 0 { 0.0 } else { 100.0 * a.outside_family as f64 / retrieved_n as f64 },
         passes_mean: a.passes_mean,
         fit: fit_words(a, settings, centres_nm),
         epsilon: a.epsilon,

@@ -273,27 +273,38 @@ impl Engine {
         }
         let (mut radiance, radiance_key) = self.radiance_stage(config, &side, control, &mut report)?;
         let truth = radiance.truth.clone();
-        let mut probed: Vec<Probed> = probes.iter().map(|p| Probed::locate(*p, &truth, &side.viewing)).collect();
         let typical = radiance.typical_water_w_m2_sr_nm.clone();
-        // The paper's per-scene approximation reads the pupil radiance at a few hundred pixels:
-        // taken now, so that the pupil radiance cube can go once the detector has seen it.
-        let approximation = crate::correction::SceneApproximation::new(
-            &radiance.radiance,
-            &radiance.truth_rrs,
-            &side.band_atmosphere,
-            &truth.surface,
-            config.correction.approx_points,
-            config.seed,
-        )
-        .map_err(super::stages::failed(Stage::Correction))?;
+        // Three reads of the radiance product, each on one thread, run side by side:
+        // - the probes' pixels (the typical water pixel: a selection over the chl map);
+        // - the paper's per-scene approximation, which reads the pupil radiance at a few hundred
+        //   pixels: taken now, so that the pupil radiance cube can go once the detector has seen
+        //   it;
+        // - the pixels the correction compares with the truth: a run that keeps no cubes then
+        //   lets the true Rrs cube go before the detector reads out (unless the cache keeps the
+        //   radiance product: then it is the cache's to hold).
+        let ((mut probed, approximation), truth_rrs) = rayon::join(
+            || {
+                rayon::join(
+                    || probes.iter().map(|p| Probed::locate(*p, &truth, &side.viewing)).collect::<Vec<Probed>>(),
+                    || {
+                        crate::correction::SceneApproximation::new(
+                            &radiance.radiance,
+                            &radiance.truth_rrs,
+                            &side.band_atmosphere,
+                            &truth.surface,
+                            config.correction.approx_points,
+                            config.seed,
+                        )
+                    },
+                )
+            },
+            || crate::correction::TruthRrsSample::of(&radiance.truth_rrs, &truth.surface),
+        );
+        let approximation = approximation.map_err(super::stages::failed(Stage::Correction))?;
         let mut views = self.keep_views.then(|| {
             let (rows, cols, bands) = radiance.radiance.dim();
             CubeViews::of_radiance(&radiance, super::views::stride_for(rows, cols, bands, self.view_bytes))
         });
-        // The pixels the correction compares with the truth, taken now: a run that keeps no cubes
-        // then lets the true Rrs cube go before the detector reads out (unless the cache keeps
-        // the radiance product: then it is the cache's to hold).
-        let truth_rrs = crate::correction::TruthRrsSample::of(&radiance.truth_rrs, &truth.surface);
         if !self.keep_cubes
             && let Some(product) = Arc::get_mut(&mut radiance)
         {

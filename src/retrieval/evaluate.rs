@@ -198,8 +198,11 @@ pub fn evaluate(product: &Product, truth: &Truth) -> ProductMetrics {
         _ => 0,
     };
     let plan = Plan { product, truth, depth, true_substrates, classes, siop_sets: product.siop_set_names.len() };
+    // One block a task (rayon would otherwise hand a thread runs of several blocks, and the
+    // last run leave the other thread waiting).
     let blocks: Vec<Block> = (0..rows.div_ceil(ROWS_PER_BLOCK))
         .into_par_iter()
+        .with_max_len(1)
         .map(|i| plan.block(i * ROWS_PER_BLOCK..((i + 1) * ROWS_PER_BLOCK).min(rows)))
         .collect();
     let all = blocks.iter().fold(plan.empty_block(), Block::merge);
