@@ -193,4 +193,34 @@ mod tests {
         assert_eq!(one[1].n, rows * cols - 1, "the flagged value is left out");
         assert!(one.iter().all(|d| d.mean_rel.is_finite() && d.median_abs_rel > 0.0));
     }
+
+    /// Merged band by band from blocks of 4 096 pixels (here three), each band's count, maximum and
+    /// median are those of the whole image's pixels taken one by one, and its mean agrees to the
+    /// rounding of 10⁴ additions (the blocks' sums are added in block order, not pixel by pixel).
+    #[test]
+    fn the_blocks_merge_to_the_whole_images_statistics() {
+        let (rows, cols, nb) = (97, 113, 3);
+        let value = |i: usize| 0.001 + 1e-5 * ((i * 7919) % 1013) as f32;
+        let truth = Array3::from_shape_fn((rows, cols, nb), |(r, c, b)| value(r * 31 + c * 7 + b));
+        let rrs = Array3::from_shape_fn((rows, cols, nb), |(r, c, b)| value(r * 17 + c * 13 + b * 5));
+        let mut flags = Array3::zeros((rows, cols, nb));
+        flags[[50, 60, 2]] = 1;
+        let got = compare(&Reflectance { rrs: rrs.clone(), flags: flags.clone() }, &truth, None);
+        for (b, d) in got.iter().enumerate() {
+            let mut rel: Vec<f64> = (0..rows * cols)
+                .filter(|&p| flags[[p / cols, p % cols, b]] == 0)
+                .map(|p| {
+                    let (x, y) = (f64::from(rrs[[p / cols, p % cols, b]]), f64::from(truth[[p / cols, p % cols, b]]));
+                    (x - y) / y
+                })
+                .collect();
+            assert_eq!(d.n, rel.len());
+            let mean = rel.iter().sum::<f64>() / rel.len() as f64;
+            assert!((d.mean_rel - mean).abs() <= 1e-12 * mean.abs().max(1e-3), "band {b}: {} vs {mean}", d.mean_rel);
+            rel.iter_mut().for_each(|v| *v = v.abs());
+            assert_eq!(d.max_abs_rel, rel.iter().copied().fold(0.0, f64::max));
+            rel.sort_by(f64::total_cmp);
+            assert_eq!(d.median_abs_rel, rel[rel.len() / 2], "band {b}");
+        }
+    }
 }
