@@ -312,9 +312,9 @@ impl RunControl {
     }
 
     /// Fill `outputs` (see [`RowSplit`]) row by row: `f(guard, row)` writes row `guard.index()`
-    /// of every buffer, `stride` elements each. Rows run in parallel, at most [`ROW_TASK_LEN`] rows to a
-    /// task; each checks for
-    /// cancellation first and counts one unit of progress (`rows` are added to the total).
+    /// of every buffer, `stride` elements each. Rows run in parallel, at most [`ROW_TASK_LEN`]
+    /// rows to a task; each checks for cancellation first and counts one unit of progress (`rows`
+    /// are added to the total).
     pub fn fill_rows<'a, O, E>(
         &self,
         outputs: O,
