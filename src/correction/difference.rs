@@ -174,14 +174,21 @@ pub(super) const MEDIAN_SAMPLES: usize = 200_000;
 mod tests {
     use super::*;
 
-    /// The sums are taken in fixed blocks: one thread and three give the same bits.
-    #[test]
-    fn the_comparison_does_not_depend_on_the_threads() {
+    /// A 97 × 113 × 3 truth and a product unlike it (10 961 pixels: three blocks of 4 096).
+    fn truth_and_product() -> (Array3<f32>, Array3<f32>) {
         let (rows, cols, nb) = (97, 113, 3);
         let value = |i: usize| 0.001 + 1e-5 * ((i * 7919) % 1013) as f32;
         let truth = Array3::from_shape_fn((rows, cols, nb), |(r, c, b)| value(r * 31 + c * 7 + b));
         let rrs = Array3::from_shape_fn((rows, cols, nb), |(r, c, b)| value(r * 17 + c * 13 + b * 5));
-        let mut flags = Array3::zeros((rows, cols, nb));
+        (truth, rrs)
+    }
+
+    /// The sums are taken in fixed blocks: one thread and three give the same bits.
+    #[test]
+    fn the_comparison_does_not_depend_on_the_threads() {
+        let (truth, rrs) = truth_and_product();
+        let (rows, cols, _) = truth.dim();
+        let mut flags = Array3::zeros(truth.dim());
         flags[[5, 6, 1]] = 1;
         let a = Reflectance { rrs, flags };
         let on = |threads: usize| {
@@ -199,11 +206,9 @@ mod tests {
     /// rounding of 10⁴ additions (the blocks' sums are added in block order, not pixel by pixel).
     #[test]
     fn the_blocks_merge_to_the_whole_images_statistics() {
-        let (rows, cols, nb) = (97, 113, 3);
-        let value = |i: usize| 0.001 + 1e-5 * ((i * 7919) % 1013) as f32;
-        let truth = Array3::from_shape_fn((rows, cols, nb), |(r, c, b)| value(r * 31 + c * 7 + b));
-        let rrs = Array3::from_shape_fn((rows, cols, nb), |(r, c, b)| value(r * 17 + c * 13 + b * 5));
-        let mut flags = Array3::zeros((rows, cols, nb));
+        let (truth, rrs) = truth_and_product();
+        let (rows, cols, _) = truth.dim();
+        let mut flags = Array3::zeros(truth.dim());
         flags[[50, 60, 2]] = 1;
         let got = compare(&Reflectance { rrs: rrs.clone(), flags: flags.clone() }, &truth, None);
         for (b, d) in got.iter().enumerate() {
