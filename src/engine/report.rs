@@ -249,15 +249,7 @@ pub(super) fn aerosol_summary(
                 || {
                     let mut alpha: Vec<f64> =
                         a.angstrom.iter().filter(|v| v.is_finite()).map(|&v| f64::from(v)).collect();
-                    let angstrom_true = crate::atmosphere::AtmosphereSpec { aot550: 1.0, ..truth.clone() }
-                        .build()
-                        .ok()
-                        .and_then(|atm| {
-                            let tau = |nm: f64| atm.column(nm).ok().and_then(|c| c.aerosol.map(|x| x.0));
-                            Some(-(tau(865.0)? / tau(443.0)?).ln() / (865.0f64 / 443.0).ln())
-                        })
-                        .unwrap_or(f64::NAN);
-                    (q(&mut alpha, 0.5), angstrom_true)
+                    (q(&mut alpha, 0.5), true_angstrom(truth))
                 },
             )
         },
@@ -282,6 +274,19 @@ pub(super) fn aerosol_summary(
         epsilon: a.epsilon,
         members_epsilon,
     }
+}
+
+/// The Ångström exponent (443/865 nm) of the scene's aerosol model, from its own optics; NaN
+/// where the scene has no aerosol.
+fn true_angstrom(truth: &crate::atmosphere::AtmosphereSpec) -> f64 {
+    crate::atmosphere::AtmosphereSpec { aot550: 1.0, ..truth.clone() }
+        .build()
+        .ok()
+        .and_then(|atm| {
+            let tau = |nm: f64| atm.column(nm).ok().and_then(|c| c.aerosol.map(|x| x.0));
+            Some(-(tau(865.0)? / tau(443.0)?).ln() / (865.0f64 / 443.0).ln())
+        })
+        .unwrap_or(f64::NAN)
 }
 
 /// The correction's fit in words: its label, and for dark-spectrum fitting the models chosen

@@ -260,9 +260,6 @@ fn default_almi_bands(bands: &[BandResponse]) -> Vec<usize> {
     (0..max).map(|k| usable[k * (usable.len() - 1) / (max - 1)]).collect()
 }
 
-/// One aLMI pixel as stored: (chl, cdom, nap, set, cost, flags).
-type AlmiRow = (f32, f32, f32, i16, f32, u8);
-
 /// aLMI's model at the instrument's bands: the bands it uses and each SIOP set's band IOPs,
 /// packed side by side for the pixel loop. Reading and integrating eight sets is most of a small
 /// preview's retrieval time, and depends only on the spec and the bands.
@@ -341,17 +338,28 @@ pub(super) fn retrieve_almi(
 ) -> Result<Product, RetrievalError> {
     let AlmiModel { used, sets, packed } = model;
     let (rows, cols, nb) = inputs.rrs.dim();
-    let results: Vec<Vec<AlmiRow>> = control.map_rows(rows, |at| {
+    // Written in place, row by row, as the correction writes its Rrs (collected as rows of
+    // per-pixel tuples, the maps were then copied out on one thread: 20–25 ms a design while the
+    // other thread waited, perf timeline).
+    let n = rows * cols;
+    let (mut chl, mut cdom, mut nap, mut cost) = (vec![0.0f32; n], vec![0.0f32; n], vec![0.0f32; n], vec![0.0f32; n]);
+    let (mut set, mut flags) = (vec![-1i16; n], vec![0u8; n]);
+    let outputs = (
+        (chl.as_mut_slice(), cdom.as_mut_slice(), nap.as_mut_slice()),
+        (set.as_mut_slice(), cost.as_mut_slice(), flags.as_mut_slice()),
+    );
+    control.fill_rows(outputs, rows, cols, |at, ((chl, cdom, nap), (set, cost, flags))| {
         let r = at.index();
         let mut obs = vec![0.0; used.len()];
         let mut valid = vec![false; used.len()];
         let nedr: Vec<f64> = used.iter().map(|&b| inputs.nedr[b]).collect();
         let mut scratch = Scratch::default();
-        let row = (0..cols)
-            .map(|c| {
-                at.column(c);
+        for c in 0..cols {
+            at.column(c);
+            // ([chl, CDOM, NAP], SIOP set (−1: none), cost, flags).
+            let (values, set_index, pixel_cost, pixel_flags) = 'pixel: {
                 if !inputs.surface.is_water(r, c) {
-                    return (0.0, 0.0, 0.0, -1, 0.0, ProductFlags::LAND);
+                    break 'pixel ([0.0; 3], -1, 0.0, ProductFlags::LAND);
                 }
                 for (k, &b) in used.iter().enumerate() {
                     debug_assert!(b < nb);
@@ -363,59 +371,45 @@ pub(super) fn retrieve_almi(
                     Mode::Reference => invert_reference(sets, settings.g0, settings.g1, &obs, &valid),
                 };
                 if p.flags & AlmiFlags::FAILED != 0 || p.set.is_none() {
-                    return (0.0, 0.0, 0.0, -1, 0.0, ProductFlags::FAILED);
+                    break 'pixel ([0.0; 3], -1, 0.0, ProductFlags::FAILED);
                 }
-                let mut flags = ProductFlags::RETURNED;
+                let mut f = ProductFlags::RETURNED;
                 if p.flags & AlmiFlags::PHYSICAL != 0 {
-                    flags |= ProductFlags::PHYSICAL;
+                    f |= ProductFlags::PHYSICAL;
                 }
                 if p.flags & AlmiFlags::AT_BOUND != 0 {
-                    flags |= ProductFlags::AT_BOUND;
+                    f |= ProductFlags::AT_BOUND;
                 }
-                (p.chl as f32, p.cdom as f32, p.nap as f32, p.set.map_or(-1, i16::from), p.cost as f32, flags)
-            })
-            .collect();
-        Ok::<_, RetrievalError>(row)
+                ([p.chl as f32, p.cdom as f32, p.nap as f32], p.set.map_or(-1, i16::from), p.cost as f32, f)
+            };
+            [chl[c], cdom[c], nap[c]] = values;
+            (set[c], cost[c], flags[c]) = (set_index, pixel_cost, pixel_flags);
+        }
+        Ok::<_, RetrievalError>(())
     })?;
-    // Each map copied out of the rows on every thread, row by row (copied on one thread, the six
-    // maps were 20–25 ms a design while the other thread waited: perf timeline).
-    let bad_shape = |e: ndarray::ShapeError| {
-        RetrievalError::Invalid(FieldError { field: "aLMI maps".into(), message: e.to_string() })
-    };
-    let map_of = |k: &(dyn Fn(&AlmiRow) -> f32 + Sync)| {
-        Array2::from_shape_vec((rows, cols), gather_rows(&results, cols, k)).map_err(bad_shape)
-    };
-    let siop_set = Array2::from_shape_vec((rows, cols), gather_rows(&results, cols, |p| p.3)).map_err(bad_shape)?;
-    let flags = Array2::from_shape_vec((rows, cols), gather_rows(&results, cols, |p| p.5)).map_err(bad_shape)?;
+    let grid = |v| grid_of(rows, cols, v);
     Ok(Product {
         name: ALMI.title.into(),
-        chl_mg_m3: Some(map_of(&|p| p.0)?),
-        cdom_per_m: Some(map_of(&|p| p.1)?),
-        nap_g_m3: Some(map_of(&|p| p.2)?),
+        chl_mg_m3: Some(grid(chl)?),
+        cdom_per_m: Some(grid(cdom)?),
+        nap_g_m3: Some(grid(nap)?),
         depth_m: None,
         substrate_names: Vec::new(),
         substrate_fractions: None,
         siop_set_names: sets.iter().map(|s| s.name.clone()).collect(),
-        siop_set: Some(siop_set),
-        cost: map_of(&|p| p.4)?,
+        siop_set: Some(grid_of(rows, cols, set)?),
+        cost: grid(cost)?,
         sdi: None,
         iterations: None,
         extras: Vec::new(),
-        flags,
+        flags: grid_of(rows, cols, flags)?,
     })
 }
 
-/// `k` of every pixel of `rows` (each `cols` long), row-major; the rows copied side by side.
-fn gather_rows<T: Copy + Default + Send>(
-    rows: &[Vec<AlmiRow>],
-    cols: usize,
-    k: impl Fn(&AlmiRow) -> T + Sync,
-) -> Vec<T> {
-    let mut out = vec![T::default(); rows.len() * cols];
-    out.par_chunks_mut(cols.max(1)).zip(rows.par_iter()).for_each(|(out, row)| {
-        out.iter_mut().zip(row).for_each(|(o, p)| *o = k(p));
-    });
-    out
+/// `values` (row-major, one a pixel) as the `rows` × `cols` map of a product.
+fn grid_of<T>(rows: usize, cols: usize, values: Vec<T>) -> Result<Array2<T>, RetrievalError> {
+    Array2::from_shape_vec((rows, cols), values)
+        .map_err(|e| RetrievalError::Invalid(FieldError { field: "product maps".into(), message: e.to_string() }))
 }
 
 /// Check SAMBUCA's bounds and quadrature setting; the message names the field.
